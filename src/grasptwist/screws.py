@@ -1,0 +1,215 @@
+"""Screw algebra on numpy arrays.
+
+A screw (twist or wrench) is six numbers ``(omega; v)``: ``omega`` its
+angular part and ``v`` the value of its field at the frame origin, so that
+the field at a point ``p`` is ``V(p) = v + omega x p`` (paper, eq. 2).
+
+Every function takes any leading batch shape: screws are ``(..., 6)``,
+points and vectors ``(..., 3)``; leading shapes broadcast.  Products are
+written out component by component rather than through ``einsum`` or
+``matmul`` so that each row's result is bit-for-bit the same whatever batch
+it is computed in (BLAS kernels may change their summation order with the
+array's size), and because this is the fastest form for long batches.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+__all__ = [
+    "dot",
+    "cross",
+    "norm",
+    "unit",
+    "screw",
+    "klein",
+    "field_at",
+    "constant_field",
+    "line_through",
+    "line_between",
+    "twist_at",
+    "pitch",
+    "axis_point",
+    "rigid_motion",
+]
+
+
+def dot(a, b):
+    """Dot product over the last axis: ``(..., 3), (..., 3) -> (...)``.
+
+    >>> float(dot([1.0, 2.0, 3.0], [4.0, 5.0, 6.0]))
+    32.0
+    """
+    a = np.asarray(a, dtype=float)
+    b = np.asarray(b, dtype=float)
+    return a[..., 0] * b[..., 0] + a[..., 1] * b[..., 1] + a[..., 2] * b[..., 2]
+
+
+def cross(a, b):
+    """Cross product over the last axis: ``(..., 3), (..., 3) -> (..., 3)``.
+
+    >>> cross([1.0, 0, 0], [0, 1.0, 0]).tolist()
+    [0.0, 0.0, 1.0]
+    """
+    a = np.asarray(a, dtype=float)
+    b = np.asarray(b, dtype=float)
+    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
+    b0, b1, b2 = b[..., 0], b[..., 1], b[..., 2]
+    return np.stack((a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0), axis=-1)
+
+
+def norm(a):
+    """Euclidean length over the last axis: ``(..., 3) -> (...)``.
+
+    >>> float(norm([3.0, 4.0, 0.0]))
+    5.0
+    """
+    return np.sqrt(dot(a, a))
+
+
+def unit(a):
+    """``a / |a|`` over the last axis; a zero vector gives NaN (no warning).
+
+    >>> unit([0.0, 0.0, 2.0]).tolist()
+    [0.0, 0.0, 1.0]
+    """
+    a = np.asarray(a, dtype=float)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return a / norm(a)[..., None]
+
+
+def screw(omega, v):
+    """Join an angular part and an origin velocity into ``(omega; v)``.
+
+    ``(..., 3), (..., 3) -> (..., 6)``.
+
+    >>> screw([0, 0, 1], [1, 0, 0]).tolist()
+    [0.0, 0.0, 1.0, 1.0, 0.0, 0.0]
+    """
+    omega, v = np.broadcast_arrays(np.asarray(omega, float), np.asarray(v, float))
+    return np.concatenate((omega, v), axis=-1)
+
+
+def klein(x, y):
+    """Klein form (paper eq. 4): ``[X|Y] = omega_X . v_Y + omega_Y . v_X``.
+
+    ``(..., 6), (..., 6) -> (...)``.  Independent of the origin; zero when the
+    screws are reciprocal.  For two unit lines it is ``-d sin(angle)``, with
+    ``d`` the distance between their axes.
+
+    >>> float(klein([0, 0, 1, 0, 0, 0], [0, 0, 0, 0, 0, 1]))
+    1.0
+    """
+    x = np.asarray(x, dtype=float)
+    y = np.asarray(y, dtype=float)
+    return dot(x[..., :3], y[..., 3:]) + dot(y[..., :3], x[..., 3:])
+
+
+def field_at(s, p):
+    """Value of a screw's field at a point (paper eq. 2): ``v + omega x p``.
+
+    ``(..., 6), (..., 3) -> (..., 3)``.  For a twist this is the velocity of
+    the body point at ``p``.
+
+    >>> field_at([0, 0, 1, 0, 0, 0], [1.0, 0, 0]).tolist()
+    [0.0, 1.0, 0.0]
+    """
+    s = np.asarray(s, dtype=float)
+    return s[..., 3:] + cross(s[..., :3], p)
+
+
+def constant_field(s):
+    """The paper's operator Omega (eq. 5): the constant field ``omega_X``.
+
+    As a screw it is the pure translation ``(0; omega)``, so ``Omega^2 = 0``
+    and a unit line ``L`` has ``[L | Omega L] = 1`` (eq. 6).
+    ``(..., 6) -> (..., 6)``.
+
+    >>> constant_field([1.0, 2, 3, 4, 5, 6]).tolist()
+    [0.0, 0.0, 0.0, 1.0, 2.0, 3.0]
+    """
+    s = np.asarray(s, dtype=float)
+    return np.concatenate((np.zeros_like(s[..., :3]), s[..., :3]), axis=-1)
+
+
+def line_through(p, d):
+    """Unit zero-pitch screw through ``p`` along ``d`` (eq. 15, normalised).
+
+    ``(d/|d|; p x d/|d|)``; its field vanishes on the axis.  A zero ``d``
+    gives NaN.  ``(..., 3), (..., 3) -> (..., 6)``.
+
+    >>> line_through([0, 1.0, 0], [2.0, 0, 0]).tolist()
+    [1.0, 0.0, 0.0, 0.0, 0.0, -1.0]
+    """
+    e = unit(d)
+    return screw(e, cross(p, e))
+
+
+def line_between(p, q):
+    """Unit line through ``p`` and ``q``, directed from ``p`` to ``q``.
+
+    ``(..., 3), (..., 3) -> (..., 6)``; coincident points give NaN.
+
+    >>> line_between([0, 1.0, 0], [3.0, 1, 0]).tolist()
+    [1.0, 0.0, 0.0, 0.0, 0.0, -1.0]
+    """
+    p = np.asarray(p, dtype=float)
+    return line_through(p, np.asarray(q, dtype=float) - p)
+
+
+def twist_at(omega, velocity, point):
+    """The twist with angular velocity ``omega`` whose point ``point`` moves
+    with ``velocity``, as ``(omega; v)`` at the origin.
+
+    ``v = velocity + omega x (o - point)``.  ``(..., 3) x3 -> (..., 6)``.
+
+    >>> twist_at([0, 0, 1.0], [0, 0, 0], [1.0, 0, 0]).tolist()
+    [0.0, 0.0, 1.0, 0.0, -1.0, 0.0]
+    """
+    omega = np.asarray(omega, dtype=float)
+    point = np.asarray(point, dtype=float)
+    return screw(omega, np.asarray(velocity, dtype=float) - cross(omega, point))
+
+
+def pitch(s):
+    """Pitch ``h = omega . v / |omega|^2``; ``inf`` for a pure translation.
+
+    ``(..., 6) -> (...)``.
+
+    >>> float(pitch([0, 0, 1.0, 0, 0, 2.0]))
+    2.0
+    """
+    s = np.asarray(s, dtype=float)
+    w2 = dot(s[..., :3], s[..., :3])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(w2 > 0, dot(s[..., :3], s[..., 3:]) / np.where(w2 > 0, w2, 1.0), np.inf)
+
+
+def axis_point(s):
+    """Point of the screw axis nearest the origin: ``omega x v / |omega|^2``.
+
+    NaN for a pure translation.  ``(..., 6) -> (..., 3)``.
+
+    >>> (axis_point([0, 0, 1.0, 0, -1.0, 0]) + 0.0).tolist()
+    [1.0, 0.0, 0.0]
+    """
+    s = np.asarray(s, dtype=float)
+    w2 = dot(s[..., :3], s[..., :3])
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return cross(s[..., :3], s[..., 3:]) / w2[..., None]
+
+
+def rigid_motion(s, rotation, translation):
+    """Screw carried by the rigid motion ``x -> R x + t`` (the adjoint map).
+
+    ``omega' = R omega``, ``v' = R v + t x R omega``.
+    ``(..., 6), (..., 3, 3), (..., 3) -> (..., 6)``.
+
+    >>> rigid_motion([0, 0, 1.0, 0, 0, 0], np.eye(3), [1.0, 0, 0]).tolist()
+    [0.0, 0.0, 1.0, 0.0, -1.0, 0.0]
+    """
+    s = np.asarray(s, dtype=float)
+    rotation = np.asarray(rotation, dtype=float)
+    w = np.einsum("...ij,...j->...i", rotation, s[..., :3])
+    v = np.einsum("...ij,...j->...i", rotation, s[..., 3:])
+    return screw(w, v + cross(translation, w))
