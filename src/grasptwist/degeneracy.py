@@ -1,0 +1,117 @@
+"""Per-grasp status codes, tolerances and their messages.
+
+The engine never raises on a bad grasp: each row of a batch gets a
+:class:`Status` and a *culprit* (the index 0, 1 or 2 of the contact the
+condition is about, or -1 when it is about the grasp as a whole), and its
+numbers are NaN.  :func:`status_message` turns that pair into one sentence.
+
+All tolerances are relative: the engine measures every condition in the
+grasp's own frame (origin at the contacts' centroid, lengths divided by the
+grasp's size), so a grasp scaled by 1e-3 or 1e3, or moved anywhere, gets
+the same verdict.
+"""
+
+from __future__ import annotations
+
+from enum import IntEnum
+
+import numpy as np
+
+__all__ = [
+    "Status",
+    "DEGENERACY_TOL",
+    "CONDITION_WARNING",
+    "IN_PLANE_TOL",
+    "status_message",
+    "conditioning_warning",
+]
+
+#: A dimensionless measure at or below this makes the grasp degenerate.
+#: Amplitudes carry a relative error of about ``1e-16 / conditioning``, so at
+#: the threshold they still have about 6 correct digits.
+DEGENERACY_TOL = 1e-9
+
+#: A conditioning figure below this is worth a warning: amplitudes may be
+#: more than a thousand times the twist's own size.
+CONDITION_WARNING = 1e-3
+
+#: Normal velocities this small, relative to the contacts' speeds, count as
+#: zero when deciding whether a twist keeps every contact in its tangent plane.
+IN_PLANE_TOL = 1e-9
+
+
+class Status(IntEnum):
+    """Why a grasp could not be resolved by a method (0: it could)."""
+
+    OK = 0
+    NONFINITE_INPUT = 1
+    COINCIDENT_CONTACTS = 2
+    COLLINEAR_CONTACTS = 3
+    WRIST_COPLANAR = 4
+    ZERO_NORMAL = 5
+    NORMALS_RANK_DEFICIENT = 6
+    THETA_NOT_UNIQUE = 7
+    THETA_SIGMA_ZERO = 8
+    OVERFLOW = 9
+
+    @property
+    def code(self) -> str:
+        """Stable kebab-case name used in JSON output, e.g. ``wrist-coplanar``."""
+        return self.name.lower().replace("_", "-")
+
+
+_MESSAGES = {
+    Status.OK: "ok",
+    Status.NONFINITE_INPUT: "the input holds NaN or infinity",
+    Status.COINCIDENT_CONTACTS: "contacts {j} and {k} coincide, so Sigma_{i} has no axis",
+    Status.COLLINEAR_CONTACTS: "the contacts are collinear: {i} lies on the line through {j} and {k}",
+    Status.WRIST_COPLANAR: (
+        "the wrist lies in the plane of the contacts, so every [Sigma_i|Psi_i] is 0 (Proposition 1 needs it off the plane)"
+    ),
+    Status.ZERO_NORMAL: "the normal at contact {i} has zero length",
+    Status.NORMALS_RANK_DEFICIENT: "the three normal lines have rank < 3, so the tangent twists are not a three-system",
+    Status.THETA_NOT_UNIQUE: (
+        "Theta_{i} is not unique: the normals at {j} and {k} leave more than one axis through contact {i} "
+        "that keeps them in their tangent planes"
+    ),
+    Status.THETA_SIGMA_ZERO: (
+        "[Theta_{i}|Sigma_{i}] = 0: the axis of Theta_{i} meets or is parallel to the line through {j} and {k}"
+    ),
+    Status.OVERFLOW: "the numbers overflow double precision (coordinates or twist too large)",
+}
+
+
+def status_message(status, culprit=-1, names=("1", "2", "3")) -> str:
+    """One sentence saying which condition failed and for which contacts.
+
+    Parameters
+    ----------
+    status : int or Status
+    culprit : int
+        Contact index 0..2 the condition is about (``i`` in the message; ``j``
+        and ``k`` follow it cyclically), or -1.
+    names : sequence of 3 str
+        Contact names to use in the message.
+
+    >>> status_message(Status.COINCIDENT_CONTACTS, 0)
+    'contacts 2 and 3 coincide, so Sigma_1 has no axis'
+    """
+    i = int(culprit) if int(culprit) >= 0 else 0
+    return _MESSAGES[Status(int(status))].format(i=names[i], j=names[(i + 1) % 3], k=names[(i + 2) % 3])
+
+
+def conditioning_warning(conditioning, basis: str) -> str | None:
+    """A warning sentence when ``conditioning`` is below :data:`CONDITION_WARNING`.
+
+    >>> conditioning_warning(2e-5, "off-tangent")
+    'off-tangent basis is nearly degenerate (conditioning 2e-05 < 0.001): amplitudes are large and sensitive'
+    >>> conditioning_warning(0.6, "tangent") is None
+    True
+    """
+    c = float(conditioning)
+    if not np.isfinite(c) or c >= CONDITION_WARNING:
+        return None
+    return (
+        f"{basis} basis is nearly degenerate (conditioning {c:.3g} < {CONDITION_WARNING:g}): "
+        "amplitudes are large and sensitive"
+    )

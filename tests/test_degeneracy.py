@@ -1,0 +1,146 @@
+"""Every degenerate condition gets its own status, culprit and message; near-degenerate
+grasps still resolve; a batch keeps its good rows exactly as they are alone."""
+
+import numpy as np
+import pytest
+
+import grasptwist as gt
+from grasptwist.degeneracy import conditioning_warning
+from grasp_gen import grasps
+
+S = gt.Status
+EX1 = np.array([[1, 0, 0], [-0.5, 0.866, 0], [-0.5, -0.866, 0]], float)
+EX2 = np.array([[0, 2, 2], [2, 0, 2], [2, 2, 0]], float)
+TWIST = np.array([0.3, -0.2, 1.0, 0.1, 0.5, -0.4])
+RIGHT = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0]], float)
+
+
+def off(points, wrist=(0, 0, 1.0), twist=TWIST):
+    return gt.decompose_off_tangent(points, wrist, twist)
+
+
+def tan(points, normals, twist=TWIST):
+    return gt.decompose_tangent(points, normals, twist)
+
+
+@pytest.mark.parametrize(
+    "result, status, culprit, message",
+    [
+        (lambda: off(EX1, (0, 0, 0.0)), S.WRIST_COPLANAR, -1, "the wrist lies in the plane of the contacts"),
+        (lambda: off(EX1, (0.3, 0.2, 0.0)), S.WRIST_COPLANAR, -1, "every [Sigma_i|Psi_i] is 0"),
+        (lambda: off(EX1, EX1[1]), S.WRIST_COPLANAR, -1, "wrist lies in the plane"),
+        (lambda: off([[0, 0, 0], [1, 0, 0], [1, 0, 0]]), S.COINCIDENT_CONTACTS, 0, "contacts 2 and 3 coincide"),
+        (lambda: off([[2, 2, 2]] * 3), S.COINCIDENT_CONTACTS, 0, "coincide"),
+        (lambda: off([[0, 0, 0], [1, 0, 0], [3, 0, 0]]), S.COLLINEAR_CONTACTS, 1, "2 lies on the line through 3 and 1"),
+        (lambda: off([[0, 0, 0], [2, 0, 0], [1, 0, 0]]), S.COLLINEAR_CONTACTS, 2, "3 lies on the line through 1 and 2"),
+        (lambda: off(EX1, (0, np.nan, 1.0)), S.NONFINITE_INPUT, -1, "NaN or infinity"),
+        (lambda: off(EX1 * [1, np.inf, 1]), S.NONFINITE_INPUT, -1, "NaN or infinity"),
+        (lambda: off(EX1, twist=[0, 0, np.nan, 0, 0, 0]), S.NONFINITE_INPUT, -1, "NaN or infinity"),
+        (lambda: off(EX1 * 1e200, (0, 0, 1e200), [1e200, 0, 0, 0, 0, 0]), S.OVERFLOW, -1, "overflow"),
+        (lambda: tan(EX2, [[1, 0, 0], [0, 0, 0], [0, 0, 1]]), S.ZERO_NORMAL, 1, "normal at contact 2 has zero length"),
+        (lambda: tan(EX2, [[np.nan, 0, 0], [0, 1, 0], [0, 0, 1]]), S.NONFINITE_INPUT, -1, "NaN"),
+        # Example 1's radial normals: three coplanar lines through the axis -> rank 2 (a finding: the
+        # tangent method cannot serve the paper's own cylinder grasp)
+        (lambda: tan(EX1, -EX1), S.NORMALS_RANK_DEFICIENT, -1, "rank < 3"),
+        # antipodal pinch: the normals at 1 and 2 are one line
+        (lambda: tan([[-1, 0, 0], [1, 0, 0], [0, 1, 0.5]], [[1, 0, 0], [-1, 0, 0], [0, -1, 0]]), S.NORMALS_RANK_DEFICIENT, -1, "rank"),
+        # the normal at 2 points along p1 p2: any axis through p1 in the plane x = const keeps p2 tangent
+        (lambda: tan(RIGHT, [[0, 0, 1], [1, 0, 0], [0, 0, 1]]), S.THETA_NOT_UNIQUE, 0, "Theta_1 is not unique"),
+        # Theta_1 along y through p1 meets the line p2 p3 at p3
+        (lambda: tan(RIGHT, [[0, 0, 1], [0, 1, 0], [1, 0, 1]]), S.THETA_SIGMA_ZERO, 0, "[Theta_1|Sigma_1] = 0"),
+        (lambda: tan(EX2 * 1e200, np.eye(3), [1e200, 1e200, 1e200, 0, 0, 0]), S.OVERFLOW, -1, "overflow"),
+    ],
+)
+def test_each_condition_has_its_status_culprit_and_message(result, status, culprit, message):
+    r = result()
+    assert r.status == status, gt.status_message(r.status, r.culprit)
+    assert r.culprit == culprit
+    assert message in gt.status_message(r.status, r.culprit)
+    amplitudes = (r.x, r.y) if isinstance(r, gt.OffTangentResult) else (r.alpha, r.beta)
+    assert all(np.isnan(a).all() for a in amplitudes)
+    assert np.isnan(r.residual)
+
+
+def test_huge_coordinates_resolve_when_the_numbers_fit():
+    # the grasp's own frame keeps 1e200 coordinates from overflowing in squares and products
+    r = tan(EX2 * 1e200, np.eye(3), np.array([1, 1, 1, 0, 0, 0]) / np.sqrt(3))
+    assert r.status == S.OK
+    np.testing.assert_allclose(r.alpha, [0.5774] * 3, atol=1e-4)
+    np.testing.assert_allclose(r.theta_sigma, [np.sqrt(2) * 1e200] * 3, rtol=1e-12)
+
+
+def test_status_codes_are_stable_strings():
+    assert [s.code for s in S] == [
+        "ok",
+        "nonfinite-input",
+        "coincident-contacts",
+        "collinear-contacts",
+        "wrist-coplanar",
+        "zero-normal",
+        "normals-rank-deficient",
+        "theta-not-unique",
+        "theta-sigma-zero",
+        "overflow",
+    ]
+
+
+def test_messages_use_the_contact_names():
+    msg = gt.status_message(S.COLLINEAR_CONTACTS, 1, ("thumb", "index", "middle"))
+    assert msg == "the contacts are collinear: index lies on the line through middle and thumb"
+
+
+@pytest.mark.parametrize("height", [1e-6, 1e-7, 1e-8])
+def test_wrist_just_above_the_plane_resolves_with_a_warning(height):
+    size = np.sqrt(3) * 0.866 * 2 / np.sqrt(3)  # longest side of Example 1's triangle is 1.732
+    r = off(EX1, (0.1, 0.2, height * 1.732))
+    assert r.status == S.OK
+    assert np.isfinite(r.x).all() and np.isfinite(r.y).all()
+    assert np.max(np.abs(np.r_[r.x, r.y])) > 0.1 / height  # large ...
+    a, b = r.components()
+    recon = a.sum(0) + b.sum(0)
+    np.testing.assert_allclose(recon, TWIST, atol=1e-15 / height)  # ... and still reconstructing
+    assert r.residual < 1e-15 / height
+    assert 1e-2 * height < r.conditioning < gt.CONDITION_WARNING
+    assert conditioning_warning(r.conditioning, "off-tangent").startswith("off-tangent basis is nearly degenerate")
+    assert size > 0
+
+
+def test_amplitudes_grow_smoothly_as_the_wrist_approaches_the_plane():
+    heights = np.logspace(0, -8, 9)
+    wrists = np.c_[np.zeros((9, 2)), heights]
+    r = off(EX1, wrists, [0, 0, 1, 0, 0, 0])
+    assert (r.status == S.OK).all()
+    peak = np.max(np.abs(r.y), axis=-1)
+    ratio = peak[1:] / peak[:-1]
+    np.testing.assert_allclose(ratio[3:], 10, rtol=1e-3)  # y ~ 1/h once h << size
+    assert np.all(np.diff(r.conditioning) < 0)
+
+
+def test_a_mixed_batch_keeps_good_rows_bit_for_bit():
+    rng = np.random.default_rng(7)
+    points, normals, wrist, twist = grasps(rng, 12)
+    bad = [
+        (0, lambda: points.__setitem__((0, 2), points[0, 1])),  # coincident
+        (3, lambda: wrist.__setitem__(3, points[3].mean(0))),  # coplanar wrist
+        (5, lambda: normals.__setitem__((5, 0), 0.0)),  # zero normal
+        (7, lambda: points.__setitem__((7, 1, 0), np.nan)),  # NaN
+        (9, lambda: twist.__setitem__((9, 4), np.inf)),  # infinite twist
+    ]
+    for _, spoil in bad:
+        spoil()
+    o = gt.decompose_off_tangent(points, wrist, twist)
+    t = gt.decompose_tangent(points, normals, twist)
+    bad_rows = [i for i, _ in bad]
+    assert set(np.flatnonzero(~o.ok)) <= set(bad_rows) and {0, 3, 7, 9} <= set(np.flatnonzero(~o.ok))
+    assert {0, 5, 7, 9} <= set(np.flatnonzero(~t.ok))
+    for i in range(12):
+        one_o = gt.decompose_off_tangent(points[i], wrist[i], twist[i])
+        one_t = gt.decompose_tangent(points[i], normals[i], twist[i])
+        for name in ("sigma", "psi", "sigma_psi", "x", "y", "status", "culprit", "conditioning", "residual"):
+            np.testing.assert_array_equal(getattr(o, name)[i], getattr(one_o, name), err_msg=name)
+        for name in ("theta", "theta_sigma", "alpha", "beta", "normal_velocity", "in_tangent_planes", "status"):
+            np.testing.assert_array_equal(getattr(t, name)[i], getattr(one_t, name), err_msg=name)
+        if o.ok[i]:
+            assert np.isfinite(o.x[i]).all() and np.isfinite(o.residual[i])
+        else:
+            assert np.isnan(o.x[i]).all()
