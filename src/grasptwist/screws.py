@@ -23,6 +23,7 @@ __all__ = [
     "unit",
     "screw",
     "klein",
+    "klein_table",
     "field_at",
     "constant_field",
     "line_through",
@@ -103,6 +104,19 @@ def klein(x, y):
     x = np.asarray(x, dtype=float)
     y = np.asarray(y, dtype=float)
     return dot(x[..., :3], y[..., 3:]) + dot(y[..., :3], x[..., 3:])
+
+
+def klein_table(a, b):
+    """All products ``[A_i | B_j]`` of two lists of screws (like the paper's eq. 18).
+
+    ``(..., m, 6), (..., n, 6) -> (..., m, n)``.
+
+    >>> klein_table([[0, 0, 1.0, 0, 0, 0]], [[0, 0, 0, 0, 0, 1.0], [0, 0, 0, 1.0, 0, 0]]).tolist()
+    [[1.0, 0.0]]
+    """
+    a = np.asarray(a, dtype=float)
+    b = np.asarray(b, dtype=float)
+    return klein(a[..., :, None, :], b[..., None, :, :])
 
 
 def field_at(s, p):
