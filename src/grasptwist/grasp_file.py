@@ -1,0 +1,788 @@
+"""Grasp files: read YAML grasp descriptions into arrays, strictly checked.
+
+A grasp file holds one grasp per YAML document (see ``docs/grasp-format.md``
+for the format).  Reading never constructs arbitrary Python objects and
+never lets a parser exception escape: every problem becomes a
+:class:`GraspFileError` that names the file, line, column and field path.
+
+How the YAML is read, and why
+-----------------------------
+The file is parsed into *events* by the safe loader (libyaml's
+``CSafeLoader`` when available, else the pure-Python ``SafeLoader``) and the
+events are assembled here into a small node tree, instead of letting PyYAML
+compose or construct.  Doing the composition ourselves lets us
+
+- stop at a nesting depth of ``MAX_DEPTH`` before anything recurses: both
+  PyYAML composers recurse once per level (the pure one hits
+  ``RecursionError``, the C one can exhaust the C stack), and both scanners
+  slow down quadratically with depth, so a deep document must end the
+  parse at once;
+- reject aliases outright, so no alias bomb can expand, and reject every
+  tag except the core ones, so no tag can ever construct an object;
+- see duplicate keys, which PyYAML silently merges;
+- resolve plain scalars with the YAML 1.2 core schema (``1e-3`` is a
+  number, ``yes`` is a string, as in editors' YAML language servers),
+  identically for both parsers.
+
+The two parsers report the same events and marks, so results and error
+positions do not depend on whether libyaml is installed; only the wording
+of YAML syntax errors differs between them.
+"""
+
+from __future__ import annotations
+
+import math
+import os
+import re
+import sys
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import yaml
+
+from grasptwist import screws
+
+__all__ = [
+    "Twist",
+    "Grasp",
+    "GraspFileError",
+    "DEFAULT_MAX_BYTES",
+    "MAX_DEPTH",
+    "read_grasps",
+    "load_grasps",
+    "grasp_schema",
+]
+
+DEFAULT_MAX_BYTES = 1 << 20
+"""Default size cap in bytes; larger files are rejected before parsing."""
+
+MAX_DEPTH = 32
+"""Deepest collection nesting accepted.  A valid grasp needs 4 (document,
+``contacts``, a contact, its ``point``); the margin lets mistyped nested
+values get their specific error instead of ``too-deep``."""
+
+# Parser used by read_grasps; tests swap it to check both give the same.
+_LOADER = yaml.CSafeLoader if yaml.__with_libyaml__ else yaml.SafeLoader
+
+# Keys of each mapping, in the order the values are checked.
+GRASP_KEYS = ("name", "units", "wrist", "contacts", "twists")
+CONTACT_KEYS = ("name", "point", "normal")
+TWIST_KEYS = ("name", "screw", "angular", "linear", "at")
+
+
+@dataclass(frozen=True, eq=False)
+class Twist:
+    """A desired object twist from a grasp file.
+
+    Attributes
+    ----------
+    name : str
+        Its ``name``, or ``"1"``, ``"2"``, ... by position in ``twists``.
+    screw : numpy.ndarray
+        ``(6,)`` read-only ``(omega; v)``, ``v`` the velocity of the frame
+        origin (``at`` already applied).
+    line : int or None
+        1-based line of the twist's entry in the file.
+    """
+
+    name: str
+    screw: np.ndarray
+    line: int | None
+
+
+@dataclass(frozen=True, eq=False)
+class Grasp:
+    """One grasp (one YAML document) of a grasp file.
+
+    Arrays are read-only.  ``eq=False``: dataclass equality would compare
+    arrays with ``==`` and fail; compare fields explicitly instead.
+
+    Attributes
+    ----------
+    name : str
+        Its ``name``; by default the file's stem, or ``stem#k`` (``k``
+        counting documents from 1) when the file yields several entries.
+    units : str or None
+        The ``units`` label, echoed in outputs.
+    file : str
+        The file as named by the caller (``"<stdin>"``, ``"<string>"``).
+    document : int
+        0-based index of the document in the stream.
+    contact_names : tuple of str
+        Names of contacts 1, 2, 3 (default ``"1"``, ``"2"``, ``"3"``).
+    points : numpy.ndarray
+        ``(3, 3)``, row ``i`` the contact point ``p_i``.
+    normals : numpy.ndarray
+        ``(3, 3)``, row ``i`` the unit normal ``n_i`` pointing into the object.
+    wrist : numpy.ndarray or None
+        ``(3,)`` wrist point ``c``, or None when not given.
+    twists : tuple of Twist
+        The desired twists, possibly none.
+    line : int
+        1-based line where the document starts.
+    """
+
+    name: str
+    units: str | None
+    file: str
+    document: int
+    contact_names: tuple[str, str, str]
+    points: np.ndarray
+    normals: np.ndarray
+    wrist: np.ndarray | None
+    twists: tuple[Twist, ...]
+    line: int
+
+
+class GraspFileError(Exception):
+    """A grasp file (or one document of it) that cannot be used.
+
+    ``str(error)`` is one printable line, ``file:line:column: message``
+    (``:line:column`` left out when unknown).
+
+    Attributes
+    ----------
+    code : str
+        Stable kebab-case code (table in ``docs/grasp-format.md``).
+    message : str
+        What is wrong, starting with the field path when there is one.
+    file : str
+    line, column : int or None
+        1-based position.
+    document : int or None
+        0-based document index; None for whole-file errors.
+    """
+
+    code: str
+    message: str
+    file: str
+    line: int | None
+    column: int | None
+    document: int | None
+
+    def __init__(self, code, message, file, line=None, column=None, document=None):
+        # All fields go to args so that errors pickle (multiprocessing).
+        super().__init__(code, message, file, line, column, document)
+        self.code = code
+        self.message = message
+        self.file = file
+        self.line = line
+        self.column = column
+        self.document = document
+
+    def __str__(self):
+        where = self.file
+        if self.line is not None:
+            where += f":{self.line}"
+            if self.column is not None:
+                where += f":{self.column}"
+        return f"{where}: {self.message}"
+
+
+def read_grasps(source, *, file=None, max_bytes=DEFAULT_MAX_BYTES):
+    """Read every grasp of a grasp file, keeping errors as values.
+
+    Parameters
+    ----------
+    source : str, os.PathLike or bytes
+        A path (``"-"`` reads standard input) or the file's content.  A
+        ``str`` is content exactly when ``file`` is given, else a path;
+        bytes are always content.
+    file : str, optional
+        Name used in results and messages; default the path, ``"<stdin>"``
+        or ``"<string>"``.
+    max_bytes : int
+        Size cap; a larger input fails with ``too-large`` before parsing.
+
+    Returns
+    -------
+    list of Grasp or GraspFileError
+        One entry per YAML document, in order.  A syntax error that stops
+        the parser ends the list with one error after the good documents
+        before it; a whole-file failure gives a single error.
+    """
+    is_content = isinstance(source, (bytes, bytearray, memoryview)) or (isinstance(source, str) and file is not None)
+    if file is None:
+        file = "<string>" if is_content else "<stdin>" if source == "-" else os.fspath(source)
+    try:
+        data = _encode(source) if is_content else _read_file(source, max_bytes)
+        if len(data) > max_bytes:
+            raise _Reject("too-large", "", f"larger than the size limit of {max_bytes} bytes")
+        text = _decode(data)
+    except _Reject as reject:
+        return [reject.error(file, None)]
+    return _read_text(text, file)
+
+
+def load_grasps(source, **kw):
+    """Like :func:`read_grasps`, but raise its first :class:`GraspFileError`."""
+    entries = read_grasps(source, **kw)
+    for entry in entries:
+        if isinstance(entry, GraspFileError):
+            raise entry
+    return entries
+
+
+def grasp_schema():
+    """The JSON Schema of a grasp document (a fresh dict on each call)."""
+    # Imported here: only the ``schema`` command and tests need them.
+    import json
+    from importlib.resources import files
+
+    return json.loads(files("grasptwist").joinpath("grasp_schema.json").read_text("utf-8"))
+
+
+# --------------------------------------------------------------------------
+# Whole-file checks: size, encoding, characters.
+
+
+class _Reject(Exception):
+    """Internal: one located problem, turned into a GraspFileError later."""
+
+    def __init__(self, code, path, problem, line=None, column=None):
+        super().__init__(code)
+        self.code = code
+        self.message = f"{path}: {problem}" if path else problem
+        self.line = line
+        self.column = column
+
+    def error(self, file, document):
+        return GraspFileError(self.code, self.message, file, self.line, self.column, document)
+
+
+class _StreamStop(_Reject):
+    """Internal: a problem after which the rest of the stream is not read."""
+
+
+def _at(node):
+    """Keyword arguments locating a node (1-based)."""
+    return {"line": node.line, "column": node.column}
+
+
+def _at_mark(mark):
+    """Keyword arguments locating a parser mark (0-based) as 1-based."""
+    return {"line": mark.line + 1, "column": mark.column + 1}
+
+
+def _encode(content):
+    """Content given as bytes or str, as bytes (to check size and UTF-8 alike)."""
+    if not isinstance(content, str):
+        return bytes(content)
+    try:
+        return content.encode("utf-8")
+    except UnicodeEncodeError as exc:  # lone surrogates
+        raise _Reject("invalid-utf8", "", f"not valid Unicode at character {exc.start}") from None
+
+
+def _read_file(path, max_bytes):
+    """At most ``max_bytes + 1`` bytes of a file, or of stdin for ``"-"``.
+
+    One byte past the cap is enough to know it is exceeded, without
+    trusting stat (pipes, /proc) or reading a huge file into memory.
+    """
+    try:
+        if isinstance(path, str) and path == "-":
+            return sys.stdin.buffer.read(max_bytes + 1)
+        with open(path, "rb") as handle:
+            return handle.read(max_bytes + 1)
+    except OSError as exc:
+        raise _Reject("read-error", "", f"cannot read: {exc.strerror or exc}") from None
+
+
+# What PyYAML's and libyaml's readers refuse (YAML 1.1 "printable").
+_NON_PRINTABLE = re.compile("[^\x09\x0a\x0d\x20-\x7e\x85\xa0-\ud7ff\ue000-\ufffd\U00010000-\U0010ffff]")
+
+
+def _decode(data):
+    """Strict UTF-8 text of ``data``, checked for characters YAML refuses.
+
+    Done here rather than by the parsers so that both report the same
+    error at the same place.
+    """
+    try:
+        text = data.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        start = data.rfind(b"\n", 0, exc.start) + 1
+        column = len(data[start : exc.start].decode("utf-8", "replace")) + 1
+        raise _Reject(
+            "invalid-utf8",
+            "",
+            f"not valid UTF-8 (byte offset {exc.start}: {data[exc.start:exc.start + 1]!r})",
+            line=data.count(b"\n", 0, exc.start) + 1,
+            column=column,
+        ) from None
+    bad = _NON_PRINTABLE.search(text)
+    if bad:
+        pos = bad.start()
+        raise _Reject(
+            "control-character",
+            "",
+            f"control character U+{ord(bad.group()):04X} is not allowed in YAML (escape it in a double-quoted string)",
+            line=text.count("\n", 0, pos) + 1,
+            column=pos - text.rfind("\n", 0, pos),
+        )
+    return text
+
+
+# --------------------------------------------------------------------------
+# Events -> node tree.
+
+
+class _Node:
+    """A composed YAML node.
+
+    ``kind`` is ``"mapping"`` (``value``: dict key -> (key node, value
+    node)), ``"sequence"`` (list of nodes) or ``"scalar"`` (the resolved
+    str, int, float, bool or None).  ``line``/``column`` are 1-based.
+    """
+
+    __slots__ = ("kind", "value", "line", "column")
+
+    def __init__(self, kind, value, mark):
+        self.kind = kind
+        self.value = value
+        self.line = mark.line + 1
+        self.column = mark.column + 1
+
+
+_CORE = "tag:yaml.org,2002:"
+
+# YAML 1.2 core schema: the plain scalars that are not strings.
+_PLAIN_NUMBER = re.compile(
+    r"""(?P<int>[-+]?[0-9]+)
+      | 0o(?P<oct>[0-7]+)
+      | 0x(?P<hex>[0-9a-fA-F]+)
+      | (?P<float>[-+]?(?:\.[0-9]+|[0-9]+(?:\.[0-9]*)?)(?:[eE][-+]?[0-9]+)?)
+      | (?P<inf>[-+]?)\.(?:inf|Inf|INF)
+      | (?P<nan>\.(?:nan|NaN|NAN))""",
+    re.VERBOSE,
+)
+_PLAIN_WORDS = {
+    "": None, "~": None, "null": None, "Null": None, "NULL": None,
+    "true": True, "True": True, "TRUE": True,
+    "false": False, "False": False, "FALSE": False,
+}  # fmt: skip
+_NUMBER_START = frozenset("+-.0123456789")
+
+
+def _resolve_plain(text):
+    """Value of an untagged plain scalar under the YAML 1.2 core schema."""
+    if text and text[0] in _NUMBER_START:
+        match = _PLAIN_NUMBER.fullmatch(text)
+        if match:
+            kind = match.lastgroup
+            if kind == "int":
+                return int(text)
+            if kind == "float":
+                return float(text)
+            if kind == "oct":
+                return int(match["oct"], 8)
+            if kind == "hex":
+                return int(match["hex"], 16)
+            if kind == "nan":
+                return math.nan
+            return -math.inf if match["inf"] == "-" else math.inf
+    return _PLAIN_WORDS.get(text, text)
+
+
+# Core scalar tags: the Python types the tagged text must resolve to.
+_SCALAR_TAGS = {
+    _CORE + "str": (str,),
+    _CORE + "int": (int,),
+    _CORE + "float": (int, float),
+    _CORE + "bool": (bool,),
+    _CORE + "null": (type(None),),
+}
+_COLLECTION_TAGS = {"mapping": _CORE + "map", "sequence": _CORE + "seq"}
+
+
+def _short_tag(tag):
+    return "!!" + tag[len(_CORE) :] if tag.startswith(_CORE) else tag
+
+
+def _scalar(event, stack):
+    """The node of a scalar event, its value resolved from text and tag."""
+    tag = event.tag
+    text = event.value
+    if tag is None:
+        value = _resolve_plain(text) if event.implicit[0] else text
+    elif tag == "!":  # the non-specific tag: a string
+        value = text
+    elif tag in _SCALAR_TAGS:
+        value = text if tag == _CORE + "str" else _resolve_plain(text)
+        if type(value) not in _SCALAR_TAGS[tag]:
+            kind = "not-a-number" if tag in (_CORE + "int", _CORE + "float") else "bad-scalar"
+            raise _Reject(kind, _stack_path(stack), f"{text!r} is not a valid {_short_tag(tag)}", **_at_mark(event.start_mark))
+    else:
+        raise _forbidden_tag(tag, event, _stack_path(stack))
+    return _Node("scalar", value, event.start_mark)
+
+
+def _forbidden_tag(tag, event, path):
+    return _Reject(
+        "forbidden-tag",
+        path,
+        f"tag {_short_tag(tag)} is not allowed (only the core tags !!str, !!int, !!float, !!bool, !!null, !!seq, !!map)",
+        **_at_mark(event.start_mark),
+    )
+
+
+def _stack_path(stack):
+    """Field path of the node that comes next in the innermost open collection."""
+    path = ""
+    for node, key in stack:
+        if node.kind == "sequence":
+            path += f"[{len(node.value)}]"
+        elif key is not None:
+            path = _join(path, key.value)
+    return path
+
+
+_SIMPLE_KEY = re.compile(r"[A-Za-z_][A-Za-z0-9_-]*")
+
+
+def _join(path, key):
+    """``path.key``, or ``path["key"]`` for keys that do not read as names."""
+    if isinstance(key, str) and _SIMPLE_KEY.fullmatch(key):
+        return f"{path}.{key}" if path else key
+    return f"{path}[{key!r}]"
+
+
+_STARTS = {yaml.MappingStartEvent: "mapping", yaml.SequenceStartEvent: "sequence"}
+_ENDS = (yaml.MappingEndEvent, yaml.SequenceEndEvent)
+
+
+def _compose(parser):
+    """Node tree of one document, read up to and including its end event.
+
+    Returns the root node, or the document's first problem as a
+    ``_Reject``; after a problem the document's remaining events are only
+    counted for depth.  Raises ``_StreamStop`` for nesting beyond
+    ``MAX_DEPTH``.
+    """
+    stack = []  # open collections, innermost last: [node, key awaiting its value]
+    root = problem = None
+    depth = 0
+    while True:
+        event = parser.get_event()
+        kind = type(event)
+        if kind is yaml.DocumentEndEvent:
+            return problem or root
+        if kind in _STARTS:
+            depth += 1
+            if depth > MAX_DEPTH:
+                raise _StreamStop(
+                    "too-deep",
+                    _stack_path(stack) if problem is None else "",
+                    f"nested deeper than {MAX_DEPTH} levels",
+                    **_at_mark(event.start_mark),
+                )
+        elif kind in _ENDS:
+            depth -= 1
+        if problem is not None:
+            continue
+        try:
+            node = _step(stack, event, kind)
+        except _Reject as reject:
+            problem = reject
+            continue
+        if node is not None:
+            root = node
+
+
+def _step(stack, event, kind):
+    """Apply one event to the open collections; return the root when complete."""
+    if kind is yaml.ScalarEvent:
+        node = _scalar(event, stack)
+    elif kind in _STARTS:
+        collection = _STARTS[kind]
+        if event.tag not in (None, "!", _COLLECTION_TAGS[collection]):
+            raise _forbidden_tag(event.tag, event, _stack_path(stack))
+        stack.append([_Node(collection, {} if collection == "mapping" else [], event.start_mark), None])
+        return None
+    elif kind in _ENDS:
+        node = stack.pop()[0]
+    elif kind is yaml.AliasEvent:
+        raise _Reject(
+            "alias",
+            _stack_path(stack),
+            f"aliases (*{event.anchor}) are not allowed; write the value out",
+            **_at_mark(event.start_mark),
+        )
+    else:  # no other event can occur inside a document
+        raise AssertionError(f"unexpected YAML event {event}")
+    if not stack:
+        return node
+    frame = stack[-1]
+    parent, key = frame
+    if parent.kind == "sequence":
+        parent.value.append(node)
+    elif key is None:
+        _check_key(node, parent, stack)
+        frame[1] = node
+    else:
+        parent.value[key.value] = (key, node)
+        frame[1] = None
+    return None
+
+
+def _check_key(key, mapping, stack):
+    """Keys must be strings and must not repeat."""
+    if key.kind != "scalar" or not isinstance(key.value, str):
+        raise _Reject("invalid-key", _stack_path(stack), f"keys must be strings, got {_describe(key)}", **_at(key))
+    if key.value in mapping.value:
+        first = mapping.value[key.value][0]
+        raise _Reject(
+            "duplicate-key",
+            _join(_stack_path(stack), key.value),
+            f"duplicate key (first given at line {first.line})",
+            **_at(key),
+        )
+
+
+# --------------------------------------------------------------------------
+# Stream -> grasps.
+
+
+def _read_text(text, file):
+    """Parse ``text`` and turn each document into a Grasp or an error."""
+    roots = []  # (start line, root node or _Reject), one per complete document
+    stop = None
+    parser = _LOADER(text)
+    try:
+        parser.get_event()  # StreamStartEvent
+        while not parser.check_event(yaml.StreamEndEvent):
+            start = parser.get_event()  # DocumentStartEvent
+            roots.append((start.start_mark.line + 1, _compose(parser)))
+    except _StreamStop as reject:
+        stop = reject
+    except yaml.YAMLError as exc:
+        stop = _syntax_error(exc, text)
+    finally:
+        parser.dispose()
+    if not roots and stop is None:
+        return [GraspFileError("empty-document", "no YAML document in the file", file)]
+    several = len(roots) + (stop is not None) > 1
+    stem = Path(file).stem
+    entries = []
+    for document, (line, root) in enumerate(roots):
+        name = f"{stem}#{document + 1}" if several else stem
+        try:
+            if isinstance(root, _Reject):
+                raise root
+            entries.append(_grasp(root, file=file, document=document, name=name, line=line))
+        except _Reject as reject:
+            entries.append(reject.error(file, document))
+    if stop is not None:
+        entries.append(stop.error(file, len(roots)))
+    return entries
+
+
+def _syntax_error(exc, text):
+    """A ``_StreamStop`` for a PyYAML or libyaml syntax error."""
+    mark = getattr(exc, "problem_mark", None)
+    if mark is None:
+        return _StreamStop("yaml-syntax", "", f"invalid YAML: {exc}")
+    problem = exc.problem or "syntax error"
+    lines = text.split("\n")
+    if mark.line < len(lines) and lines[mark.line][mark.column : mark.column + 1] == "\t":
+        # The two parsers word this differently; it is common enough to fix.
+        problem = "tab character; YAML indentation must use spaces"
+    return _StreamStop("yaml-syntax", "", f"invalid YAML: {problem}", line=mark.line + 1, column=mark.column + 1)
+
+
+def _grasp(root, *, file, document, name, line):
+    """Check one document's node tree and build its Grasp."""
+    if root.kind == "scalar" and root.value is None:
+        raise _Reject("empty-document", "", "empty document", **_at(root))
+    fields = _mapping(root, "", GRASP_KEYS, ("contacts",))
+    if "name" in fields:
+        name = _name(fields["name"], "name")
+    units = _name(fields["units"], "units") if "units" in fields else None
+    wrist = _readonly(_vector(fields["wrist"], 3, "wrist")) if "wrist" in fields else None
+    contact_names, points, normals = _contacts(fields["contacts"])
+    twists = _twists(fields["twists"]) if "twists" in fields else ()
+    return Grasp(
+        name=name,
+        units=units,
+        file=file,
+        document=document,
+        contact_names=contact_names,
+        points=points,
+        normals=normals,
+        wrist=wrist,
+        twists=twists,
+        line=line,
+    )
+
+
+def _contacts(node):
+    """Names, points and unit normals of the three contacts."""
+    items = _sequence(node, "contacts")
+    if len(items) != 3:
+        raise _Reject("contact-count", "contacts", f"expected exactly 3 contacts, got {len(items)}", **_at(node))
+    names, points, normals = [], [], []
+    for i, item in enumerate(items):
+        path = f"contacts[{i}]"
+        fields = _mapping(item, path, CONTACT_KEYS, ("point", "normal"))
+        names.append(_entry_name(fields, item, "contacts", i, names))
+        points.append(_vector(fields["point"], 3, path + ".point"))
+        normal = _vector(fields["normal"], 3, path + ".normal")
+        if not any(normal):
+            raise _Reject("zero-normal", path + ".normal", "a zero vector has no direction", **_at(fields["normal"]))
+        normals.append(normal)
+    normals = np.array(normals)
+    # Scale by the largest component first: screws.unit squares the
+    # components, which would overflow for 1e200 or underflow for 1e-200.
+    normals = screws.unit(normals / np.abs(normals).max(axis=1, keepdims=True))
+    return tuple(names), _readonly(np.array(points)), _readonly(normals)
+
+
+def _twists(node):
+    """The desired twists, converted to ``(omega; v)`` at the origin."""
+    items = _sequence(node, "twists")
+    names, parts = [], []
+    for i, item in enumerate(items):
+        path = f"twists[{i}]"
+        fields = _mapping(item, path, TWIST_KEYS, ())
+        names.append(_entry_name(fields, item, "twists", i, names))
+        parts.append(_twist_parts(fields, item, path))
+    if not items:
+        return ()
+    omega, velocity, at = np.array(parts).transpose(1, 0, 2)
+    with np.errstate(over="ignore", invalid="ignore"):
+        screw = screws.twist_at(omega, velocity, at)
+    overflowed = np.flatnonzero(~np.isfinite(screw).all(axis=1))
+    if overflowed.size:
+        i = int(overflowed[0])
+        raise _Reject(
+            "non-finite",
+            f"twists[{i}]",
+            "the velocity of the origin overflows (linear + angular x (origin - at))",
+            **_at(items[i]),
+        )
+    return tuple(Twist(name, _readonly(s), item.line) for name, s, item in zip(names, screw, items))
+
+
+def _twist_parts(fields, item, path):
+    """``(angular, linear, at)`` of one twist entry, zeros where not given."""
+    zero = [0.0, 0.0, 0.0]
+    if "screw" in fields:
+        for other in ("angular", "linear", "at"):
+            if other in fields:
+                raise _Reject(
+                    "conflicting-keys",
+                    _join(path, other),
+                    "cannot be combined with 'screw' (give screw, or angular/linear/at)",
+                    **_at(fields[other]),
+                )
+        screw = _vector(fields["screw"], 6, path + ".screw")
+        return screw[:3], screw[3:], zero
+    if "angular" not in fields and "linear" not in fields:
+        raise _Reject("missing-key", path, "needs 'screw', or 'angular' and/or 'linear'", **_at(item))
+    return tuple(_vector(fields[key], 3, f"{path}.{key}") if key in fields else zero for key in ("angular", "linear", "at"))
+
+
+def _entry_name(fields, item, collection, index, taken):
+    """Name of entry ``index`` of a list of contacts or twists (default: its
+    1-based position), checked to be unique among the names ``taken``."""
+    path = f"{collection}[{index}]"
+    node = fields.get("name")
+    name = _name(node, path + ".name") if node is not None else str(index + 1)
+    if name in taken:
+        raise _Reject(
+            "duplicate-name",
+            path + ".name" if node is not None else path,
+            f"duplicate name {name!r} (also {collection}[{taken.index(name)}])",
+            **_at(node if node is not None else item),
+        )
+    return name
+
+
+# --------------------------------------------------------------------------
+# Typed values.
+
+
+def _describe(node):
+    """How a node reads in a message: 'a list', 'the string "x"', ..."""
+    if node.kind != "scalar":
+        return "a list" if node.kind == "sequence" else "a mapping"
+    value = node.value
+    if value is None:
+        return "null"
+    if isinstance(value, bool):
+        return f"a boolean ({str(value).lower()})"
+    if isinstance(value, (int, float)):
+        return f"the number {value}"
+    shown = value if len(value) <= 30 else value[:27] + "..."
+    return f"the string {shown!r}"
+
+
+def _mapping(node, path, keys, required):
+    """The ``{key: value node}`` of a mapping node with only known keys."""
+    if node.kind != "mapping":
+        raise _Reject("not-a-mapping", path or "top level", f"expected a mapping, got {_describe(node)}", **_at(node))
+    fields = {}
+    for key, (key_node, value) in node.value.items():
+        if key not in keys:
+            raise _Reject("unknown-key", _join(path, key), f"unknown key{_suggest(key, keys)}", **_at(key_node))
+        fields[key] = value
+    for key in required:
+        if key not in fields:
+            raise _Reject("missing-key", _join(path, key), "required key is missing", **_at(node))
+    return fields
+
+
+def _suggest(key, keys):
+    # difflib is only needed on this error path.
+    from difflib import get_close_matches
+
+    close = get_close_matches(key, keys, n=1)
+    if close:
+        return f" (did you mean {close[0]!r}?)"
+    return f" (expected one of: {', '.join(keys)})"
+
+
+def _sequence(node, path):
+    if node.kind != "sequence":
+        raise _Reject("not-a-list", path, f"expected a list, got {_describe(node)}", **_at(node))
+    return node.value
+
+
+def _name(node, path):
+    """A non-empty single-line string."""
+    if node.kind != "scalar" or not isinstance(node.value, str):
+        raise _Reject("not-a-string", path, f"expected a string, got {_describe(node)} (quote it)", **_at(node))
+    if not node.value.strip() or "\n" in node.value or "\r" in node.value:
+        raise _Reject("invalid-name", path, "must be a non-empty single line", **_at(node))
+    return node.value
+
+
+def _vector(node, length, path):
+    """A list of ``length`` finite numbers, as floats."""
+    if node.kind != "sequence":
+        raise _Reject("not-a-list", path, f"expected {length} numbers, got {_describe(node)}", **_at(node))
+    if len(node.value) != length:
+        raise _Reject("vector-length", path, f"expected {length} numbers, got {len(node.value)}", **_at(node))
+    return [_number(item, f"{path}[{i}]") for i, item in enumerate(node.value)]
+
+
+def _number(node, path):
+    """A finite number (int or float; booleans and strings are not numbers)."""
+    value = node.value
+    if node.kind != "scalar" or type(value) not in (int, float):
+        raise _Reject("not-a-number", path, f"expected a number, got {_describe(node)}", **_at(node))
+    try:
+        value = float(value)
+    except OverflowError:  # an integer beyond the float range
+        value = math.inf
+    if not math.isfinite(value):
+        raise _Reject("non-finite", path, f"expected a finite number, got {node.value}", **_at(node))
+    return value
+
+
+def _readonly(values):
+    array = np.array(values, dtype=float)
+    array.setflags(write=False)
+    return array
