@@ -21,12 +21,22 @@ from .degeneracy import CONDITION_WARNING
 __all__ = ["TableWriter", "BasisTableWriter", "CheckTableWriter", "WRITERS", "console", "fmt_number", "fmt_vector"]
 
 
+class _TextView(io.TextIOWrapper):
+    """A text view of a binary stream that leaves the stream open when it goes."""
+
+    def __del__(self):
+        try:
+            self.detach()
+        except ValueError:  # already detached, or the stream was closed by its owner
+            pass
+
+
 def console(out: IO[bytes] | IO[str], color: bool | None = None, width: int | None = None) -> Console:
     """A rich console on ``out``: colour only on a terminal and never under NO_COLOR."""
     if isinstance(out, io.TextIOBase):
         text = out
     else:
-        text = io.TextIOWrapper(out, encoding="utf-8", write_through=True)
+        text = _TextView(out, encoding="utf-8", write_through=True)
     terminal = color if color is not None else (text.isatty() and "NO_COLOR" not in os.environ)
     return Console(
         file=text,
