@@ -334,14 +334,16 @@ class _Node:
 
     ``kind`` is ``"mapping"`` (``value``: dict key -> (key node, value
     node)), ``"sequence"`` (list of nodes) or ``"scalar"`` (the resolved
-    str, int, float, bool or None).  ``line``/``column`` are 1-based.
+    str, int, float, bool or None, and its ``text`` as written).
+    ``line``/``column`` are 1-based.
     """
 
-    __slots__ = ("kind", "value", "line", "column")
+    __slots__ = ("kind", "value", "text", "line", "column")
 
-    def __init__(self, kind, value, mark):
+    def __init__(self, kind, value, mark, text=None):
         self.kind = kind
         self.value = value
+        self.text = text
         self.line = mark.line + 1
         self.column = mark.column + 1
 
@@ -413,10 +415,10 @@ def _scalar(event, stack):
         value = text if tag == _CORE + "str" else _resolve_plain(text)
         if type(value) not in _SCALAR_TAGS[tag]:
             kind = "not-a-number" if tag in (_CORE + "int", _CORE + "float") else "bad-scalar"
-            raise _Reject(kind, _stack_path(stack), f"{text!r} is not a valid {_short_tag(tag)}", **_at_mark(event.start_mark))
+            raise _Reject(kind, _here(stack), f"{text!r} is not a valid {_short_tag(tag)}", **_at_mark(event.start_mark))
     else:
-        raise _forbidden_tag(tag, event, _stack_path(stack))
-    return _Node("scalar", value, event.start_mark)
+        raise _forbidden_tag(tag, event, _here(stack))
+    return _Node("scalar", value, event.start_mark, text)
 
 
 def _forbidden_tag(tag, event, path):
@@ -437,6 +439,11 @@ def _stack_path(stack):
         elif key is not None:
             path = _join(path, key.value)
     return path
+
+
+def _here(stack):
+    """Path of the next node for a message: the stack path, or "top level"."""
+    return _stack_path(stack) or "top level"
 
 
 _SIMPLE_KEY = re.compile(r"[A-Za-z_][A-Za-z0-9_-]*")
@@ -498,7 +505,7 @@ def _step(stack, event, kind):
     elif kind in _STARTS:
         collection = _STARTS[kind]
         if event.tag not in (None, "!", _COLLECTION_TAGS[collection]):
-            raise _forbidden_tag(event.tag, event, _stack_path(stack))
+            raise _forbidden_tag(event.tag, event, _here(stack))
         stack.append([_Node(collection, {} if collection == "mapping" else [], event.start_mark), None])
         return None
     elif kind in _ENDS:
@@ -506,7 +513,7 @@ def _step(stack, event, kind):
     elif kind is yaml.AliasEvent:
         raise _Reject(
             "alias",
-            _stack_path(stack),
+            _here(stack),
             f"aliases (*{event.anchor}) are not allowed; write the value out",
             **_at_mark(event.start_mark),
         )
@@ -530,7 +537,7 @@ def _step(stack, event, kind):
 def _check_key(key, mapping, stack):
     """Keys must be strings and must not repeat."""
     if key.kind != "scalar" or not isinstance(key.value, str):
-        raise _Reject("invalid-key", _stack_path(stack), f"keys must be strings, got {_describe(key)}", **_at(key))
+        raise _Reject("invalid-key", _here(stack), f"keys must be strings, got {_describe(key)}", **_at(key))
     if key.value in mapping.value:
         first = mapping.value[key.value][0]
         raise _Reject(
@@ -751,12 +758,17 @@ def _sequence(node, path):
 
 
 def _name(node, path):
-    """A non-empty single-line string."""
-    if node.kind != "scalar" or not isinstance(node.value, str):
-        raise _Reject("not-a-string", path, f"expected a string, got {_describe(node)} (quote it)", **_at(node))
-    if not node.value.strip() or "\n" in node.value or "\r" in node.value:
+    """A label: a non-empty single line, taken as written.
+
+    A plain ``1``, ``1e3`` or ``true`` is the label "1", "1e3", "true":
+    PyYAML's dumper leaves strings like "1e3" unquoted (YAML 1.1 reads
+    them as strings), and a label has no use for the number.
+    """
+    if node.kind != "scalar" or node.value is None:
+        raise _Reject("not-a-string", path, f"expected a name, got {_describe(node)}", **_at(node))
+    if not node.text.strip() or "\n" in node.text or "\r" in node.text:
         raise _Reject("invalid-name", path, "must be a non-empty single line", **_at(node))
-    return node.value
+    return node.text
 
 
 def _vector(node, length, path):

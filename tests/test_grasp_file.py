@@ -1,0 +1,576 @@
+"""The grasp-file loader: format, located errors, safety, both YAML parsers."""
+
+import io
+import pickle
+import sys
+import time
+from pathlib import Path
+
+import jsonschema
+import numpy as np
+import pytest
+import yaml
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from grasptwist import grasp_file, screws
+from grasptwist.grasp_file import (
+    DEFAULT_MAX_BYTES,
+    MAX_DEPTH,
+    Grasp,
+    GraspFileError,
+    grasp_schema,
+    load_grasps,
+    read_grasps,
+)
+
+INVALID = Path(__file__).parent / "invalid_grasps"
+BUNDLED = Path(__file__).parent.parent / "grasps"
+LOADERS = [yaml.SafeLoader] + ([yaml.CSafeLoader] if yaml.__with_libyaml__ else [])
+
+CONTACTS = """\
+contacts:
+  - point: [1, 0, 0]
+    normal: [-1, 0, 0]
+  - point: [-0.5, 0.866, 0]
+    normal: [0.5, -0.866, 0]
+  - point: [-0.5, -0.866, 0]
+    normal: [0.5, 0.866, 0]
+"""
+
+
+@pytest.fixture(params=LOADERS, ids=lambda loader: loader.__name__)
+def loader(request, monkeypatch):
+    """Run the test once with each available YAML parser."""
+    monkeypatch.setattr(grasp_file, "_LOADER", request.param)
+    return request.param
+
+
+def read(text, name="g.yaml", **kw):
+    return read_grasps(text, file=name, **kw)
+
+
+def only_error(text, **kw):
+    (entry,) = read(text, **kw)
+    assert isinstance(entry, GraspFileError), entry
+    return entry
+
+
+def only_grasp(text, **kw):
+    (entry,) = read(text, **kw)
+    assert isinstance(entry, Grasp), str(entry)
+    return entry
+
+
+def summary(entry):
+    """What must agree between the two parsers: everything but YAML's own wording."""
+    if isinstance(entry, GraspFileError):
+        message = None if entry.code == "yaml-syntax" else entry.message
+        return ("error", entry.code, message, entry.file, entry.line, entry.column, entry.document)
+    return (
+        "grasp",
+        entry.name,
+        entry.units,
+        entry.file,
+        entry.document,
+        entry.line,
+        entry.contact_names,
+        entry.points.tolist(),
+        entry.normals.tolist(),
+        None if entry.wrist is None else entry.wrist.tolist(),
+        [(t.name, t.screw.tolist(), t.line) for t in entry.twists],
+    )
+
+
+# --------------------------------------------------------------------------
+# The invalid fixtures: each file's header says what it must give.
+
+
+def fixture_header(path):
+    """``(code, line, column, schema verdict)`` from the file's ``# expect:``/``# schema:`` lines."""
+    lines = path.read_bytes().decode("ascii", "replace").splitlines()
+    code, where = lines[0].removeprefix("# expect: ").split()
+    line, column = (None, None) if where == "-" else map(int, where.split(":"))
+    verdict = lines[1].removeprefix("# schema: ").split()[0]
+    return code, line, column, verdict
+
+
+FIXTURES = sorted(INVALID.glob("*.yaml"))
+
+
+def test_fixtures_cover_every_rejection():
+    codes = {fixture_header(path)[0] for path in FIXTURES}
+    assert len(FIXTURES) >= 15
+    assert codes >= {
+        "unknown-key", "duplicate-key", "contact-count", "vector-length", "not-a-number", "non-finite",
+        "zero-normal", "duplicate-name", "empty-document", "not-a-mapping", "invalid-utf8", "forbidden-tag",
+        "alias", "missing-key", "conflicting-keys", "yaml-syntax", "control-character", "not-a-list",
+        "not-a-string", "invalid-name", "invalid-key",
+    }  # fmt: skip
+
+
+@pytest.mark.parametrize("path", FIXTURES, ids=lambda p: p.stem)
+def test_invalid_fixture_is_rejected_where_its_header_says(path, loader):
+    code, line, column, _ = fixture_header(path)
+    entries = read_grasps(path)
+    error = next(e for e in entries if isinstance(e, GraspFileError))
+    assert (error.code, error.line, error.column) == (code, line, column)
+    where = f"{path}:{line}:{column}: " if line else f"{path}: "
+    assert str(error).startswith(where)
+    assert error.file == str(path)
+
+
+@pytest.mark.parametrize("path", FIXTURES, ids=lambda p: p.stem)
+def test_invalid_fixture_against_the_json_schema(path):
+    """``rejects``: the schema catches it too; ``accepts``: a JSON Schema cannot
+    express the rule (only the loader catches it); ``not-data``: no YAML data."""
+    *_, verdict = fixture_header(path)
+    if verdict == "not-data":
+        with pytest.raises(yaml.YAMLError):
+            list(yaml.safe_load_all(path.read_bytes()))
+        return
+    validator = jsonschema.Draft202012Validator(grasp_schema())
+    documents = list(yaml.safe_load_all(path.read_bytes())) or [None]  # no document reads as null
+    valid = [validator.is_valid(document) for document in documents]
+    assert verdict in ("rejects", "accepts")
+    assert all(valid) == (verdict == "accepts")
+
+
+@pytest.mark.parametrize("path", FIXTURES + sorted(BUNDLED.glob("*.yaml")), ids=lambda p: p.stem)
+def test_both_parsers_give_identical_results(path):
+    if len(LOADERS) < 2:
+        pytest.skip("libyaml not available")
+    results = []
+    for parser in LOADERS:
+        with pytest.MonkeyPatch.context() as patch:
+            patch.setattr(grasp_file, "_LOADER", parser)
+            results.append([summary(entry) for entry in read_grasps(path)])
+    assert results[0] == results[1]
+
+
+# --------------------------------------------------------------------------
+# Safety.
+
+
+@pytest.mark.parametrize(
+    "template",
+    [
+        '!!python/object/apply:os.system ["touch {}"]\n',
+        "name: x\n" + CONTACTS.replace("point: [1, 0, 0]", 'point: !!python/object/apply:os.system ["touch {}"]'),
+        CONTACTS + 'twists:\n  - !!python/object/apply:os.system ["touch {}"]\n',
+        '? !!python/object/apply:os.system ["touch {}"]\n: 1\n',
+    ],
+    ids=["top-level", "nested-value", "list-item", "key"],
+)
+def test_python_tags_never_run(template, loader, tmp_path):
+    target = tmp_path / "pwned"
+    text = template.format(target)
+    (error,) = read(text)
+    assert error.code == "forbidden-tag"
+    assert not target.exists()
+    # Control: the same text does run under an unsafe loader, so the test can fail.
+    yaml.load(text, Loader=yaml.UnsafeLoader)
+    assert target.exists()
+
+
+def test_billion_laughs_fails_at_the_first_alias(loader):
+    text = 'a: &a ["lol","lol","lol","lol","lol","lol","lol","lol","lol"]\n'
+    text += "".join(f"{b}: &{b} [*{a},*{a},*{a},*{a},*{a},*{a},*{a},*{a},*{a}]\n" for a, b in zip("abcdefgh", "bcdefghi"))
+    start = time.perf_counter()
+    error = only_error(text)
+    assert time.perf_counter() - start < 1
+    assert (error.code, error.line, error.column) == ("alias", 2, 8)
+
+
+@pytest.mark.parametrize(
+    "deep, line",
+    [
+        ("[" * 20000 + "]" * 20000, 9),
+        ("{a: " * 20000 + "1" + "}" * 20000, 9),
+        ("- " * 20000 + "1", 9),
+        ("".join(" " * i + "a:\n" for i in range(200)) + " " * 200 + "1\n", 9 + MAX_DEPTH),
+    ],
+    ids=["flow-lists", "flow-maps", "block-lists", "block-maps"],
+)
+def test_deep_nesting_fails_fast(deep, line, loader):
+    text = CONTACTS + "---\n" + deep + "\n---\n" + CONTACTS
+    start = time.perf_counter()
+    entries = read(text, max_bytes=1 << 30)
+    assert time.perf_counter() - start < 1
+    # The good document before is kept; the parse stops at the deep one.
+    assert isinstance(entries[0], Grasp)
+    (error,) = entries[1:]
+    assert (error.code, error.line, error.document) == ("too-deep", line, 1)
+    assert f"deeper than {MAX_DEPTH}" in error.message
+
+
+def test_nesting_up_to_the_limit_gets_the_specific_error(loader):
+    text = CONTACTS.replace("[1, 0, 0]", "[1, 0, " + "[" * (MAX_DEPTH - 4) + "]" * (MAX_DEPTH - 4) + "]")
+    error = only_error(text)
+    assert (error.code, error.message) == ("not-a-number", "contacts[0].point[2]: expected a number, got a list")
+
+
+def test_oversized_content_is_refused_before_parsing():
+    error = only_error(b"[" * 101, max_bytes=100)
+    assert (error.code, error.line, error.document) == ("too-large", None, None)
+    assert str(error) == "g.yaml: larger than the size limit of 100 bytes"
+    assert isinstance(read(b"#" * 100, max_bytes=100)[0], GraspFileError)  # at the cap: parsed (empty)
+    assert read(b"#" * 100, max_bytes=100)[0].code == "empty-document"
+
+
+def test_an_endless_file_is_read_only_up_to_the_cap():
+    (error,) = read_grasps("/dev/zero", max_bytes=DEFAULT_MAX_BYTES)
+    assert (error.code, error.file) == ("too-large", "/dev/zero")
+
+
+@pytest.mark.parametrize("path", ["no/such/file.yaml", "."])
+def test_unreadable_paths_give_read_error(path):
+    (error,) = read_grasps(path)
+    assert error.code == "read-error"
+    assert str(error).startswith(f"{path}: cannot read: ")
+
+
+def test_invalid_utf8_is_located_by_line_and_character():
+    error = only_error("name: x\ncontacts: [é, ".encode() + b"\xff\xfe]\n")
+    assert (error.code, error.line, error.column) == ("invalid-utf8", 2, 15)
+    assert "byte offset 23" in error.message
+
+
+def test_lone_surrogate_in_str_content():
+    assert only_error("name: \udc80\n").code == "invalid-utf8"
+
+
+def test_utf8_bom_is_accepted(loader):
+    assert only_grasp("\ufeffname: bom\n" + CONTACTS).name == "bom"
+
+
+def test_random_bytes_never_raise(loader):
+    # Every outcome is a Grasp or a GraspFileError, whatever the input.
+    rng = np.random.default_rng(3)
+    seeds = [CONTACTS.encode(), b"- [{a: *b}, !!x 1, &c ~]\n", b"\t\x00\xff---\n..."]
+    for _ in range(300):
+        seed = seeds[rng.integers(len(seeds))]
+        data = bytearray(seed)
+        for _ in range(rng.integers(1, 6)):
+            data[rng.integers(len(data))] = rng.integers(256)
+        for entry in read_grasps(bytes(data)):
+            assert isinstance(entry, (Grasp, GraspFileError))
+
+
+@settings(max_examples=150, deadline=None)
+@given(st.text(alphabet=st.sampled_from(list(" \t\n-:?[]{},&*!|>'\"#%@`~.0123456789aez_\u00e9\u2028")), max_size=60))
+def test_random_yaml_like_text_never_raises(text):
+    for parser in LOADERS:
+        with pytest.MonkeyPatch.context() as patch:
+            patch.setattr(grasp_file, "_LOADER", parser)
+            for entry in read(text):
+                assert isinstance(entry, (Grasp, GraspFileError))
+
+
+# --------------------------------------------------------------------------
+# Format: values, defaults, conversions.
+
+
+def test_complete_grasp(loader):
+    grasp = only_grasp(
+        "name: cyl\nunits: mm\nwrist: [0, 0, 1]\n"
+        + CONTACTS.replace("  - point: [1", "  - name: thumb\n    point: [1")
+        + "twists:\n  - name: spin\n    angular: [0, 0, 1]\n  - screw: [1, 2, 3, 4, 5, 6]\n"
+    )
+    assert (grasp.name, grasp.units, grasp.file, grasp.document, grasp.line) == ("cyl", "mm", "g.yaml", 0, 1)
+    assert grasp.contact_names == ("thumb", "2", "3")
+    assert grasp.points.tolist() == [[1, 0, 0], [-0.5, 0.866, 0], [-0.5, -0.866, 0]]
+    assert grasp.wrist.tolist() == [0, 0, 1]
+    assert [(t.name, t.screw.tolist(), t.line) for t in grasp.twists] == [
+        ("spin", [0, 0, 1, 0, 0, 0], 13),
+        ("2", [1, 2, 3, 4, 5, 6], 15),
+    ]
+
+
+def test_defaults(loader):
+    grasp = only_grasp(CONTACTS, name="some/dir/mug.yaml")
+    assert (grasp.name, grasp.units, grasp.wrist, grasp.twists) == ("mug", None, None, ())
+    assert grasp.contact_names == ("1", "2", "3")
+    assert only_grasp(CONTACTS + "twists: []\n").twists == ()
+
+
+def test_arrays_are_read_only_floats(loader):
+    grasp = only_grasp("wrist: [0, 0, 1]\n" + CONTACTS + "twists:\n  - angular: [0, 0, 1]\n")
+    for array in (grasp.points, grasp.normals, grasp.wrist, grasp.twists[0].screw):
+        assert array.dtype == np.float64
+        with pytest.raises(ValueError):
+            array[0] = 1.0
+
+
+def test_normals_are_normalised_even_at_extreme_scales(loader):
+    text = CONTACTS.replace("[-1, 0, 0]", "[-3.0e+200, 4.0e+200, 0]").replace("[0.5, -0.866, 0]", "[1.0e-200, 0, 1.0e-200]")
+    normals = only_grasp(text).normals
+    np.testing.assert_allclose(normals[0], [-0.6, 0.8, 0], rtol=1e-15)
+    np.testing.assert_allclose(normals[1], [0.5**0.5, 0, 0.5**0.5], rtol=1e-15)
+    np.testing.assert_allclose(screws.norm(normals), 1, rtol=1e-15)
+
+
+@pytest.mark.parametrize(
+    "twist, expected",
+    [
+        ("angular: [0, 0, 1]", [0, 0, 1, 0, 0, 0]),
+        ("linear: [0, 0, 1]", [0, 0, 0, 0, 0, 1]),
+        ("angular: [0, 0, 1]\n    at: [1, 0, 0]", [0, 0, 1, 0, -1, 0]),
+        ("angular: [0, 0, 2]\n    linear: [0, 1, 0]\n    at: [1, 0, 0]", [0, 0, 2, 0, -1, 0]),
+        ("linear: [1, 2, 3]\n    at: [7, 8, 9]", [0, 0, 0, 1, 2, 3]),
+        ("screw: [0, -1, 0, 0, 0, 0.5]", [0, -1, 0, 0, 0, 0.5]),
+    ],
+)
+def test_twists_are_moved_to_the_origin(twist, expected, loader):
+    (t,) = only_grasp(CONTACTS + "twists:\n  - " + twist + "\n").twists
+    assert t.screw.tolist() == expected
+    # The origin screw gives the stated velocity at `at`.
+    if "at:" in twist:
+        fields = yaml.safe_load("  - " + twist)[0]
+        np.testing.assert_allclose(screws.field_at(t.screw, fields["at"]), fields.get("linear", [0, 0, 0]))
+
+
+@pytest.mark.parametrize(
+    "text, value",
+    [
+        ("1e-3", 1e-3), ("1E+3", 1e3), ("-.5", -0.5), ("+2.", 2.0), ("0x1F", 31), ("0o17", 15),
+        ("012", 12), ("1e200", 1e200), ("!!float 1", 1.0), ("!!int '7'", 7), ("-0", 0.0),
+        ("123456789012345678901234567890", 1.2345678901234568e29),
+    ],
+)  # fmt: skip
+def test_yaml_12_core_numbers(text, value, loader):
+    grasp = only_grasp(f"wrist: [{text}, 0, 0]\n" + CONTACTS)
+    assert grasp.wrist[0] == value
+
+
+@pytest.mark.parametrize(
+    "text, code, problem",
+    [
+        ("true", "not-a-number", "expected a number, got a boolean (true)"),
+        ("'1'", "not-a-number", "expected a number, got the string '1'"),
+        ("1_000", "not-a-number", "expected a number, got the string '1_000'"),
+        ("~", "not-a-number", "expected a number, got null"),
+        ("!!str 1", "not-a-number", "expected a number, got the string '1'"),
+        ("!!int abc", "not-a-number", "'abc' is not a valid !!int"),
+        ("!!bool 1", "bad-scalar", "'1' is not a valid !!bool"),
+        (".NaN", "non-finite", "expected a finite number, got nan"),
+        ("+.inf", "non-finite", "expected a finite number, got inf"),
+        ("1" * 400, "non-finite", "expected a finite number, got " + "1" * 400),
+        ("[1]", "not-a-number", "expected a number, got a list"),
+    ],
+)
+def test_non_numbers(text, code, problem, loader):
+    error = only_error(f"wrist: [0, {text}, 0]\n" + CONTACTS)
+    assert (error.code, error.message, error.line, error.column) == (code, "wrist[1]: " + problem, 1, 12)
+
+
+@pytest.mark.parametrize("name", ["1", "1e3", "true", "0x1F", "yes", "a b", "'quoted: yes'"])
+def test_names_are_taken_as_written(name, loader):
+    grasp = only_grasp(f"name: {name}\n" + CONTACTS.replace("- point: [1", f"- name: {name}\n    point: [1"))
+    assert grasp.name == grasp.contact_names[0] == name.strip("'")
+
+
+def test_core_tags_are_allowed(loader):
+    text = "!!map\nname: !!str x\nwrist: !!seq [!!float 0, !!int 0, ! 1]\n" + CONTACTS
+    assert only_error(text).message == "wrist[2]: expected a number, got the string '1'"
+    assert only_grasp(text.replace("! 1", "1")).name == "x"
+
+
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        ("!!set {a}", "top level: tag !!set is not allowed"),
+        ("wrist: !!omap [a: 1]", "wrist: tag !!omap is not allowed"),
+        ("wrist: !!binary aGk=", "wrist: tag !!binary is not allowed"),
+        ("wrist: !!map [1]", "wrist: tag !!map is not allowed"),
+        ("wrist: !<tag:example.com,2000:x> 1", "wrist: tag tag:example.com,2000:x is not allowed"),
+    ],
+)
+def test_other_tags_are_forbidden(text, message, loader):
+    error = only_error(text + "\n")
+    assert error.code == "forbidden-tag"
+    assert error.message.startswith(message)
+
+
+def test_unknown_key_suggestion(loader):
+    error = only_error(CONTACTS + "twist:\n  - angular: [0, 0, 1]\n")
+    assert error.message == "twist: unknown key (did you mean 'twists'?)"
+    assert (error.line, error.column) == (8, 1)
+
+
+def test_odd_keys_are_quoted_in_paths(loader):
+    assert only_error(CONTACTS + "'a b': 1\n").message.startswith("['a b']: unknown key")
+
+
+def test_duplicate_key_in_flow_mapping(loader):
+    flow = "  - {point: [1, 0, 0], normal: [-1, 0, 0], point: [2, 0, 0]}\n"
+    error = only_error(CONTACTS.replace("  - point: [1, 0, 0]\n    normal: [-1, 0, 0]\n", flow))
+    assert (error.code, error.message, error.line, error.column) == (
+        "duplicate-key", "contacts[0].point: duplicate key (first given at line 2)", 2, 44,
+    )  # fmt: skip
+
+
+def test_empty_and_null_documents(loader):
+    for text in ("", "\n\n", "# c\n", "  \n# c\n"):
+        error = only_error(text)
+        assert (error.code, error.line, error.document) == ("empty-document", None, None)
+    assert [e.code for e in read("---\n---\nnull\n")] == ["empty-document"] * 2
+
+
+# --------------------------------------------------------------------------
+# Multi-document streams.
+
+
+def test_multi_document_keeps_good_documents_around_a_bad_one(loader):
+    text = CONTACTS + "---\n" + CONTACTS.replace("[1, 0, 0]", "[1, 0]") + "---\nname: third\n" + CONTACTS
+    first, second, third = read(text, name="hand.yaml")
+    assert (first.name, first.document, first.line) == ("hand#1", 0, 1)
+    assert (second.code, second.document, second.line) == ("vector-length", 1, 10)
+    assert (third.name, third.document, third.line) == ("third", 2, 16)
+
+
+def test_syntax_error_keeps_the_documents_before_it(loader):
+    text = CONTACTS + "---\n" + CONTACTS + "---\nwrist: [0, 0\n---\n" + CONTACTS
+    *good, error = read(text, name="hand.yaml")
+    assert [g.name for g in good] == ["hand#1", "hand#2"]
+    assert (error.code, error.document, error.line) == ("yaml-syntax", 2, 18)
+
+
+def test_depth_is_checked_after_a_documents_first_problem(loader):
+    # After its first problem the rest of a document is only skimmed, but a
+    # nesting bomb in it still stops the parse at once (and is what is reported).
+    text = "bad: !!python/none 1\nx: " + "[" * 100000 + "\n---\n" + CONTACTS
+    start = time.perf_counter()
+    (error,) = read(text)
+    assert time.perf_counter() - start < 1
+    assert (error.code, error.line, error.column) == ("too-deep", 2, 35)
+
+
+# --------------------------------------------------------------------------
+# Sources and the error type.
+
+
+def test_sources(tmp_path, monkeypatch, loader):
+    path = tmp_path / "pinch.yaml"
+    path.write_text(CONTACTS)
+    assert read_grasps(path)[0].file == str(path)
+    assert read_grasps(str(path))[0].name == "pinch"
+    assert read_grasps(path, file="shown.yaml")[0].file == "shown.yaml"
+    assert read_grasps(CONTACTS.encode())[0].file == "<string>"
+    assert read_grasps(CONTACTS, file="x/typed.yaml")[0].name == "typed"
+    monkeypatch.setattr(sys, "stdin", io.TextIOWrapper(io.BytesIO(CONTACTS.encode())))
+    (grasp,) = read_grasps("-")
+    assert (grasp.file, grasp.name) == ("<stdin>", "<stdin>")
+
+
+def test_load_grasps_raises_the_first_error():
+    assert len(load_grasps(CONTACTS + "---\n" + CONTACTS, file="a.yaml")) == 2
+    with pytest.raises(GraspFileError) as caught:
+        load_grasps(CONTACTS + "---\nwrist: 1\n" + CONTACTS + "---\n- 1\n", file="a.yaml")
+    assert str(caught.value) == "a.yaml:9:8: wrist: expected 3 numbers, got the number 1"
+
+
+def test_error_is_one_line_and_pickles():
+    error = GraspFileError("vector-length", "contacts[2].normal: expected 3 numbers, got 2", "grasps/mug.yaml", 7, 13, 0)
+    assert str(error) == "grasps/mug.yaml:7:13: contacts[2].normal: expected 3 numbers, got 2"
+    assert str(GraspFileError("read-error", "cannot read: x", "f.yaml")) == "f.yaml: cannot read: x"
+    copy = pickle.loads(pickle.dumps(error))
+    assert (copy.code, copy.message, copy.file, copy.line, copy.column, copy.document, str(copy)) == (
+        error.code, error.message, error.file, error.line, error.column, error.document, str(error),
+    )  # fmt: skip
+
+
+def test_schema_names_the_same_keys_as_the_loader():
+    schema = grasp_schema()
+    definitions = schema["$defs"]
+    assert tuple(schema["properties"]) == grasp_file.GRASP_KEYS
+    assert tuple(definitions["contact"]["properties"]) == grasp_file.CONTACT_KEYS
+    assert tuple(definitions["twist"]["properties"]) == grasp_file.TWIST_KEYS
+    jsonschema.Draft202012Validator.check_schema(schema)
+
+
+# --------------------------------------------------------------------------
+# Round trip: random valid grasps written by PyYAML load back exactly.
+
+coordinate = st.floats(allow_nan=False, allow_infinity=False, min_value=-1e300, max_value=1e300)
+vector = st.lists(coordinate, min_size=3, max_size=3)
+label = st.text(st.characters(blacklist_categories=("Cc", "Cs", "Zl", "Zp")), min_size=1, max_size=12).filter(
+    lambda s: s.strip()
+)
+twist_entry = st.one_of(
+    st.fixed_dictionaries({"screw": st.lists(st.floats(-1e3, 1e3), min_size=6, max_size=6)}),
+    st.fixed_dictionaries(
+        {"angular": st.lists(st.floats(-1e3, 1e3), min_size=3, max_size=3)},
+        optional={"linear": vector, "at": st.lists(st.floats(-1e3, 1e3), min_size=3, max_size=3)},
+    ),
+)
+document = st.fixed_dictionaries(
+    {
+        "contacts": st.lists(
+            st.fixed_dictionaries(
+                {"point": vector, "normal": vector.filter(any)},
+                optional={"name": label},
+            ),
+            min_size=3,
+            max_size=3,
+        ),
+    },
+    optional={"name": label, "units": label, "wrist": vector, "twists": st.lists(twist_entry, max_size=4)},
+)
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.lists(document, min_size=1, max_size=3))
+def test_pyyaml_dumped_grasps_load_back(documents):
+    text = yaml.safe_dump_all(documents, allow_unicode=True)
+    validator = jsonschema.Draft202012Validator(grasp_schema())
+    for parser in LOADERS:
+        with pytest.MonkeyPatch.context() as patch:
+            patch.setattr(grasp_file, "_LOADER", parser)
+            entries = read(text, name="r.yaml")
+        assert len(entries) == len(documents)
+        for i, (doc, grasp) in enumerate(zip(documents, entries)):
+            assert validator.is_valid(doc)
+            default_names = [str(k + 1) for k in range(3)]
+            names = tuple(c.get("name", d) for c, d in zip(doc["contacts"], default_names))
+            if len(set(names)) < 3:  # an explicit name equal to another's default
+                assert grasp.code == "duplicate-name"
+                continue
+            assert isinstance(grasp, Grasp), str(grasp)
+            assert grasp.name == doc.get("name", f"r#{i + 1}" if len(documents) > 1 else "r")
+            assert grasp.units == doc.get("units")
+            assert grasp.contact_names == names
+            assert grasp.points.tolist() == [c["point"] for c in doc["contacts"]]
+            given_normals = np.array([c["normal"] for c in doc["contacts"]])
+            np.testing.assert_allclose(screws.norm(grasp.normals), 1, rtol=1e-14)
+            scaled = given_normals / np.abs(given_normals).max(axis=1, keepdims=True)
+            np.testing.assert_allclose(grasp.normals * screws.norm(scaled)[:, None], scaled, rtol=1e-14, atol=1e-15)
+            if "wrist" in doc:
+                assert grasp.wrist.tolist() == doc["wrist"]
+            check_twists(doc.get("twists", []), grasp.twists)
+
+
+def check_twists(entries, twists):
+    assert len(twists) == len(entries)
+    for k, (entry, twist) in enumerate(zip(entries, twists)):
+        assert twist.name == str(k + 1)
+        if "screw" in entry:
+            assert twist.screw.tolist() == entry["screw"]
+            continue
+        omega = np.array(entry["angular"])
+        at = np.array(entry.get("at", [0.0, 0.0, 0.0]))
+        linear = np.array(entry.get("linear", [0.0, 0.0, 0.0]))
+        if not np.isfinite(screws.twist_at(omega, linear, at)).all():
+            continue  # cannot happen with these ranges; the overflow case has a fixture
+        assert twist.screw[:3].tolist() == entry["angular"]
+        # v at the origin gives back `linear` at `at`, to rounding.
+        velocity = screws.field_at(twist.screw, at)
+        scale = max(1.0, float(np.abs(linear).max()), float(np.abs(omega).max() * np.abs(at).max()))
+        assert np.abs(velocity - linear).max() <= 1e-12 * scale
+
+
+def test_libyaml_is_used_when_present():
+    # The parser comparisons need libyaml; skip visibly rather than pass vacuously.
+    if not yaml.__with_libyaml__:
+        pytest.skip("PyYAML without libyaml: only the pure parser is tested")
+    assert grasp_file._LOADER is yaml.CSafeLoader
