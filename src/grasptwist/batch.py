@@ -9,7 +9,7 @@ order the grasps came.  No math here: only stacking and slicing.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import dataclass
 from typing import Iterable, Iterator, Sequence
 
 import numpy as np
@@ -117,11 +117,13 @@ def _run(jobs, method):
     out = {"velocity": contact_velocities(points, screws)}
     if method != "off-tangent":
         out["tangent"] = decompose_tangent(points, normals, screws)
+        out["tangent"].residual  # once for the whole chunk; rows share it
     if method != "tangent":
         with_wrist = np.array([g.wrist is not None for g, _ in jobs])
         if with_wrist.any():
             wrists = np.stack([g.wrist for g, _ in jobs if g.wrist is not None])
             out["off_tangent"] = decompose_off_tangent(points[with_wrist], wrists, screws[with_wrist])
+            out["off_tangent"].residual
             out["off_row"] = np.cumsum(with_wrist) - 1
     return out
 
@@ -129,14 +131,9 @@ def _run(jobs, method):
 def _resolution(grasp, twist, method, results, row):
     off = None
     if "off_tangent" in results and grasp.wrist is not None:
-        off = _row(results["off_tangent"], results["off_row"][row])
-    tan = _row(results["tangent"], row) if "tangent" in results else None
+        off = results["off_tangent"].row(results["off_row"][row])
+    tan = results["tangent"].row(row) if "tangent" in results else None
     return Resolution(grasp, twist, results["velocity"][row], off, tan, method)
-
-
-def _row(result, i):
-    """Row ``i`` of a batched engine result, as a result of the same type."""
-    return type(result)(**{f.name: getattr(result, f.name)[i] for f in fields(result)})
 
 
 def _no_twist(grasp: Grasp) -> GraspFileError:

@@ -17,26 +17,48 @@ Shapes: ``points`` and ``normals`` are ``(..., 3, 3)`` (contact, xyz),
 grasp can take many twists or many grasps one twist.  Indices ``(i, j, k)``
 run cyclically over ``(0, 1, 2), (1, 2, 0), (2, 0, 1)``.
 
-Numerics: every basis is built in the grasp's own frame (origin at the
-contacts' centroid, lengths divided by the grasp's half-extent ``s``) and
-mapped back at the end.  Amplitudes do not change under that map (it sends
-unit lines to unit lines), the degeneracy tests become scale and position
-free, and coordinates like 1e200 do not overflow.
+How it is computed
+------------------
+Eqs. 14 and 27 divide Klein products.  For a unit line ``L`` through ``a``
+along ``d``, ``[T|L] = d . T(a)``; with ``U_i = p_k - p_j`` (the side
+opposite contact ``i``), ``E_i = p_i - c`` and ``m = (p_2 - p_1) x (p_3 - p_1)``
+(twice the contacts' area, normal to their plane), the products reduce to
+closed forms that need no 6-vector algebra:
 
-A degenerate grasp never raises: its row gets a :class:`~grasptwist.degeneracy.Status`
-and NaN amplitudes, while every other row is computed exactly as it would
-be alone (all arithmetic is element-wise).
+* ``[Sigma_i|Psi_i] = D / (|U_i| |E_i|)`` with ``D = m . (p_1 - c)``, the same
+  ``D`` for every ``i``, so
+  ``x_i = |U_i| E_i . T(p_i) / D`` and ``y_i = |E_i| U_i . T(p_j) / D``;
+* ``Sigma_i(p_i) = m / |U_i|``, so ``[Theta_i|Sigma_i] = w^_i . m / |U_i|``
+  and ``alpha_i = U_i . T(p_j) / (w^_i . m)``;
+* every ``Theta_j`` and ``Sigma_j`` (``j != i``) keeps ``p_i`` in its tangent
+  plane, so the normal velocity ``T(p_i) . n_i`` is ``beta_i Sigma_i(p_i) . n_i``:
+  ``beta_i = |U_i| T(p_i) . n_i / (m . n_i)``.
+
+Differences of points are divided by the grasp's extent ``s`` before any
+product, so degeneracy tests are free of scale and position and coordinates
+like 1e200 do not overflow.  All arithmetic is element-wise: a row's numbers
+do not depend on the batch it is in.
+
+The tangent method is degenerate exactly when some normal lies in the
+contacts' plane (``m . n_i = 0``): a normal line set of rank < 3, a
+``Theta_i`` that is not unique, and ``[Theta_i|Sigma_i] = 0`` each imply it.
+So the engine gates on ``m . n_i`` and then names the specific condition.
+
+A degenerate grasp never raises: its row gets a
+:class:`~grasptwist.degeneracy.Status` and NaN amplitudes, while every other
+row is computed exactly as it would be alone.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
+from functools import cached_property
 from typing import NamedTuple
 
 import numpy as np
 
 from .degeneracy import DEGENERACY_TOL, IN_PLANE_TOL, Status
-from .screws import cross, dot, field_at, klein, line_through, norm, screw
+from .screws import cross, dot, field_at, norm
 
 __all__ = [
     "OffTangentResult",
@@ -70,8 +92,37 @@ def contact_velocities(points, twist):
     return field_at(twist[..., None, :], points)
 
 
-@dataclass(frozen=True)
-class OffTangentResult:
+class _Result:
+    """What both results share: row access and the lazily computed residual."""
+
+    @property
+    def ok(self) -> np.ndarray:
+        """``status == 0`` per row."""
+        return self.status == Status.OK
+
+    def row(self, i):
+        """Row ``i`` (an index into the leading axis) as a result of the same type."""
+        r = type(self)(**{f.name: getattr(self, f.name)[i] for f in fields(self)})
+        if "residual" in self.__dict__:  # carry a residual already computed for the batch
+            r.__dict__["residual"] = self.__dict__["residual"][i]
+        return r
+
+    @cached_property
+    def residual(self) -> np.ndarray:
+        """``max_i |R(p_i)| / max_i |T(p_i)|``, ``R`` = the sum of the components minus ``T``.
+
+        Computed on first access from the returned screws and amplitudes;
+        NaN in failed rows, 0 for the zero twist.
+        """
+        r = sum(a.sum(axis=-2) for a in self.components()) - self.twist
+        err = np.max(norm(field_at(r[..., None, :], self.points)), axis=-1)
+        ref = np.max(norm(field_at(self.twist[..., None, :], self.points)), axis=-1)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return np.where(ref > 0, err / np.where(ref > 0, ref, 1.0), err)
+
+
+@dataclass(frozen=True, eq=False)
+class OffTangentResult(_Result):
     """Proposition 1 for a batch: ``T = sum x_i Sigma_i + sum y_i Psi_i``.
 
     Attributes
@@ -88,9 +139,10 @@ class OffTangentResult:
     conditioning : (...)
         ``min_i |[Sigma_i|Psi_i]| / size`` (dimensionless; size = longest
         side of the contact triangle).
+    points, twist : (..., 3, 3), (..., 6)
+        The inputs, for :attr:`residual`.
     residual : (...)
-        ``max_i |R(p_i)| / max_i |T(p_i)|`` for ``R`` the reconstruction
-        minus ``T``, in the grasp's frame.
+        See :attr:`_Result.residual`.
     """
 
     sigma: np.ndarray
@@ -101,20 +153,16 @@ class OffTangentResult:
     status: np.ndarray
     culprit: np.ndarray
     conditioning: np.ndarray
-    residual: np.ndarray
-
-    @property
-    def ok(self) -> np.ndarray:
-        """``status == 0`` per row."""
-        return self.status == Status.OK
+    points: np.ndarray
+    twist: np.ndarray
 
     def components(self):
         """The component twists ``(x_i Sigma_i, y_i Psi_i)``, each ``(..., 3, 6)``."""
         return self.x[..., None] * self.sigma, self.y[..., None] * self.psi
 
 
-@dataclass(frozen=True)
-class TangentResult:
+@dataclass(frozen=True, eq=False)
+class TangentResult(_Result):
     """Proposition 2 and its extension: ``T = sum alpha_i Theta_i + sum beta_i Sigma_i``.
 
     Attributes
@@ -138,11 +186,14 @@ class TangentResult:
     in_tangent_planes : (...) bool
         Every normal velocity is zero to ``IN_PLANE_TOL`` relative to the
         contacts' speeds: ``T`` is realisable by tangent sliding alone.
-    points : (..., 3, 3)
-        The contacts, kept for :meth:`contact_split`.
-    status, culprit, conditioning, residual
-        As in :class:`OffTangentResult`; conditioning is
-        ``min_i |[Theta_i|Sigma_i]| / size``.
+    status, culprit : (...) int8
+        As in :class:`OffTangentResult`.
+    conditioning : (...)
+        The smaller of ``min_i |[Theta_i|Sigma_i]| / size`` and of
+        ``min_i |sin|`` of the angle between normal ``i`` and the contacts'
+        plane; both go to 0 at every degenerate grasp.
+    points, twist : (..., 3, 3), (..., 6)
+        The inputs, for :attr:`residual` and :meth:`contact_split`.
     """
 
     theta: np.ndarray
@@ -152,16 +203,11 @@ class TangentResult:
     beta: np.ndarray
     normal_velocity: np.ndarray
     in_tangent_planes: np.ndarray
-    points: np.ndarray
     status: np.ndarray
     culprit: np.ndarray
     conditioning: np.ndarray
-    residual: np.ndarray
-
-    @property
-    def ok(self) -> np.ndarray:
-        """``status == 0`` per row."""
-        return self.status == Status.OK
+    points: np.ndarray
+    twist: np.ndarray
 
     def components(self):
         """The component twists ``(alpha_i Theta_i, beta_i Sigma_i)``, each ``(..., 3, 6)``."""
@@ -186,15 +232,16 @@ class TangentResult:
         return self.alpha[..., None, :, None] * theta_at, self.beta[..., None] * sigma_at
 
 
-class _Frame(NamedTuple):
-    """A batch of grasps in their own frame: ``p = centroid + scale * q``."""
+class _Contacts(NamedTuple):
+    """The contact triangle of a batch of grasps, in units of its extent ``s``."""
 
-    centroid: np.ndarray  # (..., 3)
-    scale: np.ndarray  # (...)
-    q: np.ndarray  # (..., 3, 3)
-    size: np.ndarray  # (...) longest side of the triangle q
-    sigma: np.ndarray  # (..., 3, 6) Sigma_i in the frame
-    status: np.ndarray  # (...) coincident / collinear / non-finite
+    scale: np.ndarray  # (...) s: the largest coordinate difference between contacts
+    side: np.ndarray  # (..., 3, 3) U_i / s, side i = p_k - p_j
+    side_len: np.ndarray  # (..., 3) |U_i| / s
+    size: np.ndarray  # (...) longest side / s
+    m: np.ndarray  # (..., 3) m / s^2, twice the area, normal to the plane
+    sigma: np.ndarray  # (..., 3, 6) Sigma_i
+    status: np.ndarray  # (...) non-finite / coincident / collinear
     culprit: np.ndarray  # (...)
 
 
@@ -229,33 +276,36 @@ def decompose_off_tangent(points, wrist, twist, *, tol=DEGENERACY_TOL) -> OffTan
     points = _checked(points, (3, 3), "points")
     wrist = _checked(wrist, (3,), "wrist")
     twist = _checked(twist, (6,), "twist")
-    f = _frame(points, tol)
+    g = _contacts(points, tol)
     with np.errstate(all="ignore"):
-        c = (wrist - f.centroid) / f.scale[..., None]
-        psi = line_through(f.q, f.q - c[..., None, :])
-        sigma_psi = klein(f.sigma, psi)
-        conditioning = np.min(np.abs(sigma_psi), axis=-1) / f.size
+        s = g.scale[..., None]
+        e = (points - wrist[..., None, :]) / s[..., None]  # E_i / s
+        e_len = norm(e)
+        d = dot(g.m, e[..., 0, :])  # D / s^3, one for all i
+        conditioning = np.min(np.abs(d[..., None]) / (g.side_len * e_len), axis=-1) / g.size
         grasp_status, culprit = _first_failure(
-            f,
+            g,
             (~np.isfinite(wrist).all(axis=-1), Status.NONFINITE_INPUT, -1),
             (~(conditioning > tol), Status.WRIST_COPLANAR, -1),
         )
-        t = _into_frame(twist, f)[..., None, :]
-        x = klein(t, psi) / sigma_psi
-        y = klein(t, f.sigma) / sigma_psi
-        residual = _residual(t[..., 0, :], f.q, (x, f.sigma), (y, psi))
-    status, culprit = _row_status(grasp_status, culprit, twist, (x, y, residual))
+        speed = field_at(twist[..., None, :], points) / s[..., None]  # T(p_i) / s
+        x = g.side_len * dot(e, speed) / d[..., None]
+        y = e_len * dot(g.side, speed[..., _J, :]) / d[..., None]
+        psi = _line(points, e / e_len[..., None])
+        sigma_psi = s * d[..., None] / (g.side_len * e_len)
+    status, culprit = _row_status(grasp_status, culprit, twist, (x, y))
     shape = status.shape
     return OffTangentResult(
-        sigma=_spread(_out_of_frame(f.sigma, f), shape + (3, 6)),
-        psi=_spread(_out_of_frame(psi, f), shape + (3, 6)),
-        sigma_psi=_spread(sigma_psi * f.scale[..., None], shape + (3,)),
+        sigma=_spread(g.sigma, shape + (3, 6)),
+        psi=_spread(psi, shape + (3, 6)),
+        sigma_psi=_spread(sigma_psi, shape + (3,)),
         x=_failed_to_nan(x, status),
         y=_failed_to_nan(y, status),
         status=status,
         culprit=culprit,
         conditioning=_spread(conditioning, shape),
-        residual=_failed_to_nan(residual, status),
+        points=_spread(points, shape + (3, 3)),
+        twist=_spread(twist, shape + (6,)),
     )
 
 
@@ -291,116 +341,81 @@ def decompose_tangent(points, normals, twist, *, tol=DEGENERACY_TOL) -> TangentR
     points = _checked(points, (3, 3), "points")
     normals = _checked(normals, (3, 3), "normals")
     twist = _checked(twist, (6,), "twist")
-    f = _frame(points, tol)
+    g = _contacts(points, tol)
     with np.errstate(all="ignore"):
+        s = g.scale[..., None]
         n_len = norm(normals)
         n = normals / n_len[..., None]
-        theta, uniqueness = _theta(f.q, n)
-        theta_sigma = klein(theta, f.sigma)
-        conditioning = np.min(np.abs(theta_sigma), axis=-1) / f.size
+        # eq. 21-22 with p_i p_j = U_k and p_i p_k = -U_j
+        a = cross(g.side[..., _K, :], n[..., _J, :])
+        b = cross(n[..., _K, :], g.side[..., _J, :])
+        w = cross(a, b)
+        w_len = norm(w)
+        w_unit = w / w_len[..., None]
+        wm = dot(w_unit, g.m[..., None, :])  # w^_i . m / s^2
+        mn = dot(g.m[..., None, :], n)  # m . n_i / s^2
+        plane_sine = np.abs(mn) / norm(g.m)[..., None]
+        theta_sigma_rel = np.abs(wm) / (g.side_len * g.size[..., None])
+        conditioning = np.minimum(np.min(theta_sigma_rel, axis=-1), np.min(plane_sine, axis=-1))
+        degenerate = ~(conditioning > tol)
+        uniqueness = np.minimum(
+            np.minimum(norm(a) / g.side_len[..., _K], norm(b) / g.side_len[..., _J]), w_len / (norm(a) * norm(b))
+        )
         grasp_status, culprit = _first_failure(
-            f,
+            g,
             (~np.isfinite(normals).all(axis=(-2, -1)), Status.NONFINITE_INPUT, -1),
             (~(n_len > 0).all(axis=-1), Status.ZERO_NORMAL, np.argmin(n_len, axis=-1)),
-            (~(_normal_lines_volume(f.q, n) > tol), Status.NORMALS_RANK_DEFICIENT, -1),
-            (~(uniqueness > tol).all(axis=-1), Status.THETA_NOT_UNIQUE, np.argmin(uniqueness, axis=-1)),
-            (~(conditioning > tol), Status.THETA_SIGMA_ZERO, np.argmin(np.abs(theta_sigma), axis=-1)),
+            (degenerate & _rank_deficient(points, n, g, degenerate, tol), Status.NORMALS_RANK_DEFICIENT, -1),
+            (degenerate & ~(uniqueness > tol).all(axis=-1), Status.THETA_NOT_UNIQUE, np.argmin(uniqueness, axis=-1)),
+            (degenerate & ~(theta_sigma_rel > tol).all(axis=-1), Status.THETA_SIGMA_ZERO, np.argmin(theta_sigma_rel, axis=-1)),
+            (degenerate, Status.NORMAL_IN_CONTACT_PLANE, np.argmin(plane_sine, axis=-1)),
         )
-        t = _into_frame(twist, f)[..., None, :]
-        alpha = klein(t, f.sigma) / theta_sigma
-        rest = t[..., 0, :] - _combine(alpha, theta)
-        beta = klein(rest[..., None, :], theta) / theta_sigma
-        residual = _residual(t[..., 0, :], f.q, (alpha, theta), (beta, f.sigma))
-        speed = field_at(twist[..., None, :], points)
-        normal_velocity = dot(speed, n)
+        velocity = field_at(twist[..., None, :], points)
+        normal_velocity = dot(velocity, n)
+        alpha = dot(g.side, velocity[..., _J, :]) / (s * wm)
+        beta = g.side_len * normal_velocity / (s * mn)
+        theta = _line(points, w_unit)
         # Round-off in v + omega x p scales with |v| + |omega||p|, not with the result.
         slack = IN_PLANE_TOL * np.max(norm(twist[..., None, 3:]) + norm(twist[..., None, :3]) * norm(points), axis=-1)
         in_planes = np.max(np.abs(normal_velocity), axis=-1) <= slack
-    status, culprit = _row_status(grasp_status, culprit, twist, (alpha, beta, residual))
+        theta_sigma = s * wm / g.side_len
+    status, culprit = _row_status(grasp_status, culprit, twist, (alpha, beta))
     shape = status.shape
     return TangentResult(
-        theta=_spread(_out_of_frame(theta, f), shape + (3, 6)),
-        sigma=_spread(_out_of_frame(f.sigma, f), shape + (3, 6)),
-        theta_sigma=_spread(theta_sigma * f.scale[..., None], shape + (3,)),
+        theta=_spread(theta, shape + (3, 6)),
+        sigma=_spread(g.sigma, shape + (3, 6)),
+        theta_sigma=_spread(theta_sigma, shape + (3,)),
         alpha=_failed_to_nan(alpha, status),
         beta=_failed_to_nan(beta, status),
         normal_velocity=_failed_to_nan(normal_velocity, status),
         in_tangent_planes=in_planes & (status == Status.OK),
-        points=_spread(points, shape + (3, 3)),
         status=status,
         culprit=culprit,
         conditioning=_spread(conditioning, shape),
-        residual=_failed_to_nan(residual, status),
+        points=_spread(points, shape + (3, 3)),
+        twist=_spread(twist, shape + (6,)),
     )
 
 
-def _theta(q, n):
-    """Unit ``Theta_i`` (eq. 22) in the frame, and how unique each is.
+def _contacts(points, tol) -> _Contacts:
+    """The contact triangle and its degeneracies.
 
-    ``w_i`` must be orthogonal to ``a = p_i p_j x n_j`` and ``b = p_i p_k x n_k``
-    (eq. 21).  Crossing the *unit* ``a`` and ``b`` keeps ``w_i`` accurate
-    at any scale; the null space of ``(a; b)`` is a single line exactly when
-    ``a`` and ``b`` are non-zero and not parallel, so uniqueness is the least
-    of ``|a|/|p_i p_j|``, ``|b|/|p_i p_k|`` and ``|a^ x b^|`` (sines, 0..1).
+    Contacts coincide when the shortest side is ``<= tol`` times the longest;
+    they are collinear when twice the area is ``<= tol`` times the longest
+    side squared (a height ``<= tol`` times the size).
     """
-    r_j = q[..., _J, :] - q
-    r_k = q[..., _K, :] - q
-    a = cross(r_j, n[..., _J, :])
-    b = cross(r_k, n[..., _K, :])
-    a_len, b_len = norm(a), norm(b)
-    w = cross(a / a_len[..., None], b / b_len[..., None])
-    uniqueness = np.minimum(np.minimum(a_len / norm(r_j), b_len / norm(r_k)), norm(w))
-    return line_through(q, w), uniqueness
-
-
-def _normal_lines_volume(q, n):
-    """How far the normal lines ``nu_i = (n_i; q_i x n_i)`` are from rank < 3.
-
-    Gram-Schmidt on the three 6-vectors: the product of the orthogonalised
-    lengths over the product of the original lengths, in ``[0, 1]``; accurate
-    to round-off even near 0, unlike a Gram determinant.
-    """
-    nu = line_through(q, n)
-    r1, r2, r3 = nu[..., 0, :], nu[..., 1, :], nu[..., 2, :]
-    u1 = r1 / _len6(r1)[..., None]
-    r2o = r2 - _dot6(r2, u1)[..., None] * u1
-    u2 = r2o / _len6(r2o)[..., None]
-    r3o = r3 - _dot6(r3, u1)[..., None] * u1 - _dot6(r3, u2)[..., None] * u2
-    return _len6(r2o) * _len6(r3o) / (_len6(r2) * _len6(r3))
-
-
-def _dot6(a, b):
-    return dot(a[..., :3], b[..., :3]) + dot(a[..., 3:], b[..., 3:])
-
-
-def _len6(a):
-    return np.sqrt(_dot6(a, a))
-
-
-def _frame(points, tol) -> _Frame:
-    """Move a batch of grasps into its own frame and test the contacts.
-
-    The frame has its origin at the centroid and unit length ``s`` = the
-    largest coordinate offset of a contact from it (no squares, so 1e200
-    coordinates do not overflow).  Contacts coincide when the shortest side
-    of their triangle is ``<= tol`` times the longest; they are collinear
-    when twice the triangle's area is ``<= tol`` times the longest side
-    squared (a height ``<= tol`` times the size).
-    """
-    centroid = (points[..., 0, :] + points[..., 1, :] + points[..., 2, :]) / 3
-    offset = points - centroid[..., None, :]
+    side = points[..., _K, :] - points[..., _J, :]
     with np.errstate(all="ignore"):
-        scale = np.max(np.abs(offset), axis=(-2, -1))
-        q = offset / scale[..., None, None]
-        side = q[..., _K, :] - q[..., _J, :]  # side i is opposite contact i, from p_j to p_k
+        scale = np.max(np.abs(side), axis=(-2, -1))
+        side = side / scale[..., None, None]
         side_len = norm(side)
         size = np.max(side_len, axis=-1)
-        twice_area = norm(cross(q[..., 1, :] - q[..., 0, :], q[..., 2, :] - q[..., 0, :]))
+        m = cross(side[..., 1, :], side[..., 2, :])
         status = np.select(
             [
                 ~np.isfinite(points).all(axis=(-2, -1)),
                 ~(np.min(side_len, axis=-1) > tol * size),
-                ~(twice_area > tol * size * size),
+                ~(norm(m) > tol * size * size),
             ],
             [Status.NONFINITE_INPUT, Status.COINCIDENT_CONTACTS, Status.COLLINEAR_CONTACTS],
             Status.OK,
@@ -412,17 +427,53 @@ def _frame(points, tol) -> _Frame:
             [np.argmin(side_len, axis=-1), np.argmax(side_len, axis=-1)],
             -1,
         ).astype(np.int8)
-        sigma = line_through(q[..., _J, :], side)
-    return _Frame(centroid, scale, q, size, sigma, status, culprit)
+        sigma = _line(points[..., _J, :], side / side_len[..., None])
+    return _Contacts(scale, side, side_len, size, m, sigma, status, culprit)
 
 
-def _first_failure(frame: _Frame, *checks):
-    """Status and culprit of each grasp: the frame's own, else the first
+def _line(p, d):
+    """Unit lines ``(d; p x d)`` for unit directions ``d``: ``(..., 3) x2 -> (..., 6)``."""
+    return np.concatenate((d, cross(p, d)), axis=-1)
+
+
+def _rank_deficient(points, n, g: _Contacts, rows, tol):
+    """Whether the normal lines ``nu_i = (n_i; p_i x n_i)`` have rank < 3, tested
+    only in ``rows`` (False elsewhere) since it costs more than the rest.
+
+    Gram-Schmidt on the three 6-vectors, taken about ``p_1`` in units of
+    ``s``: the product of the orthogonalised lengths over the original ones
+    is in ``[0, 1]`` and accurate to round-off even near 0.
+    """
+    out = np.zeros(rows.shape, dtype=bool)
+    if not rows.any():
+        return out
+    shape = rows.shape
+    q = np.broadcast_to((points - points[..., :1, :]) / g.scale[..., None, None], shape + (3, 3))[rows]
+    nu = _line(q, np.broadcast_to(n, shape + (3, 3))[rows])
+    r1, r2, r3 = nu[..., 0, :], nu[..., 1, :], nu[..., 2, :]
+    u1 = r1 / _len6(r1)[..., None]
+    r2o = r2 - _dot6(r2, u1)[..., None] * u1
+    u2 = r2o / _len6(r2o)[..., None]
+    r3o = r3 - _dot6(r3, u1)[..., None] * u1 - _dot6(r3, u2)[..., None] * u2
+    out[rows] = ~(_len6(r2o) * _len6(r3o) / (_len6(r2) * _len6(r3)) > tol)
+    return out
+
+
+def _dot6(a, b):
+    return dot(a[..., :3], b[..., :3]) + dot(a[..., 3:], b[..., 3:])
+
+
+def _len6(a):
+    return np.sqrt(_dot6(a, a))
+
+
+def _first_failure(g: _Contacts, *checks):
+    """Status and culprit of each grasp: the triangle's own, else the first
     failing ``(mask, status, culprit)`` check, in order."""
-    masks = [frame.status != Status.OK] + [m for m, _, _ in checks]
+    masks = [g.status != Status.OK] + [m for m, _, _ in checks]
     shape = np.broadcast_shapes(*(np.shape(m) for m in masks))
-    status = np.select(masks, [frame.status] + [s for _, s, _ in checks], Status.OK)
-    culprit = np.select(masks, [frame.culprit] + [c for _, _, c in checks], -1)
+    status = np.select(masks, [g.status] + [s for _, s, _ in checks], Status.OK)
+    culprit = np.select(masks, [g.culprit] + [c for _, _, c in checks], -1)
     return np.broadcast_to(status, shape).astype(np.int8), np.broadcast_to(culprit, shape).astype(np.int8)
 
 
@@ -434,36 +485,10 @@ def _row_status(grasp_status, culprit, twist, outputs):
     status = np.where((grasp_status == Status.OK) & twist_bad, Status.NONFINITE_INPUT, grasp_status)
     finite = np.ones(shape, dtype=bool)
     for out in outputs:
-        finite &= np.isfinite(out).all(axis=-1) if out.ndim > len(shape) else np.isfinite(out)
+        finite &= np.isfinite(out).all(axis=-1)
     status = np.where((status == Status.OK) & ~finite, Status.OVERFLOW, status)
     culprit = np.where(status == grasp_status, culprit, -1)
     return np.broadcast_to(status, shape).astype(np.int8), np.broadcast_to(culprit, shape).astype(np.int8)
-
-
-def _into_frame(twist, f: _Frame):
-    """``(omega; v)`` at the origin -> ``(omega; T(centroid) / s)`` in the frame."""
-    omega = twist[..., :3]
-    return screw(omega, (twist[..., 3:] + cross(omega, f.centroid)) / f.scale[..., None])
-
-
-def _out_of_frame(s, f: _Frame):
-    """Inverse of :func:`_into_frame` for ``(..., 3, 6)`` screws: ``v = s v' + g x omega``."""
-    omega = s[..., :3]
-    return screw(omega, f.scale[..., None, None] * s[..., 3:] + cross(f.centroid[..., None, :], omega))
-
-
-def _combine(amplitude, basis):
-    """``sum_i amplitude_i basis_i``: ``(..., 3), (..., 3, 6) -> (..., 6)``."""
-    a = amplitude[..., None]
-    return a[..., 0, :] * basis[..., 0, :] + a[..., 1, :] * basis[..., 1, :] + a[..., 2, :] * basis[..., 2, :]
-
-
-def _residual(t, q, *parts):
-    """``max_i |R(q_i)| / max_i |T(q_i)|``, ``R`` = sum of the parts minus ``T``."""
-    r = sum(_combine(a, b) for a, b in parts) - t
-    err = np.max(norm(field_at(r[..., None, :], q)), axis=-1)
-    ref = np.max(norm(field_at(t[..., None, :], q)), axis=-1)
-    return np.where(ref > 0, err / np.where(ref > 0, ref, 1.0), err)
 
 
 def _failed_to_nan(a, status):
@@ -480,7 +505,7 @@ def _spread(a, shape):
 def _checked(a, trailing, name):
     """``a`` as a float array whose shape ends in ``trailing`` (checked once, here)."""
     a = np.asarray(a, dtype=float)
-    if a.shape[a.ndim - len(trailing) :] != trailing or a.ndim < len(trailing):
+    if a.ndim < len(trailing) or a.shape[a.ndim - len(trailing) :] != trailing:
         want = "(..., " + ", ".join(map(str, trailing)) + ")"
         raise ValueError(f"{name} must have shape {want}, got {a.shape}")
     return a

@@ -53,6 +53,7 @@ class Status(IntEnum):
     THETA_NOT_UNIQUE = 7
     THETA_SIGMA_ZERO = 8
     OVERFLOW = 9
+    NORMAL_IN_CONTACT_PLANE = 10
 
     @property
     def code(self) -> str:
@@ -78,6 +79,10 @@ _MESSAGES = {
         "[Theta_{i}|Sigma_{i}] = 0: the axis of Theta_{i} meets or is parallel to the line through {j} and {k}"
     ),
     Status.OVERFLOW: "the numbers overflow double precision (coordinates or twist too large)",
+    Status.NORMAL_IN_CONTACT_PLANE: (
+        "the normal at contact {i} lies in the plane of the contacts, so no tangent-plus-Sigma motion "
+        "can move contact {i} along it"
+    ),
 }
 
 
