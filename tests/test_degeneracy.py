@@ -61,12 +61,17 @@ def test_each_condition_has_its_status_culprit_and_message(result, status, culpr
     assert np.isnan(r.residual)
 
 
-def test_huge_coordinates_resolve_when_the_numbers_fit():
-    # the grasp's own frame keeps 1e200 coordinates from overflowing in squares and products
-    r = tan(EX2 * 1e200, np.eye(3), np.array([1, 1, 1, 0, 0, 0]) / np.sqrt(3))
+def test_huge_coordinates_resolve_within_range_and_overflow_beyond_it():
+    t = np.array([1, 1, 1, 0, 0, 0]) / np.sqrt(3)
+    r = tan(EX2 * 1e100, np.eye(3), t)
     assert r.status == S.OK
     np.testing.assert_allclose(r.alpha, [0.5774] * 3, atol=1e-4)
-    np.testing.assert_allclose(r.theta_sigma, [np.sqrt(2) * 1e200] * 3, rtol=1e-12)
+    np.testing.assert_allclose(r.theta_sigma, [np.sqrt(2) * 1e100] * 3, rtol=1e-12)
+    r = tan(EX2 * 1e200, np.eye(3), t)
+    assert r.status == S.OVERFLOW and np.isnan(r.alpha).all()
+    r = tan(EX2 * 1e-100, np.eye(3), t * [1, 1, 1, 1e-100, 1e-100, 1e-100])
+    assert r.status == S.OK
+    np.testing.assert_allclose(r.alpha, [0.5774] * 3, atol=1e-4)
 
 
 def test_status_codes_are_stable_strings():

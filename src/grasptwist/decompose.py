@@ -34,10 +34,17 @@ closed forms that need no 6-vector algebra:
   plane, so the normal velocity ``T(p_i) . n_i`` is ``beta_i Sigma_i(p_i) . n_i``:
   ``beta_i = |U_i| T(p_i) . n_i / (m . n_i)``.
 
-Differences of points are divided by the grasp's extent ``s`` before any
-product, so degeneracy tests are free of scale and position and coordinates
-like 1e200 do not overflow.  All arithmetic is element-wise: a row's numbers
-do not depend on the batch it is in.
+Only differences of points enter the tests and amplitudes, and every
+degeneracy measure is a ratio of like quantities, so verdicts do not depend
+on the grasp's scale or position.  Coordinates must stay within about
+1e-150..1e150 in size (squares of lengths are formed); a row whose numbers
+overflow gets the status ``overflow``.
+
+Speed: rows are processed in chunks of :data:`CHUNK` whose temporaries stay
+in the CPU cache, in a components-first layout (``(contact, xyz, row)``) so
+that every numpy call runs over contiguous memory.  Results are views of
+that layout with the documented shapes.  All arithmetic is element-wise: a
+row's numbers do not depend on the batch or chunk it is in.
 
 The tangent method is degenerate exactly when some normal lies in the
 contacts' plane (``m . n_i = 0``): a normal line set of rank < 3, a
@@ -53,12 +60,13 @@ from __future__ import annotations
 
 from dataclasses import dataclass, fields
 from functools import cached_property
+from math import prod
 from typing import NamedTuple
 
 import numpy as np
 
 from .degeneracy import DEGENERACY_TOL, IN_PLANE_TOL, Status
-from .screws import cross, dot, field_at, norm
+from .screws import field_at, norm
 
 __all__ = [
     "OffTangentResult",
@@ -70,6 +78,10 @@ __all__ = [
 
 _J = [1, 2, 0]  # j = i + 1 (mod 3)
 _K = [2, 0, 1]  # k = i + 2 (mod 3)
+
+#: Rows per chunk: small enough for a chunk's temporaries to stay in cache,
+#: large enough that numpy's per-call overhead is noise.
+CHUNK = 4096
 
 
 def contact_velocities(points, twist):
@@ -87,9 +99,8 @@ def contact_velocities(points, twist):
     >>> contact_velocities([[1.0, 0, 0], [0, 1, 0], [0, 0, 1]], [0, 0, 1.0, 0, 0, 0]).tolist()
     [[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 0.0]]
     """
-    points = _checked(points, (3, 3), "points")
-    twist = _checked(twist, (6,), "twist")
-    return field_at(twist[..., None, :], points)
+    inputs = {"points": _checked(points, (3, 3), "points"), "twist": _checked(twist, (6,), "twist")}
+    return _chunked(_velocity_rows, inputs, {"velocity": (3, 3)}, None)["velocity"]
 
 
 class _Result:
@@ -232,19 +243,6 @@ class TangentResult(_Result):
         return self.alpha[..., None, :, None] * theta_at, self.beta[..., None] * sigma_at
 
 
-class _Contacts(NamedTuple):
-    """The contact triangle of a batch of grasps, in units of its extent ``s``."""
-
-    scale: np.ndarray  # (...) s: the largest coordinate difference between contacts
-    side: np.ndarray  # (..., 3, 3) U_i / s, side i = p_k - p_j
-    side_len: np.ndarray  # (..., 3) |U_i| / s
-    size: np.ndarray  # (...) longest side / s
-    m: np.ndarray  # (..., 3) m / s^2, twice the area, normal to the plane
-    sigma: np.ndarray  # (..., 3, 6) Sigma_i
-    status: np.ndarray  # (...) non-finite / coincident / collinear
-    culprit: np.ndarray  # (...)
-
-
 def decompose_off_tangent(points, wrist, twist, *, tol=DEGENERACY_TOL) -> OffTangentResult:
     """Resolve ``twist`` on the off-tangent basis (Proposition 1).
 
@@ -273,40 +271,13 @@ def decompose_off_tangent(points, wrist, twist, *, tol=DEGENERACY_TOL) -> OffTan
     >>> np.round(r.y, 4).tolist(), bool(np.allclose(r.x, 0))
     ([-0.4714, -0.4714, -0.4714], True)
     """
-    points = _checked(points, (3, 3), "points")
-    wrist = _checked(wrist, (3,), "wrist")
-    twist = _checked(twist, (6,), "twist")
-    g = _contacts(points, tol)
-    with np.errstate(all="ignore"):
-        s = g.scale[..., None]
-        e = (points - wrist[..., None, :]) / s[..., None]  # E_i / s
-        e_len = norm(e)
-        d = dot(g.m, e[..., 0, :])  # D / s^3, one for all i
-        conditioning = np.min(np.abs(d[..., None]) / (g.side_len * e_len), axis=-1) / g.size
-        grasp_status, culprit = _first_failure(
-            g,
-            (~np.isfinite(wrist).all(axis=-1), Status.NONFINITE_INPUT, -1),
-            (~(conditioning > tol), Status.WRIST_COPLANAR, -1),
-        )
-        speed = field_at(twist[..., None, :], points) / s[..., None]  # T(p_i) / s
-        x = g.side_len * dot(e, speed) / d[..., None]
-        y = e_len * dot(g.side, speed[..., _J, :]) / d[..., None]
-        psi = _line(points, e / e_len[..., None])
-        sigma_psi = s * d[..., None] / (g.side_len * e_len)
-    status, culprit = _row_status(grasp_status, culprit, twist, (x, y))
-    shape = status.shape
-    return OffTangentResult(
-        sigma=_spread(g.sigma, shape + (3, 6)),
-        psi=_spread(psi, shape + (3, 6)),
-        sigma_psi=_spread(sigma_psi, shape + (3,)),
-        x=_failed_to_nan(x, status),
-        y=_failed_to_nan(y, status),
-        status=status,
-        culprit=culprit,
-        conditioning=_spread(conditioning, shape),
-        points=_spread(points, shape + (3, 3)),
-        twist=_spread(twist, shape + (6,)),
-    )
+    inputs = {
+        "points": _checked(points, (3, 3), "points"),
+        "wrist": _checked(wrist, (3,), "wrist"),
+        "twist": _checked(twist, (6,), "twist"),
+    }
+    out = _chunked(_off_tangent_rows, inputs, _OFF_TANGENT_OUT, tol)
+    return OffTangentResult(**out)
 
 
 def decompose_tangent(points, normals, twist, *, tol=DEGENERACY_TOL) -> TangentResult:
@@ -338,168 +309,283 @@ def decompose_tangent(points, normals, twist, *, tol=DEGENERACY_TOL) -> TangentR
     >>> np.round(r.alpha, 4).tolist(), np.round(r.beta, 4).tolist(), bool(r.in_tangent_planes)
     ([0.5774, 0.5774, 0.5774], [0.0, 0.0, 0.0], True)
     """
-    points = _checked(points, (3, 3), "points")
-    normals = _checked(normals, (3, 3), "normals")
-    twist = _checked(twist, (6,), "twist")
-    g = _contacts(points, tol)
-    with np.errstate(all="ignore"):
-        s = g.scale[..., None]
-        n_len = norm(normals)
-        n = normals / n_len[..., None]
-        # eq. 21-22 with p_i p_j = U_k and p_i p_k = -U_j
-        a = cross(g.side[..., _K, :], n[..., _J, :])
-        b = cross(n[..., _K, :], g.side[..., _J, :])
-        w = cross(a, b)
-        w_len = norm(w)
-        w_unit = w / w_len[..., None]
-        wm = dot(w_unit, g.m[..., None, :])  # w^_i . m / s^2
-        mn = dot(g.m[..., None, :], n)  # m . n_i / s^2
-        plane_sine = np.abs(mn) / norm(g.m)[..., None]
-        theta_sigma_rel = np.abs(wm) / (g.side_len * g.size[..., None])
-        conditioning = np.minimum(np.min(theta_sigma_rel, axis=-1), np.min(plane_sine, axis=-1))
-        degenerate = ~(conditioning > tol)
-        uniqueness = np.minimum(
-            np.minimum(norm(a) / g.side_len[..., _K], norm(b) / g.side_len[..., _J]), w_len / (norm(a) * norm(b))
-        )
-        grasp_status, culprit = _first_failure(
-            g,
-            (~np.isfinite(normals).all(axis=(-2, -1)), Status.NONFINITE_INPUT, -1),
-            (~(n_len > 0).all(axis=-1), Status.ZERO_NORMAL, np.argmin(n_len, axis=-1)),
-            (degenerate & _rank_deficient(points, n, g, degenerate, tol), Status.NORMALS_RANK_DEFICIENT, -1),
-            (degenerate & ~(uniqueness > tol).all(axis=-1), Status.THETA_NOT_UNIQUE, np.argmin(uniqueness, axis=-1)),
-            (degenerate & ~(theta_sigma_rel > tol).all(axis=-1), Status.THETA_SIGMA_ZERO, np.argmin(theta_sigma_rel, axis=-1)),
-            (degenerate, Status.NORMAL_IN_CONTACT_PLANE, np.argmin(plane_sine, axis=-1)),
-        )
-        velocity = field_at(twist[..., None, :], points)
-        normal_velocity = dot(velocity, n)
-        alpha = dot(g.side, velocity[..., _J, :]) / (s * wm)
-        beta = g.side_len * normal_velocity / (s * mn)
-        theta = _line(points, w_unit)
-        # Round-off in v + omega x p scales with |v| + |omega||p|, not with the result.
-        slack = IN_PLANE_TOL * np.max(norm(twist[..., None, 3:]) + norm(twist[..., None, :3]) * norm(points), axis=-1)
-        in_planes = np.max(np.abs(normal_velocity), axis=-1) <= slack
-        theta_sigma = s * wm / g.side_len
-    status, culprit = _row_status(grasp_status, culprit, twist, (alpha, beta))
-    shape = status.shape
-    return TangentResult(
-        theta=_spread(theta, shape + (3, 6)),
-        sigma=_spread(g.sigma, shape + (3, 6)),
-        theta_sigma=_spread(theta_sigma, shape + (3,)),
-        alpha=_failed_to_nan(alpha, status),
-        beta=_failed_to_nan(beta, status),
-        normal_velocity=_failed_to_nan(normal_velocity, status),
-        in_tangent_planes=in_planes & (status == Status.OK),
-        status=status,
-        culprit=culprit,
-        conditioning=_spread(conditioning, shape),
-        points=_spread(points, shape + (3, 3)),
-        twist=_spread(twist, shape + (6,)),
-    )
+    inputs = {
+        "points": _checked(points, (3, 3), "points"),
+        "normals": _checked(normals, (3, 3), "normals"),
+        "twist": _checked(twist, (6,), "twist"),
+    }
+    out = _chunked(_tangent_rows, inputs, _TANGENT_OUT, tol)
+    return TangentResult(**out)
 
 
-def _contacts(points, tol) -> _Contacts:
-    """The contact triangle and its degeneracies.
+# --- the row kernels ----------------------------------------------------------
+# Arrays here are components-first: a point set is (contact, xyz, row), a
+# vector (xyz, row), a per-contact number (contact, row).
+
+_OFF_TANGENT_OUT = {
+    "sigma": (3, 6),
+    "psi": (3, 6),
+    "sigma_psi": (3,),
+    "x": (3,),
+    "y": (3,),
+    "status": (),
+    "culprit": (),
+    "conditioning": (),
+}
+_TANGENT_OUT = {
+    "theta": (3, 6),
+    "sigma": (3, 6),
+    "theta_sigma": (3,),
+    "alpha": (3,),
+    "beta": (3,),
+    "normal_velocity": (3,),
+    "in_tangent_planes": (),
+    "status": (),
+    "culprit": (),
+    "conditioning": (),
+}
+_DTYPES = {"status": np.int8, "culprit": np.int8, "in_tangent_planes": bool}
+_TRAILING = {"points": (3, 3), "normals": (3, 3), "wrist": (3,), "twist": (6,)}
+
+
+class _Triangle(NamedTuple):
+    """The contacts' triangle for a chunk of rows."""
+
+    side: np.ndarray  # (3, 3, n) U_i = p_k - p_j
+    side_len: np.ndarray  # (3, n)
+    unit_side: np.ndarray  # (3, 3, n) direction of Sigma_i
+    size: np.ndarray  # (n,) longest side
+    m: np.ndarray  # (3, n) (p_2 - p_1) x (p_3 - p_1)
+    m_len: np.ndarray  # (n,)
+    checks: list  # the failure checks of the triangle, in order
+
+
+def _triangle(p) -> _Triangle:
+    """Sides, area vector and the degeneracy checks of the contact triangle.
 
     Contacts coincide when the shortest side is ``<= tol`` times the longest;
     they are collinear when twice the area is ``<= tol`` times the longest
     side squared (a height ``<= tol`` times the size).
     """
-    side = points[..., _K, :] - points[..., _J, :]
-    with np.errstate(all="ignore"):
-        scale = np.max(np.abs(side), axis=(-2, -1))
-        side = side / scale[..., None, None]
-        side_len = norm(side)
-        size = np.max(side_len, axis=-1)
-        m = cross(side[..., 1, :], side[..., 2, :])
-        status = np.select(
-            [
-                ~np.isfinite(points).all(axis=(-2, -1)),
-                ~(np.min(side_len, axis=-1) > tol * size),
-                ~(norm(m) > tol * size * size),
-            ],
-            [Status.NONFINITE_INPUT, Status.COINCIDENT_CONTACTS, Status.COLLINEAR_CONTACTS],
-            Status.OK,
-        ).astype(np.int8)
-        # The pair that coincides is opposite the shortest side; the contact
-        # between the other two is opposite the longest.
-        culprit = np.select(
-            [status == Status.COINCIDENT_CONTACTS, status == Status.COLLINEAR_CONTACTS],
-            [np.argmin(side_len, axis=-1), np.argmax(side_len, axis=-1)],
-            -1,
-        ).astype(np.int8)
-        sigma = _line(points[..., _J, :], side / side_len[..., None])
-    return _Contacts(scale, side, side_len, size, m, sigma, status, culprit)
+    side = p[_K] - p[_J]
+    side_len = np.sqrt(_dot(side, side))
+    size = _max3(side_len)
+    unit_side = side / side_len[:, None]
+    # m from unit sides: no fourth powers of lengths, so no under- or overflow
+    m = _cross(unit_side[1], unit_side[2])
+    area_scale = side_len[1] * side_len[2]
+    m_len = np.sqrt(_dot(m, m)) * area_scale
+    m *= area_scale
+    finite = np.isfinite(p).all(axis=(0, 1))
+    checks = [
+        (lambda tol: ~finite, Status.NONFINITE_INPUT, None),
+        (lambda tol: ~np.isfinite(size * size), Status.OVERFLOW, None),
+        # the pair that coincides is opposite the shortest side
+        (lambda tol: ~(_min3(side_len) > tol * size), Status.COINCIDENT_CONTACTS, lambda rows: np.argmin(side_len[:, rows], 0)),
+        # the contact between the other two is opposite the longest side
+        (lambda tol: ~(m_len > tol * size * size), Status.COLLINEAR_CONTACTS, lambda rows: np.argmax(side_len[:, rows], 0)),
+    ]
+    return _Triangle(side, side_len, unit_side, size, m, m_len, checks)
 
 
-def _line(p, d):
-    """Unit lines ``(d; p x d)`` for unit directions ``d``: ``(..., 3) x2 -> (..., 6)``."""
-    return np.concatenate((d, cross(p, d)), axis=-1)
+def _velocity_rows(ins, out, tol):
+    out["velocity"][...] = _velocity(ins["twist"], ins["points"])
 
 
-def _rank_deficient(points, n, g: _Contacts, rows, tol):
-    """Whether the normal lines ``nu_i = (n_i; p_i x n_i)`` have rank < 3, tested
-    only in ``rows`` (False elsewhere) since it costs more than the rest.
+def _off_tangent_rows(ins, out, tol):
+    """Proposition 1 on one chunk (see the module docstring for the formulas)."""
+    p, c, t = ins["points"], ins["wrist"], ins["twist"]
+    tri = _triangle(p)
+    e = p - c  # E_i, (3, 3, n)
+    e_len = np.sqrt(_dot(e, e))
+    d = _dot(tri.m, e[0])  # D, the same for every i
+    le = tri.side_len * e_len
+    conditioning = np.abs(d) / (_max3(le) * tri.size)
+    v = _velocity(t, p)
+    x = tri.side_len * _dot(e, v) / d
+    y = e_len * _dot(tri.side, v[_J]) / d
+    e /= e_len[:, None]
+    _put_lines(out["sigma"], p[_J], tri.unit_side)
+    _put_lines(out["psi"], p, e)
+    out["sigma_psi"][...] = d / le
+    out["conditioning"][...] = conditioning
+    checks = tri.checks + [
+        (lambda tol: ~np.isfinite(c).all(axis=0), Status.NONFINITE_INPUT, None),
+        (lambda tol: ~(conditioning > tol), Status.WRIST_COPLANAR, None),
+    ]
+    _settle(out, checks, t, tol, x=x, y=y)
 
-    Gram-Schmidt on the three 6-vectors, taken about ``p_1`` in units of
-    ``s``: the product of the orthogonalised lengths over the original ones
-    is in ``[0, 1]`` and accurate to round-off even near 0.
+
+def _tangent_rows(ins, out, tol):
+    """Proposition 2 and the off-plane rest on one chunk (formulas in the module docstring)."""
+    p, t = ins["points"], ins["twist"]
+    tri = _triangle(p)
+    n_len = np.sqrt(_dot(ins["normals"], ins["normals"]))
+    n = ins["normals"] / n_len[:, None]
+    # eqs. 21-22 with p_i p_j along U_k and p_i p_k along -U_j; unit sides keep
+    # |w| free of the grasp's size (no underflow) and |a|, |b| sines
+    a = _cross(tri.unit_side[_K], n[_J])
+    b = _cross(n[_K], tri.unit_side[_J])
+    w = _cross(a, b)
+    w_len = np.sqrt(_dot(w, w))
+    w /= w_len[:, None]
+    wm = _dot(w, tri.m)
+    mn = _dot(tri.m, n)
+    plane_sine = np.abs(mn) / tri.m_len
+    theta_sigma = np.abs(wm) / (tri.side_len * tri.size)
+    conditioning = np.minimum(_min3(theta_sigma), _min3(plane_sine))
+    v = _velocity(t, p)
+    nv = _dot(v, n)
+    alpha = _dot(tri.side, v[_J]) / wm
+    beta = tri.side_len * nv / mn
+    _put_lines(out["theta"], p, w)
+    _put_lines(out["sigma"], p[_J], tri.unit_side)
+    out["theta_sigma"][...] = wm / tri.side_len
+    out["normal_velocity"][...] = nv
+    out["conditioning"][...] = conditioning
+    # Round-off in v + omega x p scales with |v| + |omega||p|, not with the result.
+    reach = np.sqrt(_dot(t[3:], t[3:])) + np.sqrt(_dot(t[:3], t[:3])) * np.sqrt(_dot(p, p))
+    out["in_tangent_planes"][...] = _max3(np.abs(nv)) <= IN_PLANE_TOL * _max3(reach)
+
+    def uniqueness(rows):
+        """Sines that vanish when eq. 22's two constraints do not fix one axis."""
+        a_len, b_len = np.sqrt(_dot(a[..., rows], a[..., rows])), np.sqrt(_dot(b[..., rows], b[..., rows]))
+        return np.minimum(np.minimum(a_len, b_len), w_len[:, rows] / (a_len * b_len))
+
+    degenerate = ~(conditioning > tol)
+    checks = tri.checks + [
+        (lambda tol: ~np.isfinite(ins["normals"]).all(axis=(0, 1)), Status.NONFINITE_INPUT, None),
+        (lambda tol: ~(n_len > 0).all(axis=0), Status.ZERO_NORMAL, lambda rows: np.argmin(n_len[:, rows], 0)),
+        (_subset(degenerate, lambda rows: _rank_deficient(p[..., rows], n[..., rows], tri.size[rows], tol)), Status.NORMALS_RANK_DEFICIENT, None),
+        (_subset(degenerate, lambda rows: ~(uniqueness(rows) > tol).all(axis=0)), Status.THETA_NOT_UNIQUE, lambda rows: np.argmin(uniqueness(rows), 0)),
+        (_subset(degenerate, lambda rows: ~(theta_sigma[:, rows] > tol).all(axis=0)), Status.THETA_SIGMA_ZERO, lambda rows: np.argmin(theta_sigma[:, rows], 0)),
+        (lambda tol: degenerate, Status.NORMAL_IN_CONTACT_PLANE, lambda rows: np.argmin(plane_sine[:, rows], 0)),
+    ]
+    _settle(out, checks, t, tol, alpha=alpha, beta=beta, normal_velocity=nv)
+
+
+def _subset(candidates, test):
+    """A check that runs ``test`` only on the candidate rows (it costs more than the rest)."""
+
+    def mask(tol):
+        hit = np.zeros(candidates.shape, dtype=bool)
+        rows = np.flatnonzero(candidates)
+        if rows.size:
+            hit[rows] = test(rows)
+        return hit
+
+    return mask
+
+
+def _rank_deficient(p, n, size, tol):
+    """Whether the normal lines ``nu_i = (n_i; p_i x n_i)`` have rank < 3.
+
+    Gram-Schmidt on the three 6-vectors, taken about ``p_1`` in units of the
+    size: the product of the orthogonalised lengths over the original ones is
+    in ``[0, 1]`` and accurate to round-off even near 0.
     """
-    out = np.zeros(rows.shape, dtype=bool)
-    if not rows.any():
-        return out
-    shape = rows.shape
-    q = np.broadcast_to((points - points[..., :1, :]) / g.scale[..., None, None], shape + (3, 3))[rows]
-    nu = _line(q, np.broadcast_to(n, shape + (3, 3))[rows])
-    r1, r2, r3 = nu[..., 0, :], nu[..., 1, :], nu[..., 2, :]
-    u1 = r1 / _len6(r1)[..., None]
-    r2o = r2 - _dot6(r2, u1)[..., None] * u1
-    u2 = r2o / _len6(r2o)[..., None]
-    r3o = r3 - _dot6(r3, u1)[..., None] * u1 - _dot6(r3, u2)[..., None] * u2
-    out[rows] = ~(_len6(r2o) * _len6(r3o) / (_len6(r2) * _len6(r3)) > tol)
+    nu = np.concatenate((n, _cross((p - p[0]) / size, n)), axis=1)  # (contact, 6, rows)
+    r1, r2, r3 = nu
+    u1 = r1 / np.sqrt((r1 * r1).sum(0))
+    r2o = r2 - (r2 * u1).sum(0) * u1
+    u2 = r2o / np.sqrt((r2o * r2o).sum(0))
+    r3o = r3 - (r3 * u1).sum(0) * u1 - (r3 * u2).sum(0) * u2
+    volume = np.sqrt((r2o * r2o).sum(0) * (r3o * r3o).sum(0) / ((r2 * r2).sum(0) * (r3 * r3).sum(0)))
+    return ~(volume > tol)
+
+
+def _settle(out, checks, twist, tol, **amplitudes):
+    """Status and culprit per row from the checks in order (first failure wins),
+    then a non-finite twist, then overflow; amplitudes of failed rows become NaN."""
+    n = twist.shape[-1]
+    status = out["status"]
+    culprit = out["culprit"]
+    status[...] = Status.OK
+    culprit[...] = -1
+    checks = checks + [(lambda tol: ~np.isfinite(twist).all(axis=0), Status.NONFINITE_INPUT, None)]
+    for mask, code, blame in checks:
+        rows = np.flatnonzero(mask(tol) & (status == Status.OK))
+        if rows.size:
+            status[rows] = code
+            if blame is not None:
+                culprit[rows] = blame(rows)
+    finite = np.ones(n, dtype=bool)
+    for a in amplitudes.values():
+        finite &= np.isfinite(a).all(axis=0)
+    status[(status == Status.OK) & ~finite] = Status.OVERFLOW
+    failed = status != Status.OK
+    for name, a in amplitudes.items():
+        a[:, failed] = np.nan
+        out[name][...] = a
+
+
+def _chunked(rows_kernel, inputs, spec, tol):
+    """Run ``rows_kernel`` over the broadcast batch in cache-sized chunks.
+
+    Inputs are flattened to ``(N, ...)``; each chunk is handed to the kernel
+    components-first and the kernel writes into components-first outputs,
+    which come back as ``(batch..., ...)`` views.  The broadcast inputs
+    ``points`` and ``twist`` are returned too.
+    """
+    shape = np.broadcast_shapes(*(a.shape[: a.ndim - len(_TRAILING[k])] for k, a in inputs.items()))
+    n = prod(shape)
+    full = {k: np.broadcast_to(a, shape + _TRAILING[k]) for k, a in inputs.items()}
+    flat = {k: a.reshape((n,) + _TRAILING[k]) for k, a in full.items()}
+    out = {k: np.empty(comp + (n,), dtype=_DTYPES.get(k, float)) for k, comp in spec.items()}
+    with np.errstate(all="ignore"):
+        for start in range(0, n, CHUNK):
+            part = slice(start, min(start + CHUNK, n))
+            rows_kernel(
+                {k: np.ascontiguousarray(np.moveaxis(a[part], 0, -1)) for k, a in flat.items()},
+                {k: o[..., part] for k, o in out.items()},
+                tol,
+            )
+    result = {k: np.moveaxis(o, -1, 0).reshape(shape + spec[k]) for k, o in out.items()}
+    result.update(points=full["points"], twist=full["twist"])
+    return result
+
+
+# --- components-first vector algebra ------------------------------------------
+
+
+def _dot(a, b):
+    """Dot product over axis -2 of ``(..., 3, n)`` arrays."""
+    return a[..., 0, :] * b[..., 0, :] + a[..., 1, :] * b[..., 1, :] + a[..., 2, :] * b[..., 2, :]
+
+
+def _cross(a, b):
+    """Cross product over axis -2 of ``(..., 3, n)`` arrays."""
+    out = np.empty(np.broadcast_shapes(a.shape, b.shape))
+    a0, a1, a2 = a[..., 0, :], a[..., 1, :], a[..., 2, :]
+    b0, b1, b2 = b[..., 0, :], b[..., 1, :], b[..., 2, :]
+    np.multiply(a1, b2, out=out[..., 0, :])
+    out[..., 0, :] -= a2 * b1
+    np.multiply(a2, b0, out=out[..., 1, :])
+    out[..., 1, :] -= a0 * b2
+    np.multiply(a0, b1, out=out[..., 2, :])
+    out[..., 2, :] -= a1 * b0
     return out
 
 
-def _dot6(a, b):
-    return dot(a[..., :3], b[..., :3]) + dot(a[..., 3:], b[..., 3:])
+def _velocity(t, p):
+    """``T(p_i) = v + omega x p_i`` for ``t (6, n)``, ``p (3, 3, n)``."""
+    v = _cross(t[:3], p)
+    v += t[3:]
+    return v
 
 
-def _len6(a):
-    return np.sqrt(_dot6(a, a))
+def _put_lines(out, p, d):
+    """Write unit lines ``(d; p x d)`` into ``out (3, 6, n)``."""
+    out[:, :3] = d
+    out[:, 3:] = _cross(p, d)
 
 
-def _first_failure(g: _Contacts, *checks):
-    """Status and culprit of each grasp: the triangle's own, else the first
-    failing ``(mask, status, culprit)`` check, in order."""
-    masks = [g.status != Status.OK] + [m for m, _, _ in checks]
-    shape = np.broadcast_shapes(*(np.shape(m) for m in masks))
-    status = np.select(masks, [g.status] + [s for _, s, _ in checks], Status.OK)
-    culprit = np.select(masks, [g.culprit] + [c for _, _, c in checks], -1)
-    return np.broadcast_to(status, shape).astype(np.int8), np.broadcast_to(culprit, shape).astype(np.int8)
+def _max3(a):
+    return np.maximum(np.maximum(a[0], a[1]), a[2])
 
 
-def _row_status(grasp_status, culprit, twist, outputs):
-    """Per-(grasp, twist) status: the grasp's, a non-finite twist, or an
-    overflow that left a non-finite number in an otherwise good row."""
-    twist_bad = ~np.isfinite(twist).all(axis=-1)
-    shape = np.broadcast_shapes(grasp_status.shape, twist_bad.shape)
-    status = np.where((grasp_status == Status.OK) & twist_bad, Status.NONFINITE_INPUT, grasp_status)
-    finite = np.ones(shape, dtype=bool)
-    for out in outputs:
-        finite &= np.isfinite(out).all(axis=-1)
-    status = np.where((status == Status.OK) & ~finite, Status.OVERFLOW, status)
-    culprit = np.where(status == grasp_status, culprit, -1)
-    return np.broadcast_to(status, shape).astype(np.int8), np.broadcast_to(culprit, shape).astype(np.int8)
-
-
-def _failed_to_nan(a, status):
-    """A copy of ``a`` with NaN in the rows whose status is not OK."""
-    bad = status != Status.OK
-    return np.where(bad.reshape(bad.shape + (1,) * (np.ndim(a) - bad.ndim)), np.nan, a)
-
-
-def _spread(a, shape):
-    """Broadcast a per-grasp array to the full (grasp, twist) batch shape (a view)."""
-    return np.broadcast_to(a, shape)
+def _min3(a):
+    return np.minimum(np.minimum(a[0], a[1]), a[2])
 
 
 def _checked(a, trailing, name):
