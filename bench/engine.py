@@ -1,0 +1,99 @@
+"""Engine speed: the public API against batched numpy.linalg.solve and a Python loop.
+
+Run: ``python bench/engine.py [--n 1000000]``.  All three compute the same
+things on the same grasps in this one process: both decompositions and the
+contact velocities.  The baseline builds the same basis screws with plain
+numpy (NOTES.md's definitions) and solves the 6x6 systems with
+``numpy.linalg.solve``; the loop calls the public API once per grasp on a
+sample and is scaled to ``n``.  Peak memory is that of a fresh process
+running the engine part alone.
+"""
+
+import argparse
+import resource
+import subprocess
+import sys
+import time
+
+import numpy as np
+
+import grasptwist as gt
+from _data import grasp_arrays
+
+
+def engine(points, normals, wrist, twist):
+    off = gt.decompose_off_tangent(points, wrist, twist)
+    tan = gt.decompose_tangent(points, normals, twist)
+    return off, tan, gt.contact_velocities(points, twist)
+
+
+def baseline(points, normals, wrist, twist):
+    """The same three computations: bases by NOTES.md, amplitudes by numpy.linalg.solve."""
+    p = points
+    n = normals / np.linalg.norm(normals, axis=-1, keepdims=True)
+
+    def line(a, d):
+        d = d / np.linalg.norm(d, axis=-1, keepdims=True)
+        return np.concatenate([d, np.cross(a, d)], axis=-1)
+
+    j, k = [1, 2, 0], [2, 0, 1]
+    sigma = line(p[:, j], p[:, k] - p[:, j])
+    psi = line(p, p - wrist[:, None, :])
+    theta = line(p, np.cross(np.cross(n[:, j], p[:, j] - p), np.cross(n[:, k], p[:, k] - p)))
+    rhs = twist[..., None]
+    xy = np.linalg.solve(np.concatenate([sigma, psi], axis=1).transpose(0, 2, 1), rhs)[..., 0]
+    ab = np.linalg.solve(np.concatenate([theta, sigma], axis=1).transpose(0, 2, 1), rhs)[..., 0]
+    velocity = twist[:, None, 3:] + np.cross(twist[:, None, :3], p)
+    return xy, ab, velocity
+
+
+def best_of(repeats, fn, *args):
+    times = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        out = fn(*args)
+        times.append(time.perf_counter() - t0)
+    return min(times), out
+
+
+def peak_memory_mib(n):
+    """Peak resident memory of a fresh process that builds the data and runs the engine once."""
+    subprocess.run([sys.executable, __file__, "--child", str(n)], check=True)
+    return resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss / 1024
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--n", type=int, default=1_000_000, help="grasps (default 10^6)")
+    ap.add_argument("--loop", type=int, default=2000, help="grasps in the Python-loop sample")
+    ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--child", type=int, help=argparse.SUPPRESS)
+    args = ap.parse_args()
+    if args.child:
+        engine(*grasp_arrays(args.child))
+        return
+    peak = peak_memory_mib(args.n)  # first: a child forked from a large parent inherits its peak
+    data = grasp_arrays(args.n)
+    t_engine, (off, tan, vel) = best_of(args.repeats, engine, *data)
+    t_solve, (xy, ab, vel_b) = best_of(max(1, args.repeats - 1), baseline, *data)
+    sample = [a[: args.loop] for a in data]
+    t0 = time.perf_counter()
+    for row in zip(*sample):
+        engine(*row)
+    t_loop = (time.perf_counter() - t0) * args.n / args.loop
+
+    ok = off.ok & tan.ok & (off.conditioning > gt.CONDITION_WARNING) & (tan.conditioning > gt.CONDITION_WARNING)
+    agree = max(
+        np.max(np.abs(np.c_[off.x, off.y][ok] - xy[ok])),
+        np.max(np.abs(np.c_[tan.alpha, tan.beta][ok] - ab[ok])),
+        np.max(np.abs(vel - vel_b)),
+    )
+    print(f"grasps: {args.n:,} ({ok.mean():.1%} well-conditioned for both methods; max |difference| there {agree:.1e})")
+    print(f"{'engine (public API)':32s} {t_engine:8.3f} s")
+    print(f"{'batched numpy.linalg.solve':32s} {t_solve:8.3f} s   engine is {t_solve / t_engine:6.1f}x faster (target >= 4)")
+    print(f"{'Python loop (from %d grasps)' % args.loop:32s} {t_loop:8.1f} s   engine is {t_loop / t_engine:6.0f}x faster (target >= 300)")
+    print(f"{'peak memory, engine process':32s} {peak:8.0f} MiB (target < 2048)")
+
+
+if __name__ == "__main__":
+    main()
