@@ -371,6 +371,21 @@ def test_names_are_taken_as_written(name, loader):
     assert grasp.name == grasp.contact_names[0] == name.strip("'")
 
 
+@pytest.mark.parametrize(
+    "quoted, char",
+    [('"a\\nb"', "U+000A"), ('"\\e[2J\\e[31mred"', "U+001B"), ('"nul\\0"', "U+0000"), ('"a\\tb"', "U+0009"),
+     ('"next\\Nline"', "U+0085"), ('"a\\Lb"', "U+2028"), ('"a\\Pb"', "U+2029")],
+    ids=["newline", "escape", "nul", "tab", "nel", "line-separator", "paragraph-separator"],
+)  # fmt: skip
+def test_names_that_would_break_a_diagnostic_line_or_drive_a_terminal(quoted, char, loader):
+    # The file holds only printable characters; YAML's double-quoted escapes make the controls.
+    for text in (f"name: {quoted}\n" + CONTACTS, f"units: {quoted}\n" + CONTACTS,
+                 CONTACTS.replace("- point: [1", f"- name: {quoted}\n    point: [1")):  # fmt: skip
+        error = only_error(text)
+        assert error.code == "invalid-name" and error.message.endswith(f"without control characters (found {char})")
+    assert only_grasp('name: "caf\u00e9 \u2013 \U0001F91D"\n' + CONTACTS).name == "caf\u00e9 \u2013 \U0001F91D"
+
+
 def test_core_tags_are_allowed(loader):
     text = "!!map\nname: !!str x\nwrist: !!seq [!!float 0, !!int 0, ! 1]\n" + CONTACTS
     assert only_error(text).message == "wrist[2]: expected a number, got the string '1'"

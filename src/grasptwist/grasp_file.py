@@ -767,9 +767,25 @@ def _name(node, path):
     """
     if node.kind != "scalar" or node.value is None:
         raise _Reject("not-a-string", path, f"expected a name, got {_describe(node)}", **_at(node))
-    if not node.text.strip() or "\n" in node.text or "\r" in node.text:
+    if not node.text.strip():
         raise _Reject("invalid-name", path, "must be a non-empty single line", **_at(node))
+    bad = _NOT_IN_A_NAME.search(node.text)
+    if bad:
+        raise _Reject(
+            "invalid-name",
+            path,
+            f"must be a non-empty single line without control characters (found U+{ord(bad.group()):04X})",
+            **_at(node),
+        )
     return node.text
+
+
+# Names are echoed into one-line diagnostics and terminal tables, so none of
+# the characters that break a line or drive a terminal: C0 and C1 controls
+# (newline, ESC, NUL, NEL ...), which double-quoted escapes such as "\e[2J"
+# or "\0" can produce although the file itself holds none, and the Unicode
+# line and paragraph separators.
+_NOT_IN_A_NAME = re.compile("[\x00-\x1f\x7f-\x9f\u2028\u2029]")
 
 
 def _vector(node, length, path):
