@@ -354,15 +354,27 @@ def test_yaml_12_core_numbers(text, value, loader):
         ("!!str 1", "not-a-number", "expected a number, got the string '1'"),
         ("!!int abc", "not-a-number", "'abc' is not a valid !!int"),
         ("!!bool 1", "bad-scalar", "'1' is not a valid !!bool"),
-        (".NaN", "non-finite", "expected a finite number, got nan"),
-        ("+.inf", "non-finite", "expected a finite number, got inf"),
-        ("1" * 400, "non-finite", "expected a finite number, got " + "1" * 400),
+        (".NaN", "non-finite", "expected a finite number, got .NaN"),
+        ("+.inf", "non-finite", "expected a finite number, got +.inf"),
+        ("1" * 400, "non-finite", "expected a finite number, got " + "1" * 27 + "..."),
+        # beyond Python's 4300-digit limit of int(str) and str(int)
+        ("-" + "9" * 5000, "non-finite", "expected a finite number, got -" + "9" * 26 + "..."),
+        ("0x" + "f" * 5000, "non-finite", "expected a finite number, got 0x" + "f" * 25 + "..."),
         ("[1]", "not-a-number", "expected a number, got a list"),
     ],
 )
 def test_non_numbers(text, code, problem, loader):
     error = only_error(f"wrist: [0, {text}, 0]\n" + CONTACTS)
     assert (error.code, error.message, error.line, error.column) == (code, "wrist[1]: " + problem, 1, 12)
+
+
+def test_integers_of_any_length_anywhere_give_an_error_not_an_exception(loader):
+    # int() and str() of more than 4300 decimal digits raise ValueError in Python 3.11+.
+    long = "7" * 5000
+    assert only_error(f"? {long}\n: x\n" + CONTACTS).message == f"top level: keys must be strings, got the number {long[:27]}..."
+    assert only_error(f"contacts: 0x{long}\n").message == f"contacts: expected a list, got the number 0x{long[:25]}..."
+    assert only_grasp(f"name: {long}\n" + CONTACTS).name == long  # a label, as written
+    assert only_grasp(f"wrist: [0, {'0' * 5000}1, 0o{'0' * 5000}7]\n" + CONTACTS).wrist.tolist() == [0, 1, 7]
 
 
 @pytest.mark.parametrize("name", ["1", "1e3", "true", "0x1F", "yes", "a b", "'quoted: yes'"])

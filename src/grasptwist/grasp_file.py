@@ -376,17 +376,35 @@ def _resolve_plain(text):
         if match:
             kind = match.lastgroup
             if kind == "int":
-                return int(text)
+                return _integer(text.lstrip("+-"), 10, text[0] == "-")
             if kind == "float":
                 return float(text)
             if kind == "oct":
-                return int(match["oct"], 8)
+                return _integer(match["oct"], 8)
             if kind == "hex":
-                return int(match["hex"], 16)
+                return _integer(match["hex"], 16)
             if kind == "nan":
                 return math.nan
             return -math.inf if match["inf"] == "-" else math.inf
     return _PLAIN_WORDS.get(text, text)
+
+
+# Bits beyond which an integer is far outside the float range (2**1024).
+_INTEGER_BITS = 1100
+
+
+def _integer(digits, base, negative=False):
+    """An integer literal's value; ``+-inf`` when it is far beyond the float range.
+
+    Such a value can only be refused as ``non-finite``, and Python (3.11+)
+    refuses to convert more than 4300 decimal digits to or from ``int``, so
+    a long literal anywhere in a file would otherwise raise ``ValueError``.
+    """
+    significant = digits.lstrip("0")
+    if len(significant) * math.log2(base) > _INTEGER_BITS:
+        return -math.inf if negative else math.inf
+    value = int(significant or "0", base)
+    return -value if negative else value
 
 
 # Core scalar tags: the Python types the tagged text must resolve to.
@@ -722,9 +740,13 @@ def _describe(node):
     if isinstance(value, bool):
         return f"a boolean ({str(value).lower()})"
     if isinstance(value, (int, float)):
-        return f"the number {value}"
-    shown = value if len(value) <= 30 else value[:27] + "..."
-    return f"the string {shown!r}"
+        return f"the number {_shorten(node.text)}"
+    return f"the string {_shorten(value)!r}"
+
+
+def _shorten(text):
+    """``text`` cut to 30 characters for a message (a long number or string stays one short line)."""
+    return text if len(text) <= 30 else text[:27] + "..."
 
 
 def _mapping(node, path, keys, required):
@@ -807,7 +829,7 @@ def _number(node, path):
     except OverflowError:  # an integer beyond the float range
         value = math.inf
     if not math.isfinite(value):
-        raise _Reject("non-finite", path, f"expected a finite number, got {node.value}", **_at(node))
+        raise _Reject("non-finite", path, f"expected a finite number, got {_shorten(node.text)}", **_at(node))
     return value
 
 
