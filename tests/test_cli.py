@@ -196,14 +196,14 @@ def test_output_file_is_written_whole_or_not_at_all(files, monkeypatch):
     assert not out.exists()
     calls = []
 
-    def explode(res, order):
+    def explode(rec):
         calls.append(1)
         if len(calls) == 2:
             raise RuntimeError("disk on fire")
-        return real(res, order)
+        return real(rec)
 
-    real = report.record
-    monkeypatch.setattr(report, "record", explode)
+    real = report.ENCODERS["json"]
+    monkeypatch.setitem(report.ENCODERS, "json", explode)
     r = run("resolve", files / "poly.yaml", "--json", "-o", out)
     assert r.exit_code == 1 and "internal error: RuntimeError: disk on fire" in r.stderr
     assert "Traceback" not in r.output

@@ -1,15 +1,15 @@
-"""Run the engine over a stream of loaded grasps, many rows per call.
+"""Run the engine over many (grasp, twist) rows at once.
 
-Front ends hand this module grasps (and loader errors) in file order; it
-pairs every grasp with its twists, stacks the rows of many grasps into one
-array per input, calls the engine once per chunk and hands back one
-:class:`Resolution` per (grasp, twist), or the error in its place, in the
-order the grasps came.  No math here: only stacking and slicing.
+Front ends hand this module loaded grasps (and loader errors) in file order,
+or the arrays of a data set; it stacks the rows into blocks, calls the
+engine once per block and hands back :class:`Block` objects (columns of
+results for consecutive rows) with the errors in their places.  No math
+here: only stacking and slicing.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Iterable, Iterator, Sequence
 
 import numpy as np
@@ -23,7 +23,7 @@ from .decompose import (
 )
 from .grasp_file import Grasp, GraspFileError, Twist
 
-__all__ = ["METHODS", "Resolution", "resolve", "NO_TWIST", "ZERO_TWIST"]
+__all__ = ["METHODS", "Block", "resolve", "resolve_arrays", "NO_TWIST", "ZERO_TWIST", "CONTACT_NAMES"]
 
 METHODS = ("both", "off-tangent", "tangent")
 
@@ -33,26 +33,83 @@ NO_TWIST = "no-twist"
 #: The twist whose resolution carries just the bases (``basis`` and ``check``).
 ZERO_TWIST = Twist(name="0", screw=np.zeros(6), line=None)
 
+#: Contact names of a grasp that does not name its contacts.
+CONTACT_NAMES = ("1", "2", "3")
+
 
 @dataclass(frozen=True)
-class Resolution:
-    """One (grasp, twist) row: each method's result for that row, or None.
+class Block:
+    """Consecutive (grasp, twist) rows with every method's results, as columns.
 
-    ``off_tangent`` is None when the method was not asked for or the grasp
-    has no wrist (see ``off_tangent_skipped``).
+    Per-row labels are lists; ``points`` ... ``velocity`` are arrays over
+    the rows.  ``off_tangent`` is None when the method was not asked for;
+    rows without a wrist (``has_wrist`` False) carry the status
+    ``nonfinite-input`` there and are reported as skipped.
     """
 
-    grasp: Grasp
-    twist: Twist
-    velocity: np.ndarray  # (3, 3)
+    file: list
+    grasp: list
+    units: list
+    twist_name: list
+    contact_names: list
+    points: np.ndarray  # (n, 3, 3)
+    normals: np.ndarray  # (n, 3, 3) unit
+    twist: np.ndarray  # (n, 6)
+    has_wrist: np.ndarray  # (n,) bool
+    velocity: np.ndarray  # (n, 3, 3)
     off_tangent: OffTangentResult | None
     tangent: TangentResult | None
     method: str
 
-    @property
-    def off_tangent_skipped(self) -> bool:
-        """The off-tangent method was asked for but the grasp has no wrist."""
-        return self.method != "tangent" and self.grasp.wrist is None
+    def __len__(self) -> int:
+        return len(self.grasp)
+
+    def part(self, start: int, stop: int) -> "Block":
+        """Rows ``start:stop`` as a block of their own (views, no copies)."""
+        s = slice(start, stop)
+        cut = {f: getattr(self, f)[s] for f in ("file", "grasp", "units", "twist_name", "contact_names", "points", "normals", "twist", "has_wrist", "velocity")}
+        return replace(self, **cut, off_tangent=_part(self.off_tangent, s), tangent=_part(self.tangent, s))
+
+
+def _part(result, s):
+    return None if result is None else result.row(s)
+
+
+def resolve_arrays(points, normals, wrist, twist, method="both", *, file="", grasp=None, twist_name=None, units=None) -> Block:
+    """One block from arrays of rows (a data set, or stacked grasps).
+
+    ``wrist`` may be None (no row has one) or hold NaN rows for grasps
+    without one; ``grasp`` and ``twist_name`` are per-row labels
+    (default: the row index and ``"0"``).  ``normals`` should be unit
+    already (records show them as given).
+    """
+    if method not in METHODS:
+        raise ValueError(f"method must be one of {METHODS}, got {method!r}")
+    n = len(points)
+    has_wrist = np.zeros(n, bool) if wrist is None else np.isfinite(wrist).all(axis=-1)
+    off = tan = None
+    if method != "off-tangent":
+        tan = decompose_tangent(points, normals, twist)
+    if method != "tangent":
+        off = decompose_off_tangent(points, np.full((n, 3), np.nan) if wrist is None else wrist, twist)
+    for r in (off, tan):
+        if r is not None:
+            r.residual  # once for the whole block; rows share it
+    return Block(
+        file=file if isinstance(file, list) else [file] * n,
+        grasp=grasp if grasp is not None else [str(i) for i in range(n)],
+        units=units if isinstance(units, list) else [units] * n,
+        twist_name=twist_name if twist_name is not None else ["0"] * n,
+        contact_names=[CONTACT_NAMES] * n,
+        points=points,
+        normals=normals,
+        twist=twist,
+        has_wrist=has_wrist,
+        velocity=contact_velocities(points, twist),
+        off_tangent=off,
+        tangent=tan,
+        method=method,
+    )
 
 
 def resolve(
@@ -60,7 +117,7 @@ def resolve(
     twists: Sequence[Twist] | None = None,
     method: str = "both",
     chunk: int = 2048,
-) -> Iterator[Resolution | GraspFileError]:
+) -> Iterator[Block | GraspFileError]:
     """Resolve every grasp against its twists, in order.
 
     Parameters
@@ -72,11 +129,9 @@ def resolve(
 
     Yields
     ------
-    Resolution per (grasp, twist); a loader's GraspFileError as it came; a
-    GraspFileError with code :data:`NO_TWIST` for a grasp with no twist.
+    Blocks of consecutive rows and, in their places, the loader's errors and
+    an error with code :data:`NO_TWIST` for each grasp without a twist.
     """
-    if method not in METHODS:
-        raise ValueError(f"method must be one of {METHODS}, got {method!r}")
     pending: list[Grasp | GraspFileError] = []
     rows = 0
     for item in items:
@@ -90,50 +145,37 @@ def resolve(
 
 
 def _flush(pending, twists, method):
-    jobs = []  # (grasp, twist) in order
+    jobs = [(g, t) for g in pending if isinstance(g, Grasp) for t in (twists if twists is not None else g.twists)]
+    block = _stack(jobs, method) if jobs else None
+    start = row = 0
     for item in pending:
-        if isinstance(item, Grasp):
-            for twist in twists if twists is not None else item.twists:
-                jobs.append((item, twist))
-    results = _run(jobs, method) if jobs else None
-    row = 0
-    for item in pending:
-        if not isinstance(item, Grasp):
-            yield item
+        own = () if not isinstance(item, Grasp) else twists if twists is not None else item.twists
+        if own:
+            row += len(own)
             continue
-        own = twists if twists is not None else item.twists
-        if not own:
-            yield _no_twist(item)
-        for twist in own:
-            yield _resolution(item, twist, method, results, row)
-            row += 1
+        if row > start:
+            yield block.part(start, row)
+        start = row
+        yield item if not isinstance(item, Grasp) else _no_twist(item)
+    if block is not None and row > start:
+        yield block.part(start, row) if start else block
 
 
-def _run(jobs, method):
-    """The engine on all rows at once; the off-tangent method on rows with a wrist only."""
-    points = np.stack([g.points for g, _ in jobs])
-    normals = np.stack([g.normals for g, _ in jobs])
-    screws = np.stack([t.screw for _, t in jobs])
-    out = {"velocity": contact_velocities(points, screws)}
-    if method != "off-tangent":
-        out["tangent"] = decompose_tangent(points, normals, screws)
-        out["tangent"].residual  # once for the whole chunk; rows share it
-    if method != "tangent":
-        with_wrist = np.array([g.wrist is not None for g, _ in jobs])
-        if with_wrist.any():
-            wrists = np.stack([g.wrist for g, _ in jobs if g.wrist is not None])
-            out["off_tangent"] = decompose_off_tangent(points[with_wrist], wrists, screws[with_wrist])
-            out["off_tangent"].residual
-            out["off_row"] = np.cumsum(with_wrist) - 1
-    return out
-
-
-def _resolution(grasp, twist, method, results, row):
-    off = None
-    if "off_tangent" in results and grasp.wrist is not None:
-        off = results["off_tangent"].row(results["off_row"][row])
-    tan = results["tangent"].row(row) if "tangent" in results else None
-    return Resolution(grasp, twist, results["velocity"][row], off, tan, method)
+def _stack(jobs, method) -> Block:
+    grasps = [g for g, _ in jobs]
+    nan = np.full(3, np.nan)
+    block = resolve_arrays(
+        np.stack([g.points for g in grasps]),
+        np.stack([g.normals for g in grasps]),
+        None if all(g.wrist is None for g in grasps) else np.stack([nan if g.wrist is None else g.wrist for g in grasps]),
+        np.stack([t.screw for _, t in jobs]),
+        method,
+        file=[g.file for g in grasps],
+        grasp=[g.name for g in grasps],
+        twist_name=[t.name for _, t in jobs],
+        units=[g.units for g in grasps],
+    )
+    return replace(block, contact_names=[g.contact_names for g in grasps])
 
 
 def _no_twist(grasp: Grasp) -> GraspFileError:

@@ -32,6 +32,19 @@ app = typer.Typer(
 )
 
 
+def _version(value: bool) -> None:
+    if value:
+        sys.stdout.write(f"grasptwist {__version__}\n")
+        raise typer.Exit(EXIT_OK)
+
+
+@app.callback()
+def _root(
+    version: bool = typer.Option(False, "--version", callback=_version, is_eager=True, help="Print the version and exit."),
+) -> None:
+    """Resolve a desired object twist into finger-tip twists for a three-fingered grasp (screw theory)."""
+
+
 class Method(str, Enum):
     both = "both"
     off_tangent = "off-tangent"
@@ -43,6 +56,12 @@ class Format(str, Enum):
     json = "json"
     jsonl = "jsonl"
     csv = "csv"
+    npz = "npz"
+
+
+class ExtraPoint(str, Enum):
+    wrist = "wrist"
+    at = "at"
 
 
 class Order(str, Enum):
@@ -77,8 +96,8 @@ def _cli_twists(texts: list[str] | None, at: str | None):
     return twists
 
 
-class _Diagnostics:
-    """One line per problem on stderr, counted; a progress bar on a terminal."""
+class _Stderr:
+    """Diagnostics on stderr: one line each, counted; colour only on a terminal."""
 
     def __init__(self, quiet: bool = False):
         self.failed = 0
@@ -86,21 +105,24 @@ class _Diagnostics:
         self.quiet = quiet
         self.color = sys.stderr.isatty() and "NO_COLOR" not in os.environ
 
-    def error(self, where: str, message: str) -> None:
-        label = "\x1b[31merror\x1b[0m" if self.color else "error"
-        sys.stderr.write(f"{where}: {label}: {message}\n")
-
-    def warning(self, where: str, message: str) -> None:
+    def take(self, out) -> None:
+        """Count a pipeline Output and print its lines."""
+        self.records += out.records
+        self.failed += out.failed
+        for line in out.errors:
+            self._line(line, ": error: ", "31")
         if not self.quiet:
-            label = "\x1b[33mwarning\x1b[0m" if self.color else "warning"
-            sys.stderr.write(f"{where}: {label}: {message}\n")
+            for line in out.warnings:
+                self._line(line, ": warning: ", "33")
+
+    def _line(self, line: str, label: str, colour: str) -> None:
+        if self.color:
+            line = line.replace(label, f": \x1b[{colour}m{label[2:-2]}\x1b[0m: ", 1)
+        sys.stderr.write(line + "\n")
 
     def summary(self) -> None:
-        sys.stderr.write(f"{self.records} records, {self.failed} failed\n")
-
-
-def _where(file, line=None, column=None) -> str:
-    return ":".join(str(x) for x in (file, line, column) if x is not None)
+        if not self.quiet:
+            sys.stderr.write(f"{self.records} records, {self.failed} failed\n")
 
 
 @contextmanager
@@ -113,7 +135,7 @@ def _output(path: str | None) -> Iterator:
     folder = os.path.dirname(os.path.abspath(path))
     fd, tmp = tempfile.mkstemp(prefix=".grasptwist-", dir=folder)
     try:
-        with os.fdopen(fd, "wb") as out:
+        with os.fdopen(fd, "w+b") as out:  # readable too: zip archives seek and read back
             yield out
         os.replace(tmp, path)
     except BaseException:
@@ -121,47 +143,21 @@ def _output(path: str | None) -> Iterator:
         raise
 
 
-def _report_record(diag: _Diagnostics, rec: dict) -> None:
-    diag.records += 1
-    if "error" in rec:
-        err = rec["error"]
-        diag.failed += 1
-        diag.error(_where(rec["file"], err["line"], err["column"]), f"{err['code']}: {err['message']}")
+@contextmanager
+def _progress(total: int):
+    """A rich progress bar on stderr when it is a terminal and there is more than one input."""
+    if total < 2 or not sys.stderr.isatty():
+        yield lambda n: None
         return
-    where = f"{rec['file']}: grasp '{rec['grasp']}'" + (f", twist '{rec['twist']['name']}'" if "twist" in rec else "")
-    for method in ("off_tangent", "tangent"):
-        m = rec.get(method)
-        if isinstance(m, dict) and "error" in m:
-            diag.error(where, f"{method.replace('_', '-')}: {m['error']['code']}: {m['error']['message']}")
-    if not rec["ok"]:
-        diag.failed += 1
-    for w in rec["warnings"]:
-        diag.warning(where, w)
-
-
-def _progress(paths: list, enabled: bool):
-    """Wrap the file list in a rich progress bar on a terminal (rich imported only then)."""
-    if not enabled or len(paths) < 2 or not sys.stderr.isatty():
-        return paths, None
     from rich.progress import Progress
 
     from .table import console
 
-    progress = Progress(console=console(sys.stderr, width=None), transient=True)
-    return progress.track(paths, description="resolving"), progress
+    with Progress(console=console(sys.stderr), transient=True) as bar:
+        task = bar.add_task("resolving", total=total)
+        yield lambda n: bar.advance(task, n)
 
 
-def _grasps(paths: list, max_bytes: Optional[int]):
-    from .inputs import read
-
-    for path in paths:
-        if isinstance(path, str):
-            yield from read(path, max_bytes)
-        else:
-            yield path  # an error found while expanding folders
-
-
-_PATHS = typer.Argument(..., metavar="PATH...", help="Grasp files, folders (searched for *.yaml, *.yml) or - for stdin.")
 _METHOD = typer.Option(Method.both, "--method", help="Decomposition(s) to run.")
 _OUTPUT = typer.Option(None, "-o", "--output", metavar="FILE", help="Write to FILE (atomically) instead of stdout.")
 _DIGITS = typer.Option(4, "--digits", min=0, max=17, help="Decimals in tables (JSON and CSV keep full precision).")
@@ -172,18 +168,25 @@ _DEBUG = typer.Option(False, "--debug", help="Show the Python traceback of an in
 _JSON = typer.Option(False, "--json", help="Same as --format json.")
 
 
+_WORKERS = typer.Option(0, "-j", "--workers", min=0, help="Processes for folders of files (0: automatic, both cores for 256+ files).")
+_PATHS_HELP = "Grasp files (.yaml, .yml), data sets (.npz, .npy), folders (searched for *.yaml, *.yml) or - for stdin."
+_PATHS = typer.Argument(..., metavar="PATH...", help=_PATHS_HELP)
+
+
 @app.command()
 def resolve(
     paths: List[str] = _PATHS,
     twist: Optional[List[str]] = typer.Option(None, "--twist", metavar="W1,W2,W3,V1,V2,V3", help="Object twist (omega; v); repeatable; replaces the files' twists."),
     at: Optional[str] = typer.Option(None, "--at", metavar="X,Y,Z", help="Point whose velocity the --twist linear part gives (default: the origin)."),
     method: Method = _METHOD,
-    fmt: Format = typer.Option(Format.table, "-f", "--format", help="table for people; json, jsonl or csv for programs."),
+    fmt: Format = typer.Option(Format.table, "-f", "--format", help="table for people; json, jsonl, csv or npz (arrays, with -o) for programs."),
     json_: bool = _JSON,
     output: Optional[str] = _OUTPUT,
     digits: int = _DIGITS,
     order: Order = _ORDER,
+    extra_point: ExtraPoint = typer.Option(ExtraPoint.wrist, "--extra-point", help="Role of a .npy's 19th-21st columns: the wrist, or the point the twists' linear velocity is given at."),
     max_bytes: Optional[int] = _MAX_BYTES,
+    workers: int = _WORKERS,
     quiet: bool = _QUIET,
     debug: bool = _DEBUG,
 ) -> None:
@@ -192,13 +195,21 @@ def resolve(
     Example: spin the paper's cylinder about z and read the Psi amplitudes:
 
         grasptwist resolve grasps/cylinder.yaml --twist 0,0,1,0,0,0 --json | jq '.[0].off_tangent.y'
+
+    A data set of grasps as arrays, results as arrays:
+
+        grasptwist resolve grasps.npz --twist 0,0,1,0,0,0 -f npz -o results.npz
     """
-    from .report import record
+    from .pipeline import Job
 
     twists = _cli_twists(twist, at)
+    if extra_point == ExtraPoint.at and at is not None:
+        raise typer.BadParameter("--extra-point at gives each row its own point; drop --at", param_hint="--at")
     fmt = Format.json if json_ else fmt
-    job = _Job(paths, twists, method.value, max_bytes, quiet)
-    _run(debug, lambda: job.emit(fmt.value, output, "resolve", lambda r: record(r, order.value), digits=digits))
+    if fmt == Format.npz and output is None and sys.stdout.isatty():
+        raise typer.BadParameter("npz is binary: give -o FILE.npz", param_hint="--format")
+    job = Job("resolve", None if twists is None else tuple(twists), method.value, order.value, fmt.value, max_bytes, extra_point.value)
+    _run(debug, lambda: _emit(job, paths, output, quiet, workers, digits=digits))
 
 
 @app.command()
@@ -211,6 +222,7 @@ def basis(
     digits: int = _DIGITS,
     order: Order = _ORDER,
     max_bytes: Optional[int] = _MAX_BYTES,
+    workers: int = _WORKERS,
     quiet: bool = _QUIET,
     debug: bool = _DEBUG,
 ) -> None:
@@ -220,11 +232,10 @@ def basis(
 
         grasptwist basis grasps/cylinder.yaml --method off-tangent
     """
-    from .report import basis_record
+    from .pipeline import Job
 
-    fmt = _not_csv(Format.json if json_ else fmt)
-    job = _Job(paths, None, method.value, max_bytes, quiet)
-    _run(debug, lambda: job.emit(fmt.value, output, "basis", lambda r: basis_record(r, order.value), digits=digits))
+    job = Job("basis", None, method.value, order.value, _records_only(Format.json if json_ else fmt).value, max_bytes)
+    _run(debug, lambda: _emit(job, paths, output, quiet, workers, digits=digits))
 
 
 @app.command()
@@ -235,6 +246,7 @@ def check(
     json_: bool = _JSON,
     output: Optional[str] = _OUTPUT,
     max_bytes: Optional[int] = _MAX_BYTES,
+    workers: int = _WORKERS,
     quiet: bool = _QUIET,
     debug: bool = _DEBUG,
 ) -> None:
@@ -244,11 +256,10 @@ def check(
 
         grasptwist check grasps/ -f jsonl | jq -c 'select(.ok | not)'
     """
-    from .report import check_record
+    from .pipeline import Job
 
-    fmt = _not_csv(Format.json if json_ else fmt)
-    job = _Job(paths, None, method.value, max_bytes, quiet)
-    _run(debug, lambda: job.emit(fmt.value, output, "check", check_record))
+    job = Job("check", None, method.value, "omega-v", _records_only(Format.json if json_ else fmt).value, max_bytes)
+    _run(debug, lambda: _emit(job, paths, output, quiet, workers))
 
 
 @app.command()
@@ -268,46 +279,44 @@ def schema(output: Optional[str] = _OUTPUT, debug: bool = _DEBUG) -> None:
     _run(debug, job)
 
 
-def _not_csv(fmt: Format) -> Format:
-    if fmt == Format.csv:
-        raise typer.BadParameter("csv is for resolve records; use table, json or jsonl", param_hint="--format")
+def _records_only(fmt: Format) -> Format:
+    if fmt in (Format.csv, Format.npz):
+        raise typer.BadParameter(f"{fmt.value} is for resolve results; use table, json or jsonl", param_hint="--format")
     return fmt
 
 
-class _Job:
-    """Files in, grasps through the engine, one record each out: shared by resolve, basis and check."""
+def _workers(requested: int, paths: list) -> int:
+    """Processes for a batch: both cores for a folder of files, one for a few."""
+    if requested > 0:
+        return requested
+    return min(os.cpu_count() or 1, 4) if len(paths) >= 256 else 1
 
-    def __init__(self, paths, twists, method, max_bytes, quiet):
-        self.paths = paths
-        self.twists = twists
-        self.method = method
-        self.max_bytes = max_bytes
-        self.diag = _Diagnostics(quiet)
 
-    def emit(self, fmt, output, kind, to_record, **table_options) -> int:
-        from .batch import ZERO_TWIST
-        from .batch import resolve as resolve_all
-        from .inputs import expand
-        from .report import error_record, writer
+def _emit(job, paths: list[str], output, quiet: bool, workers: int, **table_options) -> int:
+    """Files in, records out: the body of resolve, basis and check."""
+    from .inputs import expand
+    from .pipeline import run, write_npz
+    from .report import writer
 
-        # basis and check resolve the zero twist: the bases do not depend on the twist
-        twists = self.twists if kind == "resolve" else [ZERO_TWIST]
-        files, progress = _progress(list(expand(self.paths)), enabled=True)
-        with _output(output) as out, (progress or _nothing()):
-            w = writer(fmt, out, kind, **table_options)
-            for item in resolve_all(_grasps(files, self.max_bytes), twists, self.method):
-                rec = error_record(item) if not hasattr(item, "grasp") else to_record(item)
-                _report_record(self.diag, rec)
-                w.write(rec)
+    stderr = _Stderr(quiet)
+    inputs = list(expand(paths))
+    with _output(output) as out, _progress(len(inputs)) as advance:
+        if job.fmt == "npz":
+            outputs = write_npz(job, inputs, out)
+        else:
+            w = writer(job.fmt, out, job.kind, **table_options)
+            outputs = run(job, inputs, _workers(workers, inputs))
+        for o in outputs:
+            if job.fmt != "npz":
+                for encoded in o.encoded:
+                    w.write(encoded)
+                out.flush()  # a batch streams: each group is out as soon as it is ready
+            stderr.take(o)
+            advance(o.inputs)
+        if job.fmt != "npz":
             w.close()
-        if not self.diag.quiet:
-            self.diag.summary()
-        return EXIT_FAILED if self.diag.failed else EXIT_OK
-
-
-@contextmanager
-def _nothing():
-    yield
+    stderr.summary()
+    return EXIT_FAILED if stderr.failed else EXIT_OK
 
 
 def _run(debug: bool, job) -> None:

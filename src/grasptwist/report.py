@@ -1,10 +1,13 @@
-"""Output: records (the JSON contract), and writers for JSON, JSONL, CSV and tables.
+"""Output: records (the JSON contract), their diagnostics, and writers.
 
-A *record* is one (grasp, twist) row as a dict of plain values and numpy
-arrays, exactly the contract documented in the README.  The writers turn
-records into bytes or text; none of them computes anything.  JSON goes
-through orjson, which writes numpy arrays natively, floats at full
-precision (shortest round-trip form) and NaN as ``null``.
+A *record* is one (grasp, twist) row as a dict of plain values, exactly the
+contract documented in the README.  :func:`records` builds them a block at
+a time (arrays are turned into lists once per block, which is what makes a
+million records a second-scale job).  Encoders turn a record into bytes for
+JSON, JSONL or CSV; writers put encoded records on a stream.  Nothing here
+computes: every number comes from the engine.  JSON goes through orjson:
+floats at full precision (shortest round-trip form), NaN never (failed
+methods carry an ``error`` object instead of numbers).
 """
 
 from __future__ import annotations
@@ -16,18 +19,20 @@ from typing import IO
 import numpy as np
 import orjson
 
-from .batch import Resolution
+from .batch import Block
 from .degeneracy import Status, conditioning_warning, status_message
 from .grasp_file import GraspFileError
 from .screws import klein_table
 
 __all__ = [
     "ORDERS",
-    "record",
+    "records",
     "basis_record",
     "check_record",
     "error_record",
+    "diagnostics",
     "dumps",
+    "ENCODERS",
     "writer",
     "CSV_COLUMNS",
 ]
@@ -42,124 +47,133 @@ def _screws(a, order):
     return a[..., _V_OMEGA] if order == "v-omega" else a
 
 
-def record(res: Resolution, order: str = "omega-v") -> dict:
-    """The output record of one resolution (see the README's output contract)."""
-    g = res.grasp
-    rec = _grasp_fields(g)
-    rec["twist"] = {"name": res.twist.name, "screw": _screws(res.twist.screw, order)}
-    rec["contacts"] = rec.pop("contacts")  # keep the documented key order
-    rec["contact_velocity"] = res.velocity
-    warnings = []
-    if res.method != "tangent":
-        rec["off_tangent"] = None if res.off_tangent is None else _off_tangent(res.off_tangent, g, order, warnings)
-    if res.tangent is not None:
-        rec["tangent"] = _tangent(res.tangent, g, order, warnings)
-    rec["warnings"] = warnings
-    rec["ok"] = _methods_ok(rec)
-    return rec
-
-
-def _grasp_fields(g):
-    return {
-        "file": g.file,
-        "grasp": g.name,
-        "units": g.units,
-        "contacts": [{"name": n, "point": g.points[i], "normal": g.normals[i]} for i, n in enumerate(g.contact_names)],
-    }
-
-
-def basis_record(res: Resolution, order: str = "omega-v") -> dict:
-    """The bases of one grasp with their tables of Klein products (``res`` resolves the zero twist)."""
-    g = res.grasp
-    rec = _grasp_fields(g)
-    off, tan = res.off_tangent, res.tangent
-    if res.method != "tangent":
-        rec["off_tangent"] = None if off is None else _failure(off, g) if not off.ok else {
-            "sigma": _screws(off.sigma, order),
-            "psi": _screws(off.psi, order),
-            "sigma_psi": klein_table(off.sigma, off.psi),
-            "conditioning": float(off.conditioning),
+def records(block: Block, order: str = "omega-v") -> list[dict]:
+    """The output records of a block's rows (see the README's output contract)."""
+    twist = _screws(block.twist, order).tolist()
+    points, normals, velocity = block.points.tolist(), block.normals.tolist(), block.velocity.tolist()
+    off = _columns(block.off_tangent, order, "sigma", "psi", "sigma_psi", "x", "y")
+    tan = _columns(block.tangent, order, "theta", "theta_sigma", "alpha", "beta", "normal_velocity", "in_tangent_planes")
+    out = []
+    for i in range(len(block)):
+        names = block.contact_names[i]
+        rec = {
+            "file": block.file[i],
+            "grasp": block.grasp[i],
+            "units": block.units[i],
+            "twist": {"name": block.twist_name[i], "screw": twist[i]},
+            "contacts": [{"name": names[c], "point": points[i][c], "normal": normals[i][c]} for c in range(3)],
+            "contact_velocity": velocity[i],
         }
-    if tan is not None:
-        rec["tangent"] = _failure(tan, g) if not tan.ok else {
-            "theta": _screws(tan.theta, order),
-            "sigma": _screws(tan.sigma, order),
-            "theta_sigma": klein_table(tan.theta, tan.sigma),
-            "conditioning": float(tan.conditioning),
-        }
-    rec["warnings"] = _basis_warnings(res)
-    rec["ok"] = _methods_ok(rec)
-    return rec
+        warnings = []
+        if off is not None:
+            rec["off_tangent"] = _method(off, i, names, "off-tangent", warnings) if block.has_wrist[i] else None
+        if tan is not None:
+            rec["tangent"] = _method(tan, i, names, "tangent", warnings)
+        rec["warnings"] = warnings
+        rec["ok"] = _methods_ok(rec)
+        out.append(rec)
+    return out
 
 
-def check_record(res: Resolution) -> dict:
-    """Validation and degeneracy verdict of one grasp, per method."""
-    g = res.grasp
-    rec = {"file": g.file, "grasp": g.name}
-    for key, r in (("off_tangent", res.off_tangent), ("tangent", res.tangent)):
-        if key == "off_tangent" and res.method == "tangent" or key == "tangent" and r is None:
-            continue
-        if r is None:
-            rec[key] = None
-            continue
-        rec[key] = {"conditioning": float(r.conditioning)} if r.ok else {**_failure(r, g), "conditioning": float(r.conditioning)}
-    rec["warnings"] = _basis_warnings(res)
-    rec["ok"] = _methods_ok(rec)
-    return rec
+def _columns(result, order, *names):
+    """A result's fields as per-row lists, plus its status, culprit, conditioning and residual."""
+    if result is None:
+        return None
+    cols = {n: (_screws(getattr(result, n), order) if getattr(result, n).ndim == 3 else getattr(result, n)).tolist() for n in names}
+    for n in ("status", "culprit", "conditioning", "residual"):
+        cols[n] = np.asarray(getattr(result, n)).tolist()
+    cols["_fields"] = names
+    return cols
 
 
-def _basis_warnings(res):
-    warnings = []
-    for r, name in ((res.off_tangent, "off-tangent"), (res.tangent, "tangent")):
-        if r is not None and r.ok:
-            _warn(warnings, r.conditioning, name)
-    return warnings
+def _method(cols, i, names, label, warnings):
+    status = cols["status"][i]
+    if status != Status.OK:
+        return _failure(status, cols["culprit"][i], names)
+    _warn(warnings, cols["conditioning"][i], label)
+    m = {n: cols[n][i] for n in cols["_fields"]}
+    m["conditioning"] = cols["conditioning"][i]
+    m["residual"] = cols["residual"][i]
+    return m
 
 
-def _methods_ok(rec):
-    return not any(isinstance(m, dict) and "error" in m for m in (rec.get("off_tangent"), rec.get("tangent")))
-
-
-def _failure(result, grasp):
-    status = Status(int(result.status))
-    return {"error": {"code": status.code, "message": status_message(status, result.culprit, grasp.contact_names)}}
-
-
-def _off_tangent(r, grasp, order, warnings):
-    if not r.ok:
-        return _failure(r, grasp)
-    _warn(warnings, r.conditioning, "off-tangent")
-    return {
-        "sigma": _screws(r.sigma, order),
-        "psi": _screws(r.psi, order),
-        "sigma_psi": r.sigma_psi,
-        "x": r.x,
-        "y": r.y,
-        "conditioning": float(r.conditioning),
-        "residual": float(r.residual),
-    }
-
-
-def _tangent(r, grasp, order, warnings):
-    if not r.ok:
-        return _failure(r, grasp)
-    _warn(warnings, r.conditioning, "tangent")
-    return {
-        "theta": _screws(r.theta, order),
-        "theta_sigma": r.theta_sigma,
-        "alpha": r.alpha,
-        "beta": r.beta,
-        "normal_velocity": r.normal_velocity,
-        "in_tangent_planes": bool(r.in_tangent_planes),
-        "conditioning": float(r.conditioning),
-        "residual": float(r.residual),
-    }
+def _failure(status, culprit, names):
+    status = Status(int(status))
+    return {"error": {"code": status.code, "message": status_message(status, culprit, names)}}
 
 
 def _warn(warnings, conditioning, basis):
     text = conditioning_warning(conditioning, basis)
     if text:
         warnings.append(text)
+
+
+def _methods_ok(rec):
+    return not any(isinstance(m, dict) and "error" in m for m in (rec.get("off_tangent"), rec.get("tangent")))
+
+
+def _grasp_fields(block: Block, i: int) -> dict:
+    names = block.contact_names[i]
+    return {
+        "file": block.file[i],
+        "grasp": block.grasp[i],
+        "units": block.units[i],
+        "contacts": [
+            {"name": names[c], "point": block.points[i, c].tolist(), "normal": block.normals[i, c].tolist()}
+            for c in range(3)
+        ],
+    }
+
+
+def basis_record(block: Block, i: int, order: str = "omega-v") -> dict:
+    """The bases of row ``i``'s grasp with their Klein products (cf. eq. 18)."""
+    rec = _grasp_fields(block, i)
+    names = block.contact_names[i]
+    warnings = []
+    if block.off_tangent is not None:
+        off = block.off_tangent.row(i)
+        rec["off_tangent"] = None if not block.has_wrist[i] else _failure(off.status, off.culprit, names) if not off.ok else {
+            "sigma": _screws(off.sigma, order).tolist(),
+            "psi": _screws(off.psi, order).tolist(),
+            "sigma_psi": klein_table(off.sigma, off.psi).tolist(),
+            "conditioning": float(off.conditioning),
+        }
+        if block.has_wrist[i] and off.ok:
+            _warn(warnings, off.conditioning, "off-tangent")
+    if block.tangent is not None:
+        tan = block.tangent.row(i)
+        rec["tangent"] = _failure(tan.status, tan.culprit, names) if not tan.ok else {
+            "theta": _screws(tan.theta, order).tolist(),
+            "sigma": _screws(tan.sigma, order).tolist(),
+            "theta_sigma": klein_table(tan.theta, tan.sigma).tolist(),
+            "conditioning": float(tan.conditioning),
+        }
+        if tan.ok:
+            _warn(warnings, tan.conditioning, "tangent")
+    rec["warnings"] = warnings
+    rec["ok"] = _methods_ok(rec)
+    return rec
+
+
+def check_record(block: Block, i: int) -> dict:
+    """Validation and degeneracy verdict of row ``i``'s grasp, per method."""
+    rec = {"file": block.file[i], "grasp": block.grasp[i]}
+    names = block.contact_names[i]
+    warnings = []
+    for key, label, result in (("off_tangent", "off-tangent", block.off_tangent), ("tangent", "tangent", block.tangent)):
+        if result is None:
+            continue
+        r = result.row(i)
+        if key == "off_tangent" and not block.has_wrist[i]:
+            rec[key] = None
+        elif r.ok:
+            rec[key] = {"conditioning": float(r.conditioning)}
+            _warn(warnings, r.conditioning, label)
+        else:
+            rec[key] = {**_failure(r.status, r.culprit, names), "conditioning": float(r.conditioning)}
+    rec["warnings"] = warnings
+    rec["ok"] = _methods_ok(rec)
+    return rec
 
 
 def error_record(err: GraspFileError) -> dict:
@@ -171,56 +185,35 @@ def error_record(err: GraspFileError) -> dict:
     }
 
 
-def _numpy_default(obj):
-    # orjson serialises C-contiguous float arrays itself; broadcast views come here.
-    if isinstance(obj, np.ndarray):
-        return obj.tolist()
-    raise TypeError(f"cannot serialise {type(obj).__name__}")
+def diagnostics(rec: dict) -> tuple[list[str], list[str]]:
+    """The stderr lines a record calls for: ``(errors, warnings)``, one line each.
 
-
-_JSON_OPTS = orjson.OPT_SERIALIZE_NUMPY
+    ``path:line:col: error: code: message`` for an input that failed;
+    ``path: grasp 'g'[, twist 't']: error: method: code: message`` for a
+    method that failed; the same with ``warning:`` for each warning.
+    """
+    if "error" in rec:
+        err = rec["error"]
+        where = ":".join(str(x) for x in (rec["file"], err["line"], err["column"]) if x is not None)
+        return [f"{where}: error: {err['code']}: {err['message']}"], []
+    where = f"{rec['file']}: grasp '{rec['grasp']}'" + (f", twist '{rec['twist']['name']}'" if "twist" in rec else "")
+    errors = [
+        f"{where}: error: {label}: {m['error']['code']}: {m['error']['message']}"
+        for key, label in (("off_tangent", "off-tangent"), ("tangent", "tangent"))
+        if isinstance(m := rec.get(key), dict) and "error" in m
+    ]
+    return errors, [f"{where}: warning: {w}" for w in rec["warnings"]]
 
 
 def dumps(obj, indent: bool = False) -> bytes:
-    """JSON bytes: full-precision floats, NaN and infinities as ``null``."""
-    opts = _JSON_OPTS | orjson.OPT_INDENT_2 if indent else _JSON_OPTS
-    return orjson.dumps(obj, default=_numpy_default, option=opts)
+    """JSON bytes at full precision (numpy arrays allowed)."""
+    return orjson.dumps(obj, option=orjson.OPT_SERIALIZE_NUMPY | (orjson.OPT_INDENT_2 if indent else 0))
 
 
-# --- writers -------------------------------------------------------------------
+# --- encoders and writers ------------------------------------------------------
 
 
-class _JsonArray:
-    """One JSON array, written element by element so a batch streams."""
-
-    def __init__(self, out: IO[bytes]):
-        self.out = out
-        self.count = 0
-
-    def write(self, rec: dict) -> None:
-        self.out.write(b"[\n" if self.count == 0 else b",\n")
-        self.out.write(dumps(rec))
-        self.count += 1
-
-    def close(self) -> None:
-        self.out.write(b"[]\n" if self.count == 0 else b"\n]\n")
-
-
-class _JsonLines:
-    """One compact JSON record per line, flushed per record."""
-
-    def __init__(self, out: IO[bytes]):
-        self.out = out
-
-    def write(self, rec: dict) -> None:
-        self.out.write(dumps(rec) + b"\n")
-        self.out.flush()
-
-    def close(self) -> None:
-        pass
-
-
-def _columns():
+def _columns_csv():
     cols = ["file", "grasp", "twist", "ok", "error"]
     cols += [f"twist{i}" for i in range(1, 7)]
     cols += [f"v{i}_{a}" for i in range(1, 4) for a in "xyz"]
@@ -231,41 +224,23 @@ def _columns():
 
 
 #: CSV header, one column per field; the README documents each.
-CSV_COLUMNS = _columns()
+CSV_COLUMNS = _columns_csv()
 
 
-class _Csv:
-    """One row per record; empty cells where a value does not apply."""
-
-    def __init__(self, out: IO[bytes]):
-        self.out = out
-        self.text = io.StringIO()
-        self.csv = csv.writer(self.text, lineterminator="\n")
-        self.csv.writerow(CSV_COLUMNS)
-        self._drain()
-
-    def _drain(self):
-        self.out.write(self.text.getvalue().encode())
-        self.text.seek(0)
-        self.text.truncate()
-
-    def write(self, rec: dict) -> None:
-        self.csv.writerow([_cell(v) for v in _csv_values(rec)])
-        self._drain()
-
-    def close(self) -> None:
-        pass
+def _csv_line(rec: dict) -> bytes:
+    text = io.StringIO()
+    csv.writer(text, lineterminator="\n").writerow([_cell(v) for v in _csv_values(rec)])
+    return text.getvalue().encode()
 
 
 def _csv_values(rec):
     if "error" in rec:
         err = rec["error"]
         return [rec["file"], "", "", False, f"{err['code']}: {err['message']}"] + [None] * (len(CSV_COLUMNS) - 5)
-    off, tan = rec.get("off_tangent"), rec.get("tangent")
     values = [rec["file"], rec["grasp"], rec["twist"]["name"], rec["ok"], ""]
-    values += list(rec["twist"]["screw"]) + list(np.ravel(rec["contact_velocity"]))
-    values += _method_cells(off, ("x", "y"), 6)
-    values += _method_cells(tan, ("alpha", "beta", "normal_velocity"), 9, extra=("in_tangent_planes",))
+    values += rec["twist"]["screw"] + [v for row in rec["contact_velocity"] for v in row]
+    values += _method_cells(rec.get("off_tangent"), ("x", "y"), 6)
+    values += _method_cells(rec.get("tangent"), ("alpha", "beta", "normal_velocity"), 9, extra=("in_tangent_planes",))
     return values
 
 
@@ -273,22 +248,56 @@ def _method_cells(m, names, n, extra=()):
     if not m or "error" in m:
         error = f"{m['error']['code']}: {m['error']['message']}" if m else ""
         return [None] * (n + len(extra) + 1) + [error]
-    cells = [v for name in names for v in m[name]]
-    return cells + [m[e] for e in extra] + [m["conditioning"], ""]
+    return [v for name in names for v in m[name]] + [m[e] for e in extra] + [m["conditioning"], ""]
 
 
 def _cell(v):
     if v is None:
         return ""
-    if isinstance(v, (bool, np.bool_)):
+    if isinstance(v, bool):
         return "true" if v else "false"
-    if isinstance(v, (float, np.floating)):
-        return "" if not np.isfinite(v) else repr(float(v) + 0.0)  # + 0.0: no "-0.0"
+    if isinstance(v, float):
+        return repr(v + 0.0)  # + 0.0: no "-0.0"
     return v
 
 
+#: Record -> bytes, per machine format (table records stay dicts: rich draws them).
+ENCODERS = {"json": dumps, "jsonl": dumps, "csv": _csv_line, "table": lambda rec: rec}
+
+
+class _JsonArray:
+    """One JSON array, written element by element so a batch streams."""
+
+    def __init__(self, out: IO[bytes]):
+        self.out = out
+        self.count = 0
+
+    def write(self, encoded: bytes) -> None:
+        self.out.write(b"[\n" if self.count == 0 else b",\n")
+        self.out.write(encoded)
+        self.count += 1
+
+    def close(self) -> None:
+        self.out.write(b"[]\n" if self.count == 0 else b"\n]\n")
+
+
+class _Lines:
+    """One encoded record per line (JSONL, CSV rows after a header), flushed per batch."""
+
+    def __init__(self, out: IO[bytes], header: bytes = b"", newline: bytes = b"\n"):
+        self.out = out
+        self.newline = newline
+        out.write(header)
+
+    def write(self, encoded: bytes) -> None:
+        self.out.write(encoded + self.newline)
+
+    def close(self) -> None:
+        self.out.flush()
+
+
 def writer(fmt: str, out: IO[bytes], kind: str = "resolve", **table_options):
-    """A writer with ``write(record)`` and ``close()``.
+    """A writer with ``write(encoded)`` and ``close()`` for records encoded by ``ENCODERS[fmt]``.
 
     ``fmt`` is ``json``, ``jsonl``, ``csv`` (resolve records only) or
     ``table``; ``kind`` says which records a table shows: ``resolve``,
@@ -298,4 +307,8 @@ def writer(fmt: str, out: IO[bytes], kind: str = "resolve", **table_options):
         from . import table  # rich is imported only for people-facing output
 
         return table.WRITERS[kind](out, **table_options)
-    return {"json": _JsonArray, "jsonl": _JsonLines, "csv": _Csv}[fmt](out)
+    if fmt == "json":
+        return _JsonArray(out)
+    if fmt == "jsonl":
+        return _Lines(out)
+    return _Lines(out, header=",".join(CSV_COLUMNS).encode() + b"\n", newline=b"")

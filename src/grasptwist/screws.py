@@ -21,6 +21,7 @@ __all__ = [
     "cross",
     "norm",
     "unit",
+    "direction",
     "screw",
     "klein",
     "klein_table",
@@ -77,6 +78,24 @@ def unit(a):
     a = np.asarray(a, dtype=float)
     with np.errstate(invalid="ignore", divide="ignore"):
         return a / norm(a)[..., None]
+
+
+def direction(a):
+    """Unit vector along ``a`` for any finite size of ``a``; zero stays zero.
+
+    Dividing by the largest component first keeps the squares in the norm
+    from overflowing (``1e200``) or underflowing (``1e-200``).
+    ``(..., 3) -> (..., 3)``.
+
+    >>> direction([0.0, 3e200, 4e200]).tolist()
+    [0.0, 0.6, 0.8]
+    """
+    a = np.asarray(a, dtype=float)
+    big = np.max(np.abs(a), axis=-1, keepdims=True)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        scaled = np.where(big > 0, a / big, a)
+        length = norm(scaled)[..., None]
+        return np.where(length > 0, scaled / length, scaled)
 
 
 def screw(omega, v):

@@ -1,0 +1,247 @@
+"""Array data sets in and out: ``.npz`` of named arrays, ``.npy`` of rows, ``.npz`` results.
+
+Input layouts (see the README):
+
+* ``.npz`` with ``points (N,3,3)``, ``normals (N,3,3)`` and optionally
+  ``wrist (N,3)``, ``twist (N,6)`` or ``(6,)``, ``names (N,)``;
+* ``.npy`` of shape ``(N,18)`` or ``(N,21)``: per row ``p1 p2 p3 n1 n2 n3``
+  (xyz each) and, with 21 columns, one more point whose role
+  ``extra_point`` names: the ``wrist``, or the point ``at`` which the
+  twists' linear velocity is given.
+
+A ``.npy`` is memory-mapped and read a chunk of rows at a time, so a data
+set larger than memory streams with bounded memory; ``.npz`` members are
+read whole (numpy cannot map them).  Problems with the file itself are
+:class:`~grasptwist.grasp_file.GraspFileError` (code ``bad-dataset``);
+problems with a row (NaN, a degenerate grasp) are that row's status.
+"""
+
+from __future__ import annotations
+
+import os
+import tempfile
+import zipfile
+from dataclasses import dataclass
+from typing import IO, Iterator, Sequence
+
+import numpy as np
+
+from .batch import Block, resolve_arrays
+from .degeneracy import Status
+from .grasp_file import GraspFileError, Twist
+from .screws import direction, twist_at
+
+__all__ = ["DATASET_SUFFIXES", "EXTRA_POINT_ROLES", "Dataset", "open_dataset", "dataset_blocks", "NpzWriter"]
+
+DATASET_SUFFIXES = (".npz", ".npy")
+EXTRA_POINT_ROLES = ("wrist", "at")
+_NPZ_KEYS = ("points", "normals", "wrist", "twist", "names")
+
+#: Rows per engine call on a data set: bounded memory, long vectors.
+ROWS_PER_BLOCK = 65536
+
+
+@dataclass(frozen=True)
+class Dataset:
+    """A data set's arrays (``.npy`` columns are memory-mapped views)."""
+
+    path: str
+    points: np.ndarray  # (N, 3, 3)
+    normals: np.ndarray  # (N, 3, 3)
+    wrist: np.ndarray | None  # (N, 3)
+    at: np.ndarray | None  # (N, 3): where each twist's linear part is given
+    twist: np.ndarray | None  # (N, 6) or (6,)
+    names: np.ndarray | None  # (N,)
+
+    def __len__(self) -> int:
+        return len(self.points)
+
+
+def _bad(path, message) -> GraspFileError:
+    return GraspFileError(code="bad-dataset", message=message, file=path)
+
+
+def open_dataset(path: str, extra_point: str = "wrist") -> Dataset:
+    """Open a ``.npz`` or ``.npy`` data set and check its layout.
+
+    Raises
+    ------
+    GraspFileError
+        ``read-error`` when it cannot be read, ``bad-dataset`` when its
+        arrays do not have the documented names, shapes or a numeric type.
+    """
+    try:
+        if path.endswith(".npy"):
+            return _open_npy(path, np.load(path, mmap_mode="r", allow_pickle=False), extra_point)
+        with np.load(path, allow_pickle=False) as npz:
+            return _open_npz(path, {k: npz[k] for k in npz.files})
+    except GraspFileError:
+        raise
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile) as exc:
+        raise GraspFileError(code="read-error", message=f"cannot read as a numpy file: {exc}", file=path) from None
+
+
+def _numeric(path, name, a, tail):
+    if a.dtype.kind not in "fiu":
+        raise _bad(path, f"{name}: expected numbers, got dtype {a.dtype}")
+    if a.ndim != len(tail) + 1 or a.shape[1:] != tail:
+        raise _bad(path, f"{name}: expected shape (N, {', '.join(map(str, tail))}), got {a.shape}")
+    return a
+
+
+def _open_npy(path, a, extra_point):
+    if a.ndim != 2 or a.shape[1] not in (18, 21):
+        raise _bad(path, f"expected rows of 18 or 21 numbers (p1 p2 p3 n1 n2 n3 [point]), got shape {a.shape}")
+    _numeric(path, "rows", a, (a.shape[1],))
+    n = len(a)
+    extra = a[:, 18:21] if a.shape[1] == 21 else None
+    return Dataset(
+        path=path,
+        points=a[:, 0:9].reshape(n, 3, 3),
+        normals=a[:, 9:18].reshape(n, 3, 3),
+        wrist=extra if extra_point == "wrist" else None,
+        at=extra if extra_point == "at" else None,
+        twist=None,
+        names=None,
+    )
+
+
+def _open_npz(path, arrays):
+    unknown = sorted(set(arrays) - set(_NPZ_KEYS))
+    if unknown:
+        raise _bad(path, f"unknown array(s) {', '.join(unknown)}; expected {', '.join(_NPZ_KEYS)}")
+    for key in ("points", "normals"):
+        if key not in arrays:
+            raise _bad(path, f"missing array '{key}' (N, 3, 3)")
+    points = _numeric(path, "points", arrays["points"], (3, 3))
+    n = len(points)
+    normals = _numeric(path, "normals", arrays["normals"], (3, 3))
+    wrist = _numeric(path, "wrist", arrays["wrist"], (3,)) if "wrist" in arrays else None
+    twist = arrays.get("twist")
+    if twist is not None and not (twist.shape == (6,) and twist.dtype.kind in "fiu"):
+        _numeric(path, "twist", twist, (6,))
+    names = arrays.get("names")
+    if names is not None and (names.ndim != 1 or names.dtype.kind not in "USiu"):
+        raise _bad(path, f"names: expected a 1-D array of strings or numbers, got {names.dtype} {names.shape}")
+    for key, a in (("normals", normals), ("wrist", wrist), ("twist", twist if twist is not None and twist.ndim == 2 else None), ("names", names)):
+        if a is not None and len(a) != n:
+            raise _bad(path, f"{key}: {len(a)} rows, but points has {n}")
+    return Dataset(path, points, normals, wrist, None, twist, names)
+
+
+def dataset_blocks(ds: Dataset, twists: Sequence[Twist] | None, method: str, rows: int = ROWS_PER_BLOCK) -> Iterator[Block]:
+    """Resolve a data set a chunk of rows at a time.
+
+    Each grasp is paired with every twist of ``twists`` (the command line's)
+    or else with the data set's own twist; with ``at`` points, a twist's
+    linear part is the velocity of the row's ``at`` point.
+
+    Raises
+    ------
+    GraspFileError
+        ``no-twist`` when neither gives a twist.
+    """
+    if twists is None and ds.twist is None:
+        raise GraspFileError(
+            code="no-twist",
+            message="the data set has no 'twist' array: pass --twist W1,W2,W3,V1,V2,V3 (repeatable)",
+            file=ds.path,
+        )
+    given = np.stack([t.screw for t in twists]) if twists is not None else None
+    k = len(given) if given is not None else 1
+    for start in range(0, len(ds), max(1, rows // k)):
+        stop = min(len(ds), start + max(1, rows // k))
+        index = np.repeat(np.arange(start, stop), k)  # row-major: grasp, then its twists
+        if given is not None:
+            screw = np.tile(given, (stop - start, 1))
+            names = [t.name for t in twists] * (stop - start)
+        else:
+            own = np.asarray(ds.twist, dtype=float)
+            screw = np.broadcast_to(own, (stop - start, 6)) if own.ndim == 1 else own[start:stop]
+            names = ["twist"] * (stop - start)
+        if ds.at is not None:
+            at = np.asarray(ds.at[start:stop], dtype=float)[index - start]
+            screw = twist_at(screw[:, :3], screw[:, 3:], at)
+        label = ds.names[start:stop][index - start].astype(str).tolist() if ds.names is not None else index.astype(str).tolist()
+        wrist = None if ds.wrist is None else np.asarray(ds.wrist[start:stop], dtype=float)[index - start]
+        yield resolve_arrays(
+            np.asarray(ds.points[start:stop], dtype=float)[index - start],
+            # unit normals exactly as the grasp-file loader makes them
+            direction(np.asarray(ds.normals[start:stop], dtype=float))[index - start],
+            wrist,
+            np.ascontiguousarray(screw, dtype=float),
+            method,
+            file=ds.path,
+            grasp=label,
+            twist_name=names,
+        )
+
+
+class NpzWriter:
+    """Results as arrays in one ``.npz``, with bounded memory.
+
+    Each block's columns are appended to temporary files; :meth:`close`
+    streams them into the archive as ``.npy`` members.  Arrays: ``file``,
+    ``grasp``, ``twist_name`` (strings), ``twist (N,6)``,
+    ``contact_velocity (N,3,3)``, and per method asked for ``x``, ``y``,
+    ``off_tangent_status``, ``off_tangent_conditioning`` /  ``alpha``,
+    ``beta``, ``normal_velocity``, ``in_tangent_planes``,
+    ``tangent_status``, ``tangent_conditioning``; ``status_legend[k]`` is
+    the name of status ``k``, and status -1 means "skipped" (no wrist).
+    Amplitudes are NaN where a method failed.
+    """
+
+    def __init__(self, out: IO[bytes], order: str = "omega-v"):
+        self.out = out
+        self.order = order
+        self.tmp = tempfile.TemporaryDirectory(prefix="grasptwist-npz-")
+        self.files: dict[str, tuple[IO[bytes], np.dtype, tuple]] = {}
+        self.rows = 0
+
+    def write(self, block: Block) -> None:
+        from .report import _screws  # the one definition of the output order
+
+        cols = {"twist": _screws(block.twist, self.order), "contact_velocity": block.velocity}
+        if block.off_tangent is not None:
+            r = block.off_tangent
+            cols.update(x=r.x, y=r.y, off_tangent_status=np.where(block.has_wrist, r.status, -1).astype(np.int8))
+            cols["off_tangent_conditioning"] = r.conditioning
+        if block.tangent is not None:
+            r = block.tangent
+            cols.update(alpha=r.alpha, beta=r.beta, normal_velocity=r.normal_velocity)
+            cols.update(in_tangent_planes=r.in_tangent_planes, tangent_status=r.status, tangent_conditioning=r.conditioning)
+        for name, a in cols.items():
+            self._append(name, np.ascontiguousarray(a))
+        for name in ("file", "grasp", "twist_name"):
+            self._append_text(name, getattr(block, name))
+        self.rows += len(block)
+
+    def _append(self, name, a):
+        if name not in self.files:
+            self.files[name] = (open(os.path.join(self.tmp.name, name), "w+b"), a.dtype, a.shape[1:])
+        self.files[name][0].write(a.tobytes())
+
+    def _append_text(self, name, values):
+        if name not in self.files:
+            self.files[name] = (open(os.path.join(self.tmp.name, name), "w+b"), None, ())
+        self.files[name][0].write("".join(f"{v}\n" for v in values).encode())
+
+    def close(self) -> None:
+        with zipfile.ZipFile(self.out, "w", zipfile.ZIP_STORED, allowZip64=True) as z:
+            for name, (fh, dtype, tail) in self.files.items():
+                fh.flush()
+                fh.seek(0)
+                with z.open(name + ".npy", "w", force_zip64=True) as member:
+                    if dtype is None:  # strings: fixed width, built once
+                        text = np.array(fh.read().decode().split("\n")[:-1], dtype=str)
+                        np.lib.format.write_array(member, text, allow_pickle=False)
+                    else:
+                        header = {"descr": np.lib.format.dtype_to_descr(dtype), "fortran_order": False, "shape": (self.rows, *tail)}
+                        np.lib.format.write_array_header_2_0(member, header)
+                        while chunk := fh.read(1 << 22):
+                            member.write(chunk)
+                fh.close()
+            legend = np.array([s.code for s in Status])
+            with z.open("status_legend.npy", "w") as member:
+                np.lib.format.write_array(member, legend, allow_pickle=False)
+        self.tmp.cleanup()

@@ -1,0 +1,188 @@
+"""Inputs to encoded output, a group of files at a time, on one or more processes.
+
+A command is a :class:`Job`.  :func:`run` splits its inputs into groups of
+grasp files (and data sets, each a stream of row blocks), turns each group
+into records, their diagnostics and their encoded bytes with
+:func:`run_group`, and yields the results in input order.  With several
+workers the groups of files are spread over a process pool; everything a
+worker sends back is already encoded, so the parent only writes.
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+from functools import partial
+from typing import Iterator, Sequence
+
+import numpy as np
+
+from .batch import ZERO_TWIST, Block, resolve
+from .degeneracy import CONDITION_WARNING
+from .datasets import DATASET_SUFFIXES, NpzWriter, dataset_blocks, open_dataset
+from .grasp_file import GraspFileError, Twist
+from .inputs import STDIN, read
+from .report import ENCODERS, basis_record, check_record, diagnostics, error_record, records
+
+__all__ = ["Job", "Output", "run", "run_group", "blocks", "write_npz", "FILES_PER_GROUP"]
+
+#: Grasp files per group: enough rows for the engine's vectors, small enough to stream.
+FILES_PER_GROUP = 64
+
+
+@dataclass(frozen=True)
+class Job:
+    """What a command asks for (everything a worker needs, picklable)."""
+
+    kind: str = "resolve"  # resolve, basis or check
+    twists: tuple[Twist, ...] | None = None
+    method: str = "both"
+    order: str = "omega-v"
+    fmt: str = "jsonl"
+    max_bytes: int | None = None
+    extra_point: str = "wrist"
+
+
+@dataclass
+class Output:
+    """The encoded records of one group, with their stderr lines and counts."""
+
+    encoded: list = field(default_factory=list)
+    errors: list[str] = field(default_factory=list)
+    warnings: list[str] = field(default_factory=list)
+    records: int = 0
+    failed: int = 0
+    inputs: int = 0
+
+    def add(self, rec: dict, encode) -> None:
+        errors, warnings = diagnostics(rec)
+        self.errors += errors
+        self.warnings += warnings
+        self.records += 1
+        self.failed += not rec["ok"]
+        self.encoded.append(encode(rec))
+
+
+def run(job: Job, paths: Sequence, workers: int = 1) -> Iterator[Output]:
+    """Every input's output, in order.  ``paths`` holds file names, ``-``,
+    and errors found while listing folders."""
+    groups = list(_groups(paths))
+    files = [g for g in groups if not _is_dataset(g)]
+    if workers > 1 and len(files) > 1 and not any(STDIN in g for g in files):
+        import multiprocessing
+
+        with multiprocessing.get_context("fork").Pool(workers) as pool:
+            done = pool.imap(partial(run_group, job), files)
+            for g in groups:
+                yield from (_dataset(job, g) if _is_dataset(g) else [next(done)])
+        return
+    for g in groups:
+        yield from (_dataset(job, g) if _is_dataset(g) else [run_group(job, g)])
+
+
+def run_group(job: Job, paths: Sequence) -> Output:
+    """Read a group of grasp files and resolve them into one encoded :class:`Output`."""
+    items = []
+    for p in paths:
+        items.extend(read(p, job.max_bytes) if isinstance(p, str) else [p])
+    out = Output(inputs=len(paths))
+    twists = [ZERO_TWIST] if job.kind != "resolve" else job.twists
+    for x in resolve(items, twists, job.method):
+        _emit(job, x, out)
+    return out
+
+
+def blocks(job: Job, paths: Sequence) -> Iterator[Block | GraspFileError]:
+    """Blocks and errors of every input, in order (for writers that take blocks, like npz)."""
+    for g in _groups(paths):
+        if _is_dataset(g):
+            try:
+                yield from dataset_blocks(open_dataset(g, job.extra_point), job.twists, job.method)
+            except GraspFileError as err:
+                yield err
+            continue
+        items = []
+        for p in g:
+            items.extend(read(p, job.max_bytes) if isinstance(p, str) else [p])
+        yield from resolve(items, job.twists, job.method)
+
+
+def _emit(job: Job, x, out: Output) -> None:
+    encode = ENCODERS[job.fmt]
+    if not isinstance(x, Block):
+        out.add(error_record(x), encode)
+    elif job.kind == "resolve":
+        for rec in records(x, job.order):
+            out.add(rec, encode)
+    else:
+        for i in range(len(x)):
+            out.add(basis_record(x, i, job.order) if job.kind == "basis" else check_record(x, i), encode)
+
+
+def _dataset(job: Job, path: str) -> Iterator[Output]:
+    """A data set's outputs, a block of rows each; the first one counts the input."""
+    twists = [ZERO_TWIST] if job.kind != "resolve" else job.twists
+    first = True
+    try:
+        for block in dataset_blocks(open_dataset(path, job.extra_point), twists, job.method):
+            out = Output(inputs=int(first))
+            _emit(job, block, out)
+            first = False
+            yield out
+    except GraspFileError as err:
+        out = Output(inputs=int(first))
+        _emit(job, err, out)
+        yield out
+
+
+def _is_dataset(group) -> bool:
+    return isinstance(group, str)
+
+
+def _groups(paths):
+    """Consecutive grasp files in lists of FILES_PER_GROUP; each data set on its own (a str)."""
+    group = []
+    for p in paths:
+        if isinstance(p, str) and p.endswith(DATASET_SUFFIXES) and os.path.isfile(p):
+            if group:
+                yield group
+                group = []
+            yield p
+            continue
+        group.append(p)
+        if len(group) >= FILES_PER_GROUP:
+            yield group
+            group = []
+    if group:
+        yield group
+
+
+def write_npz(job: Job, paths: Sequence, out) -> Iterator[Output]:
+    """Resolve everything into one ``.npz`` on ``out``.
+
+    Yields an :class:`Output` per block with its counts and stderr lines
+    (records are built only for the rows that need a line: failed or
+    nearly degenerate ones); the archive is complete when the iterator is.
+    """
+    w = NpzWriter(out, job.order)
+    for x in blocks(job, paths):
+        o = Output(inputs=1)
+        if isinstance(x, Block):
+            w.write(x)
+            for i in np.flatnonzero(_needs_a_line(x)):
+                o.add(records(x.part(i, i + 1), job.order)[0], lambda rec: None)
+            o.records = len(x)
+            o.encoded = []
+        else:
+            o.add(error_record(x), lambda rec: None)
+        yield o
+    w.close()
+
+
+def _needs_a_line(block: Block):
+    """Rows whose record fails or warns."""
+    flag = np.zeros(len(block), bool)
+    for r, asked in ((block.off_tangent, block.has_wrist), (block.tangent, True)):
+        if r is not None:
+            flag |= (~r.ok | (r.conditioning < CONDITION_WARNING)) & asked
+    return flag

@@ -1,0 +1,166 @@
+"""Array data sets: .npz and .npy in, JSONL/CSV/npz out, equal to the per-file path."""
+
+import json
+
+import numpy as np
+import pytest
+import yaml
+from typer.testing import CliRunner
+
+import grasptwist as gt
+from grasptwist import datasets
+from grasptwist.cli import app
+from grasp_gen import grasps
+
+N = 240
+
+
+def run(*args):
+    return CliRunner().invoke(app, [str(a) for a in args])
+
+
+def jsonl(result):
+    return [json.loads(line) for line in result.stdout.splitlines()]
+
+
+@pytest.fixture(scope="module")
+def data():
+    """Random grasps with a few rows made degenerate in each way the engine names."""
+    rng = np.random.default_rng(5)
+    points, normals, wrist, twist = grasps(rng, N)
+    wrist[3] = points[3].mean(0)  # wrist in the contacts' plane
+    points[7, 2] = points[7, 0] + 2 * (points[7, 1] - points[7, 0])  # collinear contacts
+    points[11, 1] = points[11, 0]  # coincident contacts
+    m = np.cross(points[15, 1] - points[15, 0], points[15, 2] - points[15, 0])
+    normals[15, 1] = np.cross(m, normals[15, 1])  # a normal in the contacts' plane
+    normals[19, 2] = 0  # zero normal
+    return points, normals, wrist, twist
+
+
+def write_yaml_files(folder, points, normals, wrist, twist):
+    """One grasp file per row, named so that sorting keeps the row order."""
+    for i in range(len(points)):
+        doc = {
+            "name": str(i),
+            "wrist": wrist[i].tolist(),
+            "contacts": [{"point": points[i, c].tolist(), "normal": normals[i, c].tolist()} for c in range(3)],
+            "twists": [{"name": "twist", "screw": twist[i].tolist()}],
+        }
+        if not np.any(normals[i, :, :].any(axis=1) == 0):
+            (folder / f"g{i:04d}.yaml").write_text(yaml.safe_dump(doc))
+
+
+def comparable(rec):
+    """The numbers and verdicts of a record, without its file name."""
+    out = {k: rec[k] for k in ("grasp", "twist", "contact_velocity", "ok")}
+    for method in ("off_tangent", "tangent"):
+        out[method] = rec[method]
+    return out
+
+
+def test_npz_gives_the_same_records_as_one_yaml_file_per_grasp(tmp_path, data):
+    points, normals, wrist, twist = data
+    np.savez(tmp_path / "set.npz", points=points, normals=normals, wrist=wrist, twist=twist, names=np.arange(N).astype(str))
+    folder = tmp_path / "files"
+    folder.mkdir()
+    write_yaml_files(folder, points, normals, wrist, twist)
+    from_arrays = jsonl(run("resolve", tmp_path / "set.npz", "-f", "jsonl"))
+    from_files = {r["grasp"]: r for r in jsonl(run("resolve", folder, "-f", "jsonl"))}
+    assert len(from_arrays) == N and len(from_files) == N - 1  # the zero normal cannot be written as a file
+    for rec in from_arrays:
+        if rec["grasp"] in from_files:
+            assert comparable(rec) == comparable(from_files[rec["grasp"]]), rec["grasp"]
+    codes = {r["grasp"]: (r["off_tangent"].get("error", {}).get("code"), r["tangent"].get("error", {}).get("code")) for r in from_arrays}
+    assert codes["3"] == ("wrist-coplanar", None)
+    assert codes["7"] == ("collinear-contacts", "collinear-contacts")
+    assert codes["11"] == ("coincident-contacts", "coincident-contacts")
+    assert codes["15"][0] is None and codes["15"][1] in {"normals-rank-deficient", "theta-not-unique", "theta-sigma-zero", "normal-in-contact-plane"}
+    assert codes["19"] == (None, "zero-normal")
+
+
+def test_npz_output_arrays_match_the_records_and_carry_a_status_legend(tmp_path, data):
+    points, normals, wrist, twist = data
+    np.savez(tmp_path / "set.npz", points=points, normals=normals, wrist=wrist, twist=twist)
+    r = run("resolve", tmp_path / "set.npz", "-f", "npz", "-o", tmp_path / "out.npz")
+    assert r.exit_code == 1  # degenerate rows fail; every row is still written
+    z = np.load(tmp_path / "out.npz")
+    off = gt.decompose_off_tangent(points, wrist, twist)
+    tan = gt.decompose_tangent(points, gt.screws.direction(normals), twist)  # unit as loaded
+    np.testing.assert_array_equal(z["x"], off.x)
+    np.testing.assert_array_equal(z["beta"], tan.beta)
+    np.testing.assert_array_equal(z["tangent_status"], tan.status)
+    np.testing.assert_array_equal(z["contact_velocity"], gt.contact_velocities(points, twist))
+    assert [z["status_legend"][s] for s in z["off_tangent_status"][[0, 3, 7]]] == ["ok", "wrist-coplanar", "collinear-contacts"]
+    assert z["grasp"][:3].tolist() == ["0", "1", "2"] and z["twist"].shape == (N, 6)
+    assert "5 records" not in r.stderr and r.stderr.strip().splitlines()[-1] == f"{N} records, 5 failed"
+
+
+def test_npy_rows_with_a_wrist_or_a_twist_point(tmp_path, data):
+    points, normals, wrist, twist = data
+    rows = np.concatenate([points.reshape(N, 9), normals.reshape(N, 9), wrist], axis=1)
+    np.save(tmp_path / "rows21.npy", rows)
+    np.save(tmp_path / "rows18.npy", rows[:, :18])
+    spin = "0,0,1,0,0.5,0"
+    screw = np.array([0, 0, 1, 0, 0.5, 0.0])
+    with_wrist = jsonl(run("resolve", tmp_path / "rows21.npy", "--twist", spin, "-f", "jsonl"))
+    off = gt.decompose_off_tangent(points, wrist, screw)
+    assert [r["off_tangent"].get("x") for r in with_wrist[:3]] == off.x[:3].tolist()
+    no_wrist = jsonl(run("resolve", tmp_path / "rows18.npy", "--twist", spin, "-f", "jsonl"))
+    assert all(r["off_tangent"] is None for r in no_wrist)
+    # the 19th-21st columns as the point whose velocity the twist's linear part gives
+    at = jsonl(run("resolve", tmp_path / "rows21.npy", "--twist", spin, "--extra-point", "at", "-f", "jsonl"))
+    moved = gt.screws.twist_at(screw[:3], screw[3:], wrist)
+    assert [r["twist"]["screw"] for r in at[:3]] == moved[:3].tolist()
+    np.testing.assert_allclose([r["contact_velocity"] for r in at[:3]], gt.contact_velocities(points[:3], moved[:3]))
+
+
+def test_several_twists_per_grasp_and_small_blocks_give_the_same_rows(tmp_path, data, monkeypatch):
+    points, normals, wrist, _ = data
+    np.savez(tmp_path / "set.npz", points=points[:20], normals=normals[:20], wrist=wrist[:20])
+    args = ("resolve", tmp_path / "set.npz", "--twist", "0,0,1,0,0,0", "--twist", "0,0,0,0,0,1", "-f", "jsonl")
+    whole = jsonl(run(*args))
+    monkeypatch.setattr(datasets, "ROWS_PER_BLOCK", 7)
+    assert jsonl(run(*args)) == whole
+    assert [(r["grasp"], r["twist"]["name"]) for r in whole[:4]] == [
+        ("0", "0,0,1,0,0,0"),
+        ("0", "0,0,0,0,0,1"),
+        ("1", "0,0,1,0,0,0"),
+        ("1", "0,0,0,0,0,1"),
+    ]
+
+
+def test_a_npy_is_read_through_a_memory_map(tmp_path, data):
+    points, normals, *_ = data
+    np.save(tmp_path / "rows.npy", np.concatenate([points.reshape(N, 9), normals.reshape(N, 9)], axis=1))
+    ds = datasets.open_dataset(str(tmp_path / "rows.npy"))
+    assert isinstance(ds.points.base, np.memmap) or isinstance(ds.points, np.memmap)
+    np.testing.assert_array_equal(ds.normals, normals)
+
+
+@pytest.mark.parametrize(
+    "arrays, fragment",
+    [
+        ({"points": np.zeros((4, 3, 2)), "normals": np.zeros((4, 3, 3))}, "points: expected shape (N, 3, 3), got (4, 3, 2)"),
+        ({"points": np.zeros((4, 3, 3))}, "missing array 'normals'"),
+        ({"points": np.zeros((4, 3, 3)), "normals": np.zeros((4, 3, 3)), "wrists": np.zeros((4, 3))}, "unknown array(s) wrists"),
+        ({"points": np.zeros((4, 3, 3)), "normals": np.zeros((5, 3, 3))}, "normals: 5 rows, but points has 4"),
+        ({"points": np.full((4, 3, 3), "a"), "normals": np.zeros((4, 3, 3))}, "points: expected numbers"),
+        ({"points": np.zeros((4, 3, 3)), "normals": np.zeros((4, 3, 3)), "twist": np.zeros(5)}, "twist: expected shape (N, 6)"),
+    ],
+)
+def test_bad_npz_files_fail_with_one_line(tmp_path, arrays, fragment):
+    np.savez(tmp_path / "bad.npz", **arrays)
+    r = run("resolve", tmp_path / "bad.npz", "--twist", "0,0,1,0,0,0", "-f", "jsonl")
+    assert r.exit_code == 1
+    [rec] = jsonl(r)
+    assert rec["error"]["code"] == "bad-dataset" and fragment in rec["error"]["message"]
+    assert f"{tmp_path / 'bad.npz'}: error: bad-dataset: " in r.stderr and "Traceback" not in r.output
+
+
+def test_a_file_that_is_not_numpy_and_a_wrong_row_length(tmp_path):
+    (tmp_path / "junk.npz").write_bytes(b"not a zip")
+    np.save(tmp_path / "rows.npy", np.zeros((3, 20)))
+    r = run("resolve", tmp_path / "junk.npz", tmp_path / "rows.npy", "--twist", "0,0,1,0,0,0", "-f", "jsonl")
+    codes = [(rec["error"]["code"], rec["error"]["message"]) for rec in jsonl(r)]
+    assert codes[0][0] == "read-error"
+    assert codes[1] == ("bad-dataset", "expected rows of 18 or 21 numbers (p1 p2 p3 n1 n2 n3 [point]), got shape (3, 20)")
