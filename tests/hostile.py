@@ -1,0 +1,108 @@
+"""Helpers shared by the hostile-input tests (corpus, sweeps, fuzzing): run the
+command line, read its JSON strictly, and check what must hold for any input."""
+
+import json
+import math
+import os
+import subprocess
+import sys
+import time
+import warnings
+from pathlib import Path
+
+from typer.testing import CliRunner
+
+from grasptwist.cli import app
+
+#: Fields of a record that may be null in an ``ok`` record: every other null
+#: would be a NaN that orjson wrote as null.
+NULLABLE = {"units", "off_tangent"}
+
+
+def run(*args, input=None):
+    """``grasptwist ARGS`` through typer's CliRunner; returns (result, seconds).
+
+    Python warnings issued during the run are kept in ``result.python_warnings``
+    (pytest would otherwise swallow them, or print them, depending on its plugins):
+    a user would see each as lines of noise on stderr.
+    """
+    start = time.monotonic()
+    with warnings.catch_warnings(record=True) as caught:
+        warnings.simplefilter("always")
+        result = CliRunner().invoke(app, [str(a) for a in args], input=input)
+    result.python_warnings = [f"{w.category.__name__}: {w.message}" for w in caught]
+    return result, time.monotonic() - start
+
+
+def entry_point():
+    """The installed ``grasptwist`` script (``python -m grasptwist`` where there is none)."""
+    exe = Path(sys.executable).parent / "grasptwist"
+    return [str(exe)] if exe.exists() else [sys.executable, "-m", "grasptwist"]
+
+
+def run_installed(*args, cwd=None, timeout=20):
+    """``grasptwist ARGS`` in a subprocess, colourless; returns (CompletedProcess, seconds)."""
+    env = {**os.environ, "NO_COLOR": "1"}
+    start = time.monotonic()
+    proc = subprocess.run(entry_point() + [str(a) for a in args], capture_output=True, text=True, cwd=cwd, env=env, timeout=timeout)
+    return proc, time.monotonic() - start
+
+
+def strict_json(text):
+    """``json.loads`` that refuses NaN and Infinity instead of reading them."""
+
+    def refuse(name):
+        raise AssertionError(f"{name} in JSON output")
+
+    return json.loads(text, parse_constant=refuse)
+
+
+def jsonl(text):
+    """The records of ``-f jsonl`` output, each checked by :func:`check_record`."""
+    records = [strict_json(line) for line in text.splitlines()]
+    for rec in records:
+        check_record(rec)
+    return records
+
+
+def check_record(rec):
+    """What holds for every record: an ``ok`` flag, and in an ok record no NaN
+    (written as null), no infinity and no error anywhere."""
+    assert isinstance(rec.get("ok"), bool), rec
+    if rec["ok"]:
+        _walk_finite(rec, "")
+        assert "error" not in rec
+
+
+def _walk_finite(value, key):
+    if value is None:
+        assert key in NULLABLE, f"null (a NaN?) at {key!r} in an ok record"
+    elif isinstance(value, float):
+        assert math.isfinite(value), f"{value} at {key!r} in an ok record"
+    elif isinstance(value, dict):
+        assert "error" not in value, f"error at {key!r} in an ok record"
+        for k, v in value.items():
+            _walk_finite(v, k)
+    elif isinstance(value, list):
+        for v in value:
+            _walk_finite(v, key)
+
+
+def error_codes(rec):
+    """Every error code in a record: the file's, or each failed method's."""
+    found = [rec["error"]["code"]] if "error" in rec else []
+    for method in ("off_tangent", "tangent"):
+        if isinstance(rec.get(method), dict) and "error" in rec[method]:
+            found.append(rec[method]["error"]["code"])
+    return found
+
+
+def error_lines(stderr):
+    """The diagnostic lines that report an error."""
+    return [line for line in stderr.splitlines() if ": error: " in line]
+
+
+def assert_no_crash(output):
+    """Nothing a user should never see: a traceback or the catch-all internal error."""
+    assert "Traceback" not in output, output[-2000:]
+    assert "internal error" not in output, output[-2000:]
