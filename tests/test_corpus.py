@@ -142,15 +142,8 @@ def _check_alone(row, path, exit_code, stdout, stderr, seconds, limit):
         assert f"{failed[0]['error']['line']}:{failed[0]['error']['column']}" == row.where
 
 
-OVERFLOW_WARNS = pytest.mark.xfail(
-    strict=True,
-    reason="decompose.py: the lazy `residual` (screws.cross via field_at) computes without np.errstate, "
-    "so 1e200 coordinates issue numpy RuntimeWarnings, printed with their source lines on stderr",
-)
-
-
 def _alone_case(row):
-    return pytest.param(row.file, row, id=row.file, marks=[OVERFLOW_WARNS] if row.file == "overflow-product.yaml" else [])
+    return pytest.param(row.file, row, id=row.file)
 
 
 @pytest.mark.parametrize("corpus_file, row", [_alone_case(r) for r in ROWS], indirect=["corpus_file"])
@@ -177,7 +170,6 @@ def test_hostile_files_through_the_installed_command(corpus_file, tmp_path):
     assert "\x1b" not in proc.stdout + proc.stderr  # no terminal control from a file reaches the terminal
 
 
-@OVERFLOW_WARNS
 def test_overflow_prints_no_python_warning(tmp_path):
     path = materialise("overflow-product.yaml", tmp_path)
     proc, _ = run_installed("resolve", path, "-f", "jsonl")
@@ -276,11 +268,6 @@ def test_a_mixed_folder_gives_each_file_exactly_what_it_gives_alone(mixed):
         assert by_file[str(folder / "good" / name)], name
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="inputs.py: a folder walk hands a named pipe (FIFO) called *.yaml to the loader, whose open() "
-    "blocks until a writer comes: the whole batch hangs (an explicit FIFO path is refused, as 'no such file')",
-)
 def test_a_named_pipe_in_a_folder_does_not_hang_the_batch(tmp_path):
     shutil.copyfile(BUNDLED / "sphere.yaml", tmp_path / "sphere.yaml")
     os.mkfifo(tmp_path / "pipe.yaml")
@@ -292,11 +279,6 @@ def test_a_named_pipe_in_a_folder_does_not_hang_the_batch(tmp_path):
     assert sum(r["file"].endswith("sphere.yaml") for r in records) == 5
 
 
-@pytest.mark.xfail(
-    strict=True,
-    reason="cli.py/report.py: the file's path is written raw into the diagnostic, so a file name holding a "
-    "newline splits its error over two lines, and an ESC in it reaches the terminal",
-)
 def test_a_file_name_cannot_split_or_colour_its_error_line(tmp_path):
     # File names come from whoever filled the folder; the loader cannot vet them as it vets names inside.
     bad = tmp_path / "two\nlines \x1b[31mred.yaml"

@@ -125,10 +125,10 @@ class _Result:
         Computed on first access from the returned screws and amplitudes;
         NaN in failed rows, 0 for the zero twist.
         """
-        r = sum(a.sum(axis=-2) for a in self.components()) - self.twist
-        err = np.max(norm(field_at(r[..., None, :], self.points)), axis=-1)
-        ref = np.max(norm(field_at(self.twist[..., None, :], self.points)), axis=-1)
-        with np.errstate(invalid="ignore", divide="ignore"):
+        with np.errstate(all="ignore"):  # failed rows hold NaN, overflowed ones inf
+            r = sum(a.sum(axis=-2) for a in self.components()) - self.twist
+            err = np.max(norm(field_at(r[..., None, :], self.points)), axis=-1)
+            ref = np.max(norm(field_at(self.twist[..., None, :], self.points)), axis=-1)
             return np.where(ref > 0, err / np.where(ref > 0, ref, 1.0), err)
 
 

@@ -30,7 +30,12 @@ def expand(paths: Iterable[str]) -> Iterator[str | GraspFileError]:
         elif os.path.isdir(path):
             yield from _walk(path)
         else:
-            yield _io_error(path, "no such file or folder")
+            yield _io_error(path, _not_a_file(path))
+
+
+def _not_a_file(path: str) -> str:
+    # a pipe, socket or device would block or never end: never open one
+    return "not a regular file (a pipe, socket or device)" if os.path.exists(path) else "no such file or folder"
 
 
 def _walk(top: str) -> Iterator[str | GraspFileError]:
@@ -50,7 +55,8 @@ def _walk(top: str) -> Iterator[str | GraspFileError]:
         dirs.sort()
         found.extend(os.path.join(folder, f) for f in files if f.endswith(GRASP_SUFFIXES))
     yield from errors
-    yield from sorted(found, key=lambda p: os.path.relpath(p, top).split(os.sep))
+    for path in sorted(found, key=lambda p: os.path.relpath(p, top).split(os.sep)):
+        yield path if os.path.isfile(path) else _io_error(path, _not_a_file(path))
 
 
 def read(path: str, max_bytes: int | None = None) -> list[Grasp | GraspFileError]:

@@ -192,17 +192,30 @@ def diagnostics(rec: dict) -> tuple[list[str], list[str]]:
     ``path: grasp 'g'[, twist 't']: error: method: code: message`` for a
     method that failed; the same with ``warning:`` for each warning.
     """
+    file = _printable(rec["file"])
     if "error" in rec:
         err = rec["error"]
-        where = ":".join(str(x) for x in (rec["file"], err["line"], err["column"]) if x is not None)
-        return [f"{where}: error: {err['code']}: {err['message']}"], []
-    where = f"{rec['file']}: grasp '{rec['grasp']}'" + (f", twist '{rec['twist']['name']}'" if "twist" in rec else "")
+        where = ":".join(str(x) for x in (file, err["line"], err["column"]) if x is not None)
+        return [f"{where}: error: {err['code']}: {_printable(err['message'])}"], []
+    where = f"{file}: grasp '{_printable(rec['grasp'])}'"
+    if "twist" in rec:
+        where += f", twist '{_printable(rec['twist']['name'])}'"
     errors = [
         f"{where}: error: {label}: {m['error']['code']}: {m['error']['message']}"
         for key, label in (("off_tangent", "off-tangent"), ("tangent", "tangent"))
         if isinstance(m := rec.get(key), dict) and "error" in m
     ]
     return errors, [f"{where}: warning: {w}" for w in rec["warnings"]]
+
+
+def _printable(text) -> str:
+    """``text`` with control and separator characters escaped: file and data-set
+    names come from whoever filled the folder, and a newline or an escape
+    sequence in one must not split a diagnostic or reach the terminal."""
+    text = str(text)
+    if text.isprintable():
+        return text
+    return "".join(c if c.isprintable() else c.encode("unicode_escape").decode("ascii") for c in text)
 
 
 def dumps(obj, indent: bool = False) -> bytes:
