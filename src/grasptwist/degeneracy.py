@@ -64,7 +64,7 @@ class Status(IntEnum):
 _MESSAGES = {
     Status.OK: "ok",
     Status.NONFINITE_INPUT: "the input holds NaN or infinity",
-    Status.COINCIDENT_CONTACTS: "contacts {j} and {k} coincide, so Sigma_{i} has no axis",
+    Status.COINCIDENT_CONTACTS: "contacts {j} and {k} coincide, so Sigma_{n} has no axis",
     Status.COLLINEAR_CONTACTS: "the contacts are collinear: {i} lies on the line through {j} and {k}",
     Status.WRIST_COPLANAR: (
         "the wrist lies in the plane of the contacts, so every [Sigma_i|Psi_i] is 0 (Proposition 1 needs it off the plane)"
@@ -72,11 +72,11 @@ _MESSAGES = {
     Status.ZERO_NORMAL: "the normal at contact {i} has zero length",
     Status.NORMALS_RANK_DEFICIENT: "the three normal lines have rank < 3, so the tangent twists are not a three-system",
     Status.THETA_NOT_UNIQUE: (
-        "Theta_{i} is not unique: the normals at {j} and {k} leave more than one axis through contact {i} "
+        "Theta_{n} is not unique: the normals at {j} and {k} leave more than one axis through contact {i} "
         "that keeps them in their tangent planes"
     ),
     Status.THETA_SIGMA_ZERO: (
-        "[Theta_{i}|Sigma_{i}] = 0: the axis of Theta_{i} meets or is parallel to the line through {j} and {k}"
+        "[Theta_{n}|Sigma_{n}] = 0: the axis of Theta_{n} (through contact {i}) meets or is parallel to the line through {j} and {k}"
     ),
     Status.OVERFLOW: "the numbers overflow double precision (coordinates or twist too large)",
     Status.NORMAL_IN_CONTACT_PLANE: (
@@ -93,8 +93,9 @@ def status_message(status, culprit=-1, names=("1", "2", "3")) -> str:
     ----------
     status : int or Status
     culprit : int
-        Contact index 0..2 the condition is about (``i`` in the message; ``j``
-        and ``k`` follow it cyclically), or -1.
+        Contact index 0..2 the condition is about (its name is ``i`` in the
+        message, ``j`` and ``k`` follow it cyclically, and basis screws are
+        numbered 1..3 by position), or -1.
     names : sequence of 3 str
         Contact names to use in the message.
 
@@ -102,7 +103,7 @@ def status_message(status, culprit=-1, names=("1", "2", "3")) -> str:
     'contacts 2 and 3 coincide, so Sigma_1 has no axis'
     """
     i = int(culprit) if int(culprit) >= 0 else 0
-    return _MESSAGES[Status(int(status))].format(i=names[i], j=names[(i + 1) % 3], k=names[(i + 2) % 3])
+    return _MESSAGES[Status(int(status))].format(i=names[i], j=names[(i + 1) % 3], k=names[(i + 2) % 3], n=i + 1)
 
 
 def conditioning_warning(conditioning, basis: str) -> str | None:
