@@ -181,12 +181,17 @@ def _verdict(rec, names):
     off = rec.get("off_tangent")
     if off and "error" not in off:
         amplitudes = list(off["x"]) + list(off["y"])
-        used = [f"Psi_{n} keeps finger {n} fixed" for n in _nonzero(names, off["y"], amplitudes)]
-        if used:
-            lines.append("off-tangent: " + "; ".join(used) + " while the other two move (a wrist rotation could do the same).")
+        held = _nonzero(names, off["y"], amplitudes)
         moved = _nonzero(names, off["x"], amplitudes)
+        if held:
+            lines.append(
+                f"off-tangent: Psi part: finger(s) {', '.join(held)} each held fixed in turn while the object "
+                "turns about the line from the wrist through it."
+            )
         if moved:
-            lines.append(f"off-tangent: Sigma_i moves finger i alone, about the line of the other two: finger(s) {', '.join(moved)}.")
+            lines.append(f"off-tangent: Sigma part: finger(s) {', '.join(moved)} each moved alone, about the line through the other two.")
+        elif held:
+            lines.append("off-tangent: the twist is a rotation about the wrist: the wrist alone could make it.")
     return lines
 
 
