@@ -168,7 +168,7 @@ _DEBUG = typer.Option(False, "--debug", help="Show the Python traceback of an in
 _JSON = typer.Option(False, "--json", help="Same as --format json.")
 
 
-_WORKERS = typer.Option(0, "-j", "--workers", min=0, help="Processes for folders of files (0: automatic, both cores for 256+ files).")
+_WORKERS = typer.Option(0, "-j", "--workers", min=0, help="Processes for big batches (0: every core, used for 256+ files or 8192+ data-set grasps).")
 _PATHS_HELP = "Grasp files (.yaml, .yml), data sets (.npz, .npy), folders (searched for *.yaml, *.yml) or - for stdin."
 _PATHS = typer.Argument(..., metavar="PATH...", help=_PATHS_HELP)
 
@@ -285,11 +285,9 @@ def _records_only(fmt: Format) -> Format:
     return fmt
 
 
-def _workers(requested: int, paths: list) -> int:
-    """Processes for a batch: both cores for a folder of files, one for a few."""
-    if requested > 0:
-        return requested
-    return min(os.cpu_count() or 1, 4) if len(paths) >= 256 else 1
+def _workers(requested: int) -> int:
+    """Processes: as asked, or every core (the pipeline uses them only for big batches)."""
+    return requested if requested > 0 else min(os.cpu_count() or 1, 8)
 
 
 def _emit(job, paths: list[str], output, quiet: bool, workers: int, **table_options) -> int:
@@ -305,7 +303,7 @@ def _emit(job, paths: list[str], output, quiet: bool, workers: int, **table_opti
             outputs = write_npz(job, inputs, out)
         else:
             w = writer(job.fmt, out, job.kind, **table_options)
-            outputs = run(job, inputs, _workers(workers, inputs))
+            outputs = run(job, inputs, _workers(workers))
         for o in outputs:
             if job.fmt != "npz":
                 for encoded in o.encoded:

@@ -129,8 +129,10 @@ def _open_npz(path, arrays):
     return Dataset(path, points, normals, wrist, None, twist, names)
 
 
-def dataset_blocks(ds: Dataset, twists: Sequence[Twist] | None, method: str, rows: int = ROWS_PER_BLOCK) -> Iterator[Block]:
-    """Resolve a data set a chunk of rows at a time.
+def dataset_blocks(
+    ds: Dataset, twists: Sequence[Twist] | None, method: str, rows: int | None = None, start: int = 0, stop: int | None = None
+) -> Iterator[Block]:
+    """Resolve the grasps ``start:stop`` of a data set, a chunk of ``rows`` rows at a time.
 
     Each grasp is paired with every twist of ``twists`` (the command line's)
     or else with the data set's own twist; with ``at`` points, a twist's
@@ -149,32 +151,38 @@ def dataset_blocks(ds: Dataset, twists: Sequence[Twist] | None, method: str, row
         )
     given = np.stack([t.screw for t in twists]) if twists is not None else None
     k = len(given) if given is not None else 1
-    for start in range(0, len(ds), max(1, rows // k)):
-        stop = min(len(ds), start + max(1, rows // k))
-        index = np.repeat(np.arange(start, stop), k)  # row-major: grasp, then its twists
-        if given is not None:
-            screw = np.tile(given, (stop - start, 1))
-            names = [t.name for t in twists] * (stop - start)
-        else:
-            own = np.asarray(ds.twist, dtype=float)
-            screw = np.broadcast_to(own, (stop - start, 6)) if own.ndim == 1 else own[start:stop]
-            names = ["twist"] * (stop - start)
-        if ds.at is not None:
-            at = np.asarray(ds.at[start:stop], dtype=float)[index - start]
-            screw = twist_at(screw[:, :3], screw[:, 3:], at)
-        label = ds.names[start:stop][index - start].astype(str).tolist() if ds.names is not None else index.astype(str).tolist()
-        wrist = None if ds.wrist is None else np.asarray(ds.wrist[start:stop], dtype=float)[index - start]
-        yield resolve_arrays(
-            np.asarray(ds.points[start:stop], dtype=float)[index - start],
-            # unit normals exactly as the grasp-file loader makes them
-            direction(np.asarray(ds.normals[start:stop], dtype=float))[index - start],
-            wrist,
-            np.ascontiguousarray(screw, dtype=float),
-            method,
-            file=ds.path,
-            grasp=label,
-            twist_name=names,
-        )
+    step = max(1, (rows or ROWS_PER_BLOCK) // k)
+    end = len(ds) if stop is None else min(stop, len(ds))
+    for first in range(start, end, step):
+        yield _block(ds, given, twists, method, first, min(end, first + step), k)
+
+
+def _block(ds, given, twists, method, start, stop, k):
+    """Rows ``start:stop`` of ``ds``, each paired with its ``k`` twists."""
+    index = np.repeat(np.arange(start, stop), k)  # row-major: grasp, then its twists
+    if given is not None:
+        screw = np.tile(given, (stop - start, 1))
+        names = [t.name for t in twists] * (stop - start)
+    else:
+        own = np.asarray(ds.twist, dtype=float)
+        screw = np.broadcast_to(own, (stop - start, 6)) if own.ndim == 1 else own[start:stop]
+        names = ["twist"] * (stop - start)
+    if ds.at is not None:
+        at = np.asarray(ds.at[start:stop], dtype=float)[index - start]
+        screw = twist_at(screw[:, :3], screw[:, 3:], at)
+    label = ds.names[start:stop][index - start].astype(str).tolist() if ds.names is not None else index.astype(str).tolist()
+    wrist = None if ds.wrist is None else np.asarray(ds.wrist[start:stop], dtype=float)[index - start]
+    return resolve_arrays(
+        np.asarray(ds.points[start:stop], dtype=float)[index - start],
+        # unit normals exactly as the grasp-file loader makes them
+        direction(np.asarray(ds.normals[start:stop], dtype=float))[index - start],
+        wrist,
+        np.ascontiguousarray(screw, dtype=float),
+        method,
+        file=ds.path,
+        grasp=label,
+        twist_name=names,
+    )
 
 
 class NpzWriter:

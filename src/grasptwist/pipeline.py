@@ -29,6 +29,9 @@ __all__ = ["Job", "Output", "run", "run_group", "blocks", "write_npz", "FILES_PE
 #: Grasp files per group: enough rows for the engine's vectors, small enough to stream.
 FILES_PER_GROUP = 64
 
+#: Records built and encoded at once (and per output written, for data sets).
+RECORDS_AT_ONCE = 2048
+
 
 @dataclass(frozen=True)
 class Job:
@@ -68,16 +71,22 @@ def run(job: Job, paths: Sequence, workers: int = 1) -> Iterator[Output]:
     and errors found while listing folders."""
     groups = list(_groups(paths))
     files = [g for g in groups if not _is_dataset(g)]
-    if workers > 1 and len(files) > 1 and not any(STDIN in g for g in files):
-        import multiprocessing
-
-        with multiprocessing.get_context("fork").Pool(workers) as pool:
+    # a pool pays for itself from a few groups on; stdin is the parent's to read
+    if workers > 1 and len(files) >= 4 and not any(STDIN in g for g in files):
+        with _pool(workers) as pool:
             done = pool.imap(partial(run_group, job), files)
             for g in groups:
-                yield from (_dataset(job, g) if _is_dataset(g) else [next(done)])
+                yield from (_dataset(job, g, workers) if _is_dataset(g) else [next(done)])
         return
     for g in groups:
-        yield from (_dataset(job, g) if _is_dataset(g) else [run_group(job, g)])
+        yield from (_dataset(job, g, workers) if _is_dataset(g) else [run_group(job, g)])
+
+
+def _pool(workers):
+    import multiprocessing
+
+    # fork: workers start at once and share the parent's open data set
+    return multiprocessing.get_context("fork").Pool(workers)
 
 
 def run_group(job: Job, paths: Sequence) -> Output:
@@ -112,27 +121,65 @@ def _emit(job: Job, x, out: Output) -> None:
     if not isinstance(x, Block):
         out.add(error_record(x), encode)
     elif job.kind == "resolve":
-        for rec in records(x, job.order):
-            out.add(rec, encode)
+        # a few thousand records at a time: their floats as Python objects
+        # would otherwise fill memory and keep the garbage collector busy
+        for start in range(0, len(x), RECORDS_AT_ONCE):
+            for rec in records(x.part(start, start + RECORDS_AT_ONCE), job.order):
+                out.add(rec, encode)
     else:
         for i in range(len(x)):
             out.add(basis_record(x, i, job.order) if job.kind == "basis" else check_record(x, i), encode)
 
 
-def _dataset(job: Job, path: str) -> Iterator[Output]:
-    """A data set's outputs, a block of rows each; the first one counts the input."""
-    twists = [ZERO_TWIST] if job.kind != "resolve" else job.twists
-    first = True
+#: The data set being resolved, for the workers forked to share it.
+_SHARED: dict = {}
+
+#: Grasps per task when a data set is spread over processes.
+GRASPS_PER_TASK = 8192
+
+
+def _dataset(job: Job, path: str, workers: int = 1) -> Iterator[Output]:
+    """A data set's outputs, a few thousand records each; the first one counts the input."""
     try:
-        for block in dataset_blocks(open_dataset(path, job.extra_point), twists, job.method):
-            out = Output(inputs=int(first))
-            _emit(job, block, out)
-            first = False
-            yield out
+        ds = open_dataset(path, job.extra_point)
+        if job.twists is None and ds.twist is None and job.kind == "resolve":
+            next(dataset_blocks(ds, None, job.method))  # raises the no-twist error
     except GraspFileError as err:
-        out = Output(inputs=int(first))
+        out = Output(inputs=1)
         _emit(job, err, out)
         yield out
+        return
+    tasks = [(start, min(len(ds), start + GRASPS_PER_TASK)) for start in range(0, len(ds), GRASPS_PER_TASK)]
+    _SHARED["dataset"] = ds
+    try:
+        if workers > 1 and len(tasks) > 1:
+            with _pool(workers) as pool:
+                parts = pool.imap(partial(_dataset_task, job), tasks)
+                yield from _counted(parts)
+        else:
+            yield from _counted(_dataset_task(job, t) for t in tasks)
+    finally:
+        _SHARED.clear()
+
+
+def _counted(parts):
+    first = True
+    for outs in parts:
+        for out in outs:
+            out.inputs, first = int(first), False
+            yield out
+
+
+def _dataset_task(job: Job, rows: tuple[int, int]) -> list[Output]:
+    """Records of the data set's grasps ``rows``, in outputs of RECORDS_AT_ONCE."""
+    twists = [ZERO_TWIST] if job.kind != "resolve" else job.twists
+    outs = []
+    for block in dataset_blocks(_SHARED["dataset"], twists, job.method, start=rows[0], stop=rows[1]):
+        for start in range(0, len(block), RECORDS_AT_ONCE):
+            out = Output()
+            _emit(job, block.part(start, start + RECORDS_AT_ONCE), out)
+            outs.append(out)
+    return outs
 
 
 def _is_dataset(group) -> bool:

@@ -20,7 +20,7 @@ import numpy as np
 import orjson
 
 from .batch import Block
-from .degeneracy import Status, conditioning_warning, status_message
+from .degeneracy import CONDITION_WARNING, Status, conditioning_warning, status_message
 from .grasp_file import GraspFileError
 from .screws import klein_table
 
@@ -87,12 +87,13 @@ def _columns(result, order, *names):
 
 
 def _method(cols, i, names, label, warnings):
-    status = cols["status"][i]
-    if status != Status.OK:
-        return _failure(status, cols["culprit"][i], names)
-    _warn(warnings, cols["conditioning"][i], label)
+    if cols["status"][i]:
+        return _failure(cols["status"][i], cols["culprit"][i], names)
+    conditioning = cols["conditioning"][i]
+    if conditioning < CONDITION_WARNING:
+        warnings.append(conditioning_warning(conditioning, label))
     m = {n: cols[n][i] for n in cols["_fields"]}
-    m["conditioning"] = cols["conditioning"][i]
+    m["conditioning"] = conditioning
     m["residual"] = cols["residual"][i]
     return m
 
@@ -192,6 +193,8 @@ def diagnostics(rec: dict) -> tuple[list[str], list[str]]:
     ``path: grasp 'g'[, twist 't']: error: method: code: message`` for a
     method that failed; the same with ``warning:`` for each warning.
     """
+    if rec["ok"] and not rec.get("warnings"):
+        return [], []
     file = _printable(rec["file"])
     if "error" in rec:
         err = rec["error"]
