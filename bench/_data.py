@@ -19,3 +19,34 @@ def grasp_arrays(n, seed=0):
     wrist = centre[:, 0] + rng.normal(size=(n, 3)) + [0, 0, 2.0]
     twist = rng.normal(size=(n, 6))
     return points, normals, wrist, twist
+
+
+def save_npz(path, n, seed=0):
+    """A data set of ``n`` grasps as the ``.npz`` that ``grasptwist resolve`` reads."""
+    points, normals, wrist, twist = grasp_arrays(n, seed)
+    np.savez(path, points=points, normals=normals, wrist=wrist, twist=twist)
+
+
+def timed(command, repeats=1):
+    """Best wall-clock time of a shell-less command, in seconds; it must succeed (exit 0 or 1)."""
+    import subprocess
+    import time
+
+    best = float("inf")
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        done = subprocess.run(command, stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+        best = min(best, time.perf_counter() - t0)
+        if done.returncode not in (0, 1):
+            raise SystemExit(f"{' '.join(map(str, command))} failed: {done.stderr.decode()[-500:]}")
+    return best
+
+
+def grasptwist_command():
+    """The installed ``grasptwist`` script next to this interpreter (else ``python -m grasptwist``)."""
+    import shutil
+    import sys
+    from pathlib import Path
+
+    script = Path(sys.executable).parent / "grasptwist"
+    return [str(script)] if script.exists() else [shutil.which("grasptwist") or sys.executable, *([] if shutil.which("grasptwist") else ["-m", "grasptwist"])]
