@@ -259,3 +259,17 @@ def test_installed_entry_point_in_a_subprocess(files):
     p = subprocess.run(cmd + ["resolve", str(files / "cyl.yaml"), "-f", "csv"], capture_output=True, text=True, timeout=60)
     assert p.returncode == 1 and "Traceback" not in p.stderr
     assert list(csv.reader(io.StringIO(p.stdout)))[1][3] == "false"
+
+
+def test_two_workers_write_exactly_what_one_writes(files, monkeypatch):
+    from grasptwist import pipeline
+
+    for i in range(9):
+        (files / f"more{i}.yaml").write_text(POLY.replace("name: poly", f"name: poly{i}"))
+    (files / "more5.yaml").write_text("contacts: [\n")  # a bad file among them
+    monkeypatch.setattr(pipeline, "FILES_PER_GROUP", 2)  # 6 groups: enough for the pool
+    one = run("resolve", files, "-f", "jsonl", "-j", "1")
+    two = run("resolve", files, "-f", "jsonl", "-j", "2")
+    assert two.exit_code == one.exit_code == 1
+    assert two.stdout == one.stdout and two.stderr == one.stderr
+    assert len(one.stdout.splitlines()) == 2 + 1 + 16 + 1  # poly, cyl, 8 good files x 2 twists, the bad one

@@ -164,3 +164,15 @@ def test_a_file_that_is_not_numpy_and_a_wrong_row_length(tmp_path):
     codes = [(rec["error"]["code"], rec["error"]["message"]) for rec in jsonl(r)]
     assert codes[0][0] == "read-error"
     assert codes[1] == ("bad-dataset", "expected rows of 18 or 21 numbers (p1 p2 p3 n1 n2 n3 [point]), got shape (3, 20)")
+
+
+def test_a_data_set_over_two_workers_gives_the_same_output(tmp_path, data, monkeypatch):
+    from grasptwist import pipeline
+
+    points, normals, wrist, twist = data
+    np.savez(tmp_path / "set.npz", points=points, normals=normals, wrist=wrist, twist=twist)
+    monkeypatch.setattr(pipeline, "GRASPS_PER_TASK", 50)
+    monkeypatch.setattr(pipeline, "RECORDS_AT_ONCE", 17)
+    one = run("resolve", tmp_path / "set.npz", "-f", "jsonl", "-j", "1")
+    two = run("resolve", tmp_path / "set.npz", "-f", "jsonl", "-j", "2")
+    assert two.stdout == one.stdout and two.stderr == one.stderr and len(jsonl(one)) == N
