@@ -273,3 +273,28 @@ def test_two_workers_write_exactly_what_one_writes(files, monkeypatch):
     assert two.exit_code == one.exit_code == 1
     assert two.stdout == one.stdout and two.stderr == one.stderr
     assert len(one.stdout.splitlines()) == 2 + 1 + 16 + 1  # poly, cyl, 8 good files x 2 twists, the bad one
+
+
+def test_a_progress_bar_on_a_terminal_and_only_there(files):
+    import pty
+
+    exe = Path(sys.executable).parent / "grasptwist"
+    cmd = [str(exe)] if exe.exists() else [sys.executable, "-m", "grasptwist"]
+    out = files / "out.jsonl"
+    main, child = pty.openpty()
+    proc = subprocess.run(cmd + ["resolve", str(files), "-f", "jsonl", "-o", str(out)], stderr=child, timeout=60)
+    os.close(child)
+    seen = b""
+    while True:
+        try:
+            chunk = os.read(main, 65536)
+        except OSError:
+            break
+        if not chunk:
+            break
+        seen += chunk
+    os.close(main)
+    assert proc.returncode == 1 and b"resolving" in seen and b"3 records, 1 failed" in seen
+    assert len(out.read_text().splitlines()) == 3
+    piped = subprocess.run(cmd + ["resolve", str(files), "-f", "jsonl"], capture_output=True, timeout=60)
+    assert b"resolving" not in piped.stderr and b"\x1b[" not in piped.stderr
