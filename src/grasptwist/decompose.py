@@ -103,8 +103,27 @@ def contact_velocities(points, twist):
     return _chunked(_velocity_rows, inputs, {"velocity": (3, 3)}, None)["velocity"]
 
 
+@dataclass(frozen=True, eq=False)
 class _Result:
-    """What both results share: row access and the lazily computed residual."""
+    """What both results share: per-row status, conditioning and inputs, row
+    access and the lazily computed residual.
+
+    Attributes
+    ----------
+    status, culprit : (...) int8
+        :class:`~grasptwist.degeneracy.Status` of each row and the contact it
+        is about (0..2, or -1).
+    conditioning : (...)
+        The method's dimensionless conditioning figure (see each result).
+    points, twist : (..., 3, 3), (..., 6)
+        The inputs, broadcast to the batch shape.
+    """
+
+    status: np.ndarray
+    culprit: np.ndarray
+    conditioning: np.ndarray
+    points: np.ndarray
+    twist: np.ndarray
 
     @property
     def ok(self) -> np.ndarray:
@@ -145,15 +164,12 @@ class OffTangentResult(_Result):
         ``[Sigma_i | Psi_i]`` (eq. 14's denominators; a length).
     x, y : (..., 3)
         Amplitudes, eq. 14.  NaN where ``status != 0``.
-    status, culprit : (...) int8
-        :class:`~grasptwist.degeneracy.Status` and the contact it is about.
     conditioning : (...)
         ``min_i |[Sigma_i|Psi_i]| / size`` (dimensionless; size = longest
         side of the contact triangle).
-    points, twist : (..., 3, 3), (..., 6)
-        The inputs, for :attr:`residual`.
-    residual : (...)
-        See :attr:`_Result.residual`.
+
+    ``status``, ``culprit``, ``points``, ``twist`` and ``residual`` are as in
+    every result (``_Result``).
     """
 
     sigma: np.ndarray
@@ -161,11 +177,6 @@ class OffTangentResult(_Result):
     sigma_psi: np.ndarray
     x: np.ndarray
     y: np.ndarray
-    status: np.ndarray
-    culprit: np.ndarray
-    conditioning: np.ndarray
-    points: np.ndarray
-    twist: np.ndarray
 
     def components(self):
         """The component twists ``(x_i Sigma_i, y_i Psi_i)``, each ``(..., 3, 6)``."""
@@ -197,14 +208,13 @@ class TangentResult(_Result):
     in_tangent_planes : (...) bool
         Every normal velocity is zero to ``IN_PLANE_TOL`` relative to the
         contacts' speeds: ``T`` is realisable by tangent sliding alone.
-    status, culprit : (...) int8
-        As in :class:`OffTangentResult`.
     conditioning : (...)
         The smaller of ``min_i |[Theta_i|Sigma_i]| / size`` and of
         ``min_i |sin|`` of the angle between normal ``i`` and the contacts'
         plane; both go to 0 at every degenerate grasp.
-    points, twist : (..., 3, 3), (..., 6)
-        The inputs, for :attr:`residual` and :meth:`contact_split`.
+
+    ``status``, ``culprit``, ``points``, ``twist`` and ``residual`` are as in
+    every result (``_Result``).
     """
 
     theta: np.ndarray
@@ -214,11 +224,6 @@ class TangentResult(_Result):
     beta: np.ndarray
     normal_velocity: np.ndarray
     in_tangent_planes: np.ndarray
-    status: np.ndarray
-    culprit: np.ndarray
-    conditioning: np.ndarray
-    points: np.ndarray
-    twist: np.ndarray
 
     def components(self):
         """The component twists ``(alpha_i Theta_i, beta_i Sigma_i)``, each ``(..., 3, 6)``."""
