@@ -28,6 +28,11 @@ compose or construct.  Doing the composition ourselves lets us
 The two parsers report the same events and marks, so results and error
 positions do not depend on whether libyaml is installed; only the wording
 of YAML syntax errors differs between them.
+
+For speed, a plainly written valid document is first read straight from
+its events into floats and strings (``_fast_document``); at anything it is
+not sure of, the document's recorded events go through the general path
+above, which gives every error.  Both paths give the same grasps.
 """
 
 from __future__ import annotations
@@ -37,6 +42,7 @@ import os
 import re
 import sys
 from dataclasses import dataclass
+from itertools import chain
 from pathlib import Path
 
 import numpy as np
@@ -284,15 +290,40 @@ def _read_file(path, max_bytes):
     """
     try:
         if isinstance(path, str) and path == "-":
-            return sys.stdin.buffer.read(max_bytes + 1)
+            return _read_capped(sys.stdin.buffer, max_bytes + 1)
         with open(path, "rb") as handle:
-            return handle.read(max_bytes + 1)
+            return _read_capped(handle, max_bytes + 1)
     except OSError as exc:
         raise _Reject("read-error", "", f"cannot read: {exc.strerror or exc}") from None
 
 
+_CHUNK = 1 << 16
+
+
+def _read_capped(handle, limit):
+    """``handle.read(limit)``, in chunks: reading a small file with a 1 MiB
+    ``limit`` allocates (and frees) a 1 MiB buffer each time, which costs
+    more than parsing the file."""
+    if type(limit) is not int or limit <= _CHUNK:
+        return handle.read(limit)
+    data = handle.read(_CHUNK)
+    if len(data) < _CHUNK:  # a short read of a blocking stream: its end
+        return data
+    parts = [data]
+    limit -= _CHUNK
+    while limit > 0:
+        data = handle.read(min(limit, _CHUNK))
+        if not data:
+            break
+        parts.append(data)
+        limit -= len(data)
+    return b"".join(parts)
+
+
 # What PyYAML's and libyaml's readers refuse (YAML 1.1 "printable").
 _NON_PRINTABLE = re.compile("[^\x09\x0a\x0d\x20-\x7e\x85\xa0-\ud7ff\ue000-\ufffd\U00010000-\U0010ffff]")
+
+_ASCII_PRINTABLE = b"\t\n\r" + bytes(range(0x20, 0x7F))
 
 
 def _decode(data):
@@ -313,6 +344,10 @@ def _decode(data):
             line=data.count(b"\n", 0, exc.start) + 1,
             column=column,
         ) from None
+    # Most files are ASCII: deleting their allowed bytes is ~10x quicker
+    # than the search, which then runs only to locate a culprit.
+    if data.isascii() and not data.translate(None, _ASCII_PRINTABLE):
+        return text
     bad = _NON_PRINTABLE.search(text)
     if bad:
         pos = bad.start()
@@ -479,8 +514,8 @@ _STARTS = {yaml.MappingStartEvent: "mapping", yaml.SequenceStartEvent: "sequence
 _ENDS = (yaml.MappingEndEvent, yaml.SequenceEndEvent)
 
 
-def _compose(parser):
-    """Node tree of one document, read up to and including its end event.
+def _compose(get_event):
+    """Node tree of one document, read (``get_event()``) up to and including its end event.
 
     Returns the root node, or the document's first problem as a
     ``_Reject``; after a problem the document's remaining events are only
@@ -491,7 +526,7 @@ def _compose(parser):
     root = problem = None
     depth = 0
     while True:
-        event = parser.get_event()
+        event = get_event()
         kind = type(event)
         if kind is yaml.DocumentEndEvent:
             return problem or root
@@ -568,19 +603,300 @@ def _check_key(key, mapping, stack):
 
 
 # --------------------------------------------------------------------------
+# Events -> grasp, for plain valid documents.
+#
+# Nearly every document read is a valid grasp written plainly: no tags,
+# numbers as plain decimal scalars.  ``_fast_document`` reads such a document
+# straight from its events into strings and floats, without a node tree or
+# the general checks, and is several times quicker.  At the first thing it
+# does not take for certain (a tag, an alias, a non-decimal or non-finite
+# number, a null, an unknown, repeated or missing key, a wrong count, a
+# repeated or invalid name, deeper nesting than a grasp has, an overflow...)
+# it raises ``_Bail``; ``_read_text`` then composes the document again from
+# its recorded events with ``_compose`` and checks it with ``_grasp``, which
+# give every error and its position.  So the fast path returns a grasp only
+# where the general one returns the same grasp, bit for bit
+# (tests/test_grasp_file_speed_paths.py compares the two).
+
+
+class _Bail(Exception):
+    """Internal: the fast path leaves this document to the general one."""
+
+
+_ScalarEvent = yaml.ScalarEvent
+_SequenceStart = yaml.SequenceStartEvent
+_SequenceEnd = yaml.SequenceEndEvent
+_MappingStart = yaml.MappingStartEvent
+_MappingEnd = yaml.MappingEndEvent
+
+# The plain scalars _resolve_plain reads as a decimal int or float.  For
+# them float(text) is the value _number gives (both round correctly), except
+# that an integer "-0" is int 0, so 0.0 rather than -0.0.
+_DECIMAL = re.compile(r"[-+]?(?:\.[0-9]+|[0-9]+(?:\.[0-9]*)?)(?:[eE][-+]?[0-9]+)?")
+_NULLS = frozenset(word for word, value in _PLAIN_WORDS.items() if value is None)
+_INF = math.inf
+_ZERO = (0.0, 0.0, 0.0)
+
+
+def _fast_document(get, keep):
+    """A plain valid document's ``_Parts``, from the events after its start.
+
+    ``get()`` gives the next event; each one read is passed to ``keep``.
+    """
+    event = get()
+    keep(event)
+    if type(event) is not _MappingStart or event.tag is not None:
+        raise _Bail
+    name = units = wrist = contacts = None
+    twists = ()
+    seen = []
+    while True:
+        event = get()
+        keep(event)
+        if type(event) is not _ScalarEvent:
+            if type(event) is _MappingEnd:
+                break
+            raise _Bail
+        key = event.value
+        if event.tag is not None or key in seen:
+            raise _Bail
+        seen.append(key)
+        if key == "contacts":
+            contacts = _fast_contacts(get, keep)
+        elif key == "twists":
+            twists = _fast_twists(get, keep)
+        elif key == "wrist":
+            wrist = _fast_vector(get, keep, 3)
+        elif key == "name":
+            name = _fast_name(get, keep)
+        elif key == "units":
+            units = _fast_name(get, keep)
+        else:
+            raise _Bail
+    if contacts is None:
+        raise _Bail
+    event = get()
+    keep(event)
+    if type(event) is not yaml.DocumentEndEvent:
+        raise _Bail
+    return _Parts(name, units, wrist, contacts, twists)
+
+
+def _fast_name(get, keep):
+    """What ``_name`` returns for the next node, if it accepts it."""
+    event = get()
+    keep(event)
+    if type(event) is not _ScalarEvent or event.tag is not None:
+        raise _Bail
+    text = event.value
+    if (event.implicit[0] and text in _NULLS) or not text.strip() or _NOT_IN_A_NAME.search(text):
+        raise _Bail
+    return text
+
+
+def _fast_vector(get, keep, length):
+    """What ``_vector`` returns for the next node, if it is a flat list of
+    ``length`` plain decimal finite numbers."""
+    event = get()
+    keep(event)
+    if type(event) is not _SequenceStart or event.tag is not None:
+        raise _Bail
+    values = []
+    for _ in range(length):
+        event = get()
+        keep(event)
+        if type(event) is not _ScalarEvent or event.tag is not None or not event.implicit[0]:
+            raise _Bail
+        text = event.value
+        if _DECIMAL.fullmatch(text) is None:
+            raise _Bail
+        value = float(text)
+        if not -_INF < value < _INF:
+            raise _Bail
+        if not value and text[0] == "-":
+            value = float(_resolve_plain(text))  # -0 is the int 0
+        values.append(value)
+    event = get()
+    keep(event)
+    if type(event) is not _SequenceEnd:
+        raise _Bail
+    return values
+
+
+def _fast_contacts(get, keep):
+    """``_contacts`` for the next node, with the normals made unit."""
+    event = get()
+    keep(event)
+    if type(event) is not _SequenceStart or event.tag is not None:
+        raise _Bail
+    names, points, normals = [], [], []
+    while True:
+        event = get()
+        keep(event)
+        if type(event) is not _MappingStart:
+            if type(event) is _SequenceEnd:
+                break
+            raise _Bail
+        if event.tag is not None or len(names) == 3:
+            raise _Bail
+        name = point = normal = None
+        while True:
+            event = get()
+            keep(event)
+            if type(event) is not _ScalarEvent:
+                if type(event) is _MappingEnd:
+                    break
+                raise _Bail
+            key = event.value
+            if event.tag is not None:
+                raise _Bail
+            if key == "point" and point is None:
+                point = _fast_vector(get, keep, 3)
+            elif key == "normal" and normal is None:
+                normal = _fast_vector(get, keep, 3)
+            elif key == "name" and name is None:
+                name = _fast_name(get, keep)
+            else:
+                raise _Bail
+        if point is None or normal is None or not any(normal):
+            raise _Bail
+        if name is None:
+            name = str(len(names) + 1)
+        if name in names:
+            raise _Bail
+        names.append(name)
+        points.append(point)
+        normals.append(_unit_normal(*normal))
+    if len(names) != 3:
+        raise _Bail
+    return tuple(names), points, normals
+
+
+def _unit_normal(x, y, z):
+    """``_contacts``'s normalisation of a non-zero finite vector in floats:
+    the same operations as ``screws.unit(a / np.abs(a).max())``, in the same
+    order, so the same IEEE results."""
+    big = max(abs(x), abs(y), abs(z))
+    x /= big
+    y /= big
+    z /= big
+    length = math.sqrt(x * x + y * y + z * z)
+    return [x / length, y / length, z / length]
+
+
+def _fast_twists(get, keep):
+    """``_twists`` for the next node, as ``(name, screw list, line)`` tuples."""
+    event = get()
+    keep(event)
+    if type(event) is not _SequenceStart or event.tag is not None:
+        raise _Bail
+    names, twists = [], []
+    while True:
+        event = get()
+        keep(event)
+        if type(event) is not _MappingStart:
+            if type(event) is _SequenceEnd:
+                break
+            raise _Bail
+        if event.tag is not None:
+            raise _Bail
+        line = event.start_mark.line + 1
+        fields = {}
+        while True:
+            event = get()
+            keep(event)
+            if type(event) is not _ScalarEvent:
+                if type(event) is _MappingEnd:
+                    break
+                raise _Bail
+            key = event.value
+            if event.tag is not None or key in fields:
+                raise _Bail
+            if key == "angular" or key == "linear" or key == "at":
+                fields[key] = _fast_vector(get, keep, 3)
+            elif key == "name":
+                fields[key] = _fast_name(get, keep)
+            elif key == "screw":
+                fields[key] = _fast_vector(get, keep, 6)
+            else:
+                raise _Bail
+        name = fields.pop("name", None)
+        if name is None:
+            name = str(len(names) + 1)
+        if name in names:
+            raise _Bail
+        screw = fields.get("screw")
+        if screw is not None:
+            if len(fields) != 1:
+                raise _Bail
+            w0, w1, w2, u0, u1, u2 = screw
+            p0, p1, p2 = _ZERO
+        elif "angular" in fields or "linear" in fields:
+            w0, w1, w2 = fields.get("angular", _ZERO)
+            u0, u1, u2 = fields.get("linear", _ZERO)
+            p0, p1, p2 = fields.get("at", _ZERO)
+        else:
+            raise _Bail
+        # screws.twist_at: velocity - cross(omega, at), term by term.
+        v0 = u0 - (w1 * p2 - w2 * p1)
+        v1 = u1 - (w2 * p0 - w0 * p2)
+        v2 = u2 - (w0 * p1 - w1 * p0)
+        if not (-_INF < v0 < _INF and -_INF < v1 < _INF and -_INF < v2 < _INF):
+            raise _Bail
+        names.append(name)
+        twists.append((name, [w0, w1, w2, v0, v1, v2], line))
+    return twists
+
+
+class _Parts:
+    """What ``_fast_document`` read; ``grasp`` makes it a Grasp."""
+
+    __slots__ = ("name", "units", "wrist", "contacts", "twists")
+
+    def __init__(self, name, units, wrist, contacts, twists):
+        self.name = name
+        self.units = units
+        self.wrist = wrist
+        self.contacts = contacts
+        self.twists = twists
+
+    def grasp(self, *, file, document, name, line):
+        contact_names, points, normals = self.contacts
+        return Grasp(
+            name=name,
+            units=self.units,
+            file=file,
+            document=document,
+            contact_names=contact_names,
+            points=_readonly(points),
+            normals=_readonly(normals),
+            wrist=None if self.wrist is None else _readonly(self.wrist),
+            twists=tuple(Twist(twist, _readonly(screw), twist_line) for twist, screw, twist_line in self.twists),
+            line=line,
+        )
+
+
+# --------------------------------------------------------------------------
 # Stream -> grasps.
 
 
 def _read_text(text, file):
     """Parse ``text`` and turn each document into a Grasp or an error."""
-    roots = []  # (start line, root node or _Reject), one per complete document
+    roots = []  # (start line, _Parts, root node or _Reject), one per complete document
     stop = None
     parser = _LOADER(text)
+    get_event = parser.get_event
     try:
-        parser.get_event()  # StreamStartEvent
+        get_event()  # StreamStartEvent
         while not parser.check_event(yaml.StreamEndEvent):
-            start = parser.get_event()  # DocumentStartEvent
-            roots.append((start.start_mark.line + 1, _compose(parser)))
+            start = get_event()  # DocumentStartEvent
+            events = []
+            try:
+                root = _fast_document(get_event, events.append)
+            except _Bail:
+                # The general composer, from the document's first event.
+                root = _compose(chain(events, iter(get_event, None)).__next__)
+            roots.append((start.start_mark.line + 1, root))
     except _StreamStop as reject:
         stop = reject
     except yaml.YAMLError as exc:
@@ -590,11 +906,19 @@ def _read_text(text, file):
     if not roots and stop is None:
         return [GraspFileError("empty-document", "no YAML document in the file", file)]
     several = len(roots) + (stop is not None) > 1
-    stem = Path(file).stem
+    stem = None  # Path(file).stem, only if a grasp has no name of its own
     entries = []
     for document, (line, root) in enumerate(roots):
-        name = f"{stem}#{document + 1}" if several else stem
+        if type(root) is _Parts and root.name is not None:
+            name = root.name
+        else:
+            if stem is None:
+                stem = Path(file).stem
+            name = f"{stem}#{document + 1}" if several else stem
         try:
+            if type(root) is _Parts:
+                entries.append(root.grasp(file=file, document=document, name=name, line=line))
+                continue
             if isinstance(root, _Reject):
                 raise root
             entries.append(_grasp(root, file=file, document=document, name=name, line=line))

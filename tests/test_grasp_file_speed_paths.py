@@ -1,0 +1,284 @@
+"""The loader's two paths give the same: the fast one (``_fast_document``,
+plain valid documents straight from the events) and the general one
+(``_compose`` + ``_grasp``, every document, every error).
+
+Each input is read twice, once as the loader does it and once with the fast
+path switched off, and the entries are compared field by field, arrays bit
+for bit.  Also: the fast path is really taken for ordinary grasps (else the
+loader is slow without failing a test), and the chunked capped read.
+"""
+
+import io
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+import yaml
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+from grasptwist import grasp_file
+from grasptwist.grasp_file import Grasp, GraspFileError, read_grasps
+
+TESTS = Path(__file__).parent
+FILES = sorted(
+    path
+    for folder in (TESTS.parent / "grasps", TESTS / "invalid_grasps", TESTS / "corpus")
+    if folder.is_dir()
+    for path in folder.rglob("*.yaml")
+)
+LOADERS = [yaml.SafeLoader] + ([yaml.CSafeLoader] if yaml.__with_libyaml__ else [])
+
+CONTACTS = """\
+contacts:
+  - point: [1, 0, 0]
+    normal: [-1, 0, 0]
+  - point: [-0.5, 0.866, 0]
+    normal: [0.5, -0.866, 0]
+  - point: [-0.5, -0.866, 0]
+    normal: [0.5, 0.866, 0]
+"""
+
+
+@pytest.fixture(params=LOADERS, ids=lambda loader: loader.__name__)
+def loader(request, monkeypatch):
+    monkeypatch.setattr(grasp_file, "_LOADER", request.param)
+    return request.param
+
+
+def _general_only(get, keep):
+    raise grasp_file._Bail
+
+
+def _array(a):
+    return None if a is None else (a.dtype.str, a.shape, a.tobytes(), a.flags.writeable, a.flags.c_contiguous)
+
+
+def signature(entries):
+    out = []
+    for e in entries:
+        if isinstance(e, GraspFileError):
+            out.append(("error", e.code, e.message, e.file, e.line, e.column, e.document, str(e)))
+        else:
+            assert type(e) is Grasp
+            twists = tuple((t.name, _array(t.screw), t.line) for t in e.twists)
+            out.append(
+                ("grasp", e.name, e.units, e.file, e.document, e.contact_names, e.line)
+                + (_array(e.points), _array(e.normals), _array(e.wrist), twists)
+            )
+    return out
+
+
+def both_paths(source, **kw):
+    """The entries of ``source`` by the loader, checked equal to the general path's."""
+    fast = read_grasps(source, **kw)
+    saved = grasp_file._fast_document
+    grasp_file._fast_document = _general_only
+    try:
+        general = read_grasps(source, **kw)
+    finally:
+        grasp_file._fast_document = saved
+    assert signature(fast) == signature(general)
+    return fast
+
+
+@pytest.mark.parametrize("path", FILES, ids=lambda p: f"{p.parent.name}/{p.name}")
+def test_files_read_the_same_both_ways(path, loader):
+    both_paths(path)
+    both_paths(path.read_bytes(), file="other/name.yaml")
+
+
+# Values at which the fast path must hand over, or where its arithmetic must
+# match numpy's to the bit.
+NUMBERS = [
+    "0", "-0", "+0", "-00", "-0.0", "0.0", "-0e5", ".5", "-.5", "+.5", "1.", "1e3", "1E+3", "007",
+    "1e-320", "4.9e-324", "1e-400", "-1e-400", "1e200", "-1e200", "1.7976931348623157e308",
+    "1.7976931348623159e308", "1e309", "9" * 400, "-" + "9" * 320, "1" + "0" * 308, "0." + "0" * 400 + "1",
+    "0x1F", "0o17", "1_000", ".inf", "-.inf", ".nan", "'1'", '"2"', "!!float 1", "!!int 2", "! 3", "&a 4",
+    "true", "null", "~", "", "1e", ".", "+", "1e5.5", "١", "0.1", "-2.718281828459045", "123456789012345678901234567890",
+]  # fmt: skip
+NAMES = [
+    "a", "'q'", '"d"', "1", "1e3", "true", "null", "~", "''", "' '", '"\\e[2J"', '"\\0"', '"a\\tb"', '"\\L"',
+    "!!str s", "! t", "&n m", "[a]", "{a: b}", "2", "'1'", "é",
+]  # fmt: skip
+
+
+@pytest.mark.parametrize("number", NUMBERS)
+def test_numbers_everywhere(number, loader):
+    for vector in (f"[{number}, 0, 0]", f"[1, {number}, 2]", f"[0, 0, {number}]"):
+        both_paths(CONTACTS.replace("[1, 0, 0]", vector, 1), file="g.yaml")
+        both_paths(CONTACTS.replace("[-1, 0, 0]", vector, 1), file="g.yaml")
+        both_paths(f"wrist: {vector}\n" + CONTACTS, file="g.yaml")
+        for twist in (f"angular: {vector}", f"linear: {vector}", f"at: {vector}\n    angular: [1, 1, 1]"):
+            both_paths(CONTACTS + f"twists:\n  - {twist}\n", file="g.yaml")
+        both_paths(CONTACTS + f"twists:\n  - screw: [1, 2, 3, {vector[1:-1]}]\n", file="g.yaml")
+
+
+@pytest.mark.parametrize("name", NAMES)
+def test_names_everywhere(name, loader):
+    both_paths(f"name: {name}\n" + CONTACTS, file="g.yaml")
+    both_paths(f"units: {name}\n" + CONTACTS, file="g.yaml")
+    both_paths(CONTACTS.replace("  - point: [1, 0, 0]", f"  - name: {name}\n    point: [1, 0, 0]"), file="g.yaml")
+    both_paths(CONTACTS + f"twists:\n  - name: {name}\n    angular: [0, 0, 1]\n  - linear: [1, 0, 0]\n", file="g.yaml")
+
+
+SHAPES = [
+    "",
+    "null",
+    "[]",
+    "- 1",
+    "!!map {contacts: []}",
+    "&top " + CONTACTS.replace("\n", "\n", 1),
+    CONTACTS + "name: x\nname: y\n",
+    CONTACTS + "contacts: []\n",
+    "'contacts':" + CONTACTS[len("contacts:") :],
+    "!!str contacts:" + CONTACTS[len("contacts:") :],
+    CONTACTS.replace("point", "'point'"),
+    CONTACTS.replace("- point: [1, 0, 0]", "- !!map {point: [1, 0, 0]}"),
+    CONTACTS.replace("[1, 0, 0]", "!!seq [1, 0, 0]"),
+    CONTACTS.replace("[1, 0, 0]", "&p [1, 0, 0]"),
+    CONTACTS.replace("[1, 0, 0]", "[1, [0], 0]"),
+    CONTACTS.replace("[1, 0, 0]", "[1, 0, 0, 0]"),
+    CONTACTS.replace("[1, 0, 0]", "[1, 0]"),
+    CONTACTS.replace("[1, 0, 0]", "[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[[1]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]]"),
+    CONTACTS.replace("[-1, 0, 0]", "[0, 0, 0]"),
+    CONTACTS.replace("[-1, 0, 0]", "[-0.0, 0, -0]"),
+    CONTACTS.replace("    normal: [-1, 0, 0]\n", ""),
+    CONTACTS.replace("    normal: [-1, 0, 0]\n", "    normal: [-1, 0, 0]\n    normal: [-1, 0, 0]\n"),
+    CONTACTS.replace("    normal: [-1, 0, 0]\n", "    normal: [-1, 0, 0]\n    point: [1, 0, 0]\n"),
+    CONTACTS.replace("    normal: [-1, 0, 0]\n", "    normal: [-1, 0, 0]\n    extra: 1\n"),
+    CONTACTS.replace("    normal: [-1, 0, 0]\n", "    normal: [-1, 0, 0]\n    name: a\n    name: b\n"),
+    CONTACTS.replace("  - point: [1, 0, 0]\n    normal: [-1, 0, 0]\n", ""),
+    CONTACTS + "  - point: [1, 0, 0]\n    normal: [-1, 0, 0]\n",
+    CONTACTS.replace("  - point: [1, 0, 0]", "  - name: '2'\n    point: [1, 0, 0]"),
+    CONTACTS.replace("  - point: [1, 0, 0]", "  - *a"),
+    CONTACTS.replace("  - point: [1, 0, 0]", "  - [1, 0, 0]\n  - point: [1, 0, 0]"),
+    CONTACTS + "wrist: *a\n",
+    CONTACTS + "extra: 1\n",
+    CONTACTS + "? [a]\n: 1\n",
+    CONTACTS + "1: 1\n",
+    CONTACTS + "twists:\n",
+    CONTACTS + "twists: []\n",
+    CONTACTS + "twists: {}\n",
+    CONTACTS + "twists:\n  - at: [0, 0, 1]\n",
+    CONTACTS + "twists:\n  - name: z\n",
+    CONTACTS + "twists:\n  - {}\n",
+    CONTACTS + "twists:\n  - screw: [1, 2, 3, 4, 5, 6]\n    angular: [0, 0, 1]\n",
+    CONTACTS + "twists:\n  - screw: [1, 2, 3, 4, 5, 6]\n    at: [0, 0, 1]\n",
+    CONTACTS + "twists:\n  - screw: [1, 2, 3, 4, 5, 6]\n    screw: [1, 2, 3, 4, 5, 6]\n",
+    CONTACTS + "twists:\n  - screw: [1, 2, 3, 4, 5]\n",
+    CONTACTS + "twists:\n  - angular: [0, 0, 1]\n    angular: [0, 0, 1]\n",
+    CONTACTS + "twists:\n  - angular: [0, 0, 1]\n    spin: 1\n",
+    CONTACTS + "twists:\n  - angular: [0, 0, 1]\n  - name: '1'\n    linear: [1, 0, 0]\n",
+    CONTACTS + "twists:\n  - angular: [1e200, 1e200, 1e200]\n    at: [1e200, -1e200, 0]\n",
+    CONTACTS + "twists:\n  - angular: [1e200, 0, 0]\n    at: [0, 1e200, 0]\n  - angular: [1, 0, 0]\n",
+    CONTACTS + "twists:\n  - angular: [1e-200, 3, -7e-300]\n    linear: [1e300, -1e-300, 5]\n    at: [1e10, -1e-310, 2]\n",
+    CONTACTS + "twists:\n  - !!map {angular: [0, 0, 1]}\n",
+    CONTACTS + "twists:\n  - &t {angular: [0, 0, 1]}\n  - *t\n",
+    CONTACTS + "twists:\n  - angular: [0, 0, 1]\n  - [1, 2, 3]\n",
+    CONTACTS + "twists:\n  - angular: [0, 0, 1]\n...\n---\n" + CONTACTS,
+    CONTACTS + "---\n" + CONTACTS + "name: second\n---\n",
+    CONTACTS + "---\nname: broken\n" + CONTACTS + "  - [1, 2\n",
+    CONTACTS + "]\n",
+    CONTACTS + "\tx: 1\n",
+    (
+        "contacts: [{point: [1, 0, 0], normal: [-1, 0, 0]}, {point: [0, 1, 0], normal: [0, -1, 0]},"
+        " {point: [0, 0, 1], normal: [0, 0, -1]}]\ntwists: [{screw: [0, 0, 1, 0, 0, 0]}]\n"
+    ),
+    "\ufeff" + CONTACTS,
+    CONTACTS.replace("[1, 0, 0]", "[1, 0, 0]  # é"),
+    CONTACTS + "name: \x7f\n",
+    CONTACTS + "name: \x0b\n",
+    CONTACTS + "name: é\x85\x01\n",
+]
+
+
+@pytest.mark.parametrize("text", SHAPES, ids=range(len(SHAPES)))
+def test_shapes(text, loader):
+    both_paths(text, file="dir/shape.yaml")
+    both_paths(text.encode("utf-8", "surrogatepass"))
+
+
+finite = st.floats(allow_nan=False, allow_infinity=False)
+extreme = st.sampled_from([0.0, -0.0, 1e-310, -5e-324, 1e200, -1e200, 1.7976931348623157e308, 3.0, -0.5])
+number = st.one_of(
+    finite.map(repr),
+    extreme.map(repr),
+    st.integers(-(10**30), 10**30).map(str),
+    st.sampled_from(NUMBERS),
+)
+vector = st.lists(number, min_size=3, max_size=3).map(lambda v: "[" + ", ".join(v) + "]")
+
+
+@st.composite
+def documents(draw):
+    lines = []
+    if draw(st.booleans()):
+        lines.append(f"name: {draw(st.sampled_from(NAMES + ['g', 'h']))}")
+    if draw(st.booleans()):
+        lines.append(f"wrist: {draw(vector)}")
+    lines.append("contacts:")
+    for _ in range(3):
+        lines.append(f"  - point: {draw(vector)}")
+        lines.append(f"    normal: {draw(vector)}")
+    twists = draw(st.integers(0, 3))
+    if twists:
+        lines.append("twists:")
+    for _ in range(twists):
+        if draw(st.booleans()):
+            six = ", ".join(draw(st.lists(number, min_size=6, max_size=6)))
+            lines.append(f"  - screw: [{six}]")
+        else:
+            keys = draw(st.lists(st.sampled_from(["angular", "linear", "at"]), min_size=1, max_size=3, unique=True))
+            lines += [f"  {'-' if i == 0 else ' '} {key}: {draw(vector)}" for i, key in enumerate(keys)]
+    return "\n".join(lines) + "\n"
+
+
+@settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.lists(documents(), min_size=1, max_size=3), st.sampled_from(LOADERS))
+def test_random_documents(docs, parser):
+    saved = grasp_file._LOADER
+    grasp_file._LOADER = parser
+    try:
+        both_paths("---\n".join(docs), file="random.yaml")
+    finally:
+        grasp_file._LOADER = saved
+
+
+def test_ordinary_grasps_take_the_fast_path(monkeypatch, loader):
+    """Every bundled grasp is read without the general composer (which is
+    several times slower), so a change that sends them there fails here."""
+
+    def fail(get_event):
+        raise AssertionError("general path taken")
+
+    monkeypatch.setattr(grasp_file, "_compose", fail)
+    bundled = sorted((TESTS.parent / "grasps").rglob("*.yaml"))
+    assert bundled
+    for path in bundled:
+        for entry in read_grasps(path):
+            assert isinstance(entry, Grasp), str(entry)
+
+
+@pytest.mark.parametrize("size", [0, 1, 65535, 65536, 65537, 200_000, 200_001, 200_002, 300_000])
+def test_capped_read_in_chunks(size, tmp_path, monkeypatch):
+    path = tmp_path / "big.yaml"
+    path.write_bytes(b"#" * size)
+    cap = 200_000
+    expected = "too-large" if size > cap else "empty-document"
+    (entry,) = read_grasps(path, max_bytes=cap)
+    assert entry.code == expected
+    with open(path, "rb") as handle:
+        assert grasp_file._read_capped(handle, cap + 1) == b"#" * min(size, cap + 1)
+    monkeypatch.setattr(sys, "stdin", io.TextIOWrapper(io.BytesIO(b"#" * size)))
+    (entry,) = read_grasps("-", max_bytes=cap)
+    assert (entry.code, entry.file) == (expected, "<stdin>")
+
+
+def test_arrays_of_the_fast_path_are_read_only_float_copies(loader):
+    (grasp,) = both_paths(f"wrist: [1, 2, 3]\n{CONTACTS}twists:\n  - angular: [0, 0, 1]\n  - angular: [1, 0, 0]\n", file="g.yaml")
+    arrays = [grasp.points, grasp.normals, grasp.wrist] + [twist.screw for twist in grasp.twists]
+    for array in arrays:
+        assert array.dtype == np.float64 and not array.flags.writeable and array.flags.owndata
+    assert [a.shape for a in arrays] == [(3, 3), (3, 3), (3,), (6,), (6,)]
