@@ -1,6 +1,6 @@
 """Grasp files: read YAML grasp descriptions into arrays, strictly checked.
 
-A grasp file holds one grasp per YAML document (see ``docs/grasp-format.md``
+A grasp file holds one grasp per YAML document (see "Grasp files" in README.md
 for the format).  Reading never constructs arbitrary Python objects and
 never lets a parser exception escape: every problem becomes a
 :class:`GraspFileError` that names the file, line, column and field path.
@@ -151,7 +151,7 @@ class GraspFileError(Exception):
     Attributes
     ----------
     code : str
-        Stable kebab-case code (table in ``docs/grasp-format.md``).
+        Stable kebab-case code (table in README.md, "Grasp files").
     message : str
         What is wrong, starting with the field path when there is one.
     file : str
