@@ -24,7 +24,7 @@ from .degeneracy import CONDITION_WARNING
 from .datasets import DATASET_SUFFIXES, NpzWriter, dataset_blocks, open_dataset
 from .grasp_file import GraspFileError, Twist
 from .inputs import STDIN, read
-from .report import ENCODERS, basis_record, check_record, diagnostics, error_record, records
+from .report import ENCODERS, JOINERS, basis_record, check_record, diagnostics, error_record, records
 
 __all__ = ["Job", "Output", "run", "run_group", "blocks", "write_npz", "FILES_PER_GROUP"]
 
@@ -134,6 +134,9 @@ def _no_gc():
 def _emit(job: Job, x, out: Output) -> None:
     with _no_gc():
         _emit_records(job, x, out)
+    if job.fmt in JOINERS and out.encoded:
+        # one bytes object per output: cheap to send from a worker, one write
+        out.encoded = [JOINERS[job.fmt](out.encoded)]
 
 
 def _emit_records(job: Job, x, out: Output) -> None:

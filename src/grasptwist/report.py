@@ -314,6 +314,9 @@ def _cell(v):
 #: Record -> bytes, per machine format (table records stay dicts: rich draws them).
 ENCODERS = {"json": dumps, "jsonl": dumps, "csv": _csv_line, "table": lambda rec: rec}
 
+#: Encoded records -> one bytes object that the format's writer takes as one record.
+JOINERS = {"json": b",\n".join, "jsonl": b"\n".join, "csv": b"".join}
+
 
 class _JsonArray:
     """One JSON array, written element by element so a batch streams."""
