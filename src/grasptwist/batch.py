@@ -66,13 +66,25 @@ class Block:
 
     def part(self, start: int, stop: int) -> "Block":
         """Rows ``start:stop`` as a block of their own (views, no copies)."""
-        s = slice(start, stop)
-        cut = {f: getattr(self, f)[s] for f in ("file", "grasp", "units", "twist_name", "contact_names", "points", "normals", "twist", "has_wrist", "velocity")}
-        return replace(self, **cut, off_tangent=_part(self.off_tangent, s), tangent=_part(self.tangent, s))
+        return self.take(slice(start, stop))
+
+    def take(self, rows) -> "Block":
+        """The rows ``rows`` (a slice, or an array of indices) as a block of their own."""
+        cut = {f: _pick(getattr(self, f), rows) for f in _ROW_FIELDS}
+        return replace(self, **cut, off_tangent=_take(self.off_tangent, rows), tangent=_take(self.tangent, rows))
 
 
-def _part(result, s):
-    return None if result is None else result.row(s)
+_ROW_FIELDS = ("file", "grasp", "units", "twist_name", "contact_names", "points", "normals", "twist", "has_wrist", "velocity")
+
+
+def _pick(column, rows):
+    if isinstance(column, list) and not isinstance(rows, slice):
+        return [column[i] for i in rows]
+    return column[rows]
+
+
+def _take(result, rows):
+    return None if result is None else result.row(rows)
 
 
 def resolve_arrays(points, normals, wrist, twist, method="both", *, file="", grasp=None, twist_name=None, units=None) -> Block:

@@ -134,6 +134,9 @@ def _output(path: str | None) -> Iterator:
         return
     folder = os.path.dirname(os.path.abspath(path))
     fd, tmp = tempfile.mkstemp(prefix=".grasptwist-", dir=folder)
+    umask = os.umask(0)
+    os.umask(umask)
+    os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes it private; the output is an ordinary file
     try:
         with os.fdopen(fd, "w+b") as out:  # readable too: zip archives seek and read back
             yield out
@@ -168,7 +171,7 @@ _DEBUG = typer.Option(False, "--debug", help="Show the Python traceback of an in
 _JSON = typer.Option(False, "--json", help="Same as --format json.")
 
 
-_WORKERS = typer.Option(0, "-j", "--workers", min=0, help="Processes for big batches (0: every core, used for 256+ files or 8192+ data-set grasps).")
+_WORKERS = typer.Option(0, "-j", "--workers", min=0, help="Processes for big batches (0: every core, used for 256+ files or 4096+ data-set grasps).")
 _PATHS_HELP = "Grasp files (.yaml, .yml), data sets (.npz, .npy), folders (searched for *.yaml, *.yml) or - for stdin."
 _PATHS = typer.Argument(..., metavar="PATH...", help=_PATHS_HELP)
 

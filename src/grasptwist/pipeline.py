@@ -24,7 +24,8 @@ from .degeneracy import CONDITION_WARNING
 from .datasets import DATASET_SUFFIXES, NpzWriter, dataset_blocks, open_dataset
 from .grasp_file import GraspFileError, Twist
 from .inputs import STDIN, read
-from .report import ENCODERS, JOINERS, basis_record, check_record, diagnostics, error_record, records
+from .json_rows import encode_records
+from .report import ENCODERS, JOINERS, basis_record, check_record, diagnostics, dumps, error_record, records
 
 __all__ = ["Job", "Output", "run", "run_group", "blocks", "write_npz", "FILES_PER_GROUP"]
 
@@ -32,7 +33,7 @@ __all__ = ["Job", "Output", "run", "run_group", "blocks", "write_npz", "FILES_PE
 FILES_PER_GROUP = 64
 
 #: Records built and encoded at once (and per output written, for data sets).
-RECORDS_AT_ONCE = 2048
+RECORDS_AT_ONCE = 1024
 
 
 @dataclass(frozen=True)
@@ -60,12 +61,22 @@ class Output:
     inputs: int = 0
 
     def add(self, rec: dict, encode) -> None:
+        self._note(rec)
+        self.records += 1
+        self.encoded.append(encode(rec))
+
+    def add_encoded(self, texts: list[bytes], talking: list[dict]) -> None:
+        """Records already encoded; ``talking`` are those with errors or warnings."""
+        for rec in talking:
+            self._note(rec)
+        self.records += len(texts)
+        self.encoded += texts
+
+    def _note(self, rec: dict) -> None:
         errors, warnings = diagnostics(rec)
         self.errors += errors
         self.warnings += warnings
-        self.records += 1
         self.failed += not rec["ok"]
-        self.encoded.append(encode(rec))
 
 
 def run(job: Job, paths: Sequence, workers: int = 1) -> Iterator[Output]:
@@ -147,8 +158,13 @@ def _emit_records(job: Job, x, out: Output) -> None:
         # a few thousand records at a time: their floats as Python objects
         # would otherwise fill memory and keep the garbage collector busy
         for start in range(0, len(x), RECORDS_AT_ONCE):
-            for rec in records(x.part(start, start + RECORDS_AT_ONCE), job.order):
-                out.add(rec, encode)
+            part = x.part(start, start + RECORDS_AT_ONCE)
+            if job.fmt in ("json", "jsonl"):
+                texts, talking = encode_records(part, job.order, records, dumps)
+                out.add_encoded(texts, talking)
+            else:
+                for rec in records(part, job.order):
+                    out.add(rec, encode)
     else:
         for i in range(len(x)):
             out.add(basis_record(x, i, job.order) if job.kind == "basis" else check_record(x, i), encode)
@@ -158,7 +174,7 @@ def _emit_records(job: Job, x, out: Output) -> None:
 _SHARED: dict = {}
 
 #: Grasps per task when a data set is spread over processes.
-GRASPS_PER_TASK = 8192
+GRASPS_PER_TASK = 4096
 
 
 def _dataset(job: Job, path: str, workers: int = 1) -> Iterator[Output]:

@@ -1,0 +1,59 @@
+"""The template encoder writes, byte for byte, what encoding each record writes."""
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+from grasptwist.batch import resolve_arrays
+from grasptwist.json_rows import encode_records
+from grasptwist.report import dumps, records
+from grasptwist.screws import direction
+from grasp_gen import grasps
+
+
+def block(seed, n, method, wrists):
+    rng = np.random.default_rng(seed)
+    points, normals, wrist, twist = grasps(rng, n)
+    twist[: n // 4] = np.round(twist[: n // 4], 1)  # short numbers, -0.0 and zeros too
+    twist[1] = 0.0
+    wrist[2] = points[2].mean(0)  # a failing off-tangent row
+    points[3, 1] = points[3, 0]  # a row failing both methods
+    wrist[4] = points[4].mean(0) + 1e-6 * np.cross(points[4, 1] - points[4, 0], points[4, 2] - points[4, 0])  # a warning
+    twist[5] = [0, 0, 0, 0, 0, 1e-300]
+    if wrists == "none":
+        wrist = None
+    elif wrists == "some":
+        wrist[::3] = np.nan
+    names = [f"g{i}" if i % 5 else 'quote " and \\ and \u00e9' for i in range(n)]
+    return resolve_arrays(
+        points, direction(normals), wrist, twist, method, file=["a%s.yaml"] * n, grasp=names, units=["m" if i % 2 else None for i in range(n)]
+    )
+
+
+@settings(max_examples=25, deadline=None)
+@given(
+    st.integers(0, 2**32 - 1),
+    st.integers(6, 40),
+    st.sampled_from(["both", "off-tangent", "tangent"]),
+    st.sampled_from(["omega-v", "v-omega"]),
+    st.sampled_from(["all", "some", "none"]),
+)
+def test_template_texts_equal_encoding_each_record(seed, n, method, order, wrists):
+    b = block(seed, n, method, wrists)
+    texts, talking = encode_records(b, order, records, dumps)
+    expected = [dumps(r) for r in records(b, order)]
+    assert texts == expected
+    assert sorted(dumps(r) for r in talking) == sorted(e for e, r in zip(expected, records(b, order)) if not r["ok"] or r["warnings"])
+
+
+def test_most_rows_take_the_template():
+    b = block(3, 200, "both", "all")
+    calls = []
+
+    def counting(part, order):
+        calls.append(len(part))
+        return records(part, order)
+
+    encode_records(b, "omega-v", counting, dumps)
+    assert sum(calls) < 20 + 2  # the few non-plain rows one by one, plus one marker row per template
