@@ -1,7 +1,6 @@
 """The template encoder writes, byte for byte, what encoding each record writes."""
 
 import numpy as np
-import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
