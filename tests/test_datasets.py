@@ -92,6 +92,8 @@ def test_npz_output_arrays_match_the_records_and_carry_a_status_legend(tmp_path,
     np.testing.assert_array_equal(z["contact_velocity"], gt.contact_velocities(points, twist))
     assert [z["status_legend"][s] for s in z["off_tangent_status"][[0, 3, 7]]] == ["ok", "wrist-coplanar", "collinear-contacts"]
     assert z["grasp"][:3].tolist() == ["0", "1", "2"] and z["twist"].shape == (N, 6)
+    assert z["files"].tolist() == [str(tmp_path / "set.npz")] and not z["file_index"].any()
+    assert z["twist_names"].tolist() == ["twist"] and not z["twist_index"].any()
     assert "5 records" not in r.stderr and r.stderr.strip().splitlines()[-1] == f"{N} records, 5 failed"
 
 
@@ -112,6 +114,19 @@ def test_npy_rows_with_a_wrist_or_a_twist_point(tmp_path, data):
     moved = gt.screws.twist_at(screw[:3], screw[3:], wrist)
     assert [r["twist"]["screw"] for r in at[:3]] == moved[:3].tolist()
     np.testing.assert_allclose([r["contact_velocity"] for r in at[:3]], gt.contact_velocities(points[:3], moved[:3]))
+
+
+def test_npz_output_spills_to_disk_and_reads_back_the_same(tmp_path, data, monkeypatch):
+    points, normals, wrist, twist = data
+    np.savez(tmp_path / "set.npz", points=points, normals=normals, wrist=wrist, twist=twist)
+    run("resolve", tmp_path / "set.npz", "-f", "npz", "-o", tmp_path / "held.npz")
+    monkeypatch.setattr(datasets, "SPILL_BYTES", 1000)
+    monkeypatch.setattr(datasets, "ROWS_PER_BLOCK", 50)
+    run("resolve", tmp_path / "set.npz", "-f", "npz", "-o", tmp_path / "spilled.npz")
+    held, spilled = np.load(tmp_path / "held.npz"), np.load(tmp_path / "spilled.npz")
+    assert sorted(held.files) == sorted(spilled.files)
+    for name in held.files:
+        np.testing.assert_array_equal(held[name], spilled[name], err_msg=name)
 
 
 def test_several_twists_per_grasp_and_small_blocks_give_the_same_rows(tmp_path, data, monkeypatch):

@@ -41,8 +41,8 @@ CONTACT_NAMES = ("1", "2", "3")
 class Block:
     """Consecutive (grasp, twist) rows with every method's results, as columns.
 
-    Per-row labels are lists; ``points`` ... ``velocity`` are arrays over
-    the rows.  ``off_tangent`` is None when the method was not asked for;
+    Per-row labels are lists (or numpy string arrays); ``points`` ...
+    ``velocity`` are arrays over the rows.  ``off_tangent`` is None when the method was not asked for;
     rows without a wrist (``has_wrist`` False) carry the status
     ``nonfinite-input`` there and are reported as skipped.
     """
@@ -78,7 +78,7 @@ _ROW_FIELDS = ("file", "grasp", "units", "twist_name", "contact_names", "points"
 
 
 def _pick(column, rows):
-    if isinstance(column, list) and not isinstance(rows, slice):
+    if isinstance(column, list) and not isinstance(rows, slice):  # numpy arrays index themselves
         return [column[i] for i in rows]
     return column[rows]
 
@@ -104,9 +104,6 @@ def resolve_arrays(points, normals, wrist, twist, method="both", *, file="", gra
         tan = decompose_tangent(points, normals, twist)
     if method != "tangent":
         off = decompose_off_tangent(points, np.full((n, 3), np.nan) if wrist is None else wrist, twist)
-    for r in (off, tan):
-        if r is not None:
-            r.residual  # once for the whole block; rows share it
     return Block(
         file=file if isinstance(file, list) else [file] * n,
         grasp=grasp if grasp is not None else [str(i) for i in range(n)],

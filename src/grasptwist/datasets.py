@@ -40,6 +40,9 @@ _NPZ_KEYS = ("points", "normals", "wrist", "twist", "names")
 #: Rows per engine call on a data set: bounded memory, long vectors.
 ROWS_PER_BLOCK = 65536
 
+#: Result bytes an NpzWriter holds in memory before it spills to temporary files.
+SPILL_BYTES = 512 << 20
+
 
 @dataclass(frozen=True)
 class Dataset:
@@ -170,7 +173,8 @@ def _block(ds, given, twists, method, start, stop, k):
     if ds.at is not None:
         at = np.asarray(ds.at[start:stop], dtype=float)[index - start]
         screw = twist_at(screw[:, :3], screw[:, 3:], at)
-    label = ds.names[start:stop][index - start].astype(str).tolist() if ds.names is not None else index.astype(str).tolist()
+    # labels stay a numpy string array: a million Python strings cost more than the engine
+    label = ds.names[start:stop][index - start].astype(str) if ds.names is not None else index.astype(str)
     wrist = None if ds.wrist is None else np.asarray(ds.wrist[start:stop], dtype=float)[index - start]
     return resolve_arrays(
         np.asarray(ds.points[start:stop], dtype=float)[index - start],
@@ -188,28 +192,41 @@ def _block(ds, given, twists, method, start, stop, k):
 class NpzWriter:
     """Results as arrays in one ``.npz``, with bounded memory.
 
-    Each block's columns are appended to temporary files; :meth:`close`
-    streams them into the archive as ``.npy`` members.  Arrays: ``file``,
-    ``grasp``, ``twist_name`` (strings), ``twist (N,6)``,
-    ``contact_velocity (N,3,3)``, and per method asked for ``x``, ``y``,
-    ``off_tangent_status``, ``off_tangent_conditioning`` /  ``alpha``,
-    ``beta``, ``normal_velocity``, ``in_tangent_planes``,
+    Arrays over all rows: ``grasp`` (labels), ``file_index`` into ``files``
+    and ``twist_index`` into ``twist_names`` (each distinct name once),
+    ``twist (N,6)``, ``contact_velocity (N,3,3)``, and per method asked for
+    ``x``, ``y``, ``off_tangent_status``, ``off_tangent_conditioning`` /
+    ``alpha``, ``beta``, ``normal_velocity``, ``in_tangent_planes``,
     ``tangent_status``, ``tangent_conditioning``; ``status_legend[k]`` is
     the name of status ``k``, and status -1 means "skipped" (no wrist).
     Amplitudes are NaN where a method failed.
+
+    Columns are kept in memory up to :data:`SPILL_BYTES`, then spilled to
+    temporary files; :meth:`close` streams everything into the archive.
     """
 
     def __init__(self, out: IO[bytes], order: str = "omega-v"):
         self.out = out
         self.order = order
-        self.tmp = tempfile.TemporaryDirectory(prefix="grasptwist-npz-")
-        self.files: dict[str, tuple[IO[bytes], np.dtype, tuple]] = {}
+        self.chunks: dict[str, list[np.ndarray]] = {}
+        self.spilled: dict[str, IO[bytes]] = {}
+        self.widths: dict[str, int] = {}  # string columns: the widest value
+        self.kinds: dict[str, tuple] = {}  # dtype and trailing shape of each column
+        self.names = {"files": {}, "twist_names": {}}
+        self.held = 0
         self.rows = 0
+        self.tmp = None
 
     def write(self, block: Block) -> None:
         from .report import _screws  # the one definition of the output order
 
-        cols = {"twist": _screws(block.twist, self.order), "contact_velocity": block.velocity}
+        cols = {
+            "grasp": np.asarray(block.grasp, dtype=str),
+            "file_index": self._index("files", block.file),
+            "twist_index": self._index("twist_names", block.twist_name),
+            "twist": _screws(block.twist, self.order),
+            "contact_velocity": block.velocity,
+        }
         if block.off_tangent is not None:
             r = block.off_tangent
             cols.update(x=r.x, y=r.y, off_tangent_status=np.where(block.has_wrist, r.status, -1).astype(np.int8))
@@ -219,37 +236,60 @@ class NpzWriter:
             cols.update(alpha=r.alpha, beta=r.beta, normal_velocity=r.normal_velocity)
             cols.update(in_tangent_planes=r.in_tangent_planes, tangent_status=r.status, tangent_conditioning=r.conditioning)
         for name, a in cols.items():
-            self._append(name, np.ascontiguousarray(a))
-        for name in ("file", "grasp", "twist_name"):
-            self._append_text(name, getattr(block, name))
+            a = np.ascontiguousarray(a)
+            if a.dtype.kind == "U":
+                self.widths[name] = max(self.widths.get(name, 1), a.dtype.itemsize // 4)
+            self.kinds.setdefault(name, (a.dtype, a.shape[1:]))
+            self.chunks.setdefault(name, []).append(a)
+            self.held += a.nbytes
         self.rows += len(block)
+        if self.held > SPILL_BYTES:
+            self._spill()
 
-    def _append(self, name, a):
-        if name not in self.files:
-            self.files[name] = (open(os.path.join(self.tmp.name, name), "w+b"), a.dtype, a.shape[1:])
-        self.files[name][0].write(a.tobytes())
+    def _index(self, table, values):
+        """Indices of ``values`` in a growing table of distinct names."""
+        seen = self.names[table]
+        distinct = dict.fromkeys(values)  # usually one file and one twist name per block
+        for v in distinct:
+            seen.setdefault(v, len(seen))
+        if len(distinct) == 1:
+            return np.full(len(values), seen[values[0]], dtype=np.int32)
+        return np.fromiter(map(seen.__getitem__, values), dtype=np.int32, count=len(values))
 
-    def _append_text(self, name, values):
-        if name not in self.files:
-            self.files[name] = (open(os.path.join(self.tmp.name, name), "w+b"), None, ())
-        self.files[name][0].write("".join(f"{v}\n" for v in values).encode())
+    def _spill(self):
+        if self.tmp is None:
+            self.tmp = tempfile.TemporaryDirectory(prefix="grasptwist-npz-")
+        for name, chunks in self.chunks.items():
+            if name not in self.spilled:
+                self.spilled[name] = open(os.path.join(self.tmp.name, name), "w+b")
+            for a in chunks:
+                np.save(self.spilled[name], a, allow_pickle=False)
+            chunks.clear()
+        self.held = 0
+
+    def _parts(self, name):
+        fh = self.spilled.get(name)
+        if fh is not None:
+            end = fh.tell()
+            fh.seek(0)
+            while fh.tell() < end:
+                yield np.load(fh, allow_pickle=False)
+        yield from self.chunks[name]
 
     def close(self) -> None:
         with zipfile.ZipFile(self.out, "w", zipfile.ZIP_STORED, allowZip64=True) as z:
-            for name, (fh, dtype, tail) in self.files.items():
-                fh.flush()
-                fh.seek(0)
+            for name, (dtype, tail) in self.kinds.items():
+                dtype = np.dtype(f"<U{self.widths[name]}") if name in self.widths else dtype
+                header = {"descr": np.lib.format.dtype_to_descr(dtype), "fortran_order": False, "shape": (self.rows, *tail)}
                 with z.open(name + ".npy", "w", force_zip64=True) as member:
-                    if dtype is None:  # strings: fixed width, built once
-                        text = np.array(fh.read().decode().split("\n")[:-1], dtype=str)
-                        np.lib.format.write_array(member, text, allow_pickle=False)
-                    else:
-                        header = {"descr": np.lib.format.dtype_to_descr(dtype), "fortran_order": False, "shape": (self.rows, *tail)}
-                        np.lib.format.write_array_header_2_0(member, header)
-                        while chunk := fh.read(1 << 22):
-                            member.write(chunk)
+                    np.lib.format.write_array_header_2_0(member, header)
+                    for a in self._parts(name):
+                        member.write(np.ascontiguousarray(a.astype(dtype, copy=False)).data)
+            tables = {"status_legend": [s.code for s in Status], **{k: list(v) for k, v in self.names.items()}}
+            for name, values in tables.items():
+                with z.open(name + ".npy", "w") as member:
+                    np.lib.format.write_array(member, np.array(values, dtype=str), allow_pickle=False)
+        if self.tmp is not None:
+            for fh in self.spilled.values():
                 fh.close()
-            legend = np.array([s.code for s in Status])
-            with z.open("status_legend.npy", "w") as member:
-                np.lib.format.write_array(member, legend, allow_pickle=False)
-        self.tmp.cleanup()
+            self.tmp.cleanup()

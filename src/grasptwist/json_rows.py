@@ -21,7 +21,7 @@ import numpy as np
 import orjson
 
 from .batch import Block
-from .degeneracy import CONDITION_WARNING
+from .report import talking_rows
 
 __all__ = ["encode_records"]
 
@@ -54,12 +54,10 @@ def encode_records(block: Block, order: str, records, dumps) -> tuple[list[bytes
 
 
 def _plain_rows(block: Block) -> np.ndarray:
-    plain = np.ones(len(block), bool)
-    for r, asked in ((block.off_tangent, block.has_wrist), (block.tangent, None)):
-        if r is not None:
-            plain &= r.ok & ~(r.conditioning < CONDITION_WARNING)
-            if asked is not None:
-                plain &= asked
+    """Rows with nothing to say and every method asked for present."""
+    plain = ~talking_rows(block)
+    if block.off_tangent is not None:
+        plain &= block.has_wrist  # a skipped method is a null: another template
     return plain
 
 

@@ -20,12 +20,11 @@ from typing import Iterator, Sequence
 import numpy as np
 
 from .batch import ZERO_TWIST, Block, resolve
-from .degeneracy import CONDITION_WARNING
 from .datasets import DATASET_SUFFIXES, NpzWriter, dataset_blocks, open_dataset
 from .grasp_file import GraspFileError, Twist
 from .inputs import STDIN, read
 from .json_rows import encode_records
-from .report import ENCODERS, JOINERS, basis_record, check_record, diagnostics, dumps, error_record, records
+from .report import ENCODERS, JOINERS, basis_record, check_record, diagnostics, dumps, error_record, records, talking_rows
 
 __all__ = ["Job", "Output", "run", "run_group", "blocks", "write_npz", "FILES_PER_GROUP"]
 
@@ -255,20 +254,12 @@ def write_npz(job: Job, paths: Sequence, out) -> Iterator[Output]:
         o = Output(inputs=1)
         if isinstance(x, Block):
             w.write(x)
-            for i in np.flatnonzero(_needs_a_line(x)):
-                o.add(records(x.part(i, i + 1), job.order)[0], lambda rec: None)
+            talking = np.flatnonzero(talking_rows(x))
+            for rec in records(x.take(talking), job.order) if talking.size else []:
+                o.add(rec, lambda rec: None)
             o.records = len(x)
             o.encoded = []
         else:
             o.add(error_record(x), lambda rec: None)
         yield o
     w.close()
-
-
-def _needs_a_line(block: Block):
-    """Rows whose record fails or warns."""
-    flag = np.zeros(len(block), bool)
-    for r, asked in ((block.off_tangent, block.has_wrist), (block.tangent, True)):
-        if r is not None:
-            flag |= (~r.ok | (r.conditioning < CONDITION_WARNING)) & asked
-    return flag

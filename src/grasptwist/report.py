@@ -31,6 +31,7 @@ __all__ = [
     "check_record",
     "error_record",
     "diagnostics",
+    "talking_rows",
     "dumps",
     "ENCODERS",
     "writer",
@@ -120,6 +121,15 @@ def _method_rows(block, result, order, names, label, warnings):
     for i in np.flatnonzero((status == Status.OK) & (result.conditioning < CONDITION_WARNING) & asked):
         warnings[i].append(conditioning_warning(result.conditioning[i], label))
     return rows
+
+
+def talking_rows(block: Block) -> np.ndarray:
+    """Rows whose record has something for stderr: a failed method or a warning."""
+    talk = np.zeros(len(block), bool)
+    for r, asked in ((block.off_tangent, block.has_wrist), (block.tangent, True)):
+        if r is not None:
+            talk |= (~r.ok | (r.conditioning < CONDITION_WARNING)) & asked
+    return talk
 
 
 def _failed_rows(block):

@@ -91,7 +91,8 @@ def direction(a):
     [0.0, 0.6, 0.8]
     """
     a = np.asarray(a, dtype=float)
-    big = np.max(np.abs(a), axis=-1, keepdims=True)
+    m = np.abs(a)
+    big = np.maximum(np.maximum(m[..., 0], m[..., 1]), m[..., 2])[..., None]  # faster than max over a short axis
     with np.errstate(invalid="ignore", divide="ignore"):
         scaled = np.where(big > 0, a / big, a)
         length = norm(scaled)[..., None]
