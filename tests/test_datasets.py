@@ -191,3 +191,25 @@ def test_a_data_set_over_two_workers_gives_the_same_output(tmp_path, data, monke
     one = run("resolve", tmp_path / "set.npz", "-f", "jsonl", "-j", "1")
     two = run("resolve", tmp_path / "set.npz", "-f", "jsonl", "-j", "2")
     assert two.stdout == one.stdout and two.stderr == one.stderr and len(jsonl(one)) == N
+
+
+def test_workers_spool_through_the_kernel_to_pipes_and_files(tmp_path, data):
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    points, normals, wrist, twist = data
+    np.savez(tmp_path / "set.npz", points=points, normals=normals, wrist=wrist, twist=twist)
+    exe = Path(sys.executable).parent / "grasptwist"
+    cmd = [str(exe)] if exe.exists() else [sys.executable, "-m", "grasptwist"]
+    one = subprocess.run(cmd + ["resolve", str(tmp_path / "set.npz"), "-f", "json", "-j", "1"], capture_output=True, timeout=120)
+    script = (
+        "import sys; from grasptwist import pipeline; pipeline.GRASPS_PER_TASK = 30; pipeline.RECORDS_AT_ONCE = 7; "
+        "from grasptwist.cli import main; sys.argv = ['grasptwist'] + sys.argv[1:]; main()"
+    )
+    args = ["resolve", str(tmp_path / "set.npz"), "-f", "json", "-j", "2"]
+    piped = subprocess.run([sys.executable, "-c", script] + args, capture_output=True, timeout=120)
+    to_file = subprocess.run([sys.executable, "-c", script] + args + ["-o", str(tmp_path / "out.json")], capture_output=True, timeout=120)
+    assert piped.stdout == one.stdout == (tmp_path / "out.json").read_bytes()
+    assert piped.returncode == to_file.returncode == one.returncode == 1
+    assert len(json.loads(one.stdout)) == N

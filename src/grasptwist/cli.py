@@ -311,6 +311,8 @@ def _emit(job, paths: list[str], output, quiet: bool, workers: int, **table_opti
             if job.fmt != "npz":
                 for encoded in o.encoded:
                     w.write(encoded)
+                if o.spool:
+                    w.write_spooled(o.spool)
                 out.flush()  # a batch streams: each group is out as soon as it is ready
             stderr.take(o)
             advance(o.inputs)

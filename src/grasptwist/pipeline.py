@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import gc
 import os
+import tempfile
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from functools import partial
@@ -58,6 +59,7 @@ class Output:
     records: int = 0
     failed: int = 0
     inputs: int = 0
+    spool: str | None = None  # a file holding ``encoded`` (see _spooled)
 
     def add(self, rec: dict, encode) -> None:
         self._note(rec)
@@ -94,11 +96,36 @@ def run(job: Job, paths: Sequence, workers: int = 1) -> Iterator[Output]:
         yield from (_dataset(job, g, workers) if _is_dataset(g) else [run_group(job, g)])
 
 
+@contextmanager
 def _pool(workers):
+    """A forked pool (workers start at once and share the parent's open data
+    set) and a spool folder in which they leave their encoded output."""
     import multiprocessing
+    import shutil
+    import tempfile
 
-    # fork: workers start at once and share the parent's open data set
-    return multiprocessing.get_context("fork").Pool(workers)
+    shm = "/dev/shm"
+    spool = tempfile.mkdtemp(prefix="grasptwist-", dir=shm if os.access(shm, os.W_OK) else None)
+    _SHARED.update(spool=spool, parent=os.getpid())
+    try:
+        with multiprocessing.get_context("fork").Pool(workers) as pool:
+            yield pool
+    finally:
+        shutil.rmtree(spool, ignore_errors=True)
+        _SHARED.pop("spool", None)
+
+
+def _spooled(out: Output) -> Output:
+    """In a worker, move an output's bytes to a spool file: the parent copies the
+    file to its output in the kernel instead of receiving the bytes by pipe."""
+    spool = _SHARED.get("spool")
+    if spool and os.getpid() != _SHARED["parent"] and out.encoded and isinstance(out.encoded[0], bytes):
+        fd, path = tempfile.mkstemp(dir=spool)
+        with os.fdopen(fd, "wb") as f:
+            for blob in out.encoded:
+                f.write(blob)
+        out.encoded, out.spool = [], path
+    return out
 
 
 def run_group(job: Job, paths: Sequence) -> Output:
@@ -110,7 +137,7 @@ def run_group(job: Job, paths: Sequence) -> Output:
     twists = [ZERO_TWIST] if job.kind != "resolve" else job.twists
     for x in resolve(items, twists, job.method):
         _emit(job, x, out)
-    return out
+    return _spooled(out)
 
 
 def blocks(job: Job, paths: Sequence) -> Iterator[Block | GraspFileError]:
@@ -216,7 +243,7 @@ def _dataset_task(job: Job, rows: tuple[int, int]) -> list[Output]:
         for start in range(0, len(block), RECORDS_AT_ONCE):
             out = Output()
             _emit(job, block.part(start, start + RECORDS_AT_ONCE), out)
-            outs.append(out)
+            outs.append(_spooled(out))
     return outs
 
 
