@@ -42,6 +42,7 @@ __all__ = [
     "Segment",
     "METHODS",
     "default_method",
+    "legend_text",
     "grasp_scene",
     "plot_grasp",
     "render",
@@ -209,10 +210,21 @@ KINDS = {
     "twist-axis": "twist axis",
     "twist-translation": "twist (pure translation)",
     "contact-velocity": "contact velocity T(p_i)",
-    "sigma-part": "part from x_i Σ_i or β_i Σ_i",
-    "psi-part": "part from y_j Ψ_j",
-    "theta-part": "part from α_j Θ_j",
+    "sigma-part": "part x_i Σ_i(p_i)",  # β_i Σ_i(p_i) in the tangent method: see legend_text
+    "psi-part": "part y_j Ψ_j(p_i)",
+    "theta-part": "part α_j Θ_j(p_i)",
 }
+
+
+def legend_text(kind: str, method: str) -> str:
+    """The legend's words for a kind; the Sigma parts' amplitude is named by the method.
+
+    >>> legend_text("sigma-part", "tangent")
+    'part β_i Σ_i(p_i)'
+    """
+    if kind == "sigma-part" and method == "tangent":
+        return "part β_i Σ_i(p_i)"
+    return KINDS[kind]
 
 
 def default_method(wrist) -> str:
@@ -317,7 +329,8 @@ def scene(
             (segments if isinstance(twist_element, Segment) else arrows).append(twist_element)
         arrows += _velocity_arrows(points, t, r, method, names, size, ok)
     if ok:
-        amp = "   ".join(f"{n} = {_vec(a)}" for n, a in amplitudes) if twist is not None else "basis only"
+        largest = max(float(np.max(np.abs(a))) for _, a in amplitudes)
+        amp = "   ".join(f"{n} = {_vec(a, largest)}" for n, a in amplitudes) if twist is not None else "basis only"
         lines.append(f"{method}: {amp}")
         warning = conditioning_warning(r.conditioning, method)
         if warning:
@@ -344,15 +357,17 @@ def _velocity_arrows(points, t, r, method, names, size, ok):
         sigma_at = field_at(r.sigma, points)  # Sigma_i(p_i)
         psi_at = field_at(r.psi[None, :, :], points[:, None, :])  # [i, j] = Psi_j(p_i)
         for i in range(3):
-            parts[i].append((r.x[i] * sigma_at[i], f"x{_sub(names[i])} Σ{_sub(names[i])}", "sigma-part"))
+            at = f"(p{_sub(names[i])})"
+            parts[i].append((r.x[i] * sigma_at[i], f"x{_sub(names[i])} Σ{_sub(names[i])}{at}", "sigma-part"))
             for j in (_J[i], _K[i]):
-                parts[i].append((r.y[j] * psi_at[i, j], f"y{_sub(names[j])} Ψ{_sub(names[j])}", "psi-part"))
+                parts[i].append((r.y[j] * psi_at[i, j], f"y{_sub(names[j])} Ψ{_sub(names[j])}{at}", "psi-part"))
     elif ok:
         theta_velocity, sigma_velocity = r.contact_split()
         for i in range(3):
+            at = f"(p{_sub(names[i])})"
             for j in (_J[i], _K[i]):
-                parts[i].append((theta_velocity[i, j], f"α{_sub(names[j])} Θ{_sub(names[j])}", "theta-part"))
-            parts[i].append((sigma_velocity[i], f"β{_sub(names[i])} Σ{_sub(names[i])}", "sigma-part"))
+                parts[i].append((theta_velocity[i, j], f"α{_sub(names[j])} Θ{_sub(names[j])}{at}", "theta-part"))
+            parts[i].append((sigma_velocity[i], f"β{_sub(names[i])} Σ{_sub(names[i])}{at}", "sigma-part"))
     # One length per unit velocity for every arrow, fitted so that the longest
     # drawn chain at any contact is _VELOCITY_LEN of the grasp's size.
     longest = max(max(norm(velocity)), max((sum(float(norm(v)) for v, _, _ in p) for p in parts), default=0.0))
@@ -404,16 +419,22 @@ def _square(p, n, half):
 def _views(points, wrist):
     """An oblique view and one down the contacts' plane normal (on the wrist's side).
 
-    The oblique view tilts 50 degrees from the normal towards a horizontal
-    direction, so that it shows the plane and what stands off it.
+    The oblique view tilts 50 degrees from the normal towards a direction in
+    the plane that leans upwards, so that it shows the plane, what stands off
+    it, and some height even when the plane is vertical.
     """
     m = unit(cross(points[1] - points[0], points[2] - points[0]))
     if not np.all(np.isfinite(m)):  # collinear contacts: no plane, look down z
         m = np.array([0.0, 0.0, 1.0])
     if wrist is not None and dot(wrist - points.mean(axis=0), m) < 0:
         m = -m
-    u = cross(m, [0.0, 0.0, 1.0])
-    u = unit(u) if norm(u) > 1e-6 else np.array([np.cos(np.radians(-60)), np.sin(np.radians(-60)), 0.0])
+    z = np.array([0.0, 0.0, 1.0])
+    across = cross(m, z)
+    if norm(across) > 1e-6:
+        up = unit(z - dot(z, m) * m)
+        u = np.cos(np.radians(55)) * unit(across) + np.sin(np.radians(55)) * up
+    else:  # horizontal plane: matplotlib's default azimuth
+        u = np.array([np.cos(np.radians(-60)), np.sin(np.radians(-60)), 0.0])
     tilt = np.radians(50)
     return (("oblique", np.cos(tilt) * m + np.sin(tilt) * u), ("down the contact-plane normal", m))
 
@@ -433,9 +454,18 @@ def _sub(name: str) -> str:
     return name if len(name) <= 2 else f"({name})"
 
 
-def _vec(a) -> str:
-    """``(a, b, c)`` with 3 significant digits; ``-0`` shown as ``0``."""
-    return "(" + ", ".join(f"{float(x) + 0.0:.3g}" for x in np.asarray(a).ravel()) + ")"
+def _vec(a, ref=0.0) -> str:
+    """``(a, b, c)`` with 3 significant digits.
+
+    Entries below 1e-12 of the largest of ``a`` and ``ref`` are round-off and
+    shown as 0 (and ``-0`` as ``0``).
+
+    >>> _vec([1.0, -2e-17, -0.0]), _vec([8e-17, 0, 0], ref=0.6)
+    ('(1, 0, 0)', '(0, 0, 0)')
+    """
+    a = np.asarray(a, dtype=float).ravel()
+    a = np.where(np.abs(a) <= 1e-12 * max(float(np.max(np.abs(a), initial=0.0)), ref), 0.0, a)
+    return "(" + ", ".join(f"{x + 0.0:.3g}" for x in a) + ")"
 
 
 # --- objects from the grasp-file loader ---------------------------------------
@@ -579,7 +609,7 @@ def render(scene: Scene, path, *, size=(1400, 700), dpi=100) -> Path:
         ax.view_init(elev=elev, azim=azim)
         ax.set_title(view_name, fontsize=9)
     fig.suptitle(scene.title, fontsize=10)
-    handles = [_legend_handle(k) for k in scene.kinds()]
+    handles = [_legend_handle(k, scene.method) for k in scene.kinds()]
     fig.legend(handles=handles, loc="lower center", ncol=min(len(handles), 7), fontsize=8, frameon=False)
     fig.subplots_adjust(left=0.0, right=1.0, top=0.9, bottom=0.1, wspace=0.0)
     fig.savefig(path, dpi=dpi)
@@ -635,16 +665,17 @@ def _label_axes(ax, direction):
             axis.set_label_text(name)
 
 
-def _legend_handle(kind):
+def _legend_handle(kind, method):
     from matplotlib.lines import Line2D
     from matplotlib.patches import Patch as PatchArtist
 
     st = _STYLE[kind]
+    text = legend_text(kind, method)
     if "marker" in st:
-        return Line2D([], [], color=st["color"], marker=st["marker"], ls="none", label=KINDS[kind])
+        return Line2D([], [], color=st["color"], marker=st["marker"], ls="none", label=text)
     if "alpha" in st:
-        return PatchArtist(facecolor=st["color"], alpha=max(st["alpha"], 0.4), label=KINDS[kind])
-    return Line2D([], [], color=st["color"], lw=st["lw"], ls=st.get("ls", "-"), label=KINDS[kind])
+        return PatchArtist(facecolor=st["color"], alpha=max(st["alpha"], 0.4), label=text)
+    return Line2D([], [], color=st["color"], lw=st["lw"], ls=st.get("ls", "-"), label=text)
 
 
 def _elev_azim(direction):
