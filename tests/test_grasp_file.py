@@ -13,6 +13,7 @@ import yaml
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from conftest import CONTACTS, LOADERS
 from grasptwist import grasp_file, screws
 from grasptwist.grasp_file import (
     DEFAULT_MAX_BYTES,
@@ -26,26 +27,6 @@ from grasptwist.grasp_file import (
 
 INVALID = Path(__file__).parent / "invalid_grasps"
 BUNDLED = Path(__file__).parent.parent / "grasps"
-LOADERS = [yaml.SafeLoader] + ([yaml.CSafeLoader] if yaml.__with_libyaml__ else [])
-
-CONTACTS = """\
-contacts:
-  - point: [1, 0, 0]
-    normal: [-1, 0, 0]
-  - point: [-0.5, 0.866, 0]
-    normal: [0.5, -0.866, 0]
-  - point: [-0.5, -0.866, 0]
-    normal: [0.5, 0.866, 0]
-"""
-
-
-@pytest.fixture(params=LOADERS, ids=lambda loader: loader.__name__)
-def loader(request, monkeypatch):
-    """Run the test once with each available YAML parser."""
-    monkeypatch.setattr(grasp_file, "_LOADER", request.param)
-    return request.param
-
-
 def read(text, name="g.yaml", **kw):
     return read_grasps(text, file=name, **kw)
 

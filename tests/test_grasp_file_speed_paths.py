@@ -14,10 +14,10 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-import yaml
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
+from conftest import CONTACTS, LOADERS
 from grasptwist import grasp_file
 from grasptwist.grasp_file import Grasp, GraspFileError, read_grasps
 
@@ -28,25 +28,6 @@ FILES = sorted(
     if folder.is_dir()
     for path in folder.rglob("*.yaml")
 )
-LOADERS = [yaml.SafeLoader] + ([yaml.CSafeLoader] if yaml.__with_libyaml__ else [])
-
-CONTACTS = """\
-contacts:
-  - point: [1, 0, 0]
-    normal: [-1, 0, 0]
-  - point: [-0.5, 0.866, 0]
-    normal: [0.5, -0.866, 0]
-  - point: [-0.5, -0.866, 0]
-    normal: [0.5, 0.866, 0]
-"""
-
-
-@pytest.fixture(params=LOADERS, ids=lambda loader: loader.__name__)
-def loader(request, monkeypatch):
-    monkeypatch.setattr(grasp_file, "_LOADER", request.param)
-    return request.param
-
-
 def _general_only(get, keep):
     raise grasp_file._Bail
 

@@ -650,15 +650,8 @@ def _fast_document(get, keep):
     name = units = wrist = contacts = None
     twists = ()
     seen = []
-    while True:
-        event = get()
-        keep(event)
-        if type(event) is not _ScalarEvent:
-            if type(event) is _MappingEnd:
-                break
-            raise _Bail
-        key = event.value
-        if event.tag is not None or key in seen:
+    for key in _fast_keys(get, keep):
+        if key in seen:
             raise _Bail
         seen.append(key)
         if key == "contacts":
@@ -680,6 +673,38 @@ def _fast_document(get, keep):
     if type(event) is not yaml.DocumentEndEvent:
         raise _Bail
     return _Parts(name, units, wrist, contacts, twists)
+
+
+def _fast_keys(get, keep):
+    """Each key of the mapping whose start was just read (untagged plain keys only)."""
+    while True:
+        event = get()
+        keep(event)
+        if type(event) is not _ScalarEvent:
+            if type(event) is _MappingEnd:
+                return
+            raise _Bail
+        if event.tag is not None:
+            raise _Bail
+        yield event.value
+
+
+def _fast_entries(get, keep):
+    """The start event of each mapping in the sequence that comes next (untagged only)."""
+    event = get()
+    keep(event)
+    if type(event) is not _SequenceStart or event.tag is not None:
+        raise _Bail
+    while True:
+        event = get()
+        keep(event)
+        if type(event) is not _MappingStart:
+            if type(event) is _SequenceEnd:
+                return
+            raise _Bail
+        if event.tag is not None:
+            raise _Bail
+        yield event
 
 
 def _fast_name(get, keep):
@@ -725,31 +750,12 @@ def _fast_vector(get, keep, length):
 
 def _fast_contacts(get, keep):
     """``_contacts`` for the next node, with the normals made unit."""
-    event = get()
-    keep(event)
-    if type(event) is not _SequenceStart or event.tag is not None:
-        raise _Bail
     names, points, normals = [], [], []
-    while True:
-        event = get()
-        keep(event)
-        if type(event) is not _MappingStart:
-            if type(event) is _SequenceEnd:
-                break
-            raise _Bail
-        if event.tag is not None or len(names) == 3:
+    for _ in _fast_entries(get, keep):
+        if len(names) == 3:
             raise _Bail
         name = point = normal = None
-        while True:
-            event = get()
-            keep(event)
-            if type(event) is not _ScalarEvent:
-                if type(event) is _MappingEnd:
-                    break
-                raise _Bail
-            key = event.value
-            if event.tag is not None:
-                raise _Bail
+        for key in _fast_keys(get, keep):
             if key == "point" and point is None:
                 point = _fast_vector(get, keep, 3)
             elif key == "normal" and normal is None:
@@ -786,31 +792,12 @@ def _unit_normal(x, y, z):
 
 def _fast_twists(get, keep):
     """``_twists`` for the next node, as ``(name, screw list, line)`` tuples."""
-    event = get()
-    keep(event)
-    if type(event) is not _SequenceStart or event.tag is not None:
-        raise _Bail
     names, twists = [], []
-    while True:
-        event = get()
-        keep(event)
-        if type(event) is not _MappingStart:
-            if type(event) is _SequenceEnd:
-                break
-            raise _Bail
-        if event.tag is not None:
-            raise _Bail
-        line = event.start_mark.line + 1
+    for start in _fast_entries(get, keep):
+        line = start.start_mark.line + 1
         fields = {}
-        while True:
-            event = get()
-            keep(event)
-            if type(event) is not _ScalarEvent:
-                if type(event) is _MappingEnd:
-                    break
-                raise _Bail
-            key = event.value
-            if event.tag is not None or key in fields:
+        for key in _fast_keys(get, keep):
+            if key in fields:
                 raise _Bail
             if key == "angular" or key == "linear" or key == "at":
                 fields[key] = _fast_vector(get, keep, 3)

@@ -1,0 +1,27 @@
+"""Fixtures shared by the loader's tests."""
+
+import pytest
+import yaml
+
+from grasptwist import grasp_file
+
+#: The YAML parsers the loader can run on here: the pure one, and libyaml's when present.
+LOADERS = [yaml.SafeLoader] + ([yaml.CSafeLoader] if yaml.__with_libyaml__ else [])
+
+#: Three valid contacts (the paper's Example 1), to build test documents from.
+CONTACTS = """\
+contacts:
+  - point: [1, 0, 0]
+    normal: [-1, 0, 0]
+  - point: [-0.5, 0.866, 0]
+    normal: [0.5, -0.866, 0]
+  - point: [-0.5, -0.866, 0]
+    normal: [0.5, 0.866, 0]
+"""
+
+
+@pytest.fixture(params=LOADERS, ids=lambda loader: loader.__name__)
+def loader(request, monkeypatch):
+    """Run the test once with each available YAML parser."""
+    monkeypatch.setattr(grasp_file, "_LOADER", request.param)
+    return request.param
