@@ -1,5 +1,6 @@
 """The picture's geometry (plain data from plot.scene) and headless rendering."""
 
+import itertools
 import subprocess
 import sys
 from pathlib import Path
@@ -7,12 +8,12 @@ from types import SimpleNamespace
 
 import numpy as np
 import pytest
+from grasp_gen import grasps
 
 import grasptwist as gt
 from grasptwist import plot, screws
 from grasptwist.degeneracy import Status
 from grasptwist.grasp_file import load_grasps
-from grasp_gen import grasps
 
 BUNDLED = sorted((Path(__file__).parent.parent / "grasps").glob("*.yaml"))
 EX1 = np.array([[1, 0, 0], [-0.5, 0.866, 0], [-0.5, -0.866, 0]], float)
@@ -99,7 +100,7 @@ def test_contact_velocity_arrows_equal_the_engine_and_their_parts_sum_to_them(ca
         np.testing.assert_array_equal(chain[0].origin, points[i])
         np.testing.assert_allclose(sum(a.vector for a in chain), v.vector, atol=1e-9 * (1 + screws.norm(v.vector)))
         # chained tip to tail, ending at the contact velocity's tip
-        for a, b in zip(chain, chain[1:]):
+        for a, b in itertools.pairwise(chain):
             np.testing.assert_allclose(a.tip, b.origin, atol=1e-12)
         np.testing.assert_allclose(chain[-1].tip, v.tip, atol=1e-9)
 
@@ -191,6 +192,13 @@ def test_import_needs_no_matplotlib_and_says_how_to_install_it():
     assert "pip install 'grasptwist[plot]'" in out
 
 
+def test_render_without_matplotlib_raises_missing_matplotlib(monkeypatch, tmp_path):
+    monkeypatch.setitem(sys.modules, "matplotlib", None)  # makes `import matplotlib` fail
+    with pytest.raises(plot.MissingMatplotlib, match="grasptwist\\[plot\\]"):
+        plot.render(make_scene("ex2-tangent"), tmp_path / "x.png")
+    assert not (tmp_path / "x.png").exists()
+
+
 def test_safe_names_and_unsupported_format(tmp_path):
     assert plot._safe_name("a b/c:d") == "a_b_c_d"
     with pytest.raises(ValueError, match=".png"):
@@ -216,7 +224,7 @@ def test_renders_png_of_the_requested_size_and_svg_headless(case, tmp_path):
 
 def test_render_grasps_writes_one_image_per_grasp_and_twist(tmp_path):
     pytest.importorskip("matplotlib")
-    twist = lambda name, s: SimpleNamespace(name=name, screw=np.asarray(s, float))  # noqa: E731
+    twist = lambda name, s: SimpleNamespace(name=name, screw=np.asarray(s, float))
     cylinder = SimpleNamespace(
         name="cylinder",
         contact_names=("1", "2", "3"),

@@ -34,16 +34,17 @@ from .degeneracy import Status, conditioning_warning, status_message
 from .screws import axis_point, cross, dot, field_at, norm, pitch, unit
 
 __all__ = [
+    "KINDS",
+    "METHODS",
     "Arrow",
     "Marker",
     "MissingMatplotlib",
     "Patch",
     "Scene",
     "Segment",
-    "METHODS",
     "default_method",
-    "legend_text",
     "grasp_scene",
+    "legend_text",
     "plot_grasp",
     "render",
     "render_grasps",
@@ -550,20 +551,20 @@ def _check_suffix(suffix: str):
 
 # kind -> matplotlib style
 _STYLE = {
-    "contact": dict(color="black", marker="o", s=40),
-    "wrist": dict(color="tab:purple", marker="^", s=60),
-    "normal": dict(color="0.45", lw=1.2),
-    "tangent-plane": dict(color="tab:cyan", alpha=0.25),
-    "contact-plane": dict(color="0.6", alpha=0.15),
-    "sigma-axis": dict(color="tab:blue", lw=1.4, ls="-"),
-    "psi-axis": dict(color="tab:orange", lw=1.4, ls="-"),
-    "theta-axis": dict(color="tab:green", lw=1.4, ls="-"),
-    "twist-axis": dict(color="tab:red", lw=2.2, ls="--"),
-    "twist-translation": dict(color="tab:red", lw=2.2),
-    "contact-velocity": dict(color="black", lw=2.4),
-    "sigma-part": dict(color="tab:blue", lw=1.4),
-    "psi-part": dict(color="tab:orange", lw=1.4),
-    "theta-part": dict(color="tab:green", lw=1.4),
+    "contact": {"color": "black", "marker": "o", "s": 40},
+    "wrist": {"color": "tab:purple", "marker": "^", "s": 60},
+    "normal": {"color": "0.45", "lw": 1.2},
+    "tangent-plane": {"color": "tab:cyan", "alpha": 0.25},
+    "contact-plane": {"color": "0.6", "alpha": 0.15},
+    "sigma-axis": {"color": "tab:blue", "lw": 1.4, "ls": "-"},
+    "psi-axis": {"color": "tab:orange", "lw": 1.4, "ls": "-"},
+    "theta-axis": {"color": "tab:green", "lw": 1.4, "ls": "-"},
+    "twist-axis": {"color": "tab:red", "lw": 2.2, "ls": "--"},
+    "twist-translation": {"color": "tab:red", "lw": 2.2},
+    "contact-velocity": {"color": "black", "lw": 2.4},
+    "sigma-part": {"color": "tab:blue", "lw": 1.4},
+    "psi-part": {"color": "tab:orange", "lw": 1.4},
+    "theta-part": {"color": "tab:green", "lw": 1.4},
 }
 
 
