@@ -13,6 +13,7 @@ import os
 import sys
 import tempfile
 from contextlib import contextmanager
+from dataclasses import replace
 from enum import Enum
 from typing import Iterator, List, Optional
 
@@ -110,12 +111,13 @@ class _Stderr:
         self.records += out.records
         self.failed += out.failed
         for line in out.errors:
-            self._line(line, ": error: ", "31")
+            self.say(line, ": error: ", "31")
         if not self.quiet:
             for line in out.warnings:
-                self._line(line, ": warning: ", "33")
+                self.say(line, ": warning: ", "33")
 
-    def _line(self, line: str, label: str, colour: str) -> None:
+    def say(self, line: str, label: str, colour: str) -> None:
+        """Print one diagnostic line, its label coloured on a terminal."""
         if self.color:
             line = line.replace(label, f": \x1b[{colour}m{label[2:-2]}\x1b[0m: ", 1)
         sys.stderr.write(line + "\n")
@@ -282,6 +284,90 @@ def schema(output: Optional[str] = _OUTPUT, debug: bool = _DEBUG) -> None:
     _run(debug, job)
 
 
+class PlotMethod(str, Enum):
+    off_tangent = "off-tangent"
+    tangent = "tangent"
+
+
+@app.command()
+def plot(
+    path: str = typer.Argument(..., metavar="PATH", help="A grasp file, or a folder for one image per grasp and twist."),
+    output: str = typer.Option(..., "-o", "--output", metavar="FILE|FOLDER", help="The image (.png, .svg or .pdf), or the folder for a folder's images."),
+    twist: Optional[str] = typer.Option(None, "--twist", metavar="W1,W2,W3,V1,V2,V3", help="Draw this twist (omega; v) instead of the file's."),
+    twist_name: Optional[str] = typer.Option(None, "--twist-name", metavar="NAME", help="Which of the file's twists to draw (or the name of --twist)."),
+    at: Optional[str] = typer.Option(None, "--at", metavar="X,Y,Z", help="Point whose velocity the --twist linear part gives."),
+    method: Optional[PlotMethod] = typer.Option(None, "--method", help="Basis to draw (default: off-tangent with a wrist, else tangent)."),
+    max_bytes: Optional[int] = _MAX_BYTES,
+    debug: bool = _DEBUG,
+) -> None:
+    """Draw a grasp, its basis screw axes and the finger-tip velocities (needs grasptwist[plot]).
+
+    Example: the paper's cylinder spinning about z, and every bundled grasp:
+
+        grasptwist plot grasps/cylinder.yaml --twist-name spin-z -o cylinder.png
+
+        grasptwist plot grasps/ -o pictures/
+    """
+    twists = _cli_twists([twist] if twist else None, at)
+    if twists and twist_name:
+        twists = [replace(twists[0], name=twist_name)]
+    _run(debug, lambda: _plot(path, output, twists, twist_name, method.value if method else None, max_bytes))
+
+
+def _plot(path, output, twists, twist_name, method, max_bytes) -> int:
+    from . import plot as pictures
+    from .grasp_file import Grasp
+    from .inputs import expand, read
+    from .report import diagnostics, error_record
+
+    stderr = _Stderr()
+    try:
+        pictures.require_matplotlib()
+    except pictures.MissingMatplotlib as exc:
+        sys.stderr.write(f"grasptwist: error: {exc}\n")
+        return EXIT_FAILED
+    grasps = []
+    for item in expand([path]):
+        for entry in read(item, max_bytes) if isinstance(item, str) else [item]:
+            if isinstance(entry, Grasp):
+                grasps.append(replace(entry, twists=tuple(twists)) if twists else entry)
+            else:
+                stderr.failed += 1
+                for line in diagnostics(error_record(entry))[0]:
+                    stderr.say(line, ": error: ", "31")
+    if os.path.isdir(path):
+        for grasp in grasps:
+            try:
+                written = pictures.render_grasps([grasp], output, method=method)
+            except ValueError as exc:  # e.g. off-tangent asked of a grasp without a wrist
+                stderr.failed += 1
+                stderr.say(f"{grasp.file}: grasp '{grasp.name}': error: {exc}", ": error: ", "31")
+                continue
+            sys.stdout.write("".join(f"{p}\n" for p in written))
+    elif grasps:
+        grasp = grasps[0]
+        if len(grasps) > 1:
+            sys.stderr.write(f"{path}: warning: drawing the first of its {len(grasps)} grasps, '{grasp.name}'\n")
+        chosen = _chosen_twist(grasp, twist_name if not twists else None)
+        try:
+            written = pictures.plot_grasp(grasp, output, chosen, method=method)
+        except ValueError as exc:
+            raise typer.BadParameter(str(exc))
+        sys.stdout.write(f"{written}\n")
+    return EXIT_FAILED if stderr.failed else EXIT_OK
+
+
+def _chosen_twist(grasp, name):
+    """The twist a single picture shows: the named one, else the first (or none)."""
+    if name is None:
+        return grasp.twists[0] if grasp.twists else None
+    for twist in grasp.twists:
+        if twist.name == name:
+            return twist
+    known = ", ".join(t.name for t in grasp.twists) or "none"
+    raise typer.BadParameter(f"grasp '{grasp.name}' has no twist '{name}' (it has: {known})", param_hint="--twist-name")
+
+
 def _records_only(fmt: Format) -> Format:
     if fmt in (Format.csv, Format.npz):
         raise typer.BadParameter(f"{fmt.value} is for resolve results; use table, json or jsonl", param_hint="--format")
@@ -326,8 +412,8 @@ def _run(debug: bool, job) -> None:
     """Run a command body; turn anything unexpected into one line and exit 1."""
     try:
         code = job()
-    except (typer.Exit, typer.Abort, KeyboardInterrupt):
-        raise
+    except (typer.Exit, typer.Abort, typer.BadParameter, KeyboardInterrupt):
+        raise  # typer's own ways out: exit codes, usage errors (2)
     except BrokenPipeError:
         # the reader (e.g. `head`) went away: not an error of ours
         sys.stderr.close()
