@@ -102,7 +102,6 @@ def _pool(workers):
     set) and a spool folder in which they leave their encoded output."""
     import multiprocessing
     import shutil
-    import tempfile
 
     shm = "/dev/shm"
     spool = tempfile.mkdtemp(prefix="grasptwist-", dir=shm if os.access(shm, os.W_OK) else None)
@@ -115,16 +114,21 @@ def _pool(workers):
         _SHARED.pop("spool", None)
 
 
-def _spooled(out: Output) -> Output:
-    """In a worker, move an output's bytes to a spool file: the parent copies the
-    file to its output in the kernel instead of receiving the bytes by pipe."""
+def _sealed(job: Job, out: Output) -> Output:
+    """An output ready to send: its records joined into one bytes object (one
+    write), and in a worker moved to a spool file, which the parent copies to
+    its output in the kernel instead of receiving the bytes by pipe."""
+    if job.fmt not in JOINERS or not out.encoded:
+        return out
+    blob = JOINERS[job.fmt](out.encoded)
     spool = _SHARED.get("spool")
-    if spool and os.getpid() != _SHARED["parent"] and out.encoded and isinstance(out.encoded[0], bytes):
+    if spool and os.getpid() != _SHARED["parent"]:
         fd, path = tempfile.mkstemp(dir=spool)
         with os.fdopen(fd, "wb") as f:
-            for blob in out.encoded:
-                f.write(blob)
+            f.write(blob)
         out.encoded, out.spool = [], path
+    else:
+        out.encoded = [blob]
     return out
 
 
@@ -137,7 +141,7 @@ def run_group(job: Job, paths: Sequence) -> Output:
     twists = [ZERO_TWIST] if job.kind != "resolve" else job.twists
     for x in resolve(items, twists, job.method):
         _emit(job, x, out)
-    return _spooled(out)
+    return _sealed(job, out)
 
 
 def blocks(job: Job, paths: Sequence) -> Iterator[Block | GraspFileError]:
@@ -171,9 +175,6 @@ def _no_gc():
 def _emit(job: Job, x, out: Output) -> None:
     with _no_gc():
         _emit_records(job, x, out)
-    if job.fmt in JOINERS and out.encoded:
-        # one bytes object per output: cheap to send from a worker, one write
-        out.encoded = [JOINERS[job.fmt](out.encoded)]
 
 
 def _emit_records(job: Job, x, out: Output) -> None:
@@ -212,7 +213,7 @@ def _dataset(job: Job, path: str, workers: int = 1) -> Iterator[Output]:
     except GraspFileError as err:
         out = Output(inputs=1)
         _emit(job, err, out)
-        yield out
+        yield _sealed(job, out)
         return
     tasks = [(start, min(len(ds), start + GRASPS_PER_TASK)) for start in range(0, len(ds), GRASPS_PER_TASK)]
     _SHARED["dataset"] = ds
@@ -243,7 +244,7 @@ def _dataset_task(job: Job, rows: tuple[int, int]) -> list[Output]:
         for start in range(0, len(block), RECORDS_AT_ONCE):
             out = Output()
             _emit(job, block.part(start, start + RECORDS_AT_ONCE), out)
-            outs.append(_spooled(out))
+            outs.append(_sealed(job, out))
     return outs
 
 
