@@ -149,18 +149,28 @@ def _output(path: str | None) -> Iterator:
 
 
 @contextmanager
-def _progress(total: int):
-    """A rich progress bar on stderr when it is a terminal and there is more than one input."""
-    if total < 2 or not sys.stderr.isatty():
-        yield lambda n: None
+def _progress(inputs: list):
+    """A rich progress bar on stderr when it is a terminal and there is more
+    than one input or a data set (whose records are counted as they come)."""
+    from .datasets import DATASET_SUFFIXES
+
+    big = len(inputs) > 1 or any(isinstance(p, str) and p.endswith(DATASET_SUFFIXES) for p in inputs)
+    if not big or not sys.stderr.isatty():
+        yield lambda output: None
         return
     from rich.progress import Progress
 
     from .table import console
 
     with Progress(console=console(sys.stderr), transient=True) as bar:
-        task = bar.add_task("resolving", total=total)
-        yield lambda n: bar.advance(task, n)
+        task = bar.add_task("resolving", total=len(inputs))
+
+        def advance(output):
+            if output.grows:
+                bar.update(task, total=bar.tasks[0].total + output.grows)
+            bar.advance(task, output.done)
+
+        yield advance
 
 
 _METHOD = typer.Option(Method.both, "--method", help="Decomposition(s) to run.")
@@ -387,7 +397,7 @@ def _emit(job, paths: list[str], output, quiet: bool, workers: int, **table_opti
 
     stderr = _Stderr(quiet)
     inputs = list(expand(paths))
-    with _output(output) as out, _progress(len(inputs)) as advance:
+    with _output(output) as out, _progress(inputs) as advance:
         if job.fmt == "npz":
             outputs = write_npz(job, inputs, out)
         else:
@@ -401,7 +411,7 @@ def _emit(job, paths: list[str], output, quiet: bool, workers: int, **table_opti
                     w.write_spooled(o.spool)
                 out.flush()  # a batch streams: each group is out as soon as it is ready
             stderr.take(o)
-            advance(o.inputs)
+            advance(o)
         if job.fmt != "npz":
             w.close()
     stderr.summary()

@@ -58,8 +58,9 @@ class Output:
     warnings: list[str] = field(default_factory=list)
     records: int = 0
     failed: int = 0
-    inputs: int = 0
-    spool: str | None = None  # a file holding ``encoded`` (see _spooled)
+    done: int = 0  # progress: files read, or data-set records made
+    grows: int = 0  # progress: work found beyond the one unit an input was counted as
+    spool: str | None = None  # a file holding ``encoded`` (see _sealed)
 
     def add(self, rec: dict, encode) -> None:
         self._note(rec)
@@ -137,26 +138,34 @@ def run_group(job: Job, paths: Sequence) -> Output:
     items = []
     for p in paths:
         items.extend(read(p, job.max_bytes) if isinstance(p, str) else [p])
-    out = Output(inputs=len(paths))
+    out = Output(done=len(paths))
     twists = [ZERO_TWIST] if job.kind != "resolve" else job.twists
     for x in resolve(items, twists, job.method):
         _emit(job, x, out)
     return _sealed(job, out)
 
 
-def blocks(job: Job, paths: Sequence) -> Iterator[Block | GraspFileError]:
-    """Blocks and errors of every input, in order (for writers that take blocks, like npz)."""
+def blocks(job: Job, paths: Sequence) -> Iterator[tuple[Block | GraspFileError, int | None]]:
+    """Blocks and errors of every input, in order (for writers that take
+    blocks, like npz), each with its progress news: None for a group of
+    files (one unit a file), else the records a data set holds beyond the
+    one unit it counted as (on its first block; 0 after)."""
     for g in _groups(paths):
         if _is_dataset(g):
             try:
-                yield from dataset_blocks(open_dataset(g, job.extra_point), job.twists, job.method)
+                ds = open_dataset(g, job.extra_point)
+                grows = len(ds) * (len(job.twists) if job.twists else 1) - 1
+                for block in dataset_blocks(ds, job.twists, job.method):
+                    yield block, grows
+                    grows = 0
             except GraspFileError as err:
-                yield err
+                yield err, None
             continue
         items = []
         for p in g:
             items.extend(read(p, job.max_bytes) if isinstance(p, str) else [p])
-        yield from resolve(items, job.twists, job.method)
+        for x in resolve(items, job.twists, job.method):
+            yield x, None
 
 
 @contextmanager
@@ -205,34 +214,39 @@ GRASPS_PER_TASK = 4096
 
 
 def _dataset(job: Job, path: str, workers: int = 1) -> Iterator[Output]:
-    """A data set's outputs, a few thousand records each; the first one counts the input."""
+    """A data set's outputs, a few thousand records each; the first one
+    tells the progress bar how many records the data set holds."""
     try:
         ds = open_dataset(path, job.extra_point)
         if job.twists is None and ds.twist is None and job.kind == "resolve":
             next(dataset_blocks(ds, None, job.method))  # raises the no-twist error
     except GraspFileError as err:
-        out = Output(inputs=1)
+        out = Output(done=1)
         _emit(job, err, out)
         yield _sealed(job, out)
         return
+    rows = len(ds) * (len(job.twists) if job.twists and job.kind == "resolve" else 1)
     tasks = [(start, min(len(ds), start + GRASPS_PER_TASK)) for start in range(0, len(ds), GRASPS_PER_TASK)]
     _SHARED["dataset"] = ds
     try:
         if workers > 1 and len(tasks) > 1:
             with _pool(workers) as pool:
                 parts = pool.imap(partial(_dataset_task, job), tasks)
-                yield from _counted(parts)
+                yield from _counted(parts, rows)
         else:
-            yield from _counted(_dataset_task(job, t) for t in tasks)
+            yield from _counted((_dataset_task(job, t) for t in tasks), rows)
     finally:
         _SHARED.clear()
 
 
-def _counted(parts):
+def _counted(parts, rows):
+    """The outputs of a data set's tasks, with their progress: records made,
+    and on the first, the records beyond the one unit the input counted as."""
     first = True
     for outs in parts:
         for out in outs:
-            out.inputs, first = int(first), False
+            out.done, out.grows = out.records, rows - 1 if first else 0
+            first = False
             yield out
 
 
@@ -278,8 +292,8 @@ def write_npz(job: Job, paths: Sequence, out) -> Iterator[Output]:
     nearly degenerate ones); the archive is complete when the iterator is.
     """
     w = NpzWriter(out, job.order)
-    for x in blocks(job, paths):
-        o = Output(inputs=1)
+    for x, grows in blocks(job, paths):
+        o = Output(done=len(x) if grows is not None else 1, grows=grows or 0)
         if isinstance(x, Block):
             w.write(x)
             talking = np.flatnonzero(talking_rows(x))
