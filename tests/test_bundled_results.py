@@ -1,0 +1,62 @@
+"""Every bundled grasp resolved end to end (loader, engine, records), its key numbers pinned.
+
+The numbers are those the files' headers state; a grasp that is degenerate
+for a method has that method's specific error instead.
+"""
+
+import json
+from pathlib import Path
+
+import numpy as np
+import pytest
+from typer.testing import CliRunner
+
+from grasptwist.cli import app
+
+GRASPS = Path(__file__).parent.parent / "grasps"
+ZERO = [0, 0, 0]
+RANK = "normals-rank-deficient"
+
+# (file, grasp, twist): (x, y, alpha, beta, in_tangent_planes); a str is the method's error code
+EXPECTED = {
+    ("box-edge.yaml", "box-edge", "tip-over-edge"): ([-1.2037, 0.2825, 0.1065], [0, -0.2515, 0.7922], [0, 10, -26.6667], [10.8333, 27.9682, 10.5475], False),
+    ("box-edge.yaml", "box-edge", "slide-x"): ([0, -0.4238, 0.4262], [1.0879, -0.503, -0.5942], [40, 20, 20], ZERO, True),
+    ("box-edge.yaml", "box-edge", "turn-y"): ([0, -0.5297, 0.5327], [0.0272, 0, 0], [1, 0, 0], ZERO, True),
+    ("cylinder.yaml", "cylinder", "sigma-1"): ([1, 0, 0], ZERO, RANK, RANK, None),
+    ("cylinder.yaml", "cylinder", "spin-z"): (ZERO, [-0.4714] * 3, RANK, RANK, None),
+    ("cylinder.yaml", "cylinder", "lift-z"): ([0.6667] * 3, ZERO, RANK, RANK, None),
+    ("handle.yaml", "mug-handle", "lift-z"): ([-7.8704, -1.9813, 5.0369], [38.7475, -54.6961, 16.0097], "theta-not-unique", "theta-not-unique", None),
+    ("handle.yaml", "mug-handle", "pour"): ([7.5, 5.1515, -1.8133], ZERO, "theta-not-unique", "theta-not-unique", None),
+    ("handle.yaml", "mug-handle", "turn-z"): ([-15.5556, -24.5687, -10.0335], ZERO, "theta-not-unique", "theta-not-unique", None),
+    ("polyhedron.yaml", "polyhedron", "diagonal-spin"): (ZERO, [0.4082] * 3, [0.5774] * 3, ZERO, True),
+    ("sphere.yaml", "sphere-tripod", "roll-x"): ([0.5877, -0.2938, -0.2938], [0, -0.2778, 0.2778], [0, 0.637, -0.637], ZERO, True),
+    ("sphere.yaml", "sphere-tripod", "spin-z"): (ZERO, [-0.3439] * 3, [0.7887] * 3, ZERO, True),
+    ("sphere.yaml", "sphere-tripod", "lift-z"): ([1.0508] * 3, ZERO, ZERO, [1.0508] * 3, False),
+    ("sphere.yaml", "sphere-equator", "roll-x"): ([0.6667, -0.3333, -0.3333], ZERO, RANK, RANK, None),
+    ("sphere.yaml", "sphere-equator", "lift-z"): ([0.9524] * 3, ZERO, RANK, RANK, None),
+}
+
+
+@pytest.fixture(scope="module")
+def records():
+    result = CliRunner().invoke(app, ["resolve", str(GRASPS), "-f", "jsonl"])
+    assert result.exit_code == 1  # the degenerate grasps fail their tangent method
+    return {(Path(r["file"]).name, r["grasp"], r["twist"]["name"]): r for r in map(json.loads, result.stdout.splitlines())}
+
+
+def test_every_bundled_grasp_and_twist_is_pinned(records):
+    assert set(records) == set(EXPECTED)
+
+
+@pytest.mark.parametrize("key", sorted(EXPECTED), ids=lambda k: f"{k[1]}/{k[2]}")
+def test_bundled_numbers(records, key):
+    rec = records[key]
+    x, y, alpha, beta, in_planes = EXPECTED[key]
+    np.testing.assert_allclose(rec["off_tangent"]["x"], x, atol=1e-4)
+    np.testing.assert_allclose(rec["off_tangent"]["y"], y, atol=1e-4)
+    if isinstance(alpha, str):
+        assert rec["tangent"]["error"]["code"] == alpha and rec["ok"] is False
+    else:
+        np.testing.assert_allclose(rec["tangent"]["alpha"], alpha, atol=1e-4)
+        np.testing.assert_allclose(rec["tangent"]["beta"], beta, atol=1e-4)
+        assert rec["tangent"]["in_tangent_planes"] is in_planes and rec["ok"] is True
