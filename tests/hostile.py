@@ -106,3 +106,8 @@ def assert_no_crash(output):
     """Nothing a user should never see: a traceback or the catch-all internal error."""
     assert "Traceback" not in output, output[-2000:]
     assert "internal error" not in output, output[-2000:]
+
+
+def summary(records, failed):
+    """The CLI's closing stderr line."""
+    return f"{records} record{'' if records == 1 else 's'}, {failed} failed"

@@ -17,7 +17,7 @@ from pathlib import Path
 
 import pytest
 
-from hostile import assert_no_crash, error_codes, error_lines, jsonl, run, run_installed
+from hostile import assert_no_crash, error_codes, error_lines, jsonl, run, run_installed, summary
 
 CORPUS = Path(__file__).parent / "corpus"
 TABLE = CORPUS / "expected.tsv"
@@ -128,11 +128,11 @@ def _check_alone(row, path, exit_code, stdout, stderr, seconds, limit):
     errors = error_lines(stderr)
     lines = stderr.splitlines()
     if row.code is None:
-        assert errors == [] and lines[-1] == f"{row.records} records, 0 failed"
+        assert errors == [] and lines[-1] == summary(row.records, 0)
         return
     # a few lines: the errors (one per failed method at most), then the summary
     assert 1 <= len(errors) <= 2 and len(lines) <= len(errors) + 1, stderr
-    assert lines[-1] == f"{row.records} records, {row.records - row.ok} failed"
+    assert lines[-1] == summary(row.records, row.records - row.ok)
     prefix = f"{path}:{row.where}: error: " if row.where else f"{path}: "
     assert all(line.startswith(prefix) for line in errors), (prefix, errors)
     assert any(f"{row.code}: " in line and row.fragment in line for line in errors), errors
@@ -242,7 +242,7 @@ def test_a_mixed_folder_gives_each_file_exactly_what_it_gives_alone(mixed):
         assert [line for line in errors if line.startswith(path + ":")] == theirs, path
         total, failed, lines = total + len(mine), failed + sum(not r["ok"] for r in mine), lines + len(theirs)
     assert len(errors) == lines  # no error line that is not some file's own
-    assert result.stderr.splitlines()[-1] == f"{total} records, {failed} failed"
+    assert result.stderr.splitlines()[-1] == summary(total, failed)
 
     # One error record and at least one error line per bad input; the good ones all ok.
     by_file = {path: [r for r in records if r["file"] == path] for path in read}

@@ -17,7 +17,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from grasptwist.grasp_file import Grasp, GraspFileError, load_grasps, read_grasps
-from hostile import assert_no_crash, jsonl, run
+from hostile import assert_no_crash, jsonl, run, summary
 
 # --------------------------------------------------------------------------
 # Inputs.
@@ -135,7 +135,7 @@ def check_cli(data):
     records = jsonl(result.stdout)
     assert records and result.exit_code == (0 if all(r["ok"] for r in records) else 1)
     lines = result.stderr.splitlines()
-    assert lines[-1] == f"{len(records)} records, {sum(not r['ok'] for r in records)} failed"
+    assert lines[-1] == summary(len(records), sum(not r["ok"] for r in records))
     assert all(line.startswith("<stdin>") for line in lines[:-1]), lines
 
 

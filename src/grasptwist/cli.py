@@ -30,6 +30,7 @@ app = typer.Typer(
     add_completion=True,
     rich_markup_mode=None,
     pretty_exceptions_enable=False,
+    context_settings={"help_option_names": ["-h", "--help"]},
 )
 
 
@@ -104,7 +105,7 @@ class _Stderr:
         self.failed = 0
         self.records = 0
         self.quiet = quiet
-        self.color = sys.stderr.isatty() and "NO_COLOR" not in os.environ
+        self.color = sys.stderr.isatty() and not os.environ.get("NO_COLOR")
 
     def take(self, out) -> None:
         """Count a pipeline Output and print its lines."""
@@ -124,7 +125,7 @@ class _Stderr:
 
     def summary(self) -> None:
         if not self.quiet:
-            sys.stderr.write(f"{self.records} records, {self.failed} failed\n")
+            sys.stderr.write(f"{self.records} record{'' if self.records == 1 else 's'}, {self.failed} failed\n")
 
 
 @contextmanager

@@ -467,6 +467,7 @@ def _tangent_rows(ins, out, tol):
         (lambda tol: degenerate, Status.NORMAL_IN_CONTACT_PLANE, lambda rows: np.argmin(plane_sine[:, rows], 0)),
     ]
     _settle(out, checks, t, tol, alpha=alpha, beta=beta, normal_velocity=nv)
+    out["in_tangent_planes"][out["status"] != Status.OK] = False  # unknown where the method failed
 
 
 def _subset(candidates, test):

@@ -37,7 +37,7 @@ def console(out: IO[bytes] | IO[str], color: bool | None = None, width: int | No
         text = out
     else:
         text = _TextView(out, encoding="utf-8", write_through=True)
-    terminal = color if color is not None else (text.isatty() and "NO_COLOR" not in os.environ)
+    terminal = color if color is not None else (text.isatty() and not os.environ.get("NO_COLOR"))
     return Console(
         file=text,
         force_terminal=terminal,
