@@ -295,3 +295,40 @@ def test_a_progress_bar_on_a_terminal_and_only_there(files):
     assert len(out.read_text().splitlines()) == 3
     piped = subprocess.run(cmd + ["resolve", str(files), "-f", "jsonl"], capture_output=True, timeout=60)
     assert b"resolving" not in piped.stderr and b"\x1b[" not in piped.stderr
+
+
+def test_what_a_new_user_ran_into(files, tmp_path):
+    # -o into a folder that does not exist: a usage error naming the user's path, before any work
+    r = run("resolve", files / "poly.yaml", "--json", "-o", tmp_path / "missing" / "o.json")
+    assert r.exit_code == 2 and f"cannot write {tmp_path / 'missing' / 'o.json'}: no folder" in r.output
+    # an --at that makes the origin velocity overflow: a usage error, no numpy warning
+    r = run("resolve", files / "poly.yaml", "--twist", "1e300,0,0,0,0,0", "--at", "0,1e300,1e300")
+    assert r.exit_code == 2 and "the velocity of the origin overflows" in r.output and "Warning" not in r.output
+    # basis and check offer only the formats they write
+    assert run("basis", files / "poly.yaml", "-f", "csv").exit_code == 2
+    assert run("check", files / "poly.yaml", "-f", "npz").exit_code == 2
+    # --extra-point at only means something for .npy rows
+    assert run("resolve", files / "poly.yaml", "--extra-point", "at").exit_code == 2
+    # -h, and one record is one record
+    assert run("resolve", "-h").exit_code == 0
+    r = run("resolve", files / "poly.yaml", "--twist", "0,0,1,0,0,0", "-f", "jsonl")
+    assert r.stderr.splitlines()[-1] == "1 record, 0 failed"
+    # zeros are written without a sign
+    assert b"-0.0" not in run("resolve", files / "cyl.yaml", "--method", "off-tangent", "--json").stdout_bytes
+    # stdin is read once
+    r = run("resolve", "-", "-", "-f", "jsonl", input=POLY)
+    assert r.exit_code == 1 and "-: error: read-error: cannot read: standard input can be read only once" in r.stderr
+
+
+def test_a_reader_that_goes_away_ends_the_run_quietly_with_141(files):
+    exe = Path(sys.executable).parent / "grasptwist"
+    cmd = [str(exe)] if exe.exists() else [sys.executable, "-m", "grasptwist"]
+    big = files / "big"
+    big.mkdir()
+    for i in range(300):
+        (big / f"g{i:03d}.yaml").write_text(POLY)
+    p = subprocess.Popen(cmd + ["resolve", str(big), "-f", "jsonl"], stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    p.stdout.readline()
+    p.stdout.close()  # like `| head -1`
+    err = p.stderr.read()
+    assert p.wait(timeout=60) == 141 and b"Traceback" not in err and b"Exception ignored" not in err

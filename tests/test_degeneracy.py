@@ -186,3 +186,8 @@ def test_a_mixed_batch_keeps_good_rows_bit_for_bit():
             assert np.isfinite(o.x[i]).all() and np.isfinite(o.residual[i])
         else:
             assert np.isnan(o.x[i]).all()
+
+
+def test_in_tangent_planes_is_false_where_the_tangent_method_failed():
+    r = gt.decompose_tangent(EX1, -EX1, [0, 0, 1, 0, 0, 0])  # rank 2; the spin keeps every contact tangent
+    assert r.status == S.NORMALS_RANK_DEFICIENT and not r.in_tangent_planes and np.isnan(r.normal_velocity).all()

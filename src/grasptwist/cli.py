@@ -21,7 +21,7 @@ import typer
 
 from . import __version__
 
-EXIT_OK, EXIT_FAILED, EXIT_USAGE = 0, 1, 2
+EXIT_OK, EXIT_FAILED, EXIT_USAGE, EXIT_BROKEN_PIPE = 0, 1, 2, 141
 
 app = typer.Typer(
     name="grasptwist",
@@ -61,6 +61,12 @@ class Format(str, Enum):
     npz = "npz"
 
 
+class RecordFormat(str, Enum):
+    table = "table"
+    json = "json"
+    jsonl = "jsonl"
+
+
 class ExtraPoint(str, Enum):
     wrist = "wrist"
     at = "at"
@@ -87,6 +93,8 @@ def _cli_twists(texts: list[str] | None, at: str | None):
         if at is not None:
             raise typer.BadParameter("--at applies to --twist; give at least one --twist", param_hint="--at")
         return None
+    import numpy as np
+
     from .grasp_file import Twist
     from .screws import twist_at
 
@@ -94,7 +102,11 @@ def _cli_twists(texts: list[str] | None, at: str | None):
     twists = []
     for text in texts:
         w = _floats(text, 6, "--twist")
-        twists.append(Twist(name=text.replace(" ", ""), screw=twist_at(w[:3], w[3:], point), line=None))
+        with np.errstate(all="ignore"):
+            screw = twist_at(w[:3], w[3:], point)
+        if not np.isfinite(screw).all():
+            raise typer.BadParameter(f"{text!r} at {at}: the velocity of the origin overflows", param_hint="--twist")
+        twists.append(Twist(name=text.replace(" ", ""), screw=screw, line=None))
     return twists
 
 
@@ -136,6 +148,7 @@ def _output(path: str | None) -> Iterator:
         sys.stdout.buffer.flush()
         return
     folder = os.path.dirname(os.path.abspath(path))
+    _writable_folder(path)
     fd, tmp = tempfile.mkstemp(prefix=".grasptwist-", dir=folder)
     umask = os.umask(0)
     os.umask(umask)
@@ -147,6 +160,15 @@ def _output(path: str | None) -> Iterator:
     except BaseException:
         os.unlink(tmp)
         raise
+
+
+def _writable_folder(path: str) -> None:
+    """A usage error, before any work, when ``path``'s folder cannot take a file."""
+    folder = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(folder):
+        raise typer.BadParameter(f"cannot write {path}: no folder {os.path.dirname(path) or folder}", param_hint="-o")
+    if not os.access(folder, os.W_OK):
+        raise typer.BadParameter(f"cannot write {path}: the folder is not writable", param_hint="-o")
 
 
 @contextmanager
@@ -208,12 +230,12 @@ def resolve(
 ) -> None:
     """Resolve object twists into finger-tip twists and amplitudes: one record per (grasp, twist).
 
-    Example: spin the paper's cylinder about z and read the Psi amplitudes:
+    Examples: spin the paper's cylinder about z and read the Psi amplitudes
+    (--method off-tangent: the cylinder is degenerate for the tangent method);
+    a data set of grasps as arrays, results as arrays:
 
-        grasptwist resolve grasps/cylinder.yaml --twist 0,0,1,0,0,0 --json | jq '.[0].off_tangent.y'
-
-    A data set of grasps as arrays, results as arrays:
-
+    \b
+        grasptwist resolve grasps/cylinder.yaml --method off-tangent --twist 0,0,1,0,0,0 --json | jq '.[0].off_tangent.y'
         grasptwist resolve grasps.npz --twist 0,0,1,0,0,0 -f npz -o results.npz
     """
     from .pipeline import Job
@@ -221,18 +243,20 @@ def resolve(
     twists = _cli_twists(twist, at)
     if extra_point == ExtraPoint.at and at is not None:
         raise typer.BadParameter("--extra-point at gives each row its own point; drop --at", param_hint="--at")
+    if extra_point == ExtraPoint.at and not any(p.endswith(".npy") for p in paths):
+        raise typer.BadParameter("applies to .npy data sets (their 19th-21st columns)", param_hint="--extra-point")
     fmt = Format.json if json_ else fmt
     if fmt == Format.npz and output is None and sys.stdout.isatty():
         raise typer.BadParameter("npz is binary: give -o FILE.npz", param_hint="--format")
     job = Job("resolve", None if twists is None else tuple(twists), method.value, order.value, fmt.value, max_bytes, extra_point.value)
-    _run(debug, lambda: _emit(job, paths, output, quiet, workers, digits=digits))
+    _run(debug, lambda: _emit(job, paths, output, quiet, workers, digits=digits, order=order.value))
 
 
 @app.command()
 def basis(
     paths: List[str] = _PATHS,
     method: Method = _METHOD,
-    fmt: Format = typer.Option(Format.table, "-f", "--format", help="table, json or jsonl."),
+    fmt: RecordFormat = typer.Option(RecordFormat.table, "-f", "--format", help="table for people, json or jsonl for programs."),
     json_: bool = _JSON,
     output: Optional[str] = _OUTPUT,
     digits: int = _DIGITS,
@@ -246,19 +270,20 @@ def basis(
 
     Example (the paper's eqs. 16-18, with unit Psi):
 
+    \b
         grasptwist basis grasps/cylinder.yaml --method off-tangent
     """
     from .pipeline import Job
 
-    job = Job("basis", None, method.value, order.value, _records_only(Format.json if json_ else fmt).value, max_bytes)
-    _run(debug, lambda: _emit(job, paths, output, quiet, workers, digits=digits))
+    job = Job("basis", None, method.value, order.value, "json" if json_ else fmt.value, max_bytes)
+    _run(debug, lambda: _emit(job, paths, output, quiet, workers, digits=digits, order=order.value))
 
 
 @app.command()
 def check(
     paths: List[str] = _PATHS,
     method: Method = _METHOD,
-    fmt: Format = typer.Option(Format.table, "-f", "--format", help="table, json or jsonl."),
+    fmt: RecordFormat = typer.Option(RecordFormat.table, "-f", "--format", help="table for people, json or jsonl for programs."),
     json_: bool = _JSON,
     output: Optional[str] = _OUTPUT,
     max_bytes: Optional[int] = _MAX_BYTES,
@@ -270,11 +295,12 @@ def check(
 
     Example, over a folder, listing only the failures:
 
+    \b
         grasptwist check grasps/ -f jsonl | jq -c 'select(.ok | not)'
     """
     from .pipeline import Job
 
-    job = Job("check", None, method.value, "omega-v", _records_only(Format.json if json_ else fmt).value, max_bytes)
+    job = Job("check", None, method.value, "omega-v", "json" if json_ else fmt.value, max_bytes)
     _run(debug, lambda: _emit(job, paths, output, quiet, workers))
 
 
@@ -282,7 +308,10 @@ def check(
 def schema(output: Optional[str] = _OUTPUT, debug: bool = _DEBUG) -> None:
     """Print the JSON Schema of grasp files (for editors with a YAML language server).
 
-    Example: grasptwist schema -o grasp.schema.json
+    Example:
+
+    \b
+        grasptwist schema -o grasp.schema.json
     """
     from .grasp_file import grasp_schema
     from .report import dumps
@@ -313,10 +342,10 @@ def plot(
 ) -> None:
     """Draw a grasp, its basis screw axes and the finger-tip velocities (needs grasptwist[plot]).
 
-    Example: the paper's cylinder spinning about z, and every bundled grasp:
+    Examples: the paper's cylinder spinning about z, and every bundled grasp:
 
+    \b
         grasptwist plot grasps/cylinder.yaml --twist-name spin-z -o cylinder.png
-
         grasptwist plot grasps/ -o pictures/
     """
     twists = _cli_twists([twist] if twist else None, at)
@@ -327,11 +356,16 @@ def plot(
 
 def _plot(path, output, twists, twist_name, method, max_bytes) -> int:
     from . import plot as pictures
+    from .datasets import DATASET_SUFFIXES
     from .grasp_file import Grasp
     from .inputs import expand, read
     from .report import diagnostics, error_record
 
     stderr = _Stderr()
+    if path.endswith(DATASET_SUFFIXES):
+        raise typer.BadParameter("plot draws grasp files (.yaml, .yml) or folders of them, not data sets", param_hint="PATH")
+    if not os.path.isdir(path):
+        _writable_folder(output)
     try:
         pictures.require_matplotlib()
     except pictures.MissingMatplotlib as exc:
@@ -379,12 +413,6 @@ def _chosen_twist(grasp, name):
     raise typer.BadParameter(f"grasp '{grasp.name}' has no twist '{name}' (it has: {known})", param_hint="--twist-name")
 
 
-def _records_only(fmt: Format) -> Format:
-    if fmt in (Format.csv, Format.npz):
-        raise typer.BadParameter(f"{fmt.value} is for resolve results; use table, json or jsonl", param_hint="--format")
-    return fmt
-
-
 def _workers(requested: int) -> int:
     """Processes: as asked, or every core (the pipeline uses them only for big batches)."""
     return requested if requested > 0 else min(os.cpu_count() or 1, 8)
@@ -426,9 +454,10 @@ def _run(debug: bool, job) -> None:
     except (typer.Exit, typer.Abort, typer.BadParameter, KeyboardInterrupt):
         raise  # typer's own ways out: exit codes, usage errors (2)
     except BrokenPipeError:
-        # the reader (e.g. `head`) went away: not an error of ours
-        sys.stderr.close()
-        raise typer.Exit(EXIT_FAILED)
+        # The reader (e.g. `head`) went away: stop quietly with the status of a
+        # Unix filter killed by SIGPIPE, and keep Python's final flush quiet too.
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        raise typer.Exit(EXIT_BROKEN_PIPE)
     except Exception as exc:  # noqa: BLE001 - the one place a traceback is turned into a line
         if debug:
             raise

@@ -96,6 +96,8 @@ def _open_npy(path, a, extra_point):
     if a.ndim != 2 or a.shape[1] not in (18, 21):
         raise _bad(path, f"expected rows of 18 or 21 numbers (p1 p2 p3 n1 n2 n3 [point]), got shape {a.shape}")
     _numeric(path, "rows", a, (a.shape[1],))
+    if extra_point == "at" and a.shape[1] != 21:
+        raise _bad(path, "--extra-point at needs rows of 21 numbers (the point is the last 3)")
     n = len(a)
     extra = a[:, 18:21] if a.shape[1] == 21 else None
     return Dataset(

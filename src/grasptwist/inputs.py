@@ -24,8 +24,12 @@ STDIN = "-"
 
 def expand(paths: Iterable[str]) -> Iterator[str | GraspFileError]:
     """Every grasp file named by ``paths``, folders expanded, in order."""
+    stdin_seen = False
     for path in paths:
-        if path == STDIN or os.path.isfile(path):
+        if path == STDIN and stdin_seen:
+            yield _io_error(path, "standard input can be read only once")
+        elif path == STDIN or os.path.isfile(path):
+            stdin_seen |= path == STDIN
             yield path
         elif os.path.isdir(path):
             yield from _walk(path)

@@ -152,6 +152,7 @@ def _by_template(block, order, records, dumps, rows, in_planes):
     template, slots = _template(block, order, records, dumps, in_planes)
     part = np.flatnonzero(rows)
     numbers = np.concatenate([_value(block, *c)[part].reshape(len(part), -1) for c in _columns(block)], axis=1)
+    numbers += 0.0  # no -0.0, as in report._rows
     columns = []
     for slot in slots:
         if isinstance(slot, list):

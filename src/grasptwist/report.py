@@ -104,8 +104,12 @@ def records(block: Block, order: str = "omega-v") -> list[dict]:
 
 
 def _rows(a):
-    """Row views of a C-contiguous copy of ``a`` (orjson writes contiguous arrays natively)."""
-    a = np.ascontiguousarray(a)
+    """Row views of a C-contiguous copy of ``a`` (orjson writes contiguous arrays natively).
+
+    Floats get ``+ 0.0``, which turns ``-0.0`` into ``0.0``: a round-off sign
+    on zero means nothing and reads oddly (``jq`` prints ``-0``).
+    """
+    a = np.ascontiguousarray(a + 0.0 if a.dtype.kind == "f" else a)
     return list(a) if a.ndim > 1 else a.tolist()
 
 

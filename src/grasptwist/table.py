@@ -67,10 +67,12 @@ def fmt_vector(v, digits: int) -> str:
 class _Writer:
     """Common start of the table writers: a console and a record counter."""
 
-    def __init__(self, out: IO[bytes], digits: int = 4, color: bool | None = None, width: int | None = None):
+    def __init__(self, out: IO[bytes], digits: int = 4, color: bool | None = None, width: int | None = None, order: str = "omega-v"):
         self.con = console(out, color, width)
         self.digits = digits
         self.count = 0
+        # screws are printed in the order asked for; say which when it is not the paper's
+        self.order_note = "  (screws as (v; omega))" if order == "v-omega" else ""
 
     def write(self, rec: dict) -> None:
         if "error" in rec:  # the error line is on stderr; tables carry results only
@@ -85,7 +87,7 @@ class _Writer:
 
     def title(self, rec: dict, *more) -> Text:
         units = f" [{rec['units']}]" if rec.get("units") else ""
-        return Text.assemble((rec["grasp"], "bold"), f" ({rec['file']}){units}", *more)
+        return Text.assemble((rec["grasp"], "bold"), f" ({rec['file']}){units}", *more, self.order_note)
 
 
 class TableWriter(_Writer):
