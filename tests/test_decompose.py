@@ -272,3 +272,19 @@ def test_wrong_shapes_are_rejected_at_the_boundary():
         gt.decompose_off_tangent(np.zeros((3, 2)), EX1_WRIST, np.zeros(6))
     with pytest.raises(ValueError, match="twist"):
         gt.decompose_tangent(EX2, EX2_NORMALS, np.zeros(5))
+
+
+def test_without_bases_the_amplitudes_and_verdicts_are_the_same():
+    rng = np.random.default_rng(4)
+    points, normals, wrist, twist = grasps(rng, 30)
+    wrist[0] = points[0].mean(0)
+    for full, lean in (
+        (gt.decompose_off_tangent(points, wrist, twist), gt.decompose_off_tangent(points, wrist, twist, bases=False)),
+        (gt.decompose_tangent(points, normals, twist), gt.decompose_tangent(points, normals, twist, bases=False)),
+    ):
+        assert lean.sigma is None and lean.row(3).sigma is None
+        for name in ("status", "culprit", "conditioning"):
+            np.testing.assert_array_equal(getattr(lean, name), getattr(full, name))
+        amplitudes = ("x", "y") if isinstance(full, gt.OffTangentResult) else ("alpha", "beta", "normal_velocity", "in_tangent_planes")
+        for name in amplitudes:
+            np.testing.assert_array_equal(getattr(lean, name), getattr(full, name))

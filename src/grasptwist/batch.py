@@ -87,13 +87,14 @@ def _take(result, rows):
     return None if result is None else result.row(rows)
 
 
-def resolve_arrays(points, normals, wrist, twist, method="both", *, file="", grasp=None, twist_name=None, units=None) -> Block:
+def resolve_arrays(points, normals, wrist, twist, method="both", *, file="", grasp=None, twist_name=None, units=None, bases=True) -> Block:
     """One block from arrays of rows (a data set, or stacked grasps).
 
     ``wrist`` may be None (no row has one) or hold NaN rows for grasps
     without one; ``grasp`` and ``twist_name`` are per-row labels
     (default: the row index and ``"0"``).  ``normals`` should be unit
-    already (records show them as given).
+    already (records show them as given).  ``bases=False`` leaves out the
+    basis screws, for outputs that do not show them (npz).
     """
     if method not in METHODS:
         raise ValueError(f"method must be one of {METHODS}, got {method!r}")
@@ -101,9 +102,9 @@ def resolve_arrays(points, normals, wrist, twist, method="both", *, file="", gra
     has_wrist = np.zeros(n, bool) if wrist is None else np.isfinite(wrist).all(axis=-1)
     off = tan = None
     if method != "off-tangent":
-        tan = decompose_tangent(points, normals, twist)
+        tan = decompose_tangent(points, normals, twist, bases=bases)
     if method != "tangent":
-        off = decompose_off_tangent(points, np.full((n, 3), np.nan) if wrist is None else wrist, twist)
+        off = decompose_off_tangent(points, np.full((n, 3), np.nan) if wrist is None else wrist, twist, bases=bases)
     return Block(
         file=file if isinstance(file, list) else [file] * n,
         grasp=grasp if grasp is not None else [str(i) for i in range(n)],

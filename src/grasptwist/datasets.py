@@ -135,13 +135,20 @@ def _open_npz(path, arrays):
 
 
 def dataset_blocks(
-    ds: Dataset, twists: Sequence[Twist] | None, method: str, rows: int | None = None, start: int = 0, stop: int | None = None
+    ds: Dataset,
+    twists: Sequence[Twist] | None,
+    method: str,
+    rows: int | None = None,
+    start: int = 0,
+    stop: int | None = None,
+    bases: bool = True,
 ) -> Iterator[Block]:
     """Resolve the grasps ``start:stop`` of a data set, a chunk of ``rows`` rows at a time.
 
     Each grasp is paired with every twist of ``twists`` (the command line's)
     or else with the data set's own twist; with ``at`` points, a twist's
-    linear part is the velocity of the row's ``at`` point.
+    linear part is the velocity of the row's ``at`` point.  ``bases=False``
+    leaves the basis screws out (see :func:`~grasptwist.batch.resolve_arrays`).
 
     Raises
     ------
@@ -159,12 +166,18 @@ def dataset_blocks(
     step = max(1, (rows or ROWS_PER_BLOCK) // k)
     end = len(ds) if stop is None else min(stop, len(ds))
     for first in range(start, end, step):
-        yield _block(ds, given, twists, method, first, min(end, first + step), k)
+        yield _block(ds, given, twists, method, first, min(end, first + step), k, bases)
 
 
-def _block(ds, given, twists, method, start, stop, k):
+def _block(ds, given, twists, method, start, stop, k, bases):
     """Rows ``start:stop`` of ``ds``, each paired with its ``k`` twists."""
     index = np.repeat(np.arange(start, stop), k)  # row-major: grasp, then its twists
+    # each grasp's row repeated for its twists (no copy when there is one twist)
+    rows = slice(None) if k == 1 else index - start
+
+    def column(a):
+        return None if a is None else np.asarray(a[start:stop], dtype=float)[rows]
+
     if given is not None:
         screw = np.tile(given, (stop - start, 1))
         names = [t.name for t in twists] * (stop - start)
@@ -173,21 +186,21 @@ def _block(ds, given, twists, method, start, stop, k):
         screw = np.broadcast_to(own, (stop - start, 6)) if own.ndim == 1 else own[start:stop]
         names = ["twist"] * (stop - start)
     if ds.at is not None:
-        at = np.asarray(ds.at[start:stop], dtype=float)[index - start]
+        at = column(ds.at)
         screw = twist_at(screw[:, :3], screw[:, 3:], at)
     # labels stay a numpy string array: a million Python strings cost more than the engine
-    label = ds.names[start:stop][index - start].astype(str) if ds.names is not None else index.astype(str)
-    wrist = None if ds.wrist is None else np.asarray(ds.wrist[start:stop], dtype=float)[index - start]
+    label = ds.names[start:stop][rows].astype(str) if ds.names is not None else index.astype(str)
     return resolve_arrays(
-        np.asarray(ds.points[start:stop], dtype=float)[index - start],
+        column(ds.points),
         # unit normals exactly as the grasp-file loader makes them
-        direction(np.asarray(ds.normals[start:stop], dtype=float))[index - start],
-        wrist,
+        direction(np.asarray(ds.normals[start:stop], dtype=float))[rows],
+        column(ds.wrist),
         np.ascontiguousarray(screw, dtype=float),
         method,
         file=ds.path,
         grasp=label,
         twist_name=names,
+        bases=bases,
     )
 
 

@@ -103,6 +103,10 @@ def contact_velocities(points, twist):
     return _chunked(_velocity_rows, inputs, {"velocity": (3, 3)}, None)["velocity"]
 
 
+def _index(a, i):
+    return None if a is None else a[i]
+
+
 @dataclass(frozen=True, eq=False)
 class _Result:
     """What both results share: per-row status, conditioning and inputs, row
@@ -132,7 +136,7 @@ class _Result:
 
     def row(self, i):
         """Row ``i`` (an index into the leading axis) as a result of the same type."""
-        r = type(self)(**{f.name: getattr(self, f.name)[i] for f in fields(self)})
+        r = type(self)(**{f.name: _index(getattr(self, f.name), i) for f in fields(self)})
         if "residual" in self.__dict__:  # carry a residual already computed for the batch
             r.__dict__["residual"] = self.__dict__["residual"][i]
         return r
@@ -248,7 +252,7 @@ class TangentResult(_Result):
         return self.alpha[..., None, :, None] * theta_at, self.beta[..., None] * sigma_at
 
 
-def decompose_off_tangent(points, wrist, twist, *, tol=DEGENERACY_TOL) -> OffTangentResult:
+def decompose_off_tangent(points, wrist, twist, *, tol=DEGENERACY_TOL, bases=True) -> OffTangentResult:
     """Resolve ``twist`` on the off-tangent basis (Proposition 1).
 
     ``x_i = [T|Psi_i] / [Sigma_i|Psi_i]``, ``y_i = [T|Sigma_i] / [Sigma_i|Psi_i]``
@@ -262,6 +266,10 @@ def decompose_off_tangent(points, wrist, twist, *, tol=DEGENERACY_TOL) -> OffTan
     twist : (..., 6) array, ``(omega; v)`` with ``v`` at the origin.
     tol : float
         Relative tolerance of the degeneracy tests (see :mod:`grasptwist.degeneracy`).
+    bases : bool
+        False leaves out the basis screws (``sigma``, ``psi`` are None, and
+        so cannot give components or a residual): a third less work and
+        memory when only amplitudes and statuses are wanted.
 
     Returns
     -------
@@ -281,11 +289,11 @@ def decompose_off_tangent(points, wrist, twist, *, tol=DEGENERACY_TOL) -> OffTan
         "wrist": _checked(wrist, (3,), "wrist"),
         "twist": _checked(twist, (6,), "twist"),
     }
-    out = _chunked(_off_tangent_rows, inputs, _OFF_TANGENT_OUT, tol)
-    return OffTangentResult(**out)
+    out = _chunked(_off_tangent_rows, inputs, _without_bases(_OFF_TANGENT_OUT, bases), tol)
+    return OffTangentResult(**{**dict.fromkeys(_BASES & _OFF_TANGENT_OUT.keys()), **out})
 
 
-def decompose_tangent(points, normals, twist, *, tol=DEGENERACY_TOL) -> TangentResult:
+def decompose_tangent(points, normals, twist, *, tol=DEGENERACY_TOL, bases=True) -> TangentResult:
     """Resolve ``twist`` on the tangent basis ``Theta`` plus the off-plane ``Sigma``.
 
     ``alpha_i = [T|Sigma_i] / [Theta_i|Sigma_i]`` (eq. 27) and
@@ -300,6 +308,9 @@ def decompose_tangent(points, normals, twist, *, tol=DEGENERACY_TOL) -> TangentR
     twist : (..., 6) array, ``(omega; v)`` with ``v`` at the origin.
     tol : float
         Relative tolerance of the degeneracy tests.
+    bases : bool
+        False leaves out the basis screws (``theta``, ``sigma`` are None),
+        as for :func:`decompose_off_tangent`.
 
     Returns
     -------
@@ -319,8 +330,8 @@ def decompose_tangent(points, normals, twist, *, tol=DEGENERACY_TOL) -> TangentR
         "normals": _checked(normals, (3, 3), "normals"),
         "twist": _checked(twist, (6,), "twist"),
     }
-    out = _chunked(_tangent_rows, inputs, _TANGENT_OUT, tol)
-    return TangentResult(**out)
+    out = _chunked(_tangent_rows, inputs, _without_bases(_TANGENT_OUT, bases), tol)
+    return TangentResult(**{**dict.fromkeys(_BASES & _TANGENT_OUT.keys()), **out})
 
 
 # --- the row kernels ----------------------------------------------------------
@@ -350,6 +361,11 @@ _TANGENT_OUT = {
     "conditioning": (),
 }
 _DTYPES = {"status": np.int8, "culprit": np.int8, "in_tangent_planes": bool}
+_BASES = {"sigma", "psi", "theta"}
+
+
+def _without_bases(spec, bases):
+    return spec if bases else {k: v for k, v in spec.items() if k not in _BASES}
 _TRAILING = {"points": (3, 3), "normals": (3, 3), "wrist": (3,), "twist": (6,)}
 
 
@@ -410,8 +426,9 @@ def _off_tangent_rows(ins, out, tol):
     x = tri.side_len * _dot(e, v) / d
     y = e_len * _dot(tri.side, v[_J]) / d
     e /= e_len[:, None]
-    _put_lines(out["sigma"], p[_J], tri.unit_side)
-    _put_lines(out["psi"], p, e)
+    if "sigma" in out:
+        _put_lines(out["sigma"], p[_J], tri.unit_side)
+        _put_lines(out["psi"], p, e)
     out["sigma_psi"][...] = d / le
     out["conditioning"][...] = conditioning
     checks = tri.checks + [
@@ -443,8 +460,9 @@ def _tangent_rows(ins, out, tol):
     nv = _dot(v, n)
     alpha = _dot(tri.side, v[_J]) / wm
     beta = tri.side_len * nv / mn
-    _put_lines(out["theta"], p, w)
-    _put_lines(out["sigma"], p[_J], tri.unit_side)
+    if "theta" in out:
+        _put_lines(out["theta"], p, w)
+        _put_lines(out["sigma"], p[_J], tri.unit_side)
     out["theta_sigma"][...] = wm / tri.side_len
     out["normal_velocity"][...] = nv
     out["conditioning"][...] = conditioning

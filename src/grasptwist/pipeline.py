@@ -155,7 +155,7 @@ def blocks(job: Job, paths: Sequence) -> Iterator[tuple[Block | GraspFileError, 
             try:
                 ds = open_dataset(g, job.extra_point)
                 grows = len(ds) * (len(job.twists) if job.twists else 1) - 1
-                for block in dataset_blocks(ds, job.twists, job.method):
+                for block in dataset_blocks(ds, job.twists, job.method, bases=False):  # npz shows no screws
                     yield block, grows
                     grows = 0
             except GraspFileError as err:

@@ -117,6 +117,8 @@ def _method_rows(block, result, order, names, label, warnings):
     """One method's per-row dicts (``error`` objects where it failed), warnings appended."""
     if result is None:
         return None
+    if result.sigma is None:  # resolved without bases (bases=False): numbers and verdicts only
+        names = tuple(n for n in names if n not in ("sigma", "psi", "theta", "residual"))
     columns = [_rows(_screws(a, order) if a.ndim == 3 else a) for a in (np.asarray(getattr(result, n)) for n in names)]
     rows = [dict(zip(names, values)) for values in zip(*columns)]
     status = np.asarray(result.status)
