@@ -49,4 +49,11 @@ def grasptwist_command():
     from pathlib import Path
 
     script = Path(sys.executable).parent / "grasptwist"
-    return [str(script)] if script.exists() else [shutil.which("grasptwist") or sys.executable, *([] if shutil.which("grasptwist") else ["-m", "grasptwist"])]
+    return (
+        [str(script)]
+        if script.exists()
+        else [
+            shutil.which("grasptwist") or sys.executable,
+            *([] if shutil.which("grasptwist") else ["-m", "grasptwist"]),
+        ]
+    )

@@ -90,8 +90,12 @@ def main():
     )
     print(f"grasps: {args.n:,} ({ok.mean():.1%} well-conditioned for both methods; max |difference| there {agree:.1e})")
     print(f"{'engine (public API)':32s} {t_engine:8.3f} s")
-    print(f"{'batched numpy.linalg.solve':32s} {t_solve:8.3f} s   engine is {t_solve / t_engine:6.1f}x faster (target >= 4)")
-    print(f"{'Python loop (from %d grasps)' % args.loop:32s} {t_loop:8.1f} s   engine is {t_loop / t_engine:6.0f}x faster (target >= 300)")
+    print(
+        f"{'batched numpy.linalg.solve':32s} {t_solve:8.3f} s   engine is {t_solve / t_engine:6.1f}x faster (target >= 4)"
+    )
+    print(
+        f"{f'Python loop (from {args.loop} grasps)':32s} {t_loop:8.1f} s   engine is {t_loop / t_engine:6.0f}x faster (target >= 300)"
+    )
     print(f"{'peak memory, engine process':32s} {peak:8.0f} MiB (target < 2048)")
 
 

@@ -11,8 +11,8 @@ uses).
 
 import argparse
 import json
-import shlex
 import os
+import shlex
 import tempfile
 import time
 
@@ -52,11 +52,17 @@ def main():
             dumps(r)
         rates[name] = len(records) / (time.perf_counter() - t0)
     print(f"records: {count:,} ({size / count:.0f} bytes each, {size / 1e9:.2f} GB)")
-    print(f"grasptwist resolve -f jsonl | cat    {t_pipe:7.2f} s   {count / t_pipe:10,.0f} records/s (target >= 100,000)")
+    print(
+        f"grasptwist resolve -f jsonl | cat    {t_pipe:7.2f} s   {count / t_pipe:10,.0f} records/s (target >= 100,000)"
+    )
     print(f"grasptwist resolve -f jsonl -o file  {t_file:7.2f} s   {count / t_file:10,.0f} records/s")
-    print(f"the same bytes from memory to disk   {t_disk:7.2f} s   {count / t_disk:10,.0f} records/s (the disk's ceiling)")
+    print(
+        f"the same bytes from memory to disk   {t_disk:7.2f} s   {count / t_disk:10,.0f} records/s (the disk's ceiling)"
+    )
     print(f"encoding alone, json             {rates['json']:10,.0f} records/s")
-    print(f"encoding alone, orjson           {rates['orjson']:10,.0f} records/s   ({rates['orjson'] / rates['json']:.1f}x json)")
+    print(
+        f"encoding alone, orjson           {rates['orjson']:10,.0f} records/s   ({rates['orjson'] / rates['json']:.1f}x json)"
+    )
 
 
 if __name__ == "__main__":

@@ -27,10 +27,19 @@ def baseline(src, dst):
     tan = gt.decompose_tangent(p, n, t)
     v = gt.contact_velocities(p, t)
     np.savez(
-        dst, twist=t, contact_velocity=v, x=off.x, y=off.y, off_tangent_status=off.status,
-        off_tangent_conditioning=off.conditioning, alpha=tan.alpha, beta=tan.beta,
-        normal_velocity=tan.normal_velocity, in_tangent_planes=tan.in_tangent_planes,
-        tangent_status=tan.status, tangent_conditioning=tan.conditioning,
+        dst,
+        twist=t,
+        contact_velocity=v,
+        x=off.x,
+        y=off.y,
+        off_tangent_status=off.status,
+        off_tangent_conditioning=off.conditioning,
+        alpha=tan.alpha,
+        beta=tan.beta,
+        normal_velocity=tan.normal_velocity,
+        in_tangent_planes=tan.in_tangent_planes,
+        tangent_status=tan.status,
+        tangent_conditioning=tan.conditioning,
     )
     return time.perf_counter() - t0
 

@@ -43,7 +43,9 @@ def main():
         ours.append(wall(ours_cmd))
     b, o = statistics.median(base), statistics.median(ours)
     print(f"python -c 'import numpy, yaml, typer'          median {b * 1000:6.0f} ms")
-    print(f"grasptwist resolve polyhedron.yaml --format json median {o * 1000:6.0f} ms   ratio {o / b:4.2f} (target <= 1.25)")
+    print(
+        f"grasptwist resolve polyhedron.yaml --format json median {o * 1000:6.0f} ms   ratio {o / b:4.2f} (target <= 1.25)"
+    )
 
 
 if __name__ == "__main__":

@@ -3,7 +3,7 @@
 import pytest
 import yaml
 
-from grasptwist import grasp_file
+from grasptwist.io import grasp_file
 
 #: The YAML parsers the loader can run on here: the pure one, and libyaml's when present.
 LOADERS = [yaml.SafeLoader] + ([yaml.CSafeLoader] if yaml.__with_libyaml__ else [])

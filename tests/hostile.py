@@ -44,7 +44,9 @@ def run_installed(*args, cwd=None, timeout=20):
     """``grasptwist ARGS`` in a subprocess, colourless; returns (CompletedProcess, seconds)."""
     env = {**os.environ, "NO_COLOR": "1"}
     start = time.monotonic()
-    proc = subprocess.run(entry_point() + [str(a) for a in args], capture_output=True, text=True, cwd=cwd, env=env, timeout=timeout)
+    proc = subprocess.run(
+        entry_point() + [str(a) for a in args], capture_output=True, text=True, cwd=cwd, env=env, timeout=timeout
+    )
     return proc, time.monotonic() - start
 
 

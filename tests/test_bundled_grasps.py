@@ -11,7 +11,7 @@ import numpy as np
 import pytest
 import yaml
 
-from grasptwist.grasp_file import Grasp, grasp_schema, load_grasps
+from grasptwist.io.grasp_file import Grasp, grasp_schema, load_grasps
 
 GRASPS = Path(__file__).parent.parent / "grasps"
 BUNDLED = sorted(GRASPS.glob("*.yaml"))
@@ -57,7 +57,11 @@ EXPECTED = {
             units="m",
             contacts=("thumb", "index", "middle"),
             points=[[0.0, 0.031721, -0.014792], [-0.027471, -0.01586, -0.014792], [0.027471, -0.01586, -0.014792]],
-            normals=[unit(0.0, -0.031721, 0.014792), unit(0.027471, 0.01586, 0.014792), unit(-0.027471, 0.01586, 0.014792)],
+            normals=[
+                unit(0.0, -0.031721, 0.014792),
+                unit(0.027471, 0.01586, 0.014792),
+                unit(-0.027471, 0.01586, 0.014792),
+            ],
             wrist=[0, 0, 0.11],
             twists={"roll-x": [1, 0, 0, 0, 0, 0], "spin-z": [0, 0, 1, 0, 0, 0], "lift-z": [0, 0, 0, 0, 0, 0.05]},
         ),

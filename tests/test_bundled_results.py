@@ -19,17 +19,47 @@ RANK = "normals-rank-deficient"
 
 # (file, grasp, twist): (x, y, alpha, beta, in_tangent_planes); a str is the method's error code
 EXPECTED = {
-    ("box-edge.yaml", "box-edge", "tip-over-edge"): ([-1.2037, 0.2825, 0.1065], [0, -0.2515, 0.7922], [0, 10, -26.6667], [10.8333, 27.9682, 10.5475], False),
-    ("box-edge.yaml", "box-edge", "slide-x"): ([0, -0.4238, 0.4262], [1.0879, -0.503, -0.5942], [40, 20, 20], ZERO, True),
+    ("box-edge.yaml", "box-edge", "tip-over-edge"): (
+        [-1.2037, 0.2825, 0.1065],
+        [0, -0.2515, 0.7922],
+        [0, 10, -26.6667],
+        [10.8333, 27.9682, 10.5475],
+        False,
+    ),
+    ("box-edge.yaml", "box-edge", "slide-x"): (
+        [0, -0.4238, 0.4262],
+        [1.0879, -0.503, -0.5942],
+        [40, 20, 20],
+        ZERO,
+        True,
+    ),
     ("box-edge.yaml", "box-edge", "turn-y"): ([0, -0.5297, 0.5327], [0.0272, 0, 0], [1, 0, 0], ZERO, True),
     ("cylinder.yaml", "cylinder", "sigma-1"): ([1, 0, 0], ZERO, RANK, RANK, None),
     ("cylinder.yaml", "cylinder", "spin-z"): (ZERO, [-0.4714] * 3, RANK, RANK, None),
     ("cylinder.yaml", "cylinder", "lift-z"): ([0.6667] * 3, ZERO, RANK, RANK, None),
-    ("handle.yaml", "mug-handle", "lift-z"): ([-7.8704, -1.9813, 5.0369], [38.7475, -54.6961, 16.0097], "theta-not-unique", "theta-not-unique", None),
+    ("handle.yaml", "mug-handle", "lift-z"): (
+        [-7.8704, -1.9813, 5.0369],
+        [38.7475, -54.6961, 16.0097],
+        "theta-not-unique",
+        "theta-not-unique",
+        None,
+    ),
     ("handle.yaml", "mug-handle", "pour"): ([7.5, 5.1515, -1.8133], ZERO, "theta-not-unique", "theta-not-unique", None),
-    ("handle.yaml", "mug-handle", "turn-z"): ([-15.5556, -24.5687, -10.0335], ZERO, "theta-not-unique", "theta-not-unique", None),
+    ("handle.yaml", "mug-handle", "turn-z"): (
+        [-15.5556, -24.5687, -10.0335],
+        ZERO,
+        "theta-not-unique",
+        "theta-not-unique",
+        None,
+    ),
     ("polyhedron.yaml", "polyhedron", "diagonal-spin"): (ZERO, [0.4082] * 3, [0.5774] * 3, ZERO, True),
-    ("sphere.yaml", "sphere-tripod", "roll-x"): ([0.5877, -0.2938, -0.2938], [0, -0.2778, 0.2778], [0, 0.637, -0.637], ZERO, True),
+    ("sphere.yaml", "sphere-tripod", "roll-x"): (
+        [0.5877, -0.2938, -0.2938],
+        [0, -0.2778, 0.2778],
+        [0, 0.637, -0.637],
+        ZERO,
+        True,
+    ),
     ("sphere.yaml", "sphere-tripod", "spin-z"): (ZERO, [-0.3439] * 3, [0.7887] * 3, ZERO, True),
     ("sphere.yaml", "sphere-tripod", "lift-z"): ([1.0508] * 3, ZERO, ZERO, [1.0508] * 3, False),
     ("sphere.yaml", "sphere-equator", "roll-x"): ([0.6667, -0.3333, -0.3333], ZERO, RANK, RANK, None),
@@ -41,7 +71,9 @@ EXPECTED = {
 def records():
     result = CliRunner().invoke(app, ["resolve", str(GRASPS), "-f", "jsonl"])
     assert result.exit_code == 1  # the degenerate grasps fail their tangent method
-    return {(Path(r["file"]).name, r["grasp"], r["twist"]["name"]): r for r in map(json.loads, result.stdout.splitlines())}
+    return {
+        (Path(r["file"]).name, r["grasp"], r["twist"]["name"]): r for r in map(json.loads, result.stdout.splitlines())
+    }
 
 
 def test_every_bundled_grasp_and_twist_is_pinned(records):

@@ -13,8 +13,8 @@ import pytest
 from typer.testing import CliRunner
 
 import grasptwist as gt
-from grasptwist import report
 from grasptwist.cli import app
+from grasptwist.output import records as report
 
 # Example 2's polyhedron, with a wrist off the contacts' plane x + y + z = 4
 POLY = """\
@@ -71,7 +71,18 @@ def test_json_records_match_the_engine(files):
     tan = gt.decompose_tangent(POINTS, np.eye(3), TWISTS)
     for i, rec in enumerate(recs):
         assert rec["ok"] is True and rec["units"] == "m" and rec["grasp"] == "poly"
-        assert list(rec) == ["file", "grasp", "units", "twist", "contacts", "contact_velocity", "off_tangent", "tangent", "warnings", "ok"]
+        assert list(rec) == [
+            "file",
+            "grasp",
+            "units",
+            "twist",
+            "contacts",
+            "contact_velocity",
+            "off_tangent",
+            "tangent",
+            "warnings",
+            "ok",
+        ]
         assert [c["name"] for c in rec["contacts"]] == ["thumb", "index", "middle"]
         assert rec["contacts"][0]["normal"] == [1.0, 0.0, 0.0]  # normalised on load
         assert rec["off_tangent"]["x"] == off.x[i].tolist() and rec["off_tangent"]["y"] == off.y[i].tolist()
@@ -117,7 +128,14 @@ def test_twist_option_replaces_the_files_twists_and_at_moves_its_reference(files
     [rec] = no_nan(r.stdout)
     # the point (1,0,0) is still: v_origin = 0 + omega x (0 - at) = (0, -1, 0)
     assert rec["twist"] == {"name": "0,0,1,0,0,0", "screw": [0.0, 0.0, 1.0, 0.0, -1.0, 0.0]}
-    assert len(no_nan(run("resolve", files / "poly.yaml", "--twist", "1,0,0,0,0,0", "--twist", "0,1,0,0,0,0", "--json").stdout)) == 2
+    assert (
+        len(
+            no_nan(
+                run("resolve", files / "poly.yaml", "--twist", "1,0,0,0,0,0", "--twist", "0,1,0,0,0,0", "--json").stdout
+            )
+        )
+        == 2
+    )
 
 
 def test_stdin(files):
@@ -131,7 +149,9 @@ def test_a_degenerate_method_fails_its_record_but_keeps_the_other(files):
     assert r.exit_code == 1
     [rec] = no_nan(r.stdout)
     assert rec["ok"] is False
-    assert rec["tangent"] == {"error": {"code": "normals-rank-deficient", "message": gt.status_message(gt.Status.NORMALS_RANK_DEFICIENT)}}
+    assert rec["tangent"] == {
+        "error": {"code": "normals-rank-deficient", "message": gt.status_message(gt.Status.NORMALS_RANK_DEFICIENT)}
+    }
     np.testing.assert_allclose(rec["off_tangent"]["y"], [-0.4714] * 3, atol=1e-4)
     assert "cyl.yaml: grasp 'cyl', twist 'spin-z': error: tangent: normals-rank-deficient:" in r.stderr
 
@@ -250,16 +270,20 @@ def test_installed_entry_point_in_a_subprocess(files):
     exe = Path(sys.executable).parent / "grasptwist"
     cmd = [str(exe)] if exe.exists() else [sys.executable, "-m", "grasptwist"]
     env = {k: v for k, v in os.environ.items() if k != "NO_COLOR"}
-    p = subprocess.run(cmd + ["resolve", "-", "--json"], input=POLY, capture_output=True, text=True, env=env, timeout=60)
+    p = subprocess.run(
+        cmd + ["resolve", "-", "--json"], input=POLY, capture_output=True, text=True, env=env, timeout=60
+    )
     assert p.returncode == 0, p.stderr
     assert len(no_nan(p.stdout)) == 2 and p.stderr == "2 records, 0 failed\n"
-    p = subprocess.run(cmd + ["resolve", str(files / "cyl.yaml"), "-f", "csv"], capture_output=True, text=True, timeout=60)
+    p = subprocess.run(
+        cmd + ["resolve", str(files / "cyl.yaml"), "-f", "csv"], capture_output=True, text=True, timeout=60
+    )
     assert p.returncode == 1 and "Traceback" not in p.stderr
     assert list(csv.reader(io.StringIO(p.stdout)))[1][3] == "false"
 
 
 def test_two_workers_write_exactly_what_one_writes(files, monkeypatch):
-    from grasptwist import pipeline
+    from grasptwist.run import pipeline
 
     for i in range(9):
         (files / f"more{i}.yaml").write_text(POLY.replace("name: poly", f"name: poly{i}"))

@@ -29,7 +29,9 @@ def test_one_grasp_and_twist_to_png_and_svg(tmp_path):
     assert r.exit_code == 0, r.output
     assert r.stdout == f"{tmp_path / 'c.png'}\n"
     assert png_size(tmp_path / "c.png") == (1400, 700)
-    r = run("plot", GRASPS / "polyhedron.yaml", "--twist", "0,0,1,0,0,0", "--method", "tangent", "-o", tmp_path / "p.svg")
+    r = run(
+        "plot", GRASPS / "polyhedron.yaml", "--twist", "0,0,1,0,0,0", "--method", "tangent", "-o", tmp_path / "p.svg"
+    )
     assert r.exit_code == 0 and (tmp_path / "p.svg").read_text().lstrip().startswith("<?xml")
 
 

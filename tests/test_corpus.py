@@ -50,7 +50,18 @@ def _table():
         f = dict(zip(header, line.split("\t"), strict=True))
         total, ok = map(int, f["records"].split("/"))
         dash = lambda v: None if v == "-" else v  # noqa: E731
-        rows.append(Expected(f["file"], int(f["exit"]), dash(f["code"]), dash(f["where"]), total, ok, f["category"], dash(f["fragment"])))
+        rows.append(
+            Expected(
+                f["file"],
+                int(f["exit"]),
+                dash(f["code"]),
+                dash(f["where"]),
+                total,
+                ok,
+                f["category"],
+                dash(f["fragment"]),
+            )
+        )
     return rows
 
 
@@ -142,7 +153,9 @@ def _check_alone(row, path, exit_code, stdout, stderr, seconds, limit):
         assert f"{failed[0]['error']['line']}:{failed[0]['error']['column']}" == row.where
 
 
-@pytest.mark.parametrize("corpus_file, row", [pytest.param(r.file, r, id=r.file) for r in ROWS], indirect=["corpus_file"])
+@pytest.mark.parametrize(
+    "corpus_file, row", [pytest.param(r.file, r, id=r.file) for r in ROWS], indirect=["corpus_file"]
+)
 def test_each_hostile_file_alone(corpus_file, row):
     result, seconds = run("resolve", corpus_file, "-f", "jsonl")
     assert result.exception is None or isinstance(result.exception, SystemExit), repr(result.exception)
@@ -267,7 +280,9 @@ def test_a_named_pipe_in_a_folder_does_not_hang_the_batch(tmp_path):
         sock.bind(str(tmp_path / "socket.yaml"))
         proc, _ = run_installed("resolve", tmp_path, "-f", "jsonl", timeout=4)
     records = jsonl(proc.stdout)
-    assert [r["error"]["code"] for r in records if r["file"].endswith(("pipe.yaml", "socket.yaml"))] == ["read-error"] * 2
+    assert [r["error"]["code"] for r in records if r["file"].endswith(("pipe.yaml", "socket.yaml"))] == [
+        "read-error"
+    ] * 2
     assert sum(r["file"].endswith("sphere.yaml") for r in records) == 5
 
 

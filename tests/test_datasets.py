@@ -8,9 +8,9 @@ import yaml
 from typer.testing import CliRunner
 
 import grasptwist as gt
-from grasptwist import datasets
-from grasptwist.cli import app
 from grasp_gen import grasps
+from grasptwist.cli import app
+from grasptwist.io import datasets
 
 N = 240
 
@@ -60,7 +60,9 @@ def comparable(rec):
 
 def test_npz_gives_the_same_records_as_one_yaml_file_per_grasp(tmp_path, data):
     points, normals, wrist, twist = data
-    np.savez(tmp_path / "set.npz", points=points, normals=normals, wrist=wrist, twist=twist, names=np.arange(N).astype(str))
+    np.savez(
+        tmp_path / "set.npz", points=points, normals=normals, wrist=wrist, twist=twist, names=np.arange(N).astype(str)
+    )
     folder = tmp_path / "files"
     folder.mkdir()
     write_yaml_files(folder, points, normals, wrist, twist)
@@ -70,11 +72,19 @@ def test_npz_gives_the_same_records_as_one_yaml_file_per_grasp(tmp_path, data):
     for rec in from_arrays:
         if rec["grasp"] in from_files:
             assert comparable(rec) == comparable(from_files[rec["grasp"]]), rec["grasp"]
-    codes = {r["grasp"]: (r["off_tangent"].get("error", {}).get("code"), r["tangent"].get("error", {}).get("code")) for r in from_arrays}
+    codes = {
+        r["grasp"]: (r["off_tangent"].get("error", {}).get("code"), r["tangent"].get("error", {}).get("code"))
+        for r in from_arrays
+    }
     assert codes["3"] == ("wrist-coplanar", None)
     assert codes["7"] == ("collinear-contacts", "collinear-contacts")
     assert codes["11"] == ("coincident-contacts", "coincident-contacts")
-    assert codes["15"][0] is None and codes["15"][1] in {"normals-rank-deficient", "theta-not-unique", "theta-sigma-zero", "normal-in-contact-plane"}
+    assert codes["15"][0] is None and codes["15"][1] in {
+        "normals-rank-deficient",
+        "theta-not-unique",
+        "theta-sigma-zero",
+        "normal-in-contact-plane",
+    }
     assert codes["19"] == (None, "zero-normal")
 
 
@@ -90,7 +100,11 @@ def test_npz_output_arrays_match_the_records_and_carry_a_status_legend(tmp_path,
     np.testing.assert_array_equal(z["beta"], tan.beta)
     np.testing.assert_array_equal(z["tangent_status"], tan.status)
     np.testing.assert_array_equal(z["contact_velocity"], gt.contact_velocities(points, twist))
-    assert [z["status_legend"][s] for s in z["off_tangent_status"][[0, 3, 7]]] == ["ok", "wrist-coplanar", "collinear-contacts"]
+    assert [z["status_legend"][s] for s in z["off_tangent_status"][[0, 3, 7]]] == [
+        "ok",
+        "wrist-coplanar",
+        "collinear-contacts",
+    ]
     assert z["grasp"][:3].tolist() == ["0", "1", "2"] and z["twist"].shape == (N, 6)
     assert z["files"].tolist() == [str(tmp_path / "set.npz")] and not z["file_index"].any()
     assert z["twist_names"].tolist() == ["twist"] and not z["twist_index"].any()
@@ -155,12 +169,21 @@ def test_a_npy_is_read_through_a_memory_map(tmp_path, data):
 @pytest.mark.parametrize(
     "arrays, fragment",
     [
-        ({"points": np.zeros((4, 3, 2)), "normals": np.zeros((4, 3, 3))}, "points: expected shape (N, 3, 3), got (4, 3, 2)"),
+        (
+            {"points": np.zeros((4, 3, 2)), "normals": np.zeros((4, 3, 3))},
+            "points: expected shape (N, 3, 3), got (4, 3, 2)",
+        ),
         ({"points": np.zeros((4, 3, 3))}, "missing array 'normals'"),
-        ({"points": np.zeros((4, 3, 3)), "normals": np.zeros((4, 3, 3)), "wrists": np.zeros((4, 3))}, "unknown array(s) wrists"),
+        (
+            {"points": np.zeros((4, 3, 3)), "normals": np.zeros((4, 3, 3)), "wrists": np.zeros((4, 3))},
+            "unknown array(s) wrists",
+        ),
         ({"points": np.zeros((4, 3, 3)), "normals": np.zeros((5, 3, 3))}, "normals: 5 rows, but points has 4"),
         ({"points": np.full((4, 3, 3), "a"), "normals": np.zeros((4, 3, 3))}, "points: expected numbers"),
-        ({"points": np.zeros((4, 3, 3)), "normals": np.zeros((4, 3, 3)), "twist": np.zeros(5)}, "twist: expected shape (N, 6)"),
+        (
+            {"points": np.zeros((4, 3, 3)), "normals": np.zeros((4, 3, 3)), "twist": np.zeros(5)},
+            "twist: expected shape (N, 6)",
+        ),
     ],
 )
 def test_bad_npz_files_fail_with_one_line(tmp_path, arrays, fragment):
@@ -178,11 +201,14 @@ def test_a_file_that_is_not_numpy_and_a_wrong_row_length(tmp_path):
     r = run("resolve", tmp_path / "junk.npz", tmp_path / "rows.npy", "--twist", "0,0,1,0,0,0", "-f", "jsonl")
     codes = [(rec["error"]["code"], rec["error"]["message"]) for rec in jsonl(r)]
     assert codes[0][0] == "read-error"
-    assert codes[1] == ("bad-dataset", "expected rows of 18 or 21 numbers (p1 p2 p3 n1 n2 n3 [point]), got shape (3, 20)")
+    assert codes[1] == (
+        "bad-dataset",
+        "expected rows of 18 or 21 numbers (p1 p2 p3 n1 n2 n3 [point]), got shape (3, 20)",
+    )
 
 
 def test_a_data_set_over_two_workers_gives_the_same_output(tmp_path, data, monkeypatch):
-    from grasptwist import pipeline
+    from grasptwist.run import pipeline
 
     points, normals, wrist, twist = data
     np.savez(tmp_path / "set.npz", points=points, normals=normals, wrist=wrist, twist=twist)
@@ -202,14 +228,18 @@ def test_workers_spool_through_the_kernel_to_pipes_and_files(tmp_path, data):
     np.savez(tmp_path / "set.npz", points=points, normals=normals, wrist=wrist, twist=twist)
     exe = Path(sys.executable).parent / "grasptwist"
     cmd = [str(exe)] if exe.exists() else [sys.executable, "-m", "grasptwist"]
-    one = subprocess.run(cmd + ["resolve", str(tmp_path / "set.npz"), "-f", "json", "-j", "1"], capture_output=True, timeout=120)
+    one = subprocess.run(
+        cmd + ["resolve", str(tmp_path / "set.npz"), "-f", "json", "-j", "1"], capture_output=True, timeout=120
+    )
     script = (
-        "import sys; from grasptwist import pipeline; pipeline.GRASPS_PER_TASK = 30; pipeline.RECORDS_AT_ONCE = 7; "
+        "import sys; from grasptwist.run import pipeline; pipeline.GRASPS_PER_TASK = 30; pipeline.RECORDS_AT_ONCE = 7; "
         "from grasptwist.cli import main; sys.argv = ['grasptwist'] + sys.argv[1:]; main()"
     )
     args = ["resolve", str(tmp_path / "set.npz"), "-f", "json", "-j", "2"]
     piped = subprocess.run([sys.executable, "-c", script] + args, capture_output=True, timeout=120)
-    to_file = subprocess.run([sys.executable, "-c", script] + args + ["-o", str(tmp_path / "out.json")], capture_output=True, timeout=120)
+    to_file = subprocess.run(
+        [sys.executable, "-c", script] + args + ["-o", str(tmp_path / "out.json")], capture_output=True, timeout=120
+    )
     assert piped.stdout == one.stdout == (tmp_path / "out.json").read_bytes()
     assert piped.returncode == to_file.returncode == one.returncode == 1
     assert len(json.loads(one.stdout)) == N

@@ -7,8 +7,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import grasptwist as gt
-from grasptwist import screws
 from grasp_gen import grasps, rotation
+from grasptwist.engine import screws
 
 EX1 = np.array([[1, 0, 0], [-0.5, 0.866, 0], [-0.5, -0.866, 0]], float)
 EX1_WRIST = np.array([0, 0, 1.0])
@@ -285,6 +285,10 @@ def test_without_bases_the_amplitudes_and_verdicts_are_the_same():
         assert lean.sigma is None and lean.row(3).sigma is None
         for name in ("status", "culprit", "conditioning"):
             np.testing.assert_array_equal(getattr(lean, name), getattr(full, name))
-        amplitudes = ("x", "y") if isinstance(full, gt.OffTangentResult) else ("alpha", "beta", "normal_velocity", "in_tangent_planes")
+        amplitudes = (
+            ("x", "y")
+            if isinstance(full, gt.OffTangentResult)
+            else ("alpha", "beta", "normal_velocity", "in_tangent_planes")
+        )
         for name in amplitudes:
             np.testing.assert_array_equal(getattr(lean, name), getattr(full, name))

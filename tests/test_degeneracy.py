@@ -5,8 +5,8 @@ import numpy as np
 import pytest
 
 import grasptwist as gt
-from grasptwist.degeneracy import conditioning_warning
 from grasp_gen import grasps
+from grasptwist.engine.degeneracy import conditioning_warning
 
 S = gt.Status
 EX1 = np.array([[1, 0, 0], [-0.5, 0.866, 0], [-0.5, -0.866, 0]], float)
@@ -34,7 +34,12 @@ def tan(points, normals, twist=TWIST):
         (lambda: off([[0, 0, 0], [1, 0, 0], [3, 0, 0]]), S.COLLINEAR_CONTACTS, 1, "2 lies on the line through 3 and 1"),
         (lambda: off([[0, 0, 0], [2, 0, 0], [1, 0, 0]]), S.COLLINEAR_CONTACTS, 2, "3 lies on the line through 1 and 2"),
         (lambda: off(EX1, (0, np.nan, 1.0)), S.NONFINITE_INPUT, -1, "NaN or infinity"),
-        (lambda: off(np.where([[0, 1, 0], [0, 0, 0], [0, 0, 0]], np.inf, EX1)), S.NONFINITE_INPUT, -1, "NaN or infinity"),
+        (
+            lambda: off(np.where([[0, 1, 0], [0, 0, 0], [0, 0, 0]], np.inf, EX1)),
+            S.NONFINITE_INPUT,
+            -1,
+            "NaN or infinity",
+        ),
         (lambda: off(EX1, twist=[0, 0, np.nan, 0, 0, 0]), S.NONFINITE_INPUT, -1, "NaN or infinity"),
         (lambda: off(EX1 * 1e200, (0, 0, 1e200), [1e200, 0, 0, 0, 0, 0]), S.OVERFLOW, -1, "overflow"),
         (lambda: tan(EX2, [[1, 0, 0], [0, 0, 0], [0, 0, 1]]), S.ZERO_NORMAL, 1, "normal at contact 2 has zero length"),
@@ -43,7 +48,12 @@ def tan(points, normals, twist=TWIST):
         # tangent method cannot serve the paper's own cylinder grasp)
         (lambda: tan(EX1, -EX1), S.NORMALS_RANK_DEFICIENT, -1, "rank < 3"),
         # antipodal pinch: the normals at 1 and 2 are one line
-        (lambda: tan([[-1, 0, 0], [1, 0, 0], [0, 1, 0.5]], [[1, 0, 0], [-1, 0, 0], [0, -1, 0]]), S.NORMALS_RANK_DEFICIENT, -1, "rank"),
+        (
+            lambda: tan([[-1, 0, 0], [1, 0, 0], [0, 1, 0.5]], [[1, 0, 0], [-1, 0, 0], [0, -1, 0]]),
+            S.NORMALS_RANK_DEFICIENT,
+            -1,
+            "rank",
+        ),
         # the normal at 2 points along p1 p2: any axis through p1 in the plane x = const keeps p2 tangent
         (lambda: tan(RIGHT, [[0, 0, 1], [1, 0, 0], [0, 0, 1]]), S.THETA_NOT_UNIQUE, 0, "Theta_1 is not unique"),
         # Theta_1 along y through p1 meets the line p2 p3 at p3
@@ -123,7 +133,9 @@ def test_a_normal_within_tolerance_of_the_plane_is_named_when_no_finer_condition
     assert hit.sum() > 10
     np.testing.assert_array_equal(r.culprit[hit], which[hit])
     i = np.flatnonzero(hit)[0]
-    assert gt.status_message(r.status[i], r.culprit[i]).startswith(f"the normal at contact {which[i] + 1} lies in the plane")
+    assert gt.status_message(r.status[i], r.culprit[i]).startswith(
+        f"the normal at contact {which[i] + 1} lies in the plane"
+    )
 
 
 def test_messages_use_the_contact_names():

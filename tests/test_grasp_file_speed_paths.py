@@ -18,8 +18,8 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from conftest import CONTACTS, LOADERS
-from grasptwist import grasp_file
-from grasptwist.grasp_file import Grasp, GraspFileError, read_grasps
+from grasptwist.io import grasp_file
+from grasptwist.io.grasp_file import Grasp, GraspFileError, read_grasps
 
 TESTS = Path(__file__).parent
 FILES = sorted(
@@ -28,6 +28,8 @@ FILES = sorted(
     if folder.is_dir()
     for path in folder.rglob("*.yaml")
 )
+
+
 def _general_only(get, keep):
     raise grasp_file._Bail
 
@@ -154,7 +156,8 @@ SHAPES = [
     CONTACTS + "twists:\n  - angular: [0, 0, 1]\n  - name: '1'\n    linear: [1, 0, 0]\n",
     CONTACTS + "twists:\n  - angular: [1e200, 1e200, 1e200]\n    at: [1e200, -1e200, 0]\n",
     CONTACTS + "twists:\n  - angular: [1e200, 0, 0]\n    at: [0, 1e200, 0]\n  - angular: [1, 0, 0]\n",
-    CONTACTS + "twists:\n  - angular: [1e-200, 3, -7e-300]\n    linear: [1e300, -1e-300, 5]\n    at: [1e10, -1e-310, 2]\n",
+    CONTACTS
+    + "twists:\n  - angular: [1e-200, 3, -7e-300]\n    linear: [1e300, -1e-300, 5]\n    at: [1e10, -1e-310, 2]\n",
     CONTACTS + "twists:\n  - !!map {angular: [0, 0, 1]}\n",
     CONTACTS + "twists:\n  - &t {angular: [0, 0, 1]}\n  - *t\n",
     CONTACTS + "twists:\n  - angular: [0, 0, 1]\n  - [1, 2, 3]\n",
@@ -258,7 +261,9 @@ def test_capped_read_in_chunks(size, tmp_path, monkeypatch):
 
 
 def test_arrays_of_the_fast_path_are_read_only_float_copies(loader):
-    (grasp,) = both_paths(f"wrist: [1, 2, 3]\n{CONTACTS}twists:\n  - angular: [0, 0, 1]\n  - angular: [1, 0, 0]\n", file="g.yaml")
+    (grasp,) = both_paths(
+        f"wrist: [1, 2, 3]\n{CONTACTS}twists:\n  - angular: [0, 0, 1]\n  - angular: [1, 0, 0]\n", file="g.yaml"
+    )
     arrays = [grasp.points, grasp.normals, grasp.wrist] + [twist.screw for twist in grasp.twists]
     for array in arrays:
         assert array.dtype == np.float64 and not array.flags.writeable and array.flags.owndata

@@ -4,11 +4,11 @@ import numpy as np
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from grasptwist.batch import resolve_arrays
-from grasptwist.json_rows import encode_records
-from grasptwist.report import dumps, records
-from grasptwist.screws import direction
 from grasp_gen import grasps
+from grasptwist.engine.screws import direction
+from grasptwist.output.json_rows import encode_records
+from grasptwist.output.records import dumps, records
+from grasptwist.run.batch import resolve_arrays
 
 
 def block(seed, n, method, wrists):
@@ -18,7 +18,9 @@ def block(seed, n, method, wrists):
     twist[1] = 0.0
     wrist[2] = points[2].mean(0)  # a failing off-tangent row
     points[3, 1] = points[3, 0]  # a row failing both methods
-    wrist[4] = points[4].mean(0) + 1e-6 * np.cross(points[4, 1] - points[4, 0], points[4, 2] - points[4, 0])  # a warning
+    wrist[4] = points[4].mean(0) + 1e-6 * np.cross(
+        points[4, 1] - points[4, 0], points[4, 2] - points[4, 0]
+    )  # a warning
     twist[5] = [0, 0, 0, 0, 0, 1e-300]
     if wrists == "none":
         wrist = None
@@ -26,7 +28,14 @@ def block(seed, n, method, wrists):
         wrist[::3] = np.nan
     names = [f"g{i}" if i % 5 else 'quote " and \\ and \u00e9' for i in range(n)]
     return resolve_arrays(
-        points, direction(normals), wrist, twist, method, file=["a%s.yaml"] * n, grasp=names, units=["m" if i % 2 else None for i in range(n)]
+        points,
+        direction(normals),
+        wrist,
+        twist,
+        method,
+        file=["a%s.yaml"] * n,
+        grasp=names,
+        units=["m" if i % 2 else None for i in range(n)],
     )
 
 
@@ -43,7 +52,9 @@ def test_template_texts_equal_encoding_each_record(seed, n, method, order, wrist
     texts, talking = encode_records(b, order, records, dumps)
     expected = [dumps(r) for r in records(b, order)]
     assert texts == expected
-    assert sorted(dumps(r) for r in talking) == sorted(e for e, r in zip(expected, records(b, order)) if not r["ok"] or r["warnings"])
+    assert sorted(dumps(r) for r in talking) == sorted(
+        e for e, r in zip(expected, records(b, order)) if not r["ok"] or r["warnings"]
+    )
 
 
 def test_most_rows_take_the_template():

@@ -3,8 +3,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from grasptwist import screws
 from grasp_gen import rotation
+from grasptwist.engine import screws
 
 seeds = st.integers(0, 2**32 - 1)
 

@@ -14,7 +14,7 @@ import numpy as np
 import pytest
 
 import grasptwist as gt
-from grasptwist.degeneracy import CONDITION_WARNING
+from grasptwist.engine.degeneracy import CONDITION_WARNING
 from hostile import assert_no_crash, jsonl, run
 
 STEPS = np.r_[np.logspace(0, -12, 13), 0.0]  # 1, 1e-1, ..., 1e-12, 0
@@ -74,8 +74,12 @@ def as_yaml(sweep):
     vec = lambda v: "[" + ", ".join(repr(float(x)) for x in v) + "]"  # noqa: E731
     docs = []
     for k, step in enumerate(STEPS):
-        contacts = "".join(f"  - {{point: {vec(p)}, normal: {vec(n)}}}\n" for p, n in zip(sweep.points[k], sweep.normals))
-        docs.append(f"name: step-{step!r}\nwrist: {vec(sweep.wrist[k])}\ncontacts:\n{contacts}twists:\n  - screw: {vec(TWIST)}\n")
+        contacts = "".join(
+            f"  - {{point: {vec(p)}, normal: {vec(n)}}}\n" for p, n in zip(sweep.points[k], sweep.normals)
+        )
+        docs.append(
+            f"name: step-{step!r}\nwrist: {vec(sweep.wrist[k])}\ncontacts:\n{contacts}twists:\n  - screw: {vec(TWIST)}\n"
+        )
     return "---\n".join(docs)
 
 
@@ -87,7 +91,7 @@ def test_the_engine_grows_smoothly_then_fails_specifically(sweep):
         codes = [gt.Status(int(s)).code for s in r.status]
         first_bad = int(np.argmin(ok))
         # ok down to a small step, then failed to the end, with the expected codes only
-        assert ok[: first_bad].all() and not ok[first_bad:].any() and STEPS[first_bad - 1] <= 1e-3, codes
+        assert ok[:first_bad].all() and not ok[first_bad:].any() and STEPS[first_bad - 1] <= 1e-3, codes
         assert set(codes[first_bad:]) <= set(allowed) and codes[-1] == allowed[-1], codes
         a = amplitudes(r)
         assert np.isfinite(a[ok]).all() and np.isnan(a[~ok]).all()
@@ -96,7 +100,9 @@ def test_the_engine_grows_smoothly_then_fails_specifically(sweep):
         assert np.all(np.diff(r.conditioning[ok]) < 0)
         if method in sweep.one_over_step:
             small = STEPS[:first_bad] <= 1e-3
-            np.testing.assert_allclose(peak[small] * STEPS[:first_bad][small], (peak * STEPS[:first_bad])[small][0], rtol=1e-2)
+            np.testing.assert_allclose(
+                peak[small] * STEPS[:first_bad][small], (peak * STEPS[:first_bad])[small][0], rtol=1e-2
+            )
         # the threshold is crossed inside the sweep, so the warning band is not empty
         assert (r.conditioning[ok] < CONDITION_WARNING).any() and (r.conditioning[ok] >= CONDITION_WARNING).any()
 
@@ -122,7 +128,11 @@ def test_the_cli_reports_the_same_with_warnings_and_errors(sweep, tmp_path):
             np.testing.assert_allclose(np.concatenate(_amplitudes_of(got)), amplitudes(r)[k], rtol=1e-12, atol=0)
             assert got["conditioning"] == pytest.approx(r.conditioning[k], rel=1e-12)
             warns = [w for w in rec["warnings"] if w.startswith(f"{label} basis is nearly degenerate")]
-            assert len(warns) == (r.conditioning[k] < CONDITION_WARNING), (rec["grasp"], got["conditioning"], rec["warnings"])
+            assert len(warns) == (r.conditioning[k] < CONDITION_WARNING), (
+                rec["grasp"],
+                got["conditioning"],
+                rec["warnings"],
+            )
             warned += len(warns)
         assert records[-1][method]["error"]["code"] == sweep.methods[method][-1]
     warning_lines = [line for line in result.stderr.splitlines() if ": warning: " in line]

@@ -8,18 +8,20 @@ The engine (pure numpy, batched over leading axes):
 [0.6667, 0.6667, 0.6667]
 """
 
-from .decompose import (
+from .engine import screws
+from .engine.decompose import (
     OffTangentResult,
     TangentResult,
     contact_velocities,
     decompose_off_tangent,
     decompose_tangent,
 )
-from .degeneracy import CONDITION_WARNING, DEGENERACY_TOL, Status, status_message
+from .engine.degeneracy import CONDITION_WARNING, DEGENERACY_TOL, Status, status_message
 
 __version__ = "0.1.0"
 
 __all__ = [
+    "screws",
     "decompose_off_tangent",
     "decompose_tangent",
     "contact_velocities",

@@ -12,10 +12,10 @@ from __future__ import annotations
 import os
 import sys
 import tempfile
+from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import replace
 from enum import Enum
-from typing import Iterator, List, Optional
 
 import typer
 
@@ -42,7 +42,9 @@ def _version(value: bool) -> None:
 
 @app.callback()
 def _root(
-    version: bool = typer.Option(False, "--version", callback=_version, is_eager=True, help="Print the version and exit."),
+    version: bool = typer.Option(
+        False, "--version", callback=_version, is_eager=True, help="Print the version and exit."
+    ),
 ) -> None:
     """Resolve a desired object twist into finger-tip twists for a three-fingered grasp (screw theory)."""
 
@@ -95,8 +97,8 @@ def _cli_twists(texts: list[str] | None, at: str | None):
         return None
     import numpy as np
 
-    from .grasp_file import Twist
-    from .screws import twist_at
+    from .engine.screws import twist_at
+    from .model import Twist
 
     point = _floats(at, 3, "--at") if at is not None else [0.0, 0.0, 0.0]
     twists = []
@@ -175,7 +177,7 @@ def _writable_folder(path: str) -> None:
 def _progress(inputs: list):
     """A rich progress bar on stderr when it is a terminal and there is more
     than one input or a data set (whose records are counted as they come)."""
-    from .datasets import DATASET_SUFFIXES
+    from .io.datasets import DATASET_SUFFIXES
 
     big = len(inputs) > 1 or any(isinstance(p, str) and p.endswith(DATASET_SUFFIXES) for p in inputs)
     if not big or not sys.stderr.isatty():
@@ -183,7 +185,7 @@ def _progress(inputs: list):
         return
     from rich.progress import Progress
 
-    from .table import console
+    from .output.table import console
 
     with Progress(console=console(sys.stderr), transient=True) as bar:
         task = bar.add_task("resolving", total=len(inputs))
@@ -200,30 +202,51 @@ _METHOD = typer.Option(Method.both, "--method", help="Decomposition(s) to run.")
 _OUTPUT = typer.Option(None, "-o", "--output", metavar="FILE", help="Write to FILE (atomically) instead of stdout.")
 _DIGITS = typer.Option(4, "--digits", min=0, max=17, help="Decimals in tables (JSON and CSV keep full precision).")
 _ORDER = typer.Option(Order.omega_v, "--order", help="Order of every printed 6-vector: (omega; v) or (v; omega).")
-_MAX_BYTES = typer.Option(None, "--max-bytes", min=1, help="Refuse grasp files larger than this many bytes (default 1 MiB).")
+_MAX_BYTES = typer.Option(
+    None, "--max-bytes", min=1, help="Refuse grasp files larger than this many bytes (default 1 MiB)."
+)
 _QUIET = typer.Option(False, "-q", "--quiet", help="No warnings or summary on stderr (errors still).")
 _DEBUG = typer.Option(False, "--debug", help="Show the Python traceback of an internal error.")
 _JSON = typer.Option(False, "--json", help="Same as --format json.")
 
 
-_WORKERS = typer.Option(0, "-j", "--workers", min=0, help="Processes for big batches (0: every core, used for 256+ files or 4096+ data-set grasps).")
+_WORKERS = typer.Option(
+    0,
+    "-j",
+    "--workers",
+    min=0,
+    help="Processes for big batches (0: every core, used for 256+ files or 4096+ data-set grasps).",
+)
 _PATHS_HELP = "Grasp files (.yaml, .yml), data sets (.npz, .npy), folders (searched for *.yaml, *.yml) or - for stdin."
 _PATHS = typer.Argument(..., metavar="PATH...", help=_PATHS_HELP)
 
 
 @app.command()
 def resolve(
-    paths: List[str] = _PATHS,
-    twist: Optional[List[str]] = typer.Option(None, "--twist", metavar="W1,W2,W3,V1,V2,V3", help="Object twist (omega; v); repeatable; replaces the files' twists."),
-    at: Optional[str] = typer.Option(None, "--at", metavar="X,Y,Z", help="Point whose velocity the --twist linear part gives (default: the origin)."),
+    paths: list[str] = _PATHS,
+    twist: list[str] | None = typer.Option(
+        None,
+        "--twist",
+        metavar="W1,W2,W3,V1,V2,V3",
+        help="Object twist (omega; v); repeatable; replaces the files' twists.",
+    ),
+    at: str | None = typer.Option(
+        None, "--at", metavar="X,Y,Z", help="Point whose velocity the --twist linear part gives (default: the origin)."
+    ),
     method: Method = _METHOD,
-    fmt: Format = typer.Option(Format.table, "-f", "--format", help="table for people; json, jsonl, csv or npz (arrays, with -o) for programs."),
+    fmt: Format = typer.Option(
+        Format.table, "-f", "--format", help="table for people; json, jsonl, csv or npz (arrays, with -o) for programs."
+    ),
     json_: bool = _JSON,
-    output: Optional[str] = _OUTPUT,
+    output: str | None = _OUTPUT,
     digits: int = _DIGITS,
     order: Order = _ORDER,
-    extra_point: ExtraPoint = typer.Option(ExtraPoint.wrist, "--extra-point", help="Role of a .npy's 19th-21st columns: the wrist, or the point the twists' linear velocity is given at."),
-    max_bytes: Optional[int] = _MAX_BYTES,
+    extra_point: ExtraPoint = typer.Option(
+        ExtraPoint.wrist,
+        "--extra-point",
+        help="Role of a .npy's 19th-21st columns: the wrist, or the point the twists' linear velocity is given at.",
+    ),
+    max_bytes: int | None = _MAX_BYTES,
     workers: int = _WORKERS,
     quiet: bool = _QUIET,
     debug: bool = _DEBUG,
@@ -238,7 +261,7 @@ def resolve(
         grasptwist resolve grasps/cylinder.yaml --method off-tangent --twist 0,0,1,0,0,0 --json | jq '.[0].off_tangent.y'
         grasptwist resolve grasps.npz --twist 0,0,1,0,0,0 -f npz -o results.npz
     """
-    from .pipeline import Job
+    from .run.pipeline import Job
 
     twists = _cli_twists(twist, at)
     if extra_point == ExtraPoint.at and at is not None:
@@ -248,20 +271,30 @@ def resolve(
     fmt = Format.json if json_ else fmt
     if fmt == Format.npz and output is None and sys.stdout.isatty():
         raise typer.BadParameter("npz is binary: give -o FILE.npz", param_hint="--format")
-    job = Job("resolve", None if twists is None else tuple(twists), method.value, order.value, fmt.value, max_bytes, extra_point.value)
+    job = Job(
+        "resolve",
+        None if twists is None else tuple(twists),
+        method.value,
+        order.value,
+        fmt.value,
+        max_bytes,
+        extra_point.value,
+    )
     _run(debug, lambda: _emit(job, paths, output, quiet, workers, digits=digits, order=order.value))
 
 
 @app.command()
 def basis(
-    paths: List[str] = _PATHS,
+    paths: list[str] = _PATHS,
     method: Method = _METHOD,
-    fmt: RecordFormat = typer.Option(RecordFormat.table, "-f", "--format", help="table for people, json or jsonl for programs."),
+    fmt: RecordFormat = typer.Option(
+        RecordFormat.table, "-f", "--format", help="table for people, json or jsonl for programs."
+    ),
     json_: bool = _JSON,
-    output: Optional[str] = _OUTPUT,
+    output: str | None = _OUTPUT,
     digits: int = _DIGITS,
     order: Order = _ORDER,
-    max_bytes: Optional[int] = _MAX_BYTES,
+    max_bytes: int | None = _MAX_BYTES,
     workers: int = _WORKERS,
     quiet: bool = _QUIET,
     debug: bool = _DEBUG,
@@ -273,7 +306,7 @@ def basis(
     \b
         grasptwist basis grasps/cylinder.yaml --method off-tangent
     """
-    from .pipeline import Job
+    from .run.pipeline import Job
 
     job = Job("basis", None, method.value, order.value, "json" if json_ else fmt.value, max_bytes)
     _run(debug, lambda: _emit(job, paths, output, quiet, workers, digits=digits, order=order.value))
@@ -281,12 +314,14 @@ def basis(
 
 @app.command()
 def check(
-    paths: List[str] = _PATHS,
+    paths: list[str] = _PATHS,
     method: Method = _METHOD,
-    fmt: RecordFormat = typer.Option(RecordFormat.table, "-f", "--format", help="table for people, json or jsonl for programs."),
+    fmt: RecordFormat = typer.Option(
+        RecordFormat.table, "-f", "--format", help="table for people, json or jsonl for programs."
+    ),
     json_: bool = _JSON,
-    output: Optional[str] = _OUTPUT,
-    max_bytes: Optional[int] = _MAX_BYTES,
+    output: str | None = _OUTPUT,
+    max_bytes: int | None = _MAX_BYTES,
     workers: int = _WORKERS,
     quiet: bool = _QUIET,
     debug: bool = _DEBUG,
@@ -298,14 +333,14 @@ def check(
     \b
         grasptwist check grasps/ -f jsonl | jq -c 'select(.ok | not)'
     """
-    from .pipeline import Job
+    from .run.pipeline import Job
 
     job = Job("check", None, method.value, "omega-v", "json" if json_ else fmt.value, max_bytes)
     _run(debug, lambda: _emit(job, paths, output, quiet, workers))
 
 
 @app.command()
-def schema(output: Optional[str] = _OUTPUT, debug: bool = _DEBUG) -> None:
+def schema(output: str | None = _OUTPUT, debug: bool = _DEBUG) -> None:
     """Print the JSON Schema of grasp files (for editors with a YAML language server).
 
     Example:
@@ -313,8 +348,8 @@ def schema(output: Optional[str] = _OUTPUT, debug: bool = _DEBUG) -> None:
     \b
         grasptwist schema -o grasp.schema.json
     """
-    from .grasp_file import grasp_schema
-    from .report import dumps
+    from .io.grasp_file import grasp_schema
+    from .output.records import dumps
 
     def job():
         with _output(output) as out:
@@ -331,13 +366,29 @@ class PlotMethod(str, Enum):
 
 @app.command()
 def plot(
-    path: str = typer.Argument(..., metavar="PATH", help="A grasp file, or a folder for one image per grasp and twist."),
-    output: str = typer.Option(..., "-o", "--output", metavar="FILE|FOLDER", help="The image (.png, .svg or .pdf), or the folder for a folder's images."),
-    twist: Optional[str] = typer.Option(None, "--twist", metavar="W1,W2,W3,V1,V2,V3", help="Draw this twist (omega; v) instead of the file's."),
-    twist_name: Optional[str] = typer.Option(None, "--twist-name", metavar="NAME", help="Which of the file's twists to draw (or the name of --twist)."),
-    at: Optional[str] = typer.Option(None, "--at", metavar="X,Y,Z", help="Point whose velocity the --twist linear part gives."),
-    method: Optional[PlotMethod] = typer.Option(None, "--method", help="Basis to draw (default: off-tangent with a wrist, else tangent)."),
-    max_bytes: Optional[int] = _MAX_BYTES,
+    path: str = typer.Argument(
+        ..., metavar="PATH", help="A grasp file, or a folder for one image per grasp and twist."
+    ),
+    output: str = typer.Option(
+        ...,
+        "-o",
+        "--output",
+        metavar="FILE|FOLDER",
+        help="The image (.png, .svg or .pdf), or the folder for a folder's images.",
+    ),
+    twist: str | None = typer.Option(
+        None, "--twist", metavar="W1,W2,W3,V1,V2,V3", help="Draw this twist (omega; v) instead of the file's."
+    ),
+    twist_name: str | None = typer.Option(
+        None, "--twist-name", metavar="NAME", help="Which of the file's twists to draw (or the name of --twist)."
+    ),
+    at: str | None = typer.Option(
+        None, "--at", metavar="X,Y,Z", help="Point whose velocity the --twist linear part gives."
+    ),
+    method: PlotMethod | None = typer.Option(
+        None, "--method", help="Basis to draw (default: off-tangent with a wrist, else tangent)."
+    ),
+    max_bytes: int | None = _MAX_BYTES,
     debug: bool = _DEBUG,
 ) -> None:
     """Draw a grasp, its basis screw axes and the finger-tip velocities (needs grasptwist[plot]).
@@ -356,14 +407,16 @@ def plot(
 
 def _plot(path, output, twists, twist_name, method, max_bytes) -> int:
     from . import plot as pictures
-    from .datasets import DATASET_SUFFIXES
-    from .grasp_file import Grasp
-    from .inputs import expand, read
-    from .report import diagnostics, error_record
+    from .io.datasets import DATASET_SUFFIXES
+    from .io.inputs import expand, read
+    from .model import Grasp
+    from .output.records import diagnostics, error_record
 
     stderr = _Stderr()
     if path.endswith(DATASET_SUFFIXES):
-        raise typer.BadParameter("plot draws grasp files (.yaml, .yml) or folders of them, not data sets", param_hint="PATH")
+        raise typer.BadParameter(
+            "plot draws grasp files (.yaml, .yml) or folders of them, not data sets", param_hint="PATH"
+        )
     if not os.path.isdir(path):
         _writable_folder(output)
     try:
@@ -397,7 +450,7 @@ def _plot(path, output, twists, twist_name, method, max_bytes) -> int:
         try:
             written = pictures.plot_grasp(grasp, output, chosen, method=method)
         except ValueError as exc:
-            raise typer.BadParameter(str(exc))
+            raise typer.BadParameter(str(exc)) from None
         sys.stdout.write(f"{written}\n")
     return EXIT_FAILED if stderr.failed else EXIT_OK
 
@@ -420,9 +473,9 @@ def _workers(requested: int) -> int:
 
 def _emit(job, paths: list[str], output, quiet: bool, workers: int, **table_options) -> int:
     """Files in, records out: the body of resolve, basis and check."""
-    from .inputs import expand
-    from .pipeline import run, write_npz
-    from .report import writer
+    from .io.inputs import expand
+    from .output.records import writer
+    from .run.pipeline import run, write_npz
 
     stderr = _Stderr(quiet)
     inputs = list(expand(paths))
@@ -457,12 +510,14 @@ def _run(debug: bool, job) -> None:
         # The reader (e.g. `head`) went away: stop quietly with the status of a
         # Unix filter killed by SIGPIPE, and keep Python's final flush quiet too.
         os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
-        raise typer.Exit(EXIT_BROKEN_PIPE)
+        raise typer.Exit(EXIT_BROKEN_PIPE) from None
     except Exception as exc:  # noqa: BLE001 - the one place a traceback is turned into a line
         if debug:
             raise
-        sys.stderr.write(f"grasptwist: internal error: {type(exc).__name__}: {exc} (rerun with --debug for the traceback)\n")
-        raise typer.Exit(EXIT_FAILED)
+        sys.stderr.write(
+            f"grasptwist: internal error: {type(exc).__name__}: {exc} (rerun with --debug for the traceback)\n"
+        )
+        raise typer.Exit(EXIT_FAILED) from None
     raise typer.Exit(code)
 
 

@@ -12,7 +12,7 @@ Input layouts (see the README):
 A ``.npy`` is memory-mapped and read a chunk of rows at a time, so a data
 set larger than memory streams with bounded memory; ``.npz`` members are
 read whole (numpy cannot map them).  Problems with the file itself are
-:class:`~grasptwist.grasp_file.GraspFileError` (code ``bad-dataset``);
+:class:`~grasptwist.model.InputError` (code ``bad-dataset``);
 problems with a row (NaN, a degenerate grasp) are that row's status.
 """
 
@@ -21,15 +21,16 @@ from __future__ import annotations
 import os
 import tempfile
 import zipfile
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass
-from typing import IO, Iterator, Sequence
+from typing import IO
 
 import numpy as np
 
-from .batch import Block, resolve_arrays
-from .degeneracy import Status
-from .grasp_file import GraspFileError, Twist
-from .screws import direction, twist_at
+from ..engine.degeneracy import Status
+from ..engine.screws import direction, twist_at
+from ..model import GraspFileError, Twist
+from ..run.batch import Block, resolve_arrays
 
 __all__ = ["DATASET_SUFFIXES", "EXTRA_POINT_ROLES", "Dataset", "open_dataset", "dataset_blocks", "NpzWriter"]
 
@@ -128,7 +129,12 @@ def _open_npz(path, arrays):
     names = arrays.get("names")
     if names is not None and (names.ndim != 1 or names.dtype.kind not in "USiu"):
         raise _bad(path, f"names: expected a 1-D array of strings or numbers, got {names.dtype} {names.shape}")
-    for key, a in (("normals", normals), ("wrist", wrist), ("twist", twist if twist is not None and twist.ndim == 2 else None), ("names", names)):
+    for key, a in (
+        ("normals", normals),
+        ("wrist", wrist),
+        ("twist", twist if twist is not None and twist.ndim == 2 else None),
+        ("names", names),
+    ):
         if a is not None and len(a) != n:
             raise _bad(path, f"{key}: {len(a)} rows, but points has {n}")
     return Dataset(path, points, normals, wrist, None, twist, names)
@@ -148,7 +154,7 @@ def dataset_blocks(
     Each grasp is paired with every twist of ``twists`` (the command line's)
     or else with the data set's own twist; with ``at`` points, a twist's
     linear part is the velocity of the row's ``at`` point.  ``bases=False``
-    leaves the basis screws out (see :func:`~grasptwist.batch.resolve_arrays`).
+    leaves the basis screws out (see :func:`~grasptwist.run.batch.resolve_arrays`).
 
     Raises
     ------
@@ -233,7 +239,7 @@ class NpzWriter:
         self.tmp = None
 
     def write(self, block: Block) -> None:
-        from .report import _screws  # the one definition of the output order
+        from ..output.records import _screws  # the one definition of the output order
 
         cols = {
             "grasp": np.asarray(block.grasp, dtype=str),
@@ -249,7 +255,9 @@ class NpzWriter:
         if block.tangent is not None:
             r = block.tangent
             cols.update(alpha=r.alpha, beta=r.beta, normal_velocity=r.normal_velocity)
-            cols.update(in_tangent_planes=r.in_tangent_planes, tangent_status=r.status, tangent_conditioning=r.conditioning)
+            cols.update(
+                in_tangent_planes=r.in_tangent_planes, tangent_status=r.status, tangent_conditioning=r.conditioning
+            )
         for name, a in cols.items():
             a = np.ascontiguousarray(a)
             if a.dtype.kind == "U":
@@ -276,7 +284,7 @@ class NpzWriter:
             self.tmp = tempfile.TemporaryDirectory(prefix="grasptwist-npz-")
         for name, chunks in self.chunks.items():
             if name not in self.spilled:
-                self.spilled[name] = open(os.path.join(self.tmp.name, name), "w+b")
+                self.spilled[name] = open(os.path.join(self.tmp.name, name), "w+b")  # noqa: SIM115 - closed by close()
             for a in chunks:
                 np.save(self.spilled[name], a, allow_pickle=False)
             chunks.clear()
@@ -295,7 +303,11 @@ class NpzWriter:
         with zipfile.ZipFile(self.out, "w", zipfile.ZIP_STORED, allowZip64=True) as z:
             for name, (dtype, tail) in self.kinds.items():
                 dtype = np.dtype(f"<U{self.widths[name]}") if name in self.widths else dtype
-                header = {"descr": np.lib.format.dtype_to_descr(dtype), "fortran_order": False, "shape": (self.rows, *tail)}
+                header = {
+                    "descr": np.lib.format.dtype_to_descr(dtype),
+                    "fortran_order": False,
+                    "shape": (self.rows, *tail),
+                }
                 with z.open(name + ".npy", "w", force_zip64=True) as member:
                     np.lib.format.write_array_header_2_0(member, header)
                     for a in self._parts(name):

@@ -9,19 +9,19 @@ here: only stacking and slicing.
 
 from __future__ import annotations
 
+from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass, replace
-from typing import Iterable, Iterator, Sequence
 
 import numpy as np
 
-from .decompose import (
+from ..engine.decompose import (
     OffTangentResult,
     TangentResult,
     contact_velocities,
     decompose_off_tangent,
     decompose_tangent,
 )
-from .grasp_file import Grasp, GraspFileError, Twist
+from ..model import CONTACT_NAMES, Grasp, GraspFileError, Twist
 
 __all__ = ["METHODS", "Block", "resolve", "resolve_arrays", "NO_TWIST", "ZERO_TWIST", "CONTACT_NAMES"]
 
@@ -32,9 +32,6 @@ NO_TWIST = "no-twist"
 
 #: The twist whose resolution carries just the bases (``basis`` and ``check``).
 ZERO_TWIST = Twist(name="0", screw=np.zeros(6), line=None)
-
-#: Contact names of a grasp that does not name its contacts.
-CONTACT_NAMES = ("1", "2", "3")
 
 
 @dataclass(frozen=True)
@@ -64,17 +61,28 @@ class Block:
     def __len__(self) -> int:
         return len(self.grasp)
 
-    def part(self, start: int, stop: int) -> "Block":
+    def part(self, start: int, stop: int) -> Block:
         """Rows ``start:stop`` as a block of their own (views, no copies)."""
         return self.take(slice(start, stop))
 
-    def take(self, rows) -> "Block":
+    def take(self, rows) -> Block:
         """The rows ``rows`` (a slice, or an array of indices) as a block of their own."""
         cut = {f: _pick(getattr(self, f), rows) for f in _ROW_FIELDS}
         return replace(self, **cut, off_tangent=_take(self.off_tangent, rows), tangent=_take(self.tangent, rows))
 
 
-_ROW_FIELDS = ("file", "grasp", "units", "twist_name", "contact_names", "points", "normals", "twist", "has_wrist", "velocity")
+_ROW_FIELDS = (
+    "file",
+    "grasp",
+    "units",
+    "twist_name",
+    "contact_names",
+    "points",
+    "normals",
+    "twist",
+    "has_wrist",
+    "velocity",
+)
 
 
 def _pick(column, rows):
@@ -87,7 +95,9 @@ def _take(result, rows):
     return None if result is None else result.row(rows)
 
 
-def resolve_arrays(points, normals, wrist, twist, method="both", *, file="", grasp=None, twist_name=None, units=None, bases=True) -> Block:
+def resolve_arrays(
+    points, normals, wrist, twist, method="both", *, file="", grasp=None, twist_name=None, units=None, bases=True
+) -> Block:
     """One block from arrays of rows (a data set, or stacked grasps).
 
     ``wrist`` may be None (no row has one) or hold NaN rows for grasps
@@ -177,7 +187,9 @@ def _stack(jobs, method) -> Block:
     block = resolve_arrays(
         np.stack([g.points for g in grasps]),
         np.stack([g.normals for g in grasps]),
-        None if all(g.wrist is None for g in grasps) else np.stack([nan if g.wrist is None else g.wrist for g in grasps]),
+        None
+        if all(g.wrist is None for g in grasps)
+        else np.stack([nan if g.wrist is None else g.wrist for g in grasps]),
         np.stack([t.screw for _, t in jobs]),
         method,
         file=[g.file for g in grasps],

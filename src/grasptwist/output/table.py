@@ -7,6 +7,7 @@ here; records keep full precision.
 
 from __future__ import annotations
 
+import contextlib
 import io
 import os
 from typing import IO
@@ -16,7 +17,7 @@ from rich.console import Console
 from rich.table import Table
 from rich.text import Text
 
-from .degeneracy import CONDITION_WARNING
+from ..engine.degeneracy import CONDITION_WARNING
 
 __all__ = ["TableWriter", "BasisTableWriter", "CheckTableWriter", "WRITERS", "console", "fmt_number", "fmt_vector"]
 
@@ -25,10 +26,8 @@ class _TextView(io.TextIOWrapper):
     """A text view of a binary stream that leaves the stream open when it goes."""
 
     def __del__(self):
-        try:
+        with contextlib.suppress(ValueError):  # already detached, or the stream was closed by its owner
             self.detach()
-        except ValueError:  # already detached, or the stream was closed by its owner
-            pass
 
 
 def console(out: IO[bytes] | IO[str], color: bool | None = None, width: int | None = None) -> Console:
@@ -67,7 +66,14 @@ def fmt_vector(v, digits: int) -> str:
 class _Writer:
     """Common start of the table writers: a console and a record counter."""
 
-    def __init__(self, out: IO[bytes], digits: int = 4, color: bool | None = None, width: int | None = None, order: str = "omega-v"):
+    def __init__(
+        self,
+        out: IO[bytes],
+        digits: int = 4,
+        color: bool | None = None,
+        width: int | None = None,
+        order: str = "omega-v",
+    ):
         self.con = console(out, color, width)
         self.digits = digits
         self.count = 0
@@ -128,16 +134,26 @@ class TableWriter(_Writer):
             return Text("off-tangent: skipped (the grasp has no wrist)", style="dim")
         if "error" in m:
             return _error_text("off-tangent", m)
-        t = _table("i", "x_i", "y_i", "Sigma_i (moves finger i only)", "Psi_i (keeps finger i fixed)", numbers=("x_i", "y_i"))
+        t = _table(
+            "i", "x_i", "y_i", "Sigma_i (moves finger i only)", "Psi_i (keeps finger i fixed)", numbers=("x_i", "y_i")
+        )
         t.title = f"off-tangent (Proposition 1)   conditioning {m['conditioning']:.3g}"
         for i, n in enumerate(names):
-            t.add_row(n, fmt_number(m["x"][i], d), fmt_number(m["y"][i], d), fmt_vector(m["sigma"][i], d), fmt_vector(m["psi"][i], d))
+            t.add_row(
+                n,
+                fmt_number(m["x"][i], d),
+                fmt_number(m["y"][i], d),
+                fmt_vector(m["sigma"][i], d),
+                fmt_vector(m["psi"][i], d),
+            )
         return t
 
     def _tangent(self, m, names, d):
         if "error" in m:
             return _error_text("tangent", m)
-        t = _table("i", "alpha_i", "beta_i", "Theta_i (keeps finger i fixed, others slide)", numbers=("alpha_i", "beta_i"))
+        t = _table(
+            "i", "alpha_i", "beta_i", "Theta_i (keeps finger i fixed, others slide)", numbers=("alpha_i", "beta_i")
+        )
         t.title = f"tangent (Proposition 2 + off-plane rest)   conditioning {m['conditioning']:.3g}"
         for i, n in enumerate(names):
             t.add_row(n, fmt_number(m["alpha"][i], d), fmt_number(m["beta"][i], d), fmt_vector(m["theta"][i], d))
@@ -191,7 +207,9 @@ def _verdict(rec, names):
                 "turns about the line from the wrist through it."
             )
         if moved:
-            lines.append(f"off-tangent: Sigma part: finger(s) {', '.join(moved)} each moved alone, about the line through the other two.")
+            lines.append(
+                f"off-tangent: Sigma part: finger(s) {', '.join(moved)} each moved alone, about the line through the other two."
+            )
         elif held:
             lines.append("off-tangent: the twist is a rotation about the wrist: the wrist alone could make it.")
     return lines
@@ -243,7 +261,12 @@ class CheckTableWriter(_Writer):
 
     def write(self, rec: dict) -> None:
         if "error" not in rec:
-            self.table.add_row(rec["file"], rec["grasp"], _verdict_cell(rec.get("off_tangent", False)), _verdict_cell(rec.get("tangent")))
+            self.table.add_row(
+                rec["file"],
+                rec["grasp"],
+                _verdict_cell(rec.get("off_tangent", False)),
+                _verdict_cell(rec.get("tangent")),
+            )
 
     def close(self) -> None:
         if self.table.row_count:

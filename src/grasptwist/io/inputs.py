@@ -12,9 +12,10 @@ from __future__ import annotations
 
 import os
 import sys
-from typing import Iterable, Iterator
+from collections.abc import Iterable, Iterator
 
-from .grasp_file import DEFAULT_MAX_BYTES, Grasp, GraspFileError, read_grasps
+from ..model import Grasp, GraspFileError
+from .grasp_file import DEFAULT_MAX_BYTES, read_grasps
 
 __all__ = ["GRASP_SUFFIXES", "STDIN", "expand", "read"]
 

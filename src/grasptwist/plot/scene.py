@@ -6,7 +6,7 @@ Two layers, so the geometry can be tested without pixels:
   into a :class:`Scene`: labelled points, segments (screw axes), arrows
   (normals and velocities) and plane patches, each with a *kind* that the
   renderer styles and the legend names.  Everything in it comes from the
-  engine (:mod:`grasptwist.decompose`) and :mod:`grasptwist.screws`.
+  engine (:mod:`grasptwist.engine.decompose`) and :mod:`grasptwist.engine.screws`.
 * :func:`render` draws a scene with matplotlib, two 3D views side by side.
   matplotlib is an optional extra: it is imported only inside the functions
   that draw, so ``import grasptwist.plot`` works without it, and
@@ -29,9 +29,9 @@ from pathlib import Path
 
 import numpy as np
 
-from .decompose import contact_velocities, decompose_off_tangent, decompose_tangent
-from .degeneracy import Status, conditioning_warning, status_message
-from .screws import axis_point, cross, dot, field_at, norm, pitch, unit
+from ..engine.decompose import contact_velocities, decompose_off_tangent, decompose_tangent
+from ..engine.degeneracy import Status, conditioning_warning, status_message
+from ..engine.screws import axis_point, cross, dot, field_at, norm, pitch, unit
 
 __all__ = [
     "KINDS",
@@ -151,7 +151,7 @@ class Scene:
     method : str
         ``"off-tangent"`` or ``"tangent"``.
     status : int
-        The engine's :class:`~grasptwist.degeneracy.Status` for this grasp
+        The engine's :class:`~grasptwist.engine.degeneracy.Status` for this grasp
         and method; when not 0 the scene has no basis axes or components.
     markers, segments, arrows, patches : tuple
         The drawn elements; see :data:`KINDS` for their kinds.
@@ -312,12 +312,17 @@ def scene(
         markers.append(Marker(wrist, "c", "wrist"))
     arrows = [Arrow(points[i], unit(normals[i]), f"n{_sub(names[i])}", "normal", _NORMAL_LEN * size) for i in range(3)]
     patches = [Patch(points, "p1 p2 p3", "contact-plane")]
-    patches += [Patch(_square(points[i], normals[i], _PATCH_HALF * size), f"Π{_sub(names[i])}", "tangent-plane") for i in range(3)]
+    patches += [
+        Patch(_square(points[i], normals[i], _PATCH_HALF * size), f"Π{_sub(names[i])}", "tangent-plane")
+        for i in range(3)
+    ]
     segments = []
     if ok:
         for kind, symbol, basis in bases:
             for i in range(3):
-                segments.append(_axis_segment(basis[i], centroid, _AXIS_HALF * size, symbol + _sub(names[i]), f"{kind}-axis"))
+                segments.append(
+                    _axis_segment(basis[i], centroid, _AXIS_HALF * size, symbol + _sub(names[i]), f"{kind}-axis")
+                )
 
     lines = [f"{grasp_name}" + (f" — {twist_name}" if twist_name else "")]
     notes = []

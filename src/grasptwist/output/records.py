@@ -20,10 +20,10 @@ from typing import IO
 import numpy as np
 import orjson
 
-from .batch import Block
-from .degeneracy import CONDITION_WARNING, Status, conditioning_warning, status_message
-from .grasp_file import GraspFileError
-from .screws import klein_table
+from ..engine.degeneracy import CONDITION_WARNING, Status, conditioning_warning, status_message
+from ..engine.screws import klein_table
+from ..model import GraspFileError
+from ..run.batch import Block
 
 __all__ = [
     "ORDERS",
@@ -50,7 +50,16 @@ def _screws(a, order):
 
 
 _OFF_TANGENT_FIELDS = ("sigma", "psi", "sigma_psi", "x", "y", "conditioning", "residual")
-_TANGENT_FIELDS = ("theta", "theta_sigma", "alpha", "beta", "normal_velocity", "in_tangent_planes", "conditioning", "residual")
+_TANGENT_FIELDS = (
+    "theta",
+    "theta_sigma",
+    "alpha",
+    "beta",
+    "normal_velocity",
+    "in_tangent_planes",
+    "conditioning",
+    "residual",
+)
 
 
 def records(block: Block, order: str = "omega-v") -> list[dict]:
@@ -184,22 +193,32 @@ def basis_record(block: Block, i: int, order: str = "omega-v") -> dict:
     warnings = []
     if block.off_tangent is not None:
         off = block.off_tangent.row(i)
-        rec["off_tangent"] = None if not block.has_wrist[i] else _failure(off.status, off.culprit, names) if not off.ok else {
-            "sigma": _screws(off.sigma, order).tolist(),
-            "psi": _screws(off.psi, order).tolist(),
-            "sigma_psi": klein_table(off.sigma, off.psi).tolist(),
-            "conditioning": float(off.conditioning),
-        }
+        rec["off_tangent"] = (
+            None
+            if not block.has_wrist[i]
+            else _failure(off.status, off.culprit, names)
+            if not off.ok
+            else {
+                "sigma": _screws(off.sigma, order).tolist(),
+                "psi": _screws(off.psi, order).tolist(),
+                "sigma_psi": klein_table(off.sigma, off.psi).tolist(),
+                "conditioning": float(off.conditioning),
+            }
+        )
         if block.has_wrist[i] and off.ok:
             _warn(warnings, off.conditioning, "off-tangent")
     if block.tangent is not None:
         tan = block.tangent.row(i)
-        rec["tangent"] = _failure(tan.status, tan.culprit, names) if not tan.ok else {
-            "theta": _screws(tan.theta, order).tolist(),
-            "sigma": _screws(tan.sigma, order).tolist(),
-            "theta_sigma": klein_table(tan.theta, tan.sigma).tolist(),
-            "conditioning": float(tan.conditioning),
-        }
+        rec["tangent"] = (
+            _failure(tan.status, tan.culprit, names)
+            if not tan.ok
+            else {
+                "theta": _screws(tan.theta, order).tolist(),
+                "sigma": _screws(tan.sigma, order).tolist(),
+                "theta_sigma": klein_table(tan.theta, tan.sigma).tolist(),
+                "conditioning": float(tan.conditioning),
+            }
+        )
         if tan.ok:
             _warn(warnings, tan.conditioning, "tangent")
     rec["warnings"] = warnings
@@ -212,7 +231,10 @@ def check_record(block: Block, i: int) -> dict:
     rec = {"file": block.file[i], "grasp": block.grasp[i]}
     names = block.contact_names[i]
     warnings = []
-    for key, label, result in (("off_tangent", "off-tangent", block.off_tangent), ("tangent", "tangent", block.tangent)):
+    for key, label, result in (
+        ("off_tangent", "off-tangent", block.off_tangent),
+        ("tangent", "tangent", block.tangent),
+    ):
         if result is None:
             continue
         r = result.row(i)

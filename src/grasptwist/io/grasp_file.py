@@ -41,14 +41,14 @@ import math
 import os
 import re
 import sys
-from dataclasses import dataclass
 from itertools import chain
 from pathlib import Path
 
 import numpy as np
 import yaml
 
-from grasptwist import screws
+from ..engine import screws
+from ..model import Grasp, GraspFileError, Twist
 
 __all__ = [
     "Twist",
@@ -76,115 +76,6 @@ _LOADER = yaml.CSafeLoader if yaml.__with_libyaml__ else yaml.SafeLoader
 GRASP_KEYS = ("name", "units", "wrist", "contacts", "twists")
 CONTACT_KEYS = ("name", "point", "normal")
 TWIST_KEYS = ("name", "screw", "angular", "linear", "at")
-
-
-@dataclass(frozen=True, eq=False)
-class Twist:
-    """A desired object twist from a grasp file.
-
-    Attributes
-    ----------
-    name : str
-        Its ``name``, or ``"1"``, ``"2"``, ... by position in ``twists``.
-    screw : numpy.ndarray
-        ``(6,)`` read-only ``(omega; v)``, ``v`` the velocity of the frame
-        origin (``at`` already applied).
-    line : int or None
-        1-based line of the twist's entry in the file.
-    """
-
-    name: str
-    screw: np.ndarray
-    line: int | None
-
-
-@dataclass(frozen=True, eq=False)
-class Grasp:
-    """One grasp (one YAML document) of a grasp file.
-
-    Arrays are read-only.  ``eq=False``: dataclass equality would compare
-    arrays with ``==`` and fail; compare fields explicitly instead.
-
-    Attributes
-    ----------
-    name : str
-        Its ``name``; by default the file's stem, or ``stem#k`` (``k``
-        counting documents from 1) when the file yields several entries.
-    units : str or None
-        The ``units`` label, echoed in outputs.
-    file : str
-        The file as named by the caller (``"<stdin>"``, ``"<string>"``).
-    document : int
-        0-based index of the document in the stream.
-    contact_names : tuple of str
-        Names of contacts 1, 2, 3 (default ``"1"``, ``"2"``, ``"3"``).
-    points : numpy.ndarray
-        ``(3, 3)``, row ``i`` the contact point ``p_i``.
-    normals : numpy.ndarray
-        ``(3, 3)``, row ``i`` the unit normal ``n_i`` pointing into the object.
-    wrist : numpy.ndarray or None
-        ``(3,)`` wrist point ``c``, or None when not given.
-    twists : tuple of Twist
-        The desired twists, possibly none.
-    line : int
-        1-based line where the document starts.
-    """
-
-    name: str
-    units: str | None
-    file: str
-    document: int
-    contact_names: tuple[str, str, str]
-    points: np.ndarray
-    normals: np.ndarray
-    wrist: np.ndarray | None
-    twists: tuple[Twist, ...]
-    line: int
-
-
-class GraspFileError(Exception):
-    """A grasp file (or one document of it) that cannot be used.
-
-    ``str(error)`` is one printable line, ``file:line:column: message``
-    (``:line:column`` left out when unknown).
-
-    Attributes
-    ----------
-    code : str
-        Stable kebab-case code (table in README.md, "Grasp files").
-    message : str
-        What is wrong, starting with the field path when there is one.
-    file : str
-    line, column : int or None
-        1-based position.
-    document : int or None
-        0-based document index; None for whole-file errors.
-    """
-
-    code: str
-    message: str
-    file: str
-    line: int | None
-    column: int | None
-    document: int | None
-
-    def __init__(self, code, message, file, line=None, column=None, document=None):
-        # All fields go to args so that errors pickle (multiprocessing).
-        super().__init__(code, message, file, line, column, document)
-        self.code = code
-        self.message = message
-        self.file = file
-        self.line = line
-        self.column = column
-        self.document = document
-
-    def __str__(self):
-        where = self.file
-        if self.line is not None:
-            where += f":{self.line}"
-            if self.column is not None:
-                where += f":{self.column}"
-        return f"{where}: {self.message}"
 
 
 def read_grasps(source, *, file=None, max_bytes=DEFAULT_MAX_BYTES):
@@ -237,7 +128,7 @@ def grasp_schema():
     import json
     from importlib.resources import files
 
-    return json.loads(files("grasptwist").joinpath("grasp_schema.json").read_text("utf-8"))
+    return json.loads(files("grasptwist.io").joinpath("grasp_schema.json").read_text("utf-8"))
 
 
 # --------------------------------------------------------------------------
@@ -340,7 +231,7 @@ def _decode(data):
         raise _Reject(
             "invalid-utf8",
             "",
-            f"not valid UTF-8 (byte offset {exc.start}: {data[exc.start:exc.start + 1]!r})",
+            f"not valid UTF-8 (byte offset {exc.start}: {data[exc.start : exc.start + 1]!r})",
             line=data.count(b"\n", 0, exc.start) + 1,
             column=column,
         ) from None
@@ -469,7 +360,9 @@ def _scalar(event, stack):
         value = text if tag == _CORE + "str" else _resolve_plain(text)
         if type(value) not in _SCALAR_TAGS[tag]:
             kind = "not-a-number" if tag in (_CORE + "int", _CORE + "float") else "bad-scalar"
-            raise _Reject(kind, _here(stack), f"{text!r} is not a valid {_short_tag(tag)}", **_at_mark(event.start_mark))
+            raise _Reject(
+                kind, _here(stack), f"{text!r} is not a valid {_short_tag(tag)}", **_at_mark(event.start_mark)
+            )
     else:
         raise _forbidden_tag(tag, event, _here(stack))
     return _Node("scalar", value, event.start_mark, text)
@@ -1018,7 +911,9 @@ def _twist_parts(fields, item, path):
         return screw[:3], screw[3:], zero
     if "angular" not in fields and "linear" not in fields:
         raise _Reject("missing-key", path, "needs 'screw', or 'angular' and/or 'linear'", **_at(item))
-    return tuple(_vector(fields[key], 3, f"{path}.{key}") if key in fields else zero for key in ("angular", "linear", "at"))
+    return tuple(
+        _vector(fields[key], 3, f"{path}.{key}") if key in fields else zero for key in ("angular", "linear", "at")
+    )
 
 
 def _entry_name(fields, item, collection, index, taken):

@@ -4,7 +4,7 @@ A million-record JSONL run spends most of its time making a dict per record
 and encoding it.  Most records are *plain*: every method asked for
 succeeded, with no warning.  Their JSON differs only in numbers and names,
 so it is ``template % values``: the template is found by running the real
-record builder (:func:`grasptwist.report.records`) once on a one-row block
+record builder (:func:`grasptwist.output.records.records`) once on a one-row block
 whose numbers and names are unique markers, encoding that record, and
 cutting the text at each marker.  The layout therefore lives in one place;
 this module only learns it.  The numbers of all rows are then encoded by
@@ -20,8 +20,8 @@ from dataclasses import fields, replace
 import numpy as np
 import orjson
 
-from .batch import Block
-from .report import talking_rows
+from ..run.batch import Block
+from .records import talking_rows
 
 __all__ = ["encode_records"]
 
@@ -67,7 +67,11 @@ def _in_planes(block: Block) -> np.ndarray:
 
 def _numeric(obj):
     """The float-array fields of a block or result, in a fixed order."""
-    return [f.name for f in fields(obj) if isinstance(getattr(obj, f.name), np.ndarray) and getattr(obj, f.name).dtype.kind == "f"]
+    return [
+        f.name
+        for f in fields(obj)
+        if isinstance(getattr(obj, f.name), np.ndarray) and getattr(obj, f.name).dtype.kind == "f"
+    ]
 
 
 def _columns(block: Block):
@@ -88,7 +92,10 @@ def _value(block, owner, name):
 def _marker_block(block: Block, in_planes: bool) -> Block:
     """A one-row copy of ``block`` whose numbers and names are markers."""
     cols = _columns(block)
-    marked = {c: (k * _MARK + np.arange(_value(block, *c)[0].size) + 0.5).reshape((1,) + _value(block, *c).shape[1:]) for k, c in enumerate(cols)}
+    marked = {
+        c: (k * _MARK + np.arange(_value(block, *c)[0].size) + 0.5).reshape((1,) + _value(block, *c).shape[1:])
+        for k, c in enumerate(cols)
+    }
 
     def result(owner):
         r = getattr(block, owner)
@@ -157,7 +164,9 @@ def _by_template(block, order, records, dumps, rows, in_planes):
     for slot in slots:
         if isinstance(slot, list):
             start, stop, rows = slot
-            run = np.ascontiguousarray(numbers[:, start:stop].reshape(len(part), rows, -1) if rows > 1 else numbers[:, start:stop])
+            run = np.ascontiguousarray(
+                numbers[:, start:stop].reshape(len(part), rows, -1) if rows > 1 else numbers[:, start:stop]
+            )
             cut = rows > 1  # a table: records are "[[...]]" inside the outer brackets
             text = orjson.dumps(run, option=orjson.OPT_SERIALIZE_NUMPY)
             columns.append(text[3:-3].split(b"]],[[") if cut else text[2:-2].split(b"],["))

@@ -52,7 +52,7 @@ contacts' plane (``m . n_i = 0``): a normal line set of rank < 3, a
 So the engine gates on ``m . n_i`` and then names the specific condition.
 
 A degenerate grasp never raises: its row gets a
-:class:`~grasptwist.degeneracy.Status` and NaN amplitudes, while every other
+:class:`~grasptwist.engine.degeneracy.Status` and NaN amplitudes, while every other
 row is computed exactly as it would be alone.
 """
 
@@ -115,7 +115,7 @@ class _Result:
     Attributes
     ----------
     status, culprit : (...) int8
-        :class:`~grasptwist.degeneracy.Status` of each row and the contact it
+        :class:`~grasptwist.engine.degeneracy.Status` of each row and the contact it
         is about (0..2, or -1).
     conditioning : (...)
         The method's dimensionless conditioning figure (see each result).
@@ -265,7 +265,7 @@ def decompose_off_tangent(points, wrist, twist, *, tol=DEGENERACY_TOL, bases=Tru
         The point ``c`` (centre of the wrist's spherical joint).
     twist : (..., 6) array, ``(omega; v)`` with ``v`` at the origin.
     tol : float
-        Relative tolerance of the degeneracy tests (see :mod:`grasptwist.degeneracy`).
+        Relative tolerance of the degeneracy tests (see :mod:`grasptwist.engine.degeneracy`).
     bases : bool
         False leaves out the basis screws (``sigma``, ``psi`` are None, and
         so cannot give components or a residual): a third less work and
@@ -366,6 +366,8 @@ _BASES = {"sigma", "psi", "theta"}
 
 def _without_bases(spec, bases):
     return spec if bases else {k: v for k, v in spec.items() if k not in _BASES}
+
+
 _TRAILING = {"points": (3, 3), "normals": (3, 3), "wrist": (3,), "twist": (6,)}
 
 
@@ -402,9 +404,17 @@ def _triangle(p) -> _Triangle:
         (lambda tol: ~finite, Status.NONFINITE_INPUT, None),
         (lambda tol: ~np.isfinite(size * size), Status.OVERFLOW, None),
         # the pair that coincides is opposite the shortest side
-        (lambda tol: ~(_min3(side_len) > tol * size), Status.COINCIDENT_CONTACTS, lambda rows: np.argmin(side_len[:, rows], 0)),
+        (
+            lambda tol: ~(_min3(side_len) > tol * size),
+            Status.COINCIDENT_CONTACTS,
+            lambda rows: np.argmin(side_len[:, rows], 0),
+        ),
         # the contact between the other two is opposite the longest side
-        (lambda tol: ~(m_len > tol * size * size), Status.COLLINEAR_CONTACTS, lambda rows: np.argmax(side_len[:, rows], 0)),
+        (
+            lambda tol: ~(m_len > tol * size * size),
+            Status.COLLINEAR_CONTACTS,
+            lambda rows: np.argmax(side_len[:, rows], 0),
+        ),
     ]
     return _Triangle(side, side_len, unit_side, size, m, m_len, checks)
 
@@ -479,9 +489,21 @@ def _tangent_rows(ins, out, tol):
     checks = tri.checks + [
         (lambda tol: ~np.isfinite(ins["normals"]).all(axis=(0, 1)), Status.NONFINITE_INPUT, None),
         (lambda tol: ~(n_len > 0).all(axis=0), Status.ZERO_NORMAL, lambda rows: np.argmin(n_len[:, rows], 0)),
-        (_subset(degenerate, lambda rows: _rank_deficient(p[..., rows], n[..., rows], tri.size[rows], tol)), Status.NORMALS_RANK_DEFICIENT, None),
-        (_subset(degenerate, lambda rows: ~(uniqueness(rows) > tol).all(axis=0)), Status.THETA_NOT_UNIQUE, lambda rows: np.argmin(uniqueness(rows), 0)),
-        (_subset(degenerate, lambda rows: ~(theta_sigma[:, rows] > tol).all(axis=0)), Status.THETA_SIGMA_ZERO, lambda rows: np.argmin(theta_sigma[:, rows], 0)),
+        (
+            _subset(degenerate, lambda rows: _rank_deficient(p[..., rows], n[..., rows], tri.size[rows], tol)),
+            Status.NORMALS_RANK_DEFICIENT,
+            None,
+        ),
+        (
+            _subset(degenerate, lambda rows: ~(uniqueness(rows) > tol).all(axis=0)),
+            Status.THETA_NOT_UNIQUE,
+            lambda rows: np.argmin(uniqueness(rows), 0),
+        ),
+        (
+            _subset(degenerate, lambda rows: ~(theta_sigma[:, rows] > tol).all(axis=0)),
+            Status.THETA_SIGMA_ZERO,
+            lambda rows: np.argmin(theta_sigma[:, rows], 0),
+        ),
         (lambda tol: degenerate, Status.NORMAL_IN_CONTACT_PLANE, lambda rows: np.argmin(plane_sine[:, rows], 0)),
     ]
     _settle(out, checks, t, tol, alpha=alpha, beta=beta, normal_velocity=nv)

@@ -13,19 +13,29 @@ from __future__ import annotations
 import gc
 import os
 import tempfile
+from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field
 from functools import partial
-from typing import Iterator, Sequence
 
 import numpy as np
 
+from ..io.datasets import DATASET_SUFFIXES, NpzWriter, dataset_blocks, open_dataset
+from ..io.inputs import STDIN, read
+from ..model import GraspFileError, Twist
+from ..output.json_rows import encode_records
+from ..output.records import (
+    ENCODERS,
+    JOINERS,
+    basis_record,
+    check_record,
+    diagnostics,
+    dumps,
+    error_record,
+    records,
+    talking_rows,
+)
 from .batch import ZERO_TWIST, Block, resolve
-from .datasets import DATASET_SUFFIXES, NpzWriter, dataset_blocks, open_dataset
-from .grasp_file import GraspFileError, Twist
-from .inputs import STDIN, read
-from .json_rows import encode_records
-from .report import ENCODERS, JOINERS, basis_record, check_record, diagnostics, dumps, error_record, records, talking_rows
 
 __all__ = ["Job", "Output", "run", "run_group", "blocks", "write_npz", "FILES_PER_GROUP"]
 

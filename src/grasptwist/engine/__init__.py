@@ -1,0 +1,1 @@
+"""The math: screw algebra and the paper's decompositions, pure functions on arrays."""

@@ -1,0 +1,130 @@
+"""The data types every layer shares: grasps, twists and input errors.
+
+No parsing and no math here: the loaders in :mod:`grasptwist.io` build these,
+the runner in :mod:`grasptwist.run` feeds them to the engine, and the
+writers in :mod:`grasptwist.output` report them.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+__all__ = ["Twist", "Grasp", "InputError", "GraspFileError", "CONTACT_NAMES"]
+
+#: Contact names of a grasp that does not name its contacts.
+CONTACT_NAMES = ("1", "2", "3")
+
+
+@dataclass(frozen=True, eq=False)
+class Twist:
+    """A desired object twist from a grasp file.
+
+    Attributes
+    ----------
+    name : str
+        Its ``name``, or ``"1"``, ``"2"``, ... by position in ``twists``.
+    screw : numpy.ndarray
+        ``(6,)`` read-only ``(omega; v)``, ``v`` the velocity of the frame
+        origin (``at`` already applied).
+    line : int or None
+        1-based line of the twist's entry in the file.
+    """
+
+    name: str
+    screw: np.ndarray
+    line: int | None
+
+
+@dataclass(frozen=True, eq=False)
+class Grasp:
+    """One grasp (one YAML document) of a grasp file.
+
+    Arrays are read-only.  ``eq=False``: dataclass equality would compare
+    arrays with ``==`` and fail; compare fields explicitly instead.
+
+    Attributes
+    ----------
+    name : str
+        Its ``name``; by default the file's stem, or ``stem#k`` (``k``
+        counting documents from 1) when the file yields several entries.
+    units : str or None
+        The ``units`` label, echoed in outputs.
+    file : str
+        The file as named by the caller (``"<stdin>"``, ``"<string>"``).
+    document : int
+        0-based index of the document in the stream.
+    contact_names : tuple of str
+        Names of contacts 1, 2, 3 (default ``"1"``, ``"2"``, ``"3"``).
+    points : numpy.ndarray
+        ``(3, 3)``, row ``i`` the contact point ``p_i``.
+    normals : numpy.ndarray
+        ``(3, 3)``, row ``i`` the unit normal ``n_i`` pointing into the object.
+    wrist : numpy.ndarray or None
+        ``(3,)`` wrist point ``c``, or None when not given.
+    twists : tuple of Twist
+        The desired twists, possibly none.
+    line : int
+        1-based line where the document starts.
+    """
+
+    name: str
+    units: str | None
+    file: str
+    document: int
+    contact_names: tuple[str, str, str]
+    points: np.ndarray
+    normals: np.ndarray
+    wrist: np.ndarray | None
+    twists: tuple[Twist, ...]
+    line: int
+
+
+class InputError(Exception):
+    """An input (a grasp file or one document of it, a data set, a path) that cannot be used.
+
+    ``str(error)`` is one printable line, ``file:line:column: message``
+    (``:line:column`` left out when unknown).
+
+    Attributes
+    ----------
+    code : str
+        Stable kebab-case code (tables in README.md, "Grasp files" and "Exit codes and diagnostics").
+    message : str
+        What is wrong, starting with the field path when there is one.
+    file : str
+    line, column : int or None
+        1-based position.
+    document : int or None
+        0-based document index; None for whole-file errors.
+    """
+
+    code: str
+    message: str
+    file: str
+    line: int | None
+    column: int | None
+    document: int | None
+
+    def __init__(self, code, message, file, line=None, column=None, document=None):
+        # All fields go to args so that errors pickle (multiprocessing).
+        super().__init__(code, message, file, line, column, document)
+        self.code = code
+        self.message = message
+        self.file = file
+        self.line = line
+        self.column = column
+        self.document = document
+
+    def __str__(self):
+        where = self.file
+        if self.line is not None:
+            where += f":{self.line}"
+            if self.column is not None:
+                where += f":{self.column}"
+        return f"{where}: {self.message}"
+
+
+#: The name the Python API has always used for a grasp file's errors.
+GraspFileError = InputError

@@ -1,0 +1,1 @@
+"""Outputs: records (the JSON contract), their encodings and writers, tables."""

@@ -1,0 +1,1 @@
+"""Running the engine over many inputs: batching rows and the worker pool."""
