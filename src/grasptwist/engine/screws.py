@@ -17,6 +17,8 @@ from __future__ import annotations
 import numpy as np
 
 __all__ = [
+    "J",
+    "K",
     "dot",
     "cross",
     "norm",
@@ -34,6 +36,12 @@ __all__ = [
     "axis_point",
     "rigid_motion",
 ]
+
+#: Cyclic contact indices of the paper: for contact ``i`` (0-based), the other
+#: two are ``j = J[i]`` and ``k = K[i]``, so ``(i, j, k)`` runs over
+#: ``(0, 1, 2), (1, 2, 0), (2, 0, 1)``.
+J = (1, 2, 0)
+K = (2, 0, 1)
 
 
 def dot(a, b):
