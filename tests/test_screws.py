@@ -95,3 +95,53 @@ def test_batch_shapes_broadcast():
     d = np.ones((5, 3))
     assert screws.line_through(p, d).shape == (4, 5, 6)
     assert screws.klein(np.ones((2, 1, 6)), np.ones((3, 6))).shape == (2, 3)
+
+
+def _extreme_vectors(rng, n):
+    """Random vectors over 600 orders of magnitude, with exact zeros mixed in."""
+    v = rng.normal(size=(n, 3)) * 10.0 ** rng.uniform(-300, 300, size=(n, 1))
+    v[rng.random((n, 3)) < 0.1] = 0.0
+    return v
+
+
+@given(seeds)
+@settings(max_examples=20)
+def test_three_component_forms_give_the_array_forms_bits(seed):
+    rng = np.random.default_rng(seed)
+    a, b, c = (rng.normal(size=(50, 3)) * 10.0 ** rng.uniform(-5, 5, size=(50, 1)) for _ in range(3))
+    s = rng.normal(size=50)
+    comp = lambda v: tuple(v.T)  # noqa: E731  (x, y, z), each an array over rows
+    np.testing.assert_array_equal(screws.dot3(comp(a), comp(b)), screws.dot(a, b))
+    np.testing.assert_array_equal(np.stack(screws.cross3(comp(a), comp(b)), -1), screws.cross(a, b))
+    np.testing.assert_array_equal(np.stack(screws.add3(comp(a), comp(b)), -1), a + b)
+    np.testing.assert_array_equal(np.stack(screws.sub3(comp(a), comp(b)), -1), a - b)
+    np.testing.assert_array_equal(np.stack(screws.mul3(comp(a), s), -1), a * s[:, None])
+    np.testing.assert_array_equal(np.stack(screws.div3(comp(a), s), -1), a / s[:, None])
+    twist = screws.twist_at(a, b, c)
+    np.testing.assert_array_equal(np.stack(screws.twist_at3(comp(a), comp(b), comp(c)), -1), twist[:, 3:])
+    # ... and in plain floats, one row at a time
+    for i in range(5):
+        assert screws.dot3(a[i].tolist(), b[i].tolist()) == screws.dot(a[i], b[i])
+        assert screws.cross3(a[i].tolist(), b[i].tolist()) == tuple(screws.cross(a[i], b[i]).tolist())
+        assert screws.twist_at3(a[i].tolist(), b[i].tolist(), c[i].tolist()) == tuple(twist[i, 3:].tolist())
+
+
+@given(seeds)
+@settings(max_examples=20)
+def test_direction3_gives_directions_bits_at_any_size(seed):
+    v = _extreme_vectors(np.random.default_rng(seed), 200)
+    v = v[np.any(v != 0, axis=1)]
+    want = screws.direction(v)
+    got = np.array([screws.direction3(*row) for row in v.tolist()])
+    np.testing.assert_array_equal(got, want)
+    np.testing.assert_allclose(np.linalg.norm(got, axis=1), 1.0, rtol=1e-15)
+
+
+def test_direction3_of_a_zero_vector_raises_where_direction_keeps_zero():
+    np.testing.assert_array_equal(screws.direction([0.0, 0.0, 0.0]), 0.0)
+    with pytest.raises(ZeroDivisionError):
+        screws.direction3(0.0, 0.0, 0.0)
+
+
+def test_the_cyclic_indices_are_the_papers():
+    assert [(i, screws.J[i], screws.K[i]) for i in range(3)] == [(0, 1, 2), (1, 2, 0), (2, 0, 1)]
