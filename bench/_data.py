@@ -2,6 +2,8 @@
 
 import numpy as np
 
+from grasptwist.engine import formulas, screws
+
 
 def grasp_arrays(n, seed=0):
     """``n`` random grasps: points, normals, wrist ``(n, 3)``, twist ``(n, 6)``.
@@ -19,6 +21,23 @@ def grasp_arrays(n, seed=0):
     wrist = centre[:, 0] + rng.normal(size=(n, 3)) + [0, 0, 2.0]
     twist = rng.normal(size=(n, 6))
     return points, normals, wrist, twist
+
+
+def solve_baseline(points, normals, wrist, twist):
+    """Both decompositions and the contact velocities the plain way, batched or for one grasp.
+
+    The basis screws of :mod:`grasptwist.engine.formulas`, the amplitudes by
+    ``numpy.linalg.solve`` of the two 6x6 systems ``[Sigma Psi] (x; y) = T``
+    and ``[Theta Sigma] (alpha; beta) = T``.  Returns ``(x; y)``,
+    ``(alpha; beta)`` ``(..., 6)`` and the contact velocities ``(..., 3, 3)``.
+    """
+    sigma = formulas.sigma_lines(points)
+    psi = formulas.psi_lines(points, wrist)
+    theta = formulas.theta_lines(points, normals)
+    rhs = twist[..., None]
+    xy = np.linalg.solve(np.swapaxes(np.concatenate([sigma, psi], axis=-2), -1, -2), rhs)[..., 0]
+    ab = np.linalg.solve(np.swapaxes(np.concatenate([theta, sigma], axis=-2), -1, -2), rhs)[..., 0]
+    return xy, ab, screws.field_at(twist[..., None, :], points)
 
 
 def save_npz(path, n, seed=0):

@@ -2,11 +2,12 @@
 
 Run: ``python bench/engine.py [--n 1000000]``.  All three compute the same
 things on the same grasps in this one process: both decompositions and the
-contact velocities.  The baseline builds the same basis screws with plain
-numpy (NOTES.md's definitions) and solves the 6x6 systems with
-``numpy.linalg.solve``; the loop calls the public API once per grasp on a
-sample and is scaled to ``n``.  Peak memory is that of a fresh process
-running the engine part alone.
+contact velocities.  The baseline builds the basis screws by the paper's
+formulas (``grasptwist.engine.formulas``) and solves the 6x6 systems with
+``numpy.linalg.solve`` (``_data.solve_baseline``); the loop calls the public
+API once per grasp (which takes the small-batch path) on a sample and is
+scaled to ``n``.  Peak memory is that of a fresh process running the engine
+part alone.
 """
 
 import argparse
@@ -18,33 +19,13 @@ import time
 import numpy as np
 
 import grasptwist as gt
-from _data import grasp_arrays
+from _data import grasp_arrays, solve_baseline
 
 
 def engine(points, normals, wrist, twist):
     off = gt.decompose_off_tangent(points, wrist, twist)
     tan = gt.decompose_tangent(points, normals, twist)
     return off, tan, gt.contact_velocities(points, twist)
-
-
-def baseline(points, normals, wrist, twist):
-    """The same three computations: bases by NOTES.md, amplitudes by numpy.linalg.solve."""
-    p = points
-    n = normals / np.linalg.norm(normals, axis=-1, keepdims=True)
-
-    def line(a, d):
-        d = d / np.linalg.norm(d, axis=-1, keepdims=True)
-        return np.concatenate([d, np.cross(a, d)], axis=-1)
-
-    j, k = [1, 2, 0], [2, 0, 1]
-    sigma = line(p[:, j], p[:, k] - p[:, j])
-    psi = line(p, p - wrist[:, None, :])
-    theta = line(p, np.cross(np.cross(n[:, j], p[:, j] - p), np.cross(n[:, k], p[:, k] - p)))
-    rhs = twist[..., None]
-    xy = np.linalg.solve(np.concatenate([sigma, psi], axis=1).transpose(0, 2, 1), rhs)[..., 0]
-    ab = np.linalg.solve(np.concatenate([theta, sigma], axis=1).transpose(0, 2, 1), rhs)[..., 0]
-    velocity = twist[:, None, 3:] + np.cross(twist[:, None, :3], p)
-    return xy, ab, velocity
 
 
 def best_of(repeats, fn, *args):
@@ -75,7 +56,7 @@ def main():
     peak = peak_memory_mib(args.n)  # first: a child forked from a large parent inherits its peak
     data = grasp_arrays(args.n)
     t_engine, (off, tan, vel) = best_of(args.repeats, engine, *data)
-    t_solve, (xy, ab, vel_b) = best_of(max(1, args.repeats - 1), baseline, *data)
+    t_solve, (xy, ab, vel_b) = best_of(max(1, args.repeats - 1), solve_baseline, *data)
     sample = [a[: args.loop] for a in data]
     t0 = time.perf_counter()
     for row in zip(*sample):

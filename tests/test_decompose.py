@@ -1,5 +1,6 @@
-"""The engine against the paper (NOTES.md's corrected values), an independent
-6x6 solve, the reciprocity identities, rigid motions and random grasps."""
+"""The engine against the paper (the corrected values of README, "Conventions"),
+its formulas as written (grasptwist.engine.formulas), an independent 6x6
+solve, the reciprocity identities, rigid motions and random grasps."""
 
 import numpy as np
 import pytest
@@ -8,7 +9,7 @@ from hypothesis import strategies as st
 
 import grasptwist as gt
 from grasp_gen import grasps, rotation
-from grasptwist.engine import screws
+from grasptwist.engine import formulas, screws
 
 EX1 = np.array([[1, 0, 0], [-0.5, 0.866, 0], [-0.5, -0.866, 0]], float)
 EX1_WRIST = np.array([0, 0, 1.0])
@@ -20,7 +21,7 @@ seeds = st.integers(0, 2**32 - 1)
 scales = st.sampled_from([1e-3, 1e-2, 1.0, 1e2, 1e3])
 
 
-# --- the paper's examples, NOTES.md's corrected values -----------------------
+# --- the paper's examples, corrected values (README, "Conventions") ----------
 
 
 def test_example_1_basis_screws_eq16_eq17_and_products_eq18():
@@ -100,13 +101,15 @@ def test_example_2_second_approach_splits_each_contact_velocity():
 
 
 def test_tangent_method_resolves_an_out_of_plane_twist_with_beta():
-    # lifting the polyhedron along z pushes contacts 1, 2 out of... no: n1 = x, n2 = y keep z tangent;
-    # contact 3 (normal z) must move off its plane: beta_3 only.
+    # lifting the polyhedron along z keeps contacts 1 and 2 (normals x, y) in their
+    # tangent planes; contact 3 (normal z) must leave its plane: beta_3 alone.
+    # Sigma_3(p_3) = m / |U_3| = (4, 4, 4) / sqrt(8), so beta_3 Sigma_3(p_3) . n_3 = 1 gives 1/sqrt(2).
     t = np.array([0, 0, 0, 0, 0, 1.0])
     r = gt.decompose_tangent(EX2, EX2_NORMALS, t)
     np.testing.assert_allclose(r.normal_velocity, [0, 0, 1], atol=1e-12)
     assert not r.in_tangent_planes
-    assert abs(r.beta[2]) > 0.1 and np.allclose(r.beta[:2], 0, atol=1e-12)
+    np.testing.assert_allclose(r.beta, [0, 0, 1 / np.sqrt(2)], rtol=1e-15, atol=1e-15)
+    np.testing.assert_allclose(r.alpha, [-0.5, 0.5, 0], rtol=1e-15, atol=1e-15)
     a, b = r.components()
     np.testing.assert_allclose(a.sum(0) + b.sum(0), t, atol=1e-12)
 
@@ -119,29 +122,67 @@ def test_contact_velocities_example_1b():
 # --- random grasps -------------------------------------------------------------
 
 
-def _independent_solve(points, wrist, normals, twist):
-    """Both decompositions by numpy.linalg.solve on bases built here from NOTES.md."""
-    p = points
-    n = normals / np.linalg.norm(normals, axis=-1, keepdims=True)
+def _solve(points, normals, wrist, twist):
+    """Both decompositions by numpy.linalg.solve of ``[basis] a = T`` on the bases of
+    formulas.py: a check of eqs. 14 and 27 that uses no Klein product."""
+    sigma = formulas.sigma_lines(points)
+    psi = formulas.psi_lines(points, wrist)
+    theta = formulas.theta_lines(points, normals)
+    off = np.linalg.solve(np.swapaxes(np.concatenate([sigma, psi], -2), -1, -2), twist[..., None])[..., 0]
+    tan = np.linalg.solve(np.swapaxes(np.concatenate([theta, sigma], -2), -1, -2), twist[..., None])[..., 0]
+    return off, tan
 
-    def line(a, d):
-        d = d / np.linalg.norm(d, axis=-1, keepdims=True)
-        return np.concatenate([d, np.cross(a, d)], axis=-1)
 
-    j, k = [1, 2, 0], [2, 0, 1]
-    sigma = line(p[:, j], p[:, k] - p[:, j])
-    psi = line(p, p - wrist[:, None, :])
-    w = np.cross(np.cross(n[:, j], p[:, j] - p), np.cross(n[:, k], p[:, k] - p))
-    theta = line(p, w)
-    off = np.linalg.solve(np.concatenate([sigma, psi], axis=1).transpose(0, 2, 1), twist[..., None])[..., 0]
-    tan = np.linalg.solve(np.concatenate([theta, sigma], axis=1).transpose(0, 2, 1), twist[..., None])[..., 0]
-    return off, tan, sigma, psi, theta
+def _near(got, want, tol):
+    """``|got - want| <= tol`` everywhere (``tol`` broadcasts, e.g. one per row)."""
+    err = np.abs(got - want)
+    assert np.all(err <= tol), np.max(err / tol)
 
 
 def _close_relative(a, b, ref, rtol):
     """|a - b| <= rtol * max|ref| per row (rows of amplitudes share one scale)."""
     scale = np.max(np.abs(ref), axis=-1, keepdims=True)
     assert np.all(np.abs(a - b) <= rtol * scale), np.max(np.abs(a - b) / scale)
+
+
+@settings(max_examples=12, deadline=None)
+@given(seeds, scales, st.booleans())
+def test_the_engine_computes_the_papers_formulas(seed, scale, moved):
+    """The closed forms of the kernels against formulas.py, row by row, on a few
+    hundred random grasps at every scale, optionally moved far from the origin."""
+    rng = np.random.default_rng(seed)
+    points, normals, wrist, twist = grasps(rng, 300, scale=scale)
+    if moved:
+        rot, shift = rotation(rng, 300), rng.normal(size=(300, 3)) * 20 * scale
+        points = np.einsum("gij,gkj->gki", rot, points) + shift[:, None]
+        normals = np.einsum("gij,gkj->gki", rot, normals)
+        wrist = np.einsum("gij,gj->gi", rot, wrist) + shift
+        twist = screws.rigid_motion(twist, rot, shift)
+    off = gt.decompose_off_tangent(points, wrist, twist)
+    tan = gt.decompose_tangent(points, normals, twist)
+    assert off.ok.all()
+    good = tan.ok & (tan.conditioning > gt.CONDITION_WARNING)
+    assert good.mean() > 0.8  # the filter may drop a few near-degenerate normals, not hide a bug
+    reach = np.max(np.abs(points), axis=(-1, -2))[:, None, None]  # moments p x d scale with it
+    size = np.max(np.linalg.norm(points - points[:, [1, 2, 0]], axis=-1), axis=-1)[:, None]
+
+    sigma, psi = formulas.sigma_lines(points), formulas.psi_lines(points, wrist)
+    theta = formulas.theta_lines(points, normals)
+    every = slice(None)
+    for got, want, rows in ((off.sigma, sigma, every), (off.psi, psi, every), (tan.theta, theta, good)):
+        _near(got[rows, :, :3], want[rows, :, :3], 1e-12)  # unit directions
+        _near(got[rows, :, 3:], want[rows, :, 3:], 1e-12 * reach[rows])
+    np.testing.assert_array_equal(tan.sigma, off.sigma)
+    _near(off.sigma_psi, screws.klein(sigma, psi), 1e-12 * size)
+    _near(tan.theta_sigma[good], screws.klein(theta, sigma)[good], 1e-12 * size[good])
+
+    x, y = formulas.off_tangent_amplitudes(sigma, psi, twist)
+    _close_relative(np.c_[off.x, off.y], np.c_[x, y], np.c_[x, y], 1e-9)
+    alpha, beta = formulas.tangent_amplitudes(theta, sigma, twist)
+    _close_relative(np.c_[tan.alpha, tan.beta][good], np.c_[alpha, beta][good], np.c_[alpha, beta][good], 1e-8)
+    nv = formulas.normal_velocities(points, normals, twist)
+    speed = np.max(np.linalg.norm(gt.contact_velocities(points, twist), axis=-1), -1, keepdims=True)
+    _near(tan.normal_velocity, nv, 1e-12 * speed)
 
 
 @settings(max_examples=25, deadline=None)
@@ -153,11 +194,8 @@ def test_reconstruction_and_independent_solve_on_random_grasps(seed, scale):
     tan = gt.decompose_tangent(points, normals, twist)
     assert off.ok.all()
     good = tan.ok & (tan.conditioning > gt.CONDITION_WARNING)
-    assert good.mean() > 0.8  # the filter may drop a few near-degenerate normals, not hide a bug
-    ref_off, ref_tan, sigma, psi, theta = _independent_solve(points, wrist, normals, twist)
-
-    np.testing.assert_allclose(off.sigma, sigma, rtol=1e-9, atol=1e-12 * scale)
-    np.testing.assert_allclose(off.psi, psi, rtol=1e-9, atol=1e-12 * scale)
+    assert good.mean() > 0.8
+    ref_off, ref_tan = _solve(points, normals, wrist, twist)
     _close_relative(np.concatenate([off.x, off.y], -1), ref_off, ref_off, 1e-8)
     amp = np.concatenate([tan.alpha, tan.beta], -1)[good]
     _close_relative(amp, ref_tan[good], ref_tan[good], 1e-8)

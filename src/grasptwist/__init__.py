@@ -9,14 +9,18 @@ The engine (pure numpy, batched over leading axes):
 """
 
 from .engine import screws
+from .engine.checks import check_normals, check_points, check_twist, check_wrist
 from .engine.decompose import (
     OffTangentResult,
+    Resolution,
     TangentResult,
     contact_velocities,
     decompose_off_tangent,
     decompose_tangent,
+    resolve,
 )
 from .engine.degeneracy import CONDITION_WARNING, DEGENERACY_TOL, Status, status_message
+from .engine.prepared import PreparedGrasp, prepare
 
 __version__ = "0.1.0"
 
@@ -25,10 +29,18 @@ __all__ = [
     "decompose_off_tangent",
     "decompose_tangent",
     "contact_velocities",
+    "resolve",
+    "Resolution",
+    "prepare",
+    "PreparedGrasp",
     "OffTangentResult",
     "TangentResult",
     "Status",
     "status_message",
     "DEGENERACY_TOL",
     "CONDITION_WARNING",
+    "check_points",
+    "check_normals",
+    "check_wrist",
+    "check_twist",
 ]

@@ -1,59 +1,38 @@
-"""The paper's two decompositions of an object twist, on batches of grasps.
+"""The paper's two decompositions of an object twist, for one grasp or batches of millions.
 
 * :func:`decompose_off_tangent` -- Proposition 1 (eqs. 8-14): ``T = sum x_i
   Sigma_i + sum y_i Psi_i``, where ``Sigma_i`` (the line ``p_j p_k``) moves
   only contact ``i`` and ``Psi_i`` (the line from the wrist ``c`` through
   ``p_i``) keeps contact ``i`` fixed.
-* :func:`decompose_tangent` -- Proposition 2 (eqs. 19-27) and the extension
-  of NOTES.md: ``T = sum alpha_i Theta_i + sum beta_i Sigma_i``, where
-  ``Theta_i`` keeps contact ``i`` fixed and the other two sliding in their
-  tangent planes.  ``beta = 0`` exactly when ``T`` moves every contact in its
-  tangent plane.
+* :func:`decompose_tangent` -- Proposition 2 (eqs. 19-27) and its extension
+  to any twist (README, "The tangent method beyond the paper"): ``T = sum
+  alpha_i Theta_i + sum beta_i Sigma_i``, where ``Theta_i`` keeps contact
+  ``i`` fixed and the other two sliding in their tangent planes.  ``beta =
+  0`` exactly when ``T`` moves every contact in its tangent plane.
 * :func:`contact_velocities` -- ``T(p_i)``.
 
 Shapes: ``points`` and ``normals`` are ``(..., 3, 3)`` (contact, xyz),
 ``wrist`` is ``(..., 3)``, ``twist`` is ``(..., 6)`` as ``(omega; v)`` with
 ``v`` the velocity of the frame origin.  Leading shapes broadcast, so one
-grasp can take many twists or many grasps one twist.  Indices ``(i, j, k)``
-run cyclically over ``(0, 1, 2), (1, 2, 0), (2, 0, 1)``.
+grasp can take many twists or many grasps one twist.  Arguments are checked
+by :mod:`~grasptwist.engine.checks`.
 
-How it is computed
-------------------
-Eqs. 14 and 27 divide Klein products.  For a unit line ``L`` through ``a``
-along ``d``, ``[T|L] = d . T(a)``; with ``U_i = p_k - p_j`` (the side
-opposite contact ``i``), ``E_i = p_i - c`` and ``m = (p_2 - p_1) x (p_3 - p_1)``
-(twice the contacts' area, normal to their plane), the products reduce to
-closed forms that need no 6-vector algebra:
+The numbers come from the closed forms of :mod:`~grasptwist.engine.kernels`,
+run one of two ways with the same operations, so a row gets the same bits
+either way and whatever batch it is in:
 
-* ``[Sigma_i|Psi_i] = D / (|U_i| |E_i|)`` with ``D = m . (p_1 - c)``, the same
-  ``D`` for every ``i``, so
-  ``x_i = |U_i| E_i . T(p_i) / D`` and ``y_i = |E_i| U_i . T(p_j) / D``;
-* ``Sigma_i(p_i) = m / |U_i|``, so ``[Theta_i|Sigma_i] = w^_i . m / |U_i|``
-  and ``alpha_i = U_i . T(p_j) / (w^_i . m)``;
-* every ``Theta_j`` and ``Sigma_j`` (``j != i``) keeps ``p_i`` in its tangent
-  plane, so the normal velocity ``T(p_i) . n_i`` is ``beta_i Sigma_i(p_i) . n_i``:
-  ``beta_i = |U_i| T(p_i) . n_i / (m . n_i)``.
-
-Only differences of points enter the tests and amplitudes, and every
-degeneracy measure is a ratio of like quantities, so verdicts do not depend
-on the grasp's scale or position.  Coordinates must stay within about
-1e-150..1e150 in size (squares of lengths are formed); a row whose numbers
-overflow gets the status ``overflow``.
-
-Speed: rows are processed in chunks of :data:`CHUNK` whose temporaries stay
-in the CPU cache, in a components-first layout (``(contact, xyz, row)``) so
-that every numpy call runs over contiguous memory.  Results are views of
-that layout with the documented shapes.  All arithmetic is element-wise: a
-row's numbers do not depend on the batch or chunk it is in.
-
-The tangent method is degenerate exactly when some normal lies in the
-contacts' plane (``m . n_i = 0``): a normal line set of rank < 3, a
-``Theta_i`` that is not unique, and ``[Theta_i|Sigma_i] = 0`` each imply it.
-So the engine gates on ``m . n_i`` and then names the specific condition.
+* up to :data:`SMALL_BATCH` rows, each row in plain Python floats (a call
+  for one grasp inside a control loop costs tens of microseconds, not the
+  fixed cost of the batch machinery);
+* above it, in chunks of :data:`CHUNK` rows whose temporaries stay in the
+  CPU cache, each component of each vector one contiguous array over the
+  chunk's rows.  Results are views of that components-first layout with the
+  documented shapes.
 
 A degenerate grasp never raises: its row gets a
-:class:`~grasptwist.engine.degeneracy.Status` and NaN amplitudes, while every other
-row is computed exactly as it would be alone.
+:class:`~grasptwist.engine.degeneracy.Status` and NaN amplitudes, while every
+other row is computed exactly as it would be alone.  For many twists on one
+grasp, :func:`~grasptwist.engine.prepared.prepare` does the grasp's part once.
 """
 
 from __future__ import annotations
@@ -65,10 +44,14 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .degeneracy import DEGENERACY_TOL, IN_PLANE_TOL, Status
+from . import kernels
+from .checks import SHAPES, check_normals, check_points, check_twist, check_wrist
+from .degeneracy import DEGENERACY_TOL, Status
 from .screws import field_at, norm
 
 __all__ = [
+    "Resolution",
+    "resolve",
     "OffTangentResult",
     "TangentResult",
     "decompose_off_tangent",
@@ -76,12 +59,14 @@ __all__ = [
     "contact_velocities",
 ]
 
-_J = [1, 2, 0]  # j = i + 1 (mod 3)
-_K = [2, 0, 1]  # k = i + 2 (mod 3)
-
 #: Rows per chunk: small enough for a chunk's temporaries to stay in cache,
-#: large enough that numpy's per-call overhead is noise.
-CHUNK = 8192
+#: large enough that numpy's per-call overhead is noise (each temporary is
+#: 128 KiB; measured with bench/engine.py, smaller chunks lose to the allocator).
+CHUNK = 16384
+
+#: Batches of up to this many rows are computed row by row in plain floats:
+#: below it that is faster than the chunked arrays' fixed cost.
+SMALL_BATCH = 12
 
 
 def contact_velocities(points, twist):
@@ -99,8 +84,8 @@ def contact_velocities(points, twist):
     >>> contact_velocities([[1.0, 0, 0], [0, 1, 0], [0, 0, 1]], [0, 0, 1.0, 0, 0, 0]).tolist()
     [[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 0.0]]
     """
-    inputs = {"points": _checked(points, (3, 3), "points"), "twist": _checked(twist, (6,), "twist")}
-    return _chunked(_velocity_rows, inputs, {"velocity": (3, 3)}, None)["velocity"]
+    inputs = {"points": check_points(points), "twist": check_twist(twist)}
+    return _run(_VELOCITIES, ("velocity",), inputs, (), bases=True)[0]["velocity"]["velocity"]
 
 
 def _index(a, i):
@@ -128,6 +113,15 @@ class _Result:
     conditioning: np.ndarray
     points: np.ndarray
     twist: np.ndarray
+
+    @classmethod
+    def _of(cls, values):
+        """An instance from a dict of every field's value.  It skips the frozen
+        dataclass ``__init__``, which only assigns them, one by one: for one
+        grasp that is a noticeable part of the call."""
+        r = object.__new__(cls)
+        r.__dict__.update(values)
+        return r
 
     @property
     def ok(self) -> np.ndarray:
@@ -205,8 +199,9 @@ class TangentResult(_Result):
         Tangent amplitudes, eq. 27.
     beta : (..., 3)
         Off-plane remainder amplitudes, ``beta_i = [R|Theta_i]/[Sigma_i|Theta_i]``
-        with ``R = T - sum alpha_i Theta_i`` (NOTES.md).  Zero when ``T``
-        keeps every contact in its tangent plane.
+        with ``R = T - sum alpha_i Theta_i`` (README, "The tangent method
+        beyond the paper").  Zero when ``T`` keeps every contact in its
+        tangent plane.
     normal_velocity : (..., 3)
         ``[T | nu_i] = T(p_i) . n_i`` with unit normals.
     in_tangent_planes : (...) bool
@@ -277,20 +272,16 @@ def decompose_off_tangent(points, wrist, twist, *, tol=DEGENERACY_TOL, bases=Tru
 
     Examples
     --------
-    Paper Example 1b, a spin about z (NOTES.md's corrected values):
+    Paper Example 1b, a spin about z (corrected values: README, "Conventions"):
 
     >>> p = [[1, 0, 0], [-0.5, 0.866, 0], [-0.5, -0.866, 0]]
     >>> r = decompose_off_tangent(p, [0, 0, 1], [0, 0, 1, 0, 0, 0])
     >>> np.round(r.y, 4).tolist(), bool(np.allclose(r.x, 0))
     ([-0.4714, -0.4714, -0.4714], True)
     """
-    inputs = {
-        "points": _checked(points, (3, 3), "points"),
-        "wrist": _checked(wrist, (3,), "wrist"),
-        "twist": _checked(twist, (6,), "twist"),
-    }
-    out = _chunked(_off_tangent_rows, inputs, _without_bases(_OFF_TANGENT_OUT, bases), tol)
-    return OffTangentResult(**{**dict.fromkeys(_BASES & _OFF_TANGENT_OUT.keys()), **out})
+    inputs = {"points": check_points(points), "wrist": check_wrist(wrist), "twist": check_twist(twist)}
+    parts, inputs = _run(_OFF_TANGENT, ("off_tangent",), inputs, (tol, bases), bases)
+    return _result(OffTangentResult, parts["off_tangent"], inputs)
 
 
 def decompose_tangent(points, normals, twist, *, tol=DEGENERACY_TOL, bases=True) -> TangentResult:
@@ -325,320 +316,239 @@ def decompose_tangent(points, normals, twist, *, tol=DEGENERACY_TOL, bases=True)
     >>> np.round(r.alpha, 4).tolist(), np.round(r.beta, 4).tolist(), bool(r.in_tangent_planes)
     ([0.5774, 0.5774, 0.5774], [0.0, 0.0, 0.0], True)
     """
-    inputs = {
-        "points": _checked(points, (3, 3), "points"),
-        "normals": _checked(normals, (3, 3), "normals"),
-        "twist": _checked(twist, (6,), "twist"),
-    }
-    out = _chunked(_tangent_rows, inputs, _without_bases(_TANGENT_OUT, bases), tol)
-    return TangentResult(**{**dict.fromkeys(_BASES & _TANGENT_OUT.keys()), **out})
+    inputs = {"points": check_points(points), "normals": check_normals(normals), "twist": check_twist(twist)}
+    parts, inputs = _run(_TANGENT, ("tangent",), inputs, (tol, bases), bases)
+    return _result(TangentResult, parts["tangent"], inputs)
 
 
-# --- the row kernels ----------------------------------------------------------
-# Arrays here are components-first: a point set is (contact, xyz, row), a
-# vector (xyz, row), a per-contact number (contact, row).
+class Resolution(NamedTuple):
+    """Both methods' results and the contact velocities of the same rows."""
 
-_OFF_TANGENT_OUT = {
-    "sigma": (3, 6),
-    "psi": (3, 6),
-    "sigma_psi": (3,),
-    "x": (3,),
-    "y": (3,),
-    "status": (),
-    "culprit": (),
-    "conditioning": (),
+    off_tangent: OffTangentResult | None  # None without a wrist
+    tangent: TangentResult
+    velocity: np.ndarray  # (..., 3, 3), T(p_i)
+
+
+def resolve(points, normals, wrist, twist, *, tol=DEGENERACY_TOL, bases=True) -> Resolution:
+    """Both decompositions and the contact velocities in one call.
+
+    The same numbers, bit for bit, as :func:`decompose_off_tangent`,
+    :func:`decompose_tangent` and :func:`contact_velocities` called
+    separately, for less: the contact triangle and the contact velocities are
+    computed once.  Arguments as for those; ``wrist`` may be None (then
+    ``off_tangent`` is None).  For many twists on one grasp see
+    :func:`~grasptwist.engine.prepared.prepare`.
+
+    Returns
+    -------
+    Resolution
+        ``(off_tangent, tangent, velocity)``.
+
+    Examples
+    --------
+    Paper Example 2 (no wrist given):
+
+    >>> r = resolve([[0, 2, 2], [2, 0, 2], [2, 2, 0]], np.eye(3), None, [0.57735, 0.57735, 0.57735, 0, 0, 0])
+    >>> r.off_tangent is None, np.round(r.tangent.alpha, 4).tolist(), r.velocity.shape
+    (True, [0.5774, 0.5774, 0.5774], (3, 3))
+    """
+    inputs = {"points": check_points(points), "normals": check_normals(normals)}
+    if wrist is not None:
+        inputs["wrist"] = check_wrist(wrist)
+    inputs["twist"] = check_twist(twist)
+    if wrist is None:
+        parts, inputs = _run(_RESOLVE_NO_WRIST, ("velocity", "tangent"), inputs, (tol, bases), bases)
+    else:
+        parts, inputs = _run(kernels.resolve, ("velocity", "off_tangent", "tangent"), inputs, (tol, bases), bases)
+    return Resolution(
+        None if wrist is None else _result(OffTangentResult, parts["off_tangent"], inputs),
+        _result(TangentResult, parts["tangent"], inputs),
+        parts["velocity"]["velocity"],
+    )
+
+
+# --- running the kernels ------------------------------------------------------
+# A kernel here maps its inputs (components), the scalar kind and ``args`` to
+# ``{part: (values, checks)}``; each part becomes one result.
+
+_OFF_TANGENT = lambda p, c, t, ops, *a: {"off_tangent": kernels.off_tangent(p, c, t, ops, *a)}  # noqa: E731
+_TANGENT = lambda p, n, t, ops, *a: {"tangent": kernels.tangent(p, n, t, ops, *a)}  # noqa: E731
+_VELOCITIES = lambda p, t, ops: {"velocity": kernels.velocities(p, t, ops)}  # noqa: E731
+_RESOLVE_NO_WRIST = lambda p, n, t, ops, *a: kernels.resolve(p, n, None, t, ops, *a)  # noqa: E731
+
+#: Each part's outputs and their trailing shapes.
+_OUTPUTS = {
+    "off_tangent": {
+        "sigma": (3, 6),
+        "psi": (3, 6),
+        "sigma_psi": (3,),
+        "x": (3,),
+        "y": (3,),
+        "status": (),
+        "culprit": (),
+        "conditioning": (),
+    },
+    "tangent": {
+        "theta": (3, 6),
+        "sigma": (3, 6),
+        "theta_sigma": (3,),
+        "alpha": (3,),
+        "beta": (3,),
+        "normal_velocity": (3,),
+        "in_tangent_planes": (),
+        "status": (),
+        "culprit": (),
+        "conditioning": (),
+    },
+    "velocity": {"velocity": (3, 3)},
 }
-_TANGENT_OUT = {
-    "theta": (3, 6),
-    "sigma": (3, 6),
-    "theta_sigma": (3,),
-    "alpha": (3,),
-    "beta": (3,),
-    "normal_velocity": (3,),
-    "in_tangent_planes": (),
-    "status": (),
-    "culprit": (),
-    "conditioning": (),
+_LEAN_OUTPUTS = {
+    part: {k: v for k, v in spec.items() if k not in ("sigma", "psi", "theta")} for part, spec in _OUTPUTS.items()
 }
 _DTYPES = {"status": np.int8, "culprit": np.int8, "in_tangent_planes": bool}
-_BASES = {"sigma", "psi", "theta"}
+# How _row_by_row reads each output: (name, dtype, where in (values, status, culprit)).
+_PLANS = {
+    bases: {
+        part: [(k, _DTYPES.get(k, float), 1 if k == "status" else 2 if k == "culprit" else 0) for k in spec]
+        for part, spec in outputs.items()
+    }
+    for bases, outputs in ((True, _OUTPUTS), (False, _LEAN_OUTPUTS))
+}
 
 
-def _without_bases(spec, bases):
-    return spec if bases else {k: v for k, v in spec.items() if k not in _BASES}
+def _result(cls, out, inputs):
+    """A result of type ``cls`` from a part's outputs (bases None if left out)."""
+    return cls._of({**_NO_BASES[cls], **out, "points": inputs["points"], "twist": inputs["twist"]})
 
 
-_TRAILING = {"points": (3, 3), "normals": (3, 3), "wrist": (3,), "twist": (6,)}
+_NO_BASES = {OffTangentResult: {"sigma": None, "psi": None}, TangentResult: {"theta": None, "sigma": None}}
 
 
-class _Triangle(NamedTuple):
-    """The contacts' triangle for a chunk of rows."""
+def _run(kernel, names, inputs, args, bases):
+    """``kernel`` (whose parts are ``names``) over the broadcast batch of ``inputs``.
 
-    side: np.ndarray  # (3, 3, n) U_i = p_k - p_j
-    side_len: np.ndarray  # (3, n)
-    unit_side: np.ndarray  # (3, 3, n) direction of Sigma_i
-    size: np.ndarray  # (n,) longest side
-    m: np.ndarray  # (3, n) (p_2 - p_1) x (p_3 - p_1)
-    m_len: np.ndarray  # (n,)
-    checks: list  # the failure checks of the triangle, in order
-
-
-def _triangle(p) -> _Triangle:
-    """Sides, area vector and the degeneracy checks of the contact triangle.
-
-    Contacts coincide when the shortest side is ``<= tol`` times the longest;
-    they are collinear when twice the area is ``<= tol`` times the longest
-    side squared (a height ``<= tol`` times the size).
+    Returns ``{part: {output: array with the batch shape in front}}`` and the
+    inputs broadcast to the batch shape.
     """
-    side = p[_K] - p[_J]
-    side_len = np.sqrt(_dot(side, side))
-    size = _max3(side_len)
-    unit_side = side / side_len[:, None]
-    # m from unit sides: no fourth powers of lengths, so no under- or overflow
-    m = _cross(unit_side[1], unit_side[2])
-    area_scale = side_len[1] * side_len[2]
-    m_len = np.sqrt(_dot(m, m)) * area_scale
-    m *= area_scale
-    finite = np.isfinite(p).all(axis=(0, 1))
-    checks = [
-        (lambda tol: ~finite, Status.NONFINITE_INPUT, None),
-        (lambda tol: ~np.isfinite(size * size), Status.OVERFLOW, None),
-        # the pair that coincides is opposite the shortest side
-        (
-            lambda tol: ~(_min3(side_len) > tol * size),
-            Status.COINCIDENT_CONTACTS,
-            lambda rows: np.argmin(side_len[:, rows], 0),
-        ),
-        # the contact between the other two is opposite the longest side
-        (
-            lambda tol: ~(m_len > tol * size * size),
-            Status.COLLINEAR_CONTACTS,
-            lambda rows: np.argmax(side_len[:, rows], 0),
-        ),
-    ]
-    return _Triangle(side, side_len, unit_side, size, m, m_len, checks)
-
-
-def _velocity_rows(ins, out, tol):
-    out["velocity"][...] = _velocity(ins["twist"], ins["points"])
-
-
-def _off_tangent_rows(ins, out, tol):
-    """Proposition 1 on one chunk (see the module docstring for the formulas)."""
-    p, c, t = ins["points"], ins["wrist"], ins["twist"]
-    tri = _triangle(p)
-    e = p - c  # E_i, (3, 3, n)
-    e_len = np.sqrt(_dot(e, e))
-    d = _dot(tri.m, e[0])  # D, the same for every i
-    le = tri.side_len * e_len
-    conditioning = np.abs(d) / (_max3(le) * tri.size)
-    v = _velocity(t, p)
-    x = tri.side_len * _dot(e, v) / d
-    y = e_len * _dot(tri.side, v[_J]) / d
-    e /= e_len[:, None]
-    if "sigma" in out:
-        _put_lines(out["sigma"], p[_J], tri.unit_side)
-        _put_lines(out["psi"], p, e)
-    out["sigma_psi"][...] = d / le
-    out["conditioning"][...] = conditioning
-    checks = tri.checks + [
-        (lambda tol: ~np.isfinite(c).all(axis=0), Status.NONFINITE_INPUT, None),
-        (lambda tol: ~(conditioning > tol), Status.WRIST_COPLANAR, None),
-    ]
-    _settle(out, checks, t, tol, x=x, y=y)
-
-
-def _tangent_rows(ins, out, tol):
-    """Proposition 2 and the off-plane rest on one chunk (formulas in the module docstring)."""
-    p, t = ins["points"], ins["twist"]
-    tri = _triangle(p)
-    n_len = np.sqrt(_dot(ins["normals"], ins["normals"]))
-    n = ins["normals"] / n_len[:, None]
-    # eqs. 21-22 with p_i p_j along U_k and p_i p_k along -U_j; unit sides keep
-    # |w| free of the grasp's size (no underflow) and |a|, |b| sines
-    a = _cross(tri.unit_side[_K], n[_J])
-    b = _cross(n[_K], tri.unit_side[_J])
-    w = _cross(a, b)
-    w_len = np.sqrt(_dot(w, w))
-    w /= w_len[:, None]
-    wm = _dot(w, tri.m)
-    mn = _dot(tri.m, n)
-    plane_sine = np.abs(mn) / tri.m_len
-    theta_sigma = np.abs(wm) / (tri.side_len * tri.size)
-    conditioning = np.minimum(_min3(theta_sigma), _min3(plane_sine))
-    v = _velocity(t, p)
-    nv = _dot(v, n)
-    alpha = _dot(tri.side, v[_J]) / wm
-    beta = tri.side_len * nv / mn
-    if "theta" in out:
-        _put_lines(out["theta"], p, w)
-        _put_lines(out["sigma"], p[_J], tri.unit_side)
-    out["theta_sigma"][...] = wm / tri.side_len
-    out["normal_velocity"][...] = nv
-    out["conditioning"][...] = conditioning
-    # Round-off in v + omega x p scales with |v| + |omega||p|, not with the result.
-    reach = np.sqrt(_dot(t[3:], t[3:])) + np.sqrt(_dot(t[:3], t[:3])) * np.sqrt(_dot(p, p))
-    out["in_tangent_planes"][...] = _max3(np.abs(nv)) <= IN_PLANE_TOL * _max3(reach)
-
-    def uniqueness(rows):
-        """Sines that vanish when eq. 22's two constraints do not fix one axis."""
-        a_len, b_len = np.sqrt(_dot(a[..., rows], a[..., rows])), np.sqrt(_dot(b[..., rows], b[..., rows]))
-        return np.minimum(np.minimum(a_len, b_len), w_len[:, rows] / (a_len * b_len))
-
-    degenerate = ~(conditioning > tol)
-    checks = tri.checks + [
-        (lambda tol: ~np.isfinite(ins["normals"]).all(axis=(0, 1)), Status.NONFINITE_INPUT, None),
-        (lambda tol: ~(n_len > 0).all(axis=0), Status.ZERO_NORMAL, lambda rows: np.argmin(n_len[:, rows], 0)),
-        (
-            _subset(degenerate, lambda rows: _rank_deficient(p[..., rows], n[..., rows], tri.size[rows], tol)),
-            Status.NORMALS_RANK_DEFICIENT,
-            None,
-        ),
-        (
-            _subset(degenerate, lambda rows: ~(uniqueness(rows) > tol).all(axis=0)),
-            Status.THETA_NOT_UNIQUE,
-            lambda rows: np.argmin(uniqueness(rows), 0),
-        ),
-        (
-            _subset(degenerate, lambda rows: ~(theta_sigma[:, rows] > tol).all(axis=0)),
-            Status.THETA_SIGMA_ZERO,
-            lambda rows: np.argmin(theta_sigma[:, rows], 0),
-        ),
-        (lambda tol: degenerate, Status.NORMAL_IN_CONTACT_PLANE, lambda rows: np.argmin(plane_sine[:, rows], 0)),
-    ]
-    _settle(out, checks, t, tol, alpha=alpha, beta=beta, normal_velocity=nv)
-    out["in_tangent_planes"][out["status"] != Status.OK] = False  # unknown where the method failed
-
-
-def _subset(candidates, test):
-    """A check that runs ``test`` only on the candidate rows (it costs more than the rest)."""
-
-    def mask(tol):
-        hit = np.zeros(candidates.shape, dtype=bool)
-        rows = np.flatnonzero(candidates)
-        if rows.size:
-            hit[rows] = test(rows)
-        return hit
-
-    return mask
-
-
-def _rank_deficient(p, n, size, tol):
-    """Whether the normal lines ``nu_i = (n_i; p_i x n_i)`` have rank < 3.
-
-    Gram-Schmidt on the three 6-vectors, taken about ``p_1`` in units of the
-    size: the product of the orthogonalised lengths over the original ones is
-    in ``[0, 1]`` and accurate to round-off even near 0.
-    """
-    nu = np.concatenate((n, _cross((p - p[0]) / size, n)), axis=1)  # (contact, 6, rows)
-    r1, r2, r3 = nu
-    u1 = r1 / np.sqrt((r1 * r1).sum(0))
-    r2o = r2 - (r2 * u1).sum(0) * u1
-    u2 = r2o / np.sqrt((r2o * r2o).sum(0))
-    r3o = r3 - (r3 * u1).sum(0) * u1 - (r3 * u2).sum(0) * u2
-    volume = np.sqrt((r2o * r2o).sum(0) * (r3o * r3o).sum(0) / ((r2 * r2).sum(0) * (r3 * r3).sum(0)))
-    return ~(volume > tol)
-
-
-def _settle(out, checks, twist, tol, **amplitudes):
-    """Status and culprit per row from the checks in order (first failure wins),
-    then a non-finite twist, then overflow; amplitudes of failed rows become NaN."""
-    n = twist.shape[-1]
-    status = out["status"]
-    culprit = out["culprit"]
-    status[...] = Status.OK
-    culprit[...] = -1
-    checks = checks + [(lambda tol: ~np.isfinite(twist).all(axis=0), Status.NONFINITE_INPUT, None)]
-    for mask, code, blame in checks:
-        rows = np.flatnonzero(mask(tol) & (status == Status.OK))
-        if rows.size:
-            status[rows] = code
-            if blame is not None:
-                culprit[rows] = blame(rows)
-    finite = np.ones(n, dtype=bool)
-    for a in amplitudes.values():
-        finite &= np.isfinite(a).all(axis=0)
-    status[(status == Status.OK) & ~finite] = Status.OVERFLOW
-    failed = status != Status.OK
-    for name, a in amplitudes.items():
-        a[:, failed] = np.nan
-        out[name][...] = a
-
-
-def _chunked(rows_kernel, inputs, spec, tol):
-    """Run ``rows_kernel`` over the broadcast batch in cache-sized chunks.
-
-    Inputs are flattened to ``(N, ...)``; each chunk is handed to the kernel
-    components-first and the kernel writes into components-first outputs,
-    which come back as ``(batch..., ...)`` views.  The broadcast inputs
-    ``points`` and ``twist`` are returned too.
-    """
-    shape = np.broadcast_shapes(*(a.shape[: a.ndim - len(_TRAILING[k])] for k, a in inputs.items()))
+    shape = ()
+    for k, a in inputs.items():
+        if a.ndim != len(SHAPES[k]):  # a batch axis: broadcast (else one grasp, nothing to do)
+            shape = np.broadcast_shapes(*(a.shape[: a.ndim - len(SHAPES[k])] for k, a in inputs.items()))
+            inputs = {k: np.broadcast_to(a, shape + SHAPES[k]) for k, a in inputs.items()}
+            break
     n = prod(shape)
-    full = {k: np.broadcast_to(a, shape + _TRAILING[k]) for k, a in inputs.items()}
-    flat = {k: a.reshape((n,) + _TRAILING[k]) for k, a in full.items()}
-    out = {k: np.empty(comp + (n,), dtype=_DTYPES.get(k, float)) for k, comp in spec.items()}
+    if n <= SMALL_BATCH:
+        return _row_by_row(kernel, inputs, args, {name: _PLANS[bool(bases)][name] for name in names}, shape, n), inputs
+    return _chunked(
+        kernel, inputs, args, {name: (_OUTPUTS if bases else _LEAN_OUTPUTS)[name] for name in names}, shape, n
+    ), inputs
+
+
+def _one(kernel, row, args):
+    """``kernel`` on one row of nested lists: ``{part: (values, status, culprit)}``."""
+    try:
+        parts = kernel(*row, kernels.FLOATS, *args)
+        return {k: (v, *kernels.settle_one(v, c, kernels.AMPLITUDES.get(k))) for k, (v, c) in parts.items()}
+    except ZeroDivisionError:  # an exactly degenerate grasp: IEEE division on numpy scalars instead
+        with np.errstate(all="ignore"):
+            parts = kernel(*(np.array(a, dtype=float) for a in row), kernels.ARRAYS, *args)
+            return {k: (v, *kernels.settle_one(v, c, kernels.AMPLITUDES.get(k))) for k, (v, c) in parts.items()}
+
+
+def _row_by_row(kernel, inputs, args, plans, shape, n):
+    """The small-batch path: each row in plain floats, no chunks and no layout change."""
+    if shape == ():
+        rows = [_one(kernel, [a.tolist() for a in inputs.values()], args)]
+    else:
+        columns = [a.reshape((n,) + SHAPES[k]).tolist() for k, a in inputs.items()]
+        rows = [_one(kernel, row, args) for row in zip(*columns)]
+    if shape == ():
+        return {
+            part: {k: np.array(rows[0][part][at][k] if at == 0 else rows[0][part][at], dtype) for k, dtype, at in plan}
+            for part, plan in plans.items()
+        }
+    return {
+        part: {
+            k: np.array([row[part][at][k] if at == 0 else row[part][at] for row in rows], dtype).reshape(
+                shape + _OUTPUTS[part][k]
+            )
+            for k, dtype, at in plan
+        }
+        for part, plan in plans.items()
+    }
+
+
+def _chunked(kernel, inputs, args, outputs, shape, n):
+    """The batched path: ``kernel`` over cache-sized chunks of rows, components-first.
+
+    Each chunk's inputs are copied components-first (each component one
+    contiguous array over the chunk's rows) and the kernel's values are
+    written into components-first outputs, which come back as
+    ``(batch..., ...)`` views.
+    """
+    flat = [a.reshape((n,) + SHAPES[k]) for k, a in inputs.items()]
+    out = {
+        name: {k: np.empty(comp + (n,), dtype=_DTYPES.get(k, float)) for k, comp in spec.items()}
+        for name, spec in outputs.items()
+    }
     with np.errstate(all="ignore"):
         for start in range(0, n, CHUNK):
             part = slice(start, min(start + CHUNK, n))
-            rows_kernel(
-                {k: np.ascontiguousarray(np.moveaxis(a[part], 0, -1)) for k, a in flat.items()},
-                {k: o[..., part] for k, o in out.items()},
-                tol,
+            parts = kernel(
+                *(_components(np.ascontiguousarray(np.moveaxis(a[part], 0, -1))) for a in flat), kernels.ARRAYS, *args
             )
-    result = {k: np.moveaxis(o, -1, 0).reshape(shape + spec[k]) for k, o in out.items()}
-    result.update(points=full["points"], twist=full["twist"])
-    return result
+            for name, (values, checks) in parts.items():
+                chunk = {k: o[..., part] for k, o in out[name].items()}
+                failed = _settle_rows(values, checks, kernels.AMPLITUDES[name], chunk) if "status" in chunk else None
+                for k, o in chunk.items():
+                    if k in values:
+                        _put(o, values[k])
+                        if failed is not None and k in kernels.FAILED:
+                            o[..., failed] = kernels.FAILED[k]
+    return {
+        name: {k: np.moveaxis(o, -1, 0).reshape(shape + outputs[name][k]) for k, o in arrays.items()}
+        for name, arrays in out.items()
+    }
 
 
-# --- components-first vector algebra ------------------------------------------
+def _components(a):
+    """A components-first array ``(..., rows)`` as nested tuples of ``(rows,)`` arrays."""
+    return tuple(_components(c) for c in a) if a.ndim > 1 else a
 
 
-def _dot(a, b):
-    """Dot product over axis -2 of ``(..., 3, n)`` arrays."""
-    return a[..., 0, :] * b[..., 0, :] + a[..., 1, :] * b[..., 1, :] + a[..., 2, :] * b[..., 2, :]
+def _put(out, value):
+    """Write a kernel value (nested tuples of row arrays) into ``out (..., rows)``."""
+    if type(value) is tuple:
+        for o, v in zip(out, value):
+            _put(o, v)
+    else:
+        out[...] = value
 
 
-def _cross(a, b, out=None):
-    """Cross product over axis -2 of ``(..., 3, n)`` arrays (into ``out`` if given)."""
-    if out is None:
-        out = np.empty(np.broadcast_shapes(a.shape, b.shape))
-    a0, a1, a2 = a[..., 0, :], a[..., 1, :], a[..., 2, :]
-    b0, b1, b2 = b[..., 0, :], b[..., 1, :], b[..., 2, :]
-    np.multiply(a1, b2, out=out[..., 0, :])
-    out[..., 0, :] -= a2 * b1
-    np.multiply(a2, b0, out=out[..., 1, :])
-    out[..., 1, :] -= a0 * b2
-    np.multiply(a0, b1, out=out[..., 2, :])
-    out[..., 2, :] -= a1 * b0
-    return out
-
-
-def _velocity(t, p):
-    """``T(p_i) = v + omega x p_i`` for ``t (6, n)``, ``p (3, 3, n)``."""
-    v = _cross(t[:3], p)
-    v += t[3:]
-    return v
-
-
-def _put_lines(out, p, d):
-    """Write unit lines ``(d; p x d)`` into ``out (3, 6, n)``."""
-    out[:, :3] = d
-    _cross(p, d, out=out[:, 3:])
-
-
-def _max3(a):
-    return np.maximum(np.maximum(a[0], a[1]), a[2])
-
-
-def _min3(a):
-    return np.minimum(np.minimum(a[0], a[1]), a[2])
-
-
-def _checked(a, trailing, name):
-    """``a`` as a float array whose shape ends in ``trailing`` (checked once, here)."""
-    a = np.asarray(a, dtype=float)
-    if a.ndim < len(trailing) or a.shape[a.ndim - len(trailing) :] != trailing:
-        want = "(..., " + ", ".join(map(str, trailing)) + ")"
-        raise ValueError(f"{name} must have shape {want}, got {a.shape}")
-    return a
+def _settle_rows(values, checks, amplitudes, out):
+    """:func:`~grasptwist.engine.kernels.settle_one` for a chunk: status and culprit
+    per row (the first failed check wins, then overflow of the amplitudes) into
+    ``out``; returns the failed rows as a mask."""
+    status, culprit = out["status"], out["culprit"]
+    status[...] = Status.OK
+    culprit[...] = -1
+    for code, failed, blame, gate in checks:
+        todo = status == Status.OK
+        if gate is not None:
+            todo &= gate
+            rows = np.flatnonzero(todo)
+            if not rows.size:
+                continue
+            hit = rows[failed(None if rows.size == todo.size else rows)]
+        else:
+            hit = np.flatnonzero(failed & todo)
+        if hit.size:
+            status[hit] = code
+            if blame is not None:
+                culprit[hit] = blame(hit)
+    finite = status == Status.OK
+    for k in amplitudes:
+        for c in values[k]:
+            finite &= np.isfinite(c)
+    status[(status == Status.OK) & ~finite] = Status.OVERFLOW
+    return status != Status.OK

@@ -665,22 +665,10 @@ def _fast_contacts(get, keep):
             raise _Bail
         names.append(name)
         points.append(point)
-        normals.append(_unit_normal(*normal))
+        normals.append(screws.direction3(*normal))
     if len(names) != 3:
         raise _Bail
     return tuple(names), points, normals
-
-
-def _unit_normal(x, y, z):
-    """``_contacts``'s normalisation of a non-zero finite vector in floats:
-    the same operations as ``screws.unit(a / np.abs(a).max())``, in the same
-    order, so the same IEEE results."""
-    big = max(abs(x), abs(y), abs(z))
-    x /= big
-    y /= big
-    z /= big
-    length = math.sqrt(x * x + y * y + z * z)
-    return [x / length, y / length, z / length]
 
 
 def _fast_twists(get, keep):
@@ -717,10 +705,8 @@ def _fast_twists(get, keep):
             p0, p1, p2 = fields.get("at", _ZERO)
         else:
             raise _Bail
-        # screws.twist_at: velocity - cross(omega, at), term by term.
-        v0 = u0 - (w1 * p2 - w2 * p1)
-        v1 = u1 - (w2 * p0 - w0 * p2)
-        v2 = u2 - (w0 * p1 - w1 * p0)
+        # the same operations as _twists's screws.twist_at, so the same bits
+        v0, v1, v2 = screws.twist_at3((w0, w1, w2), (u0, u1, u2), (p0, p1, p2))
         if not (-_INF < v0 < _INF and -_INF < v1 < _INF and -_INF < v2 < _INF):
             raise _Bail
         names.append(name)
@@ -861,11 +847,7 @@ def _contacts(node):
         normal = _vector(fields["normal"], 3, path + ".normal")
         if not any(normal):
             raise _Reject("zero-normal", path + ".normal", "a zero vector has no direction", **_at(fields["normal"]))
-        normals.append(normal)
-    normals = np.array(normals)
-    # Scale by the largest component first: screws.unit squares the
-    # components, which would overflow for 1e200 or underflow for 1e-200.
-    normals = screws.unit(normals / np.abs(normals).max(axis=1, keepdims=True))
+        normals.append(screws.direction3(*normal))  # of any finite size: no over- or underflow
     return tuple(names), _readonly(np.array(points)), _readonly(normals)
 
 
