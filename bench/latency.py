@@ -1,8 +1,8 @@
 """Latency of one grasp per call, against a per-grasp ``numpy.linalg.solve`` baseline.
 
 Run: ``python bench/latency.py [--calls 3000]``.  Everything runs in this one
-process, the candidates interleaved call by call over a cycle of random
-grasps; each figure is the median of ``--calls`` calls.  The baseline is
+process, the candidates taking turns in blocks of calls over a cycle of
+random grasps; each figure is the median of ``--calls`` calls.  The baseline is
 ``_data.solve_baseline`` on one grasp: the basis screws by the paper's
 formulas and both 6x6 systems solved with ``numpy.linalg.solve``.
 
@@ -24,16 +24,22 @@ import grasptwist as gt
 from _data import grasp_arrays, solve_baseline
 
 
-def medians(candidates, calls, cycle):
-    """Median seconds per call of each candidate, called in turn on ``cycle`` arguments."""
+def medians(candidates, calls, cycle, block=25):
+    """Median seconds per call of each candidate on ``cycle``'s arguments in turn.
+
+    The candidates take turns in blocks of ``block`` calls: long enough for a
+    candidate to run warm, as in a loop, short enough that a change in the
+    machine's load hits every candidate alike.
+    """
     times = {name: [] for name in candidates}
     clock = time.perf_counter
-    for k in range(calls):
-        args = cycle[k % len(cycle)]
+    for start in range(0, calls, block):
         for name, fn in candidates.items():
-            t0 = clock()
-            fn(*args)
-            times[name].append(clock() - t0)
+            for k in range(start, min(start + block, calls)):
+                args = cycle[k % len(cycle)]
+                t0 = clock()
+                fn(*args)
+                times[name].append(clock() - t0)
     return {name: statistics.median(t) for name, t in times.items()}
 
 

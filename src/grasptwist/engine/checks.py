@@ -33,7 +33,10 @@ def _check(a, name):
         raise ValueError(f"{name} must hold real numbers, got {_WHAT.get(kind, f'dtype {a.dtype}')}")
     if a.shape[-len(trailing) :] != trailing:  # also when a has fewer axes
         raise ValueError(f"{name} must have shape {_want(trailing)}, got {a.shape}")
-    return a if a.dtype == np.float64 else a.astype(np.float64)
+    return a if a.dtype is _FLOAT else a.astype(_FLOAT)
+
+
+_FLOAT = np.dtype(np.float64)
 
 
 def _want(trailing):

@@ -85,7 +85,7 @@ def contact_velocities(points, twist):
     [[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 0.0]]
     """
     inputs = {"points": check_points(points), "twist": check_twist(twist)}
-    return _run(_VELOCITIES, ("velocity",), inputs, (), bases=True)[0]["velocity"]["velocity"]
+    return _run(_velocities, ("velocity",), inputs, (), bases=True)[0]["velocity"]["velocity"]
 
 
 def _index(a, i):
@@ -280,7 +280,7 @@ def decompose_off_tangent(points, wrist, twist, *, tol=DEGENERACY_TOL, bases=Tru
     ([-0.4714, -0.4714, -0.4714], True)
     """
     inputs = {"points": check_points(points), "wrist": check_wrist(wrist), "twist": check_twist(twist)}
-    parts, inputs = _run(_OFF_TANGENT, ("off_tangent",), inputs, (tol, bases), bases)
+    parts, inputs = _run(_off_tangent, ("off_tangent",), inputs, (tol, bases), bases)
     return _result(OffTangentResult, parts["off_tangent"], inputs)
 
 
@@ -317,16 +317,25 @@ def decompose_tangent(points, normals, twist, *, tol=DEGENERACY_TOL, bases=True)
     ([0.5774, 0.5774, 0.5774], [0.0, 0.0, 0.0], True)
     """
     inputs = {"points": check_points(points), "normals": check_normals(normals), "twist": check_twist(twist)}
-    parts, inputs = _run(_TANGENT, ("tangent",), inputs, (tol, bases), bases)
+    parts, inputs = _run(_tangent, ("tangent",), inputs, (tol, bases), bases)
     return _result(TangentResult, parts["tangent"], inputs)
 
 
 class Resolution(NamedTuple):
-    """Both methods' results and the contact velocities of the same rows."""
+    """Both methods' results and the contact velocities of the same rows.
 
-    off_tangent: OffTangentResult | None  # None without a wrist
+    Attributes
+    ----------
+    off_tangent : OffTangentResult or None
+        None when no wrist was given.
+    tangent : TangentResult
+    velocity : (..., 3, 3)
+        ``T(p_i)``, as :func:`contact_velocities`.
+    """
+
+    off_tangent: OffTangentResult | None
     tangent: TangentResult
-    velocity: np.ndarray  # (..., 3, 3), T(p_i)
+    velocity: np.ndarray
 
 
 def resolve(points, normals, wrist, twist, *, tol=DEGENERACY_TOL, bases=True) -> Resolution:
@@ -352,13 +361,12 @@ def resolve(points, normals, wrist, twist, *, tol=DEGENERACY_TOL, bases=True) ->
     >>> r.off_tangent is None, np.round(r.tangent.alpha, 4).tolist(), r.velocity.shape
     (True, [0.5774, 0.5774, 0.5774], (3, 3))
     """
-    inputs = {"points": check_points(points), "normals": check_normals(normals)}
-    if wrist is not None:
-        inputs["wrist"] = check_wrist(wrist)
-    inputs["twist"] = check_twist(twist)
     if wrist is None:
-        parts, inputs = _run(_RESOLVE_NO_WRIST, ("velocity", "tangent"), inputs, (tol, bases), bases)
+        inputs = {"points": check_points(points), "normals": check_normals(normals), "twist": check_twist(twist)}
+        parts, inputs = _run(_resolve_without_wrist, ("velocity", "tangent"), inputs, (tol, bases), bases)
     else:
+        inputs = {"points": check_points(points), "normals": check_normals(normals), "wrist": check_wrist(wrist)}
+        inputs["twist"] = check_twist(twist)
         parts, inputs = _run(kernels.resolve, ("velocity", "off_tangent", "tangent"), inputs, (tol, bases), bases)
     return Resolution(
         None if wrist is None else _result(OffTangentResult, parts["off_tangent"], inputs),
@@ -371,10 +379,22 @@ def resolve(points, normals, wrist, twist, *, tol=DEGENERACY_TOL, bases=True) ->
 # A kernel here maps its inputs (components), the scalar kind and ``args`` to
 # ``{part: (values, checks)}``; each part becomes one result.
 
-_OFF_TANGENT = lambda p, c, t, ops, *a: {"off_tangent": kernels.off_tangent(p, c, t, ops, *a)}  # noqa: E731
-_TANGENT = lambda p, n, t, ops, *a: {"tangent": kernels.tangent(p, n, t, ops, *a)}  # noqa: E731
-_VELOCITIES = lambda p, t, ops: {"velocity": kernels.velocities(p, t, ops)}  # noqa: E731
-_RESOLVE_NO_WRIST = lambda p, n, t, ops, *a: kernels.resolve(p, n, None, t, ops, *a)  # noqa: E731
+
+def _off_tangent(points, wrist, twist, ops, *args):
+    return {"off_tangent": kernels.off_tangent(points, wrist, twist, ops, *args)}
+
+
+def _tangent(points, normals, twist, ops, *args):
+    return {"tangent": kernels.tangent(points, normals, twist, ops, *args)}
+
+
+def _velocities(points, twist, ops):
+    return {"velocity": kernels.velocities(points, twist, ops)}
+
+
+def _resolve_without_wrist(points, normals, twist, ops, *args):
+    return kernels.resolve(points, normals, None, twist, ops, *args)
+
 
 #: Each part's outputs and their trailing shapes.
 _OUTPUTS = {

@@ -71,7 +71,6 @@ __all__ = [
     "velocities",
     "resolve",
     "settle_one",
-    "at",
     "AMPLITUDES",
     "FAILED",
 ]
@@ -85,6 +84,7 @@ class Ops(NamedTuple):
 
     sqrt: Callable
     isfinite: Callable
+    nonfinite: Callable  # whether any of a sequence is NaN or infinite
     not_: Callable
     minimum: Callable  # of two
     max3: Callable  # of a triple
@@ -112,10 +112,23 @@ def _arg3(better):
     return arg
 
 
+def _nonfinite_floats(components):
+    s = sum(components)  # finite only if every term is; else look closer (it may just overflow)
+    return s - s != 0 and not all(map(math.isfinite, components))
+
+
+def _nonfinite_arrays(components):
+    finite = np.isfinite(components[0])
+    for c in components[1:]:
+        finite &= np.isfinite(c)
+    return ~finite
+
+
 #: Plain Python floats (one grasp).
 FLOATS = Ops(
     math.sqrt,
     math.isfinite,
+    _nonfinite_floats,
     operator.not_,
     _fmin,
     lambda a: _fmax(_fmax(a[0], a[1]), a[2]),
@@ -128,6 +141,7 @@ FLOATS = Ops(
 ARRAYS = Ops(
     np.sqrt,
     np.isfinite,
+    _nonfinite_arrays,
     np.logical_not,
     np.minimum,
     lambda a: np.maximum(np.maximum(a[0], a[1]), a[2]),
@@ -152,14 +166,6 @@ def at(x, rows):
     if type(x) is tuple:
         return tuple(at(a, rows) for a in x)
     return x[rows]
-
-
-def _nonfinite(ops, components):
-    """Whether some component is NaN or infinite."""
-    finite = ops.isfinite(components[0])
-    for c in components[1:]:
-        finite &= ops.isfinite(c)
-    return ops.not_(finite)
 
 
 def _all_above(a, tol):
@@ -205,7 +211,7 @@ def _triangle(p, tol, ops) -> _Triangle:
     m_len = sqrt(dot3(m, m)) * area_scale
     m = mul3(m, area_scale)
     checks = [
-        (Status.NONFINITE_INPUT, _nonfinite(ops, (*p[0], *p[1], *p[2])), None, None),
+        (Status.NONFINITE_INPUT, ops.nonfinite((*p[0], *p[1], *p[2])), None, None),
         (Status.OVERFLOW, ops.not_(ops.isfinite(size * size)), None, None),
         # the pair that coincides is opposite the shortest side
         (
@@ -230,7 +236,7 @@ def _shared(points, twist, ops, tol, bases):
     ``T(p_i)``, the lines ``Sigma_i`` (if ``bases``) and whether the twist is finite."""
     tri = _triangle(points, tol, ops)
     sigma = _sigma_lines(points, tri) if bases else None
-    return tri, _contact_velocities(twist, points), sigma, _nonfinite(ops, twist)
+    return tri, _contact_velocities(twist, points), sigma, ops.nonfinite(twist)
 
 
 def velocities(points, twist, ops):
@@ -276,7 +282,7 @@ def off_tangent(points, wrist, twist, ops, tol, bases=True, shared=None):
             _line(p[2], div3(e[2], e_len[2])),
         )
     checks = tri.checks + [
-        (Status.NONFINITE_INPUT, _nonfinite(ops, c), None, None),
+        (Status.NONFINITE_INPUT, ops.nonfinite(c), None, None),
         (Status.WRIST_COPLANAR, ops.not_(conditioning > tol), None, None),
         (Status.NONFINITE_INPUT, bad_twist, None, None),
     ]
@@ -345,7 +351,7 @@ def tangent(points, normals, twist, ops, tol, bases=True, shared=None):
 
     degenerate = ops.not_(conditioning > tol)
     checks = tri.checks + [
-        (Status.NONFINITE_INPUT, _nonfinite(ops, (*normals[0], *normals[1], *normals[2])), None, None),
+        (Status.NONFINITE_INPUT, ops.nonfinite((*normals[0], *normals[1], *normals[2])), None, None),
         (
             Status.ZERO_NORMAL,
             ops.not_((n_len[0] > 0) & (n_len[1] > 0) & (n_len[2] > 0)),
@@ -420,7 +426,7 @@ def settle_one(values, checks, amplitudes):
             break
     else:
         status, culprit = Status.OK, -1
-        if amplitudes and _nonfinite(FLOATS, sum((values[name] for name in amplitudes), ())):
+        if amplitudes and _nonfinite_floats(sum((values[name] for name in amplitudes), ())):
             status = Status.OVERFLOW
     if status != Status.OK:
         for name in values.keys() & FAILED.keys():
