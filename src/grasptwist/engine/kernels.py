@@ -60,7 +60,7 @@ from typing import Any, NamedTuple
 import numpy as np
 
 from .degeneracy import IN_PLANE_TOL, Status
-from .screws import add3, cross3, div3, dot3, mul3, sub3
+from .screws import J, K, add3, cross3, div3, dot3, mul3, sub3
 
 __all__ = [
     "Ops",
@@ -201,7 +201,7 @@ def _triangle(p, tol, ops) -> _Triangle:
     side squared (a height ``<= tol`` times the size).
     """
     sqrt = ops.sqrt
-    side = (sub3(p[2], p[1]), sub3(p[0], p[2]), sub3(p[1], p[0]))
+    side = (sub3(p[K[0]], p[J[0]]), sub3(p[K[1]], p[J[1]]), sub3(p[K[2]], p[J[2]]))  # U_i = p_k - p_j
     side_len = (sqrt(dot3(side[0], side[0])), sqrt(dot3(side[1], side[1])), sqrt(dot3(side[2], side[2])))
     size = ops.max3(side_len)
     unit_side = (div3(side[0], side_len[0]), div3(side[1], side_len[1]), div3(side[2], side_len[2]))
@@ -271,7 +271,11 @@ def off_tangent(points, wrist, twist, ops, tol, bases=True, shared=None):
     values = {
         "sigma_psi": (d / le[0], d / le[1], d / le[2]),
         "x": (ls[0] * dot3(e[0], v[0]) / d, ls[1] * dot3(e[1], v[1]) / d, ls[2] * dot3(e[2], v[2]) / d),
-        "y": (e_len[0] * dot3(u[0], v[1]) / d, e_len[1] * dot3(u[1], v[2]) / d, e_len[2] * dot3(u[2], v[0]) / d),
+        "y": (
+            e_len[0] * dot3(u[0], v[J[0]]) / d,
+            e_len[1] * dot3(u[1], v[J[1]]) / d,
+            e_len[2] * dot3(u[2], v[J[2]]) / d,
+        ),
         "conditioning": conditioning,
     }
     if bases:
@@ -292,7 +296,7 @@ def off_tangent(points, wrist, twist, ops, tol, bases=True, shared=None):
 def _sigma_lines(p, tri):
     """``Sigma_i``: the line through ``p_j`` along ``p_k - p_j``."""
     us = tri.unit_side
-    return (_line(p[1], us[0]), _line(p[2], us[1]), _line(p[0], us[2]))
+    return (_line(p[J[0]], us[0]), _line(p[J[1]], us[1]), _line(p[J[2]], us[2]))
 
 
 def tangent(points, normals, twist, ops, tol, bases=True, shared=None):
@@ -308,8 +312,8 @@ def tangent(points, normals, twist, ops, tol, bases=True, shared=None):
     us = tri.unit_side
     # eqs. 21-22 with p_i p_j along U_k and p_i p_k along -U_j; unit sides keep
     # |w| free of the grasp's size (no underflow) and |a|, |b| sines
-    a = (cross3(us[2], n[1]), cross3(us[0], n[2]), cross3(us[1], n[0]))
-    b = (cross3(n[2], us[1]), cross3(n[0], us[2]), cross3(n[1], us[0]))
+    a = (cross3(us[K[0]], n[J[0]]), cross3(us[K[1]], n[J[1]]), cross3(us[K[2]], n[J[2]]))
+    b = (cross3(n[K[0]], us[J[0]]), cross3(n[K[1]], us[J[1]]), cross3(n[K[2]], us[J[2]]))
     w = (cross3(a[0], b[0]), cross3(a[1], b[1]), cross3(a[2], b[2]))
     w_len = (sqrt(dot3(w[0], w[0])), sqrt(dot3(w[1], w[1])), sqrt(dot3(w[2], w[2])))
     w = (div3(w[0], w_len[0]), div3(w[1], w_len[1]), div3(w[2], w_len[2]))
@@ -330,7 +334,7 @@ def tangent(points, normals, twist, ops, tol, bases=True, shared=None):
     )
     values = {
         "theta_sigma": (wm[0] / ls[0], wm[1] / ls[1], wm[2] / ls[2]),
-        "alpha": (dot3(u[0], v[1]) / wm[0], dot3(u[1], v[2]) / wm[1], dot3(u[2], v[0]) / wm[2]),
+        "alpha": (dot3(u[0], v[J[0]]) / wm[0], dot3(u[1], v[J[1]]) / wm[1], dot3(u[2], v[J[2]]) / wm[2]),
         "beta": (ls[0] * nv[0] / mn[0], ls[1] * nv[1] / mn[1], ls[2] * nv[2] / mn[2]),
         "normal_velocity": nv,
         "in_tangent_planes": ops.max3((abs(nv[0]), abs(nv[1]), abs(nv[2]))) <= IN_PLANE_TOL * ops.max3(reach),
