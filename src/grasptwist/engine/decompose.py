@@ -477,16 +477,14 @@ def _one(kernel, row, args):
 
 def _row_by_row(kernel, inputs, args, plans, shape, n):
     """The small-batch path: each row in plain floats, no chunks and no layout change."""
-    if shape == ():
-        rows = [_one(kernel, [a.tolist() for a in inputs.values()], args)]
-    else:
-        columns = [a.reshape((n,) + SHAPES[k]).tolist() for k, a in inputs.items()]
-        rows = [_one(kernel, row, args) for row in zip(*columns)]
-    if shape == ():
+    if shape == ():  # one grasp: its values straight into arrays
+        settled = _one(kernel, [a.tolist() for a in inputs.values()], args)
         return {
-            part: {k: np.array(rows[0][part][at][k] if at == 0 else rows[0][part][at], dtype) for k, dtype, at in plan}
+            part: {k: np.array(settled[part][at][k] if at == 0 else settled[part][at], dtype) for k, dtype, at in plan}
             for part, plan in plans.items()
         }
+    columns = [a.reshape((n,) + SHAPES[k]).tolist() for k, a in inputs.items()]
+    rows = [_one(kernel, row, args) for row in zip(*columns)]
     return {
         part: {
             k: np.array([row[part][at][k] if at == 0 else row[part][at] for row in rows], dtype).reshape(
