@@ -141,16 +141,18 @@ def _check_alone(row, path, exit_code, stdout, stderr, seconds, limit):
     if row.code is None:
         assert errors == [] and lines[-1] == summary(row.records, 0)
         return
-    # a few lines: the errors (one per failed method at most), then the summary
-    assert 1 <= len(errors) <= 2 and len(lines) <= len(errors) + 1, stderr
-    assert lines[-1] == summary(row.records, row.records - row.ok)
-    prefix = f"{path}:{row.where}: error: " if row.where else f"{path}: "
-    assert all(line.startswith(prefix) for line in errors), (prefix, errors)
-    assert any(f"{row.code}: " in line and row.fragment in line for line in errors), errors
+    # the errors, one line each (a file's problems one per record, a grasp's one per failed method), then the summary
     failed = [r for r in records if not r["ok"]]
-    assert all(row.code in error_codes(r) for r in failed)
-    if row.where and "error" in failed[0]:  # the record locates the error as stderr does
-        assert f"{failed[0]['error']['line']}:{failed[0]['error']['column']}" == row.where
+    assert len(errors) == sum(len(error_codes(r)) for r in failed) and len(lines) == len(errors) + 1, stderr
+    assert lines[-1] == summary(row.records, row.records - row.ok)
+    assert all(line.startswith(f"{path}:") for line in errors), errors
+    prefix = f"{path}:{row.where}: error: {row.code}: " if row.where else f"{path}: "
+    assert any(line.startswith(prefix) and f"{row.code}: " in line and row.fragment in line for line in errors), errors
+    assert any(row.code in error_codes(r) for r in failed)
+    located = [(r["error"]["line"], r["error"]["column"]) for r in failed if "error" in r]
+    assert located == sorted(located, key=lambda at: (at[0] or 0, at[1] or 0))  # in file order
+    if row.where and located[0][0] is not None:  # the record locates the error as stderr does
+        assert tuple(map(int, row.where.split(":"))) in located
 
 
 @pytest.mark.parametrize(

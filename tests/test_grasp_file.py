@@ -149,8 +149,8 @@ def test_both_parsers_give_identical_results(path):
 def test_python_tags_never_run(template, loader, tmp_path):
     target = tmp_path / "pwned"
     text = template.format(target)
-    (error,) = read(text)
-    assert error.code == "forbidden-tag"
+    errors = read(text)
+    assert [e.code for e in errors if e.code != "missing-key"] == ["forbidden-tag"]
     assert not target.exists()
     # Control: the same text does run under an unsafe loader, so the test can fail.
     yaml.load(text, Loader=yaml.UnsafeLoader)
@@ -163,9 +163,11 @@ def test_billion_laughs_fails_at_the_first_alias(loader):
         f"{b}: &{b} [*{a},*{a},*{a},*{a},*{a},*{a},*{a},*{a},*{a}]\n" for a, b in zip("abcdefgh", "bcdefghi")
     )
     start = time.perf_counter()
-    error = only_error(text)
+    errors = read(text)
     assert time.perf_counter() - start < 1
-    assert (error.code, error.line, error.column) == ("alias", 2, 8)
+    aliases = [e for e in errors if e.code == "alias"]
+    assert len(aliases) == 8 * 9  # each refused where it stands, none expanded
+    assert (aliases[0].line, aliases[0].column, aliases[-1].line, aliases[-1].column) == (2, 8, 9, 32)
 
 
 @pytest.mark.parametrize(
@@ -205,9 +207,12 @@ def test_oversized_content_is_refused_before_parsing():
 
 
 @pytest.mark.skipif(not Path("/dev/zero").exists(), reason="needs /dev/zero")
-def test_an_endless_file_is_read_only_up_to_the_cap():
+def test_a_device_is_never_read():
+    # an endless stream: refused after opening, before any byte is read
     (error,) = read_grasps("/dev/zero", max_bytes=DEFAULT_MAX_BYTES)
-    assert (error.code, error.file) == ("too-large", "/dev/zero")
+    assert (error.code, error.file, error.message) == (
+        "read-error", "/dev/zero", "cannot read: not a regular file (a pipe, socket or device)"
+    )  # fmt: skip
 
 
 @pytest.mark.parametrize("path", ["no/such/file.yaml", "."])
@@ -363,7 +368,7 @@ def test_integers_of_any_length_anywhere_give_an_error_not_an_exception(loader):
         only_error(f"? {long}\n: x\n" + CONTACTS).message
         == f"top level: keys must be strings, got the number {long[:27]}..."
     )
-    assert only_error(f"contacts: 0x{long}\n").message == f"contacts: expected a list, got the number 0x{long[:25]}..."
+    assert only_error(f"contacts: 0x{long}\n").message.endswith(f", got the number 0x{long[:25]}...")
     assert only_grasp(f"name: {long}\n" + CONTACTS).name == long  # a label, as written
     assert only_grasp(f"wrist: [0, {'0' * 5000}1, 0o{'0' * 5000}7]\n" + CONTACTS).wrist.tolist() == [0, 1, 7]
 
@@ -406,9 +411,12 @@ def test_core_tags_are_allowed(loader):
     ],
 )
 def test_other_tags_are_forbidden(text, message, loader):
-    error = only_error(text + "\n")
+    *others, error = read(text + "\n")
     assert error.code == "forbidden-tag"
     assert error.message.startswith(message)
+    # a refused node is passed over in silence; the document's other problems are not
+    top = message.startswith("top level")
+    assert [str(e) for e in others] == ([] if top else ["g.yaml:1:1: contacts: required key is missing"])
 
 
 def test_unknown_key_suggestion(loader):
@@ -549,14 +557,17 @@ def test_pyyaml_dumped_grasps_load_back(documents):
         with pytest.MonkeyPatch.context() as patch:
             patch.setattr(grasp_file, "_LOADER", parser)
             entries = read(text, name="r.yaml")
-        assert len(entries) == len(documents)
-        for i, (doc, grasp) in enumerate(zip(documents, entries)):
+        assert [e.document for e in entries] == sorted(e.document for e in entries)
+        by_document = [[e for e in entries if e.document == i] for i in range(len(documents))]
+        assert sum(map(len, by_document)) == len(entries)
+        for i, (doc, mine) in enumerate(zip(documents, by_document)):
             assert validator.is_valid(doc)
             default_names = [str(k + 1) for k in range(3)]
             names = tuple(c.get("name", d) for c, d in zip(doc["contacts"], default_names))
             if len(set(names)) < 3:  # an explicit name equal to another's default
-                assert grasp.code == "duplicate-name"
+                assert [e.code for e in mine] == ["duplicate-name"] * (3 - len(set(names)))
                 continue
+            (grasp,) = mine
             assert isinstance(grasp, Grasp), str(grasp)
             assert grasp.name == doc.get("name", f"r#{i + 1}" if len(documents) > 1 else "r")
             assert grasp.units == doc.get("units")
