@@ -1176,9 +1176,16 @@ def _mapping(node, path, keys, required, problems):
         return None
     fields = {}
     meant = set()  # the keys that misspelled ones were taken for
+    unknown = 0
     for key, (key_node, value) in node.value.items():
         if key in keys:
             fields[key] = value
+            continue
+        unknown += 1
+        if unknown > MAX_ERRORS:
+            # After MAX_ERRORS unknown keys (all before it in the file) this
+            # one's problem can never be reported: count it, spare the rest.
+            problems.count += 1
             continue
         # difflib is only needed on this error path.
         from difflib import get_close_matches
