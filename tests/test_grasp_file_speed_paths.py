@@ -134,10 +134,24 @@ def both_paths(source, **kw):
     return fast
 
 
-@pytest.mark.parametrize("path", FILES, ids=lambda p: f"{p.parent.name}/{p.name}")
-def test_files_read_the_same_both_ways(path, loader):
+BIG = 1 << 16
+
+
+def _file_cases():
+    """Each file with each parser; the pure-Python parser's seconds over a big
+    file (corpus/many-contacts.yaml) are left to the long run."""
+    for path in FILES:
+        for parser in LOADERS:
+            slow = path.stat().st_size >= BIG and parser is yaml.SafeLoader
+            name = f"{parser.__name__}-{path.parent.name}/{path.name}"
+            yield pytest.param(path, parser, id=name, marks=[pytest.mark.slow] if slow else [])
+
+
+@pytest.mark.parametrize("path, parser", list(_file_cases()))
+def test_files_read_the_same_both_ways(path, parser, monkeypatch):
+    monkeypatch.setattr(grasp_file, "_LOADER", parser)
     both_paths(path)
-    if path.stat().st_size < 1 << 16:  # content under another name: every small file checks that
+    if path.stat().st_size < BIG:  # content under another name: every small file checks that
         both_paths(path.read_bytes(), file="other/name.yaml")
 
 
