@@ -132,7 +132,15 @@ def check_loader(data):
     """Only GraspFileError escapes; every result is sound; every error one line."""
     with contextlib.suppress(GraspFileError):
         load_grasps(data, file="fuzz.yaml")
-    for entry in read_grasps(data, file="fuzz.yaml"):
+    entries = read_grasps(data, file="fuzz.yaml")
+    # in file order: by document, and each document's problems by position
+    errors = [e for e in entries if isinstance(e, GraspFileError)]
+    located = [(e.document, e.line, e.column) for e in errors if e.line is not None]
+    assert located == sorted(located)
+    assert [e.document for e in entries if e.document is not None] == sorted(
+        e.document for e in entries if e.document is not None
+    )
+    for entry in entries:
         if isinstance(entry, GraspFileError):
             assert "\n" not in str(entry) and "\r" not in str(entry) and str(entry).startswith("fuzz.yaml")
             continue
