@@ -334,8 +334,10 @@ class _Node:
     """A composed YAML node.
 
     ``kind`` is ``"mapping"`` (``value``: dict key -> (key node, value
-    node)), ``"sequence"`` (list of nodes) or ``"scalar"`` (the resolved
-    str, int, float, bool or None, and its ``text`` as written).
+    node)), ``"sequence"`` (list of nodes), ``"scalar"`` (the resolved
+    str, int, float, bool or None, and its ``text`` as written) or
+    ``"invalid"`` (refused for its YAML, its problem already reported: a
+    forbidden tag, an alias, a tag its text does not fit).
     ``line``/``column`` are 1-based.
     """
 
@@ -899,27 +901,28 @@ class _Entries:
         self._first_unnamed = None  # the first document's grasp, when it took the default name
 
     def add(self, line, root, problems):
-        """The entries of the next document: its ``_Parts`` (``problems`` None) or node tree."""
+        """The entries of the next document, from its ``_Parts`` (``problems``
+        None) or its node tree (with the problems found composing it)."""
         document = self.documents
         self.documents += 1
         if document == 1:
             self._number_the_first()
-        name = None
         if type(root) is _Parts:
-            name = root.name
-        if name is None:
-            name = self._default_name(document)
-        if type(root) is _Parts:
+            named = root.name is not None
+            name = root.name if named else self._default_name(document)
             grasp = root.grasp(file=self.file, document=document, name=name, line=line)
         else:
-            grasp = _grasp(root, problems, file=self.file, document=document, name=name, line=line)
-        if grasp is None:
-            first = problems.first()
-            self.reported += len(first)
-            self.unreported += problems.count - len(first)
-            self.entries += [reject.error(self.file, document) for reject in first]
-            return
-        if document == 0 and not (root.name is not None if type(root) is _Parts else "name" in root.value):
+            grasp = _grasp(
+                root, problems, file=self.file, document=document, name=self._default_name(document), line=line
+            )
+            if grasp is None:
+                first = problems.first()
+                self.reported += len(first)
+                self.unreported += problems.count - len(first)
+                self.entries += [reject.error(self.file, document) for reject in first]
+                return
+            named = "name" in root.value
+        if document == 0 and not named:
             self._first_unnamed = len(self.entries)
         self.entries.append(grasp)
 
