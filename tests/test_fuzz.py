@@ -6,7 +6,7 @@ GraspFileError (and what it returns is sound), the command exits 0 or 1,
 never shows a traceback or an internal error, writes parseable records with no
 NaN in an ok one, and only one-line diagnostics.
 
-The default run tries a few hundred inputs per property; the long run
+The default run tries 100 to 200 inputs per property; the long run
 (``python -m pytest -m slow tests/test_fuzz.py``) tries 10,000 each.
 """
 
@@ -177,7 +177,7 @@ def fuzz(strategy, check, examples):
     property_()
 
 
-SHORT = {"loader": 250, "cli": 150}
+SHORT = {"loader": 200, "cli": 100}
 LONG = 10_000
 
 
@@ -193,7 +193,7 @@ def test_the_generator_makes_valid_grasps_too():
     documents with plain numbers must load (and some hostile ones must not)."""
     seen = {"grasp": 0, "error": 0}
 
-    @settings(max_examples=100, deadline=None, database=None)
+    @settings(max_examples=60, deadline=None, database=None)
     @given(st.lists(st.fixed_dictionaries({"point": st.lists(st.floats(-5, 5), min_size=3, max_size=3),
                                            "normal": st.lists(st.floats(0.5, 5), min_size=3, max_size=3)}),
                     min_size=3, max_size=3))  # fmt: skip
@@ -204,10 +204,10 @@ def test_the_generator_makes_valid_grasps_too():
 
     plain()
 
-    @settings(max_examples=100, deadline=None, database=None)
+    @settings(max_examples=60, deadline=None, database=None)
     @given(yaml_documents())
     def hostile(data):
         seen["error"] += any(isinstance(e, GraspFileError) for e in read_grasps(data, file="x.yaml"))
 
     hostile()
-    assert seen["grasp"] == 100 and seen["error"] > 20
+    assert seen["grasp"] == 60 and seen["error"] > 12
