@@ -1,6 +1,8 @@
 """The grasp-file loader: format, located errors, safety, both YAML parsers."""
 
+import errno
 import io
+import os
 import pickle
 import sys
 import time
@@ -217,11 +219,11 @@ def test_a_device_is_never_read():
     )  # fmt: skip
 
 
-@pytest.mark.parametrize("path", ["no/such/file.yaml", "."])
-def test_unreadable_paths_give_read_error(path):
+@pytest.mark.parametrize("path, why", [("no/such/file.yaml", errno.ENOENT), (".", errno.EISDIR)])
+def test_unreadable_paths_give_read_error(path, why):
     (error,) = read_grasps(path)
     assert error.code == "read-error"
-    assert str(error).startswith(f"{path}: cannot read: ")
+    assert str(error) == f"{path}: cannot read: {os.strerror(why)}"
 
 
 def test_invalid_utf8_is_located_by_line_and_character():

@@ -40,6 +40,7 @@ above, which gives every error.  Both paths give the same grasps.
 
 from __future__ import annotations
 
+import errno
 import math
 import os
 import re
@@ -255,8 +256,10 @@ def _read_file(path, max_bytes):
             return _read_capped(sys.stdin.buffer, max_bytes + 1)
         fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
         with open(fd, "rb") as handle:
-            if not stat.S_ISREG(os.fstat(fd).st_mode):
-                raise _Reject("read-error", "", f"cannot read: {NOT_REGULAR}")
+            mode = os.fstat(fd).st_mode
+            if not stat.S_ISREG(mode):
+                why = os.strerror(errno.EISDIR) if stat.S_ISDIR(mode) else NOT_REGULAR
+                raise _Reject("read-error", "", f"cannot read: {why}")
             return _read_capped(handle, max_bytes + 1)
     except OSError as exc:
         raise _Reject("read-error", "", f"cannot read: {exc.strerror or exc}") from None
