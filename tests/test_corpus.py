@@ -12,12 +12,14 @@ go through the installed command too, and create nothing.
 import os
 import shutil
 import socket
+import subprocess
+import sys
 from dataclasses import dataclass
 from pathlib import Path
 
 import pytest
 
-from hostile import assert_no_crash, error_codes, error_lines, jsonl, run, run_installed, summary
+from hostile import assert_no_crash, entry_point, error_codes, error_lines, jsonl, run, run_installed, summary
 
 CORPUS = Path(__file__).parent / "corpus"
 TABLE = CORPUS / "expected.tsv"
@@ -141,16 +143,18 @@ def _check_alone(row, path, exit_code, stdout, stderr, seconds, limit):
     if row.code is None:
         assert errors == [] and lines[-1] == summary(row.records, 0)
         return
-    # a few lines: the errors (one per failed method at most), then the summary
-    assert 1 <= len(errors) <= 2 and len(lines) <= len(errors) + 1, stderr
-    assert lines[-1] == summary(row.records, row.records - row.ok)
-    prefix = f"{path}:{row.where}: error: " if row.where else f"{path}: "
-    assert all(line.startswith(prefix) for line in errors), (prefix, errors)
-    assert any(f"{row.code}: " in line and row.fragment in line for line in errors), errors
+    # the errors, one line each (a file's problems one per record, a grasp's one per failed method), then the summary
     failed = [r for r in records if not r["ok"]]
-    assert all(row.code in error_codes(r) for r in failed)
-    if row.where and "error" in failed[0]:  # the record locates the error as stderr does
-        assert f"{failed[0]['error']['line']}:{failed[0]['error']['column']}" == row.where
+    assert len(errors) == sum(len(error_codes(r)) for r in failed) and len(lines) == len(errors) + 1, stderr
+    assert lines[-1] == summary(row.records, row.records - row.ok)
+    assert all(line.startswith(f"{path}:") for line in errors), errors
+    prefix = f"{path}:{row.where}: error: {row.code}: " if row.where else f"{path}: "
+    assert any(line.startswith(prefix) and f"{row.code}: " in line and row.fragment in line for line in errors), errors
+    assert any(row.code in error_codes(r) for r in failed)
+    located = [(r["error"]["line"], r["error"]["column"]) for r in failed if "error" in r]
+    assert located == sorted(located, key=lambda at: (at[0] or 0, at[1] or 0))  # in file order
+    if row.where and located[0][0] is not None:  # the record locates the error as stderr does
+        assert tuple(map(int, row.where.split(":"))) in located
 
 
 @pytest.mark.parametrize(
@@ -296,3 +300,56 @@ def test_a_file_name_cannot_split_or_colour_its_error_line(tmp_path):
     lines = result.stderr.splitlines()
     assert len(lines) == 2 and ": error: contact-count: " in lines[0], lines
     assert "\x1b" not in result.stderr
+
+
+# --------------------------------------------------------------------------
+# Memory: per-file limits keep a small hostile file small.
+
+
+def run_measured(*args, cwd):
+    """``grasptwist ARGS`` in a fresh process: (exit status, stderr, peak RSS in MB).
+
+    A wrapper process runs the command and reads ``getrusage(RUSAGE_CHILDREN)``:
+    its only children are the command and its workers, so the figure is theirs
+    (the largest of them), not that of some earlier test's subprocess.
+    """
+    wrapper = (
+        "import resource, subprocess, sys; code = subprocess.run(sys.argv[1:]).returncode; "
+        "print(code, resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss)"
+    )
+    env = {**os.environ, "NO_COLOR": "1"}
+    proc = subprocess.run(
+        [sys.executable, "-c", wrapper, *entry_point(), *map(str, args)],
+        capture_output=True, text=True, cwd=cwd, env=env, timeout=60,
+    )  # fmt: skip
+    code, kib = map(int, proc.stdout.split())
+    return code, proc.stderr, kib / 1024 if sys.platform != "darwin" else kib / 2**20
+
+
+DASHES = b"---\n" * (1 << 18)  # 1 MiB: 262,144 empty documents
+
+
+def _dashes_check(folder, files, limit_mb):
+    code, stderr, peak = run_measured("resolve", folder, "-f", "jsonl", "-o", "out.jsonl", cwd=folder.parent)
+    records = jsonl((folder.parent / "out.jsonl").read_text())
+    # per file: 100 errors, one too-many-documents (at document 10,001), one count of the 9,900 others
+    assert len(records) == 102 * files and code == 1
+    assert [r["error"]["code"] for r in records[-2:]] == ["too-many-documents", "too-many-errors"]
+    assert stderr.splitlines()[-1] == summary(102 * files, 102 * files)
+    assert peak < limit_mb, f"{peak:.0f} MB"
+
+
+def test_a_mebibyte_of_document_markers_is_cut_short_in_little_memory(tmp_path):
+    # 0.1: 262,144 records and 1.3 GB; now 102 records and ~40 MB (an interpreter's worth)
+    (tmp_path / "in").mkdir()
+    (tmp_path / "in" / "dashes.yaml").write_bytes(DASHES)
+    _dashes_check(tmp_path / "in", 1, 150)
+
+
+@pytest.mark.slow
+def test_sixteen_such_files_in_one_folder(tmp_path):
+    # 0.1: 20 GB; now ~50 MB
+    (tmp_path / "in").mkdir()
+    for k in range(16):
+        (tmp_path / "in" / f"{k:02d}.yaml").write_bytes(DASHES)
+    _dashes_check(tmp_path / "in", 16, 300)

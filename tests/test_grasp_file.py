@@ -1,6 +1,8 @@
 """The grasp-file loader: format, located errors, safety, both YAML parsers."""
 
+import errno
 import io
+import os
 import pickle
 import sys
 import time
@@ -25,6 +27,8 @@ from grasptwist.io.grasp_file import (
     load_grasps,
     read_grasps,
 )
+from hostile import jsonl, run
+from hostile import summary as summary_line
 
 INVALID = Path(__file__).parent / "invalid_grasps"
 BUNDLED = Path(__file__).parent.parent / "grasps"
@@ -149,8 +153,8 @@ def test_both_parsers_give_identical_results(path):
 def test_python_tags_never_run(template, loader, tmp_path):
     target = tmp_path / "pwned"
     text = template.format(target)
-    (error,) = read(text)
-    assert error.code == "forbidden-tag"
+    errors = read(text)
+    assert [e.code for e in errors if e.code != "missing-key"] == ["forbidden-tag"]
     assert not target.exists()
     # Control: the same text does run under an unsafe loader, so the test can fail.
     yaml.load(text, Loader=yaml.UnsafeLoader)
@@ -163,9 +167,11 @@ def test_billion_laughs_fails_at_the_first_alias(loader):
         f"{b}: &{b} [*{a},*{a},*{a},*{a},*{a},*{a},*{a},*{a},*{a}]\n" for a, b in zip("abcdefgh", "bcdefghi")
     )
     start = time.perf_counter()
-    error = only_error(text)
+    errors = read(text)
     assert time.perf_counter() - start < 1
-    assert (error.code, error.line, error.column) == ("alias", 2, 8)
+    aliases = [e for e in errors if e.code == "alias"]
+    assert len(aliases) == 8 * 9  # each refused where it stands, none expanded
+    assert (aliases[0].line, aliases[0].column, aliases[-1].line, aliases[-1].column) == (2, 8, 9, 32)
 
 
 @pytest.mark.parametrize(
@@ -205,16 +211,19 @@ def test_oversized_content_is_refused_before_parsing():
 
 
 @pytest.mark.skipif(not Path("/dev/zero").exists(), reason="needs /dev/zero")
-def test_an_endless_file_is_read_only_up_to_the_cap():
+def test_a_device_is_never_read():
+    # an endless stream: refused after opening, before any byte is read
     (error,) = read_grasps("/dev/zero", max_bytes=DEFAULT_MAX_BYTES)
-    assert (error.code, error.file) == ("too-large", "/dev/zero")
+    assert (error.code, error.file, error.message) == (
+        "read-error", "/dev/zero", "cannot read: not a regular file (a pipe, socket or device)"
+    )  # fmt: skip
 
 
-@pytest.mark.parametrize("path", ["no/such/file.yaml", "."])
-def test_unreadable_paths_give_read_error(path):
+@pytest.mark.parametrize("path, why", [("no/such/file.yaml", errno.ENOENT), (".", errno.EISDIR)])
+def test_unreadable_paths_give_read_error(path, why):
     (error,) = read_grasps(path)
     assert error.code == "read-error"
-    assert str(error).startswith(f"{path}: cannot read: ")
+    assert str(error) == f"{path}: cannot read: {os.strerror(why)}"
 
 
 def test_invalid_utf8_is_located_by_line_and_character():
@@ -363,7 +372,7 @@ def test_integers_of_any_length_anywhere_give_an_error_not_an_exception(loader):
         only_error(f"? {long}\n: x\n" + CONTACTS).message
         == f"top level: keys must be strings, got the number {long[:27]}..."
     )
-    assert only_error(f"contacts: 0x{long}\n").message == f"contacts: expected a list, got the number 0x{long[:25]}..."
+    assert only_error(f"contacts: 0x{long}\n").message.endswith(f", got the number 0x{long[:25]}...")
     assert only_grasp(f"name: {long}\n" + CONTACTS).name == long  # a label, as written
     assert only_grasp(f"wrist: [0, {'0' * 5000}1, 0o{'0' * 5000}7]\n" + CONTACTS).wrist.tolist() == [0, 1, 7]
 
@@ -406,9 +415,12 @@ def test_core_tags_are_allowed(loader):
     ],
 )
 def test_other_tags_are_forbidden(text, message, loader):
-    error = only_error(text + "\n")
+    *others, error = read(text + "\n")
     assert error.code == "forbidden-tag"
     assert error.message.startswith(message)
+    # a refused node is passed over in silence; the document's other problems are not
+    top = message.startswith("top level")
+    assert [str(e) for e in others] == ([] if top else ["g.yaml:1:1: contacts: required key is missing"])
 
 
 def test_unknown_key_suggestion(loader):
@@ -437,6 +449,183 @@ def test_empty_and_null_documents(loader):
 
 
 # --------------------------------------------------------------------------
+# Every problem of a document, in file order.
+
+# Issue 12's example: a misspelled key, a quoted number and a 4-number normal.
+THREE_MISTAKES = """\
+name: pinch
+wrist: [0, 0, "1"]
+contacts:
+  - point: [1, 0, 0]
+    nromal: [-1, 0, 0]
+  - point: [-0.5, 0.866, 0]
+    normal: [0.5, -0.866, 0, 1]
+  - point: [-0.5, -0.866, 0]
+    normal: [0.5, 0.866, 0]
+"""
+
+
+def where(entries):
+    return [(e.code, e.line, e.column, e.document) for e in entries]
+
+
+def test_every_problem_of_a_document_is_reported(loader):
+    errors = read(THREE_MISTAKES)
+    assert where(errors) == [("not-a-number", 2, 15, 0), ("unknown-key", 5, 5, 0), ("vector-length", 7, 13, 0)]
+    assert [e.message for e in errors] == [
+        "wrist[2]: expected a number, got the string '1'",
+        "contacts[0].nromal: unknown key (did you mean 'normal'?)",
+        "contacts[1].normal: expected 3 numbers, got 4",
+    ]
+    # The JSON Schema says the misspelling twice (unknown key, missing key); the suggestion says it once.
+    validator = jsonschema.Draft202012Validator(grasp_schema())
+    assert len(list(validator.iter_errors(yaml.safe_load(THREE_MISTAKES)))) == 4
+    with pytest.raises(GraspFileError) as caught:
+        load_grasps(THREE_MISTAKES, file="g.yaml")
+    assert str(caught.value) == "g.yaml:2:15: wrist[2]: expected a number, got the string '1'"
+
+
+def test_the_command_line_gives_each_problem_its_record_and_line(tmp_path):
+    path = tmp_path / "pinch.yaml"
+    path.write_text(THREE_MISTAKES + "---\n" + (BUNDLED / "polyhedron.yaml").read_text())
+    result, _ = run("resolve", path, "-f", "jsonl")
+    assert result.exit_code == 1
+    records = jsonl(result.stdout)
+    assert [(r["ok"], r.get("error", {}).get("code")) for r in records] == [
+        (False, "not-a-number"), (False, "unknown-key"), (False, "vector-length"), (True, None),
+    ]  # fmt: skip
+    assert [(r["error"]["line"], r["error"]["column"]) for r in records[:3]] == [(2, 15), (5, 5), (7, 13)]
+    lines = result.stderr.splitlines()
+    assert lines[:3] == [f"{path}:{e.line}:{e.column}: error: {e.code}: {e.message}" for e in read(THREE_MISTAKES)]
+    assert lines[3:] == [summary_line(4, 3)]
+
+
+def test_the_readme_shows_what_the_command_prints(tmp_path, monkeypatch):
+    example = (Path(__file__).parent.parent / "README.md").read_text("utf-8").split("For this `pinch.yaml`")[1]
+    text = example.split("```yaml\n")[1].split("```")[0]
+    printed = example.split("```\n")[2]  # the block after the YAML one
+    assert text == THREE_MISTAKES
+    monkeypatch.chdir(tmp_path)
+    Path("pinch.yaml").write_text(text)
+    result, _ = run("resolve", "pinch.yaml")
+    assert (result.exit_code, result.stderr) == (1, printed)
+
+
+def test_the_schema_states_the_units_of_angular_velocity():
+    twist = grasp_schema()["$defs"]["twist"]["properties"]
+    assert "radians per unit time" in twist["angular"]["description"]
+    assert "radians per unit time" in twist["screw"]["description"]
+
+
+def test_problems_come_in_file_order_whatever_order_they_are_found_in(loader):
+    # the checks go name, contacts, twists; the file has them the other way round
+    errors = read("twists:\n  - angular: [0, 0]\ncontacts: 3\nname: [x]\n")
+    assert where(errors) == [("vector-length", 2, 14, 0), ("not-a-list", 3, 11, 0), ("not-a-string", 4, 7, 0)]
+
+
+def test_refused_yaml_does_not_stop_the_checks(loader):
+    text = (
+        "wrist: !!python/tuple [0, 0, 0]\ncontacts: &c\n  - {point: *p, normal: [1, 0, 0]}\n"
+        "  - {point: [0, 1, 0], normal: [0, 1, 0], point: [1, 1, 1]}\n  - {point: [0, 0, 1], normal: [0, 0, x]}\n"
+    )
+    assert where(read(text)) == [
+        ("forbidden-tag", 1, 8, 0), ("alias", 3, 13, 0), ("duplicate-key", 4, 43, 0), ("not-a-number", 5, 39, 0),
+    ]  # fmt: skip
+    # a refused node is passed over: no second error for what it holds or stands for
+    assert where(read("contacts: !!set {a, b}\n")) == [("forbidden-tag", 1, 11, 0)]
+    assert where(read("wrist: [!!binary aGk=, 0, 0]\n" + CONTACTS)) == [("forbidden-tag", 1, 9, 0)]
+
+
+def test_a_misspelling_is_one_problem_an_unknown_key_and_a_missing_one_are_two(loader):
+    assert where(read(CONTACTS.replace("normal: [-1", "nromal: [-1"))) == [("unknown-key", 3, 5, 0)]
+    unrelated = where(read(CONTACTS.replace("normal: [-1", "color: [-1")))
+    assert unrelated == [("missing-key", 2, 5, 0), ("unknown-key", 3, 5, 0)]
+
+
+@pytest.mark.parametrize(
+    "text, message",
+    [
+        (
+            CONTACTS + "twists:\n  - angular: [0, 0, 1, 0, 0, 0]\n",
+            "twists[0].angular: expected 3 numbers, got 6; a 6-vector (omega; v) goes under `screw:`",
+        ),
+        (
+            CONTACTS + "twists:\n  - screw: [0, 0, 1]\n",
+            "twists[0].screw: expected 6 numbers, got 3; a 3-vector goes under `angular:` or `linear:`",
+        ),
+        (
+            "contacts:\n  thumb: {point: [0, 2, 2], normal: [1, 0, 0]}\n",
+            "contacts: expected a list of 3 contacts like [{point: [x, y, z], normal: [x, y, z]}, ...], got a mapping;"
+            " write each as '- name: thumb' with its point and normal under it",
+        ),
+        (
+            "contacts:\n  point: [0, 2, 2]\n  normal: [1, 0, 0]\n",
+            "contacts: expected a list of 3 contacts like [{point: [x, y, z], normal: [x, y, z]}, ...], got a mapping;"
+            " start each of the three contacts with '- '",
+        ),
+    ],
+    ids=["angular-6", "screw-3", "contacts-by-name", "one-contact-unlisted"],
+)
+def test_messages_that_say_what_to_write(text, message, loader):
+    assert only_error(text).message == message
+
+
+# --------------------------------------------------------------------------
+# Per-file limits.
+
+
+def test_a_file_of_document_markers_is_cut_short(loader):
+    start = time.perf_counter()
+    entries = read(b"---\n" * (1 << 18))  # 1 MiB: 262,144 empty documents
+    assert time.perf_counter() - start < 2
+    assert where(entries[:2]) == [("empty-document", 2, 1, 0), ("empty-document", 3, 1, 1)]
+    assert len(entries) == grasp_file.MAX_ERRORS + 2 == 102
+    assert where(entries[-2:]) == [("too-many-documents", 10001, 1, 10000), ("too-many-errors", None, None, None)]
+    assert [e.message for e in entries[-2:]] == [
+        "more than 10000 documents; the rest of the file is not read",
+        "9900 more problems in this file not reported (only the first 100 are)",
+    ]
+
+
+def test_good_documents_past_the_error_limit_still_load(loader, monkeypatch):
+    monkeypatch.setattr(grasp_file, "MAX_ERRORS", 3)
+    entries = read("---\n" * 5 + CONTACTS + "---\n- 1\n", name="g.yaml")
+    assert where(entries[:3]) == [("empty-document", k + 1, 1, k - 1) for k in (1, 2, 3)]
+    assert (entries[3].name, entries[3].document) == ("g#5", 4)
+    assert entries[4].message == "2 more problems in this file not reported (only the first 3 are)"
+    assert len(entries) == 5
+
+
+def test_the_document_limit_keeps_the_documents_before_it(loader, monkeypatch):
+    monkeypatch.setattr(grasp_file, "MAX_DOCUMENTS", 2)
+    first, second, stop = read(CONTACTS + "---\n" + CONTACTS + "---\n" + CONTACTS, name="g.yaml")
+    assert (first.name, second.name) == ("g#1", "g#2")
+    assert (stop.code, stop.line, stop.document) == ("too-many-documents", 16, 2)
+
+
+def test_a_document_with_many_problems_reports_the_first_in_file_order(loader):
+    # 150 bad twists early in the file, found after 150 bad contacts later in it
+    twists = "".join(f"  - angular: [{k}]\n" for k in range(150))
+    contacts = "".join(f"  - {{point: [{k}], normal: [1, 0, 0]}}\n" for k in range(150))
+    entries = read(f"twists:\n{twists}contacts:\n{contacts}")
+    assert [e.message for e in entries[:-1]] == [f"twists[{k}].angular: expected 3 numbers, got 1" for k in range(100)]
+    assert [e.line for e in entries[:-1]] == list(range(2, 102))
+    # the other 50 twists, the contact count and the 150 contacts' points
+    assert entries[-1].message == "201 more problems in this file not reported (only the first 100 are)"
+
+
+def test_default_names(loader):
+    assert [e.name for e in read(CONTACTS)] == ["g"]
+    assert [e.name for e in read(CONTACTS + "---\n" + CONTACTS)] == ["g#1", "g#2"]
+    assert [e.name for e in read("name: g\n" + CONTACTS + "---\n" + CONTACTS)] == ["g", "g#2"]
+    labels = lambda entries: [e.code if isinstance(e, GraspFileError) else e.name for e in entries]  # noqa: E731
+    assert labels(read(CONTACTS + "---\n[")) == ["g#1", "yaml-syntax"]
+    assert labels(read("- 1\n---\n" + CONTACTS)) == ["not-a-mapping", "g#2"]
+    # a file name's undecodable bytes (surrogate escapes) and controls are shown escaped
+    assert [e.name for e in read(CONTACTS, name="d/a\x1bb \udcff.yaml")] == ["a\\x1bb \\xff"]
+
+
+# --------------------------------------------------------------------------
 # Multi-document streams.
 
 
@@ -456,8 +645,8 @@ def test_syntax_error_keeps_the_documents_before_it(loader):
 
 
 def test_depth_is_checked_after_a_documents_first_problem(loader):
-    # After its first problem the rest of a document is only skimmed, but a
-    # nesting bomb in it still stops the parse at once (and is what is reported).
+    # A nesting bomb after a document's first problem still stops the parse
+    # at once, and is what is reported for the document it cuts.
     text = "bad: !!python/none 1\nx: " + "[" * 100000 + "\n---\n" + CONTACTS
     start = time.perf_counter()
     (error,) = read(text)
@@ -549,14 +738,17 @@ def test_pyyaml_dumped_grasps_load_back(documents):
         with pytest.MonkeyPatch.context() as patch:
             patch.setattr(grasp_file, "_LOADER", parser)
             entries = read(text, name="r.yaml")
-        assert len(entries) == len(documents)
-        for i, (doc, grasp) in enumerate(zip(documents, entries)):
+        assert [e.document for e in entries] == sorted(e.document for e in entries)
+        by_document = [[e for e in entries if e.document == i] for i in range(len(documents))]
+        assert sum(map(len, by_document)) == len(entries)
+        for i, (doc, mine) in enumerate(zip(documents, by_document)):
             assert validator.is_valid(doc)
             default_names = [str(k + 1) for k in range(3)]
             names = tuple(c.get("name", d) for c, d in zip(doc["contacts"], default_names))
             if len(set(names)) < 3:  # an explicit name equal to another's default
-                assert grasp.code == "duplicate-name"
+                assert [e.code for e in mine] == ["duplicate-name"] * (3 - len(set(names)))
                 continue
+            (grasp,) = mine
             assert isinstance(grasp, Grasp), str(grasp)
             assert grasp.name == doc.get("name", f"r#{i + 1}" if len(documents) > 1 else "r")
             assert grasp.units == doc.get("units")

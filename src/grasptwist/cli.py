@@ -217,7 +217,7 @@ _WORKERS = typer.Option(
     min=0,
     help="Processes for big batches (0: every core, used for 256+ files or 4096+ data-set grasps).",
 )
-_PATHS_HELP = "Grasp files (.yaml, .yml), data sets (.npz, .npy), folders (searched for *.yaml, *.yml) or - for stdin."
+_PATHS_HELP = "Grasp files (.yaml, .yml, .json; any case), data sets (.npz, .npy), folders of grasp files or - (stdin)."
 _PATHS = typer.Argument(..., metavar="PATH...", help=_PATHS_HELP)
 
 

@@ -4,6 +4,8 @@ A grasp file holds one grasp per YAML document (see "Grasp files" in README.md
 for the format).  Reading never constructs arbitrary Python objects and
 never lets a parser exception escape: every problem becomes a
 :class:`GraspFileError` that names the file, line, column and field path.
+Every problem of a document is reported, in file order, not just its first
+(at most ``MAX_ERRORS`` per file; one more entry counts the rest).
 
 How the YAML is read, and why
 -----------------------------
@@ -19,7 +21,8 @@ compose or construct.  Doing the composition ourselves lets us
   and both scanners slow down quadratically with depth, so a deep document
   must end the parse at once;
 - reject aliases outright, so no alias bomb can expand, and reject every
-  tag except the core ones, so no tag can ever construct an object;
+  tag except the core ones, so no tag can ever construct an object, and go
+  on composing after either, to find the document's other problems;
 - see duplicate keys, which PyYAML silently merges;
 - resolve plain scalars with the YAML 1.2 core schema (``1e-3`` is a
   number, ``yes`` is a string, as in editors' YAML language servers),
@@ -37,10 +40,13 @@ above, which gives every error.  Both paths give the same grasps.
 
 from __future__ import annotations
 
+import errno
 import math
 import os
 import re
+import stat
 import sys
+from dataclasses import replace
 from itertools import chain
 from pathlib import Path
 
@@ -56,6 +62,8 @@ __all__ = [
     "GraspFileError",
     "DEFAULT_MAX_BYTES",
     "MAX_DEPTH",
+    "MAX_DOCUMENTS",
+    "MAX_ERRORS",
     "read_grasps",
     "load_grasps",
     "grasp_schema",
@@ -68,6 +76,19 @@ MAX_DEPTH = 32
 """Deepest collection nesting accepted.  A valid grasp needs 4 (document,
 ``contacts``, a contact, its ``point``); the margin lets mistyped nested
 values get their specific error instead of ``too-deep``."""
+
+MAX_DOCUMENTS = 10_000
+"""Most documents read from one file; the rest of a longer file is refused
+with one ``too-many-documents`` entry.  A grasp takes at least about 110
+bytes, so no valid file within the default size cap has this many; a file of
+``---`` lines would otherwise give one entry per 4 bytes."""
+
+MAX_ERRORS = 100
+"""Most problems reported for one file (the first, in file order); one more
+``too-many-errors`` entry says how many were left out."""
+
+#: Why a path that is not a regular file (or folder) is not read.
+NOT_REGULAR = "not a regular file (a pipe, socket or device)"
 
 # Parser used by read_grasps; tests swap it to check both give the same.
 _LOADER = yaml.CSafeLoader if yaml.__with_libyaml__ else yaml.SafeLoader
@@ -96,9 +117,22 @@ def read_grasps(source, *, file=None, max_bytes=DEFAULT_MAX_BYTES):
     Returns
     -------
     list of Grasp or GraspFileError
-        One entry per YAML document, in order.  A syntax error that stops
-        the parser ends the list with one error after the good documents
-        before it; a whole-file failure gives a single error.
+        In file order: a Grasp for each good document and an error for each
+        problem of a bad one (several per document, each with its own
+        position).  A syntax error, a too-deep document or more than
+        ``MAX_DOCUMENTS`` documents stop the reading: one error after the
+        entries before it.  Beyond ``MAX_ERRORS`` problems one last
+        ``too-many-errors`` error counts the rest.  A whole-file failure
+        gives a single error.
+
+    Examples
+    --------
+    >>> text = "contacts:\\n  - {point: [0, 0], normal: [1, 0, '0']}\\n"
+    >>> for error in read_grasps(text, file="g.yaml"):
+    ...     print(error)
+    g.yaml:2:3: contacts: expected exactly 3 contacts, got 1
+    g.yaml:2:13: contacts[0].point: expected 3 numbers, got 2
+    g.yaml:2:36: contacts[0].normal[2]: expected a number, got the string '0'
     """
     is_content = isinstance(source, (bytes, bytearray, memoryview)) or (isinstance(source, str) and file is not None)
     if file is None:
@@ -153,6 +187,42 @@ class _StreamStop(_Reject):
     """Internal: a problem after which the rest of the stream is not read."""
 
 
+class _Problems:
+    """The problems of one document as they are found: the first ``keep`` of
+    them in file order, and how many there are in all.
+
+    At most ``2 * keep`` are held between trims, so a document with a
+    hundred thousand problems costs no more memory than one with ``keep``.
+    """
+
+    __slots__ = ("keep", "count", "_held")
+
+    def __init__(self, keep):
+        self.keep = keep
+        self.count = 0
+        self._held = []
+
+    def add(self, reject):
+        self.count += 1
+        if self.keep:
+            self._held.append(reject)
+            if len(self._held) >= 2 * self.keep:
+                self._trim()
+
+    def first(self):
+        """The problems kept, in file order (found order among equal positions)."""
+        self._trim()
+        return self._held
+
+    def _trim(self):
+        self._held.sort(key=_position)  # stable: ties stay in the order found
+        del self._held[self.keep :]
+
+
+def _position(reject):
+    return reject.line or 0, reject.column or 0
+
+
 def _at(node):
     """Keyword arguments locating a node (1-based)."""
     return {"line": node.line, "column": node.column}
@@ -174,15 +244,22 @@ def _encode(content):
 
 
 def _read_file(path, max_bytes):
-    """At most ``max_bytes + 1`` bytes of a file, or of stdin for ``"-"``.
+    """At most ``max_bytes + 1`` bytes of a regular file, or of stdin for ``"-"``.
 
     One byte past the cap is enough to know it is exceeded, without
-    trusting stat (pipes, /proc) or reading a huge file into memory.
+    trusting stat (/proc) or reading a huge file into memory.  The file is
+    opened non-blocking and checked after opening: a path that is (or was
+    swapped for) a FIFO, socket or device never hangs or streams forever.
     """
     try:
         if isinstance(path, str) and path == "-":
             return _read_capped(sys.stdin.buffer, max_bytes + 1)
-        with open(path, "rb") as handle:
+        fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
+        with open(fd, "rb") as handle:
+            mode = os.fstat(fd).st_mode
+            if not stat.S_ISREG(mode):
+                why = os.strerror(errno.EISDIR) if stat.S_ISDIR(mode) else NOT_REGULAR
+                raise _Reject("read-error", "", f"cannot read: {why}")
             return _read_capped(handle, max_bytes + 1)
     except OSError as exc:
         raise _Reject("read-error", "", f"cannot read: {exc.strerror or exc}") from None
@@ -260,8 +337,10 @@ class _Node:
     """A composed YAML node.
 
     ``kind`` is ``"mapping"`` (``value``: dict key -> (key node, value
-    node)), ``"sequence"`` (list of nodes) or ``"scalar"`` (the resolved
-    str, int, float, bool or None, and its ``text`` as written).
+    node)), ``"sequence"`` (list of nodes), ``"scalar"`` (the resolved
+    str, int, float, bool or None, and its ``text`` as written) or
+    ``"invalid"`` (refused for its YAML, its problem already reported: a
+    forbidden tag, an alias, a tag its text does not fit).
     ``line``/``column`` are 1-based.
     """
 
@@ -348,8 +427,9 @@ def _short_tag(tag):
     return "!!" + tag[len(_CORE) :] if tag.startswith(_CORE) else tag
 
 
-def _scalar(event, stack):
-    """The node of a scalar event, its value resolved from text and tag."""
+def _scalar(event, stack, problems):
+    """The node of a scalar event, its value resolved from text and tag
+    (an ``"invalid"`` node, its problem added, for a tag it does not fit)."""
     tag = event.tag
     text = event.value
     if tag is None:
@@ -360,11 +440,13 @@ def _scalar(event, stack):
         value = text if tag == _CORE + "str" else _resolve_plain(text)
         if type(value) not in _SCALAR_TAGS[tag]:
             kind = "not-a-number" if tag in (_CORE + "int", _CORE + "float") else "bad-scalar"
-            raise _Reject(
-                kind, _here(stack), f"{text!r} is not a valid {_short_tag(tag)}", **_at_mark(event.start_mark)
+            problems.add(
+                _Reject(kind, _here(stack), f"{text!r} is not a valid {_short_tag(tag)}", **_at_mark(event.start_mark))
             )
+            return _Node("invalid", None, event.start_mark, text)
     else:
-        raise _forbidden_tag(tag, event, _here(stack))
+        problems.add(_forbidden_tag(tag, event, _here(stack)))
+        return _Node("invalid", None, event.start_mark, text)
     return _Node("scalar", value, event.start_mark, text)
 
 
@@ -380,7 +462,7 @@ def _forbidden_tag(tag, event, path):
 def _stack_path(stack):
     """Field path of the node that comes next in the innermost open collection."""
     path = ""
-    for node, key in stack:
+    for node, key, _ in stack:
         if node.kind == "sequence":
             path += f"[{len(node.value)}]"
         elif key is not None:
@@ -407,92 +489,101 @@ _STARTS = {yaml.MappingStartEvent: "mapping", yaml.SequenceStartEvent: "sequence
 _ENDS = (yaml.MappingEndEvent, yaml.SequenceEndEvent)
 
 
-def _compose(get_event):
+def _compose(get_event, problems):
     """Node tree of one document, read (``get_event()``) up to and including its end event.
 
-    Returns the root node, or the document's first problem as a
-    ``_Reject``; after a problem the document's remaining events are only
-    counted for depth.  Raises ``_StreamStop`` for nesting beyond
-    ``MAX_DEPTH``.
+    Each problem found goes to ``problems`` and composing goes on, so that
+    one pass finds them all: a node with a problem of its own (a forbidden
+    tag, an alias, a tagged scalar its tag does not fit) becomes an
+    ``"invalid"`` node, which the checks pass over in silence, and the value
+    of a key that is not a string, or is repeated, is skipped.  Raises
+    ``_StreamStop`` for nesting beyond ``MAX_DEPTH``.
     """
-    stack = []  # open collections, innermost last: [node, key awaiting its value]
-    root = problem = None
+    stack = []  # open collections, innermost last: [node, key awaiting its value, tag allowed]
+    root = None
     depth = 0
+    skip = None  # while a value is skipped: its collections still open
     while True:
         event = get_event()
         kind = type(event)
         if kind is yaml.DocumentEndEvent:
-            return problem or root
+            return root
         if kind in _STARTS:
             depth += 1
             if depth > MAX_DEPTH:
                 raise _StreamStop(
                     "too-deep",
-                    _stack_path(stack) if problem is None else "",
+                    _stack_path(stack),
                     f"nested deeper than {MAX_DEPTH} levels",
                     **_at_mark(event.start_mark),
                 )
         elif kind in _ENDS:
             depth -= 1
-        if problem is not None:
+        if skip is not None:
+            skip += (kind in _STARTS) - (kind in _ENDS)
+            if not skip:
+                skip = None
             continue
-        try:
-            node = _step(stack, event, kind)
-        except _Reject as reject:
-            problem = reject
+        if kind in _STARTS:
+            collection = _STARTS[kind]
+            allowed = event.tag in (None, "!", _COLLECTION_TAGS[collection])
+            if not allowed:
+                problems.add(_forbidden_tag(event.tag, event, _here(stack)))
+            stack.append([_Node(collection, {} if collection == "mapping" else [], event.start_mark), None, allowed])
             continue
-        if node is not None:
+        if kind in _ENDS:
+            node, _, allowed = stack.pop()
+            if not allowed:
+                node.kind = "invalid"  # its content was composed for the problems in it
+        elif kind is yaml.ScalarEvent:
+            node = _scalar(event, stack, problems)
+        elif kind is yaml.AliasEvent:
+            problems.add(
+                _Reject(
+                    "alias",
+                    _here(stack),
+                    f"aliases (*{event.anchor}) are not allowed; write the value out",
+                    **_at_mark(event.start_mark),
+                )
+            )
+            node = _Node("invalid", None, event.start_mark)
+        else:  # no other event can occur inside a document
+            raise AssertionError(f"unexpected YAML event {event}")
+        if not stack:
             root = node
+            continue
+        frame = stack[-1]
+        parent, key = frame[0], frame[1]
+        if parent.kind == "sequence":
+            parent.value.append(node)
+        elif key is not None:
+            parent.value[key.value] = (key, node)
+            frame[1] = None
+        elif _good_key(node, parent, stack, problems):
+            frame[1] = node
+        else:
+            skip = 0  # the value that comes next
 
 
-def _step(stack, event, kind):
-    """Apply one event to the open collections; return the root when complete."""
-    if kind is yaml.ScalarEvent:
-        node = _scalar(event, stack)
-    elif kind in _STARTS:
-        collection = _STARTS[kind]
-        if event.tag not in (None, "!", _COLLECTION_TAGS[collection]):
-            raise _forbidden_tag(event.tag, event, _here(stack))
-        stack.append([_Node(collection, {} if collection == "mapping" else [], event.start_mark), None])
-        return None
-    elif kind in _ENDS:
-        node = stack.pop()[0]
-    elif kind is yaml.AliasEvent:
-        raise _Reject(
-            "alias",
-            _here(stack),
-            f"aliases (*{event.anchor}) are not allowed; write the value out",
-            **_at_mark(event.start_mark),
-        )
-    else:  # no other event can occur inside a document
-        raise AssertionError(f"unexpected YAML event {event}")
-    if not stack:
-        return node
-    frame = stack[-1]
-    parent, key = frame
-    if parent.kind == "sequence":
-        parent.value.append(node)
-    elif key is None:
-        _check_key(node, parent, stack)
-        frame[1] = node
-    else:
-        parent.value[key.value] = (key, node)
-        frame[1] = None
-    return None
-
-
-def _check_key(key, mapping, stack):
-    """Keys must be strings and must not repeat."""
+def _good_key(key, mapping, stack, problems):
+    """Whether ``key`` can key ``mapping``: a string, not repeated (its problem added if not)."""
+    if key.kind == "invalid":  # its problem is already added
+        return False
     if key.kind != "scalar" or not isinstance(key.value, str):
-        raise _Reject("invalid-key", _here(stack), f"keys must be strings, got {_describe(key)}", **_at(key))
+        problems.add(_Reject("invalid-key", _here(stack), f"keys must be strings, got {_describe(key)}", **_at(key)))
+        return False
     if key.value in mapping.value:
         first = mapping.value[key.value][0]
-        raise _Reject(
-            "duplicate-key",
-            _join(_stack_path(stack), key.value),
-            f"duplicate key (first given at line {first.line})",
-            **_at(key),
+        problems.add(
+            _Reject(
+                "duplicate-key",
+                _join(_stack_path(stack), key.value),
+                f"duplicate key (first given at line {first.line})",
+                **_at(key),
+            )
         )
+        return False
+    return True
 
 
 # --------------------------------------------------------------------------
@@ -747,52 +838,130 @@ class _Parts:
 
 
 def _read_text(text, file):
-    """Parse ``text`` and turn each document into a Grasp or an error."""
-    roots = []  # (start line, _Parts, root node or _Reject), one per complete document
+    """Parse ``text`` and turn each document into a Grasp or its errors, as it is read."""
+    entries = _Entries(file)
     stop = None
     parser = _LOADER(text)
     get_event = parser.get_event
     try:
         get_event()  # StreamStartEvent
         while not parser.check_event(yaml.StreamEndEvent):
+            if entries.documents == MAX_DOCUMENTS:
+                raise _StreamStop(
+                    "too-many-documents",
+                    "",
+                    f"more than {MAX_DOCUMENTS} documents; the rest of the file is not read",
+                    **_at_mark(parser.peek_event().start_mark),
+                )
             start = get_event()  # DocumentStartEvent
             events = []
+            problems = None
             try:
                 root = _fast_document(get_event, events.append)
             except _Bail:
                 # The general composer, from the document's first event.
-                root = _compose(chain(events, iter(get_event, None)).__next__)
-            roots.append((start.start_mark.line + 1, root))
+                problems = _Problems(MAX_ERRORS - entries.reported)
+                root = _compose(chain(events, iter(get_event, None)).__next__, problems)
+            entries.add(start.start_mark.line + 1, root, problems)
     except _StreamStop as reject:
         stop = reject
     except yaml.YAMLError as exc:
         stop = _syntax_error(exc, text)
     finally:
         parser.dispose()
-    if not roots and stop is None:
-        return [GraspFileError("empty-document", "no YAML document in the file", file)]
-    several = len(roots) + (stop is not None) > 1
-    stem = None  # Path(file).stem, only if a grasp has no name of its own
-    entries = []
-    for document, (line, root) in enumerate(roots):
-        if type(root) is _Parts and root.name is not None:
-            name = root.name
+    return entries.close(stop)
+
+
+class _Entries:
+    """The entries of one file, made as its documents are read.
+
+    Unnamed grasps are called after the file's stem, ``stem#k`` when the
+    file has several documents (or a stop after the first): the first
+    document's grasp is named ``stem`` until a second document shows up.
+    """
+
+    def __init__(self, file):
+        self.file = file
+        self.entries = []
+        self.documents = 0
+        self.reported = 0  # problems given an entry, at most MAX_ERRORS
+        self.unreported = 0
+        self._stem = None
+        self._first_unnamed = None  # the first document's grasp, when it took the default name
+
+    def add(self, line, root, problems):
+        """The entries of the next document, from its ``_Parts`` (``problems``
+        None) or its node tree (with the problems found composing it)."""
+        document = self.documents
+        self.documents += 1
+        if document == 1:
+            self._number_the_first()
+        if type(root) is _Parts:
+            named = root.name is not None
+            name = root.name if named else self._default_name(document)
+            grasp = root.grasp(file=self.file, document=document, name=name, line=line)
         else:
-            if stem is None:
-                stem = Path(file).stem
-            name = f"{stem}#{document + 1}" if several else stem
-        try:
-            if type(root) is _Parts:
-                entries.append(root.grasp(file=file, document=document, name=name, line=line))
-                continue
-            if isinstance(root, _Reject):
-                raise root
-            entries.append(_grasp(root, file=file, document=document, name=name, line=line))
-        except _Reject as reject:
-            entries.append(reject.error(file, document))
-    if stop is not None:
-        entries.append(stop.error(file, len(roots)))
-    return entries
+            grasp = _grasp(
+                root, problems, file=self.file, document=document, name=self._default_name(document), line=line
+            )
+            if grasp is None:
+                first = problems.first()
+                self.reported += len(first)
+                self.unreported += problems.count - len(first)
+                self.entries += [reject.error(self.file, document) for reject in first]
+                return
+            named = "name" in root.value
+        if document == 0 and not named:
+            self._first_unnamed = len(self.entries)
+        self.entries.append(grasp)
+
+    def close(self, stop):
+        """All the entries, ``stop`` (the problem that ended the reading, or None) among them."""
+        if stop is not None:
+            self._number_the_first()
+            self.entries.append(stop.error(self.file, self.documents))
+        elif not self.documents:
+            return [GraspFileError("empty-document", "no YAML document in the file", self.file)]
+        if self.unreported:
+            self.entries.append(
+                GraspFileError(
+                    "too-many-errors",
+                    f"{self.unreported} more problems in this file not reported (only the first {MAX_ERRORS} are)",
+                    self.file,
+                )
+            )
+        return self.entries
+
+    def _default_name(self, document):
+        if self._stem is None:
+            self._stem = _stem_name(self.file)
+        return self._stem if document == 0 else f"{self._stem}#{document + 1}"
+
+    def _number_the_first(self):
+        """The file has more than one document: an unnamed first grasp is ``stem#1``."""
+        if self._first_unnamed is not None:
+            grasp = self.entries[self._first_unnamed]
+            self.entries[self._first_unnamed] = replace(grasp, name=f"{grasp.name}#1")
+            self._first_unnamed = None
+
+
+# Characters a grasp name must not hold (see _NOT_IN_A_NAME), and the
+# surrogates that stand for undecodable bytes in a file name.
+_NOT_IN_A_STEM = re.compile("[\x00-\x1f\x7f-\x9f\u2028\u2029\ud800-\udfff]")
+
+
+def _stem_name(file):
+    """A file's stem as a valid grasp name: bytes that are not UTF-8 (which
+    Python keeps as surrogates) and control characters shown escaped,
+    ``\\xff``, ``\\x1b``, as in a Python string."""
+
+    def escape(match):
+        code = ord(match.group())
+        if 0xDC80 <= code <= 0xDCFF:  # os.fsdecode's stand-in for byte code - 0xDC00
+            code -= 0xDC00
+        return f"\\x{code:02x}" if code < 0x100 else f"\\u{code:04x}"
+
+    return _NOT_IN_A_STEM.sub(escape, Path(file).stem)
 
 
 def _syntax_error(exc, text):
@@ -808,17 +977,23 @@ def _syntax_error(exc, text):
     return _StreamStop("yaml-syntax", "", f"invalid YAML: {problem}", line=mark.line + 1, column=mark.column + 1)
 
 
-def _grasp(root, *, file, document, name, line):
-    """Check one document's node tree and build its Grasp."""
+def _grasp(root, problems, *, file, document, name, line):
+    """Check one document's node tree: its Grasp, or None when ``problems`` has any."""
     if root.kind == "scalar" and root.value is None:
-        raise _Reject("empty-document", "", "empty document", **_at(root))
-    fields = _mapping(root, "", GRASP_KEYS, ("contacts",))
+        problems.add(_Reject("empty-document", "", "empty document", **_at(root)))
+        return None
+    fields = _mapping(root, "", GRASP_KEYS, ("contacts",), problems)
+    if fields is None:
+        return None
     if "name" in fields:
-        name = _name(fields["name"], "name")
-    units = _name(fields["units"], "units") if "units" in fields else None
-    wrist = _readonly(_vector(fields["wrist"], 3, "wrist")) if "wrist" in fields else None
-    contact_names, points, normals = _contacts(fields["contacts"])
-    twists = _twists(fields["twists"]) if "twists" in fields else ()
+        name = _name(fields["name"], "name", problems)
+    units = _name(fields["units"], "units", problems) if "units" in fields else None
+    wrist = _vector(fields["wrist"], 3, "wrist", problems) if "wrist" in fields else None
+    contacts = _contacts(fields["contacts"], problems) if "contacts" in fields else None
+    twists = _twists(fields["twists"], problems) if "twists" in fields else ()
+    if problems.count:
+        return None
+    contact_names, points, normals = contacts
     return Grasp(
         name=name,
         units=units,
@@ -827,95 +1002,137 @@ def _grasp(root, *, file, document, name, line):
         contact_names=contact_names,
         points=points,
         normals=normals,
-        wrist=wrist,
+        wrist=None if wrist is None else _readonly(wrist),
         twists=twists,
         line=line,
     )
 
 
-def _contacts(node):
-    """Names, points and unit normals of the three contacts."""
-    items = _sequence(node, "contacts")
+# What contacts look like, for the message when they are not a list.
+_CONTACTS_SHAPE = "a list of 3 contacts like [{point: [x, y, z], normal: [x, y, z]}, ...]"
+
+
+def _contacts(node, problems):
+    """Names, points and unit normals of the three contacts (None after a problem)."""
+    items = _sequence(node, "contacts", problems, _CONTACTS_SHAPE, _contacts_hint)
+    if items is None:
+        return None
     if len(items) != 3:
-        raise _Reject("contact-count", "contacts", f"expected exactly 3 contacts, got {len(items)}", **_at(node))
-    names, points, normals = [], [], []
+        problems.add(
+            _Reject("contact-count", "contacts", f"expected exactly 3 contacts, got {len(items)}", **_at(node))
+        )
+    names, points, normals = {}, [], []
     for i, item in enumerate(items):
         path = f"contacts[{i}]"
-        fields = _mapping(item, path, CONTACT_KEYS, ("point", "normal"))
-        names.append(_entry_name(fields, item, "contacts", i, names))
-        points.append(_vector(fields["point"], 3, path + ".point"))
-        normal = _vector(fields["normal"], 3, path + ".normal")
-        if not any(normal):
-            raise _Reject("zero-normal", path + ".normal", "a zero vector has no direction", **_at(fields["normal"]))
-        normals.append(screws.direction3(*normal))  # of any finite size: no over- or underflow
+        fields = _mapping(item, path, CONTACT_KEYS, ("point", "normal"), problems)
+        if fields is None:
+            continue
+        _entry_name(fields, item, "contacts", i, names, problems)
+        points.append(_vector(fields["point"], 3, path + ".point", problems) if "point" in fields else None)
+        normal = _vector(fields["normal"], 3, path + ".normal", problems) if "normal" in fields else None
+        if normal is not None and not any(normal):
+            problems.add(
+                _Reject("zero-normal", path + ".normal", "a zero vector has no direction", **_at(fields["normal"]))
+            )
+        normals.append(normal)
+    if problems.count:
+        return None
+    normals = [screws.direction3(*n) for n in normals]  # of any finite size: no over- or underflow
     return tuple(names), _readonly(np.array(points)), _readonly(normals)
 
 
-def _twists(node):
-    """The desired twists, converted to ``(omega; v)`` at the origin."""
-    items = _sequence(node, "twists")
-    names, parts = [], []
+def _contacts_hint(node):
+    """What to change when ``contacts`` is a mapping."""
+    if node.kind != "mapping" or not node.value:
+        return ""
+    if set(node.value) & set(CONTACT_KEYS):
+        return "; start each of the three contacts with '- '"
+    name = _shorten(str(next(iter(node.value))))
+    return f"; write each as '- name: {name}' with its point and normal under it"
+
+
+def _twists(node, problems):
+    """The desired twists, converted to ``(omega; v)`` at the origin (None after a problem)."""
+    items = _sequence(node, "twists", problems)
+    if items is None:
+        return None
+    names, parts = {}, []
     for i, item in enumerate(items):
         path = f"twists[{i}]"
-        fields = _mapping(item, path, TWIST_KEYS, ())
-        names.append(_entry_name(fields, item, "twists", i, names))
-        parts.append(_twist_parts(fields, item, path))
-    if not items:
-        return ()
+        fields = _mapping(item, path, TWIST_KEYS, (), problems)
+        if fields is None:
+            continue
+        _entry_name(fields, item, "twists", i, names, problems)
+        parts.append(_twist_parts(fields, item, path, problems))
+    if problems.count or not items:
+        return None if problems.count else ()
     omega, velocity, at = np.array(parts).transpose(1, 0, 2)
     with np.errstate(over="ignore", invalid="ignore"):
         screw = screws.twist_at(omega, velocity, at)
-    overflowed = np.flatnonzero(~np.isfinite(screw).all(axis=1))
-    if overflowed.size:
-        i = int(overflowed[0])
-        raise _Reject(
-            "non-finite",
-            f"twists[{i}]",
-            "the velocity of the origin overflows (linear + angular x (origin - at))",
-            **_at(items[i]),
+    for i in np.flatnonzero(~np.isfinite(screw).all(axis=1)):
+        problems.add(
+            _Reject(
+                "non-finite",
+                f"twists[{i}]",
+                "the velocity of the origin overflows (linear + angular x (origin - at))",
+                **_at(items[i]),
+            )
         )
+    if problems.count:
+        return None
     return tuple(Twist(name, _readonly(s), item.line) for name, s, item in zip(names, screw, items))
 
 
-def _twist_parts(fields, item, path):
-    """``(angular, linear, at)`` of one twist entry, zeros where not given."""
+def _twist_parts(fields, item, path, problems):
+    """``(angular, linear, at)`` of one twist entry, zeros where not given (None after a problem)."""
     zero = [0.0, 0.0, 0.0]
     if "screw" in fields:
         for other in ("angular", "linear", "at"):
             if other in fields:
-                raise _Reject(
-                    "conflicting-keys",
-                    _join(path, other),
-                    "cannot be combined with 'screw' (give screw, or angular/linear/at)",
-                    **_at(fields[other]),
+                problems.add(
+                    _Reject(
+                        "conflicting-keys",
+                        _join(path, other),
+                        "cannot be combined with 'screw' (give screw, or angular/linear/at)",
+                        **_at(fields[other]),
+                    )
                 )
-        screw = _vector(fields["screw"], 6, path + ".screw")
-        return screw[:3], screw[3:], zero
+        screw = _vector(fields["screw"], 6, path + ".screw", problems)
+        return None if screw is None else (screw[:3], screw[3:], zero)
     if "angular" not in fields and "linear" not in fields:
-        raise _Reject("missing-key", path, "needs 'screw', or 'angular' and/or 'linear'", **_at(item))
-    return tuple(
-        _vector(fields[key], 3, f"{path}.{key}") if key in fields else zero for key in ("angular", "linear", "at")
-    )
+        problems.add(_Reject("missing-key", path, "needs 'screw', or 'angular' and/or 'linear'", **_at(item)))
+    parts = [
+        _vector(fields[key], 3, f"{path}.{key}", problems) if key in fields else zero
+        for key in ("angular", "linear", "at")
+    ]
+    return None if None in parts else parts
 
 
-def _entry_name(fields, item, collection, index, taken):
-    """Name of entry ``index`` of a list of contacts or twists (default: its
-    1-based position), checked to be unique among the names ``taken``."""
+def _entry_name(fields, item, collection, index, taken, problems):
+    """Name entry ``index`` of a list of contacts or twists (default: its
+    1-based position) in ``taken`` (name -> index), unless it is invalid or
+    already taken."""
     path = f"{collection}[{index}]"
     node = fields.get("name")
-    name = _name(node, path + ".name") if node is not None else str(index + 1)
+    name = _name(node, path + ".name", problems) if node is not None else str(index + 1)
+    if name is None:
+        return
     if name in taken:
-        raise _Reject(
-            "duplicate-name",
-            path + ".name" if node is not None else path,
-            f"duplicate name {name!r} (also {collection}[{taken.index(name)}])",
-            **_at(node if node is not None else item),
+        problems.add(
+            _Reject(
+                "duplicate-name",
+                path + ".name" if node is not None else path,
+                f"duplicate name {name!r} (also {collection}[{taken[name]}])",
+                **_at(node if node is not None else item),
+            )
         )
-    return name
+        return
+    taken[name] = index
 
 
 # --------------------------------------------------------------------------
-# Typed values.
+# Typed values.  Each adds its problems and returns None after one; an
+# "invalid" node (its problem already added) is passed over in silence.
 
 
 def _describe(node):
@@ -937,56 +1154,77 @@ def _shorten(text):
     return text if len(text) <= 30 else text[:27] + "..."
 
 
-def _mapping(node, path, keys, required):
-    """The ``{key: value node}`` of a mapping node with only known keys."""
+def _mapping(node, path, keys, required, problems):
+    """The ``{key: value node}`` of the known keys of a mapping node."""
+    if node.kind == "invalid":
+        return None
     if node.kind != "mapping":
-        raise _Reject("not-a-mapping", path or "top level", f"expected a mapping, got {_describe(node)}", **_at(node))
+        problems.add(
+            _Reject("not-a-mapping", path or "top level", f"expected a mapping, got {_describe(node)}", **_at(node))
+        )
+        return None
     fields = {}
+    meant = set()  # the keys that misspelled ones were taken for
+    unknown = 0
     for key, (key_node, value) in node.value.items():
-        if key not in keys:
-            raise _Reject("unknown-key", _join(path, key), f"unknown key{_suggest(key, keys)}", **_at(key_node))
-        fields[key] = value
+        if key in keys:
+            fields[key] = value
+            continue
+        unknown += 1
+        if unknown > MAX_ERRORS:
+            # After MAX_ERRORS unknown keys (all before it in the file) this
+            # one's problem can never be reported: count it, spare the rest.
+            problems.count += 1
+            continue
+        # difflib is only needed on this error path.
+        from difflib import get_close_matches
+
+        close = get_close_matches(key, keys, n=1)
+        meant.update(close)
+        hint = f"did you mean {close[0]!r}?" if close else f"expected one of: {', '.join(keys)}"
+        problems.add(_Reject("unknown-key", _join(path, key), f"unknown key ({hint})", **_at(key_node)))
     for key in required:
-        if key not in fields:
-            raise _Reject("missing-key", _join(path, key), "required key is missing", **_at(node))
+        if key not in fields and key not in meant:  # a misspelling already says it
+            problems.add(_Reject("missing-key", _join(path, key), "required key is missing", **_at(node)))
     return fields
 
 
-def _suggest(key, keys):
-    # difflib is only needed on this error path.
-    from difflib import get_close_matches
-
-    close = get_close_matches(key, keys, n=1)
-    if close:
-        return f" (did you mean {close[0]!r}?)"
-    return f" (expected one of: {', '.join(keys)})"
-
-
-def _sequence(node, path):
-    if node.kind != "sequence":
-        raise _Reject("not-a-list", path, f"expected a list, got {_describe(node)}", **_at(node))
-    return node.value
+def _sequence(node, path, problems, expected="a list", hint=None):
+    """The items of a sequence node."""
+    if node.kind == "sequence":
+        return node.value
+    if node.kind != "invalid":
+        more = hint(node) if hint else ""
+        problems.add(_Reject("not-a-list", path, f"expected {expected}, got {_describe(node)}{more}", **_at(node)))
+    return None
 
 
-def _name(node, path):
+def _name(node, path, problems):
     """A label: a non-empty single line, taken as written.
 
     A plain ``1``, ``1e3`` or ``true`` is the label "1", "1e3", "true":
     PyYAML's dumper leaves strings like "1e3" unquoted (YAML 1.1 reads
     them as strings), and a label has no use for the number.
     """
+    if node.kind == "invalid":
+        return None
     if node.kind != "scalar" or node.value is None:
-        raise _Reject("not-a-string", path, f"expected a name, got {_describe(node)}", **_at(node))
+        problems.add(_Reject("not-a-string", path, f"expected a name, got {_describe(node)}", **_at(node)))
+        return None
     if not node.text.strip():
-        raise _Reject("invalid-name", path, "must be a non-empty single line", **_at(node))
+        problems.add(_Reject("invalid-name", path, "must be a non-empty single line", **_at(node)))
+        return None
     bad = _NOT_IN_A_NAME.search(node.text)
     if bad:
-        raise _Reject(
-            "invalid-name",
-            path,
-            f"must be a non-empty single line without control characters (found U+{ord(bad.group()):04X})",
-            **_at(node),
+        problems.add(
+            _Reject(
+                "invalid-name",
+                path,
+                f"must be a non-empty single line without control characters (found U+{ord(bad.group()):04X})",
+                **_at(node),
+            )
         )
+        return None
     return node.text
 
 
@@ -998,26 +1236,40 @@ def _name(node, path):
 _NOT_IN_A_NAME = re.compile("[\x00-\x1f\x7f-\x9f\u2028\u2029]")
 
 
-def _vector(node, length, path):
+def _vector(node, length, path, problems):
     """A list of ``length`` finite numbers, as floats."""
+    if node.kind == "invalid":
+        return None
     if node.kind != "sequence":
-        raise _Reject("not-a-list", path, f"expected {length} numbers, got {_describe(node)}", **_at(node))
-    if len(node.value) != length:
-        raise _Reject("vector-length", path, f"expected {length} numbers, got {len(node.value)}", **_at(node))
-    return [_number(item, f"{path}[{i}]") for i, item in enumerate(node.value)]
+        problems.add(_Reject("not-a-list", path, f"expected {length} numbers, got {_describe(node)}", **_at(node)))
+        return None
+    values = [_number(item, f"{path}[{i}]", problems) for i, item in enumerate(node.value)]
+    if len(values) != length:
+        hint = ""
+        if length == 3 and len(values) == 6:
+            hint = "; a 6-vector (omega; v) goes under `screw:`"
+        elif length == 6 and len(values) == 3:
+            hint = "; a 3-vector goes under `angular:` or `linear:`"
+        problems.add(_Reject("vector-length", path, f"expected {length} numbers, got {len(values)}{hint}", **_at(node)))
+        return None
+    return None if None in values else values
 
 
-def _number(node, path):
+def _number(node, path, problems):
     """A finite number (int or float; booleans and strings are not numbers)."""
     value = node.value
+    if node.kind == "invalid":
+        return None
     if node.kind != "scalar" or type(value) not in (int, float):
-        raise _Reject("not-a-number", path, f"expected a number, got {_describe(node)}", **_at(node))
+        problems.add(_Reject("not-a-number", path, f"expected a number, got {_describe(node)}", **_at(node)))
+        return None
     try:
         value = float(value)
     except OverflowError:  # an integer beyond the float range
         value = math.inf
     if not math.isfinite(value):
-        raise _Reject("non-finite", path, f"expected a finite number, got {_shorten(node.text)}", **_at(node))
+        problems.add(_Reject("non-finite", path, f"expected a finite number, got {_shorten(node.text)}", **_at(node)))
+        return None
     return value
 
 

@@ -1,26 +1,40 @@
 """Which files a command reads: paths, folders and stdin, in a stable order.
 
-A folder is searched recursively for ``*.yaml`` and ``*.yml``; its files are
-sorted by their path relative to it.  Symbolic links are followed, but a
-folder reached twice (a link cycle, or two links to one place) is read only
-the first time.  A path that does not exist, or a folder that cannot be
-listed, becomes a :class:`GraspFileError` in its place so that the rest of
-the batch goes on.
+A folder is searched at any depth for grasp files: names ending in ``.yaml``,
+``.yml`` or ``.json`` (JSON is YAML), in any letter case.  Its files come
+sorted by their path relative to it.  The walk keeps its own stack instead
+of recursing, so no depth of folders can exhaust Python's recursion limit.
+Symbolic links are followed, but a folder reached twice (a link cycle, or two
+links to one place) is read only the first time.  A path that cannot be read,
+a folder that cannot be listed, and a folder with no grasp file at all each
+become a :class:`GraspFileError` in its place, so that the rest of the batch
+goes on.  Names are ``str`` throughout: bytes that are not UTF-8 are kept
+as Python's surrogate escapes (``os.fsdecode``), so every path still opens.
 """
 
 from __future__ import annotations
 
+import errno
 import os
 import sys
 from collections.abc import Iterable, Iterator
 
 from ..model import Grasp, GraspFileError
-from .grasp_file import DEFAULT_MAX_BYTES, read_grasps
+from .grasp_file import DEFAULT_MAX_BYTES, NOT_REGULAR, read_grasps
 
-__all__ = ["GRASP_SUFFIXES", "STDIN", "expand", "read"]
+__all__ = ["GRASP_SUFFIXES", "STDIN", "expand", "is_grasp_file", "read"]
 
-GRASP_SUFFIXES = (".yaml", ".yml")
+GRASP_SUFFIXES = (".yaml", ".yml", ".json")
 STDIN = "-"
+
+
+def is_grasp_file(name: str) -> bool:
+    """Whether a folder's entry ``name`` is read as a grasp file (its suffix, in any case).
+
+    >>> [is_grasp_file(n) for n in ("box.yaml", "BOX.YML", "hand.json", "notes.txt", "yaml")]
+    [True, True, True, False, False]
+    """
+    return name.lower().endswith(GRASP_SUFFIXES)
 
 
 def expand(paths: Iterable[str]) -> Iterator[str | GraspFileError]:
@@ -39,29 +53,71 @@ def expand(paths: Iterable[str]) -> Iterator[str | GraspFileError]:
 
 
 def _not_a_file(path: str) -> str:
-    # a pipe, socket or device would block or never end: never open one
-    return "not a regular file (a pipe, socket or device)" if os.path.exists(path) else "no such file or folder"
+    """Why ``path`` is neither a regular file nor a folder (a pipe, socket or
+    device would block or never end: never open one)."""
+    try:
+        os.stat(path)
+    except OSError as exc:
+        if exc.errno == errno.ENOENT:
+            return "a symbolic link to nothing" if os.path.islink(path) else "no such file or folder"
+        return exc.strerror or str(exc)  # e.g. a link to itself: too many levels of symbolic links
+    return NOT_REGULAR
 
 
 def _walk(top: str) -> Iterator[str | GraspFileError]:
-    seen: set[str] = set()
-    found: list[str] = []
-    errors: list[GraspFileError] = []
+    """The grasp files under the folder ``top``, depth first in name order.
 
-    def on_error(exc: OSError):
-        errors.append(_io_error(exc.filename or top, exc.strerror or str(exc)))
-
-    for folder, dirs, files in os.walk(top, followlinks=True, onerror=on_error):
-        real = os.path.realpath(folder)
-        if real in seen:
-            dirs[:] = []  # a cycle, or a second link to a folder already read
+    Visiting each folder's entries in name order, a subfolder's files at its
+    name's place, gives the files sorted by their path's components.
+    """
+    seen: set[tuple[int, int]] = set()  # (device, inode) of the folders listed
+    pending: list[tuple[bool, str | GraspFileError]] = [(True, top)]  # (a folder?, path or error), next last
+    empty = True
+    while pending:
+        folder, item = pending.pop()
+        if not folder:
+            empty = False
+            yield item
             continue
-        seen.add(real)
-        dirs.sort()
-        found.extend(os.path.join(folder, f) for f in files if f.endswith(GRASP_SUFFIXES))
-    yield from errors
-    for path in sorted(found, key=lambda p: os.path.relpath(p, top).split(os.sep)):
-        yield path if os.path.isfile(path) else _io_error(path, _not_a_file(path))
+        try:
+            info = os.stat(item)
+            if (info.st_dev, info.st_ino) in seen:
+                continue  # a cycle, or a second link to a folder already read
+            seen.add((info.st_dev, info.st_ino))
+            with os.scandir(item) as listing:
+                entries = sorted(listing, key=lambda entry: entry.name)
+        except OSError as exc:
+            empty = False
+            yield _io_error(item, exc.strerror or str(exc))
+            continue
+        for entry in reversed(entries):
+            if _is_dir(entry):
+                pending.append((True, entry.path))
+            elif is_grasp_file(entry.name):
+                pending.append(
+                    (False, entry.path if _is_file(entry) else _io_error(entry.path, _not_a_file(entry.path)))
+                )
+    if empty:
+        suffixes = ", ".join(GRASP_SUFFIXES[:-1]) + " or " + GRASP_SUFFIXES[-1]
+        yield GraspFileError(
+            "no-grasp-files",
+            f"no grasp files in this folder or below it (looked for names ending in {suffixes}, in any letter case)",
+            top,
+        )
+
+
+def _is_dir(entry: os.DirEntry) -> bool:
+    try:
+        return entry.is_dir()  # follows a link
+    except OSError:
+        return False
+
+
+def _is_file(entry: os.DirEntry) -> bool:
+    try:
+        return entry.is_file()  # follows a link; no system call for a plain file
+    except OSError:
+        return False
 
 
 def read(path: str, max_bytes: int | None = None) -> list[Grasp | GraspFileError]:
