@@ -7,7 +7,6 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-from grasptwist import plot
 from grasptwist.cli import app
 
 pytest.importorskip("matplotlib")
@@ -35,28 +34,56 @@ def test_one_grasp_and_twist_to_png_and_svg(tmp_path):
     assert r.exit_code == 0 and (tmp_path / "p.svg").read_text().lstrip().startswith("<?xml")
 
 
-def test_a_folder_gives_one_image_per_grasp_and_twist(tmp_path):
-    r = run("plot", GRASPS, "-o", tmp_path / "out")
-    assert r.exit_code == 0, r.output
-    written = r.stdout.split()
-    assert len(written) == 15 and all(Path(p).exists() for p in written)
-    assert Path(written[0]).name == "box-edge-tip-over-edge.png"
+def test_a_folder_gives_one_image_per_grasp_and_twist_and_an_error_line_per_bad_input(tmp_path):
+    # one good grasp (drawn once: the drawing itself is tested in test_plot), one the method
+    # cannot draw, one file that cannot be read
+    folder = tmp_path / "in"
+    folder.mkdir()
+    cylinder = (GRASPS / "cylinder.yaml").read_text()
+    (folder / "a.yaml").write_text(cylinder.replace("name: cylinder", "name: cylinder/a"))
+    (folder / "b.yaml").write_text(cylinder.replace("name: cylinder", "name: no-wrist").replace("wrist:", "#"))
+    (folder / "c.yaml").write_text("contacts: [\n")
+    r = run(
+        "plot",
+        folder,
+        "-o",
+        tmp_path / "out",
+        "--twist",
+        "0,0,1,0,0,0",
+        "--twist-name",
+        "spin",
+        "--method",
+        "off-tangent",
+    )
+    assert r.exit_code == 1
+    assert r.stdout == f"{tmp_path / 'out' / 'cylinder_a-spin.png'}\n"
+    assert png_size(tmp_path / "out" / "cylinder_a-spin.png") == (1400, 700)
+    errors = r.stderr.splitlines()
+    assert len(errors) == 2
+    assert errors[0].startswith(f"{folder / 'c.yaml'}:2:1: error: ")
+    assert errors[1] == (
+        f"{folder / 'b.yaml'}: grasp 'no-wrist': error: "
+        "the off-tangent method needs a wrist point; use --method tangent or add a wrist"
+    )
 
 
 def test_usage_errors_exit_2(tmp_path):
     r = run("plot", GRASPS / "cylinder.yaml", "--twist-name", "nope", "-o", tmp_path / "x.png")
     assert r.exit_code == 2 and "has no twist 'nope' (it has: sigma-1, spin-z, lift-z)" in r.output
-    assert run("plot", GRASPS / "cylinder.yaml", "-o", tmp_path / "x.gif").exit_code == 2
-    assert not (tmp_path / "x.png").exists()
+    r = run("plot", GRASPS / "cylinder.yaml", "-o", tmp_path / "x.gif")
+    assert r.exit_code == 2 and "cannot write '.gif': use one of .png, .svg, .pdf" in r.output
+    r = run("plot", tmp_path / "rows.npz", "-o", tmp_path / "x.png")
+    assert r.exit_code == 2 and "plot draws grasp files (.yaml, .yml) or folders of them, not data sets" in r.output
+    (tmp_path / "g.yaml").write_text((GRASPS / "cylinder.yaml").read_text().replace("wrist:", "#"))
+    r = run("plot", tmp_path / "g.yaml", "--method", "off-tangent", "-o", tmp_path / "x.png")
+    assert r.exit_code == 2 and "the off-tangent method needs a wrist point" in r.output
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["g.yaml"]
 
 
 def test_without_matplotlib_it_says_how_to_install_it(tmp_path, monkeypatch):
-    def missing():
-        raise plot.MissingMatplotlib("grasptwist plot needs matplotlib: pip install 'grasptwist[plot]'")
-
-    monkeypatch.setattr(plot, "require_matplotlib", missing)
+    monkeypatch.setitem(sys.modules, "matplotlib", None)  # makes `import matplotlib` fail
     r = run("plot", GRASPS / "cylinder.yaml", "-o", tmp_path / "c.png")
-    assert r.exit_code == 1
+    assert r.exit_code == 1 and r.stdout == "" and not (tmp_path / "c.png").exists()
     assert r.stderr == "grasptwist: error: grasptwist plot needs matplotlib: pip install 'grasptwist[plot]'\n"
 
 

@@ -1,4 +1,57 @@
-"""Pictures of a grasp and a twist: the scene as data, rendered by matplotlib."""
+"""Pictures of a grasp and a twist: the scene as data (:mod:`.scene`), drawn by matplotlib (:mod:`.render`)."""
 
-from .scene import *  # noqa: F401,F403
-from .scene import __all__  # noqa: F401
+from .render import (
+    FORMATS,
+    MissingMatplotlib,
+    Note,
+    TwistNotFound,
+    chosen_twist,
+    image_name,
+    image_paths,
+    plot_grasp,
+    render,
+    render_grasps,
+    render_inputs,
+    require_matplotlib,
+)
+from .scene import (
+    KINDS,
+    METHODS,
+    Arrow,
+    Marker,
+    Patch,
+    Scene,
+    Segment,
+    check_method,
+    default_method,
+    grasp_scene,
+    legend_text,
+    scene,
+)
+
+__all__ = [
+    "FORMATS",
+    "KINDS",
+    "METHODS",
+    "Arrow",
+    "Marker",
+    "MissingMatplotlib",
+    "Note",
+    "Patch",
+    "Scene",
+    "Segment",
+    "TwistNotFound",
+    "check_method",
+    "chosen_twist",
+    "default_method",
+    "grasp_scene",
+    "image_name",
+    "image_paths",
+    "legend_text",
+    "plot_grasp",
+    "render",
+    "render_grasps",
+    "render_inputs",
+    "require_matplotlib",
+    "scene",
+]

@@ -1,20 +1,11 @@
-"""Pictures of a grasp, its basis screw axes and the finger-tip motions of a twist.
+"""The picture of a grasp, its basis screw axes and a twist's finger-tip motions, as data.
 
-Two layers, so the geometry can be tested without pixels:
-
-* :func:`scene` (pure numpy, no matplotlib) turns a grasp, a twist and a method
-  into a :class:`Scene`: labelled points, segments (screw axes), arrows
-  (normals and velocities) and plane patches, each with a *kind* that the
-  renderer styles and the legend names.  Everything in it comes from the
-  engine (:mod:`grasptwist.engine.decompose`) and :mod:`grasptwist.engine.screws`.
-* :func:`render` draws a scene with matplotlib, two 3D views side by side.
-  matplotlib is an optional extra: it is imported only inside the functions
-  that draw, so ``import grasptwist.plot`` works without it, and
-  :func:`require_matplotlib` says how to install it.
-
-:func:`plot_grasp` and :func:`render_grasps` do both for objects shaped like
-the grasp-file loader's ``Grasp`` (``name, contact_names, points, normals,
-wrist, twists``) and ``Twist`` (``name, screw``).
+:func:`scene` (numpy only, no matplotlib) turns a grasp, a twist and a method
+into a :class:`Scene`: labelled points, segments (screw axes), arrows (normals
+and velocities) and plane patches, each with a *kind* that the renderer
+(:mod:`grasptwist.plot.render`) styles and the legend names.  Every number in
+it comes from the engine (:mod:`grasptwist.engine.decompose`,
+:mod:`grasptwist.engine.screws`), so tests check the geometry, not pixels.
 
 Velocity arrows keep their true vectors; the scene also gives the one length
 per unit velocity (``Arrow.scale``) that draws them all at a common scale
@@ -23,41 +14,30 @@ fitted to the grasp, so their lengths compare with each other.
 
 from __future__ import annotations
 
-import re
 from dataclasses import dataclass, field
-from pathlib import Path
 
 import numpy as np
 
 from ..engine.decompose import contact_velocities, decompose_off_tangent, decompose_tangent
 from ..engine.degeneracy import Status, conditioning_warning, status_message
-from ..engine.screws import axis_point, cross, dot, field_at, norm, pitch, unit
+from ..engine.screws import J, K, axis_point, cross, dot, field_at, norm, pitch, rigid_motion, unit
 
 __all__ = [
     "KINDS",
     "METHODS",
     "Arrow",
     "Marker",
-    "MissingMatplotlib",
     "Patch",
     "Scene",
     "Segment",
+    "check_method",
     "default_method",
     "grasp_scene",
     "legend_text",
-    "plot_grasp",
-    "render",
-    "render_grasps",
-    "require_matplotlib",
     "scene",
 ]
 
 METHODS = ("off-tangent", "tangent")
-FORMATS = (".png", ".svg", ".pdf")
-INSTALL_HINT = "grasptwist plot needs matplotlib: pip install 'grasptwist[plot]'"
-
-_J = [1, 2, 0]
-_K = [2, 0, 1]
 
 # Lengths drawn relative to the grasp's size (the longest side of the contact triangle).
 _AXIS_HALF = 0.9  # half-length of an axis segment: reaches every contact from the centroid
@@ -65,22 +45,6 @@ _NORMAL_LEN = 0.25
 _PATCH_HALF = 0.15  # half-side of a tangent-plane square
 _VELOCITY_LEN = 0.45  # the longest chain of velocity arrows at one contact
 _FAR_AXIS = 3.0  # a twist axis further than this from the centroid is not drawn
-
-
-class MissingMatplotlib(RuntimeError):
-    """matplotlib is not installed; the message says how to install it."""
-
-
-def require_matplotlib():
-    """Import and return matplotlib, or raise :class:`MissingMatplotlib`.
-
-    The CLI turns the error into its message and exit status 1.
-    """
-    try:
-        import matplotlib
-    except ImportError as exc:
-        raise MissingMatplotlib(INSTALL_HINT) from exc
-    return matplotlib
 
 
 # --- scene data ---------------------------------------------------------------
@@ -237,6 +201,29 @@ def default_method(wrist) -> str:
     return "tangent" if wrist is None else "off-tangent"
 
 
+def check_method(method: str | None, wrist) -> str:
+    """The method a picture of a grasp with this ``wrist`` uses: ``method``, or the default.
+
+    Raises
+    ------
+    ValueError
+        An unknown ``method``, or ``"off-tangent"`` with no ``wrist``.
+
+    >>> check_method(None, None)
+    'tangent'
+    >>> check_method("off-tangent", None)
+    Traceback (most recent call last):
+    ...
+    ValueError: the off-tangent method needs a wrist point; use --method tangent or add a wrist
+    """
+    method = method or default_method(wrist)
+    if method not in METHODS:
+        raise ValueError(f"unknown method {method!r}: choose one of {', '.join(METHODS)}")
+    if method == "off-tangent" and wrist is None:
+        raise ValueError("the off-tangent method needs a wrist point; use --method tangent or add a wrist")
+    return method
+
+
 def scene(
     points,
     normals,
@@ -282,13 +269,9 @@ def scene(
     Raises
     ------
     ValueError
-        Unknown method, or the off-tangent method without a wrist.
+        Unknown method, or the off-tangent method without a wrist (:func:`check_method`).
     """
-    method = method or default_method(wrist)
-    if method not in METHODS:
-        raise ValueError(f"unknown method {method!r}: choose one of {', '.join(METHODS)}")
-    if method == "off-tangent" and wrist is None:
-        raise ValueError("the off-tangent method needs a wrist point; use --method tangent or add a wrist")
+    method = check_method(method, wrist)
     points = np.asarray(points, dtype=float)
     normals = np.asarray(normals, dtype=float)
     wrist = None if wrist is None else np.asarray(wrist, dtype=float)
@@ -365,13 +348,13 @@ def _velocity_arrows(points, t, r, method, names, size, ok):
         for i in range(3):
             at = f"(p{_sub(names[i])})"
             parts[i].append((r.x[i] * sigma_at[i], f"x{_sub(names[i])} Σ{_sub(names[i])}{at}", "sigma-part"))
-            for j in (_J[i], _K[i]):
+            for j in (J[i], K[i]):
                 parts[i].append((r.y[j] * psi_at[i, j], f"y{_sub(names[j])} Ψ{_sub(names[j])}{at}", "psi-part"))
     elif ok:
         theta_velocity, sigma_velocity = r.contact_split()
         for i in range(3):
             at = f"(p{_sub(names[i])})"
-            for j in (_J[i], _K[i]):
+            for j in (J[i], K[i]):
                 parts[i].append((theta_velocity[i, j], f"α{_sub(names[j])} Θ{_sub(names[j])}{at}", "theta-part"))
             parts[i].append((sigma_velocity[i], f"β{_sub(names[i])} Σ{_sub(names[i])}{at}", "sigma-part"))
     # One length per unit velocity for every arrow, fitted so that the longest
@@ -407,9 +390,9 @@ def _twist_element(t, centroid, size):
 def _axis_segment(s, centre, half, label, kind) -> Segment:
     """The piece of the axis of screw ``s (6,)`` of half-length ``half``
     centred on the axis point nearest ``centre``."""
-    a = axis_point(s)
+    # The axis point nearest the origin, in a frame moved so that `centre` is its origin.
+    foot = centre + axis_point(rigid_motion(s, np.eye(3), -centre))
     d = unit(s[:3])
-    foot = a + dot(centre - a, d) * d
     return Segment(foot - half * d, foot + half * d, label, kind)
 
 
@@ -447,7 +430,7 @@ def _views(points, wrist):
 
 def _grasp_size(points) -> float:
     """Longest side of the contact triangle (1 if the contacts coincide)."""
-    size = float(np.max(norm(points - points[_J])))
+    size = float(np.max(norm(points - points[list(J)])))
     return size if size > 0 and np.isfinite(size) else 1.0
 
 
@@ -496,195 +479,3 @@ def grasp_scene(grasp, twist=None, *, twist_name: str | None = None, method: str
         grasp_name=grasp.name,
         twist_name=twist_name,
     )
-
-
-def plot_grasp(grasp, path, twist=None, *, twist_name=None, method=None, size=(1400, 700), dpi=100) -> Path:
-    """Render one grasp and twist to ``path`` (see :func:`grasp_scene`, :func:`render`)."""
-    return render(grasp_scene(grasp, twist, twist_name=twist_name, method=method), path, size=size, dpi=dpi)
-
-
-def render_grasps(grasps, folder, *, method=None, suffix=".png", size=(1400, 700), dpi=100) -> list[Path]:
-    """One image per (grasp, twist) in ``folder`` (created if missing).
-
-    Files are named ``<grasp>-<twist><suffix>`` (``<grasp><suffix>`` for a
-    grasp without twists, drawn with its basis only), sanitised to letters,
-    digits, ``.``, ``_`` and ``-``; a name already used gets ``-2``, ``-3``...
-    ``method`` None picks :func:`default_method` per grasp.
-
-    Returns
-    -------
-    list of Path, in the order of ``grasps`` and their twists.
-    """
-    _check_suffix(suffix)
-    require_matplotlib()
-    folder = Path(folder)
-    folder.mkdir(parents=True, exist_ok=True)
-    written, used = [], set()
-    for grasp in grasps:
-        for twist in tuple(grasp.twists) or (None,):
-            stem = _safe_name(grasp.name) + ("" if twist is None else "-" + _safe_name(twist.name))
-            path = folder / (_unused(stem, used) + suffix)
-            written.append(plot_grasp(grasp, path, twist, method=method, size=size, dpi=dpi))
-    return written
-
-
-def _safe_name(name: str) -> str:
-    """A file-name-safe form of ``name``.
-
-    >>> _safe_name("Example 1/b: spin z")
-    'Example_1_b_spin_z'
-    """
-    return re.sub(r"[^A-Za-z0-9._-]+", "_", str(name)).strip("._") or "unnamed"
-
-
-def _unused(stem: str, used: set) -> str:
-    """``stem``, or ``stem-2``, ``stem-3``... whichever is not in ``used`` yet (then added)."""
-    name, n = stem, 1
-    while name.lower() in used:  # lower: case-insensitive file systems
-        n += 1
-        name = f"{stem}-{n}"
-    used.add(name.lower())
-    return name
-
-
-def _check_suffix(suffix: str):
-    if suffix.lower() not in FORMATS:
-        raise ValueError(f"cannot write {suffix or 'a file without suffix'!r}: use one of {', '.join(FORMATS)}")
-
-
-# --- rendering (matplotlib, imported here only) -------------------------------
-
-# kind -> matplotlib style
-_STYLE = {
-    "contact": {"color": "black", "marker": "o", "s": 40},
-    "wrist": {"color": "tab:purple", "marker": "^", "s": 60},
-    "normal": {"color": "0.45", "lw": 1.2},
-    "tangent-plane": {"color": "tab:cyan", "alpha": 0.25},
-    "contact-plane": {"color": "0.6", "alpha": 0.15},
-    "sigma-axis": {"color": "tab:blue", "lw": 1.4, "ls": "-"},
-    "psi-axis": {"color": "tab:orange", "lw": 1.4, "ls": "-"},
-    "theta-axis": {"color": "tab:green", "lw": 1.4, "ls": "-"},
-    "twist-axis": {"color": "tab:red", "lw": 2.2, "ls": "--"},
-    "twist-translation": {"color": "tab:red", "lw": 2.2},
-    "contact-velocity": {"color": "black", "lw": 2.4},
-    "sigma-part": {"color": "tab:blue", "lw": 1.4},
-    "psi-part": {"color": "tab:orange", "lw": 1.4},
-    "theta-part": {"color": "tab:green", "lw": 1.4},
-}
-
-
-def render(scene: Scene, path, *, size=(1400, 700), dpi=100) -> Path:
-    """Draw ``scene`` to ``path`` in two 3D views side by side.
-
-    The format follows the suffix (``.png``, ``.svg``, ``.pdf``).  Drawing
-    uses a ``Figure`` on an Agg canvas, never pyplot, so it works headless and
-    leaves the caller's matplotlib backend alone.
-
-    Parameters
-    ----------
-    scene : Scene
-    path : str or Path
-    size : (int, int)
-        Width and height in pixels (a PNG has exactly this size).
-    dpi : float
-        Pixels per inch: font sizes are in points, so a higher dpi makes the
-        text larger relative to the picture.
-
-    Returns
-    -------
-    Path
-    """
-    path = Path(path)
-    _check_suffix(path.suffix)
-    require_matplotlib()
-    from matplotlib.backends.backend_agg import FigureCanvasAgg
-    from matplotlib.figure import Figure
-
-    fig = Figure(figsize=(size[0] / dpi, size[1] / dpi), dpi=dpi)
-    FigureCanvasAgg(fig)
-    centre, half = scene.bounds()
-    for n, (view_name, direction) in enumerate(scene.views or (("view", np.array([0.0, 0.0, 1.0])),)):
-        ax = fig.add_subplot(1, len(scene.views or [0]), n + 1, projection="3d")
-        _draw(ax, scene, direction, head=0.07 * half)
-        for setter, c in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), centre):
-            setter(c - half, c + half)
-        ax.set_proj_type("ortho")  # lengths compare across the picture
-        ax.set_box_aspect((1, 1, 1), zoom=1.05)
-        _label_axes(ax, direction)
-        elev, azim = _elev_azim(direction)
-        ax.view_init(elev=elev, azim=azim)
-        ax.set_title(view_name, fontsize=9)
-    fig.suptitle(scene.title, fontsize=10)
-    handles = [_legend_handle(k, scene.method) for k in scene.kinds()]
-    fig.legend(handles=handles, loc="lower center", ncol=min(len(handles), 7), fontsize=8, frameon=False)
-    fig.subplots_adjust(left=0.0, right=1.0, top=0.9, bottom=0.1, wspace=0.0)
-    fig.savefig(path, dpi=dpi)
-    return path
-
-
-def _draw(ax, scene: Scene, view, head: float):
-    """Put every element of ``scene`` on one 3D axes seen along ``view``; arrow heads about ``head`` long."""
-    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
-
-    for p in scene.patches:
-        st = _STYLE[p.kind]
-        ax.add_collection3d(Poly3DCollection([p.corners], facecolor=st["color"], alpha=st["alpha"], edgecolor="none"))
-    for s in scene.segments:
-        st = _STYLE[s.kind]
-        ax.plot(*np.transpose([s.start, s.end]), color=st["color"], lw=st["lw"], ls=st["ls"])
-        ax.text(*s.end, " " + s.label, color=st["color"], fontsize=8)
-    for a in scene.drawn_arrows():
-        st = _STYLE[a.kind]
-        for line in _arrow_lines(a.origin, a.scale * a.vector, view, head):
-            ax.plot(*line.T, color=st["color"], lw=st["lw"], solid_capstyle="round")
-    for m in scene.markers:
-        st = _STYLE[m.kind]
-        ax.scatter(*m.position, color=st["color"], marker=st["marker"], s=st["s"], depthshade=False)
-        ax.text(*m.position, "  " + m.label, color=st["color"], fontsize=9, fontweight="bold")
-
-
-def _arrow_lines(origin, vector, view, head):
-    """Shaft and two barbs of an arrow, as ``(2, 3)`` point pairs.
-
-    The barbs lie in the plane facing the camera (``view``), so an arrow is
-    never seen edge-on (matplotlib's 3D quiver keeps them in a vertical plane,
-    which hides them for horizontal arrows seen from above).
-    """
-    tip = origin + vector
-    length = float(norm(vector))
-    h = min(head, 0.4 * length)
-    back = vector / length
-    side = cross(view, back)
-    if float(norm(side)) < 1e-6:  # arrow points at the camera: any side will do
-        side = cross(np.eye(3)[np.argmin(np.abs(back))], back)
-    side = unit(side)
-    barbs = [np.array([tip, tip - h * back + sign * 0.45 * h * side]) for sign in (1, -1)]
-    return [np.array([origin, tip])] + barbs
-
-
-def _label_axes(ax, direction):
-    """Name the x, y, z axes, except one seen end-on, whose ticks would pile up."""
-    for e, (name, axis) in enumerate(zip("xyz", (ax.xaxis, ax.yaxis, ax.zaxis))):
-        if abs(float(unit(direction)[e])) > 0.95:
-            axis.set_ticklabels([])
-        else:
-            axis.set_label_text(name)
-
-
-def _legend_handle(kind, method):
-    from matplotlib.lines import Line2D
-    from matplotlib.patches import Patch as PatchArtist
-
-    st = _STYLE[kind]
-    text = legend_text(kind, method)
-    if "marker" in st:
-        return Line2D([], [], color=st["color"], marker=st["marker"], ls="none", label=text)
-    if "alpha" in st:
-        return PatchArtist(facecolor=st["color"], alpha=max(st["alpha"], 0.4), label=text)
-    return Line2D([], [], color=st["color"], lw=st["lw"], ls=st.get("ls", "-"), label=text)
-
-
-def _elev_azim(direction):
-    """matplotlib's ``(elev, azim)`` in degrees for a camera along ``direction``."""
-    d = unit(direction)
-    return float(np.degrees(np.arcsin(np.clip(d[2], -1, 1)))), float(np.degrees(np.arctan2(d[1], d[0])))

@@ -1,0 +1,363 @@
+"""Drawing a :class:`~grasptwist.plot.scene.Scene` with matplotlib, and the files it goes to.
+
+matplotlib is an optional extra: it is imported only inside the functions
+that draw, so ``import grasptwist.plot`` works without it, and
+:func:`require_matplotlib` says how to install it.  Drawing uses a ``Figure``
+on an Agg canvas, never pyplot, so it runs headless and leaves the caller's
+matplotlib backend alone.
+
+:func:`plot_grasp`, :func:`render_grasps` and :func:`render_inputs` take
+objects shaped like :class:`~grasptwist.model.Grasp` (``name, contact_names,
+points, normals, wrist, twists``) and :class:`~grasptwist.model.Twist`
+(``name, screw``).
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from collections.abc import Iterator
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+import numpy as np
+
+from ..engine.screws import cross, norm, unit
+from .scene import Scene, check_method, grasp_scene, legend_text
+
+__all__ = [
+    "FORMATS",
+    "MissingMatplotlib",
+    "Note",
+    "TwistNotFound",
+    "chosen_twist",
+    "image_name",
+    "image_paths",
+    "plot_grasp",
+    "render",
+    "render_grasps",
+    "render_inputs",
+    "require_matplotlib",
+]
+
+#: Image formats, by file suffix.
+FORMATS = (".png", ".svg", ".pdf")
+INSTALL_HINT = "grasptwist plot needs matplotlib: pip install 'grasptwist[plot]'"
+
+
+class MissingMatplotlib(RuntimeError):
+    """matplotlib is not installed; the message says how to install it."""
+
+
+def require_matplotlib():
+    """Import and return matplotlib, or raise :class:`MissingMatplotlib`.
+
+    The CLI turns the error into its message and exit status 1.
+    """
+    try:
+        import matplotlib
+    except ImportError as exc:
+        raise MissingMatplotlib(INSTALL_HINT) from exc
+    return matplotlib
+
+
+# --- files --------------------------------------------------------------------
+
+
+def plot_grasp(grasp, path, twist=None, *, twist_name=None, method=None, size=(1400, 700), dpi=100) -> Path:
+    """Render one grasp and twist to ``path``.
+
+    See :func:`~grasptwist.plot.scene.grasp_scene` for ``twist``,
+    ``twist_name`` and ``method``, and :func:`render` for the rest.
+    """
+    return render(grasp_scene(grasp, twist, twist_name=twist_name, method=method), path, size=size, dpi=dpi)
+
+
+def image_name(grasp_name: str, twist_name: str | None = None) -> str:
+    """The file stem of a picture: ``<grasp>-<twist>``, or ``<grasp>`` without a twist.
+
+    Each name is sanitised to letters, digits, ``.``, ``_`` and ``-`` (any run
+    of other characters becomes one ``_``; leading and trailing ``.`` and ``_``
+    go, so a name never hides the file or climbs out of the folder).
+
+    >>> image_name("Example 1/b", "spin z"), image_name("../x"), image_name("???")
+    ('Example_1_b-spin_z', 'x', 'unnamed')
+    """
+    safe = [re.sub(r"[^A-Za-z0-9._-]+", "_", str(n)).strip("._") or "unnamed" for n in (grasp_name, twist_name)]
+    return safe[0] if twist_name is None else "-".join(safe)
+
+
+def image_paths(grasps, folder, suffix=".png") -> list[tuple[Path, object, object]]:
+    """Where :func:`render_grasps` draws each grasp and twist: ``(path, grasp, twist)``.
+
+    One entry per twist of each grasp, in order, and one with twist None for a
+    grasp without twists.  Paths are ``folder / (image_name(...) + suffix)``;
+    a name already used (ignoring case, for case-insensitive file systems)
+    gets ``-2``, ``-3``...
+    """
+    _check_suffix(suffix)
+    folder = Path(folder)
+    plan, used = [], set()
+    for grasp in grasps:
+        for twist in tuple(grasp.twists) or (None,):
+            stem = image_name(grasp.name, None if twist is None else twist.name)
+            name, n = stem, 1
+            while name.lower() in used:
+                n += 1
+                name = f"{stem}-{n}"
+            used.add(name.lower())
+            plan.append((folder / (name + suffix), grasp, twist))
+    return plan
+
+
+def render_grasps(grasps, folder, *, method=None, suffix=".png", size=(1400, 700), dpi=100) -> list[Path]:
+    """One image per grasp and twist in ``folder`` (created if missing), named by :func:`image_paths`.
+
+    A grasp without twists is drawn with its basis only; ``method`` None picks
+    :func:`~grasptwist.plot.scene.default_method` per grasp.
+
+    Returns
+    -------
+    list of Path, in the order of ``grasps`` and their twists.
+    """
+    plan = image_paths(grasps, folder, suffix)
+    require_matplotlib()
+    Path(folder).mkdir(parents=True, exist_ok=True)
+    return [plot_grasp(grasp, path, twist, method=method, size=size, dpi=dpi) for path, grasp, twist in plan]
+
+
+class TwistNotFound(ValueError):
+    """The grasp has no twist of the name asked for."""
+
+
+def chosen_twist(grasp, name: str | None = None):
+    """The twist a single picture shows: the one called ``name``, else the first (None when there are none).
+
+    Raises
+    ------
+    TwistNotFound
+        No twist has that name; the message lists the names there are.
+    """
+    if name is None:
+        return grasp.twists[0] if grasp.twists else None
+    for twist in grasp.twists:
+        if twist.name == name:
+            return twist
+    known = ", ".join(t.name for t in grasp.twists) or "none"
+    raise TwistNotFound(f"grasp '{grasp.name}' has no twist '{name}' (it has: {known})")
+
+
+@dataclass(frozen=True)
+class Note:
+    """A line for standard error: an input or grasp that gives no picture (``error``), or a warning."""
+
+    line: str
+    error: bool = True
+
+
+def render_inputs(
+    path: str, output, *, twists=(), twist_name: str | None = None, method: str | None = None, max_bytes=None
+) -> Iterator[Path | Note]:
+    """What ``grasptwist plot PATH -o OUTPUT`` draws: read the grasp files, render, report.
+
+    Yields each image written (a :class:`~pathlib.Path`) and a :class:`Note`
+    for each input that could not be read or drawn; reading comes first, so
+    the notes about files come before the images.
+
+    Parameters
+    ----------
+    path : str
+        A grasp file (``-`` for standard input), or a folder searched like
+        every command's inputs (:func:`grasptwist.io.inputs.expand`).
+    output : str or Path
+        For a folder ``path``, the folder that gets one image per grasp and
+        twist (:func:`render_grasps`, named across all the folder's grasps; a
+        grasp the method cannot draw gives an error note and the others go on).  For a file, the one image, of its
+        first grasp (a warning note when it has more).
+    twists : sequence of Twist
+        Draw these instead of the files' twists.
+    twist_name : str or None
+        Without ``twists``, which of a single file's twists to draw (default
+        its first).
+    method : ``"off-tangent"``, ``"tangent"`` or None (the default per grasp).
+    max_bytes : int or None
+        The grasp-file size cap (None: the loader's default).
+
+    Raises
+    ------
+    MissingMatplotlib
+        Before anything is read.
+    TwistNotFound, ValueError
+        For a single file: no twist called ``twist_name``; an unknown method,
+        the off-tangent method without a wrist, or an unsupported suffix.
+    """
+    from ..io.inputs import expand, read
+    from ..model import InputError
+    from ..output.records import diagnostics, error_record
+
+    require_matplotlib()
+    grasps = []
+    for item in expand([path]):
+        for entry in read(item, max_bytes) if isinstance(item, str) else [item]:
+            if isinstance(entry, InputError):
+                for line in diagnostics(error_record(entry))[0]:
+                    yield Note(line)
+            else:
+                grasps.append(replace(entry, twists=tuple(twists)) if twists else entry)
+    if os.path.isdir(path):
+        drawable = []
+        for grasp in grasps:
+            try:
+                check_method(method, grasp.wrist)
+                drawable.append(grasp)
+            except ValueError as exc:  # off-tangent asked of a grasp without a wrist
+                yield Note(f"{grasp.file}: grasp '{grasp.name}': error: {exc}")
+        yield from render_grasps(drawable, output, method=method)
+    elif grasps:
+        grasp = grasps[0]
+        if len(grasps) > 1:
+            yield Note(f"{path}: warning: drawing the first of its {len(grasps)} grasps, '{grasp.name}'", error=False)
+        yield plot_grasp(grasp, output, chosen_twist(grasp, None if twists else twist_name), method=method)
+
+
+def _check_suffix(suffix: str):
+    if suffix.lower() not in FORMATS:
+        raise ValueError(f"cannot write {suffix or 'a file without suffix'!r}: use one of {', '.join(FORMATS)}")
+
+
+# --- drawing (matplotlib, imported here only) ----------------------------------
+
+# kind -> matplotlib style
+_STYLE = {
+    "contact": {"color": "black", "marker": "o", "s": 40},
+    "wrist": {"color": "tab:purple", "marker": "^", "s": 60},
+    "normal": {"color": "0.45", "lw": 1.2},
+    "tangent-plane": {"color": "tab:cyan", "alpha": 0.25},
+    "contact-plane": {"color": "0.6", "alpha": 0.15},
+    "sigma-axis": {"color": "tab:blue", "lw": 1.4, "ls": "-"},
+    "psi-axis": {"color": "tab:orange", "lw": 1.4, "ls": "-"},
+    "theta-axis": {"color": "tab:green", "lw": 1.4, "ls": "-"},
+    "twist-axis": {"color": "tab:red", "lw": 2.2, "ls": "--"},
+    "twist-translation": {"color": "tab:red", "lw": 2.2},
+    "contact-velocity": {"color": "black", "lw": 2.4},
+    "sigma-part": {"color": "tab:blue", "lw": 1.4},
+    "psi-part": {"color": "tab:orange", "lw": 1.4},
+    "theta-part": {"color": "tab:green", "lw": 1.4},
+}
+
+
+def render(scene: Scene, path, *, size=(1400, 700), dpi=100) -> Path:
+    """Draw ``scene`` to ``path`` in two 3D views side by side.
+
+    The format follows the suffix (``.png``, ``.svg``, ``.pdf``).  Drawing
+    uses a ``Figure`` on an Agg canvas, never pyplot, so it works headless and
+    leaves the caller's matplotlib backend alone.
+
+    Parameters
+    ----------
+    scene : Scene
+    path : str or Path
+    size : (int, int)
+        Width and height in pixels (a PNG has exactly this size).
+    dpi : float
+        Pixels per inch: font sizes are in points, so a higher dpi makes the
+        text larger relative to the picture.
+
+    Returns
+    -------
+    Path
+    """
+    path = Path(path)
+    _check_suffix(path.suffix)
+    require_matplotlib()
+    from matplotlib.backends.backend_agg import FigureCanvasAgg
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=(size[0] / dpi, size[1] / dpi), dpi=dpi)
+    FigureCanvasAgg(fig)
+    centre, half = scene.bounds()
+    for n, (view_name, direction) in enumerate(scene.views or (("view", np.array([0.0, 0.0, 1.0])),)):
+        ax = fig.add_subplot(1, len(scene.views or [0]), n + 1, projection="3d")
+        _draw(ax, scene, direction, head=0.07 * half)
+        for setter, c in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), centre):
+            setter(c - half, c + half)
+        ax.set_proj_type("ortho")  # lengths compare across the picture
+        ax.set_box_aspect((1, 1, 1), zoom=1.05)
+        _label_axes(ax, direction)
+        elev, azim = _elev_azim(direction)
+        ax.view_init(elev=elev, azim=azim)
+        ax.set_title(view_name, fontsize=9)
+    fig.suptitle(scene.title, fontsize=10)
+    handles = [_legend_handle(k, scene.method) for k in scene.kinds()]
+    fig.legend(handles=handles, loc="lower center", ncol=min(len(handles), 7), fontsize=8, frameon=False)
+    fig.subplots_adjust(left=0.0, right=1.0, top=0.9, bottom=0.1, wspace=0.0)
+    fig.savefig(path, dpi=dpi)
+    return path
+
+
+def _draw(ax, scene: Scene, view, head: float):
+    """Put every element of ``scene`` on one 3D axes seen along ``view``; arrow heads about ``head`` long."""
+    from mpl_toolkits.mplot3d.art3d import Poly3DCollection
+
+    for p in scene.patches:
+        st = _STYLE[p.kind]
+        ax.add_collection3d(Poly3DCollection([p.corners], facecolor=st["color"], alpha=st["alpha"], edgecolor="none"))
+    for s in scene.segments:
+        st = _STYLE[s.kind]
+        ax.plot(*np.transpose([s.start, s.end]), color=st["color"], lw=st["lw"], ls=st["ls"])
+        ax.text(*s.end, " " + s.label, color=st["color"], fontsize=8)
+    for a in scene.drawn_arrows():
+        st = _STYLE[a.kind]
+        for line in _arrow_lines(a.origin, a.scale * a.vector, view, head):
+            ax.plot(*line.T, color=st["color"], lw=st["lw"], solid_capstyle="round")
+    for m in scene.markers:
+        st = _STYLE[m.kind]
+        ax.scatter(*m.position, color=st["color"], marker=st["marker"], s=st["s"], depthshade=False)
+        ax.text(*m.position, "  " + m.label, color=st["color"], fontsize=9, fontweight="bold")
+
+
+def _arrow_lines(origin, vector, view, head):
+    """Shaft and two barbs of an arrow, as ``(2, 3)`` point pairs.
+
+    The barbs lie in the plane facing the camera (``view``), so an arrow is
+    never seen edge-on (matplotlib's 3D quiver keeps them in a vertical plane,
+    which hides them for horizontal arrows seen from above).
+    """
+    tip = origin + vector
+    length = float(norm(vector))
+    h = min(head, 0.4 * length)
+    back = vector / length
+    side = cross(view, back)
+    if float(norm(side)) < 1e-6:  # arrow points at the camera: any side will do
+        side = cross(np.eye(3)[np.argmin(np.abs(back))], back)
+    side = unit(side)
+    barbs = [np.array([tip, tip - h * back + sign * 0.45 * h * side]) for sign in (1, -1)]
+    return [np.array([origin, tip])] + barbs
+
+
+def _label_axes(ax, direction):
+    """Name the x, y, z axes, except one seen end-on, whose ticks would pile up."""
+    for e, (name, axis) in enumerate(zip("xyz", (ax.xaxis, ax.yaxis, ax.zaxis))):
+        if abs(float(unit(direction)[e])) > 0.95:
+            axis.set_ticklabels([])
+        else:
+            axis.set_label_text(name)
+
+
+def _legend_handle(kind, method):
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch as PatchArtist
+
+    st = _STYLE[kind]
+    text = legend_text(kind, method)
+    if "marker" in st:
+        return Line2D([], [], color=st["color"], marker=st["marker"], ls="none", label=text)
+    if "alpha" in st:
+        return PatchArtist(facecolor=st["color"], alpha=max(st["alpha"], 0.4), label=text)
+    return Line2D([], [], color=st["color"], lw=st["lw"], ls=st.get("ls", "-"), label=text)
+
+
+def _elev_azim(direction):
+    """matplotlib's ``(elev, azim)`` in degrees for a camera along ``direction``."""
+    d = unit(direction)
+    return float(np.degrees(np.arcsin(np.clip(d[2], -1, 1)))), float(np.degrees(np.arctan2(d[1], d[0])))
