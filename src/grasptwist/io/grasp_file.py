@@ -37,9 +37,11 @@ above, which gives every error.  Both paths give the same grasps.
 
 from __future__ import annotations
 
+import errno
 import math
 import os
 import re
+import stat
 import sys
 from itertools import chain
 from pathlib import Path
@@ -182,10 +184,20 @@ def _read_file(path, max_bytes):
     try:
         if isinstance(path, str) and path == "-":
             return _read_capped(sys.stdin.buffer, max_bytes + 1)
-        with open(path, "rb") as handle:
+        with open(path, "rb", opener=_open_regular) as handle:
             return _read_capped(handle, max_bytes + 1)
     except OSError as exc:
         raise _Reject("read-error", "", f"cannot read: {exc.strerror or exc}") from None
+
+
+def _open_regular(path, flags):
+    """Open without blocking and insist on a regular file: a path swapped for
+    a FIFO after the folder was listed must not hang the run in ``open``."""
+    fd = os.open(path, flags | os.O_NONBLOCK)
+    if not stat.S_ISREG(os.fstat(fd).st_mode):
+        os.close(fd)
+        raise OSError(errno.EINVAL, "not a regular file (a pipe, socket or device)")
+    return fd
 
 
 _CHUNK = 1 << 16

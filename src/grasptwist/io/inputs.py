@@ -39,8 +39,14 @@ def expand(paths: Iterable[str]) -> Iterator[str | GraspFileError]:
 
 
 def _not_a_file(path: str) -> str:
+    try:
+        os.stat(path)
+    except FileNotFoundError:
+        return "no such file or folder"
+    except OSError as exc:  # e.g. a link to itself: "Too many levels of symbolic links"
+        return exc.strerror or str(exc)
     # a pipe, socket or device would block or never end: never open one
-    return "not a regular file (a pipe, socket or device)" if os.path.exists(path) else "no such file or folder"
+    return "not a regular file (a pipe, socket or device)"
 
 
 def _walk(top: str) -> Iterator[str | GraspFileError]:
