@@ -508,33 +508,6 @@ def _emit(job, paths: list[str], output, quiet: bool, workers: int, **table_opti
     return EXIT_FAILED if stderr.failed else EXIT_OK
 
 
-class Interrupted(BaseException):
-    """A stop signal arrived; raised in the main thread so that the run unwinds,
-    removing its temporary file, spool and worker processes."""
-
-    def __init__(self, signum: int):
-        super().__init__(signum)
-        self.signum = signum
-
-
-def _stop_on_signals() -> None:
-    """Turn SIGINT, SIGTERM and SIGHUP into :class:`Interrupted` (once: later
-    ones must not cut the clean-up short); a signal ignored by whoever
-    started us (``nohup``, a background job) stays ignored."""
-    from .run.pool import STOP_SIGNALS
-
-    stopping = []
-
-    def stop(signum, frame):
-        if not stopping:
-            stopping.append(signum)
-            raise Interrupted(signum)
-
-    for sig in STOP_SIGNALS:
-        if signal.getsignal(sig) is not signal.SIG_IGN:
-            signal.signal(sig, stop)
-
-
 def _drop_stdout() -> None:
     """Send what stdout still buffers to /dev/null: after a failure it must
     neither block the exit on a stalled reader nor fail a second time."""
@@ -545,24 +518,25 @@ def _drop_stdout() -> None:
     os.dup2(os.open(os.devnull, os.O_WRONLY), fd)
 
 
-def _stopped(signum: int) -> int:
+def _stopped(stop) -> int:
     """Say which signal stopped the run; the exit status a shell gives for it."""
     _drop_stdout()
-    _say(f"grasptwist: stopped by {signal.Signals(signum).name}")
-    return 128 + signum
+    _say(f"grasptwist: stopped by {stop.name}")
+    return stop.exit_status
 
 
 def _run(debug: bool, job) -> None:
     """Run a command body; turn every way it can end into one line and an exit status."""
     from .run.pool import WorkerDied
+    from .run.signals import Interrupted
     from .run.target import WriteError
 
     try:
         code = job()
     except (typer.Exit, typer.Abort, typer.BadParameter):
         raise  # typer's own ways out: exit codes, usage errors (2)
-    except (Interrupted, KeyboardInterrupt) as exc:
-        raise typer.Exit(_stopped(exc.signum if isinstance(exc, Interrupted) else signal.SIGINT)) from None
+    except (Interrupted, KeyboardInterrupt) as exc:  # KeyboardInterrupt: run without main(), as by tests
+        raise typer.Exit(_stopped(exc if isinstance(exc, Interrupted) else Interrupted(signal.SIGINT))) from None
     except BrokenPipeError:
         # The reader (e.g. `head`) went away: stop quietly with the status of a
         # Unix filter killed by SIGPIPE, and keep Python's final flush quiet too.
@@ -581,12 +555,14 @@ def _run(debug: bool, job) -> None:
 
 
 def main() -> None:
-    """Entry point of the ``grasptwist`` script."""
-    _stop_on_signals()  # from the start: a signal while starting up ends quietly too
+    """Run the command line (the ``grasptwist`` script is :func:`grasptwist.__main__.main`)."""
+    from .run.signals import Interrupted, stop_on_signals
+
+    stop_on_signals()
     try:
         app()
-    except Interrupted as stop:
-        sys.exit(_stopped(stop.signum))
+    except Interrupted as stop:  # while typer parsed the command line
+        sys.exit(_stopped(stop))
 
 
 if __name__ == "__main__":

@@ -18,13 +18,11 @@ import os
 import signal
 from collections import deque
 from collections.abc import Callable, Iterator
-from contextlib import contextmanager
 from typing import Any
 
-__all__ = ["Pool", "WorkerDied", "WorkerFailed", "STOP_SIGNALS"]
+from .signals import STOP_SIGNALS, signals_blocked
 
-#: The signals that end a run; the parent handles them, workers ignore them.
-STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
+__all__ = ["Pool", "WorkerDied", "WorkerFailed"]
 
 _PR_SET_PDEATHSIG = 1
 
@@ -132,7 +130,7 @@ class Pool:
         """End the workers: let them exit (``wait``, which an idle worker does
         at once) or kill them; one still busy after a second is killed too.
         Stop signals wait until this is done: it must not be cut short."""
-        with _signals_blocked():
+        with signals_blocked():
             for worker in self._workers:
                 if not wait:
                     worker.kill()
@@ -166,7 +164,7 @@ class _Worker:
     def fork(cls, task, conn, parents_ends: list) -> _Worker:
         sentinel, alive = os.pipe()
         parent = os.getpid()
-        with _signals_blocked():  # the child must not run the parent's handlers before it ignores them
+        with signals_blocked():  # the child must not run the parent's handlers before it ignores them
             pid = os.fork()
             if pid == 0:
                 try:
@@ -192,15 +190,6 @@ class _Worker:
             _, status = os.waitpid(self.pid, 0)
             self.exitcode = os.waitstatus_to_exitcode(status)
         return self.exitcode
-
-
-@contextmanager
-def _signals_blocked():
-    old = signal.pthread_sigmask(signal.SIG_BLOCK, STOP_SIGNALS)
-    try:
-        yield
-    finally:
-        signal.pthread_sigmask(signal.SIG_SETMASK, old)
 
 
 def _serve(conn, task: Callable[[int], Any], parent: int) -> None:

@@ -23,6 +23,7 @@ from __future__ import annotations
 
 import errno
 import os
+import re
 import stat
 import sys
 from collections.abc import Iterator
@@ -113,7 +114,7 @@ def opened(path: str | None) -> Iterator[IO[bytes]]:
     how, real = check_target(path)
     if how == "through":
         try:
-            raw = open(path, "wb")  # noqa: SIM115 - closed below; a FIFO waits for its reader, as with `>`
+            raw = _open_through(path)
         except OSError as exc:
             raise WriteError(path, exc) from None
         with _errors_named(path):
@@ -122,6 +123,17 @@ def opened(path: str | None) -> Iterator[IO[bytes]]:
             return
     with _errors_named(path), _replacing(real) as f:
         yield guarded(f, path)
+
+
+def _open_through(path: str) -> IO[bytes]:
+    """A pipe or device opened for writing; a name of one of our own file
+    descriptors (``/dev/stdout``, ``/dev/fd/N``) is that descriptor as it is
+    (reopening would truncate a file the shell opened for appending)."""
+    match = re.fullmatch(r"/dev/(stdout|stderr)|/(?:dev|proc/self)/fd/(\d+)", os.path.abspath(path))
+    if match:
+        fd = {"stdout": 1, "stderr": 2}.get(match[1]) or int(match[2])
+        return os.fdopen(os.dup(fd), "wb")
+    return open(path, "wb")  # noqa: SIM115 - the caller closes it; a FIFO waits for its reader, as with `>`
 
 
 @contextmanager
