@@ -159,6 +159,7 @@ def _output(path: str | None) -> Iterator:
     """stdout, or ``path`` by the rule of :mod:`grasptwist.run.target`: a file
     replaced atomically on success only, a pipe or device written through;
     an unusable ``path`` is a usage error before any work."""
+    from .run.signals import finishing
     from .run.target import check_target, opened
 
     if path is not None and path != "-":
@@ -168,6 +169,7 @@ def _output(path: str | None) -> Iterator:
             raise typer.BadParameter(str(exc), param_hint="-o") from None
     with opened(path) as out:
         yield out
+        finishing()  # all written: commit it and end normally, whatever signal comes now
 
 
 def _writable_folder(path: str) -> None:

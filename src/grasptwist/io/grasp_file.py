@@ -184,17 +184,19 @@ def _read_file(path, max_bytes):
     try:
         if isinstance(path, str) and path == "-":
             return _read_capped(sys.stdin.buffer, max_bytes + 1)
-        with open(path, "rb", opener=_open_regular) as handle:
+        with open(path, "rb", opener=_open_no_pipe) as handle:
             return _read_capped(handle, max_bytes + 1)
     except OSError as exc:
         raise _Reject("read-error", "", f"cannot read: {exc.strerror or exc}") from None
 
 
-def _open_regular(path, flags):
-    """Open without blocking and insist on a regular file: a path swapped for
-    a FIFO after the folder was listed must not hang the run in ``open``."""
+def _open_no_pipe(path, flags):
+    """Open without blocking and refuse a pipe or socket, whose reading could
+    wait forever: a path swapped for a FIFO after the folder was listed must
+    not hang the run (devices such as /dev/zero are read up to the cap)."""
     fd = os.open(path, flags | os.O_NONBLOCK)
-    if not stat.S_ISREG(os.fstat(fd).st_mode):
+    mode = os.fstat(fd).st_mode
+    if stat.S_ISFIFO(mode) or stat.S_ISSOCK(mode):
         os.close(fd)
         raise OSError(errno.EINVAL, "not a regular file (a pipe, socket or device)")
     return fd

@@ -177,12 +177,14 @@ class Spool:
             yield None
             return
         sweep(shm, SPOOL_STEM)  # what runs killed by SIGKILL left
-        folder = tempfile.mkdtemp(prefix=owned_prefix(SPOOL_STEM), dir=shm)
+        folder = None
         try:
+            folder = tempfile.mkdtemp(prefix=owned_prefix(SPOOL_STEM), dir=shm)
             fs = os.statvfs(folder)
             yield cls(folder, min(budget, fs.f_bavail * fs.f_frsize // 4) // max(1, workers))
         finally:
-            shutil.rmtree(folder, ignore_errors=True)
+            if folder is not None:
+                shutil.rmtree(folder, ignore_errors=True)
 
     def put(self, blob: bytes) -> str | None:
         """A new spool file holding ``blob``, or None if it must go by pipe."""

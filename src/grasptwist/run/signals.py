@@ -13,7 +13,7 @@ from __future__ import annotations
 import signal
 from contextlib import contextmanager
 
-__all__ = ["STOP_SIGNALS", "Interrupted", "stop_on_signals", "signals_blocked"]
+__all__ = ["STOP_SIGNALS", "Interrupted", "stop_on_signals", "finishing", "signals_blocked"]
 
 #: The signals that end a run; the parent handles them, workers ignore them.
 STOP_SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
@@ -34,20 +34,36 @@ class Interrupted(BaseException):
         self.exit_status = 128 + signum
 
 
+class _Stop:
+    """The handler: raise once, and not at all once the run is finishing."""
+
+    def __init__(self):
+        self.raised = False
+        self.finishing = False
+
+    def __call__(self, signum, frame):
+        if not (self.raised or self.finishing):
+            self.raised = True
+            raise Interrupted(signum)
+
+
 def stop_on_signals() -> None:
     """From now on, the first stop signal raises :class:`Interrupted` and later
     ones are ignored.  A signal that whoever started us ignores (``nohup``,
     a background job's SIGINT) stays ignored."""
-    stopping = []
-
-    def stop(signum, frame):
-        if not stopping:
-            stopping.append(signum)
-            raise Interrupted(signum)
-
+    stop = _Stop()
     for sig in STOP_SIGNALS:
         if signal.getsignal(sig) is not signal.SIG_IGN:
             signal.signal(sig, stop)
+
+
+def finishing() -> None:
+    """The output is complete: stop signals no longer stop the run (an exit
+    status of 130 must mean that the output is incomplete)."""
+    for sig in STOP_SIGNALS:
+        handler = signal.getsignal(sig)
+        if isinstance(handler, _Stop):
+            handler.finishing = True
 
 
 @contextmanager
