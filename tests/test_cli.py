@@ -291,18 +291,18 @@ def test_installed_entry_point_in_a_subprocess(files):
     assert "resolving" not in p.stderr and "\x1b[" not in p.stderr and p.stderr.endswith("1 record, 1 failed\n")
 
 
-def test_two_workers_write_exactly_what_one_writes(files, monkeypatch):
-    from grasptwist.run import pipeline
+def test_two_workers_write_exactly_what_one_writes(files):
+    from grasptwist.run.pipeline import TUNING
 
-    for i in range(9):
-        (files / f"more{i}.yaml").write_text(POLY.replace("name: poly", f"name: poly{i}"))
-    (files / "more5.yaml").write_text("contacts: [\n")  # a bad file among them
-    monkeypatch.setattr(pipeline, "FILES_PER_GROUP", 2)  # 6 groups: enough for the pool
+    more = TUNING.files_per_group * TUNING.min_groups  # just enough groups for the pool
+    for i in range(more):
+        (files / f"more{i:03}.yaml").write_text(POLY.replace("name: poly", f"name: poly{i}"))
+    (files / "more005.yaml").write_text("contacts: [\n")  # a bad file among them
     one = run("resolve", files, "-f", "jsonl", "-j", "1")
     two = run("resolve", files, "-f", "jsonl", "-j", "2")
     assert two.exit_code == one.exit_code == 1
     assert two.stdout == one.stdout and two.stderr == one.stderr
-    assert len(one.stdout.splitlines()) == 2 + 1 + 16 + 1  # poly, cyl, 8 good files x 2 twists, the bad one
+    assert len(one.stdout.splitlines()) == 2 + 1 + 2 * (more - 1) + 1  # poly, cyl, good files x 2 twists, the bad one
 
 
 def test_a_progress_bar_on_a_terminal(files):

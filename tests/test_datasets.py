@@ -207,16 +207,25 @@ def test_a_file_that_is_not_numpy_and_a_wrong_row_length(tmp_path):
     )
 
 
-def test_a_data_set_over_two_workers_gives_the_same_output(tmp_path, data, monkeypatch):
-    from grasptwist.run import pipeline
+def test_a_data_set_over_two_workers_gives_the_same_output(tmp_path, data):
+    from pathlib import Path
+
+    from grasptwist.run.pipeline import Job, Tuning, run
+
+    def written(workers):
+        text, lines = b"", []
+        for out in run(Job(fmt="jsonl"), [str(tmp_path / "set.npz")], workers, tuning):
+            text += b"".join(x + b"\n" for x in out.encoded) + (
+                Path(out.spool).read_bytes() + b"\n" if out.spool else b""
+            )
+            lines += out.errors + out.warnings
+        return text, lines
 
     points, normals, wrist, twist = data
     np.savez(tmp_path / "set.npz", points=points, normals=normals, wrist=wrist, twist=twist)
-    monkeypatch.setattr(pipeline, "GRASPS_PER_TASK", 50)
-    monkeypatch.setattr(pipeline, "RECORDS_AT_ONCE", 17)
-    one = run("resolve", tmp_path / "set.npz", "-f", "jsonl", "-j", "1")
-    two = run("resolve", tmp_path / "set.npz", "-f", "jsonl", "-j", "2")
-    assert two.stdout == one.stdout and two.stderr == one.stderr and len(jsonl(one)) == N
+    tuning = Tuning(grasps_per_task=50, records_at_once=17)  # 5 tasks of 3 outputs
+    one, two = written(1), written(2)
+    assert two == one and len(one[0].splitlines()) == N
 
 
 def test_workers_spool_through_the_kernel_to_pipes_and_files(tmp_path, data):
@@ -224,22 +233,19 @@ def test_workers_spool_through_the_kernel_to_pipes_and_files(tmp_path, data):
     import sys
     from pathlib import Path
 
-    points, normals, wrist, twist = data
+    from grasptwist.run.pipeline import TUNING
+
+    points, normals, wrist, twist = (np.tile(a, (1 + TUNING.grasps_per_task // N,) + (1,) * (a.ndim - 1)) for a in data)
+    n = len(points)  # two tasks of several outputs each for the pool
     np.savez(tmp_path / "set.npz", points=points, normals=normals, wrist=wrist, twist=twist)
     exe = Path(sys.executable).parent / "grasptwist"
     cmd = [str(exe)] if exe.exists() else [sys.executable, "-m", "grasptwist"]
-    one = subprocess.run(
-        cmd + ["resolve", str(tmp_path / "set.npz"), "-f", "json", "-j", "1"], capture_output=True, timeout=120
-    )
-    script = (
-        "import sys; from grasptwist.run import pipeline; pipeline.GRASPS_PER_TASK = 30; pipeline.RECORDS_AT_ONCE = 7; "
-        "from grasptwist.cli import main; sys.argv = ['grasptwist'] + sys.argv[1:]; main()"
-    )
-    args = ["resolve", str(tmp_path / "set.npz"), "-f", "json", "-j", "2"]
-    piped = subprocess.run([sys.executable, "-c", script] + args, capture_output=True, timeout=120)
+    args = ["resolve", str(tmp_path / "set.npz"), "-f", "json"]
+    one = subprocess.run(cmd + args + ["-j", "1"], capture_output=True, timeout=120)
+    piped = subprocess.run(cmd + args + ["-j", "2"], capture_output=True, timeout=120)
     to_file = subprocess.run(
-        [sys.executable, "-c", script] + args + ["-o", str(tmp_path / "out.json")], capture_output=True, timeout=120
+        cmd + args + ["-j", "2", "-o", str(tmp_path / "out.json")], capture_output=True, timeout=120
     )
     assert piped.stdout == one.stdout == (tmp_path / "out.json").read_bytes()
     assert piped.returncode == to_file.returncode == one.returncode == 1
-    assert len(json.loads(one.stdout)) == N
+    assert len(json.loads(one.stdout)) == n

@@ -8,39 +8,44 @@ The engine (pure numpy, batched over leading axes):
 [0.6667, 0.6667, 0.6667]
 """
 
-from .engine import screws
-from .engine.checks import check_normals, check_points, check_twist, check_wrist
-from .engine.decompose import (
-    OffTangentResult,
-    Resolution,
-    TangentResult,
-    contact_velocities,
-    decompose_off_tangent,
-    decompose_tangent,
-    resolve,
-)
-from .engine.degeneracy import CONDITION_WARNING, DEGENERACY_TOL, Status, status_message
-from .engine.prepared import PreparedGrasp, prepare
+from importlib import import_module
 
 __version__ = "0.1.0"
 
-__all__ = [
-    "screws",
-    "decompose_off_tangent",
-    "decompose_tangent",
-    "contact_velocities",
-    "resolve",
-    "Resolution",
-    "prepare",
-    "PreparedGrasp",
-    "OffTangentResult",
-    "TangentResult",
-    "Status",
-    "status_message",
-    "DEGENERACY_TOL",
-    "CONDITION_WARNING",
-    "check_points",
-    "check_normals",
-    "check_wrist",
-    "check_twist",
-]
+#: Public name -> the module defining it; imported on first use, so that the
+#: command line can handle signals before numpy is imported.
+_EXPORTS = {
+    "screws": ".engine.screws",
+    "decompose_off_tangent": ".engine.decompose",
+    "decompose_tangent": ".engine.decompose",
+    "contact_velocities": ".engine.decompose",
+    "OffTangentResult": ".engine.decompose",
+    "TangentResult": ".engine.decompose",
+    "Status": ".engine.degeneracy",
+    "status_message": ".engine.degeneracy",
+    "DEGENERACY_TOL": ".engine.degeneracy",
+    "CONDITION_WARNING": ".engine.degeneracy",
+    "resolve": ".engine.decompose",
+    "Resolution": ".engine.decompose",
+    "prepare": ".engine.prepared",
+    "PreparedGrasp": ".engine.prepared",
+    "check_points": ".engine.checks",
+    "check_normals": ".engine.checks",
+    "check_wrist": ".engine.checks",
+    "check_twist": ".engine.checks",
+}
+
+__all__ = list(_EXPORTS)
+
+
+def __getattr__(name: str):
+    if name not in _EXPORTS:
+        raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+    module = import_module(_EXPORTS[name], __name__)
+    value = module if name == "screws" else getattr(module, name)
+    globals()[name] = value
+    return value
+
+
+def __dir__():
+    return sorted({*globals(), *_EXPORTS})

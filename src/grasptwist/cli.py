@@ -4,14 +4,17 @@ A thin layer: it parses options, asks :mod:`inputs` for files, the loader
 for grasps, :mod:`batch` for resolutions and :mod:`report` for output.
 stdout carries data only; every diagnostic goes to stderr as one line
 ``path:line:col: error: message``.  Exit codes: 0 all records ok, 1 some
-record failed (the others are still written in full), 2 usage error.
+record failed (the others are still written in full), 2 usage error,
+3 the output could not be written, 4 a worker process died, 128 + the
+signal's number when SIGINT, SIGTERM or SIGHUP stopped the run, 141 the
+reader of stdout went away.
 """
 
 from __future__ import annotations
 
 import os
+import signal
 import sys
-import tempfile
 from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import replace
@@ -21,7 +24,7 @@ import typer
 
 from . import __version__
 
-EXIT_OK, EXIT_FAILED, EXIT_USAGE, EXIT_BROKEN_PIPE = 0, 1, 2, 141
+EXIT_OK, EXIT_FAILED, EXIT_USAGE, EXIT_WRITE, EXIT_WORKER, EXIT_BROKEN_PIPE = 0, 1, 2, 3, 4, 141
 
 app = typer.Typer(
     name="grasptwist",
@@ -135,33 +138,38 @@ class _Stderr:
         """Print one diagnostic line, its label coloured on a terminal."""
         if self.color:
             line = line.replace(label, f": \x1b[{colour}m{label[2:-2]}\x1b[0m: ", 1)
-        sys.stderr.write(line + "\n")
+        _say(line)
 
     def summary(self) -> None:
         if not self.quiet:
-            sys.stderr.write(f"{self.records} record{'' if self.records == 1 else 's'}, {self.failed} failed\n")
+            _say(f"{self.records} record{'' if self.records == 1 else 's'}, {self.failed} failed")
+
+
+def _say(line: str) -> None:
+    """One line on stderr; if stderr is gone (a hung-up terminal), there is nobody to tell."""
+    try:
+        sys.stderr.write(line + "\n")
+        sys.stderr.flush()
+    except (OSError, ValueError):
+        pass
 
 
 @contextmanager
 def _output(path: str | None) -> Iterator:
-    """stdout, or ``path`` written atomically: a temporary file renamed on success only."""
-    if path is None or path == "-":
-        yield sys.stdout.buffer
-        sys.stdout.buffer.flush()
-        return
-    folder = os.path.dirname(os.path.abspath(path))
-    _writable_folder(path)
-    fd, tmp = tempfile.mkstemp(prefix=".grasptwist-", dir=folder)
-    umask = os.umask(0)
-    os.umask(umask)
-    os.chmod(tmp, 0o666 & ~umask)  # mkstemp makes it private; the output is an ordinary file
-    try:
-        with os.fdopen(fd, "w+b") as out:  # readable too: zip archives seek and read back
-            yield out
-        os.replace(tmp, path)
-    except BaseException:
-        os.unlink(tmp)
-        raise
+    """stdout, or ``path`` by the rule of :mod:`grasptwist.run.target`: a file
+    replaced atomically on success only, a pipe or device written through;
+    an unusable ``path`` is a usage error before any work."""
+    from .run.signals import finishing
+    from .run.target import check_target, opened
+
+    if path is not None and path != "-":
+        try:
+            check_target(path)
+        except ValueError as exc:
+            raise typer.BadParameter(str(exc), param_hint="-o") from None
+    with opened(path) as out:
+        yield out
+        finishing()  # all written: commit it and end normally, whatever signal comes now
 
 
 def _writable_folder(path: str) -> None:
@@ -272,13 +280,13 @@ def resolve(
     if fmt == Format.npz and output is None and sys.stdout.isatty():
         raise typer.BadParameter("npz is binary: give -o FILE.npz", param_hint="--format")
     job = Job(
-        "resolve",
-        None if twists is None else tuple(twists),
-        method.value,
-        order.value,
-        fmt.value,
-        max_bytes,
-        extra_point.value,
+        kind="resolve",
+        twists=None if twists is None else tuple(twists),
+        method=method.value,
+        order=order.value,
+        fmt=fmt.value,
+        max_bytes=max_bytes,
+        extra_point=extra_point.value,
     )
     _run(debug, lambda: _emit(job, paths, output, quiet, workers, digits=digits, order=order.value))
 
@@ -308,7 +316,9 @@ def basis(
     """
     from .run.pipeline import Job
 
-    job = Job("basis", None, method.value, order.value, "json" if json_ else fmt.value, max_bytes)
+    job = Job(
+        kind="basis", method=method.value, order=order.value, fmt="json" if json_ else fmt.value, max_bytes=max_bytes
+    )
     _run(debug, lambda: _emit(job, paths, output, quiet, workers, digits=digits, order=order.value))
 
 
@@ -335,7 +345,7 @@ def check(
     """
     from .run.pipeline import Job
 
-    job = Job("check", None, method.value, "omega-v", "json" if json_ else fmt.value, max_bytes)
+    job = Job(kind="check", method=method.value, fmt="json" if json_ else fmt.value, max_bytes=max_bytes)
     _run(debug, lambda: _emit(job, paths, output, quiet, workers))
 
 
@@ -500,30 +510,61 @@ def _emit(job, paths: list[str], output, quiet: bool, workers: int, **table_opti
     return EXIT_FAILED if stderr.failed else EXIT_OK
 
 
+def _drop_stdout() -> None:
+    """Send what stdout still buffers to /dev/null: after a failure it must
+    neither block the exit on a stalled reader nor fail a second time."""
+    try:
+        fd = sys.stdout.fileno()
+    except (AttributeError, OSError, ValueError):  # not a real file (tests' capture)
+        return
+    os.dup2(os.open(os.devnull, os.O_WRONLY), fd)
+
+
+def _stopped(stop) -> int:
+    """Say which signal stopped the run; the exit status a shell gives for it."""
+    _drop_stdout()
+    _say(f"grasptwist: stopped by {stop.name}")
+    return stop.exit_status
+
+
 def _run(debug: bool, job) -> None:
-    """Run a command body; turn anything unexpected into one line and exit 1."""
+    """Run a command body; turn every way it can end into one line and an exit status."""
+    from .run.pool import WorkerDied
+    from .run.signals import Interrupted
+    from .run.target import WriteError
+
     try:
         code = job()
-    except (typer.Exit, typer.Abort, typer.BadParameter, KeyboardInterrupt):
+    except (typer.Exit, typer.Abort, typer.BadParameter):
         raise  # typer's own ways out: exit codes, usage errors (2)
+    except (Interrupted, KeyboardInterrupt) as exc:  # KeyboardInterrupt: run without main(), as by tests
+        raise typer.Exit(_stopped(exc if isinstance(exc, Interrupted) else Interrupted(signal.SIGINT))) from None
     except BrokenPipeError:
         # The reader (e.g. `head`) went away: stop quietly with the status of a
         # Unix filter killed by SIGPIPE, and keep Python's final flush quiet too.
-        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        _drop_stdout()
         raise typer.Exit(EXIT_BROKEN_PIPE) from None
+    except (WriteError, WorkerDied) as exc:
+        _drop_stdout()
+        _say(f"grasptwist: error: {exc}")
+        raise typer.Exit(EXIT_WRITE if isinstance(exc, WriteError) else EXIT_WORKER) from None
     except Exception as exc:  # noqa: BLE001 - the one place a traceback is turned into a line
         if debug:
             raise
-        sys.stderr.write(
-            f"grasptwist: internal error: {type(exc).__name__}: {exc} (rerun with --debug for the traceback)\n"
-        )
+        _say(f"grasptwist: internal error: {type(exc).__name__}: {exc} (rerun with --debug for the traceback)")
         raise typer.Exit(EXIT_FAILED) from None
     raise typer.Exit(code)
 
 
 def main() -> None:
-    """Entry point of the ``grasptwist`` script."""
-    app()
+    """Run the command line (the ``grasptwist`` script is :func:`grasptwist.__main__.main`)."""
+    from .run.signals import Interrupted, stop_on_signals
+
+    stop_on_signals()
+    try:
+        app()
+    except Interrupted as stop:  # while typer parsed the command line
+        sys.exit(_stopped(stop))
 
 
 if __name__ == "__main__":

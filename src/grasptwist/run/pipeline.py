@@ -4,14 +4,17 @@ A command is a :class:`Job`.  :func:`run` splits its inputs into groups of
 grasp files (and data sets, each a stream of row blocks), turns each group
 into records, their diagnostics and their encoded bytes with
 :func:`run_group`, and yields the results in input order.  With several
-workers the groups of files are spread over a process pool; everything a
-worker sends back is already encoded, so the parent only writes.
+workers the groups of files (or a data set's rows) are spread over a
+:class:`~grasptwist.run.pool.Pool`; everything a worker sends back is already
+encoded, so the parent only writes.  How big a group or a task is, and how
+much may wait in memory, is one :class:`Tuning`.
 """
 
 from __future__ import annotations
 
 import gc
 import os
+import shutil
 import tempfile
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
@@ -36,19 +39,18 @@ from ..output.records import (
     talking_rows,
 )
 from .batch import ZERO_TWIST, Block, resolve
+from .pool import Pool
+from .scratch import owned_prefix, sweep
 
-__all__ = ["Job", "Output", "run", "run_group", "blocks", "write_npz", "FILES_PER_GROUP"]
+__all__ = ["Job", "Tuning", "TUNING", "Output", "Spool", "run", "run_group", "blocks", "write_npz"]
 
-#: Grasp files per group: enough rows for the engine's vectors, small enough to stream.
-FILES_PER_GROUP = 64
-
-#: Records built and encoded at once (and per output written, for data sets).
-RECORDS_AT_ONCE = 1024
+#: Name stem of the spool folders in /dev/shm.
+SPOOL_STEM = "grasptwist-"
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, kw_only=True)
 class Job:
-    """What a command asks for (everything a worker needs, picklable)."""
+    """What a command asks for (everything a worker needs)."""
 
     kind: str = "resolve"  # resolve, basis or check
     twists: tuple[Twist, ...] | None = None
@@ -57,6 +59,33 @@ class Job:
     fmt: str = "jsonl"
     max_bytes: int | None = None
     extra_point: str = "wrist"
+
+
+@dataclass(frozen=True, kw_only=True)
+class Tuning:
+    """How work is cut up and how much of it may wait: sizes that change
+    speed and memory, never output.
+
+    >>> Tuning(files_per_group=2).records_at_once
+    1024
+    """
+
+    #: Grasp files per group: enough rows for the engine's vectors, small enough to stream.
+    files_per_group: int = 64
+    #: Records built and encoded at once (and per output written, for data sets).
+    records_at_once: int = 1024
+    #: Grasps per task when a data set is spread over processes.
+    grasps_per_task: int = 4096
+    #: Groups of files from which a pool pays for its start.
+    min_groups: int = 4
+    #: Tasks a worker may hold that the parent has not yet taken: a slow reader stops the workers.
+    in_flight: int = 2
+    #: Bytes all workers together may leave in /dev/shm (at most a quarter of its free space).
+    spool_bytes: int = 64 << 20
+
+
+#: The tuning the command line uses.
+TUNING = Tuning()
 
 
 @dataclass
@@ -91,59 +120,100 @@ class Output:
         self.failed += not rec["ok"]
 
 
-def run(job: Job, paths: Sequence, workers: int = 1) -> Iterator[Output]:
+def run(job: Job, paths: Sequence, workers: int = 1, tuning: Tuning = TUNING) -> Iterator[Output]:
     """Every input's output, in order.  ``paths`` holds file names, ``-``,
     and errors found while listing folders."""
-    groups = list(_groups(paths))
+    groups = list(_groups(paths, tuning.files_per_group))
     files = [g for g in groups if not _is_dataset(g)]
     # a pool pays for itself from a few groups on; stdin is the parent's to read
-    if workers > 1 and len(files) >= 4 and not any(STDIN in g for g in files):
-        with _pool(workers) as pool:
-            done = pool.imap(partial(run_group, job), files)
+    if workers > 1 and len(files) >= tuning.min_groups and not any(STDIN in g for g in files):
+
+        def task(spool, i):
+            return [run_group(job, files[i], tuning, spool)]
+
+        with _parallel(task, len(files), workers, tuning) as done:
             for g in groups:
-                yield from (_dataset(job, g, workers) if _is_dataset(g) else [next(done)])
+                yield from (_dataset(job, g, workers, tuning) if _is_dataset(g) else next(done))
         return
     for g in groups:
-        yield from (_dataset(job, g, workers) if _is_dataset(g) else [run_group(job, g)])
+        yield from (_dataset(job, g, workers, tuning) if _is_dataset(g) else [run_group(job, g, tuning)])
 
 
 @contextmanager
-def _pool(workers):
-    """A forked pool (workers start at once and share the parent's open data
-    set) and a spool folder in which they leave their encoded output."""
-    import multiprocessing
-    import shutil
-
-    shm = "/dev/shm"
-    spool = tempfile.mkdtemp(prefix="grasptwist-", dir=shm if os.access(shm, os.W_OK) else None)
-    _SHARED.update(spool=spool, parent=os.getpid())
-    try:
-        with multiprocessing.get_context("fork").Pool(workers) as pool:
-            yield pool
-    finally:
-        shutil.rmtree(spool, ignore_errors=True)
-        _SHARED.pop("spool", None)
+def _parallel(task, count: int, workers: int, tuning: Tuning) -> Iterator[Iterator[list[Output]]]:
+    """``task(spool, i)`` for ``i < count`` on a pool of forked workers, in
+    order; the workers share the parent's open files and data sets, and
+    leave their encoded output in a :class:`Spool`."""
+    with (
+        Spool.opened(workers, tuning.spool_bytes) as spool,
+        Pool(partial(task, spool), workers, tuning.in_flight) as pool,
+    ):
+        yield pool.results(count)
 
 
-def _sealed(job: Job, out: Output) -> Output:
+class Spool:
+    """A folder in ``/dev/shm`` where workers leave encoded output, which the
+    parent copies to its own output in the kernel (``sendfile``) instead of
+    receiving the bytes by pipe.
+
+    Each worker keeps at most ``share`` bytes there not yet taken by the
+    parent (which deletes a file once copied); past that, or when a write
+    fails (``/dev/shm`` full), :meth:`put` declines and the bytes go by pipe.
+    """
+
+    def __init__(self, folder: str, share: int):
+        self.folder = folder
+        self.share = share
+        self._mine: list[tuple[str, int]] = []  # (path, size) put by this process
+
+    @classmethod
+    @contextmanager
+    def opened(cls, workers: int, budget: int) -> Iterator[Spool | None]:
+        """A spool for ``workers`` processes holding at most ``budget`` bytes
+        in all (less when ``/dev/shm`` has little free: a quarter of its free
+        space), removed on exit; None where there is no ``/dev/shm``."""
+        shm = "/dev/shm"
+        if not os.access(shm, os.W_OK):
+            yield None
+            return
+        sweep(shm, SPOOL_STEM)  # what runs killed by SIGKILL left
+        folder = None
+        try:
+            folder = tempfile.mkdtemp(prefix=owned_prefix(SPOOL_STEM), dir=shm)
+            fs = os.statvfs(folder)
+            yield cls(folder, min(budget, fs.f_bavail * fs.f_frsize // 4) // max(1, workers))
+        finally:
+            if folder is not None:
+                shutil.rmtree(folder, ignore_errors=True)
+
+    def put(self, blob: bytes) -> str | None:
+        """A new spool file holding ``blob``, or None if it must go by pipe."""
+        self._mine = [(path, size) for path, size in self._mine if os.path.exists(path)]
+        if sum(size for _, size in self._mine) + len(blob) > self.share:
+            return None
+        fd, path = tempfile.mkstemp(dir=self.folder)
+        try:
+            with os.fdopen(fd, "wb") as f:
+                f.write(blob)
+        except OSError:  # /dev/shm is full after all
+            os.unlink(path)
+            return None
+        self._mine.append((path, len(blob)))
+        return path
+
+
+def _sealed(job: Job, out: Output, spool: Spool | None = None) -> Output:
     """An output ready to send: its records joined into one bytes object (one
-    write), and in a worker moved to a spool file, which the parent copies to
-    its output in the kernel instead of receiving the bytes by pipe."""
+    write), and in a worker put in the ``spool`` when it has room."""
     if job.fmt not in JOINERS or not out.encoded:
         return out
     blob = JOINERS[job.fmt](out.encoded)
-    spool = _SHARED.get("spool")
-    if spool and os.getpid() != _SHARED["parent"]:
-        fd, path = tempfile.mkstemp(dir=spool)
-        with os.fdopen(fd, "wb") as f:
-            f.write(blob)
-        out.encoded, out.spool = [], path
-    else:
-        out.encoded = [blob]
+    out.spool = spool.put(blob) if spool is not None else None
+    out.encoded = [] if out.spool else [blob]
     return out
 
 
-def run_group(job: Job, paths: Sequence) -> Output:
+def run_group(job: Job, paths: Sequence, tuning: Tuning = TUNING, spool: Spool | None = None) -> Output:
     """Read a group of grasp files and resolve them into one encoded :class:`Output`."""
     items = []
     for p in paths:
@@ -151,16 +221,16 @@ def run_group(job: Job, paths: Sequence) -> Output:
     out = Output(done=len(paths))
     twists = [ZERO_TWIST] if job.kind != "resolve" else job.twists
     for x in resolve(items, twists, job.method):
-        _emit(job, x, out)
-    return _sealed(job, out)
+        _emit(job, x, out, tuning.records_at_once)
+    return _sealed(job, out, spool)
 
 
-def blocks(job: Job, paths: Sequence) -> Iterator[tuple[Block | GraspFileError, int | None]]:
+def blocks(job: Job, paths: Sequence, tuning: Tuning = TUNING) -> Iterator[tuple[Block | GraspFileError, int | None]]:
     """Blocks and errors of every input, in order (for writers that take
     blocks, like npz), each with its progress news: None for a group of
     files (one unit a file), else the records a data set holds beyond the
     one unit it counted as (on its first block; 0 after)."""
-    for g in _groups(paths):
+    for g in _groups(paths, tuning.files_per_group):
         if _is_dataset(g):
             try:
                 ds = open_dataset(g, job.extra_point)
@@ -191,20 +261,20 @@ def _no_gc():
             gc.enable()
 
 
-def _emit(job: Job, x, out: Output) -> None:
+def _emit(job: Job, x, out: Output, at_once: int) -> None:
     with _no_gc():
-        _emit_records(job, x, out)
+        _emit_records(job, x, out, at_once)
 
 
-def _emit_records(job: Job, x, out: Output) -> None:
+def _emit_records(job: Job, x, out: Output, at_once: int) -> None:
     encode = ENCODERS[job.fmt]
     if not isinstance(x, Block):
         out.add(error_record(x), encode)
     elif job.kind == "resolve":
         # a few thousand records at a time: their floats as Python objects
         # would otherwise fill memory and keep the garbage collector busy
-        for start in range(0, len(x), RECORDS_AT_ONCE):
-            part = x.part(start, start + RECORDS_AT_ONCE)
+        for start in range(0, len(x), at_once):
+            part = x.part(start, start + at_once)
             if job.fmt in ("json", "jsonl"):
                 texts, talking = encode_records(part, job.order, records, dumps)
                 out.add_encoded(texts, talking)
@@ -216,14 +286,7 @@ def _emit_records(job: Job, x, out: Output) -> None:
             out.add(basis_record(x, i, job.order) if job.kind == "basis" else check_record(x, i), encode)
 
 
-#: The data set being resolved, for the workers forked to share it.
-_SHARED: dict = {}
-
-#: Grasps per task when a data set is spread over processes.
-GRASPS_PER_TASK = 4096
-
-
-def _dataset(job: Job, path: str, workers: int = 1) -> Iterator[Output]:
+def _dataset(job: Job, path: str, workers: int, tuning: Tuning) -> Iterator[Output]:
     """A data set's outputs, a few thousand records each; the first one
     tells the progress bar how many records the data set holds."""
     try:
@@ -232,21 +295,21 @@ def _dataset(job: Job, path: str, workers: int = 1) -> Iterator[Output]:
             next(dataset_blocks(ds, None, job.method))  # raises the no-twist error
     except GraspFileError as err:
         out = Output(done=1)
-        _emit(job, err, out)
+        _emit(job, err, out, tuning.records_at_once)
         yield _sealed(job, out)
         return
     rows = len(ds) * (len(job.twists) if job.twists and job.kind == "resolve" else 1)
-    tasks = [(start, min(len(ds), start + GRASPS_PER_TASK)) for start in range(0, len(ds), GRASPS_PER_TASK)]
-    _SHARED["dataset"] = ds
-    try:
-        if workers > 1 and len(tasks) > 1:
-            with _pool(workers) as pool:
-                parts = pool.imap(partial(_dataset_task, job), tasks)
-                yield from _counted(parts, rows)
-        else:
-            yield from _counted((_dataset_task(job, t) for t in tasks), rows)
-    finally:
-        _SHARED.clear()
+    step = tuning.grasps_per_task
+    tasks = [(start, min(len(ds), start + step)) for start in range(0, len(ds), step)]
+    if workers > 1 and len(tasks) > 1:
+
+        def task(spool, i):
+            return _dataset_task(job, ds, tasks[i], tuning, spool)
+
+        with _parallel(task, len(tasks), workers, tuning) as parts:
+            yield from _counted(parts, rows)
+    else:
+        yield from _counted((_dataset_task(job, ds, t, tuning) for t in tasks), rows)
 
 
 def _counted(parts, rows):
@@ -260,15 +323,16 @@ def _counted(parts, rows):
             yield out
 
 
-def _dataset_task(job: Job, rows: tuple[int, int]) -> list[Output]:
-    """Records of the data set's grasps ``rows``, in outputs of RECORDS_AT_ONCE."""
+def _dataset_task(job: Job, ds, rows: tuple[int, int], tuning: Tuning, spool: Spool | None = None) -> list[Output]:
+    """Records of the data set's grasps ``rows``, in outputs of ``tuning.records_at_once``."""
     twists = [ZERO_TWIST] if job.kind != "resolve" else job.twists
+    at_once = tuning.records_at_once
     outs = []
-    for block in dataset_blocks(_SHARED["dataset"], twists, job.method, start=rows[0], stop=rows[1]):
-        for start in range(0, len(block), RECORDS_AT_ONCE):
+    for block in dataset_blocks(ds, twists, job.method, start=rows[0], stop=rows[1]):
+        for start in range(0, len(block), at_once):
             out = Output()
-            _emit(job, block.part(start, start + RECORDS_AT_ONCE), out)
-            outs.append(_sealed(job, out))
+            _emit(job, block.part(start, start + at_once), out, at_once)
+            outs.append(_sealed(job, out, spool))
     return outs
 
 
@@ -276,8 +340,8 @@ def _is_dataset(group) -> bool:
     return isinstance(group, str)
 
 
-def _groups(paths):
-    """Consecutive grasp files in lists of FILES_PER_GROUP; each data set on its own (a str)."""
+def _groups(paths, size: int):
+    """Consecutive grasp files in lists of ``size``; each data set on its own (a str)."""
     group = []
     for p in paths:
         if isinstance(p, str) and p.endswith(DATASET_SUFFIXES) and os.path.isfile(p):
@@ -287,14 +351,14 @@ def _groups(paths):
             yield p
             continue
         group.append(p)
-        if len(group) >= FILES_PER_GROUP:
+        if len(group) >= size:
             yield group
             group = []
     if group:
         yield group
 
 
-def write_npz(job: Job, paths: Sequence, out) -> Iterator[Output]:
+def write_npz(job: Job, paths: Sequence, out, tuning: Tuning = TUNING) -> Iterator[Output]:
     """Resolve everything into one ``.npz`` on ``out``.
 
     Yields an :class:`Output` per block with its counts and stderr lines
@@ -302,7 +366,7 @@ def write_npz(job: Job, paths: Sequence, out) -> Iterator[Output]:
     nearly degenerate ones); the archive is complete when the iterator is.
     """
     w = NpzWriter(out, job.order)
-    for x, grows in blocks(job, paths):
+    for x, grows in blocks(job, paths, tuning):
         o = Output(done=len(x) if grows is not None else 1, grows=grows or 0)
         if isinstance(x, Block):
             w.write(x)
