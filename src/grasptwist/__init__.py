@@ -17,6 +17,7 @@ from .engine.decompose import (
     decompose_tangent,
 )
 from .engine.degeneracy import CONDITION_WARNING, DEGENERACY_TOL, Status, status_message
+from .engine.kinematics import JointRates, finger_jacobian, joint_rates
 
 __version__ = "0.1.0"
 
@@ -31,4 +32,7 @@ __all__ = [
     "status_message",
     "DEGENERACY_TOL",
     "CONDITION_WARNING",
+    "finger_jacobian",
+    "joint_rates",
+    "JointRates",
 ]
