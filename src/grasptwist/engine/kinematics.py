@@ -172,9 +172,12 @@ class JointRates:
         finger cannot follow the contact.
     conditioning : (...)
         ``sigma_3 / sigma_1`` of ``J`` (its smallest over its largest singular
-        value) when the rank is 3, else 0.  Dimensionless; below
-        :data:`~grasptwist.engine.degeneracy.CONDITION_WARNING` the rates may be
-        that many times larger than the velocity over the finger's size.
+        value) when the rank is 3, else 0.  Dimensionless: the rates can reach
+        ``|V| / (conditioning sigma_1)``, ``sigma_1`` being about the finger's
+        length; below :data:`~grasptwist.engine.degeneracy.CONDITION_WARNING`
+        that is worth a warning.
+
+    The arrays are read-only (broadcast views).
     """
 
     rates: np.ndarray
