@@ -33,7 +33,15 @@ _EXPORTS = {
     "check_normals": ".engine.checks",
     "check_wrist": ".engine.checks",
     "check_twist": ".engine.checks",
+    "finger_jacobian": ".engine.kinematics",
+    "joint_rates": ".engine.kinematics",
+    "JointRates": ".engine.kinematics",
+    "hand": ".hand",
+    "path": ".path",
 }
+
+#: Names above that are modules themselves.
+_MODULES = {"screws", "hand", "path"}
 
 __all__ = list(_EXPORTS)
 
@@ -42,7 +50,7 @@ def __getattr__(name: str):
     if name not in _EXPORTS:
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
     module = import_module(_EXPORTS[name], __name__)
-    value = module if name == "screws" else getattr(module, name)
+    value = module if name in _MODULES else getattr(module, name)
     globals()[name] = value
     return value
 

@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Twist", "Grasp", "InputError", "GraspFileError", "CONTACT_NAMES"]
+__all__ = ["Twist", "Grasp", "InputError", "GraspFileError", "CONTACT_NAMES", "Joint", "Finger", "Hand"]
 
 #: Contact names of a grasp that does not name its contacts.
 CONTACT_NAMES = ("1", "2", "3")
@@ -128,3 +128,89 @@ class InputError(Exception):
 
 #: The name the Python API has always used for a grasp file's errors.
 GraspFileError = InputError
+
+
+@dataclass(frozen=True, eq=False)
+class Joint:
+    """One movable joint of a finger.
+
+    Attributes
+    ----------
+    name : str
+    type : str
+        ``"revolute"`` (URDF ``continuous`` too) or ``"prismatic"``.
+    velocity_limit : float or None
+        Largest rate (rad or length per unit time), None when not given.
+    lower, upper : float or None
+        Position limits, None when not given.
+    line : int or None
+        1-based line of its definition (URDF element or grasp-file entry).
+    """
+
+    name: str
+    type: str
+    velocity_limit: float | None
+    lower: float | None
+    upper: float | None
+    line: int | None
+
+
+@dataclass(frozen=True, eq=False)
+class Finger:
+    """A finger: a serial chain of joints at its home configuration (every joint at 0).
+
+    Arrays are read-only, in the hand's root frame (the grasp's frame).
+    :func:`grasptwist.engine.kinematics.forward_kinematics` moves them to
+    other joint positions.
+
+    Attributes
+    ----------
+    name : str
+    tip : str or None
+        The link whose body touches the contact (URDF), None for inline joints.
+    joints : tuple of Joint
+        Base to tip.
+    screws : numpy.ndarray
+        ``(n, 6)`` joint screws ``(omega; v)``: unit lines for revolute joints,
+        ``(0; d)`` for prismatic ones.
+    points : numpy.ndarray
+        ``(n, 3)`` a point of each joint (its frame's origin; on a revolute axis).
+    tip_pose : numpy.ndarray or None
+        ``(4, 4)`` pose of the tip link, None for inline joints.
+    length : float
+        From the first joint through the others to the tip link's origin: a
+        contact farther than this from the tip is a frame mix-up.
+    joint_index : tuple of int
+        Position of each joint in :attr:`Hand.joint_names`.
+    """
+
+    name: str
+    tip: str | None
+    joints: tuple[Joint, ...]
+    screws: np.ndarray
+    points: np.ndarray
+    tip_pose: np.ndarray | None
+    length: float
+    joint_index: tuple[int, ...]
+
+
+@dataclass(frozen=True, eq=False)
+class Hand:
+    """A hand: its fingers in contact order, and the joints that move them.
+
+    Attributes
+    ----------
+    fingers : tuple of Finger
+    joint_names : tuple of str
+        Every finger's joints, each once, in finger then joint order: the
+        columns of a ``joint_positions`` array.
+    source : str or None
+        The robot description it was read from (as referenced), None for inline joints.
+    root : str or None
+        The URDF's root link, whose frame is the grasp's frame.
+    """
+
+    fingers: tuple[Finger, ...]
+    joint_names: tuple[str, ...]
+    source: str | None
+    root: str | None

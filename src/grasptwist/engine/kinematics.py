@@ -1,0 +1,535 @@
+"""Finger kinematics: joint screws, the finger Jacobian at a contact, joint rates.
+
+A finger is a serial chain.  At a configuration, each of its joints is a screw
+in the grasp's frame, ``(omega; v)`` as in :mod:`grasptwist.engine.screws`:
+
+* a revolute joint through the point ``a`` along the unit vector ``d`` is the
+  unit line ``(d; a x d)``; per unit rate it moves a point ``p`` of the links
+  after it with ``d x (p - a)``;
+* a prismatic joint along the unit vector ``d`` is the translation ``(0; d)``;
+  per unit rate it moves every such point with ``d``.
+
+The tip's contact point ``p`` therefore moves with ``J qdot``, where column
+``j`` of the ``3 x n`` Jacobian ``J`` is joint ``j``'s field at ``p`` (paper,
+eq. 2).  A point contact with friction that does not slip must move with the
+object's velocity there, ``T(p) = v + omega x p``, so the joint rates solve
+
+.. math::
+
+    J \\dot q = T(p),
+
+in the minimum-norm least-squares sense (:func:`joint_rates`).  Each
+component ``C`` of the paper's decompositions asks ``C(p)`` of the finger
+instead (:func:`component_joint_rates`).
+
+Forward kinematics (:func:`forward_kinematics`) moves a chain's joint screws
+from its home configuration (all joints at 0) to any batch of joint positions
+by the product of exponentials; :func:`chain_from_origins` builds the home
+screws from URDF-style joint origins.
+
+Shapes: joint screws are ``(..., n, 6)``, points and velocities ``(..., 3)``,
+joint positions ``(..., n)``; leading shapes broadcast.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import NamedTuple
+
+import numpy as np
+
+from .screws import cross, dot, field_at, norm, unit
+
+__all__ = [
+    "RANK_TOL",
+    "FOLLOW_TOL",
+    "OFF_TANGENT_FIXED",
+    "TANGENT_FIXED",
+    "JointRates",
+    "ChainState",
+    "joint_screw",
+    "finger_jacobian",
+    "joint_rates",
+    "component_joint_rates",
+    "velocity_limit_ratio",
+    "forward_kinematics",
+    "chain_from_origins",
+    "chain_length",
+]
+
+#: Singular values of a finger's Jacobian at or below ``RANK_TOL`` times its
+#: largest count as zero: they set the rank, and their directions get no joint
+#: rate (a direction that needs ``1e9`` times the velocity's size in joint rates
+#: is one the finger cannot follow in practice).
+RANK_TOL = 1e-9
+
+#: A finger whose relative residual ``|J qdot - V| / |V|`` exceeds this cannot
+#: follow its contact (code ``finger-cannot-follow``).
+FOLLOW_TOL = 1e-6
+
+_I = np.eye(3, dtype=bool)
+
+#: ``OFF_TANGENT_FIXED[c, f]``: component ``c`` of the off-tangent decomposition,
+#: in basis order ``Sigma_1..3, Psi_1..3``, leaves contact ``f`` still.  ``Sigma_i``
+#: is the line through the two other contacts, so it moves contact ``i`` alone;
+#: ``Psi_i`` is a line through ``p_i`` (Proposition 1).
+OFF_TANGENT_FIXED = np.concatenate((~_I, _I))
+OFF_TANGENT_FIXED.flags.writeable = False
+
+#: ``TANGENT_FIXED[c, f]`` for the tangent decomposition's components
+#: ``Theta_1..3, Sigma_1..3``: ``Theta_i`` is a line through ``p_i`` (eq. 22).
+TANGENT_FIXED = np.concatenate((_I, ~_I))
+TANGENT_FIXED.flags.writeable = False
+
+
+def _checked(a, trailing, name):
+    """``a`` as a float array whose shape ends in ``trailing`` (None: any size)."""
+    a = np.asarray(a, dtype=float)
+    if a.ndim < len(trailing) or any(
+        want is not None and got != want for got, want in zip(a.shape[a.ndim - len(trailing) :], trailing)
+    ):
+        want = "(..., " + ", ".join("n" if t is None else str(t) for t in trailing) + ")"
+        raise ValueError(f"{name} must have shape {want}, got {a.shape}")
+    return a
+
+
+def joint_screw(axis, point, prismatic=False):
+    """The screw of a revolute joint (unit line) or a prismatic one (translation).
+
+    .. math::
+
+        S = (d;\\ a \\times d) \\text{ (revolute)}, \\qquad S = (0;\\ d) \\text{ (prismatic)},
+
+    with ``d = axis / |axis|`` and ``a = point`` (ignored for a prismatic joint).
+
+    Parameters
+    ----------
+    axis : (..., 3) array
+        Joint direction, any non-zero length.
+    point : (..., 3) array
+        A point on a revolute joint's axis.
+    prismatic : (...) bool array
+
+    Returns
+    -------
+    (..., 6) array, ``(omega; v)``.
+
+    >>> joint_screw([0, 0, 2.0], [1.0, 0, 0]).tolist()
+    [0.0, 0.0, 1.0, 0.0, -1.0, 0.0]
+    >>> joint_screw([0, 0, 2.0], [1.0, 0, 0], prismatic=True).tolist()
+    [0.0, 0.0, 0.0, 0.0, 0.0, 1.0]
+    """
+    d = unit(_checked(axis, (3,), "axis"))
+    a = _checked(point, (3,), "point")
+    prismatic = np.asarray(prismatic, dtype=bool)[..., None]
+    omega = np.where(prismatic, 0.0, d)
+    return np.concatenate(np.broadcast_arrays(omega, np.where(prismatic, d, cross(a, d))), axis=-1)
+
+
+def finger_jacobian(joint_screws, points):
+    """The ``3 x n`` Jacobian of a finger at a point of its tip link.
+
+    Column ``j`` is joint ``j``'s field at ``p``, the velocity it gives ``p``
+    per unit rate:
+
+    .. math::
+
+        J_{:, j} = v_j + \\omega_j \\times p = d_j \\times (p - a_j) \\text{ (revolute)}
+        \\text{ or } d_j \\text{ (prismatic)}.
+
+    Parameters
+    ----------
+    joint_screws : (..., n, 6) array
+        The finger's joints, base to tip, as ``(omega; v)`` at the configuration.
+    points : (..., 3) array
+        The contact point on the tip link.
+
+    Returns
+    -------
+    (..., 3, n) array
+
+    >>> finger_jacobian([[0, 0, 1.0, 0, 0, 0], [0, 0, 0, 1.0, 0, 0]], [1.0, 0, 0]).tolist()
+    [[0.0, 1.0], [1.0, 0.0], [0.0, 0.0]]
+    """
+    screws = _checked(joint_screws, (None, 6), "joint_screws")
+    p = _checked(points, (3,), "points")
+    return np.swapaxes(field_at(screws, p[..., None, :]), -1, -2)
+
+
+@dataclass(frozen=True, eq=False)
+class JointRates:
+    """Joint rates of a batch of fingers, with how well they follow.
+
+    Attributes
+    ----------
+    rates : (..., n)
+        Minimum-norm least-squares joint rates ``qdot = J^+ V``; NaN where the
+        Jacobian or the velocity is not finite.
+    rank : (...) int
+        Rank of ``J``: its singular values above ``RANK_TOL`` times the largest.
+    residual : (...)
+        ``|J qdot - V| / |V|`` (0 for ``V = 0``).  Above :data:`FOLLOW_TOL` the
+        finger cannot follow the contact.
+    conditioning : (...)
+        ``sigma_3 / sigma_1`` of ``J`` (its smallest over its largest singular
+        value) when the rank is 3, else 0.  Dimensionless: the rates can reach
+        ``|V| / (conditioning sigma_1)``, ``sigma_1`` being about the finger's
+        length; below :data:`~grasptwist.engine.degeneracy.CONDITION_WARNING`
+        that is worth a warning.
+
+    The arrays are read-only (broadcast views).
+    """
+
+    rates: np.ndarray
+    rank: np.ndarray
+    residual: np.ndarray
+    conditioning: np.ndarray
+
+
+def joint_rates(joint_screws, points, velocities):
+    """Joint rates that move a finger's contact point with a given velocity.
+
+    The minimum-norm least-squares solution of ``J qdot = V``, through the
+    singular value decomposition ``J = U S W^T``:
+
+    .. math::
+
+        \\dot q = \\sum_{\\sigma_k > \\epsilon \\sigma_1} \\frac{u_k \\cdot V}{\\sigma_k} w_k,
+        \\qquad \\epsilon = \\mathtt{RANK\\_TOL} = 10^{-9}.
+
+    Among the rates that bring ``J qdot`` nearest to ``V`` it is the shortest,
+    so a redundant finger (``n > 3``) gets no motion in its null space.  The
+    Jacobian's decomposition is computed once for its own batch shape, so
+    ``velocities`` may add leading axes (several velocities for one finger).
+
+    Parameters
+    ----------
+    joint_screws : (..., n, 6) array
+        The finger's joint screws at the configuration, ``(omega; v)``.
+    points : (..., 3) array
+        Contact point on the tip link.
+    velocities : (..., 3) array
+        Velocity the contact point must have, e.g. ``T(p)``.
+
+    Returns
+    -------
+    JointRates
+        Its arrays have the broadcast batch shape.
+
+    >>> r = joint_rates([[0, 0, 1.0, 0, 0, 0], [0, 0, 1.0, 0, -1.0, 0]], [2.0, 0, 0], [0, 1.0, 0])
+    >>> r.rates.round(12).tolist(), int(r.rank), round(float(r.residual), 12), float(r.conditioning)
+    ([0.4, 0.2], 1, 0.0, 0.0)
+    """
+    jac = finger_jacobian(joint_screws, points)
+    vel = _checked(velocities, (3,), "velocities")
+    shape = np.broadcast_shapes(jac.shape[:-2], vel.shape[:-1])
+    n = jac.shape[-1]
+    finite = np.isfinite(jac).all(axis=(-2, -1))
+    if n == 0:  # a finger with no joint reaches nothing
+        rates = np.zeros(shape + (0,))
+        rank = np.zeros(jac.shape[:-2], dtype=int)
+        s = np.zeros(jac.shape[:-2] + (0,))
+    else:
+        # LAPACK fails on NaN: decompose zeros in those rows and mark them afterwards.
+        u, s, wt = np.linalg.svd(np.where(finite[..., None, None], jac, 0.0), full_matrices=False)
+        keep = s > RANK_TOL * s[..., :1]
+        rank = keep.sum(axis=-1)
+        inverse = np.where(keep, 1.0 / np.where(keep, s, 1.0), 0.0)
+        coords = (np.swapaxes(u, -1, -2) @ vel[..., None])[..., 0] * inverse
+        rates = (np.swapaxes(wt, -1, -2) @ coords[..., None])[..., 0]
+        rates = np.where(finite[..., None], rates, np.nan)
+    error = (jac @ rates[..., None])[..., 0] - vel
+    size = norm(vel)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        residual = np.where(size > 0, norm(error) / np.where(size > 0, size, 1.0), norm(error))
+        conditioning = s[..., 2] / s[..., 0] if s.shape[-1] == 3 else np.zeros(rank.shape)
+    conditioning = np.where(rank == 3, conditioning, np.where(finite, 0.0, np.nan))
+    return JointRates(
+        rates=np.broadcast_to(rates, shape + (n,)),
+        rank=np.broadcast_to(np.where(finite, rank, 0), shape),
+        residual=np.broadcast_to(residual, shape),
+        conditioning=np.broadcast_to(conditioning, shape),
+    )
+
+
+def component_joint_rates(joint_screws, point, twist, components, fixed):
+    """A finger's joint rates for a twist and for each of its components.
+
+    Component ``c`` (a twist, amplitude times basis screw) asks the contact
+    point to move with ``C_c(p)``; since the joint rates are linear in the
+    velocity, the components' rates add up to the twist's.  Where ``fixed``
+    says the component leaves this contact still (``Sigma_i`` moves contact
+    ``i`` alone; ``Psi_i`` and ``Theta_i`` keep contact ``i`` fixed), its rates
+    are exactly zero rather than rounding noise.
+
+    Parameters
+    ----------
+    joint_screws : (..., n, 6) array
+    point : (..., 3) array
+        This finger's contact point.
+    twist : (..., 6) array
+        The object twist, ``(omega; v)``.
+    components : (..., m, 6) array
+        Its components, e.g. ``(x_i Sigma_i, y_i Psi_i)`` concatenated.
+    fixed : (..., m) bool array
+        Whether each component leaves this contact still: a column of
+        :data:`OFF_TANGENT_FIXED` or :data:`TANGENT_FIXED`.
+
+    Returns
+    -------
+    total : JointRates
+        For ``T(p)``, batch shape ``(...)``.
+    rates : (..., m, n) array
+        Component ``c``'s joint rates in row ``c``.
+
+    A Cartesian finger (three prismatic joints) at ``p = (1, 0, 0)``; the
+    second component turns about the z axis through ``p``, leaving it still:
+
+    >>> screws = np.hstack((np.zeros((3, 3)), np.eye(3)))
+    >>> comps = [[0, 0, 0, 1.0, 0, 0], [0, 0, 1.0, 0, -1.0, 0]]
+    >>> total, rates = component_joint_rates(screws, [1.0, 0, 0], np.sum(comps, 0), comps, [False, True])
+    >>> rates.tolist(), total.rates.tolist()
+    ([[1.0, 0.0, 0.0], [0.0, 0.0, 0.0]], [1.0, 0.0, 0.0])
+    """
+    p = _checked(point, (3,), "point")
+    velocities = field_at(_checked(components, (None, 6), "components"), p[..., None, :])
+    still = np.asarray(fixed, dtype=bool)[..., None]
+    velocities = np.where(still, 0.0, velocities)
+    total_velocity = field_at(_checked(twist, (6,), "twist"), p)
+    lead = np.broadcast_shapes(total_velocity.shape[:-1], velocities.shape[:-2])
+    velocities = np.concatenate(
+        (
+            np.broadcast_to(total_velocity[..., None, :], lead + (1, 3)),
+            np.broadcast_to(velocities, lead + velocities.shape[-2:]),
+        ),
+        axis=-2,
+    )
+    # One decomposition of J serves the twist and every component.
+    result = joint_rates(
+        _checked(joint_screws, (None, 6), "joint_screws")[..., None, :, :], p[..., None, :], velocities
+    )
+    total = JointRates(
+        result.rates[..., 0, :], result.rank[..., 0], result.residual[..., 0], result.conditioning[..., 0]
+    )
+    return total, np.where(still, 0.0, result.rates[..., 1:, :])
+
+
+def velocity_limit_ratio(rates, limits):
+    """How far joint rates exceed their velocity limits: ``max_j |qdot_j| / limit_j``.
+
+    .. math::
+
+        \\rho = \\max_{j:\\ \\ell_j \\text{ given}} |\\dot q_j| / \\ell_j .
+
+    Above 1 the motion must be slowed down by the factor ``rho``.
+
+    Parameters
+    ----------
+    rates : (..., n) array
+    limits : (n,) array
+        Positive limits; NaN (or None) for a joint without one.
+
+    Returns
+    -------
+    (...) array
+        NaN where no joint has a limit.
+
+    >>> float(velocity_limit_ratio([2.0, -6.0, 100.0], [4.0, 3.0, None]))
+    2.0
+    """
+    rates = _checked(rates, (None,), "rates")
+    limits = np.asarray(limits, dtype=float)
+    if limits.shape != rates.shape[-1:] or not np.all(np.isnan(limits) | (limits > 0)):
+        raise ValueError(f"limits must be positive numbers or NaN, one per joint, got {limits.tolist()}")
+    given = ~np.isnan(limits)
+    if not given.any():
+        return np.full(rates.shape[:-1], np.nan)
+    return np.max(np.abs(rates[..., given]) / limits[given], axis=-1)
+
+
+class ChainState(NamedTuple):
+    """A serial chain at a batch of configurations (see :func:`forward_kinematics`)."""
+
+    #: ``(..., n, 6)`` joint screws ``(omega; v)`` in the root frame.
+    screws: np.ndarray
+    #: ``(..., n, 3)`` each joint frame's origin (on a revolute joint's axis).
+    points: np.ndarray
+    #: ``(..., 4, 4)`` pose of the tip link, or None when no home pose was given.
+    tip: np.ndarray | None
+
+
+def _skew(w):
+    """``[w]``, the matrix of ``x -> w x x``: ``(..., 3) -> (..., 3, 3)``."""
+    z = np.zeros_like(w[..., 0])
+    return np.stack(
+        (
+            np.stack((z, -w[..., 2], w[..., 1]), axis=-1),
+            np.stack((w[..., 2], z, -w[..., 0]), axis=-1),
+            np.stack((-w[..., 1], w[..., 0], z), axis=-1),
+        ),
+        axis=-2,
+    )
+
+
+def _apply(r, x):
+    """``R x`` over batches: ``(..., 3, 3), (..., 3) -> (..., 3)``."""
+    return (r @ x[..., None])[..., 0]
+
+
+def _joint_motion(screw, angle):
+    """The rigid motion ``exp([S] q)`` of a unit line or a pure translation ``S``.
+
+    Rodrigues' rotation about ``omega`` by ``q``, ``R = I + sin q [w] + (1 - cos q) [w]^2``,
+    moving the axis point ``a = w x v`` onto itself: ``t = (I - R) a + w (w . v) q``
+    (the last term is the pitch's advance; 0 for a joint line).  A screw with
+    ``omega = 0`` translates by ``v q``.  ``(..., 6), (...) -> (R (..., 3, 3), t (..., 3))``.
+    """
+    w, v = screw[..., :3], screw[..., 3:]
+    k = _skew(w)
+    k2 = k @ k
+    s, c = np.sin(angle)[..., None, None], np.cos(angle)[..., None, None]
+    turn = s * k + (1.0 - c) * k2  # R - I, without the cancellation of forming I first
+    rotation = np.eye(3) + turn
+    translation = -_apply(turn, cross(w, v)) + w * (dot(w, v) * angle)[..., None]
+    translation = np.where(np.any(w != 0, axis=-1)[..., None], translation, v * angle[..., None])
+    return rotation, translation
+
+
+def forward_kinematics(home_screws, home_points, home_tip, positions):
+    """Joint screws, joint points and tip pose of a serial chain at joint positions.
+
+    The product of exponentials in the root ("space") frame: with ``S_j`` the
+    joints' screws at home (every joint at 0) and ``M`` the tip's home pose,
+
+    .. math::
+
+        g_j = e^{[S_1] q_1} \\cdots e^{[S_j] q_j}, \\qquad
+        S_j(q) = \\mathrm{Ad}_{g_{j-1}} S_j, \\qquad
+        \\mathrm{tip}(q) = g_n M,
+
+    where ``Ad_(R, t)`` carries ``(omega; v)`` to ``(R omega; R v + t x R omega)``.
+
+    Parameters
+    ----------
+    home_screws : (..., n, 6) array
+        Unit lines (revolute joints) or ``(0; d)`` (prismatic ones), base to tip.
+    home_points : (..., n, 3) array
+        Each joint frame's origin at home.
+    home_tip : (..., 4, 4) array or None
+        The tip link's pose at home.
+    positions : (..., n) array
+        Joint positions (radians, lengths).
+
+    Returns
+    -------
+    ChainState
+        With the broadcast batch shape.
+
+    >>> s = forward_kinematics([[0, 0, 1.0, 0, 0, 0], [0, 0, 1.0, 0, -1.0, 0]], [[0, 0, 0], [1.0, 0, 0]], None, [np.pi / 2, 0])
+    >>> (s.screws[1].round(12) + 0.0).tolist(), (s.points[1].round(12) + 0.0).tolist()
+    ([0.0, 0.0, 1.0, 1.0, 0.0, 0.0], [0.0, 1.0, 0.0])
+    """
+    screws = _checked(home_screws, (None, 6), "home_screws")
+    points = _checked(home_points, (screws.shape[-2], 3), "home_points")
+    q = _checked(positions, (screws.shape[-2],), "positions")
+    tip = None if home_tip is None else _checked(home_tip, (4, 4), "home_tip")
+    lead = np.broadcast_shapes(
+        screws.shape[:-2], points.shape[:-2], q.shape[:-1], () if tip is None else tip.shape[:-2]
+    )
+    n = screws.shape[-2]
+    out_screws = np.empty(lead + (n, 6))
+    out_points = np.empty(lead + (n, 3))
+    rotation, translation = None, None  # g_0 = identity
+    for j in range(n):
+        s, a = screws[..., j, :], points[..., j, :]
+        if rotation is None:
+            out_screws[..., j, :], out_points[..., j, :] = s, a
+        else:
+            w = _apply(rotation, s[..., :3])
+            out_screws[..., j, :3] = w
+            out_screws[..., j, 3:] = _apply(rotation, s[..., 3:]) + cross(translation, w)
+            out_points[..., j, :] = _apply(rotation, a) + translation
+        r, t = _joint_motion(s, q[..., j])
+        if rotation is None:
+            rotation, translation = r, t
+        else:
+            rotation, translation = rotation @ r, _apply(rotation, t) + translation
+    if tip is None:
+        return ChainState(out_screws, out_points, None)
+    pose = np.empty(lead + (4, 4))
+    pose[..., 3, :] = (0.0, 0.0, 0.0, 1.0)
+    if rotation is None:
+        pose[..., :3, :] = tip[..., :3, :]
+    else:
+        pose[..., :3, :3] = rotation @ tip[..., :3, :3]
+        pose[..., :3, 3] = _apply(rotation, tip[..., :3, 3]) + translation
+    return ChainState(out_screws, out_points, pose)
+
+
+def chain_from_origins(origins, axes, kinds):
+    """Home joint screws of a chain given URDF-style: each joint's origin in its parent.
+
+    Joint ``j``'s frame is ``F_j = F_{j-1} O_j`` with every joint at 0
+    (``F_0 = I``, the root); its axis in the root frame is ``R(F_j) d_j`` and its
+    point the origin of ``F_j``.  Fixed joints only carry the frame along.
+
+    Parameters
+    ----------
+    origins : (m, 4, 4) array
+        ``O_j``: joint ``j``'s frame in its parent link's frame, root to tip.
+    axes : (m, 3) array
+        Each joint's axis in its own frame (ignored for fixed joints).
+    kinds : sequence of str
+        ``"revolute"``, ``"prismatic"`` or ``"fixed"`` per joint.
+
+    Returns
+    -------
+    screws : (n, 6) array
+        The ``n`` movable joints' home screws.
+    points : (n, 3) array
+        Their frames' origins.
+    tip : (4, 4) array
+        The last frame ``F_m`` (the tip link's pose at home).
+
+    >>> up = np.eye(4); up[2, 3] = 1.0
+    >>> s, p, tip = chain_from_origins([up, up], [[0, 1.0, 0], [1.0, 0, 0]], ["revolute", "fixed"])
+    >>> s.tolist(), tip[:3, 3].tolist()
+    ([[0.0, 1.0, 0.0, -1.0, 0.0, 0.0]], [0.0, 0.0, 2.0])
+    """
+    origins = _checked(origins, (4, 4), "origins")
+    axes = _checked(axes, (3,), "axes")
+    frame = np.eye(4)
+    screws, points = [], []
+    for origin, axis, kind in zip(origins, axes, kinds, strict=True):
+        frame = frame @ origin
+        if kind != "fixed":
+            points.append(frame[:3, 3])
+            screws.append(joint_screw(frame[:3, :3] @ axis, frame[:3, 3], kind == "prismatic"))
+    return np.reshape(screws, (-1, 6)), np.reshape(points, (-1, 3)), frame
+
+
+def chain_length(points, tip):
+    """A chain's length: from its first joint through the others to the tip.
+
+    .. math::
+
+        L = \\sum_{j=1}^{n-1} |a_{j+1} - a_j| + |t - a_n| .
+
+    Rigid links keep it the same at every configuration of revolute joints.
+
+    Parameters
+    ----------
+    points : (..., n, 3) array
+        Joint points, base to tip.
+    tip : (..., 3) array
+        The tip link's origin.
+
+    Returns
+    -------
+    (...) array
+
+    >>> float(chain_length([[0, 0, 0], [0, 0, 3.0]], [4.0, 0, 3]))
+    7.0
+    """
+    path = np.concatenate((_checked(points, (None, 3), "points"), _checked(tip, (3,), "tip")[..., None, :]), axis=-2)
+    return norm(np.diff(path, axis=-2)).sum(axis=-1)

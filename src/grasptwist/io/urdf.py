@@ -1,0 +1,392 @@
+"""Hands from robot descriptions (URDF), read as untrusted input.
+
+A URDF names its links and the joints between them; a finger is the chain of
+joints from the root link to the link that touches the object (its tip).
+The robot model is read by yourdfpy (the optional extra ``grasptwist[urdf]``),
+never with its scene graph, so meshes are never opened.  Around it:
+
+* the reference: ``package://PKG/path`` is resolved inside the installed
+  Python package ``PKG``, any other path relative to the referring file's
+  folder; one that resolves (symbolic links followed) outside that package
+  or folder is refused (``path-outside``);
+* the bytes: at most ``max_bytes`` are read (a regular file only), and the XML
+  is parsed by lxml with entity resolution, DTD loading and network access
+  off and its size limits on, before yourdfpy sees it; a document type
+  declaration (DTDs, entities, external references: a robot description needs
+  none) is refused outright (``forbidden-dtd``);
+* the joints: mimic, floating and planar joints on a finger are refused
+  (``unsupported-joint``); ``continuous`` joints are revolute.
+
+Every refusal is a :class:`~grasptwist.model.InputError` with a code:
+
+=====================  ==========================================================
+``read-error``         missing or unreadable file, not a regular file
+``too-large``          more than ``max_bytes``
+``unsupported-url``    a URL scheme other than ``package://``
+``package-not-found``  ``package://PKG``: no installed Python package ``PKG``
+``path-outside``       the path resolves outside its package or folder
+``urdf-syntax``        not well-formed XML
+``forbidden-dtd``      a document type declaration
+``invalid-urdf``       not a URDF tree (root element, links, joints, numbers)
+``unknown-link``       a tip that is no link of the URDF
+``unsupported-joint``  a mimic, floating or planar joint on a finger
+``urdf-unavailable``   yourdfpy is not installed
+=====================  ==========================================================
+"""
+
+from __future__ import annotations
+
+import io
+import math
+import os
+import re
+import stat
+from importlib.util import find_spec
+from pathlib import Path
+
+import numpy as np
+
+from ..engine.kinematics import chain_from_origins, chain_length
+from ..model import Finger, Hand, InputError, Joint
+from .grasp_file import DEFAULT_MAX_BYTES
+
+__all__ = ["load_urdf_hand", "resolve_urdf"]
+
+_PACKAGE = "package://"
+_URL = re.compile(r"^[A-Za-z][A-Za-z0-9+.-]*://")
+_MOVABLE = {"revolute": "revolute", "continuous": "revolute", "prismatic": "prismatic", "fixed": "fixed"}
+_UNSUPPORTED = {"floating", "planar"}
+
+
+def resolve_urdf(reference, folder=None):
+    """The file a URDF reference names, refused if it leaves its package or folder.
+
+    Parameters
+    ----------
+    reference : str or os.PathLike
+        ``package://PKG/path`` (``PKG`` an installed Python package) or a path.
+    folder : str or os.PathLike, optional
+        The referring file's folder: a path is taken relative to it and must
+        stay inside it.  None: a path is used as given (the caller chose it).
+
+    Returns
+    -------
+    pathlib.Path
+        Absolute, symbolic links resolved.
+
+    Raises
+    ------
+    InputError
+        ``unsupported-url``, ``package-not-found`` or ``path-outside``.
+
+    >>> resolve_urdf("package://grasptwist/io/urdf.py").name
+    'urdf.py'
+    """
+    text = os.fspath(reference)
+    if text.startswith(_PACKAGE):
+        package, _, rest = text[len(_PACKAGE) :].partition("/")
+        return _inside(_package_folder(package, text), rest, text)
+    if _URL.match(text):
+        raise InputError("unsupported-url", f"only package:// URLs and file paths are read, got {text!r}", text)
+    if folder is None:
+        return Path(text).resolve()
+    return _inside(Path(folder).resolve(), text, text)
+
+
+def _package_folder(package, reference):
+    # A dotted name would import its parent package (running its code) to find it.
+    spec = find_spec(package) if package.isidentifier() else None
+    if spec is None or not spec.submodule_search_locations:
+        raise InputError("package-not-found", f"no installed Python package {package!r}", reference)
+    return Path(next(iter(spec.submodule_search_locations))).resolve()
+
+
+def _inside(base, relative, reference):
+    path = (base / relative).resolve()
+    if not path.is_relative_to(base):
+        raise InputError("path-outside", f"{reference!r} resolves outside {str(base)!r}", reference)
+    return path
+
+
+def _read(path, max_bytes, file):
+    """At most ``max_bytes + 1`` bytes of a regular file (a FIFO or device would block or never end)."""
+    try:
+        fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0))
+        try:
+            if not stat.S_ISREG(os.fstat(fd).st_mode):
+                raise InputError("read-error", "cannot read: not a regular file", file)
+            with os.fdopen(fd, "rb", closefd=False) as handle:
+                data = handle.read(max_bytes + 1)
+        finally:
+            os.close(fd)
+    except OSError as exc:
+        raise InputError("read-error", f"cannot read: {exc.strerror or exc}", file) from None
+    if len(data) > max_bytes:
+        raise InputError("too-large", f"larger than the size limit of {max_bytes} bytes", file)
+    return data
+
+
+_SPACE = re.compile(rb"[ \t\r\n]*")
+_LXML_WHERE = re.compile(r", line \d+, column \d+$")
+
+
+def _doctype_offset(data):
+    """Offset of a ``<!DOCTYPE`` in the prolog (the only place XML allows one), or None.
+
+    A linear scan over the XML declaration, comments, processing instructions
+    and white space, so that every document type declaration gets the same
+    code whatever lxml would make of it (refused entity, amplification limit).
+    """
+    i = 3 if data.startswith(b"\xef\xbb\xbf") else 0
+    while True:
+        i = _SPACE.match(data, i).end()
+        for opening, closing in ((b"<?", b"?>"), (b"<!--", b"-->")):
+            if data.startswith(opening, i):
+                end = data.find(closing, i + len(opening))
+                if end < 0:
+                    return None
+                i = end + len(closing)
+                break
+        else:
+            return i if data.startswith(b"<!DOCTYPE", i) else None
+
+
+def _parse(data, file):
+    """The XML tree of a URDF, parsed without entities, DTDs or network."""
+    from lxml import etree
+
+    offset = _doctype_offset(data)
+    if offset is not None:
+        raise _dtd_error(file, data.count(b"\n", 0, offset) + 1, offset - data.rfind(b"\n", 0, offset))
+    parser = etree.XMLParser(
+        resolve_entities=False,
+        no_network=True,
+        load_dtd=False,
+        dtd_validation=False,
+        huge_tree=False,
+        remove_comments=True,
+    )
+    try:
+        root = etree.fromstring(data, parser)
+    except etree.XMLSyntaxError as exc:
+        line, column = exc.position if exc.position else (None, None)
+        message = _LXML_WHERE.sub("", exc.msg)  # the position is in the error's own fields
+        raise InputError("urdf-syntax", f"not well-formed XML: {message}", file, line or None, column or None) from None
+    info = root.getroottree().docinfo
+    if info.doctype or info.internalDTD is not None or info.externalDTD is not None:  # e.g. in UTF-16, unseen above
+        raise _dtd_error(file, None, None)
+    if root.tag != "robot" or not root.get("name"):
+        raise InputError("invalid-urdf", "the root element must be <robot name=...>", file, root.sourceline)
+    return root
+
+
+def _dtd_error(file, line, column):
+    return InputError(
+        "forbidden-dtd",
+        "a document type declaration (DTD, entities): a robot description needs none",
+        file,
+        line,
+        column,
+    )
+
+
+#: Attributes yourdfpy reads with float(): how many numbers each holds.
+_NUMBERS = {("origin", "xyz"): 3, ("origin", "rpy"): 3, ("axis", "xyz"): 3}
+_LIMITS = ("effort", "velocity", "lower", "upper")
+
+
+def _check_joint_elements(root, file):
+    """Located checks of what yourdfpy reads from each <joint> without checking it."""
+    for element in root.iterfind("joint"):
+        line = element.sourceline
+        name = element.get("name")
+        if not name:
+            raise InputError("invalid-urdf", "a <joint> without a name", file, line)
+        if element.get("type") is None:
+            raise InputError("invalid-urdf", f"joint {name!r}: no type", file, line)
+        for tag in ("parent", "child"):
+            child = element.find(tag)
+            if child is None or not child.get("link"):
+                raise InputError("invalid-urdf", f"joint {name!r}: no <{tag} link=...>", file, line)
+        for (tag, attribute), count in _NUMBERS.items():
+            child = element.find(tag)
+            if child is not None and child.get(attribute) is not None:
+                _numbers(child.get(attribute), count, f"joint {name!r}: <{tag} {attribute}>", file, child.sourceline)
+        limit = element.find("limit")
+        for attribute in _LIMITS if limit is not None else ():
+            if limit.get(attribute) is not None:
+                _numbers(limit.get(attribute), 1, f"joint {name!r}: <limit {attribute}>", file, limit.sourceline)
+
+
+def _numbers(text, count, what, file, line):
+    try:
+        values = [float(word) for word in text.split()]
+    except ValueError:
+        values = None
+    if values is None or len(values) != count or not all(map(math.isfinite, values)):
+        raise InputError("invalid-urdf", f"{what}: expected {count} finite number(s), got {text[:40]!r}", file, line)
+
+
+def _never_open(fname):
+    """yourdfpy's hook for mesh files: never called without a scene graph; refuse if it ever is."""
+    raise PermissionError(f"grasptwist never opens meshes ({fname})")
+
+
+def _model(data, file):
+    try:
+        import yourdfpy
+    except ImportError:
+        raise InputError(
+            "urdf-unavailable", "reading a URDF needs yourdfpy: pip install 'grasptwist[urdf]'", file
+        ) from None
+    try:
+        # The bytes passed _parse: no DTD, so yourdfpy's own lxml parse has no entity to expand.
+        return yourdfpy.URDF.load(
+            io.BytesIO(data),
+            build_scene_graph=False,
+            build_collision_scene_graph=False,
+            load_meshes=False,
+            load_collision_meshes=False,
+            filename_handler=_never_open,
+        )
+    except Exception as exc:  # whatever yourdfpy trips on is a bad file, not a crash
+        raise InputError("invalid-urdf", f"yourdfpy cannot read it: {type(exc).__name__}: {exc}", file) from None
+
+
+def load_urdf_hand(urdf, tips, *, names=None, folder=None, max_bytes=DEFAULT_MAX_BYTES):
+    """A hand from a URDF: one finger per tip link, its joints at home (all 0).
+
+    The hand's frame (and so the grasp's) is the URDF's root link's frame.
+    Finger ``f``'s joints are the movable joints on the path from the root to
+    ``tips[f]``; fixed joints only carry frames along.  Move the fingers to
+    joint positions with :func:`grasptwist.hand.finger_states`.
+
+    Parameters
+    ----------
+    urdf : str or os.PathLike
+        ``package://PKG/path`` or a path (see :func:`resolve_urdf`).
+    tips : sequence of str
+        The link touching each contact, in contact order.
+    names : sequence of str, optional
+        Finger names; default ``"1"``, ``"2"``, ...
+    folder : str or os.PathLike, optional
+        The referring grasp file's folder; a path must stay inside it.
+    max_bytes : int
+        Size cap of the URDF (default 1 MiB, as for grasp files).
+
+    Returns
+    -------
+    Hand
+
+    Raises
+    ------
+    InputError
+        With one of the codes in this module's table.
+
+    >>> hand = load_urdf_hand("package://robot_properties_fingers/urdf/pro/trifingerpro.urdf",
+    ...                       ["finger_tip_link_0", "finger_tip_link_120", "finger_tip_link_240"])
+    >>> hand.root, len(hand.joint_names), [j.name for j in hand.fingers[0].joints]  # doctest: +NORMALIZE_WHITESPACE
+    ('base_link', 9, ['finger_base_to_upper_joint_0', 'finger_upper_to_middle_joint_0',
+                      'finger_middle_to_lower_joint_0'])
+    """
+    text = os.fspath(urdf)
+    file = text if text.startswith(_PACKAGE) or folder is None else os.path.join(os.fspath(folder), text)
+    data = _read(resolve_urdf(urdf, folder), max_bytes, file)
+    root = _parse(data, file)
+    _check_joint_elements(root, file)
+    model = _model(data, file)
+    lines = {element.get("name"): element.sourceline for element in root.iterfind("joint")}
+    parent_joint = _tree(model, lines, file)
+    names = [str(i + 1) for i in range(len(tips))] if names is None else list(names)
+    if len(names) != len(tips):
+        raise ValueError(f"names: expected {len(tips)} finger names, got {len(names)}")
+    fingers, joint_names = [], {}
+    for name, tip in zip(names, tips, strict=True):
+        path = _path(model, parent_joint, tip, lines, file)
+        finger = _finger(name, tip, path, lines, file, joint_names)
+        fingers.append(finger)
+    roots = [link for link in model.link_map if link not in parent_joint]
+    return Hand(tuple(fingers), tuple(joint_names), text, roots[0])
+
+
+def _tree(model, lines, file):
+    """Each link's parent joint, after checking that the links form one tree."""
+    parent_joint = {}
+    for joint in model.robot.joints:
+        where = lines.get(joint.name)
+        for link in (joint.parent, joint.child):
+            if link not in model.link_map:
+                raise InputError("invalid-urdf", f"joint {joint.name!r}: no link named {link!r}", file, where)
+        if joint.child in parent_joint:
+            raise InputError("invalid-urdf", f"link {joint.child!r} is the child of two joints", file, where)
+        parent_joint[joint.child] = joint
+    roots = [link for link in model.link_map if link not in parent_joint]
+    if len(roots) != 1:
+        raise InputError("invalid-urdf", f"expected one root link, found {len(roots)}: {', '.join(roots[:5])}", file)
+    return parent_joint
+
+
+def _path(model, parent_joint, tip, lines, file):
+    """The joints from the root to ``tip``."""
+    if tip not in model.link_map:
+        raise InputError("unknown-link", f"no link named {tip!r} in the URDF", file)
+    path, link = [], tip
+    while link in parent_joint:
+        joint = parent_joint[link]
+        if len(path) > len(parent_joint):  # every link has one parent, so only a cycle can get here
+            raise InputError("invalid-urdf", f"the joints above link {tip!r} form a cycle", file, lines.get(joint.name))
+        path.append(joint)
+        link = joint.parent
+    return path[::-1]
+
+
+def _finger(name, tip, path, lines, file, joint_names):
+    origins, axes, kinds, joints = [], [], [], []
+    for joint in path:
+        where = lines.get(joint.name)
+        if joint.type in _UNSUPPORTED or joint.mimic is not None:
+            what = "a mimic joint" if joint.mimic is not None else f"a {joint.type} joint"
+            raise InputError("unsupported-joint", f"joint {joint.name!r} on finger {name!r} is {what}", file, where)
+        kind = _MOVABLE.get(joint.type)
+        if kind is None:
+            raise InputError("invalid-urdf", f"joint {joint.name!r}: unknown type {joint.type!r}", file, where)
+        axis = np.asarray(joint.axis, dtype=float)
+        if kind != "fixed" and not np.any(axis):
+            raise InputError("invalid-urdf", f"joint {joint.name!r}: zero axis", file, where)
+        origins.append(np.eye(4) if joint.origin is None else joint.origin)
+        axes.append(axis)
+        kinds.append(kind)
+        if kind != "fixed":
+            joints.append(_joint(joint, kind, where, file))
+            joint_names.setdefault(joint.name, len(joint_names))
+    screws, points, tip_pose = chain_from_origins(np.reshape(origins, (-1, 4, 4)), np.reshape(axes, (-1, 3)), kinds)
+    # A prismatic joint lengthens the finger by up to its travel.
+    travel = sum(max(abs(j.lower or 0.0), abs(j.upper or 0.0)) for j in joints if j.type == "prismatic")
+    for array in (screws, points, tip_pose):
+        array.flags.writeable = False
+    return Finger(
+        name=name,
+        tip=tip,
+        joints=tuple(joints),
+        screws=screws,
+        points=points,
+        tip_pose=tip_pose,
+        length=float(chain_length(points, tip_pose[:3, 3])) + travel,
+        joint_index=tuple(joint_names[j.name] for j in joints),
+    )
+
+
+def _joint(joint, kind, line, file):
+    limit = joint.limit
+    velocity = None if limit is None else limit.velocity
+    if velocity is not None and velocity < 0:
+        raise InputError("invalid-urdf", f"joint {joint.name!r}: negative velocity limit {velocity}", file, line)
+    bounded = limit is not None and joint.type != "continuous"
+    return Joint(
+        name=joint.name,
+        type=kind,
+        velocity_limit=velocity or None,  # URDFs write velocity="0" for "no limit"
+        lower=limit.lower if bounded else None,
+        upper=limit.upper if bounded else None,
+        line=line,
+    )
