@@ -268,6 +268,12 @@ def test_the_polyhedron_pose_target_crosses_the_wrist_halfway():
         assert c.t_start == c.t_end and abs(c.t_start - 1.0) <= 1e-9
         assert d.min_conditioning["tangent"] == (pytest.approx(0.5), 0.0)
         assert d.warning_start["tangent"] is None and 0.9 < d.first_warning[1] < 1.0
+    # Spinning about the diagonal first changes nothing of that (the plane's normal is the axis): the
+    # target, still a screw along the diagonal from there, is crossed halfway again, at t = 1 + 1.
+    spin = Segment(1.0, twist=[*(0.5 * np.ones(3) / np.sqrt(3)), 0, 0, 0])
+    d = degeneracies(POLYHEDRON, POLYHEDRON_NORMALS, POLYHEDRON_WRIST, [spin, *path], [0.0, 1.5, 3.0])
+    (c,) = d.crossings
+    assert c.t_start == c.t_end and abs(c.t_start - 2.0) <= 1e-9
 
 
 def test_a_tangential_zero_is_found_and_bracketed():

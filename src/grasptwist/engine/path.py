@@ -306,6 +306,10 @@ class _Plan(NamedTuple):
     body: np.ndarray  # (K, 6) body twist
     space: np.ndarray  # (K, 6) space twist (constant along the segment too)
 
+    def index(self, t):
+        """The segment of each time: the one starting at or before it (the last one for the end)."""
+        return np.clip(np.searchsorted(self.start, t, side="right") - 1, 0, len(self.start) - 1)
+
 
 def _plan(segments) -> _Plan:
     segments = check_segments(segments)
@@ -340,7 +344,7 @@ def _times(times, end):
 
 
 def _poses(plan, t) -> Poses:
-    k = np.clip(np.searchsorted(plan.start, t, side="right") - 1, 0, len(plan.start) - 1)
+    k = plan.index(t)
     r, x = se3.compose(plan.rotation[k], plan.position[k], *se3.exp(plan.body[k], t - plan.start[k]))
     return Poses(t, k, r, x, plan.space[k])
 
@@ -561,101 +565,114 @@ def _turning_points(plan, points, wrist):
     return np.concatenate(found) if found else np.empty(0)
 
 
-def _wrist_crossings(plan, points, wrist, extra, tol, found):
-    """Locate the zeros of ``D`` (``wrist-coplanar``), the smallest conditioning and the first warning."""
-    zero = np.zeros(6)
+class _Signed:
+    """The engine's off-tangent conditioning along a path, signed like ``[Sigma_1|Psi_1]`` (so
+    continuous through a zero of ``D``), and bisection on it."""
 
-    def signed(t):
-        """The engine's off-tangent conditioning at times ``t``, signed like ``[Sigma_1|Psi_1]``."""
-        pose = _poses(plan, np.asarray(t, dtype=float))
-        moved = se3.transform(pose.rotation[..., None, :, :], pose.position[..., None, :], points)
-        r = decompose_off_tangent(moved, wrist, zero, tol=tol, bases=False)
+    def __init__(self, plan, points, wrist, tol):
+        self.plan, self.points, self.wrist, self.tol = plan, points, wrist, tol
+
+    def __call__(self, t):
+        pose = _poses(self.plan, np.asarray(t, dtype=float))
+        moved = se3.transform(pose.rotation[..., None, :, :], pose.position[..., None, :], self.points)
+        r = decompose_off_tangent(moved, self.wrist, np.zeros(6), tol=self.tol, bases=False)
         return np.copysign(r.conditioning, r.sigma_psi[..., 0])
 
-    def below(t):
-        return ~(np.abs(signed(t)) > tol)  # the engine's own test: NaN counts as degenerate
+    def below(self, t):
+        """At or below the tolerance: the engine's own test (NaN counts as degenerate)."""
+        return ~(np.abs(self(t)) > self.tol)
 
-    def bisect(test, lo, hi):
-        """Brackets ``[lo, hi]`` with ``test`` False at ``lo``, True at ``hi``, shrunk to ``_PRECISION``."""
+    def bisect(self, test, lo, hi):
+        """Shrink brackets ``[lo, hi]``, ``test`` False at ``lo`` and True at ``hi``, to ``_PRECISION``
+        of the shorter of their ends' segments; all brackets at once, one engine call per step."""
         lo, hi = np.array(lo, dtype=float), np.array(hi, dtype=float)
-        seg = np.searchsorted(plan.start, np.stack((lo, hi)), side="right") - 1
-        eps = _PRECISION * plan.duration[np.clip(seg, 0, len(plan.start) - 1)].min(axis=0)
+        eps = _PRECISION * np.minimum(self.plan.duration[self.plan.index(lo)], self.plan.duration[self.plan.index(hi)])
         for _ in range(int(np.max(np.ceil(np.log2(np.maximum((hi - lo) / eps, 1))), initial=0))):
             mid = 0.5 * (lo + hi)
             up = test(mid)
             lo, hi = np.where(up, lo, mid), np.where(up, mid, hi)
         return lo, hi
 
-    def root(lo, hi, sign_hi):
-        """Sign changes of the conditioning in ``[lo, hi]``, to ``_PRECISION``."""
-        a, b = bisect(lambda t: np.sign(signed(t)) == sign_hi, lo, hi)
+    def root(self, lo, hi, sign_hi):
+        """The sign change in each ``[lo, hi]`` (``sign_hi`` the sign at ``hi``), to ``_PRECISION``."""
+        a, b = self.bisect(lambda t: np.sign(self(t)) == sign_hi, lo, hi)
         return 0.5 * (a + b)
 
+
+def _wrist_crossings(plan, points, wrist, extra, tol, found):
+    """``wrist-coplanar`` along the path, the smallest off-tangent conditioning and its first warning."""
+    f = _Signed(plan, points, wrist, tol)
     nodes = np.unique(np.concatenate((plan.start, [plan.end], _turning_points(plan, points, wrist), extra)))
-    values = signed(nodes)
-    low = ~(np.abs(values) > tol)
+    values = f(nodes)
+    zones = _zones(f, nodes, values)
+    found.crossings += [Crossing("off-tangent", Status.WRIST_COPLANAR.code, a, b, -1) for a, b in zones]
+    starts = [a for a, _ in zones]
+    found.minimum["off-tangent"] = _smallest(f, nodes, values, starts)
+    found.warning["off-tangent"] = _warning_start(f, nodes, values, starts)
+
+
+def _zones(f, nodes, values):
+    """``(t_start, t_end)`` of every stretch at or below the tolerance (module docstring)."""
+    low = ~(np.abs(values) > f.tol)
     last = len(nodes) - 1
-
-    def crossing(t_start, t_end):
-        found.crossings.append(Crossing("off-tangent", Status.WRIST_COPLANAR.code, float(t_start), float(t_end), -1))
-
-    # Zones at or below the tolerance, as (i, k, t): outer nodes i < k (-1 and last + 1 stand for the
-    # path's ends) and a time t inside (None: the zone holds the nodes i + 1 .. k - 1).
+    found = []
+    # Zones as (i, k, t): outer nodes i < k (-1 and last + 1 stand for the path's ends) and a time t
+    # inside (None: the zone holds the nodes i + 1 .. k - 1).
     runs = np.split(np.flatnonzero(low), np.flatnonzero(np.diff(np.flatnonzero(low)) > 1) + 1)
     zones = [(r[0] - 1, r[-1] + 1, None) for r in runs if r.size]
     flips = np.flatnonzero(~low[:-1] & ~low[1:] & (values[:-1] * values[1:] < 0))
-    roots = root(nodes[flips], nodes[flips + 1], np.sign(values[flips + 1]))
-    for j, t, hit in zip(flips, roots, below(roots)):
+    roots = f.root(nodes[flips], nodes[flips + 1], np.sign(values[flips + 1]))
+    for j, t, hit in zip(flips, roots, f.below(roots)):
         if hit:
             zones.append((j, j + 1, t))
         else:  # the zone is narrower than the root's bracket: the root is all of it
-            crossing(t, t)
-    # Each zone's ends, all bisected together: `below` turns True at a left end and False at a right end.
+            found.append((float(t), float(t)))
+    # The zones' ends, all bisected together: `below` turns True at a left end and False at a right end.
     left = [(nodes[i], nodes[i + 1] if t is None else t) for i, _, t in zones if i >= 0]
     right = [(nodes[k - 1] if t is None else t, nodes[k]) for _, k, t in zones if k <= last]
     brackets = np.array(left + right, dtype=float).reshape(-1, 2)
     flip = np.arange(len(brackets)) >= len(left)
-    lo, hi = bisect(lambda t: below(t) != flip, brackets[:, 0], brackets[:, 1])
+    lo, hi = f.bisect(lambda t: f.below(t) != flip, brackets[:, 0], brackets[:, 1])
     starts, stops = iter(hi[: len(left)]), iter(lo[len(left) :])
     for i, k, t in zones:
-        start = next(starts) if i >= 0 else 0.0
-        stop = next(stops) if k <= last else plan.end
-        segment = np.clip(np.searchsorted(plan.start, 0.5 * (start + stop), side="right") - 1, 0, len(plan.start) - 1)
-        if (
-            i >= 0
-            and k <= last
-            and values[i] * values[k] < 0
-            and stop - start <= math.sqrt(tol) * plan.duration[segment]
-        ):
-            start = stop = t if t is not None else root(nodes[i], nodes[k], np.sign(values[k]))
-        crossing(start, stop)
-    zones_start = [c.t_start for c in found.crossings if c.method == "off-tangent"]
+        start = float(next(starts)) if i >= 0 else 0.0
+        stop = float(next(stops)) if k <= last else f.plan.end
+        sign_change = i >= 0 and k <= last and values[i] * values[k] < 0
+        if sign_change and stop - start <= math.sqrt(f.tol) * f.plan.duration[f.plan.index(start)]:
+            start = stop = float(t if t is not None else f.root(nodes[i], nodes[k], np.sign(values[k])))
+        found.append((start, stop))
+    return sorted(found)
 
-    # The smallest conditioning: at a zone, or near the best node (refined by a golden-section search).
-    times = np.concatenate((nodes, zones_start))
-    size = np.abs(np.concatenate((values, signed(zones_start))))
+
+def _smallest(f, nodes, values, starts):
+    """``(value, t)`` of the smallest conditioning: at a zone, or near the best node, refined there
+    by a golden-section search (between nodes ``|D|`` has no interior minimum, but the conditioning
+    divides it by a length that varies too)."""
+    times = np.concatenate((nodes, starts))
+    size = np.abs(np.concatenate((values, f(starts))))
     best = int(np.nanargmin(size)) if np.isfinite(size).any() else 0
     value, at = float(size[best]), float(times[best])
     if best < len(nodes):
-        t, v = _golden(lambda t: abs(float(signed(t))), nodes[max(best - 1, 0)], nodes[min(best + 1, last)], plan)
+        lo, hi = nodes[max(best - 1, 0)], nodes[min(best + 1, len(nodes) - 1)]
+        t, v = _golden(lambda t: abs(float(f(t))), lo, hi, _PRECISION * f.plan.duration[f.plan.index(nodes[best])])
         if v < value:
             value, at = v, t
-    found.minimum["off-tangent"] = (value, at)
+    return value, at
 
-    # The first warning: the first node below CONDITION_WARNING or the first zone, whichever is
-    # earlier; then its onset between that time and the node before.
+
+def _warning_start(f, nodes, values, starts):
+    """The first time the conditioning is below ``CONDITION_WARNING``: the first such node or the
+    first zone, whichever is earlier, moved back to the onset between it and the node before."""
     warned = np.flatnonzero(np.abs(values) < CONDITION_WARNING)
-    first = min(zones_start + ([float(nodes[warned[0]])] if warned.size else []), default=None)
+    first = min(starts + ([float(nodes[warned[0]])] if warned.size else []), default=None)
     if first is not None and first > 0:
         before = nodes[np.searchsorted(nodes, first, side="left") - 1]
-        first = float(bisect(lambda t: np.abs(signed(t)) < CONDITION_WARNING, before, first)[1])
-    found.warning["off-tangent"] = first
+        first = float(f.bisect(lambda t: np.abs(f(t)) < CONDITION_WARNING, before, first)[1])
+    return first
 
 
-def _golden(f, lo, hi, plan):
-    """Golden-section search for a minimum of ``f`` on ``[lo, hi]``: ``(t, f(t))`` of the best point tried."""
-    k = int(np.clip(np.searchsorted(plan.start, 0.5 * (lo + hi), side="right") - 1, 0, len(plan.start) - 1))
-    eps = _PRECISION * plan.duration[k]
+def _golden(f, lo, hi, eps):
+    """Golden-section search for a minimum of ``f`` on ``[lo, hi]`` down to ``eps``: ``(t, f(t))``."""
     a, b = float(lo), float(hi)
     c, d = b - _GOLDEN * (b - a), a + _GOLDEN * (b - a)
     fc, fd = f(c), f(d)
