@@ -11,7 +11,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Twist", "Grasp", "InputError", "GraspFileError", "CONTACT_NAMES", "Joint", "Finger", "Hand"]
+__all__ = ["Twist", "Grasp", "Segment", "InputError", "GraspFileError", "CONTACT_NAMES", "Joint", "Finger", "Hand"]
 
 #: Contact names of a grasp that does not name its contacts.
 CONTACT_NAMES = ("1", "2", "3")
@@ -79,6 +79,39 @@ class Grasp:
     wrist: np.ndarray | None
     twists: tuple[Twist, ...]
     line: int
+
+
+@dataclass(frozen=True, eq=False)
+class Segment:
+    """One piece of an object path, held for ``duration``: a constant twist or a pose target.
+
+    Poses are the object's rigid motion from its start, ``p -> R p + x``
+    (identity at ``t = 0``), in the grasp frame.  Checked by
+    :func:`grasptwist.path.check_segments`; the math is in
+    :mod:`grasptwist.engine.path`.
+
+    Attributes
+    ----------
+    duration : float
+        Time the segment lasts, > 0.
+    twist : array-like of 6 or None
+        A constant twist ``(omega; v)``; None for a pose target.
+    frame : str
+        The frame ``twist`` is given in: ``"space"`` (the fixed grasp frame;
+        ``v`` the velocity of the point at the grasp frame's origin) or
+        ``"body"`` (moving with the object, coincident with the grasp frame
+        at ``t = 0``).
+    position : array-like of 3 or None
+        A pose target's position ``x``; None for a twist.
+    rotation : array-like (3, 3) or None
+        A pose target's rotation matrix ``R``; None for a twist.
+    """
+
+    duration: float
+    twist: np.ndarray | None = None
+    frame: str = "space"
+    position: np.ndarray | None = None
+    rotation: np.ndarray | None = None
 
 
 class InputError(Exception):

@@ -1,0 +1,37 @@
+"""Following an object path (gross manipulation): the public API.
+
+>>> import numpy as np
+>>> from grasptwist.path import Segment, integrate
+>>> integrate([Segment(1.0, twist=[0, 0, 0, 1, 0, 0])], [0.5]).position.tolist()
+[[0.5, 0.0, 0.0]]
+
+The math is in :mod:`grasptwist.engine.path`; rigid motions in :mod:`grasptwist.engine.se3`.
+"""
+
+from .engine.path import (
+    FRAMES,
+    METHODS,
+    Crossing,
+    FollowResult,
+    PathDegeneracies,
+    Poses,
+    check_segments,
+    degeneracies,
+    follow,
+    integrate,
+)
+from .model import Segment
+
+__all__ = [
+    "Segment",
+    "integrate",
+    "follow",
+    "degeneracies",
+    "check_segments",
+    "Poses",
+    "FollowResult",
+    "Crossing",
+    "PathDegeneracies",
+    "FRAMES",
+    "METHODS",
+]
