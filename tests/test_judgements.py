@@ -1,0 +1,91 @@
+"""Which fingers each component moves, and the rotation-about-the-wrist verdict, on random grasps."""
+
+import numpy as np
+import pytest
+
+import grasptwist as gt
+from grasp_gen import grasps
+from grasptwist.engine.judgements import about_wrist, active, off_tangent_moves, tangent_moves
+
+N = 300
+
+
+@pytest.fixture(scope="module")
+def batch():
+    rng = np.random.default_rng(11)
+    points, normals, wrist, twist = grasps(rng, N)
+    return points, gt.screws.direction(normals), wrist, twist
+
+
+def fingers(moves):
+    return [np.flatnonzero(c).tolist() for c in moves]
+
+
+def test_a_twist_made_of_one_component_moves_only_its_fingers(batch):
+    points, normals, wrist, _ = batch
+    basis = gt.decompose_off_tangent(points, wrist, np.zeros(6))
+    off = gt.decompose_off_tangent(points, wrist, 2.5 * basis.sigma[:, 1])
+    assert {tuple(map(tuple, fingers(m))) for m in off_tangent_moves(off.x, off.y)} == {((), (1,), (), (), (), ())}
+    off = gt.decompose_off_tangent(points, wrist, -0.3 * basis.psi[:, 2])
+    assert {tuple(map(tuple, fingers(m))) for m in off_tangent_moves(off.x, off.y)} == {((), (), (), (), (), (0, 1))}
+    tangent = gt.decompose_tangent(points, normals, np.zeros(6))
+    tan = gt.decompose_tangent(points, normals, 0.7 * tangent.theta[:, 0])
+    moves = tangent_moves(tan.alpha, tan.beta, tan.normal_velocity, tan.in_tangent_planes)
+    assert {tuple(map(tuple, fingers(m))) for m in moves} == {((1, 2), (), (), (), (), ())}
+
+
+def test_no_sigma_component_is_active_exactly_when_the_twist_is_in_the_tangent_planes(batch):
+    points, normals, _, twist = batch
+    basis = gt.decompose_tangent(points, normals, np.zeros(6))
+    in_planes = np.einsum("ni,nij->nj", np.random.default_rng(2).normal(size=(N, 3)), basis.theta)
+    # half the rows slide in their tangent planes, half do not; one is the zero twist
+    t = np.where(np.arange(N)[:, None] % 2 == 0, in_planes, twist)
+    t[1] = 0.0
+    tan = gt.decompose_tangent(points, normals, t)
+    assert tan.ok.all() and tan.in_tangent_planes.sum() == N // 2 + 1  # the zero twist is in its planes too
+    moves = tangent_moves(tan.alpha, tan.beta, tan.normal_velocity, tan.in_tangent_planes)
+    np.testing.assert_array_equal(moves[:, 3:].any(axis=(1, 2)), ~tan.in_tangent_planes)
+    # a Sigma component moves its own finger only; a Theta component the two others
+    np.testing.assert_array_equal(moves[:, 3:] & ~np.eye(3, dtype=bool), False)
+    np.testing.assert_array_equal(moves[:, :3] & np.eye(3, dtype=bool), False)
+    assert not moves[1].any()  # the zero twist moves nothing
+
+
+def test_about_the_wrist_means_the_wrist_does_not_move(batch):
+    points, _, wrist, twist = batch
+    omega = twist[:, :3]
+    spin = np.concatenate([omega, -np.cross(omega, wrist)], axis=1)  # T(c) = 0: a rotation about the wrist
+    off = gt.decompose_off_tangent(points, wrist, spin)
+    assert about_wrist(off.x, off.y).all()
+    assert not off_tangent_moves(off.x, off.y)[:, :3].any()  # no Sigma part
+    off = gt.decompose_off_tangent(points, wrist, spin + [0, 0, 0, 1e-3, 0, 0])  # the wrist slides a little
+    assert not about_wrist(off.x, off.y).any()
+    assert not about_wrist(np.zeros(3), np.zeros(3))  # the zero twist is no rotation
+
+
+def test_judgements_do_not_depend_on_scale_or_position(batch):
+    points, normals, wrist, twist = batch
+    twist = twist.copy()
+    twist[::3, :3] = 0.0  # translations: only some components act
+    off = gt.decompose_off_tangent(points, wrist, twist)
+    tan = gt.decompose_tangent(points, normals, twist)
+    moved = [
+        off_tangent_moves(off.x, off.y),
+        tangent_moves(tan.alpha, tan.beta, tan.normal_velocity, tan.in_tangent_planes),
+    ]
+    scale, offset = 1e-4, np.array([3.0, -2.0, 7.0])
+    # the same motion seen in a frame scaled by 1e-4 and moved: omega stays, v is scaled and shifted
+    t = np.concatenate([twist[:, :3], scale * twist[:, 3:] - np.cross(offset, twist[:, :3])], axis=1)
+    off = gt.decompose_off_tangent(points * scale + offset, wrist * scale + offset, t)
+    tan = gt.decompose_tangent(points * scale + offset, normals, t)
+    np.testing.assert_array_equal(off_tangent_moves(off.x, off.y), moved[0])
+    np.testing.assert_array_equal(
+        tangent_moves(tan.alpha, tan.beta, tan.normal_velocity, tan.in_tangent_planes), moved[1]
+    )
+
+
+def test_a_failed_row_moves_nothing():
+    nan = np.full(3, np.nan)
+    assert not off_tangent_moves(nan, nan).any() and not about_wrist(nan, nan)
+    assert not tangent_moves(nan, nan, nan, False).any()
+    assert active([np.nan, 1.0]).tolist() == [False, False]  # NaN in a row: its maximum is unknown
