@@ -92,3 +92,21 @@ def test_bundled_numbers(records, key):
         np.testing.assert_allclose(rec["tangent"]["alpha"], alpha, atol=1e-4)
         np.testing.assert_allclose(rec["tangent"]["beta"], beta, atol=1e-4)
         assert rec["tangent"]["in_tangent_planes"] is in_planes and rec["ok"] is True
+
+
+@pytest.mark.parametrize("key", sorted(EXPECTED), ids=lambda k: f"{k[1]}/{k[2]}")
+def test_bundled_judgements_follow_the_pinned_amplitudes(records, key):
+    """``moves`` lists a component's fingers exactly where its pinned amplitude is not 0."""
+    rec = records[key]
+    x, y, alpha, beta, _ = EXPECTED[key]
+    off = rec["off_tangent"]
+    assert [bool(m) for m in off["moves"]] == [a != 0 for a in x + y]
+    assert off["moves"] == [[0], [1], [2], [1, 2], [0, 2], [0, 1]] or not all(x + y)
+    assert off["about_wrist"] is (not any(x) and any(y))
+    if not isinstance(alpha, str):
+        assert [bool(m) for m in rec["tangent"]["moves"]] == [a != 0 for a in alpha + beta]
+
+
+def test_the_spins_about_the_wrist_are_the_ones_the_files_say(records):
+    spins = {(k[1], k[2]) for k, rec in records.items() if rec["off_tangent"]["about_wrist"]}
+    assert spins == {("cylinder", "spin-z"), ("polyhedron", "diagonal-spin"), ("sphere-tripod", "spin-z")}

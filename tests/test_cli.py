@@ -17,7 +17,8 @@ from typer.testing import CliRunner
 import grasptwist as gt
 from grasptwist.cli import app
 from grasptwist.io.grasp_file import grasp_schema
-from grasptwist.output import records as report
+from grasptwist.output.columns import CSV_COLUMNS
+from grasptwist.output.writers import JsonArray
 
 # Example 2's polyhedron, with a wrist off the contacts' plane x + y + z = 4
 POLY = """\
@@ -106,7 +107,7 @@ def test_jsonl_is_one_compact_record_per_line_equal_to_json(files):
 def test_csv_has_the_documented_columns_and_full_precision(files):
     r = run("resolve", files / "poly.yaml", "-f", "csv")
     rows = list(csv.DictReader(io.StringIO(r.stdout)))
-    assert list(rows[0]) == report.CSV_COLUMNS and len(rows) == 2
+    assert list(rows[0]) == CSV_COLUMNS and len(rows) == 2
     off = gt.decompose_off_tangent(POINTS, WRIST, TWISTS)
     tan = gt.decompose_tangent(POINTS, np.eye(3), TWISTS)
     for i, row in enumerate(rows):
@@ -217,8 +218,8 @@ def test_output_file_is_written_whole_or_not_at_all(files, monkeypatch):
         real(self, encoded)  # half the output is on disk when the run fails
         raise RuntimeError("disk on fire")
 
-    real = report._JsonArray.write
-    monkeypatch.setattr(report._JsonArray, "write", explode)
+    real = JsonArray.write
+    monkeypatch.setattr(JsonArray, "write", explode)
     r = run("resolve", files / "poly.yaml", "--json", "-o", out)
     assert r.exit_code == 1 and "internal error: RuntimeError: disk on fire" in r.stderr
     assert "Traceback" not in r.output

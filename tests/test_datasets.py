@@ -11,6 +11,10 @@ import grasptwist as gt
 from grasp_gen import grasps
 from grasptwist.cli import app
 from grasptwist.io import datasets
+from grasptwist.model import Twist
+from grasptwist.output.npz import NpzWriter
+from grasptwist.output.records import dumps, records
+from grasptwist.run.batch import dataset_blocks
 
 N = 240
 
@@ -130,27 +134,36 @@ def test_npy_rows_with_a_wrist_or_a_twist_point(tmp_path, data):
     np.testing.assert_allclose([r["contact_velocity"] for r in at[:3]], gt.contact_velocities(points[:3], moved[:3]))
 
 
-def test_npz_output_spills_to_disk_and_reads_back_the_same(tmp_path, data, monkeypatch):
+def test_npz_output_spills_to_disk_and_reads_back_the_same(tmp_path, data):
     points, normals, wrist, twist = data
     np.savez(tmp_path / "set.npz", points=points, normals=normals, wrist=wrist, twist=twist)
     run("resolve", tmp_path / "set.npz", "-f", "npz", "-o", tmp_path / "held.npz")
-    monkeypatch.setattr(datasets, "SPILL_BYTES", 1000)
-    monkeypatch.setattr(datasets, "ROWS_PER_BLOCK", 50)
-    run("resolve", tmp_path / "set.npz", "-f", "npz", "-o", tmp_path / "spilled.npz")
+    ds = datasets.open_dataset(str(tmp_path / "set.npz"))
+    with open(tmp_path / "spilled.npz", "wb") as out:
+        w = NpzWriter(out, spill_bytes=1000)
+        for block in dataset_blocks(ds, None, "both", rows=50, bases=False):
+            w.write(block)
+        w.close()
+    assert w.spilled
     held, spilled = np.load(tmp_path / "held.npz"), np.load(tmp_path / "spilled.npz")
     assert sorted(held.files) == sorted(spilled.files)
     for name in held.files:
         np.testing.assert_array_equal(held[name], spilled[name], err_msg=name)
 
 
-def test_several_twists_per_grasp_and_small_blocks_give_the_same_rows(tmp_path, data, monkeypatch):
+def test_several_twists_per_grasp_and_small_blocks_give_the_same_rows(tmp_path, data):
     points, normals, wrist, _ = data
     np.savez(tmp_path / "set.npz", points=points[:20], normals=normals[:20], wrist=wrist[:20])
     args = ("resolve", tmp_path / "set.npz", "--twist", "0,0,1,0,0,0", "--twist", "0,0,0,0,0,1", "-f", "jsonl")
-    whole = jsonl(run(*args))
-    monkeypatch.setattr(datasets, "ROWS_PER_BLOCK", 7)
-    assert jsonl(run(*args)) == whole
-    assert [(r["grasp"], r["twist"]["name"]) for r in whole[:4]] == [
+    whole = run(*args).stdout.encode().splitlines()
+    twists = [
+        Twist(name, np.array(screw, float), None)
+        for name, screw in (("0,0,1,0,0,0", [0, 0, 1, 0, 0, 0]), ("0,0,0,0,0,1", [0, 0, 0, 0, 0, 1]))
+    ]
+    blocks = list(dataset_blocks(datasets.open_dataset(str(tmp_path / "set.npz")), twists, "both", rows=7))
+    assert [len(b) for b in blocks[:2]] == [6, 6]  # 3 grasps a block, each with its 2 twists
+    assert [dumps(rec) for b in blocks for rec in records(b)] == whole
+    assert [(r["grasp"], r["twist"]["name"]) for r in map(json.loads, whole[:4])] == [
         ("0", "0,0,1,0,0,0"),
         ("0", "0,0,0,0,0,1"),
         ("1", "0,0,1,0,0,0"),

@@ -5,6 +5,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from grasp_gen import grasps
+from grasptwist.engine.decompose import decompose_tangent
 from grasptwist.engine.screws import direction
 from grasptwist.output.json_rows import encode_records
 from grasptwist.output.records import dumps, records
@@ -22,6 +23,9 @@ def block(seed, n, method, wrists):
         points[4, 1] - points[4, 0], points[4, 2] - points[4, 0]
     )  # a warning
     twist[5] = [0, 0, 0, 0, 0, 1e-300]
+    # verdicts that need templates of their own: a rotation about the wrist, a twist in the tangent planes
+    twist[6, 3:] = -np.cross(twist[6, :3], wrist[6])
+    twist[7] = decompose_tangent(points[7], direction(normals[7]), np.zeros(6)).theta[1]
     if wrists == "none":
         wrist = None
     elif wrists == "some":
@@ -42,7 +46,7 @@ def block(seed, n, method, wrists):
 @settings(max_examples=25, deadline=None)
 @given(
     st.integers(0, 2**32 - 1),
-    st.integers(6, 40),
+    st.integers(8, 40),
     st.sampled_from(["both", "off-tangent", "tangent"]),
     st.sampled_from(["omega-v", "v-omega"]),
     st.sampled_from(["all", "some", "none"]),
@@ -52,6 +56,10 @@ def test_template_texts_equal_encoding_each_record(seed, n, method, order, wrist
     texts, talking = encode_records(b, order, records, dumps)
     expected = [dumps(r) for r in records(b, order)]
     assert texts == expected
+    if method != "tangent" and wrists == "all":
+        assert b'"about_wrist":true' in texts[6] and b'"about_wrist":false' in texts[0]
+    if method != "off-tangent":
+        assert b'"in_tangent_planes":true' in texts[7] and b'"moves":[[],[0,2],[],[],[],[]]' in texts[7]
     assert sorted(dumps(r) for r in talking) == sorted(
         e for e, r in zip(expected, records(b, order)) if not r["ok"] or r["warnings"]
     )

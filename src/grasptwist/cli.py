@@ -23,6 +23,8 @@ from enum import Enum
 import typer
 
 from . import __version__
+from .output.formats import FORMATS, names_for
+from .results import ALL_METHODS, KINDS, METHOD_CHOICES
 
 EXIT_OK, EXIT_FAILED, EXIT_USAGE, EXIT_WRITE, EXIT_WORKER, EXIT_BROKEN_PIPE = 0, 1, 2, 3, 4, 141
 
@@ -52,24 +54,16 @@ def _root(
     """Resolve a desired object twist into finger-tip twists for a three-fingered grasp (screw theory)."""
 
 
-class Method(str, Enum):
-    both = "both"
-    off_tangent = "off-tangent"
-    tangent = "tangent"
+def _choices(name: str, values) -> type[Enum]:
+    """A typer choice type of ``values`` (members named as Python allows: ``off-tangent`` is ``off_tangent``)."""
+    return Enum(name, {v.replace("-", "_"): v for v in values}, type=str)
 
 
-class Format(str, Enum):
-    table = "table"
-    json = "json"
-    jsonl = "jsonl"
-    csv = "csv"
-    npz = "npz"
-
-
-class RecordFormat(str, Enum):
-    table = "table"
-    json = "json"
-    jsonl = "jsonl"
+#: ``--method``: the registry's methods, or ``both``.
+Method = _choices("Method", METHOD_CHOICES)
+#: ``-f`` of ``resolve``, and of ``basis`` and ``check``: from the format registry.
+Format = _choices("Format", names_for("resolve"))
+RecordFormat = _choices("RecordFormat", names_for("basis"))
 
 
 class ExtraPoint(str, Enum):
@@ -206,7 +200,7 @@ def _progress(inputs: list):
         yield advance
 
 
-_METHOD = typer.Option(Method.both, "--method", help="Decomposition(s) to run.")
+_METHOD = typer.Option(Method(ALL_METHODS), "--method", help="Decomposition(s) to run.")
 _OUTPUT = typer.Option(None, "-o", "--output", metavar="FILE", help="Write to FILE (atomically) instead of stdout.")
 _DIGITS = typer.Option(4, "--digits", min=0, max=17, help="Decimals in tables (JSON and CSV keep full precision).")
 _ORDER = typer.Option(Order.omega_v, "--order", help="Order of every printed 6-vector: (omega; v) or (v; omega).")
@@ -277,8 +271,8 @@ def resolve(
     if extra_point == ExtraPoint.at and not any(p.endswith(".npy") for p in paths):
         raise typer.BadParameter("applies to .npy data sets (their 19th-21st columns)", param_hint="--extra-point")
     fmt = Format.json if json_ else fmt
-    if fmt == Format.npz and output is None and sys.stdout.isatty():
-        raise typer.BadParameter("npz is binary: give -o FILE.npz", param_hint="--format")
+    if FORMATS[fmt.value].binary and output is None and sys.stdout.isatty():
+        raise typer.BadParameter(f"{fmt.value} is binary: give -o FILE.{fmt.value}", param_hint="--format")
     job = Job(
         kind="resolve",
         twists=None if twists is None else tuple(twists),
@@ -369,9 +363,7 @@ def schema(output: str | None = _OUTPUT, debug: bool = _DEBUG) -> None:
     _run(debug, job)
 
 
-class PlotMethod(str, Enum):
-    off_tangent = "off-tangent"
-    tangent = "tangent"
+PlotMethod = _choices("PlotMethod", [k.label for k in KINDS if k.method])
 
 
 @app.command()
@@ -484,28 +476,24 @@ def _workers(requested: int) -> int:
 def _emit(job, paths: list[str], output, quiet: bool, workers: int, **table_options) -> int:
     """Files in, records out: the body of resolve, basis and check."""
     from .io.inputs import expand
-    from .output.records import writer
-    from .run.pipeline import run, write_npz
+    from .run.pipeline import run, write_blocks
 
     stderr = _Stderr(quiet)
     inputs = list(expand(paths))
+    fmt = FORMATS[job.fmt]
     with _output(output) as out, _progress(inputs) as advance:
-        if job.fmt == "npz":
-            outputs = write_npz(job, inputs, out)
-        else:
-            w = writer(job.fmt, out, job.kind, **table_options)
-            outputs = run(job, inputs, _workers(workers))
+        w = fmt.open(out, job.kind, **table_options)
+        # block writers (npz) take results here; the others get records encoded where they were made
+        outputs = write_blocks(job, inputs, w) if fmt.takes_blocks else run(job, inputs, _workers(workers))
         for o in outputs:
-            if job.fmt != "npz":
-                for encoded in o.encoded:
-                    w.write(encoded)
-                if o.spool:
-                    w.write_spooled(o.spool)
-                out.flush()  # a batch streams: each group is out as soon as it is ready
+            for encoded in o.encoded:
+                w.write(encoded)
+            if o.spool:
+                w.write_spooled(o.spool)
+            out.flush()  # a batch streams: each group is out as soon as it is ready
             stderr.take(o)
             advance(o)
-        if job.fmt != "npz":
-            w.close()
+        w.close()
     stderr.summary()
     return EXIT_FAILED if stderr.failed else EXIT_OK
 

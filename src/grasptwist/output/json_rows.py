@@ -1,15 +1,18 @@
-"""JSON text of many plain records at once, by a template derived from :func:`report.records`.
+"""JSON text of many plain records at once, by a template derived from :func:`records.records`.
 
 A million-record JSONL run spends most of its time making a dict per record
-and encoding it.  Most records are *plain*: every method asked for
-succeeded, with no warning.  Their JSON differs only in numbers and names,
-so it is ``template % values``: the template is found by running the real
-record builder (:func:`grasptwist.output.records.records`) once on a one-row block
-whose numbers and names are unique markers, encoding that record, and
-cutting the text at each marker.  The layout therefore lives in one place;
-this module only learns it.  The numbers of all rows are then encoded by
-orjson in one call (shortest round-trip form, as for single records) and
-split.  Rows that are not plain go through the ordinary builder.
+and encoding it.  Most records are *plain*: every kind asked for applies
+and succeeded, with no warning.  Their JSON differs only in numbers, names
+and a few verdicts (the ``flag`` and ``fingers`` fields of the registry,
+:data:`grasptwist.results.KINDS`), so plain rows with the same verdicts
+share one text ``template % values``.  The template is found by running the
+real record builder (:func:`grasptwist.output.records.records`) once on a
+one-row block of those verdicts whose numbers and names are unique
+markers, encoding that record, and cutting the text at each marker.  The
+layout therefore lives in one place; this module only learns it.  The
+numbers of all rows are then encoded by orjson in one call (shortest
+round-trip form, as for single records) and split.  Rows that are not
+plain go through the ordinary builder.
 """
 
 from __future__ import annotations
@@ -20,17 +23,17 @@ from dataclasses import fields, replace
 import numpy as np
 import orjson
 
-from ..run.batch import Block
-from .records import talking_rows
+from .records import present, talking_rows
 
 __all__ = ["encode_records"]
 
 _MARK = 1 << 20  # number marker: column * _MARK + position + 0.5 (exact, unique)
 _STRING_COLUMNS = ("file", "grasp", "units", "twist_name")
 _TOKEN = re.compile(rb'"\\u0001(\w+)\\u0001"|-?\d+\.5')
+_CODED = ("flag", "fingers")  # field kinds whose few distinct values go into the template
 
 
-def encode_records(block: Block, order: str, records, dumps) -> tuple[list[bytes], list[dict]]:
+def encode_records(block, order: str, records, dumps) -> tuple[list[bytes], list[dict]]:
     """The JSON of each row's record, and the records that are not plain.
 
     Plain rows go by template, the others through ``records`` and ``dumps``;
@@ -45,91 +48,83 @@ def encode_records(block: Block, order: str, records, dumps) -> tuple[list[bytes
         if not rec["ok"] or rec["warnings"]:
             others.append(rec)
         out[i] = dumps(rec)
-    for in_planes in (False, True):
-        rows = plain & (_in_planes(block) == in_planes)
-        if rows.any():
-            for i, text in zip(np.flatnonzero(rows), _by_template(block, order, records, dumps, rows, in_planes)):
+    rows = np.flatnonzero(plain)
+    if rows.size:
+        codes = _verdicts(block)[rows]
+        _, variant = np.unique(codes, axis=0 if codes.ndim > 1 else None, return_inverse=True)
+        for v in range(variant.max() + 1):
+            part = rows[variant.reshape(-1) == v]
+            for i, text in zip(part, _by_template(block, order, records, dumps, part)):
                 out[i] = text
     return out, others
 
 
-def _plain_rows(block: Block) -> np.ndarray:
-    """Rows with nothing to say and every method asked for present."""
+def _plain_rows(block) -> np.ndarray:
+    """Rows with nothing to say and every kind asked for present."""
     plain = ~talking_rows(block)
-    if block.off_tangent is not None:
-        plain &= block.has_wrist  # a skipped method is a null: another template
+    for kind in block.kinds():
+        plain &= block.applies(kind.key)  # a skipped kind is a null: another template
     return plain
 
 
-def _in_planes(block: Block) -> np.ndarray:
-    return np.zeros(len(block), bool) if block.tangent is None else np.asarray(block.tangent.in_tangent_planes)
-
-
-def _numeric(obj):
-    """The float-array fields of a block or result, in a fixed order."""
-    return [
-        f.name
-        for f in fields(obj)
-        if isinstance(getattr(obj, f.name), np.ndarray) and getattr(obj, f.name).dtype.kind == "f"
+def _verdicts(block) -> np.ndarray:
+    """Integers equal where every coded field's JSON is: ``(N,)`` when their
+    bits fit one int64 (the usual case, and quick to sort), else ``(N, k)``."""
+    bits = [
+        np.asarray(block.value(kind.key, f), dtype=bool).reshape(len(block), -1)
+        for kind in block.kinds()
+        for f in present(block, kind.fields)
+        if f.kind in _CODED
     ]
+    bits = np.concatenate(bits, axis=1) if bits else np.zeros((len(block), 0), bool)
+    words = [bits[:, k : k + 62] for k in range(0, bits.shape[1], 62)] or [bits]
+    codes = [w @ (1 << np.arange(w.shape[1], dtype=np.int64)) for w in words]
+    return codes[0] if len(codes) == 1 else np.stack(codes, axis=1)
 
 
-def _columns(block: Block):
-    """``(owner, field)`` of every float column, block first, then each result."""
-    cols = [("block", n) for n in _numeric(block)]
-    for owner in ("off_tangent", "tangent"):
-        r = getattr(block, owner)
-        if r is not None:
-            cols += [(owner, n) for n in _numeric(r)] + [(owner, "residual")]
-    return cols
+def _columns(block):
+    """``(owner, field)`` of every float column: the block's own (owner None,
+    field a name), then each kind's number fields (owner its key)."""
+    own = [
+        (None, f.name)
+        for f in fields(block)
+        if isinstance(getattr(block, f.name), np.ndarray) and getattr(block, f.name).dtype.kind == "f"
+    ]
+    return own + [(kind.key, f) for kind in block.kinds() for f in present(block, kind.fields) if f.kind not in _CODED]
 
 
 def _value(block, owner, name):
-    obj = block if owner == "block" else getattr(block, owner)
-    return np.asarray(getattr(obj, name))
+    return np.asarray(getattr(block, name) if owner is None else block.value(owner, name))
 
 
-def _marker_block(block: Block, in_planes: bool) -> Block:
-    """A one-row copy of ``block`` whose numbers and names are markers."""
+def _marker_block(block, row: int):
+    """A one-row copy of row ``row`` (a plain one) whose numbers and names are markers;
+    its coded fields keep the row's values."""
     cols = _columns(block)
     marked = {
         c: (k * _MARK + np.arange(_value(block, *c)[0].size) + 0.5).reshape((1,) + _value(block, *c).shape[1:])
         for k, c in enumerate(cols)
     }
-
-    def result(owner):
-        r = getattr(block, owner)
-        if r is None:
-            return None
-        values = {n: marked[(owner, n)] for n in _numeric(r)}
-        values.update(status=np.zeros(1, np.int8), culprit=np.full(1, -1, np.int8))
-        if owner == "tangent":
-            values["in_tangent_planes"] = np.full(1, in_planes)
-        one = replace(r.row(slice(0, 1)), **values)
-        one.__dict__["residual"] = marked[(owner, "residual")]
-        return one
-
     names = {c: [f"\x01{c}\x01"] for c in _STRING_COLUMNS}
-    return replace(
-        block.part(0, 1),
-        **{n: marked[("block", n)] for n in _numeric(block)},
+    one = replace(
+        block.take([row]),
+        **{name: marked[(owner, name)] for owner, name in cols if owner is None},
         **names,
         contact_names=[tuple(f"\x01contact{c}\x01" for c in range(3))],
-        has_wrist=np.ones(1, bool),
-        off_tangent=result("off_tangent"),
-        tangent=result("tangent"),
     )
+    one.values.update({c: marked[c] for c in cols if c[0] is not None})
+    return one
 
 
-def _template(block, order, records, dumps, in_planes):
-    """``(template, slots)`` for plain rows of this kind of block.
+def _template(block, order, records, dumps, row):
+    """``(template, slots)`` for plain rows with the verdicts of row ``row``.
 
     A slot is a string column's name, or a *run*: ``[start, stop, rows]``,
     consecutive numbers of one column that the JSON writes as one vector or
     table (``,`` within a row, ``],[`` between rows), so that a run's text
     for every record comes from one orjson call on that column slice.
     """
-    text = dumps(records(_marker_block(block, in_planes), order)[0])
+    text = dumps(records(_marker_block(block, row), order)[0])
     cols = _columns(block)
     offsets = np.cumsum([0] + [_value(block, *c)[0].size for c in cols])
     pieces, slots = [], []
@@ -155,11 +150,11 @@ def _template(block, order, records, dumps, in_planes):
     return b"%s".join(p.replace(b"%", b"%%") for p in pieces), slots
 
 
-def _by_template(block, order, records, dumps, rows, in_planes):
-    template, slots = _template(block, order, records, dumps, in_planes)
-    part = np.flatnonzero(rows)
+def _by_template(block, order, records, dumps, part):
+    """The texts of the plain rows ``part``, which share their verdicts."""
+    template, slots = _template(block, order, records, dumps, part[0])
     numbers = np.concatenate([_value(block, *c)[part].reshape(len(part), -1) for c in _columns(block)], axis=1)
-    numbers += 0.0  # no -0.0, as in report._rows
+    numbers += 0.0  # no -0.0, as in records._rows
     columns = []
     for slot in slots:
         if isinstance(slot, list):

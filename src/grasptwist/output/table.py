@@ -2,7 +2,11 @@
 
 Imported only when a table is asked for, so that machine formats never pay
 for rich's import.  Numbers are rounded to ``digits`` decimals here and only
-here; records keep full precision.
+here; records keep full precision.  Each result kind has a renderer class
+(named by its registry entry's ``table``) giving its extra contact columns,
+its ``resolve`` table, its verdict sentences and its ``basis`` tables; the
+verdicts only print what the records say (``moves``, ``about_wrist``,
+``in_tangent_planes``).
 """
 
 from __future__ import annotations
@@ -18,8 +22,19 @@ from rich.table import Table
 from rich.text import Text
 
 from ..engine.degeneracy import CONDITION_WARNING
+from ..results import KINDS
 
-__all__ = ["TableWriter", "BasisTableWriter", "CheckTableWriter", "WRITERS", "console", "fmt_number", "fmt_vector"]
+__all__ = [
+    "TableWriter",
+    "BasisTableWriter",
+    "CheckTableWriter",
+    "OffTangentTable",
+    "TangentTable",
+    "WRITERS",
+    "console",
+    "fmt_number",
+    "fmt_vector",
+]
 
 
 class _TextView(io.TextIOWrapper):
@@ -96,44 +111,94 @@ class _Writer:
         return Text.assemble((rec["grasp"], "bold"), f" ({rec['file']}){units}", *more, self.order_note)
 
 
+def _renderers(rec: dict) -> list:
+    """``(kind, renderer)`` of every kind the record holds, in registry order."""
+    return [(kind, globals()[kind.table]) for kind in KINDS if kind.key in rec]
+
+
+def _shown(m) -> bool:
+    """Whether a kind's object holds results (not skipped, not failed)."""
+    return m is not None and "error" not in m
+
+
 class TableWriter(_Writer):
-    """A resolve record as tables of contacts and of each method, then a verdict."""
+    """A resolve record as tables of contacts and of each kind, then their verdicts."""
 
     def show(self, rec: dict) -> None:
         d = self.digits
         names = [c["name"] for c in rec["contacts"]]
         twist = rec["twist"]
+        kinds = _renderers(rec)
         self.con.print(self.title(rec, "  twist ", (twist["name"], "bold"), f" = {fmt_vector(twist['screw'], d)}"))
-        self.con.print(self._contacts(rec, d))
-        off = rec.get("off_tangent", False)
-        if off is not False:
-            self.con.print(self._off_tangent(off, names, d))
-        tan = rec.get("tangent")
-        if tan is not None:
-            self.con.print(self._tangent(tan, names, d))
-        for line in _verdict(rec, names):
-            self.con.print(line)
+        self.con.print(self._contacts(rec, kinds, d))
+        for kind, render in kinds:
+            m = rec[kind.key]
+            self.con.print(_not_shown(kind, render, m) if not _shown(m) else render.resolve(m, names, d))
+        for kind, render in kinds:
+            if _shown(rec[kind.key]):
+                for line in render.verdict(rec[kind.key], names):
+                    self.con.print(line)
         for warning in rec["warnings"]:
             self.con.print(Text(f"warning: {warning}", style="yellow"))
 
-    def _contacts(self, rec, d):
+    def _contacts(self, rec, kinds, d):
+        extra = [c for kind, render in kinds if _shown(rec[kind.key]) for c in render.contact_columns(rec[kind.key], d)]
         t = _table("contact", "point", "normal (unit)", "velocity T(p_i)")
-        tan = rec.get("tangent") or {}
-        if "normal_velocity" in tan:
-            t.add_column("normal velocity", justify="right")
+        for header, _ in extra:
+            t.add_column(header, justify="right")
         for i, c in enumerate(rec["contacts"]):
             row = [c["name"], fmt_vector(c["point"], d), fmt_vector(c["normal"], d)]
             row.append(fmt_vector(rec["contact_velocity"][i], d))
-            if "normal_velocity" in tan:
-                row.append(fmt_number(tan["normal_velocity"][i], d))
-            t.add_row(*row)
+            t.add_row(*row, *(cells[i] for _, cells in extra))
         return t
 
-    def _off_tangent(self, m, names, d):
-        if m is None:
-            return Text("off-tangent: skipped (the grasp has no wrist)", style="dim")
-        if "error" in m:
-            return _error_text("off-tangent", m)
+
+def _table(*columns, numbers=()):
+    """A plain table; the columns named in ``numbers`` are right-aligned."""
+    t = Table(box=box.SIMPLE_HEAD, title_justify="left", title_style="bold")
+    for c in columns:
+        t.add_column(c, justify="right" if c in numbers else "left")
+    return t
+
+
+def _not_shown(kind, render, m) -> Text:
+    """The line of a kind that was skipped (``null``) or failed."""
+    if m is None:
+        return Text(f"{kind.label}: skipped ({render.skipped})", style="dim")
+    return Text(f"{kind.label}: failed: {m['error']['code']}: {m['error']['message']}", style="red")
+
+
+def _fingers(names, moves, components) -> list[str]:
+    """Names of the fingers whose components (indices into ``moves``) move a finger."""
+    return [names[i] for i, c in enumerate(components) if moves[c]]
+
+
+def _products(title, names, table, d, conditioning) -> list:
+    """A title line and a 3x3 table of Klein products."""
+    t = _table("", *names, numbers=names)
+    for i, n in enumerate(names):
+        t.add_row(n, *(fmt_number(v, d) for v in table[i]))
+    return [Text(f"{title}   conditioning {conditioning:.3g}", style="bold"), t]
+
+
+def _screws(names, d, *columns):
+    t = _table("i", *(f"{name}_i" for name, _ in columns))
+    for i, n in enumerate(names):
+        t.add_row(n, *(fmt_vector(screws[i], d) for _, screws in columns))
+    return t
+
+
+class OffTangentTable:
+    """The off-tangent method (Proposition 1): amplitudes, basis screws, verdicts."""
+
+    skipped = "the grasp has no wrist"
+
+    @staticmethod
+    def contact_columns(m, d) -> list:
+        return []
+
+    @staticmethod
+    def resolve(m, names, d):
         t = _table(
             "i", "x_i", "y_i", "Sigma_i (moves finger i only)", "Psi_i (keeps finger i fixed)", numbers=("x_i", "y_i")
         )
@@ -148,59 +213,12 @@ class TableWriter(_Writer):
             )
         return t
 
-    def _tangent(self, m, names, d):
-        if "error" in m:
-            return _error_text("tangent", m)
-        t = _table(
-            "i", "alpha_i", "beta_i", "Theta_i (keeps finger i fixed, others slide)", numbers=("alpha_i", "beta_i")
-        )
-        t.title = f"tangent (Proposition 2 + off-plane rest)   conditioning {m['conditioning']:.3g}"
-        for i, n in enumerate(names):
-            t.add_row(n, fmt_number(m["alpha"][i], d), fmt_number(m["beta"][i], d), fmt_vector(m["theta"][i], d))
-        return t
-
-
-def _table(*columns, numbers=()):
-    """A plain table; the columns named in ``numbers`` are right-aligned."""
-    t = Table(box=box.SIMPLE_HEAD, title_justify="left", title_style="bold")
-    for c in columns:
-        t.add_column(c, justify="right" if c in numbers else "left")
-    return t
-
-
-def _error_text(method, m):
-    return Text(f"{method}: failed: {m['error']['code']}: {m['error']['message']}", style="red")
-
-
-def _nonzero(names, values, reference):
-    """Names whose value is not round-off next to the largest of ``reference``."""
-    floor = 1e-9 * max((abs(float(v)) for v in _flat(reference)), default=0.0)
-    return [n for n, v in zip(names, values) if abs(float(v)) > floor]
-
-
-def _flat(values):
-    for v in values:
-        yield from (_flat(v) if hasattr(v, "__len__") else (v,))
-
-
-def _verdict(rec, names):
-    """Plain sentences on what the fingers must do."""
-    lines = []
-    tan = rec.get("tangent")
-    if tan and "error" not in tan:
-        if tan["in_tangent_planes"]:
-            lines.append("verdict: tangent sliding alone realises this twist (every beta_i = 0).")
-        else:
-            off = _nonzero(names, tan["normal_velocity"], rec["contact_velocity"])
-            lines.append(
-                "verdict: not realisable by tangent sliding alone: "
-                f"finger(s) {', '.join(off)} must also move off their tangent planes (the beta_i Sigma_i part)."
-            )
-    off = rec.get("off_tangent")
-    if off and "error" not in off:
-        amplitudes = list(off["x"]) + list(off["y"])
-        held = _nonzero(names, off["y"], amplitudes)
-        moved = _nonzero(names, off["x"], amplitudes)
+    @staticmethod
+    def verdict(m, names) -> list[str]:
+        """Plain sentences from the record's ``moves`` and ``about_wrist``."""
+        lines = []
+        held = _fingers(names, m["moves"], (3, 4, 5))  # Psi_i holds finger i
+        moved = _fingers(names, m["moves"], (0, 1, 2))  # Sigma_i moves finger i alone
         if held:
             lines.append(
                 f"off-tangent: Psi part: finger(s) {', '.join(held)} each held fixed in turn while the object "
@@ -210,9 +228,54 @@ def _verdict(rec, names):
             lines.append(
                 f"off-tangent: Sigma part: finger(s) {', '.join(moved)} each moved alone, about the line through the other two."
             )
-        elif held:
+        if m["about_wrist"]:
             lines.append("off-tangent: the twist is a rotation about the wrist: the wrist alone could make it.")
-    return lines
+        return lines
+
+    @staticmethod
+    def basis(m, names, d) -> list:
+        return [
+            _screws(names, d, ("Sigma", m["sigma"]), ("Psi", m["psi"])),
+            *_products("[Sigma_i | Psi_j]", names, m["sigma_psi"], d, m["conditioning"]),
+        ]
+
+
+class TangentTable:
+    """The tangent method (Proposition 2 and the off-plane rest): amplitudes, bases, verdict."""
+
+    skipped = "not asked for"
+
+    @staticmethod
+    def contact_columns(m, d) -> list:
+        return [("normal velocity", [fmt_number(v, d) for v in m["normal_velocity"]])]
+
+    @staticmethod
+    def resolve(m, names, d):
+        t = _table(
+            "i", "alpha_i", "beta_i", "Theta_i (keeps finger i fixed, others slide)", numbers=("alpha_i", "beta_i")
+        )
+        t.title = f"tangent (Proposition 2 + off-plane rest)   conditioning {m['conditioning']:.3g}"
+        for i, n in enumerate(names):
+            t.add_row(n, fmt_number(m["alpha"][i], d), fmt_number(m["beta"][i], d), fmt_vector(m["theta"][i], d))
+        return t
+
+    @staticmethod
+    def verdict(m, names) -> list[str]:
+        """A plain sentence from the record's ``in_tangent_planes`` and ``moves``."""
+        if m["in_tangent_planes"]:
+            return ["verdict: tangent sliding alone realises this twist (every beta_i = 0)."]
+        off = _fingers(names, m["moves"], (3, 4, 5))  # beta_i Sigma_i moves finger i off its plane
+        return [
+            "verdict: not realisable by tangent sliding alone: "
+            f"finger(s) {', '.join(off)} must also move off their tangent planes (the beta_i Sigma_i part)."
+        ]
+
+    @staticmethod
+    def basis(m, names, d) -> list:
+        return [
+            _screws(names, d, ("Theta", m["theta"]), ("Sigma", m["sigma"])),
+            *_products("[Theta_i | Sigma_j]", names, m["theta_sigma"], d, m["conditioning"]),
+        ]
 
 
 class BasisTableWriter(_Writer):
@@ -222,34 +285,12 @@ class BasisTableWriter(_Writer):
         d = self.digits
         names = [c["name"] for c in rec["contacts"]]
         self.con.print(self.title(rec))
-        off, tan = rec.get("off_tangent", False), rec.get("tangent")
-        if off is None:
-            self.con.print(Text("off-tangent: skipped (the grasp has no wrist)", style="dim"))
-        elif off is not False and "error" in off:
-            self.con.print(_error_text("off-tangent", off))
-        elif off is not False:
-            self._screws(names, d, ("Sigma", off["sigma"]), ("Psi", off["psi"]))
-            self._products("[Sigma_i | Psi_j]", names, off["sigma_psi"], d, off["conditioning"])
-        if tan is not None and "error" in tan:
-            self.con.print(_error_text("tangent", tan))
-        elif tan is not None:
-            self._screws(names, d, ("Theta", tan["theta"]), ("Sigma", tan["sigma"]))
-            self._products("[Theta_i | Sigma_j]", names, tan["theta_sigma"], d, tan["conditioning"])
+        for kind, render in _renderers(rec):
+            m = rec[kind.key]
+            for item in render.basis(m, names, d) if _shown(m) else [_not_shown(kind, render, m)]:
+                self.con.print(item)
         for warning in rec["warnings"]:
             self.con.print(Text(f"warning: {warning}", style="yellow"))
-
-    def _screws(self, names, d, *columns):
-        t = _table("i", *(f"{name}_i" for name, _ in columns))
-        for i, n in enumerate(names):
-            t.add_row(n, *(fmt_vector(screws[i], d) for _, screws in columns))
-        self.con.print(t)
-
-    def _products(self, title, names, table, d, conditioning):
-        self.con.print(Text(f"{title}   conditioning {conditioning:.3g}", style="bold"))
-        t = _table("", *names, numbers=names)
-        for i, n in enumerate(names):
-            t.add_row(n, *(fmt_number(v, d) for v in table[i]))
-        self.con.print(t)
 
 
 class CheckTableWriter(_Writer):
@@ -257,16 +298,11 @@ class CheckTableWriter(_Writer):
 
     def __init__(self, out, **options):
         super().__init__(out, **options)
-        self.table = _table("file", "grasp", "off-tangent", "tangent")
+        self.table = _table("file", "grasp", *(k.label for k in KINDS))
 
     def write(self, rec: dict) -> None:
         if "error" not in rec:
-            self.table.add_row(
-                rec["file"],
-                rec["grasp"],
-                _verdict_cell(rec.get("off_tangent", False)),
-                _verdict_cell(rec.get("tangent")),
-            )
+            self.table.add_row(rec["file"], rec["grasp"], *(_verdict_cell(rec.get(k.key, False)) for k in KINDS))
 
     def close(self) -> None:
         if self.table.row_count:

@@ -2,30 +2,40 @@
 
 Front ends hand this module loaded grasps (and loader errors) in file order,
 or the arrays of a data set; it stacks the rows into blocks, calls the
-engine once per block and hands back :class:`Block` objects (columns of
-results for consecutive rows) with the errors in their places.  No math
-here: only stacking and slicing.
+engine once per block for every result kind asked for (the registry,
+:data:`grasptwist.results.KINDS`) and hands back :class:`Block` objects
+(columns of results for consecutive rows) with the errors in their places.
+No math here: only stacking and slicing.
 """
 
 from __future__ import annotations
 
 from collections.abc import Iterable, Iterator, Sequence
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, field, replace
+from typing import Any
 
 import numpy as np
 
-from ..engine.decompose import (
-    OffTangentResult,
-    TangentResult,
-    contact_velocities,
-    decompose_off_tangent,
-    decompose_tangent,
-)
+from ..engine.decompose import contact_velocities
+from ..engine.screws import direction, twist_at
+from ..io.datasets import Dataset
 from ..model import CONTACT_NAMES, Grasp, GraspFileError, Twist
+from ..results import BY_KEY, KINDS, METHOD_CHOICES, Field, ResultKind, selected
 
-__all__ = ["METHODS", "Block", "resolve", "resolve_arrays", "NO_TWIST", "ZERO_TWIST", "CONTACT_NAMES"]
+__all__ = [
+    "METHODS",
+    "Block",
+    "resolve",
+    "resolve_arrays",
+    "dataset_blocks",
+    "ROWS_PER_BLOCK",
+    "NO_TWIST",
+    "ZERO_TWIST",
+    "CONTACT_NAMES",
+]
 
-METHODS = ("both", "off-tangent", "tangent")
+#: The ``--method`` choices (from the registry).
+METHODS = METHOD_CHOICES
 
 #: Error code of a grasp that has no twist to resolve.
 NO_TWIST = "no-twist"
@@ -33,15 +43,19 @@ NO_TWIST = "no-twist"
 #: The twist whose resolution carries just the bases (``basis`` and ``check``).
 ZERO_TWIST = Twist(name="0", screw=np.zeros(6), line=None)
 
+#: Rows per engine call on a data set: bounded memory, long vectors.
+ROWS_PER_BLOCK = 65536
+
 
 @dataclass(frozen=True)
 class Block:
-    """Consecutive (grasp, twist) rows with every method's results, as columns.
+    """Consecutive (grasp, twist) rows with every result kind's results, as columns.
 
     Per-row labels are lists (or numpy string arrays); ``points`` ...
-    ``velocity`` are arrays over the rows.  ``off_tangent`` is None when the method was not asked for;
-    rows without a wrist (``has_wrist`` False) carry the status
-    ``nonfinite-input`` there and are reported as skipped.
+    ``velocity`` are arrays over the rows.  ``results`` maps the key of each
+    kind computed (in registry order) to its engine result; a kind's rows
+    where it does not apply (:meth:`applies`, e.g. no wrist) hold the status
+    ``nonfinite-input`` and are reported as skipped.
     """
 
     file: list
@@ -54,12 +68,35 @@ class Block:
     twist: np.ndarray  # (n, 6)
     has_wrist: np.ndarray  # (n,) bool
     velocity: np.ndarray  # (n, 3, 3)
-    off_tangent: OffTangentResult | None
-    tangent: TangentResult | None
-    method: str
+    results: dict[str, Any]
+    bases: bool = True  # False: resolved without the basis screws (fields that need them are left out)
+    # field values computed so far, by (kind key, Field); a new block starts empty
+    values: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def __len__(self) -> int:
         return len(self.grasp)
+
+    def kinds(self) -> list[ResultKind]:
+        """The kinds computed for this block, in registry order."""
+        return [k for k in KINDS if k.key in self.results]
+
+    def applies(self, key: str) -> np.ndarray:
+        """Rows where kind ``key`` means something (its record field is null elsewhere)."""
+        return np.asarray(BY_KEY[key].applies(self), dtype=bool)
+
+    def value(self, key: str, f: Field) -> np.ndarray:
+        """Field ``f`` of kind ``key`` over the rows, computed once per block."""
+        got = self.values.get((key, f))
+        if got is None:
+            got = self.values[(key, f)] = f.values(self.results[key])
+        return got
+
+    def failed_rows(self) -> np.ndarray:
+        """Per row: did a kind that applies fail?"""
+        failed = np.zeros(len(self), bool)
+        for key, r in self.results.items():
+            failed |= ~r.ok & self.applies(key)
+        return failed
 
     def part(self, start: int, stop: int) -> Block:
         """Rows ``start:stop`` as a block of their own (views, no copies)."""
@@ -68,7 +105,7 @@ class Block:
     def take(self, rows) -> Block:
         """The rows ``rows`` (a slice, or an array of indices) as a block of their own."""
         cut = {f: _pick(getattr(self, f), rows) for f in _ROW_FIELDS}
-        return replace(self, **cut, off_tangent=_take(self.off_tangent, rows), tangent=_take(self.tangent, rows))
+        return replace(self, **cut, results={k: r.row(rows) for k, r in self.results.items()})
 
 
 _ROW_FIELDS = (
@@ -91,10 +128,6 @@ def _pick(column, rows):
     return column[rows]
 
 
-def _take(result, rows):
-    return None if result is None else result.row(rows)
-
-
 def resolve_arrays(
     points, normals, wrist, twist, method="both", *, file="", grasp=None, twist_name=None, units=None, bases=True
 ) -> Block:
@@ -103,18 +136,19 @@ def resolve_arrays(
     ``wrist`` may be None (no row has one) or hold NaN rows for grasps
     without one; ``grasp`` and ``twist_name`` are per-row labels
     (default: the row index and ``"0"``).  ``normals`` should be unit
-    already (records show them as given).  ``bases=False`` leaves out the
-    basis screws, for outputs that do not show them (npz).
+    already (records show them as given).  ``method`` is one of
+    :data:`METHODS`.  ``bases=False`` leaves out the basis screws, for
+    outputs that do not show them (npz).
     """
-    if method not in METHODS:
-        raise ValueError(f"method must be one of {METHODS}, got {method!r}")
+    kinds = selected(method)
     n = len(points)
     has_wrist = np.zeros(n, bool) if wrist is None else np.isfinite(wrist).all(axis=-1)
-    off = tan = None
-    if method != "off-tangent":
-        tan = decompose_tangent(points, normals, twist, bases=bases)
-    if method != "tangent":
-        off = decompose_off_tangent(points, np.full((n, 3), np.nan) if wrist is None else wrist, twist, bases=bases)
+    inputs = {
+        "points": points,
+        "normals": normals,
+        "wrist": np.full((n, 3), np.nan) if wrist is None else wrist,
+        "twist": twist,
+    }
     return Block(
         file=file if isinstance(file, list) else [file] * n,
         grasp=grasp if grasp is not None else [str(i) for i in range(n)],
@@ -126,9 +160,8 @@ def resolve_arrays(
         twist=twist,
         has_wrist=has_wrist,
         velocity=contact_velocities(points, twist),
-        off_tangent=off,
-        tangent=tan,
-        method=method,
+        results={k.key: k.compute(inputs, bases) for k in kinds},
+        bases=bases,
     )
 
 
@@ -144,7 +177,7 @@ def resolve(
     ----------
     items : grasps and loader errors, in the order to report them.
     twists : twists that replace each grasp's own (the command line's ``--twist``).
-    method : ``"both"``, ``"off-tangent"`` or ``"tangent"``.
+    method : one of :data:`METHODS`.
     chunk : rows per engine call; a chunk is flushed when full or at the end.
 
     Yields
@@ -210,4 +243,74 @@ def _no_twist(grasp: Grasp) -> GraspFileError:
         file=grasp.file,
         line=grasp.line,
         column=1,
+    )
+
+
+def dataset_blocks(
+    ds: Dataset,
+    twists: Sequence[Twist] | None,
+    method: str,
+    rows: int = ROWS_PER_BLOCK,
+    start: int = 0,
+    stop: int | None = None,
+    bases: bool = True,
+) -> Iterator[Block]:
+    """Resolve the grasps ``start:stop`` of a data set, about ``rows`` rows at a time.
+
+    Each grasp is paired with every twist of ``twists`` (the command line's)
+    or else with the data set's own twist; with ``at`` points, a twist's
+    linear part is the velocity of the row's ``at`` point.  ``bases=False``
+    leaves the basis screws out (see :func:`resolve_arrays`).
+
+    Raises
+    ------
+    GraspFileError
+        ``no-twist`` when neither gives a twist.
+    """
+    if twists is None and ds.twist is None:
+        raise GraspFileError(
+            code=NO_TWIST,
+            message="the data set has no 'twist' array: pass --twist W1,W2,W3,V1,V2,V3 (repeatable)",
+            file=ds.path,
+        )
+    given = np.stack([t.screw for t in twists]) if twists is not None else None
+    k = len(given) if given is not None else 1
+    step = max(1, rows // k)
+    end = len(ds) if stop is None else min(stop, len(ds))
+    for first in range(start, end, step):
+        yield _dataset_block(ds, given, twists, method, first, min(end, first + step), k, bases)
+
+
+def _dataset_block(ds, given, twists, method, start, stop, k, bases):
+    """Rows ``start:stop`` of ``ds``, each paired with its ``k`` twists."""
+    index = np.repeat(np.arange(start, stop), k)  # row-major: grasp, then its twists
+    # each grasp's row repeated for its twists (no copy when there is one twist)
+    rows = slice(None) if k == 1 else index - start
+
+    def column(a):
+        return None if a is None else np.asarray(a[start:stop], dtype=float)[rows]
+
+    if given is not None:
+        screw = np.tile(given, (stop - start, 1))
+        names = [t.name for t in twists] * (stop - start)
+    else:
+        own = np.asarray(ds.twist, dtype=float)
+        screw = np.broadcast_to(own, (stop - start, 6)) if own.ndim == 1 else own[start:stop]
+        names = ["twist"] * (stop - start)
+    if ds.at is not None:
+        at = column(ds.at)
+        screw = twist_at(screw[:, :3], screw[:, 3:], at)
+    # labels stay a numpy string array: a million Python strings cost more than the engine
+    label = ds.names[start:stop][rows].astype(str) if ds.names is not None else index.astype(str)
+    return resolve_arrays(
+        column(ds.points),
+        # unit normals exactly as the grasp-file loader makes them
+        direction(np.asarray(ds.normals[start:stop], dtype=float))[rows],
+        column(ds.wrist),
+        np.ascontiguousarray(screw, dtype=float),
+        method,
+        file=ds.path,
+        grasp=label,
+        twist_name=names,
+        bases=bases,
     )

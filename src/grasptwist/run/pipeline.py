@@ -12,7 +12,6 @@ much may wait in memory, is one :class:`Tuning`.
 
 from __future__ import annotations
 
-import gc
 import os
 import shutil
 import tempfile
@@ -23,26 +22,16 @@ from functools import partial
 
 import numpy as np
 
-from ..io.datasets import DATASET_SUFFIXES, NpzWriter, dataset_blocks, open_dataset
+from ..io.datasets import DATASET_SUFFIXES, open_dataset
 from ..io.inputs import STDIN, read
 from ..model import GraspFileError, Twist
-from ..output.json_rows import encode_records
-from ..output.records import (
-    ENCODERS,
-    JOINERS,
-    basis_record,
-    check_record,
-    diagnostics,
-    dumps,
-    error_record,
-    records,
-    talking_rows,
-)
-from .batch import ZERO_TWIST, Block, resolve
+from ..output.formats import FORMATS
+from ..output.records import basis_record, check_record, diagnostics, error_record, records, talking_rows
+from .batch import ZERO_TWIST, Block, dataset_blocks, resolve
 from .pool import Pool
 from .scratch import owned_prefix, sweep
 
-__all__ = ["Job", "Tuning", "TUNING", "Output", "Spool", "run", "run_group", "blocks", "write_npz"]
+__all__ = ["Job", "Tuning", "TUNING", "Output", "Spool", "run", "run_group", "blocks", "write_blocks"]
 
 #: Name stem of the spool folders in /dev/shm.
 SPOOL_STEM = "grasptwist-"
@@ -205,9 +194,10 @@ class Spool:
 def _sealed(job: Job, out: Output, spool: Spool | None = None) -> Output:
     """An output ready to send: its records joined into one bytes object (one
     write), and in a worker put in the ``spool`` when it has room."""
-    if job.fmt not in JOINERS or not out.encoded:
+    join = FORMATS[job.fmt].join
+    if join is None or not out.encoded:
         return out
-    blob = JOINERS[job.fmt](out.encoded)
+    blob = join(out.encoded)
     out.spool = spool.put(blob) if spool is not None else None
     out.encoded = [] if out.spool else [blob]
     return out
@@ -229,13 +219,15 @@ def blocks(job: Job, paths: Sequence, tuning: Tuning = TUNING) -> Iterator[tuple
     """Blocks and errors of every input, in order (for writers that take
     blocks, like npz), each with its progress news: None for a group of
     files (one unit a file), else the records a data set holds beyond the
-    one unit it counted as (on its first block; 0 after)."""
+    one unit it counted as (on its first block; 0 after).  Data sets are
+    resolved without basis screws when the format shows none."""
+    bases = FORMATS[job.fmt].bases
     for g in _groups(paths, tuning.files_per_group):
         if _is_dataset(g):
             try:
                 ds = open_dataset(g, job.extra_point)
                 grows = len(ds) * (len(job.twists) if job.twists else 1) - 1
-                for block in dataset_blocks(ds, job.twists, job.method, bases=False):  # npz shows no screws
+                for block in dataset_blocks(ds, job.twists, job.method, bases=bases):
                     yield block, grows
                     grows = 0
             except GraspFileError as err:
@@ -248,39 +240,17 @@ def blocks(job: Job, paths: Sequence, tuning: Tuning = TUNING) -> Iterator[tuple
             yield x, None
 
 
-@contextmanager
-def _no_gc():
-    """Records are acyclic dicts and lists: building thousands of them with the
-    cyclic garbage collector on spends more time collecting than building."""
-    was_on = gc.isenabled()
-    gc.disable()
-    try:
-        yield
-    finally:
-        if was_on:
-            gc.enable()
-
-
 def _emit(job: Job, x, out: Output, at_once: int) -> None:
-    with _no_gc():
-        _emit_records(job, x, out, at_once)
-
-
-def _emit_records(job: Job, x, out: Output, at_once: int) -> None:
-    encode = ENCODERS[job.fmt]
+    """Records of ``x`` (a block, or an input's error) encoded into ``out``."""
+    fmt = FORMATS[job.fmt]
+    encode = fmt.encode
     if not isinstance(x, Block):
         out.add(error_record(x), encode)
     elif job.kind == "resolve":
         # a few thousand records at a time: their floats as Python objects
-        # would otherwise fill memory and keep the garbage collector busy
+        # would otherwise fill memory
         for start in range(0, len(x), at_once):
-            part = x.part(start, start + at_once)
-            if job.fmt in ("json", "jsonl"):
-                texts, talking = encode_records(part, job.order, records, dumps)
-                out.add_encoded(texts, talking)
-            else:
-                for rec in records(part, job.order):
-                    out.add(rec, encode)
+            out.add_encoded(*fmt.encode_rows(x.part(start, start + at_once), job.order))
     else:
         for i in range(len(x)):
             out.add(basis_record(x, i, job.order) if job.kind == "basis" else check_record(x, i), encode)
@@ -358,14 +328,13 @@ def _groups(paths, size: int):
         yield group
 
 
-def write_npz(job: Job, paths: Sequence, out, tuning: Tuning = TUNING) -> Iterator[Output]:
-    """Resolve everything into one ``.npz`` on ``out``.
+def write_blocks(job: Job, paths: Sequence, w, tuning: Tuning = TUNING) -> Iterator[Output]:
+    """Resolve everything into ``w``, a writer that takes blocks (npz).
 
     Yields an :class:`Output` per block with its counts and stderr lines
     (records are built only for the rows that need a line: failed or
-    nearly degenerate ones); the archive is complete when the iterator is.
+    nearly degenerate ones); the caller closes ``w``.
     """
-    w = NpzWriter(out, job.order)
     for x, grows in blocks(job, paths, tuning):
         o = Output(done=len(x) if grows is not None else 1, grows=grows or 0)
         if isinstance(x, Block):
@@ -378,4 +347,3 @@ def write_npz(job: Job, paths: Sequence, out, tuning: Tuning = TUNING) -> Iterat
         else:
             o.add(error_record(x), lambda rec: None)
         yield o
-    w.close()

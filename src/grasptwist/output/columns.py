@@ -1,0 +1,143 @@
+"""Result blocks as named flat columns: the one definition CSV, npz (and Parquet) share.
+
+A block's columns are groups (:class:`~grasptwist.results.Column`): first the
+rows' own (file, grasp, twist name, ok, error, the twist, the contact
+velocities), then each result kind's from the registry
+(:data:`grasptwist.results.KINDS`), each kind ending with ``<key>_error``.
+:func:`columns` gives them as flat ``(N,)`` arrays named and ordered as the
+CSV header (:data:`CSV_COLUMNS`); :func:`arrays` gives the groups whole, as
+npz stores them.  Values that do not apply (a kind that failed, was skipped
+or not asked for) are masked in the flat columns (``numpy.ma``): CSV writes
+them empty, Parquet as nulls.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..engine.degeneracy import Status, status_message
+from ..results import CULPRIT, KINDS, STATUS, Column
+
+__all__ = ["ORDERS", "in_order", "BLOCK_COLUMNS", "CSV_COLUMNS", "columns", "arrays", "error_texts"]
+
+#: Screw orders for output: the paper's ``(omega; v)`` or ``(v; omega)``.
+ORDERS = ("omega-v", "v-omega")
+_V_OMEGA = [3, 4, 5, 0, 1, 2]
+
+
+def in_order(a: np.ndarray, order: str) -> np.ndarray:
+    """``(..., 6)`` screws in the output order ``order`` (one of :data:`ORDERS`).
+
+    >>> in_order(np.arange(6), "v-omega").tolist()
+    [3, 4, 5, 0, 1, 2]
+    """
+    return a[..., _V_OMEGA] if order == "v-omega" else a
+
+
+def _block(get):
+    return lambda _, block: get(block)
+
+
+#: The rows' own columns, before every kind's.  npz stores ``file`` and
+#: ``twist_name`` as indices into tables of distinct names.
+BLOCK_COLUMNS = (
+    Column("file", _block(lambda b: b.file), ("file",), dtype="U", only_where_ok=False),
+    Column("grasp", _block(lambda b: b.grasp), ("grasp",), dtype="U", only_where_ok=False),
+    Column("twist_name", _block(lambda b: b.twist_name), ("twist",), dtype="U", only_where_ok=False),
+    Column("ok", _block(lambda b: ~b.failed_rows()), ("ok",), dtype="?", array=False, only_where_ok=False),
+    # an input that failed has only this (see records.error_record); rows of a block have none
+    Column("error", _block(lambda b: np.full(len(b), "")), ("error",), dtype="U", array=False, only_where_ok=False),
+    Column("twist", _block(lambda b: b.twist), tuple(f"twist{i}" for i in range(1, 7)), only_where_ok=False),
+    Column(
+        "contact_velocity",
+        _block(lambda b: b.velocity),
+        tuple(f"v{i}_{a}" for i in range(1, 4) for a in "xyz"),
+        only_where_ok=False,
+    ),
+)
+
+#: Columns that hold screws, written in the order asked for.
+_SCREWS = {"twist"}
+
+
+def _error_column(key: str) -> Column:
+    return Column(
+        f"{key}_error",
+        lambda r, block: error_texts(block, key),
+        (f"{key}_error",),
+        "U",
+        array=False,
+        only_where_ok=False,
+    )
+
+
+def _groups():
+    """Every column group with the key of its kind (None for the rows' own)."""
+    groups = [(None, c) for c in BLOCK_COLUMNS]
+    for kind in KINDS:
+        groups += [(kind.key, c) for c in kind.columns] + [(kind.key, _error_column(kind.key))]
+    return groups
+
+
+_GROUPS = _groups()
+
+#: CSV header: every flat column, in order; the README documents each.
+CSV_COLUMNS = [name for _, c in _GROUPS for name in c.flat]
+
+
+def error_texts(block, key: str) -> np.ndarray:
+    """``code: message`` of kind ``key`` where it failed and applies, else empty."""
+    status, culprit = block.value(key, STATUS), block.value(key, CULPRIT)
+    texts = np.full(len(block), "", dtype=object)
+    for i in np.flatnonzero((status != Status.OK) & block.applies(key)):
+        s = Status(int(status[i]))
+        texts[i] = f"{s.code}: {status_message(s, culprit[i], block.contact_names[i])}"
+    return texts
+
+
+def _values(block, key, column: Column, order: str):
+    """A group's ``(N, ...)`` values (labels may be a list), or None for a kind not computed."""
+    if key is not None and key not in block.results:
+        return None
+    values = column.get(block.results.get(key), block)
+    return in_order(values, order) if column.name in _SCREWS else values
+
+
+def columns(block, order: str = "omega-v") -> dict[str, np.ndarray]:
+    """The block's flat columns, ``name -> (N,)`` array, in the order of :data:`CSV_COLUMNS`.
+
+    Values that do not apply are masked (a :class:`numpy.ma.MaskedArray`):
+    every value of a kind not computed, and of a group marked
+    ``only_where_ok``, where its kind failed or does not apply.  Flat
+    columns of a group are views of its array (no copies).
+    """
+    n = len(block)
+    out = {}
+    for key, column in _GROUPS:
+        if not column.flat:
+            continue
+        values = _values(block, key, column, order)
+        if values is None:
+            blank = np.ma.masked_all((n,), dtype=column.dtype if column.dtype != "U" else object)
+            out.update(dict.fromkeys(column.flat, blank))
+            continue
+        flat = np.asarray(values).reshape(n, -1)
+        valid = block.results[key].ok & block.applies(key) if key is not None and column.only_where_ok else None
+        for j, name in enumerate(column.flat):
+            out[name] = flat[:, j] if valid is None else np.ma.masked_array(flat[:, j], mask=~valid)
+    return out
+
+
+def arrays(block, order: str = "omega-v") -> dict[str, np.ndarray]:
+    """The block's column groups that npz stores, ``name -> (N, ...)`` array, for the kinds computed.
+
+    Labels (``file``, ``grasp``, ``twist_name``) may come as lists.  Values are the engine's everywhere (NaN amplitudes where a kind failed;
+    statuses say which rows those are).
+    """
+    out = {}
+    for key, column in _GROUPS:
+        if column.array:
+            values = _values(block, key, column, order)
+            if values is not None:
+                out[column.name] = values
+    return out

@@ -1,0 +1,59 @@
+"""CSV text of result blocks, from their flat columns (:func:`columns.columns`).
+
+One line per record, the cells of a block made a column at a time: floats
+in Python's shortest round-trip form (``repr``) with no ``-0.0``, booleans
+``true``/``false``, masked values (what does not apply) empty, text quoted
+by the :mod:`csv` module when it must be.
+"""
+
+from __future__ import annotations
+
+import csv
+import io
+
+import numpy as np
+
+from .columns import CSV_COLUMNS, columns
+from .records import records, talking_rows
+
+__all__ = ["HEADER", "encode_rows", "error_row"]
+
+#: The header line.
+HEADER = ",".join(CSV_COLUMNS).encode() + b"\n"
+
+
+def _cells(a: np.ndarray) -> list:
+    """The CSV cells of one flat column."""
+    data = np.ma.getdata(a)
+    if data.dtype.kind == "f":
+        cells = list(map(repr, (data + 0.0).tolist()))  # + 0.0: no "-0.0"
+    elif data.dtype.kind == "b":
+        cells = ["true" if v else "false" for v in data.tolist()]
+    else:
+        cells = data.tolist()
+    for i in np.flatnonzero(np.ma.getmaskarray(a)):
+        cells[i] = ""
+    return cells
+
+
+def _lines(rows) -> list[bytes]:
+    """Each row as one CSV line."""
+    text = io.StringIO()
+    write = csv.writer(text, lineterminator="\n").writerow
+    ends = np.cumsum([write(row) for row in rows]).tolist()
+    whole = text.getvalue()
+    return [whole[a:b].encode() for a, b in zip([0] + ends, ends)]
+
+
+def encode_rows(block, order: str) -> tuple[list[bytes], list[dict]]:
+    """The CSV line of each row, and the records of the rows with something to say."""
+    cells = [_cells(a) for a in columns(block, order).values()]
+    talking = np.flatnonzero(talking_rows(block))
+    return _lines(zip(*cells)), records(block.take(talking), order) if talking.size else []
+
+
+def error_row(rec: dict) -> bytes:
+    """The CSV line of an input that failed (:func:`records.error_record`)."""
+    err = rec["error"]
+    row = [rec["file"], "", "", "false", f"{err['code']}: {err['message']}"]  # file, grasp, twist, ok, error
+    return _lines([row + [""] * (len(CSV_COLUMNS) - len(row))])[0]
