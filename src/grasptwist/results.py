@@ -146,8 +146,9 @@ class ResultKind:
     fields, basis_fields, check_fields : tuple of Field
         Its object in ``resolve``, ``basis`` and ``check`` records, in order.
     columns : tuple of Column
-        Its column groups in CSV order; the output adds a ``<key>_error``
-        column after them.
+        Its column groups in CSV order; the output adds ``<key>_status``
+        (npz: the engine's status, -1 where the kind does not apply) and
+        ``<key>_error`` (CSV: ``code: message`` where it failed) after them.
     table : str
         Name of its renderer class in :mod:`grasptwist.output.table`.
     method : bool
@@ -164,16 +165,6 @@ class ResultKind:
     columns: tuple[Column, ...]
     table: str
     method: bool = True
-
-
-def _status(key: str) -> Column:
-    """``<key>_status``: the engine's status, -1 where the kind does not apply (skipped)."""
-    return Column(
-        f"{key}_status",
-        lambda r, block: np.where(block.applies(key), r.status, -1).astype(np.int8),
-        dtype="i1",
-        only_where_ok=False,
-    )
 
 
 def _numbered(name: str, n: int = 3) -> tuple[str, ...]:
@@ -222,7 +213,6 @@ OFF_TANGENT = ResultKind(
     columns=(
         Column("x", _attribute("x"), _numbered("x")),
         Column("y", _attribute("y"), _numbered("y")),
-        _status("off_tangent"),
         Column("off_tangent_conditioning", _attribute("conditioning"), ("off_tangent_conditioning",)),
     ),
     table="OffTangentTable",
@@ -260,7 +250,6 @@ TANGENT = ResultKind(
         Column("beta", _attribute("beta"), _numbered("beta")),
         Column("normal_velocity", _attribute("normal_velocity"), _numbered("normal_velocity")),
         Column("in_tangent_planes", _attribute("in_tangent_planes"), ("in_tangent_planes",), dtype="?"),
-        _status("tangent"),
         Column("tangent_conditioning", _attribute("conditioning"), ("tangent_conditioning",)),
     ),
     table="TangentTable",

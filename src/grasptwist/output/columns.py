@@ -3,7 +3,8 @@
 A block's columns are groups (:class:`~grasptwist.results.Column`): first the
 rows' own (file, grasp, twist name, ok, error, the twist, the contact
 velocities), then each result kind's from the registry
-(:data:`grasptwist.results.KINDS`), each kind ending with ``<key>_error``.
+(:data:`grasptwist.results.KINDS`), each kind's ending with ``<key>_status``
+(npz only) and ``<key>_error`` (CSV only).
 :func:`columns` gives them as flat ``(N,)`` arrays named and ordered as the
 CSV header (:data:`CSV_COLUMNS`); :func:`arrays` gives the groups whole, as
 npz stores them.  Values that do not apply (a kind that failed, was skipped
@@ -60,6 +61,16 @@ BLOCK_COLUMNS = (
 _SCREWS = {"twist"}
 
 
+def _status_column(key: str) -> Column:
+    """``<key>_status``: the engine's status, -1 where the kind does not apply (skipped)."""
+    return Column(
+        f"{key}_status",
+        lambda r, block: np.where(block.applies(key), block.value(key, STATUS), -1).astype(np.int8),
+        dtype="i1",
+        only_where_ok=False,
+    )
+
+
 def _error_column(key: str) -> Column:
     return Column(
         f"{key}_error",
@@ -75,7 +86,8 @@ def _groups():
     """Every column group with the key of its kind (None for the rows' own)."""
     groups = [(None, c) for c in BLOCK_COLUMNS]
     for kind in KINDS:
-        groups += [(kind.key, c) for c in kind.columns] + [(kind.key, _error_column(kind.key))]
+        own = (*kind.columns, _status_column(kind.key), _error_column(kind.key))
+        groups += [(kind.key, c) for c in own]
     return groups
 
 

@@ -28,6 +28,8 @@ __all__ = [
     "error_record",
     "diagnostics",
     "talking_rows",
+    "json_values",
+    "present",
     "dumps",
 ]
 
