@@ -90,19 +90,40 @@ class SpeedTable:
 
 
 T.SpeedTable = SpeedTable
-from grasptwist.cli import main
 
-sys.argv = ["grasptwist"] + sys.argv[1:]
-main()
+import json
+from typer.testing import CliRunner
+from grasptwist.cli import app
+
+runs = [CliRunner().invoke(app, args) for args in json.loads(sys.argv[1])]
+print(json.dumps([(r.exit_code, r.stdout, r.stderr) for r in runs]))
 """
 
+POLY = "grasps/polyhedron.yaml"
+COMMANDS = {
+    "jsonl": ["resolve", POLY, "--method", "speed", "-f", "jsonl"],
+    "json": ["resolve", POLY, "-f", "json"],
+    "csv": ["resolve", POLY, "-f", "csv"],
+    "npz": ["resolve", POLY, "-f", "npz", "-o", "{tmp}/out.npz"],
+    "table": ["resolve", POLY, "--method", "speed", "--digits", "3"],
+    "basis": ["basis", POLY, "--json"],
+    "basis table": ["basis", POLY],
+    "check": ["check", POLY, "--json"],
+}
 
-def grasptwist(*args, tmp=None):
+
+@pytest.fixture(scope="module")
+def out(tmp_path_factory):
+    """Each command's stdout, run in one fresh interpreter with the kind registered."""
+    tmp = tmp_path_factory.mktemp("registry")
+    commands = [[a.format(tmp=tmp) for a in args] for args in COMMANDS.values()]
     done = subprocess.run(
-        [sys.executable, "-c", SETUP, *map(str, args)], cwd=ROOT, capture_output=True, text=tmp is None, timeout=60
+        [sys.executable, "-c", SETUP, json.dumps(commands)], cwd=ROOT, capture_output=True, text=True, timeout=120
     )
     assert done.returncode == 0, done.stderr
-    return done.stdout
+    runs = json.loads(done.stdout)
+    assert all(code == 0 for code, _, _ in runs), runs
+    return {name: stdout for name, (_, stdout, _) in zip(COMMANDS, runs)} | {"tmp": tmp}
 
 
 @pytest.fixture(scope="module")
@@ -113,27 +134,22 @@ def expected():
     return np.linalg.norm(gt.contact_velocities(points, twist), axis=-1)
 
 
-def test_a_new_kind_is_in_records_csv_and_npz(expected, tmp_path):
-    g = "grasps/polyhedron.yaml"
-    [rec] = map(json.loads, grasptwist("resolve", g, "--method", "speed", "-f", "jsonl").splitlines())
+def test_a_new_kind_is_in_records_csv_and_npz(expected, out):
+    [rec] = map(json.loads, out["jsonl"].splitlines())
     assert "off_tangent" not in rec and "tangent" not in rec and rec["ok"] is True
     assert rec["speed"] == {"speed": expected.tolist(), "conditioning": 1.0}
-    both = json.loads(grasptwist("resolve", g, "-f", "json"))[0]
+    both = json.loads(out["json"])[0]
     assert list(both)[-5:] == ["off_tangent", "tangent", "speed", "warnings", "ok"]
-    [row] = csv.DictReader(io.StringIO(grasptwist("resolve", g, "-f", "csv")))
+    [row] = csv.DictReader(io.StringIO(out["csv"]))
     assert [float(row[f"speed{i}"]) for i in (1, 2, 3)] == expected.tolist() and row["speed_error"] == ""
     assert list(row)[-5:] == ["tangent_error", "speed1", "speed2", "speed3", "speed_error"]
-    grasptwist("resolve", g, "-f", "npz", "-o", tmp_path / "out.npz")
-    z = np.load(tmp_path / "out.npz")
+    z = np.load(out["tmp"] / "out.npz")
     np.testing.assert_array_equal(z["speed"], [expected])
     assert z["speed_status"].tolist() == [0] and "x" in z.files
 
 
-def test_a_new_kind_is_in_tables_basis_and_check():
-    g = "grasps/polyhedron.yaml"
-    table = grasptwist("resolve", g, "--method", "speed", "--digits", "3")
+def test_a_new_kind_is_in_tables_basis_and_check(out):
+    table = out["table"]
     assert "speeds shown with the contacts" in table and "speed: fastest finger" in table and "1.633" in table
-    basis = json.loads(grasptwist("basis", g, "--json"))[0]
-    assert basis["speed"] == {"conditioning": 1.0} and "speed: no basis" in grasptwist("basis", g)
-    check = json.loads(grasptwist("check", g, "--json"))[0]
-    assert check["speed"] == {"conditioning": 1.0}
+    assert json.loads(out["basis"])[0]["speed"] == {"conditioning": 1.0} and "speed: no basis" in out["basis table"]
+    assert json.loads(out["check"])[0]["speed"] == {"conditioning": 1.0}
