@@ -41,6 +41,7 @@ def encode_records(block, order: str, records, dumps) -> tuple[list[bytes], list
     returned are the ones with something to say (errors, warnings).
     """
     plain = _plain_rows(block)
+    codes = _verdicts(block)  # judged once here, for the non-plain rows' records too
     out: list = [None] * len(block)
     others = []
     rows = np.flatnonzero(~plain)
@@ -50,8 +51,7 @@ def encode_records(block, order: str, records, dumps) -> tuple[list[bytes], list
         out[i] = dumps(rec)
     rows = np.flatnonzero(plain)
     if rows.size:
-        codes = _verdicts(block)[rows]
-        _, variant = np.unique(codes, axis=0 if codes.ndim > 1 else None, return_inverse=True)
+        _, variant = np.unique(codes[rows], axis=0 if codes.ndim > 1 else None, return_inverse=True)
         for v in range(variant.max() + 1):
             part = rows[variant.reshape(-1) == v]
             for i, text in zip(part, _by_template(block, order, records, dumps, part)):
@@ -67,15 +67,15 @@ def _plain_rows(block) -> np.ndarray:
     return plain
 
 
+def _coded(block) -> list:
+    """``(kind key, field)`` of every coded field."""
+    return [(kind.key, f) for kind in block.kinds() for f in present(block, kind.fields) if f.kind in _CODED]
+
+
 def _verdicts(block) -> np.ndarray:
     """Integers equal where every coded field's JSON is: ``(N,)`` when their
     bits fit one int64 (the usual case, and quick to sort), else ``(N, k)``."""
-    bits = [
-        np.asarray(block.value(kind.key, f), dtype=bool).reshape(len(block), -1)
-        for kind in block.kinds()
-        for f in present(block, kind.fields)
-        if f.kind in _CODED
-    ]
+    bits = [np.asarray(block.value(*c), dtype=bool).reshape(len(block), -1) for c in _coded(block)]
     bits = np.concatenate(bits, axis=1) if bits else np.zeros((len(block), 0), bool)
     words = [bits[:, k : k + 62] for k in range(0, bits.shape[1], 62)] or [bits]
     codes = [w @ (1 << np.arange(w.shape[1], dtype=np.int64)) for w in words]
@@ -113,6 +113,7 @@ def _marker_block(block, row: int):
         contact_names=[tuple(f"\x01contact{c}\x01" for c in range(3))],
     )
     one.values.update({c: marked[c] for c in cols if c[0] is not None})
+    one.values.update({c: block.value(*c)[[row]] for c in _coded(block)})  # known already: no need to judge again
     return one
 
 

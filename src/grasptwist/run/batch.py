@@ -70,7 +70,7 @@ class Block:
     velocity: np.ndarray  # (n, 3, 3)
     results: dict[str, Any]
     bases: bool = True  # False: resolved without the basis screws (fields that need them are left out)
-    # field values computed so far, by (kind key, Field); a new block starts empty
+    # field values computed so far, by (kind key, Field); a block cut from another keeps its rows of them
     values: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def __len__(self) -> int:
@@ -105,7 +105,9 @@ class Block:
     def take(self, rows) -> Block:
         """The rows ``rows`` (a slice, or an array of indices) as a block of their own."""
         cut = {f: _pick(getattr(self, f), rows) for f in _ROW_FIELDS}
-        return replace(self, **cut, results={k: r.row(rows) for k, r in self.results.items()})
+        block = replace(self, **cut, results={k: r.row(rows) for k, r in self.results.items()})
+        block.values.update({k: v[rows] for k, v in self.values.items()})  # what is known stays known
+        return block
 
 
 _ROW_FIELDS = (
