@@ -167,9 +167,13 @@ def _by_template(block, order, records, dumps, part):
             text = orjson.dumps(run, option=orjson.OPT_SERIALIZE_NUMPY)
             columns.append(text[3:-3].split(b"]],[[") if cut else text[2:-2].split(b"],["))
         elif slot.startswith("contact"):
-            columns.append(_labels([block.contact_names[i][int(slot[-1])] for i in part]))
+            names, c = block.contact_names, int(slot[-1])
+            columns.append(_labels([names[i][c] for i in part]))
         else:
-            columns.append(_labels([getattr(block, slot)[i] for i in part]))
+            labels = getattr(block, slot)  # a list, or a numpy array of a data set's labels
+            columns.append(
+                _labels(labels[part].tolist() if isinstance(labels, np.ndarray) else [labels[i] for i in part])
+            )
     return [template % values for values in zip(*columns)]
 
 
