@@ -274,9 +274,11 @@ def test_a_stop_signal_ends_a_parallel_run_cleanly(tmp_path, rows, sig, group, t
 
 
 def test_a_stop_signal_removes_the_npz_spill(tmp_path, rows):
-    # a spill threshold of 1 MiB instead of 512 MiB, so that a small data set spills
+    # the npz format with a spill threshold of 1 MiB instead of 512 MiB, so that a small data set spills
     launcher = (
-        "import sys; from grasptwist.io import datasets; datasets.SPILL_BYTES = 1 << 20; "
+        "import dataclasses; from grasptwist.output import formats, npz; "
+        "formats.FORMATS['npz'] = dataclasses.replace(formats.FORMATS['npz'], "
+        "open=lambda out, kind, order='omega-v', **_: npz.NpzWriter(out, order, spill_bytes=1 << 20)); "
         "from grasptwist.cli import main; main()"
     )
     run = Run(tmp_path, "resolve", rows, *TWIST, "-f", "npz", "-o", tmp_path / "out.npz", launcher=launcher)
