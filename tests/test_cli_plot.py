@@ -84,7 +84,11 @@ def test_without_matplotlib_it_says_how_to_install_it(tmp_path, monkeypatch):
     monkeypatch.setitem(sys.modules, "matplotlib", None)  # makes `import matplotlib` fail
     r = run("plot", GRASPS / "cylinder.yaml", "-o", tmp_path / "c.png")
     assert r.exit_code == 1 and r.stdout == "" and not (tmp_path / "c.png").exists()
-    assert r.stderr == "grasptwist: error: grasptwist plot needs matplotlib: pip install 'grasptwist[plot]'\n"
+    # one line, the word "grasptwist" once at its start (0.1 doubled it: "grasptwist: error: grasptwist plot ...")
+    assert (
+        r.stderr
+        == "grasptwist plot needs matplotlib: pip install matplotlib (from a clone of grasptwist: pip install '.[plot]')\n"
+    )
 
 
 def test_the_other_commands_never_import_matplotlib_or_rich_for_machine_output():

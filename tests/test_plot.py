@@ -308,7 +308,10 @@ def test_import_needs_no_matplotlib_and_says_how_to_install_it():
         "try:\n    p.require_matplotlib()\nexcept p.MissingMatplotlib as e:\n    print(e)\n"
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
-    assert out == "grasptwist plot needs matplotlib: pip install 'grasptwist[plot]'\n"
+    assert (
+        out
+        == "grasptwist plot needs matplotlib: pip install matplotlib (from a clone of grasptwist: pip install '.[plot]')\n"
+    )
 
 
 def test_render_without_matplotlib_raises_missing_matplotlib(monkeypatch, tmp_path):

@@ -393,7 +393,7 @@ def plot(
     max_bytes: int | None = _MAX_BYTES,
     debug: bool = _DEBUG,
 ) -> None:
-    """Draw a grasp, its basis screw axes and the finger-tip velocities (needs grasptwist[plot]).
+    """Draw a grasp, its basis screw axes and the finger-tip velocities (needs matplotlib: the extra grasptwist[plot]).
 
     Examples: the paper's cylinder spinning about z, and every bundled grasp:
 
@@ -408,11 +408,10 @@ def plot(
 
 
 def _plot(path, output, twists, twist_name, method, max_bytes) -> int:
+    """The body of ``plot``: the drawing and its notes come from plot.render_inputs;
+    here only usage errors, stdout and stderr."""
     from . import plot as pictures
     from .io.datasets import DATASET_SUFFIXES
-    from .io.inputs import expand, read
-    from .model import Grasp
-    from .output.records import diagnostics, error_record
 
     stderr = _Stderr()
     if path.endswith(DATASET_SUFFIXES):
@@ -422,50 +421,22 @@ def _plot(path, output, twists, twist_name, method, max_bytes) -> int:
     if not os.path.isdir(path):
         _writable_folder(output)
     try:
-        pictures.require_matplotlib()
-    except pictures.MissingMatplotlib as exc:
-        sys.stderr.write(f"grasptwist: error: {exc}\n")
-        return EXIT_FAILED
-    grasps = []
-    for item in expand([path]):
-        for entry in read(item, max_bytes) if isinstance(item, str) else [item]:
-            if isinstance(entry, Grasp):
-                grasps.append(replace(entry, twists=tuple(twists)) if twists else entry)
+        for item in pictures.render_inputs(
+            path, output, twists=twists, twist_name=twist_name, method=method, max_bytes=max_bytes
+        ):
+            if isinstance(item, pictures.Note):
+                stderr.failed += item.error
+                stderr.say(item.line, ": error: " if item.error else ": warning: ", "31" if item.error else "33")
             else:
-                stderr.failed += 1
-                for line in diagnostics(error_record(entry))[0]:
-                    stderr.say(line, ": error: ", "31")
-    if os.path.isdir(path):
-        for grasp in grasps:
-            try:
-                written = pictures.render_grasps([grasp], output, method=method)
-            except ValueError as exc:  # e.g. off-tangent asked of a grasp without a wrist
-                stderr.failed += 1
-                stderr.say(f"{grasp.file}: grasp '{grasp.name}': error: {exc}", ": error: ", "31")
-                continue
-            sys.stdout.write("".join(f"{p}\n" for p in written))
-    elif grasps:
-        grasp = grasps[0]
-        if len(grasps) > 1:
-            sys.stderr.write(f"{path}: warning: drawing the first of its {len(grasps)} grasps, '{grasp.name}'\n")
-        chosen = _chosen_twist(grasp, twist_name if not twists else None)
-        try:
-            written = pictures.plot_grasp(grasp, output, chosen, method=method)
-        except ValueError as exc:
-            raise typer.BadParameter(str(exc)) from None
-        sys.stdout.write(f"{written}\n")
+                sys.stdout.write(f"{item}\n")
+    except pictures.MissingMatplotlib as exc:
+        sys.stderr.write(f"{exc}\n")  # the README's line: "grasptwist plot needs matplotlib: ..."
+        return EXIT_FAILED
+    except pictures.TwistNotFound as exc:
+        raise typer.BadParameter(str(exc), param_hint="--twist-name") from None
+    except ValueError as exc:  # an unknown method or suffix, off-tangent without a wrist
+        raise typer.BadParameter(str(exc)) from None
     return EXIT_FAILED if stderr.failed else EXIT_OK
-
-
-def _chosen_twist(grasp, name):
-    """The twist a single picture shows: the named one, else the first (or none)."""
-    if name is None:
-        return grasp.twists[0] if grasp.twists else None
-    for twist in grasp.twists:
-        if twist.name == name:
-            return twist
-    known = ", ".join(t.name for t in grasp.twists) or "none"
-    raise typer.BadParameter(f"grasp '{grasp.name}' has no twist '{name}' (it has: {known})", param_hint="--twist-name")
 
 
 def _workers(requested: int) -> int:

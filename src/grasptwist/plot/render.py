@@ -42,7 +42,9 @@ __all__ = [
 
 #: Image formats, by file suffix.
 FORMATS = (".png", ".svg", ".pdf")
-INSTALL_HINT = "grasptwist plot needs matplotlib: pip install 'grasptwist[plot]'"
+INSTALL_HINT = (
+    "grasptwist plot needs matplotlib: pip install matplotlib (from a clone of grasptwist: pip install '.[plot]')"
+)
 
 
 class MissingMatplotlib(RuntimeError):
