@@ -316,7 +316,7 @@ def test_import_needs_no_matplotlib_and_says_how_to_install_it():
 
 def test_render_without_matplotlib_raises_missing_matplotlib(monkeypatch, tmp_path):
     monkeypatch.setitem(sys.modules, "matplotlib", None)  # makes `import matplotlib` fail
-    with pytest.raises(plot.MissingMatplotlib, match="grasptwist\\[plot\\]"):
+    with pytest.raises(plot.MissingMatplotlib, match=r"pip install '\.\[plot\]'"):
         plot.render(make_scene("ex2-tangent"), tmp_path / "x.png")
     assert not (tmp_path / "x.png").exists()
 
