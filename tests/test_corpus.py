@@ -123,7 +123,7 @@ def test_the_table_lists_every_corpus_file_and_the_issue_s_cases():
         "alias-bomb.yaml", "deep-20000.yaml", "far-above-cap.yaml", "multi-document-one-bad.yaml",
     ]  # fmt: skip
     assert set(required) <= set(BY_NAME)
-    # every tangent degeneracy NOTES.md lists has its own file, with its own code
+    # every tangent degeneracy the README lists ("Degenerate grasps") has its own file, with its own code
     assert {"normals-rank-deficient", "theta-not-unique", "theta-sigma-zero"} <= {r.code for r in ROWS}
 
 
