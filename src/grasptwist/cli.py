@@ -398,7 +398,9 @@ def follow(
 
     segments = _cli_segments(twist, duration, frame.value)
     if segments and path is not None:
-        raise typer.BadParameter("--path picks one of the files' paths; --twist replaces them: give one", param_hint="--path")
+        raise typer.BadParameter(
+            "--path picks one of the files' paths; --twist replaces them: give one", param_hint="--path"
+        )
     if samples is not None and dt is not None:
         raise typer.BadParameter("give --samples or --dt, not both", param_hint="--dt")
     if dt is not None and not (dt > 0 and dt != float("inf")):
@@ -426,7 +428,8 @@ def _cli_segments(twists, durations, frame):
         return None
     if len(twists or ()) != len(durations or ()):
         raise typer.BadParameter(
-            f"each --twist needs a --duration: got {len(twists or ())} and {len(durations or ())}", param_hint="--duration"
+            f"each --twist needs a --duration: got {len(twists or ())} and {len(durations or ())}",
+            param_hint="--duration",
         )
     from .path import Segment, check_segments
 

@@ -11,7 +11,18 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Twist", "Grasp", "Segment", "ObjectPath", "InputError", "GraspFileError", "CONTACT_NAMES", "Joint", "Finger", "Hand"]
+__all__ = [
+    "Twist",
+    "Grasp",
+    "Segment",
+    "ObjectPath",
+    "InputError",
+    "GraspFileError",
+    "CONTACT_NAMES",
+    "Joint",
+    "Finger",
+    "Hand",
+]
 
 #: Contact names of a grasp that does not name its contacts.
 CONTACT_NAMES = ("1", "2", "3")

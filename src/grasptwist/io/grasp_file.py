@@ -1183,7 +1183,9 @@ def _segment(item, path, frame, problems):
         return None if pose is None else Segment(duration, position=pose[0], rotation=pose[1])
     if not {"screw", "angular", "linear"} & set(fields):
         problems.add(
-            _Reject("missing-key", path, "needs a twist ('screw', or 'angular' and/or 'linear') or a 'pose'", **_at(item))
+            _Reject(
+                "missing-key", path, "needs a twist ('screw', or 'angular' and/or 'linear') or a 'pose'", **_at(item)
+            )
         )
         return None
     parts = _twist_parts(fields, item, path, problems)
@@ -1228,7 +1230,7 @@ def _pose(node, path, problems):
             rotation = se3.quaternion_to_matrix(np.divide(quaternion, np.abs(quaternion).max()))
         elif quaternion is not None:
             problems.add(
-                    _Reject(
+                _Reject(
                     "invalid-rotation",
                     path + ".rotation",
                     "a quaternion (w, x, y, z) of zero length has no rotation",

@@ -23,7 +23,17 @@ from .columns import CSV_COLUMNS, columns
 from .csv_rows import lines
 from .records import _printable, dumps
 
-__all__ = ["ENCODINGS", "Encoding", "sample_records", "summary_record", "diagnostics", "CSV_HEADER", "csv_rows", "path_arrays", "crossing_text"]
+__all__ = [
+    "ENCODINGS",
+    "Encoding",
+    "sample_records",
+    "summary_record",
+    "diagnostics",
+    "CSV_HEADER",
+    "csv_rows",
+    "path_arrays",
+    "crossing_text",
+]
 
 #: The block columns a follow CSV row leaves out (the path's own replace them).
 _NOT_IN_CSV = ("file", "grasp", "twist")
@@ -139,7 +149,9 @@ def diagnostics(rec: dict) -> tuple[list[str], list[str]]:
     warnings = []
     if s["first_warning"] is not None:
         w = s["first_warning"]
-        warnings.append(f"{where}: warning: {w['method']}: conditioning below {CONDITION_WARNING:g} from t = {w['t']:.6g}")
+        warnings.append(
+            f"{where}: warning: {w['method']}: conditioning below {CONDITION_WARNING:g} from t = {w['t']:.6g}"
+        )
     return errors, warnings
 
 
@@ -165,7 +177,6 @@ def path_arrays(samples, order: str = "omega-v") -> dict[str, np.ndarray]:
     (quaternions, w first); its ``twist`` is the instantaneous space twist."""
     position, quaternion = _pose(samples)
     return {"t": samples.poses.time, "segment": samples.poses.segment, "position": position, "rotation": quaternion}
-
 
 
 def csv_error_row(rec: dict) -> bytes:

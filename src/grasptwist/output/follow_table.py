@@ -39,8 +39,13 @@ class FollowTable:
 
     def _header(self, rec, methods):
         vector = 3 * (self.width + 1) - 1
-        cells = [f"{'t':>{self.width}}", "seg", f"{'position':<{vector}}", f"{'rotation (w x y z)':<{vector + self.width + 1}}"]
-        for key, label, amplitudes in methods:
+        cells = [
+            f"{'t':>{self.width}}",
+            "seg",
+            f"{'position':<{vector}}",
+            f"{'rotation (w x y z)':<{vector + self.width + 1}}",
+        ]
+        for _, label, amplitudes in methods:
             cells += [f"{f'{label} {a}':<{vector}}" for a in amplitudes] + [f"{'cond':>{self.width}}"]
         if self.current is not None:
             self._say()
@@ -60,7 +65,12 @@ class FollowTable:
             self._header(rec, methods)
             self.current = here
         pose = rec["pose"]
-        cells = [self._number(rec["t"]), f"{rec['segment']:>3}", self._vector(pose["position"]), self._vector(pose["rotation"])]
+        cells = [
+            self._number(rec["t"]),
+            f"{rec['segment']:>3}",
+            self._vector(pose["position"]),
+            self._vector(pose["rotation"]),
+        ]
         vector = 3 * (self.width + 1) - 1
         for key, _, amplitudes in methods:
             m = rec[key]
@@ -86,7 +96,11 @@ class FollowTable:
         if smallest:
             self._say(f"  smallest conditioning: {'; '.join(smallest)}")
         w = s["first_warning"]
-        self._say("  no conditioning warning" if w is None else f"  first warning: {w['method']} at t = {w['t']:.{self.digits}f}")
+        self._say(
+            "  no conditioning warning"
+            if w is None
+            else f"  first warning: {w['method']} at t = {w['t']:.{self.digits}f}"
+        )
 
     def close(self) -> None:
         self.out.flush()

@@ -26,7 +26,17 @@ from ..results import selected
 from .batch import Block
 from .pipeline import Output
 
-__all__ = ["FollowJob", "Samples", "Summary", "follow_inputs", "write_follow", "sample_times", "NO_PATH", "COMMAND_LINE", "MAX_SAMPLES"]
+__all__ = [
+    "FollowJob",
+    "Samples",
+    "Summary",
+    "follow_inputs",
+    "write_follow",
+    "sample_times",
+    "NO_PATH",
+    "COMMAND_LINE",
+    "MAX_SAMPLES",
+]
 
 #: Error code of a grasp with no path to follow (or none of the name asked for).
 NO_PATH = "no-path"
@@ -168,7 +178,15 @@ def _path(job, grasp, p):
         yield GraspFileError("too-many-samples", f"path '{p.name}': {exc}", grasp.file, p.line, None)
         return
     for start in range(0, len(times), CHUNK):
-        f = follow(grasp.points, grasp.normals, wrist, p.segments, times[start : start + CHUNK], method=job.method, bases=job.bases)
+        f = follow(
+            grasp.points,
+            grasp.normals,
+            wrist,
+            p.segments,
+            times[start : start + CHUNK],
+            method=job.method,
+            bases=job.bases,
+        )
         yield Samples(p.name, _block(grasp, p.name, f, job.bases), f.poses)
     found = degeneracies(grasp.points, grasp.normals, grasp.wrist, p.segments, times)
     yield Summary(grasp.file, grasp, p.name, len(times), found, labels)
