@@ -256,3 +256,11 @@ def test_a_grasp_without_the_path_asked_for_is_a_located_error_and_the_others_st
     recs = jsonl(r.stdout)
     assert [rec["t"] for rec in recs if "t" in rec] == [0, 0.5, 1, 1.5, 2, 2.5, 3, math.pi]
     assert "polyhedron.yaml:17:1: error: no-path: grasp 'polyhedron' has no path named 'turn-x'" in r.stderr
+
+
+def test_the_readme_shows_the_cylinders_real_table(monkeypatch):
+    monkeypatch.chdir(GRASPS.parent)
+    readme = (GRASPS.parent / "README.md").read_text("utf-8")
+    shown = readme.split("`grasptwist follow grasps/cylinder.yaml --method off-tangent --samples 5`:\n\n```\n")[1]
+    r = run("follow", "grasps/cylinder.yaml", "--method", "off-tangent", "--samples", 5)
+    assert r.stdout == shown.split("```")[0]
