@@ -73,7 +73,7 @@ segment, which is negligible.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import NamedTuple
 
 import numpy as np
@@ -425,7 +425,8 @@ def follow(points, normals, wrist, segments, times, *, method="both", bases=Fals
         wrist = se3._shaped(wrist, (3,), "wrist")
         shapes.append(wrist.shape[:-1])
     grasps = np.broadcast_shapes(*shapes)
-    poses = integrate(segments, times)
+    plan = _plan(segments)
+    poses = _poses(plan, _times(times, plan.end))
     lead = poses.time.shape
     ones = (1,) * len(grasps)
     # (T..., 1..., 1, 3, 3): one pose for every grasp and contact of a time
@@ -440,12 +441,29 @@ def follow(points, normals, wrist, segments, times, *, method="both", bases=Fals
         flat[2][rows] = se3.transform(flat[0][rows], flat[1][rows], points)
         flat[3][rows] = se3.rotate(flat[0][rows], normals)
     twist = poses.twist.reshape(lead + ones + (6,))
+    # What moves with the object is resolved once per segment on the grasp at rest, with the
+    # segment's body twist, and carried to each sample by its pose (module docstring: the
+    # tangent method and the contact velocities see no wrist, so a rigid motion changes nothing).
+    body = plan.body.reshape((-1,) + ones + (6,))
     off = tan = None
     if method != "tangent" and wrist is not None:
         off = decompose_off_tangent(moved, wrist, twist, bases=bases)
     if method != "off-tangent":
-        tan = decompose_tangent(moved, turned, twist, bases=bases)
-    return FollowResult(poses, moved, turned, wrist, contact_velocities(moved, twist), off, tan)
+        tan = _carried(decompose_tangent(points, normals, body, bases=bases).row(poses.segment), poses, moved, twist)
+    velocities = se3.rotate(r, contact_velocities(points, body)[poses.segment])
+    return FollowResult(poses, moved, turned, wrist, velocities, off, tan)
+
+
+def _carried(result, poses, moved, twist):
+    """A result for the grasp at rest and a segment's body twist, as it is in the moved grasp:
+    the same amplitudes and verdicts, the basis lines carried by the pose (``Ad_H``)."""
+    lead = poses.time.shape
+    shape = moved.shape[:-2]
+    ones = (1,) * (len(shape) - len(lead))
+    r = poses.rotation.reshape(lead + ones + (1, 3, 3))
+    x = poses.position.reshape(lead + ones + (1, 3))
+    lines = {k: rigid_motion(getattr(result, k), r, x) for k in ("theta", "sigma") if getattr(result, k) is not None}
+    return replace(result, points=moved, twist=np.broadcast_to(twist, shape + (6,)), **lines)
 
 
 # --- degeneracies ------------------------------------------------------------------
