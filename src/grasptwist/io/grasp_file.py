@@ -1169,16 +1169,9 @@ def _segment(item, path, frame, problems):
             _Reject("invalid-duration", path + ".duration", f"must be > 0, got {duration!r}", **_at(fields["duration"]))
         )
     if "pose" in fields:
-        for other in ("screw", "angular", "linear", "at"):
-            if other in fields:
-                problems.add(
-                    _Reject(
-                        "conflicting-keys",
-                        _join(path, other),
-                        "cannot be combined with 'pose' (give a twist or a pose target)",
-                        **_at(fields[other]),
-                    )
-                )
+        _conflicts(
+            fields, path, ("screw", "angular", "linear", "at"), "'pose' (give a twist or a pose target)", problems
+        )
         pose = _pose(fields["pose"], path + ".pose", problems)
         return None if pose is None else Segment(duration, position=pose[0], rotation=pose[1])
     if not {"screw", "angular", "linear"} & set(fields):
@@ -1206,6 +1199,15 @@ def _segment(item, path, frame, problems):
     return Segment(duration, twist=screw, frame=frame)
 
 
+def _conflicts(fields, path, others, what, problems):
+    """A ``conflicting-keys`` problem for each key of ``others`` given beside ``what``."""
+    for other in others:
+        if other in fields:
+            problems.add(
+                _Reject("conflicting-keys", _join(path, other), f"cannot be combined with {what}", **_at(fields[other]))
+            )
+
+
 def _pose(node, path, problems):
     """``(position, rotation matrix)`` of a pose target: position default zero, rotation a
     quaternion ``(w, x, y, z)`` or a rotation vector, default none."""
@@ -1214,16 +1216,8 @@ def _pose(node, path, problems):
         return None
     position = _vector(fields["position"], 3, path + ".position", problems) if "position" in fields else [0.0] * 3
     rotation = np.eye(3)
-    if "rotation" in fields and "rotvec" in fields:
-        problems.add(
-            _Reject(
-                "conflicting-keys",
-                path + ".rotvec",
-                "cannot be combined with 'rotation' (give a quaternion or a rotation vector)",
-                **_at(fields["rotvec"]),
-            )
-        )
-    elif "rotation" in fields:
+    if "rotation" in fields:
+        _conflicts(fields, path, ("rotvec",), "'rotation' (give a quaternion or a rotation vector)", problems)
         quaternion = _vector(fields["rotation"], 4, path + ".rotation", problems)
         if quaternion is not None and any(quaternion):
             # scaled first: the engine normalises it, and a huge one must not overflow on the way
