@@ -3,7 +3,7 @@
 import pytest
 import yaml
 
-from grasptwist.io import grasp_file
+from grasptwist.io.grasp_file import Reading
 
 #: The YAML parsers the loader can run on here: the pure one, and libyaml's when present.
 LOADERS = [yaml.SafeLoader] + ([yaml.CSafeLoader] if yaml.__with_libyaml__ else [])
@@ -21,7 +21,6 @@ contacts:
 
 
 @pytest.fixture(params=LOADERS, ids=lambda loader: loader.__name__)
-def loader(request, monkeypatch):
-    """Run the test once with each available YAML parser."""
-    monkeypatch.setattr(grasp_file, "_LOADER", request.param)
-    return request.param
+def loader(request):
+    """Run the test once with each available YAML parser: the ``reading=`` to pass."""
+    return Reading(parser=request.param)
