@@ -1,5 +1,6 @@
 """Fixtures shared by the loader's tests."""
 
+import numpy as np
 import pytest
 import yaml
 
@@ -24,3 +25,17 @@ contacts:
 def loader(request):
     """Run the test once with each available YAML parser: the ``reading=`` to pass."""
     return Reading(parser=request.param)
+
+
+def in_plane(points, normals, which, tilt):
+    """``normals`` (``(N, 3, 3)``) with normal ``which[k]`` of grasp ``k`` turned into its contacts' plane,
+    plus ``tilt[k]`` (a scalar or ``(N,)``) along that plane's unit normal: a tangent method at or near
+    its ``normal-in-contact-plane`` threshold."""
+    m = np.cross(points[:, 1] - points[:, 0], points[:, 2] - points[:, 0])
+    m /= np.linalg.norm(m, axis=1, keepdims=True)
+    rows = np.arange(len(points))
+    n = normals[rows, which]
+    n = n - np.sum(n * m, axis=1)[:, None] * m
+    out = normals.copy()
+    out[rows, which] = n / np.linalg.norm(n, axis=1, keepdims=True) + np.reshape(tilt, (-1, 1)) * m
+    return out
