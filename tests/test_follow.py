@@ -264,3 +264,24 @@ def test_the_readme_shows_the_cylinders_real_table(monkeypatch):
     shown = readme.split("`grasptwist follow grasps/cylinder.yaml --method off-tangent --samples 5`:\n\n```\n")[1]
     r = run("follow", "grasps/cylinder.yaml", "--method", "off-tangent", "--samples", 5)
     assert r.stdout == shown.split("```")[0]
+
+
+def test_without_a_wrist_off_tangent_is_null_and_a_constant_failure_names_the_contacts(tmp_path):
+    contacts = (
+        "contacts:\n"
+        "  - {name: a, point: [0, 0, 0], normal: [1, 0, 0]}\n"
+        "  - {name: b, point: [1, 0, 0], normal: [0, 1, 0]}\n"
+        "  - {name: c, point: [1, 0, 0], normal: [0, 0, 1]}\n"
+        "paths:\n"
+        "  - segments: [{angular: [0, 0, 1], duration: 2}]\n"
+    )
+    (tmp_path / "g.yaml").write_text(contacts)
+    r = run("follow", tmp_path / "g.yaml", "--samples", 2, "-f", "jsonl")
+    first, _, summary = jsonl(r.stdout)
+    assert first["off_tangent"] is None and first["tangent"]["error"]["code"] == "coincident-contacts"
+    s = summary["summary"]
+    assert s["min_conditioning"]["off_tangent"] is None
+    assert s["degenerate"] == [
+        {"method": "tangent", "code": "coincident-contacts", "t_start": 0, "t_end": 2, "culprit": "a"}
+    ]
+    assert "tangent: coincident-contacts: from t = 0.000000 to t = 2.000000: contacts b and c coincide" in r.stderr

@@ -140,12 +140,12 @@ def crossing_text(c: dict, names=("1", "2", "3"), digits: int = 4) -> str:
     return f"from t = {a} to t = {b}: {status_message(_STATUS[c['code']], culprit, names)}"
 
 
-def diagnostics(rec: dict) -> tuple[list[str], list[str]]:
-    """The stderr lines of a summary record: one error per degenerate stretch, one warning for
-    the first time a conditioning falls below the warning level."""
+def diagnostics(rec: dict, names=("1", "2", "3")) -> tuple[list[str], list[str]]:
+    """The stderr lines of a summary record (its grasp's contacts named ``names``): one error per
+    degenerate stretch, one warning for the first time a conditioning falls below the warning level."""
     where = f"{_printable(rec['file'])}: grasp '{_printable(rec['grasp'])}', path '{_printable(rec['path'])}'"
     s = rec["summary"]
-    errors = [f"{where}: error: {c['method']}: {c['code']}: {crossing_text(c, digits=6)}" for c in s["degenerate"]]
+    errors = [f"{where}: error: {c['method']}: {c['code']}: {crossing_text(c, names, 6)}" for c in s["degenerate"]]
     warnings = []
     if s["first_warning"] is not None:
         w = s["first_warning"]

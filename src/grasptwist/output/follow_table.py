@@ -27,6 +27,7 @@ class FollowTable:
         self.digits = digits
         self.width = digits + 4  # sign, up to two digits before the point, the point
         self.current = None  # (file, grasp, path) of the timeline being written
+        self.names = ("1", "2", "3")  # its contacts' names
 
     def _number(self, v) -> str:
         return "-" if v is None else f"{v:{self.width}.{self.digits}f}"
@@ -64,6 +65,7 @@ class FollowTable:
         if here != self.current:
             self._header(rec, methods)
             self.current = here
+            self.names = tuple(c["name"] for c in rec["contacts"])
         pose = rec["pose"]
         cells = [
             self._number(rec["t"]),
@@ -85,7 +87,7 @@ class FollowTable:
         s = rec["summary"]
         self._say(f"summary: duration {s['duration']:.{self.digits}f}, {s['samples']} samples")
         for c in s["degenerate"]:
-            self._say(f"  {crossing_text(c, digits=self.digits)} ({c['method']} degenerate)")
+            self._say(f"  {crossing_text(c, self.names, self.digits)} ({c['method']} degenerate)")
         if not s["degenerate"]:
             self._say("  no degeneracy along the path")
         smallest = [

@@ -154,7 +154,9 @@ def write_follow(job: FollowJob, inputs: Iterable, w, fmt: str, order: str = "om
         encode = encoding.error if isinstance(item, GraspFileError) else encoding.summary
         if encode is not None:
             w.write(encode(rec))
-        errors, warnings = diagnostics(rec) if isinstance(item, GraspFileError) else fr.diagnostics(rec)
+        errors, warnings = (
+            diagnostics(rec) if isinstance(item, GraspFileError) else fr.diagnostics(rec, item.grasp.contact_names)
+        )
         yield Output(errors=errors, warnings=warnings, records=1, failed=int(not rec["ok"]))
 
 
