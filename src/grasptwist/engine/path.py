@@ -343,8 +343,10 @@ def _times(times, end):
     return t
 
 
-def _poses(plan, t) -> Poses:
-    k = plan.index(t)
+def _poses(plan, t, k=None) -> Poses:
+    """Poses at times ``t``, in segments ``k`` (default: each time's own; a time on a boundary
+    can be taken as the end of the segment before)."""
+    k = plan.index(t) if k is None else k
     r, x = se3.compose(plan.rotation[k], plan.position[k], *se3.exp(plan.body[k], t - plan.start[k]))
     return Poses(t, k, r, x, plan.space[k])
 
