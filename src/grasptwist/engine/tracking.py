@@ -23,7 +23,10 @@ Events located between the grid's times by bisection, each trial time
 reached by one Runge-Kutta step from the grid time before it: the first time
 a joint leaves its position limits, and the first time the finger's Jacobian
 loses rank (rank < 3) or its conditioning falls below
-:data:`~.degeneracy.CONDITION_WARNING`.
+:data:`~.degeneracy.CONDITION_WARNING`.  An event is seen at the first grid
+time where it holds, then located back to its start; one that begins and
+ends within a single step is missed (unlike the grasp's degeneracies, whose
+functions :mod:`.path` bounds in closed form), so ``steps`` sets that grain.
 """
 
 from __future__ import annotations
