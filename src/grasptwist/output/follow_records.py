@@ -56,7 +56,7 @@ _KEY = {k.label: k.key for k in KINDS}
 
 
 def _pose(samples):
-    """Per sample ``(position, quaternion w-first)`` as lists."""
+    """Per sample ``(position (N, 3), quaternion w first (N, 4))``, no ``-0.0``."""
     p = samples.poses
     return p.position + 0.0, matrix_to_quaternion(p.rotation) + 0.0
 
