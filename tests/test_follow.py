@@ -285,3 +285,15 @@ def test_without_a_wrist_off_tangent_is_null_and_a_constant_failure_names_the_co
         {"method": "tangent", "code": "coincident-contacts", "t_start": 0, "t_end": 2, "culprit": "a"}
     ]
     assert "tangent: coincident-contacts: from t = 0.000000 to t = 2.000000: contacts b and c coincide" in r.stderr
+
+
+def test_o_follows_the_resolve_rule_and_a_data_set_is_refused_without_costing_the_others(tmp_path):
+    r = run("follow", CYLINDER, "-o", tmp_path / "missing" / "out.jsonl")
+    assert r.exit_code == 2 and "no folder" in r.stderr
+    np.savez(tmp_path / "d.npz", points=np.zeros((1, 3, 3)), normals=np.ones((1, 3, 3)))
+    out = tmp_path / "out.jsonl"
+    r = run("follow", tmp_path / "d.npz", POLYHEDRON, "--samples", 2, "-f", "jsonl", "-o", out)
+    assert r.exit_code == 1 and r.stdout == ""
+    refused, *rows, summary = jsonl(out.read_text())
+    assert refused["error"]["code"] == "read-error" and "not data sets" in refused["error"]["message"]
+    assert len(rows) == 2 and summary["ok"] is True
