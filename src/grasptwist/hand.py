@@ -43,6 +43,7 @@ __all__ = [
     "joint_positions",
     "finger_states",
     "velocity_limits",
+    "padded",
     "joint_screw",
     "finger_jacobian",
     "joint_rates",
@@ -123,3 +124,41 @@ def velocity_limits(finger):
     [2.0, nan]
     """
     return np.array([np.nan if j.velocity_limit is None else j.velocity_limit for j in finger.joints], dtype=float)
+
+
+def padded(hands, screws):
+    """Rows of hands as arrays of one shape: joint screws and velocity limits, padded to ``J``.
+
+    ``J`` is the longest finger's joint count; a shorter finger's extra joints
+    are zero screws (no motion: they change no rank, rate or residual) with no
+    limit.  Rows without a hand are all padding.
+
+    Parameters
+    ----------
+    hands : sequence of Hand or None
+        One per row.
+    screws : sequence of (tuple of 3 (n_f, 6) arrays) or None
+        Each row's fingers' joint screws at its configuration (e.g.
+        :func:`finger_states`), None where the row has no hand.
+
+    Returns
+    -------
+    joint_screws : (N, 3, J, 6) array
+    limits : (N, 3, J) array
+        NaN where a joint has no limit, and in the padding.
+
+    >>> h = Hand((Finger("1", None, (Joint("a", "revolute", 2.0, None, None, None),), None, None, None, 1.0, (0,)),) * 3, ("a",), None, None)
+    >>> s, lim = padded([h, None], [(np.ones((1, 6)),) * 3, None])
+    >>> s.shape, lim[:, 0].tolist()
+    ((2, 3, 1, 6), [[2.0], [nan]])
+    """
+    width = max((len(f.joints) for h in hands if h is not None for f in h.fingers), default=0)
+    out = np.zeros((len(hands), 3, width, 6))
+    limits = np.full((len(hands), 3, width), np.nan)
+    for i, (hand, fingers) in enumerate(zip(hands, screws, strict=True)):
+        if hand is None:
+            continue
+        for f, (finger, s) in enumerate(zip(hand.fingers, fingers, strict=True)):
+            out[i, f, : len(s)] = s
+            limits[i, f, : len(s)] = velocity_limits(finger)
+    return out, limits

@@ -67,6 +67,11 @@ class Grasp:
         The desired twists, possibly none.
     line : int
         1-based line where the document starts.
+    hand : Hand or None
+        The hand whose fingers touch the contacts, finger ``f`` contact ``f``.
+    joint_positions : numpy.ndarray or None
+        ``(n_joints,)`` the hand's configuration, in ``hand.joint_names``
+        order (zeros for joints given inline, at their configuration).
     """
 
     name: str
@@ -79,6 +84,8 @@ class Grasp:
     wrist: np.ndarray | None
     twists: tuple[Twist, ...]
     line: int
+    hand: Hand | None = None
+    joint_positions: np.ndarray | None = None
 
 
 @dataclass(frozen=True, eq=False)

@@ -38,6 +38,7 @@ import numpy as np
 
 from .engine import judgements
 from .engine.decompose import decompose_off_tangent, decompose_tangent
+from .engine.kinematics import OFF_TANGENT_FIXED, TANGENT_FIXED, hand_joint_rates
 from .engine.screws import klein_table
 
 __all__ = [
@@ -153,6 +154,15 @@ class ResultKind:
         Name of its renderer class in :mod:`grasptwist.output.table`.
     method : bool
         Offered by ``--method`` (``both`` runs every method).
+    needs : tuple of str
+        Inputs beyond every block's that it needs (``joint_screws``): it is
+        computed only for blocks that have them, and its columns are not in
+        the fixed CSV header.
+    record : str or None
+        Name of a function in :mod:`grasptwist.output.kind_records` that
+        writes its objects into a block's records (``(block, records,
+        order) -> None``), for an object whose shape depends on the row (a
+        hand's joints); None: the object of its ``fields``.
     """
 
     key: str
@@ -165,6 +175,8 @@ class ResultKind:
     columns: tuple[Column, ...]
     table: str
     method: bool = True
+    needs: tuple[str, ...] = ()
+    record: str | None = None
 
 
 def _numbered(name: str, n: int = 3) -> tuple[str, ...]:
@@ -255,8 +267,42 @@ TANGENT = ResultKind(
     table="TangentTable",
 )
 
-#: Every result kind, in the order records hold them.
-KINDS: tuple[ResultKind, ...] = (OFF_TANGENT, TANGENT)
+#: Which contacts each component of a method's decomposition leaves still, in basis order.
+_FIXED = {"off_tangent": OFF_TANGENT_FIXED, "tangent": TANGENT_FIXED}
+
+
+def _decompositions(inputs) -> dict:
+    """The component twists of the methods computed before, for their joint rates."""
+    return {
+        key: (np.concatenate(inputs[key].components(), axis=-2), fixed)
+        for key, fixed in _FIXED.items()
+        if key in inputs
+    }
+
+
+HAND = ResultKind(
+    key="hand",
+    label="hand",
+    compute=lambda inputs, bases: hand_joint_rates(
+        inputs["joint_screws"],
+        inputs["points"],
+        inputs["twist"],
+        inputs["joint_limits"],
+        _decompositions(inputs) if bases else None,
+    ),
+    applies=lambda block: block.has_hand,
+    fields=(),
+    basis_fields=(),
+    check_fields=(),
+    columns=(),
+    table="HandTable",
+    method=False,
+    needs=("joint_screws",),
+    record="hand_objects",
+)
+
+#: Every result kind, in the order records hold them (a kind may use those before it).
+KINDS: tuple[ResultKind, ...] = (OFF_TANGENT, TANGENT, HAND)
 
 #: The kinds by key.
 BY_KEY: dict[str, ResultKind] = {k.key: k for k in KINDS}

@@ -94,7 +94,7 @@ NOT_REGULAR = "not a regular file (a pipe, socket or device)"
 _LOADER = yaml.CSafeLoader if yaml.__with_libyaml__ else yaml.SafeLoader
 
 # Keys of each mapping, in the order the values are checked.
-GRASP_KEYS = ("name", "units", "wrist", "contacts", "twists")
+GRASP_KEYS = ("name", "units", "wrist", "contacts", "twists", "hand")
 CONTACT_KEYS = ("name", "point", "normal")
 TWIST_KEYS = ("name", "screw", "angular", "linear", "at")
 
@@ -991,6 +991,7 @@ def _grasp(root, problems, *, file, document, name, line):
     wrist = _vector(fields["wrist"], 3, "wrist", problems) if "wrist" in fields else None
     contacts = _contacts(fields["contacts"], problems) if "contacts" in fields else None
     twists = _twists(fields["twists"], problems) if "twists" in fields else ()
+    hand = _hand(fields["hand"], contacts, file, problems) if "hand" in fields else None
     if problems.count:
         return None
     contact_names, points, normals = contacts
@@ -1005,7 +1006,16 @@ def _grasp(root, problems, *, file, document, name, line):
         wrist=None if wrist is None else _readonly(wrist),
         twists=twists,
         line=line,
+        hand=None if hand is None else hand[0],
+        joint_positions=None if hand is None else _readonly(hand[1]),
     )
+
+
+def _hand(node, contacts, file, problems):
+    """``(Hand, joint positions)`` of the ``hand`` key (see :mod:`grasptwist.io.grasp_hand`)."""
+    from .grasp_hand import read_hand  # only documents with a hand need it
+
+    return read_hand(node, None if contacts is None else contacts[1], file, problems)
 
 
 # What contacts look like, for the message when they are not a list.

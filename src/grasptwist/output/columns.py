@@ -86,6 +86,8 @@ def _groups():
     """Every column group with the key of its kind (None for the rows' own)."""
     groups = [(None, c) for c in BLOCK_COLUMNS]
     for kind in KINDS:
+        if kind.needs:  # computed only for some inputs: not in the fixed header
+            continue
         own = (*kind.columns, _status_column(kind.key), _error_column(kind.key))
         groups += [(kind.key, c) for c in own]
     return groups

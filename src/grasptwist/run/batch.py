@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import hand
 from ..engine.decompose import contact_velocities
 from ..engine.screws import direction, twist_at
 from ..io.datasets import Dataset
@@ -69,12 +70,20 @@ class Block:
     has_wrist: np.ndarray  # (n,) bool
     velocity: np.ndarray  # (n, 3, 3)
     results: dict[str, Any]
+    hands: list | None = None  # per row its Hand or None; None: no row has one
     bases: bool = True  # False: resolved without the basis screws (fields that need them are left out)
     # field values computed so far, by (kind key, Field); a block cut from another keeps its rows of them
     values: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
     def __len__(self) -> int:
         return len(self.grasp)
+
+    @property
+    def has_hand(self) -> np.ndarray:
+        """Rows whose grasp has a hand."""
+        if self.hands is None:
+            return np.zeros(len(self), bool)
+        return np.array([h is not None for h in self.hands], dtype=bool)
 
     def kinds(self) -> list[ResultKind]:
         """The kinds computed for this block, in registry order."""
@@ -104,7 +113,7 @@ class Block:
 
     def take(self, rows) -> Block:
         """The rows ``rows`` (a slice, or an array of indices) as a block of their own."""
-        cut = {f: _pick(getattr(self, f), rows) for f in _ROW_FIELDS}
+        cut = {f: _pick(getattr(self, f), rows) for f in _ROW_FIELDS if getattr(self, f) is not None}
         block = replace(self, **cut, results={k: r.row(rows) for k, r in self.results.items()})
         block.values.update({k: v[rows] for k, v in self.values.items()})  # what is known stays known
         return block
@@ -121,6 +130,7 @@ _ROW_FIELDS = (
     "twist",
     "has_wrist",
     "velocity",
+    "hands",
 )
 
 
@@ -131,7 +141,20 @@ def _pick(column, rows):
 
 
 def resolve_arrays(
-    points, normals, wrist, twist, method="both", *, file="", grasp=None, twist_name=None, units=None, bases=True
+    points,
+    normals,
+    wrist,
+    twist,
+    method="both",
+    *,
+    file="",
+    grasp=None,
+    twist_name=None,
+    units=None,
+    bases=True,
+    hands=None,
+    joint_screws=None,
+    joint_limits=None,
 ) -> Block:
     """One block from arrays of rows (a data set, or stacked grasps).
 
@@ -140,7 +163,9 @@ def resolve_arrays(
     (default: the row index and ``"0"``).  ``normals`` should be unit
     already (records show them as given).  ``method`` is one of
     :data:`METHODS`.  ``bases=False`` leaves out the basis screws, for
-    outputs that do not show them (npz).
+    outputs that do not show them (npz).  ``hands`` (per row a Hand or None)
+    with ``joint_screws (N, 3, J, 6)`` and ``joint_limits (N, 3, J)``
+    (:func:`grasptwist.hand.padded`) adds the kinds that need them.
     """
     kinds = selected(method)
     n = len(points)
@@ -151,6 +176,12 @@ def resolve_arrays(
         "wrist": np.full((n, 3), np.nan) if wrist is None else wrist,
         "twist": twist,
     }
+    if hands is not None:
+        inputs.update(joint_screws=joint_screws, joint_limits=joint_limits)
+    results = {}
+    for k in kinds:
+        if all(name in inputs for name in k.needs):
+            results[k.key] = inputs[k.key] = k.compute(inputs, bases)  # later kinds may use earlier ones
     return Block(
         file=file if isinstance(file, list) else [file] * n,
         grasp=grasp if grasp is not None else [str(i) for i in range(n)],
@@ -162,8 +193,9 @@ def resolve_arrays(
         twist=twist,
         has_wrist=has_wrist,
         velocity=contact_velocities(points, twist),
-        results={k.key: k.compute(inputs, bases) for k in kinds},
+        results=results,
         bases=bases,
+        hands=hands,
     )
 
 
@@ -231,8 +263,22 @@ def _stack(jobs, method) -> Block:
         grasp=[g.name for g in grasps],
         twist_name=[t.name for _, t in jobs],
         units=[g.units for g in grasps],
+        **_hand_inputs(grasps),
     )
     return replace(block, contact_names=[g.contact_names for g in grasps])
+
+
+def _hand_inputs(grasps) -> dict:
+    """The hand keywords of :func:`resolve_arrays` for grasps (none when no grasp has a hand)."""
+    if all(g.hand is None for g in grasps):
+        return {}
+    states = {}  # each grasp's fingers once, whatever its number of twists
+    for g in grasps:
+        if g.hand is not None and id(g) not in states:
+            states[id(g)] = tuple(s.screws for s in hand.finger_states(g.hand, g.joint_positions))
+    hands = [g.hand for g in grasps]
+    screws, limits = hand.padded(hands, [states.get(id(g)) for g in grasps])
+    return {"hands": hands, "joint_screws": screws, "joint_limits": limits}
 
 
 def _no_twist(grasp: Grasp) -> GraspFileError:
