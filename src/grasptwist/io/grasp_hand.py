@@ -100,16 +100,16 @@ def read_hand(node, points, file, problems):
     if urdf:
         return _urdf_hand(fields, fingers, names, points, file, problems)
     taken = {}  # joint names, unique over the hand
-    joints = [_joints(f["joints"], f"hand.fingers[{i}]", taken, problems) for i, f in enumerate(fingers)]
+    joints = [_joints(f["joints"], f"hand.fingers[{i}]", names[i], taken, problems) for i, f in enumerate(fingers)]
     if problems.count or points is None:
         return None
     hand = inline_hand(names, joints, points)
     return hand, np.zeros(len(hand.joint_names))
 
 
-def _joints(node, path, taken, problems):
+def _joints(node, path, finger, taken, problems):
     """An inline finger's joints as ``(name or None, type, axis, point, limit, line)`` tuples;
-    ``taken`` maps the joint names given so far to their paths."""
+    ``taken`` maps the joint names so far (given, or ``<finger>.<k>``) to their paths."""
     items = gf._sequence(node, path + ".joints", problems)
     if items is None:
         return None
@@ -120,17 +120,19 @@ def _joints(node, path, taken, problems):
         if fields is None:
             continue
         name = gf._name(fields["name"], where + ".name", problems) if "name" in fields else None
-        if name in taken:
+        final = f"{finger}.{j + 1}" if name is None else name
+        if final in taken:
+            named = "name" in fields
             problems.add(
                 gf._Reject(
                     "duplicate-name",
-                    where + ".name",
-                    f"duplicate joint name {name!r} (also {taken[name]})",
-                    **gf._at(fields["name"]),
+                    where + ".name" if named else where,
+                    f"duplicate joint name {final!r} (also {taken[final]})",
+                    **gf._at(fields["name"] if named else item),
                 )
             )
-        elif name is not None:
-            taken[name] = where
+        else:
+            taken[final] = where
         kind = gf._name(fields["type"], where + ".type", problems) if "type" in fields else "revolute"
         if kind is not None and kind not in JOINT_TYPES:
             problems.add(
