@@ -322,7 +322,9 @@ def test_ordinary_grasps_take_the_fast_path(monkeypatch, loader):
 
     monkeypatch.setattr(grasp_file, "_compose", fail)
     bundled = sorted((TESTS.parent / "grasps").rglob("*.yaml"))
-    assert bundled
+    # a hand is read by the general path only: files with one hold few grasps
+    bundled = [p for p in bundled if "\nhand:" not in p.read_text("utf-8")]
+    assert len(bundled) >= 5
     for path in bundled:
         for entry in read_grasps(path):
             assert isinstance(entry, Grasp), str(entry)

@@ -126,39 +126,38 @@ def velocity_limits(finger):
     return np.array([np.nan if j.velocity_limit is None else j.velocity_limit for j in finger.joints], dtype=float)
 
 
-def padded(hands, screws):
-    """Rows of hands as arrays of one shape: joint screws and velocity limits, padded to ``J``.
+def padded(hand, screws, width=None):
+    """A hand's joint screws and velocity limits as arrays of one shape, padded to ``width`` joints.
 
-    ``J`` is the longest finger's joint count; a shorter finger's extra joints
-    are zero screws (no motion: they change no rank, rate or residual) with no
-    limit.  Rows without a hand are all padding.
+    A finger with fewer joints gets zero screws (no motion: they change no
+    rank, rate or residual) with no limit.
 
     Parameters
     ----------
-    hands : sequence of Hand or None
-        One per row.
-    screws : sequence of (tuple of 3 (n_f, 6) arrays) or None
-        Each row's fingers' joint screws at its configuration (e.g.
-        :func:`finger_states`), None where the row has no hand.
+    hand : Hand
+    screws : sequence of 3 (..., n_f, 6) arrays
+        Each finger's joint screws at its configurations (e.g. the
+        ``screws`` of :func:`finger_states`).
+    width : int, optional
+        Joints per finger after padding; default the longest finger's.
 
     Returns
     -------
-    joint_screws : (N, 3, J, 6) array
-    limits : (N, 3, J) array
+    joint_screws : (..., 3, width, 6) array
+    limits : (3, width) array
         NaN where a joint has no limit, and in the padding.
 
     >>> h = Hand((Finger("1", None, (Joint("a", "revolute", 2.0, None, None, None),), None, None, None, 1.0, (0,)),) * 3, ("a",), None, None)
-    >>> s, lim = padded([h, None], [(np.ones((1, 6)),) * 3, None])
-    >>> s.shape, lim[:, 0].tolist()
-    ((2, 3, 1, 6), [[2.0], [nan]])
+    >>> s, limits = padded(h, [np.ones((5, 1, 6))] * 3, width=2)
+    >>> s.shape, limits[0].tolist()
+    ((5, 3, 2, 6), [2.0, nan])
     """
-    width = max((len(f.joints) for h in hands if h is not None for f in h.fingers), default=0)
-    out = np.zeros((len(hands), 3, width, 6))
-    limits = np.full((len(hands), 3, width), np.nan)
-    for i, (hand, fingers) in enumerate(zip(hands, screws, strict=True)):
-        if hand is None:
-            continue
-        for f, (finger, s) in enumerate(zip(hand.fingers, fingers, strict=True)):
-            out[i, f, : len(s)] = s
-            limits[i, f, : len(s)] = velocity_limits(finger)
+    width = max(len(f.joints) for f in hand.fingers) if width is None else width
+    lead = np.broadcast_shapes(*(np.shape(s)[:-2] for s in screws))
+    out = np.zeros(lead + (3, width, 6))
+    limits = np.full((3, width), np.nan)
+    for f, (finger, s) in enumerate(zip(hand.fingers, screws, strict=True)):
+        n = len(finger.joints)
+        out[..., f, :n, :] = s
+        limits[f, :n] = velocity_limits(finger)
     return out, limits

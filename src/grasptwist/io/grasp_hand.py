@@ -17,6 +17,7 @@ are the engine's (:mod:`grasptwist.engine.kinematics`).
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import numpy as np
@@ -26,6 +27,7 @@ from ..model import Finger, Hand, InputError, Joint
 from . import grasp_file as gf
 
 __all__ = [
+    "load_hand_file",
     "HAND_KEYS",
     "INLINE_FINGER_KEYS",
     "URDF_FINGER_KEYS",
@@ -101,7 +103,7 @@ def read_hand(node, points, file, problems):
         return _urdf_hand(fields, fingers, names, points, file, problems)
     taken = {}  # joint names, unique over the hand
     joints = [_joints(f["joints"], f"hand.fingers[{i}]", names[i], taken, problems) for i, f in enumerate(fingers)]
-    if problems.count or points is None:
+    if problems.count:
         return None
     hand = inline_hand(names, joints, points)
     return hand, np.zeros(len(hand.joint_names))
@@ -185,9 +187,11 @@ def inline_hand(names, fingers, points):
         point or None, velocity limit or None, line)``; a joint without a
         name is ``"<finger>.<k>"``, a prismatic joint without a point is
         drawn through the contact.
-    points : (3, 3) array
+    points : (3, 3) array or None
         The contacts, finger ``f`` touching row ``f``: each finger's length
-        runs from its first joint to its contact.
+        runs from its first joint to its contact.  None (a hand file): to
+        its last joint, and a prismatic joint without a point is drawn
+        through the origin.
 
     Returns
     -------
@@ -198,13 +202,15 @@ def inline_hand(names, fingers, points):
     (('a.1', 'b.1', 'c.1'), [[0.0, 0.0, 1.0, 0.0, 0.0, 0.0]], 1.0)
     """
     out, joint_names = [], []
-    for name, joints, contact in zip(names, fingers, np.asarray(points, dtype=float), strict=True):
+    contacts = [None] * 3 if points is None else np.asarray(points, dtype=float)
+    for name, joints, contact in zip(names, fingers, contacts, strict=True):
         first = len(joint_names)
         made = []
         for k, (joint, kind, _, _, limit, line) in enumerate(joints):
             made.append(Joint(joint or f"{name}.{k + 1}", kind, limit, None, None, line))
             joint_names.append(made[-1].name)
-        at = np.array([contact if p is None else p for _, _, _, p, _, _ in joints], dtype=float).reshape(-1, 3)
+        through = np.zeros(3) if contact is None else contact
+        at = np.array([through if p is None else p for _, _, _, p, _, _ in joints], dtype=float).reshape(-1, 3)
         screws = joint_screw(np.reshape([j[2] for j in joints], (-1, 3)), at, [j[1] == "prismatic" for j in joints])
         for a in (screws, at):
             a.flags.writeable = False
@@ -216,7 +222,7 @@ def inline_hand(names, fingers, points):
                 screws=screws,
                 points=at,
                 tip_pose=None,
-                length=float(chain_length(at, contact)),
+                length=float(chain_length(at, at[-1] if contact is None else contact)),
                 joint_index=tuple(range(first, len(joint_names))),
             )
         )
@@ -251,9 +257,11 @@ def _urdf_hand(fields, fingers, names, points, file, problems):
                 )
             )
         values[name] = value
-    if problems.count or points is None:
+    if problems.count:
         return None
     q = hands.joint_positions(hand, values)
+    if points is None:  # a hand file: the contacts come with each row
+        return hand, q
     for f, (finger, state) in enumerate(zip(hand.fingers, hands.finger_states(hand, q))):
         distance = float(np.linalg.norm(points[f] - state.tip[:3, 3]))
         if distance > finger.length:
@@ -289,3 +297,48 @@ def _positions(node, problems):
         if number is not None:
             out[str(key)] = (number, key_node)
     return out
+
+
+def load_hand_file(path, *, max_bytes=gf.DEFAULT_MAX_BYTES):
+    """The hand of a YAML file that holds just a ``hand:`` mapping (``--hand``).
+
+    Checked like a grasp file's ``hand`` (without contacts, so without
+    ``contact-off-finger``: a data set's rows bring their own).
+
+    Returns
+    -------
+    (Hand, (n_joints,) joint positions)
+
+    Raises
+    ------
+    InputError
+        The file's first problem, located and coded like a grasp file's.
+    """
+    import yaml
+
+    file = os.fspath(path)
+    problems = gf._Problems(gf.MAX_ERRORS)
+    text = ""
+    try:
+        data = gf._read_file(path, max_bytes)
+        if len(data) > max_bytes:
+            raise gf._Reject("too-large", "", f"larger than the size limit of {max_bytes} bytes")
+        text = gf._decode(data)
+        parser = gf._LOADER(text)
+        try:
+            parser.get_event()  # StreamStartEvent
+            if parser.check_event(yaml.StreamEndEvent):
+                raise gf._Reject("empty-document", "", "no YAML document in the file")
+            parser.get_event()  # DocumentStartEvent
+            root = gf._compose(parser.get_event, problems)
+        finally:
+            parser.dispose()
+    except gf._Reject as reject:
+        raise reject.error(file, None) from None
+    except yaml.YAMLError as exc:
+        raise gf._syntax_error(exc, text).error(file, 0) from None
+    fields = gf._mapping(root, "", ("hand",), ("hand",), problems)
+    hand = read_hand(fields["hand"], None, file, problems) if fields and "hand" in fields else None
+    if problems.count:
+        raise problems.first()[0].error(file, 0)
+    return hand

@@ -29,6 +29,7 @@ __all__ = [
     "resolve",
     "resolve_arrays",
     "dataset_blocks",
+    "check_positions",
     "ROWS_PER_BLOCK",
     "NO_TWIST",
     "ZERO_TWIST",
@@ -272,13 +273,15 @@ def _hand_inputs(grasps) -> dict:
     """The hand keywords of :func:`resolve_arrays` for grasps (none when no grasp has a hand)."""
     if all(g.hand is None for g in grasps):
         return {}
-    states = {}  # each grasp's fingers once, whatever its number of twists
+    width = max(len(f.joints) for g in grasps if g.hand is not None for f in g.hand.fingers)
+    made = {}  # each grasp's fingers once, whatever its number of twists
     for g in grasps:
-        if g.hand is not None and id(g) not in states:
-            states[id(g)] = tuple(s.screws for s in hand.finger_states(g.hand, g.joint_positions))
-    hands = [g.hand for g in grasps]
-    screws, limits = hand.padded(hands, [states.get(id(g)) for g in grasps])
-    return {"hands": hands, "joint_screws": screws, "joint_limits": limits}
+        if g.hand is not None and id(g) not in made:
+            states = hand.finger_states(g.hand, g.joint_positions)
+            made[id(g)] = hand.padded(g.hand, [s.screws for s in states], width)
+    none = (np.zeros((3, width, 6)), np.full((3, width), np.nan))
+    screws, limits = zip(*(made.get(id(g), none) for g in grasps))
+    return {"hands": [g.hand for g in grasps], "joint_screws": np.stack(screws), "joint_limits": np.stack(limits)}
 
 
 def _no_twist(grasp: Grasp) -> GraspFileError:
@@ -302,6 +305,7 @@ def dataset_blocks(
     start: int = 0,
     stop: int | None = None,
     bases: bool = True,
+    hand_of_rows=None,
 ) -> Iterator[Block]:
     """Resolve the grasps ``start:stop`` of a data set, about ``rows`` rows at a time.
 
@@ -309,12 +313,17 @@ def dataset_blocks(
     or else with the data set's own twist; with ``at`` points, a twist's
     linear part is the velocity of the row's ``at`` point.  ``bases=False``
     leaves the basis screws out (see :func:`resolve_arrays`).
+    ``hand_of_rows`` (a Hand, e.g. from ``--hand``) holds every row: at the
+    data set's ``joint_positions`` (at 0 without them), its joint rates are
+    computed per row.
 
     Raises
     ------
     GraspFileError
-        ``no-twist`` when neither gives a twist.
+        ``no-twist`` when neither gives a twist; ``bad-dataset`` when
+        ``joint_positions`` does not fit the hand, or comes without one.
     """
+    check_positions(ds, hand_of_rows)
     if twists is None and ds.twist is None:
         raise GraspFileError(
             code=NO_TWIST,
@@ -326,10 +335,41 @@ def dataset_blocks(
     step = max(1, rows // k)
     end = len(ds) if stop is None else min(stop, len(ds))
     for first in range(start, end, step):
-        yield _dataset_block(ds, given, twists, method, first, min(end, first + step), k, bases)
+        yield _dataset_block(ds, given, twists, method, first, min(end, first + step), k, bases, hand_of_rows)
 
 
-def _dataset_block(ds, given, twists, method, start, stop, k, bases):
+def check_positions(ds, hand_of_rows) -> None:
+    """Raise ``bad-dataset`` when a data set's ``joint_positions`` do not fit ``hand_of_rows``."""
+    if ds.joint_positions is None:
+        return
+    if hand_of_rows is None:
+        raise GraspFileError(
+            "bad-dataset", "joint_positions: give the hand they belong to with --hand FILE.yaml", ds.path
+        )
+    if ds.joint_positions.shape[1] != len(hand_of_rows.joint_names):
+        raise GraspFileError(
+            "bad-dataset",
+            f"joint_positions: {ds.joint_positions.shape[1]} columns, but the hand has "
+            f"{len(hand_of_rows.joint_names)} joints ({', '.join(hand_of_rows.joint_names)})",
+            ds.path,
+        )
+
+
+def _rows_hand(ds, hand_of_rows, start, stop, rows, n):
+    """The hand keywords of :func:`resolve_arrays` for rows ``start:stop`` of a data set."""
+    if hand_of_rows is None:
+        return {}
+    q = None if ds.joint_positions is None else np.asarray(ds.joint_positions[start:stop], dtype=float)[rows]
+    states = hand.finger_states(hand_of_rows, q)
+    screws, limits = hand.padded(hand_of_rows, [s.screws for s in states])
+    return {
+        "hands": [hand_of_rows] * n,
+        "joint_screws": np.broadcast_to(screws, (n, *screws.shape[-3:])),
+        "joint_limits": np.broadcast_to(limits, (n, *limits.shape)),
+    }
+
+
+def _dataset_block(ds, given, twists, method, start, stop, k, bases, hand_of_rows=None):
     """Rows ``start:stop`` of ``ds``, each paired with its ``k`` twists."""
     index = np.repeat(np.arange(start, stop), k)  # row-major: grasp, then its twists
     # each grasp's row repeated for its twists (no copy when there is one twist)
@@ -361,4 +401,5 @@ def _dataset_block(ds, given, twists, method, start, stop, k, bases):
         grasp=label,
         twist_name=names,
         bases=bases,
+        **_rows_hand(ds, hand_of_rows, start, stop, rows, len(index)),
     )
