@@ -125,3 +125,18 @@ def test_a_bad_hand_file_is_a_usage_error_naming_its_place(tmp_path):
     result = run("resolve", ROOT / "grasps" / "polyhedron.yaml", "--hand", hand_file)
     assert result.exit_code == 2
     assert f"not-a-list: {hand_file}:2:12: hand.fingers: expected a list, got the number 3" in result.stderr
+
+
+def test_the_plot_scene_draws_each_finger_joint_axis():
+    from grasptwist.io.grasp_file import load_grasps
+    from grasptwist.plot.scene import grasp_scene
+
+    (g,) = load_grasps(THREE)
+    axes = grasp_scene(g, g.twists[0]).of_kind("joint-axis")
+    assert [s.label for s in axes] == list(g.hand.joint_names)
+    east_2 = axes[1]  # about y through the knuckle (2, 0.3, 2.4)
+    np.testing.assert_allclose((east_2.start + east_2.end) / 2, [2.0, 0.3, 2.4])
+    direction = east_2.end - east_2.start
+    np.testing.assert_allclose(direction / np.linalg.norm(direction), [0, 1, 0], atol=1e-15)
+    size = np.linalg.norm(g.points[0] - g.points[1])  # the contact triangle's longest side, sqrt(4.5)
+    assert np.linalg.norm(direction) == pytest.approx(0.24 * size)
