@@ -38,8 +38,9 @@ from typing import NamedTuple
 
 import numpy as np
 
+from . import se3
 from .degeneracy import Status
-from .screws import cross, dot, field_at, norm, unit
+from .screws import cross, field_at, norm, unit
 
 __all__ = [
     "RANK_TOL",
@@ -481,41 +482,9 @@ class ChainState(NamedTuple):
     tip: np.ndarray | None
 
 
-def _skew(w):
-    """``[w]``, the matrix of ``x -> w x x``: ``(..., 3) -> (..., 3, 3)``."""
-    z = np.zeros_like(w[..., 0])
-    return np.stack(
-        (
-            np.stack((z, -w[..., 2], w[..., 1]), axis=-1),
-            np.stack((w[..., 2], z, -w[..., 0]), axis=-1),
-            np.stack((-w[..., 1], w[..., 0], z), axis=-1),
-        ),
-        axis=-2,
-    )
-
-
 def _apply(r, x):
     """``R x`` over batches: ``(..., 3, 3), (..., 3) -> (..., 3)``."""
     return (r @ x[..., None])[..., 0]
-
-
-def _joint_motion(screw, angle):
-    """The rigid motion ``exp([S] q)`` of a unit line or a pure translation ``S``.
-
-    Rodrigues' rotation about ``omega`` by ``q``, ``R = I + sin q [w] + (1 - cos q) [w]^2``,
-    moving the axis point ``a = w x v`` onto itself: ``t = (I - R) a + w (w . v) q``
-    (the last term is the pitch's advance; 0 for a joint line).  A screw with
-    ``omega = 0`` translates by ``v q``.  ``(..., 6), (...) -> (R (..., 3, 3), t (..., 3))``.
-    """
-    w, v = screw[..., :3], screw[..., 3:]
-    k = _skew(w)
-    k2 = k @ k
-    s, c = np.sin(angle)[..., None, None], np.cos(angle)[..., None, None]
-    turn = s * k + (1.0 - c) * k2  # R - I, without the cancellation of forming I first
-    rotation = np.eye(3) + turn
-    translation = -_apply(turn, cross(w, v)) + w * (dot(w, v) * angle)[..., None]
-    translation = np.where(np.any(w != 0, axis=-1)[..., None], translation, v * angle[..., None])
-    return rotation, translation
 
 
 def forward_kinematics(home_screws, home_points, home_tip, positions):
@@ -572,7 +541,7 @@ def forward_kinematics(home_screws, home_points, home_tip, positions):
             out_screws[..., j, :3] = w
             out_screws[..., j, 3:] = _apply(rotation, s[..., 3:]) + cross(translation, w)
             out_points[..., j, :] = _apply(rotation, a) + translation
-        r, t = _joint_motion(s, q[..., j])
+        r, t = se3.exp(s, q[..., j])  # the joint's motion, exp([S_j] q_j)
         if rotation is None:
             rotation, translation = r, t
         else:
