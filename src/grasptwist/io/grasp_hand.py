@@ -324,7 +324,7 @@ def load_hand_file(path, *, max_bytes=gf.DEFAULT_MAX_BYTES):
         if len(data) > max_bytes:
             raise gf._Reject("too-large", "", f"larger than the size limit of {max_bytes} bytes")
         text = gf._decode(data)
-        parser = gf._LOADER(text)
+        parser = gf.READING.parser(text)
         try:
             parser.get_event()  # StreamStartEvent
             if parser.check_event(yaml.StreamEndEvent):
