@@ -1,6 +1,8 @@
 """The ``hand:`` key of grasp files: both forms, every error located and coded,
 and what a hand adds to records (joint rates, finger-cannot-follow, warnings)."""
 
+import csv
+import io
 import json
 import re
 import shutil
@@ -252,6 +254,11 @@ def test_a_planar_finger_cannot_follow_out_of_its_plane(tmp_path):
     assert hand["fingers"][0]["residual"] == pytest.approx(1.0)  # the whole velocity is out of reach
     assert "x" in rec["off_tangent"] and "alpha" in rec["tangent"]  # the decomposition stays
     assert "error: hand: finger-cannot-follow: finger planar cannot follow" in result.stderr
+    path = tmp_path / "g.yaml"
+    out = CliRunner().invoke(app, ["resolve", str(path), "-f", "csv", "--twist", "0,0,1,0,0,0"]).stdout
+    header, row = csv.reader(io.StringIO(out))
+    assert row[header.index("hand_error")].startswith("finger-cannot-follow: finger planar cannot follow")
+    assert row[header.index("ok")] == "false" and row[header.index("qdot_planar_planar.1")] == ""
 
 
 def test_a_planar_finger_follows_in_its_plane_with_a_warning(tmp_path):

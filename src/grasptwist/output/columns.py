@@ -17,7 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..engine.degeneracy import Status, status_message
-from ..results import CULPRIT, KINDS, STATUS, Column
+from ..results import BY_KEY, CULPRIT, KINDS, STATUS, Column
 
 __all__ = ["ORDERS", "in_order", "BLOCK_COLUMNS", "CSV_COLUMNS", "header", "columns", "arrays", "error_texts"]
 
@@ -117,9 +117,11 @@ def error_texts(block, key: str) -> np.ndarray:
     if key not in block.results:
         return texts
     status, culprit = block.value(key, STATUS), block.value(key, CULPRIT)
+    named = BY_KEY[key].culprit_names
     for i in np.flatnonzero((status != Status.OK) & block.applies(key)):
         s = Status(int(status[i]))
-        texts[i] = f"{s.code}: {status_message(s, culprit[i], block.contact_names[i])}"
+        names = block.contact_names[i] if named is None else named(block, i)
+        texts[i] = f"{s.code}: {status_message(s, culprit[i], names)}"
     return texts
 
 

@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..engine.degeneracy import CONDITION_WARNING, Status, status_message
+from ..results import BY_KEY
 
 __all__ = ["hand_objects"]
 
@@ -67,8 +68,8 @@ def hand_objects(block, order, warnings):
         obj = {"fingers": fingers, "velocity_limit_ratio": _number(r.velocity_limit_ratio[i]), "ok": bool(r.ok[i])}
         if not r.ok[i]:
             status = Status(int(r.status[i]))
-            finger_names = tuple(f.name for f in hand.fingers)
-            obj["error"] = {"code": status.code, "message": status_message(status, r.culprit[i], finger_names)}
+            names = BY_KEY["hand"].culprit_names(block, i)  # the culprit is a finger
+            obj["error"] = {"code": status.code, "message": status_message(status, r.culprit[i], names)}
         more = {
             key: {"joint_rates": [[_finger_rates(c[f], fi) for f, fi in enumerate(hand.fingers)] for c in parts[i]]}
             for key, parts in r.components.items()
