@@ -16,6 +16,8 @@ this module gathers them.
 
 from __future__ import annotations
 
+from typing import NamedTuple
+
 import numpy as np
 
 from .engine.kinematics import (
@@ -32,6 +34,8 @@ from .engine.kinematics import (
     joint_screw,
     velocity_limit_ratio,
 )
+from .engine.path import check_segments
+from .engine.tracking import FingerTrack, track_finger
 from .io.urdf import load_urdf_hand
 from .model import Finger, Hand, Joint
 
@@ -44,6 +48,9 @@ __all__ = [
     "finger_states",
     "velocity_limits",
     "padded",
+    "HandTrack",
+    "track",
+    "SEGMENT_INTERVALS",
     "joint_screw",
     "finger_jacobian",
     "joint_rates",
@@ -161,3 +168,104 @@ def padded(hand, screws, width=None):
         out[..., f, :n, :] = s
         limits[f, :n] = velocity_limits(finger)
     return out, limits
+
+
+class HandTrack(NamedTuple):
+    """A hand following its grasp's contacts along a path (see :func:`track`).
+
+    Attributes
+    ----------
+    positions : (T, n_joints)
+        Joint positions at the sample times, in ``hand.joint_names`` order.
+    fingers : tuple of FingerTrack
+        Each finger's track (its own joints), in contact order.
+    """
+
+    positions: np.ndarray
+    fingers: tuple[FingerTrack, ...]
+
+
+def _limits(finger, which):
+    """A finger's lower or upper joint position limits, NaN where none: ``(n,)``."""
+    return np.array([np.nan if getattr(j, which) is None else getattr(j, which) for j in finger.joints], dtype=float)
+
+
+#: :func:`track` integrates each segment over at least this many intervals (of
+#: ``steps`` Runge-Kutta steps each), however few the samples: the tip's error
+#: and the events' times do not depend on the sampling.
+SEGMENT_INTERVALS = 20
+
+
+def track(hand, positions, points, segments, times, steps=16) -> HandTrack:
+    """Every finger keeping its tip on its contact while the object follows a path.
+
+    Finger ``f`` follows contact ``f`` by :func:`grasptwist.path.track_finger`
+    (resolved rates with forward-kinematics feedback), from ``positions``
+    and within its joints' position limits.  A finger given inline has no
+    tip link: the point it touches is the contact itself at ``t = 0``.  The
+    integration's grid holds the sample times and
+    :data:`SEGMENT_INTERVALS` equal intervals of each segment.
+
+    Parameters
+    ----------
+    hand : Hand
+    positions : (n_joints,) array or None
+        Joint positions at ``t = 0`` (None: every joint at 0).
+    points : (3, 3) array
+        The contacts at ``t = 0``, row ``f`` touched by finger ``f``.
+    segments : sequence of Segment
+    times : (T,) array
+        Increasing sample times.
+    steps : int
+        Runge-Kutta steps per interval between sample times.
+
+    Returns
+    -------
+    HandTrack
+
+    >>> from grasptwist.model import Finger, Joint
+    >>> from grasptwist.path import Segment
+    >>> slides = np.hstack((np.zeros((3, 3)), np.eye(3)))  # a Cartesian finger follows anything
+    >>> f = Finger("1", None, tuple(Joint(n, "prismatic", None, None, None, None) for n in "xyz"), slides, np.zeros((3, 3)), None, 1.0, (0, 1, 2))
+    >>> h = Hand((f, f, f), ("x", "y", "z"), None, None)
+    >>> t = track(h, None, np.eye(3), [Segment(1.0, twist=[0, 0, 0, 0.5, 0, 0])], [0.0, 1.0])
+    >>> t.positions[-1].round(12).tolist()
+    [0.5, 0.0, 0.0]
+    """
+    q0 = np.zeros(len(hand.joint_names)) if positions is None else np.asarray(positions, dtype=float)
+    points = np.asarray(points, dtype=float)
+    times = np.asarray(times, dtype=float)
+    ends = np.cumsum([0.0] + [s.duration for s in check_segments(segments)])
+    grid = [np.linspace(a, b, SEGMENT_INTERVALS + 1) for a, b in zip(ends[:-1], ends[1:])]
+    grid = np.union1d(times, np.concatenate(grid))
+    grid = grid[grid <= times[-1]] if times.size else times
+    rows = np.searchsorted(grid, times)
+    fingers = []
+    out = np.tile(q0, (len(times), 1))
+    for f, finger in enumerate(hand.fingers):
+        tip = finger.tip_pose
+        if tip is None:
+            tip = np.eye(4)
+            tip[:3, 3] = points[f]
+        index = list(finger.joint_index)
+        fingers.append(
+            track_finger(
+                finger.screws,
+                finger.points,
+                tip,
+                q0[index],
+                points[f],
+                segments,
+                grid,
+                lower=_limits(finger, "lower"),
+                upper=_limits(finger, "upper"),
+                steps=steps,
+            )
+        )
+        fingers[-1] = fingers[-1]._replace(**{k: getattr(fingers[-1], k)[rows] for k in _PER_SAMPLE})
+        out[:, index] = fingers[-1].positions
+    return HandTrack(out, tuple(fingers))
+
+
+#: The fields of a FingerTrack that hold one row per grid time.
+_PER_SAMPLE = ("time", "positions", "rates", "rank", "conditioning", "error")

@@ -82,17 +82,48 @@ def sample_records(samples, order: str = "omega-v") -> list[dict]:
         for kind in KINDS:
             if kind.key in rec:
                 new[kind.key] = rec[kind.key]
+        if samples.joint_positions is not None:
+            new["joint_positions"] = _finger_positions(samples.block.hands[i], samples.joint_positions[i])
         new["warnings"] = rec["warnings"]
         new["ok"] = rec["ok"]
         out.append(new)
     return out
 
 
+def _finger_positions(hand, positions) -> list[list[float]]:
+    """Per finger of ``hand``, its joints' positions from a ``(n_joints,)`` row in ``hand.joint_names`` order."""
+    return [(positions[list(f.joint_index)] + 0.0).tolist() for f in hand.fingers]
+
+
+def hand_summary(grasp, tracked) -> dict:
+    """The ``hand`` object of a path's summary: the first time a joint leaves its position
+    limits, and per finger its own first events and largest tip error (README "Paths")."""
+    fingers, first = [], None
+    for finger, track in zip(grasp.hand.fingers, tracked.fingers):
+        exit_ = None
+        if track.limit_exit is not None:
+            t, j = track.limit_exit
+            exit_ = {"joint": finger.joints[j].name, "t": t}
+            if first is None or t < first["t"]:
+                first = {"finger": finger.name, **exit_}
+        fingers.append(
+            {
+                "name": finger.name,
+                "joint_limit": exit_,
+                "rank_loss": track.rank_loss,
+                "first_warning": track.warning,
+                "tip_error": float(track.error.max()),
+            }
+        )
+    return {"joint_limit": first, "fingers": fingers}
+
+
 def summary_record(summary) -> dict:
     """The record closing a path: its duration, samples, smallest conditioning
-    per method, degenerate stretches and first warning (README "Paths")."""
+    per method, degenerate stretches and first warning, and with a hand its
+    fingers' events (README "Paths")."""
     found, names = summary.found, summary.grasp.contact_names
-    labels = [k.label for k in KINDS if k.label in summary.labels]
+    labels = [k.label for k in KINDS if k.method and k.label in summary.labels]
     smallest = {}
     for label in labels:
         value = found.min_conditioning.get(label)
@@ -110,19 +141,19 @@ def summary_record(summary) -> dict:
     ]
     started = [(t, m) for m, t in found.warning_start.items() if t is not None and m in labels]
     first = min(started, default=None)
-    return {
-        "file": summary.file,
-        "grasp": summary.grasp.name,
-        "path": summary.path,
-        "summary": {
-            "duration": found.duration,
-            "samples": summary.samples,
-            "min_conditioning": smallest,
-            "degenerate": degenerate,
-            "first_warning": None if first is None else {"method": first[1], "t": first[0]},
-        },
-        "ok": not degenerate,
+    out = {
+        "duration": found.duration,
+        "samples": summary.samples,
+        "min_conditioning": smallest,
+        "degenerate": degenerate,
+        "first_warning": None if first is None else {"method": first[1], "t": first[0]},
     }
+    ok = not degenerate
+    if summary.hand is not None:
+        out["hand"] = hand_summary(summary.grasp, summary.hand)
+        # a joint out of its limits, or a finger that cannot follow, stops the motion too
+        ok = ok and out["hand"]["joint_limit"] is None and all(f["rank_loss"] is None for f in out["hand"]["fingers"])
+    return {"file": summary.file, "grasp": summary.grasp.name, "path": summary.path, "summary": out, "ok": ok}
 
 
 def crossing_text(c: dict, names=("1", "2", "3"), digits: int = 4) -> str:

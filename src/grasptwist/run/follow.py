@@ -5,6 +5,9 @@ the engine moves the grasp along the path and resolves every sample's
 instantaneous twist (:func:`grasptwist.engine.path.follow`, a chunk of
 samples at a time so that memory stays bounded), then finds the path's
 degeneracies between the samples (:func:`grasptwist.engine.path.degeneracies`).
+A grasp with a hand has its fingers follow the contacts first
+(:func:`grasptwist.hand.track`): each sample's joint rates are the hand
+result at the integrated joint positions, as ``resolve`` computes it.
 Samples come out as ordinary result :class:`~grasptwist.run.batch.Block`
 objects, so that records, columns and warnings are the ones ``resolve``
 writes.  No math here: only slicing and labelling.
@@ -18,11 +21,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from .. import hand
 from ..engine.path import PathDegeneracies, Poses, degeneracies, follow
+from ..hand import HandTrack
 from ..io.datasets import DATASET_SUFFIXES
 from ..io.inputs import read
 from ..model import Grasp, GraspFileError, ObjectPath
-from ..results import selected
+from ..results import BY_KEY, selected
 from .batch import Block
 from .pipeline import Output
 
@@ -87,12 +92,14 @@ class Samples:
     """Consecutive samples of one path: the results block and where each sample is.
 
     ``block``'s ``twist_name`` holds the path's name; ``poses`` are the
-    samples' times, segments, poses and space twists.
+    samples' times, segments, poses and space twists; ``joint_positions``
+    ``(N, n_joints)`` the hand's integrated joint positions (None: no hand).
     """
 
     path: str
     block: Block
     poses: Poses
+    joint_positions: np.ndarray | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -105,6 +112,7 @@ class Summary:
     samples: int
     found: PathDegeneracies
     labels: tuple[str, ...]  # the methods run
+    hand: HandTrack | None = None  # the fingers' tracks, when the grasp has a hand
 
 
 def sample_times(duration: float, samples: int | None = None, dt: float | None = None) -> np.ndarray:
@@ -179,7 +187,11 @@ def _path(job, grasp, p):
     except ValueError as exc:
         yield GraspFileError("too-many-samples", f"path '{p.name}': {exc}", grasp.file, p.line, None)
         return
+    tracked = (
+        None if grasp.hand is None else hand.track(grasp.hand, grasp.joint_positions, grasp.points, p.segments, times)
+    )
     for start in range(0, len(times), CHUNK):
+        q = None if tracked is None else tracked.positions[start : start + CHUNK]
         f = follow(
             grasp.points,
             grasp.normals,
@@ -189,14 +201,20 @@ def _path(job, grasp, p):
             method=job.method,
             bases=job.bases,
         )
-        yield Samples(p.name, _block(grasp, p.name, f, job.bases), f.poses)
+        yield Samples(p.name, _block(grasp, p.name, f, job.bases, q), f.poses, q)
     found = degeneracies(grasp.points, grasp.normals, grasp.wrist, p.segments, times)
-    yield Summary(grasp.file, grasp, p.name, len(times), found, labels)
+    yield Summary(grasp.file, grasp, p.name, len(times), found, labels, tracked)
 
 
-def _block(grasp, name, f, bases) -> Block:
+def _block(grasp, name, f, bases, positions=None) -> Block:
     n = len(f.poses.time)
     results = {"off_tangent": f.off_tangent, "tangent": f.tangent}
+    results = {k: r for k, r in results.items() if r is not None}
+    if positions is not None:  # the hand's joint rates at its integrated positions, as resolve's
+        states = hand.finger_states(grasp.hand, positions)
+        screws, limits = hand.padded(grasp.hand, [s.screws for s in states])
+        inputs = {"joint_screws": screws, "joint_limits": limits, "points": f.points, "twist": f.poses.twist}
+        results["hand"] = BY_KEY["hand"].compute({**inputs, **results}, bases)
     return Block(
         file=[grasp.file] * n,
         grasp=[grasp.name] * n,
@@ -208,8 +226,9 @@ def _block(grasp, name, f, bases) -> Block:
         twist=f.poses.twist,
         has_wrist=np.full(n, grasp.wrist is not None),
         velocity=f.velocities,
-        results={k: r for k, r in results.items() if r is not None},
+        results=results,
         bases=bases,
+        hands=None if positions is None else [grasp.hand] * n,
     )
 
 
