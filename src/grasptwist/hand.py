@@ -236,9 +236,12 @@ def track(hand, positions, points, segments, times, steps=16) -> HandTrack:
     points = np.asarray(points, dtype=float)
     times = np.asarray(times, dtype=float)
     ends = np.cumsum([0.0] + [s.duration for s in check_segments(segments)])
-    grid = [np.linspace(a, b, SEGMENT_INTERVALS + 1) for a, b in zip(ends[:-1], ends[1:])]
-    grid = np.union1d(times, np.concatenate(grid))
-    grid = grid[grid <= times[-1]] if times.size else times
+    extra = np.concatenate([np.linspace(a, b, SEGMENT_INTERVALS + 1)[1:-1] for a, b in zip(ends[:-1], ends[1:])])
+    if times.size:  # none within round-off of a sample time or a boundary (no step of length ~0)
+        near = np.concatenate((times, ends))
+        gap = np.abs(extra[:, None] - near[None, :]).min(axis=1)
+        extra = extra[(gap > 1e-9 * ends[-1]) & (extra < times[-1])]
+    grid = np.union1d(times, extra)
     rows = np.searchsorted(grid, times)
     fingers = []
     out = np.tile(q0, (len(times), 1))

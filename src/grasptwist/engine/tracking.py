@@ -24,9 +24,14 @@ reached by one Runge-Kutta step from the grid time before it: the first time
 a joint leaves its position limits, and the first time the finger's Jacobian
 loses rank (rank < 3) or its conditioning falls below
 :data:`~.degeneracy.CONDITION_WARNING`.  An event is seen at the first grid
-time where it holds, then located back to its start; one that begins and
-ends within a single step is missed (unlike the grasp's degeneracies, whose
-functions :mod:`.path` bounds in closed form), so ``steps`` sets that grain.
+time where it holds, then located back to its start.  A conditioning that
+dips below a level and comes back within one step (a Jacobian passing
+through a singular configuration: the conditioning is ``|sin|`` of an angle
+or a length going through zero, a tangential zero of ``sigma_3 / sigma_1``) is
+found at the local minima of the conditioning over the steps' ends: a
+golden-section search between the neighbouring steps finds its smallest
+value, and, below the level, bisection its start.  A joint that leaves its
+limits and comes back within one step is missed, so ``steps`` sets that grain.
 """
 
 from __future__ import annotations
@@ -37,8 +42,8 @@ import numpy as np
 
 from . import se3
 from .degeneracy import CONDITION_WARNING
-from .kinematics import forward_kinematics, joint_rates
-from .path import _plan, _poses, _times
+from .kinematics import RANK_TOL, forward_kinematics, joint_rates
+from .path import _golden, _plan, _poses, _times
 from .screws import field_at, norm
 
 __all__ = ["FingerTrack", "track_finger"]
@@ -152,28 +157,51 @@ def track_finger(
         k4 = rates(t + h, q + h * k3, gain, k)
         return q + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
 
-    def judge(t, q):
+    def assess(t, q):
         """What happened at ``(t, q)``: the joint out of its limits, then 0 for a rank loss and
-        0 for a conditioning below the warning level; -1 for nothing."""
+        0 for a conditioning below the warning level (-1 for nothing); and the conditioning."""
         target, point, screws, velocity = state(t, q)
         r = joint_rates(screws, point, velocity)
         out = np.flatnonzero((q < lower) | (q > upper))
-        return (int(out[0]) if out.size else -1, int(r.rank < 3) - 1, int(r.conditioning < CONDITION_WARNING) - 1)
+        c = float(r.conditioning)
+        return (int(out[0]) if out.size else -1, int(r.rank < 3) - 1, int(c < CONDITION_WARNING) - 1), c
+
+    def judge(t, q):
+        return assess(t, q)[0]
+
+    def conditioning(t, q):
+        return assess(t, q)[1]
 
     grid = np.unique(np.concatenate((times, plan.start, [plan.end])))
     grid = grid[grid <= times[-1]]
-    first = [(0.0, w) if w >= 0 else None for w in judge(0.0, q)]
+    events, c = assess(0.0, q)
+    first = [(0.0, w) if w >= 0 else None for w in events]
     at = {0.0: q.copy()}
+    ends, starts, values = [0.0], [q.copy()], [c]  # every step's end and state there, and the conditioning
     for a, b in zip(grid[:-1], grid[1:]):
         h = (b - a) / steps
         for s in range(steps):
             t0, t1 = a + s * h, (a + (s + 1) * h if s < steps - 1 else b)
             q1 = step(t0, q, t1 - t0)
-            for e, w in enumerate(judge(t1, q1)):
+            events, c = assess(t1, q1)
+            for e, w in enumerate(events):
                 if first[e] is None and w >= 0:
                     first[e] = _locate(lambda t, e=e, t0=t0, q=q: judge(t, step(t0, q, t - t0))[e], t0, t1)
+            ends.append(t1)
+            starts.append(q1)
+            values.append(c)
             q = q1
         at[float(b)] = q.copy()
+
+    def reached(t):
+        """The conditioning at ``t``, reached by one step from the last step's end before it."""
+        k = max(int(np.searchsorted(ends, t, side="right")) - 1, 0)
+        return conditioning(t, step(ends[k], starts[k], t - ends[k]) if t > ends[k] else starts[k])
+
+    for e, level in ((1, RANK_TOL), (2, CONDITION_WARNING)):
+        dip = _dip(reached, np.array(ends), np.array(values), level)
+        if dip is not None and (first[e] is None or dip < first[e][0]):
+            first[e] = (dip, 0)
     track = np.array([at[float(t)] for t in times])
     rows = [state(t, p) for t, p in zip(times, track)]
     solved = [joint_rates(screws, point, velocity) for _, point, screws, velocity in rows]
@@ -189,6 +217,23 @@ def track_finger(
         rank_loss=None if rank is None else rank[0],
         warning=None if warning is None else warning[0],
     )
+
+
+def _dip(f, t, values, level):
+    """The first time ``f`` (the conditioning) falls to ``level`` or below between its values at ``t``,
+    found at its local minima (module docstring); None if it never does there."""
+    mid, before, after = values[1:-1], values[:-2], values[2:]
+    # A local minimum that the steeper of its sides, continued for one more step, takes to the
+    # level: a dip through zero (V-shaped or tangential) between steps always is one, round-off
+    # wobbles of a steady conditioning are not.
+    deep = 2 * mid - np.maximum(before, after) <= level
+    inner = np.flatnonzero((mid <= before) & (mid <= after) & deep & (mid > level)) + 1
+    for i in inner:
+        lo, hi = t[i - 1], t[i + 1]
+        at, low = _golden(f, lo, hi, _PRECISION * (hi - lo))
+        if low <= level:
+            return _locate(lambda s: 0 if f(s) <= level else -1, lo, at)[0]
+    return None
 
 
 def _locate(test, lo, hi):

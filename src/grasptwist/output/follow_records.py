@@ -33,6 +33,8 @@ __all__ = [
     "csv_rows",
     "path_arrays",
     "crossing_text",
+    "hand_event_texts",
+    "hand_summary",
 ]
 
 #: The block columns a follow CSV row leaves out (the path's own replace them).
@@ -171,6 +173,30 @@ def crossing_text(c: dict, names=("1", "2", "3"), digits: int = 4) -> str:
     return f"from t = {a} to t = {b}: {status_message(_STATUS[c['code']], culprit, names)}"
 
 
+def hand_event_texts(hand: dict, digits: int = 4) -> tuple[list[str], list[str]]:
+    """A summary's hand events in words: ``(errors, warnings)``, the joint-limit exit and the
+    rank losses (the motion cannot be made), then the fingers' conditioning warnings.
+
+    >>> hand_event_texts({"joint_limit": {"finger": "east", "joint": "e2", "t": 0.5},
+    ...                   "fingers": [{"name": "east", "rank_loss": None, "first_warning": 0.25}]})
+    (["joint 'e2' of finger 'east' leaves its position limits at t = 0.5000"], ["finger 'east': conditioning below 0.001 from t = 0.2500"])
+    """
+    errors, warnings = [], []
+    if hand["joint_limit"] is not None:
+        j = hand["joint_limit"]
+        errors.append(
+            f"joint '{j['joint']}' of finger '{j['finger']}' leaves its position limits at t = {j['t']:.{digits}f}"
+        )
+    for f in hand["fingers"]:
+        if f["rank_loss"] is not None:
+            errors.append(f"finger '{f['name']}' loses rank (its Jacobian) at t = {f['rank_loss']:.{digits}f}")
+        if f["first_warning"] is not None:
+            warnings.append(
+                f"finger '{f['name']}': conditioning below {CONDITION_WARNING:g} from t = {f['first_warning']:.{digits}f}"
+            )
+    return errors, warnings
+
+
 def diagnostics(rec: dict, names=("1", "2", "3")) -> tuple[list[str], list[str]]:
     """The stderr lines of a summary record (its grasp's contacts named ``names``): one error per
     degenerate stretch, one warning for the first time a conditioning falls below the warning level."""
@@ -183,6 +209,10 @@ def diagnostics(rec: dict, names=("1", "2", "3")) -> tuple[list[str], list[str]]
         warnings.append(
             f"{where}: warning: {w['method']}: conditioning below {CONDITION_WARNING:g} from t = {w['t']:.6g}"
         )
+    if "hand" in s:
+        hand_errors, hand_warnings = hand_event_texts(s["hand"], 6)
+        errors += [f"{where}: error: hand: {text}" for text in hand_errors]
+        warnings += [f"{where}: warning: hand: {text}" for text in hand_warnings]
     return errors, warnings
 
 

@@ -11,7 +11,7 @@ from __future__ import annotations
 
 from typing import IO
 
-from .follow_records import crossing_text
+from .follow_records import crossing_text, hand_event_texts
 
 __all__ = ["FollowTable"]
 
@@ -103,6 +103,12 @@ class FollowTable:
             if w is None
             else f"  first warning: {w['method']} at t = {w['t']:.{self.digits}f}"
         )
+        if "hand" in s:
+            errors, warnings = hand_event_texts(s["hand"], self.digits)
+            for text in errors + warnings:
+                self._say(f"  hand: {text}")
+            if not errors and not warnings:
+                self._say("  hand: every finger follows, within its joint limits and well conditioned")
 
     def close(self) -> None:
         self.out.flush()
