@@ -17,6 +17,7 @@ Two hands are built here as URDFs (the form that carries joint position limits):
   (``|y| <= 1e-9``).
 """
 
+import io
 import json
 import math
 from pathlib import Path
@@ -28,11 +29,13 @@ from typer.testing import CliRunner
 from grasptwist.cli import app
 from grasptwist.engine.kinematics import forward_kinematics
 from grasptwist.io.grasp_file import read_grasps
+from grasptwist.output.follow_table import FollowTable
 
 pytest.importorskip("yourdfpy")
 
 GRASPS = Path(__file__).parent.parent / "grasps"
 HAND = GRASPS / "three-finger-hand.yaml"
+README = (Path(__file__).parent.parent / "README.md").read_text()
 
 
 def run(*args):
@@ -161,9 +164,16 @@ def _tips(grasp, rec):
 def test_the_bundled_hand_keeps_its_tips_on_the_moving_contacts(samples):
     (grasp,) = read_grasps(HAND)
     size = max(np.linalg.norm(grasp.points[i] - grasp.points[j]) for i, j in ((0, 1), (1, 2), (0, 2)))
-    r = run("follow", HAND, "--samples", samples, "-f", "jsonl")
+    r = run("follow", HAND, "--samples", samples, "--method", "off-tangent", "-f", "jsonl")
     assert r.exit_code == 0, r.output
     *recs, summary = jsonl(r.stdout)
+    table = io.BytesIO()
+    writer = FollowTable(table)
+    for rec in [*recs, summary]:
+        writer.write(rec)
+    # the README's excerpt is this command's table (the table writes what the records hold)
+    excerpt = README.split("--samples 3 --method off-tangent` ends\n\n```\n")[1].split("```")[0]
+    assert table.getvalue().decode().endswith(excerpt)
     assert len(recs) == samples * len(grasp.paths)
     worst = 0.0
     for rec in recs:
