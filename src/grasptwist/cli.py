@@ -219,7 +219,9 @@ _WORKERS = typer.Option(
     min=0,
     help="Processes for big batches (0: every core, used for 256+ files or 4096+ data-set grasps).",
 )
-_PATHS_HELP = "Grasp files (.yaml, .yml, .json; any case), data sets (.npz, .npy), folders of grasp files or - (stdin)."
+_PATHS_HELP = (
+    "Grasp files (.yaml, .yml, .json; any case), data sets (.npz, .npy, .parquet), folders of grasp files or - (stdin)."
+)
 _PATHS = typer.Argument(..., metavar="PATH...", help=_PATHS_HELP)
 
 
@@ -237,7 +239,7 @@ def resolve(
     ),
     method: Method = _METHOD,
     fmt: Format = typer.Option(
-        Format.table, "-f", "--format", help="table for people; json, jsonl, csv or npz (arrays, with -o) for programs."
+        Format.table, "-f", "--format", help="table for people; json, jsonl, csv, npz or parquet (with -o) for programs."
     ),
     json_: bool = _JSON,
     output: str | None = _OUTPUT,
@@ -488,6 +490,7 @@ def _stopped(stop) -> int:
 
 def _run(debug: bool, job) -> None:
     """Run a command body; turn every way it can end into one line and an exit status."""
+    from .extras import MissingExtra
     from .run.pool import WorkerDied
     from .run.signals import Interrupted
     from .run.target import WriteError
@@ -503,6 +506,9 @@ def _run(debug: bool, job) -> None:
         # Unix filter killed by SIGPIPE, and keep Python's final flush quiet too.
         _drop_stdout()
         raise typer.Exit(EXIT_BROKEN_PIPE) from None
+    except MissingExtra as exc:  # e.g. -f parquet without pyarrow, found before any output
+        _say(f"grasptwist: error: {exc}")
+        raise typer.Exit(EXIT_USAGE) from None
     except (WriteError, WorkerDied) as exc:
         _drop_stdout()
         _say(f"grasptwist: error: {exc}")

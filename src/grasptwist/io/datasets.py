@@ -1,4 +1,4 @@
-"""Array data sets in: ``.npz`` of named arrays, ``.npy`` of rows.
+"""Array data sets in: ``.npz`` of named arrays, ``.npy`` of rows, ``.parquet`` of named columns.
 
 Input layouts (see the README):
 
@@ -7,7 +7,8 @@ Input layouts (see the README):
 * ``.npy`` of shape ``(N,18)`` or ``(N,21)``: per row ``p1 p2 p3 n1 n2 n3``
   (xyz each) and, with 21 columns, one more point whose role
   ``extra_point`` names: the ``wrist``, or the point ``at`` which the
-  twists' linear velocity is given.
+  twists' linear velocity is given;
+* ``.parquet`` of flat columns (:mod:`grasptwist.io.parquet`).
 
 A ``.npy`` is memory-mapped and read a chunk of rows at a time, so a data
 set larger than memory streams with bounded memory; ``.npz`` members are
@@ -30,14 +31,14 @@ from ..model import GraspFileError
 
 __all__ = ["DATASET_SUFFIXES", "EXTRA_POINT_ROLES", "Dataset", "open_dataset"]
 
-DATASET_SUFFIXES = (".npz", ".npy")
+DATASET_SUFFIXES = (".npz", ".npy", ".parquet")
 EXTRA_POINT_ROLES = ("wrist", "at")
 _NPZ_KEYS = ("points", "normals", "wrist", "twist", "names")
 
 
 @dataclass(frozen=True)
 class Dataset:
-    """A data set's arrays (``.npy`` columns are memory-mapped views)."""
+    """A data set's arrays (``.npy`` columns are memory-mapped views; Parquet's read rows when sliced)."""
 
     path: str
     points: np.ndarray  # (N, 3, 3)
@@ -56,7 +57,7 @@ def _bad(path, message) -> GraspFileError:
 
 
 def open_dataset(path: str, extra_point: str = "wrist") -> Dataset:
-    """Open a ``.npz`` or ``.npy`` data set and check its layout.
+    """Open a ``.npz``, ``.npy`` or ``.parquet`` data set and check its layout.
 
     Raises
     ------
@@ -64,6 +65,10 @@ def open_dataset(path: str, extra_point: str = "wrist") -> Dataset:
         ``read-error`` when it cannot be read, ``bad-dataset`` when its
         arrays do not have the documented names, shapes or a numeric type.
     """
+    if path.endswith(".parquet"):
+        from .parquet import open_parquet  # pyarrow only when a Parquet file is read
+
+        return open_parquet(path)
     try:
         if path.endswith(".npy"):
             return _open_npy(path, np.load(path, mmap_mode="r", allow_pickle=False), extra_point)

@@ -19,7 +19,16 @@ import numpy as np
 from ..engine.degeneracy import Status, status_message
 from ..results import CULPRIT, KINDS, STATUS, Column
 
-__all__ = ["ORDERS", "in_order", "BLOCK_COLUMNS", "CSV_COLUMNS", "columns", "arrays", "error_texts"]
+__all__ = [
+    "ORDERS",
+    "in_order",
+    "BLOCK_COLUMNS",
+    "CSV_COLUMNS",
+    "TYPED_COLUMNS",
+    "columns",
+    "arrays",
+    "error_texts",
+]
 
 #: Screw orders for output: the paper's ``(omega; v)`` or ``(v; omega)``.
 ORDERS = ("omega-v", "v-omega")
@@ -97,6 +106,19 @@ _GROUPS = _groups()
 CSV_COLUMNS = [name for _, c in _GROUPS for name in c.flat]
 
 
+_STATUSES = {f"{kind.key}_status" for kind in KINDS}
+
+
+def _typed_names(column: Column) -> tuple[str, ...]:
+    """Flat names of a group in typed outputs: a status (no CSV column) is one column under its own name."""
+    return (column.name,) if column.name in _STATUSES else column.flat
+
+
+#: Typed flat outputs (Parquet): the CSV's columns and each kind's ``<key>_status``
+#: (after its conditioning), ``name -> numpy type`` (``U`` text, ``?``, ``i1``, ``f8``).
+TYPED_COLUMNS = {name: c.dtype for _, c in _GROUPS for name in _typed_names(c)}
+
+
 def error_texts(block, key: str) -> np.ndarray:
     """``code: message`` of kind ``key`` where it failed and applies, else empty."""
     status, culprit = block.value(key, STATUS), block.value(key, CULPRIT)
@@ -115,8 +137,9 @@ def _values(block, key, column: Column, order: str):
     return in_order(values, order) if column.name in _SCREWS else values
 
 
-def columns(block, order: str = "omega-v") -> dict[str, np.ndarray]:
-    """The block's flat columns, ``name -> (N,)`` array, in the order of :data:`CSV_COLUMNS`.
+def columns(block, order: str = "omega-v", typed: bool = False) -> dict[str, np.ndarray]:
+    """The block's flat columns, ``name -> (N,)`` array, in the order of :data:`CSV_COLUMNS`
+    (``typed``: of :data:`TYPED_COLUMNS`, statuses included).
 
     Values that do not apply are masked (a :class:`numpy.ma.MaskedArray`):
     every value of a kind not computed, and of a group marked
@@ -126,16 +149,17 @@ def columns(block, order: str = "omega-v") -> dict[str, np.ndarray]:
     n = len(block)
     out = {}
     for key, column in _GROUPS:
-        if not column.flat:
+        names = _typed_names(column) if typed else column.flat
+        if not names:
             continue
         values = _values(block, key, column, order)
         if values is None:
             blank = np.ma.masked_all((n,), dtype=column.dtype if column.dtype != "U" else object)
-            out.update(dict.fromkeys(column.flat, blank))
+            out.update(dict.fromkeys(names, blank))
             continue
         flat = np.asarray(values).reshape(n, -1)
         valid = block.results[key].ok & block.applies(key) if key is not None and column.only_where_ok else None
-        for j, name in enumerate(column.flat):
+        for j, name in enumerate(names):
             out[name] = flat[:, j] if valid is None else np.ma.masked_array(flat[:, j], mask=~valid)
     return out
 

@@ -5,7 +5,7 @@ it, and runs a command by looking its format up in :data:`FORMATS` rather
 than comparing names.  A format either encodes records where they are
 made (in worker processes too) and writes the encoded bytes in order
 (``json``, ``jsonl``, ``csv``, ``table``), or takes whole result blocks in
-the writing process (``npz``: ``takes_blocks``).
+the writing process (``npz``, ``parquet``: ``takes_blocks``).
 """
 
 from __future__ import annotations
@@ -81,6 +81,12 @@ def _npz(out: IO[bytes], kind: str, order: str = "omega-v", **_):
     return NpzWriter(out, order)
 
 
+def _parquet(out: IO[bytes], kind: str, order: str = "omega-v", **_):
+    from .parquet import ParquetWriter  # pyarrow only when Parquet is asked for
+
+    return ParquetWriter(out, order)
+
+
 def _json_rows(block, order):
     return encode_records(block, order, records, dumps)
 
@@ -103,6 +109,7 @@ FORMATS: dict[str, OutputFormat] = {
             join=b"".join,
         ),
         OutputFormat("npz", ("resolve",), _npz, binary=True, takes_blocks=True, bases=False),
+        OutputFormat("parquet", ("resolve",), _parquet, binary=True, takes_blocks=True, bases=False),
     )
 }
 

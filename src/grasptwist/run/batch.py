@@ -296,8 +296,12 @@ def _dataset_block(ds, given, twists, method, start, stop, k, bases):
         screw = np.tile(given, (stop - start, 1))
         names = [t.name for t in twists] * (stop - start)
     else:
-        own = np.asarray(ds.twist, dtype=float)
-        screw = np.broadcast_to(own, (stop - start, 6)) if own.ndim == 1 else own[start:stop]
+        own = ds.twist  # sliced before it is read: a Parquet column reads only these rows
+        screw = (
+            np.broadcast_to(np.asarray(own, dtype=float), (stop - start, 6))
+            if own.ndim == 1
+            else np.asarray(own[start:stop], dtype=float)
+        )
         names = ["twist"] * (stop - start)
     if ds.at is not None:
         at = column(ds.at)

@@ -1,0 +1,92 @@
+"""Results as one Parquet file: the CSV's columns, typed, from the one columns definition.
+
+Columns and their order are :data:`~grasptwist.output.columns.TYPED_COLUMNS`
+(the CSV's, and each kind's ``<key>_status`` after its conditioning): text
+as dictionary-encoded strings, ``ok`` and ``in_tangent_planes`` as
+booleans, statuses as int8 (-1: skipped), numbers as float64; a value that
+does not apply (an empty CSV cell) is null.  Rows are written in row groups
+of about :data:`ROW_GROUP_ROWS` as blocks arrive, so memory stays bounded.
+pyarrow (the extra ``grasptwist[parquet]``) is imported only here.
+"""
+
+from __future__ import annotations
+
+from typing import IO
+
+import numpy as np
+
+from ..extras import require
+from .columns import TYPED_COLUMNS, columns
+
+__all__ = ["ROW_GROUP_ROWS", "schema", "table", "ParquetWriter"]
+
+#: Rows per row group written (about 25 MB of results before compression).
+ROW_GROUP_ROWS = 65536
+
+
+def _arrow_type(pa, dtype: str):
+    text = pa.dictionary(pa.int32(), pa.string())
+    return {"U": text, "?": pa.bool_(), "i1": pa.int8(), "f8": pa.float64()}[dtype]
+
+
+def schema():
+    """The Arrow schema of results: :data:`TYPED_COLUMNS` with their types.
+
+    >>> s = schema()
+    >>> str(s.field("ok").type), str(s.field("tangent_status").type), str(s.field("file").type)
+    ('bool', 'int8', 'dictionary<values=string, indices=int32, ordered=0>')
+    """
+    pa = require("pyarrow", "Parquet output")
+    return pa.schema([(name, _arrow_type(pa, dtype)) for name, dtype in TYPED_COLUMNS.items()])
+
+
+def _array(pa, values, arrow_type):
+    """One column as an Arrow array: masked values null, text dictionary-encoded."""
+    mask = np.ma.getmaskarray(values) if np.ma.isMaskedArray(values) else None
+    data = np.ma.getdata(values)
+    if pa.types.is_dictionary(arrow_type):
+        return pa.array(np.asarray(data, dtype=object), pa.string(), mask=mask).dictionary_encode()
+    return pa.array(np.asarray(data), arrow_type, mask=mask if mask is not None and mask.any() else None)
+
+
+def table(block, order: str = "omega-v"):
+    """A result block as an Arrow table of :func:`schema`."""
+    pa = require("pyarrow", "Parquet output")
+    s = schema()
+    flat = columns(block, order, typed=True)
+    return pa.Table.from_arrays([_array(pa, flat[f.name], f.type) for f in s], schema=s)
+
+
+class ParquetWriter:
+    """Result blocks into one Parquet file, a row group at a time.
+
+    Blocks are held until they make :data:`ROW_GROUP_ROWS` rows (or the end),
+    then written as one row group.
+    """
+
+    def __init__(self, out: IO[bytes], order: str = "omega-v", row_group_rows: int = ROW_GROUP_ROWS):
+        pq = require("pyarrow.parquet", "-f parquet")
+        self.order = order
+        self.row_group_rows = row_group_rows
+        self.pending: list = []
+        self.rows = 0
+        self.writer = pq.ParquetWriter(out, schema())
+
+    def write(self, block) -> None:
+        """Append a block's rows."""
+        self.pending.append(table(block, self.order))
+        self.rows += len(block)
+        if self.rows >= self.row_group_rows:
+            self._flush()
+
+    def _flush(self) -> None:
+        if self.rows:
+            import pyarrow as pa
+
+            self.writer.write_table(pa.concat_tables(self.pending), row_group_size=self.rows)
+        self.pending, self.rows = [], 0
+
+    def close(self) -> None:
+        """Write what is held and the file's footer."""
+        self._flush()
+        self.writer.close()
