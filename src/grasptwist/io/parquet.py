@@ -23,7 +23,15 @@ import numpy as np
 from ..extras import MissingExtra, require
 from ..model import GraspFileError
 
-__all__ = ["POINT_COLUMNS", "NORMAL_COLUMNS", "WRIST_COLUMNS", "TWIST_COLUMNS", "NAME_COLUMN", "open_parquet"]
+__all__ = [
+    "POINT_COLUMNS",
+    "NORMAL_COLUMNS",
+    "WRIST_COLUMNS",
+    "TWIST_COLUMNS",
+    "NAME_COLUMN",
+    "open_parquet",
+    "table_dataset",
+]
 
 
 def _xyz(stem: str) -> tuple[str, ...]:
@@ -61,14 +69,31 @@ def open_parquet(path: str):
         ``bad-dataset`` when the file is not Parquet, or lacks a column, or
         a column has the wrong type; ``read-error`` without pyarrow.
     """
-    from .datasets import Dataset
-
     try:
-        pa = require("pyarrow", "reading Parquet")
+        require("pyarrow", "reading Parquet")
     except MissingExtra as exc:
         raise GraspFileError(code="read-error", message=str(exc), file=path) from None
     reader = _RowGroups(path)
-    schema = reader.file.schema_arrow
+    return _dataset(path, reader.file.schema_arrow, reader)
+
+
+def table_dataset(table, path: str = ""):
+    """A data set of an Arrow table in memory with the columns of a Parquet data set (for Dask partitions).
+
+    Raises
+    ------
+    GraspFileError
+        ``bad-dataset`` as :func:`open_parquet`.
+    """
+    return _dataset(path, table.schema, _Table(table))
+
+
+def _dataset(path: str, schema, reader):
+    """The data set of ``reader``'s rows once ``schema`` has the documented columns; ``reader`` learns which to read."""
+    import pyarrow as pa
+
+    from .datasets import Dataset
+
     present = {}
     for key, names in _GROUPS.items():
         found = [n for n in names if n in schema.names]
@@ -99,6 +124,20 @@ def open_parquet(path: str):
         arrays.get("twist"),
         names,
     )
+
+
+class _Table:
+    """An Arrow table's rows (the reader of :func:`table_dataset`)."""
+
+    def __init__(self, table):
+        self.table = table
+        self.columns: list[str] = []
+
+    def __len__(self) -> int:
+        return self.table.num_rows
+
+    def rows(self, start: int, stop: int):
+        return self.table.slice(start, stop - start).select(self.columns)
 
 
 class _RowGroups:
@@ -154,7 +193,7 @@ class _Rows:
 
     ndim = 2
 
-    def __init__(self, reader: _RowGroups):
+    def __init__(self, reader):
         self.reader = reader
 
     def __len__(self) -> int:
@@ -168,7 +207,7 @@ class _Rows:
 class _Numbers(_Rows):
     """``(N, *shape)`` floats from a group of columns."""
 
-    def __init__(self, reader: _RowGroups, columns: tuple[str, ...], shape: tuple[int, ...]):
+    def __init__(self, reader, columns: tuple[str, ...], shape: tuple[int, ...]):
         super().__init__(reader)
         self.columns = columns
         self.shape = (len(reader), *shape)
