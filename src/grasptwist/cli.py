@@ -239,7 +239,10 @@ def resolve(
     ),
     method: Method = _METHOD,
     fmt: Format = typer.Option(
-        Format.table, "-f", "--format", help="table for people; json, jsonl, csv, npz or parquet (with -o) for programs."
+        Format.table,
+        "-f",
+        "--format",
+        help="table for people; json, jsonl, csv, npz or parquet (with -o) for programs.",
     ),
     json_: bool = _JSON,
     output: str | None = _OUTPUT,

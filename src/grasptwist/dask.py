@@ -32,7 +32,7 @@ from .model import Twist
 from .output.columns import arrays
 from .output.formats import FORMATS
 
-__all__ = ["resolve_dataframe", "resolve_array", "result_dtype"]
+__all__ = ["resolve_dataframe", "to_parquet", "resolve_array", "result_dtype"]
 
 _WHAT = "grasptwist.dask"
 #: npz groups that are labels, not numbers: not fields of resolve_array's records.
@@ -43,7 +43,9 @@ def _twists(twists: Mapping[str, object] | None) -> list[Twist] | None:
     """``name -> (omega; v)`` as the command line's ``--twist`` values (at the origin)."""
     if twists is None:
         return None
-    return [Twist(name=name, screw=np.asarray(screw, dtype=float).reshape(6), line=None) for name, screw in twists.items()]
+    return [
+        Twist(name=name, screw=np.asarray(screw, dtype=float).reshape(6), line=None) for name, screw in twists.items()
+    ]
 
 
 def _frame(table):
@@ -96,6 +98,18 @@ def resolve_dataframe(ddf, twists: Mapping[str, object] | None = None, method="b
     return ddf.map_partitions(
         _resolve_partition, _twists(twists), method, order, file, meta=meta, enforce_metadata=False
     )
+
+
+def to_parquet(results, folder: str, **options):
+    """Write :func:`resolve_dataframe`'s results as a folder of Parquet shards (one per partition).
+
+    The files are those of ``-f parquet`` (same columns, types and writer
+    options); ``options`` go to :meth:`dask.dataframe.DataFrame.to_parquet`
+    (e.g. ``storage_options`` for an object store).  Computes the results.
+    """
+    from .output.parquet import WRITE_OPTIONS, schema
+
+    return results.to_parquet(folder, write_index=False, schema=schema(), **{**WRITE_OPTIONS, **options})
 
 
 def _resolve_rows(rows: np.ndarray, has_wrist: bool, method: str, order: str, dtype: np.dtype) -> np.ndarray:

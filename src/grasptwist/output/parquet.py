@@ -18,10 +18,14 @@ import numpy as np
 from ..extras import require
 from .columns import TYPED_COLUMNS, columns
 
-__all__ = ["ROW_GROUP_ROWS", "schema", "table", "ParquetWriter"]
+__all__ = ["ROW_GROUP_ROWS", "WRITE_OPTIONS", "schema", "table", "ParquetWriter"]
 
 #: Rows per row group written (about 25 MB of results before compression).
 ROW_GROUP_ROWS = 65536
+
+#: Options of pyarrow's Parquet writer for results: dictionary pages for text
+#: only (on floats they cost five times the write and save nothing).
+WRITE_OPTIONS = {"use_dictionary": [name for name, dtype in TYPED_COLUMNS.items() if dtype == "U"]}
 
 
 def _arrow_type(pa, dtype: str):
@@ -42,11 +46,12 @@ def schema():
 
 def _array(pa, values, arrow_type):
     """One column as an Arrow array: masked values null, text dictionary-encoded."""
-    mask = np.ma.getmaskarray(values) if np.ma.isMaskedArray(values) else None
-    data = np.ma.getdata(values)
+    masked = np.ma.isMaskedArray(values)
+    mask = np.ma.getmaskarray(values) if masked and np.ma.getmaskarray(values).any() else None
+    data = np.ma.getdata(values) if masked else values  # labels may be lists or numpy text: both as they are
     if pa.types.is_dictionary(arrow_type):
-        return pa.array(np.asarray(data, dtype=object), pa.string(), mask=mask).dictionary_encode()
-    return pa.array(np.asarray(data), arrow_type, mask=mask if mask is not None and mask.any() else None)
+        return pa.array(data, pa.string(), mask=mask).dictionary_encode()
+    return pa.array(data, arrow_type, mask=mask)
 
 
 def table(block, order: str = "omega-v"):
@@ -70,7 +75,7 @@ class ParquetWriter:
         self.row_group_rows = row_group_rows
         self.pending: list = []
         self.rows = 0
-        self.writer = pq.ParquetWriter(out, schema())
+        self.writer = pq.ParquetWriter(out, schema(), **WRITE_OPTIONS)
 
     def write(self, block) -> None:
         """Append a block's rows."""
@@ -90,3 +95,8 @@ class ParquetWriter:
         """Write what is held and the file's footer."""
         self._flush()
         self.writer.close()
+
+    def __del__(self):
+        # Never closed: the run failed and its output is being discarded; pyarrow's
+        # own finaliser would write a footer to the closed output (a second error).
+        self.writer.is_open = False
