@@ -216,8 +216,21 @@ def test_a_corrupt_parquet_file_is_one_bad_dataset_record_and_the_others_keep_th
 
 
 def test_a_parquet_data_set_over_two_workers_gives_the_same_output(files):
-    one, two = (run("resolve", files / "set.parquet", "-f", "jsonl", "-j", j) for j in ("1", "2"))
-    assert two.stdout == one.stdout and len(one.stdout.splitlines()) == N
+    from pathlib import Path
+
+    from grasptwist.run.pipeline import Job, Tuning, run
+
+    def written(workers):
+        text = b""
+        for out in run(Job(fmt="jsonl"), [str(files / "set.parquet")], workers, tuning):
+            text += b"".join(x + b"\n" for x in out.encoded) + (
+                Path(out.spool).read_bytes() + b"\n" if out.spool else b""
+            )
+        return text
+
+    tuning = Tuning(grasps_per_task=50, records_at_once=17)  # tasks across row groups of 70, read by forked workers
+    one, two = written(1), written(2)
+    assert two == one and len(one.splitlines()) == N
 
 
 def without(*modules):
@@ -255,3 +268,33 @@ def test_resolving_grasp_files_never_imports_pyarrow_dask_or_pandas():
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
     assert out.stdout.split() == ["0", "False", "False", "False", "False"]
+
+
+def test_a_stop_signal_leaves_no_parquet_file_and_no_debris(tmp_path):
+    import os
+    import signal
+
+    from test_faults import Run, assert_no_debris
+
+    rng = np.random.default_rng(11)
+    names = (*parquet.POINT_COLUMNS, *parquet.NORMAL_COLUMNS, *parquet.WRIST_COLUMNS)
+    pq.write_table(pa.table({n: rng.normal(size=200_000) for n in names}), tmp_path / "rows.parquet")
+    (tmp_path / "out.parquet").write_text("old\n")
+    run = Run(
+        tmp_path,
+        "resolve",
+        tmp_path / "rows.parquet",
+        "--twist",
+        "0,0,1,0,0,0",
+        "-f",
+        "parquet",
+        "-o",
+        tmp_path / "out.parquet",
+    )
+    run.wait_started()  # the first block's warnings: the writer is open
+    os.kill(run.p.pid, signal.SIGTERM)
+    code, seconds, _ = run.finish()
+    assert code == 128 + signal.SIGTERM and seconds < 5
+    assert run.said() == ["grasptwist: stopped by SIGTERM"]  # nothing from pyarrow's writer either
+    assert (tmp_path / "out.parquet").read_text() == "old\n"
+    assert_no_debris(run, tmp_path)
