@@ -50,11 +50,21 @@ def save_parquet(folder, n, shards):
 
 @pytest.fixture(scope="module")
 def client():
+    """Two worker processes: a real cluster, whose tasks are pickled and sent."""
     with (
-        distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster,
+        distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0") as cluster,
         distributed.Client(cluster) as c,
     ):
         yield c
+
+
+@pytest.fixture
+def synchronous():
+    """Dask's scheduler in this process (the cluster's start is paid once, by the tests that need it)."""
+    import dask
+
+    with dask.config.set(scheduler="synchronous"):
+        yield
 
 
 def cli_parquet(shards, out):
@@ -88,7 +98,7 @@ def test_a_few_hundred_thousand_rows_of_sharded_parquet(client, tmp_path):
     assert_dask_equals_the_command_line(tmp_path, 300_000, shards=6)
 
 
-def test_resolve_dataframe_keeps_the_types_and_takes_named_twists(client, tmp_path):
+def test_resolve_dataframe_keeps_the_types_and_takes_named_twists(synchronous, tmp_path):
     save_parquet(tmp_path / "in", 100, shards=2)
     spin = {"spin-z": [0, 0, 1, 0, 0, 0], "lift": [0, 0, 0, 0, 0, 1]}
     ddf = resolve_dataframe(dd.read_parquet(tmp_path / "in"), twists=spin, method="tangent", file="set")
@@ -99,7 +109,7 @@ def test_resolve_dataframe_keeps_the_types_and_takes_named_twists(client, tmp_pa
     assert set(out["file"]) == {"set"}
 
 
-def test_resolve_array_equals_the_engine_bit_for_bit(client):
+def test_resolve_array_equals_the_engine_bit_for_bit(synchronous):
     points, normals, wrist, twist = grasp_arrays(5000, seed=3)
     chunks = (1300,)
     r = resolve_array(
