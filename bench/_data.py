@@ -83,20 +83,11 @@ def save_parquet(folder, n, shards=8, seed=0):
     in the columns ``grasptwist resolve`` reads; returns their paths."""
     import os
 
-    import pyarrow as pa
     import pyarrow.parquet as pq
 
     from grasptwist.io import parquet
 
-    points, normals, wrist, twist = grasp_arrays(n, seed)
-    groups = (
-        (parquet.POINT_COLUMNS, points.reshape(n, 9)),
-        (parquet.NORMAL_COLUMNS, normals.reshape(n, 9)),
-        (parquet.WRIST_COLUMNS, wrist),
-        (parquet.TWIST_COLUMNS, twist),
-    )
-    table = pa.table({name: values[:, j] for names, values in groups for j, name in enumerate(names)})
-    table = table.append_column(parquet.NAME_COLUMN, pa.array(np.arange(n).astype(str)))
+    table = parquet.grasp_table(*grasp_arrays(n, seed), names=np.arange(n).astype(str))
     os.makedirs(folder, exist_ok=True)
     paths = []
     for i, start in enumerate(range(0, n, -(-n // shards))):

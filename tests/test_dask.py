@@ -30,16 +30,7 @@ def grasp_arrays(n, seed=0):
 
 def save_parquet(folder, n, shards):
     """``n`` random grasps as ``shards`` Parquet files in ``folder`` (named rows, row groups of 10,000)."""
-    pa = pytest.importorskip("pyarrow")
-    points, normals, wrist, twist = grasp_arrays(n)
-    groups = (
-        (parquet.POINT_COLUMNS, points.reshape(n, 9)),
-        (parquet.NORMAL_COLUMNS, normals.reshape(n, 9)),
-        (parquet.WRIST_COLUMNS, wrist),
-        (parquet.TWIST_COLUMNS, twist),
-    )
-    table = pa.table({name: values[:, j] for names, values in groups for j, name in enumerate(names)})
-    table = table.append_column(parquet.NAME_COLUMN, pa.array(np.arange(n).astype(str)))
+    table = parquet.grasp_table(*grasp_arrays(n), names=np.arange(n).astype(str))
     folder.mkdir()
     size = -(-n // shards)
     paths = [folder / f"part-{i:03d}.parquet" for i in range(shards)]

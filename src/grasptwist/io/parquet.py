@@ -31,6 +31,7 @@ __all__ = [
     "NAME_COLUMN",
     "open_parquet",
     "table_dataset",
+    "grasp_table",
 ]
 
 
@@ -51,6 +52,26 @@ NAME_COLUMN = "name"
 
 _GROUPS = {"points": POINT_COLUMNS, "normals": NORMAL_COLUMNS, "wrist": WRIST_COLUMNS, "twist": TWIST_COLUMNS}
 _SHAPES = {"points": (3, 3), "normals": (3, 3), "wrist": (3,), "twist": (6,)}
+
+
+def grasp_table(points, normals, wrist=None, twist=None, names=None):
+    """Grasps as an Arrow table with the columns above: what ``pyarrow.parquet.write_table`` makes a data set of.
+
+    >>> t = grasp_table(np.zeros((2, 3, 3)), np.ones((2, 3, 3)), twist=np.zeros((2, 6)), names=["a", "b"])
+    >>> t.num_rows, t.column_names[:2], t.column_names[-7:]
+    (2, ['p1_x', 'p1_y'], ['w_x', 'w_y', 'w_z', 'v_x', 'v_y', 'v_z', 'name'])
+    """
+    pa = require("pyarrow", "writing Parquet")
+    n = len(points)
+    groups = {"points": points, "normals": normals, "wrist": wrist, "twist": twist}
+    columns = {}
+    for key, values in groups.items():
+        if values is not None:
+            flat = np.asarray(values, dtype=float).reshape(n, -1)
+            columns.update({name: flat[:, j] for j, name in enumerate(_GROUPS[key])})
+    if names is not None:
+        columns[NAME_COLUMN] = pa.array(names)
+    return pa.table(columns)
 
 
 def _bad(path: str, message: str) -> GraspFileError:
