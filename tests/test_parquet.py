@@ -298,3 +298,16 @@ def test_a_stop_signal_leaves_no_parquet_file_and_no_debris(tmp_path):
     assert run.said() == ["grasptwist: stopped by SIGTERM"]  # nothing from pyarrow's writer either
     assert (tmp_path / "out.parquet").read_text() == "old\n"
     assert_no_debris(run, tmp_path)
+
+
+def test_without_dask_grasptwist_dask_says_how_to_install_it():
+    code = without("dask", "dask.array") + (
+        "import numpy as np; from grasptwist.dask import resolve_array; from grasptwist.extras import MissingExtra\n"
+        "try:\n    resolve_array(np.zeros((1, 3, 3)), np.ones((1, 3, 3)), None, np.zeros((1, 6)))\n"
+        "except MissingExtra as exc:\n    print(exc)\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert out.stdout == (
+        "grasptwist.dask needs dask: pip install 'dask[dataframe]' distributed "
+        "(from a clone of grasptwist: pip install '.[dask]')\n"
+    )
