@@ -2,7 +2,7 @@
 
 Run: ``python bench/dask.py [--n 2000000]`` (needs the extra ``grasptwist[dask]``).
 Both resolve the same ``n`` grasps, stored as 8 Parquet shards: Dask reads
-the folder, runs :func:`grasptwist.dask.resolve_dataframe` on a
+the folder (Arrow types: no conversion to numpy and back), runs :func:`grasptwist.dask.resolve_dataframe` on a
 ``distributed.LocalCluster(n_workers=2, processes=True)`` and writes a folder
 of Parquet shards; the command line runs ``grasptwist resolve shards... -f
 parquet -o out.parquet`` (one process, start-up included).  The cluster's
@@ -43,7 +43,7 @@ def main():
             t_dask = float("inf")
             for i in range(args.repeats):
                 t0 = time.perf_counter()
-                results = resolve_dataframe(dd.read_parquet(os.path.join(tmp, "in")))
+                results = resolve_dataframe(dd.read_parquet(os.path.join(tmp, "in"), dtype_backend="pyarrow"))
                 to_parquet(results, f"{tmp}/dask{i}")
                 t_dask = min(t_dask, time.perf_counter() - t0)
         rows = sum(pq.ParquetFile(p).metadata.num_rows for p in glob.glob(f"{tmp}/dask0/*.parquet"))

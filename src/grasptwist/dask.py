@@ -79,6 +79,8 @@ def resolve_dataframe(ddf, twists: Mapping[str, object] | None = None, method="b
         Columns of a Parquet data set: ``p1_x ... p3_z``, ``n1_x ... n3_z``,
         optional ``c_x c_y c_z`` (wrist), ``w_x ... v_z`` (twist), ``name``
         (else rows are named by the index).  Other columns are ignored.
+        Read with ``dd.read_parquet(..., dtype_backend="pyarrow")``, the
+        columns reach the engine without a round trip through numpy types.
     twists : mapping of str to 6-vector, optional
         Named twists ``(omega; v)`` for every grasp (as ``--twist``; rows
         grasp-major); default: each row's own.
