@@ -88,7 +88,8 @@ def open_parquet(path: str):
     ------
     GraspFileError
         ``bad-dataset`` when the file is not Parquet, or lacks a column, or
-        a column has the wrong type; ``read-error`` without pyarrow.
+        a column has the wrong type; ``read-error`` when it cannot be opened
+        or without pyarrow.
     """
     try:
         require("pyarrow", "reading Parquet")
@@ -127,14 +128,14 @@ def _dataset(path: str, schema, reader):
                 raise _bad(path, f"column {n}: expected numbers, got {t}")
         if found:
             present[key] = names
-    names = None
+    labels = None
     if NAME_COLUMN in schema.names:
         t = schema.field(NAME_COLUMN).type
         t = t.value_type if pa.types.is_dictionary(t) else t
         if not (pa.types.is_string(t) or pa.types.is_large_string(t) or pa.types.is_integer(t)):
             raise _bad(path, f"column {NAME_COLUMN}: expected text or integers, got {t}")
-        names = _Names(reader)
-    reader.columns = [n for names_ in present.values() for n in names_] + ([NAME_COLUMN] if names else [])
+        labels = _Names(reader)
+    reader.columns = [n for names in present.values() for n in names] + ([NAME_COLUMN] if labels else [])
     arrays = {key: _Numbers(reader, cols, _SHAPES[key]) for key, cols in present.items()}
     return Dataset(
         path,
@@ -143,7 +144,7 @@ def _dataset(path: str, schema, reader):
         arrays.get("wrist"),
         None,
         arrays.get("twist"),
-        names,
+        labels,
     )
 
 
@@ -174,6 +175,8 @@ class _RowGroups:
         self.pid = os.getpid()  # a forked worker opens the file anew (no shared offsets or threads)
         try:
             self.file = pq.ParquetFile(self.path)
+        except OSError as exc:  # the file itself: gone, a folder, no permission
+            raise GraspFileError(code="read-error", message=f"cannot read: {exc}", file=self.path) from None
         except Exception as exc:  # noqa: BLE001 - pyarrow raises several kinds for a file that is not Parquet
             raise _bad(self.path, f"cannot read as Parquet: {exc}") from None
         meta = self.file.metadata
