@@ -12,13 +12,13 @@ fields are the npz arrays.  Neither computes anything until asked: run
 them on any Dask scheduler, e.g. a :class:`distributed.LocalCluster` or a
 cluster's :class:`distributed.Client`.
 
-Dask, distributed, pandas and pyarrow are the extra ``grasptwist[dask]``.
+Dask, distributed, pandas and pyarrow are the extra ``grasptwist[dask]``
+(imported when these functions run, not with this module).  For example
+(tests/test_dask.py runs such code on a cluster)::
 
->>> import dask.array as da, numpy as np
->>> points = da.from_array(np.array([[[1, 0, 0], [-0.5, 0.866, 0], [-0.5, -0.866, 0]]] * 4), chunks=(2, 3, 3))
->>> r = resolve_array(points, -points, da.zeros((4, 3)) + [0, 0, 1], da.zeros((4, 6)) + [0, 0, 0, 0, 0, 1])
->>> r["x"].compute()[0].round(4).tolist(), r.numblocks
-([0.6667, 0.6667, 0.6667], (2,))
+    points = da.from_array(np.array([[[1, 0, 0], [-0.5, 0.866, 0], [-0.5, -0.866, 0]]] * 4), chunks=(2, 3, 3))
+    r = resolve_array(points, -points, da.zeros((4, 3)) + [0, 0, 1], da.zeros((4, 6)) + [0, 0, 0, 0, 0, 1])
+    r["x"].compute()[0]  # array([0.6667, 0.6667, 0.6667]), in 2 chunks of 2 rows
 """
 
 from __future__ import annotations
