@@ -21,6 +21,8 @@ import time
 from pathlib import Path
 
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from typer.testing import CliRunner
 
 from grasptwist.cli import EXIT_USAGE, app
@@ -239,3 +241,18 @@ def test_a_twist_line_is_checked_as_a_grasp_files_twist():
     assert (error.code, error.line) == ("non-finite", 1)
     (error,) = read_twist_line(b'"spin"', file="-", line=4)
     assert error.code == "not-a-mapping" and error.message.startswith("expected a twist [wx, wy, wz, vx, vy, vz]")
+
+
+@settings(max_examples=200, deadline=None)
+@given(
+    st.lists(
+        st.one_of(st.floats(allow_nan=False, allow_infinity=False), st.integers(-(2**63), 2**63 - 1)),
+        min_size=6,
+        max_size=6,
+    )
+)
+def test_a_plain_array_line_reads_as_the_same_twist_written_as_a_screw_mapping(values):
+    text = json.dumps(values)
+    plain = read_twist_line(text.encode(), file="-", line=1)  # a plain array: the quick way
+    general = read_twist_line(f'{{"screw": {text}}}'.encode(), file="-", line=1)  # the loader's general path
+    assert plain.screw.tobytes() == general.screw.tobytes() and plain.name == general.name == "1"

@@ -51,6 +51,7 @@ from itertools import chain
 from pathlib import Path
 
 import numpy as np
+import orjson
 import yaml
 
 from ..engine import screws
@@ -1328,6 +1329,10 @@ def read_twist_line(data, *, file, line, max_bytes=DEFAULT_MAX_BYTES):
     >>> print(*read_twist_line(b"[0, 0, 1]", file="<stdin>", line=5))
     <stdin>:5:1: screw: expected 6 numbers, got 3; a 3-vector goes under `angular:` or `linear:`
     """
+    if len(data) <= max_bytes:
+        screw = _fast_screw(data)
+        if screw is not None:
+            return Twist(str(line), _readonly([*screw[:3], *screws.twist_at3(screw[:3], screw[3:], _ZERO)]), line)
     problems = _Problems(MAX_ERRORS)
     try:
         root = _line_node(_line_text(data, max_bytes), problems)
@@ -1361,6 +1366,21 @@ def read_twist_line(data, *, file, line, max_bytes=DEFAULT_MAX_BYTES):
             )
         )
     return [_on_line(reject.error(file, None), line) for reject in problems.first()]
+
+
+def _fast_screw(data):
+    """The six numbers of a line that is a plain JSON array of six finite numbers
+    (as floats, the values the general path reads), else None."""
+    try:
+        value = orjson.loads(data)
+    except orjson.JSONDecodeError:
+        return None
+    if type(value) is not list or len(value) != 6:
+        return None
+    for x in value:
+        if (type(x) is not float and type(x) is not int) or not -_INF < x < _INF:
+            return None
+    return [float(x) for x in value]
 
 
 def _line_text(data, max_bytes):

@@ -21,18 +21,17 @@ import os
 import stat
 import sys
 from collections.abc import Iterator
-from itertools import chain
 
 from ..model import Grasp, GraspFileError, Twist
 from .grasp_file import DEFAULT_MAX_BYTES, NOT_REGULAR, read_grasps, read_line, read_twist_line
 from .inputs import STDIN
 
-__all__ = ["JSONL_SUFFIX", "is_json_lines", "numbered_lines", "grasp_batches", "twist_batches"]
+__all__ = ["JSONL_SUFFIX", "is_json_lines", "numbered_batches", "grasp_batches", "twist_batches"]
 
 JSONL_SUFFIX = ".jsonl"
 
-# Bytes read at a time while passing over the rest of a line that is too long.
-_SKIP = 1 << 16
+# Most bytes read at a time.
+_CHUNK = 1 << 16
 _BOM = b"\xef\xbb\xbf"
 
 
@@ -45,34 +44,57 @@ def is_json_lines(path: str) -> bool:
     return path.lower().endswith(JSONL_SUFFIX)
 
 
-def numbered_lines(handle, max_bytes: int, head=()) -> Iterator[tuple[int, bytes]]:
-    """``(line number, line)`` of each non-blank line of ``handle`` (after the
-    lines ``head`` already read from it), as soon as it is complete.
+def numbered_batches(handle, max_bytes: int, per_batch: int, head: bytes = b"") -> Iterator[list[tuple[int, bytes]]]:
+    """``(line number, line)`` of the non-blank lines of ``head`` and then ``handle``,
+    in lists of the complete lines that have arrived (at most ``per_batch``):
+    it waits for input only when no complete line is left, so each line is
+    handed on as soon as it arrives, and lines that come together go together.
 
     A line longer than ``max_bytes`` comes cut to ``max_bytes + 1`` bytes (so
-    that it is refused), its rest read and dropped a piece at a time.
+    that it is refused) as soon as that much of it has arrived; its rest is
+    dropped as it comes.
     """
-    for number, line in enumerate(chain(head, iter(lambda: handle.readline(max_bytes + 2), b"")), 1):
-        rest = line
-        while len(rest) > max_bytes and not rest.endswith(b"\n"):
-            rest = handle.readline(_SKIP)
-        if line.strip():
-            yield number, line[: max_bytes + 1] if len(line.rstrip(b"\r\n")) > max_bytes else line
+    number, pending, skipping = 0, b"", False
+    chunk, ended = head, False
+    while True:
+        *lines, pending = (pending + chunk).split(b"\n")
+        if ended and pending:
+            lines.append(pending)
+            pending = b""
+        batch = []
+        for line in lines:
+            if skipping:  # the end of a line already refused
+                skipping = False
+                continue
+            number += 1
+            if line.strip():
+                batch.append((number, line))
+        if not skipping and len(pending) > max_bytes:
+            number += 1
+            batch.append((number, pending[: max_bytes + 1]))
+            skipping = True
+        if skipping:
+            pending = b""
+        for start in range(0, len(batch), per_batch):
+            yield batch[start : start + per_batch]
+        if ended:
+            return
+        chunk = handle.read1(_CHUNK)
+        ended = not chunk
 
 
-def _sniff(handle, max_bytes: int) -> tuple[bool, list[bytes]]:
+def _sniff(handle, max_bytes: int) -> tuple[bool, bytes]:
     """Whether ``handle`` holds JSON Lines (its first non-blank character is ``{``),
-    and the lines read to tell."""
-    head, size = [], 0
-    while size <= max_bytes:
-        line = handle.readline(max_bytes + 2)
-        if not line:
+    and the bytes read to tell."""
+    head = b""
+    while len(head) <= max_bytes:
+        chunk = handle.read1(_CHUNK)
+        if not chunk:
             break
-        head.append(line)
-        size += len(line)
-        text = line.removeprefix(_BOM) if len(head) == 1 else line
-        if text.strip():
-            return text.lstrip()[:1] == b"{", head
+        head += chunk
+        text = head.removeprefix(_BOM).lstrip()
+        if text:
+            return text[:1] == b"{", head
     return False, head
 
 
@@ -83,38 +105,6 @@ def _opened(path: str):
         os.close(fd)
         raise OSError(NOT_REGULAR)
     return os.fdopen(fd, "rb")
-
-
-def _interactive(handle) -> bool:
-    """Whether lines may arrive one by one (a pipe, terminal or socket, not a file)."""
-    try:
-        return not stat.S_ISREG(os.fstat(handle.fileno()).st_mode)
-    except (OSError, ValueError, AttributeError):
-        return True
-
-
-def _batches(entries, handle, per_batch: int):
-    """Lists of what ``entries`` gives: each alone when lines may arrive one by
-    one (each must be out before the next arrives), else ``per_batch`` at a time."""
-    per_batch = 1 if _interactive(handle) else per_batch
-    batch = []
-    for items in entries:
-        batch.extend(items)
-        if len(batch) >= per_batch:
-            yield batch
-            batch = []
-    if batch:
-        yield batch
-
-
-def _source(path: str, file: str):
-    """The handle of ``path`` (``-``: standard input), or the error for it."""
-    if path == STDIN:
-        return sys.stdin.buffer
-    try:
-        return _opened(path)
-    except OSError as exc:
-        return GraspFileError("read-error", f"cannot read: {exc.strerror or exc}", file)
 
 
 def grasp_batches(
@@ -140,8 +130,9 @@ def twist_batches(
 
 
 def _stream(path, max_bytes, per_batch, read, sniff):
-    """``read(line, file=, line=, max_bytes=)`` of each line of ``path``, in batches;
-    with ``sniff``, a stream that is not JSON Lines is read whole as a YAML grasp file."""
+    """``read(line, file=, line=, max_bytes=)`` of each line of ``path``, in batches
+    (see :func:`numbered_batches`); with ``sniff``, a stream that is not JSON
+    Lines is read whole as a YAML grasp file."""
     cap = DEFAULT_MAX_BYTES if max_bytes is None else max_bytes
     file = "<stdin>" if path == STDIN else path
     try:
@@ -150,15 +141,14 @@ def _stream(path, max_bytes, per_batch, read, sniff):
         yield [GraspFileError("read-error", f"cannot read: {exc.strerror or exc}", file)]
         return
     try:
-        head = ()
+        head = b""
         if sniff:
             json_lines, head = _sniff(handle, cap)
             if not json_lines:
-                data = b"".join(head)
-                yield read_grasps(data + handle.read(max(0, cap + 1 - len(data))), file=file, max_bytes=cap)
+                yield read_grasps(head + handle.read(max(0, cap + 1 - len(head))), file=file, max_bytes=cap)
                 return
-        entries = (read(line, file=file, line=n, max_bytes=cap) for n, line in numbered_lines(handle, cap, head))
-        yield from _batches(entries, handle, per_batch)
+        for batch in numbered_batches(handle, cap, per_batch, head):
+            yield [entry for n, line in batch for entry in read(line, file=file, line=n, max_bytes=cap)]
     finally:
         if path != STDIN:
             handle.close()

@@ -14,7 +14,7 @@ from collections.abc import Iterator, Sequence
 
 from ..io.inputs import STDIN, read
 from ..io.lines import grasp_batches, is_json_lines, twist_batches
-from ..model import Grasp, GraspFileError
+from ..model import Grasp, GraspFileError, Twist
 from .batch import Block, resolve
 
 __all__ = ["is_stream", "grasp_stream", "twist_stream"]
@@ -48,9 +48,25 @@ def twist_stream(
     yield errors
     for batch in twist_batches(twists_from, max_bytes, per_batch):
         out: list[Block | GraspFileError] = []
-        for twist in batch:
-            out.extend([twist] if isinstance(twist, GraspFileError) else resolve(grasps, [twist], method))
+        run: list[Twist] = []  # consecutive good twists, resolved together
+        for twist in [*batch, None]:
+            if isinstance(twist, Twist):
+                run.append(twist)
+                continue
+            out.extend(_twist_major(grasps, run, method))
+            run = []
+            if twist is not None:
+                out.append(twist)
         yield out
+
+
+def _twist_major(grasps, twists, method):
+    """The rows of each twist with every grasp, twist by twist."""
+    if not twists:
+        return []
+    if len(grasps) == 1:  # one grasp: its rows with the twists are in twist order already
+        return resolve(grasps, twists, method)
+    return [x for t in twists for x in resolve(grasps, [t], method)]
 
 
 def _items(path, max_bytes, per_batch):
