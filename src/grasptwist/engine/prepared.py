@@ -86,18 +86,20 @@ class PreparedGrasp:
             )
             self._fast.append((_RESULTS[name], template, rows))
         # ... the map with a failed method's rows zeroed (the fast path does not read them),
-        # and the largest sum of |entries| of a row: a twist no component of which exceeds
-        # _LARGEST / gain can neither overflow the product nor meet a non-finite entry.
+        # and its largest |entry|: a twist whose sum of |components| stays below _LARGEST / gain
+        # can neither overflow the product (nor any partial sum of it) nor meet a non-finite entry.
         used = np.zeros(len(self.map), bool)
         for name, rows in self._rows.items():
             used[rows] = self._status.get(name, Status.OK) == Status.OK
         self._used_map = np.where(used[:, None], self.map, 0.0)
-        gain = float(np.abs(self._used_map).sum(axis=1).max())
+        gain = float(np.abs(self._used_map).max())
         self._largest_twist = _LARGEST / gain if math.isfinite(gain) and gain > 0 else 0.0
         # The largest |p_i| as the kernel forms it: in_tangent_planes compares the normal
         # velocities with |v| + |omega| |p_i|, which is largest for the largest |p_i|.
         self._reach = max(math.sqrt(dot3(p, p)) for p in points.tolist())
         self._nv = self._rows["tangent"].start + 6  # the normal velocities' first row of the map
+        self._slots = (0, 1) if len(self._fast) == 2 else (1,)  # where each method goes in a Resolution
+        self._tangent_works = self._status["tangent"] == Status.OK
 
     def resolve(self, twist) -> Resolution:
         """Both decompositions and the contact velocities of ``twist`` on this grasp.
@@ -131,9 +133,7 @@ class PreparedGrasp:
         t = check_twist(twist)
         if t.ndim == 1:
             values = t.tolist()
-            # small enough that no product can overflow, and no NaN (which min and max pass over)
-            largest = self._largest_twist
-            if -largest < min(values) and max(values) < largest and sum(values) * 0.0 == 0.0:
+            if sum(map(abs, values)) < self._largest_twist:  # no product can overflow (NaN fails too)
                 return self._one(t, values)
         return self._many(t)
 
@@ -141,26 +141,30 @@ class PreparedGrasp:
         """One twist whose amplitudes are sure to be finite: the hot path of a control loop."""
         r = self._used_map.dot(t)
         triples = r.reshape(-1, 3)  # x, y, ..., T(p_3): one row each
-        parts = []
-        for cls, template, rows in self._fast:
-            result = cls._of(template)
+        parts = [None, None]  # off-tangent, tangent
+        for slot, (cls, template, rows) in zip(self._slots, self._fast):
+            result = parts[slot] = object.__new__(cls)  # as cls._of does, without the call
             values = result.__dict__
+            values.update(template)
             values["twist"] = t
             for a, i in rows:
                 values[a] = triples[i]
-            if rows and cls is TangentResult:
-                values["in_tangent_planes"] = self._in_tangent_planes(twist, r)
-            parts.append(result)
-        off_tangent, tangent = parts if len(parts) == 2 else (None, *parts)
-        return Resolution(off_tangent, tangent, triples[-3:])
+        if self._tangent_works:
+            parts[1].__dict__["in_tangent_planes"] = self._in_tangent_planes(twist, r)
+        return tuple.__new__(Resolution, (*parts, triples[-3:]))  # Resolution's own __new__ is Python
 
     def _in_tangent_planes(self, twist, r):
         """The kernel's verdict for one twist: every normal velocity within ``IN_PLANE_TOL``
         of the largest contact speed's bound ``|v| + |omega| max |p_i|``."""
         w, v = twist[:3], twist[3:]
-        bound = IN_PLANE_TOL * (math.sqrt(dot3(v, v)) + math.sqrt(dot3(w, w)) * self._reach)
-        n0, n1, n2 = r[self._nv : self._nv + 3].tolist()
-        return _TRUE if max(abs(n0), abs(n1), abs(n2)) <= bound else _FALSE
+        speed, spin = math.sqrt(dot3(v, v)), math.sqrt(dot3(w, w))
+        i = self._nv
+        return (
+            _TRUE
+            if max(abs(r.item(i)), abs(r.item(i + 1)), abs(r.item(i + 2)))
+            <= IN_PLANE_TOL * (speed + spin * self._reach)
+            else _FALSE
+        )
 
     def _many(self, t):
         """Twists with any leading axes ``(..., 6)``, including a non-finite one."""
