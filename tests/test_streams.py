@@ -27,6 +27,7 @@ from typer.testing import CliRunner
 
 from grasptwist.cli import EXIT_USAGE, app
 from grasptwist.io.grasp_file import read_line, read_twist_line
+from grasptwist.io.lines import numbered_batches
 
 ROOT = Path(__file__).resolve().parents[1]
 POLY = ROOT / "grasps" / "polyhedron.yaml"
@@ -256,3 +257,32 @@ def test_a_plain_array_line_reads_as_the_same_twist_written_as_a_screw_mapping(v
     plain = read_twist_line(text.encode(), file="-", line=1)  # a plain array: the quick way
     general = read_twist_line(f'{{"screw": {text}}}'.encode(), file="-", line=1)  # the loader's general path
     assert plain.screw.tobytes() == general.screw.tobytes() and plain.name == general.name == "1"
+
+
+class Chunks:
+    """A stream whose ``read1`` hands out given pieces, as a pipe does."""
+
+    def __init__(self, pieces):
+        self.pieces = list(pieces)
+
+    def read1(self, n):
+        return self.pieces.pop(0) if self.pieces else b""
+
+
+@settings(max_examples=300, deadline=None)
+@given(
+    st.lists(st.sampled_from([b"", b" ", b"ab", b"abcdefgh", b"abcdefghijkl", b"x" * 30]), max_size=12),
+    st.lists(st.integers(1, 40), min_size=1, max_size=20),
+    st.integers(1, 5),
+)
+def test_lines_are_the_same_however_the_stream_is_cut(lines, cuts, per_batch):
+    data = b"\n".join(lines)
+    pieces, at = [], 0
+    for k in cuts * (len(data) // sum(cuts) + 1):
+        pieces.append(data[at : at + k])
+        at += k
+    pieces = [p for p in pieces if p]
+    batches = list(numbered_batches(Chunks(pieces), 10, per_batch))
+    got = [entry for batch in batches for entry in batch]
+    want = [(i, line if len(line) <= 10 else line[:11]) for i, line in enumerate(lines, 1) if line.strip()]
+    assert got == want and all(0 < len(b) <= per_batch for b in batches)

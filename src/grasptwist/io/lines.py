@@ -68,7 +68,7 @@ def numbered_batches(handle, max_bytes: int, per_batch: int, head: bytes = b"") 
                 continue
             number += 1
             if line.strip():
-                batch.append((number, line))
+                batch.append((number, line[: max_bytes + 1]))
         if not skipping and len(pending) > max_bytes:
             number += 1
             batch.append((number, pending[: max_bytes + 1]))
