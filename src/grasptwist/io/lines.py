@@ -53,6 +53,10 @@ def numbered_batches(handle, max_bytes: int, per_batch: int, head: bytes = b"") 
     A line longer than ``max_bytes`` comes cut to ``max_bytes + 1`` bytes (so
     that it is refused) as soon as that much of it has arrived; its rest is
     dropped as it comes.
+
+    >>> import io
+    >>> list(numbered_batches(io.BytesIO(b'{"a": 1}\n\n[1, 2]\n' + b"x" * 9), 8, 64))
+    [[(1, b'{"a": 1}'), (3, b'[1, 2]'), (4, b'xxxxxxxxx')]]
     """
     number, pending, skipping = 0, b"", False
     chunk, ended = head, False
