@@ -55,7 +55,7 @@ def numbered_batches(handle, max_bytes: int, per_batch: int, head: bytes = b"") 
     dropped as it comes.
 
     >>> import io
-    >>> list(numbered_batches(io.BytesIO(b'{"a": 1}\n\n[1, 2]\n' + b"x" * 9), 8, 64))
+    >>> list(numbered_batches(io.BytesIO(b'{"a": 1}\\n\\n[1, 2]\\n' + b"x" * 9), 8, 64))
     [[(1, b'{"a": 1}'), (3, b'[1, 2]'), (4, b'xxxxxxxxx')]]
     """
     number, pending, skipping = 0, b"", False
