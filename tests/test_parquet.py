@@ -311,3 +311,18 @@ def test_without_dask_grasptwist_dask_says_how_to_install_it():
         "grasptwist.dask needs dask: pip install 'dask[dataframe]' distributed "
         "(from a clone of grasptwist: pip install '.[dask]')\n"
     )
+
+
+def test_a_hands_joint_columns_flow_to_parquet(tmp_path):
+    from pathlib import Path
+
+    grasp = Path(__file__).parent.parent / "grasps" / "three-finger-hand.yaml"
+    assert run("resolve", grasp, "-f", "parquet", "-o", tmp_path / "hand.parquet").exit_code == 0
+    table, rows = pq.read_table(tmp_path / "hand.parquet"), csv_rows(run("resolve", grasp, "-f", "csv").stdout)
+    statuses = ["off_tangent_status", "tangent_status", "hand_status"]
+    assert [c for c in table.column_names if c not in statuses] == list(rows[0])
+    assert str(table.schema.field("hand_status").type) == "int8" and table.column("hand_status").to_pylist() == [
+        0
+    ] * len(rows)
+    joints = [c for c in rows[0] if c.startswith("qdot_")]
+    assert len(joints) == 9 and all(table.column(c).to_pylist() == [float(r[c]) for r in rows] for c in joints)

@@ -109,9 +109,9 @@ def to_parquet(results, folder: str, **options):
     options); ``options`` go to :meth:`dask.dataframe.DataFrame.to_parquet`
     (e.g. ``storage_options`` for an object store).  Computes the results.
     """
-    from .output.parquet import WRITE_OPTIONS, schema
+    from .output.parquet import schema, write_options
 
-    return results.to_parquet(folder, write_index=False, schema=schema(), **{**WRITE_OPTIONS, **options})
+    return results.to_parquet(folder, write_index=False, schema=schema(), **{**write_options(), **options})
 
 
 def _resolve_rows(rows: np.ndarray, has_wrist: bool, method: str, order: str, dtype: np.dtype) -> np.ndarray:

@@ -1,7 +1,8 @@
 """Results as one Parquet file: the CSV's columns, typed, from the one columns definition.
 
-Columns and their order are :data:`~grasptwist.output.columns.TYPED_COLUMNS`
-(the CSV's, and each kind's ``<key>_status`` after its conditioning): text
+Columns and their order are :func:`~grasptwist.output.columns.typed_header`
+(the CSV's, a hand's joint columns included, and each kind's ``<key>_status``
+after its conditioning): text
 as dictionary-encoded strings, ``ok`` and ``in_tangent_planes`` as
 booleans, statuses as int8 (-1: skipped), numbers as float64; a value that
 does not apply (an empty CSV cell) is null.  Rows are written in row groups
@@ -16,32 +17,33 @@ from typing import IO
 import numpy as np
 
 from ..extras import require
-from .columns import TYPED_COLUMNS, columns
+from .columns import columns, typed_header
 
-__all__ = ["ROW_GROUP_ROWS", "WRITE_OPTIONS", "schema", "table", "ParquetWriter"]
+__all__ = ["ROW_GROUP_ROWS", "write_options", "schema", "table", "ParquetWriter"]
 
 #: Rows per row group written (about 25 MB of results before compression).
 ROW_GROUP_ROWS = 65536
 
-#: Options of pyarrow's Parquet writer for results: dictionary pages for text
-#: only (on floats they cost five times the write and save nothing).
-WRITE_OPTIONS = {"use_dictionary": [name for name, dtype in TYPED_COLUMNS.items() if dtype == "U"]}
+
+def write_options(hand=None) -> dict:
+    """Options of pyarrow's Parquet writer for results: dictionary pages for text
+    only (on floats they cost five times the write and save nothing)."""
+    return {"use_dictionary": [name for name, dtype in typed_header(hand).items() if dtype == "U"]}
 
 
 def _arrow_type(pa, dtype: str):
-    text = pa.dictionary(pa.int32(), pa.string())
-    return {"U": text, "?": pa.bool_(), "i1": pa.int8(), "f8": pa.float64()}[dtype]
+    return pa.dictionary(pa.int32(), pa.string()) if dtype == "U" else pa.from_numpy_dtype(np.dtype(dtype))
 
 
-def schema():
-    """The Arrow schema of results: :data:`TYPED_COLUMNS` with their types.
+def schema(hand=None):
+    """The Arrow schema of results: :func:`~grasptwist.output.columns.typed_header` with their types.
 
     >>> s = schema()
     >>> str(s.field("ok").type), str(s.field("tangent_status").type), str(s.field("file").type)
     ('bool', 'int8', 'dictionary<values=string, indices=int32, ordered=0>')
     """
     pa = require("pyarrow", "Parquet output")
-    return pa.schema([(name, _arrow_type(pa, dtype)) for name, dtype in TYPED_COLUMNS.items()])
+    return pa.schema([(name, _arrow_type(pa, dtype)) for name, dtype in typed_header(hand).items()])
 
 
 def _array(pa, values, arrow_type):
@@ -54,11 +56,11 @@ def _array(pa, values, arrow_type):
     return pa.array(data, arrow_type, mask=mask)
 
 
-def table(block, order: str = "omega-v"):
-    """A result block as an Arrow table of :func:`schema`."""
+def table(block, order: str = "omega-v", hand=None):
+    """A result block as an Arrow table of :func:`schema` (``hand``: the run's, whose joint columns follow)."""
     pa = require("pyarrow", "Parquet output")
-    s = schema()
-    flat = columns(block, order, typed=True)
+    s = schema(hand)
+    flat = columns(block, order, hand, typed=True)
     return pa.Table.from_arrays([_array(pa, flat[f.name], f.type) for f in s], schema=s)
 
 
@@ -69,17 +71,18 @@ class ParquetWriter:
     then written as one row group.
     """
 
-    def __init__(self, out: IO[bytes], order: str = "omega-v", row_group_rows: int = ROW_GROUP_ROWS):
+    def __init__(self, out: IO[bytes], order: str = "omega-v", row_group_rows: int = ROW_GROUP_ROWS, hand=None):
         pq = require("pyarrow.parquet", "-f parquet")
         self.order = order
+        self.hand = hand
         self.row_group_rows = row_group_rows
         self.pending: list = []
         self.rows = 0
-        self.writer = pq.ParquetWriter(out, schema(), **WRITE_OPTIONS)
+        self.writer = pq.ParquetWriter(out, schema(hand), **write_options(hand))
 
     def write(self, block) -> None:
         """Append a block's rows."""
-        self.pending.append(table(block, self.order))
+        self.pending.append(table(block, self.order, self.hand))
         self.rows += len(block)
         if self.rows >= self.row_group_rows:
             self._flush()
