@@ -70,6 +70,7 @@ def assert_dask_equals_the_command_line(tmp_path, n, shards):
 
 def on_a_cluster(tmp_path, n):
     """resolve_dataframe on two worker processes, against the command line."""
+    tmp_path.mkdir(exist_ok=True)
     with (
         distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0") as cluster,
         distributed.Client(cluster) as client,
@@ -79,8 +80,10 @@ def on_a_cluster(tmp_path, n):
         assert_dask_equals_the_command_line(tmp_path, n, shards=3 if n < 10_000 else 6)
 
 
-def in_this_process(tmp_path):
-    """The other checks, on Dask's scheduler in this process."""
+def the_default_run(tmp_path):
+    """A small data set on the cluster, then the other checks on Dask's scheduler in this process
+    (one process: Python, dask and pandas start once)."""
+    on_a_cluster(tmp_path / "cluster", 3000)
     with dask.config.set(scheduler="synchronous"):
         types_and_named_twists(tmp_path)
         array_equals_the_engine()
