@@ -343,7 +343,7 @@ def write_blocks(job: Job, paths: Sequence, w, tuning: Tuning = TUNING) -> Itera
             for rec in records(x.take(talking), job.order) if talking.size else []:
                 o.add(rec, lambda rec: None)
             o.records = len(x)
-            o.encoded = []
         else:
             o.add(error_record(x), lambda rec: None)
+        o.encoded = []  # the rows went to ``w``; an input that failed has its stderr line only
         yield o
