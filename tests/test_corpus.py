@@ -345,12 +345,3 @@ def test_a_mebibyte_of_document_markers_is_cut_short_in_little_memory(tmp_path):
     (tmp_path / "in").mkdir()
     (tmp_path / "in" / "dashes.yaml").write_bytes(DASHES)
     _dashes_check(tmp_path / "in", 1, 150)
-
-
-@pytest.mark.slow
-def test_sixteen_such_files_in_one_folder(tmp_path):
-    # 0.1: 20 GB; now ~50 MB
-    (tmp_path / "in").mkdir()
-    for k in range(16):
-        (tmp_path / "in" / f"{k:02d}.yaml").write_bytes(DASHES)
-    _dashes_check(tmp_path / "in", 16, 300)
