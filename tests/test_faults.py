@@ -39,7 +39,7 @@ from grasptwist.model import GraspFileError
 from grasptwist.run.pipeline import TUNING, Spool
 from grasptwist.run.pool import Pool, WorkerDied, WorkerFailed
 from grasptwist.run.scratch import owned_prefix
-from hostile import assert_no_crash, jsonl, run_installed, summary
+from hostile import assert_no_crash, jsonl, run_installed, run_measured, summary
 
 ROOT = Path(__file__).resolve().parents[1]
 POLY = ROOT / "grasps" / "polyhedron.yaml"
@@ -456,14 +456,15 @@ def test_sixteen_mebibytes_of_document_markers_take_little_memory(tmp_path):
     (tmp_path / "in").mkdir()
     for k in range(16):
         (tmp_path / "in" / f"{k:02d}.yaml").write_bytes(b"---\n" * (1 << 18))  # 1 MiB of empty documents
-    run = Run(tmp_path, "resolve", tmp_path / "in", "-f", "jsonl", "-j", "2", "-o", tmp_path / "out.jsonl")
-    code, seconds, usage = run.finish()
-    print(f"sixteen files of '---': {seconds:.2f} s, peak {usage.ru_maxrss / 1024:.0f} MB")
-    assert code == 1 and usage.ru_maxrss < 300 * 1024  # kB
+    start = time.monotonic()
+    code, stderr, peak = run_measured("resolve", "in", "-f", "jsonl", "-j", "2", "-o", "out.jsonl", cwd=tmp_path)
+    print(f"sixteen files of '---': {time.monotonic() - start:.2f} s, peak {peak:.0f} MB")
+    assert code == 1 and peak < 300
     # per file: 100 errors, too-many-documents at document 10,001, one line counting the 9,900 others
     assert len(jsonl((tmp_path / "out.jsonl").read_text())) == 16 * 102
-    assert run.lines[-2].endswith("9900 more problems in this file not reported (only the first 100 are)")
-    assert run.lines[-1] == summary(16 * 102, 16 * 102)
+    lines = stderr.splitlines()
+    assert lines[-2].endswith("9900 more problems in this file not reported (only the first 100 are)")
+    assert lines[-1] == summary(16 * 102, 16 * 102)
 
 
 @pytest.fixture(scope="module")
@@ -477,18 +478,16 @@ def bomb(tmp_path_factory) -> Path:
 def test_an_npz_zip_bomb_is_refused_unread_and_costs_no_other_record(tmp_path, bomb):
     # 0.1 inflated every member whole: 2.85 GB and 12.7 s for the 2.8 MB bomb, MemoryError under a limit
     start = time.monotonic()
-    run = Run(tmp_path, "resolve", bomb, POLY, "-f", "jsonl", stdout=subprocess.PIPE)
-    out = run.p.stdout.read()
-    code, _, usage = run.finish()
+    code, stderr, peak = run_measured("resolve", bomb, POLY, "-f", "jsonl", "-o", "out.jsonl", cwd=tmp_path)
     seconds = time.monotonic() - start
-    print(f"npz bomb: {seconds:.2f} s, peak {usage.ru_maxrss / 1024:.0f} MB")
-    assert code == 1 and usage.ru_maxrss < 150 * 1024 and seconds < 5
-    assert run.lines[0] == (
+    print(f"npz bomb: {seconds:.2f} s, peak {peak:.0f} MB")
+    assert code == 1 and peak < 150 and seconds < 5
+    assert stderr.splitlines()[0] == (
         f"{bomb}: error: bad-dataset: points: declares 288,000,128 bytes in "
         f"{zipfile.ZipFile(bomb).getinfo('points.npy').compress_size:,} compressed "
         f"(over {MAX_INFLATION} times): refused unread, as a likely zip bomb"
     )
-    records = jsonl(out.decode())
+    records = jsonl((tmp_path / "out.jsonl").read_text())
     assert [r["file"] for r in records] == [str(bomb), str(POLY)] and records[1]["ok"]
 
 
