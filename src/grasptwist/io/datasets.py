@@ -50,7 +50,8 @@ INFLATION_FLOOR = 64 << 20
 
 @dataclass(frozen=True)
 class Dataset:
-    """A data set's arrays (``.npy`` columns are memory-mapped views)."""
+    """A data set's arrays: ``.npy`` columns are memory-mapped views, ``.npz``
+    members :class:`Member` objects; both are read by slicing rows."""
 
     path: str
     points: np.ndarray  # (N, 3, 3)
@@ -89,7 +90,8 @@ def open_dataset(path: str, extra_point: str = "wrist") -> Dataset:
         return _open_npz(path, members)
     except GraspFileError:
         raise
-    except (OSError, ValueError, EOFError, zipfile.BadZipFile, NotImplementedError) as exc:
+    # zipfile: RuntimeError for an encrypted member, NotImplementedError for an unknown compression
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile, NotImplementedError, RuntimeError) as exc:
         raise GraspFileError(code="read-error", message=f"cannot read as a numpy file: {exc}", file=path) from None
 
 
