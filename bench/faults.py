@@ -132,6 +132,8 @@ def spool(tmp: Path):
 
 
 if __name__ == "__main__":
+    # a shell starts a background job with SIGINT ignored, and its children would inherit that
+    signal.signal(signal.SIGINT, signal.default_int_handler)
     with tempfile.TemporaryDirectory() as d:
         hostile(Path(d))
         stopping(Path(d))
