@@ -471,7 +471,7 @@ def test_sixteen_mebibytes_of_document_markers_take_little_memory(tmp_path):
 def bomb(tmp_path_factory) -> Path:
     """A 280 kB ``.npz`` declaring 288 MB of zeros (the issue's bomb, a tenth the size, to be quick to make)."""
     path = tmp_path_factory.mktemp("bomb") / "bomb.npz"
-    np.savez_compressed(path, points=np.zeros((4_000_000, 3, 3)), normals=np.zeros((4_000_000, 3, 3)))
+    np.savez_compressed(path, points=np.zeros((4_000_000, 3, 3)))
     return path
 
 
@@ -493,7 +493,7 @@ def test_an_npz_zip_bomb_is_refused_unread_and_costs_no_other_record(tmp_path, b
 
 @pytest.mark.parametrize("save", [np.savez, np.savez_compressed], ids=["stored", "compressed"])
 def test_npz_members_are_read_a_block_at_a_time_with_the_same_records(tmp_path, rows, save):
-    data = np.load(rows, mmap_mode="r")[:20_000]
+    data = np.load(rows, mmap_mode="r")[: 3 * TUNING.grasps_per_task]  # three tasks for two workers
     n = len(data)
     save(
         tmp_path / "set.npz",
@@ -505,7 +505,7 @@ def test_npz_members_are_read_a_block_at_a_time_with_the_same_records(tmp_path, 
     )
     ds = open_dataset(str(tmp_path / "set.npz"))
     assert isinstance(ds.points, Member) and ds.points.shape == (n, 3, 3)
-    np.testing.assert_array_equal(ds.points[4000:4100], data[4000:4100, :9].reshape(100, 3, 3))
+    np.testing.assert_array_equal(ds.points[5000:5100], data[5000:5100, :9].reshape(100, 3, 3))
     np.testing.assert_array_equal(ds.twist[n - 5 :], data[n - 5 :, :6])
     # forked workers, each reading its own tasks' rows: as one process reading them all
     args = ("resolve", tmp_path / "set.npz", "-f", "jsonl", "-q")
