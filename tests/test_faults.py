@@ -514,6 +514,23 @@ def test_npz_members_are_read_a_block_at_a_time_with_the_same_records(tmp_path, 
     assert two.finish()[0] == one.finish()[0] in (0, 1)
 
 
+def test_a_damaged_npz_member_is_a_read_error_where_it_is_found(tmp_path, rows):
+    points = np.load(rows, mmap_mode="r")[:3000, :9].reshape(-1, 3, 3)
+    np.savez_compressed(tmp_path / "set.npz", points=points, normals=points)
+    info = zipfile.ZipFile(tmp_path / "set.npz").getinfo("points.npy")
+    data = bytearray((tmp_path / "set.npz").read_bytes())
+    end = info.header_offset + info.compress_size  # the member's last bytes: its checksum fails at its end
+    data[end - 100 : end - 50] = bytes(50)
+    (tmp_path / "set.npz").write_bytes(data)
+    proc, _ = run_installed("resolve", tmp_path / "set.npz", POLY, *TWIST, "-f", "jsonl", "-j", "1")
+    assert_no_crash(proc.stderr)
+    assert proc.returncode == 1
+    [line] = [x for x in proc.stderr.splitlines() if "read-error" in x]
+    assert line.startswith(f"{tmp_path / 'set.npz'}: error: read-error: points.npy: ")
+    assert line.endswith("(damaged, or changed while being read)")
+    assert jsonl(proc.stdout)[-1]["file"] == str(POLY)  # the next input is still resolved
+
+
 @pytest.mark.parametrize(
     ("member", "message"),
     [

@@ -26,6 +26,7 @@ from __future__ import annotations
 
 import os
 import zipfile
+import zlib
 from dataclasses import dataclass
 from math import prod
 
@@ -208,9 +209,15 @@ class Member:
         start, stop, _ = rows.indices(len(self))
         stop = max(start, stop)
         row = prod(self.shape[1:]) * self.dtype.itemsize
-        f = self._file()
-        f.seek(self.offset + start * row)
-        data = f.read((stop - start) * row)
+        try:
+            f = self._file()
+            f.seek(self.offset + start * row)
+            data = f.read((stop - start) * row)
+        except (OSError, EOFError, zipfile.BadZipFile, zlib.error) as exc:
+            # the archive's checksum is checked only once a member has been read to its end
+            raise GraspFileError(
+                code="read-error", message=f"{self.name}: {exc} (damaged, or changed while being read)", file=self.path
+            ) from None
         return np.frombuffer(data, self.dtype).reshape((stop - start, *self.shape[1:]))
 
     def __array__(self, dtype=None, copy=None):

@@ -92,7 +92,8 @@ def _rows(a):
     Floats get ``+ 0.0``, which turns ``-0.0`` into ``0.0``: a round-off sign
     on zero means nothing and reads oddly (``jq`` prints ``-0``).
     """
-    a = np.ascontiguousarray(a + 0.0 if a.dtype.kind == "f" else a)
+    with np.errstate(invalid="ignore"):  # a signalling NaN from a data set's bytes is no news
+        a = np.ascontiguousarray(a + 0.0 if a.dtype.kind == "f" else a)
     return list(a) if a.ndim > 1 else a.tolist()
 
 

@@ -298,11 +298,16 @@ def _dataset_task(job: Job, ds, rows: tuple[int, int], tuning: Tuning, spool: Sp
     twists = [ZERO_TWIST] if job.kind != "resolve" else job.twists
     at_once = tuning.records_at_once
     outs = []
-    for block in dataset_blocks(ds, twists, job.method, start=rows[0], stop=rows[1]):
-        for start in range(0, len(block), at_once):
-            out = Output()
-            _emit(job, block.part(start, start + at_once), out, at_once)
-            outs.append(_sealed(job, out, spool))
+    try:
+        for block in dataset_blocks(ds, twists, job.method, start=rows[0], stop=rows[1]):
+            for start in range(0, len(block), at_once):
+                out = Output()
+                _emit(job, block.part(start, start + at_once), out, at_once)
+                outs.append(_sealed(job, out, spool))
+    except GraspFileError as err:  # a damaged .npz member, found only as it is read
+        out = Output()
+        _emit(job, err, out, at_once)
+        outs.append(_sealed(job, out, spool))
     return outs
 
 
