@@ -343,6 +343,119 @@ def check(
     _run(debug, lambda: _emit(job, paths, output, quiet, workers))
 
 
+FollowFormat = _choices("FollowFormat", names_for("follow"))
+
+
+class Frame(str, Enum):
+    space = "space"
+    body = "body"
+
+
+@app.command()
+def follow(
+    paths: list[str] = typer.Argument(
+        ..., metavar="PATH...", help="Grasp files (.yaml, .yml, .json; any case), folders of them or - (stdin)."
+    ),
+    path: str | None = typer.Option(None, "--path", metavar="NAME", help="Follow only the files' paths of this name."),
+    twist: list[str] | None = typer.Option(
+        None,
+        "--twist",
+        metavar="W1,W2,W3,V1,V2,V3",
+        help="A segment's constant twist (omega; v), each with a --duration, in order: a path replacing the files'.",
+    ),
+    duration: list[float] | None = typer.Option(
+        None, "--duration", metavar="T", help="How long the --twist of the same rank is held (> 0)."
+    ),
+    frame: Frame = typer.Option(Frame.space, "--frame", help="Frame of the --twist segments."),
+    samples: int | None = typer.Option(
+        None, "--samples", min=2, max=1_000_000, help="Samples per path, evenly spaced, ends included (default 21)."
+    ),
+    dt: float | None = typer.Option(None, "--dt", metavar="DT", help="Time step between samples instead of --samples."),
+    method: Method = _METHOD,
+    fmt: FollowFormat = typer.Option(
+        FollowFormat.table, "-f", "--format", help="table for people; json, jsonl, csv or npz (with -o) for programs."
+    ),
+    json_: bool = _JSON,
+    output: str | None = _OUTPUT,
+    digits: int = _DIGITS,
+    order: Order = _ORDER,
+    max_bytes: int | None = _MAX_BYTES,
+    quiet: bool = _QUIET,
+    debug: bool = _DEBUG,
+) -> None:
+    """Move the object along each path, the contacts with it, resolve every sample and find the degeneracies between samples.
+
+    One record per sample, then a summary per path; exit 1 if a method is
+    degenerate somewhere on a path. Examples: the paper's cylinder turning
+    half a turn about x (its wrist crosses the contacts' plane at t = pi/2);
+    a path from the command line, a quarter turn about z then a lift:
+
+    \b
+        grasptwist follow grasps/cylinder.yaml --method off-tangent --samples 5
+        grasptwist follow grasps/polyhedron.yaml --twist 0,0,1,0,0,0 --duration 1.5708 --twist 0,0,0,0,0,1 --duration 1 -f jsonl
+    """
+    from .run.follow import FollowJob
+
+    segments = _cli_segments(twist, duration, frame.value)
+    if segments and path is not None:
+        raise typer.BadParameter(
+            "--path picks one of the files' paths; --twist replaces them: give one", param_hint="--path"
+        )
+    if samples is not None and dt is not None:
+        raise typer.BadParameter("give --samples or --dt, not both", param_hint="--dt")
+    if dt is not None and not (dt > 0 and dt != float("inf")):
+        raise typer.BadParameter(f"must be a finite number > 0, got {dt}", param_hint="--dt")
+    fmt = FollowFormat.json if json_ else fmt
+    if FORMATS[fmt.value].binary and output is None and sys.stdout.isatty():
+        raise typer.BadParameter(f"{fmt.value} is binary: give -o FILE.{fmt.value}", param_hint="--format")
+    job = FollowJob(
+        method=method.value,
+        path=path,
+        segments=segments,
+        samples=samples,
+        dt=dt,
+        max_bytes=max_bytes,
+        bases=FORMATS[fmt.value].bases,
+    )
+    _run(debug, lambda: _follow(job, paths, output, quiet, fmt.value, digits=digits, order=order.value))
+
+
+def _cli_segments(twists, durations, frame):
+    """``--twist``/``--duration`` pairs as path segments (None without ``--twist``)."""
+    if not twists and not durations:
+        if frame != "space":
+            raise typer.BadParameter("applies to --twist segments", param_hint="--frame")
+        return None
+    if len(twists or ()) != len(durations or ()):
+        raise typer.BadParameter(
+            f"each --twist needs a --duration: got {len(twists or ())} and {len(durations or ())}",
+            param_hint="--duration",
+        )
+    from .path import Segment, check_segments
+
+    segments = [Segment(d, twist=_floats(t, 6, "--twist"), frame=frame) for t, d in zip(twists, durations)]
+    try:
+        return check_segments(segments)
+    except ValueError as exc:
+        raise typer.BadParameter(str(exc).replace("segments[", "segment ["), param_hint="--duration") from None
+
+
+def _follow(job, paths: list[str], output, quiet: bool, fmt: str, **table_options) -> int:
+    """The body of follow: records out, counts and diagnostics on stderr."""
+    from .io.inputs import expand
+    from .run.follow import write_follow
+
+    stderr = _Stderr(quiet)
+    with _output(output) as out:
+        w = FORMATS[fmt].open(out, "follow", **table_options)
+        for o in write_follow(job, expand(paths), w, fmt, table_options.get("order", "omega-v")):
+            out.flush()
+            stderr.take(o)
+        w.close()
+    stderr.summary()
+    return EXIT_FAILED if stderr.failed else EXIT_OK
+
+
 @app.command()
 def schema(output: str | None = _OUTPUT, debug: bool = _DEBUG) -> None:
     """Print the JSON Schema of grasp files (for editors with a YAML language server).

@@ -11,7 +11,18 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Twist", "Grasp", "Segment", "InputError", "GraspFileError", "CONTACT_NAMES", "Joint", "Finger", "Hand"]
+__all__ = [
+    "Twist",
+    "Grasp",
+    "Segment",
+    "ObjectPath",
+    "InputError",
+    "GraspFileError",
+    "CONTACT_NAMES",
+    "Joint",
+    "Finger",
+    "Hand",
+]
 
 #: Contact names of a grasp that does not name its contacts.
 CONTACT_NAMES = ("1", "2", "3")
@@ -67,6 +78,8 @@ class Grasp:
         The desired twists, possibly none.
     line : int
         1-based line where the document starts.
+    paths : tuple of ObjectPath
+        The object paths of its ``paths`` key, possibly none.
     """
 
     name: str
@@ -79,6 +92,7 @@ class Grasp:
     wrist: np.ndarray | None
     twists: tuple[Twist, ...]
     line: int
+    paths: tuple[ObjectPath, ...] = ()
 
 
 @dataclass(frozen=True, eq=False)
@@ -112,6 +126,25 @@ class Segment:
     frame: str = "space"
     position: np.ndarray | None = None
     rotation: np.ndarray | None = None
+
+
+@dataclass(frozen=True, eq=False)
+class ObjectPath:
+    """A named object path of a grasp file: its segments, in order.
+
+    Attributes
+    ----------
+    name : str
+        Its ``name``, or ``"1"``, ``"2"``, ... by position in ``paths``.
+    segments : tuple of Segment
+        Checked by :func:`grasptwist.path.check_segments`.
+    line : int or None
+        1-based line of the path's entry in the file.
+    """
+
+    name: str
+    segments: tuple[Segment, ...]
+    line: int | None
 
 
 class InputError(Exception):

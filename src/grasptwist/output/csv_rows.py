@@ -17,7 +17,7 @@ from .columns import CSV_COLUMNS, columns
 from .names import escaped_each
 from .records import records, talking_rows
 
-__all__ = ["HEADER", "encode_rows", "error_row"]
+__all__ = ["HEADER", "encode_rows", "error_row", "lines"]
 
 #: The header line.
 HEADER = ",".join(CSV_COLUMNS).encode() + b"\n"
@@ -53,6 +53,11 @@ def encode_rows(block, order: str) -> tuple[list[bytes], list[dict]]:
     cells = [_cells(a) for a in columns(block, order).values()]
     talking = np.flatnonzero(talking_rows(block))
     return _lines(zip(*cells)), records(block.take(talking), order) if talking.size else []
+
+
+def lines(named: dict) -> list[bytes]:
+    """The CSV line of each row of flat columns ``name -> (N,)`` array (masked: empty cells)."""
+    return _lines(zip(*(_cells(a) for a in named.values())))
 
 
 def error_row(rec: dict) -> bytes:

@@ -49,10 +49,10 @@ class NpzWriter:
         self.rows = 0
         self.tmp = None
 
-    def write(self, block) -> None:
-        """Append a block's rows."""
+    def write(self, block, extra: dict | None = None) -> None:
+        """Append a block's rows, and ``extra`` arrays over them (``follow``'s times and poses)."""
         cols = {}
-        for name, a in arrays(block, self.order).items():
+        for name, a in {**arrays(block, self.order), **(extra or {})}.items():
             if name in _INDEXED:
                 index, table = _INDEXED[name]
                 cols[index] = self._index(table, a)
