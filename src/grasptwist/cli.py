@@ -248,6 +248,13 @@ def resolve(
         "--extra-point",
         help="Role of a .npy's 19th-21st columns: the wrist, or the point the twists' linear velocity is given at.",
     ),
+    hand: str | None = typer.Option(
+        None,
+        "--hand",
+        metavar="FILE.yaml",
+        help="The hand of a data set's rows (a YAML file holding just hand:), at its joint_positions; "
+        "its joints name the CSV and npz joint-rate columns.",
+    ),
     max_bytes: int | None = _MAX_BYTES,
     workers: int = _WORKERS,
     quiet: bool = _QUIET,
@@ -281,8 +288,30 @@ def resolve(
         fmt=fmt.value,
         max_bytes=max_bytes,
         extra_point=extra_point.value,
+        hand=_hand_option(hand, paths, fmt.value),
     )
     _run(debug, lambda: _emit(job, paths, output, quiet, workers, digits=digits, order=order.value))
+
+
+def _hand_option(path: str | None, paths: list[str], fmt: str):
+    """The run's hand: ``--hand``'s, or for CSV and npz of one grasp file, that file's first hand
+    (its joints name the columns; a folder's grasps may each have another)."""
+    from .model import InputError
+
+    if path is not None:
+        from .io.grasp_hand import load_hand_file
+
+        try:
+            return load_hand_file(path)[0]
+        except InputError as err:
+            raise typer.BadParameter(f"{err.code}: {err}", param_hint="--hand") from None
+    if not FORMATS[fmt].per_hand or len(paths) != 1 or not paths[0].lower().endswith((".yaml", ".yml", ".json")):
+        return None
+    if not os.path.isfile(paths[0]):
+        return None
+    from .io.inputs import read
+
+    return next((g.hand for g in read(paths[0]) if getattr(g, "hand", None) is not None), None)
 
 
 @app.command()
@@ -566,7 +595,7 @@ def _emit(job, paths: list[str], output, quiet: bool, workers: int, **table_opti
     inputs = list(expand(paths))
     fmt = FORMATS[job.fmt]
     with _output(output) as out, _progress(inputs) as advance:
-        w = fmt.open(out, job.kind, **table_options)
+        w = fmt.open(out, job.kind, **table_options, **fmt.hand_options(job.hand))
         # block writers (npz) take results here; the others get records encoded where they were made
         outputs = write_blocks(job, inputs, w) if fmt.takes_blocks else run(job, inputs, _workers(workers))
         for o in outputs:

@@ -80,6 +80,11 @@ class Grasp:
         1-based line where the document starts.
     paths : tuple of ObjectPath
         The object paths of its ``paths`` key, possibly none.
+    hand : Hand or None
+        The hand whose fingers touch the contacts, finger ``f`` contact ``f``.
+    joint_positions : numpy.ndarray or None
+        ``(n_joints,)`` the hand's configuration, in ``hand.joint_names``
+        order (zeros for joints given inline, at their configuration).
     """
 
     name: str
@@ -93,6 +98,8 @@ class Grasp:
     twists: tuple[Twist, ...]
     line: int
     paths: tuple[ObjectPath, ...] = ()
+    hand: Hand | None = None
+    joint_positions: np.ndarray | None = None
 
 
 @dataclass(frozen=True, eq=False)

@@ -124,7 +124,7 @@ class Reading:
 READING = Reading()
 
 # Keys of each mapping, in the order the values are checked.
-GRASP_KEYS = ("name", "units", "wrist", "contacts", "twists", "paths")
+GRASP_KEYS = ("name", "units", "wrist", "contacts", "twists", "paths", "hand")
 CONTACT_KEYS = ("name", "point", "normal")
 TWIST_KEYS = ("name", "screw", "angular", "linear", "at")
 PATH_KEYS = ("name", "frame", "segments")
@@ -1030,6 +1030,7 @@ def _grasp(root, problems, *, file, document, name, line):
     contacts = _contacts(fields["contacts"], problems) if "contacts" in fields else None
     twists = _twists(fields["twists"], problems) if "twists" in fields else ()
     paths = _paths(fields["paths"], problems) if "paths" in fields else ()
+    hand = _hand(fields["hand"], contacts, file, problems) if "hand" in fields else None
     if problems.count:
         return None
     contact_names, points, normals = contacts
@@ -1045,7 +1046,16 @@ def _grasp(root, problems, *, file, document, name, line):
         twists=twists,
         line=line,
         paths=paths,
+        hand=None if hand is None else hand[0],
+        joint_positions=None if hand is None else _readonly(hand[1]),
     )
+
+
+def _hand(node, contacts, file, problems):
+    """``(Hand, joint positions)`` of the ``hand`` key (see :mod:`grasptwist.io.grasp_hand`)."""
+    from .grasp_hand import read_hand  # only documents with a hand need it
+
+    return read_hand(node, None if contacts is None else contacts[1], file, problems)
 
 
 # What contacts look like, for the message when they are not a list.

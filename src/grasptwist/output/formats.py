@@ -53,6 +53,9 @@ class OutputFormat:
         encoded records.
     bases : bool
         It shows basis screws (False: resolve without them, a third less work).
+    per_hand : bool
+        Its columns depend on the run's hand (the joints of ``--hand``):
+        ``open``, ``encode`` and ``encode_rows`` take ``hand=``.
     """
 
     name: str
@@ -64,6 +67,11 @@ class OutputFormat:
     binary: bool = False
     takes_blocks: bool = False
     bases: bool = True
+    per_hand: bool = False
+
+    def hand_options(self, hand) -> dict:
+        """The keyword arguments that give ``open``/``encode``/``encode_rows`` the run's hand."""
+        return {"hand": hand} if self.per_hand else {}
 
 
 def _table(out: IO[bytes], kind: str, order: str = "omega-v", **table_options):
@@ -76,12 +84,12 @@ def _table(out: IO[bytes], kind: str, order: str = "omega-v", **table_options):
     return table.WRITERS[kind](out, order=order, **table_options)
 
 
-def _csv(out: IO[bytes], kind: str, **_):
+def _csv(out: IO[bytes], kind: str, hand=None, **_):
     if kind == "follow":
         from .follow_records import CSV_HEADER
 
         return Lines(out, header=CSV_HEADER, newline=b"")
-    return Lines(out, header=csv_rows.HEADER, newline=b"")
+    return Lines(out, header=csv_rows.header_line(hand), newline=b"")
 
 
 def _record_rows(block, order):
@@ -89,10 +97,10 @@ def _record_rows(block, order):
     return recs, [r for r in recs if not r["ok"] or r["warnings"]]
 
 
-def _npz(out: IO[bytes], kind: str, order: str = "omega-v", **_):
+def _npz(out: IO[bytes], kind: str, order: str = "omega-v", hand=None, **_):
     from .npz import NpzWriter
 
-    return NpzWriter(out, order)
+    return NpzWriter(out, order, hand=hand)
 
 
 def _json_rows(block, order):
@@ -115,8 +123,9 @@ FORMATS: dict[str, OutputFormat] = {
             csv_rows.error_row,
             csv_rows.encode_rows,
             join=b"".join,
+            per_hand=True,
         ),
-        OutputFormat("npz", ("resolve", "follow"), _npz, binary=True, takes_blocks=True, bases=False),
+        OutputFormat("npz", ("resolve", "follow"), _npz, binary=True, takes_blocks=True, bases=False, per_hand=True),
     )
 }
 

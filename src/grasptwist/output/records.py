@@ -45,7 +45,8 @@ def records(block, order: str = "omega-v") -> list[dict]:
     """
     n = len(block)
     warnings = [[] for _ in range(n)]
-    objects = [(k.key, _kind_rows(block, k, order, warnings)) for k in block.kinds()]
+    objects = [(k.key, _kind_rows(block, k, order, warnings)) for k in block.kinds() if k.record is None]
+    written = [(k.key, _written(k)(block, order, warnings)) for k in block.kinds() if k.record is not None]
     ok = (~block.failed_rows()).tolist()
     out = []
     rows = zip(
@@ -74,6 +75,14 @@ def records(block, order: str = "omega-v") -> list[dict]:
         }
         for key, rows_of_kind in objects:
             rec[key] = rows_of_kind[i]
+        for key, rows_of_kind in written:
+            obj, more = rows_of_kind[i]
+            if obj is None:  # the row has none: its record is as without the kind
+                continue
+            rec[key] = obj
+            for owner, fields in more.items():  # fields the kind adds to other kinds' objects
+                if isinstance(rec.get(owner), dict) and "error" not in rec[owner]:
+                    rec[owner].update(fields)
         rec["warnings"] = warnings[i]
         rec["ok"] = ok[i]
         out.append(rec)
@@ -84,6 +93,13 @@ def _contact_names(block) -> list:
     """Each row's contact names, escaped (:func:`~grasptwist.output.names.escaped`)."""
     safe = {names: tuple(escaped_each(names)) for names in set(block.contact_names)}
     return [safe[names] for names in block.contact_names]
+
+
+def _written(kind):
+    """The record writer a kind names (:attr:`~grasptwist.results.ResultKind.record`)."""
+    from . import kind_records
+
+    return getattr(kind_records, kind.record)
 
 
 def _rows(a):
@@ -179,6 +195,8 @@ def _row_objects(block, i, fields_of, order, warnings, with_failure=()):
     out = {}
     for kind in block.kinds():
         key = kind.key
+        if kind.record is not None:  # a resolve-only kind (a hand's joint rates)
+            continue
         if not block.applies(key)[i]:
             out[key] = None
             continue
