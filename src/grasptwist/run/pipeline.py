@@ -341,7 +341,7 @@ def _dataset_task(job: Job, ds, rows: tuple[int, int], tuning: Tuning, spool: Sp
                 out = Output()
                 _emit(job, block.part(start, start + at_once), out, at_once)
                 outs.append(_sealed(job, out, spool))
-    except GraspFileError as err:  # rows that cannot be read (a corrupt Parquet row group): an error record
+    except GraspFileError as err:  # a damaged .npz member or Parquet row group, found only as it is read
         out = Output()
         _emit(job, err, out, at_once)
         outs.append(_sealed(job, out, spool))
@@ -387,5 +387,5 @@ def write_blocks(job: Job, paths: Sequence, w, tuning: Tuning = TUNING) -> Itera
             o.records = len(x)
         else:
             o.add(error_record(x), lambda rec: None)
-        o.encoded = []  # the rows are in w; an input that failed has its line on stderr only
+        o.encoded = []  # the rows went to ``w``; an input that failed has its stderr line only
         yield o
