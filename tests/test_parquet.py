@@ -10,6 +10,7 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
+import grasptwist as gt
 from grasp_gen import grasps
 from grasptwist.cli import app
 from grasptwist.io import parquet
@@ -86,7 +87,8 @@ def test_a_parquet_data_set_gives_the_records_of_the_same_npz(files):
     a, b = csv_rows(from_parquet.stdout), csv_rows(from_npz.stdout)
     assert len(a) == N and [r["grasp"] for r in a] == [f"g{i}" for i in range(N)]
     assert [{**r, "file": ""} for r in a] == [{**r, "file": ""} for r in b]
-    assert a[4]["x1"] == "" and a[4]["alpha1"] != ""  # no wrist: off-tangent skipped, tangent resolved
+    assert a[4]["x1"] == "" and a[4]["alpha1"] != ""  # a null wrist: off-tangent fails, tangent resolved
+    assert a[4]["off_tangent_error"].startswith("nonfinite-input")
     assert a[9]["ok"] == "false" and a[9]["twist1"] == "nan"  # a null twist value reads as NaN
 
 
@@ -121,8 +123,8 @@ def test_parquet_out_has_the_csv_values_and_typed_columns(files, tmp_path):
     npz = np.load(run_npz(files, tmp_path))
     assert table.column("tangent_status").to_pylist() == npz["tangent_status"].tolist()
     statuses = table.column("off_tangent_status").to_pylist()
-    assert statuses == npz["off_tangent_status"].tolist() and statuses[4] == -1  # -1: skipped, no wrist
-    assert set(statuses) >= {0, -1} and any(s > 0 for s in statuses)
+    assert statuses == npz["off_tangent_status"].tolist() and statuses[4] == gt.Status.NONFINITE_INPUT  # null wrist
+    assert set(statuses) == {0, gt.Status.NONFINITE_INPUT, gt.Status.COLLINEAR_CONTACTS}
 
 
 def run_npz(files, tmp_path):

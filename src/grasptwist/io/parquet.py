@@ -2,8 +2,7 @@
 
 Columns (see the README, "Data sets of arrays"): ``p1_x p1_y p1_z ...
 p3_z`` (the contact points) and ``n1_x ... n3_z`` (their normals); optional
-``c_x c_y c_z`` (the wrist; a row whose wrist holds a null or NaN has
-none), ``w_x w_y w_z v_x v_y v_z`` (the twist ``(omega; v)``) and ``name``
+``c_x c_y c_z`` (the wrist), ``w_x w_y w_z v_x v_y v_z`` (the twist ``(omega; v)``) and ``name``
 (text or integers).  Numbers may be any float or integer type; nulls read
 as NaN (that row's status says so).  Other columns are ignored, so a table
 that carries more than grasps reads as it is.
