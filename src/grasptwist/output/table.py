@@ -143,7 +143,7 @@ class Grid:
     t
     <BLANKLINE>
       i     x
-     ───────
+     ─────────
       1   2.5
     <BLANKLINE>
     """
