@@ -30,7 +30,6 @@ __all__ = [
     "talking_rows",
     "json_values",
     "present",
-    "printable",
     "dumps",
 ]
 
@@ -231,14 +230,14 @@ def diagnostics(rec: dict) -> tuple[list[str], list[str]]:
     """
     if rec["ok"] and not rec.get("warnings"):
         return [], []
-    file = printable(rec["file"])
+    file = _printable(rec["file"])
     if "error" in rec:
         err = rec["error"]
         where = ":".join(str(x) for x in (file, err["line"], err["column"]) if x is not None)
-        return [f"{where}: error: {err['code']}: {printable(err['message'])}"], []
-    where = f"{file}: grasp '{printable(rec['grasp'])}'"
+        return [f"{where}: error: {err['code']}: {_printable(err['message'])}"], []
+    where = f"{file}: grasp '{_printable(rec['grasp'])}'"
     if "twist" in rec:
-        where += f", twist '{printable(rec['twist']['name'])}'"
+        where += f", twist '{_printable(rec['twist']['name'])}'"
     errors = [
         f"{where}: error: {k.label}: {m['error']['code']}: {m['error']['message']}"
         for k in KINDS
@@ -247,7 +246,7 @@ def diagnostics(rec: dict) -> tuple[list[str], list[str]]:
     return errors, [f"{where}: warning: {w}" for w in rec["warnings"]]
 
 
-def printable(text) -> str:
+def _printable(text) -> str:
     """``text`` with control and separator characters escaped: file and data-set
     names come from whoever filled the folder, and a newline or an escape
     sequence in one must not split a diagnostic or reach the terminal."""

@@ -12,7 +12,7 @@ Renderers return :class:`Grid` tables (made by :func:`_table`, used like
 rich's ``Table``), ``str`` or rich ``Text`` lines.  A writer lays them out
 itself, a record at a time, straight onto the output: drawing rich tables
 cost milliseconds a record, which made tables of data sets unusable.  Every
-text a table shows goes through :func:`~grasptwist.output.records.printable`
+text a table shows goes through :func:`~grasptwist.output.names.escaped`
 and is never read as rich markup, so a name like ``[/]x`` or one holding an
 escape sequence is shown as it is, escaped where it is not printable.  A
 table wider than the output (``COLUMNS``, else the terminal; a pipe or
@@ -37,7 +37,7 @@ from rich.text import Text
 
 from ..engine.degeneracy import CONDITION_WARNING, Status
 from ..results import KINDS
-from .records import printable
+from .names import escaped
 
 __all__ = [
     "TableWriter",
@@ -180,7 +180,7 @@ class Grid:
 
 
 def _plain(cell) -> str:
-    return cell.plain if isinstance(cell, Text) else printable(cell)
+    return cell.plain if isinstance(cell, Text) else escaped(cell)
 
 
 def _len(text: str) -> int:
@@ -215,7 +215,7 @@ def _lines(grid: Grid, part, widths, cells, sizes) -> list[str]:
 
 def _head(grid: Grid, part, widths) -> list[str]:
     """The header line of the columns ``part`` and the rule under it."""
-    headers = [printable(h) for h in grid.headers]
+    headers = [escaped(h) for h in grid.headers]
     rule = " " + "─" * (_span([widths[i] for i in part]) - 2)
     return [_row(headers, [_len(h) for h in headers], widths, grid.right, part), rule]
 
@@ -289,18 +289,18 @@ class _Writer:
     def cell(self, item) -> tuple[str, int]:
         """A text as it goes out (see :meth:`styled`) and the columns it takes."""
         if isinstance(item, str):
-            text = item if item.isprintable() else printable(item)
+            text = item if item.isprintable() else escaped(item)
             return text, _len(text)
-        return self.styled(item), _len(printable(item.plain))
+        return self.styled(item), _len(escaped(item.plain))
 
     def styled(self, item) -> str:
         """A text as it goes out: control characters escaped, styles as ANSI codes when colour is on."""
         if isinstance(item, str):
-            return printable(item)
+            return escaped(item)
         if not self.color:
-            return printable(item.plain)
+            return escaped(item.plain)
         return "".join(
-            s.style.render(printable(s.text), color_system=ColorSystem.STANDARD) if s.style else printable(s.text)
+            s.style.render(escaped(s.text), color_system=ColorSystem.STANDARD) if s.style else escaped(s.text)
             for s in item.render(self._rich())
             if s.text != "\n"
         )
@@ -327,7 +327,7 @@ class _Writer:
     def title(self, rec: dict) -> Text:
         units = f" [{rec['units']}]" if rec.get("units") else ""
         return Text.assemble(
-            (printable(rec["grasp"]), "bold"), f" ({printable(rec['file'])}){printable(units)}", self.order_note
+            (escaped(rec["grasp"]), "bold"), f" ({escaped(rec['file'])}){escaped(units)}", self.order_note
         )
 
     def warnings(self, lines: list[str], rec: dict) -> None:
@@ -353,7 +353,7 @@ class TableWriter(_Writer):
         names = [c["name"] for c in rec["contacts"]]
         twist = rec["twist"]
         kinds = _renderers(rec)
-        spec = Text.assemble("twist ", (printable(twist["name"]), "bold"), f" = {fmt_vector(twist['screw'], d)}")
+        spec = Text.assemble("twist ", (escaped(twist["name"]), "bold"), f" = {fmt_vector(twist['screw'], d)}")
         self.flow(lines, self.title(rec), spec)
         self.add(lines, self._contacts(rec, kinds, d))
         for kind, render in kinds:
