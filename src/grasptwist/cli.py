@@ -136,6 +136,7 @@ class _Stderr:
         self.records = 0
         self.quiet = quiet
         self.shown = {Warnings.all: None, Warnings.summary: WARNINGS_SHOWN, Warnings.none: 0}[Warnings(warnings)]
+        self.counting = warnings == Warnings.summary
         self.unshown: dict[str, int] = {}  # warnings not printed, by kind
         self.hint = None if quiet else hint
         self.color = sys.stderr.isatty() and not os.environ.get("NO_COLOR")
@@ -158,7 +159,7 @@ class _Stderr:
         if self.shown is None or self.shown > 0:
             self.say(line, ": warning: ", "33")
             self.shown = None if self.shown is None else self.shown - 1
-        else:
+        elif self.counting:
             kind = _warning_kind(line)
             self.unshown[kind] = self.unshown.get(kind, 0) + 1
 
@@ -233,14 +234,16 @@ def _writable_folder(path: str) -> None:
 
 
 @contextmanager
-def _progress(inputs: list, command: str):
+def _progress(inputs: list, command: str, out):
     """A rich progress bar on stderr, named after ``command``, when it is a
     terminal and there is more than one input or a data set (whose records
-    are counted as they come)."""
+    are counted as they come); not when the output ``out`` goes to a
+    terminal too, where it shows the progress itself (and a bar would be
+    drawn between its lines)."""
     from .io.datasets import DATASET_SUFFIXES
 
     big = len(inputs) > 1 or any(isinstance(p, str) and p.endswith(DATASET_SUFFIXES) for p in inputs)
-    if not big or not sys.stderr.isatty():
+    if not big or not sys.stderr.isatty() or out.isatty():
         yield lambda output: None
         return
     from rich.progress import Progress
@@ -521,7 +524,7 @@ def _emit(job, paths: list[str], output, stderr_options: tuple, workers: int, **
     stderr = _Stderr(*stderr_options, hint=_table_hint(job.kind) if job.fmt == "table" else None)
     inputs = list(expand(paths))
     fmt = FORMATS[job.fmt]
-    with _output(output) as out, _progress(inputs, job.kind) as advance:
+    with _output(output) as out, _progress(inputs, job.kind, out) as advance:
         w = fmt.open(out, job.kind, **table_options)
         # block writers (npz) take results here; the others get records encoded where they were made
         outputs = write_blocks(job, inputs, w) if fmt.takes_blocks else run(job, inputs, _workers(workers))
