@@ -169,9 +169,12 @@ class Grid:
         """The table as lines (``cell(c)`` gives a cell's text and its width on
         screen); wider than ``width``,
         as parts of whole columns, each with the first column again."""
-        drawn = [[cell(c) for c in row] for row in self.rows]
-        cells = [[text for text, _ in row] for row in drawn]
-        sizes = [[n for _, n in row] for row in drawn]
+        cells, sizes = [], []
+        for row in self.rows:
+            # most cells are numbers: plain ASCII, their own width (checked inline: this runs per cell)
+            drawn = [(c, len(c)) if c.__class__ is str and c.isascii() and c.isprintable() else cell(c) for c in row]
+            cells.append([text for text, _ in drawn])
+            sizes.append([n for _, n in drawn])
         widths = [max([_len(h), *(row[i] for row in sizes)]) for i, h in enumerate(self.headers)]
         out = [cell(self.title)[0]] if self.title else []
         for part in _parts(widths, width):
@@ -215,7 +218,7 @@ def _lines(grid: Grid, part, widths, cells, sizes) -> list[str]:
 
 def _head(grid: Grid, part, widths) -> list[str]:
     """The header line of the columns ``part`` and the rule under it."""
-    headers = [escaped(h) for h in grid.headers]
+    headers = [h if h.isprintable() else escaped(h) for h in grid.headers]
     rule = " " + "─" * (_span([widths[i] for i in part]) - 2)
     return [_row(headers, [_len(h) for h in headers], widths, grid.right, part), rule]
 
