@@ -254,3 +254,29 @@ def test_the_readme_shows_what_the_quick_start_prints():
         timeout=60,
     )
     assert p.returncode == 0 and p.stdout == shown
+
+
+def test_a_renderer_may_return_rich_groups_and_renderables():
+    from rich.console import Group
+    from rich.panel import Panel
+    from rich.text import Text
+
+    from grasptwist.output.table import Grid, TableWriter
+
+    buf = io.BytesIO()
+    w = TableWriter(buf, width=40)
+    grid = Grid()
+    grid.add_column("joint")
+    grid.add_column("rate", justify="right")
+    grid.add_row("[/]knuckle", "0.2500")
+    lines = []
+    w.add(lines, Group(Text("hand: joint rates", style="bold"), grid))
+    assert [line for line in lines if line] == [
+        "hand: joint rates",
+        "  joint          rate",
+        " " + "─" * 21,
+        "  [/]knuckle   0.2500",
+    ]
+    w.add(lines, Panel(grid))  # rich draws it, the grid inside too
+    panel = buf.getvalue().decode()
+    assert "│   [/]knuckle   0.2500" in panel and max(len(x) for x in panel.splitlines()) == 40

@@ -9,7 +9,8 @@ verdicts only print what the records say (``moves``, ``about_wrist``,
 ``in_tangent_planes``).
 
 Renderers return :class:`Grid` tables (made by :func:`_table`, used like
-rich's ``Table``), ``str`` or rich ``Text`` lines.  A writer lays them out
+rich's ``Table``), ``str`` or rich ``Text`` lines, or rich ``Group`` objects of
+those; anything else rich draws is drawn by rich, more slowly.  A writer lays them out
 itself, a record at a time, straight onto the output: drawing rich tables
 cost milliseconds a record, which made tables of data sets unusable.  Every
 text a table shows goes through :func:`~grasptwist.output.names.escaped`
@@ -32,7 +33,7 @@ from typing import IO
 import orjson
 from rich.cells import cell_len
 from rich.color import ColorSystem
-from rich.console import Console
+from rich.console import Console, Group
 from rich.text import Text
 
 from ..engine.degeneracy import CONDITION_WARNING, Status
@@ -165,6 +166,11 @@ class Grid:
     def row_count(self) -> int:
         return len(self.rows)
 
+    def __rich_console__(self, console, options):
+        """Drawn by rich too (inside a renderable of rich's own), without colour."""
+        for line in self.lines(lambda c: (escaped(_plain(c)), _len(escaped(_plain(c)))), options.max_width):
+            yield Text(line.rstrip())
+
     def lines(self, cell, width: int | None = None) -> list[str]:
         """The table as lines (``cell(c)`` gives a cell's text and its width on
         screen); wider than ``width``,
@@ -278,6 +284,9 @@ class _Writer:
             lines += [line.rstrip() for line in item.lines(self.cell, self.width)]
         elif isinstance(item, str | Text):
             lines += self._prose(item)
+        elif isinstance(item, Group):
+            for part in item.renderables:
+                self.add(lines, part)
         else:  # a renderer drawing with rich itself: let rich lay it out, after what is pending
             self._put(lines)
             lines.clear()
