@@ -104,9 +104,9 @@ def test_columns_sets_the_width_of_a_piped_table_and_no_columns_means_no_limit()
         "polyhedron (grasps/polyhedron.yaml)".replace("grasps/polyhedron.yaml", str(POLY)),
         "  twist diagonal-spin = (0.5774, 0.5774, 0.5774; 0.0000, 0.0000, 0.0000)",
     ]
-    wide = piped(["resolve", POLY], COLUMNS="400").stdout
+    wide = run("resolve", POLY, env={"COLUMNS": "400"}).stdout
     assert re.search(r"^  contact +point +normal \(unit\) +velocity T\(p_i\) +normal velocity$", wide, re.M)
-    assert piped(["resolve", POLY]).stdout == wide  # a pipe without COLUMNS: no limit
+    assert run("resolve", POLY, env={"COLUMNS": None}).stdout == wide  # not a terminal, no COLUMNS: no limit
     assert max(len(line) for line in wide.splitlines()) > 120
 
 
