@@ -300,6 +300,8 @@ class _Writer:
 
     def cell(self, item) -> tuple[str, int]:
         """A text as it goes out (see :meth:`styled`) and the columns it takes."""
+        if not isinstance(item, Text):
+            item = str(item)  # a number a renderer did not format
         if isinstance(item, str):
             text = item if item.isprintable() else escaped(item)
             return text, _len(text)
