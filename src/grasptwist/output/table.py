@@ -171,7 +171,7 @@ class Grid:
         for line in self.lines(lambda c: (escaped(_plain(c)), _len(escaped(_plain(c)))), options.max_width):
             yield Text(line.rstrip())
 
-    def lines(self, cell, width: int | None = None) -> list[str]:
+    def lines(self, cell, width: int | None = None, bold: bool = False) -> list[str]:
         """The table as lines (``cell(c)`` gives a cell's text and its width on
         screen); wider than ``width``,
         as parts of whole columns, each with the first column again."""
@@ -184,7 +184,7 @@ class Grid:
         widths = [max([_len(h), *(row[i] for row in sizes)]) for i, h in enumerate(self.headers)]
         out = [cell(self.title)[0]] if self.title else []
         for part in _parts(widths, width):
-            out += ["", *_lines(self, part, widths, cells, sizes)]
+            out += ["", *_lines(self, part, widths, cells, sizes, bold)]
         return [*out, ""]
 
 
@@ -216,17 +216,20 @@ def _span(widths) -> int:
     return sum(widths) + 3 * len(widths) + 1
 
 
-def _lines(grid: Grid, part, widths, cells, sizes) -> list[str]:
+def _lines(grid: Grid, part, widths, cells, sizes, bold: bool = False) -> list[str]:
     """Header, rule and rows of the columns ``part`` (rich's SIMPLE_HEAD look)."""
-    out = _head(grid, part, widths)
+    out = _head(grid, part, widths, bold)
     return out + [_row(row, size, widths, grid.right, part) for row, size in zip(cells, sizes)]
 
 
-def _head(grid: Grid, part, widths) -> list[str]:
-    """The header line of the columns ``part`` and the rule under it."""
+def _head(grid: Grid, part, widths, bold: bool = False) -> list[str]:
+    """The header line of the columns ``part`` (``bold``: in bold, on a terminal) and the rule under it."""
     headers = [h if h.isprintable() else escaped(h) for h in grid.headers]
+    lengths = [_len(h) for h in headers]
+    if bold:
+        headers = [f"\x1b[1m{h}\x1b[0m" if h else h for h in headers]
     rule = " " + "─" * (_span([widths[i] for i in part]) - 2)
-    return [_row(headers, [_len(h) for h in headers], widths, grid.right, part), rule]
+    return [_row(headers, lengths, widths, grid.right, part), rule]
 
 
 def _row(texts, lengths, widths, right, part) -> str:
@@ -281,7 +284,7 @@ class _Writer:
     def add(self, lines: list[str], item) -> None:
         """Lay out one thing a renderer returned: a Grid, a line, or any rich renderable."""
         if isinstance(item, Grid):
-            lines += [line.rstrip() for line in item.lines(self.cell, self.width)]
+            lines += [line.rstrip() for line in item.lines(self.cell, self.width, self.color)]
         elif isinstance(item, str | Text):
             lines += self._prose(item)
         elif isinstance(item, Group):
@@ -563,7 +566,7 @@ class CheckTableWriter(_Writer):
             verdicts = [_VERDICT_WIDTH] * len(KINDS)
             self.widths = [max(w, *(n[i] for _, n in rows)) for i, w in enumerate([*verdicts, 0, 0])]
             self.widths = [max(w, _len(h)) for w, h in zip(self.widths, self.grid.headers)]
-            lines = ["", *(line.rstrip() for line in _head(self.grid, part, self.widths))]
+            lines = ["", *(line.rstrip() for line in _head(self.grid, part, self.widths, self.color))]
         for texts, lengths in rows:
             widths = [max(w, n) for w, n in zip(self.widths, lengths)]  # an overlong cell pushes the rest of its row
             lines.append(_row(texts, lengths, widths, self.grid.right, part).rstrip())
