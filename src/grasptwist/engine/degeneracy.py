@@ -54,6 +54,7 @@ class Status(IntEnum):
     THETA_SIGMA_ZERO = 8
     OVERFLOW = 9
     NORMAL_IN_CONTACT_PLANE = 10
+    FINGER_CANNOT_FOLLOW = 11
 
     @property
     def code(self) -> str:
@@ -82,6 +83,10 @@ _MESSAGES = {
     Status.NORMAL_IN_CONTACT_PLANE: (
         "the normal at contact {i} lies in the plane of the contacts, so no tangent-plus-Sigma motion "
         "can move contact {i} along it"
+    ),
+    Status.FINGER_CANNOT_FOLLOW: (
+        "finger {i} cannot follow its contact: no joint rates move it with the object's velocity there "
+        "(relative residual above 1e-6)"
     ),
 }
 

@@ -53,8 +53,9 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from ..engine import screws
-from ..model import Grasp, GraspFileError, Twist
+from ..engine import screws, se3
+from ..engine.path import FRAMES, check_segments
+from ..model import Grasp, GraspFileError, ObjectPath, Segment, Twist
 
 __all__ = [
     "Twist",
@@ -123,9 +124,12 @@ class Reading:
 READING = Reading()
 
 # Keys of each mapping, in the order the values are checked.
-GRASP_KEYS = ("name", "units", "wrist", "contacts", "twists")
+GRASP_KEYS = ("name", "units", "wrist", "contacts", "twists", "paths", "hand")
 CONTACT_KEYS = ("name", "point", "normal")
 TWIST_KEYS = ("name", "screw", "angular", "linear", "at")
+PATH_KEYS = ("name", "frame", "segments")
+SEGMENT_KEYS = ("duration", "screw", "angular", "linear", "at", "pose")
+POSE_KEYS = ("position", "rotation", "rotvec")
 
 
 def read_grasps(source, *, file=None, max_bytes=DEFAULT_MAX_BYTES, reading=READING):
@@ -1025,6 +1029,8 @@ def _grasp(root, problems, *, file, document, name, line):
     wrist = _vector(fields["wrist"], 3, "wrist", problems) if "wrist" in fields else None
     contacts = _contacts(fields["contacts"], problems) if "contacts" in fields else None
     twists = _twists(fields["twists"], problems) if "twists" in fields else ()
+    paths = _paths(fields["paths"], problems) if "paths" in fields else ()
+    hand = _hand(fields["hand"], contacts, file, problems) if "hand" in fields else None
     if problems.count:
         return None
     contact_names, points, normals = contacts
@@ -1039,7 +1045,17 @@ def _grasp(root, problems, *, file, document, name, line):
         wrist=None if wrist is None else _readonly(wrist),
         twists=twists,
         line=line,
+        paths=paths,
+        hand=None if hand is None else hand[0],
+        joint_positions=None if hand is None else _readonly(hand[1]),
     )
+
+
+def _hand(node, contacts, file, problems):
+    """``(Hand, joint positions)`` of the ``hand`` key (see :mod:`grasptwist.io.grasp_hand`)."""
+    from .grasp_hand import read_hand  # only documents with a hand need it
+
+    return read_hand(node, None if contacts is None else contacts[1], file, problems)
 
 
 # What contacts look like, for the message when they are not a list.
@@ -1140,6 +1156,132 @@ def _twist_parts(fields, item, path, problems):
         for key in ("angular", "linear", "at")
     ]
     return None if None in parts else parts
+
+
+def _paths(node, problems):
+    """The object paths, their segments checked (None after a problem)."""
+    items = _sequence(node, "paths", problems)
+    if items is None:
+        return None
+    names, found = {}, []
+    for i, item in enumerate(items):
+        path = f"paths[{i}]"
+        fields = _mapping(item, path, PATH_KEYS, ("segments",), problems)
+        if fields is None:
+            continue
+        _entry_name(fields, item, "paths", i, names, problems)
+        frame = _frame(fields["frame"], path + ".frame", problems) if "frame" in fields else "space"
+        if "segments" in fields:  # checked whatever the frame, so that every problem is found
+            found.append(_segments(fields["segments"], path + ".segments", frame or "space", problems))
+    if problems.count:
+        return None
+    return tuple(ObjectPath(name, segments, item.line) for name, segments, item in zip(names, found, items))
+
+
+def _frame(node, path, problems):
+    """``space`` or ``body``."""
+    if node.kind == "invalid":
+        return None
+    if node.kind != "scalar" or node.value not in FRAMES:
+        problems.add(_Reject("invalid-frame", path, f"expected space or body, got {_describe(node)}", **_at(node)))
+        return None
+    return node.value
+
+
+def _segments(node, path, frame, problems):
+    """A path's segments (None after a problem)."""
+    items = _sequence(node, path, problems)
+    if items is None:
+        return None
+    if not items:
+        problems.add(_Reject("empty-path", path, "a path needs at least one segment", **_at(node)))
+        return None
+    segments = [_segment(item, f"{path}[{k}]", frame, problems) for k, item in enumerate(items)]
+    if problems.count:
+        return None
+    return check_segments(segments)
+
+
+def _segment(item, path, frame, problems):
+    """One segment: a ``duration`` and a constant twist or a ``pose`` target."""
+    fields = _mapping(item, path, SEGMENT_KEYS, ("duration",), problems)
+    if fields is None:
+        return None
+    duration = _number(fields["duration"], path + ".duration", problems) if "duration" in fields else None
+    if duration is not None and not duration > 0:
+        problems.add(
+            _Reject("invalid-duration", path + ".duration", f"must be > 0, got {duration!r}", **_at(fields["duration"]))
+        )
+    if "pose" in fields:
+        _conflicts(
+            fields, path, ("screw", "angular", "linear", "at"), "'pose' (give a twist or a pose target)", problems
+        )
+        pose = _pose(fields["pose"], path + ".pose", problems)
+        return None if pose is None else Segment(duration, position=pose[0], rotation=pose[1])
+    if not {"screw", "angular", "linear"} & set(fields):
+        problems.add(
+            _Reject(
+                "missing-key", path, "needs a twist ('screw', or 'angular' and/or 'linear') or a 'pose'", **_at(item)
+            )
+        )
+        return None
+    parts = _twist_parts(fields, item, path, problems)
+    if parts is None:
+        return None
+    with np.errstate(over="ignore", invalid="ignore"):
+        screw = screws.twist_at(*(np.array(p) for p in parts))
+    if not np.isfinite(screw).all():
+        problems.add(
+            _Reject(
+                "non-finite",
+                path,
+                "the velocity of the origin overflows (linear + angular x (origin - at))",
+                **_at(item),
+            )
+        )
+        return None
+    return Segment(duration, twist=screw, frame=frame)
+
+
+def _conflicts(fields, path, others, what, problems):
+    """A ``conflicting-keys`` problem for each key of ``others`` given beside ``what``."""
+    for other in others:
+        if other in fields:
+            problems.add(
+                _Reject("conflicting-keys", _join(path, other), f"cannot be combined with {what}", **_at(fields[other]))
+            )
+
+
+def _pose(node, path, problems):
+    """``(position, rotation matrix)`` of a pose target: position default zero, rotation a
+    quaternion ``(w, x, y, z)`` or a rotation vector, default none."""
+    fields = _mapping(node, path, POSE_KEYS, (), problems)
+    if fields is None:
+        return None
+    position = _vector(fields["position"], 3, path + ".position", problems) if "position" in fields else [0.0] * 3
+    rotation = np.eye(3)
+    if "rotation" in fields:
+        _conflicts(fields, path, ("rotvec",), "'rotation' (give a quaternion or a rotation vector)", problems)
+        quaternion = _vector(fields["rotation"], 4, path + ".rotation", problems)
+        if quaternion is not None and any(quaternion):
+            # scaled first: the engine normalises it, and a huge one must not overflow on the way
+            rotation = se3.quaternion_to_matrix(np.divide(quaternion, np.abs(quaternion).max()))
+        elif quaternion is not None:
+            problems.add(
+                _Reject(
+                    "invalid-rotation",
+                    path + ".rotation",
+                    "a quaternion (w, x, y, z) of zero length has no rotation",
+                    **_at(fields["rotation"]),
+                )
+            )
+    elif "rotvec" in fields:
+        rotvec = _vector(fields["rotvec"], 3, path + ".rotvec", problems)
+        if rotvec is not None:
+            rotation = se3.rotvec_to_matrix(rotvec)
+    if position is None or problems.count:
+        return None
+    return np.array(position), rotation
 
 
 def _entry_name(fields, item, collection, index, taken, problems):

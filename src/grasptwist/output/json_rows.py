@@ -63,7 +63,10 @@ def _plain_rows(block) -> np.ndarray:
     """Rows with nothing to say and every kind asked for present."""
     plain = ~talking_rows(block)
     for kind in block.kinds():
-        plain &= block.applies(kind.key)  # a skipped kind is a null: another template
+        if kind.record is not None:  # objects whose shape depends on the row: no template
+            plain &= ~block.applies(kind.key)
+        else:
+            plain &= block.applies(kind.key)  # a skipped kind is a null: another template
     return plain
 
 

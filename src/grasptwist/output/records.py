@@ -44,7 +44,8 @@ def records(block, order: str = "omega-v") -> list[dict]:
     """
     n = len(block)
     warnings = [[] for _ in range(n)]
-    objects = [(k.key, _kind_rows(block, k, order, warnings)) for k in block.kinds()]
+    objects = [(k.key, _kind_rows(block, k, order, warnings)) for k in block.kinds() if k.record is None]
+    written = [(k.key, _written(k)(block, order, warnings)) for k in block.kinds() if k.record is not None]
     ok = (~block.failed_rows()).tolist()
     out = []
     rows = zip(
@@ -73,10 +74,25 @@ def records(block, order: str = "omega-v") -> list[dict]:
         }
         for key, rows_of_kind in objects:
             rec[key] = rows_of_kind[i]
+        for key, rows_of_kind in written:
+            obj, more = rows_of_kind[i]
+            if obj is None:  # the row has none: its record is as without the kind
+                continue
+            rec[key] = obj
+            for owner, fields in more.items():  # fields the kind adds to other kinds' objects
+                if isinstance(rec.get(owner), dict) and "error" not in rec[owner]:
+                    rec[owner].update(fields)
         rec["warnings"] = warnings[i]
         rec["ok"] = ok[i]
         out.append(rec)
     return out
+
+
+def _written(kind):
+    """The record writer a kind names (:attr:`~grasptwist.results.ResultKind.record`)."""
+    from . import kind_records
+
+    return getattr(kind_records, kind.record)
 
 
 def _rows(a):
@@ -171,6 +187,8 @@ def _row_objects(block, i, fields_of, order, warnings, with_failure=()):
     out = {}
     for kind in block.kinds():
         key = kind.key
+        if kind.record is not None:  # a resolve-only kind (a hand's joint rates)
+            continue
         if not block.applies(key)[i]:
             out[key] = None
             continue

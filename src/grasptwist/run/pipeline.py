@@ -24,10 +24,10 @@ import numpy as np
 
 from ..io.datasets import DATASET_SUFFIXES, open_dataset
 from ..io.inputs import STDIN, read
-from ..model import GraspFileError, Twist
+from ..model import GraspFileError, Hand, Twist
 from ..output.formats import FORMATS
 from ..output.records import basis_record, check_record, diagnostics, error_record, records, talking_rows
-from .batch import ZERO_TWIST, Block, dataset_blocks, resolve
+from .batch import ZERO_TWIST, Block, check_positions, dataset_blocks, resolve
 from .pool import Pool
 from .scratch import owned_prefix, sweep
 
@@ -48,6 +48,7 @@ class Job:
     fmt: str = "jsonl"
     max_bytes: int | None = None
     extra_point: str = "wrist"
+    hand: Hand | None = None  # --hand: the hand of a data set's rows, whose joints CSV and npz columns name
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -227,7 +228,7 @@ def blocks(job: Job, paths: Sequence, tuning: Tuning = TUNING) -> Iterator[tuple
             try:
                 ds = open_dataset(g, job.extra_point)
                 grows = len(ds) * (len(job.twists) if job.twists else 1) - 1
-                for block in dataset_blocks(ds, job.twists, job.method, bases=bases):
+                for block in dataset_blocks(ds, job.twists, job.method, bases=bases, hand_of_rows=job.hand):
                     yield block, grows
                     grows = 0
             except GraspFileError as err:
@@ -243,14 +244,15 @@ def blocks(job: Job, paths: Sequence, tuning: Tuning = TUNING) -> Iterator[tuple
 def _emit(job: Job, x, out: Output, at_once: int) -> None:
     """Records of ``x`` (a block, or an input's error) encoded into ``out``."""
     fmt = FORMATS[job.fmt]
-    encode = fmt.encode
+    hand = fmt.hand_options(job.hand)
+    encode = partial(fmt.encode, **hand) if hand else fmt.encode
     if not isinstance(x, Block):
         out.add(error_record(x), encode)
     elif job.kind == "resolve":
         # a few thousand records at a time: their floats as Python objects
         # would otherwise fill memory
         for start in range(0, len(x), at_once):
-            out.add_encoded(*fmt.encode_rows(x.part(start, start + at_once), job.order))
+            out.add_encoded(*fmt.encode_rows(x.part(start, start + at_once), job.order, **hand))
     else:
         for i in range(len(x)):
             out.add(basis_record(x, i, job.order) if job.kind == "basis" else check_record(x, i), encode)
@@ -261,8 +263,9 @@ def _dataset(job: Job, path: str, workers: int, tuning: Tuning) -> Iterator[Outp
     tells the progress bar how many records the data set holds."""
     try:
         ds = open_dataset(path, job.extra_point)
+        check_positions(ds, job.hand)
         if job.twists is None and ds.twist is None and job.kind == "resolve":
-            next(dataset_blocks(ds, None, job.method))  # raises the no-twist error
+            next(dataset_blocks(ds, None, job.method, hand_of_rows=job.hand))  # raises the no-twist error
     except GraspFileError as err:
         out = Output(done=1)
         _emit(job, err, out, tuning.records_at_once)
@@ -298,7 +301,7 @@ def _dataset_task(job: Job, ds, rows: tuple[int, int], tuning: Tuning, spool: Sp
     twists = [ZERO_TWIST] if job.kind != "resolve" else job.twists
     at_once = tuning.records_at_once
     outs = []
-    for block in dataset_blocks(ds, twists, job.method, start=rows[0], stop=rows[1]):
+    for block in dataset_blocks(ds, twists, job.method, start=rows[0], stop=rows[1], hand_of_rows=job.hand):
         for start in range(0, len(block), at_once):
             out = Output()
             _emit(job, block.part(start, start + at_once), out, at_once)
