@@ -287,7 +287,10 @@ _WORKERS = typer.Option(
     min=0,
     help="Processes for big batches (0: every core, used for 256+ files or 4096+ data-set grasps).",
 )
-_PATHS_HELP = "Grasp files (.yaml, .yml, .json; any case), data sets (.npz, .npy), folders of grasp files or - (stdin)."
+_PATHS_HELP = (
+    "Grasp files (.yaml, .yml, .json; any case), JSON Lines of grasps (.jsonl), data sets (.npz, .npy), "
+    "folders of grasp files or - (stdin: YAML, or JSON Lines if it starts with '{')."
+)
 _PATHS = typer.Argument(..., metavar="PATH...", help=_PATHS_HELP)
 
 
@@ -302,6 +305,12 @@ def resolve(
     ),
     at: str | None = typer.Option(
         None, "--at", metavar="X,Y,Z", help="Point whose velocity the --twist linear part gives (default: the origin)."
+    ),
+    twists_from: str | None = typer.Option(
+        None,
+        "--twists-from",
+        metavar="FILE|-",
+        help="Twists one per line (JSON: [w1,w2,w3,v1,v2,v3] or a twist mapping), each resolved as it arrives.",
     ),
     method: Method = _METHOD,
     fmt: Format = typer.Option(
@@ -342,6 +351,10 @@ def resolve(
     from .run.pipeline import Job
 
     twists = _cli_twists(twist, at)
+    if twists_from is not None and twists is not None:
+        raise typer.BadParameter("give twists by --twist or by --twists-from, not both", param_hint="--twists-from")
+    if twists_from == "-" and "-" in paths:
+        raise typer.BadParameter("standard input can be read only once", param_hint="--twists-from")
     if extra_point == ExtraPoint.at and at is not None:
         raise typer.BadParameter("--extra-point at gives each row its own point; drop --at", param_hint="--at")
     if extra_point == ExtraPoint.at and not any(p.endswith(".npy") for p in paths):
@@ -358,6 +371,7 @@ def resolve(
         max_bytes=max_bytes,
         extra_point=extra_point.value,
         hand=_hand_option(hand, paths, fmt.value),
+        twists_from=twists_from,
     )
     _run(debug, lambda: _emit(job, paths, output, (quiet, warnings), workers, digits=digits, order=order.value))
 
