@@ -23,6 +23,7 @@ from dataclasses import fields, replace
 import numpy as np
 import orjson
 
+from .names import escaped
 from .records import present, talking_rows
 
 __all__ = ["encode_records"]
@@ -185,6 +186,7 @@ def _by_template(block, order, records, dumps, part):
 
 
 def _labels(values):
-    """JSON of each value, encoding each distinct value once (names repeat)."""
-    encoded = {v: orjson.dumps(v) for v in set(values)}
+    """JSON of each value, escaped as in the records (:func:`~grasptwist.output.names.escaped`),
+    encoding each distinct value once (names repeat)."""
+    encoded = {v: orjson.dumps(escaped(v, controls=False)) for v in set(values)}
     return [encoded[v] for v in values]
