@@ -733,6 +733,17 @@ def test_data_set_names_with_control_characters_are_escaped_in_tables(tmp_path):
         assert "\\x1b]0;owned\\x07" in r.stdout and "[/]y" in r.stdout
 
 
+def test_an_undecodable_file_name_renders_in_tables(tmp_path):
+    folder = os.fsencode(tmp_path)
+    with open(folder + b"/b\xff.yaml", "wb") as f:
+        f.write(MARKUP_GRASP.encode())
+    (tmp_path / "good.yaml").write_text(POLY.read_text())
+    for command in ("resolve", "basis", "check"):
+        r = invoke(command, tmp_path)
+        assert r.exit_code == 0, r.output
+        assert "b\\xff.yaml" in r.stdout and "polyhedron" in r.stdout
+
+
 # --------------------------------------------------------------------------
 # Soaks: faults at random moments (python -m pytest -m slow tests/test_faults.py)
 
