@@ -189,7 +189,7 @@ def _rows_npz(path: Path, n: int, wrist_offset: float = 1.0) -> Path:
 
 
 def test_a_long_table_points_to_the_machine_formats_once(tmp_path):
-    hint = f"grasptwist: hint: more than {TABLE_HINT_AT} records: -f json, jsonl, csv or npz"
+    hint = f"grasptwist: hint: more than {TABLE_HINT_AT} records: -f json, jsonl, csv, npz or parquet"
     r = run("resolve", _rows_npz(tmp_path / "many.npz", TABLE_HINT_AT + 1))
     assert r.exit_code == 0 and r.stderr.count(hint) == 1
     assert r.stdout.count("twist twist = (0.0000, 0.0000, 1.0000; 0.0000, 0.0000, 0.0000)") == TABLE_HINT_AT + 1
