@@ -97,6 +97,7 @@ def test_status_codes_are_stable_strings():
         "theta-sigma-zero",
         "overflow",
         "normal-in-contact-plane",
+        "no-wrist",
     ]
 
 

@@ -96,7 +96,8 @@ def test_the_batch_holds_every_status_of_each_method(batch):
     assert set(np.unique(r.off_tangent.status)) == {
         S.OK, S.NONFINITE_INPUT, S.COINCIDENT_CONTACTS, S.COLLINEAR_CONTACTS, S.WRIST_COPLANAR, S.OVERFLOW
     }  # fmt: skip
-    assert set(np.unique(r.tangent.status)) == set(S) - {S.WRIST_COPLANAR}
+    # no-wrist is never the engine's: it marks the rows of grasps without a wrist in a batch of records
+    assert set(np.unique(r.tangent.status)) == set(S) - {S.WRIST_COPLANAR, S.NO_WRIST}
     assert len(p) > SMALL_BATCH
 
 

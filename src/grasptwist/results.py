@@ -18,8 +18,9 @@ How to add a result kind
    ``conditioning`` like :mod:`grasptwist.engine.decompose`'s.
 2. Describe it here with a :class:`ResultKind` appended to :data:`KINDS`:
    its record key and label, ``compute`` (which block inputs it needs),
-   ``applies`` (rows where it is meaningful; elsewhere its record field is
-   ``null``), its :class:`Field` lists for ``resolve``, ``basis`` and
+   ``applies`` (rows where it can run) with ``missing`` (the status of the
+   other rows: a warning there, or a failure when the kind was asked for
+   by name), its :class:`Field` lists for ``resolve``, ``basis`` and
    ``check`` records, and its :class:`Column` groups.
 3. Write its table renderer in :mod:`grasptwist.output.table`, the class
    that ``table`` names.
@@ -38,6 +39,7 @@ import numpy as np
 
 from .engine import judgements
 from .engine.decompose import decompose_off_tangent, decompose_tangent
+from .engine.degeneracy import Status
 from .engine.screws import klein_table
 
 __all__ = [
@@ -141,8 +143,12 @@ class ResultKind:
         (``points``, ``normals``, ``wrist`` (NaN rows where none),
         ``twist``, ...); ``bases=False`` may leave the basis screws out.
     applies : callable
-        ``block -> (N,) bool``: rows where the kind means something; its
-        record field is ``null`` elsewhere, and a failure there is not one.
+        ``block -> (N,) bool``: rows where the kind can run.  Elsewhere its
+        status is ``missing``: asked for by name (``--method``), the row
+        fails with it; under ``both`` the kind is skipped there (its record
+        field is ``null``) with a warning.
+    missing : Status
+        Why the kind cannot run where it does not apply.
     fields, basis_fields, check_fields : tuple of Field
         Its object in ``resolve``, ``basis`` and ``check`` records, in order.
     columns : tuple of Column
@@ -165,6 +171,7 @@ class ResultKind:
     columns: tuple[Column, ...]
     table: str
     method: bool = True
+    missing: Status = Status.NONFINITE_INPUT
 
 
 def _numbered(name: str, n: int = 3) -> tuple[str, ...]:
@@ -192,6 +199,7 @@ OFF_TANGENT = ResultKind(
         inputs["points"], inputs["wrist"], inputs["twist"], bases=bases
     ),
     applies=lambda block: block.has_wrist,
+    missing=Status.NO_WRIST,
     fields=(
         Field("sigma", "screws", bases=True),
         Field("psi", "screws", bases=True),

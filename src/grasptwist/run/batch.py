@@ -17,10 +17,11 @@ from typing import Any
 import numpy as np
 
 from ..engine.decompose import contact_velocities
+from ..engine.judgements import outward_normals
 from ..engine.screws import direction, twist_at
 from ..io.datasets import Dataset
 from ..model import CONTACT_NAMES, Grasp, GraspFileError, Twist
-from ..results import BY_KEY, KINDS, METHOD_CHOICES, Field, ResultKind, selected
+from ..results import ALL_METHODS, BY_KEY, KINDS, METHOD_CHOICES, Field, ResultKind, selected
 
 __all__ = [
     "METHODS",
@@ -43,6 +44,9 @@ NO_TWIST = "no-twist"
 #: The twist whose resolution carries just the bases (``basis`` and ``check``).
 ZERO_TWIST = Twist(name="0", screw=np.zeros(6), line=None)
 
+#: Key of :meth:`Block.outward`'s verdicts among a block's computed values.
+OUTWARD = (None, "outward_normals")
+
 #: Rows per engine call on a data set: bounded memory, long vectors.
 ROWS_PER_BLOCK = 65536
 
@@ -54,8 +58,9 @@ class Block:
     Per-row labels are lists (or numpy string arrays); ``points`` ...
     ``velocity`` are arrays over the rows.  ``results`` maps the key of each
     kind computed (in registry order) to its engine result; a kind's rows
-    where it does not apply (:meth:`applies`, e.g. no wrist) hold the status
-    ``nonfinite-input`` and are reported as skipped.
+    where it cannot run (no wrist) hold its ``missing`` status
+    (``no-wrist``): failures when ``method`` named the kind, else skipped
+    (see :meth:`applies`).
     """
 
     file: list
@@ -66,10 +71,12 @@ class Block:
     points: np.ndarray  # (n, 3, 3)
     normals: np.ndarray  # (n, 3, 3) unit
     twist: np.ndarray  # (n, 6)
+    wrist: np.ndarray  # (n, 3), NaN rows where there is none
     has_wrist: np.ndarray  # (n,) bool
     velocity: np.ndarray  # (n, 3, 3)
     results: dict[str, Any]
     bases: bool = True  # False: resolved without the basis screws (fields that need them are left out)
+    method: str = ALL_METHODS  # the --method asked for
     # field values computed so far, by (kind key, Field); a block cut from another keeps its rows of them
     values: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
@@ -81,14 +88,24 @@ class Block:
         return [k for k in KINDS if k.key in self.results]
 
     def applies(self, key: str) -> np.ndarray:
-        """Rows where kind ``key`` means something (its record field is null elsewhere)."""
-        return np.asarray(BY_KEY[key].applies(self), dtype=bool)
+        """Rows where kind ``key`` has a result or a failure: where it can run, and
+        everywhere when ``method`` named it; elsewhere it is skipped (null)."""
+        kind = BY_KEY[key]
+        return np.asarray(kind.applies(self), dtype=bool) | (kind.method and self.method == kind.label)
 
     def value(self, key: str, f: Field) -> np.ndarray:
         """Field ``f`` of kind ``key`` over the rows, computed once per block."""
         got = self.values.get((key, f))
         if got is None:
             got = self.values[(key, f)] = f.values(self.results[key])
+        return got
+
+    def outward(self) -> np.ndarray:
+        """Per row: do all the normals point away from the other contacts
+        (:func:`~grasptwist.engine.judgements.outward_normals`)?  Judged once per block."""
+        got = self.values.get(OUTWARD)
+        if got is None:
+            got = self.values[OUTWARD] = outward_normals(self.points, self.normals)
         return got
 
     def failed_rows(self) -> np.ndarray:
@@ -119,6 +136,7 @@ _ROW_FIELDS = (
     "points",
     "normals",
     "twist",
+    "wrist",
     "has_wrist",
     "velocity",
 )
@@ -145,13 +163,9 @@ def resolve_arrays(
     kinds = selected(method)
     n = len(points)
     has_wrist = np.zeros(n, bool) if wrist is None else np.isfinite(wrist).all(axis=-1)
-    inputs = {
-        "points": points,
-        "normals": normals,
-        "wrist": np.full((n, 3), np.nan) if wrist is None else wrist,
-        "twist": twist,
-    }
-    return Block(
+    wrist = np.full((n, 3), np.nan) if wrist is None else wrist
+    inputs = {"points": points, "normals": normals, "wrist": wrist, "twist": twist}
+    block = Block(
         file=file if isinstance(file, list) else [file] * n,
         grasp=grasp if grasp is not None else [str(i) for i in range(n)],
         units=units if isinstance(units, list) else [units] * n,
@@ -160,11 +174,19 @@ def resolve_arrays(
         points=points,
         normals=normals,
         twist=twist,
+        wrist=wrist,
         has_wrist=has_wrist,
         velocity=contact_velocities(points, twist),
         results={k.key: k.compute(inputs, bases) for k in kinds},
         bases=bases,
+        method=method,
     )
+    for k in kinds:  # rows a kind cannot run get its reason, not what the engine made of the stand-in NaN
+        can = np.asarray(k.applies(block), dtype=bool)
+        if not can.all():
+            r = block.results[k.key]
+            block.results[k.key] = replace(r, status=np.where(can, r.status, np.int8(k.missing)))
+    return block
 
 
 def resolve(
