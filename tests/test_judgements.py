@@ -119,3 +119,12 @@ def test_a_normal_at_right_angles_to_the_centroid_or_nan_is_not_outward():
     tangent = np.array([[0.0, 1, 0], p[1], p[2]])  # contact 1's normal is perpendicular to g - p_1
     assert outward_normals(p, p).item() and not outward_normals(p, tangent).item()
     assert not outward_normals(p, np.full((3, 3), np.nan)).item()
+
+
+def test_reversed_normals_change_only_the_sign_of_the_normal_velocities(batch):
+    # what the README promises a user whose normals get the outward-normals warning
+    points, normals, _, twist = batch
+    inward, outward = gt.decompose_tangent(points, normals, twist), gt.decompose_tangent(points, -normals, twist)
+    for name in ("theta", "alpha", "beta", "conditioning", "in_tangent_planes", "status"):
+        np.testing.assert_allclose(getattr(outward, name), getattr(inward, name), rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(outward.normal_velocity, -inward.normal_velocity, rtol=1e-12, atol=1e-12)
