@@ -190,3 +190,9 @@ def test_twist_names_pair_with_twists_in_order(files):
 def test_twist_names_that_do_not_pair_are_a_usage_error(files, args, message):
     p, _ = run_installed("resolve", files / "wrist.yaml", *args)
     assert p.returncode == 2 and p.stdout == "" and message in p.stderr and "--twist-name" in p.stderr
+
+
+def test_plot_help_says_how_to_install_matplotlib_from_a_clone():
+    p, _ = run_installed("plot", "--help")
+    text = " ".join(p.stdout.split())  # as one line, however the help is wrapped
+    assert p.returncode == 0 and "from a clone, pip install '.[plot]'" in text and "grasptwist[plot]" not in text

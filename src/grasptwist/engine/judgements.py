@@ -27,7 +27,7 @@ from __future__ import annotations
 import numpy as np
 
 from .degeneracy import IN_PLANE_TOL
-from .screws import direction, dot
+from .screws import dot
 
 __all__ = ["ALONE", "ALL_BUT", "active", "off_tangent_moves", "tangent_moves", "about_wrist", "outward_normals"]
 
@@ -191,9 +191,10 @@ def outward_normals(points, normals, tol=IN_PLANE_TOL):
         \\hat n_i \\cdot \\widehat{(g - p_i)} < -\\mathrm{tol}
         \\quad \\text{for } i = 1, 2, 3, \\qquad g = \\tfrac13 \\textstyle\\sum_j p_j
 
-    Both vectors are made unit, so the test is a cosine: the same for a
-    grasp scaled or moved anywhere, and normals at right angles to
-    ``g - p_i`` (within ``tol``) do not count as outward.
+    It is a test of the cosine between the two, so the same for a grasp
+    scaled or moved anywhere (lengths from about 1e-150 to 1e150), and
+    normals at right angles to ``g - p_i`` (within ``tol``) do not count as
+    outward.
 
     Parameters
     ----------
@@ -215,7 +216,8 @@ def outward_normals(points, normals, tol=IN_PLANE_TOL):
     >>> outward_normals(p, -p).item(), outward_normals(p, p).item()
     (False, True)
     """
-    points = np.asarray(points, dtype=float)
-    toward = direction(points.mean(axis=-2, keepdims=True) - points)
-    with np.errstate(invalid="ignore"):  # NaN input: no verdict
-        return np.all(dot(direction(normals), toward) < -tol, axis=-1)
+    points, normals = np.asarray(points, dtype=float), np.asarray(normals, dtype=float)
+    toward = points.mean(axis=-2, keepdims=True) - points
+    with np.errstate(all="ignore"):  # NaN input: no verdict; lengths beyond 1e150 overflow to none either
+        lengths = np.sqrt(dot(normals, normals) * dot(toward, toward))
+        return np.all(dot(normals, toward) < -tol * lengths, axis=-1)
