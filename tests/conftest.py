@@ -1,9 +1,10 @@
 """Fixtures shared by the loader's tests."""
 
+import numpy as np
 import pytest
 import yaml
 
-from grasptwist.io import grasp_file
+from grasptwist.io.grasp_file import Reading
 
 #: The YAML parsers the loader can run on here: the pure one, and libyaml's when present.
 LOADERS = [yaml.SafeLoader] + ([yaml.CSafeLoader] if yaml.__with_libyaml__ else [])
@@ -21,7 +22,20 @@ contacts:
 
 
 @pytest.fixture(params=LOADERS, ids=lambda loader: loader.__name__)
-def loader(request, monkeypatch):
-    """Run the test once with each available YAML parser."""
-    monkeypatch.setattr(grasp_file, "_LOADER", request.param)
-    return request.param
+def loader(request):
+    """Run the test once with each available YAML parser: the ``reading=`` to pass."""
+    return Reading(parser=request.param)
+
+
+def in_plane(points, normals, which, tilt):
+    """``normals`` (``(N, 3, 3)``) with normal ``which[k]`` of grasp ``k`` turned into its contacts' plane,
+    plus ``tilt[k]`` (a scalar or ``(N,)``) along that plane's unit normal: a tangent method at or near
+    its ``normal-in-contact-plane`` threshold."""
+    m = np.cross(points[:, 1] - points[:, 0], points[:, 2] - points[:, 0])
+    m /= np.linalg.norm(m, axis=1, keepdims=True)
+    rows = np.arange(len(points))
+    n = normals[rows, which]
+    n = n - np.sum(n * m, axis=1)[:, None] * m
+    out = normals.copy()
+    out[rows, which] = n / np.linalg.norm(n, axis=1, keepdims=True) + np.reshape(tilt, (-1, 1)) * m
+    return out

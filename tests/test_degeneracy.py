@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 import grasptwist as gt
+from conftest import in_plane
 from grasp_gen import grasps
 from grasptwist.engine.degeneracy import conditioning_warning
 
@@ -101,27 +102,15 @@ def test_status_codes_are_stable_strings():
     ]
 
 
-def _in_plane(points, normals, which, tilt):
-    """``normals`` with normal ``which`` of each grasp turned into the contacts' plane, plus ``tilt`` off it."""
-    m = np.cross(points[:, 1] - points[:, 0], points[:, 2] - points[:, 0])
-    m /= np.linalg.norm(m, axis=1, keepdims=True)
-    rows = np.arange(len(points))
-    n = normals[rows, which]
-    n = n - np.sum(n * m, axis=1)[:, None] * m
-    out = normals.copy()
-    out[rows, which] = n / np.linalg.norm(n, axis=1, keepdims=True) + tilt * m
-    return out
-
-
 def test_the_tangent_method_fails_exactly_when_a_normal_lies_in_the_contact_plane():
     rng = np.random.default_rng(11)
     points, normals, _, twist = grasps(rng, 300)
     which = rng.integers(0, 3, 300)
-    flat = gt.decompose_tangent(points, _in_plane(points, normals, which, 0.0), twist)
+    flat = gt.decompose_tangent(points, in_plane(points, normals, which, 0.0), twist)
     assert not flat.ok.any()
     specific = {S.NORMALS_RANK_DEFICIENT, S.THETA_NOT_UNIQUE, S.THETA_SIGMA_ZERO, S.NORMAL_IN_CONTACT_PLANE}
     assert set(np.unique(flat.status)) <= specific
-    tilted = gt.decompose_tangent(points, _in_plane(points, normals, which, 1e-4), twist)
+    tilted = gt.decompose_tangent(points, in_plane(points, normals, which, 1e-4), twist)
     assert tilted.ok.all() and (tilted.conditioning < gt.CONDITION_WARNING).all()
 
 
@@ -129,7 +118,7 @@ def test_a_normal_within_tolerance_of_the_plane_is_named_when_no_finer_condition
     rng = np.random.default_rng(1)
     points, normals, _, twist = grasps(rng, 2000)
     which = rng.integers(0, 3, 2000)
-    r = gt.decompose_tangent(points, _in_plane(points, normals, which, 1e-9), twist)
+    r = gt.decompose_tangent(points, in_plane(points, normals, which, 1e-9), twist)
     hit = r.status == S.NORMAL_IN_CONTACT_PLANE
     assert hit.sum() > 10
     np.testing.assert_array_equal(r.culprit[hit], which[hit])

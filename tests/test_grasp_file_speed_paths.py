@@ -13,6 +13,7 @@ loader is slow without failing a test), and the chunked capped read.
 
 import io
 import sys
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -23,7 +24,7 @@ from hypothesis import strategies as st
 
 from conftest import CONTACTS, LOADERS
 from grasptwist.io import grasp_file
-from grasptwist.io.grasp_file import Grasp, GraspFileError, read_grasps
+from grasptwist.io.grasp_file import READING, Grasp, GraspFileError, Reading, read_grasps
 
 TESTS = Path(__file__).parent
 FILES = sorted(
@@ -32,10 +33,6 @@ FILES = sorted(
     if folder.is_dir()
     for path in folder.rglob("*.yaml")
 )
-
-
-def _general_only(get, keep):
-    raise grasp_file._Bail
 
 
 def _array(a):
@@ -116,20 +113,11 @@ def _taped(parser):
     return Taped
 
 
-def both_paths(source, **kw):
+def both_paths(source, reading=READING, **kw):
     """The entries of ``source`` by the loader, checked equal to the general path's."""
-    parser = grasp_file._LOADER
-    grasp_file._LOADER = _taped(parser)
-    try:
-        fast = read_grasps(source, **kw)
-        saved = grasp_file._fast_document
-        grasp_file._fast_document = _general_only
-        try:
-            general = read_grasps(source, **kw)
-        finally:
-            grasp_file._fast_document = saved
-    finally:
-        grasp_file._LOADER = parser
+    taped = replace(reading, parser=_taped(reading.parser))
+    fast = read_grasps(source, reading=taped, **kw)
+    general = read_grasps(source, reading=replace(taped, fast=False), **kw)
     assert signature(fast) == signature(general)
     return fast
 
@@ -148,11 +136,11 @@ def _file_cases():
 
 
 @pytest.mark.parametrize("path, parser", list(_file_cases()))
-def test_files_read_the_same_both_ways(path, parser, monkeypatch):
-    monkeypatch.setattr(grasp_file, "_LOADER", parser)
-    both_paths(path)
+def test_files_read_the_same_both_ways(path, parser):
+    reading = Reading(parser=parser)
+    both_paths(path, reading)
     if path.stat().st_size < BIG:  # content under another name: every small file checks that
-        both_paths(path.read_bytes(), file="other/name.yaml")
+        both_paths(path.read_bytes(), reading, file="other/name.yaml")
 
 
 # Values at which the fast path must hand over, or where its arithmetic must
@@ -173,20 +161,28 @@ NAMES = [
 @pytest.mark.parametrize("number", NUMBERS)
 def test_numbers_everywhere(number, loader):
     for vector in (f"[{number}, 0, 0]", f"[1, {number}, 2]", f"[0, 0, {number}]"):
-        both_paths(CONTACTS.replace("[1, 0, 0]", vector, 1), file="g.yaml")
-        both_paths(CONTACTS.replace("[-1, 0, 0]", vector, 1), file="g.yaml")
-        both_paths(f"wrist: {vector}\n" + CONTACTS, file="g.yaml")
+        both_paths(CONTACTS.replace("[1, 0, 0]", vector, 1), file="g.yaml", reading=loader)
+        both_paths(CONTACTS.replace("[-1, 0, 0]", vector, 1), file="g.yaml", reading=loader)
+        both_paths(f"wrist: {vector}\n" + CONTACTS, file="g.yaml", reading=loader)
         for twist in (f"angular: {vector}", f"linear: {vector}", f"at: {vector}\n    angular: [1, 1, 1]"):
-            both_paths(CONTACTS + f"twists:\n  - {twist}\n", file="g.yaml")
-        both_paths(CONTACTS + f"twists:\n  - screw: [1, 2, 3, {vector[1:-1]}]\n", file="g.yaml")
+            both_paths(CONTACTS + f"twists:\n  - {twist}\n", file="g.yaml", reading=loader)
+        both_paths(CONTACTS + f"twists:\n  - screw: [1, 2, 3, {vector[1:-1]}]\n", file="g.yaml", reading=loader)
 
 
 @pytest.mark.parametrize("name", NAMES)
 def test_names_everywhere(name, loader):
-    both_paths(f"name: {name}\n" + CONTACTS, file="g.yaml")
-    both_paths(f"units: {name}\n" + CONTACTS, file="g.yaml")
-    both_paths(CONTACTS.replace("  - point: [1, 0, 0]", f"  - name: {name}\n    point: [1, 0, 0]"), file="g.yaml")
-    both_paths(CONTACTS + f"twists:\n  - name: {name}\n    angular: [0, 0, 1]\n  - linear: [1, 0, 0]\n", file="g.yaml")
+    both_paths(f"name: {name}\n" + CONTACTS, file="g.yaml", reading=loader)
+    both_paths(f"units: {name}\n" + CONTACTS, file="g.yaml", reading=loader)
+    both_paths(
+        CONTACTS.replace("  - point: [1, 0, 0]", f"  - name: {name}\n    point: [1, 0, 0]"),
+        file="g.yaml",
+        reading=loader,
+    )
+    both_paths(
+        CONTACTS + f"twists:\n  - name: {name}\n    angular: [0, 0, 1]\n  - linear: [1, 0, 0]\n",
+        file="g.yaml",
+        reading=loader,
+    )
 
 
 SHAPES = [
@@ -263,8 +259,8 @@ SHAPES = [
 
 @pytest.mark.parametrize("text", SHAPES, ids=range(len(SHAPES)))
 def test_shapes(text, loader):
-    both_paths(text, file="dir/shape.yaml")
-    both_paths(text.encode("utf-8", "surrogatepass"))
+    both_paths(text, file="dir/shape.yaml", reading=loader)
+    both_paths(text.encode("utf-8", "surrogatepass"), reading=loader)
 
 
 finite = st.floats(allow_nan=False, allow_infinity=False)
@@ -305,12 +301,7 @@ def documents(draw):
 @settings(max_examples=150, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(st.lists(documents(), min_size=1, max_size=3), st.sampled_from(LOADERS))
 def test_random_documents(docs, parser):
-    saved = grasp_file._LOADER
-    grasp_file._LOADER = parser
-    try:
-        both_paths("---\n".join(docs), file="random.yaml")
-    finally:
-        grasp_file._LOADER = saved
+    both_paths("---\n".join(docs), Reading(parser=parser), file="random.yaml")
 
 
 def test_ordinary_grasps_take_the_fast_path(monkeypatch, loader):
@@ -324,7 +315,7 @@ def test_ordinary_grasps_take_the_fast_path(monkeypatch, loader):
     bundled = sorted((TESTS.parent / "grasps").rglob("*.yaml"))
     assert bundled
     for path in bundled:
-        for entry in read_grasps(path):
+        for entry in read_grasps(path, reading=loader):
             assert isinstance(entry, Grasp), str(entry)
 
 
@@ -345,7 +336,9 @@ def test_capped_read_in_chunks(size, tmp_path, monkeypatch):
 
 def test_arrays_of_the_fast_path_are_read_only_float_copies(loader):
     (grasp,) = both_paths(
-        f"wrist: [1, 2, 3]\n{CONTACTS}twists:\n  - angular: [0, 0, 1]\n  - angular: [1, 0, 0]\n", file="g.yaml"
+        f"wrist: [1, 2, 3]\n{CONTACTS}twists:\n  - angular: [0, 0, 1]\n  - angular: [1, 0, 0]\n",
+        file="g.yaml",
+        reading=loader,
     )
     arrays = [grasp.points, grasp.normals, grasp.wrist] + [twist.screw for twist in grasp.twists]
     for array in arrays:

@@ -139,7 +139,7 @@ def test_direction3_gives_directions_bits_at_any_size(seed):
 
 def test_direction3_of_a_zero_vector_raises_where_direction_keeps_zero():
     np.testing.assert_array_equal(screws.direction([0.0, 0.0, 0.0]), 0.0)
-    with pytest.raises(ZeroDivisionError):
+    with pytest.raises(ZeroDivisionError, match="division by zero"):
         screws.direction3(0.0, 0.0, 0.0)
 
 

@@ -46,7 +46,7 @@ import os
 import re
 import stat
 import sys
-from dataclasses import replace
+from dataclasses import dataclass, replace
 from itertools import chain
 from pathlib import Path
 
@@ -64,6 +64,7 @@ __all__ = [
     "MAX_DEPTH",
     "MAX_DOCUMENTS",
     "MAX_ERRORS",
+    "Reading",
     "read_grasps",
     "load_grasps",
     "grasp_schema",
@@ -90,8 +91,36 @@ MAX_ERRORS = 100
 #: Why a path that is not a regular file (or folder) is not read.
 NOT_REGULAR = "not a regular file (a pipe, socket or device)"
 
-# Parser used by read_grasps; tests swap it to check both give the same.
-_LOADER = yaml.CSafeLoader if yaml.__with_libyaml__ else yaml.SafeLoader
+
+@dataclass(frozen=True)
+class Reading:
+    """How :func:`read_grasps` reads a file: its YAML parser, per-file limits, and paths.
+
+    The defaults are what the command line uses; tests pass others to run
+    both parsers, small limits, or the general path alone.
+
+    Attributes
+    ----------
+    parser : type
+        The PyYAML loader class whose events are read: libyaml's
+        ``CSafeLoader`` where PyYAML has it, else the pure ``SafeLoader``.
+    max_documents : int
+        Documents read from one file (see :data:`MAX_DOCUMENTS`).
+    max_errors : int
+        Problems reported for one file (see :data:`MAX_ERRORS`).
+    fast : bool
+        Try the fast path on each document first (False: every document
+        through the general composer, which must give the same entries).
+    """
+
+    parser: type = yaml.CSafeLoader if yaml.__with_libyaml__ else yaml.SafeLoader
+    max_documents: int = MAX_DOCUMENTS
+    max_errors: int = MAX_ERRORS
+    fast: bool = True
+
+
+#: The command line's way of reading.
+READING = Reading()
 
 # Keys of each mapping, in the order the values are checked.
 GRASP_KEYS = ("name", "units", "wrist", "contacts", "twists")
@@ -99,7 +128,7 @@ CONTACT_KEYS = ("name", "point", "normal")
 TWIST_KEYS = ("name", "screw", "angular", "linear", "at")
 
 
-def read_grasps(source, *, file=None, max_bytes=DEFAULT_MAX_BYTES):
+def read_grasps(source, *, file=None, max_bytes=DEFAULT_MAX_BYTES, reading=READING):
     """Read every grasp of a grasp file, keeping errors as values.
 
     Parameters
@@ -113,6 +142,8 @@ def read_grasps(source, *, file=None, max_bytes=DEFAULT_MAX_BYTES):
         or ``"<string>"``.
     max_bytes : int
         Size cap; a larger input fails with ``too-large`` before parsing.
+    reading : Reading
+        The parser and per-file limits (default: the command line's).
 
     Returns
     -------
@@ -120,8 +151,8 @@ def read_grasps(source, *, file=None, max_bytes=DEFAULT_MAX_BYTES):
         In file order: a Grasp for each good document and an error for each
         problem of a bad one (several per document, each with its own
         position).  A syntax error, a too-deep document or more than
-        ``MAX_DOCUMENTS`` documents stop the reading: one error after the
-        entries before it.  Beyond ``MAX_ERRORS`` problems one last
+        ``reading.max_documents`` documents stop the reading: one error after the
+        entries before it.  Beyond ``reading.max_errors`` problems one last
         ``too-many-errors`` error counts the rest.  A whole-file failure
         gives a single error.
 
@@ -144,7 +175,7 @@ def read_grasps(source, *, file=None, max_bytes=DEFAULT_MAX_BYTES):
         text = _decode(data)
     except _Reject as reject:
         return [reject.error(file, None)]
-    return _read_text(text, file)
+    return _read_text(text, file, reading)
 
 
 def load_grasps(source, **kw):
@@ -837,30 +868,32 @@ class _Parts:
 # Stream -> grasps.
 
 
-def _read_text(text, file):
+def _read_text(text, file, reading):
     """Parse ``text`` and turn each document into a Grasp or its errors, as it is read."""
-    entries = _Entries(file)
+    entries = _Entries(file, reading.max_errors)
     stop = None
-    parser = _LOADER(text)
+    parser = reading.parser(text)
     get_event = parser.get_event
     try:
         get_event()  # StreamStartEvent
         while not parser.check_event(yaml.StreamEndEvent):
-            if entries.documents == MAX_DOCUMENTS:
+            if entries.documents == reading.max_documents:
                 raise _StreamStop(
                     "too-many-documents",
                     "",
-                    f"more than {MAX_DOCUMENTS} documents; the rest of the file is not read",
+                    f"more than {reading.max_documents} documents; the rest of the file is not read",
                     **_at_mark(parser.peek_event().start_mark),
                 )
             start = get_event()  # DocumentStartEvent
             events = []
             problems = None
             try:
+                if not reading.fast:
+                    raise _Bail
                 root = _fast_document(get_event, events.append)
             except _Bail:
                 # The general composer, from the document's first event.
-                problems = _Problems(MAX_ERRORS - entries.reported)
+                problems = _Problems(reading.max_errors - entries.reported)
                 root = _compose(chain(events, iter(get_event, None)).__next__, problems)
             entries.add(start.start_mark.line + 1, root, problems)
     except _StreamStop as reject:
@@ -880,11 +913,12 @@ class _Entries:
     document's grasp is named ``stem`` until a second document shows up.
     """
 
-    def __init__(self, file):
+    def __init__(self, file, max_errors):
         self.file = file
+        self.max_errors = max_errors
         self.entries = []
         self.documents = 0
-        self.reported = 0  # problems given an entry, at most MAX_ERRORS
+        self.reported = 0  # problems given an entry, at most max_errors
         self.unreported = 0
         self._stem = None
         self._first_unnamed = None  # the first document's grasp, when it took the default name
@@ -926,7 +960,7 @@ class _Entries:
             self.entries.append(
                 GraspFileError(
                     "too-many-errors",
-                    f"{self.unreported} more problems in this file not reported (only the first {MAX_ERRORS} are)",
+                    f"{self.unreported} more problems in this file not reported (only the first {self.max_errors} are)",
                     self.file,
                 )
             )
@@ -1171,9 +1205,9 @@ def _mapping(node, path, keys, required, problems):
             fields[key] = value
             continue
         unknown += 1
-        if unknown > MAX_ERRORS:
-            # After MAX_ERRORS unknown keys (all before it in the file) this
-            # one's problem can never be reported: count it, spare the rest.
+        if unknown > problems.keep:
+            # After as many unknown keys as can be reported (all before it in
+            # the file) this one's problem never is: count it, spare the rest.
             problems.count += 1
             continue
         # difflib is only needed on this error path.
