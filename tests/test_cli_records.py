@@ -1,9 +1,11 @@
-"""What a new user meets through the installed command (a real subprocess):
-a method asked for that cannot run, normals given outward, self-contained
-records (the wrist in every format, --twist-name)."""
+"""What a new user meets on the command line: a method asked for that cannot
+run, normals given outward, self-contained records (the wrist in every
+format, --twist-name).  Exit codes and stderr are checked on the installed
+command (a real subprocess); output contents in process, which is quicker."""
 
 import csv
 import io
+from types import SimpleNamespace
 
 import numpy as np
 import pytest
@@ -11,7 +13,7 @@ import pytest
 import grasptwist as gt
 from grasptwist.engine.degeneracy import OUTWARD_NORMALS_WARNING
 from grasptwist.io.grasp_file import load_grasps
-from hostile import jsonl, run_installed
+from hostile import jsonl, run, run_installed
 
 # Example 1's cylinder with its normals tilted out of the contacts' plane (so the tangent method resolves)
 INWARD = """\
@@ -39,6 +41,12 @@ def files(tmp_path):
     return tmp_path
 
 
+def in_process(*args):
+    """``grasptwist ARGS`` run in this process, shaped as :func:`run_installed`'s result."""
+    r, seconds = run(*args)
+    return SimpleNamespace(returncode=r.exit_code, stdout=r.stdout, stderr=r.stderr), seconds
+
+
 def where(path, twist="spin"):
     return f"{path}: grasp 'cyl'" + (f", twist '{twist}'" if twist else "")
 
@@ -56,12 +64,12 @@ def test_off_tangent_asked_for_on_a_grasp_without_wrist_fails_with_no_wrist(file
     assert rec["off_tangent"] == {"error": {"code": "no-wrist", "message": NO_WRIST}}
     assert p.stderr.splitlines() == [f"{where(path)}: error: off-tangent: no-wrist: {NO_WRIST}", "1 record, 1 failed"]
     # the same in CSV, and in npz as the status no-wrist
-    p, _ = run_installed("resolve", path, "--method", "off-tangent", "-f", "csv")
+    p, _ = in_process("resolve", path, "--method", "off-tangent", "-f", "csv")
     [row] = csv.DictReader(io.StringIO(p.stdout))
     assert p.returncode == 1 and row["ok"] == "false" and row["off_tangent_error"] == f"no-wrist: {NO_WRIST}"
     assert row["x1"] == row["y3"] == ""
     out = files / "r.npz"
-    p, _ = run_installed("resolve", path, "--method", "off-tangent", "-f", "npz", "-o", out)
+    p, _ = in_process("resolve", path, "--method", "off-tangent", "-f", "npz", "-o", out)
     with np.load(out) as z:
         assert p.returncode == 1 and z["status_legend"][z["off_tangent_status"][0]] == "no-wrist"
         assert np.isnan(z["x"]).all()
@@ -90,7 +98,7 @@ def test_under_both_the_skip_is_a_warning_and_the_tangent_result_stays(files):
     p, _ = run_installed("resolve", path, "-f", "jsonl")
     [rec] = jsonl(p.stdout)
     assert p.returncode == 0 and rec["ok"] is True and rec["off_tangent"] is None and rec["warnings"] == [SKIPPED]
-    with_wrist = jsonl(run_installed("resolve", files / "wrist.yaml", "-f", "jsonl")[0].stdout)[0]
+    with_wrist = jsonl(in_process("resolve", files / "wrist.yaml", "-f", "jsonl")[0].stdout)[0]
     assert rec["tangent"] == with_wrist["tangent"] and with_wrist["warnings"] == []
     assert p.stderr.splitlines() == [f"{where(path)}: warning: {SKIPPED}", "1 record, 0 failed"]
     out = files / "r.npz"
@@ -116,13 +124,13 @@ def test_outward_normals_get_a_warning_inward_ones_none(files, command):
         f"{where(path, twist)}: warning: {OUTWARD_NORMALS_WARNING}",
         "1 record, 0 failed",
     ]
-    p, _ = run_installed(command, files / "wrist.yaml", "-f", "jsonl")
+    p, _ = in_process(command, files / "wrist.yaml", "-f", "jsonl")
     assert p.returncode == 0 and jsonl(p.stdout)[0]["warnings"] == [] and p.stderr == "1 record, 0 failed\n"
 
 
 def test_outward_normals_warn_in_csv_and_npz_runs_too(files):
     for fmt in ("csv", "npz"):
-        p, _ = run_installed("resolve", files / "outward.yaml", "-f", fmt, "-o", files / f"r.{fmt}")
+        p, _ = in_process("resolve", files / "outward.yaml", "-f", fmt, "-o", files / f"r.{fmt}")
         assert p.returncode == 0 and f"warning: {OUTWARD_NORMALS_WARNING}" in p.stderr
 
 
@@ -132,19 +140,19 @@ def test_outward_normals_warn_in_csv_and_npz_runs_too(files):
 
 def test_every_format_carries_the_wrist(files):
     paths = [files / "wrist.yaml", files / "nowrist.yaml"]
-    p, _ = run_installed("resolve", *paths, "-f", "jsonl")
+    p, _ = in_process("resolve", *paths, "-f", "jsonl")
     assert [r["wrist"] for r in jsonl(p.stdout)] == [[0.0, 0.0, 1.0], None]
-    p, _ = run_installed("resolve", *paths, "-f", "csv")
+    p, _ = in_process("resolve", *paths, "-f", "csv")
     header, *rows = list(csv.reader(io.StringIO(p.stdout)))
     at = header.index("twist6") + 1
     assert header[at : at + 4] == ["c_x", "c_y", "c_z", "v1_x"]
     assert [row[at : at + 3] for row in rows] == [["0.0", "0.0", "1.0"], ["", "", ""]]
     out = files / "r.npz"
-    run_installed("resolve", *paths, "-f", "npz", "-o", out)
+    in_process("resolve", *paths, "-f", "npz", "-o", out)
     with np.load(out) as z:
         assert z["wrist"].shape == (2, 3)
         np.testing.assert_array_equal(z["wrist"], [[0, 0, 1], [np.nan] * 3])
-    p, _ = run_installed("basis", *paths, "-f", "jsonl")
+    p, _ = in_process("basis", *paths, "-f", "jsonl")
     assert [r["wrist"] for r in jsonl(p.stdout)] == [[0.0, 0.0, 1.0], None]
 
 
@@ -157,16 +165,16 @@ def test_a_data_set_s_wrist_rows_reach_the_records(files):
         normals=np.stack([grasp.normals] * 2),
         wrist=np.array([[0.5, 0, 1], [np.nan] * 3]),
     )
-    p, _ = run_installed("resolve", data, "--twist", "0,0,1,0,0,0", "--method", "tangent", "-f", "jsonl")
+    p, _ = in_process("resolve", data, "--twist", "0,0,1,0,0,0", "--method", "tangent", "-f", "jsonl")
     assert p.returncode == 0 and [r["wrist"] for r in jsonl(p.stdout)] == [[0.5, 0.0, 1.0], None]
-    p, _ = run_installed("resolve", data, "--twist", "0,0,1,0,0,0", "-f", "csv")
+    p, _ = in_process("resolve", data, "--twist", "0,0,1,0,0,0", "-f", "csv")
     rows = list(csv.DictReader(io.StringIO(p.stdout)))
     assert [(r["c_x"], r["c_z"], r["ok"]) for r in rows] == [("0.5", "1.0", "true"), ("", "", "true")]
 
 
 def test_twist_names_pair_with_twists_in_order(files):
     path = files / "wrist.yaml"
-    p, _ = run_installed(
+    p, _ = in_process(
         "resolve", path, "--twist", "0,0,1,0,0,0", "--twist-name", "spin-z", "--twist", "0,0,0,0,0,1",
         "--twist-name", "lift", "-f", "jsonl",
     )  # fmt: skip
@@ -175,7 +183,7 @@ def test_twist_names_pair_with_twists_in_order(files):
         ("spin-z", [0.0, 0.0, 1.0, 0.0, 0.0, 0.0]),
         ("lift", [0.0, 0.0, 0.0, 0.0, 0.0, 1.0]),
     ]
-    p, _ = run_installed("resolve", path, "--twist", "0, 0, 1, 0, 0, 0", "-f", "csv")
+    p, _ = in_process("resolve", path, "--twist", "0, 0, 1, 0, 0, 0", "-f", "csv")
     assert [r["twist"] for r in csv.DictReader(io.StringIO(p.stdout))] == ["0,0,1,0,0,0"]  # unnamed: as written
 
 
