@@ -86,7 +86,10 @@ _MESSAGES = {
         "the normal at contact {i} lies in the plane of the contacts, so no tangent-plus-Sigma motion "
         "can move contact {i} along it"
     ),
-    Status.NO_WRIST: "the grasp has no wrist, and each Psi_i is a line from it: add 'wrist: [x, y, z]'",
+    Status.NO_WRIST: (
+        "the grasp has no wrist, and each Psi_i is a line from it: give one "
+        "('wrist: [x, y, z]' in a grasp file, a 'wrist' array in a data set)"
+    ),
 }
 
 
