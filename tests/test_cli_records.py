@@ -188,15 +188,15 @@ def test_twist_names_pair_with_twists_in_order(files):
 
 
 @pytest.mark.parametrize(
-    "args, message",
+    "args, message, installed",
     [
-        (["--twist", "0,0,1,0,0,0", "--twist-name", "a", "--twist-name", "b"], "got 2 names for 1 twists"),
-        (["--twist-name", "a"], "got 1 names for 0 twists"),
-        (["--twist", "0,0,1,0,0,0", "--twist-name", " "], "a name is a non-empty line of printable text"),
+        (["--twist", "0,0,1,0,0,0", "--twist-name", "a", "--twist-name", "b"], "got 2 names for 1 twists", True),
+        (["--twist-name", "a"], "got 1 names for 0 twists", False),
+        (["--twist", "0,0,1,0,0,0", "--twist-name", " "], "a name is a non-empty line of printable text", False),
     ],
 )
-def test_twist_names_that_do_not_pair_are_a_usage_error(files, args, message):
-    p, _ = run_installed("resolve", files / "wrist.yaml", *args)
+def test_twist_names_that_do_not_pair_are_a_usage_error(files, args, message, installed):
+    p, _ = (run_installed if installed else in_process)("resolve", files / "wrist.yaml", *args)
     assert p.returncode == 2 and p.stdout == "" and message in p.stderr and "--twist-name" in p.stderr
 
 

@@ -23,7 +23,15 @@ def test_there_are_snippets_to_run():
     assert len(blocks("python")) >= 1 and len(blocks("pycon")) >= 4
 
 
-@pytest.mark.parametrize("code", blocks("python"), ids=lambda code: code.splitlines()[0][:40])
+def python_blocks():
+    """The Python blocks as parameters; those drawing images (seconds each) run with ``-m slow``."""
+    return [
+        pytest.param(code, id=code.splitlines()[0][:40], marks=[pytest.mark.slow] if "plot.render" in code else [])
+        for code in blocks("python")
+    ]
+
+
+@pytest.mark.parametrize("code", python_blocks())
 def test_each_python_block_runs(code, tmp_path, monkeypatch):
     if "plot.render" in code:
         pytest.importorskip("matplotlib")
