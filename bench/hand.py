@@ -1,5 +1,10 @@
-"""Joint rates of the TriFinger Pro at 10^5 configurations: forward kinematics,
-joint rates, rank, residual, conditioning and velocity-limit ratio, to an npz.
+"""Joint rates of the TriFinger Pro at 10^5 configurations, data set to npz.
+
+``grasptwist resolve rows.npz --hand trifinger.yaml -f npz -o out.npz`` (the
+command, start-up included): per row forward kinematics from the data set's
+``joint_positions``, joint rates, rank, residual, conditioning and
+velocity-limit ratio, and the tangent decomposition on top.  The contacts
+are on the fingertip spheres.
 
 Run: ``python bench/hand.py [--n 100000] [--loop 2000]``.  The baseline, in
 this process, is a plain loop over yourdfpy's own forward kinematics
@@ -16,8 +21,8 @@ import time
 import numpy as np
 import yourdfpy
 
+from _data import grasptwist_command, timed
 from grasptwist import hand
-from grasptwist.engine.screws import field_at
 from grasptwist.io.urdf import resolve_urdf
 
 URDF = "package://robot_properties_fingers/urdf/pro/trifingerpro.urdf"
@@ -40,32 +45,28 @@ def contact(tip):
     return tip[..., :3, 3] - TIP_RADIUS * tip[..., :3, 2]
 
 
-def vectorised(h, q, twist, out):
-    """Everything for every row through grasptwist, then one npz."""
-    t0 = time.perf_counter()
-    results = {"rates": [], "rank": [], "residual": [], "conditioning": [], "ratio": []}
-    for finger, state in zip(h.fingers, hand.finger_states(h, q)):
-        p = contact(state.tip)
-        r = hand.joint_rates(state.screws, p, field_at(twist, p))
-        results["rates"].append(r.rates)
-        for key in ("rank", "residual", "conditioning"):
-            results[key].append(getattr(r, key))
-        results["ratio"].append(hand.velocity_limit_ratio(r.rates, hand.velocity_limits(finger)))
-    np.savez(
-        out,
-        joint_positions=q,
-        joint_rates=np.concatenate(results["rates"], axis=-1),
-        finger_rank=np.stack(results["rank"], axis=-1),
-        finger_residual=np.stack(results["residual"], axis=-1),
-        finger_conditioning=np.stack(results["conditioning"], axis=-1),
-        velocity_limit_ratio=np.max(results["ratio"], axis=0),
-        joint_names=np.array(h.joint_names),
-    )
-    return time.perf_counter() - t0, np.concatenate(results["rates"], axis=-1)
+def data_set(h, q, twist, folder):
+    """The rows as a data set (contacts on the tip spheres) and the hand file, for the command."""
+    states = hand.finger_states(h, q)
+    points = np.stack([contact(s.tip) for s in states], axis=1)
+    normals = np.stack([s.tip[..., :3, 2] for s in states], axis=1)  # into the object, below each tip
+    rows = os.path.join(folder, "rows.npz")
+    np.savez(rows, points=points, normals=normals, twist=twist, joint_positions=q)
+    hand_file = os.path.join(folder, "trifinger.yaml")
+    with open(hand_file, "w") as f:
+        f.write(f"hand:\n  urdf: {URDF}\n  fingers:\n" + "".join(f"    - {{tip: {t}}}\n" for t in TIPS))
+    return rows, hand_file, points
+
+
+def command(rows, hand_file, out):
+    """``grasptwist resolve`` of the data set to npz: its best time and joint rates."""
+    seconds = timed([*grasptwist_command(), "resolve", rows, "--hand", hand_file, "-f", "npz", "-o", out], 2)
+    with np.load(out) as z:
+        return seconds, z["joint_rates"]
 
 
 def loop(h, robot, q, twist):
-    """The same per row with yourdfpy's forward kinematics and numpy.linalg.lstsq."""
+    """Joint rates and their verdicts per row with yourdfpy's forward kinematics and numpy.linalg.lstsq."""
     t0 = time.perf_counter()
     rates = np.empty_like(q)
     for row in range(len(q)):
@@ -99,16 +100,16 @@ def main():
     robot = yourdfpy.URDF.load(str(resolve_urdf(URDF)), build_scene_graph=True, load_meshes=False)
     q, twist = configurations(h, args.n)
     with tempfile.TemporaryDirectory() as tmp:
-        t_fast, fast = min(
-            (vectorised(h, q, twist, os.path.join(tmp, "out.npz")) for _ in range(2)), key=lambda r: r[0]
-        )
-        size = os.path.getsize(os.path.join(tmp, "out.npz"))
+        rows, hand_file, _ = data_set(h, q, twist, tmp)
+        out = os.path.join(tmp, "out.npz")
+        t_fast, fast = command(rows, hand_file, out)
+        size = os.path.getsize(out)
     m = min(args.loop, args.n)
     t_loop, slow = loop(h, robot, q[:m], twist[:m])
     t_scaled = t_loop * args.n / m
     agree = np.max(np.abs(fast[:m] - slow)) / np.max(np.abs(slow))
     print(f"rows: {args.n}  (npz {size / 1e6:.1f} MB)")
-    print(f"grasptwist (FK + joint rates + npz): {t_fast:.3f} s  ({t_fast / args.n * 1e6:.2f} us/row)")
+    print(f"grasptwist resolve rows.npz --hand -f npz: {t_fast:.3f} s  ({t_fast / args.n * 1e6:.2f} us/row)")
     print(f"yourdfpy + lstsq loop: {t_loop:.2f} s for {m} rows, scaled {t_scaled:.1f} s")
     print(f"largest relative difference of the rates: {agree:.1e}")
     print(f"speed-up: {t_scaled / t_fast:.0f}x  (target >= 20x)")

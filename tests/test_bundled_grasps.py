@@ -77,6 +77,28 @@ EXPECTED = {
             twists={"roll-x": [1, 0, 0, 0, 0, 0], "lift-z": [0, 0, 0, 0, 0, 0.05]},
         ),
     ],
+    "three-finger-hand.yaml": [
+        dict(
+            name="three-finger-hand",
+            units=None,
+            contacts=("1", "2", "3"),
+            points=[[1.0, 0.3, 0.4], [-1.0, -0.2, -0.1], [0.2, -1.0, -0.5]],
+            normals=[[-1, 0, 0], [1, 0, 0], [0, 1, 0]],
+            wrist=[0, 0, 3],
+            twists={"roll-push": [0.4, 0, 0.1, 0, 0.2, 0]},
+        )
+    ],
+    "trifinger-cube.yaml": [
+        dict(
+            name="trifinger-cube",
+            units="m",
+            contacts=("1", "2", "3"),
+            points=[[0.0325, 0.015, 0.045], [0.005, -0.0325, 0.025], [-0.0325, 0.0, 0.015]],
+            normals=[[-1, 0, 0], [0, 1, 0], [1, 0, 0]],
+            wrist=[0, 0, 0.29],
+            twists={"spin": [0, 0, 0.5, 0, 0, 0], "lift-tilt": [0.3, 0, 0, 0, 0.3 * 0.0325, 0.02]},
+        )
+    ],
     "box-edge.yaml": [
         dict(
             name="box-edge",

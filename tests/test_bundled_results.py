@@ -64,6 +64,39 @@ EXPECTED = {
     ("sphere.yaml", "sphere-tripod", "lift-z"): ([1.0508] * 3, ZERO, ZERO, [1.0508] * 3, False),
     ("sphere.yaml", "sphere-equator", "roll-x"): ([0.6667, -0.3333, -0.3333], ZERO, RANK, RANK, None),
     ("sphere.yaml", "sphere-equator", "lift-z"): ([0.9524] * 3, ZERO, RANK, RANK, None),
+    ("three-finger-hand.yaml", "three-finger-hand", "roll-push"): (
+        [0.0708, -0.0559, -0.3346],
+        [0.0247, -0.1369, 0.0403],
+        [-0.1503, -0.6302, 0.35],
+        [0.2245, -0.1772, -0.6364],
+        False,
+    ),
+    ("trifinger-cube.yaml", "trifinger-cube", "spin"): (
+        ZERO,
+        [-0.1871, -0.0931, -0.2241],
+        [-1.0509, 0.2167, 1.2426],
+        [-0.3375, 0.385, 0],
+        False,
+    ),
+    ("trifinger-cube.yaml", "trifinger-cube", "lift-tilt"): (
+        [-0.4387, -0.2919, -0.4596],
+        [-0.0104, 0.2593, -0.1235],
+        [-0.0585, -0.6033, 0.6851],
+        [0, 0.3465, 0],
+        False,
+    ),
+}
+
+# (file, grasp, twist): each finger's joint rates as the header states them, and the velocity-limit ratio
+JOINT_RATES = {
+    ("three-finger-hand.yaml", "three-finger-hand", "roll-push"): (
+        [[-0.14, 0.015, 0.105], [0.14, 0.01, -0.09], [-0.1, 0.21, -0.61]],
+        0.2033,
+    ),
+    ("trifinger-cube.yaml", "trifinger-cube", "spin"): (
+        [[0.0314, 0.083, -0.032], [0.0396, 0.0622, -0.0254], [0.0519, 0.0387, -0.0162]],
+        8.3e-05,
+    ),
 }
 
 
@@ -109,4 +142,40 @@ def test_bundled_judgements_follow_the_pinned_amplitudes(records, key):
 
 def test_the_spins_about_the_wrist_are_the_ones_the_files_say(records):
     spins = {(k[1], k[2]) for k, rec in records.items() if rec["off_tangent"]["about_wrist"]}
-    assert spins == {("cylinder", "spin-z"), ("polyhedron", "diagonal-spin"), ("sphere-tripod", "spin-z")}
+    assert spins == {
+        ("cylinder", "spin-z"),
+        ("polyhedron", "diagonal-spin"),
+        ("sphere-tripod", "spin-z"),
+        ("trifinger-cube", "spin"),  # about the vertical through the cube, which the wrist is on
+    }
+
+
+@pytest.mark.parametrize("key", sorted(JOINT_RATES), ids=lambda k: f"{k[1]}/{k[2]}")
+def test_bundled_hand_joint_rates(records, key):
+    rec = records[key]
+    rates, ratio = JOINT_RATES[key]
+    hand = rec["hand"]
+    assert hand["ok"] and rec["ok"]
+    assert [f["contact"] for f in hand["fingers"]] == [c["name"] for c in rec["contacts"]]
+    np.testing.assert_allclose([f["joint_rates"] for f in hand["fingers"]], rates, atol=5e-5)
+    assert [f["rank"] for f in hand["fingers"]] == [3, 3, 3]
+    assert max(f["residual"] for f in hand["fingers"]) < 1e-12
+    assert hand["velocity_limit_ratio"] == pytest.approx(ratio, rel=1e-3)
+    assert hand["velocity_limit_ratio"] == max(f["velocity_limit_ratio"] for f in hand["fingers"])
+
+
+@pytest.mark.parametrize("key", sorted(JOINT_RATES), ids=lambda k: f"{k[1]}/{k[2]}")
+def test_bundled_component_joint_rates_add_up_and_vanish_where_they_must(records, key):
+    rec = records[key]
+    total = np.array([f["joint_rates"] for f in rec["hand"]["fingers"]])
+    # components in basis order: Sigma_1..3, Psi_1..3 / Theta_1..3, Sigma_1..3; [c][finger][joint]
+    still = {"off_tangent": np.vstack((~np.eye(3, dtype=bool), np.eye(3, dtype=bool))),
+             "tangent": np.vstack((np.eye(3, dtype=bool), ~np.eye(3, dtype=bool)))}  # fmt: skip
+    parts = {}
+    for key_, fixed in still.items():
+        parts[key_] = rates = np.array(rec[key_]["joint_rates"])
+        assert rates.shape == (6, 3, 3)
+        np.testing.assert_allclose(rates.sum(axis=0), total, atol=1e-12)
+        assert (rates[fixed] == 0.0).all()  # exactly, not to round-off
+        assert (np.abs(rates[~fixed]).max(axis=-1) > 0).sum() >= 1
+    assert not np.allclose(parts["off_tangent"], parts["tangent"])  # the methods split the rates differently

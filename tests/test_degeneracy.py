@@ -98,6 +98,7 @@ def test_status_codes_are_stable_strings():
         "theta-sigma-zero",
         "overflow",
         "normal-in-contact-plane",
+        "finger-cannot-follow",  # a hand's, not a decomposition's
         "no-wrist",
     ]
 

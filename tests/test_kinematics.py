@@ -8,6 +8,7 @@ import pytest
 import grasptwist as gt
 from grasptwist import hand
 from grasptwist.engine import kinematics as kin
+from grasptwist.engine.degeneracy import Status
 from grasptwist.engine.screws import field_at, rigid_motion
 from grasptwist.io.urdf import resolve_urdf
 from hand_grasps import inline_screws, three_finger_hand, trifinger_cube
@@ -308,3 +309,27 @@ def test_component_rates_batch_over_grasps():
     )
     assert split.shape == (2, 6, 3) and total.rates.shape == (2, 3)
     assert np.allclose(split[1], 2 * split[0], rtol=1e-14, atol=0)
+
+
+def test_hand_joint_rates_pad_short_fingers_without_changing_them():
+    rng = np.random.default_rng(5)
+    fingers = [rng.normal(size=(n, 6)) for n in (3, 2, 4)]
+    fingers = [np.hstack((s[:, :3] / np.linalg.norm(s[:, :3], axis=1, keepdims=True), s[:, 3:])) for s in fingers]
+    padded = np.zeros((3, 4, 6))
+    limits = np.full((3, 4), np.nan)
+    for f, s in enumerate(fingers):
+        padded[f, : len(s)] = s
+        limits[f, : len(s)] = 0.5
+    points, twist = rng.normal(size=(3, 3)), rng.normal(size=6)
+    r = kin.hand_joint_rates(padded, points, twist, limits)
+    for f, s in enumerate(fingers):
+        alone = hand.joint_rates(s, points[f], twist[3:] + np.cross(twist[:3], points[f]))
+        np.testing.assert_allclose(r.rates[f, : len(s)], alone.rates, atol=1e-13)
+        assert (r.rates[f, len(s) :] == 0).all()
+        assert r.finger_rank[f] == alone.rank
+        assert r.finger_residual[f] == pytest.approx(float(alone.residual), abs=1e-13)
+        assert r.finger_limit_ratio[f] == pytest.approx(np.abs(alone.rates).max() / 0.5)
+    assert r.finger_rank.tolist() == [3, 2, 3]
+    assert r.status == Status.FINGER_CANNOT_FOLLOW and r.culprit == 1  # two joints cannot reach every velocity
+    assert r.conditioning == r.finger_conditioning.min() == 0.0
+    assert r.velocity_limit_ratio == r.finger_limit_ratio.max()

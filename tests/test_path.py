@@ -146,7 +146,14 @@ def test_follow_is_the_engine_on_each_moved_grasp():
         np.testing.assert_allclose(f.tangent.alpha[i], tan.alpha, rtol=1e-12, atol=1e-13)
         np.testing.assert_allclose(f.tangent.beta[i], tan.beta, rtol=1e-12, atol=1e-13)
         np.testing.assert_array_equal(f.tangent.status[i], tan.status)
-    assert f.off_tangent.residual.max() < 1e-12
+        # the tangent method is solved once per segment at rest and carried to the moved grasp
+        np.testing.assert_allclose(f.tangent.theta[i], tan.theta, atol=1e-13)
+        np.testing.assert_allclose(f.tangent.sigma[i], tan.sigma, atol=1e-13)
+        np.testing.assert_allclose(f.tangent.normal_velocity[i], tan.normal_velocity, rtol=1e-12, atol=1e-13)
+        np.testing.assert_allclose(f.tangent.conditioning[i], tan.conditioning, rtol=1e-12)
+        np.testing.assert_allclose(f.velocities[i], gt.contact_velocities(moved, pose.twist), atol=1e-13)
+        assert np.array_equal(f.tangent.points[i], f.points[i]) and np.array_equal(f.tangent.twist[i, 0], pose.twist)
+    assert f.off_tangent.residual.max() < 1e-12 and f.tangent.residual.max() < 1e-12
 
 
 def test_the_tangent_method_does_not_change_along_a_path_but_the_off_tangent_one_does():

@@ -20,7 +20,7 @@ def blocks(language):
 
 
 def test_there_are_snippets_to_run():
-    assert len(blocks("python")) >= 1 and len(blocks("pycon")) >= 4
+    assert len(blocks("python")) >= 1 and len(blocks("pycon")) >= 5
 
 
 def python_blocks():

@@ -230,7 +230,10 @@ _WORKERS = typer.Option(
     min=0,
     help="Processes for big batches (0: every core, used for 256+ files or 4096+ data-set grasps).",
 )
-_PATHS_HELP = "Grasp files (.yaml, .yml, .json; any case), data sets (.npz, .npy), folders of grasp files or - (stdin)."
+_PATHS_HELP = (
+    "Grasp files (.yaml, .yml, .json; any case), JSON Lines of grasps (.jsonl), data sets (.npz, .npy), "
+    "folders of grasp files or - (stdin: YAML, or JSON Lines if it starts with '{')."
+)
 _PATHS = typer.Argument(..., metavar="PATH...", help=_PATHS_HELP)
 
 
@@ -252,6 +255,12 @@ def resolve(
     at: str | None = typer.Option(
         None, "--at", metavar="X,Y,Z", help="Point whose velocity the --twist linear part gives (default: the origin)."
     ),
+    twists_from: str | None = typer.Option(
+        None,
+        "--twists-from",
+        metavar="FILE|-",
+        help="Twists one per line (JSON: [w1,w2,w3,v1,v2,v3] or a twist mapping), each resolved as it arrives.",
+    ),
     method: Method = _METHOD,
     fmt: Format = typer.Option(
         Format.table, "-f", "--format", help="table for people; json, jsonl, csv or npz (arrays, with -o) for programs."
@@ -264,6 +273,13 @@ def resolve(
         ExtraPoint.wrist,
         "--extra-point",
         help="Role of a .npy's 19th-21st columns: the wrist, or the point the twists' linear velocity is given at.",
+    ),
+    hand: str | None = typer.Option(
+        None,
+        "--hand",
+        metavar="FILE.yaml",
+        help="The hand of a data set's rows (a YAML file holding just hand:), at its joint_positions; "
+        "its joints name the CSV and npz joint-rate columns.",
     ),
     max_bytes: int | None = _MAX_BYTES,
     workers: int = _WORKERS,
@@ -283,6 +299,10 @@ def resolve(
     from .run.pipeline import Job
 
     twists = _cli_twists(twist, at, twist_name)
+    if twists_from is not None and twists is not None:
+        raise typer.BadParameter("give twists by --twist or by --twists-from, not both", param_hint="--twists-from")
+    if twists_from == "-" and "-" in paths:
+        raise typer.BadParameter("standard input can be read only once", param_hint="--twists-from")
     if extra_point == ExtraPoint.at and at is not None:
         raise typer.BadParameter("--extra-point at gives each row its own point; drop --at", param_hint="--at")
     if extra_point == ExtraPoint.at and not any(p.endswith(".npy") for p in paths):
@@ -298,8 +318,31 @@ def resolve(
         fmt=fmt.value,
         max_bytes=max_bytes,
         extra_point=extra_point.value,
+        hand=_hand_option(hand, paths, fmt.value),
+        twists_from=twists_from,
     )
     _run(debug, lambda: _emit(job, paths, output, quiet, workers, digits=digits, order=order.value))
+
+
+def _hand_option(path: str | None, paths: list[str], fmt: str):
+    """The run's hand: ``--hand``'s, or for CSV and npz of one grasp file, that file's first hand
+    (its joints name the columns; a folder's grasps may each have another)."""
+    from .model import InputError
+
+    if path is not None:
+        from .io.grasp_hand import load_hand_file
+
+        try:
+            return load_hand_file(path)[0]
+        except InputError as err:
+            raise typer.BadParameter(f"{err.code}: {err}", param_hint="--hand") from None
+    if not FORMATS[fmt].per_hand or len(paths) != 1 or not paths[0].lower().endswith((".yaml", ".yml", ".json")):
+        return None
+    if not os.path.isfile(paths[0]):
+        return None
+    from .io.inputs import read
+
+    return next((g.hand for g in read(paths[0]) if getattr(g, "hand", None) is not None), None)
 
 
 @app.command()
@@ -358,6 +401,119 @@ def check(
 
     job = Job(kind="check", method=method.value, fmt="json" if json_ else fmt.value, max_bytes=max_bytes)
     _run(debug, lambda: _emit(job, paths, output, quiet, workers))
+
+
+FollowFormat = _choices("FollowFormat", names_for("follow"))
+
+
+class Frame(str, Enum):
+    space = "space"
+    body = "body"
+
+
+@app.command()
+def follow(
+    paths: list[str] = typer.Argument(
+        ..., metavar="PATH...", help="Grasp files (.yaml, .yml, .json; any case), folders of them or - (stdin)."
+    ),
+    path: str | None = typer.Option(None, "--path", metavar="NAME", help="Follow only the files' paths of this name."),
+    twist: list[str] | None = typer.Option(
+        None,
+        "--twist",
+        metavar="W1,W2,W3,V1,V2,V3",
+        help="A segment's constant twist (omega; v), each with a --duration, in order: a path replacing the files'.",
+    ),
+    duration: list[float] | None = typer.Option(
+        None, "--duration", metavar="T", help="How long the --twist of the same rank is held (> 0)."
+    ),
+    frame: Frame = typer.Option(Frame.space, "--frame", help="Frame of the --twist segments."),
+    samples: int | None = typer.Option(
+        None, "--samples", min=2, max=1_000_000, help="Samples per path, evenly spaced, ends included (default 21)."
+    ),
+    dt: float | None = typer.Option(None, "--dt", metavar="DT", help="Time step between samples instead of --samples."),
+    method: Method = _METHOD,
+    fmt: FollowFormat = typer.Option(
+        FollowFormat.table, "-f", "--format", help="table for people; json, jsonl, csv or npz (with -o) for programs."
+    ),
+    json_: bool = _JSON,
+    output: str | None = _OUTPUT,
+    digits: int = _DIGITS,
+    order: Order = _ORDER,
+    max_bytes: int | None = _MAX_BYTES,
+    quiet: bool = _QUIET,
+    debug: bool = _DEBUG,
+) -> None:
+    """Move the object along each path, the contacts with it, resolve every sample and find the degeneracies between samples.
+
+    One record per sample, then a summary per path; exit 1 if a method is
+    degenerate somewhere on a path. Examples: the paper's cylinder turning
+    half a turn about x (its wrist crosses the contacts' plane at t = pi/2);
+    a path from the command line, a quarter turn about z then a lift:
+
+    \b
+        grasptwist follow grasps/cylinder.yaml --method off-tangent --samples 5
+        grasptwist follow grasps/polyhedron.yaml --twist 0,0,1,0,0,0 --duration 1.5708 --twist 0,0,0,0,0,1 --duration 1 -f jsonl
+    """
+    from .run.follow import FollowJob
+
+    segments = _cli_segments(twist, duration, frame.value)
+    if segments and path is not None:
+        raise typer.BadParameter(
+            "--path picks one of the files' paths; --twist replaces them: give one", param_hint="--path"
+        )
+    if samples is not None and dt is not None:
+        raise typer.BadParameter("give --samples or --dt, not both", param_hint="--dt")
+    if dt is not None and not (dt > 0 and dt != float("inf")):
+        raise typer.BadParameter(f"must be a finite number > 0, got {dt}", param_hint="--dt")
+    fmt = FollowFormat.json if json_ else fmt
+    if FORMATS[fmt.value].binary and output is None and sys.stdout.isatty():
+        raise typer.BadParameter(f"{fmt.value} is binary: give -o FILE.{fmt.value}", param_hint="--format")
+    job = FollowJob(
+        method=method.value,
+        path=path,
+        segments=segments,
+        samples=samples,
+        dt=dt,
+        max_bytes=max_bytes,
+        bases=FORMATS[fmt.value].bases,
+    )
+    _run(debug, lambda: _follow(job, paths, output, quiet, fmt.value, digits=digits, order=order.value))
+
+
+def _cli_segments(twists, durations, frame):
+    """``--twist``/``--duration`` pairs as path segments (None without ``--twist``)."""
+    if not twists and not durations:
+        if frame != "space":
+            raise typer.BadParameter("applies to --twist segments", param_hint="--frame")
+        return None
+    if len(twists or ()) != len(durations or ()):
+        raise typer.BadParameter(
+            f"each --twist needs a --duration: got {len(twists or ())} and {len(durations or ())}",
+            param_hint="--duration",
+        )
+    from .path import Segment, check_segments
+
+    segments = [Segment(d, twist=_floats(t, 6, "--twist"), frame=frame) for t, d in zip(twists, durations)]
+    try:
+        return check_segments(segments)
+    except ValueError as exc:
+        raise typer.BadParameter(str(exc).replace("segments[", "segment ["), param_hint="--duration") from None
+
+
+def _follow(job, paths: list[str], output, quiet: bool, fmt: str, **table_options) -> int:
+    """The body of follow: records out, counts and diagnostics on stderr."""
+    from .io.inputs import expand
+    from .run.follow import write_follow
+
+    stderr = _Stderr(quiet)
+    with _output(output) as out:
+        w = FORMATS[fmt].open(out, "follow", **table_options)
+        for o in write_follow(job, expand(paths), w, fmt, table_options.get("order", "omega-v")):
+            out.flush()
+            stderr.take(o)
+        w.close()
+    stderr.summary()
+    return EXIT_FAILED if stderr.failed else EXIT_OK
 
 
 @app.command()
@@ -470,7 +626,7 @@ def _emit(job, paths: list[str], output, quiet: bool, workers: int, **table_opti
     inputs = list(expand(paths))
     fmt = FORMATS[job.fmt]
     with _output(output) as out, _progress(inputs) as advance:
-        w = fmt.open(out, job.kind, **table_options)
+        w = fmt.open(out, job.kind, **table_options, **fmt.hand_options(job.hand))
         # block writers (npz) take results here; the others get records encoded where they were made
         outputs = write_blocks(job, inputs, w) if fmt.takes_blocks else run(job, inputs, _workers(workers))
         for o in outputs:

@@ -43,6 +43,7 @@ __all__ = [
     "joint_positions",
     "finger_states",
     "velocity_limits",
+    "padded",
     "joint_screw",
     "finger_jacobian",
     "joint_rates",
@@ -123,3 +124,40 @@ def velocity_limits(finger):
     [2.0, nan]
     """
     return np.array([np.nan if j.velocity_limit is None else j.velocity_limit for j in finger.joints], dtype=float)
+
+
+def padded(hand, screws, width=None):
+    """A hand's joint screws and velocity limits as arrays of one shape, padded to ``width`` joints.
+
+    A finger with fewer joints gets zero screws (no motion: they change no
+    rank, rate or residual) with no limit.
+
+    Parameters
+    ----------
+    hand : Hand
+    screws : sequence of 3 (..., n_f, 6) arrays
+        Each finger's joint screws at its configurations (e.g. the
+        ``screws`` of :func:`finger_states`).
+    width : int, optional
+        Joints per finger after padding; default the longest finger's.
+
+    Returns
+    -------
+    joint_screws : (..., 3, width, 6) array
+    limits : (3, width) array
+        NaN where a joint has no limit, and in the padding.
+
+    >>> h = Hand((Finger("1", None, (Joint("a", "revolute", 2.0, None, None, None),), None, None, None, 1.0, (0,)),) * 3, ("a",), None, None)
+    >>> s, limits = padded(h, [np.ones((5, 1, 6))] * 3, width=2)
+    >>> s.shape, limits[0].tolist()
+    ((5, 3, 2, 6), [2.0, nan])
+    """
+    width = max(len(f.joints) for f in hand.fingers) if width is None else width
+    lead = np.broadcast_shapes(*(np.shape(s)[:-2] for s in screws))
+    out = np.zeros(lead + (3, width, 6))
+    limits = np.full((3, width), np.nan)
+    for f, (finger, s) in enumerate(zip(hand.fingers, screws, strict=True)):
+        n = len(finger.joints)
+        out[..., f, :n, :] = s
+        limits[f, :n] = velocity_limits(finger)
+    return out, limits

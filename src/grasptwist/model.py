@@ -11,7 +11,18 @@ from dataclasses import dataclass
 
 import numpy as np
 
-__all__ = ["Twist", "Grasp", "Segment", "InputError", "GraspFileError", "CONTACT_NAMES", "Joint", "Finger", "Hand"]
+__all__ = [
+    "Twist",
+    "Grasp",
+    "Segment",
+    "ObjectPath",
+    "InputError",
+    "GraspFileError",
+    "CONTACT_NAMES",
+    "Joint",
+    "Finger",
+    "Hand",
+]
 
 #: Contact names of a grasp that does not name its contacts.
 CONTACT_NAMES = ("1", "2", "3")
@@ -67,6 +78,13 @@ class Grasp:
         The desired twists, possibly none.
     line : int
         1-based line where the document starts.
+    paths : tuple of ObjectPath
+        The object paths of its ``paths`` key, possibly none.
+    hand : Hand or None
+        The hand whose fingers touch the contacts, finger ``f`` contact ``f``.
+    joint_positions : numpy.ndarray or None
+        ``(n_joints,)`` the hand's configuration, in ``hand.joint_names``
+        order (zeros for joints given inline, at their configuration).
     """
 
     name: str
@@ -79,6 +97,9 @@ class Grasp:
     wrist: np.ndarray | None
     twists: tuple[Twist, ...]
     line: int
+    paths: tuple[ObjectPath, ...] = ()
+    hand: Hand | None = None
+    joint_positions: np.ndarray | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -112,6 +133,25 @@ class Segment:
     frame: str = "space"
     position: np.ndarray | None = None
     rotation: np.ndarray | None = None
+
+
+@dataclass(frozen=True, eq=False)
+class ObjectPath:
+    """A named object path of a grasp file: its segments, in order.
+
+    Attributes
+    ----------
+    name : str
+        Its ``name``, or ``"1"``, ``"2"``, ... by position in ``paths``.
+    segments : tuple of Segment
+        Checked by :func:`grasptwist.path.check_segments`.
+    line : int or None
+        1-based line of the path's entry in the file.
+    """
+
+    name: str
+    segments: tuple[Segment, ...]
+    line: int | None
 
 
 class InputError(Exception):

@@ -20,6 +20,7 @@ from .engine.path import (
     follow,
     integrate,
 )
+from .engine.tracking import FingerTrack, track_finger
 from .model import Segment
 
 __all__ = [
@@ -27,6 +28,8 @@ __all__ = [
     "integrate",
     "follow",
     "degeneracies",
+    "track_finger",
+    "FingerTrack",
     "check_segments",
     "Poses",
     "FollowResult",

@@ -18,9 +18,9 @@ How to add a result kind
    ``conditioning`` like :mod:`grasptwist.engine.decompose`'s.
 2. Describe it here with a :class:`ResultKind` appended to :data:`KINDS`:
    its record key and label, ``compute`` (which block inputs it needs),
-   ``applies`` (rows where it can run) with ``missing`` (the status of the
-   other rows: a warning there, or a failure when the kind was asked for
-   by name), its :class:`Field` lists for ``resolve``, ``basis`` and
+   ``applies`` (rows where it can run), for a method ``missing`` (the
+   status of the other rows: a warning there, or a failure when the method
+   was asked for by name), its :class:`Field` lists for ``resolve``, ``basis`` and
    ``check`` records, and its :class:`Column` groups.
 3. Write its table renderer in :mod:`grasptwist.output.table`, the class
    that ``table`` names.
@@ -40,6 +40,7 @@ import numpy as np
 from .engine import judgements
 from .engine.decompose import decompose_off_tangent, decompose_tangent
 from .engine.degeneracy import Status
+from .engine.kinematics import OFF_TANGENT_FIXED, TANGENT_FIXED, hand_joint_rates
 from .engine.screws import klein_table
 
 __all__ = [
@@ -117,14 +118,24 @@ class Column:
     only_where_ok : bool
         Flat columns are empty where the kind failed or does not apply
         (npz keeps the engine's values there).
+    per_hand : bool
+        Its values and names depend on the run's hand (the joints): ``get``
+        is ``(result or None, block, hand) -> (N, ...) array`` (None: the
+        kind was not computed for the block) and ``flat`` may be
+        ``hand -> tuple of str``.
     """
 
     name: str
-    get: Callable[[Any, Any], np.ndarray]
-    flat: tuple[str, ...] = ()
+    get: Callable[..., np.ndarray]
+    flat: tuple[str, ...] | Callable[[Any], tuple[str, ...]] = ()
     dtype: str = "f8"
     array: bool = True
     only_where_ok: bool = True
+    per_hand: bool = False
+
+    def names(self, hand=None) -> tuple[str, ...]:
+        """Its flat columns' names (for the run's ``hand`` when it is per hand)."""
+        return self.flat(hand) if callable(self.flat) else self.flat
 
 
 @dataclass(frozen=True)
@@ -143,12 +154,8 @@ class ResultKind:
         (``points``, ``normals``, ``wrist`` (NaN rows where none),
         ``twist``, ...); ``bases=False`` may leave the basis screws out.
     applies : callable
-        ``block -> (N,) bool``: rows where the kind can run.  Elsewhere its
-        status is ``missing``: asked for by name (``--method``), the row
-        fails with it; under ``both`` the kind is skipped there (its record
-        field is ``null``) with a warning.
-    missing : Status
-        Why the kind cannot run where it does not apply.
+        ``block -> (N,) bool``: rows where the kind can run; its record
+        field is ``null`` elsewhere (see ``missing``).
     fields, basis_fields, check_fields : tuple of Field
         Its object in ``resolve``, ``basis`` and ``check`` records, in order.
     columns : tuple of Column
@@ -159,6 +166,24 @@ class ResultKind:
         Name of its renderer class in :mod:`grasptwist.output.table`.
     method : bool
         Offered by ``--method`` (``both`` runs every method).
+    needs : tuple of str
+        Inputs beyond every block's that it needs (``joint_screws``): it is
+        computed only for blocks that have them, and its columns are not in
+        the fixed CSV header.
+    record : str or None
+        Name of a function in :mod:`grasptwist.output.kind_records` that
+        writes its objects into a block's records (``(block, records,
+        order) -> None``), for an object whose shape depends on the row (a
+        hand's joints); None: the object of its ``fields``.
+    culprit_names : callable or None
+        ``(block, row) -> names`` that its culprit indices refer to in
+        messages; None: the row's contact names.
+    missing : Status or None
+        Why a method cannot run where it does not apply (``no-wrist``):
+        its status there.  Asked for by name (``--method``), those rows
+        fail with it; under ``both`` the method is skipped there with a
+        warning.  None: nothing to say where the kind does not apply (a
+        hand's joint rates on a grasp without a hand).
     """
 
     key: str
@@ -171,7 +196,10 @@ class ResultKind:
     columns: tuple[Column, ...]
     table: str
     method: bool = True
-    missing: Status = Status.NONFINITE_INPUT
+    needs: tuple[str, ...] = ()
+    record: str | None = None
+    culprit_names: Callable[[Any, int], tuple[str, ...]] | None = None
+    missing: Status | None = None
 
 
 def _numbered(name: str, n: int = 3) -> tuple[str, ...]:
@@ -263,8 +291,87 @@ TANGENT = ResultKind(
     table="TangentTable",
 )
 
-#: Every result kind, in the order records hold them.
-KINDS: tuple[ResultKind, ...] = (OFF_TANGENT, TANGENT)
+#: Which contacts each component of a method's decomposition leaves still, in basis order.
+_FIXED = {"off_tangent": OFF_TANGENT_FIXED, "tangent": TANGENT_FIXED}
+
+
+def _decompositions(inputs) -> dict:
+    """The component twists of the methods computed before, for their joint rates."""
+    return {
+        key: (np.concatenate(inputs[key].components(), axis=-2), fixed)
+        for key, fixed in _FIXED.items()
+        if key in inputs
+    }
+
+
+def _same_hand(block, hand) -> np.ndarray:
+    """Rows whose hand has the run's hand's joints (their joint columns fit)."""
+    if block.hands is None:
+        return np.zeros(len(block), bool)
+    return np.array([h is hand or (h is not None and h.joint_names == hand.joint_names) for h in block.hands])
+
+
+def _joint_rates(r, block, hand) -> np.ndarray:
+    """``(N, total joints)``: each finger's rates in ``hand.joint_names`` order; NaN in rows of another hand."""
+    out = np.full((len(block), len(hand.joint_names)), np.nan)
+    if r is not None:
+        same = _same_hand(block, hand)
+        for f, finger in enumerate(hand.fingers):
+            out[np.ix_(same, finger.joint_index)] = r.rates[same, f, : len(finger.joints)]
+    return out
+
+
+def _per_finger(name, fill):
+    """``(N, 3)`` attribute ``name`` of the hand result, ``fill`` where there is none."""
+
+    def get(r, block, hand):
+        if r is None:
+            return np.full((len(block), 3), fill)
+        return np.where(block.has_hand[:, None], getattr(r, name), fill)
+
+    return get
+
+
+def _qdot_names(hand) -> tuple[str, ...]:
+    return tuple(f"qdot_{f.name}_{j.name}" for f in hand.fingers for j in f.joints)
+
+
+HAND = ResultKind(
+    key="hand",
+    label="hand",
+    compute=lambda inputs, bases: hand_joint_rates(
+        inputs["joint_screws"],
+        inputs["points"],
+        inputs["twist"],
+        inputs["joint_limits"],
+        _decompositions(inputs) if bases else None,
+    ),
+    applies=lambda block: block.has_hand,
+    fields=(),
+    basis_fields=(),
+    check_fields=(),
+    columns=(
+        Column("joint_rates", _joint_rates, _qdot_names, per_hand=True),
+        Column("finger_rank", _per_finger("finger_rank", -1), dtype="i8", per_hand=True),
+        Column("finger_residual", _per_finger("finger_residual", np.nan), per_hand=True),
+        Column("finger_conditioning", _per_finger("finger_conditioning", np.nan), per_hand=True),
+        Column(
+            "velocity_limit_ratio",
+            lambda r, block, hand: (
+                np.full(len(block), np.nan) if r is None else np.where(block.has_hand, r.velocity_limit_ratio, np.nan)
+            ),
+            per_hand=True,
+        ),
+    ),
+    table="HandTable",
+    method=False,
+    needs=("joint_screws",),
+    record="hand_objects",
+    culprit_names=lambda block, i: tuple(f.name for f in block.hands[i].fingers),
+)
+
+#: Every result kind, in the order records hold them (a kind may use those before it).
+KINDS: tuple[ResultKind, ...] = (OFF_TANGENT, TANGENT, HAND)
 
 #: The kinds by key.
 BY_KEY: dict[str, ResultKind] = {k.key: k for k in KINDS}
@@ -280,7 +387,7 @@ def selected(method: str) -> tuple[ResultKind, ...]:
     """The kinds a ``--method`` value runs (kinds that are not methods always run).
 
     >>> [k.key for k in selected("tangent")], [k.key for k in selected("both")]
-    (['tangent'], ['off_tangent', 'tangent'])
+    (['tangent', 'hand'], ['off_tangent', 'tangent', 'hand'])
     """
     if method not in METHOD_CHOICES:
         raise ValueError(f"method must be one of {METHOD_CHOICES}, got {method!r}")

@@ -56,7 +56,8 @@ class Status(IntEnum):
     THETA_SIGMA_ZERO = 8
     OVERFLOW = 9
     NORMAL_IN_CONTACT_PLANE = 10
-    NO_WRIST = 11  # set where a grasp has none (see grasptwist.results), never by a decomposition
+    FINGER_CANNOT_FOLLOW = 11
+    NO_WRIST = 12  # set where a grasp has none (see grasptwist.results), never by a decomposition
 
     @property
     def code(self) -> str:
@@ -85,6 +86,10 @@ _MESSAGES = {
     Status.NORMAL_IN_CONTACT_PLANE: (
         "the normal at contact {i} lies in the plane of the contacts, so no tangent-plus-Sigma motion "
         "can move contact {i} along it"
+    ),
+    Status.FINGER_CANNOT_FOLLOW: (
+        "finger {i} cannot follow its contact: no joint rates move it with the object's velocity there "
+        "(relative residual above 1e-6)"
     ),
     Status.NO_WRIST: (
         "the grasp has no wrist, and each Psi_i is a line from it: give one "

@@ -38,7 +38,9 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .screws import cross, dot, field_at, norm, unit
+from . import se3
+from .degeneracy import Status
+from .screws import cross, field_at, norm, unit
 
 __all__ = [
     "RANK_TOL",
@@ -52,6 +54,8 @@ __all__ = [
     "joint_rates",
     "component_joint_rates",
     "velocity_limit_ratio",
+    "HandRates",
+    "hand_joint_rates",
     "forward_kinematics",
     "chain_from_origins",
     "chain_length",
@@ -326,8 +330,9 @@ def velocity_limit_ratio(rates, limits):
     Parameters
     ----------
     rates : (..., n) array
-    limits : (n,) array
-        Positive limits; NaN (or None) for a joint without one.
+    limits : (..., n) array
+        Positive limits, broadcast against ``rates``; NaN (or None) for a
+        joint without one.
 
     Returns
     -------
@@ -339,12 +344,131 @@ def velocity_limit_ratio(rates, limits):
     """
     rates = _checked(rates, (None,), "rates")
     limits = np.asarray(limits, dtype=float)
-    if limits.shape != rates.shape[-1:] or not np.all(np.isnan(limits) | (limits > 0)):
+    if limits.shape[-1:] != rates.shape[-1:] or not np.all(np.isnan(limits) | (limits > 0)):
         raise ValueError(f"limits must be positive numbers or NaN, one per joint, got {limits.tolist()}")
     given = ~np.isnan(limits)
-    if not given.any():
-        return np.full(rates.shape[:-1], np.nan)
-    return np.max(np.abs(rates[..., given]) / limits[given], axis=-1)
+    with np.errstate(invalid="ignore"):
+        ratio = np.where(given, np.abs(rates) / np.where(given, limits, 1.0), 0.0)
+    return np.where(given.any(axis=-1), ratio.max(axis=-1, initial=0.0), np.nan)
+
+
+@dataclass(frozen=True, eq=False)
+class HandRates:
+    """Joint rates of a batch of three-fingered hands for their grasps' twists.
+
+    Fingers are padded to a common joint count ``J`` with zero screws, which
+    get zero rates and change no rank, residual or conditioning.
+
+    Attributes
+    ----------
+    rates : (..., 3, J)
+        Each finger's joint rates for ``T(p_f)``.
+    finger_rank, finger_residual, finger_conditioning : (..., 3)
+        Per finger, ``rank``, ``residual`` and ``conditioning`` of :class:`JointRates`.
+    finger_limit_ratio : (..., 3)
+        Per finger, :func:`velocity_limit_ratio` (NaN: no limit given).
+    velocity_limit_ratio : (...)
+        The largest over the fingers (NaN: no limit given).
+    conditioning : (...)
+        The worst finger's conditioning.
+    components : dict of str to (..., m, 3, J) array
+        Per decomposition given, each component's joint rates per finger.
+    status, culprit : (...) int8
+        ``finger-cannot-follow`` (or ``nonfinite-input``) and the finger it is
+        about (the one with the largest residual), as for the decompositions.
+    """
+
+    rates: np.ndarray
+    finger_rank: np.ndarray
+    finger_residual: np.ndarray
+    finger_conditioning: np.ndarray
+    finger_limit_ratio: np.ndarray
+    velocity_limit_ratio: np.ndarray
+    conditioning: np.ndarray
+    components: dict
+    status: np.ndarray
+    culprit: np.ndarray
+
+    @property
+    def ok(self) -> np.ndarray:
+        """``status == 0`` per row."""
+        return self.status == 0
+
+    def row(self, i):
+        """Rows ``i`` of the leading axis, as a result of the same type."""
+        values = {k: v[i] for k, v in vars(self).items() if k != "components"}
+        return HandRates(**values, components={k: v[i] for k, v in self.components.items()})
+
+
+def hand_joint_rates(joint_screws, points, twist, limits, decompositions=None):
+    """Every finger's joint rates for an object twist, and for each component of its decompositions.
+
+    Finger ``f`` is a chain whose tip touches contact ``p_f``; it must move it
+    with ``T(p_f)`` (:func:`joint_rates`), each component ``C`` with ``C(p_f)``
+    (:func:`component_joint_rates`).  Its relative residual above
+    :data:`FOLLOW_TOL` means it cannot follow: status ``finger-cannot-follow``.
+
+    Parameters
+    ----------
+    joint_screws : (..., 3, J, 6) array
+        Each finger's joint screws at the configuration, zero-padded to ``J``.
+    points : (..., 3, 3) array
+        The contact points, row ``f`` touched by finger ``f``.
+    twist : (..., 6) array
+    limits : (..., 3, J) array
+        Joint velocity limits, NaN where none is given (padding too).
+    decompositions : dict of str to (components (..., m, 6), fixed (m, 3) bool), optional
+        Component twists in basis order and which contacts each leaves
+        still (:data:`OFF_TANGENT_FIXED`, :data:`TANGENT_FIXED`).
+
+    Returns
+    -------
+    HandRates
+
+    Three Cartesian fingers follow anything:
+
+    >>> screws = np.broadcast_to(np.hstack((np.zeros((3, 3)), np.eye(3))), (3, 3, 6))
+    >>> r = hand_joint_rates(screws, np.eye(3), [0, 0, 1.0, 0, 0, 0], np.full((3, 3), 2.0))
+    >>> (r.rates[0] + 0.0).tolist(), r.finger_rank.tolist(), float(r.velocity_limit_ratio), int(r.status)
+    ([0.0, 1.0, 0.0], [3, 3, 3], 0.5, 0)
+    """
+    screws = _checked(joint_screws, (3, None, 6), "joint_screws")
+    p = _checked(points, (3, 3), "points")
+    twist = _checked(twist, (6,), "twist")
+    decompositions = decompositions or {}
+    names = list(decompositions)
+    sizes = [np.shape(decompositions[k][0])[-2] for k in names]
+    comps = [np.asarray(decompositions[k][0], dtype=float) for k in names]
+    lead = np.broadcast_shapes(screws.shape[:-3], p.shape[:-2], twist.shape[:-1], *(c.shape[:-2] for c in comps))
+    if comps:
+        every = np.concatenate([np.broadcast_to(c, lead + c.shape[-2:]) for c in comps], axis=-2)
+        fixed = np.concatenate([np.asarray(decompositions[k][1], dtype=bool) for k in names])
+    else:
+        every, fixed = np.zeros(lead + (0, 6)), np.zeros((0, 3), bool)
+    fingers = [component_joint_rates(screws[..., f, :, :], p[..., f, :], twist, every, fixed[:, f]) for f in range(3)]
+    rates = np.stack([t.rates for t, _ in fingers], axis=-2)
+    residual = np.stack([t.residual for t, _ in fingers], axis=-1)
+    parts = np.stack([c for _, c in fingers], axis=-2)  # (..., m, 3, J)
+    limit_ratio = velocity_limit_ratio(rates, limits)
+    conditioning = np.stack([t.conditioning for t, _ in fingers], axis=-1)
+    finite = np.isfinite(residual).all(axis=-1)
+    follows = (residual <= FOLLOW_TOL).all(axis=-1)
+    status = np.where(~finite, Status.NONFINITE_INPUT, np.where(follows, Status.OK, Status.FINGER_CANNOT_FOLLOW))
+    starts = np.cumsum([0, *sizes])
+    return HandRates(
+        rates=rates,
+        finger_rank=np.stack([t.rank for t, _ in fingers], axis=-1),
+        finger_residual=residual,
+        finger_conditioning=conditioning,
+        finger_limit_ratio=limit_ratio,
+        velocity_limit_ratio=np.fmax.reduce(limit_ratio, axis=-1),  # fmax: NaN only where every finger's is
+        conditioning=conditioning.min(axis=-1),
+        components={k: parts[..., a:b, :, :] for k, a, b in zip(names, starts, starts[1:])},
+        status=status.astype(np.int8),
+        culprit=np.where(status == Status.OK, -1, np.argmax(np.nan_to_num(residual, nan=np.inf), axis=-1)).astype(
+            np.int8
+        ),
+    )
 
 
 class ChainState(NamedTuple):
@@ -358,41 +482,9 @@ class ChainState(NamedTuple):
     tip: np.ndarray | None
 
 
-def _skew(w):
-    """``[w]``, the matrix of ``x -> w x x``: ``(..., 3) -> (..., 3, 3)``."""
-    z = np.zeros_like(w[..., 0])
-    return np.stack(
-        (
-            np.stack((z, -w[..., 2], w[..., 1]), axis=-1),
-            np.stack((w[..., 2], z, -w[..., 0]), axis=-1),
-            np.stack((-w[..., 1], w[..., 0], z), axis=-1),
-        ),
-        axis=-2,
-    )
-
-
 def _apply(r, x):
     """``R x`` over batches: ``(..., 3, 3), (..., 3) -> (..., 3)``."""
     return (r @ x[..., None])[..., 0]
-
-
-def _joint_motion(screw, angle):
-    """The rigid motion ``exp([S] q)`` of a unit line or a pure translation ``S``.
-
-    Rodrigues' rotation about ``omega`` by ``q``, ``R = I + sin q [w] + (1 - cos q) [w]^2``,
-    moving the axis point ``a = w x v`` onto itself: ``t = (I - R) a + w (w . v) q``
-    (the last term is the pitch's advance; 0 for a joint line).  A screw with
-    ``omega = 0`` translates by ``v q``.  ``(..., 6), (...) -> (R (..., 3, 3), t (..., 3))``.
-    """
-    w, v = screw[..., :3], screw[..., 3:]
-    k = _skew(w)
-    k2 = k @ k
-    s, c = np.sin(angle)[..., None, None], np.cos(angle)[..., None, None]
-    turn = s * k + (1.0 - c) * k2  # R - I, without the cancellation of forming I first
-    rotation = np.eye(3) + turn
-    translation = -_apply(turn, cross(w, v)) + w * (dot(w, v) * angle)[..., None]
-    translation = np.where(np.any(w != 0, axis=-1)[..., None], translation, v * angle[..., None])
-    return rotation, translation
 
 
 def forward_kinematics(home_screws, home_points, home_tip, positions):
@@ -449,7 +541,7 @@ def forward_kinematics(home_screws, home_points, home_tip, positions):
             out_screws[..., j, :3] = w
             out_screws[..., j, 3:] = _apply(rotation, s[..., 3:]) + cross(translation, w)
             out_points[..., j, :] = _apply(rotation, a) + translation
-        r, t = _joint_motion(s, q[..., j])
+        r, t = se3.exp(s, q[..., j])  # the joint's motion, exp([S_j] q_j)
         if rotation is None:
             rotation, translation = r, t
         else:

@@ -73,7 +73,7 @@ segment, which is negligible.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import NamedTuple
 
 import numpy as np
@@ -343,8 +343,10 @@ def _times(times, end):
     return t
 
 
-def _poses(plan, t) -> Poses:
-    k = plan.index(t)
+def _poses(plan, t, k=None) -> Poses:
+    """Poses at times ``t``, in segments ``k`` (default: each time's own; a time on a boundary
+    can be taken as the end of the segment before)."""
+    k = plan.index(t) if k is None else k
     r, x = se3.compose(plan.rotation[k], plan.position[k], *se3.exp(plan.body[k], t - plan.start[k]))
     return Poses(t, k, r, x, plan.space[k])
 
@@ -425,27 +427,61 @@ def follow(points, normals, wrist, segments, times, *, method="both", bases=Fals
         wrist = se3._shaped(wrist, (3,), "wrist")
         shapes.append(wrist.shape[:-1])
     grasps = np.broadcast_shapes(*shapes)
-    poses = integrate(segments, times)
+    plan = _plan(segments)
+    poses = _poses(plan, _times(times, plan.end))
     lead = poses.time.shape
     ones = (1,) * len(grasps)
-    # (T..., 1..., 1, 3, 3): one pose for every grasp and contact of a time
-    r = poses.rotation.reshape(lead + ones + (1, 3, 3))
-    x = poses.position.reshape(lead + ones + (1, 3))
-    moved = np.empty(lead + grasps + (3, 3))
-    turned = np.empty(lead + grasps + (3, 3))
-    flat = [a.reshape((-1,) + a.shape[len(lead) :]) for a in (r, x, moved, turned)]
-    step = max(1, _ROWS // max(1, math.prod(grasps)))
-    for i in range(0, flat[0].shape[0], step):
-        rows = slice(i, i + step)
-        flat[2][rows] = se3.transform(flat[0][rows], flat[1][rows], points)
-        flat[3][rows] = se3.rotate(flat[0][rows], normals)
     twist = poses.twist.reshape(lead + ones + (6,))
+    # What moves with the object is resolved once per segment on the grasp at rest, with the
+    # segment's body twist, and carried to each sample by its pose (module docstring: the
+    # tangent method and the contact velocities see no wrist, so a rigid motion changes nothing).
+    body = plan.body.reshape((-1,) + ones + (6,))
+    at_rest = np.broadcast_to(contact_velocities(points, body), (len(body),) + grasps + (3, 3))
+    points, normals = np.broadcast_to(points, grasps + (3, 3)), np.broadcast_to(normals, grasps + (3, 3))
+    moved, turned, velocities = (np.empty(lead + grasps + (3, 3)) for _ in range(3))
+    flat = [a.reshape((-1,) + a.shape[len(lead) :]) for a in (moved, turned, velocities)]
+    rotation, position, segment = poses.rotation.reshape(-1, 3, 3), poses.position.reshape(-1, 3), poses.segment.ravel()
+    step = max(1, _ROWS // max(1, math.prod(grasps)))
+    for i in range(0, len(segment), step):
+        rows = slice(i, i + step)
+        _carry(rotation[rows], points, flat[0][rows], position[rows])
+        _carry(rotation[rows], normals, flat[1][rows])
+        for k in np.unique(segment[rows]):
+            these = i + np.flatnonzero(segment[rows] == k)
+            flat[2][these] = _carry(rotation[these], at_rest[k], np.empty((len(these),) + grasps + (3, 3)))
     off = tan = None
     if method != "tangent" and wrist is not None:
         off = decompose_off_tangent(moved, wrist, twist, bases=bases)
     if method != "off-tangent":
-        tan = decompose_tangent(moved, turned, twist, bases=bases)
-    return FollowResult(poses, moved, turned, wrist, contact_velocities(moved, twist), off, tan)
+        tan = _carried(decompose_tangent(points, normals, body, bases=bases).row(poses.segment), poses, moved, twist)
+    return FollowResult(poses, moved, turned, wrist, velocities, off, tan)
+
+
+def _carry(rotation, vectors, out, translation=None):
+    """``R v (+ x)`` for every pose of a flat batch and every vector, written to ``out``.
+
+    ``(n, 3, 3), (G..., 3), out (n, G..., 3), (n, 3) -> out``: one matrix
+    product for all (a third of the memory traffic of three broadcast
+    products and sums, which is what moving the grasps costs).
+    """
+    carried = np.moveaxis(np.tensordot(rotation, vectors, axes=([-1], [-1])), 1, -1)
+    if translation is None:
+        out[...] = carried
+    else:
+        np.add(carried, translation.reshape((len(translation),) + (1,) * (vectors.ndim - 1) + (3,)), out=out)
+    return out
+
+
+def _carried(result, poses, moved, twist):
+    """A result for the grasp at rest and a segment's body twist, as it is in the moved grasp:
+    the same amplitudes and verdicts, the basis lines carried by the pose (``Ad_H``)."""
+    lead = poses.time.shape
+    shape = moved.shape[:-2]
+    ones = (1,) * (len(shape) - len(lead))
+    r = poses.rotation.reshape(lead + ones + (1, 3, 3))
+    x = poses.position.reshape(lead + ones + (1, 3))
+    lines = {k: rigid_motion(getattr(result, k), r, x) for k in ("theta", "sigma") if getattr(result, k) is not None}
+    return replace(result, points=moved, twist=np.broadcast_to(twist, shape + (6,)), **lines)
 
 
 # --- degeneracies ------------------------------------------------------------------

@@ -3,7 +3,8 @@
 Input layouts (see the README):
 
 * ``.npz`` with ``points (N,3,3)``, ``normals (N,3,3)`` and optionally
-  ``wrist (N,3)``, ``twist (N,6)`` or ``(6,)``, ``names (N,)``;
+  ``wrist (N,3)``, ``twist (N,6)`` or ``(6,)``, ``names (N,)``,
+  ``joint_positions (N, n_joints)`` (of the hand given with ``--hand``);
 * ``.npy`` of shape ``(N,18)`` or ``(N,21)``: per row ``p1 p2 p3 n1 n2 n3``
   (xyz each) and, with 21 columns, one more point whose role
   ``extra_point`` names: the ``wrist``, or the point ``at`` which the
@@ -32,7 +33,7 @@ __all__ = ["DATASET_SUFFIXES", "EXTRA_POINT_ROLES", "Dataset", "open_dataset"]
 
 DATASET_SUFFIXES = (".npz", ".npy")
 EXTRA_POINT_ROLES = ("wrist", "at")
-_NPZ_KEYS = ("points", "normals", "wrist", "twist", "names")
+_NPZ_KEYS = ("points", "normals", "wrist", "twist", "names", "joint_positions")
 
 
 @dataclass(frozen=True)
@@ -46,6 +47,7 @@ class Dataset:
     at: np.ndarray | None  # (N, 3): where each twist's linear part is given
     twist: np.ndarray | None  # (N, 6) or (6,)
     names: np.ndarray | None  # (N,)
+    joint_positions: np.ndarray | None = None  # (N, n_joints): the hand's configuration per row
 
     def __len__(self) -> int:
         return len(self.points)
@@ -119,7 +121,13 @@ def _open_npz(path, arrays):
     names = arrays.get("names")
     if names is not None and (names.ndim != 1 or names.dtype.kind not in "USiu"):
         raise _bad(path, f"names: expected a 1-D array of strings or numbers, got {names.dtype} {names.shape}")
+    positions = arrays.get("joint_positions")
+    if positions is not None and (positions.ndim != 2 or positions.dtype.kind not in "fiu"):
+        raise _bad(
+            path, f"joint_positions: expected numbers of shape (N, n_joints), got {positions.dtype} {positions.shape}"
+        )
     for key, a in (
+        ("joint_positions", positions),
         ("normals", normals),
         ("wrist", wrist),
         ("twist", twist if twist is not None and twist.ndim == 2 else None),
@@ -127,4 +135,4 @@ def _open_npz(path, arrays):
     ):
         if a is not None and len(a) != n:
             raise _bad(path, f"{key}: {len(a)} rows, but points has {n}")
-    return Dataset(path, points, normals, wrist, None, twist, names)
+    return Dataset(path, points, normals, wrist, None, twist, names, positions)

@@ -51,12 +51,16 @@ from itertools import chain
 from pathlib import Path
 
 import numpy as np
+import orjson
 import yaml
 
-from ..engine import screws
-from ..model import Grasp, GraspFileError, Twist
+from ..engine import screws, se3
+from ..engine.path import FRAMES, check_segments
+from ..model import Grasp, GraspFileError, ObjectPath, Segment, Twist
 
 __all__ = [
+    "read_line",
+    "read_twist_line",
     "Twist",
     "Grasp",
     "GraspFileError",
@@ -123,9 +127,12 @@ class Reading:
 READING = Reading()
 
 # Keys of each mapping, in the order the values are checked.
-GRASP_KEYS = ("name", "units", "wrist", "contacts", "twists")
+GRASP_KEYS = ("name", "units", "wrist", "contacts", "twists", "paths", "hand")
 CONTACT_KEYS = ("name", "point", "normal")
 TWIST_KEYS = ("name", "screw", "angular", "linear", "at")
+PATH_KEYS = ("name", "frame", "segments")
+SEGMENT_KEYS = ("duration", "screw", "angular", "linear", "at", "pose")
+POSE_KEYS = ("position", "rotation", "rotvec")
 
 
 def read_grasps(source, *, file=None, max_bytes=DEFAULT_MAX_BYTES, reading=READING):
@@ -868,9 +875,10 @@ class _Parts:
 # Stream -> grasps.
 
 
-def _read_text(text, file, reading):
-    """Parse ``text`` and turn each document into a Grasp or its errors, as it is read."""
-    entries = _Entries(file, reading.max_errors)
+def _read_text(text, file, reading, name=None):
+    """Parse ``text`` and turn each document into a Grasp or its errors, as it is read
+    (an unnamed grasp called ``name`` if given)."""
+    entries = _Entries(file, reading.max_errors, name)
     stop = None
     parser = reading.parser(text)
     get_event = parser.get_event
@@ -913,9 +921,10 @@ class _Entries:
     document's grasp is named ``stem`` until a second document shows up.
     """
 
-    def __init__(self, file, max_errors):
+    def __init__(self, file, max_errors, name=None):
         self.file = file
         self.max_errors = max_errors
+        self.name = name  # the default name, if not the file's stem
         self.entries = []
         self.documents = 0
         self.reported = 0  # problems given an entry, at most max_errors
@@ -967,6 +976,8 @@ class _Entries:
         return self.entries
 
     def _default_name(self, document):
+        if self.name is not None:
+            return self.name
         if self._stem is None:
             self._stem = _stem_name(self.file)
         return self._stem if document == 0 else f"{self._stem}#{document + 1}"
@@ -1025,6 +1036,8 @@ def _grasp(root, problems, *, file, document, name, line):
     wrist = _vector(fields["wrist"], 3, "wrist", problems) if "wrist" in fields else None
     contacts = _contacts(fields["contacts"], problems) if "contacts" in fields else None
     twists = _twists(fields["twists"], problems) if "twists" in fields else ()
+    paths = _paths(fields["paths"], problems) if "paths" in fields else ()
+    hand = _hand(fields["hand"], contacts, file, problems) if "hand" in fields else None
     if problems.count:
         return None
     contact_names, points, normals = contacts
@@ -1039,7 +1052,17 @@ def _grasp(root, problems, *, file, document, name, line):
         wrist=None if wrist is None else _readonly(wrist),
         twists=twists,
         line=line,
+        paths=paths,
+        hand=None if hand is None else hand[0],
+        joint_positions=None if hand is None else _readonly(hand[1]),
     )
+
+
+def _hand(node, contacts, file, problems):
+    """``(Hand, joint positions)`` of the ``hand`` key (see :mod:`grasptwist.io.grasp_hand`)."""
+    from .grasp_hand import read_hand  # only documents with a hand need it
+
+    return read_hand(node, None if contacts is None else contacts[1], file, problems)
 
 
 # What contacts look like, for the message when they are not a list.
@@ -1131,15 +1154,141 @@ def _twist_parts(fields, item, path, problems):
                         **_at(fields[other]),
                     )
                 )
-        screw = _vector(fields["screw"], 6, path + ".screw", problems)
+        screw = _vector(fields["screw"], 6, _join(path, "screw"), problems)
         return None if screw is None else (screw[:3], screw[3:], zero)
     if "angular" not in fields and "linear" not in fields:
         problems.add(_Reject("missing-key", path, "needs 'screw', or 'angular' and/or 'linear'", **_at(item)))
     parts = [
-        _vector(fields[key], 3, f"{path}.{key}", problems) if key in fields else zero
+        _vector(fields[key], 3, _join(path, key), problems) if key in fields else zero
         for key in ("angular", "linear", "at")
     ]
     return None if None in parts else parts
+
+
+def _paths(node, problems):
+    """The object paths, their segments checked (None after a problem)."""
+    items = _sequence(node, "paths", problems)
+    if items is None:
+        return None
+    names, found = {}, []
+    for i, item in enumerate(items):
+        path = f"paths[{i}]"
+        fields = _mapping(item, path, PATH_KEYS, ("segments",), problems)
+        if fields is None:
+            continue
+        _entry_name(fields, item, "paths", i, names, problems)
+        frame = _frame(fields["frame"], path + ".frame", problems) if "frame" in fields else "space"
+        if "segments" in fields:  # checked whatever the frame, so that every problem is found
+            found.append(_segments(fields["segments"], path + ".segments", frame or "space", problems))
+    if problems.count:
+        return None
+    return tuple(ObjectPath(name, segments, item.line) for name, segments, item in zip(names, found, items))
+
+
+def _frame(node, path, problems):
+    """``space`` or ``body``."""
+    if node.kind == "invalid":
+        return None
+    if node.kind != "scalar" or node.value not in FRAMES:
+        problems.add(_Reject("invalid-frame", path, f"expected space or body, got {_describe(node)}", **_at(node)))
+        return None
+    return node.value
+
+
+def _segments(node, path, frame, problems):
+    """A path's segments (None after a problem)."""
+    items = _sequence(node, path, problems)
+    if items is None:
+        return None
+    if not items:
+        problems.add(_Reject("empty-path", path, "a path needs at least one segment", **_at(node)))
+        return None
+    segments = [_segment(item, f"{path}[{k}]", frame, problems) for k, item in enumerate(items)]
+    if problems.count:
+        return None
+    return check_segments(segments)
+
+
+def _segment(item, path, frame, problems):
+    """One segment: a ``duration`` and a constant twist or a ``pose`` target."""
+    fields = _mapping(item, path, SEGMENT_KEYS, ("duration",), problems)
+    if fields is None:
+        return None
+    duration = _number(fields["duration"], path + ".duration", problems) if "duration" in fields else None
+    if duration is not None and not duration > 0:
+        problems.add(
+            _Reject("invalid-duration", path + ".duration", f"must be > 0, got {duration!r}", **_at(fields["duration"]))
+        )
+    if "pose" in fields:
+        _conflicts(
+            fields, path, ("screw", "angular", "linear", "at"), "'pose' (give a twist or a pose target)", problems
+        )
+        pose = _pose(fields["pose"], path + ".pose", problems)
+        return None if pose is None else Segment(duration, position=pose[0], rotation=pose[1])
+    if not {"screw", "angular", "linear"} & set(fields):
+        problems.add(
+            _Reject(
+                "missing-key", path, "needs a twist ('screw', or 'angular' and/or 'linear') or a 'pose'", **_at(item)
+            )
+        )
+        return None
+    parts = _twist_parts(fields, item, path, problems)
+    if parts is None:
+        return None
+    with np.errstate(over="ignore", invalid="ignore"):
+        screw = screws.twist_at(*(np.array(p) for p in parts))
+    if not np.isfinite(screw).all():
+        problems.add(
+            _Reject(
+                "non-finite",
+                path,
+                "the velocity of the origin overflows (linear + angular x (origin - at))",
+                **_at(item),
+            )
+        )
+        return None
+    return Segment(duration, twist=screw, frame=frame)
+
+
+def _conflicts(fields, path, others, what, problems):
+    """A ``conflicting-keys`` problem for each key of ``others`` given beside ``what``."""
+    for other in others:
+        if other in fields:
+            problems.add(
+                _Reject("conflicting-keys", _join(path, other), f"cannot be combined with {what}", **_at(fields[other]))
+            )
+
+
+def _pose(node, path, problems):
+    """``(position, rotation matrix)`` of a pose target: position default zero, rotation a
+    quaternion ``(w, x, y, z)`` or a rotation vector, default none."""
+    fields = _mapping(node, path, POSE_KEYS, (), problems)
+    if fields is None:
+        return None
+    position = _vector(fields["position"], 3, path + ".position", problems) if "position" in fields else [0.0] * 3
+    rotation = np.eye(3)
+    if "rotation" in fields:
+        _conflicts(fields, path, ("rotvec",), "'rotation' (give a quaternion or a rotation vector)", problems)
+        quaternion = _vector(fields["rotation"], 4, path + ".rotation", problems)
+        if quaternion is not None and any(quaternion):
+            # scaled first: the engine normalises it, and a huge one must not overflow on the way
+            rotation = se3.quaternion_to_matrix(np.divide(quaternion, np.abs(quaternion).max()))
+        elif quaternion is not None:
+            problems.add(
+                _Reject(
+                    "invalid-rotation",
+                    path + ".rotation",
+                    "a quaternion (w, x, y, z) of zero length has no rotation",
+                    **_at(fields["rotation"]),
+                )
+            )
+    elif "rotvec" in fields:
+        rotvec = _vector(fields["rotvec"], 3, path + ".rotvec", problems)
+        if rotvec is not None:
+            rotation = se3.rotvec_to_matrix(rotvec)
+    if position is None or problems.count:
+        return None
+    return np.array(position), rotation
 
 
 def _entry_name(fields, item, collection, index, taken, problems):
@@ -1311,3 +1460,134 @@ def _readonly(values):
     array = np.array(values, dtype=float)
     array.setflags(write=False)
     return array
+
+
+# --------------------------------------------------------------------------
+# One line of a JSON Lines stream (io/lines.py reads the stream).
+
+
+def read_line(data, *, file, line, max_bytes=DEFAULT_MAX_BYTES):
+    """The grasp of one line of a JSON Lines stream, or its errors, placed at ``line``.
+
+    The line is one grasp document (JSON is YAML), checked as in a grasp
+    file; positions count from the stream's start, an unnamed grasp is
+    ``stem#line`` and ``document`` is ``line - 1``.  ``max_bytes`` caps the
+    line, not the stream.
+
+    >>> for error in read_line(b'{"contacts": []}', file="in.jsonl", line=7):
+    ...     print(error)
+    in.jsonl:7:14: contacts: expected exactly 3 contacts, got 0
+    """
+    try:
+        text = _line_text(data, max_bytes)
+    except _Reject as reject:
+        return [_on_line(reject.error(file, None), line)]
+    return [_on_line(entry, line) for entry in _read_text(text, file, READING, name=f"{_stem_name(file)}#{line}")]
+
+
+def read_twist_line(data, *, file, line, max_bytes=DEFAULT_MAX_BYTES):
+    """The twist of one line of a JSON Lines stream of twists, or its errors.
+
+    A line is a 6-array ``(omega; v)`` (``v`` at the origin), or a mapping
+    with a grasp file's twist keys (``name``, ``screw`` or ``angular``,
+    ``linear``, ``at``), checked as there.  An unnamed twist is named after
+    its line number.
+
+    Returns
+    -------
+    Twist or list of GraspFileError
+
+    >>> read_twist_line(b"[0, 0, 1, 0, 0, 0.5]", file="-", line=3).screw.tolist()
+    [0.0, 0.0, 1.0, 0.0, 0.0, 0.5]
+    >>> t = read_twist_line(b'{"name": "spin", "angular": [0, 0, 1], "at": [1, 0, 0]}', file="-", line=4)
+    >>> t.name, t.screw.tolist()
+    ('spin', [0.0, 0.0, 1.0, 0.0, -1.0, 0.0])
+    >>> print(*read_twist_line(b"[0, 0, 1]", file="<stdin>", line=5))
+    <stdin>:5:1: screw: expected 6 numbers, got 3; a 3-vector goes under `angular:` or `linear:`
+    """
+    if len(data) <= max_bytes:
+        screw = _fast_screw(data)
+        if screw is not None:
+            return Twist(str(line), _readonly([*screw[:3], *screws.twist_at3(screw[:3], screw[3:], _ZERO)]), line)
+    problems = _Problems(MAX_ERRORS)
+    try:
+        root = _line_node(_line_text(data, max_bytes), problems)
+    except _Reject as reject:
+        return [_on_line(reject.error(file, None), line)]
+    if root.kind == "sequence":
+        fields = {"screw": root}
+    elif root.kind in ("mapping", "invalid"):
+        fields = _mapping(root, "", TWIST_KEYS, (), problems)
+    else:
+        fields = None
+        problems.add(
+            _Reject(
+                "not-a-mapping",
+                "",
+                f"expected a twist [wx, wy, wz, vx, vy, vz] or a mapping, got {_describe(root)}",
+                **_at(root),
+            )
+        )
+    name = str(line)
+    if fields is not None and "name" in fields:
+        name = _name(fields["name"], "name", problems)
+    parts = None if fields is None else _twist_parts(fields, root, "", problems)
+    if not problems.count:
+        screw = [*parts[0], *screws.twist_at3(*parts)]
+        if all(map(math.isfinite, screw)):
+            return Twist(name, _readonly(screw), line)
+        problems.add(
+            _Reject(
+                "non-finite", "", "the velocity of the origin overflows (linear + angular x (origin - at))", **_at(root)
+            )
+        )
+    return [_on_line(reject.error(file, None), line) for reject in problems.first()]
+
+
+def _fast_screw(data):
+    """The six numbers of a line that is a plain JSON array of six finite numbers
+    (as floats, the values the general path reads), else None."""
+    try:
+        value = orjson.loads(data)
+    except orjson.JSONDecodeError:
+        return None
+    if type(value) is not list or len(value) != 6:
+        return None
+    for x in value:
+        if (type(x) is not float and type(x) is not int) or not -_INF < x < _INF:
+            return None
+    return [float(x) for x in value]
+
+
+def _line_text(data, max_bytes):
+    """A line's text, checked for size and characters."""
+    if len(data) > max_bytes:
+        raise _Reject("too-large", "", f"the line is longer than the size limit of {max_bytes} bytes")
+    return _decode(data)
+
+
+def _line_node(text, problems):
+    """The node tree of the one document of a line."""
+    parser = READING.parser(text)
+    try:
+        parser.get_event()  # StreamStartEvent
+        if parser.check_event(yaml.StreamEndEvent):
+            raise _Reject("empty-document", "", "no value on the line")
+        parser.get_event()  # DocumentStartEvent
+        root = _compose(parser.get_event, problems)
+        if not parser.check_event(yaml.StreamEndEvent):
+            raise _Reject(
+                "yaml-syntax", "", "more than one document on the line", **_at_mark(parser.peek_event().start_mark)
+            )
+        return root
+    except yaml.YAMLError as exc:
+        raise _syntax_error(exc, text) from None
+    finally:
+        parser.dispose()
+
+
+def _on_line(entry, line):
+    """An entry read from one line's text, placed at ``line`` of the stream."""
+    if isinstance(entry, Grasp):
+        return replace(entry, line=line, document=line - 1, twists=tuple(replace(t, line=line) for t in entry.twists))
+    return GraspFileError(entry.code, entry.message, entry.file, line, entry.column, line - 1)

@@ -232,13 +232,20 @@ def _never_open(fname):
     raise PermissionError(f"grasptwist never opens meshes ({fname})")
 
 
-def _model(data, file):
+def _library(file):
+    """yourdfpy (and lxml, which it brings), or the error that says which extra to install."""
     try:
+        import lxml.etree  # noqa: F401 - _parse's parser
         import yourdfpy
     except ImportError:
         raise InputError(
             "urdf-unavailable", "reading a URDF needs yourdfpy: pip install 'grasptwist[urdf]'", file
         ) from None
+    return yourdfpy
+
+
+def _model(data, file):
+    yourdfpy = _library(file)
     try:
         # The bytes passed _parse: no DTD, so yourdfpy's own lxml parse has no entity to expand.
         return yourdfpy.URDF.load(
@@ -291,6 +298,7 @@ def load_urdf_hand(urdf, tips, *, names=None, folder=None, max_bytes=DEFAULT_MAX
     """
     text = os.fspath(urdf)
     file = text if text.startswith(_PACKAGE) or folder is None else os.path.join(os.fspath(folder), text)
+    _library(file)  # before the reference: a package:// one may be missing for the same reason
     data = _read(resolve_urdf(urdf, folder), max_bytes, file)
     root = _parse(data, file)
     _check_joint_elements(root, file)

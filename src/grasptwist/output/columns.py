@@ -17,9 +17,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..engine.degeneracy import Status, status_message
-from ..results import CULPRIT, KINDS, STATUS, Column
+from ..results import BY_KEY, CULPRIT, KINDS, STATUS, Column
 
-__all__ = ["ORDERS", "in_order", "BLOCK_COLUMNS", "CSV_COLUMNS", "columns", "arrays", "error_texts"]
+__all__ = ["ORDERS", "in_order", "BLOCK_COLUMNS", "CSV_COLUMNS", "header", "columns", "arrays", "error_texts"]
 
 #: Screw orders for output: the paper's ``(omega; v)`` or ``(v; omega)``.
 ORDERS = ("omega-v", "v-omega")
@@ -66,97 +66,123 @@ _SCREWS = {"twist"}
 _OPTIONAL = {"wrist"}
 
 
-def _status_column(key: str) -> Column:
+def _status(key: str, block) -> np.ndarray:
+    """The engine's status of kind ``key``, -1 where it does not apply or was not computed (skipped)."""
+    if key not in block.results:
+        return np.full(len(block), -1, np.int8)
+    return np.where(block.applies(key), block.value(key, STATUS), -1).astype(np.int8)
+
+
+def _status_column(key: str, per_hand: bool = False) -> Column:
     """``<key>_status``: the engine's status, -1 where the kind does not apply (skipped)."""
-    return Column(
-        f"{key}_status",
-        lambda r, block: np.where(block.applies(key), block.value(key, STATUS), -1).astype(np.int8),
-        dtype="i1",
-        only_where_ok=False,
-    )
+    get = (lambda r, block, hand: _status(key, block)) if per_hand else (lambda r, block: _status(key, block))
+    return Column(f"{key}_status", get, dtype="i1", only_where_ok=False, per_hand=per_hand)
 
 
-def _error_column(key: str) -> Column:
-    return Column(
-        f"{key}_error",
-        lambda r, block: error_texts(block, key),
-        (f"{key}_error",),
-        "U",
-        array=False,
-        only_where_ok=False,
-    )
+def _error_column(key: str, per_hand: bool = False) -> Column:
+    name = f"{key}_error"
+    if per_hand:
+        return Column(name, lambda r, block, hand: error_texts(block, key), (name,), "U", False, False, True)
+    return Column(name, lambda r, block: error_texts(block, key), (name,), "U", array=False, only_where_ok=False)
 
 
-def _groups():
-    """Every column group with the key of its kind (None for the rows' own)."""
+def _groups(hand=None):
+    """Every column group with the key of its kind (None for the rows' own); the
+    kinds that need a hand (joint columns) only when the run has one."""
     groups = [(None, c) for c in BLOCK_COLUMNS]
     for kind in KINDS:
-        own = (*kind.columns, _status_column(kind.key), _error_column(kind.key))
+        if kind.needs and hand is None:
+            continue
+        per_hand = bool(kind.needs)
+        own = (*kind.columns, _status_column(kind.key, per_hand), _error_column(kind.key, per_hand))
         groups += [(kind.key, c) for c in own]
     return groups
 
 
 _GROUPS = _groups()
 
-#: CSV header: every flat column, in order; the README documents each.
+#: CSV header without a hand: every flat column, in order; the README documents each.
 CSV_COLUMNS = [name for _, c in _GROUPS for name in c.flat]
+
+
+def header(hand=None) -> list[str]:
+    """The CSV header of a run, with the joint columns of its ``hand`` (None: :data:`CSV_COLUMNS`).
+
+    >>> header() == CSV_COLUMNS
+    True
+    """
+    if hand is None:
+        return CSV_COLUMNS
+    return [name for _, c in _groups(hand) for name in c.names(hand)]
 
 
 def error_texts(block, key: str) -> np.ndarray:
     """``code: message`` of kind ``key`` where it failed and applies, else empty."""
-    status, culprit = block.value(key, STATUS), block.value(key, CULPRIT)
     texts = np.full(len(block), "", dtype=object)
+    if key not in block.results:
+        return texts
+    status, culprit = block.value(key, STATUS), block.value(key, CULPRIT)
+    named = BY_KEY[key].culprit_names
     for i in np.flatnonzero((status != Status.OK) & block.applies(key)):
         s = Status(int(status[i]))
-        texts[i] = f"{s.code}: {status_message(s, culprit[i], block.contact_names[i])}"
+        names = block.contact_names[i] if named is None else named(block, i)
+        texts[i] = f"{s.code}: {status_message(s, culprit[i], names)}"
     return texts
 
 
-def _values(block, key, column: Column, order: str):
+def _values(block, key, column: Column, order: str, hand=None):
     """A group's ``(N, ...)`` values (labels may be a list), or None for a kind not computed."""
+    if column.per_hand:  # the run's hand fixes its shape: values (blank) even where not computed
+        return column.get(block.results.get(key), block, hand)
     if key is not None and key not in block.results:
         return None
     values = column.get(block.results.get(key), block)
     return in_order(values, order) if column.name in _SCREWS else values
 
 
-def columns(block, order: str = "omega-v") -> dict[str, np.ndarray]:
+def columns(block, order: str = "omega-v", hand=None) -> dict[str, np.ndarray]:
     """The block's flat columns, ``name -> (N,)`` array, in the order of :data:`CSV_COLUMNS`.
 
     Values that do not apply are masked (a :class:`numpy.ma.MaskedArray`):
     every value of a kind not computed, and of a group marked
     ``only_where_ok``, where its kind failed or does not apply.  Flat
-    columns of a group are views of its array (no copies).
+    columns of a group are views of its array (no copies).  ``hand``: the
+    run's hand, whose joint columns follow (:func:`header`).
     """
     n = len(block)
     out = {}
-    for key, column in _GROUPS:
-        if not column.flat:
+    for key, column in _GROUPS if hand is None else _groups(hand):
+        names = column.names(hand)
+        if not names:
             continue
-        values = _values(block, key, column, order)
+        values = _values(block, key, column, order, hand)
         if values is None:
             blank = np.ma.masked_all((n,), dtype=column.dtype if column.dtype != "U" else object)
-            out.update(dict.fromkeys(column.flat, blank))
+            out.update(dict.fromkeys(names, blank))
             continue
         flat = np.asarray(values).reshape(n, -1)
-        valid = block.results[key].ok & block.applies(key) if key is not None and column.only_where_ok else None
+        valid = None
+        if key is not None and column.only_where_ok:
+            computed = key in block.results
+            valid = block.results[key].ok & block.applies(key) if computed else np.zeros(n, bool)
         if column.name in _OPTIONAL:
             valid = np.isfinite(flat).all(axis=1)
-        for j, name in enumerate(column.flat):
+        for j, name in enumerate(names):
             out[name] = flat[:, j] if valid is None else np.ma.masked_array(flat[:, j], mask=~valid)
     return out
 
 
-def arrays(block, order: str = "omega-v") -> dict[str, np.ndarray]:
+def arrays(block, order: str = "omega-v", hand=None) -> dict[str, np.ndarray]:
     """The block's column groups that npz stores, ``name -> (N, ...)`` array, for the kinds computed.
 
     Labels (``file``, ``grasp``, ``twist_name``) may come as lists.  Values are the engine's everywhere (NaN amplitudes where a kind failed;
-    statuses say which rows those are).
+    statuses say which rows those are).  ``hand``: the run's hand, whose
+    joint arrays follow (NaN in rows without it).
     """
     out = {}
-    for key, column in _GROUPS:
+    for key, column in _GROUPS if hand is None else _groups(hand):
         if column.array:
-            values = _values(block, key, column, order)
+            values = _values(block, key, column, order, hand)
             if values is not None:
                 out[column.name] = values
     return out

@@ -13,13 +13,18 @@ import io
 
 import numpy as np
 
-from .columns import CSV_COLUMNS, columns
+from .columns import CSV_COLUMNS, columns, header
 from .records import records, talking_rows
 
-__all__ = ["HEADER", "encode_rows", "error_row"]
+__all__ = ["HEADER", "header_line", "encode_rows", "error_row", "lines"]
 
-#: The header line.
+#: The header line of a run without a hand.
 HEADER = ",".join(CSV_COLUMNS).encode() + b"\n"
+
+
+def header_line(hand=None) -> bytes:
+    """The header line, with the joint columns of the run's ``hand``."""
+    return HEADER if hand is None else ",".join(header(hand)).encode() + b"\n"
 
 
 def _cells(a: np.ndarray) -> list:
@@ -45,15 +50,20 @@ def _lines(rows) -> list[bytes]:
     return [whole[a:b].encode() for a, b in zip([0] + ends, ends)]
 
 
-def encode_rows(block, order: str) -> tuple[list[bytes], list[dict]]:
+def encode_rows(block, order: str, hand=None) -> tuple[list[bytes], list[dict]]:
     """The CSV line of each row, and the records of the rows with something to say."""
-    cells = [_cells(a) for a in columns(block, order).values()]
+    cells = [_cells(a) for a in columns(block, order, hand).values()]
     talking = np.flatnonzero(talking_rows(block))
     return _lines(zip(*cells)), records(block.take(talking), order) if talking.size else []
 
 
-def error_row(rec: dict) -> bytes:
+def lines(named: dict) -> list[bytes]:
+    """The CSV line of each row of flat columns ``name -> (N,)`` array (masked: empty cells)."""
+    return _lines(zip(*(_cells(a) for a in named.values())))
+
+
+def error_row(rec: dict, hand=None) -> bytes:
     """The CSV line of an input that failed (:func:`records.error_record`)."""
     err = rec["error"]
     row = [rec["file"], "", "", "false", f"{err['code']}: {err['message']}"]  # file, grasp, twist, ok, error
-    return _lines([row + [""] * (len(CSV_COLUMNS) - len(row))])[0]
+    return _lines([row + [""] * (len(header(hand)) - len(row))])[0]

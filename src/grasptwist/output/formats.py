@@ -31,7 +31,9 @@ class OutputFormat:
     name : str
         Its ``-f`` value.
     commands : tuple of str
-        The commands that offer it (``resolve``, ``basis``, ``check``).
+        The commands that offer it (``resolve``, ``basis``, ``check``,
+        ``follow``; how ``follow`` encodes its records in each format is in
+        :data:`grasptwist.output.follow_records.ENCODINGS`).
     open : callable
         ``(out, kind, order, **table_options) -> writer`` with ``write`` and
         ``close``; ``kind`` is the command.
@@ -51,6 +53,9 @@ class OutputFormat:
         encoded records.
     bases : bool
         It shows basis screws (False: resolve without them, a third less work).
+    per_hand : bool
+        Its columns depend on the run's hand (the joints of ``--hand``):
+        ``open``, ``encode`` and ``encode_rows`` take ``hand=``.
     """
 
     name: str
@@ -62,12 +67,29 @@ class OutputFormat:
     binary: bool = False
     takes_blocks: bool = False
     bases: bool = True
+    per_hand: bool = False
+
+    def hand_options(self, hand) -> dict:
+        """The keyword arguments that give ``open``/``encode``/``encode_rows`` the run's hand."""
+        return {"hand": hand} if self.per_hand else {}
 
 
 def _table(out: IO[bytes], kind: str, order: str = "omega-v", **table_options):
+    if kind == "follow":  # plain text, its own module (no rich)
+        from .follow_table import FollowTable
+
+        return FollowTable(out, order=order, **table_options)
     from . import table  # rich is imported only for people-facing output
 
     return table.WRITERS[kind](out, order=order, **table_options)
+
+
+def _csv(out: IO[bytes], kind: str, hand=None, **_):
+    if kind == "follow":
+        from .follow_records import CSV_HEADER
+
+        return Lines(out, header=CSV_HEADER, newline=b"")
+    return Lines(out, header=csv_rows.header_line(hand), newline=b"")
 
 
 def _record_rows(block, order):
@@ -75,17 +97,17 @@ def _record_rows(block, order):
     return recs, [r for r in recs if not r["ok"] or r["warnings"]]
 
 
-def _npz(out: IO[bytes], kind: str, order: str = "omega-v", **_):
+def _npz(out: IO[bytes], kind: str, order: str = "omega-v", hand=None, **_):
     from .npz import NpzWriter
 
-    return NpzWriter(out, order)
+    return NpzWriter(out, order, hand=hand)
 
 
 def _json_rows(block, order):
     return encode_records(block, order, records, dumps)
 
 
-_ALL = ("resolve", "basis", "check")
+_ALL = ("resolve", "basis", "check", "follow")
 
 #: Every output format by name, in the order ``--help`` lists them.
 FORMATS: dict[str, OutputFormat] = {
@@ -96,13 +118,14 @@ FORMATS: dict[str, OutputFormat] = {
         OutputFormat("jsonl", _ALL, lambda out, kind, **_: Lines(out), dumps, _json_rows, join=b"\n".join),
         OutputFormat(
             "csv",
-            ("resolve",),
-            lambda out, kind, **_: Lines(out, header=csv_rows.HEADER, newline=b""),
+            ("resolve", "follow"),
+            _csv,
             csv_rows.error_row,
             csv_rows.encode_rows,
             join=b"".join,
+            per_hand=True,
         ),
-        OutputFormat("npz", ("resolve",), _npz, binary=True, takes_blocks=True, bases=False),
+        OutputFormat("npz", ("resolve", "follow"), _npz, binary=True, takes_blocks=True, bases=False, per_hand=True),
     )
 }
 

@@ -31,6 +31,7 @@ _MARK = 1 << 20  # number marker: column * _MARK + position + 0.5 (exact, unique
 _STRING_COLUMNS = ("file", "grasp", "units", "twist_name")
 _TOKEN = re.compile(rb'"\\u0001(\w+)\\u0001"|-?\d+\.5')
 _CODED = ("flag", "fingers")  # field kinds whose few distinct values go into the template
+_TEMPLATE_FROM = 4  # rows in a block from which plain rows go by template
 
 
 def encode_records(block, order: str, records, dumps) -> tuple[list[bytes], list[dict]]:
@@ -40,6 +41,9 @@ def encode_records(block, order: str, records, dumps) -> tuple[list[bytes], list
     the texts equal, byte for byte, ``dumps`` of every record.  The records
     returned are the ones with something to say (errors, warnings).
     """
+    if len(block) < _TEMPLATE_FROM:  # a stream's line: learning a template costs more than it saves
+        recs = records(block, order)
+        return [dumps(rec) for rec in recs], [rec for rec in recs if not rec["ok"] or rec["warnings"]]
     plain = _plain_rows(block)
     codes = _verdicts(block)  # judged once here, for the non-plain rows' records too
     out: list = [None] * len(block)
@@ -63,7 +67,10 @@ def _plain_rows(block) -> np.ndarray:
     """Rows with nothing to say and every kind asked for present."""
     plain = ~talking_rows(block)
     for kind in block.kinds():
-        plain &= block.applies(kind.key)  # a skipped kind is a null: another template
+        if kind.record is not None:  # objects whose shape depends on the row: no template
+            plain &= ~block.applies(kind.key)
+        else:
+            plain &= block.applies(kind.key)  # a skipped kind is a null: another template
     return plain
 
 

@@ -29,7 +29,9 @@ class NpzWriter:
     ``twist_index`` into ``twist_names`` (each distinct name once),
     ``twist (N,6)``, ``wrist (N,3)`` (NaN rows for grasps without one),
     ``contact_velocity (N,3,3)``, then each result kind's
-    (e.g. ``x``, ``y``, ``off_tangent_status``, ``off_tangent_conditioning``);
+    (e.g. ``x``, ``y``, ``off_tangent_status``, ``off_tangent_conditioning``)
+    and, with a ``hand``, its joint arrays (``joint_rates`` in the order of
+    ``joint_names``, ``finger_rank`` ...);
     ``status_legend[k]`` is the name of status ``k``, and status -1 means
     "skipped" (a method not asked for by name that cannot run).  Amplitudes
     are NaN where a kind failed.
@@ -38,9 +40,10 @@ class NpzWriter:
     temporary files; :meth:`close` streams everything into the archive.
     """
 
-    def __init__(self, out: IO[bytes], order: str = "omega-v", spill_bytes: int = SPILL_BYTES):
+    def __init__(self, out: IO[bytes], order: str = "omega-v", spill_bytes: int = SPILL_BYTES, hand=None):
         self.out = out
         self.order = order
+        self.hand = hand
         self.spill_bytes = spill_bytes
         self.chunks: dict[str, list[np.ndarray]] = {}
         self.spilled: dict[str, IO[bytes]] = {}
@@ -51,10 +54,10 @@ class NpzWriter:
         self.rows = 0
         self.tmp = None
 
-    def write(self, block) -> None:
-        """Append a block's rows."""
+    def write(self, block, extra: dict | None = None) -> None:
+        """Append a block's rows, and ``extra`` arrays over them (``follow``'s times and poses)."""
         cols = {}
-        for name, a in arrays(block, self.order).items():
+        for name, a in {**arrays(block, self.order, self.hand), **(extra or {})}.items():
             if name in _INDEXED:
                 index, table = _INDEXED[name]
                 cols[index] = self._index(table, a)
@@ -117,6 +120,8 @@ class NpzWriter:
                     for a in self._parts(name):
                         member.write(np.ascontiguousarray(a.astype(dtype, copy=False)).data)
             tables = {"status_legend": [s.code for s in Status], **{k: list(v) for k, v in self.names.items()}}
+            if self.hand is not None:
+                tables["joint_names"] = list(self.hand.joint_names)
             for name, values in tables.items():
                 with z.open(name + ".npy", "w") as member:
                     np.lib.format.write_array(member, np.array(values, dtype=str), allow_pickle=False)

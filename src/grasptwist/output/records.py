@@ -50,7 +50,8 @@ def records(block, order: str = "omega-v") -> list[dict]:
     float of each.  Consumers that need lists call ``.tolist()``.
     """
     warnings = [[OUTWARD_NORMALS_WARNING] if out else [] for out in block.outward().tolist()]
-    objects = [(k.key, _kind_rows(block, k, order, warnings)) for k in block.kinds()]
+    objects = [(k.key, _kind_rows(block, k, order, warnings)) for k in block.kinds() if k.record is None]
+    written = [(k.key, _written(k)(block, order, warnings)) for k in block.kinds() if k.record is not None]
     ok = (~block.failed_rows()).tolist()
     out = []
     rows = zip(
@@ -81,10 +82,25 @@ def records(block, order: str = "omega-v") -> list[dict]:
         }
         for key, rows_of_kind in objects:
             rec[key] = rows_of_kind[i]
+        for key, rows_of_kind in written:
+            obj, more = rows_of_kind[i]
+            if obj is None:  # the row has none: its record is as without the kind
+                continue
+            rec[key] = obj
+            for owner, fields in more.items():  # fields the kind adds to other kinds' objects
+                if isinstance(rec.get(owner), dict) and "error" not in rec[owner]:
+                    rec[owner].update(fields)
         rec["warnings"] = warnings[i]
         rec["ok"] = ok[i]
         out.append(rec)
     return out
+
+
+def _written(kind):
+    """The record writer a kind names (:attr:`~grasptwist.results.ResultKind.record`)."""
+    from . import kind_records
+
+    return getattr(kind_records, kind.record)
 
 
 def _rows(a):
@@ -143,10 +159,10 @@ def _kind_rows(block, kind, order, warnings):
     conditioning = block.value(kind.key, CONDITIONING)
     for i in np.flatnonzero((status == Status.OK) & (conditioning < CONDITION_WARNING) & applies):
         warnings[i].append(conditioning_warning(conditioning[i], kind.label))
-    skipped = skipped_warning(kind.missing, kind.label)
+    skipped = [skipped_warning(kind.missing, kind.label)] if kind.missing is not None else []
     for i in np.flatnonzero(~applies):
         rows[i] = None
-        warnings[i].append(skipped)
+        warnings[i] += skipped
     return rows
 
 
@@ -155,7 +171,10 @@ def talking_rows(block) -> np.ndarray:
     talk = block.outward().copy()
     for kind in block.kinds():
         ok = block.value(kind.key, STATUS) == Status.OK
-        talk |= (~ok | (block.value(kind.key, CONDITIONING) < CONDITION_WARNING)) | ~block.applies(kind.key)
+        applies = block.applies(kind.key)
+        talk |= (~ok | (block.value(kind.key, CONDITIONING) < CONDITION_WARNING)) & applies
+        if kind.missing is not None:  # skipped: a warning
+            talk |= ~applies
     return talk
 
 
@@ -190,9 +209,12 @@ def _row_objects(block, i, fields_of, order, warnings, with_failure=()):
         warnings.append(OUTWARD_NORMALS_WARNING)
     for kind in block.kinds():
         key = kind.key
+        if kind.record is not None:  # a resolve-only kind (a hand's joint rates)
+            continue
         if not block.applies(key)[i]:
             out[key] = None
-            warnings.append(skipped_warning(kind.missing, kind.label))
+            if kind.missing is not None:
+                warnings.append(skipped_warning(kind.missing, kind.label))
             continue
         status = Status(int(block.value(key, STATUS)[i]))
 

@@ -319,3 +319,46 @@ def _verdict_cell(m):
 
 
 WRITERS = {"resolve": TableWriter, "basis": BasisTableWriter, "check": CheckTableWriter}
+
+
+class HandTable:
+    """A hand's joint rates: per finger its joints and their rates, rank, residual, conditioning."""
+
+    skipped = "the grasp has no hand"
+
+    @staticmethod
+    def contact_columns(m, d) -> list:
+        return [("finger", [f["name"] for f in m["fingers"]])]
+
+    @staticmethod
+    def resolve(m, names, d):
+        from rich.console import Group
+
+        ratio = m["velocity_limit_ratio"]
+        title = "hand: joint rates" + ("" if ratio is None else f"   velocity-limit ratio {ratio:.3g}")
+        t = _table("finger", "contact", "joint", "rate", "rank", "residual", "conditioning", numbers=("rate",))
+        for f in m["fingers"]:
+            for k, (joint, rate) in enumerate(zip(f["joints"], f["joint_rates"])):
+                first = k == 0
+                t.add_row(
+                    f["name"] if first else "",
+                    f["contact"] if first else "",
+                    joint,
+                    fmt_number(rate, d),
+                    str(f["rank"]) if first else "",
+                    f"{f['residual']:.2g}" if first else "",
+                    f"{f['conditioning']:.3g}" if first else "",
+                )
+        return Group(Text(title, style="bold"), t)
+
+    @staticmethod
+    def verdict(m, names) -> list[str]:
+        """Fingers at their velocity limits."""
+        ratio = m["velocity_limit_ratio"]
+        if ratio is not None and ratio > 1:
+            return [f"hand: the joint rates exceed their velocity limits: slow the twist down by {ratio:.3g}."]
+        return []
+
+    @staticmethod
+    def basis(m, names, d) -> list:
+        return []

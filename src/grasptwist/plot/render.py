@@ -245,6 +245,7 @@ _STYLE = {
     "sigma-part": {"color": "tab:blue", "lw": 1.4},
     "psi-part": {"color": "tab:orange", "lw": 1.4},
     "theta-part": {"color": "tab:green", "lw": 1.4},
+    "joint-axis": {"color": "tab:brown", "lw": 2.0, "ls": "-"},
 }
 
 

@@ -14,7 +14,7 @@ fitted to the grasp, so their lengths compare with each other.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -33,6 +33,7 @@ __all__ = [
     "check_method",
     "default_method",
     "grasp_scene",
+    "joint_segments",
     "legend_text",
     "scene",
 ]
@@ -45,6 +46,7 @@ _NORMAL_LEN = 0.25
 _PATCH_HALF = 0.15  # half-side of a tangent-plane square
 _VELOCITY_LEN = 0.45  # the longest chain of velocity arrows at one contact
 _FAR_AXIS = 3.0  # a twist axis further than this from the centroid is not drawn
+_JOINT_HALF = 0.12  # half-length of a finger joint's axis segment
 
 
 # --- scene data ---------------------------------------------------------------
@@ -178,6 +180,7 @@ KINDS = {
     "sigma-part": "part x_i Σ_i(p_i)",  # β_i Σ_i(p_i) in the tangent method: see legend_text
     "psi-part": "part y_j Ψ_j(p_i)",
     "theta-part": "part α_j Θ_j(p_i)",
+    "joint-axis": "finger joint axis",
 }
 
 
@@ -469,7 +472,7 @@ def grasp_scene(grasp, twist=None, *, twist_name: str | None = None, method: str
     if twist is not None and hasattr(twist, "screw"):
         twist_name = twist_name or twist.name
         twist = twist.screw
-    return scene(
+    picture = scene(
         grasp.points,
         grasp.normals,
         grasp.wrist,
@@ -479,3 +482,27 @@ def grasp_scene(grasp, twist=None, *, twist_name: str | None = None, method: str
         grasp_name=grasp.name,
         twist_name=twist_name,
     )
+    if grasp.hand is None:
+        return picture
+    joints = joint_segments(grasp.hand, grasp.joint_positions, _JOINT_HALF * _grasp_size(grasp.points))
+    return replace(picture, segments=picture.segments + joints)
+
+
+def joint_segments(hand, positions, half) -> tuple[Segment, ...]:
+    """Each finger joint's axis at ``positions``: a segment of half-length ``half``
+    through its point (a prismatic joint's along its direction).
+
+    >>> from grasptwist.io.grasp_hand import inline_hand
+    >>> h = inline_hand(["a", "b", "c"], [[("j", "revolute", [0, 0, 2], [1, 0, 0], None, 1)]] * 3, None)
+    >>> s = joint_segments(h, None, 0.5)[0]
+    >>> s.label, s.start.tolist(), s.end.tolist()
+    ('j', [1.0, 0.0, -0.5], [1.0, 0.0, 0.5])
+    """
+    from ..hand import finger_states  # the hand's forward kinematics
+
+    out = []
+    for finger, state in zip(hand.fingers, finger_states(hand, positions)):
+        for joint, screw, point in zip(finger.joints, state.screws, state.points):
+            d = unit(screw[:3] if joint.type == "revolute" else screw[3:])
+            out.append(Segment(point - half * d, point + half * d, joint.name, "joint-axis"))
+    return tuple(out)

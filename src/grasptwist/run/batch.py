@@ -16,6 +16,7 @@ from typing import Any
 
 import numpy as np
 
+from .. import hand
 from ..engine.decompose import contact_velocities
 from ..engine.judgements import outward_normals
 from ..engine.screws import direction, twist_at
@@ -29,6 +30,7 @@ __all__ = [
     "resolve",
     "resolve_arrays",
     "dataset_blocks",
+    "check_positions",
     "ROWS_PER_BLOCK",
     "NO_TWIST",
     "ZERO_TWIST",
@@ -75,6 +77,7 @@ class Block:
     has_wrist: np.ndarray  # (n,) bool
     velocity: np.ndarray  # (n, 3, 3)
     results: dict[str, Any]
+    hands: list | None = None  # per row its Hand or None; None: no row has one
     bases: bool = True  # False: resolved without the basis screws (fields that need them are left out)
     method: str = ALL_METHODS  # the --method asked for
     # field values computed so far, by (kind key, Field); a block cut from another keeps its rows of them
@@ -82,6 +85,13 @@ class Block:
 
     def __len__(self) -> int:
         return len(self.grasp)
+
+    @property
+    def has_hand(self) -> np.ndarray:
+        """Rows whose grasp has a hand."""
+        if self.hands is None:
+            return np.zeros(len(self), bool)
+        return np.array([h is not None for h in self.hands], dtype=bool)
 
     def kinds(self) -> list[ResultKind]:
         """The kinds computed for this block, in registry order."""
@@ -121,7 +131,7 @@ class Block:
 
     def take(self, rows) -> Block:
         """The rows ``rows`` (a slice, or an array of indices) as a block of their own."""
-        cut = {f: _pick(getattr(self, f), rows) for f in _ROW_FIELDS}
+        cut = {f: _pick(getattr(self, f), rows) for f in _ROW_FIELDS if getattr(self, f) is not None}
         block = replace(self, **cut, results={k: r.row(rows) for k, r in self.results.items()})
         block.values.update({k: v[rows] for k, v in self.values.items()})  # what is known stays known
         return block
@@ -139,6 +149,7 @@ _ROW_FIELDS = (
     "wrist",
     "has_wrist",
     "velocity",
+    "hands",
 )
 
 
@@ -149,7 +160,20 @@ def _pick(column, rows):
 
 
 def resolve_arrays(
-    points, normals, wrist, twist, method="both", *, file="", grasp=None, twist_name=None, units=None, bases=True
+    points,
+    normals,
+    wrist,
+    twist,
+    method="both",
+    *,
+    file="",
+    grasp=None,
+    twist_name=None,
+    units=None,
+    bases=True,
+    hands=None,
+    joint_screws=None,
+    joint_limits=None,
 ) -> Block:
     """One block from arrays of rows (a data set, or stacked grasps).
 
@@ -158,13 +182,21 @@ def resolve_arrays(
     (default: the row index and ``"0"``).  ``normals`` should be unit
     already (records show them as given).  ``method`` is one of
     :data:`METHODS`.  ``bases=False`` leaves out the basis screws, for
-    outputs that do not show them (npz).
+    outputs that do not show them (npz).  ``hands`` (per row a Hand or None)
+    with ``joint_screws (N, 3, J, 6)`` and ``joint_limits (N, 3, J)``
+    (:func:`grasptwist.hand.padded`) adds the kinds that need them.
     """
     kinds = selected(method)
     n = len(points)
     has_wrist = np.zeros(n, bool) if wrist is None else np.isfinite(wrist).all(axis=-1)
     wrist = np.full((n, 3), np.nan) if wrist is None else wrist
     inputs = {"points": points, "normals": normals, "wrist": wrist, "twist": twist}
+    if hands is not None:
+        inputs.update(joint_screws=joint_screws, joint_limits=joint_limits)
+    results = {}
+    for k in kinds:
+        if all(name in inputs for name in k.needs):
+            results[k.key] = inputs[k.key] = k.compute(inputs, bases)  # later kinds may use earlier ones
     block = Block(
         file=file if isinstance(file, list) else [file] * n,
         grasp=grasp if grasp is not None else [str(i) for i in range(n)],
@@ -177,13 +209,14 @@ def resolve_arrays(
         wrist=wrist,
         has_wrist=has_wrist,
         velocity=contact_velocities(points, twist),
-        results={k.key: k.compute(inputs, bases) for k in kinds},
+        results=results,
         bases=bases,
         method=method,
+        hands=hands,
     )
-    for k in kinds:  # rows a kind cannot run get its reason, not what the engine made of the stand-in NaN
+    for k in block.kinds():  # rows a method cannot run get its reason, not what the engine made of the stand-in NaN
         can = np.asarray(k.applies(block), dtype=bool)
-        if not can.all():
+        if k.missing is not None and not can.all():
             r = block.results[k.key]
             block.results[k.key] = replace(r, status=np.where(can, r.status, np.int8(k.missing)))
     return block
@@ -253,8 +286,24 @@ def _stack(jobs, method) -> Block:
         grasp=[g.name for g in grasps],
         twist_name=[t.name for _, t in jobs],
         units=[g.units for g in grasps],
+        **_hand_inputs(grasps),
     )
     return replace(block, contact_names=[g.contact_names for g in grasps])
+
+
+def _hand_inputs(grasps) -> dict:
+    """The hand keywords of :func:`resolve_arrays` for grasps (none when no grasp has a hand)."""
+    if all(g.hand is None for g in grasps):
+        return {}
+    width = max(len(f.joints) for g in grasps if g.hand is not None for f in g.hand.fingers)
+    made = {}  # each grasp's fingers once, whatever its number of twists
+    for g in grasps:
+        if g.hand is not None and id(g) not in made:
+            states = hand.finger_states(g.hand, g.joint_positions)
+            made[id(g)] = hand.padded(g.hand, [s.screws for s in states], width)
+    none = (np.zeros((3, width, 6)), np.full((3, width), np.nan))
+    screws, limits = zip(*(made.get(id(g), none) for g in grasps))
+    return {"hands": [g.hand for g in grasps], "joint_screws": np.stack(screws), "joint_limits": np.stack(limits)}
 
 
 def _no_twist(grasp: Grasp) -> GraspFileError:
@@ -278,6 +327,7 @@ def dataset_blocks(
     start: int = 0,
     stop: int | None = None,
     bases: bool = True,
+    hand_of_rows=None,
 ) -> Iterator[Block]:
     """Resolve the grasps ``start:stop`` of a data set, about ``rows`` rows at a time.
 
@@ -285,12 +335,17 @@ def dataset_blocks(
     or else with the data set's own twist; with ``at`` points, a twist's
     linear part is the velocity of the row's ``at`` point.  ``bases=False``
     leaves the basis screws out (see :func:`resolve_arrays`).
+    ``hand_of_rows`` (a Hand, e.g. from ``--hand``) holds every row: at the
+    data set's ``joint_positions`` (at 0 without them), its joint rates are
+    computed per row.
 
     Raises
     ------
     GraspFileError
-        ``no-twist`` when neither gives a twist.
+        ``no-twist`` when neither gives a twist; ``bad-dataset`` when
+        ``joint_positions`` does not fit the hand, or comes without one.
     """
+    check_positions(ds, hand_of_rows)
     if twists is None and ds.twist is None:
         raise GraspFileError(
             code=NO_TWIST,
@@ -302,10 +357,41 @@ def dataset_blocks(
     step = max(1, rows // k)
     end = len(ds) if stop is None else min(stop, len(ds))
     for first in range(start, end, step):
-        yield _dataset_block(ds, given, twists, method, first, min(end, first + step), k, bases)
+        yield _dataset_block(ds, given, twists, method, first, min(end, first + step), k, bases, hand_of_rows)
 
 
-def _dataset_block(ds, given, twists, method, start, stop, k, bases):
+def check_positions(ds, hand_of_rows) -> None:
+    """Raise ``bad-dataset`` when a data set's ``joint_positions`` do not fit ``hand_of_rows``."""
+    if ds.joint_positions is None:
+        return
+    if hand_of_rows is None:
+        raise GraspFileError(
+            "bad-dataset", "joint_positions: give the hand they belong to with --hand FILE.yaml", ds.path
+        )
+    if ds.joint_positions.shape[1] != len(hand_of_rows.joint_names):
+        raise GraspFileError(
+            "bad-dataset",
+            f"joint_positions: {ds.joint_positions.shape[1]} columns, but the hand has "
+            f"{len(hand_of_rows.joint_names)} joints ({', '.join(hand_of_rows.joint_names)})",
+            ds.path,
+        )
+
+
+def _rows_hand(ds, hand_of_rows, start, stop, rows, n):
+    """The hand keywords of :func:`resolve_arrays` for rows ``start:stop`` of a data set."""
+    if hand_of_rows is None:
+        return {}
+    q = None if ds.joint_positions is None else np.asarray(ds.joint_positions[start:stop], dtype=float)[rows]
+    states = hand.finger_states(hand_of_rows, q)
+    screws, limits = hand.padded(hand_of_rows, [s.screws for s in states])
+    return {
+        "hands": [hand_of_rows] * n,
+        "joint_screws": np.broadcast_to(screws, (n, *screws.shape[-3:])),
+        "joint_limits": np.broadcast_to(limits, (n, *limits.shape)),
+    }
+
+
+def _dataset_block(ds, given, twists, method, start, stop, k, bases, hand_of_rows=None):
     """Rows ``start:stop`` of ``ds``, each paired with its ``k`` twists."""
     index = np.repeat(np.arange(start, stop), k)  # row-major: grasp, then its twists
     # each grasp's row repeated for its twists (no copy when there is one twist)
@@ -337,4 +423,5 @@ def _dataset_block(ds, given, twists, method, start, stop, k, bases):
         grasp=label,
         twist_name=names,
         bases=bases,
+        **_rows_hand(ds, hand_of_rows, start, stop, rows, len(index)),
     )

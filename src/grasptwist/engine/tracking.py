@@ -1,0 +1,206 @@
+"""A finger following its contact along an object path: joint positions, rates and where it fails.
+
+Along a path (:mod:`.path`) contact ``i`` moves with the object, to
+``p(t) = R(t) p + x(t)`` with velocity ``T_s(t)(p(t))``.  A finger whose tip
+touches it at the start (joint positions ``q_0``) keeps the tip's contact
+point, fixed on the tip link, on it by resolved-rate control with
+forward-kinematics feedback:
+
+.. math::
+
+    \\dot q = J(q)^+ \\bigl(T_s(p(t)) + k\\,(p(t) - f(q))\\bigr),
+
+``f(q)`` the tip's contact point by forward kinematics and ``J(q)^+`` the
+minimum-norm least-squares inverse (:func:`.kinematics.joint_rates`).  The
+feedback pulls the drift of the integration back, so the tip stays on the
+contact to the integration's accuracy rather than drifting with it.  The
+joint positions are integrated by the classical fourth-order Runge-Kutta
+method on a grid that holds every sample time and segment boundary (where the
+twist jumps), each interval cut into ``steps`` equal steps; the gain is
+``k = 1 / (2 h)`` for a step ``h`` (well inside the method's stability).
+
+Events located between the grid's times by bisection, each trial time
+reached by one Runge-Kutta step from the grid time before it: the first time
+a joint leaves its position limits, and the first time the finger's Jacobian
+loses rank (rank < 3) or its conditioning falls below
+:data:`~.degeneracy.CONDITION_WARNING`.  An event is seen at the first grid
+time where it holds, then located back to its start; one that begins and
+ends within a single step is missed (unlike the grasp's degeneracies, whose
+functions :mod:`.path` bounds in closed form), so ``steps`` sets that grain.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+from . import se3
+from .degeneracy import CONDITION_WARNING
+from .kinematics import forward_kinematics, joint_rates
+from .path import _plan, _poses, _times
+from .screws import field_at, norm
+
+__all__ = ["FingerTrack", "track_finger"]
+
+#: Bisection of an event stops at this fraction of the grid step it is in.
+_PRECISION = 1e-10
+
+
+class FingerTrack(NamedTuple):
+    """What a finger does along a path: arrays over the sample times, then the first events.
+
+    Attributes
+    ----------
+    time : (T,)
+    positions, rates : (T, n)
+        Joint positions, and the joint rates that move the tip's contact
+        point with the contact's velocity there.
+    rank : (T,) int
+    conditioning : (T,)
+        Of the finger's Jacobian (see :class:`.kinematics.JointRates`).
+    error : (T,)
+        Distance from the tip's contact point to the contact.
+    limit_exit : (float, int) or None
+        ``(t, joint)`` of the first time a joint leaves its position limits.
+    rank_loss, warning : float or None
+        The first time the Jacobian's rank falls below 3, and its conditioning
+        below ``CONDITION_WARNING``.
+    """
+
+    time: np.ndarray
+    positions: np.ndarray
+    rates: np.ndarray
+    rank: np.ndarray
+    conditioning: np.ndarray
+    error: np.ndarray
+    limit_exit: tuple | None
+    rank_loss: float | None
+    warning: float | None
+
+
+def track_finger(
+    home_screws, home_points, home_tip, positions, contact, segments, times, *, lower=None, upper=None, steps=16
+) -> FingerTrack:
+    """Follow one contact along a path with one finger (module docstring).
+
+    Parameters
+    ----------
+    home_screws, home_points, home_tip
+        The finger at home, as :func:`.kinematics.forward_kinematics` takes
+        them (``home_tip`` the tip link's ``(4, 4)`` pose).
+    positions : (n,) array
+        Joint positions at ``t = 0``, where the tip touches ``contact``.
+    contact : (3,) array
+        The contact point at ``t = 0``.
+    segments : sequence of Segment
+    times : (T,) array
+        Increasing sample times.
+    lower, upper : (n,) arrays, optional
+        Joint position limits (NaN: none).
+    steps : int
+        Runge-Kutta steps per interval of the grid.
+
+    Returns
+    -------
+    FingerTrack
+
+    Examples
+    --------
+    A two-link arm in the plane y = 0 on a turntable (a base joint about z)
+    holding a point that moves along x:
+
+    >>> from grasptwist.path import Segment
+    >>> screws = [[0, 0, 1.0, 0, 0, 0], [0, 1.0, 0, 0, 0, 0], [0, 1.0, 0, 0, 0, 1.0]]
+    >>> tip = np.eye(4); tip[:3, 3] = [2.0, 0, 0]
+    >>> q0 = [0, -np.pi / 3, 2 * np.pi / 3]
+    >>> start = forward_kinematics(screws, [[0, 0, 0], [0, 0, 0], [1.0, 0, 0]], tip, q0).tip[:3, 3]
+    >>> track = track_finger(screws, [[0, 0, 0], [0, 0, 0], [1.0, 0, 0]], tip, q0, start,
+    ...                      [Segment(1.0, twist=[0, 0, 0, 0.2, 0, 0])], [0.0, 1.0])
+    >>> bool(track.error.max() < 1e-6), track.positions[-1].round(6).tolist()  # elbow: cos q3 = (1.2^2 - 2) / 2
+    (True, [0.0, -0.927295, 1.85459])
+    """
+    plan = _plan(segments)
+    times = _times(times, plan.end)
+    q = np.array(positions, dtype=float)
+    n = q.shape[-1]
+    lower = np.full(n, -np.inf) if lower is None else np.where(np.isnan(lower), -np.inf, lower)
+    upper = np.full(n, np.inf) if upper is None else np.where(np.isnan(upper), np.inf, upper)
+    chain = (np.asarray(home_screws, float), np.asarray(home_points, float), np.asarray(home_tip, float))
+    tip = forward_kinematics(*chain, q).tip
+    local = se3.transform(*se3.inverse(tip[:3, :3], tip[:3, 3]), np.asarray(contact, float))
+    contact = np.asarray(contact, float)
+
+    def state(t, q, k=None):
+        """The target, the tip's point, the finger's joint screws and the target's velocity at
+        ``(t, q)`` (in segment ``k``: the one being integrated, up to its end)."""
+        pose = _poses(plan, np.asarray(t, float), k)
+        target = se3.transform(pose.rotation, pose.position, contact)
+        st = forward_kinematics(*chain, q)
+        point = se3.transform(st.tip[:3, :3], st.tip[:3, 3], local)
+        return target, point, st.screws, field_at(pose.twist, target)
+
+    def rates(t, q, gain, k):
+        target, point, screws, velocity = state(t, q, k)
+        return joint_rates(screws, point, velocity + gain * (target - point)).rates
+
+    def step(t, q, h):
+        gain, k = 0.5 / h, plan.index(t)  # a step never crosses a boundary (the grid holds them)
+        k1 = rates(t, q, gain, k)
+        k2 = rates(t + h / 2, q + h / 2 * k1, gain, k)
+        k3 = rates(t + h / 2, q + h / 2 * k2, gain, k)
+        k4 = rates(t + h, q + h * k3, gain, k)
+        return q + h / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
+
+    def judge(t, q):
+        """What happened at ``(t, q)``: the joint out of its limits, then 0 for a rank loss and
+        0 for a conditioning below the warning level; -1 for nothing."""
+        target, point, screws, velocity = state(t, q)
+        r = joint_rates(screws, point, velocity)
+        out = np.flatnonzero((q < lower) | (q > upper))
+        return (int(out[0]) if out.size else -1, int(r.rank < 3) - 1, int(r.conditioning < CONDITION_WARNING) - 1)
+
+    grid = np.unique(np.concatenate((times, plan.start, [plan.end])))
+    grid = grid[grid <= times[-1]]
+    first = [(0.0, w) if w >= 0 else None for w in judge(0.0, q)]
+    at = {0.0: q.copy()}
+    for a, b in zip(grid[:-1], grid[1:]):
+        h = (b - a) / steps
+        for s in range(steps):
+            t0, t1 = a + s * h, (a + (s + 1) * h if s < steps - 1 else b)
+            q1 = step(t0, q, t1 - t0)
+            for e, w in enumerate(judge(t1, q1)):
+                if first[e] is None and w >= 0:
+                    first[e] = _locate(lambda t, e=e, t0=t0, q=q: judge(t, step(t0, q, t - t0))[e], t0, t1)
+            q = q1
+        at[float(b)] = q.copy()
+    track = np.array([at[float(t)] for t in times])
+    rows = [state(t, p) for t, p in zip(times, track)]
+    solved = [joint_rates(screws, point, velocity) for _, point, screws, velocity in rows]
+    limit, rank, warning = first
+    return FingerTrack(
+        time=times,
+        positions=track,
+        rates=np.array([r.rates for r in solved]),
+        rank=np.array([int(r.rank) for r in solved]),
+        conditioning=np.array([float(r.conditioning) for r in solved]),
+        error=np.array([float(norm(target - point)) for target, point, _, _ in rows]),
+        limit_exit=limit,
+        rank_loss=None if rank is None else rank[0],
+        warning=None if warning is None else warning[0],
+    )
+
+
+def _locate(test, lo, hi):
+    """``(t, test(t))`` at the first time in ``(lo, hi]`` where ``test(t) >= 0``, to ``_PRECISION``
+    of the step, knowing it is not so at ``lo`` and is at ``hi``."""
+    which = test(hi)
+    eps = _PRECISION * (hi - lo)
+    while hi - lo > eps:
+        mid = 0.5 * (lo + hi)
+        got = test(mid)
+        if got >= 0:
+            hi, which = mid, got
+        else:
+            lo = mid
+    return float(hi), int(which)

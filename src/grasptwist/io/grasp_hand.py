@@ -1,0 +1,344 @@
+"""The ``hand:`` key of a grasp file: joint screws given inline, or a URDF.
+
+Two forms (README, "Hands and joint rates"), never mixed:
+
+* inline: ``fingers``, each a list of ``joints`` (``type``, ``axis``,
+  ``point``, ``velocity_limit``) at the current configuration;
+* URDF: ``urdf`` (a path relative to the grasp file, or ``package://``),
+  ``joint_positions`` and ``fingers``, each naming the ``tip`` link that
+  touches its contact.
+
+Checked with the grasp file's own helpers, so problems are located and
+coded like the rest of the format; a URDF's own problems
+(:mod:`grasptwist.io.urdf`) are reported at the ``urdf`` key, the URDF's
+file and line in the message.  Forward kinematics and the length check
+are the engine's (:mod:`grasptwist.engine.kinematics`).
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+
+from ..engine.kinematics import chain_length, joint_screw
+from ..model import Finger, Hand, InputError, Joint
+from . import grasp_file as gf
+
+__all__ = [
+    "load_hand_file",
+    "HAND_KEYS",
+    "INLINE_FINGER_KEYS",
+    "URDF_FINGER_KEYS",
+    "JOINT_KEYS",
+    "JOINT_TYPES",
+    "read_hand",
+    "inline_hand",
+]
+
+HAND_KEYS = ("urdf", "joint_positions", "fingers")
+INLINE_FINGER_KEYS = ("name", "joints")
+URDF_FINGER_KEYS = ("name", "tip")
+JOINT_KEYS = ("name", "type", "axis", "point", "velocity_limit")
+JOINT_TYPES = ("revolute", "prismatic")
+
+
+def read_hand(node, points, file, problems):
+    """``(Hand, joint positions)`` of a ``hand`` node, or None after a problem.
+
+    ``points`` are the contacts (None when they had problems); ``file`` is
+    the grasp file, whose folder a relative ``urdf`` path stays inside.
+    """
+    fields = gf._mapping(node, "hand", HAND_KEYS, ("fingers",), problems)
+    if fields is None:
+        return None
+    urdf = "urdf" in fields
+    if not urdf and "joint_positions" in fields:
+        problems.add(
+            gf._Reject(
+                "conflicting-keys",
+                "hand.joint_positions",
+                "only with 'urdf' (inline joints are given at their current configuration)",
+                **gf._at(fields["joint_positions"]),
+            )
+        )
+    items = gf._sequence(fields["fingers"], "hand.fingers", problems) if "fingers" in fields else None
+    if items is None:
+        return None
+    if len(items) != 3:
+        problems.add(
+            gf._Reject(
+                "finger-count",
+                "hand.fingers",
+                f"expected exactly 3 fingers (one per contact), got {len(items)}",
+                **gf._at(fields["fingers"]),
+            )
+        )
+        return None
+    keys, required = (URDF_FINGER_KEYS, ("tip",)) if urdf else (INLINE_FINGER_KEYS, ("joints",))
+    other = "joints" if urdf else "tip"  # the other form's key: a mix-up, not a misspelling
+    names, fingers = {}, []
+    for i, item in enumerate(items):
+        path = f"hand.fingers[{i}]"
+        finger = gf._mapping(item, path, (*keys, other), required, problems)
+        if finger is None:
+            continue
+        if other in finger:
+            problems.add(
+                gf._Reject(
+                    "conflicting-keys",
+                    f"{path}.{other}",
+                    "mixes the two forms of a hand: "
+                    + ("a URDF hand's fingers name their 'tip' link" if urdf else "'tip' needs 'urdf' in the hand"),
+                    **gf._at(finger[other]),
+                )
+            )
+        gf._entry_name(finger, item, "hand.fingers", i, names, problems)
+        fingers.append(finger)
+    if problems.count:
+        return None
+    names = list(names)
+    if urdf:
+        return _urdf_hand(fields, fingers, names, points, file, problems)
+    taken = {}  # joint names, unique over the hand
+    joints = [_joints(f["joints"], f"hand.fingers[{i}]", names[i], taken, problems) for i, f in enumerate(fingers)]
+    if problems.count:
+        return None
+    hand = inline_hand(names, joints, points)
+    return hand, np.zeros(len(hand.joint_names))
+
+
+def _joints(node, path, finger, taken, problems):
+    """An inline finger's joints as ``(name or None, type, axis, point, limit, line)`` tuples;
+    ``taken`` maps the joint names so far (given, or ``<finger>.<k>``) to their paths."""
+    items = gf._sequence(node, path + ".joints", problems)
+    if items is None:
+        return None
+    out = []
+    for j, item in enumerate(items):
+        where = f"{path}.joints[{j}]"
+        fields = gf._mapping(item, where, JOINT_KEYS, ("axis",), problems)
+        if fields is None:
+            continue
+        name = gf._name(fields["name"], where + ".name", problems) if "name" in fields else None
+        final = f"{finger}.{j + 1}" if name is None else name
+        if final in taken:
+            named = "name" in fields
+            problems.add(
+                gf._Reject(
+                    "duplicate-name",
+                    where + ".name" if named else where,
+                    f"duplicate joint name {final!r} (also {taken[final]})",
+                    **gf._at(fields["name"] if named else item),
+                )
+            )
+        else:
+            taken[final] = where
+        kind = gf._name(fields["type"], where + ".type", problems) if "type" in fields else "revolute"
+        if kind is not None and kind not in JOINT_TYPES:
+            problems.add(
+                gf._Reject(
+                    "unsupported-joint",
+                    where + ".type",
+                    f"expected one of: {', '.join(JOINT_TYPES)}, got {kind!r}",
+                    **gf._at(fields["type"]),
+                )
+            )
+        axis = gf._vector(fields["axis"], 3, where + ".axis", problems) if "axis" in fields else None
+        if axis is not None and not any(axis):
+            problems.add(
+                gf._Reject("zero-axis", where + ".axis", "a zero vector has no direction", **gf._at(fields["axis"]))
+            )
+        point = gf._vector(fields["point"], 3, where + ".point", problems) if "point" in fields else None
+        if "point" not in fields and kind == "revolute":
+            problems.add(
+                gf._Reject(
+                    "missing-key", where + ".point", "a revolute joint needs a point on its axis", **gf._at(item)
+                )
+            )
+        limit = (
+            gf._number(fields["velocity_limit"], where + ".velocity_limit", problems)
+            if "velocity_limit" in fields
+            else None
+        )
+        if limit is not None and limit <= 0:
+            problems.add(
+                gf._Reject(
+                    "invalid-limit",
+                    where + ".velocity_limit",
+                    f"must be positive, got {limit:g}",
+                    **gf._at(fields["velocity_limit"]),
+                )
+            )
+        out.append((name, kind, axis, point, limit, item.line))
+    return out
+
+
+def inline_hand(names, fingers, points):
+    """A :class:`~grasptwist.model.Hand` from joints given at the current configuration.
+
+    Parameters
+    ----------
+    names : sequence of 3 str
+        Finger names.
+    fingers : sequence of 3 lists
+        Each finger's joints, base to tip, as ``(name or None, type, axis,
+        point or None, velocity limit or None, line)``; a joint without a
+        name is ``"<finger>.<k>"``, a prismatic joint without a point is
+        drawn through the contact.
+    points : (3, 3) array or None
+        The contacts, finger ``f`` touching row ``f``: each finger's length
+        runs from its first joint to its contact.  None (a hand file): to
+        its last joint, and a prismatic joint without a point is drawn
+        through the origin.
+
+    Returns
+    -------
+    Hand
+
+    >>> h = inline_hand(["a", "b", "c"], [[(None, "revolute", [0, 0, 2], [0, 0, 0], 3.0, 1)]] * 3, np.eye(3))
+    >>> h.joint_names, h.fingers[0].screws.tolist(), h.fingers[1].length
+    (('a.1', 'b.1', 'c.1'), [[0.0, 0.0, 1.0, 0.0, 0.0, 0.0]], 1.0)
+    """
+    out, joint_names = [], []
+    contacts = [None] * 3 if points is None else np.asarray(points, dtype=float)
+    for name, joints, contact in zip(names, fingers, contacts, strict=True):
+        first = len(joint_names)
+        made = []
+        for k, (joint, kind, _, _, limit, line) in enumerate(joints):
+            made.append(Joint(joint or f"{name}.{k + 1}", kind, limit, None, None, line))
+            joint_names.append(made[-1].name)
+        through = np.zeros(3) if contact is None else contact
+        at = np.array([through if p is None else p for _, _, _, p, _, _ in joints], dtype=float).reshape(-1, 3)
+        screws = joint_screw(np.reshape([j[2] for j in joints], (-1, 3)), at, [j[1] == "prismatic" for j in joints])
+        for a in (screws, at):
+            a.flags.writeable = False
+        out.append(
+            Finger(
+                name=name,
+                tip=None,
+                joints=tuple(made),
+                screws=screws,
+                points=at,
+                tip_pose=None,
+                length=float(chain_length(at, at[-1] if contact is None else contact)),
+                joint_index=tuple(range(first, len(joint_names))),
+            )
+        )
+    return Hand(tuple(out), tuple(joint_names), None, None)
+
+
+def _urdf_hand(fields, fingers, names, points, file, problems):
+    """The URDF form: load the hand, place its joints, check the contacts are on its tips."""
+    from .. import hand as hands  # the URDF reader is optional: imported only for this form
+
+    node = fields["urdf"]
+    reference = gf._name(node, "hand.urdf", problems)
+    positions = _positions(fields.get("joint_positions"), problems)
+    tips = [gf._name(f["tip"], f"hand.fingers[{i}].tip", problems) for i, f in enumerate(fingers)]
+    if problems.count:
+        return None
+    folder = Path(file).parent if not file.startswith("<") else Path.cwd()
+    try:
+        hand = hands.load_urdf_hand(reference, tips, names=names, folder=folder)
+    except InputError as err:
+        problems.add(gf._Reject(err.code, "hand.urdf", str(err), **gf._at(node)))
+        return None
+    values = {}
+    for name, (value, key_node) in positions.items():
+        if name not in hand.joint_names:
+            problems.add(
+                gf._Reject(
+                    "unknown-joint",
+                    f"hand.joint_positions.{name}",
+                    f"not a joint of the hand's fingers ({', '.join(hand.joint_names)})",
+                    **gf._at(key_node),
+                )
+            )
+        values[name] = value
+    if problems.count:
+        return None
+    q = hands.joint_positions(hand, values)
+    if points is None:  # a hand file: the contacts come with each row
+        return hand, q
+    for f, (finger, state) in enumerate(zip(hand.fingers, hands.finger_states(hand, q))):
+        distance = float(np.linalg.norm(points[f] - state.tip[:3, 3]))
+        if distance > finger.length:
+            problems.add(
+                gf._Reject(
+                    "contact-off-finger",
+                    f"hand.fingers[{f}].tip",
+                    f"contact {f + 1} is {distance:.6g} from the origin of link {finger.tip!r}, farther than "
+                    f"finger {finger.name!r} is long ({finger.length:.6g}): are the contacts in the URDF's root frame?",
+                    **gf._at(fingers[f]["tip"]),
+                )
+            )
+    return None if problems.count else (hand, q)
+
+
+def _positions(node, problems):
+    """``{joint: (position, key node)}`` of ``joint_positions`` (empty when not given)."""
+    if node is None or node.kind == "invalid":
+        return {}
+    if node.kind != "mapping":
+        problems.add(
+            gf._Reject(
+                "not-a-mapping",
+                "hand.joint_positions",
+                f"expected a mapping of joint names to positions, got {gf._describe(node)}",
+                **gf._at(node),
+            )
+        )
+        return {}
+    out = {}
+    for key, (key_node, value) in node.value.items():
+        number = gf._number(value, gf._join("hand.joint_positions", key), problems)
+        if number is not None:
+            out[str(key)] = (number, key_node)
+    return out
+
+
+def load_hand_file(path, *, max_bytes=gf.DEFAULT_MAX_BYTES):
+    """The hand of a YAML file that holds just a ``hand:`` mapping (``--hand``).
+
+    Checked like a grasp file's ``hand`` (without contacts, so without
+    ``contact-off-finger``: a data set's rows bring their own).
+
+    Returns
+    -------
+    (Hand, (n_joints,) joint positions)
+
+    Raises
+    ------
+    InputError
+        The file's first problem, located and coded like a grasp file's.
+    """
+    import yaml
+
+    file = os.fspath(path)
+    problems = gf._Problems(gf.MAX_ERRORS)
+    text = ""
+    try:
+        data = gf._read_file(path, max_bytes)
+        if len(data) > max_bytes:
+            raise gf._Reject("too-large", "", f"larger than the size limit of {max_bytes} bytes")
+        text = gf._decode(data)
+        parser = gf.READING.parser(text)
+        try:
+            parser.get_event()  # StreamStartEvent
+            if parser.check_event(yaml.StreamEndEvent):
+                raise gf._Reject("empty-document", "", "no YAML document in the file")
+            parser.get_event()  # DocumentStartEvent
+            root = gf._compose(parser.get_event, problems)
+        finally:
+            parser.dispose()
+    except gf._Reject as reject:
+        raise reject.error(file, None) from None
+    except yaml.YAMLError as exc:
+        raise gf._syntax_error(exc, text).error(file, 0) from None
+    fields = gf._mapping(root, "", ("hand",), ("hand",), problems)
+    hand = read_hand(fields["hand"], None, file, problems) if fields and "hand" in fields else None
+    if problems.count:
+        raise problems.first()[0].error(file, 0)
+    return hand

@@ -1,0 +1,210 @@
+"""Records of ``follow``: one per sample of a path, then the path's summary.
+
+A sample record is a ``resolve`` record of the moved grasp (built by
+:func:`grasptwist.output.records.records`, so the method fields, warnings and
+``ok`` are exactly resolve's) with the path's fields in place of the twist's
+name, the units and the contact velocities.  The summary record reports
+what :func:`grasptwist.engine.path.degeneracies` found.  CSV rows and npz
+arrays are the block's columns (:mod:`grasptwist.output.columns`) after the
+path's own.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from typing import NamedTuple
+
+import numpy as np
+
+from ..engine.degeneracy import CONDITION_WARNING, Status, status_message
+from ..engine.se3 import matrix_to_quaternion
+from ..results import KINDS
+from .columns import CSV_COLUMNS, columns
+from .csv_rows import lines
+from .records import _printable, dumps
+
+__all__ = [
+    "ENCODINGS",
+    "Encoding",
+    "sample_records",
+    "summary_record",
+    "diagnostics",
+    "CSV_HEADER",
+    "csv_rows",
+    "path_arrays",
+    "crossing_text",
+]
+
+#: The block columns a follow CSV row leaves out (the path's own replace them).
+_NOT_IN_CSV = ("file", "grasp", "twist")
+
+#: The path's own CSV columns, first in a row.
+_OWN = (
+    ("file", "grasp", "path", "segment", "t")
+    + tuple(f"position_{a}" for a in "xyz")
+    + tuple(f"rotation_{a}" for a in "wxyz")
+)
+
+#: The CSV header of ``follow``.
+CSV_HEADER = ",".join(_OWN + tuple(c for c in CSV_COLUMNS if c not in _NOT_IN_CSV)).encode() + b"\n"
+
+#: A status by its code.
+_STATUS = {s.code: s for s in Status}
+
+#: A kind's label -> its key (``off-tangent`` -> ``off_tangent``).
+_KEY = {k.label: k.key for k in KINDS}
+
+
+def _pose(samples):
+    """Per sample ``(position (N, 3), quaternion w first (N, 4))``, no ``-0.0``."""
+    p = samples.poses
+    return p.position + 0.0, matrix_to_quaternion(p.rotation) + 0.0
+
+
+def sample_records(samples, order: str = "omega-v") -> list[dict]:
+    """The record of each sample of a :class:`~grasptwist.run.follow.Samples`."""
+    from .records import records
+
+    position, quaternion = _pose(samples)
+    segment, time = samples.poses.segment.tolist(), samples.poses.time.tolist()
+    out = []
+    for i, rec in enumerate(records(samples.block, order)):
+        new = {
+            "file": rec["file"],
+            "grasp": rec["grasp"],
+            "path": samples.path,
+            "segment": segment[i],
+            "t": time[i],
+            "pose": {"position": position[i], "rotation": quaternion[i]},
+            "contacts": rec["contacts"],
+            "twist": {"screw": rec["twist"]["screw"]},
+        }
+        for kind in KINDS:
+            if kind.key in rec:
+                new[kind.key] = rec[kind.key]
+        new["warnings"] = rec["warnings"]
+        new["ok"] = rec["ok"]
+        out.append(new)
+    return out
+
+
+def summary_record(summary) -> dict:
+    """The record closing a path: its duration, samples, smallest conditioning
+    per method, degenerate stretches and first warning (README "Paths")."""
+    found, names = summary.found, summary.grasp.contact_names
+    labels = [k.label for k in KINDS if k.label in summary.labels]
+    smallest = {}
+    for label in labels:
+        value = found.min_conditioning.get(label)
+        smallest[_KEY[label]] = None if value is None else {"value": value[0], "t": value[1]}
+    degenerate = [
+        {
+            "method": c.method,
+            "code": c.code,
+            "t_start": c.t_start,
+            "t_end": c.t_end,
+            "culprit": names[c.culprit] if c.culprit >= 0 else None,
+        }
+        for c in found.crossings
+        if c.method in labels
+    ]
+    started = [(t, m) for m, t in found.warning_start.items() if t is not None and m in labels]
+    first = min(started, default=None)
+    return {
+        "file": summary.file,
+        "grasp": summary.grasp.name,
+        "path": summary.path,
+        "summary": {
+            "duration": found.duration,
+            "samples": summary.samples,
+            "min_conditioning": smallest,
+            "degenerate": degenerate,
+            "first_warning": None if first is None else {"method": first[1], "t": first[0]},
+        },
+        "ok": not degenerate,
+    }
+
+
+def crossing_text(c: dict, names=("1", "2", "3"), digits: int = 4) -> str:
+    """A degenerate stretch of a summary in words (the condition and when).
+
+    >>> crossing_text({"method": "off-tangent", "code": "wrist-coplanar", "t_start": 1.5707963, "t_end": 1.5707963})
+    "the wrist crosses the contacts' plane at t = 1.5708"
+    """
+    a, b = f"{c['t_start']:.{digits}f}", f"{c['t_end']:.{digits}f}"
+    if c["code"] == Status.WRIST_COPLANAR.code:
+        if c["t_start"] == c["t_end"]:
+            return f"the wrist crosses the contacts' plane at t = {a}"
+        return f"the wrist is in the contacts' plane from t = {a} to t = {b}"
+    culprit = names.index(c["culprit"]) if c.get("culprit") in names else -1
+    return f"from t = {a} to t = {b}: {status_message(_STATUS[c['code']], culprit, names)}"
+
+
+def diagnostics(rec: dict, names=("1", "2", "3")) -> tuple[list[str], list[str]]:
+    """The stderr lines of a summary record (its grasp's contacts named ``names``): one error per
+    degenerate stretch, one warning for the first time a conditioning falls below the warning level."""
+    where = f"{_printable(rec['file'])}: grasp '{_printable(rec['grasp'])}', path '{_printable(rec['path'])}'"
+    s = rec["summary"]
+    errors = [f"{where}: error: {c['method']}: {c['code']}: {crossing_text(c, names, 6)}" for c in s["degenerate"]]
+    warnings = []
+    if s["first_warning"] is not None:
+        w = s["first_warning"]
+        warnings.append(
+            f"{where}: warning: {w['method']}: conditioning below {CONDITION_WARNING:g} from t = {w['t']:.6g}"
+        )
+    return errors, warnings
+
+
+def csv_rows(samples, order: str = "omega-v") -> list[bytes]:
+    """The CSV line of each sample (header :data:`CSV_HEADER`)."""
+    block = samples.block
+    position, quaternion = _pose(samples)
+    own = {
+        "file": np.asarray(block.file, dtype=object),
+        "grasp": np.asarray(block.grasp, dtype=object),
+        "path": np.asarray(block.twist_name, dtype=object),
+        "segment": samples.poses.segment,
+        "t": samples.poses.time,
+    }
+    own.update({f"position_{a}": position[:, j] for j, a in enumerate("xyz")})
+    own.update({f"rotation_{a}": quaternion[:, j] for j, a in enumerate("wxyz")})
+    rest = {k: v for k, v in columns(block, order).items() if k not in _NOT_IN_CSV}
+    return lines({**own, **rest})
+
+
+def path_arrays(samples, order: str = "omega-v") -> dict[str, np.ndarray]:
+    """The arrays a follow npz adds to a block's: ``t``, ``segment``, ``position`` and ``rotation``
+    (quaternions, w first); its ``twist`` is the instantaneous space twist."""
+    position, quaternion = _pose(samples)
+    return {"t": samples.poses.time, "segment": samples.poses.segment, "position": position, "rotation": quaternion}
+
+
+def csv_error_row(rec: dict) -> bytes:
+    """The CSV line of an input that failed: its file, ``ok`` false and the error."""
+    err = rec["error"]
+    row = [rec["file"]] + [""] * (len(_OWN) - 1) + ["false", f"{err['code']}: {err['message']}"]
+    width = CSV_HEADER.count(b",") + 1
+    return lines({str(j): np.array([v], dtype=object) for j, v in enumerate(row + [""] * (width - len(row)))})[0]
+
+
+class Encoding(NamedTuple):
+    """How one output format encodes follow's records (None: the format does not write them)."""
+
+    samples: Callable | None  # (Samples, order) -> encoded rows
+    summary: Callable | None  # summary record -> encoded
+    error: Callable | None  # error record -> encoded
+
+
+def _json_samples(samples, order):
+    return [dumps(r) for r in sample_records(samples, order)]
+
+
+#: Per output format (:data:`grasptwist.output.formats.FORMATS`): how follow's records are encoded.
+#: CSV and npz hold the samples only; their summaries are the stderr lines (:func:`diagnostics`).
+ENCODINGS = {
+    "table": Encoding(sample_records, lambda rec: rec, lambda rec: rec),
+    "json": Encoding(_json_samples, dumps, dumps),
+    "jsonl": Encoding(_json_samples, dumps, dumps),
+    "csv": Encoding(csv_rows, None, csv_error_row),
+    "npz": Encoding(None, None, None),  # takes the blocks, with path_arrays
+}

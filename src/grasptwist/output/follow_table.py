@@ -1,0 +1,108 @@
+"""The ``follow`` table: a compact timeline per path, then its summary in words.
+
+Plain fixed-width text, written as the records come (one line per sample),
+so a long path streams and needs no memory; it reads the records only (see
+:mod:`grasptwist.output.follow_records`).  Each sample line holds the time,
+the segment, the pose (position, quaternion w first), and per method its
+amplitudes and conditioning, or the code of its failure.
+"""
+
+from __future__ import annotations
+
+from typing import IO
+
+from .follow_records import crossing_text
+
+__all__ = ["FollowTable"]
+
+#: Per method: its record key, label and the amplitudes shown.
+_METHODS = (("off_tangent", "off-tangent", ("x", "y")), ("tangent", "tangent", ("alpha", "beta")))
+
+
+class FollowTable:
+    """A writer of follow records as a table (``write(record)``, ``close()``)."""
+
+    def __init__(self, out: IO[bytes], digits: int = 4, order: str = "omega-v", **_):
+        self.out = out
+        self.digits = digits
+        self.width = digits + 4  # sign, up to two digits before the point, the point
+        self.current = None  # (file, grasp, path) of the timeline being written
+        self.names = ("1", "2", "3")  # its contacts' names
+
+    def _number(self, v) -> str:
+        return "-" if v is None else f"{v:{self.width}.{self.digits}f}"
+
+    def _vector(self, v) -> str:
+        return " ".join(self._number(float(a)) for a in v)
+
+    def _say(self, text: str = "") -> None:
+        self.out.write(text.encode() + b"\n")
+
+    def _header(self, rec, methods):
+        vector = 3 * (self.width + 1) - 1
+        cells = [
+            f"{'t':>{self.width}}",
+            "seg",
+            f"{'position':<{vector}}",
+            f"{'rotation (w x y z)':<{vector + self.width + 1}}",
+        ]
+        for _, label, amplitudes in methods:
+            cells += [f"{f'{label} {a}':<{vector}}" for a in amplitudes] + [f"{'cond':>{self.width}}"]
+        if self.current is not None:
+            self._say()
+        self._say(f"{rec['file']}: grasp '{rec['grasp']}', path '{rec['path']}'")
+        self._say("  ".join(cells).rstrip())
+
+    def write(self, rec: dict) -> None:
+        if "error" in rec:  # the error line is on stderr; tables carry results only
+            return
+        if "summary" in rec:
+            self._summary(rec)
+            self.current = None
+            return
+        methods = [m for m in _METHODS if m[0] in rec]
+        here = (rec["file"], rec["grasp"], rec["path"])
+        if here != self.current:
+            self._header(rec, methods)
+            self.current = here
+            self.names = tuple(c["name"] for c in rec["contacts"])
+        pose = rec["pose"]
+        cells = [
+            self._number(rec["t"]),
+            f"{rec['segment']:>3}",
+            self._vector(pose["position"]),
+            self._vector(pose["rotation"]),
+        ]
+        vector = 3 * (self.width + 1) - 1
+        for key, _, amplitudes in methods:
+            m = rec[key]
+            if m is None or "error" in m:
+                text = "-" if m is None else m["error"]["code"]
+                cells += [f"{text:<{len(amplitudes) * (vector + 2) - 2}}", f"{'-':>{self.width}}"]
+            else:
+                cells += [self._vector(m[a]) for a in amplitudes] + [self._number(m["conditioning"])]
+        self._say("  ".join(cells).rstrip())
+
+    def _summary(self, rec):
+        s = rec["summary"]
+        self._say(f"summary: duration {s['duration']:.{self.digits}f}, {s['samples']} samples")
+        for c in s["degenerate"]:
+            self._say(f"  {crossing_text(c, self.names, self.digits)} ({c['method']} degenerate)")
+        if not s["degenerate"]:
+            self._say("  no degeneracy along the path")
+        smallest = [
+            f"{key.replace('_', '-')} {m['value']:.{self.digits}g} at t = {m['t']:.{self.digits}f}"
+            for key, m in s["min_conditioning"].items()
+            if m is not None and m["value"] == m["value"]  # a failed method may have none (NaN)
+        ]
+        if smallest:
+            self._say(f"  smallest conditioning: {'; '.join(smallest)}")
+        w = s["first_warning"]
+        self._say(
+            "  no conditioning warning"
+            if w is None
+            else f"  first warning: {w['method']} at t = {w['t']:.{self.digits}f}"
+        )
+
+    def close(self) -> None:
+        self.out.flush()

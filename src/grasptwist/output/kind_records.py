@@ -1,0 +1,78 @@
+"""Record objects of result kinds whose shape depends on the row (see :attr:`ResultKind.record`).
+
+A hand's fingers have their own joints, so its object cannot be a fixed
+list of fields: :func:`hand_objects` writes it from the engine's
+:class:`~grasptwist.engine.kinematics.HandRates`.  Nothing is computed
+here: every number and verdict comes from the engine.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..engine.degeneracy import CONDITION_WARNING, Status, status_message
+from ..results import BY_KEY
+
+__all__ = ["hand_objects"]
+
+
+def _number(x):
+    """A float, or None for NaN (no value)."""
+    x = float(x)
+    return None if np.isnan(x) else x + 0.0
+
+
+def _finger_rates(rates, finger):
+    """One finger's rates from the padded ``(..., J)`` row: its own joints only."""
+    return (rates[..., : len(finger.joints)] + 0.0).tolist()
+
+
+def hand_objects(block, order, warnings):
+    """Per row, ``(hand object or None, {method key: {"joint_rates": ...}})``.
+
+    The hand object is the README's ``hand`` (fingers in contact order);
+    each method computed gains ``joint_rates``: per component in basis
+    order, per finger, that component's joint rates.  Rows whose finger
+    is near a singularity get a warning in ``warnings``.
+    """
+    r = block.results["hand"]
+    applies = block.applies("hand")
+    out = []
+    for i in range(len(block)):
+        hand = block.hands[i] if applies[i] else None
+        if hand is None:
+            out.append((None, {}))
+            continue
+        names = block.contact_names[i]
+        fingers = []
+        for f, finger in enumerate(hand.fingers):
+            conditioning = float(r.finger_conditioning[i, f])
+            fingers.append(
+                {
+                    "name": finger.name,
+                    "contact": names[f],
+                    "tip": finger.tip,
+                    "joints": [j.name for j in finger.joints],
+                    "joint_rates": _finger_rates(r.rates[i, f], finger),
+                    "rank": int(r.finger_rank[i, f]),
+                    "residual": _number(r.finger_residual[i, f]),
+                    "conditioning": _number(conditioning),
+                    "velocity_limit_ratio": _number(r.finger_limit_ratio[i, f]),
+                }
+            )
+            if conditioning < CONDITION_WARNING and r.status[i] == Status.OK:
+                warnings[i].append(
+                    f"hand: finger {finger.name!r} is near a singularity (conditioning {conditioning:.3g} < "
+                    f"{CONDITION_WARNING:g}): its joint rates are large and sensitive"
+                )
+        obj = {"fingers": fingers, "velocity_limit_ratio": _number(r.velocity_limit_ratio[i]), "ok": bool(r.ok[i])}
+        if not r.ok[i]:
+            status = Status(int(r.status[i]))
+            names = BY_KEY["hand"].culprit_names(block, i)  # the culprit is a finger
+            obj["error"] = {"code": status.code, "message": status_message(status, r.culprit[i], names)}
+        more = {
+            key: {"joint_rates": [[_finger_rates(c[f], fi) for f, fi in enumerate(hand.fingers)] for c in parts[i]]}
+            for key, parts in r.components.items()
+        }
+        out.append((obj, more))
+    return out

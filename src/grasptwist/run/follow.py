@@ -1,0 +1,228 @@
+"""Follow object paths: grasps in, sample blocks and per-path findings out.
+
+For each grasp of each input and each of its paths (or the command line's),
+the engine moves the grasp along the path and resolves every sample's
+instantaneous twist (:func:`grasptwist.engine.path.follow`, a chunk of
+samples at a time so that memory stays bounded), then finds the path's
+degeneracies between the samples (:func:`grasptwist.engine.path.degeneracies`).
+Samples come out as ordinary result :class:`~grasptwist.run.batch.Block`
+objects, so that records, columns and warnings are the ones ``resolve``
+writes.  No math here: only slicing and labelling.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Iterable, Iterator
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..engine.path import PathDegeneracies, Poses, degeneracies, follow
+from ..io.datasets import DATASET_SUFFIXES
+from ..io.inputs import read
+from ..model import Grasp, GraspFileError, ObjectPath
+from ..results import selected
+from .batch import Block
+from .pipeline import Output
+
+__all__ = [
+    "FollowJob",
+    "Samples",
+    "Summary",
+    "follow_inputs",
+    "write_follow",
+    "sample_times",
+    "NO_PATH",
+    "COMMAND_LINE",
+    "MAX_SAMPLES",
+]
+
+#: Error code of a grasp with no path to follow (or none of the name asked for).
+NO_PATH = "no-path"
+
+#: Name of the path given on the command line (``--twist``/``--duration``).
+COMMAND_LINE = "command-line"
+
+#: Most samples of one path (the per-path analysis holds them all at once).
+MAX_SAMPLES = 1_000_000
+
+#: Samples per engine call.
+CHUNK = 4096
+
+
+@dataclass(frozen=True)
+class FollowJob:
+    """What ``follow`` was asked.
+
+    Attributes
+    ----------
+    method : str
+        A ``--method`` value.
+    path : str or None
+        Follow only the paths of this name.
+    segments : tuple of Segment or None
+        The command line's path, replacing the files'.
+    samples : int or None
+        Samples per path, evenly spaced, both ends included.
+    dt : float or None
+        Time step between samples instead (the path's end is a sample too).
+    max_bytes : int or None
+        Size cap of a grasp file.
+    bases : bool
+        Keep the basis screws (formats that show them).
+    """
+
+    method: str = "both"
+    path: str | None = None
+    segments: tuple | None = None
+    samples: int | None = None
+    dt: float | None = None
+    max_bytes: int | None = None
+    bases: bool = True
+
+
+@dataclass(frozen=True, eq=False)
+class Samples:
+    """Consecutive samples of one path: the results block and where each sample is.
+
+    ``block``'s ``twist_name`` holds the path's name; ``poses`` are the
+    samples' times, segments, poses and space twists.
+    """
+
+    path: str
+    block: Block
+    poses: Poses
+
+
+@dataclass(frozen=True, eq=False)
+class Summary:
+    """What a path does to one grasp, after its samples."""
+
+    file: str
+    grasp: Grasp
+    path: str
+    samples: int
+    found: PathDegeneracies
+    labels: tuple[str, ...]  # the methods run
+
+
+def sample_times(duration: float, samples: int | None = None, dt: float | None = None) -> np.ndarray:
+    """Sample times over ``[0, duration]``: ``samples`` evenly spaced, or every ``dt`` and the end.
+
+    >>> sample_times(2.0, samples=3).tolist(), sample_times(1.0, dt=0.4).tolist()
+    ([0.0, 1.0, 2.0], [0.0, 0.4, 0.8, 1.0])
+    """
+    if dt is None:
+        return np.linspace(0.0, duration, samples if samples is not None else 21)
+    count = math.ceil(duration / dt)
+    if count >= MAX_SAMPLES:
+        raise ValueError(f"a step of {dt!r} gives more than {MAX_SAMPLES} samples over a duration of {duration!r}")
+    return np.append(np.arange(count) * dt, duration)
+
+
+def follow_inputs(job: FollowJob, inputs: Iterable) -> Iterator[GraspFileError | Samples | Summary]:
+    """Every path of every grasp of ``inputs`` (paths or the errors of ``expand``), in order."""
+    for item in inputs:
+        if isinstance(item, GraspFileError):
+            yield item
+        elif item.endswith(DATASET_SUFFIXES):
+            yield GraspFileError("read-error", "follow reads grasp files, not data sets", item)
+        else:
+            for entry in read(item, job.max_bytes):
+                yield from _grasp(job, entry) if isinstance(entry, Grasp) else (entry,)
+
+
+def write_follow(job: FollowJob, inputs: Iterable, w, fmt: str, order: str = "omega-v") -> Iterator[Output]:
+    """Follow every path and write its records to ``w`` in format ``fmt``; per input error,
+    sample chunk and summary, the :class:`~grasptwist.run.pipeline.Output` of its counts and
+    stderr lines (a path's lines are its summary's: samples are counted, not told)."""
+    from ..output import follow_records as fr
+    from ..output.records import diagnostics, error_record
+
+    encoding = fr.ENCODINGS[fmt]
+    for item in follow_inputs(job, inputs):
+        if isinstance(item, Samples):
+            if encoding.samples is None:
+                w.write(item.block, fr.path_arrays(item, order))
+            else:
+                for encoded in encoding.samples(item, order):
+                    w.write(encoded)
+            yield Output(records=len(item.block), failed=int(item.block.failed_rows().sum()))
+            continue
+        rec = error_record(item) if isinstance(item, GraspFileError) else fr.summary_record(item)
+        encode = encoding.error if isinstance(item, GraspFileError) else encoding.summary
+        if encode is not None:
+            w.write(encode(rec))
+        errors, warnings = (
+            diagnostics(rec) if isinstance(item, GraspFileError) else fr.diagnostics(rec, item.grasp.contact_names)
+        )
+        yield Output(errors=errors, warnings=warnings, records=1, failed=int(not rec["ok"]))
+
+
+def _grasp(job, grasp):
+    paths = (ObjectPath(COMMAND_LINE, job.segments, None),) if job.segments else grasp.paths
+    chosen = [p for p in paths if job.path is None or p.name == job.path]
+    if not chosen:
+        yield _no_path(grasp, job.path)
+    for p in chosen:
+        yield from _path(job, grasp, p)
+
+
+def _path(job, grasp, p):
+    labels = tuple(k.label for k in selected(job.method))
+    # a grasp without a wrist gets NaN, as resolve gives it: off-tangent is then null, not missing
+    wrist = grasp.wrist if grasp.wrist is not None else np.full(3, np.nan)
+    duration = float(sum(s.duration for s in p.segments))
+    try:
+        times = sample_times(duration, job.samples, job.dt)
+    except ValueError as exc:
+        yield GraspFileError("too-many-samples", f"path '{p.name}': {exc}", grasp.file, p.line, None)
+        return
+    for start in range(0, len(times), CHUNK):
+        f = follow(
+            grasp.points,
+            grasp.normals,
+            wrist,
+            p.segments,
+            times[start : start + CHUNK],
+            method=job.method,
+            bases=job.bases,
+        )
+        yield Samples(p.name, _block(grasp, p.name, f, job.bases), f.poses)
+    found = degeneracies(grasp.points, grasp.normals, grasp.wrist, p.segments, times)
+    yield Summary(grasp.file, grasp, p.name, len(times), found, labels)
+
+
+def _block(grasp, name, f, bases) -> Block:
+    n = len(f.poses.time)
+    results = {"off_tangent": f.off_tangent, "tangent": f.tangent}
+    return Block(
+        file=[grasp.file] * n,
+        grasp=[grasp.name] * n,
+        units=[grasp.units] * n,
+        twist_name=[name] * n,
+        contact_names=[grasp.contact_names] * n,
+        points=f.points,
+        normals=f.normals,
+        twist=f.poses.twist,
+        wrist=np.broadcast_to(grasp.wrist if grasp.wrist is not None else np.full(3, np.nan), (n, 3)),
+        has_wrist=np.full(n, grasp.wrist is not None),
+        velocity=f.velocities,
+        results={k: r for k, r in results.items() if r is not None},
+        bases=bases,
+    )
+
+
+def _no_path(grasp: Grasp, name: str | None) -> GraspFileError:
+    wanted = f"no path named '{name}'" if name is not None else "no path to follow"
+    return GraspFileError(
+        code=NO_PATH,
+        message=(
+            f"grasp '{grasp.name}' has {wanted}: add a 'paths:' list to the file "
+            "or pass --twist W1,W2,W3,V1,V2,V3 --duration T (repeatable)"
+        ),
+        file=grasp.file,
+        line=grasp.line,
+        column=1,
+    )
