@@ -5,6 +5,7 @@ command (a real subprocess); output contents in process, which is quicker."""
 
 import csv
 import io
+import json
 from types import SimpleNamespace
 
 import numpy as np
@@ -204,3 +205,15 @@ def test_plot_help_says_how_to_install_matplotlib_from_a_clone():
     p, _ = run_installed("plot", "--help")
     text = " ".join(p.stdout.split())  # as one line, however the help is wrapped
     assert p.returncode == 0 and "from a clone, pip install '.[plot]'" in text and "grasptwist[plot]" not in text
+
+
+def test_follow_fails_an_off_tangent_asked_for_without_wrist_as_resolve_does(files):
+    args = ("follow", files / "nowrist.yaml", "--twist", "0,0,1,0,0,0", "--duration", "1", "--samples", "2")
+    p, _ = in_process(*args, "--method", "off-tangent", "-f", "jsonl")
+    samples = [r for r in map(json.loads, p.stdout.splitlines()) if "t" in r]
+    assert p.returncode == 1 and [r["t"] for r in samples] == [0.0, 1.0]
+    assert all(r["off_tangent"] == {"error": {"code": "no-wrist", "message": NO_WRIST}} for r in samples)
+    assert not any(r["ok"] for r in samples)
+    p, _ = in_process(*args, "-f", "jsonl")
+    samples = [r for r in map(json.loads, p.stdout.splitlines()) if "t" in r]
+    assert p.returncode == 0 and all(r["off_tangent"] is None and r["warnings"] == [SKIPPED] for r in samples)

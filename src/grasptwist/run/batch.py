@@ -29,6 +29,7 @@ __all__ = [
     "Block",
     "resolve",
     "resolve_arrays",
+    "with_reasons",
     "dataset_blocks",
     "check_positions",
     "ROWS_PER_BLOCK",
@@ -214,7 +215,14 @@ def resolve_arrays(
         method=method,
         hands=hands,
     )
-    for k in block.kinds():  # rows a method cannot run get its reason, not what the engine made of the stand-in NaN
+    return with_reasons(block)
+
+
+def with_reasons(block: Block) -> Block:
+    """``block`` with each method's status, in rows where it cannot run, set to
+    the reason (its ``missing``, ``no-wrist``) instead of what the engine made
+    of the NaN standing in for the missing input; returns ``block``."""
+    for k in block.kinds():
         can = np.asarray(k.applies(block), dtype=bool)
         if k.missing is not None and not can.all():
             r = block.results[k.key]
