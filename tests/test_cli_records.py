@@ -76,10 +76,10 @@ def test_off_tangent_asked_for_on_a_grasp_without_wrist_fails_with_no_wrist(file
         assert np.isnan(z["x"]).all()
 
 
-@pytest.mark.parametrize("command", ["check", "basis"])
-def test_check_and_basis_fail_an_off_tangent_asked_for_without_wrist_and_warn_under_both(files, command):
+@pytest.mark.parametrize("command, cli", [("check", run_installed), ("basis", in_process)])
+def test_check_and_basis_fail_an_off_tangent_asked_for_without_wrist_and_warn_under_both(files, command, cli):
     path = files / "nowrist.yaml"
-    p, _ = run_installed(command, path, "--method", "off-tangent", "-f", "jsonl")
+    p, _ = cli(command, path, "--method", "off-tangent", "-f", "jsonl")
     [rec] = jsonl(p.stdout)
     assert p.returncode == 1 and rec["ok"] is False
     assert rec["off_tangent"]["error"] == {"code": "no-wrist", "message": NO_WRIST}
@@ -87,7 +87,7 @@ def test_check_and_basis_fail_an_off_tangent_asked_for_without_wrist_and_warn_un
         f"{where(path, None)}: error: off-tangent: no-wrist: {NO_WRIST}",
         "1 record, 1 failed",
     ]
-    p, _ = run_installed(command, path, "-f", "jsonl")
+    p, _ = cli(command, path, "-f", "jsonl")
     [rec] = jsonl(p.stdout)
     assert p.returncode == 0 and rec["ok"] is True and rec["off_tangent"] is None and rec["warnings"] == [SKIPPED]
     assert rec["tangent"]["conditioning"] == pytest.approx(0.0995058864995588, rel=1e-12)
@@ -113,10 +113,10 @@ def test_under_both_the_skip_is_a_warning_and_the_tangent_result_stays(files):
 # Outward normals: a warning with its code, for every command.
 
 
-@pytest.mark.parametrize("command", ["resolve", "check", "basis"])
-def test_outward_normals_get_a_warning_inward_ones_none(files, command):
+@pytest.mark.parametrize("command, cli", [("resolve", run_installed), ("check", in_process), ("basis", in_process)])
+def test_outward_normals_get_a_warning_inward_ones_none(files, command, cli):
     path = files / "outward.yaml"
-    p, _ = run_installed(command, path, "-f", "jsonl")
+    p, _ = cli(command, path, "-f", "jsonl")
     [rec] = jsonl(p.stdout)
     assert p.returncode == 0 and rec["ok"] is True
     assert rec["warnings"] == [OUTWARD_NORMALS_WARNING] and rec["warnings"][0].startswith("outward-normals: ")
