@@ -168,9 +168,19 @@ def test_a_data_set_s_wrist_rows_reach_the_records(files):
     )
     p, _ = in_process("resolve", data, "--twist", "0,0,1,0,0,0", "--method", "tangent", "-f", "jsonl")
     assert p.returncode == 0 and [r["wrist"] for r in jsonl(p.stdout)] == [[0.5, 0.0, 1.0], None]
+    # a wrist column gives every row a wrist: NaN there is a bad input, not a grasp without one
     p, _ = in_process("resolve", data, "--twist", "0,0,1,0,0,0", "-f", "csv")
     rows = list(csv.DictReader(io.StringIO(p.stdout)))
-    assert [(r["c_x"], r["c_z"], r["ok"]) for r in rows] == [("0.5", "1.0", "true"), ("", "", "true")]
+    assert [(r["c_x"], r["c_z"], r["ok"]) for r in rows] == [("0.5", "1.0", "true"), ("", "", "false")]
+    assert rows[1]["off_tangent_error"].startswith("nonfinite-input: ")
+    # a data set without one: the records say null, and off-tangent is skipped with a warning
+    np.savez(data, points=np.stack([grasp.points] * 2), normals=np.stack([grasp.normals] * 2))
+    p, _ = in_process("resolve", data, "--twist", "0,0,1,0,0,0", "-f", "jsonl")
+    recs = jsonl(p.stdout)
+    assert (
+        p.returncode == 0
+        and [(r["wrist"], r["off_tangent"], r["warnings"]) for r in recs] == [(None, None, [SKIPPED])] * 2
+    )
 
 
 def test_twist_names_pair_with_twists_in_order(files):

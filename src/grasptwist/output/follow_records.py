@@ -21,7 +21,8 @@ from ..engine.se3 import matrix_to_quaternion
 from ..results import KINDS
 from .columns import CSV_COLUMNS, columns
 from .csv_rows import lines
-from .records import _printable, dumps
+from .names import escaped
+from .records import dumps
 
 __all__ = [
     "ENCODINGS",
@@ -111,9 +112,9 @@ def summary_record(summary) -> dict:
     started = [(t, m) for m, t in found.warning_start.items() if t is not None and m in labels]
     first = min(started, default=None)
     return {
-        "file": summary.file,
-        "grasp": summary.grasp.name,
-        "path": summary.path,
+        "file": escaped(summary.file, controls=False),
+        "grasp": escaped(summary.grasp.name, controls=False),
+        "path": escaped(summary.path, controls=False),
         "summary": {
             "duration": found.duration,
             "samples": summary.samples,
@@ -143,7 +144,7 @@ def crossing_text(c: dict, names=("1", "2", "3"), digits: int = 4) -> str:
 def diagnostics(rec: dict, names=("1", "2", "3")) -> tuple[list[str], list[str]]:
     """The stderr lines of a summary record (its grasp's contacts named ``names``): one error per
     degenerate stretch, one warning for the first time a conditioning falls below the warning level."""
-    where = f"{_printable(rec['file'])}: grasp '{_printable(rec['grasp'])}', path '{_printable(rec['path'])}'"
+    where = f"{escaped(rec['file'])}: grasp '{escaped(rec['grasp'])}', path '{escaped(rec['path'])}'"
     s = rec["summary"]
     errors = [f"{where}: error: {c['method']}: {c['code']}: {crossing_text(c, names, 6)}" for c in s["degenerate"]]
     warnings = []

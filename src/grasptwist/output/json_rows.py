@@ -23,6 +23,7 @@ from dataclasses import fields, replace
 import numpy as np
 import orjson
 
+from .names import escaped
 from .records import present, talking_rows
 
 __all__ = ["encode_records"]
@@ -83,7 +84,7 @@ def _verdicts(block) -> np.ndarray:
     """Integers equal where every coded field's JSON is, and whether there is a
     wrist (a list or ``null``): ``(N,)`` when their bits fit one int64 (the
     usual case, and quick to sort), else ``(N, k)``."""
-    bits = [block.has_wrist[:, None]]
+    bits = [block.finite_wrist()[:, None]]
     bits += [np.asarray(block.value(*c), dtype=bool).reshape(len(block), -1) for c in _coded(block)]
     bits = np.concatenate(bits, axis=1)
     words = [bits[:, k : k + 62] for k in range(0, bits.shape[1], 62)] or [bits]
@@ -108,12 +109,14 @@ def _value(block, owner, name):
 
 def _marker_block(block, row: int):
     """A one-row copy of row ``row`` (a plain one) whose numbers and names are markers;
-    its coded fields keep the row's values."""
+    its coded fields keep the row's values, and so do numbers that are not finite
+    (a missing wrist is NaN, which the record writes as null)."""
     cols = _columns(block)
-    marked = {
-        c: (k * _MARK + np.arange(_value(block, *c)[0].size) + 0.5).reshape((1,) + _value(block, *c).shape[1:])
-        for k, c in enumerate(cols)
-    }
+    marked = {}
+    for k, c in enumerate(cols):
+        own = _value(block, *c)[[row]]
+        markers = (k * _MARK + np.arange(own.size) + 0.5).reshape(own.shape)
+        marked[c] = np.where(np.isfinite(own), markers, own)
     names = {c: [f"\x01{c}\x01"] for c in _STRING_COLUMNS}
     one = replace(
         block.take([row]),
@@ -189,6 +192,7 @@ def _by_template(block, order, records, dumps, part):
 
 
 def _labels(values):
-    """JSON of each value, encoding each distinct value once (names repeat)."""
-    encoded = {v: orjson.dumps(v) for v in set(values)}
+    """JSON of each value, escaped as in the records (:func:`~grasptwist.output.names.escaped`),
+    encoding each distinct value once (names repeat)."""
+    encoded = {v: orjson.dumps(escaped(v, controls=False)) for v in set(values)}
     return [encoded[v] for v in values]

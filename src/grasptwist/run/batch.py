@@ -111,6 +111,10 @@ class Block:
             got = self.values[(key, f)] = f.values(self.results[key])
         return got
 
+    def finite_wrist(self) -> np.ndarray:
+        """Per row: is there a finite wrist (records write it, else null)?"""
+        return np.isfinite(self.wrist).all(axis=-1)
+
     def outward(self) -> np.ndarray:
         """Per row: do all the normals point away from the other contacts
         (:func:`~grasptwist.engine.judgements.outward_normals`)?  Judged once per block."""
@@ -175,6 +179,7 @@ def resolve_arrays(
     hands=None,
     joint_screws=None,
     joint_limits=None,
+    has_wrist=None,
 ) -> Block:
     """One block from arrays of rows (a data set, or stacked grasps).
 
@@ -186,10 +191,13 @@ def resolve_arrays(
     outputs that do not show them (npz).  ``hands`` (per row a Hand or None)
     with ``joint_screws (N, 3, J, 6)`` and ``joint_limits (N, 3, J)``
     (:func:`grasptwist.hand.padded`) adds the kinds that need them.
+    ``has_wrist`` (per row) says which rows have a wrist; by default those
+    whose wrist is finite.
     """
     kinds = selected(method)
     n = len(points)
-    has_wrist = np.zeros(n, bool) if wrist is None else np.isfinite(wrist).all(axis=-1)
+    if has_wrist is None:
+        has_wrist = np.zeros(n, bool) if wrist is None else np.isfinite(wrist).all(axis=-1)
     wrist = np.full((n, 3), np.nan) if wrist is None else wrist
     inputs = {"points": points, "normals": normals, "wrist": wrist, "twist": twist}
     if hands is not None:
@@ -412,14 +420,14 @@ def _dataset_block(ds, given, twists, method, start, stop, k, bases, hand_of_row
         screw = np.tile(given, (stop - start, 1))
         names = [t.name for t in twists] * (stop - start)
     else:
-        own = np.asarray(ds.twist, dtype=float)
-        screw = np.broadcast_to(own, (stop - start, 6)) if own.ndim == 1 else own[start:stop]
+        own = ds.twist  # one (6,) for every row, or (N, 6) read a block at a time
+        screw = np.broadcast_to(np.asarray(own, dtype=float), (stop - start, 6)) if own.ndim == 1 else own[start:stop]
         names = ["twist"] * (stop - start)
     if ds.at is not None:
         at = column(ds.at)
         screw = twist_at(screw[:, :3], screw[:, 3:], at)
     # labels stay a numpy string array: a million Python strings cost more than the engine
-    label = ds.names[start:stop][rows].astype(str) if ds.names is not None else index.astype(str)
+    label = _labels(ds.names[start:stop][rows]) if ds.names is not None else index.astype(str)
     return resolve_arrays(
         column(ds.points),
         # unit normals exactly as the grasp-file loader makes them
@@ -431,5 +439,13 @@ def _dataset_block(ds, given, twists, method, start, stop, k, bases, hand_of_row
         grasp=label,
         twist_name=names,
         bases=bases,
+        # a data set's wrist column gives every row a wrist: NaN in it is a nonfinite-input, not "no wrist"
+        has_wrist=None if ds.wrist is None else np.ones(len(index), bool),
         **_rows_hand(ds, hand_of_rows, start, stop, rows, len(index)),
     )
+
+
+def _labels(names: np.ndarray) -> np.ndarray:
+    """A data set's ``names`` as text; bytes that are not UTF-8 are kept as
+    surrogates, which every output escapes like an undecodable file name."""
+    return np.char.decode(names, "utf-8", "surrogateescape") if names.dtype.kind == "S" else names.astype(str)

@@ -335,11 +335,16 @@ def _dataset_task(job: Job, ds, rows: tuple[int, int], tuning: Tuning, spool: Sp
     twists = [ZERO_TWIST] if job.kind != "resolve" else job.twists
     at_once = tuning.records_at_once
     outs = []
-    for block in dataset_blocks(ds, twists, job.method, start=rows[0], stop=rows[1], hand_of_rows=job.hand):
-        for start in range(0, len(block), at_once):
-            out = Output()
-            _emit(job, block.part(start, start + at_once), out, at_once)
-            outs.append(_sealed(job, out, spool))
+    try:
+        for block in dataset_blocks(ds, twists, job.method, start=rows[0], stop=rows[1], hand_of_rows=job.hand):
+            for start in range(0, len(block), at_once):
+                out = Output()
+                _emit(job, block.part(start, start + at_once), out, at_once)
+                outs.append(_sealed(job, out, spool))
+    except GraspFileError as err:  # a damaged .npz member, found only as it is read
+        out = Output()
+        _emit(job, err, out, at_once)
+        outs.append(_sealed(job, out, spool))
     return outs
 
 
@@ -380,7 +385,7 @@ def write_blocks(job: Job, paths: Sequence, w, tuning: Tuning = TUNING) -> Itera
             for rec in records(x.take(talking), job.order) if talking.size else []:
                 o.add(rec, lambda rec: None)
             o.records = len(x)
-            o.encoded = []
         else:
             o.add(error_record(x), lambda rec: None)
+        o.encoded = []  # the rows went to ``w``; an input that failed has its stderr line only
         yield o
