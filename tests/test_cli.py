@@ -296,7 +296,9 @@ def test_installed_entry_point_in_a_subprocess(files):
     assert p.returncode == 1 and "Traceback" not in p.stderr
     assert list(csv.reader(io.StringIO(p.stdout)))[1][3] == "false"
     # stderr is a pipe here: no progress bar and no colour (the terminal's are in the next test)
-    assert "resolving" not in p.stderr and "\x1b[" not in p.stderr and p.stderr.endswith("1 record, 1 failed\n")
+    assert (
+        "grasptwist resolve" not in p.stderr and "\x1b[" not in p.stderr and p.stderr.endswith("1 record, 1 failed\n")
+    )
 
 
 def test_two_workers_write_exactly_what_one_writes(files):
@@ -332,7 +334,7 @@ def test_a_progress_bar_on_a_terminal(files):
             break
         seen += chunk
     os.close(main)
-    assert proc.returncode == 1 and b"resolving" in seen and b"3 records, 1 failed" in seen
+    assert proc.returncode == 1 and b"grasptwist resolve" in seen and b"3 records, 1 failed" in seen
     assert len(out.read_text().splitlines()) == 3
 
 

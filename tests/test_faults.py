@@ -689,6 +689,62 @@ def test_a_full_disk_is_one_line_and_exit_3(tmp_path, rows):
 
 
 # --------------------------------------------------------------------------
+# 8. Names in tables: never read as rich markup, control characters escaped
+
+MARKUP_GRASP = """\
+name: "[/]x"
+wrist: [0, 0, 0]
+contacts:
+  - {name: "[/]a", point: [0, 2, 2], normal: [1, 0, 0]}
+  - {name: "[bold]b", point: [2, 0, 2], normal: [0, 1, 0]}
+  - {name: "[blink]c", point: [2, 2, 0], normal: [0, 0, 1]}
+twists:
+  - {name: "[red]t", screw: [0, 0, 1, 0, 0, 0]}
+"""
+
+
+@pytest.mark.parametrize("command", ["resolve", "basis", "check"])
+def test_markup_and_control_characters_in_names_are_shown_as_written(tmp_path, command):
+    path = tmp_path / "g\x1b[2Jrid\x07.yaml"  # a file name that would clear the screen and ring
+    path.write_text(MARKUP_GRASP)
+    r = invoke(command, path)
+    assert r.exit_code == 0, r.output  # 0.1: internal error: MarkupError
+    shown = r.stdout
+    assert "\x1b" not in shown and "\x07" not in shown
+    assert "g\\x1b[2Jrid\\x07.yaml" in shown  # escaped as stderr escapes it
+    assert "[/]x" in shown
+    if command != "check":
+        assert "[/]x (" in shown.splitlines()[0]  # the title
+        for name in ("[/]a", "[bold]b", "[blink]c"):
+            assert re.search(rf"^  {re.escape(name)} ", shown, re.M), name  # a row, neither swallowed nor raw
+    if command == "resolve":
+        assert "twist [red]t = (0.0000, 0.0000, 1.0000; 0.0000, 0.0000, 0.0000)" in shown
+
+
+def test_data_set_names_with_control_characters_are_escaped_in_tables(tmp_path):
+    path = tmp_path / "rows.npz"
+    points = np.tile([[0.0, 2, 2], [2, 0, 2], [2, 2, 0]], (2, 1, 1))
+    names = np.array(["\x1b]0;owned\x07", "[/]y"])
+    np.savez(path, points=points, normals=np.tile(np.eye(3), (2, 1, 1)), twist=[0, 0, 1, 0, 0, 0.0], names=names)
+    for command in ("resolve", "check"):
+        r = invoke(command, path)
+        assert r.exit_code == 0, r.output
+        assert "\x1b" not in r.stdout and "\x07" not in r.stdout
+        assert "\\x1b]0;owned\\x07" in r.stdout and "[/]y" in r.stdout
+
+
+def test_an_undecodable_file_name_renders_in_tables(tmp_path):
+    folder = os.fsencode(tmp_path)
+    with open(folder + b"/b\xff.yaml", "wb") as f:
+        f.write(MARKUP_GRASP.encode())
+    (tmp_path / "good.yaml").write_text(POLY.read_text())
+    for command in ("resolve", "basis", "check"):
+        r = invoke(command, tmp_path)
+        assert r.exit_code == 0, r.output
+        assert "b\\xff.yaml" in r.stdout and "polyhedron" in r.stdout
+
+
+# --------------------------------------------------------------------------
 # Soaks: faults at random moments (python -m pytest -m slow tests/test_faults.py)
 
 

@@ -92,11 +92,6 @@ def _csv(out: IO[bytes], kind: str, hand=None, **_):
     return Lines(out, header=csv_rows.header_line(hand), newline=b"")
 
 
-def _record_rows(block, order):
-    recs = records(block, order)
-    return recs, [r for r in recs if not r["ok"] or r["warnings"]]
-
-
 def _npz(out: IO[bytes], kind: str, order: str = "omega-v", hand=None, **_):
     from .npz import NpzWriter
 
@@ -113,7 +108,8 @@ _ALL = ("resolve", "basis", "check", "follow")
 FORMATS: dict[str, OutputFormat] = {
     f.name: f
     for f in (
-        OutputFormat("table", _ALL, _table, encode=lambda rec: rec, encode_rows=_record_rows),
+        # table records travel as JSON (a worker's records cost the parent far less to take than as objects)
+        OutputFormat("table", _ALL, _table, dumps, _json_rows),
         OutputFormat("json", _ALL, lambda out, kind, **_: JsonArray(out), dumps, _json_rows, join=b",\n".join),
         OutputFormat("jsonl", _ALL, lambda out, kind, **_: Lines(out), dumps, _json_rows, join=b"\n".join),
         OutputFormat(
