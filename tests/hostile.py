@@ -16,7 +16,7 @@ from grasptwist.cli import app
 
 #: Fields of a record that may be null in an ``ok`` record: every other null
 #: would be a NaN that orjson wrote as null.
-NULLABLE = {"units", "off_tangent", "tip", "velocity_limit_ratio"}  # tip: inline hands
+NULLABLE = {"units", "wrist", "off_tangent", "tip", "velocity_limit_ratio"}  # tip: inline hands
 
 
 def run(*args, input=None):

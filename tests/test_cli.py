@@ -81,12 +81,14 @@ def test_json_records_match_the_engine(files):
             "units",
             "twist",
             "contacts",
+            "wrist",
             "contact_velocity",
             "off_tangent",
             "tangent",
             "warnings",
             "ok",
         ]
+        assert rec["wrist"] == [0.0, 0.0, 0.0]
         assert [c["name"] for c in rec["contacts"]] == ["thumb", "index", "middle"]
         assert rec["contacts"][0]["normal"] == [1.0, 0.0, 0.0]  # normalised on load
         assert rec["off_tangent"]["x"] == off.x[i].tolist() and rec["off_tangent"]["y"] == off.y[i].tolist()
@@ -160,7 +162,12 @@ def test_method_selection_and_a_grasp_without_wrist(files):
     (files / "nowrist.yaml").write_text(POLY.replace("wrist: [0, 0, 0]\n", ""))
     r = run("resolve", files / "nowrist.yaml", "--json")
     rec = no_nan(r.stdout)[0]
-    assert r.exit_code == 0 and rec["off_tangent"] is None and rec["ok"] is True
+    # under the default --method both the off-tangent method is skipped, with a warning
+    assert r.exit_code == 0 and rec["off_tangent"] is None and rec["ok"] is True and rec["wrist"] is None
+    skipped = "off-tangent skipped: no-wrist: " + gt.status_message(gt.Status.NO_WRIST)
+    assert rec["warnings"] == [skipped]
+    np.testing.assert_allclose(rec["tangent"]["alpha"], [0.57735] * 3, atol=1e-5)  # the other method as ever
+    assert f"{files / 'nowrist.yaml'}: grasp 'poly', twist 'spin': warning: {skipped}" in r.stderr.splitlines()
     rec = no_nan(run("resolve", files / "poly.yaml", "--method", "tangent", "--json").stdout)[0]
     assert "off_tangent" not in rec
 

@@ -86,8 +86,19 @@ def _floats(text: str, n: int, what: str) -> list[float]:
     return values
 
 
-def _cli_twists(texts: list[str] | None, at: str | None):
-    """``--twist`` values as loader twists at the origin (``--at`` names the reference point)."""
+def _cli_twists(texts: list[str] | None, at: str | None, names: list[str] | None = None):
+    """``--twist`` values as loader twists at the origin (``--at`` names the reference point),
+    named by ``names`` (``--twist-name``, one per twist) or as written."""
+    if names and len(names) != len(texts or ()):
+        raise typer.BadParameter(
+            f"give one --twist-name per --twist (got {len(names)} names for {len(texts or ())} twists)",
+            param_hint="--twist-name",
+        )
+    for name in names or ():
+        if not name.strip() or not name.isprintable():
+            raise typer.BadParameter(
+                f"{name!r}: a name is a non-empty line of printable text", param_hint="--twist-name"
+            )
     if not texts:
         if at is not None:
             raise typer.BadParameter("--at applies to --twist; give at least one --twist", param_hint="--at")
@@ -99,13 +110,13 @@ def _cli_twists(texts: list[str] | None, at: str | None):
 
     point = _floats(at, 3, "--at") if at is not None else [0.0, 0.0, 0.0]
     twists = []
-    for text in texts:
+    for k, text in enumerate(texts):
         w = _floats(text, 6, "--twist")
         with np.errstate(all="ignore"):
             screw = twist_at(w[:3], w[3:], point)
         if not np.isfinite(screw).all():
             raise typer.BadParameter(f"{text!r} at {at}: the velocity of the origin overflows", param_hint="--twist")
-        twists.append(Twist(name=text.replace(" ", ""), screw=screw, line=None))
+        twists.append(Twist(name=names[k] if names else text.replace(" ", ""), screw=screw, line=None))
     return twists
 
 
@@ -303,6 +314,12 @@ def resolve(
         metavar="W1,W2,W3,V1,V2,V3",
         help="Object twist (omega; v); repeatable; replaces the files' twists.",
     ),
+    twist_name: list[str] | None = typer.Option(
+        None,
+        "--twist-name",
+        metavar="NAME",
+        help="Name of each --twist in the records, paired in order (default: the twist as written).",
+    ),
     at: str | None = typer.Option(
         None, "--at", metavar="X,Y,Z", help="Point whose velocity the --twist linear part gives (default: the origin)."
     ),
@@ -353,7 +370,7 @@ def resolve(
     """
     from .run.pipeline import Job
 
-    twists = _cli_twists(twist, at)
+    twists = _cli_twists(twist, at, twist_name)
     if twists_from is not None and twists is not None:
         raise typer.BadParameter("give twists by --twist or by --twists-from, not both", param_hint="--twists-from")
     if twists_from == "-" and "-" in paths:
@@ -623,7 +640,7 @@ def plot(
     max_bytes: int | None = _MAX_BYTES,
     debug: bool = _DEBUG,
 ) -> None:
-    """Draw a grasp, its basis screw axes and the finger-tip velocities (needs matplotlib: the extra grasptwist[plot]).
+    """Draw a grasp, its basis screw axes and the finger-tip velocities (needs matplotlib: from a clone, pip install '.[plot]').
 
     Examples: the paper's cylinder spinning about z, and every bundled grasp:
 

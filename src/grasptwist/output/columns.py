@@ -1,8 +1,8 @@
 """Result blocks as named flat columns: the one definition CSV, npz (and Parquet) share.
 
 A block's columns are groups (:class:`~grasptwist.results.Column`): first the
-rows' own (file, grasp, twist name, ok, error, the twist, the contact
-velocities), then each result kind's from the registry
+rows' own (file, grasp, twist name, ok, error, the twist, the wrist, the
+contact velocities), then each result kind's from the registry
 (:data:`grasptwist.results.KINDS`), each kind's ending with ``<key>_status``
 (npz only) and ``<key>_error`` (CSV only).
 :func:`columns` gives them as flat ``(N,)`` arrays named and ordered as the
@@ -60,6 +60,7 @@ BLOCK_COLUMNS = (
     # an input that failed has only this (see records.error_record); rows of a block have none
     Column("error", _block(lambda b: np.full(len(b), "")), ("error",), dtype="U", array=False, only_where_ok=False),
     Column("twist", _block(lambda b: b.twist), tuple(f"twist{i}" for i in range(1, 7)), only_where_ok=False),
+    Column("wrist", _block(lambda b: b.wrist), ("c_x", "c_y", "c_z"), only_where_ok=False),
     Column(
         "contact_velocity",
         _block(lambda b: b.velocity),
@@ -70,6 +71,10 @@ BLOCK_COLUMNS = (
 
 #: Columns that hold screws, written in the order asked for.
 _SCREWS = {"twist"}
+
+#: Columns with NaN rows where there is no value (a grasp without a wrist):
+#: npz keeps the NaN, flat columns are empty there.
+_OPTIONAL = {"wrist"}
 
 
 def _status(key: str, block) -> np.ndarray:
@@ -195,6 +200,8 @@ def columns(block, order: str = "omega-v", hand=None, typed: bool = False) -> di
         if key is not None and column.only_where_ok:
             computed = key in block.results
             valid = block.results[key].ok & block.applies(key) if computed else np.zeros(n, bool)
+        if column.name in _OPTIONAL:
+            valid = np.isfinite(flat).all(axis=1)
         for j, name in enumerate(names):
             out[name] = flat[:, j] if valid is None else np.ma.masked_array(flat[:, j], mask=~valid)
     return out

@@ -81,10 +81,12 @@ def _coded(block) -> list:
 
 
 def _verdicts(block) -> np.ndarray:
-    """Integers equal where every coded field's JSON is: ``(N,)`` when their
-    bits fit one int64 (the usual case, and quick to sort), else ``(N, k)``."""
-    bits = [np.asarray(block.value(*c), dtype=bool).reshape(len(block), -1) for c in _coded(block)]
-    bits = np.concatenate(bits, axis=1) if bits else np.zeros((len(block), 0), bool)
+    """Integers equal where every coded field's JSON is, and whether there is a
+    wrist (a list or ``null``): ``(N,)`` when their bits fit one int64 (the
+    usual case, and quick to sort), else ``(N, k)``."""
+    bits = [block.finite_wrist()[:, None]]
+    bits += [np.asarray(block.value(*c), dtype=bool).reshape(len(block), -1) for c in _coded(block)]
+    bits = np.concatenate(bits, axis=1)
     words = [bits[:, k : k + 62] for k in range(0, bits.shape[1], 62)] or [bits]
     codes = [w @ (1 << np.arange(w.shape[1], dtype=np.int64)) for w in words]
     return codes[0] if len(codes) == 1 else np.stack(codes, axis=1)
@@ -107,12 +109,14 @@ def _value(block, owner, name):
 
 def _marker_block(block, row: int):
     """A one-row copy of row ``row`` (a plain one) whose numbers and names are markers;
-    its coded fields keep the row's values."""
+    its coded fields keep the row's values, and so do numbers that are not finite
+    (a missing wrist is NaN, which the record writes as null)."""
     cols = _columns(block)
-    marked = {
-        c: (k * _MARK + np.arange(_value(block, *c)[0].size) + 0.5).reshape((1,) + _value(block, *c).shape[1:])
-        for k, c in enumerate(cols)
-    }
+    marked = {}
+    for k, c in enumerate(cols):
+        own = _value(block, *c)[[row]]
+        markers = (k * _MARK + np.arange(own.size) + 0.5).reshape(own.shape)
+        marked[c] = np.where(np.isfinite(own), markers, own)
     names = {c: [f"\x01{c}\x01"] for c in _STRING_COLUMNS}
     one = replace(
         block.take([row]),
@@ -122,6 +126,8 @@ def _marker_block(block, row: int):
     )
     one.values.update({c: marked[c] for c in cols if c[0] is not None})
     one.values.update({c: block.value(*c)[[row]] for c in _coded(block)})  # known already: no need to judge again
+    block.outward()  # the block's own verdicts (owner None) are judged on its real numbers, not on markers
+    one.values.update({c: v[[row]] for c, v in block.values.items() if c[0] is None})
     return one
 
 

@@ -15,7 +15,14 @@ from __future__ import annotations
 import numpy as np
 import orjson
 
-from ..engine.degeneracy import CONDITION_WARNING, Status, conditioning_warning, status_message
+from ..engine.degeneracy import (
+    CONDITION_WARNING,
+    OUTWARD_NORMALS_WARNING,
+    Status,
+    conditioning_warning,
+    skipped_warning,
+    status_message,
+)
 from ..model import GraspFileError
 from ..results import CONDITIONING, CULPRIT, KINDS, STATUS, Field
 from .columns import ORDERS, in_order
@@ -43,8 +50,7 @@ def records(block, order: str = "omega-v") -> list[dict]:
     views of contiguous rows, which orjson writes without making a Python
     float of each.  Consumers that need lists call ``.tolist()``.
     """
-    n = len(block)
-    warnings = [[] for _ in range(n)]
+    warnings = [[OUTWARD_NORMALS_WARNING] if out else [] for out in block.outward().tolist()]
     objects = [(k.key, _kind_rows(block, k, order, warnings)) for k in block.kinds() if k.record is None]
     written = [(k.key, _written(k)(block, order, warnings)) for k in block.kinds() if k.record is not None]
     ok = (~block.failed_rows()).tolist()
@@ -58,9 +64,10 @@ def records(block, order: str = "omega-v") -> list[dict]:
         _contact_names(block),
         _rows(block.points),
         _rows(block.normals),
+        _wrists(block),
         _rows(block.velocity),
     )
-    for i, (file, grasp, units, twist_name, screw, names, p, q, v) in enumerate(rows):
+    for i, (file, grasp, units, twist_name, screw, names, p, q, c, v) in enumerate(rows):
         rec = {
             "file": file,
             "grasp": grasp,
@@ -71,6 +78,7 @@ def records(block, order: str = "omega-v") -> list[dict]:
                 {"name": names[1], "point": p[1], "normal": q[1]},
                 {"name": names[2], "point": p[2], "normal": q[2]},
             ],
+            "wrist": c,
             "contact_velocity": v,
         }
         for key, rows_of_kind in objects:
@@ -113,6 +121,12 @@ def _rows(a):
     return list(a) if a.ndim > 1 else a.tolist()
 
 
+def _wrists(block) -> list:
+    """Per row, the wrist (a row view), or None where there is none or it is not finite."""
+    wrists = _rows(block.wrist)
+    return [c if has else None for c, has in zip(wrists, block.finite_wrist().tolist())]
+
+
 def _fingers(mask):
     """Per row of an ``(N, c, 3)`` bool mask: per component, the indices of its fingers.
 
@@ -141,7 +155,7 @@ def present(block, fields):
 
 def _kind_rows(block, kind, order, warnings):
     """One kind's per-row objects (``error`` objects where it failed, None where
-    it does not apply), warnings appended."""
+    it was skipped), warnings appended."""
     fields = present(block, kind.fields)
     values = [json_values(block.value(kind.key, f), f, order) for f in fields]
     names = [f.name for f in fields]
@@ -153,17 +167,22 @@ def _kind_rows(block, kind, order, warnings):
     conditioning = block.value(kind.key, CONDITIONING)
     for i in np.flatnonzero((status == Status.OK) & (conditioning < CONDITION_WARNING) & applies):
         warnings[i].append(conditioning_warning(conditioning[i], kind.label))
+    skipped = [skipped_warning(kind.missing, kind.label)] if kind.missing is not None else []
     for i in np.flatnonzero(~applies):
         rows[i] = None
+        warnings[i] += skipped
     return rows
 
 
 def talking_rows(block) -> np.ndarray:
-    """Rows whose record has something for stderr: a failed kind or a warning."""
-    talk = np.zeros(len(block), bool)
+    """Rows whose record has something for stderr: a failed or skipped kind, or a warning."""
+    talk = block.outward().copy()
     for kind in block.kinds():
         ok = block.value(kind.key, STATUS) == Status.OK
-        talk |= (~ok | (block.value(kind.key, CONDITIONING) < CONDITION_WARNING)) & block.applies(kind.key)
+        applies = block.applies(kind.key)
+        talk |= (~ok | (block.value(kind.key, CONDITIONING) < CONDITION_WARNING)) & applies
+        if kind.missing is not None:  # skipped: a warning
+            talk |= ~applies
     return talk
 
 
@@ -186,6 +205,7 @@ def _grasp_fields(block, i: int) -> dict:
             {"name": names[c], "point": block.points[i, c].tolist(), "normal": block.normals[i, c].tolist()}
             for c in range(3)
         ],
+        "wrist": block.wrist[i].tolist() if np.isfinite(block.wrist[i]).all() else None,
     }
 
 
@@ -193,12 +213,16 @@ def _row_objects(block, i, fields_of, order, warnings, with_failure=()):
     """Row ``i``'s object of every kind computed, from the fields ``fields_of(kind)``;
     a failed kind's object is its error plus the fields ``with_failure(kind)``."""
     out = {}
+    if block.outward()[i]:
+        warnings.append(OUTWARD_NORMALS_WARNING)
     for kind in block.kinds():
         key = kind.key
         if kind.record is not None:  # a resolve-only kind (a hand's joint rates)
             continue
         if not block.applies(key)[i]:
             out[key] = None
+            if kind.missing is not None:
+                warnings.append(skipped_warning(kind.missing, kind.label))
             continue
         status = Status(int(block.value(key, STATUS)[i]))
 

@@ -23,7 +23,7 @@ from ..io.datasets import DATASET_SUFFIXES
 from ..io.inputs import read
 from ..model import Grasp, GraspFileError, ObjectPath
 from ..results import selected
-from .batch import Block
+from .batch import Block, with_reasons
 from .pipeline import Output
 
 __all__ = [
@@ -189,15 +189,15 @@ def _path(job, grasp, p):
             method=job.method,
             bases=job.bases,
         )
-        yield Samples(p.name, _block(grasp, p.name, f, job.bases), f.poses)
+        yield Samples(p.name, _block(grasp, p.name, f, job.bases, job.method), f.poses)
     found = degeneracies(grasp.points, grasp.normals, grasp.wrist, p.segments, times)
     yield Summary(grasp.file, grasp, p.name, len(times), found, labels)
 
 
-def _block(grasp, name, f, bases) -> Block:
+def _block(grasp, name, f, bases, method) -> Block:
     n = len(f.poses.time)
     results = {"off_tangent": f.off_tangent, "tangent": f.tangent}
-    return Block(
+    block = Block(
         file=[grasp.file] * n,
         grasp=[grasp.name] * n,
         units=[grasp.units] * n,
@@ -206,11 +206,14 @@ def _block(grasp, name, f, bases) -> Block:
         points=f.points,
         normals=f.normals,
         twist=f.poses.twist,
+        wrist=np.broadcast_to(grasp.wrist if grasp.wrist is not None else np.full(3, np.nan), (n, 3)),
         has_wrist=np.full(n, grasp.wrist is not None),
         velocity=f.velocities,
         results={k: r for k, r in results.items() if r is not None},
         bases=bases,
+        method=method,
     )
+    return with_reasons(block)  # a method asked for by name that cannot run fails, as in resolve
 
 
 def _no_path(grasp: Grasp, name: str | None) -> GraspFileError:
