@@ -129,6 +129,19 @@ def array_equals_the_engine():
     print(f"{len(got)} rows in {r.numblocks[0]} chunks equal the engine")
 
 
+def readme_block(folder):
+    """The README's Dask example as printed, run in ``folder`` on 3 shards of 3,000 grasps in ``shards/``."""
+    import os
+    import re
+
+    save_parquet(folder / "shards", 3000, shards=3)
+    readme = (Path(__file__).parents[1] / "README.md").read_text("utf-8")
+    (code,) = [b for b in re.findall(r"^```python\n(.*?)^```$", readme, flags=re.M | re.S) if "import dask" in b]
+    os.chdir(folder)
+    exec(compile(code, "README.md", "exec"), {})
+    print(f"{pq.read_table(folder / 'results').num_rows} rows in results/")
+
+
 if __name__ == "__main__":
     check, folder, *rows = sys.argv[1:]
     globals()[check](Path(folder), *map(int, rows))

@@ -24,15 +24,25 @@ def test_there_are_snippets_to_run():
 
 
 def python_blocks():
-    """The Python blocks as parameters; those drawing images (seconds each) run with ``-m slow``."""
+    """The Python blocks as parameters; those drawing images or starting a Dask cluster (seconds each)
+    run with ``-m slow``."""
+    slow = ("plot.render", "import dask")
     return [
-        pytest.param(code, id=code.splitlines()[0][:40], marks=[pytest.mark.slow] if "plot.render" in code else [])
+        pytest.param(
+            code, id=code.splitlines()[0][:40], marks=[pytest.mark.slow] if any(s in code for s in slow) else []
+        )
         for code in blocks("python")
     ]
 
 
 @pytest.mark.parametrize("code", python_blocks())
 def test_each_python_block_runs(code, tmp_path, monkeypatch):
+    if "import dask" in code:
+        pytest.importorskip("distributed")
+        from test_dask import check  # a cluster in a process of its own (why: dask_checks.py)
+
+        assert check("readme_block", tmp_path) == ["3000 rows in results/"]
+        return
     if "plot.render" in code:
         pytest.importorskip("matplotlib")
     # the snippets name the bundled grasps/ by relative path, and write their images beside it
