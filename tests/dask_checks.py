@@ -53,6 +53,7 @@ def cli_parquet(shards, out):
 
 
 def assert_dask_equals_the_command_line(tmp_path, n, shards):
+    tmp_path.mkdir(exist_ok=True)
     paths = save_parquet(tmp_path / "in", n, shards=shards)
     to_parquet(resolve_dataframe(dd.read_parquet(tmp_path / "in")), str(tmp_path / "out"))
     ours = pq.read_table(tmp_path / "out").to_pandas(types_mapper=pd.ArrowDtype).drop(columns="file")
@@ -81,10 +82,10 @@ def on_a_cluster(tmp_path, n):
 
 
 def the_default_run(tmp_path):
-    """A small data set on the cluster, then the other checks on Dask's scheduler in this process
-    (one process: Python, dask and pandas start once)."""
-    on_a_cluster(tmp_path / "cluster", 3000)
+    """Every check on Dask's synchronous scheduler in this process (Python, dask and pandas start
+    once; a cluster's worker processes take seconds more, so the cluster runs with ``-m slow``)."""
     with dask.config.set(scheduler="synchronous"):
+        assert_dask_equals_the_command_line(tmp_path / "sharded", 3000, shards=3)
         types_and_named_twists(tmp_path)
         array_equals_the_engine()
 

@@ -24,11 +24,9 @@ def check(name, *args) -> list[str]:
     return out.stdout.splitlines()
 
 
-def test_on_a_two_worker_cluster_and_in_one_process(tmp_path):
-    # resolve_dataframe over 3 Parquet shards on LocalCluster(n_workers=2, processes=True) equals
-    # `grasptwist resolve shards -f parquet` bit for bit; the rest on the synchronous scheduler
+def test_sharded_parquet_named_twists_and_arrays_on_the_synchronous_scheduler(tmp_path):
+    # resolve_dataframe over 3 Parquet shards equals `grasptwist resolve shards -f parquet` bit for bit
     assert check("the_default_run", tmp_path) == [
-        "2 workers",
         "3000 rows equal, 31 with the tangent method failed",
         "200 rows, 2 twists, types kept",
         "5000 rows in 4 chunks equal the engine",
@@ -36,6 +34,7 @@ def test_on_a_two_worker_cluster_and_in_one_process(tmp_path):
 
 
 @pytest.mark.slow
-def test_a_few_hundred_thousand_rows_of_sharded_parquet(tmp_path):
+def test_a_few_hundred_thousand_rows_of_sharded_parquet_on_a_two_worker_cluster(tmp_path):
+    # LocalCluster(n_workers=2, processes=True), as the issue asks
     lines = check("on_a_cluster", tmp_path, 300_000)
     assert lines[0] == "2 workers" and lines[1].startswith("300000 rows equal")
