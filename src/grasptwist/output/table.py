@@ -377,7 +377,7 @@ class TableWriter(_Writer):
         self.add(lines, self._contacts(rec, kinds, d))
         for kind, render in kinds:
             m = rec[kind.key]
-            self.add(lines, _not_shown(kind, render, m) if not _shown(m) else render.resolve(m, names, d))
+            self.add(lines, _not_shown(kind, render, m) if not _shown(m) else render.resolve(m, names, d, rec))
         for kind, render in kinds:
             if _shown(rec[kind.key]):
                 for line in render.verdict(rec[kind.key], names):
@@ -435,13 +435,15 @@ class OffTangentTable:
     """The off-tangent method (Proposition 1): amplitudes, basis screws, verdicts."""
 
     skipped = "the grasp has no wrist"
+    #: Its components in basis order (the order of ``moves`` and of ``joint_rates``).
+    components = ("Sigma_1", "Sigma_2", "Sigma_3", "Psi_1", "Psi_2", "Psi_3")
 
     @staticmethod
     def contact_columns(m, d) -> list:
         return []
 
     @staticmethod
-    def resolve(m, names, d):
+    def resolve(m, names, d, rec):
         t = _table(
             "i", "x_i", "y_i", "Sigma_i (moves finger i only)", "Psi_i (keeps finger i fixed)", numbers=("x_i", "y_i")
         )
@@ -487,13 +489,15 @@ class TangentTable:
     """The tangent method (Proposition 2 and the off-plane rest): amplitudes, bases, verdict."""
 
     skipped = "not asked for"
+    #: Its components in basis order: ``alpha_i Theta_i``, then the off-plane rest ``beta_i Sigma_i``.
+    components = ("Theta_1", "Theta_2", "Theta_3", "Sigma_1", "Sigma_2", "Sigma_3")
 
     @staticmethod
     def contact_columns(m, d) -> list:
         return [("normal velocity", [fmt_number(v, d) for v in m["normal_velocity"]])]
 
     @staticmethod
-    def resolve(m, names, d):
+    def resolve(m, names, d, rec):
         t = _table(
             "i", "alpha_i", "beta_i", "Theta_i (keeps finger i fixed, others slide)", numbers=("alpha_i", "beta_i")
         )
@@ -607,7 +611,7 @@ class HandTable:
         return [("finger", [f["name"] for f in m["fingers"]])]
 
     @staticmethod
-    def resolve(m, names, d):
+    def resolve(m, names, d, rec):
         from rich.console import Group
 
         ratio = m["velocity_limit_ratio"]
@@ -625,7 +629,22 @@ class HandTable:
                     f"{f['residual']:.2g}" if first else "",
                     f"{f['conditioning']:.3g}" if first else "",
                 )
-        return Group(Text(title, style="bold"), t)
+        return Group(Text(title, style="bold"), t, *HandTable._moved_by(m, rec))
+
+    @staticmethod
+    def _moved_by(m, rec) -> list[Text]:
+        """Per finger, the components of each method that move it (the records' ``moves``): what a
+        controller running the components one after another asks of that finger's joints."""
+        methods = [(kind.label, render, rec[kind.key]) for kind, render in _renderers(rec) if kind.key != "hand"]
+        lines = []
+        for f, finger in enumerate(m["fingers"]):
+            parts = [
+                f"{label} {' '.join(c for c, fingers in zip(render.components, r['moves']) if f in fingers) or 'none'}"
+                for label, render, r in methods
+                if _shown(r)
+            ]
+            lines.append(Text(f"finger {escaped(finger['name'])} is moved by: {'; '.join(parts)}"))
+        return lines
 
     @staticmethod
     def verdict(m, names) -> list[str]:
