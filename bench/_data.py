@@ -76,3 +76,22 @@ def grasptwist_command():
             *([] if shutil.which("grasptwist") else ["-m", "grasptwist"]),
         ]
     )
+
+
+def save_parquet(folder, n, shards=8, seed=0):
+    """A data set of ``n`` grasps as ``shards`` Parquet files (``part-000.parquet`` ...) in ``folder``,
+    in the columns ``grasptwist resolve`` reads; returns their paths."""
+    import os
+
+    import pyarrow.parquet as pq
+
+    from grasptwist.io import parquet
+
+    table = parquet.grasp_table(*grasp_arrays(n, seed), names=np.arange(n).astype(str))
+    os.makedirs(folder, exist_ok=True)
+    paths = []
+    for i, start in enumerate(range(0, n, -(-n // shards))):
+        paths.append(os.path.join(folder, f"part-{i:03d}.parquet"))
+        part = table.slice(start, -(-n // shards))
+        pq.write_table(part, paths[-1], row_group_size=65536, use_dictionary=[parquet.NAME_COLUMN])
+    return paths

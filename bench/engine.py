@@ -7,10 +7,16 @@ formulas (``grasptwist.engine.formulas``) and solves the 6x6 systems with
 ``numpy.linalg.solve`` (``_data.solve_baseline``); the loop calls the public
 API once per grasp (which takes the small-batch path) on a sample and is
 scaled to ``n``.  Peak memory is that of a fresh process running the engine
-part alone.
+part alone.  The memory-traffic floor is numpy copying the engine's input
+and output arrays once (every byte read and written once, output freshly
+allocated, as the engine's is): no engine can take less; ``--profile``
+shows where the engine's time goes.
 """
 
 import argparse
+import cProfile
+import dataclasses
+import pstats
 import resource
 import subprocess
 import sys
@@ -26,6 +32,23 @@ def engine(points, normals, wrist, twist):
     off = gt.decompose_off_tangent(points, wrist, twist)
     tan = gt.decompose_tangent(points, normals, twist)
     return off, tan, gt.contact_velocities(points, twist)
+
+
+def outputs(inputs, results):
+    """The arrays the engine made: every array of its results that is not a view of an input."""
+    made = [getattr(r, f.name) for r in results[:2] for f in dataclasses.fields(r)] + [results[2]]
+    return [a for a in made if isinstance(a, np.ndarray) and not any(np.may_share_memory(a, i) for i in inputs)]
+
+
+def copy_once(arrays):
+    return [a.copy() for a in arrays]
+
+
+def profile(data, top=15):
+    """The engine's functions by their own time, on stdout."""
+    prof = cProfile.Profile()
+    prof.runcall(engine, *data)
+    pstats.Stats(prof, stream=sys.stdout).sort_stats("tottime").print_stats(top)
 
 
 def best_of(repeats, fn, *args):
@@ -48,6 +71,7 @@ def main():
     ap.add_argument("--n", type=int, default=1_000_000, help="grasps (default 10^6)")
     ap.add_argument("--loop", type=int, default=2000, help="grasps in the Python-loop sample")
     ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--profile", action="store_true", help="print where the engine's time goes")
     ap.add_argument("--child", type=int, help=argparse.SUPPRESS)
     args = ap.parse_args()
     if args.child:
@@ -56,6 +80,9 @@ def main():
     peak = peak_memory_mib(args.n)  # first: a child forked from a large parent inherits its peak
     data = grasp_arrays(args.n)
     t_engine, (off, tan, vel) = best_of(args.repeats, engine, *data)
+    traffic = [*data, *outputs(data, (off, tan, vel))]
+    t_floor, _ = best_of(args.repeats, copy_once, traffic)
+    nbytes = sum(a.nbytes for a in traffic)
     t_solve, (xy, ab, vel_b) = best_of(max(1, args.repeats - 1), solve_baseline, *data)
     sample = [a[: args.loop] for a in data]
     t0 = time.perf_counter()
@@ -77,7 +104,13 @@ def main():
     print(
         f"{f'Python loop (from {args.loop} grasps)':32s} {t_loop:8.1f} s   engine is {t_loop / t_engine:6.0f}x faster (target >= 300)"
     )
+    print(
+        f"{'memory-traffic floor':32s} {t_floor:8.3f} s   engine takes {t_engine / t_floor:6.1f}x the floor "
+        f"(numpy copying the {nbytes / 2**20:,.0f} MiB of input and output once)"
+    )
     print(f"{'peak memory, engine process':32s} {peak:8.0f} MiB (target < 2048)")
+    if args.profile:
+        profile(data)
 
 
 if __name__ == "__main__":

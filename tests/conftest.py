@@ -6,6 +6,9 @@ import yaml
 
 from grasptwist.io.grasp_file import Reading
 
+# a script run in processes of its own (see its docstring), not a module for --doctest-modules to import
+collect_ignore = ["dask_checks.py"]
+
 #: The YAML parsers the loader can run on here: the pure one, and libyaml's when present.
 LOADERS = [yaml.SafeLoader] + ([yaml.CSafeLoader] if yaml.__with_libyaml__ else [])
 

@@ -16,7 +16,7 @@ from grasptwist.cli import app
 
 #: Fields of a record that may be null in an ``ok`` record: every other null
 #: would be a NaN that orjson wrote as null.
-NULLABLE = {"units", "off_tangent", "tip", "velocity_limit_ratio"}  # tip: inline hands
+NULLABLE = {"units", "wrist", "off_tangent", "tip", "velocity_limit_ratio"}  # tip: inline hands
 
 
 def run(*args, input=None):
@@ -48,6 +48,28 @@ def run_installed(*args, cwd=None, timeout=20):
         entry_point() + [str(a) for a in args], capture_output=True, text=True, cwd=cwd, env=env, timeout=timeout
     )
     return proc, time.monotonic() - start
+
+
+def run_measured(*args, cwd):
+    """``grasptwist ARGS`` in a fresh process: (exit status, stderr, peak RSS in MB).
+
+    A wrapper process runs the command and reads ``getrusage(RUSAGE_CHILDREN)``:
+    its only children are the command and its workers, so the figure is theirs
+    (the largest of them), not that of some earlier test's subprocess; nor is
+    it this process's own peak, which a child forked straight from it
+    inherits (Linux copies the peak with the memory map, before ``exec``).
+    """
+    wrapper = (
+        "import resource, subprocess, sys; code = subprocess.run(sys.argv[1:]).returncode; "
+        "print(code, resource.getrusage(resource.RUSAGE_CHILDREN).ru_maxrss)"
+    )
+    env = {**os.environ, "NO_COLOR": "1"}
+    proc = subprocess.run(
+        [sys.executable, "-c", wrapper, *entry_point(), *map(str, args)],
+        capture_output=True, text=True, cwd=cwd, env=env, timeout=60,
+    )  # fmt: skip
+    code, kib = map(int, proc.stdout.split())
+    return code, proc.stderr, kib / 1024 if sys.platform != "darwin" else kib / 2**20
 
 
 def strict_json(text):

@@ -179,3 +179,20 @@ def test_bundled_component_joint_rates_add_up_and_vanish_where_they_must(records
         assert (rates[fixed] == 0.0).all()  # exactly, not to round-off
         assert (np.abs(rates[~fixed]).max(axis=-1) > 0).sum() >= 1
     assert not np.allclose(parts["off_tangent"], parts["tangent"])  # the methods split the rates differently
+
+
+def test_the_hand_table_names_the_components_that_move_each_finger():
+    """Per finger, the components whose joint rates for it are not zero, as the records give them."""
+    rec = json.loads(CliRunner().invoke(app, ["resolve", str(GRASPS / "three-finger-hand.yaml"), "-f", "json"]).stdout)[
+        0
+    ]
+    table = CliRunner().invoke(app, ["resolve", str(GRASPS / "three-finger-hand.yaml")]).stdout
+    names = {"off_tangent": ("Sigma", "Psi"), "tangent": ("Theta", "Sigma")}
+    for f, finger in enumerate(rec["hand"]["fingers"]):
+        parts = []
+        for key, label in (("off_tangent", "off-tangent"), ("tangent", "tangent")):
+            rates = rec[key]["joint_rates"]  # [component][finger][joint]
+            moving = [f"{names[key][c // 3]}_{c % 3 + 1}" for c in range(6) if np.any(rates[c][f])]
+            parts.append(f"{label} {' '.join(moving)}")
+        assert f"finger {finger['name']} is moved by: {'; '.join(parts)}" in table
+    assert "finger east is moved by: off-tangent Sigma_1 Psi_2 Psi_3; tangent Theta_2 Theta_3 Sigma_1" in table

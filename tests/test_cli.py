@@ -81,12 +81,14 @@ def test_json_records_match_the_engine(files):
             "units",
             "twist",
             "contacts",
+            "wrist",
             "contact_velocity",
             "off_tangent",
             "tangent",
             "warnings",
             "ok",
         ]
+        assert rec["wrist"] == [0.0, 0.0, 0.0]
         assert [c["name"] for c in rec["contacts"]] == ["thumb", "index", "middle"]
         assert rec["contacts"][0]["normal"] == [1.0, 0.0, 0.0]  # normalised on load
         assert rec["off_tangent"]["x"] == off.x[i].tolist() and rec["off_tangent"]["y"] == off.y[i].tolist()
@@ -160,7 +162,12 @@ def test_method_selection_and_a_grasp_without_wrist(files):
     (files / "nowrist.yaml").write_text(POLY.replace("wrist: [0, 0, 0]\n", ""))
     r = run("resolve", files / "nowrist.yaml", "--json")
     rec = no_nan(r.stdout)[0]
-    assert r.exit_code == 0 and rec["off_tangent"] is None and rec["ok"] is True
+    # under the default --method both the off-tangent method is skipped, with a warning
+    assert r.exit_code == 0 and rec["off_tangent"] is None and rec["ok"] is True and rec["wrist"] is None
+    skipped = "off-tangent skipped: no-wrist: " + gt.status_message(gt.Status.NO_WRIST)
+    assert rec["warnings"] == [skipped]
+    np.testing.assert_allclose(rec["tangent"]["alpha"], [0.57735] * 3, atol=1e-5)  # the other method as ever
+    assert f"{files / 'nowrist.yaml'}: grasp 'poly', twist 'spin': warning: {skipped}" in r.stderr.splitlines()
     rec = no_nan(run("resolve", files / "poly.yaml", "--method", "tangent", "--json").stdout)[0]
     assert "off_tangent" not in rec
 
@@ -289,7 +296,9 @@ def test_installed_entry_point_in_a_subprocess(files):
     assert p.returncode == 1 and "Traceback" not in p.stderr
     assert list(csv.reader(io.StringIO(p.stdout)))[1][3] == "false"
     # stderr is a pipe here: no progress bar and no colour (the terminal's are in the next test)
-    assert "resolving" not in p.stderr and "\x1b[" not in p.stderr and p.stderr.endswith("1 record, 1 failed\n")
+    assert (
+        "grasptwist resolve" not in p.stderr and "\x1b[" not in p.stderr and p.stderr.endswith("1 record, 1 failed\n")
+    )
 
 
 def test_two_workers_write_exactly_what_one_writes(files):
@@ -325,7 +334,7 @@ def test_a_progress_bar_on_a_terminal(files):
             break
         seen += chunk
     os.close(main)
-    assert proc.returncode == 1 and b"resolving" in seen and b"3 records, 1 failed" in seen
+    assert proc.returncode == 1 and b"grasptwist resolve" in seen and b"3 records, 1 failed" in seen
     assert len(out.read_text().splitlines()) == 3
 
 

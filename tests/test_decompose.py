@@ -330,3 +330,16 @@ def test_without_bases_the_amplitudes_and_verdicts_are_the_same():
         )
         for name in amplitudes:
             np.testing.assert_array_equal(getattr(lean, name), getattr(full, name))
+
+
+def test_row_picks_a_row_of_a_batch_and_says_so_plainly_on_a_single_result():
+    twists = np.array([[0, 0, 1, 0, 0, 0], [0, 0, 0, 0, 0, 1.0]])
+    batch = gt.decompose_off_tangent(EX1, EX1_WRIST, twists)
+    for i, twist in enumerate(twists):
+        one = gt.decompose_off_tangent(EX1, EX1_WRIST, twist)
+        np.testing.assert_array_equal(batch.row(i).y, one.y)
+        with pytest.raises(ValueError, match=r"row\(0\): this result is for one grasp and one twist"):
+            one.row(0)
+    np.testing.assert_allclose(batch.row(1).x, [2 / 3] * 3, atol=1e-4)
+    with pytest.raises(ValueError, match="one grasp and one twist"):
+        gt.decompose_tangent(EX2, EX2_NORMALS, twists[0]).row(0)

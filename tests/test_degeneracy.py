@@ -99,6 +99,7 @@ def test_status_codes_are_stable_strings():
         "overflow",
         "normal-in-contact-plane",
         "finger-cannot-follow",  # a hand's, not a decomposition's
+        "no-wrist",
     ]
 
 

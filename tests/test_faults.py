@@ -14,6 +14,7 @@ from __future__ import annotations
 import contextlib
 import errno
 import glob
+import json
 import os
 import re
 import resource
@@ -24,6 +25,7 @@ import subprocess
 import sys
 import threading
 import time
+import zipfile
 from pathlib import Path
 
 import numpy as np
@@ -31,9 +33,13 @@ import pytest
 from typer.testing import CliRunner
 
 from grasptwist.cli import EXIT_USAGE, EXIT_WORKER, EXIT_WRITE, app
+from grasptwist.io.datasets import MAX_INFLATION, Member, open_dataset
+from grasptwist.io.inputs import read
+from grasptwist.model import GraspFileError
 from grasptwist.run.pipeline import TUNING, Spool
 from grasptwist.run.pool import Pool, WorkerDied, WorkerFailed
 from grasptwist.run.scratch import owned_prefix
+from hostile import assert_no_crash, jsonl, run_installed, run_measured, summary
 
 ROOT = Path(__file__).resolve().parents[1]
 POLY = ROOT / "grasps" / "polyhedron.yaml"
@@ -135,6 +141,16 @@ def wait_for(condition, what: str, timeout: float = 30, run: Run | None = None):
             pytest.fail(f"timed out waiting for {what}")
         time.sleep(0.005)
     return value
+
+
+def catches(pid: int, sig: signal.Signals) -> bool:
+    """Whether process ``pid`` has a handler for ``sig`` (before it has one, a
+    signal has its default effect: a run still starting just dies)."""
+    with contextlib.suppress(OSError):
+        for line in Path(f"/proc/{pid}/status").read_text().splitlines():
+            if line.startswith("SigCgt:"):
+                return bool(int(line.split()[1], 16) >> (sig - 1) & 1)
+    return False
 
 
 def session(sid: int) -> list[int]:
@@ -442,6 +458,213 @@ def test_a_spool_holds_at_most_its_share_per_worker(tmp_path):
 
 
 # --------------------------------------------------------------------------
+# 6. Small hostile files stay small in memory
+
+
+def test_sixteen_mebibytes_of_document_markers_take_little_memory(tmp_path):
+    # 0.1: 262,144 records and error lines per file, 20.4 GB for the folder
+    (tmp_path / "in").mkdir()
+    for k in range(16):
+        (tmp_path / "in" / f"{k:02d}.yaml").write_bytes(b"---\n" * (1 << 18))  # 1 MiB of empty documents
+    start = time.monotonic()
+    code, stderr, peak = run_measured("resolve", "in", "-f", "jsonl", "-j", "2", "-o", "out.jsonl", cwd=tmp_path)
+    print(f"sixteen files of '---': {time.monotonic() - start:.2f} s, peak {peak:.0f} MB")
+    assert code == 1 and peak < 300
+    # per file: 100 errors, too-many-documents at document 10,001, one line counting the 9,900 others
+    assert len(jsonl((tmp_path / "out.jsonl").read_text())) == 16 * 102
+    lines = stderr.splitlines()
+    assert lines[-2].endswith("9900 more problems in this file not reported (only the first 100 are)")
+    assert lines[-1] == summary(16 * 102, 16 * 102)
+
+
+@pytest.fixture(scope="module")
+def bomb(tmp_path_factory) -> Path:
+    """A 280 kB ``.npz`` declaring 288 MB of zeros (the issue's bomb, a tenth the size, to be quick to make)."""
+    path = tmp_path_factory.mktemp("bomb") / "bomb.npz"
+    np.savez_compressed(path, points=np.zeros((4_000_000, 3, 3)))
+    return path
+
+
+def test_an_npz_zip_bomb_is_refused_unread_and_costs_no_other_record(tmp_path, bomb):
+    # 0.1 inflated every member whole: 2.85 GB and 12.7 s for the 2.8 MB bomb, MemoryError under a limit
+    start = time.monotonic()
+    code, stderr, peak = run_measured("resolve", bomb, POLY, "-f", "jsonl", "-o", "out.jsonl", cwd=tmp_path)
+    seconds = time.monotonic() - start
+    print(f"npz bomb: {seconds:.2f} s, peak {peak:.0f} MB")
+    assert code == 1 and peak < 150 and seconds < 5
+    assert stderr.splitlines()[0] == (
+        f"{bomb}: error: bad-dataset: points: declares 288,000,128 bytes in "
+        f"{zipfile.ZipFile(bomb).getinfo('points.npy').compress_size:,} compressed "
+        f"(over {MAX_INFLATION} times): refused unread, as a likely zip bomb"
+    )
+    records = jsonl((tmp_path / "out.jsonl").read_text())
+    assert [r["file"] for r in records] == [str(bomb), str(POLY)] and records[1]["ok"]
+
+
+@pytest.mark.parametrize("save", [np.savez, np.savez_compressed], ids=["stored", "compressed"])
+def test_npz_members_are_read_a_block_at_a_time_with_the_same_records(tmp_path, rows, save):
+    data = np.load(rows, mmap_mode="r")[: 3 * TUNING.grasps_per_task]  # three tasks for two workers
+    n = len(data)
+    save(
+        tmp_path / "set.npz",
+        points=data[:, :9].reshape(n, 3, 3),
+        normals=data[:, 9:18].reshape(n, 3, 3),
+        wrist=data[:, 18:],
+        twist=data[:, :6],
+        names=np.array([f"g{i}" for i in range(n)]),
+    )
+    ds = open_dataset(str(tmp_path / "set.npz"))
+    assert isinstance(ds.points, Member) and ds.points.shape == (n, 3, 3)
+    np.testing.assert_array_equal(ds.points[5000:5100], data[5000:5100, :9].reshape(100, 3, 3))
+    np.testing.assert_array_equal(ds.twist[n - 5 :], data[n - 5 :, :6])
+    # forked workers, each reading its own tasks' rows: as one process reading them all
+    args = ("resolve", tmp_path / "set.npz", "-f", "jsonl", "-q")
+    two, one = (Run(tmp_path, *args, "-j", j, stdout=subprocess.PIPE) for j in ("2", "1"))
+    assert two.p.stdout.read() == one.p.stdout.read()
+    assert two.finish()[0] == one.finish()[0] in (0, 1)
+
+
+def test_a_damaged_npz_member_is_a_read_error_where_it_is_found(tmp_path, rows):
+    points = np.load(rows, mmap_mode="r")[:3000, :9].reshape(-1, 3, 3)
+    np.savez_compressed(tmp_path / "set.npz", points=points, normals=points)
+    info = zipfile.ZipFile(tmp_path / "set.npz").getinfo("points.npy")
+    data = bytearray((tmp_path / "set.npz").read_bytes())
+    end = info.header_offset + info.compress_size  # the member's last bytes: its checksum fails at its end
+    data[end - 100 : end - 50] = bytes(50)
+    (tmp_path / "set.npz").write_bytes(data)
+    proc, _ = run_installed("resolve", tmp_path / "set.npz", POLY, *TWIST, "-f", "jsonl", "-j", "1")
+    assert_no_crash(proc.stderr)
+    assert proc.returncode == 1
+    [line] = [x for x in proc.stderr.splitlines() if "read-error" in x]
+    assert line.startswith(f"{tmp_path / 'set.npz'}: error: read-error: points.npy: ")
+    assert line.endswith("(damaged, or changed while being read)")
+    assert jsonl(proc.stdout)[-1]["file"] == str(POLY)  # the next input is still resolved
+
+
+@pytest.mark.parametrize(
+    ("member", "message"),
+    [
+        ("shape", "points: shape (5, 3, 3) of float64 needs 360 bytes, the member holds 288"),
+        ("objects", "names: holds Python objects (object), which are never read"),
+        ("fortran", "points: stored column-major; save it with np.ascontiguousarray"),
+    ],
+)
+def test_what_an_npz_member_declares_is_checked_before_it_is_read(tmp_path, member, message):
+    path = tmp_path / "odd.npz"
+    arrays = {"points": np.zeros((4, 3, 3)), "normals": np.ones((4, 3, 3))}
+    if member == "objects":
+        arrays["names"] = np.array(["a", 1, None, 2.0], dtype=object)
+    if member == "fortran":
+        arrays["points"] = np.asfortranarray(arrays["points"])
+    with zipfile.ZipFile(path, "w") as zf:
+        for key, a in arrays.items():
+            with zf.open(f"{key}.npy", "w") as f:
+                if member == "shape" and key == "points":  # a header declaring one more row than there is
+                    header = {"descr": "<f8", "fortran_order": False, "shape": (5, 3, 3)}
+                    np.lib.format.write_array_header_1_0(f, header)
+                    f.write(a.tobytes())
+                else:
+                    np.lib.format.write_array(f, a, allow_pickle=True)
+    with pytest.raises(GraspFileError, match=re.escape(message)) as err:
+        open_dataset(str(path))
+    assert err.value.code == "bad-dataset"
+
+
+# --------------------------------------------------------------------------
+# 7. Names that are not UTF-8
+
+
+@pytest.mark.parametrize("fmt", ["json", "jsonl", "csv", "check", "-o"])
+def test_an_undecodable_file_name_is_escaped_in_every_format(tmp_path, fmt):
+    # 0.1: internal error (TypeError: str is not valid UTF-8, or UnicodeEncodeError), no record at all
+    folder = tmp_path / "in"
+    folder.mkdir()
+    shutil.copy(POLY, folder / "good.yaml")
+    with open(os.fsencode(folder) + b"/b\xff.yaml", "wb") as f:
+        f.write(POLY.read_bytes())
+    out = tmp_path / "out.jsonl"
+    args = ("check", folder) if fmt == "check" else ("resolve", folder, "-f", "jsonl" if fmt == "-o" else fmt)
+    run = Run(tmp_path, *args, *(("-o", out) if fmt == "-o" else ()), stdout=subprocess.PIPE)
+    text = run.p.stdout.read()
+    assert run.finish()[0] == 0 and run.said() == [summary(2, 0)]
+    text = out.read_bytes() if fmt == "-o" else text
+    escaped = f"{folder}/b\\xff.yaml"
+    assert text.decode("utf-8").count(escaped if fmt in ("csv", "check") else json.dumps(escaped)[1:-1]) == 1
+
+
+def test_bytes_names_in_an_npz_are_decoded_and_the_other_inputs_kept(tmp_path):
+    # 0.1: internal error: UnicodeDecodeError, and the good input given alongside was lost
+    path = tmp_path / "names.npz"
+    arrays = np.random.default_rng(7).normal(size=(2, 3, 3, 3))
+    np.savez(path, points=arrays[0], normals=arrays[1], names=np.array([b"ok", b"\xff", b"caf\xc3\xa9"]))
+    proc, _ = run_installed("resolve", path, POLY, *TWIST, "-f", "jsonl")
+    assert_no_crash(proc.stderr)
+    assert [r["grasp"] for r in jsonl(proc.stdout)] == ["ok", "\\xff", "caf\u00e9", "polyhedron"]
+
+
+# --------------------------------------------------------------------------
+# 9. Deep trees
+
+DEPTH = 2000
+
+
+@pytest.fixture
+def deep_tree(tmp_path):
+    """``deep/d/d/.../d/g.yaml``, DEPTH folders down, beside ``top.yaml``; made
+    and removed by file descriptors, since the paths outgrow what Python's
+    recursive ``os.makedirs`` and ``shutil.rmtree`` can take."""
+    (tmp_path / "deep").mkdir()
+    shutil.copyfile(ROOT / "grasps" / "sphere.yaml", tmp_path / "deep" / "top.yaml")
+    fd = os.open(tmp_path / "deep", os.O_RDONLY)
+    for _ in range(DEPTH):
+        os.mkdir("d", dir_fd=fd)
+        fd, parent = os.open("d", os.O_RDONLY, dir_fd=fd), fd
+        os.close(parent)
+    leaf = os.open("g.yaml", os.O_WRONLY | os.O_CREAT, 0o644, dir_fd=fd)
+    os.write(leaf, POLY.read_bytes())
+    os.close(leaf)
+    yield tmp_path
+    os.unlink("g.yaml", dir_fd=fd)
+    for _ in range(DEPTH):
+        fd, child = os.open("..", os.O_RDONLY, dir_fd=fd), fd
+        os.close(child)
+        os.rmdir("d", dir_fd=fd)
+    os.close(fd)
+
+
+def test_a_folder_2000_levels_deep(deep_tree):
+    # 0.1: internal error: RecursionError after 11 s, and no records, not even for top.yaml
+    # relative to the tree's parent the deepest path has ~4,000 characters, within PATH_MAX
+    proc, seconds = run_installed("resolve", "deep", "-f", "jsonl", cwd=deep_tree)
+    assert_no_crash(proc.stderr)
+    deepest = "deep/" + "d/" * DEPTH + "g.yaml"
+    # every record of both files, depth first in name order: one per grasp and twist
+    expected = [deepest] * records_of(POLY) + ["deep/top.yaml"] * records_of(ROOT / "grasps" / "sphere.yaml")
+    assert [r["file"] for r in jsonl(proc.stdout)] == expected and seconds < 10
+
+
+def records_of(path):
+    return sum(len(grasp.twists) for grasp in read(str(path)))
+
+
+# --------------------------------------------------------------------------
+# 11. Nits
+
+
+def test_nan_in_a_data_set_wrist_column_is_nonfinite_input_not_no_wrist(tmp_path):
+    # 0.1: a row whose wrist held NaN or infinity was silently resolved as if it had no wrist
+    points, normals = np.random.default_rng(5).normal(size=(2, 3, 3, 3))
+    wrist = np.array([[0.0, 0.0, 1.0], [np.nan, 0.0, 1.0], [0.0, np.inf, 1.0]])
+    np.savez(tmp_path / "set.npz", points=points, normals=normals, wrist=wrist)
+    r = invoke("resolve", tmp_path / "set.npz", *TWIST, "-f", "jsonl")
+    records = jsonl(r.stdout)
+    assert ["error" not in rec["off_tangent"] for rec in records] == [True, False, False]
+    assert [rec["off_tangent"]["error"]["code"] for rec in records[1:]] == ["nonfinite-input"] * 2
+    assert all(rec["tangent"] and "alpha" in rec["tangent"] for rec in records)  # the other method still answers
+    assert r.exit_code == 1
+
+
+# --------------------------------------------------------------------------
 # 10. Write errors: one line, exit 3, nothing left
 
 
@@ -466,6 +689,62 @@ def test_a_full_disk_is_one_line_and_exit_3(tmp_path, rows):
 
 
 # --------------------------------------------------------------------------
+# 8. Names in tables: never read as rich markup, control characters escaped
+
+MARKUP_GRASP = """\
+name: "[/]x"
+wrist: [0, 0, 0]
+contacts:
+  - {name: "[/]a", point: [0, 2, 2], normal: [1, 0, 0]}
+  - {name: "[bold]b", point: [2, 0, 2], normal: [0, 1, 0]}
+  - {name: "[blink]c", point: [2, 2, 0], normal: [0, 0, 1]}
+twists:
+  - {name: "[red]t", screw: [0, 0, 1, 0, 0, 0]}
+"""
+
+
+@pytest.mark.parametrize("command", ["resolve", "basis", "check"])
+def test_markup_and_control_characters_in_names_are_shown_as_written(tmp_path, command):
+    path = tmp_path / "g\x1b[2Jrid\x07.yaml"  # a file name that would clear the screen and ring
+    path.write_text(MARKUP_GRASP)
+    r = invoke(command, path)
+    assert r.exit_code == 0, r.output  # 0.1: internal error: MarkupError
+    shown = r.stdout
+    assert "\x1b" not in shown and "\x07" not in shown
+    assert "g\\x1b[2Jrid\\x07.yaml" in shown  # escaped as stderr escapes it
+    assert "[/]x" in shown
+    if command != "check":
+        assert "[/]x (" in shown.splitlines()[0]  # the title
+        for name in ("[/]a", "[bold]b", "[blink]c"):
+            assert re.search(rf"^  {re.escape(name)} ", shown, re.M), name  # a row, neither swallowed nor raw
+    if command == "resolve":
+        assert "twist [red]t = (0.0000, 0.0000, 1.0000; 0.0000, 0.0000, 0.0000)" in shown
+
+
+def test_data_set_names_with_control_characters_are_escaped_in_tables(tmp_path):
+    path = tmp_path / "rows.npz"
+    points = np.tile([[0.0, 2, 2], [2, 0, 2], [2, 2, 0]], (2, 1, 1))
+    names = np.array(["\x1b]0;owned\x07", "[/]y"])
+    np.savez(path, points=points, normals=np.tile(np.eye(3), (2, 1, 1)), twist=[0, 0, 1, 0, 0, 0.0], names=names)
+    for command in ("resolve", "check"):
+        r = invoke(command, path)
+        assert r.exit_code == 0, r.output
+        assert "\x1b" not in r.stdout and "\x07" not in r.stdout
+        assert "\\x1b]0;owned\\x07" in r.stdout and "[/]y" in r.stdout
+
+
+def test_an_undecodable_file_name_renders_in_tables(tmp_path):
+    folder = os.fsencode(tmp_path)
+    with open(folder + b"/b\xff.yaml", "wb") as f:
+        f.write(MARKUP_GRASP.encode())
+    (tmp_path / "good.yaml").write_text(POLY.read_text())
+    for command in ("resolve", "basis", "check"):
+        r = invoke(command, tmp_path)
+        assert r.exit_code == 0, r.output
+        assert "b\\xff.yaml" in r.stdout and "polyhedron" in r.stdout
+
+
+# --------------------------------------------------------------------------
 # Soaks: faults at random moments (python -m pytest -m slow tests/test_faults.py)
 
 
@@ -483,12 +762,13 @@ def test_stop_signals_at_random_moments(tmp_path, rows, seed):
     run = Run(tmp_path, "resolve", rows, *TWIST, "-f", fmt, "-j", workers, *target, stdout=subprocess.PIPE)
     if rng.random() < 0.5:  # a reader that keeps up, or one that never reads until the end
         threading.Thread(target=lambda: [None for _ in iter(lambda: run.p.stdout.read(1 << 16), b"")]).start()
+    wait_for(lambda: catches(run.p.pid, sig), f"the run to catch {sig.name}", run=run)
     time.sleep(rng.uniform(0, 1.5))  # the moment is the point of the test
     with contextlib.suppress(ProcessLookupError):  # it finished first
         (os.killpg if group else os.kill)(run.p.pid, sig)
     code, seconds, _ = run.finish()
     assert "Traceback" not in "\n".join(run.lines)
-    if code in (0, 1):  # it finished first
+    if code in (0, 1, -sig):  # it finished first (-sig: the signal came as it exited, its handlers gone)
         assert run.said()[-1].endswith(" failed")
     else:
         assert code == 128 + sig and seconds < 5, (code, run.said())
@@ -525,7 +805,10 @@ def test_timeout_on_a_large_data_set_leaves_nothing(tmp_path):
     np.save(big, np.random.default_rng(3).normal(size=(1_500_000, 21)))  # 250 MB, ~20 s of work
     for fmt, workers in (("jsonl", "2"), ("npz", "1")):
         out = tmp_path / f"out.{fmt}"
-        run = Run(tmp_path, "resolve", big, *TWIST, "-f", fmt, "-j", workers, "-o", out, prefix=("timeout", "3"))
+        # then standard input, never closed: a run that got through the data set waits there, so
+        # `timeout` always has something to stop
+        args = ("resolve", big, "-", *TWIST, "-f", fmt, "-j", workers, "-o", out)
+        run = Run(tmp_path, *args, prefix=("timeout", "3"), stdin=subprocess.PIPE)
         code, seconds, _ = run.finish()
         assert code == 124 and "Traceback" not in "\n".join(run.lines)
         assert run.said() == ["grasptwist: stopped by SIGTERM"]

@@ -2,10 +2,12 @@
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import grasptwist as gt
 from grasp_gen import grasps
-from grasptwist.engine.judgements import about_wrist, active, off_tangent_moves, tangent_moves
+from grasptwist.engine.judgements import about_wrist, active, off_tangent_moves, outward_normals, tangent_moves
 
 N = 300
 
@@ -89,3 +91,40 @@ def test_a_failed_row_moves_nothing():
     assert not off_tangent_moves(nan, nan).any() and not about_wrist(nan, nan)
     assert not tangent_moves(nan, nan, nan, False).any()
     assert active([np.nan, 1.0]).tolist() == [False, False]  # NaN in a row: its maximum is unknown
+
+
+def test_normals_leaning_inward_are_not_outward_and_reversed_they_all_are(batch):
+    points, normals, _, _ = batch  # each normal within 60 degrees of centroid - p_i
+    assert not outward_normals(points, normals).any()
+    assert outward_normals(points, -normals).all()
+    flipped = -normals.copy()
+    flipped[:, 1] *= -1  # one normal back inward: not every normal points away
+    assert not outward_normals(points, flipped).any()
+
+
+@settings(max_examples=50, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([1e-6, 1.0, 1e6]), st.floats(-1e3, 1e3))
+def test_on_a_sphere_the_surface_normals_are_judged_by_their_sign_at_any_scale_and_place(seed, scale, shift):
+    rng = np.random.default_rng(seed)
+    centre = rng.normal(size=3)
+    on = gt.screws.unit(rng.normal(size=(20, 3, 3)))  # 20 grasps of three points on the unit sphere
+    points = (centre + on) * scale + shift
+    # a convex object: the inward normal -on_i has every other point on its inner side
+    assert not outward_normals(points, -on).any()
+    assert outward_normals(points, on).all()
+
+
+def test_a_normal_at_right_angles_to_the_centroid_or_nan_is_not_outward():
+    p = np.array([[1.0, 0, 0], [-0.5, 0.866, 0], [-0.5, -0.866, 0]])
+    tangent = np.array([[0.0, 1, 0], p[1], p[2]])  # contact 1's normal is perpendicular to g - p_1
+    assert outward_normals(p, p).item() and not outward_normals(p, tangent).item()
+    assert not outward_normals(p, np.full((3, 3), np.nan)).item()
+
+
+def test_reversed_normals_change_only_the_sign_of_the_normal_velocities(batch):
+    # what the README promises a user whose normals get the outward-normals warning
+    points, normals, _, twist = batch
+    inward, outward = gt.decompose_tangent(points, normals, twist), gt.decompose_tangent(points, -normals, twist)
+    for name in ("theta", "alpha", "beta", "conditioning", "in_tangent_planes", "status"):
+        np.testing.assert_allclose(getattr(outward, name), getattr(inward, name), rtol=1e-12, atol=1e-12)
+    np.testing.assert_allclose(outward.normal_velocity, -inward.normal_velocity, rtol=1e-12, atol=1e-12)

@@ -77,7 +77,7 @@ class SpeedTable:
         return [("speed", [T.fmt_number(v, d) for v in m["speed"]])]
 
     @staticmethod
-    def resolve(m, names, d):
+    def resolve(m, names, d, rec):
         return "speeds shown with the contacts"
 
     @staticmethod

@@ -86,8 +86,19 @@ def _floats(text: str, n: int, what: str) -> list[float]:
     return values
 
 
-def _cli_twists(texts: list[str] | None, at: str | None):
-    """``--twist`` values as loader twists at the origin (``--at`` names the reference point)."""
+def _cli_twists(texts: list[str] | None, at: str | None, names: list[str] | None = None):
+    """``--twist`` values as loader twists at the origin (``--at`` names the reference point),
+    named by ``names`` (``--twist-name``, one per twist) or as written."""
+    if names and len(names) != len(texts or ()):
+        raise typer.BadParameter(
+            f"give one --twist-name per --twist (got {len(names)} names for {len(texts or ())} twists)",
+            param_hint="--twist-name",
+        )
+    for name in names or ():
+        if not name.strip() or not name.isprintable():
+            raise typer.BadParameter(
+                f"{name!r}: a name is a non-empty line of printable text", param_hint="--twist-name"
+            )
     if not texts:
         if at is not None:
             raise typer.BadParameter("--at applies to --twist; give at least one --twist", param_hint="--at")
@@ -99,23 +110,46 @@ def _cli_twists(texts: list[str] | None, at: str | None):
 
     point = _floats(at, 3, "--at") if at is not None else [0.0, 0.0, 0.0]
     twists = []
-    for text in texts:
+    for k, text in enumerate(texts):
         w = _floats(text, 6, "--twist")
         with np.errstate(all="ignore"):
             screw = twist_at(w[:3], w[3:], point)
         if not np.isfinite(screw).all():
             raise typer.BadParameter(f"{text!r} at {at}: the velocity of the origin overflows", param_hint="--twist")
-        twists.append(Twist(name=text.replace(" ", ""), screw=screw, line=None))
+        twists.append(Twist(name=names[k] if names else text.replace(" ", ""), screw=screw, line=None))
     return twists
 
 
-class _Stderr:
-    """Diagnostics on stderr: one line each, counted; colour only on a terminal."""
+class Warnings(str, Enum):
+    all = "all"
+    summary = "summary"
+    none = "none"
 
-    def __init__(self, quiet: bool = False):
+
+#: Warnings ``--warnings summary`` prints before it only counts them.
+WARNINGS_SHOWN = 20
+
+#: Records of a table from which stderr suggests the machine formats, once.
+TABLE_HINT_AT = 50
+
+
+class _Stderr:
+    """Diagnostics on stderr: one line each, counted; colour only on a terminal.
+
+    Errors are all printed; warnings as ``--warnings`` asks (``summary``: the
+    first :data:`WARNINGS_SHOWN`, then one line counting the rest by kind);
+    ``-q`` drops warnings, the table hint and the summary.  ``hint`` is the
+    line said once when a table passes :data:`TABLE_HINT_AT` records.
+    """
+
+    def __init__(self, quiet: bool = False, warnings: Warnings = Warnings.summary, hint: str | None = None):
         self.failed = 0
         self.records = 0
         self.quiet = quiet
+        self.shown = {Warnings.all: None, Warnings.summary: WARNINGS_SHOWN, Warnings.none: 0}[Warnings(warnings)]
+        self.counting = warnings == Warnings.summary
+        self.unshown: dict[str, int] = {}  # warnings not printed, by kind
+        self.hint = None if quiet else hint
         self.color = sys.stderr.isatty() and not os.environ.get("NO_COLOR")
 
     def take(self, out) -> None:
@@ -126,7 +160,19 @@ class _Stderr:
             self.say(line, ": error: ", "31")
         if not self.quiet:
             for line in out.warnings:
-                self.say(line, ": warning: ", "33")
+                self.warn(line)
+        if self.hint and self.records > TABLE_HINT_AT:
+            _say(self.hint)
+            self.hint = None
+
+    def warn(self, line: str) -> None:
+        """Print a warning line, or count it by kind once the first ``shown`` are out."""
+        if self.shown is None or self.shown > 0:
+            self.say(line, ": warning: ", "33")
+            self.shown = None if self.shown is None else self.shown - 1
+        elif self.counting:
+            kind = _warning_kind(line)
+            self.unshown[kind] = self.unshown.get(kind, 0) + 1
 
     def say(self, line: str, label: str, colour: str) -> None:
         """Print one diagnostic line, its label coloured on a terminal."""
@@ -135,8 +181,31 @@ class _Stderr:
         _say(line)
 
     def summary(self) -> None:
-        if not self.quiet:
-            _say(f"{self.records} record{'' if self.records == 1 else 's'}, {self.failed} failed")
+        if self.quiet:
+            return
+        if self.unshown:
+            total = sum(self.unshown.values())
+            kinds = ", ".join(f"{n} {kind}" for kind, n in sorted(self.unshown.items(), key=lambda kv: -kv[1]))
+            _say(f"grasptwist: {total} more warning{'' if total == 1 else 's'} not shown (--warnings all): {kinds}")
+        _say(f"{self.records} record{'' if self.records == 1 else 's'}, {self.failed} failed")
+
+
+def _warning_kind(line: str) -> str:
+    """What a warning line is about, without its place and numbers: its message
+    up to the first parenthesis or colon (``tangent basis is nearly degenerate``).
+
+    >>> _warning_kind("a.yaml: grasp 'g': warning: tangent basis is nearly degenerate (conditioning 2e-05 < 0.001): ...")
+    'tangent basis is nearly degenerate'
+    """
+    message = line.rpartition(": warning: ")[2]
+    return message.split(" (", 1)[0].split(":", 1)[0].strip()
+
+
+def _table_hint(command: str) -> str:
+    """The line that points a reader of a long table to the machine formats."""
+    others = [f for f in names_for(command) if f != "table"]
+    listed = ", ".join(others[:-1]) + f" or {others[-1]}"
+    return f"grasptwist: hint: more than {TABLE_HINT_AT} records: -f {listed} writes them far faster, for programs"
 
 
 def _say(line: str) -> None:
@@ -176,21 +245,26 @@ def _writable_folder(path: str) -> None:
 
 
 @contextmanager
-def _progress(inputs: list):
-    """A rich progress bar on stderr when it is a terminal and there is more
-    than one input or a data set (whose records are counted as they come)."""
+def _progress(inputs: list, command: str, out):
+    """A rich progress bar on stderr, named after ``command``, when it is a
+    terminal and there is more than one input or a data set (whose records
+    are counted as they come); not when the output ``out`` goes to a
+    terminal too, where it shows the progress itself (and a bar would be
+    drawn between its lines)."""
     from .io.datasets import DATASET_SUFFIXES
 
     big = len(inputs) > 1 or any(isinstance(p, str) and p.endswith(DATASET_SUFFIXES) for p in inputs)
-    if not big or not sys.stderr.isatty():
+    if not big or not sys.stderr.isatty() or out.isatty():
         yield lambda output: None
         return
     from rich.progress import Progress
 
     from .output.table import console
 
+    # the console never wraps: lines printed under the bar (stderr is redirected
+    # through it) stay one line each, folded only by the terminal
     with Progress(console=console(sys.stderr), transient=True) as bar:
-        task = bar.add_task("resolving", total=len(inputs))
+        task = bar.add_task(f"grasptwist {command}", total=len(inputs))
 
         def advance(output):
             if output.grows:
@@ -208,6 +282,11 @@ _MAX_BYTES = typer.Option(
     None, "--max-bytes", min=1, help="Refuse grasp files larger than this many bytes (default 1 MiB)."
 )
 _QUIET = typer.Option(False, "-q", "--quiet", help="No warnings or summary on stderr (errors still).")
+_WARNINGS = typer.Option(
+    Warnings.summary,
+    "--warnings",
+    help=f"Warnings on stderr: all, none, or the first {WARNINGS_SHOWN} and a count of the rest by kind.",
+)
 _DEBUG = typer.Option(False, "--debug", help="Show the Python traceback of an internal error.")
 _JSON = typer.Option(False, "--json", help="Same as --format json.")
 
@@ -219,7 +298,10 @@ _WORKERS = typer.Option(
     min=0,
     help="Processes for big batches (0: every core, used for 256+ files or 4096+ data-set grasps).",
 )
-_PATHS_HELP = "Grasp files (.yaml, .yml, .json; any case), data sets (.npz, .npy), folders of grasp files or - (stdin)."
+_PATHS_HELP = (
+    "Grasp files (.yaml, .yml, .json; any case), JSON Lines of grasps (.jsonl), data sets (.npz, .npy, .parquet), "
+    "folders of grasp files or - (stdin: YAML, or JSON Lines if it starts with '{')."
+)
 _PATHS = typer.Argument(..., metavar="PATH...", help=_PATHS_HELP)
 
 
@@ -232,12 +314,27 @@ def resolve(
         metavar="W1,W2,W3,V1,V2,V3",
         help="Object twist (omega; v); repeatable; replaces the files' twists.",
     ),
+    twist_name: list[str] | None = typer.Option(
+        None,
+        "--twist-name",
+        metavar="NAME",
+        help="Name of each --twist in the records, paired in order (default: the twist as written).",
+    ),
     at: str | None = typer.Option(
         None, "--at", metavar="X,Y,Z", help="Point whose velocity the --twist linear part gives (default: the origin)."
     ),
+    twists_from: str | None = typer.Option(
+        None,
+        "--twists-from",
+        metavar="FILE|-",
+        help="Twists one per line (JSON: [w1,w2,w3,v1,v2,v3] or a twist mapping), each resolved as it arrives.",
+    ),
     method: Method = _METHOD,
     fmt: Format = typer.Option(
-        Format.table, "-f", "--format", help="table for people; json, jsonl, csv or npz (arrays, with -o) for programs."
+        Format.table,
+        "-f",
+        "--format",
+        help="table for people; json, jsonl, csv, npz or parquet (with -o) for programs.",
     ),
     json_: bool = _JSON,
     output: str | None = _OUTPUT,
@@ -258,6 +355,7 @@ def resolve(
     max_bytes: int | None = _MAX_BYTES,
     workers: int = _WORKERS,
     quiet: bool = _QUIET,
+    warnings: Warnings = _WARNINGS,
     debug: bool = _DEBUG,
 ) -> None:
     """Resolve object twists into finger-tip twists and amplitudes: one record per (grasp, twist).
@@ -272,7 +370,11 @@ def resolve(
     """
     from .run.pipeline import Job
 
-    twists = _cli_twists(twist, at)
+    twists = _cli_twists(twist, at, twist_name)
+    if twists_from is not None and twists is not None:
+        raise typer.BadParameter("give twists by --twist or by --twists-from, not both", param_hint="--twists-from")
+    if twists_from == "-" and "-" in paths:
+        raise typer.BadParameter("standard input can be read only once", param_hint="--twists-from")
     if extra_point == ExtraPoint.at and at is not None:
         raise typer.BadParameter("--extra-point at gives each row its own point; drop --at", param_hint="--at")
     if extra_point == ExtraPoint.at and not any(p.endswith(".npy") for p in paths):
@@ -289,8 +391,9 @@ def resolve(
         max_bytes=max_bytes,
         extra_point=extra_point.value,
         hand=_hand_option(hand, paths, fmt.value),
+        twists_from=twists_from,
     )
-    _run(debug, lambda: _emit(job, paths, output, quiet, workers, digits=digits, order=order.value))
+    _run(debug, lambda: _emit(job, paths, output, (quiet, warnings), workers, digits=digits, order=order.value))
 
 
 def _hand_option(path: str | None, paths: list[str], fmt: str):
@@ -328,6 +431,7 @@ def basis(
     max_bytes: int | None = _MAX_BYTES,
     workers: int = _WORKERS,
     quiet: bool = _QUIET,
+    warnings: Warnings = _WARNINGS,
     debug: bool = _DEBUG,
 ) -> None:
     """Show each grasp's basis screws Sigma, Psi, Theta, their Klein products and conditioning.
@@ -342,7 +446,7 @@ def basis(
     job = Job(
         kind="basis", method=method.value, order=order.value, fmt="json" if json_ else fmt.value, max_bytes=max_bytes
     )
-    _run(debug, lambda: _emit(job, paths, output, quiet, workers, digits=digits, order=order.value))
+    _run(debug, lambda: _emit(job, paths, output, (quiet, warnings), workers, digits=digits, order=order.value))
 
 
 @app.command()
@@ -357,6 +461,7 @@ def check(
     max_bytes: int | None = _MAX_BYTES,
     workers: int = _WORKERS,
     quiet: bool = _QUIET,
+    warnings: Warnings = _WARNINGS,
     debug: bool = _DEBUG,
 ) -> None:
     """Validate grasp files and report degenerate grasps without resolving; exit 1 if any fails.
@@ -369,7 +474,7 @@ def check(
     from .run.pipeline import Job
 
     job = Job(kind="check", method=method.value, fmt="json" if json_ else fmt.value, max_bytes=max_bytes)
-    _run(debug, lambda: _emit(job, paths, output, quiet, workers))
+    _run(debug, lambda: _emit(job, paths, output, (quiet, warnings), workers))
 
 
 FollowFormat = _choices("FollowFormat", names_for("follow"))
@@ -535,7 +640,7 @@ def plot(
     max_bytes: int | None = _MAX_BYTES,
     debug: bool = _DEBUG,
 ) -> None:
-    """Draw a grasp, its basis screw axes and the finger-tip velocities (needs matplotlib: the extra grasptwist[plot]).
+    """Draw a grasp, its basis screw axes and the finger-tip velocities (needs matplotlib: from a clone, pip install '.[plot]').
 
     Examples: the paper's cylinder spinning about z, and every bundled grasp:
 
@@ -586,15 +691,16 @@ def _workers(requested: int) -> int:
     return requested if requested > 0 else min(os.cpu_count() or 1, 8)
 
 
-def _emit(job, paths: list[str], output, quiet: bool, workers: int, **table_options) -> int:
-    """Files in, records out: the body of resolve, basis and check."""
+def _emit(job, paths: list[str], output, stderr_options: tuple, workers: int, **table_options) -> int:
+    """Files in, records out: the body of resolve, basis and check
+    (``stderr_options``: ``-q`` and ``--warnings``)."""
     from .io.inputs import expand
     from .run.pipeline import run, write_blocks
 
-    stderr = _Stderr(quiet)
+    stderr = _Stderr(*stderr_options, hint=_table_hint(job.kind) if job.fmt == "table" else None)
     inputs = list(expand(paths))
     fmt = FORMATS[job.fmt]
-    with _output(output) as out, _progress(inputs) as advance:
+    with _output(output) as out, _progress(inputs, job.kind, out) as advance:
         w = fmt.open(out, job.kind, **table_options, **fmt.hand_options(job.hand))
         # block writers (npz) take results here; the others get records encoded where they were made
         outputs = write_blocks(job, inputs, w) if fmt.takes_blocks else run(job, inputs, _workers(workers))
@@ -630,6 +736,7 @@ def _stopped(stop) -> int:
 
 def _run(debug: bool, job) -> None:
     """Run a command body; turn every way it can end into one line and an exit status."""
+    from .extras import MissingExtra
     from .run.pool import WorkerDied
     from .run.signals import Interrupted
     from .run.target import WriteError
@@ -645,6 +752,9 @@ def _run(debug: bool, job) -> None:
         # Unix filter killed by SIGPIPE, and keep Python's final flush quiet too.
         _drop_stdout()
         raise typer.Exit(EXIT_BROKEN_PIPE) from None
+    except MissingExtra as exc:  # e.g. -f parquet without pyarrow, found before any output
+        _say(f"grasptwist: error: {exc}")
+        raise typer.Exit(EXIT_USAGE) from None
     except (WriteError, WorkerDied) as exc:
         _drop_stdout()
         _say(f"grasptwist: error: {exc}")

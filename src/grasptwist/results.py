@@ -18,8 +18,9 @@ How to add a result kind
    ``conditioning`` like :mod:`grasptwist.engine.decompose`'s.
 2. Describe it here with a :class:`ResultKind` appended to :data:`KINDS`:
    its record key and label, ``compute`` (which block inputs it needs),
-   ``applies`` (rows where it is meaningful; elsewhere its record field is
-   ``null``), its :class:`Field` lists for ``resolve``, ``basis`` and
+   ``applies`` (rows where it can run), for a method ``missing`` (the
+   status of the other rows: a warning there, or a failure when the method
+   was asked for by name), its :class:`Field` lists for ``resolve``, ``basis`` and
    ``check`` records, and its :class:`Column` groups.
 3. Write its table renderer in :mod:`grasptwist.output.table`, the class
    that ``table`` names.
@@ -38,6 +39,7 @@ import numpy as np
 
 from .engine import judgements
 from .engine.decompose import decompose_off_tangent, decompose_tangent
+from .engine.degeneracy import Status
 from .engine.kinematics import OFF_TANGENT_FIXED, TANGENT_FIXED, hand_joint_rates
 from .engine.screws import klein_table
 
@@ -152,8 +154,8 @@ class ResultKind:
         (``points``, ``normals``, ``wrist`` (NaN rows where none),
         ``twist``, ...); ``bases=False`` may leave the basis screws out.
     applies : callable
-        ``block -> (N,) bool``: rows where the kind means something; its
-        record field is ``null`` elsewhere, and a failure there is not one.
+        ``block -> (N,) bool``: rows where the kind can run; its record
+        field is ``null`` elsewhere (see ``missing``).
     fields, basis_fields, check_fields : tuple of Field
         Its object in ``resolve``, ``basis`` and ``check`` records, in order.
     columns : tuple of Column
@@ -176,6 +178,12 @@ class ResultKind:
     culprit_names : callable or None
         ``(block, row) -> names`` that its culprit indices refer to in
         messages; None: the row's contact names.
+    missing : Status or None
+        Why a method cannot run where it does not apply (``no-wrist``):
+        its status there.  Asked for by name (``--method``), those rows
+        fail with it; under ``both`` the method is skipped there with a
+        warning.  None: nothing to say where the kind does not apply (a
+        hand's joint rates on a grasp without a hand).
     """
 
     key: str
@@ -191,6 +199,7 @@ class ResultKind:
     needs: tuple[str, ...] = ()
     record: str | None = None
     culprit_names: Callable[[Any, int], tuple[str, ...]] | None = None
+    missing: Status | None = None
 
 
 def _numbered(name: str, n: int = 3) -> tuple[str, ...]:
@@ -218,6 +227,7 @@ OFF_TANGENT = ResultKind(
         inputs["points"], inputs["wrist"], inputs["twist"], bases=bases
     ),
     applies=lambda block: block.has_wrist,
+    missing=Status.NO_WRIST,
     fields=(
         Field("sigma", "screws", bases=True),
         Field("psi", "screws", bases=True),

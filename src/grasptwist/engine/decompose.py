@@ -129,7 +129,26 @@ class _Result:
         return self.status == Status.OK
 
     def row(self, i):
-        """Row ``i`` (an index into the leading axis) as a result of the same type."""
+        """Row ``i`` (an index into the leading axis) as a result of the same type.
+
+        Raises
+        ------
+        ValueError
+            For a result of one grasp and one twist, which has no rows.
+
+        Paper Example 1 with two twists (a spin about z, a lift along z):
+
+        >>> p = [[1, 0, 0], [-0.5, 0.866, 0], [-0.5, -0.866, 0]]
+        >>> r = decompose_off_tangent(p, [0, 0, 1], [[0, 0, 1, 0, 0, 0], [0, 0, 0, 0, 0, 1]])
+        >>> r.row(1).x.round(4).tolist()
+        [0.6667, 0.6667, 0.6667]
+        >>> r.row(1).row(0)
+        Traceback (most recent call last):
+        ...
+        ValueError: row(0): this result is for one grasp and one twist (no batch axis); use it as it is
+        """
+        if np.ndim(self.status) == 0:
+            raise ValueError(f"row({i}): this result is for one grasp and one twist (no batch axis); use it as it is")
         r = type(self)(**{f.name: _index(getattr(self, f.name), i) for f in fields(self)})
         if "residual" in self.__dict__:  # carry a residual already computed for the batch
             r.__dict__["residual"] = self.__dict__["residual"][i]

@@ -24,6 +24,8 @@ __all__ = [
     "IN_PLANE_TOL",
     "status_message",
     "conditioning_warning",
+    "skipped_warning",
+    "OUTWARD_NORMALS_WARNING",
 ]
 
 #: A dimensionless measure at or below this makes the grasp degenerate.
@@ -55,6 +57,7 @@ class Status(IntEnum):
     OVERFLOW = 9
     NORMAL_IN_CONTACT_PLANE = 10
     FINGER_CANNOT_FOLLOW = 11
+    NO_WRIST = 12  # set where a grasp has none (see grasptwist.results), never by a decomposition
 
     @property
     def code(self) -> str:
@@ -87,6 +90,10 @@ _MESSAGES = {
     Status.FINGER_CANNOT_FOLLOW: (
         "finger {i} cannot follow its contact: no joint rates move it with the object's velocity there "
         "(relative residual above 1e-6)"
+    ),
+    Status.NO_WRIST: (
+        "the grasp has no wrist, and each Psi_i is a line from it: give one "
+        "('wrist: [x, y, z]' in a grasp file, a 'wrist' array in a data set)"
     ),
 }
 
@@ -126,3 +133,22 @@ def conditioning_warning(conditioning, basis: str) -> str | None:
         f"{basis} basis is nearly degenerate (conditioning {c:.3g} < {CONDITION_WARNING:g}): "
         "amplitudes are large and sensitive"
     )
+
+
+def skipped_warning(status, method: str) -> str:
+    """The warning for a method that could not run on a grasp and was not asked for by name.
+
+    >>> skipped_warning(Status.NO_WRIST, "off-tangent")[:53]
+    'off-tangent skipped: no-wrist: the grasp has no wrist'
+    """
+    s = Status(int(status))
+    return f"{method} skipped: {s.code}: {status_message(s)}"
+
+
+#: The warning for a grasp whose normals all point away from the other
+#: contacts (:func:`~grasptwist.engine.judgements.outward_normals`); it
+#: starts with its code.
+OUTWARD_NORMALS_WARNING = (
+    "outward-normals: every normal points away from the other contacts (n_i . (g - p_i) < 0, g their centroid), "
+    "but normals point into the object: flip them, unless the fingers push outward from inside a hollow"
+)

@@ -1,5 +1,6 @@
 """Judgements on a resolved twist: which fingers each component moves, and
-whether the twist is a rotation about the wrist.
+whether the twist is a rotation about the wrist; and on a grasp: whether
+its normals look outward.
 
 These are engine outputs like the amplitudes: pure functions on result
 arrays, batched over any leading shape, whose answers the records carry
@@ -26,8 +27,9 @@ from __future__ import annotations
 import numpy as np
 
 from .degeneracy import IN_PLANE_TOL
+from .screws import dot
 
-__all__ = ["ALONE", "ALL_BUT", "active", "off_tangent_moves", "tangent_moves", "about_wrist"]
+__all__ = ["ALONE", "ALL_BUT", "active", "off_tangent_moves", "tangent_moves", "about_wrist", "outward_normals"]
 
 #: ``ALONE[i, f]``: the basis screw ``Sigma_i`` moves finger ``f`` (``f == i`` only).
 ALONE = np.eye(3, dtype=bool)
@@ -173,3 +175,49 @@ def about_wrist(x, y, tol=IN_PLANE_TOL):
     """
     moves = off_tangent_moves(x, y, tol)
     return ~moves[..., :3, :].any(axis=(-2, -1)) & moves[..., 3:, :].any(axis=(-2, -1))
+
+
+def outward_normals(points, normals, tol=IN_PLANE_TOL):
+    """Whether every normal points away from the other contacts (outward, on a convex object).
+
+    Grasp files give normals pointing into the object.  On a convex object
+    the other contacts then lie on the inner side of each contact's tangent
+    plane, so a grasp whose three normals all point away from the contacts'
+    centroid ``g`` most likely has them reversed (or the fingers push
+    outward from inside a hollow, the one grasp where that is meant):
+
+    .. math::
+
+        \\hat n_i \\cdot \\widehat{(g - p_i)} < -\\mathrm{tol}
+        \\quad \\text{for } i = 1, 2, 3, \\qquad g = \\tfrac13 \\textstyle\\sum_j p_j
+
+    It is a test of the cosine between the two, so the same for a grasp
+    scaled or moved anywhere (lengths from about 1e-150 to 1e150), and
+    normals at right angles to ``g - p_i`` (within ``tol``) do not count as
+    outward.
+
+    Parameters
+    ----------
+    points, normals : (..., 3, 3) arrays
+        Contacts (contact, xyz) and their normals (any non-zero length).
+    tol : float
+        Cosines down to ``-tol`` are round-off.
+
+    Returns
+    -------
+    (...) bool
+        False where a contact is at the centroid (its cosine is 0) or an input is NaN.
+
+    Examples
+    --------
+    Paper Example 1 (normals into the cylinder), then the same reversed:
+
+    >>> p = np.array([[1.0, 0, 0], [-0.5, 0.866, 0], [-0.5, -0.866, 0]])
+    >>> outward_normals(p, -p).item(), outward_normals(p, p).item()
+    (False, True)
+    """
+    points, normals = np.asarray(points, dtype=float), np.asarray(normals, dtype=float)
+    toward = points.mean(axis=-2, keepdims=True) - points
+    with np.errstate(all="ignore"):  # NaN input: no verdict; lengths beyond 1e150 overflow to none either
+        lengths = np.sqrt(dot(normals, normals) * dot(toward, toward))
+        return np.all(dot(normals, toward) < -tol * lengths, axis=-1)

@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import fields
-from operator import itemgetter
 
 import numpy as np
 
@@ -33,6 +32,8 @@ def _frozen(a):
 
 
 _TRUE, _FALSE = _frozen(True), _frozen(False)
+#: Bound on the map product's terms on the fast path: far from overflow.
+_LARGEST = 1e300
 _AMPLITUDES = {"off_tangent": ("x", "y"), "tangent": ("alpha", "beta", "normal_velocity")}
 _RESULTS = {"off_tangent": OffTangentResult, "tangent": TangentResult}
 
@@ -72,29 +73,33 @@ class PreparedGrasp:
             self._templates[name] = {**template, "status": _frozen(np.int8(status))}
         self._rows["velocity"] = slice(3 * len(columns), 3 * len(columns) + 9)
         self.map = _frozen(np.concatenate([*columns, unit.velocity.reshape(6, 9)], axis=1).T)
-        # For the fast path: the rows that must be finite, those of the working methods and
-        # the velocities (a non-finite twist component makes one of these non-finite), ...
-        self._checked = itemgetter(
-            *(
-                i
-                for name, rows in self._rows.items()
-                if self._status.get(name, Status.OK) == Status.OK
-                for i in range(rows.start, rows.stop)
+        # For the fast path, per method: its result type, the values no twist changes (NaN
+        # amplitudes for a failed method) and, for a working one, which row of three each
+        # amplitude is.
+        self._fast = []
+        for name, template in self._templates.items():
+            failed = self._status[name] != Status.OK
+            nan = _frozen(np.full(3, np.nan))
+            template = {**template, "points": self.points, **({a: nan for a in _AMPLITUDES[name]} if failed else {})}
+            rows = (
+                () if failed else tuple((a, self._rows[name].start // 3 + i) for i, a in enumerate(_AMPLITUDES[name]))
             )
-        )
-        # ... and, per method, which row of three each amplitude is (or NaN for a failed method).
-        self._fast = [
-            (
-                name,
-                {**template, "points": self.points},
-                [(a, self._rows[name].start // 3 + i) for i, a in enumerate(_AMPLITUDES[name])],
-                None if self._status[name] == Status.OK else _frozen(np.full(3, np.nan)),
-            )
-            for name, template in self._templates.items()
-        ]
+            self._fast.append((_RESULTS[name], template, rows))
+        # ... the map with a failed method's rows zeroed (the fast path does not read them),
+        # and its largest |entry|: a twist whose sum of |components| stays below _LARGEST / gain
+        # can neither overflow the product (nor any partial sum of it) nor meet a non-finite entry.
+        used = np.zeros(len(self.map), bool)
+        for name, rows in self._rows.items():
+            used[rows] = self._status.get(name, Status.OK) == Status.OK
+        self._used_map = np.where(used[:, None], self.map, 0.0)
+        gain = float(np.abs(self._used_map).max())
+        self._largest_twist = _LARGEST / gain if math.isfinite(gain) and gain > 0 else 0.0
         # The largest |p_i| as the kernel forms it: in_tangent_planes compares the normal
         # velocities with |v| + |omega| |p_i|, which is largest for the largest |p_i|.
         self._reach = max(math.sqrt(dot3(p, p)) for p in points.tolist())
+        self._nv = self._rows["tangent"].start + 6  # the normal velocities' first row of the map
+        self._slots = (0, 1) if len(self._fast) == 2 else (1,)  # where each method goes in a Resolution
+        self._tangent_works = self._status["tangent"] == Status.OK
 
     def resolve(self, twist) -> Resolution:
         """Both decompositions and the contact velocities of ``twist`` on this grasp.
@@ -127,34 +132,39 @@ class PreparedGrasp:
         """
         t = check_twist(twist)
         if t.ndim == 1:
-            with np.errstate(all="ignore"):  # a non-finite twist or amplitude: see below
-                r = self.map @ t
-            values = r.tolist()
-            if math.isfinite(sum(self._checked(values))):
-                return self._one(t, r, values)
+            values = t.tolist()
+            if sum(map(abs, values)) < self._largest_twist:  # no product can overflow (NaN fails too)
+                return self._one(t, values)
         return self._many(t)
 
-    def _one(self, t, r, values):
-        """One finite twist with finite amplitudes: the hot path of a control loop."""
+    def _one(self, t, twist):
+        """One twist whose amplitudes are sure to be finite: the hot path of a control loop."""
+        r = self._used_map.dot(t)
         triples = r.reshape(-1, 3)  # x, y, ..., T(p_3): one row each
-        parts = {}
-        for name, template, rows, nan in self._fast:
-            out = {a: triples[i] if nan is None else nan for a, i in rows}
-            if name == "tangent":
-                out["in_tangent_planes"] = _FALSE
-                if nan is None:
-                    w0, w1, w2, v0, v1, v2 = t.tolist()
-                    speed, spin = (
-                        math.sqrt(dot3((v0, v1, v2), (v0, v1, v2))),
-                        math.sqrt(dot3((w0, w1, w2), (w0, w1, w2))),
-                    )
-                    i = 3 * rows[2][1]  # the normal velocities
-                    if max(abs(values[i]), abs(values[i + 1]), abs(values[i + 2])) <= IN_PLANE_TOL * (
-                        speed + spin * self._reach
-                    ):
-                        out["in_tangent_planes"] = _TRUE
-            parts[name] = _RESULTS[name]._of({**template, **out, "twist": t})
-        return Resolution(parts.get("off_tangent"), parts["tangent"], triples[-3:])
+        parts = [None, None]  # off-tangent, tangent
+        for slot, (cls, template, rows) in zip(self._slots, self._fast):
+            result = parts[slot] = object.__new__(cls)  # as cls._of does, without the call
+            values = result.__dict__
+            values.update(template)
+            values["twist"] = t
+            for a, i in rows:
+                values[a] = triples[i]
+        if self._tangent_works:
+            parts[1].__dict__["in_tangent_planes"] = self._in_tangent_planes(twist, r)
+        return tuple.__new__(Resolution, (*parts, triples[-3:]))  # Resolution's own __new__ is Python
+
+    def _in_tangent_planes(self, twist, r):
+        """The kernel's verdict for one twist: every normal velocity within ``IN_PLANE_TOL``
+        of the largest contact speed's bound ``|v| + |omega| max |p_i|``."""
+        w, v = twist[:3], twist[3:]
+        speed, spin = math.sqrt(dot3(v, v)), math.sqrt(dot3(w, w))
+        i = self._nv
+        return (
+            _TRUE
+            if max(abs(r.item(i)), abs(r.item(i + 1)), abs(r.item(i + 2)))
+            <= IN_PLANE_TOL * (speed + spin * self._reach)
+            else _FALSE
+        )
 
     def _many(self, t):
         """Twists with any leading axes ``(..., 6)``, including a non-finite one."""

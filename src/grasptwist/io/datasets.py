@@ -1,4 +1,4 @@
-"""Array data sets in: ``.npz`` of named arrays, ``.npy`` of rows.
+"""Array data sets in: ``.npz`` of named arrays, ``.npy`` of rows, ``.parquet`` of named columns.
 
 Input layouts (see the README):
 
@@ -8,11 +8,15 @@ Input layouts (see the README):
 * ``.npy`` of shape ``(N,18)`` or ``(N,21)``: per row ``p1 p2 p3 n1 n2 n3``
   (xyz each) and, with 21 columns, one more point whose role
   ``extra_point`` names: the ``wrist``, or the point ``at`` which the
-  twists' linear velocity is given.
+  twists' linear velocity is given;
+* ``.parquet`` of flat columns (:mod:`grasptwist.io.parquet`).
 
 A ``.npy`` is memory-mapped and read a chunk of rows at a time, so a data
-set larger than memory streams with bounded memory; ``.npz`` members are
-read whole (numpy cannot map them).  Problems with the file itself are
+set larger than memory streams with bounded memory.  An ``.npz`` member is
+read the same way, a block of rows at a time (:class:`Member`), after the
+shapes, types and sizes it declares (zip directory and ``.npy`` header) have
+been checked: a zip bomb is refused before a byte is inflated
+(:data:`MAX_INFLATION`).  Problems with the file itself are
 :class:`~grasptwist.model.InputError` (code ``bad-dataset``);
 problems with a row (NaN, a degenerate grasp) are that row's status.
 This module only reads: :func:`grasptwist.run.batch.dataset_blocks` runs
@@ -22,23 +26,36 @@ results as arrays.
 
 from __future__ import annotations
 
+import os
 import zipfile
+import zlib
 from dataclasses import dataclass
+from math import prod
 
 import numpy as np
 
 from ..model import GraspFileError
 
-__all__ = ["DATASET_SUFFIXES", "EXTRA_POINT_ROLES", "Dataset", "open_dataset"]
+__all__ = ["DATASET_SUFFIXES", "EXTRA_POINT_ROLES", "Dataset", "Member", "open_dataset", "MAX_INFLATION"]
 
-DATASET_SUFFIXES = (".npz", ".npy")
+DATASET_SUFFIXES = (".npz", ".npy", ".parquet")
 EXTRA_POINT_ROLES = ("wrist", "at")
 _NPZ_KEYS = ("points", "normals", "wrist", "twist", "names", "joint_positions")
+
+#: An ``.npz`` member may inflate to at most this many times its compressed
+#: size (zlib's own limit is about 1,000; real grasp data compresses 1-10
+#: times) ...
+MAX_INFLATION = 100
+#: ... once it declares more than this many bytes: smaller members (one
+#: twist, repeated names) may compress as much as they like.
+INFLATION_FLOOR = 64 << 20
 
 
 @dataclass(frozen=True)
 class Dataset:
-    """A data set's arrays (``.npy`` columns are memory-mapped views)."""
+    """A data set's arrays: ``.npy`` columns are memory-mapped views, ``.npz``
+    members :class:`Member` objects, Parquet columns read their row groups;
+    all are read by slicing rows."""
 
     path: str
     points: np.ndarray  # (N, 3, 3)
@@ -58,7 +75,7 @@ def _bad(path, message) -> GraspFileError:
 
 
 def open_dataset(path: str, extra_point: str = "wrist") -> Dataset:
-    """Open a ``.npz`` or ``.npy`` data set and check its layout.
+    """Open a ``.npz``, ``.npy`` or ``.parquet`` data set and check its layout.
 
     Raises
     ------
@@ -66,14 +83,24 @@ def open_dataset(path: str, extra_point: str = "wrist") -> Dataset:
         ``read-error`` when it cannot be read, ``bad-dataset`` when its
         arrays do not have the documented names, shapes or a numeric type.
     """
+    if path.endswith(".parquet"):
+        from .parquet import open_parquet  # pyarrow only when a Parquet file is read
+
+        return open_parquet(path)
     try:
         if path.endswith(".npy"):
             return _open_npy(path, np.load(path, mmap_mode="r", allow_pickle=False), extra_point)
-        with np.load(path, allow_pickle=False) as npz:
-            return _open_npz(path, {k: npz[k] for k in npz.files})
+        with zipfile.ZipFile(path) as zf:
+            members = {}
+            for info in zf.infolist():
+                key = info.filename.removesuffix(".npy")
+                # unknown members are reported by name, unread
+                members[key] = Member.declared(path, zf, info, key) if key in _NPZ_KEYS else None
+        return _open_npz(path, members)
     except GraspFileError:
         raise
-    except (OSError, ValueError, EOFError, zipfile.BadZipFile) as exc:
+    # zipfile: RuntimeError for an encrypted member, NotImplementedError for an unknown compression
+    except (OSError, ValueError, EOFError, zipfile.BadZipFile, NotImplementedError, RuntimeError) as exc:
         raise GraspFileError(code="read-error", message=f"cannot read as a numpy file: {exc}", file=path) from None
 
 
@@ -136,3 +163,84 @@ def _open_npz(path, arrays):
         if a is not None and len(a) != n:
             raise _bad(path, f"{key}: {len(a)} rows, but points has {n}")
     return Dataset(path, points, normals, wrist, None, twist, names, positions)
+
+
+class Member:
+    """One array of an ``.npz``, read a block of rows at a time, never whole.
+
+    Built from what the file declares (:meth:`declared`); ``a[start:stop]``
+    inflates just those rows.  Each process opens the file for itself (the
+    workers of a parallel run are forked, and must not share a file offset);
+    reading forward, as a run does, inflates each byte once per process.
+    """
+
+    def __init__(self, path: str, name: str, shape: tuple, dtype: np.dtype, offset: int):
+        self.path, self.name, self.shape, self.dtype, self.offset = path, name, shape, dtype, offset
+        self.ndim = len(shape)
+        self._open = None  # (pid, ZipFile, member file)
+
+    @classmethod
+    def declared(cls, path: str, zf: zipfile.ZipFile, info: zipfile.ZipInfo, key: str) -> Member:
+        """The member ``info`` of ``zf`` as its ``.npy`` header and the zip directory declare it.
+
+        Raises
+        ------
+        GraspFileError
+            ``bad-dataset`` when it would inflate more than :data:`MAX_INFLATION`
+            times, when its header's shape and type do not match its size, or
+            when it holds Python objects or is stored column-major.
+        """
+        if info.file_size > INFLATION_FLOOR and info.file_size > MAX_INFLATION * info.compress_size:
+            raise _bad(
+                path,
+                f"{key}: declares {info.file_size:,} bytes in {info.compress_size:,} compressed "
+                f"(over {MAX_INFLATION} times): refused unread, as a likely zip bomb",
+            )
+        with zf.open(info) as f:
+            version = np.lib.format.read_magic(f)
+            read_header = (
+                np.lib.format.read_array_header_1_0 if version == (1, 0) else np.lib.format.read_array_header_2_0
+            )
+            shape, fortran, dtype = read_header(f)
+            offset = f.tell()
+        if dtype.hasobject:
+            raise _bad(path, f"{key}: holds Python objects ({dtype}), which are never read")
+        if fortran and len(shape) > 1:
+            raise _bad(path, f"{key}: stored column-major; save it with np.ascontiguousarray")
+        size = prod(shape) * dtype.itemsize
+        if size != info.file_size - offset:
+            raise _bad(
+                path,
+                f"{key}: shape {shape} of {dtype} needs {size:,} bytes, the member holds {info.file_size - offset:,}",
+            )
+        return cls(path, info.filename, tuple(shape), dtype, offset)
+
+    def __len__(self) -> int:
+        return self.shape[0] if self.shape else 0
+
+    def __getitem__(self, rows: slice) -> np.ndarray:
+        """Rows ``rows`` (a slice with step 1), read from the file."""
+        start, stop, _ = rows.indices(len(self))
+        stop = max(start, stop)
+        row = prod(self.shape[1:]) * self.dtype.itemsize
+        try:
+            f = self._file()
+            f.seek(self.offset + start * row)
+            data = f.read((stop - start) * row)
+        except (OSError, EOFError, zipfile.BadZipFile, zlib.error) as exc:
+            # the archive's checksum is checked only once a member has been read to its end
+            raise GraspFileError(
+                code="read-error", message=f"{self.name}: {exc} (damaged, or changed while being read)", file=self.path
+            ) from None
+        return np.frombuffer(data, self.dtype).reshape((stop - start, *self.shape[1:]))
+
+    def __array__(self, dtype=None, copy=None):
+        """Every row: only for the members a run reads whole, one ``twist (6,)``."""
+        return self[:] if dtype is None else self[:].astype(dtype)
+
+    def _file(self):
+        pid = os.getpid()
+        if self._open is None or self._open[0] != pid:
+            zf = zipfile.ZipFile(self.path)
+            self._open = (pid, zf, zf.open(self.name))
+        return self._open[2]

@@ -51,6 +51,7 @@ from itertools import chain
 from pathlib import Path
 
 import numpy as np
+import orjson
 import yaml
 
 from ..engine import screws, se3
@@ -58,6 +59,8 @@ from ..engine.path import FRAMES, check_segments
 from ..model import Grasp, GraspFileError, ObjectPath, Segment, Twist
 
 __all__ = [
+    "read_line",
+    "read_twist_line",
     "Twist",
     "Grasp",
     "GraspFileError",
@@ -872,9 +875,10 @@ class _Parts:
 # Stream -> grasps.
 
 
-def _read_text(text, file, reading):
-    """Parse ``text`` and turn each document into a Grasp or its errors, as it is read."""
-    entries = _Entries(file, reading.max_errors)
+def _read_text(text, file, reading, name=None):
+    """Parse ``text`` and turn each document into a Grasp or its errors, as it is read
+    (an unnamed grasp called ``name`` if given)."""
+    entries = _Entries(file, reading.max_errors, name)
     stop = None
     parser = reading.parser(text)
     get_event = parser.get_event
@@ -917,9 +921,10 @@ class _Entries:
     document's grasp is named ``stem`` until a second document shows up.
     """
 
-    def __init__(self, file, max_errors):
+    def __init__(self, file, max_errors, name=None):
         self.file = file
         self.max_errors = max_errors
+        self.name = name  # the default name, if not the file's stem
         self.entries = []
         self.documents = 0
         self.reported = 0  # problems given an entry, at most max_errors
@@ -971,6 +976,8 @@ class _Entries:
         return self.entries
 
     def _default_name(self, document):
+        if self.name is not None:
+            return self.name
         if self._stem is None:
             self._stem = _stem_name(self.file)
         return self._stem if document == 0 else f"{self._stem}#{document + 1}"
@@ -1147,12 +1154,12 @@ def _twist_parts(fields, item, path, problems):
                         **_at(fields[other]),
                     )
                 )
-        screw = _vector(fields["screw"], 6, path + ".screw", problems)
+        screw = _vector(fields["screw"], 6, _join(path, "screw"), problems)
         return None if screw is None else (screw[:3], screw[3:], zero)
     if "angular" not in fields and "linear" not in fields:
         problems.add(_Reject("missing-key", path, "needs 'screw', or 'angular' and/or 'linear'", **_at(item)))
     parts = [
-        _vector(fields[key], 3, f"{path}.{key}", problems) if key in fields else zero
+        _vector(fields[key], 3, _join(path, key), problems) if key in fields else zero
         for key in ("angular", "linear", "at")
     ]
     return None if None in parts else parts
@@ -1453,3 +1460,134 @@ def _readonly(values):
     array = np.array(values, dtype=float)
     array.setflags(write=False)
     return array
+
+
+# --------------------------------------------------------------------------
+# One line of a JSON Lines stream (io/lines.py reads the stream).
+
+
+def read_line(data, *, file, line, max_bytes=DEFAULT_MAX_BYTES):
+    """The grasp of one line of a JSON Lines stream, or its errors, placed at ``line``.
+
+    The line is one grasp document (JSON is YAML), checked as in a grasp
+    file; positions count from the stream's start, an unnamed grasp is
+    ``stem#line`` and ``document`` is ``line - 1``.  ``max_bytes`` caps the
+    line, not the stream.
+
+    >>> for error in read_line(b'{"contacts": []}', file="in.jsonl", line=7):
+    ...     print(error)
+    in.jsonl:7:14: contacts: expected exactly 3 contacts, got 0
+    """
+    try:
+        text = _line_text(data, max_bytes)
+    except _Reject as reject:
+        return [_on_line(reject.error(file, None), line)]
+    return [_on_line(entry, line) for entry in _read_text(text, file, READING, name=f"{_stem_name(file)}#{line}")]
+
+
+def read_twist_line(data, *, file, line, max_bytes=DEFAULT_MAX_BYTES):
+    """The twist of one line of a JSON Lines stream of twists, or its errors.
+
+    A line is a 6-array ``(omega; v)`` (``v`` at the origin), or a mapping
+    with a grasp file's twist keys (``name``, ``screw`` or ``angular``,
+    ``linear``, ``at``), checked as there.  An unnamed twist is named after
+    its line number.
+
+    Returns
+    -------
+    Twist or list of GraspFileError
+
+    >>> read_twist_line(b"[0, 0, 1, 0, 0, 0.5]", file="-", line=3).screw.tolist()
+    [0.0, 0.0, 1.0, 0.0, 0.0, 0.5]
+    >>> t = read_twist_line(b'{"name": "spin", "angular": [0, 0, 1], "at": [1, 0, 0]}', file="-", line=4)
+    >>> t.name, t.screw.tolist()
+    ('spin', [0.0, 0.0, 1.0, 0.0, -1.0, 0.0])
+    >>> print(*read_twist_line(b"[0, 0, 1]", file="<stdin>", line=5))
+    <stdin>:5:1: screw: expected 6 numbers, got 3; a 3-vector goes under `angular:` or `linear:`
+    """
+    if len(data) <= max_bytes:
+        screw = _fast_screw(data)
+        if screw is not None:
+            return Twist(str(line), _readonly([*screw[:3], *screws.twist_at3(screw[:3], screw[3:], _ZERO)]), line)
+    problems = _Problems(MAX_ERRORS)
+    try:
+        root = _line_node(_line_text(data, max_bytes), problems)
+    except _Reject as reject:
+        return [_on_line(reject.error(file, None), line)]
+    if root.kind == "sequence":
+        fields = {"screw": root}
+    elif root.kind in ("mapping", "invalid"):
+        fields = _mapping(root, "", TWIST_KEYS, (), problems)
+    else:
+        fields = None
+        problems.add(
+            _Reject(
+                "not-a-mapping",
+                "",
+                f"expected a twist [wx, wy, wz, vx, vy, vz] or a mapping, got {_describe(root)}",
+                **_at(root),
+            )
+        )
+    name = str(line)
+    if fields is not None and "name" in fields:
+        name = _name(fields["name"], "name", problems)
+    parts = None if fields is None else _twist_parts(fields, root, "", problems)
+    if not problems.count:
+        screw = [*parts[0], *screws.twist_at3(*parts)]
+        if all(map(math.isfinite, screw)):
+            return Twist(name, _readonly(screw), line)
+        problems.add(
+            _Reject(
+                "non-finite", "", "the velocity of the origin overflows (linear + angular x (origin - at))", **_at(root)
+            )
+        )
+    return [_on_line(reject.error(file, None), line) for reject in problems.first()]
+
+
+def _fast_screw(data):
+    """The six numbers of a line that is a plain JSON array of six finite numbers
+    (as floats, the values the general path reads), else None."""
+    try:
+        value = orjson.loads(data)
+    except orjson.JSONDecodeError:
+        return None
+    if type(value) is not list or len(value) != 6:
+        return None
+    for x in value:
+        if (type(x) is not float and type(x) is not int) or not -_INF < x < _INF:
+            return None
+    return [float(x) for x in value]
+
+
+def _line_text(data, max_bytes):
+    """A line's text, checked for size and characters."""
+    if len(data) > max_bytes:
+        raise _Reject("too-large", "", f"the line is longer than the size limit of {max_bytes} bytes")
+    return _decode(data)
+
+
+def _line_node(text, problems):
+    """The node tree of the one document of a line."""
+    parser = READING.parser(text)
+    try:
+        parser.get_event()  # StreamStartEvent
+        if parser.check_event(yaml.StreamEndEvent):
+            raise _Reject("empty-document", "", "no value on the line")
+        parser.get_event()  # DocumentStartEvent
+        root = _compose(parser.get_event, problems)
+        if not parser.check_event(yaml.StreamEndEvent):
+            raise _Reject(
+                "yaml-syntax", "", "more than one document on the line", **_at_mark(parser.peek_event().start_mark)
+            )
+        return root
+    except yaml.YAMLError as exc:
+        raise _syntax_error(exc, text) from None
+    finally:
+        parser.dispose()
+
+
+def _on_line(entry, line):
+    """An entry read from one line's text, placed at ``line`` of the stream."""
+    if isinstance(entry, Grasp):
+        return replace(entry, line=line, document=line - 1, twists=tuple(replace(t, line=line) for t in entry.twists))
+    return GraspFileError(entry.code, entry.message, entry.file, line, entry.column, line - 1)

@@ -8,7 +8,9 @@ Symbolic links are followed, but a folder reached twice (a link cycle, or two
 links to one place) is read only the first time.  A path that cannot be read,
 a folder that cannot be listed, and a folder with no grasp file at all each
 become a :class:`GraspFileError` in its place, so that the rest of the batch
-goes on.  Names are ``str`` throughout: bytes that are not UTF-8 are kept
+goes on.  JSON Lines files (``*.jsonl``) are read when named, not found
+in folders (:mod:`~grasptwist.io.lines` reads them, and ``-``, a line at a
+time).  Names are ``str`` throughout: bytes that are not UTF-8 are kept
 as Python's surrogate escapes (``os.fsdecode``), so every path still opens.
 """
 

@@ -1,8 +1,8 @@
 """Result blocks as named flat columns: the one definition CSV, npz (and Parquet) share.
 
 A block's columns are groups (:class:`~grasptwist.results.Column`): first the
-rows' own (file, grasp, twist name, ok, error, the twist, the contact
-velocities), then each result kind's from the registry
+rows' own (file, grasp, twist name, ok, error, the twist, the wrist, the
+contact velocities), then each result kind's from the registry
 (:data:`grasptwist.results.KINDS`), each kind's ending with ``<key>_status``
 (npz only) and ``<key>_error`` (CSV only).
 :func:`columns` gives them as flat ``(N,)`` arrays named and ordered as the
@@ -19,7 +19,18 @@ import numpy as np
 from ..engine.degeneracy import Status, status_message
 from ..results import BY_KEY, CULPRIT, KINDS, STATUS, Column
 
-__all__ = ["ORDERS", "in_order", "BLOCK_COLUMNS", "CSV_COLUMNS", "header", "columns", "arrays", "error_texts"]
+__all__ = [
+    "ORDERS",
+    "in_order",
+    "BLOCK_COLUMNS",
+    "CSV_COLUMNS",
+    "TYPED_COLUMNS",
+    "header",
+    "typed_header",
+    "columns",
+    "arrays",
+    "error_texts",
+]
 
 #: Screw orders for output: the paper's ``(omega; v)`` or ``(v; omega)``.
 ORDERS = ("omega-v", "v-omega")
@@ -49,6 +60,7 @@ BLOCK_COLUMNS = (
     # an input that failed has only this (see records.error_record); rows of a block have none
     Column("error", _block(lambda b: np.full(len(b), "")), ("error",), dtype="U", array=False, only_where_ok=False),
     Column("twist", _block(lambda b: b.twist), tuple(f"twist{i}" for i in range(1, 7)), only_where_ok=False),
+    Column("wrist", _block(lambda b: b.wrist), ("c_x", "c_y", "c_z"), only_where_ok=False),
     Column(
         "contact_velocity",
         _block(lambda b: b.velocity),
@@ -59,6 +71,10 @@ BLOCK_COLUMNS = (
 
 #: Columns that hold screws, written in the order asked for.
 _SCREWS = {"twist"}
+
+#: Columns with NaN rows where there is no value (a grasp without a wrist):
+#: npz keeps the NaN, flat columns are empty there.
+_OPTIONAL = {"wrist"}
 
 
 def _status(key: str, block) -> np.ndarray:
@@ -111,6 +127,29 @@ def header(hand=None) -> list[str]:
     return [name for _, c in _groups(hand) for name in c.names(hand)]
 
 
+_STATUSES = {f"{kind.key}_status" for kind in KINDS}
+
+
+def _typed_names(column: Column, hand=None) -> tuple[str, ...]:
+    """Flat names of a group in typed outputs: a status (no CSV column) is one column under its own name."""
+    return (column.name,) if column.name in _STATUSES else column.names(hand)
+
+
+def typed_header(hand=None) -> dict[str, str]:
+    """Typed flat outputs (Parquet): the CSV's columns of a run (:func:`header`) and each
+    kind's ``<key>_status`` (after its conditioning), ``name -> numpy type`` (``U`` text).
+
+    >>> h = typed_header()
+    >>> h["ok"], h["tangent_status"], [n for n in h if n not in CSV_COLUMNS] == ["off_tangent_status", "tangent_status"]
+    ('?', 'i1', True)
+    """
+    return {name: c.dtype for _, c in (_GROUPS if hand is None else _groups(hand)) for name in _typed_names(c, hand)}
+
+
+#: :func:`typed_header` of a run without a hand.
+TYPED_COLUMNS = typed_header()
+
+
 def error_texts(block, key: str) -> np.ndarray:
     """``code: message`` of kind ``key`` where it failed and applies, else empty."""
     texts = np.full(len(block), "", dtype=object)
@@ -135,8 +174,9 @@ def _values(block, key, column: Column, order: str, hand=None):
     return in_order(values, order) if column.name in _SCREWS else values
 
 
-def columns(block, order: str = "omega-v", hand=None) -> dict[str, np.ndarray]:
-    """The block's flat columns, ``name -> (N,)`` array, in the order of :data:`CSV_COLUMNS`.
+def columns(block, order: str = "omega-v", hand=None, typed: bool = False) -> dict[str, np.ndarray]:
+    """The block's flat columns, ``name -> (N,)`` array, in the order of :data:`CSV_COLUMNS`
+    (``typed``: of :func:`typed_header`, statuses included).
 
     Values that do not apply are masked (a :class:`numpy.ma.MaskedArray`):
     every value of a kind not computed, and of a group marked
@@ -147,7 +187,7 @@ def columns(block, order: str = "omega-v", hand=None) -> dict[str, np.ndarray]:
     n = len(block)
     out = {}
     for key, column in _GROUPS if hand is None else _groups(hand):
-        names = column.names(hand)
+        names = _typed_names(column, hand) if typed else column.names(hand)
         if not names:
             continue
         values = _values(block, key, column, order, hand)
@@ -160,6 +200,8 @@ def columns(block, order: str = "omega-v", hand=None) -> dict[str, np.ndarray]:
         if key is not None and column.only_where_ok:
             computed = key in block.results
             valid = block.results[key].ok & block.applies(key) if computed else np.zeros(n, bool)
+        if column.name in _OPTIONAL:
+            valid = np.isfinite(flat).all(axis=1)
         for j, name in enumerate(names):
             out[name] = flat[:, j] if valid is None else np.ma.masked_array(flat[:, j], mask=~valid)
     return out

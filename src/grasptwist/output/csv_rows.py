@@ -14,6 +14,7 @@ import io
 import numpy as np
 
 from .columns import CSV_COLUMNS, columns, header
+from .names import escaped_each
 from .records import records, talking_rows
 
 __all__ = ["HEADER", "header_line", "encode_rows", "error_row", "lines"]
@@ -34,6 +35,8 @@ def _cells(a: np.ndarray) -> list:
         cells = list(map(repr, (data + 0.0).tolist()))  # + 0.0: no "-0.0"
     elif data.dtype.kind == "b":
         cells = ["true" if v else "false" for v in data.tolist()]
+    elif data.dtype.kind in "UO":  # names: escaped as in the records
+        cells = escaped_each(data.tolist())
     else:
         cells = data.tolist()
     for i in np.flatnonzero(np.ma.getmaskarray(a)):

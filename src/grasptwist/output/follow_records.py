@@ -21,7 +21,8 @@ from ..engine.se3 import matrix_to_quaternion
 from ..results import KINDS
 from .columns import CSV_COLUMNS, columns
 from .csv_rows import lines
-from .records import _printable, dumps
+from .names import escaped
+from .records import dumps
 
 __all__ = [
     "ENCODINGS",
@@ -155,7 +156,13 @@ def summary_record(summary) -> dict:
         out["hand"] = hand_summary(summary.grasp, summary.hand)
         # a joint out of its limits, or a finger that cannot follow, stops the motion too
         ok = ok and out["hand"]["joint_limit"] is None and all(f["rank_loss"] is None for f in out["hand"]["fingers"])
-    return {"file": summary.file, "grasp": summary.grasp.name, "path": summary.path, "summary": out, "ok": ok}
+    return {
+        "file": escaped(summary.file, controls=False),
+        "grasp": escaped(summary.grasp.name, controls=False),
+        "path": escaped(summary.path, controls=False),
+        "summary": out,
+        "ok": ok,
+    }
 
 
 def crossing_text(c: dict, names=("1", "2", "3"), digits: int = 4) -> str:
@@ -185,14 +192,15 @@ def hand_event_texts(hand: dict, digits: int = 4) -> tuple[list[str], list[str]]
     if hand["joint_limit"] is not None:
         j = hand["joint_limit"]
         errors.append(
-            f"joint '{j['joint']}' of finger '{j['finger']}' leaves its position limits at t = {j['t']:.{digits}f}"
+            f"joint '{escaped(j['joint'])}' of finger '{escaped(j['finger'])}' leaves its position limits "
+            f"at t = {j['t']:.{digits}f}"
         )
     for f in hand["fingers"]:
         if f["rank_loss"] is not None:
-            errors.append(f"finger '{f['name']}' loses rank (its Jacobian) at t = {f['rank_loss']:.{digits}f}")
+            errors.append(f"finger '{escaped(f['name'])}' loses rank (its Jacobian) at t = {f['rank_loss']:.{digits}f}")
         if f["first_warning"] is not None:
             warnings.append(
-                f"finger '{f['name']}': conditioning below {CONDITION_WARNING:g} from t = {f['first_warning']:.{digits}f}"
+                f"finger '{escaped(f['name'])}': conditioning below {CONDITION_WARNING:g} from t = {f['first_warning']:.{digits}f}"
             )
     return errors, warnings
 
@@ -200,7 +208,7 @@ def hand_event_texts(hand: dict, digits: int = 4) -> tuple[list[str], list[str]]
 def diagnostics(rec: dict, names=("1", "2", "3")) -> tuple[list[str], list[str]]:
     """The stderr lines of a summary record (its grasp's contacts named ``names``): one error per
     degenerate stretch, one warning for the first time a conditioning falls below the warning level."""
-    where = f"{_printable(rec['file'])}: grasp '{_printable(rec['grasp'])}', path '{_printable(rec['path'])}'"
+    where = f"{escaped(rec['file'])}: grasp '{escaped(rec['grasp'])}', path '{escaped(rec['path'])}'"
     s = rec["summary"]
     errors = [f"{where}: error: {c['method']}: {c['code']}: {crossing_text(c, names, 6)}" for c in s["degenerate"]]
     warnings = []

@@ -5,7 +5,7 @@ it, and runs a command by looking its format up in :data:`FORMATS` rather
 than comparing names.  A format either encodes records where they are
 made (in worker processes too) and writes the encoded bytes in order
 (``json``, ``jsonl``, ``csv``, ``table``), or takes whole result blocks in
-the writing process (``npz``: ``takes_blocks``).
+the writing process (``npz``, ``parquet``: ``takes_blocks``).
 """
 
 from __future__ import annotations
@@ -92,15 +92,16 @@ def _csv(out: IO[bytes], kind: str, hand=None, **_):
     return Lines(out, header=csv_rows.header_line(hand), newline=b"")
 
 
-def _record_rows(block, order):
-    recs = records(block, order)
-    return recs, [r for r in recs if not r["ok"] or r["warnings"]]
-
-
 def _npz(out: IO[bytes], kind: str, order: str = "omega-v", hand=None, **_):
     from .npz import NpzWriter
 
     return NpzWriter(out, order, hand=hand)
+
+
+def _parquet(out: IO[bytes], kind: str, order: str = "omega-v", hand=None, **_):
+    from .parquet import ParquetWriter  # pyarrow only when Parquet is asked for
+
+    return ParquetWriter(out, order, hand=hand)
 
 
 def _json_rows(block, order):
@@ -113,7 +114,8 @@ _ALL = ("resolve", "basis", "check", "follow")
 FORMATS: dict[str, OutputFormat] = {
     f.name: f
     for f in (
-        OutputFormat("table", _ALL, _table, encode=lambda rec: rec, encode_rows=_record_rows),
+        # table records travel as JSON (a worker's records cost the parent far less to take than as objects)
+        OutputFormat("table", _ALL, _table, dumps, _json_rows),
         OutputFormat("json", _ALL, lambda out, kind, **_: JsonArray(out), dumps, _json_rows, join=b",\n".join),
         OutputFormat("jsonl", _ALL, lambda out, kind, **_: Lines(out), dumps, _json_rows, join=b"\n".join),
         OutputFormat(
@@ -126,6 +128,7 @@ FORMATS: dict[str, OutputFormat] = {
             per_hand=True,
         ),
         OutputFormat("npz", ("resolve", "follow"), _npz, binary=True, takes_blocks=True, bases=False, per_hand=True),
+        OutputFormat("parquet", ("resolve",), _parquet, binary=True, takes_blocks=True, bases=False, per_hand=True),
     )
 }
 

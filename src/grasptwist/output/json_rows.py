@@ -23,6 +23,7 @@ from dataclasses import fields, replace
 import numpy as np
 import orjson
 
+from .names import escaped
 from .records import present, talking_rows
 
 __all__ = ["encode_records"]
@@ -31,6 +32,7 @@ _MARK = 1 << 20  # number marker: column * _MARK + position + 0.5 (exact, unique
 _STRING_COLUMNS = ("file", "grasp", "units", "twist_name")
 _TOKEN = re.compile(rb'"\\u0001(\w+)\\u0001"|-?\d+\.5')
 _CODED = ("flag", "fingers")  # field kinds whose few distinct values go into the template
+_TEMPLATE_FROM = 4  # rows in a block from which plain rows go by template
 
 
 def encode_records(block, order: str, records, dumps) -> tuple[list[bytes], list[dict]]:
@@ -40,6 +42,9 @@ def encode_records(block, order: str, records, dumps) -> tuple[list[bytes], list
     the texts equal, byte for byte, ``dumps`` of every record.  The records
     returned are the ones with something to say (errors, warnings).
     """
+    if len(block) < _TEMPLATE_FROM:  # a stream's line: learning a template costs more than it saves
+        recs = records(block, order)
+        return [dumps(rec) for rec in recs], [rec for rec in recs if not rec["ok"] or rec["warnings"]]
     plain = _plain_rows(block)
     codes = _verdicts(block)  # judged once here, for the non-plain rows' records too
     out: list = [None] * len(block)
@@ -76,10 +81,12 @@ def _coded(block) -> list:
 
 
 def _verdicts(block) -> np.ndarray:
-    """Integers equal where every coded field's JSON is: ``(N,)`` when their
-    bits fit one int64 (the usual case, and quick to sort), else ``(N, k)``."""
-    bits = [np.asarray(block.value(*c), dtype=bool).reshape(len(block), -1) for c in _coded(block)]
-    bits = np.concatenate(bits, axis=1) if bits else np.zeros((len(block), 0), bool)
+    """Integers equal where every coded field's JSON is, and whether there is a
+    wrist (a list or ``null``): ``(N,)`` when their bits fit one int64 (the
+    usual case, and quick to sort), else ``(N, k)``."""
+    bits = [block.finite_wrist()[:, None]]
+    bits += [np.asarray(block.value(*c), dtype=bool).reshape(len(block), -1) for c in _coded(block)]
+    bits = np.concatenate(bits, axis=1)
     words = [bits[:, k : k + 62] for k in range(0, bits.shape[1], 62)] or [bits]
     codes = [w @ (1 << np.arange(w.shape[1], dtype=np.int64)) for w in words]
     return codes[0] if len(codes) == 1 else np.stack(codes, axis=1)
@@ -102,12 +109,14 @@ def _value(block, owner, name):
 
 def _marker_block(block, row: int):
     """A one-row copy of row ``row`` (a plain one) whose numbers and names are markers;
-    its coded fields keep the row's values."""
+    its coded fields keep the row's values, and so do numbers that are not finite
+    (a missing wrist is NaN, which the record writes as null)."""
     cols = _columns(block)
-    marked = {
-        c: (k * _MARK + np.arange(_value(block, *c)[0].size) + 0.5).reshape((1,) + _value(block, *c).shape[1:])
-        for k, c in enumerate(cols)
-    }
+    marked = {}
+    for k, c in enumerate(cols):
+        own = _value(block, *c)[[row]]
+        markers = (k * _MARK + np.arange(own.size) + 0.5).reshape(own.shape)
+        marked[c] = np.where(np.isfinite(own), markers, own)
     names = {c: [f"\x01{c}\x01"] for c in _STRING_COLUMNS}
     one = replace(
         block.take([row]),
@@ -117,6 +126,8 @@ def _marker_block(block, row: int):
     )
     one.values.update({c: marked[c] for c in cols if c[0] is not None})
     one.values.update({c: block.value(*c)[[row]] for c in _coded(block)})  # known already: no need to judge again
+    block.outward()  # the block's own verdicts (owner None) are judged on its real numbers, not on markers
+    one.values.update({c: v[[row]] for c, v in block.values.items() if c[0] is None})
     return one
 
 
@@ -181,6 +192,7 @@ def _by_template(block, order, records, dumps, part):
 
 
 def _labels(values):
-    """JSON of each value, encoding each distinct value once (names repeat)."""
-    encoded = {v: orjson.dumps(v) for v in set(values)}
+    """JSON of each value, escaped as in the records (:func:`~grasptwist.output.names.escaped`),
+    encoding each distinct value once (names repeat)."""
+    encoded = {v: orjson.dumps(escaped(v, controls=False)) for v in set(values)}
     return [encoded[v] for v in values]

@@ -27,12 +27,14 @@ class NpzWriter:
     Arrays over all rows, one per column group that npz stores (see the
     README): ``grasp`` (labels), ``file_index`` into ``files`` and
     ``twist_index`` into ``twist_names`` (each distinct name once),
-    ``twist (N,6)``, ``contact_velocity (N,3,3)``, then each result kind's
+    ``twist (N,6)``, ``wrist (N,3)`` (NaN rows for grasps without one),
+    ``contact_velocity (N,3,3)``, then each result kind's
     (e.g. ``x``, ``y``, ``off_tangent_status``, ``off_tangent_conditioning``)
     and, with a ``hand``, its joint arrays (``joint_rates`` in the order of
     ``joint_names``, ``finger_rank`` ...);
     ``status_legend[k]`` is the name of status ``k``, and status -1 means
-    "skipped".  Amplitudes are NaN where a kind failed.
+    "skipped" (a method not asked for by name that cannot run).  Amplitudes
+    are NaN where a kind failed.
 
     Columns are kept in memory up to ``spill_bytes``, then spilled to
     temporary files; :meth:`close` streams everything into the archive.

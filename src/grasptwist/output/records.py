@@ -15,10 +15,18 @@ from __future__ import annotations
 import numpy as np
 import orjson
 
-from ..engine.degeneracy import CONDITION_WARNING, Status, conditioning_warning, status_message
+from ..engine.degeneracy import (
+    CONDITION_WARNING,
+    OUTWARD_NORMALS_WARNING,
+    Status,
+    conditioning_warning,
+    skipped_warning,
+    status_message,
+)
 from ..model import GraspFileError
 from ..results import CONDITIONING, CULPRIT, KINDS, STATUS, Field
 from .columns import ORDERS, in_order
+from .names import escaped, escaped_each
 
 __all__ = [
     "ORDERS",
@@ -42,24 +50,24 @@ def records(block, order: str = "omega-v") -> list[dict]:
     views of contiguous rows, which orjson writes without making a Python
     float of each.  Consumers that need lists call ``.tolist()``.
     """
-    n = len(block)
-    warnings = [[] for _ in range(n)]
+    warnings = [[OUTWARD_NORMALS_WARNING] if out else [] for out in block.outward().tolist()]
     objects = [(k.key, _kind_rows(block, k, order, warnings)) for k in block.kinds() if k.record is None]
     written = [(k.key, _written(k)(block, order, warnings)) for k in block.kinds() if k.record is not None]
     ok = (~block.failed_rows()).tolist()
     out = []
     rows = zip(
-        block.file,
-        block.grasp,
+        escaped_each(block.file),
+        escaped_each(block.grasp),
         block.units,
-        block.twist_name,
+        escaped_each(block.twist_name),
         _rows(in_order(block.twist, order)),
-        block.contact_names,
+        _contact_names(block),
         _rows(block.points),
         _rows(block.normals),
+        _wrists(block),
         _rows(block.velocity),
     )
-    for i, (file, grasp, units, twist_name, screw, names, p, q, v) in enumerate(rows):
+    for i, (file, grasp, units, twist_name, screw, names, p, q, c, v) in enumerate(rows):
         rec = {
             "file": file,
             "grasp": grasp,
@@ -70,6 +78,7 @@ def records(block, order: str = "omega-v") -> list[dict]:
                 {"name": names[1], "point": p[1], "normal": q[1]},
                 {"name": names[2], "point": p[2], "normal": q[2]},
             ],
+            "wrist": c,
             "contact_velocity": v,
         }
         for key, rows_of_kind in objects:
@@ -88,6 +97,12 @@ def records(block, order: str = "omega-v") -> list[dict]:
     return out
 
 
+def _contact_names(block) -> list:
+    """Each row's contact names, escaped (:func:`~grasptwist.output.names.escaped`)."""
+    safe = {names: tuple(escaped_each(names)) for names in set(block.contact_names)}
+    return [safe[names] for names in block.contact_names]
+
+
 def _written(kind):
     """The record writer a kind names (:attr:`~grasptwist.results.ResultKind.record`)."""
     from . import kind_records
@@ -101,8 +116,15 @@ def _rows(a):
     Floats get ``+ 0.0``, which turns ``-0.0`` into ``0.0``: a round-off sign
     on zero means nothing and reads oddly (``jq`` prints ``-0``).
     """
-    a = np.ascontiguousarray(a + 0.0 if a.dtype.kind == "f" else a)
+    with np.errstate(invalid="ignore"):  # a signalling NaN from a data set's bytes is no news
+        a = np.ascontiguousarray(a + 0.0 if a.dtype.kind == "f" else a)
     return list(a) if a.ndim > 1 else a.tolist()
+
+
+def _wrists(block) -> list:
+    """Per row, the wrist (a row view), or None where there is none or it is not finite."""
+    wrists = _rows(block.wrist)
+    return [c if has else None for c, has in zip(wrists, block.finite_wrist().tolist())]
 
 
 def _fingers(mask):
@@ -133,7 +155,7 @@ def present(block, fields):
 
 def _kind_rows(block, kind, order, warnings):
     """One kind's per-row objects (``error`` objects where it failed, None where
-    it does not apply), warnings appended."""
+    it was skipped), warnings appended."""
     fields = present(block, kind.fields)
     values = [json_values(block.value(kind.key, f), f, order) for f in fields]
     names = [f.name for f in fields]
@@ -145,17 +167,22 @@ def _kind_rows(block, kind, order, warnings):
     conditioning = block.value(kind.key, CONDITIONING)
     for i in np.flatnonzero((status == Status.OK) & (conditioning < CONDITION_WARNING) & applies):
         warnings[i].append(conditioning_warning(conditioning[i], kind.label))
+    skipped = [skipped_warning(kind.missing, kind.label)] if kind.missing is not None else []
     for i in np.flatnonzero(~applies):
         rows[i] = None
+        warnings[i] += skipped
     return rows
 
 
 def talking_rows(block) -> np.ndarray:
-    """Rows whose record has something for stderr: a failed kind or a warning."""
-    talk = np.zeros(len(block), bool)
+    """Rows whose record has something for stderr: a failed or skipped kind, or a warning."""
+    talk = block.outward().copy()
     for kind in block.kinds():
         ok = block.value(kind.key, STATUS) == Status.OK
-        talk |= (~ok | (block.value(kind.key, CONDITIONING) < CONDITION_WARNING)) & block.applies(kind.key)
+        applies = block.applies(kind.key)
+        talk |= (~ok | (block.value(kind.key, CONDITIONING) < CONDITION_WARNING)) & applies
+        if kind.missing is not None:  # skipped: a warning
+            talk |= ~applies
     return talk
 
 
@@ -169,15 +196,16 @@ def _methods_ok(rec):
 
 
 def _grasp_fields(block, i: int) -> dict:
-    names = block.contact_names[i]
+    names = escaped_each(block.contact_names[i])
     return {
-        "file": block.file[i],
-        "grasp": block.grasp[i],
+        "file": escaped(block.file[i], controls=False),
+        "grasp": escaped(block.grasp[i], controls=False),
         "units": block.units[i],
         "contacts": [
             {"name": names[c], "point": block.points[i, c].tolist(), "normal": block.normals[i, c].tolist()}
             for c in range(3)
         ],
+        "wrist": block.wrist[i].tolist() if np.isfinite(block.wrist[i]).all() else None,
     }
 
 
@@ -185,12 +213,16 @@ def _row_objects(block, i, fields_of, order, warnings, with_failure=()):
     """Row ``i``'s object of every kind computed, from the fields ``fields_of(kind)``;
     a failed kind's object is its error plus the fields ``with_failure(kind)``."""
     out = {}
+    if block.outward()[i]:
+        warnings.append(OUTWARD_NORMALS_WARNING)
     for kind in block.kinds():
         key = kind.key
         if kind.record is not None:  # a resolve-only kind (a hand's joint rates)
             continue
         if not block.applies(key)[i]:
             out[key] = None
+            if kind.missing is not None:
+                warnings.append(skipped_warning(kind.missing, kind.label))
             continue
         status = Status(int(block.value(key, STATUS)[i]))
 
@@ -224,7 +256,7 @@ def check_record(block, i: int) -> dict:
     """Validation and degeneracy verdict of row ``i``'s grasp, per kind."""
     warnings = []
     objects = _row_objects(block, i, lambda k: k.check_fields, "omega-v", warnings, with_failure=(CONDITIONING,))
-    rec = {"file": block.file[i], "grasp": block.grasp[i], **objects}
+    rec = {"file": escaped(block.file[i], controls=False), "grasp": escaped(block.grasp[i], controls=False), **objects}
     rec["warnings"] = warnings
     rec["ok"] = _methods_ok(rec)
     return rec
@@ -233,9 +265,14 @@ def check_record(block, i: int) -> dict:
 def error_record(err: GraspFileError) -> dict:
     """The record of an input that could not be read, validated or paired with a twist."""
     return {
-        "file": err.file,
+        "file": escaped(err.file, controls=False),
         "ok": False,
-        "error": {"code": err.code, "message": err.message, "line": err.line, "column": err.column},
+        "error": {
+            "code": err.code,
+            "message": escaped(err.message, controls=False),
+            "line": err.line,
+            "column": err.column,
+        },
     }
 
 
@@ -248,30 +285,20 @@ def diagnostics(rec: dict) -> tuple[list[str], list[str]]:
     """
     if rec["ok"] and not rec.get("warnings"):
         return [], []
-    file = _printable(rec["file"])
+    file = escaped(rec["file"])
     if "error" in rec:
         err = rec["error"]
         where = ":".join(str(x) for x in (file, err["line"], err["column"]) if x is not None)
-        return [f"{where}: error: {err['code']}: {_printable(err['message'])}"], []
-    where = f"{file}: grasp '{_printable(rec['grasp'])}'"
+        return [f"{where}: error: {err['code']}: {escaped(err['message'])}"], []
+    where = f"{file}: grasp '{escaped(rec['grasp'])}'"
     if "twist" in rec:
-        where += f", twist '{_printable(rec['twist']['name'])}'"
+        where += f", twist '{escaped(rec['twist']['name'])}'"
     errors = [
         f"{where}: error: {k.label}: {m['error']['code']}: {m['error']['message']}"
         for k in KINDS
         if isinstance(m := rec.get(k.key), dict) and "error" in m
     ]
     return errors, [f"{where}: warning: {w}" for w in rec["warnings"]]
-
-
-def _printable(text) -> str:
-    """``text`` with control and separator characters escaped: file and data-set
-    names come from whoever filled the folder, and a newline or an escape
-    sequence in one must not split a diagnostic or reach the terminal."""
-    text = str(text)
-    if text.isprintable():
-        return text
-    return "".join(c if c.isprintable() else c.encode("unicode_escape").decode("ascii") for c in text)
 
 
 def dumps(obj, indent: bool = False) -> bytes:

@@ -1,4 +1,4 @@
-"""Tables for people, drawn with rich from output records.
+"""Tables for people, laid out as plain lines from output records.
 
 Imported only when a table is asked for, so that machine formats never pay
 for rich's import.  Numbers are rounded to ``digits`` decimals here and only
@@ -7,22 +7,38 @@ here; records keep full precision.  Each result kind has a renderer class
 its ``resolve`` table, its verdict sentences and its ``basis`` tables; the
 verdicts only print what the records say (``moves``, ``about_wrist``,
 ``in_tangent_planes``).
+
+Renderers return :class:`Grid` tables (made by :func:`_table`, used like
+rich's ``Table``), ``str`` or rich ``Text`` lines, or rich ``Group`` objects of
+those; anything else rich draws is drawn by rich, more slowly.  A writer lays them out
+itself, a record at a time, straight onto the output: drawing rich tables
+cost milliseconds a record, which made tables of data sets unusable.  Every
+text a table shows goes through :func:`~grasptwist.output.names.escaped`
+and is never read as rich markup, so a name like ``[/]x`` or one holding an
+escape sequence is shown as it is, escaped where it is not printable.  A
+table wider than the output (``COLUMNS``, else the terminal; a pipe or
+file without ``COLUMNS`` has no limit) is split into parts of whole
+columns, each repeating the first column, so that no vector is ever cut.
 """
 
 from __future__ import annotations
 
 import contextlib
+import functools
 import io
 import os
+import textwrap
 from typing import IO
 
-from rich import box
-from rich.console import Console
-from rich.table import Table
+import orjson
+from rich.cells import cell_len
+from rich.color import ColorSystem
+from rich.console import Console, Group
 from rich.text import Text
 
-from ..engine.degeneracy import CONDITION_WARNING
+from ..engine.degeneracy import CONDITION_WARNING, Status
 from ..results import KINDS
+from .names import escaped
 
 __all__ = [
     "TableWriter",
@@ -30,8 +46,10 @@ __all__ = [
     "CheckTableWriter",
     "OffTangentTable",
     "TangentTable",
+    "Grid",
     "WRITERS",
     "console",
+    "output_width",
     "fmt_number",
     "fmt_vector",
 ]
@@ -45,41 +63,188 @@ class _TextView(io.TextIOWrapper):
             self.detach()
 
 
+def _colour(text: IO, color: bool | None) -> bool:
+    """Colour as asked, else only on a terminal and never under NO_COLOR."""
+    return color if color is not None else (text.isatty() and not os.environ.get("NO_COLOR"))
+
+
 def console(out: IO[bytes] | IO[str], color: bool | None = None, width: int | None = None) -> Console:
-    """A rich console on ``out``: colour only on a terminal and never under NO_COLOR."""
-    if isinstance(out, io.TextIOBase):
-        text = out
-    else:
-        text = _TextView(out, encoding="utf-8", write_through=True)
-    terminal = color if color is not None else (text.isatty() and not os.environ.get("NO_COLOR"))
+    """A rich console on ``out``: colour only on a terminal and never under NO_COLOR;
+    lines are never wrapped by rich (the terminal folds what is too long)."""
+    text = out if isinstance(out, io.TextIOBase) else _TextView(out, encoding="utf-8", write_through=True)
+    terminal = _colour(text, color)
     return Console(
         file=text,
         force_terminal=terminal,
         no_color=not terminal,
         highlight=False,
-        width=width if width or terminal else 160,
-        soft_wrap=False,
+        width=width or output_width(text) or 160,
+        soft_wrap=True,
     )
 
 
+def output_width(out: IO, width: int | None = None) -> int | None:
+    """Columns a table on ``out`` may take: ``width`` if given, else ``COLUMNS``,
+    else the terminal's width, else None (no limit: a pipe or a file).
+
+    >>> output_width(io.BytesIO(), 72), output_width(io.BytesIO()) is None or "COLUMNS" in os.environ
+    (72, True)
+    """
+    if width:
+        return width
+    columns = os.environ.get("COLUMNS", "")
+    if columns.isdigit() and int(columns) > 0:
+        return int(columns)
+    try:
+        return os.get_terminal_size(out.fileno()).columns or None if out.isatty() else None
+    except (AttributeError, OSError, ValueError):  # not a real file (tests' buffers)
+        return None
+
+
 def fmt_number(v, digits: int) -> str:
-    """``v`` with ``digits`` decimals; no ``-0``; ``-`` for a missing value."""
+    """``v`` with ``digits`` decimals; no ``-0``; ``-`` for a missing value.
+
+    >>> fmt_number(-0.00001, 4), fmt_number(2.5, 0), fmt_number(None, 3)
+    ('0.0000', '2', '-')
+    """
     if v is None:
         return "-"
-    s = f"{float(v):.{digits}f}"
-    return s[1:] if s.startswith("-") and float(s) == 0 else s
+    s = f"{v:.{digits}f}"
+    return s[1:] if s[0] == "-" and not s.strip("-0.") else s
 
 
 def fmt_vector(v, digits: int) -> str:
-    """A 3-vector as ``(a, b, c)`` or a screw as ``(a, b, c; d, e, f)``."""
-    parts = [fmt_number(x, digits) for x in v]
-    if len(parts) == 6:
-        return f"({', '.join(parts[:3])}; {', '.join(parts[3:])})"
-    return f"({', '.join(parts)})"
+    """A 3-vector as ``(a, b, c)`` or a screw as ``(a, b, c; d, e, f)``; no ``-0``.
+
+    >>> fmt_vector([1, 0, -0.00001, 0, -0.5, 2], 1)
+    '(1.0, 0.0, 0.0; 0.0, -0.5, 2.0)'
+    """
+    v = tuple(v)
+    form, negative_zero, zero = _vector_format(digits, len(v))
+    return (form % v).replace(negative_zero, zero)
+
+
+@functools.cache
+def _vector_format(digits: int, n: int) -> tuple[str, str, str]:
+    """The %-format of an ``n``-vector (a screw's halves split by ``;``), and
+    zero printed with and without a sign: with exactly ``digits`` decimals,
+    ``-0.00`` in a vector can only be a whole number, a negative zero."""
+    number = f"%.{digits}f"
+    form = f"({', '.join([number] * 3)}; {', '.join([number] * 3)})" if n == 6 else f"({', '.join([number] * n)})"
+    zero = number % 0.0
+    return form, "-" + zero, zero
+
+
+class Grid:
+    """A table of single-line cells, used like rich's ``Table`` (``add_column``,
+    ``add_row``, ``title``) but laid out by the writers themselves.
+
+    >>> g = Grid(title="t"); g.add_column("i"); g.add_column("x", justify="right"); g.add_row("1", "2.5")
+    >>> print("\\n".join(line.rstrip() for line in g.lines(lambda c: (c, len(c)))))
+    t
+    <BLANKLINE>
+      i     x
+     ─────────
+      1   2.5
+    <BLANKLINE>
+    """
+
+    def __init__(self, title: str | Text | None = None):
+        self.title = title
+        self.headers: list[str] = []
+        self.right: list[bool] = []
+        self.rows: list[tuple] = []
+
+    def add_column(self, header: str, justify: str = "left") -> None:
+        self.headers.append(header)
+        self.right.append(justify == "right")
+
+    def add_row(self, *cells: str | Text) -> None:
+        self.rows.append(cells)
+
+    @property
+    def row_count(self) -> int:
+        return len(self.rows)
+
+    def __rich_console__(self, console, options):
+        """Drawn by rich too (inside a renderable of rich's own), without colour."""
+        for line in self.lines(lambda c: (escaped(_plain(c)), _len(escaped(_plain(c)))), options.max_width):
+            yield Text(line.rstrip())
+
+    def lines(self, cell, width: int | None = None, bold: bool = False) -> list[str]:
+        """The table as lines (``cell(c)`` gives a cell's text and its width on
+        screen); wider than ``width``,
+        as parts of whole columns, each with the first column again."""
+        cells, sizes = [], []
+        for row in self.rows:
+            # most cells are numbers: plain ASCII, their own width (checked inline: this runs per cell)
+            drawn = [(c, len(c)) if c.__class__ is str and c.isascii() and c.isprintable() else cell(c) for c in row]
+            cells.append([text for text, _ in drawn])
+            sizes.append([n for _, n in drawn])
+        widths = [max([_len(h), *(row[i] for row in sizes)]) for i, h in enumerate(self.headers)]
+        out = [cell(self.title)[0]] if self.title else []
+        for part in _parts(widths, width):
+            out += ["", *_lines(self, part, widths, cells, sizes, bold)]
+        return [*out, ""]
+
+
+def _plain(cell) -> str:
+    return cell.plain if isinstance(cell, Text) else escaped(cell)
+
+
+def _len(text: str) -> int:
+    """Columns ``text`` takes on screen (two for a wide character)."""
+    return len(text) if text.isascii() else cell_len(text)
+
+
+def _parts(widths: list[int], width: int | None) -> list[list[int]]:
+    """Column indices of each part of a table: all if it fits ``width``, else
+    the first column and as many whole columns after it as fit, repeatedly."""
+    if width is None or _span(widths) <= width or len(widths) < 3:
+        return [list(range(len(widths)))]
+    parts, part = [], [0]
+    for i in range(1, len(widths)):
+        if len(part) > 1 and _span([widths[j] for j in (*part, i)]) > width:
+            parts.append(part)
+            part = [0]
+        part.append(i)
+    return [*parts, part]
+
+
+def _span(widths) -> int:
+    """Width of a line of columns this wide: two spaces at each end, three between."""
+    return sum(widths) + 3 * len(widths) + 1
+
+
+def _lines(grid: Grid, part, widths, cells, sizes, bold: bool = False) -> list[str]:
+    """Header, rule and rows of the columns ``part`` (rich's SIMPLE_HEAD look)."""
+    out = _head(grid, part, widths, bold)
+    # a part leaves out the rows that have nothing in its columns (continuation rows of other columns)
+    rows = [(row, size) for row, size in zip(cells, sizes) if len(part) < 2 or any(size[i] for i in part[1:])]
+    return out + [_row(row, size, widths, grid.right, part) for row, size in rows]
+
+
+def _head(grid: Grid, part, widths, bold: bool = False) -> list[str]:
+    """The header line of the columns ``part`` (``bold``: in bold, on a terminal) and the rule under it."""
+    headers = [h if h.isprintable() else escaped(h) for h in grid.headers]
+    lengths = [_len(h) for h in headers]
+    if bold:
+        headers = [f"\x1b[1m{h}\x1b[0m" if h else h for h in headers]
+    rule = " " + "─" * (_span([widths[i] for i in part]) - 2)
+    return [_row(headers, lengths, widths, grid.right, part), rule]
+
+
+def _row(texts, lengths, widths, right, part) -> str:
+    """One line of cells ``texts`` (``lengths`` wide on screen) padded to their columns' ``widths``."""
+    pieces = []
+    for i in part:
+        pad = " " * (widths[i] - lengths[i])
+        pieces.append(pad + texts[i] if right[i] else texts[i] + pad)
+    return "  " + "   ".join(pieces)
 
 
 class _Writer:
-    """Common start of the table writers: a console and a record counter."""
+    """Common start of the table writers: where lines go, how wide and coloured, a record counter."""
 
     def __init__(
         self,
@@ -89,26 +254,104 @@ class _Writer:
         width: int | None = None,
         order: str = "omega-v",
     ):
-        self.con = console(out, color, width)
+        self.out = out
+        self.text = out if isinstance(out, io.TextIOBase) else None
+        self.color = _colour(out, color)
+        self.width = output_width(out, width)
+        self._console = None  # made when a renderer returns something only rich can draw
         self.digits = digits
         self.count = 0
         # screws are printed in the order asked for; say which when it is not the paper's
         self.order_note = "  (screws as (v; omega))" if order == "v-omega" else ""
 
-    def write(self, rec: dict) -> None:
+    def write(self, encoded: bytes) -> None:
+        rec = orjson.loads(encoded)
         if "error" in rec:  # the error line is on stderr; tables carry results only
             return
-        if self.count:
-            self.con.print()
+        lines = [""] if self.count else []
         self.count += 1
-        self.show(rec)
+        self.show(rec, lines)
+        self._put(lines)
 
     def close(self) -> None:
         pass
 
-    def title(self, rec: dict, *more) -> Text:
+    def _put(self, lines: list[str]) -> None:
+        data = "\n".join(lines) + "\n"
+        if self.text is not None:
+            self.text.write(data)
+        else:
+            self.out.write(data.encode("utf-8"))
+
+    def add(self, lines: list[str], item) -> None:
+        """Lay out one thing a renderer returned: a Grid, a line, or any rich renderable."""
+        if isinstance(item, Grid):
+            lines += [line.rstrip() for line in item.lines(self.cell, self.width, self.color)]
+        elif isinstance(item, str | Text):
+            lines += self._prose(item)
+        elif isinstance(item, Group):
+            for part in item.renderables:
+                self.add(lines, part)
+        else:  # a renderer drawing with rich itself: let rich lay it out, after what is pending
+            self._put(lines)
+            lines.clear()
+            self._rich().print(item)
+            self.out.flush()
+
+    def _rich(self) -> Console:
+        if self._console is None:
+            self._console = console(self.out, self.color, self.width)
+        return self._console
+
+    def cell(self, item) -> tuple[str, int]:
+        """A text as it goes out (see :meth:`styled`) and the columns it takes."""
+        if not isinstance(item, Text):
+            item = str(item)  # a number a renderer did not format
+        if isinstance(item, str):
+            text = item if item.isprintable() else escaped(item)
+            return text, _len(text)
+        return self.styled(item), _len(escaped(item.plain))
+
+    def styled(self, item) -> str:
+        """A text as it goes out: control characters escaped, styles as ANSI codes when colour is on."""
+        if isinstance(item, str):
+            return escaped(item)
+        if not self.color:
+            return escaped(item.plain)
+        return "".join(
+            s.style.render(escaped(s.text), color_system=ColorSystem.STANDARD) if s.style else escaped(s.text)
+            for s in item.render(self._rich())
+            if s.text != "\n"
+        )
+
+    def _prose(self, item) -> list[str]:
+        """A line, folded at spaces to the width when it is a sentence of one style."""
+        plain = _plain(item)
+        if self.width is None or _len(plain) <= self.width or (isinstance(item, Text) and item.spans):
+            return [self.styled(item)]
+        style = item.style if isinstance(item, Text) else ""
+        folded = textwrap.wrap(
+            plain, self.width, subsequent_indent="  ", break_long_words=False, break_on_hyphens=False
+        )
+        return [self.styled(Text(line, style=style)) for line in folded]
+
+    def flow(self, lines: list[str], *parts: Text) -> None:
+        """Parts of one line, each on a line of its own (indented) when together they are too wide."""
+        whole = Text("  ").join(parts)
+        if self.width is None or _len(whole.plain) <= self.width:
+            lines.append(self.styled(whole))
+        else:
+            lines += [self.styled(p if i == 0 else Text("  ") + p) for i, p in enumerate(parts)]
+
+    def title(self, rec: dict) -> Text:
         units = f" [{rec['units']}]" if rec.get("units") else ""
-        return Text.assemble((rec["grasp"], "bold"), f" ({rec['file']}){units}", *more, self.order_note)
+        return Text.assemble(
+            (escaped(rec["grasp"]), "bold"), f" ({escaped(rec['file'])}){escaped(units)}", self.order_note
+        )
+
+    def warnings(self, lines: list[str], rec: dict) -> None:
+        for warning in rec["warnings"]:
+            self.add(lines, Text(f"warning: {warning}", style="yellow"))
 
 
 def _renderers(rec: dict) -> list:
@@ -124,22 +367,22 @@ def _shown(m) -> bool:
 class TableWriter(_Writer):
     """A resolve record as tables of contacts and of each kind, then their verdicts."""
 
-    def show(self, rec: dict) -> None:
+    def show(self, rec: dict, lines: list[str]) -> None:
         d = self.digits
         names = [c["name"] for c in rec["contacts"]]
         twist = rec["twist"]
         kinds = _renderers(rec)
-        self.con.print(self.title(rec, "  twist ", (twist["name"], "bold"), f" = {fmt_vector(twist['screw'], d)}"))
-        self.con.print(self._contacts(rec, kinds, d))
+        spec = Text.assemble("twist ", (escaped(twist["name"]), "bold"), f" = {fmt_vector(twist['screw'], d)}")
+        self.flow(lines, self.title(rec), spec)
+        self.add(lines, self._contacts(rec, kinds, d))
         for kind, render in kinds:
             m = rec[kind.key]
-            self.con.print(_not_shown(kind, render, m) if not _shown(m) else render.resolve(m, names, d))
+            self.add(lines, _not_shown(kind, render, m) if not _shown(m) else render.resolve(m, names, d, rec))
         for kind, render in kinds:
             if _shown(rec[kind.key]):
                 for line in render.verdict(rec[kind.key], names):
-                    self.con.print(line)
-        for warning in rec["warnings"]:
-            self.con.print(Text(f"warning: {warning}", style="yellow"))
+                    self.add(lines, line)
+        self.warnings(lines, rec)
 
     def _contacts(self, rec, kinds, d):
         extra = [c for kind, render in kinds if _shown(rec[kind.key]) for c in render.contact_columns(rec[kind.key], d)]
@@ -153,9 +396,9 @@ class TableWriter(_Writer):
         return t
 
 
-def _table(*columns, numbers=()):
+def _table(*columns, numbers=()) -> Grid:
     """A plain table; the columns named in ``numbers`` are right-aligned."""
-    t = Table(box=box.SIMPLE_HEAD, title_justify="left", title_style="bold")
+    t = Grid()
     for c in columns:
         t.add_column(c, justify="right" if c in numbers else "left")
     return t
@@ -192,17 +435,19 @@ class OffTangentTable:
     """The off-tangent method (Proposition 1): amplitudes, basis screws, verdicts."""
 
     skipped = "the grasp has no wrist"
+    #: Its components in basis order (the order of ``moves`` and of ``joint_rates``).
+    components = ("Sigma_1", "Sigma_2", "Sigma_3", "Psi_1", "Psi_2", "Psi_3")
 
     @staticmethod
     def contact_columns(m, d) -> list:
         return []
 
     @staticmethod
-    def resolve(m, names, d):
+    def resolve(m, names, d, rec):
         t = _table(
             "i", "x_i", "y_i", "Sigma_i (moves finger i only)", "Psi_i (keeps finger i fixed)", numbers=("x_i", "y_i")
         )
-        t.title = f"off-tangent (Proposition 1)   conditioning {m['conditioning']:.3g}"
+        t.title = Text(f"off-tangent (Proposition 1)   conditioning {m['conditioning']:.3g}", style="bold")
         for i, n in enumerate(names):
             t.add_row(
                 n,
@@ -244,17 +489,19 @@ class TangentTable:
     """The tangent method (Proposition 2 and the off-plane rest): amplitudes, bases, verdict."""
 
     skipped = "not asked for"
+    #: Its components in basis order: ``alpha_i Theta_i``, then the off-plane rest ``beta_i Sigma_i``.
+    components = ("Theta_1", "Theta_2", "Theta_3", "Sigma_1", "Sigma_2", "Sigma_3")
 
     @staticmethod
     def contact_columns(m, d) -> list:
         return [("normal velocity", [fmt_number(v, d) for v in m["normal_velocity"]])]
 
     @staticmethod
-    def resolve(m, names, d):
+    def resolve(m, names, d, rec):
         t = _table(
             "i", "alpha_i", "beta_i", "Theta_i (keeps finger i fixed, others slide)", numbers=("alpha_i", "beta_i")
         )
-        t.title = f"tangent (Proposition 2 + off-plane rest)   conditioning {m['conditioning']:.3g}"
+        t.title = Text(f"tangent (Proposition 2 + off-plane rest)   conditioning {m['conditioning']:.3g}", style="bold")
         for i, n in enumerate(names):
             t.add_row(n, fmt_number(m["alpha"][i], d), fmt_number(m["beta"][i], d), fmt_vector(m["theta"][i], d))
         return t
@@ -281,32 +528,65 @@ class TangentTable:
 class BasisTableWriter(_Writer):
     """A grasp's basis screws and their Klein products (cf. the paper's eq. 18)."""
 
-    def show(self, rec: dict) -> None:
+    def show(self, rec: dict, lines: list[str]) -> None:
         d = self.digits
         names = [c["name"] for c in rec["contacts"]]
-        self.con.print(self.title(rec))
+        self.add(lines, self.title(rec))
         for kind, render in _renderers(rec):
             m = rec[kind.key]
             for item in render.basis(m, names, d) if _shown(m) else [_not_shown(kind, render, m)]:
-                self.con.print(item)
-        for warning in rec["warnings"]:
-            self.con.print(Text(f"warning: {warning}", style="yellow"))
+                self.add(lines, item)
+        self.warnings(lines, rec)
+
+
+#: Widest verdict a ``check`` cell can hold: a failure's code, or ``ok (1.23e-05)``.
+_VERDICT_WIDTH = max(len("ok (1.23e-05)"), *(len(s.code) for s in Status))
 
 
 class CheckTableWriter(_Writer):
-    """One line per grasp: each method's verdict and conditioning."""
+    """One line per grasp, streamed: each method's verdict and conditioning in
+    columns of fixed width, then the file and the grasp, as wide as in the
+    first :data:`SIZING_ROWS` rows (a longer cell later pushes the rest of
+    its row; the grasp is last, so it pushes nothing)."""
 
     def __init__(self, out, **options):
         super().__init__(out, **options)
-        self.table = _table("file", "grasp", *(k.label for k in KINDS))
+        self.grid = _table(*(k.label for k in KINDS), "file", "grasp")
+        self.widths: list[int] = []
 
-    def write(self, rec: dict) -> None:
-        if "error" not in rec:
-            self.table.add_row(rec["file"], rec["grasp"], *(_verdict_cell(rec.get(k.key, False)) for k in KINDS))
+    def write(self, encoded: bytes) -> None:
+        rec = orjson.loads(encoded)
+        if "error" in rec:
+            return
+        self.count += 1
+        self.grid.add_row(*(_verdict_cell(rec.get(k.key, False)) for k in KINDS), rec["file"], rec["grasp"])
+        if self.widths or self.grid.row_count >= SIZING_ROWS:
+            self._rows()
+
+    def _rows(self) -> None:
+        """The rows held, under the header when they are the first."""
+        rows = [list(zip(*(self.cell(c) for c in row))) for row in self.grid.rows]
+        self.grid.rows.clear()
+        lines, part = [], range(len(self.grid.headers))
+        if not self.widths:
+            verdicts = [_VERDICT_WIDTH] * len(KINDS)
+            self.widths = [max(w, *(n[i] for _, n in rows)) for i, w in enumerate([*verdicts, 0, 0])]
+            self.widths = [max(w, _len(h)) for w, h in zip(self.widths, self.grid.headers)]
+            lines = ["", *(line.rstrip() for line in _head(self.grid, part, self.widths, self.color))]
+        for texts, lengths in rows:
+            widths = [max(w, n) for w, n in zip(self.widths, lengths)]  # an overlong cell pushes the rest of its row
+            lines.append(_row(texts, lengths, widths, self.grid.right, part).rstrip())
+        self._put(lines)
 
     def close(self) -> None:
-        if self.table.row_count:
-            self.con.print(self.table)
+        if self.grid.rows:
+            self._rows()
+        if self.count:
+            self._put([""])
+
+
+#: Rows of a ``check`` table held back to size its file and grasp columns.
+SIZING_ROWS = 64
 
 
 def _verdict_cell(m):
@@ -331,7 +611,7 @@ class HandTable:
         return [("finger", [f["name"] for f in m["fingers"]])]
 
     @staticmethod
-    def resolve(m, names, d):
+    def resolve(m, names, d, rec):
         from rich.console import Group
 
         ratio = m["velocity_limit_ratio"]
@@ -349,7 +629,22 @@ class HandTable:
                     f"{f['residual']:.2g}" if first else "",
                     f"{f['conditioning']:.3g}" if first else "",
                 )
-        return Group(Text(title, style="bold"), t)
+        return Group(Text(title, style="bold"), t, *HandTable._moved_by(m, rec))
+
+    @staticmethod
+    def _moved_by(m, rec) -> list[Text]:
+        """Per finger, the components of each method that move it (the records' ``moves``): what a
+        controller running the components one after another asks of that finger's joints."""
+        methods = [(kind.label, render, rec[kind.key]) for kind, render in _renderers(rec) if kind.key != "hand"]
+        lines = []
+        for f, finger in enumerate(m["fingers"]):
+            parts = [
+                f"{label} {' '.join(c for c, fingers in zip(render.components, r['moves']) if f in fingers) or 'none'}"
+                for label, render, r in methods
+                if _shown(r)
+            ]
+            lines.append(Text(f"finger {escaped(finger['name'])} is moved by: {'; '.join(parts)}"))
+        return lines
 
     @staticmethod
     def verdict(m, names) -> list[str]:

@@ -18,16 +18,18 @@ import numpy as np
 
 from .. import hand
 from ..engine.decompose import contact_velocities
+from ..engine.judgements import outward_normals
 from ..engine.screws import direction, twist_at
 from ..io.datasets import Dataset
 from ..model import CONTACT_NAMES, Grasp, GraspFileError, Twist
-from ..results import BY_KEY, KINDS, METHOD_CHOICES, Field, ResultKind, selected
+from ..results import ALL_METHODS, BY_KEY, KINDS, METHOD_CHOICES, Field, ResultKind, selected
 
 __all__ = [
     "METHODS",
     "Block",
     "resolve",
     "resolve_arrays",
+    "with_reasons",
     "dataset_blocks",
     "check_positions",
     "ROWS_PER_BLOCK",
@@ -45,6 +47,9 @@ NO_TWIST = "no-twist"
 #: The twist whose resolution carries just the bases (``basis`` and ``check``).
 ZERO_TWIST = Twist(name="0", screw=np.zeros(6), line=None)
 
+#: Key of :meth:`Block.outward`'s verdicts among a block's computed values.
+OUTWARD = (None, "outward_normals")
+
 #: Rows per engine call on a data set: bounded memory, long vectors.
 ROWS_PER_BLOCK = 65536
 
@@ -56,8 +61,9 @@ class Block:
     Per-row labels are lists (or numpy string arrays); ``points`` ...
     ``velocity`` are arrays over the rows.  ``results`` maps the key of each
     kind computed (in registry order) to its engine result; a kind's rows
-    where it does not apply (:meth:`applies`, e.g. no wrist) hold the status
-    ``nonfinite-input`` and are reported as skipped.
+    where it cannot run (no wrist) hold its ``missing`` status
+    (``no-wrist``): failures when ``method`` named the kind, else skipped
+    (see :meth:`applies`).
     """
 
     file: list
@@ -68,11 +74,13 @@ class Block:
     points: np.ndarray  # (n, 3, 3)
     normals: np.ndarray  # (n, 3, 3) unit
     twist: np.ndarray  # (n, 6)
+    wrist: np.ndarray  # (n, 3), NaN rows where there is none
     has_wrist: np.ndarray  # (n,) bool
     velocity: np.ndarray  # (n, 3, 3)
     results: dict[str, Any]
     hands: list | None = None  # per row its Hand or None; None: no row has one
     bases: bool = True  # False: resolved without the basis screws (fields that need them are left out)
+    method: str = ALL_METHODS  # the --method asked for
     # field values computed so far, by (kind key, Field); a block cut from another keeps its rows of them
     values: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
@@ -91,14 +99,28 @@ class Block:
         return [k for k in KINDS if k.key in self.results]
 
     def applies(self, key: str) -> np.ndarray:
-        """Rows where kind ``key`` means something (its record field is null elsewhere)."""
-        return np.asarray(BY_KEY[key].applies(self), dtype=bool)
+        """Rows where kind ``key`` has a result or a failure: where it can run, and
+        everywhere when ``method`` named it; elsewhere it is skipped (null)."""
+        kind = BY_KEY[key]
+        return np.asarray(kind.applies(self), dtype=bool) | (kind.method and self.method == kind.label)
 
     def value(self, key: str, f: Field) -> np.ndarray:
         """Field ``f`` of kind ``key`` over the rows, computed once per block."""
         got = self.values.get((key, f))
         if got is None:
             got = self.values[(key, f)] = f.values(self.results[key])
+        return got
+
+    def finite_wrist(self) -> np.ndarray:
+        """Per row: is there a finite wrist (records write it, else null)?"""
+        return np.isfinite(self.wrist).all(axis=-1)
+
+    def outward(self) -> np.ndarray:
+        """Per row: do all the normals point away from the other contacts
+        (:func:`~grasptwist.engine.judgements.outward_normals`)?  Judged once per block."""
+        got = self.values.get(OUTWARD)
+        if got is None:
+            got = self.values[OUTWARD] = outward_normals(self.points, self.normals)
         return got
 
     def failed_rows(self) -> np.ndarray:
@@ -129,6 +151,7 @@ _ROW_FIELDS = (
     "points",
     "normals",
     "twist",
+    "wrist",
     "has_wrist",
     "velocity",
     "hands",
@@ -156,6 +179,7 @@ def resolve_arrays(
     hands=None,
     joint_screws=None,
     joint_limits=None,
+    has_wrist=None,
 ) -> Block:
     """One block from arrays of rows (a data set, or stacked grasps).
 
@@ -167,23 +191,22 @@ def resolve_arrays(
     outputs that do not show them (npz).  ``hands`` (per row a Hand or None)
     with ``joint_screws (N, 3, J, 6)`` and ``joint_limits (N, 3, J)``
     (:func:`grasptwist.hand.padded`) adds the kinds that need them.
+    ``has_wrist`` (per row) says which rows have a wrist; by default those
+    whose wrist is finite.
     """
     kinds = selected(method)
     n = len(points)
-    has_wrist = np.zeros(n, bool) if wrist is None else np.isfinite(wrist).all(axis=-1)
-    inputs = {
-        "points": points,
-        "normals": normals,
-        "wrist": np.full((n, 3), np.nan) if wrist is None else wrist,
-        "twist": twist,
-    }
+    if has_wrist is None:
+        has_wrist = np.zeros(n, bool) if wrist is None else np.isfinite(wrist).all(axis=-1)
+    wrist = np.full((n, 3), np.nan) if wrist is None else wrist
+    inputs = {"points": points, "normals": normals, "wrist": wrist, "twist": twist}
     if hands is not None:
         inputs.update(joint_screws=joint_screws, joint_limits=joint_limits)
     results = {}
     for k in kinds:
         if all(name in inputs for name in k.needs):
             results[k.key] = inputs[k.key] = k.compute(inputs, bases)  # later kinds may use earlier ones
-    return Block(
+    block = Block(
         file=file if isinstance(file, list) else [file] * n,
         grasp=grasp if grasp is not None else [str(i) for i in range(n)],
         units=units if isinstance(units, list) else [units] * n,
@@ -192,12 +215,27 @@ def resolve_arrays(
         points=points,
         normals=normals,
         twist=twist,
+        wrist=wrist,
         has_wrist=has_wrist,
         velocity=contact_velocities(points, twist),
         results=results,
         bases=bases,
+        method=method,
         hands=hands,
     )
+    return with_reasons(block)
+
+
+def with_reasons(block: Block) -> Block:
+    """``block`` with each method's status, in rows where it cannot run, set to
+    the reason (its ``missing``, ``no-wrist``) instead of what the engine made
+    of the NaN standing in for the missing input; returns ``block``."""
+    for k in block.kinds():
+        can = np.asarray(k.applies(block), dtype=bool)
+        if k.missing is not None and not can.all():
+            r = block.results[k.key]
+            block.results[k.key] = replace(r, status=np.where(can, r.status, np.int8(k.missing)))
+    return block
 
 
 def resolve(
@@ -382,14 +420,14 @@ def _dataset_block(ds, given, twists, method, start, stop, k, bases, hand_of_row
         screw = np.tile(given, (stop - start, 1))
         names = [t.name for t in twists] * (stop - start)
     else:
-        own = np.asarray(ds.twist, dtype=float)
-        screw = np.broadcast_to(own, (stop - start, 6)) if own.ndim == 1 else own[start:stop]
+        own = ds.twist  # one (6,) for every row, or (N, 6) read a block at a time (npz, Parquet)
+        screw = np.broadcast_to(np.asarray(own, dtype=float), (stop - start, 6)) if own.ndim == 1 else own[start:stop]
         names = ["twist"] * (stop - start)
     if ds.at is not None:
         at = column(ds.at)
         screw = twist_at(screw[:, :3], screw[:, 3:], at)
     # labels stay a numpy string array: a million Python strings cost more than the engine
-    label = ds.names[start:stop][rows].astype(str) if ds.names is not None else index.astype(str)
+    label = _labels(ds.names[start:stop][rows]) if ds.names is not None else index.astype(str)
     return resolve_arrays(
         column(ds.points),
         # unit normals exactly as the grasp-file loader makes them
@@ -401,5 +439,13 @@ def _dataset_block(ds, given, twists, method, start, stop, k, bases, hand_of_row
         grasp=label,
         twist_name=names,
         bases=bases,
+        # a data set's wrist column gives every row a wrist: NaN in it is a nonfinite-input, not "no wrist"
+        has_wrist=None if ds.wrist is None else np.ones(len(index), bool),
         **_rows_hand(ds, hand_of_rows, start, stop, rows, len(index)),
     )
+
+
+def _labels(names: np.ndarray) -> np.ndarray:
+    """A data set's ``names`` as text; bytes that are not UTF-8 are kept as
+    surrogates, which every output escapes like an undecodable file name."""
+    return np.char.decode(names, "utf-8", "surrogateescape") if names.dtype.kind == "S" else names.astype(str)

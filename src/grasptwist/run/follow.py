@@ -28,7 +28,7 @@ from ..io.datasets import DATASET_SUFFIXES
 from ..io.inputs import read
 from ..model import Grasp, GraspFileError, ObjectPath
 from ..results import BY_KEY, selected
-from .batch import Block
+from .batch import Block, with_reasons
 from .pipeline import Output
 
 __all__ = [
@@ -201,12 +201,12 @@ def _path(job, grasp, p):
             method=job.method,
             bases=job.bases,
         )
-        yield Samples(p.name, _block(grasp, p.name, f, job.bases, q), f.poses, q)
+        yield Samples(p.name, _block(grasp, p.name, f, job.bases, job.method, q), f.poses, q)
     found = degeneracies(grasp.points, grasp.normals, grasp.wrist, p.segments, times)
     yield Summary(grasp.file, grasp, p.name, len(times), found, labels, tracked)
 
 
-def _block(grasp, name, f, bases, positions=None) -> Block:
+def _block(grasp, name, f, bases, method, positions=None) -> Block:
     n = len(f.poses.time)
     results = {"off_tangent": f.off_tangent, "tangent": f.tangent}
     results = {k: r for k, r in results.items() if r is not None}
@@ -215,7 +215,7 @@ def _block(grasp, name, f, bases, positions=None) -> Block:
         screws, limits = hand.padded(grasp.hand, [s.screws for s in states])
         inputs = {"joint_screws": screws, "joint_limits": limits, "points": f.points, "twist": f.poses.twist}
         results["hand"] = BY_KEY["hand"].compute({**inputs, **results}, bases)
-    return Block(
+    block = Block(
         file=[grasp.file] * n,
         grasp=[grasp.name] * n,
         units=[grasp.units] * n,
@@ -224,12 +224,15 @@ def _block(grasp, name, f, bases, positions=None) -> Block:
         points=f.points,
         normals=f.normals,
         twist=f.poses.twist,
+        wrist=np.broadcast_to(grasp.wrist if grasp.wrist is not None else np.full(3, np.nan), (n, 3)),
         has_wrist=np.full(n, grasp.wrist is not None),
         velocity=f.velocities,
         results=results,
         bases=bases,
         hands=None if positions is None else [grasp.hand] * n,
+        method=method,
     )
+    return with_reasons(block)  # a method asked for by name that cannot run fails, as in resolve
 
 
 def _no_path(grasp: Grasp, name: str | None) -> GraspFileError:

@@ -23,13 +23,14 @@ from functools import partial
 import numpy as np
 
 from ..io.datasets import DATASET_SUFFIXES, open_dataset
-from ..io.inputs import STDIN, read
+from ..io.inputs import read
 from ..model import GraspFileError, Hand, Twist
 from ..output.formats import FORMATS
 from ..output.records import basis_record, check_record, diagnostics, error_record, records, talking_rows
 from .batch import ZERO_TWIST, Block, check_positions, dataset_blocks, resolve
 from .pool import Pool
 from .scratch import owned_prefix, sweep
+from .stream import grasp_stream, is_stream, twist_stream
 
 __all__ = ["Job", "Tuning", "TUNING", "Output", "Spool", "run", "run_group", "blocks", "write_blocks"]
 
@@ -49,6 +50,7 @@ class Job:
     max_bytes: int | None = None
     extra_point: str = "wrist"
     hand: Hand | None = None  # --hand: the hand of a data set's rows, whose joints CSV and npz columns name
+    twists_from: str | None = None  # a stream of twists (a file or -) for every grasp
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -113,20 +115,44 @@ class Output:
 def run(job: Job, paths: Sequence, workers: int = 1, tuning: Tuning = TUNING) -> Iterator[Output]:
     """Every input's output, in order.  ``paths`` holds file names, ``-``,
     and errors found while listing folders."""
+    if job.twists_from is not None:
+        twists = twist_stream(paths, job.twists_from, job.method, job.max_bytes, tuning.files_per_group)
+        yield from _streamed(job, twists, tuning)
+        return
     groups = list(_groups(paths, tuning.files_per_group))
     files = [g for g in groups if not _is_dataset(g)]
-    # a pool pays for itself from a few groups on; stdin is the parent's to read
-    if workers > 1 and len(files) >= tuning.min_groups and not any(STDIN in g for g in files):
+    # a pool pays for itself from a few groups on (stdin, a stream, is the parent's to read)
+    if workers > 1 and len(files) >= tuning.min_groups:
 
         def task(spool, i):
             return [run_group(job, files[i], tuning, spool)]
 
         with _parallel(task, len(files), workers, tuning) as done:
             for g in groups:
-                yield from (_dataset(job, g, workers, tuning) if _is_dataset(g) else next(done))
+                yield from (_alone(job, g, workers, tuning) if _is_dataset(g) else next(done))
         return
     for g in groups:
-        yield from (_dataset(job, g, workers, tuning) if _is_dataset(g) else [run_group(job, g, tuning)])
+        yield from (_alone(job, g, workers, tuning) if _is_dataset(g) else [run_group(job, g, tuning)])
+
+
+def _alone(job: Job, path: str, workers: int, tuning: Tuning) -> Iterator[Output]:
+    """The outputs of an input read on its own: a stream, or a data set."""
+    if not is_stream(path):
+        return _dataset(job, path, workers, tuning)
+    twists = [ZERO_TWIST] if job.kind != "resolve" else job.twists
+    return _streamed(job, grasp_stream(path, twists, job.method, job.max_bytes, tuning.files_per_group), tuning)
+
+
+def _streamed(job: Job, batches, tuning: Tuning) -> Iterator[Output]:
+    """An output per batch of a stream (see :mod:`~grasptwist.run.stream`): each
+    line's records are written as soon as it is read."""
+    done = 1  # the stream is one unit of progress
+    for batch in batches:
+        out = Output(done=done)
+        done = 0
+        for x in batch:
+            _emit(job, x, out, tuning.records_at_once)
+        yield _sealed(job, out)
 
 
 @contextmanager
@@ -223,7 +249,15 @@ def blocks(job: Job, paths: Sequence, tuning: Tuning = TUNING) -> Iterator[tuple
     one unit it counted as (on its first block; 0 after).  Data sets are
     resolved without basis screws when the format shows none."""
     bases = FORMATS[job.fmt].bases
+    if job.twists_from is not None:
+        batches = twist_stream(paths, job.twists_from, job.method, job.max_bytes, tuning.files_per_group)
+        yield from ((x, None) for batch in batches for x in batch)
+        return
     for g in _groups(paths, tuning.files_per_group):
+        if is_stream(g):
+            batches = grasp_stream(g, job.twists, job.method, job.max_bytes, tuning.files_per_group)
+            yield from ((x, None) for batch in batches for x in batch)
+            continue
         if _is_dataset(g):
             try:
                 ds = open_dataset(g, job.extra_point)
@@ -301,11 +335,16 @@ def _dataset_task(job: Job, ds, rows: tuple[int, int], tuning: Tuning, spool: Sp
     twists = [ZERO_TWIST] if job.kind != "resolve" else job.twists
     at_once = tuning.records_at_once
     outs = []
-    for block in dataset_blocks(ds, twists, job.method, start=rows[0], stop=rows[1], hand_of_rows=job.hand):
-        for start in range(0, len(block), at_once):
-            out = Output()
-            _emit(job, block.part(start, start + at_once), out, at_once)
-            outs.append(_sealed(job, out, spool))
+    try:
+        for block in dataset_blocks(ds, twists, job.method, start=rows[0], stop=rows[1], hand_of_rows=job.hand):
+            for start in range(0, len(block), at_once):
+                out = Output()
+                _emit(job, block.part(start, start + at_once), out, at_once)
+                outs.append(_sealed(job, out, spool))
+    except GraspFileError as err:  # a damaged .npz member or Parquet row group, found only as it is read
+        out = Output()
+        _emit(job, err, out, at_once)
+        outs.append(_sealed(job, out, spool))
     return outs
 
 
@@ -314,10 +353,10 @@ def _is_dataset(group) -> bool:
 
 
 def _groups(paths, size: int):
-    """Consecutive grasp files in lists of ``size``; each data set on its own (a str)."""
+    """Consecutive grasp files in lists of ``size``; each data set and stream on its own (a str)."""
     group = []
     for p in paths:
-        if isinstance(p, str) and p.endswith(DATASET_SUFFIXES) and os.path.isfile(p):
+        if is_stream(p) or isinstance(p, str) and p.endswith(DATASET_SUFFIXES) and os.path.isfile(p):
             if group:
                 yield group
                 group = []
@@ -346,7 +385,7 @@ def write_blocks(job: Job, paths: Sequence, w, tuning: Tuning = TUNING) -> Itera
             for rec in records(x.take(talking), job.order) if talking.size else []:
                 o.add(rec, lambda rec: None)
             o.records = len(x)
-            o.encoded = []
         else:
             o.add(error_record(x), lambda rec: None)
+        o.encoded = []  # the rows went to ``w``; an input that failed has its stderr line only
         yield o

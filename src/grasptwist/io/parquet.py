@@ -1,0 +1,258 @@
+"""Parquet data sets in: flat number columns, read a row group at a time.
+
+Columns (see the README, "Data sets of arrays"): ``p1_x p1_y p1_z ...
+p3_z`` (the contact points) and ``n1_x ... n3_z`` (their normals); optional
+``c_x c_y c_z`` (the wrist), ``w_x w_y w_z v_x v_y v_z`` (the twist ``(omega; v)``) and ``name``
+(text or integers).  Numbers may be any float or integer type; nulls read
+as NaN (that row's status says so).  Other columns are ignored, so a table
+that carries more than grasps reads as it is.
+
+Only the columns named above are read, one row group at a time (held until
+rows past it are asked for), so memory is bounded by the file's row-group
+size whatever its length.  pyarrow (the extra ``grasptwist[parquet]``) is
+imported only when a Parquet file is read.
+"""
+
+from __future__ import annotations
+
+import os
+
+import numpy as np
+
+from ..extras import MissingExtra, require
+from ..model import GraspFileError
+
+__all__ = [
+    "POINT_COLUMNS",
+    "NORMAL_COLUMNS",
+    "WRIST_COLUMNS",
+    "TWIST_COLUMNS",
+    "NAME_COLUMN",
+    "open_parquet",
+    "table_dataset",
+    "grasp_table",
+]
+
+
+def _xyz(stem: str) -> tuple[str, ...]:
+    return tuple(f"{stem}{i}_{a}" for i in range(1, 4) for a in "xyz")
+
+
+#: The contact points, contact by contact: ``p1_x, p1_y, p1_z, p2_x, ..., p3_z``.
+POINT_COLUMNS = _xyz("p")
+#: The contact normals, ``n1_x ... n3_z``.
+NORMAL_COLUMNS = _xyz("n")
+#: The wrist (optional).
+WRIST_COLUMNS = ("c_x", "c_y", "c_z")
+#: The twist ``(omega; v)`` at the origin (optional).
+TWIST_COLUMNS = ("w_x", "w_y", "w_z", "v_x", "v_y", "v_z")
+#: The grasp's name (optional; else the row index).
+NAME_COLUMN = "name"
+
+_GROUPS = {"points": POINT_COLUMNS, "normals": NORMAL_COLUMNS, "wrist": WRIST_COLUMNS, "twist": TWIST_COLUMNS}
+_SHAPES = {"points": (3, 3), "normals": (3, 3), "wrist": (3,), "twist": (6,)}
+
+
+def grasp_table(points, normals, wrist=None, twist=None, names=None):
+    """Grasps as an Arrow table with the columns above: what ``pyarrow.parquet.write_table`` makes a data set of.
+
+    >>> t = grasp_table(np.zeros((2, 3, 3)), np.ones((2, 3, 3)), twist=np.zeros((2, 6)), names=["a", "b"])
+    >>> t.num_rows, t.column_names[:2], t.column_names[-7:]
+    (2, ['p1_x', 'p1_y'], ['w_x', 'w_y', 'w_z', 'v_x', 'v_y', 'v_z', 'name'])
+    """
+    pa = require("pyarrow", "writing Parquet")
+    n = len(points)
+    groups = {"points": points, "normals": normals, "wrist": wrist, "twist": twist}
+    columns = {}
+    for key, values in groups.items():
+        if values is not None:
+            flat = np.asarray(values, dtype=float).reshape(n, -1)
+            columns.update({name: flat[:, j] for j, name in enumerate(_GROUPS[key])})
+    if names is not None:
+        columns[NAME_COLUMN] = pa.array(names)
+    return pa.table(columns)
+
+
+def _bad(path: str, message: str) -> GraspFileError:
+    return GraspFileError(code="bad-dataset", message=message, file=path)
+
+
+def open_parquet(path: str):
+    """Open a Parquet data set and check its columns (no rows are read yet).
+
+    Returns a :class:`~grasptwist.io.datasets.Dataset` whose arrays read
+    their rows when sliced.
+
+    Raises
+    ------
+    GraspFileError
+        ``bad-dataset`` when the file is not Parquet, or lacks a column, or
+        a column has the wrong type; ``read-error`` when it cannot be opened
+        or without pyarrow.
+    """
+    try:
+        require("pyarrow", "reading Parquet")
+    except MissingExtra as exc:
+        raise GraspFileError(code="read-error", message=str(exc), file=path) from None
+    reader = _RowGroups(path)
+    return _dataset(path, reader.file.schema_arrow, reader)
+
+
+def table_dataset(table, path: str = ""):
+    """A data set of an Arrow table in memory with the columns of a Parquet data set (for Dask partitions).
+
+    Raises
+    ------
+    GraspFileError
+        ``bad-dataset`` as :func:`open_parquet`.
+    """
+    return _dataset(path, table.schema, _Table(table))
+
+
+def _dataset(path: str, schema, reader):
+    """The data set of ``reader``'s rows once ``schema`` has the documented columns; ``reader`` learns which to read."""
+    import pyarrow as pa
+
+    from .datasets import Dataset
+
+    present = {}
+    for key, names in _GROUPS.items():
+        found = [n for n in names if n in schema.names]
+        if found and len(found) < len(names) or not found and key in ("points", "normals"):
+            missing = [n for n in names if n not in schema.names]
+            raise _bad(path, f"missing column(s) {', '.join(missing)} (the {key})")
+        for n in found:
+            t = schema.field(n).type
+            if not (pa.types.is_floating(t) or pa.types.is_integer(t)):
+                raise _bad(path, f"column {n}: expected numbers, got {t}")
+        if found:
+            present[key] = names
+    labels = None
+    if NAME_COLUMN in schema.names:
+        t = schema.field(NAME_COLUMN).type
+        t = t.value_type if pa.types.is_dictionary(t) else t
+        if not (pa.types.is_string(t) or pa.types.is_large_string(t) or pa.types.is_integer(t)):
+            raise _bad(path, f"column {NAME_COLUMN}: expected text or integers, got {t}")
+        labels = _Names(reader)
+    reader.columns = [n for names in present.values() for n in names] + ([NAME_COLUMN] if labels else [])
+    arrays = {key: _Numbers(reader, cols, _SHAPES[key]) for key, cols in present.items()}
+    return Dataset(
+        path,
+        arrays["points"],
+        arrays["normals"],
+        arrays.get("wrist"),
+        None,
+        arrays.get("twist"),
+        labels,
+    )
+
+
+class _Table:
+    """An Arrow table's rows (the reader of :func:`table_dataset`)."""
+
+    def __init__(self, table):
+        self.table = table
+        self.columns: list[str] = []
+
+    def __len__(self) -> int:
+        return self.table.num_rows
+
+    def rows(self, start: int, stop: int):
+        return self.table.slice(start, stop - start).select(self.columns)
+
+
+class _RowGroups:
+    """A Parquet file's chosen columns, read a row group at a time; the last one read is kept."""
+
+    def __init__(self, path: str):
+        self.path = path
+        self.columns: list[str] = []
+        self._open()
+
+    def _open(self):
+        pq = require("pyarrow.parquet", "reading Parquet")
+        self.pid = os.getpid()  # a forked worker opens the file anew (no shared offsets or threads)
+        try:
+            self.file = pq.ParquetFile(self.path)
+        except OSError as exc:  # the file itself: gone, a folder, no permission
+            raise GraspFileError(code="read-error", message=f"cannot read: {exc}", file=self.path) from None
+        except Exception as exc:  # noqa: BLE001 - pyarrow raises several kinds for a file that is not Parquet
+            raise _bad(self.path, f"cannot read as Parquet: {exc}") from None
+        meta = self.file.metadata
+        self.starts = np.cumsum([0] + [meta.row_group(i).num_rows for i in range(meta.num_row_groups)])
+        self.cached: tuple[int, object] | None = None
+
+    def __len__(self) -> int:
+        return int(self.starts[-1])
+
+    def rows(self, start: int, stop: int):
+        """Rows ``start:stop`` of the chosen columns, as an Arrow table."""
+        import pyarrow as pa
+
+        if self.pid != os.getpid():
+            self._open()
+        first = int(np.searchsorted(self.starts, start, side="right")) - 1
+        parts = []
+        group = first
+        while group < len(self.starts) - 1 and self.starts[group] < stop:
+            parts.append(self._group(group))
+            group += 1
+        if not parts:
+            return self.file.schema_arrow.empty_table().select(self.columns)
+        return pa.concat_tables(parts).slice(start - int(self.starts[first]), stop - start)
+
+    def _group(self, i: int):
+        if self.cached is None or self.cached[0] != i:
+            try:
+                table = self.file.read_row_group(i, columns=self.columns, use_threads=False)
+            except Exception as exc:  # noqa: BLE001 - corrupt pages: any of pyarrow's errors
+                raise _bad(self.path, f"row group {i}: cannot read: {exc}") from None
+            self.cached = (i, table)
+        return self.cached[1]
+
+
+class _Rows:
+    """Rows of a data set that are read when sliced (``a[start:stop]``)."""
+
+    ndim = 2
+
+    def __init__(self, reader):
+        self.reader = reader
+
+    def __len__(self) -> int:
+        return len(self.reader)
+
+    def __getitem__(self, rows: slice) -> np.ndarray:
+        start, stop, _ = rows.indices(len(self))
+        return self._values(self.reader.rows(start, max(start, stop)), start)
+
+
+class _Numbers(_Rows):
+    """``(N, *shape)`` floats from a group of columns."""
+
+    def __init__(self, reader, columns: tuple[str, ...], shape: tuple[int, ...]):
+        super().__init__(reader)
+        self.columns = columns
+        self.shape = (len(reader), *shape)
+        self.ndim = 1 + len(shape)
+
+    def _values(self, table, start: int) -> np.ndarray:
+        import pyarrow as pa
+
+        cols = [table.column(c).cast(pa.float64()).to_numpy(zero_copy_only=False) for c in self.columns]
+        return np.stack(cols, axis=-1).reshape(len(table), *self.shape[1:])
+
+
+class _Names(_Rows):
+    """``(N,)`` names as text (a null name is the row's index)."""
+
+    ndim = 1
+
+    def _values(self, table, start: int) -> np.ndarray:
+        import pyarrow as pa
+
+        column = table.column(NAME_COLUMN).cast(pa.string())
+        names = column.to_numpy(zero_copy_only=False)
+        nulls = np.flatnonzero(column.is_null().to_numpy(zero_copy_only=False))
+        names[nulls] = (start + nulls).astype(str)
+        return names.astype(str)
