@@ -17,6 +17,7 @@ Two hands are built here as URDFs (the form that carries joint position limits):
   (``|y| <= 1e-9``).
 """
 
+import csv
 import io
 import json
 import math
@@ -202,3 +203,16 @@ def test_a_grasp_without_a_hand_has_no_hand_fields():
     assert "hand" not in summary["summary"] and "joint_positions" not in recs[0] and "hand" not in recs[0]
     assert set(summary["summary"]["min_conditioning"]) == {"off_tangent", "tangent"}
     assert math.isfinite(summary["summary"]["duration"])
+
+
+def test_csv_and_npz_carry_resolves_joint_columns_and_the_joint_positions(tmp_path):
+    g = _grasp(tmp_path, _turntable([3.0, 3.0, 3.0]), NORMALS, SPIN)
+    rows = list(csv.DictReader(io.StringIO(run("follow", g, "--samples", 3, "-f", "csv").stdout)))
+    assert [float(r["q_f1_f1_j0"]) for r in rows] == pytest.approx([0, 0.5, 1.0], abs=1e-12)  # 0.5 t
+    assert [float(r["qdot_f2_f2_j0"]) for r in rows] == pytest.approx([0.5] * 3, abs=1e-12)
+    assert [float(r["q_f2_f2_j1"]) for r in rows] == pytest.approx([0] * 3, abs=1e-12)
+    assert run("follow", g, "--samples", 3, "-f", "npz", "-o", tmp_path / "o.npz").exit_code == 0
+    with np.load(tmp_path / "o.npz") as d:
+        np.testing.assert_allclose(d["joint_positions"], np.outer([0, 0.5, 1.0], [1, 0, 0] * 3), atol=1e-12)
+        np.testing.assert_allclose(d["joint_rates"], np.tile([0.5, 0, 0], (3, 3)), atol=1e-12)
+        assert d["joint_names"].tolist()[:3] == ["f0_j0", "f0_j1", "f0_j2"]

@@ -550,6 +550,7 @@ def follow(
         dt=dt,
         max_bytes=max_bytes,
         bases=FORMATS[fmt.value].bases,
+        hand=_hand_option(None, paths, fmt.value),
     )
     _run(debug, lambda: _follow(job, paths, output, quiet, fmt.value, digits=digits, order=order.value))
 
@@ -581,7 +582,7 @@ def _follow(job, paths: list[str], output, quiet: bool, fmt: str, **table_option
 
     stderr = _Stderr(quiet)
     with _output(output) as out:
-        w = FORMATS[fmt].open(out, "follow", **table_options)
+        w = FORMATS[fmt].open(out, "follow", **table_options, **FORMATS[fmt].hand_options(job.hand))
         for o in write_follow(job, expand(paths), w, fmt, table_options.get("order", "omega-v")):
             out.flush()
             stderr.take(o)

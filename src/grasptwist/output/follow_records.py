@@ -12,6 +12,7 @@ path's own.
 from __future__ import annotations
 
 from collections.abc import Callable
+from functools import partial
 from typing import NamedTuple
 
 import numpy as np
@@ -19,7 +20,7 @@ import numpy as np
 from ..engine.degeneracy import CONDITION_WARNING, Status, status_message
 from ..engine.se3 import matrix_to_quaternion
 from ..results import KINDS
-from .columns import CSV_COLUMNS, columns
+from .columns import CSV_COLUMNS, columns, header
 from .csv_rows import lines
 from .names import escaped
 from .records import dumps
@@ -31,6 +32,8 @@ __all__ = [
     "summary_record",
     "diagnostics",
     "CSV_HEADER",
+    "csv_header",
+    "encodings",
     "csv_rows",
     "path_arrays",
     "crossing_text",
@@ -224,8 +227,30 @@ def diagnostics(rec: dict, names=("1", "2", "3")) -> tuple[list[str], list[str]]
     return errors, warnings
 
 
-def csv_rows(samples, order: str = "omega-v") -> list[bytes]:
-    """The CSV line of each sample (header :data:`CSV_HEADER`)."""
+def csv_header(hand=None) -> bytes:
+    """The CSV header of ``follow`` for a run's ``hand`` (None: :data:`CSV_HEADER`): resolve's
+    joint columns in their place, then the joint positions ``q_<finger>_<joint>``."""
+    if hand is None:
+        return CSV_HEADER
+    rest = tuple(c for c in header(hand) if c not in _NOT_IN_CSV)
+    return ",".join(_OWN + rest + _q_names(hand)).encode() + b"\n"
+
+
+def _q_names(hand) -> tuple[str, ...]:
+    return tuple(f"q_{f.name}_{j.name}" for f in hand.fingers for j in f.joints)
+
+
+def _joint_positions(samples, hand) -> np.ndarray:
+    """``(N, n_joints)`` the samples' joint positions in the run's ``hand`` order (NaN: another hand, or none)."""
+    out = np.full((len(samples.block), len(hand.joint_names)), np.nan)
+    own = samples.block.hands[0] if samples.block.hands else None
+    if samples.joint_positions is not None and own is not None and own.joint_names == hand.joint_names:
+        out[:] = samples.joint_positions
+    return out
+
+
+def csv_rows(samples, order: str = "omega-v", hand=None) -> list[bytes]:
+    """The CSV line of each sample (header :func:`csv_header` of the run's ``hand``)."""
     block = samples.block
     position, quaternion = _pose(samples)
     own = {
@@ -237,22 +262,28 @@ def csv_rows(samples, order: str = "omega-v") -> list[bytes]:
     }
     own.update({f"position_{a}": position[:, j] for j, a in enumerate("xyz")})
     own.update({f"rotation_{a}": quaternion[:, j] for j, a in enumerate("wxyz")})
-    rest = {k: v for k, v in columns(block, order).items() if k not in _NOT_IN_CSV}
+    rest = {k: v for k, v in columns(block, order, hand).items() if k not in _NOT_IN_CSV}
+    if hand is not None:
+        rest.update(zip(_q_names(hand), _joint_positions(samples, hand).T))
     return lines({**own, **rest})
 
 
-def path_arrays(samples, order: str = "omega-v") -> dict[str, np.ndarray]:
+def path_arrays(samples, order: str = "omega-v", hand=None) -> dict[str, np.ndarray]:
     """The arrays a follow npz adds to a block's: ``t``, ``segment``, ``position`` and ``rotation``
-    (quaternions, w first); its ``twist`` is the instantaneous space twist."""
+    (quaternions, w first), and with the run's ``hand`` its ``joint_positions (N, n_joints)``;
+    its ``twist`` is the instantaneous space twist."""
     position, quaternion = _pose(samples)
-    return {"t": samples.poses.time, "segment": samples.poses.segment, "position": position, "rotation": quaternion}
+    out = {"t": samples.poses.time, "segment": samples.poses.segment, "position": position, "rotation": quaternion}
+    if hand is not None:
+        out["joint_positions"] = _joint_positions(samples, hand)
+    return out
 
 
-def csv_error_row(rec: dict) -> bytes:
+def csv_error_row(rec: dict, hand=None) -> bytes:
     """The CSV line of an input that failed: its file, ``ok`` false and the error."""
     err = rec["error"]
     row = [rec["file"]] + [""] * (len(_OWN) - 1) + ["false", f"{err['code']}: {err['message']}"]
-    width = CSV_HEADER.count(b",") + 1
+    width = csv_header(hand).count(b",") + 1
     return lines({str(j): np.array([v], dtype=object) for j, v in enumerate(row + [""] * (width - len(row)))})[0]
 
 
@@ -268,12 +299,18 @@ def _json_samples(samples, order):
     return [dumps(r) for r in sample_records(samples, order)]
 
 
-#: Per output format (:data:`grasptwist.output.formats.FORMATS`): how follow's records are encoded.
-#: CSV and npz hold the samples only; their summaries are the stderr lines (:func:`diagnostics`).
-ENCODINGS = {
-    "table": Encoding(sample_records, lambda rec: rec, lambda rec: rec),
-    "json": Encoding(_json_samples, dumps, dumps),
-    "jsonl": Encoding(_json_samples, dumps, dumps),
-    "csv": Encoding(csv_rows, None, csv_error_row),
-    "npz": Encoding(None, None, None),  # takes the blocks, with path_arrays
-}
+def encodings(hand=None) -> dict:
+    """Per output format (:data:`grasptwist.output.formats.FORMATS`): how follow's records are
+    encoded, CSV with the joint columns of the run's ``hand``.  CSV and npz hold the samples only;
+    their summaries are the stderr lines (:func:`diagnostics`)."""
+    return {
+        "table": Encoding(sample_records, lambda rec: rec, lambda rec: rec),
+        "json": Encoding(_json_samples, dumps, dumps),
+        "jsonl": Encoding(_json_samples, dumps, dumps),
+        "csv": Encoding(partial(csv_rows, hand=hand), None, partial(csv_error_row, hand=hand)),
+        "npz": Encoding(None, None, None),  # takes the blocks, with path_arrays
+    }
+
+
+#: :func:`encodings` of a run without a hand.
+ENCODINGS = encodings()

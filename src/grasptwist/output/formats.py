@@ -86,9 +86,9 @@ def _table(out: IO[bytes], kind: str, order: str = "omega-v", **table_options):
 
 def _csv(out: IO[bytes], kind: str, hand=None, **_):
     if kind == "follow":
-        from .follow_records import CSV_HEADER
+        from .follow_records import csv_header
 
-        return Lines(out, header=CSV_HEADER, newline=b"")
+        return Lines(out, header=csv_header(hand), newline=b"")
     return Lines(out, header=csv_rows.header_line(hand), newline=b"")
 
 

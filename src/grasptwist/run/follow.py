@@ -26,7 +26,7 @@ from ..engine.path import PathDegeneracies, Poses, degeneracies, follow
 from ..hand import HandTrack
 from ..io.datasets import DATASET_SUFFIXES
 from ..io.inputs import read
-from ..model import Grasp, GraspFileError, ObjectPath
+from ..model import Grasp, GraspFileError, Hand, ObjectPath
 from ..results import BY_KEY, selected
 from .batch import Block, with_reasons
 from .pipeline import Output
@@ -76,6 +76,8 @@ class FollowJob:
         Size cap of a grasp file.
     bases : bool
         Keep the basis screws (formats that show them).
+    hand : Hand or None
+        The run's hand, whose joints name the CSV and npz joint columns.
     """
 
     method: str = "both"
@@ -85,6 +87,7 @@ class FollowJob:
     dt: float | None = None
     max_bytes: int | None = None
     bases: bool = True
+    hand: Hand | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -148,11 +151,11 @@ def write_follow(job: FollowJob, inputs: Iterable, w, fmt: str, order: str = "om
     from ..output import follow_records as fr
     from ..output.records import diagnostics, error_record
 
-    encoding = fr.ENCODINGS[fmt]
+    encoding = fr.encodings(job.hand)[fmt]
     for item in follow_inputs(job, inputs):
         if isinstance(item, Samples):
             if encoding.samples is None:
-                w.write(item.block, fr.path_arrays(item, order))
+                w.write(item.block, fr.path_arrays(item, order, job.hand))
             else:
                 for encoded in encoding.samples(item, order):
                     w.write(encoded)
