@@ -790,9 +790,30 @@ def main() -> None:
 
     stop_on_signals()
     try:
-        app()
+        code = app(standalone_mode=False)
     except Interrupted as stop:  # while typer parsed the command line
         sys.exit(_stopped(stop))
+    except _CLICK_ERROR as exc:
+        sys.exit(_usage_error(exc))
+    sys.exit(code if isinstance(code, int) else EXIT_OK)
+
+
+# The base of the usage errors of typer's click (typer 0.2x carries its own copy of click, so it is
+# found from the one typer exports, whichever click that is).
+_CLICK_ERROR = next(c for c in typer.BadParameter.__mro__ if c.__name__ == "ClickException")
+
+
+def _usage_error(exc) -> int:
+    """One line for a usage error (exit 2), as for every other diagnostic: what is wrong, and
+    where help is, instead of click's four lines of usage, hint, blank and error."""
+    if type(exc).__name__ == "NoArgsIsHelpError":  # `grasptwist` alone: the help is the answer
+        _say(exc.format_message())
+        return exc.exit_code
+    ctx = getattr(exc, "ctx", None)
+    message = " ".join(exc.format_message().split())  # on one line, whatever it quotes
+    where = f" (see '{ctx.command_path} -h')" if ctx is not None else ""
+    _say(f"grasptwist: error: {message}{where}")
+    return exc.exit_code
 
 
 if __name__ == "__main__":
