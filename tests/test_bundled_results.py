@@ -186,7 +186,8 @@ def test_the_hand_table_names_the_components_that_move_each_finger():
     rec = json.loads(CliRunner().invoke(app, ["resolve", str(GRASPS / "three-finger-hand.yaml"), "-f", "json"]).stdout)[
         0
     ]
-    table = CliRunner().invoke(app, ["resolve", str(GRASPS / "three-finger-hand.yaml")]).stdout
+    wide = {"COLUMNS": "200"}  # one line each
+    table = CliRunner().invoke(app, ["resolve", str(GRASPS / "three-finger-hand.yaml")], env=wide).stdout
     names = {"off_tangent": ("Sigma", "Psi"), "tangent": ("Theta", "Sigma")}
     for f, finger in enumerate(rec["hand"]["fingers"]):
         parts = []

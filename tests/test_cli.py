@@ -19,6 +19,7 @@ from grasptwist.cli import app
 from grasptwist.io.grasp_file import grasp_schema
 from grasptwist.output.columns import CSV_COLUMNS
 from grasptwist.output.writers import JsonArray
+from hostile import run_installed
 
 # Example 2's polyhedron, with a wrist off the contacts' plane x + y + z = 4
 POLY = """\
@@ -373,3 +374,30 @@ def test_a_reader_that_goes_away_ends_the_run_quietly_with_141(files):
     p.stdout.close()  # like `| head -1`
     err = p.stderr.read()
     assert p.wait(timeout=60) == 141 and b"Traceback" not in err and b"Exception ignored" not in err
+
+
+@pytest.mark.parametrize(
+    "args, line",
+    [
+        (
+            ["resolve", "x.yaml", "--twist", "1,2"],
+            "Invalid value: --twist needs 6 finite comma-separated numbers, got '1,2'",
+        ),
+        (["resolve", "x.yaml", "--bogus"], "No such option: --bogus"),
+        (["follow", "x.yaml", "--samples", "1"], "Invalid value for '--samples': 1 is not in the range 2<=x<=1000000."),
+    ],
+    ids=["bad-value", "unknown-option", "out-of-range"],
+)
+def test_a_usage_error_is_one_line_and_exit_2(args, line):
+    done, _ = run_installed(*args)
+    command = f"grasptwist {args[0]}"
+    assert (done.returncode, done.stdout, done.stderr) == (2, "", f"grasptwist: error: {line} (see '{command} -h')\n")
+
+
+def test_no_command_prints_the_help():
+    done, _ = run_installed()
+    assert (
+        done.returncode == 2
+        and done.stderr.startswith("Usage: grasptwist [OPTIONS] COMMAND")
+        and "resolve" in done.stderr
+    )

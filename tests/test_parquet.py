@@ -248,7 +248,9 @@ def test_without_pyarrow_parquet_says_how_to_install_it(tmp_path, files):
         f"r = CliRunner().invoke(app, ['resolve', {str(files / 'set.parquet')!r}, '-f', 'jsonl'])\n"
         "print(r.exit_code); print(r.stdout, end='')\n"
     )
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60).stdout.splitlines()
+    done = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    assert done.stderr == ""  # nothing more, not even "Exception ignored in ... __del__" at exit
+    out = done.stdout.splitlines()
     assert out[:2] == ["2", f"grasptwist: error: -f parquet needs pyarrow: {hint}"]
     assert out[2] == "1" and json.loads(out[3])["error"] == {
         "code": "read-error",

@@ -17,7 +17,7 @@ import signal
 import sys
 from collections.abc import Iterator
 from contextlib import contextmanager
-from dataclasses import replace
+from dataclasses import dataclass, field, replace
 from enum import Enum
 
 import typer
@@ -393,7 +393,8 @@ def resolve(
         hand=_hand_option(hand, paths, fmt.value),
         twists_from=twists_from,
     )
-    _run(debug, lambda: _emit(job, paths, output, (quiet, warnings), workers, digits=digits, order=order.value))
+    shared = Shared(output, quiet, warnings, workers, {"digits": digits, "order": order.value})
+    _run(debug, lambda: _emit(job, paths, shared))
 
 
 def _hand_option(path: str | None, paths: list[str], fmt: str):
@@ -446,7 +447,10 @@ def basis(
     job = Job(
         kind="basis", method=method.value, order=order.value, fmt="json" if json_ else fmt.value, max_bytes=max_bytes
     )
-    _run(debug, lambda: _emit(job, paths, output, (quiet, warnings), workers, digits=digits, order=order.value))
+    _run(
+        debug,
+        lambda: _emit(job, paths, Shared(output, quiet, warnings, workers, {"digits": digits, "order": order.value})),
+    )
 
 
 @app.command()
@@ -474,7 +478,7 @@ def check(
     from .run.pipeline import Job
 
     job = Job(kind="check", method=method.value, fmt="json" if json_ else fmt.value, max_bytes=max_bytes)
-    _run(debug, lambda: _emit(job, paths, output, (quiet, warnings), workers))
+    _run(debug, lambda: _emit(job, paths, Shared(output, quiet, warnings, workers)))
 
 
 FollowFormat = _choices("FollowFormat", names_for("follow"))
@@ -692,19 +696,32 @@ def _workers(requested: int) -> int:
     return requested if requested > 0 else min(os.cpu_count() or 1, 8)
 
 
-def _emit(job, paths: list[str], output, stderr_options: tuple, workers: int, **table_options) -> int:
-    """Files in, records out: the body of resolve, basis and check
-    (``stderr_options``: ``-q`` and ``--warnings``)."""
+@dataclass(frozen=True)
+class Shared:
+    """The options resolve, basis and check share beyond their job, as one object: where the
+    records go, how many processes make them, what stderr says, and how tables print numbers.
+    (typer declares options as parameters, so each command lists them; the same typer.Option
+    objects, defined once above.)"""
+
+    output: str | None
+    quiet: bool
+    warnings: Warnings
+    workers: int
+    table_options: dict = field(default_factory=dict)
+
+
+def _emit(job, paths: list[str], shared: Shared) -> int:
+    """Files in, records out: the body of resolve, basis and check."""
     from .io.inputs import expand
     from .run.pipeline import run, write_blocks
 
-    stderr = _Stderr(*stderr_options, hint=_table_hint(job.kind) if job.fmt == "table" else None)
+    stderr = _Stderr(shared.quiet, shared.warnings, hint=_table_hint(job.kind) if job.fmt == "table" else None)
     inputs = list(expand(paths))
     fmt = FORMATS[job.fmt]
-    with _output(output) as out, _progress(inputs, job.kind, out) as advance:
-        w = fmt.open(out, job.kind, **table_options, **fmt.hand_options(job.hand))
+    with _output(shared.output) as out, _progress(inputs, job.kind, out) as advance:
+        w = fmt.open(out, job.kind, **shared.table_options, **fmt.hand_options(job.hand))
         # block writers (npz) take results here; the others get records encoded where they were made
-        outputs = write_blocks(job, inputs, w) if fmt.takes_blocks else run(job, inputs, _workers(workers))
+        outputs = write_blocks(job, inputs, w) if fmt.takes_blocks else run(job, inputs, _workers(shared.workers))
         for o in outputs:
             for encoded in o.encoded:
                 w.write(encoded)
@@ -774,9 +791,30 @@ def main() -> None:
 
     stop_on_signals()
     try:
-        app()
+        code = app(standalone_mode=False)
     except Interrupted as stop:  # while typer parsed the command line
         sys.exit(_stopped(stop))
+    except _CLICK_ERROR as exc:
+        sys.exit(_usage_error(exc))
+    sys.exit(code if isinstance(code, int) else EXIT_OK)
+
+
+# The base of the usage errors of typer's click (typer 0.2x carries its own copy of click, so it is
+# found from the one typer exports, whichever click that is).
+_CLICK_ERROR = next(c for c in typer.BadParameter.__mro__ if c.__name__ == "ClickException")
+
+
+def _usage_error(exc) -> int:
+    """One line for a usage error (exit 2), as for every other diagnostic: what is wrong, and
+    where help is, instead of click's four lines of usage, hint, blank and error."""
+    if type(exc).__name__ == "NoArgsIsHelpError":  # `grasptwist` alone: the help is the answer
+        _say(exc.format_message())
+        return exc.exit_code
+    ctx = getattr(exc, "ctx", None)
+    message = " ".join(exc.format_message().split())  # on one line, whatever it quotes
+    where = f" (see '{ctx.command_path} -h')" if ctx is not None else ""
+    _say(f"grasptwist: error: {message}{where}")
+    return exc.exit_code
 
 
 if __name__ == "__main__":

@@ -40,7 +40,6 @@ import numpy as np
 from .engine import judgements
 from .engine.decompose import decompose_off_tangent, decompose_tangent
 from .engine.degeneracy import Status
-from .engine.kinematics import OFF_TANGENT_FIXED, TANGENT_FIXED, hand_joint_rates
 from .engine.screws import klein_table
 
 __all__ = [
@@ -291,17 +290,27 @@ TANGENT = ResultKind(
     table="TangentTable",
 )
 
-#: Which contacts each component of a method's decomposition leaves still, in basis order.
-_FIXED = {"off_tangent": OFF_TANGENT_FIXED, "tangent": TANGENT_FIXED}
-
 
 def _decompositions(inputs) -> dict:
-    """The component twists of the methods computed before, for their joint rates."""
-    return {
-        key: (np.concatenate(inputs[key].components(), axis=-2), fixed)
-        for key, fixed in _FIXED.items()
-        if key in inputs
-    }
+    """The component twists of the methods computed before, for their joint rates, with the
+    contacts each component leaves still (in basis order)."""
+    from .engine.kinematics import OFF_TANGENT_FIXED, TANGENT_FIXED
+
+    fixed = {"off_tangent": OFF_TANGENT_FIXED, "tangent": TANGENT_FIXED}
+    return {key: (np.concatenate(inputs[key].components(), axis=-2), fixed[key]) for key in fixed if key in inputs}
+
+
+def _hand_joint_rates(inputs, bases):
+    # the kinematics are imported with the first hand: runs without one never load them
+    from .engine.kinematics import hand_joint_rates
+
+    return hand_joint_rates(
+        inputs["joint_screws"],
+        inputs["points"],
+        inputs["twist"],
+        inputs["joint_limits"],
+        _decompositions(inputs) if bases else None,
+    )
 
 
 def _same_hand(block, hand) -> np.ndarray:
@@ -339,13 +348,7 @@ def _qdot_names(hand) -> tuple[str, ...]:
 HAND = ResultKind(
     key="hand",
     label="hand",
-    compute=lambda inputs, bases: hand_joint_rates(
-        inputs["joint_screws"],
-        inputs["points"],
-        inputs["twist"],
-        inputs["joint_limits"],
-        _decompositions(inputs) if bases else None,
-    ),
+    compute=_hand_joint_rates,
     applies=lambda block: block.has_hand,
     fields=(),
     basis_fields=(),

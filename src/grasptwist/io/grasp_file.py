@@ -54,8 +54,7 @@ import numpy as np
 import orjson
 import yaml
 
-from ..engine import screws, se3
-from ..engine.path import FRAMES, check_segments
+from ..engine import screws
 from ..model import Grasp, GraspFileError, ObjectPath, Segment, Twist
 
 __all__ = [
@@ -1189,6 +1188,8 @@ def _frame(node, path, problems):
     """``space`` or ``body``."""
     if node.kind == "invalid":
         return None
+    from ..engine.path import FRAMES  # paths, their engine and SE(3) only for documents with paths
+
     if node.kind != "scalar" or node.value not in FRAMES:
         problems.add(_Reject("invalid-frame", path, f"expected space or body, got {_describe(node)}", **_at(node)))
         return None
@@ -1206,6 +1207,8 @@ def _segments(node, path, frame, problems):
     segments = [_segment(item, f"{path}[{k}]", frame, problems) for k, item in enumerate(items)]
     if problems.count:
         return None
+    from ..engine.path import check_segments
+
     return check_segments(segments)
 
 
@@ -1262,6 +1265,8 @@ def _conflicts(fields, path, others, what, problems):
 def _pose(node, path, problems):
     """``(position, rotation matrix)`` of a pose target: position default zero, rotation a
     quaternion ``(w, x, y, z)`` or a rotation vector, default none."""
+    from ..engine import se3
+
     fields = _mapping(node, path, POSE_KEYS, (), problems)
     if fields is None:
         return None

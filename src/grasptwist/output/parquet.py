@@ -102,4 +102,7 @@ class ParquetWriter:
     def __del__(self):
         # Never closed: the run failed and its output is being discarded; pyarrow's
         # own finaliser would write a footer to the closed output (a second error).
-        self.writer.is_open = False
+        # No writer at all: pyarrow was missing, which the run has already said.
+        writer = getattr(self, "writer", None)
+        if writer is not None:
+            writer.is_open = False

@@ -16,7 +16,6 @@ from typing import Any
 
 import numpy as np
 
-from .. import hand
 from ..engine.decompose import contact_velocities
 from ..engine.judgements import outward_normals
 from ..engine.screws import direction, twist_at
@@ -311,6 +310,8 @@ def _hand_inputs(grasps) -> dict:
     """The hand keywords of :func:`resolve_arrays` for grasps (none when no grasp has a hand)."""
     if all(g.hand is None for g in grasps):
         return {}
+    from .. import hand  # hands, their kinematics and URDFs only for grasps with one
+
     width = max(len(f.joints) for g in grasps if g.hand is not None for f in g.hand.fingers)
     made = {}  # each grasp's fingers once, whatever its number of twists
     for g in grasps:
@@ -397,6 +398,8 @@ def _rows_hand(ds, hand_of_rows, start, stop, rows, n):
     """The hand keywords of :func:`resolve_arrays` for rows ``start:stop`` of a data set."""
     if hand_of_rows is None:
         return {}
+    from .. import hand
+
     q = None if ds.joint_positions is None else np.asarray(ds.joint_positions[start:stop], dtype=float)[rows]
     states = hand.finger_states(hand_of_rows, q)
     screws, limits = hand.padded(hand_of_rows, [s.screws for s in states])
