@@ -541,6 +541,13 @@ def test_a_misspelling_is_one_problem_an_unknown_key_and_a_missing_one_are_two(l
     assert where(read(CONTACTS.replace("normal: [-1", "nromal: [-1"), reading=loader)) == [("unknown-key", 3, 5, 0)]
     unrelated = where(read(CONTACTS.replace("normal: [-1", "color: [-1"), reading=loader))
     assert unrelated == [("missing-key", 2, 5, 0), ("unknown-key", 3, 5, 0)]
+    # a twist's motion key: the suggestion stands in for "needs 'screw', or 'angular' and/or 'linear'"
+    twists = CONTACTS + "twists:\n  - angluar: [0, 0, 1]\n  - colour: [0, 0, 1]\n"
+    assert where(read(twists, reading=loader)) == [
+        ("unknown-key", 9, 5, 0),
+        ("unknown-key", 10, 5, 0),
+        ("missing-key", 10, 5, 0),
+    ]
 
 
 @pytest.mark.parametrize(

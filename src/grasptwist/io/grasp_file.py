@@ -1155,7 +1155,7 @@ def _twist_parts(fields, item, path, problems):
                 )
         screw = _vector(fields["screw"], 6, _join(path, "screw"), problems)
         return None if screw is None else (screw[:3], screw[3:], zero)
-    if "angular" not in fields and "linear" not in fields:
+    if "angular" not in fields and "linear" not in fields and not _misspelt(item, ("screw", "angular", "linear")):
         problems.add(_Reject("missing-key", path, "needs 'screw', or 'angular' and/or 'linear'", **_at(item)))
     parts = [
         _vector(fields[key], 3, _join(path, key), problems) if key in fields else zero
@@ -1335,6 +1335,14 @@ def _describe(node):
     if isinstance(value, (int, float)):
         return f"the number {_shorten(node.text)}"
     return f"the string {_shorten(value)!r}"
+
+
+def _misspelt(node, keys):
+    """Whether a key of mapping ``node`` is a misspelling of one of ``keys``: its "did you mean"
+    line then stands in for the missing key's (as :func:`_mapping` does for required keys)."""
+    from difflib import get_close_matches
+
+    return any(key not in keys and get_close_matches(key, keys, n=1) for key in node.value)
 
 
 def _shorten(text):

@@ -36,7 +36,7 @@ from rich.color import ColorSystem
 from rich.console import Console, Group
 from rich.text import Text
 
-from ..engine.degeneracy import CONDITION_WARNING, Status
+from ..engine.degeneracy import CONDITION_WARNING
 from ..results import KINDS
 from .names import escaped
 
@@ -539,10 +539,6 @@ class BasisTableWriter(_Writer):
         self.warnings(lines, rec)
 
 
-#: Widest verdict a ``check`` cell can hold: a failure's code, or ``ok (1.23e-05)``.
-_VERDICT_WIDTH = max(len("ok (1.23e-05)"), *(len(s.code) for s in Status))
-
-
 class CheckTableWriter(_Writer):
     """One line per grasp, streamed: each method's verdict and conditioning in
     columns of fixed width, then the file and the grasp, as wide as in the
@@ -551,7 +547,8 @@ class CheckTableWriter(_Writer):
 
     def __init__(self, out, **options):
         super().__init__(out, **options)
-        self.grid = _table(*(k.label for k in KINDS), "file", "grasp")
+        self.kinds = [k for k in KINDS if k.check_fields]  # a kind with nothing to check has no column
+        self.grid = _table(*(k.label for k in self.kinds), "file", "grasp")
         self.widths: list[int] = []
 
     def write(self, encoded: bytes) -> None:
@@ -559,7 +556,7 @@ class CheckTableWriter(_Writer):
         if "error" in rec:
             return
         self.count += 1
-        self.grid.add_row(*(_verdict_cell(rec.get(k.key, False)) for k in KINDS), rec["file"], rec["grasp"])
+        self.grid.add_row(*(_verdict_cell(rec.get(k.key, False)) for k in self.kinds), rec["file"], rec["grasp"])
         if self.widths or self.grid.row_count >= SIZING_ROWS:
             self._rows()
 
@@ -569,9 +566,9 @@ class CheckTableWriter(_Writer):
         self.grid.rows.clear()
         lines, part = [], range(len(self.grid.headers))
         if not self.widths:
-            verdicts = [_VERDICT_WIDTH] * len(KINDS)
-            self.widths = [max(w, *(n[i] for _, n in rows)) for i, w in enumerate([*verdicts, 0, 0])]
-            self.widths = [max(w, _len(h)) for w, h in zip(self.widths, self.grid.headers)]
+            # every column as wide as its header and its cells in the first rows (an 80-column
+            # terminal holds both methods' verdicts and a short file and grasp name)
+            self.widths = [max(_len(h), *(n[i] for _, n in rows)) for i, h in enumerate(self.grid.headers)]
             lines = ["", *(line.rstrip() for line in _head(self.grid, part, self.widths, self.color))]
         for texts, lengths in rows:
             widths = [max(w, n) for w, n in zip(self.widths, lengths)]  # an overlong cell pushes the rest of its row
