@@ -23,10 +23,15 @@ from _data import grasptwist_command, timed
 HERE = os.path.dirname(os.path.abspath(__file__))
 
 
-def make_folder(root, count, seed=0):
+def make_folder(root, count, seed=0, with_paths=False):
     rng = random.Random(seed)
     sources = sorted(glob.glob(os.path.join(HERE, "..", "grasps", "*.yaml")))
-    texts = [Path(s).read_text() for s in sources]
+    # the grasp files of 0.1: without the files with a hand (URDF and kinematics: bench/hand.py) and
+    # with their paths (last in the file) cut off, which only `follow` reads and which send a file
+    # to the loader's general path (--with-paths keeps them)
+    texts = [t for t in (Path(s).read_text() for s in sources) if "\nhand:" not in t]
+    if not with_paths:
+        texts = [t.split("\npaths:")[0] + "\n" for t in texts]
     for i in range(count):
         sub = os.path.join(root, f"set{i // 1000:02d}")
         os.makedirs(sub, exist_ok=True)
@@ -40,9 +45,10 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--files", type=int, default=10_000)
     ap.add_argument("--repeats", type=int, default=3)
+    ap.add_argument("--with-paths", action="store_true", help="keep the bundled files' paths: sections")
     args = ap.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
-        files = make_folder(os.path.join(tmp, "grasps"), args.files)
+        files = make_folder(os.path.join(tmp, "grasps"), args.files, with_paths=args.with_paths)
         t_yaml = float("inf")
         for _ in range(args.repeats):
             t0 = time.perf_counter()
