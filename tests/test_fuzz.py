@@ -177,7 +177,7 @@ def fuzz(strategy, check, examples):
     property_()
 
 
-SHORT = {"loader": 200, "cli": 100}
+SHORT = {"loader": 100, "cli": 50}  # the default run's share; -m slow runs LONG
 LONG = 10_000
 
 
