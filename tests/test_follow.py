@@ -297,3 +297,10 @@ def test_o_follows_the_resolve_rule_and_a_data_set_is_refused_without_costing_th
     refused, *rows, summary = jsonl(out.read_text())
     assert refused["error"]["code"] == "read-error" and "not data sets" in refused["error"]["message"]
     assert len(rows) == 2 and summary["ok"] is True
+
+
+def test_the_table_escapes_a_file_name_that_would_drive_the_terminal(tmp_path):
+    name = tmp_path / "cyl\x1b[31m.yaml"  # a file name is whatever whoever filled the folder chose
+    name.write_bytes(CYLINDER.read_bytes())
+    out = run("follow", name, "--samples", 2, "--method", "off-tangent").stdout
+    assert "\x1b" not in out and f"{tmp_path}/cyl\\x1b[31m.yaml: grasp 'cylinder', path 'turn-x'" in out

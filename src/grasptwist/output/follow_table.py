@@ -12,6 +12,7 @@ from __future__ import annotations
 from typing import IO
 
 from .follow_records import crossing_text, hand_event_texts
+from .names import escaped
 
 __all__ = ["FollowTable"]
 
@@ -50,7 +51,7 @@ class FollowTable:
             cells += [f"{f'{label} {a}':<{vector}}" for a in amplitudes] + [f"{'cond':>{self.width}}"]
         if self.current is not None:
             self._say()
-        self._say(f"{rec['file']}: grasp '{rec['grasp']}', path '{rec['path']}'")
+        self._say(f"{escaped(rec['file'])}: grasp '{escaped(rec['grasp'])}', path '{escaped(rec['path'])}'")
         self._say("  ".join(cells).rstrip())
 
     def write(self, rec: dict) -> None:
