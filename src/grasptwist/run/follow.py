@@ -239,13 +239,17 @@ def _block(grasp, name, f, bases, method, positions=None) -> Block:
 
 
 def _no_path(grasp: Grasp, name: str | None) -> GraspFileError:
-    wanted = f"no path named '{name}'" if name is not None else "no path to follow"
+    if grasp.paths:  # a name that is not among them: say which there are
+        names = ", ".join(f"'{p.name}'" for p in grasp.paths)
+        message = f"grasp '{grasp.name}' has no path named '{name}' (its paths: {names})"
+    else:
+        message = (
+            f"grasp '{grasp.name}' has no path to follow: add a 'paths:' list to the file "
+            "or pass --twist W1,W2,W3,V1,V2,V3 --duration T (repeatable)"
+        )
     return GraspFileError(
         code=NO_PATH,
-        message=(
-            f"grasp '{grasp.name}' has {wanted}: add a 'paths:' list to the file "
-            "or pass --twist W1,W2,W3,V1,V2,V3 --duration T (repeatable)"
-        ),
+        message=message,
         file=grasp.file,
         line=grasp.line,
         column=1,
