@@ -381,7 +381,7 @@ def test_a_reader_that_goes_away_ends_the_run_quietly_with_141(files):
     [
         (
             ["resolve", "x.yaml", "--twist", "1,2"],
-            "Invalid value: --twist needs 6 finite comma-separated numbers, got '1,2'",
+            "Invalid value for --twist: needs 6 finite comma-separated numbers, got '1,2'",
         ),
         (["resolve", "x.yaml", "--bogus"], "No such option: --bogus"),
         (["follow", "x.yaml", "--samples", "1"], "Invalid value for '--samples': 1 is not in the range 2<=x<=1000000."),

@@ -237,7 +237,7 @@ def test_csv_and_npz_hold_the_samples_with_time_and_pose(tmp_path):
     "args, hint",
     [
         (["--twist", "1,0,0,0,0,0"], "each --twist needs a --duration"),
-        (["--twist", "1,0,0,0,0,0", "--duration", "-1"], "duration must be a finite number > 0"),
+        (["--twist", "1,0,0,0,0,0", "--duration", "-1"], "--duration number 1 must be a finite number > 0"),
         (["--samples", "3", "--dt", "0.1"], "give --samples or --dt, not both"),
         (["--dt", "0"], "must be a finite number > 0"),
         (["--frame", "body"], "applies to --twist segments"),

@@ -13,6 +13,7 @@ reader of stdout went away.
 from __future__ import annotations
 
 import os
+import re
 import signal
 import sys
 from collections.abc import Iterator
@@ -82,7 +83,7 @@ def _floats(text: str, n: int, what: str) -> list[float]:
     except ValueError:
         values = []
     if len(values) != n or not all(v == v and abs(v) != float("inf") for v in values):
-        raise typer.BadParameter(f"{what} needs {n} finite comma-separated numbers, got {text!r}")
+        raise typer.BadParameter(f"needs {n} finite comma-separated numbers, got {text!r}", param_hint=what)
     return values
 
 
@@ -101,7 +102,7 @@ def _cli_twists(texts: list[str] | None, at: str | None, names: list[str] | None
             )
     if not texts:
         if at is not None:
-            raise typer.BadParameter("--at applies to --twist; give at least one --twist", param_hint="--at")
+            raise typer.BadParameter("applies to --twist; give at least one --twist", param_hint="--at")
         return None
     import numpy as np
 
@@ -576,7 +577,9 @@ def _cli_segments(twists, durations, frame):
     try:
         return check_segments(segments)
     except ValueError as exc:
-        raise typer.BadParameter(str(exc).replace("segments[", "segment ["), param_hint="--duration") from None
+        # the engine names segments[k]; here they are the k+1-th --twist/--duration pair
+        message = re.sub(r"segments\[(\d+)\]\.duration", lambda m: f"--duration number {int(m[1]) + 1}", str(exc))
+        raise typer.BadParameter(message.replace("segments[", "segment ["), param_hint="--duration") from None
 
 
 def _follow(job, paths: list[str], output, quiet: bool, fmt: str, **table_options) -> int:
