@@ -1,4 +1,5 @@
-"""grasptwist.dask on a distributed LocalCluster: the command line's results, bit for bit.
+"""grasptwist.dask: the command line's results, bit for bit (on Dask's synchronous scheduler by
+default, on a two-worker distributed LocalCluster with -m slow).
 
 The checks are in dask_checks.py, each run in a fresh process (why: its docstring).
 """

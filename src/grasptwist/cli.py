@@ -381,8 +381,7 @@ def resolve(
     if extra_point == ExtraPoint.at and not any(p.endswith(".npy") for p in paths):
         raise typer.BadParameter("applies to .npy data sets (their 19th-21st columns)", param_hint="--extra-point")
     fmt = Format.json if json_ else fmt
-    if FORMATS[fmt.value].binary and output is None and sys.stdout.isatty():
-        raise typer.BadParameter(f"{fmt.value} is binary: give -o FILE.{fmt.value}", param_hint="--format")
+    _not_binary_to_a_terminal(fmt.value, output)
     job = Job(
         kind="resolve",
         twists=None if twists is None else tuple(twists),
@@ -545,8 +544,7 @@ def follow(
     if dt is not None and not (dt > 0 and dt != float("inf")):
         raise typer.BadParameter(f"must be a finite number > 0, got {dt}", param_hint="--dt")
     fmt = FollowFormat.json if json_ else fmt
-    if FORMATS[fmt.value].binary and output is None and sys.stdout.isatty():
-        raise typer.BadParameter(f"{fmt.value} is binary: give -o FILE.{fmt.value}", param_hint="--format")
+    _not_binary_to_a_terminal(fmt.value, output)
     job = FollowJob(
         method=method.value,
         path=path,
@@ -558,6 +556,12 @@ def follow(
         hand=_hand_option(None, paths, fmt.value),
     )
     _run(debug, lambda: _follow(job, paths, output, quiet, fmt.value, digits=digits, order=order.value))
+
+
+def _not_binary_to_a_terminal(fmt: str, output: str | None) -> None:
+    """A usage error, before any work, when a binary format (npz, parquet) would go to a terminal."""
+    if FORMATS[fmt].binary and output is None and sys.stdout.isatty():
+        raise typer.BadParameter(f"{fmt} is binary: give -o FILE.{fmt}", param_hint="--format")
 
 
 def _cli_segments(twists, durations, frame):
