@@ -881,6 +881,7 @@ def _read_text(text, file, reading, name=None):
     stop = None
     parser = reading.parser(text)
     get_event = parser.get_event
+    document_line = 0  # where the document being read starts (0-based)
     try:
         get_event()  # StreamStartEvent
         while not parser.check_event(yaml.StreamEndEvent):
@@ -892,6 +893,7 @@ def _read_text(text, file, reading, name=None):
                     **_at_mark(parser.peek_event().start_mark),
                 )
             start = get_event()  # DocumentStartEvent
+            document_line = start.start_mark.line
             events = []
             problems = None
             try:
@@ -906,7 +908,7 @@ def _read_text(text, file, reading, name=None):
     except _StreamStop as reject:
         stop = reject
     except yaml.YAMLError as exc:
-        stop = _syntax_error(exc, text)
+        stop = _syntax_error(exc, text, document_line)
     finally:
         parser.dispose()
     return entries.close(stop)
@@ -1008,9 +1010,14 @@ def _stem_name(file):
     return _NOT_IN_A_STEM.sub(escape, Path(file).stem)
 
 
-def _syntax_error(exc, text):
-    """A ``_StreamStop`` for a PyYAML or libyaml syntax error."""
+def _syntax_error(exc, text, document_line=0):
+    """A ``_StreamStop`` for a PyYAML or libyaml syntax error raised while
+    reading the document that starts at ``document_line`` (0-based) of ``text``:
+    ``too-deep`` where the document crosses ``MAX_DEPTH`` before that error."""
     mark = getattr(exc, "problem_mark", None)
+    deep = _too_deep(text, document_line, mark)
+    if deep is not None:
+        return deep
     if mark is None:
         return _StreamStop("yaml-syntax", "", f"invalid YAML: {exc}")
     problem = exc.problem or "syntax error"
@@ -1019,6 +1026,37 @@ def _syntax_error(exc, text):
         # The two parsers word this differently; it is common enough to fix.
         problem = "tab character; YAML indentation must use spaces"
     return _StreamStop("yaml-syntax", "", f"invalid YAML: {problem}", line=mark.line + 1, column=mark.column + 1)
+
+
+def _too_deep(text, document_line, mark):
+    """The ``too-deep`` stop of the text from ``document_line`` on, where it
+    nests deeper than ``MAX_DEPTH`` before ``mark`` (a parser's error mark, or
+    None for anywhere); else None.
+
+    libyaml has a nesting limit of its own (about 1000 levels in the one
+    PyYAML 6.0.4 ships) and its scanner reads a flow collection's brackets far
+    ahead of the events, so it can refuse a deep document before the events
+    that cross ``MAX_DEPTH`` are seen.  The pure-Python parser, which has no
+    such limit, reads the document again to find where the crossing is; the
+    error path alone pays for it, and it stops at the crossing.
+    """
+    rest = "\n".join(text.split("\n")[document_line:]) if document_line else text
+    parser = yaml.SafeLoader(rest)
+    try:
+        parser.get_event()  # StreamStartEvent
+        while not parser.check_event(yaml.StreamEndEvent):
+            parser.get_event()  # DocumentStartEvent
+            _compose(parser.get_event, _Problems(0))
+    except _StreamStop as stop:
+        line, column = stop.line - 1 + document_line, stop.column - 1
+        if mark is None or (line, column) <= (mark.line, mark.column):
+            stop.line = line + 1
+            return stop
+    except yaml.YAMLError:
+        pass
+    finally:
+        parser.dispose()
+    return None
 
 
 def _grasp(root, problems, *, file, document, name, line):
