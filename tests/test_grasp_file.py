@@ -531,17 +531,6 @@ def test_the_command_line_gives_each_problem_its_record_and_line(tmp_path):
     assert lines[3:] == [summary_line(4, 3)]
 
 
-def test_the_readme_shows_what_the_command_prints(tmp_path, monkeypatch):
-    example = (Path(__file__).parent.parent / "README.md").read_text("utf-8").split("For this `pinch.yaml`")[1]
-    text = example.split("```yaml\n")[1].split("```")[0]
-    printed = example.split("```\n")[2]  # the block after the YAML one
-    assert text == THREE_MISTAKES
-    monkeypatch.chdir(tmp_path)
-    Path("pinch.yaml").write_text(text)
-    result, _ = run("resolve", "pinch.yaml")
-    assert (result.exit_code, result.stderr) == (1, printed)
-
-
 def test_the_schema_states_the_units_of_angular_velocity():
     twist = grasp_schema()["$defs"]["twist"]["properties"]
     assert "radians per unit time" in twist["angular"]["description"]
