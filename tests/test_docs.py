@@ -4,6 +4,7 @@ execute, ``pycon`` sessions give the outputs shown, ``console`` commands print t
 the pages' relative links lead somewhere."""
 
 import doctest
+import functools
 import json
 import re
 from pathlib import Path
@@ -95,6 +96,7 @@ def slug(heading: str) -> str:
     return re.sub(r"[^\w\- ]", "", heading.strip().lower()).replace(" ", "-")
 
 
+@functools.cache
 def links_and_anchors(page):
     tokens = MarkdownIt("commonmark").parse(page.read_text("utf-8"))
     anchors = {slug(tokens[i + 1].content) for i, t in enumerate(tokens) if t.type == "heading_open"}
