@@ -20,6 +20,7 @@ import numpy as np
 
 from ..engine.decompose import contact_velocities, decompose_off_tangent, decompose_tangent
 from ..engine.degeneracy import Status, conditioning_warning, status_message
+from ..engine.hands import finger_states
 from ..engine.screws import J, K, axis_point, cross, dot, field_at, norm, pitch, rigid_motion, unit
 
 __all__ = [
@@ -498,8 +499,6 @@ def joint_segments(hand, positions, half) -> tuple[Segment, ...]:
     >>> s.label, s.start.tolist(), s.end.tolist()
     ('j', [1.0, 0.0, -0.5], [1.0, 0.0, 0.5])
     """
-    from ..hand import finger_states  # the hand's forward kinematics
-
     out = []
     for finger, state in zip(hand.fingers, finger_states(hand, positions)):
         for joint, screw, point in zip(finger.joints, state.screws, state.points):
