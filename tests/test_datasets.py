@@ -223,11 +223,11 @@ def test_a_file_that_is_not_numpy_and_a_wrong_row_length(tmp_path):
 def test_a_data_set_over_two_workers_gives_the_same_output(tmp_path, data):
     from pathlib import Path
 
-    from grasptwist.run.pipeline import Job, Tuning, run
+    from grasptwist.run.pipeline import Job, Tuning, record_outputs
 
     def written(workers):
         text, lines = b"", []
-        for out in run(Job(fmt="jsonl"), [str(tmp_path / "set.npz")], workers, tuning):
+        for out in record_outputs(Job(fmt="jsonl"), [str(tmp_path / "set.npz")], workers, tuning):
             text += b"".join(x + b"\n" for x in out.encoded) + (
                 Path(out.spool).read_bytes() + b"\n" if out.spool else b""
             )

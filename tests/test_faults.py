@@ -32,7 +32,8 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from grasptwist.cli import EXIT_USAGE, EXIT_WORKER, EXIT_WRITE, app
+from grasptwist.cli import app
+from grasptwist.cli.exits import EXIT_USAGE, EXIT_WORKER, EXIT_WRITE
 from grasptwist.io.datasets import MAX_INFLATION, Member, open_dataset
 from grasptwist.io.inputs import read
 from grasptwist.model import GraspFileError

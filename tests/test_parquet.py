@@ -220,11 +220,11 @@ def test_a_corrupt_parquet_file_is_one_bad_dataset_record_and_the_others_keep_th
 def test_a_parquet_data_set_over_two_workers_gives_the_same_output(files):
     from pathlib import Path
 
-    from grasptwist.run.pipeline import Job, Tuning, run
+    from grasptwist.run.pipeline import Job, Tuning, record_outputs
 
     def written(workers):
         text = b""
-        for out in run(Job(fmt="jsonl"), [str(files / "set.parquet")], workers, tuning):
+        for out in record_outputs(Job(fmt="jsonl"), [str(files / "set.parquet")], workers, tuning):
             text += b"".join(x + b"\n" for x in out.encoded) + (
                 Path(out.spool).read_bytes() + b"\n" if out.spool else b""
             )

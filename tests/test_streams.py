@@ -25,7 +25,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from typer.testing import CliRunner
 
-from grasptwist.cli import EXIT_USAGE, app
+from grasptwist.cli import app
+from grasptwist.cli.exits import EXIT_USAGE
 from grasptwist.io.grasp_file import read_line, read_twist_line
 from grasptwist.io.lines import numbered_batches
 

@@ -11,7 +11,7 @@ from .render import (
     plot_grasp,
     render,
     render_grasps,
-    render_inputs,
+    render_loaded,
     require_matplotlib,
 )
 from .scene import (
@@ -51,7 +51,7 @@ __all__ = [
     "plot_grasp",
     "render",
     "render_grasps",
-    "render_inputs",
+    "render_loaded",
     "require_matplotlib",
     "scene",
 ]

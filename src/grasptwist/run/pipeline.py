@@ -29,10 +29,10 @@ from ..output.formats import FORMATS
 from ..output.records import basis_record, check_record, diagnostics, error_record, records, talking_rows
 from .batch import ZERO_TWIST, Block, check_positions, dataset_blocks, resolve
 from .pool import Pool
-from .scratch import owned_prefix, sweep
+from .scratch import owned_prefix, remove_orphans
 from .stream import grasp_stream, is_stream, twist_stream
 
-__all__ = ["Job", "Tuning", "TUNING", "Output", "Spool", "run", "run_group", "blocks", "write_blocks"]
+__all__ = ["Job", "Tuning", "TUNING", "Output", "Spool", "record_outputs", "run_group", "blocks", "write_blocks"]
 
 #: Name stem of the spool folders in /dev/shm.
 SPOOL_STEM = "grasptwist-"
@@ -90,7 +90,7 @@ class Output:
     records: int = 0
     failed: int = 0
     done: int = 0  # progress: files read, or data-set records made
-    grows: int = 0  # progress: work found beyond the one unit an input was counted as
+    extra_work: int = 0  # progress: work found beyond the one unit an input was counted as
     spool: str | None = None  # a file holding ``encoded`` (see _sealed)
 
     def add(self, rec: dict, encode) -> None:
@@ -112,7 +112,7 @@ class Output:
         self.failed += not rec["ok"]
 
 
-def run(job: Job, paths: Sequence, workers: int = 1, tuning: Tuning = TUNING) -> Iterator[Output]:
+def record_outputs(job: Job, paths: Sequence, workers: int = 1, tuning: Tuning = TUNING) -> Iterator[Output]:
     """Every input's output, in order.  ``paths`` holds file names, ``-``,
     and errors found while listing folders."""
     if job.twists_from is not None:
@@ -151,7 +151,7 @@ def _streamed(job: Job, batches, tuning: Tuning) -> Iterator[Output]:
         out = Output(done=done)
         done = 0
         for x in batch:
-            _emit(job, x, out, tuning.records_at_once)
+            _encode_into(job, x, out, tuning.records_at_once)
         yield _sealed(job, out)
 
 
@@ -192,7 +192,7 @@ class Spool:
         if not os.access(shm, os.W_OK):
             yield None
             return
-        sweep(shm, SPOOL_STEM)  # what runs killed by SIGKILL left
+        remove_orphans(shm, SPOOL_STEM)  # what runs killed by SIGKILL left
         folder = None
         try:
             folder = tempfile.mkdtemp(prefix=owned_prefix(SPOOL_STEM), dir=shm)
@@ -238,7 +238,7 @@ def run_group(job: Job, paths: Sequence, tuning: Tuning = TUNING, spool: Spool |
     out = Output(done=len(paths))
     twists = [ZERO_TWIST] if job.kind != "resolve" else job.twists
     for x in resolve(items, twists, job.method):
-        _emit(job, x, out, tuning.records_at_once)
+        _encode_into(job, x, out, tuning.records_at_once)
     return _sealed(job, out, spool)
 
 
@@ -261,10 +261,10 @@ def blocks(job: Job, paths: Sequence, tuning: Tuning = TUNING) -> Iterator[tuple
         if _is_dataset(g):
             try:
                 ds = open_dataset(g, job.extra_point)
-                grows = len(ds) * (len(job.twists) if job.twists else 1) - 1
+                extra_work = len(ds) * (len(job.twists) if job.twists else 1) - 1
                 for block in dataset_blocks(ds, job.twists, job.method, bases=bases, hand_of_rows=job.hand):
-                    yield block, grows
-                    grows = 0
+                    yield block, extra_work
+                    extra_work = 0
             except GraspFileError as err:
                 yield err, None
             continue
@@ -275,7 +275,7 @@ def blocks(job: Job, paths: Sequence, tuning: Tuning = TUNING) -> Iterator[tuple
             yield x, None
 
 
-def _emit(job: Job, x, out: Output, at_once: int) -> None:
+def _encode_into(job: Job, x, out: Output, at_once: int) -> None:
     """Records of ``x`` (a block, or an input's error) encoded into ``out``."""
     fmt = FORMATS[job.fmt]
     hand = fmt.hand_options(job.hand)
@@ -302,7 +302,7 @@ def _dataset(job: Job, path: str, workers: int, tuning: Tuning) -> Iterator[Outp
             next(dataset_blocks(ds, None, job.method, hand_of_rows=job.hand))  # raises the no-twist error
     except GraspFileError as err:
         out = Output(done=1)
-        _emit(job, err, out, tuning.records_at_once)
+        _encode_into(job, err, out, tuning.records_at_once)
         yield _sealed(job, out)
         return
     rows = len(ds) * (len(job.twists) if job.twists and job.kind == "resolve" else 1)
@@ -325,7 +325,7 @@ def _counted(parts, rows):
     first = True
     for outs in parts:
         for out in outs:
-            out.done, out.grows = out.records, rows - 1 if first else 0
+            out.done, out.extra_work = out.records, rows - 1 if first else 0
             first = False
             yield out
 
@@ -339,11 +339,11 @@ def _dataset_task(job: Job, ds, rows: tuple[int, int], tuning: Tuning, spool: Sp
         for block in dataset_blocks(ds, twists, job.method, start=rows[0], stop=rows[1], hand_of_rows=job.hand):
             for start in range(0, len(block), at_once):
                 out = Output()
-                _emit(job, block.part(start, start + at_once), out, at_once)
+                _encode_into(job, block.part(start, start + at_once), out, at_once)
                 outs.append(_sealed(job, out, spool))
     except GraspFileError as err:  # a damaged .npz member or Parquet row group, found only as it is read
         out = Output()
-        _emit(job, err, out, at_once)
+        _encode_into(job, err, out, at_once)
         outs.append(_sealed(job, out, spool))
     return outs
 
@@ -377,8 +377,8 @@ def write_blocks(job: Job, paths: Sequence, w, tuning: Tuning = TUNING) -> Itera
     (records are built only for the rows that need a line: failed or
     nearly degenerate ones); the caller closes ``w``.
     """
-    for x, grows in blocks(job, paths, tuning):
-        o = Output(done=len(x) if grows is not None else 1, grows=grows or 0)
+    for x, extra_work in blocks(job, paths, tuning):
+        o = Output(done=len(x) if extra_work is not None else 1, extra_work=extra_work or 0)
         if isinstance(x, Block):
             w.write(x)
             talking = np.flatnonzero(talking_rows(x))
