@@ -15,7 +15,7 @@ from grasp_gen import grasps
 from grasptwist.cli import app
 from grasptwist.io import parquet
 from grasptwist.output.columns import CSV_COLUMNS, TYPED_COLUMNS
-from grasptwist.output.parquet import ParquetWriter, table
+from grasptwist.output.parquet_writer import ParquetWriter, table
 from grasptwist.run.batch import resolve_arrays
 
 pa = pytest.importorskip("pyarrow")

@@ -20,7 +20,7 @@ from ..engine import hands
 from ..engine.decompose import contact_velocities
 from ..engine.judgements import outward_normals
 from ..engine.screws import direction, twist_at
-from ..io.datasets import Dataset
+from ..io.dataset import Dataset
 from ..model import CONTACT_NAMES, Grasp, GraspFileError, Twist
 from ..results import ALL_METHODS, BY_KEY, KINDS, METHOD_CHOICES, Field, ResultKind, selected
 
