@@ -135,3 +135,15 @@ def test_facades_only_re_export(name):
         docstring = isinstance(node, ast.Expr) and isinstance(node.value, ast.Constant)
         all_ = isinstance(node, ast.Assign) and [t.id for t in node.targets if isinstance(t, ast.Name)] == ["__all__"]
         assert docstring or all_ or isinstance(node, ast.ImportFrom), f"{name}:{node.lineno}: not a re-export"
+
+
+@pytest.mark.parametrize(
+    "name", [n for n, p in MODULES.items() if p.name != "__init__.py" and not p.name.startswith("_")]
+)
+def test_every_module_says_what_is_public(name):
+    # the public API is grasptwist's _EXPORTS; each module marks its own public names
+    tree = ast.parse(MODULES[name].read_text())
+    assert any(
+        isinstance(node, ast.Assign) and any(isinstance(t, ast.Name) and t.id == "__all__" for t in node.targets)
+        for node in tree.body
+    ), f"{name} has no __all__"

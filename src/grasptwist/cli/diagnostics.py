@@ -13,6 +13,17 @@ from enum import Enum
 
 from ..output.formats import names_for
 
+__all__ = [
+    "Warnings",
+    "WARNINGS_SHOWN",
+    "TABLE_HINT_AT",
+    "Diagnostics",
+    "to_stderr",
+    "warning_kind",
+    "table_hint",
+    "progress_bar",
+]
+
 
 class Warnings(str, Enum):
     """``--warnings``: which warning lines stderr prints."""

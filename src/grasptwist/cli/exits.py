@@ -18,6 +18,22 @@ import typer
 
 from .diagnostics import to_stderr
 
+__all__ = [
+    "EXIT_OK",
+    "EXIT_FAILED",
+    "EXIT_USAGE",
+    "EXIT_WRITE",
+    "EXIT_WORKER",
+    "EXIT_BROKEN_PIPE",
+    "CLICK_ERROR",
+    "output_target",
+    "writable_folder",
+    "drop_stdout",
+    "stopped",
+    "run_command",
+    "usage_error",
+]
+
 EXIT_OK, EXIT_FAILED, EXIT_USAGE, EXIT_WRITE, EXIT_WORKER, EXIT_BROKEN_PIPE = 0, 1, 2, 3, 4, 141
 
 # The base of the usage errors of typer's click (typer 0.2x carries its own copy of click, so it is

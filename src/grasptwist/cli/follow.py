@@ -25,6 +25,8 @@ from .options import (
     segments_option,
 )
 
+__all__ = ["follow", "write_follow_records"]
+
 
 def follow(
     paths: Annotated[

@@ -19,6 +19,35 @@ from ..output.formats import FORMATS, names_for
 from ..results import ALL_METHODS, KINDS, METHOD_CHOICES
 from .diagnostics import WARNINGS_SHOWN, Warnings
 
+__all__ = [
+    "MethodChoice",
+    "ResolveFormat",
+    "RecordFormat",
+    "FollowFormat",
+    "PlotMethod",
+    "ALL",
+    "ExtraPoint",
+    "Order",
+    "Frame",
+    "Paths",
+    "Method",
+    "Output",
+    "Digits",
+    "OrderOption",
+    "MaxBytes",
+    "Quiet",
+    "WarningsOption",
+    "Debug",
+    "Json",
+    "Workers",
+    "RecordFormatOption",
+    "parse_floats",
+    "twists_option",
+    "segments_option",
+    "hand_option",
+    "not_binary_to_a_terminal",
+]
+
 
 def _choices(name: str, values) -> type[Enum]:
     """A typer choice type of ``values`` (members named as Python allows: ``off-tangent`` is ``off_tangent``)."""

@@ -11,6 +11,8 @@ from .diagnostics import Diagnostics
 from .exits import EXIT_FAILED, EXIT_OK, run_command, writable_folder
 from .options import Debug, MaxBytes, PlotMethod, twists_option
 
+__all__ = ["plot", "draw_pictures"]
+
 
 def plot(
     path: Annotated[

@@ -9,6 +9,8 @@ from ..output.formats import FORMATS
 from .diagnostics import Diagnostics, Warnings, progress_bar, table_hint
 from .exits import EXIT_FAILED, EXIT_OK, output_target
 
+__all__ = ["OutputSettings", "worker_count", "write_records"]
+
 
 @dataclass(frozen=True)
 class OutputSettings:

@@ -28,6 +28,8 @@ from .options import (
 )
 from .records import OutputSettings, write_records
 
+__all__ = ["resolve"]
+
 
 def resolve(
     paths: Paths,

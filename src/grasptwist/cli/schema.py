@@ -3,6 +3,8 @@
 from .exits import EXIT_OK, output_target, run_command
 from .options import Debug, Output
 
+__all__ = ["schema"]
+
 
 def schema(output: Output = None, debug: Debug = False) -> None:
     """Print the JSON Schema of grasp files (for editors with a YAML language server).

@@ -30,7 +30,7 @@ __all__ = [
     "Marker",
     "Patch",
     "Scene",
-    "Segment",
+    "LinePiece",
     "check_method",
     "default_method",
     "grasp_scene",
@@ -63,7 +63,7 @@ class Marker:
 
 
 @dataclass(frozen=True)
-class Segment:
+class LinePiece:
     """A straight piece of a line (a screw axis) from ``start`` to ``end``, each ``(3,)``."""
 
     start: np.ndarray
@@ -131,7 +131,7 @@ class Scene:
     method: str
     status: int
     markers: tuple[Marker, ...] = ()
-    segments: tuple[Segment, ...] = ()
+    segments: tuple[LinePiece, ...] = ()
     arrows: tuple[Arrow, ...] = ()
     patches: tuple[Patch, ...] = ()
     views: tuple[tuple[str, np.ndarray], ...] = field(default=())
@@ -319,7 +319,7 @@ def scene(
         if isinstance(twist_element, str):
             notes.append(twist_element)
         elif twist_element is not None:
-            (segments if isinstance(twist_element, Segment) else arrows).append(twist_element)
+            (segments if isinstance(twist_element, LinePiece) else arrows).append(twist_element)
         arrows += _velocity_arrows(points, t, r, method, names, size, ok)
     if ok:
         largest = max(float(np.max(np.abs(a))) for _, a in amplitudes)
@@ -391,13 +391,13 @@ def _twist_element(t, centroid, size):
     return seg
 
 
-def _axis_segment(s, centre, half, label, kind) -> Segment:
+def _axis_segment(s, centre, half, label, kind) -> LinePiece:
     """The piece of the axis of screw ``s (6,)`` of half-length ``half``
     centred on the axis point nearest ``centre``."""
     # The axis point nearest the origin, in a frame moved so that `centre` is its origin.
     foot = centre + axis_point(rigid_motion(s, np.eye(3), -centre))
     d = unit(s[:3])
-    return Segment(foot - half * d, foot + half * d, label, kind)
+    return LinePiece(foot - half * d, foot + half * d, label, kind)
 
 
 def _square(p, n, half):
@@ -489,7 +489,7 @@ def grasp_scene(grasp, twist=None, *, twist_name: str | None = None, method: str
     return replace(picture, segments=picture.segments + joints)
 
 
-def joint_segments(hand, positions, half) -> tuple[Segment, ...]:
+def joint_segments(hand, positions, half) -> tuple[LinePiece, ...]:
     """Each finger joint's axis at ``positions``: a segment of half-length ``half``
     through its point (a prismatic joint's along its direction).
 
@@ -503,5 +503,5 @@ def joint_segments(hand, positions, half) -> tuple[Segment, ...]:
     for finger, state in zip(hand.fingers, finger_states(hand, positions)):
         for joint, screw, point in zip(finger.joints, state.screws, state.points):
             d = unit(screw[:3] if joint.type == "revolute" else screw[3:])
-            out.append(Segment(point - half * d, point + half * d, joint.name, "joint-axis"))
+            out.append(LinePiece(point - half * d, point + half * d, joint.name, "joint-axis"))
     return tuple(out)
