@@ -105,7 +105,8 @@ WarningsOption = Annotated[
     Warnings,
     typer.Option(
         "--warnings",
-        help=f"Warnings on stderr: all, none, or the first {WARNINGS_SHOWN} and a count of the rest by kind.",
+        help="Warnings, and the errors of a data set's or stream's rows, on stderr: all, none, "
+        f"or the first {WARNINGS_SHOWN} of each and a count of the rest by kind.",
     ),
 ]
 Debug = Annotated[bool, typer.Option("--debug", help="Show the Python traceback of an internal error.")]
