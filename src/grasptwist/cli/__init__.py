@@ -61,7 +61,3 @@ def main() -> None:
     except CLICK_ERROR as exc:
         sys.exit(usage_error(exc))
     sys.exit(code if isinstance(code, int) else EXIT_OK)
-
-
-if __name__ == "__main__":
-    main()
