@@ -132,6 +132,7 @@ def assert_no_crash(output):
     assert "internal error" not in output, output[-2000:]
 
 
-def summary(records, failed):
-    """The CLI's closing stderr line."""
-    return f"{records} record{'' if records == 1 else 's'}, {failed} failed"
+def summary(records, failed, rows=0):
+    """The CLI's closing stderr line (``rows``: how many of the failed are rows of data sets or streams)."""
+    line = f"{records} record{'' if records == 1 else 's'}, {failed} failed"
+    return line + (f" ({rows} row{'' if rows == 1 else 's'} of data sets or streams)" if 0 < rows < failed else "")

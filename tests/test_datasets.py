@@ -223,11 +223,11 @@ def test_a_file_that_is_not_numpy_and_a_wrong_row_length(tmp_path):
 def test_a_data_set_over_two_workers_gives_the_same_output(tmp_path, data):
     from pathlib import Path
 
-    from grasptwist.run.pipeline import Job, Tuning, run
+    from grasptwist.run.pipeline import Job, Tuning, record_outputs
 
     def written(workers):
         text, lines = b"", []
-        for out in run(Job(fmt="jsonl"), [str(tmp_path / "set.npz")], workers, tuning):
+        for out in record_outputs(Job(fmt="jsonl"), [str(tmp_path / "set.npz")], workers, tuning):
             text += b"".join(x + b"\n" for x in out.encoded) + (
                 Path(out.spool).read_bytes() + b"\n" if out.spool else b""
             )
@@ -262,3 +262,56 @@ def test_workers_spool_through_the_kernel_to_pipes_and_files(tmp_path, data):
     assert piped.stdout == one.stdout == (tmp_path / "out.json").read_bytes()
     assert piped.returncode == to_file.returncode == one.returncode == 1
     assert len(json.loads(one.stdout)) == n
+
+
+# --- failed rows on stderr: the --warnings rule (issue 21) ------------------------------------
+
+#: Coincident contacts: the tangent method fails on the row, the off-tangent method is skipped
+#: for want of a wrist (a warning), the record says both.
+COINCIDENT = np.array([[1.0, 0, 0], [1.0, 0, 0], [-0.5, -0.866, 0]])
+
+
+@pytest.fixture
+def failing_rows(tmp_path):
+    """A data set of 30 grasps, rows 0..24 with coincident contacts, and a grasp file that cannot be read."""
+    good = np.array([[1.0, 0, 0], [-0.5, 0.866, 0], [-0.5, -0.866, 0]])
+    points = np.stack([COINCIDENT] * 25 + [good] * 5)
+    normals = np.broadcast_to([[-1, 0.1, 0.2], [0.5, -0.9, 0.1], [0.5, 0.9, 0.3]], points.shape)
+    np.savez(tmp_path / "rows.npz", points=points, normals=normals, twist=np.array([0, 0, 1.0, 0, 0, 0]))
+    (tmp_path / "bad.yaml").write_text("contacts: 3\n")  # one problem, a file-level error
+    return tmp_path
+
+
+@pytest.mark.parametrize("fmt", ["jsonl", "npz"])  # records encoded where made, and blocks to a writer
+def test_failed_rows_follow_the_warnings_rule_and_the_files_errors_are_always_printed(failing_rows, fmt):
+    from grasptwist.cli.diagnostics import WARNINGS_SHOWN
+
+    args = ("resolve", failing_rows / "rows.npz", failing_rows / "bad.yaml", "-f", fmt)
+    said, written = {}, {}
+    for mode in ("all", "summary", "none"):
+        out = failing_rows / f"{mode}.{fmt}"
+        r = run(*args, "-o", out, "--warnings", mode)
+        assert r.exit_code == 1, r.stderr
+        said[mode] = r.stderr.splitlines()
+        written[mode] = out.read_bytes() if fmt == "jsonl" else dict(np.load(out))
+    row = [line for line in said["all"] if ": error: tangent: coincident-contacts: " in line]
+    assert [line.split(": grasp ")[1].split(",")[0] for line in row] == [f"'{k}'" for k in range(25)]
+    bad = [line for line in said["all"] if line.startswith(f"{failing_rows / 'bad.yaml'}:")]
+    assert len(bad) == 1 and ": error: " in bad[0]
+    closing = "31 records, 26 failed (25 rows of data sets or streams)"
+    assert said["all"][-1] == closing
+    # summary: the first 20 rows' errors, the file's error, then the rest counted by code
+    assert [line for line in said["summary"] if ": error: " in line] == row[:WARNINGS_SHOWN] + bad
+    assert (
+        f"grasptwist: {25 - WARNINGS_SHOWN} more row errors not shown (--warnings all): 5 tangent coincident-contacts"
+        in said["summary"]
+    )
+    assert said["summary"][-1] == closing
+    # none: no row's error, the file's still, and no count of what was not shown
+    assert said["none"] == bad + [closing]
+    # the records do not depend on what stderr says
+    if fmt == "jsonl":
+        assert written["all"] == written["summary"] == written["none"]
+    else:
+        for key in written["all"]:
+            np.testing.assert_array_equal(written["all"][key], written["none"][key])

@@ -32,7 +32,8 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
-from grasptwist.cli import EXIT_USAGE, EXIT_WORKER, EXIT_WRITE, app
+from grasptwist.cli import app
+from grasptwist.cli.exits import EXIT_USAGE, EXIT_WORKER, EXIT_WRITE
 from grasptwist.io.datasets import MAX_INFLATION, Member, open_dataset
 from grasptwist.io.inputs import read
 from grasptwist.model import GraspFileError
@@ -89,10 +90,10 @@ class Run:
         assert self.started.wait(timeout), "the run wrote nothing on stderr"
         assert self.p.poll() is None, f"the run ended before it could be interrupted: {self.lines}"
 
-    def finish(self, timeout=30) -> tuple[int, float, resource.struct_rusage]:
-        """Exit status, seconds taken, and the resources of the run's processes."""
-        t0 = time.monotonic()
-        deadline = t0 + timeout
+    def finish(self, timeout=30) -> tuple[int, resource.struct_rusage]:
+        """Exit status and the resources of the run's processes (a run that hangs fails after
+        ``timeout`` s; how fast a run stops is measured in bench/faults.py, not asserted)."""
+        deadline = time.monotonic() + timeout
         while True:
             pid, status, usage = os.wait4(self.p.pid, os.WNOHANG)
             if pid:
@@ -103,7 +104,7 @@ class Run:
             time.sleep(0.005)
         self.p.returncode = os.waitstatus_to_exitcode(status)
         self._reader.join(10)
-        return self.p.returncode, time.monotonic() - t0, usage
+        return self.p.returncode, usage
 
     def workers(self) -> list[int]:
         try:
@@ -284,9 +285,8 @@ def test_a_stop_signal_ends_a_parallel_run_cleanly(tmp_path, rows, sig, group, t
     run.wait_started() if to_file else wait_for(run.stalled, "the run to stall on its unread pipe", run=run)
     assert len(run.workers()) == 2 and spool_of(run.p.pid)
     (os.killpg if group else os.kill)(run.p.pid, sig)
-    code, seconds, _ = run.finish()
-    print(f"{sig.name}: exit {code} after {seconds:.3f} s")
-    assert code == 128 + sig and seconds < 5
+    code, _ = run.finish()
+    assert code == 128 + sig
     assert run.said() == [f"grasptwist: stopped by {sig.name}"]  # no traceback from any process
     assert out.read_text() == "old\n"
     assert_no_debris(run, tmp_path)
@@ -303,7 +303,7 @@ def test_a_stop_signal_removes_the_npz_spill(tmp_path, rows):
     run = Run(tmp_path, "resolve", rows, *TWIST, "-f", "npz", "-o", tmp_path / "out.npz", launcher=launcher)
     wait_for(lambda: glob.glob(f"{run.tmpdir}/grasptwist-npz-*/*"), "the npz writer to spill", run=run)
     os.kill(run.p.pid, signal.SIGTERM)
-    code, seconds, _ = run.finish()
+    code, _ = run.finish()
     assert code == 128 + signal.SIGTERM and run.said() == ["grasptwist: stopped by SIGTERM"]
     assert not (tmp_path / "out.npz").exists()
     assert_no_debris(run, tmp_path)
@@ -333,9 +333,8 @@ def test_a_worker_killed_like_by_the_oom_killer_ends_the_run(tmp_path, rows):
     run.wait_started()
     victim = run.workers()[0]
     os.kill(victim, signal.SIGKILL)
-    code, seconds, _ = run.finish()
-    print(f"dead worker: exit {code} after {seconds:.3f} s")
-    assert code == EXIT_WORKER and seconds < 5
+    code, _ = run.finish()
+    assert code == EXIT_WORKER
     assert run.said() == [
         f"grasptwist: error: worker process {victim} was stopped by SIGKILL (killed; the system may be out of memory)"
     ]
@@ -365,8 +364,8 @@ def test_a_data_set_shrinking_under_a_parallel_run_is_a_bus_error_not_a_hang(tmp
     run = Run(tmp_path, "resolve", victim, *TWIST, "-f", "jsonl", "-j", "2", "-o", tmp_path / "out.jsonl")
     run.wait_started()
     os.truncate(victim, 4096)  # what rewriting it in place does first
-    code, seconds, _ = run.finish()
-    assert code == EXIT_WORKER and seconds < 5
+    code, _ = run.finish()
+    assert code == EXIT_WORKER
     [line] = run.said()
     assert "was stopped by SIGBUS (bus error; a memory-mapped input file changed or shrank" in line
     assert_no_debris(run, tmp_path)
@@ -388,7 +387,7 @@ def test_a_file_swapped_for_a_fifo_after_the_listing_is_a_read_error_not_a_hang(
     run.p.stdin.write(POLY.read_bytes())
     run.p.stdin.close()
     records = run.p.stdout.read().count(b"\n")
-    code, seconds, _ = run.finish()
+    code, _ = run.finish()
     assert code == 1 and records == 3  # stdin, a.yaml and the error record of b.yaml
     assert (
         f"{folder / 'b.yaml'}: error: read-error: cannot read: not a regular file (a pipe, socket or device)"
@@ -409,7 +408,7 @@ def test_a_reader_that_stops_reading_stops_the_workers(tmp_path, rows):
     lines = size = 0
     for chunk in iter(lambda: run.p.stdout.read(1 << 20), b""):
         lines, size = lines + chunk.count(b"\n"), size + len(chunk)
-    code, _, usage = run.finish()
+    code, usage = run.finish()
     assert code in (0, 1) and lines == 8 * TUNING.grasps_per_task
     # each worker holds at most `in_flight` tasks, and the parent is copying one more
     print(f"spool with a stalled reader: {held / 1e6:.1f} MB of {size / 1e6:.1f} MB")
@@ -470,9 +469,8 @@ def test_mebibytes_of_document_markers_in_a_folder_take_little_memory(tmp_path, 
     (tmp_path / "in").mkdir()
     for k in range(files):
         (tmp_path / "in" / f"{k:02d}.yaml").write_bytes(b"---\n" * (1 << 18))  # 1 MiB of empty documents
-    start = time.monotonic()
     code, stderr, peak = run_measured("resolve", "in", "-f", "jsonl", "-j", "2", "-o", "out.jsonl", cwd=tmp_path)
-    print(f"{files} files of '---': {time.monotonic() - start:.2f} s, peak {peak:.0f} MB")
+    print(f"{files} files of '---': peak {peak:.0f} MB")
     assert code == 1 and peak < 300
     # per file: 100 errors, too-many-documents at document 10,001, one line counting the 9,900 others
     assert len(jsonl((tmp_path / "out.jsonl").read_text())) == files * 102
@@ -492,11 +490,9 @@ def bomb(tmp_path_factory) -> Path:
 
 def test_an_npz_zip_bomb_is_refused_unread_and_costs_no_other_record(tmp_path, bomb):
     # 0.1 inflated every member whole: 2.85 GB and 12.7 s for the 2.8 MB bomb, MemoryError under a limit
-    start = time.monotonic()
     code, stderr, peak = run_measured("resolve", bomb, POLY, "-f", "jsonl", "-o", "out.jsonl", cwd=tmp_path)
-    seconds = time.monotonic() - start
-    print(f"npz bomb: {seconds:.2f} s, peak {peak:.0f} MB")
-    assert code == 1 and peak < 150 and seconds < 5
+    print(f"npz bomb: peak {peak:.0f} MB")
+    assert code == 1 and peak < 150
     assert stderr.splitlines()[0] == (
         f"{bomb}: error: bad-dataset: points: declares 72,000,128 bytes in "
         f"{zipfile.ZipFile(bomb).getinfo('points.npy').compress_size:,} compressed "
@@ -642,12 +638,12 @@ def deep_tree(tmp_path):
 def test_a_folder_2000_levels_deep(deep_tree):
     # 0.1: internal error: RecursionError after 11 s, and no records, not even for top.yaml
     # relative to the tree's parent the deepest path has ~4,000 characters, within PATH_MAX
-    proc, seconds = run_installed("resolve", "deep", "-f", "jsonl", cwd=deep_tree)
+    proc, _ = run_installed("resolve", "deep", "-f", "jsonl", cwd=deep_tree)
     assert_no_crash(proc.stderr)
     deepest = "deep/" + "d/" * DEPTH + "g.yaml"
     # every record of both files, depth first in name order: one per grasp and twist
     expected = [deepest] * records_of(POLY) + ["deep/top.yaml"] * records_of(ROOT / "grasps" / "sphere.yaml")
-    assert [r["file"] for r in jsonl(proc.stdout)] == expected and seconds < 10
+    assert [r["file"] for r in jsonl(proc.stdout)] == expected
 
 
 def records_of(path):
@@ -773,12 +769,12 @@ def test_stop_signals_at_random_moments(tmp_path, rows, seed):
     time.sleep(rng.uniform(0, 1.5))  # the moment is the point of the test
     with contextlib.suppress(ProcessLookupError):  # it finished first
         (os.killpg if group else os.kill)(run.p.pid, sig)
-    code, seconds, _ = run.finish()
+    code, _ = run.finish()
     assert "Traceback" not in "\n".join(run.lines)
     if code in (0, 1, -sig):  # it finished first (-sig: the signal came as it exited, its handlers gone)
         assert run.said()[-1].endswith(" failed")
     else:
-        assert code == 128 + sig and seconds < 5, (code, run.said())
+        assert code == 128 + sig, (code, run.said())
         assert run.said()[-1] == f"grasptwist: stopped by {sig.name}" and len(run.said()) <= 1
         assert out.read_text() == "old\n"
     assert_no_debris(run, tmp_path)
@@ -794,11 +790,11 @@ def test_workers_killed_at_random_moments(tmp_path, rows, seed):
     victim = workers[rng.integers(len(workers))]
     with contextlib.suppress(ProcessLookupError):  # it finished first
         os.kill(victim, [signal.SIGKILL, signal.SIGSEGV, signal.SIGBUS][seed % 3])
-    code, seconds, _ = run.finish()
+    code, _ = run.finish()
     if code in (0, 1):  # it finished first
         assert (tmp_path / "out.jsonl").exists()
     else:
-        assert code == EXIT_WORKER and seconds < 5
+        assert code == EXIT_WORKER
         [line] = run.lines
         assert line.startswith(f"grasptwist: error: worker process {victim} was stopped by SIG")
         assert not (tmp_path / "out.jsonl").exists()
@@ -816,7 +812,7 @@ def test_timeout_on_a_large_data_set_leaves_nothing(tmp_path):
         # `timeout` always has something to stop
         args = ("resolve", big, "-", *TWIST, "-f", fmt, "-j", workers, "-o", out)
         run = Run(tmp_path, *args, prefix=("timeout", "3"), stdin=subprocess.PIPE)
-        code, seconds, _ = run.finish()
+        code, _ = run.finish()
         assert code == 124 and "Traceback" not in "\n".join(run.lines)
         assert run.said() == ["grasptwist: stopped by SIGTERM"]
         assert not out.exists()

@@ -154,14 +154,18 @@ def check_loader(data):
 
 def check_cli(data):
     """Exit 0 or 1, no crash, records that parse with no NaN in an ok one, one-line diagnostics."""
-    result, _ = run("resolve", "-", "-f", "jsonl", input=data)
+    # standard input is a stream: every failed document's line, not the first 20 (--warnings)
+    result, _ = run("resolve", "-", "-f", "jsonl", "--warnings", "all", input=data)
     assert result.exception is None or isinstance(result.exception, SystemExit), repr(result.exception)
     assert_no_crash(result.stdout + result.stderr)
     assert result.exit_code in (0, 1), result.output
     records = jsonl(result.stdout)
     assert records and result.exit_code == (0 if all(r["ok"] for r in records) else 1)
     lines = result.stderr.splitlines()
-    assert lines[-1] == summary(len(records), sum(not r["ok"] for r in records))
+    failed = [r for r in records if not r["ok"]]
+    # of the failed, the stream's rows: all but an error of the whole input (no line)
+    rows = sum(not ("error" in r and r["error"]["line"] is None) for r in failed)
+    assert lines[-1] == summary(len(records), len(failed), rows)
     assert all(line.startswith("<stdin>") for line in lines[:-1]), lines
 
 

@@ -3,6 +3,7 @@
 import itertools
 import subprocess
 import sys
+from dataclasses import replace
 from pathlib import Path
 from types import SimpleNamespace
 
@@ -341,7 +342,7 @@ def test_one_png_of_the_requested_size_and_one_svg_headless(tmp_path):
     assert svg.read_text().lstrip().startswith("<?xml") and "<svg" in svg.read_text()
 
 
-# --- render_inputs: what `grasptwist plot` runs --------------------------------
+# --- render_loaded: what `grasptwist plot` draws of the grasps it read --------------
 
 GRASP = """\
 name: {name}
@@ -352,31 +353,36 @@ name: {name}
 """
 
 
-def test_render_inputs_of_a_folder_reports_what_it_cannot_read_or_draw(tmp_path):
+def loaded(*paths):
+    """The grasps of grasp files, read as the command line reads them."""
+    from grasptwist.io.inputs import read
+
+    return [g for p in paths for g in read(str(p))]
+
+
+def test_render_loaded_of_a_folder_reports_what_it_cannot_draw(tmp_path):
     pytest.importorskip("matplotlib")
     folder = tmp_path / "in"
     folder.mkdir()
     (folder / "a.yaml").write_text(GRASP.format(name="good/one", wrist="wrist: [0, 0, 1]\n"))
     (folder / "b.yaml").write_text(GRASP.format(name="no-wrist", wrist=""))
-    (folder / "c.yaml").write_text("contacts: [\n")
     spin = Twist("spin", SPIN_Z, None)
-    events = list(plot.render_inputs(str(folder), tmp_path / "out", twists=[spin], method="off-tangent"))
+    grasps = [replace(g, twists=(spin,)) for g in loaded(folder / "a.yaml", folder / "b.yaml")]
+    events = list(plot.render_loaded(str(folder), tmp_path / "out", grasps, method="off-tangent"))
     notes = [e for e in events if isinstance(e, plot.Note)]
-    assert [n.line.split(": error: ")[0] for n in notes] == [
-        f"{folder / 'c.yaml'}:2:1",
-        f"{folder / 'b.yaml'}: grasp 'no-wrist'",
-    ]
+    assert [n.line.split(": error: ")[0] for n in notes] == [f"{folder / 'b.yaml'}: grasp 'no-wrist'"]
     assert all(n.error for n in notes)
-    assert notes[1].line.endswith(
+    assert notes[0].line.endswith(
         "error: the off-tangent method needs a wrist point; use --method tangent or add a wrist"
     )
     assert [e for e in events if not isinstance(e, plot.Note)] == [tmp_path / "out" / "good_one-spin.png"]
     assert sorted(p.name for p in (tmp_path / "out").iterdir()) == ["good_one-spin.png"]
 
 
-def test_render_inputs_of_a_file_warns_of_more_grasps_and_refuses_an_unknown_twist_before_drawing(tmp_path):
+def test_render_loaded_of_a_file_warns_of_more_grasps_and_refuses_an_unknown_twist_before_drawing(tmp_path):
     pytest.importorskip("matplotlib")
-    events = plot.render_inputs(str(GRASPS / "sphere.yaml"), tmp_path / "s.png", twist_name="nope")
+    sphere = GRASPS / "sphere.yaml"
+    events = plot.render_loaded(str(sphere), tmp_path / "s.png", loaded(sphere), twist_name="nope")
     note = next(events)
     assert note == plot.Note(
         f"{GRASPS / 'sphere.yaml'}: warning: drawing the first of its 2 grasps, 'sphere-tripod'", False
@@ -385,5 +391,6 @@ def test_render_inputs_of_a_file_warns_of_more_grasps_and_refuses_an_unknown_twi
         next(events)
     (tmp_path / "w.yaml").write_text(GRASP.format(name="g", wrist=""))
     with pytest.raises(ValueError, match="needs a wrist"):
-        list(plot.render_inputs(str(tmp_path / "w.yaml"), tmp_path / "w.png", method="off-tangent"))
+        w = tmp_path / "w.yaml"
+        list(plot.render_loaded(str(w), tmp_path / "w.png", loaded(w), method="off-tangent"))
     assert sorted(p.name for p in tmp_path.iterdir()) == ["w.yaml"]

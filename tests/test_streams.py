@@ -25,7 +25,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from typer.testing import CliRunner
 
-from grasptwist.cli import EXIT_USAGE, app
+from grasptwist.cli import app
+from grasptwist.cli.exits import EXIT_USAGE
 from grasptwist.io.grasp_file import read_line, read_twist_line
 from grasptwist.io.lines import numbered_batches
 
@@ -286,3 +287,25 @@ def test_lines_are_the_same_however_the_stream_is_cut(lines, cuts, per_batch):
     got = [entry for batch in batches for entry in batch]
     want = [(i, line if len(line) <= 10 else line[:11]) for i, line in enumerate(lines, 1) if line.strip()]
     assert got == want and all(0 < len(b) <= per_batch for b in batches)
+
+
+def test_a_streams_failed_rows_follow_the_warnings_rule_and_a_missing_stream_is_always_said(tmp_path):
+    from grasptwist.cli.diagnostics import WARNINGS_SHOWN
+
+    coincident = [{"point": EX1[0], "normal": n} for n in NORMALS[:2]] + [{"point": EX1[2], "normal": NORMALS[2]}]
+    lines = [grasp_line(f"g{k}", contacts=coincident) for k in range(24)] + [grasp_line("fine")]
+    (tmp_path / "rows.jsonl").write_text("\n".join(lines) + "\n")
+    args = ["resolve", str(tmp_path / "rows.jsonl"), str(tmp_path / "gone.jsonl"), "-f", "jsonl", "--method", "tangent"]
+    said = {m: CliRunner().invoke(app, [*args, "--warnings", m]) for m in ("all", "summary", "none")}
+    assert said["all"].stdout == said["summary"].stdout == said["none"].stdout  # records unchanged
+    gone = [line for line in said["all"].stderr.splitlines() if "gone.jsonl" in line]
+    assert len(gone) == 1 and ": error: read-error: " in gone[0]
+    rows = [line for line in said["all"].stderr.splitlines() if "coincident-contacts" in line]
+    assert len(rows) == 24 and rows[0].startswith(f"{tmp_path / 'rows.jsonl'}: grasp 'g0'")
+    closing = "26 records, 25 failed (24 rows of data sets or streams)"
+    summary = said["summary"].stderr.splitlines()
+    assert summary == rows[:WARNINGS_SHOWN] + gone + [
+        f"grasptwist: {24 - WARNINGS_SHOWN} more row errors not shown (--warnings all): 4 tangent coincident-contacts",
+        closing,
+    ]
+    assert said["none"].stderr.splitlines() == gone + [closing]

@@ -22,7 +22,8 @@ import orjson
 import pytest
 from typer.testing import CliRunner
 
-from grasptwist.cli import TABLE_HINT_AT, WARNINGS_SHOWN, app
+from grasptwist.cli import app
+from grasptwist.cli.diagnostics import TABLE_HINT_AT, WARNINGS_SHOWN
 from grasptwist.output.table import SIZING_ROWS, WRITERS
 from grasptwist.results import KINDS
 

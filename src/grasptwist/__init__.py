@@ -10,7 +10,7 @@ The engine (pure numpy, batched over leading axes):
 
 from importlib import import_module
 
-__version__ = "0.1.0"
+from ._version import __version__ as __version__
 
 #: Public name -> the module defining it; imported on first use, so that the
 #: command line can handle signals before numpy is imported.

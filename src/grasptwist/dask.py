@@ -59,7 +59,7 @@ def _resolve_partition(df, twists, method: str, order: str, file: str):
     import pyarrow as pa
 
     from .io.parquet import NAME_COLUMN, table_dataset
-    from .output.parquet import schema, table
+    from .output.parquet_writer import schema, table
     from .run.batch import dataset_blocks
 
     rows = pa.Table.from_pandas(df, preserve_index=False)
@@ -94,7 +94,7 @@ def resolve_dataframe(ddf, twists: Mapping[str, object] | None = None, method="b
         The columns ``-f parquet`` writes, with Arrow types (``pandas.ArrowDtype``);
         write them with ``.to_parquet(folder)``.
     """
-    from .output.parquet import schema
+    from .output.parquet_writer import schema
 
     meta = _frame(schema().empty_table())
     return ddf.map_partitions(
@@ -109,7 +109,7 @@ def to_parquet(results, folder: str, **options):
     options); ``options`` go to :meth:`dask.dataframe.DataFrame.to_parquet`
     (e.g. ``storage_options`` for an object store).  Computes the results.
     """
-    from .output.parquet import schema, write_options
+    from .output.parquet_writer import schema, write_options
 
     return results.to_parquet(folder, write_index=False, schema=schema(), **{**write_options(), **options})
 

@@ -29,12 +29,13 @@ from __future__ import annotations
 import os
 import zipfile
 import zlib
-from dataclasses import dataclass
 from math import prod
 
 import numpy as np
 
 from ..model import GraspFileError
+from .dataset import Dataset
+from .parquet import open_parquet
 
 __all__ = ["DATASET_SUFFIXES", "EXTRA_POINT_ROLES", "Dataset", "Member", "open_dataset", "MAX_INFLATION"]
 
@@ -51,25 +52,6 @@ MAX_INFLATION = 100
 INFLATION_FLOOR = 64 << 20
 
 
-@dataclass(frozen=True)
-class Dataset:
-    """A data set's arrays: ``.npy`` columns are memory-mapped views, ``.npz``
-    members :class:`Member` objects, Parquet columns read their row groups;
-    all are read by slicing rows."""
-
-    path: str
-    points: np.ndarray  # (N, 3, 3)
-    normals: np.ndarray  # (N, 3, 3)
-    wrist: np.ndarray | None  # (N, 3)
-    at: np.ndarray | None  # (N, 3): where each twist's linear part is given
-    twist: np.ndarray | None  # (N, 6) or (6,)
-    names: np.ndarray | None  # (N,)
-    joint_positions: np.ndarray | None = None  # (N, n_joints): the hand's configuration per row
-
-    def __len__(self) -> int:
-        return len(self.points)
-
-
 def _bad(path, message) -> GraspFileError:
     return GraspFileError(code="bad-dataset", message=message, file=path)
 
@@ -84,8 +66,6 @@ def open_dataset(path: str, extra_point: str = "wrist") -> Dataset:
         arrays do not have the documented names, shapes or a numeric type.
     """
     if path.endswith(".parquet"):
-        from .parquet import open_parquet  # pyarrow only when a Parquet file is read
-
         return open_parquet(path)
     try:
         if path.endswith(".npy"):

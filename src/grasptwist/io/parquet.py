@@ -21,6 +21,7 @@ import numpy as np
 
 from ..extras import MissingExtra, require
 from ..model import GraspFileError
+from .dataset import Dataset
 
 __all__ = [
     "POINT_COLUMNS",
@@ -80,7 +81,7 @@ def _bad(path: str, message: str) -> GraspFileError:
 def open_parquet(path: str):
     """Open a Parquet data set and check its columns (no rows are read yet).
 
-    Returns a :class:`~grasptwist.io.datasets.Dataset` whose arrays read
+    Returns a :class:`~grasptwist.io.dataset.Dataset` whose arrays read
     their rows when sliced.
 
     Raises
@@ -112,8 +113,6 @@ def table_dataset(table, path: str = ""):
 def _dataset(path: str, schema, reader):
     """The data set of ``reader``'s rows once ``schema`` has the documented columns; ``reader`` learns which to read."""
     import pyarrow as pa
-
-    from .datasets import Dataset
 
     present = {}
     for key, names in _GROUPS.items():

@@ -23,7 +23,7 @@ from ..results import KINDS
 from .columns import CSV_COLUMNS, columns, header
 from .csv_rows import lines
 from .names import escaped
-from .records import dumps
+from .records import dumps, records
 
 __all__ = [
     "ENCODINGS",
@@ -69,8 +69,6 @@ def _pose(samples):
 
 def sample_records(samples, order: str = "omega-v") -> list[dict]:
     """The record of each sample of a :class:`~grasptwist.run.follow.Samples`."""
-    from .records import records
-
     position, quaternion = _pose(samples)
     segment, time = samples.poses.segment.tolist(), samples.poses.time.tolist()
     out = []

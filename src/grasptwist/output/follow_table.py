@@ -36,7 +36,7 @@ class FollowTable:
     def _vector(self, v) -> str:
         return " ".join(self._number(float(a)) for a in v)
 
-    def _say(self, text: str = "") -> None:
+    def _line(self, text: str = "") -> None:
         self.out.write(text.encode() + b"\n")
 
     def _header(self, rec, methods):
@@ -50,9 +50,9 @@ class FollowTable:
         for _, label, amplitudes in methods:
             cells += [f"{f'{label} {a}':<{vector}}" for a in amplitudes] + [f"{'cond':>{self.width}}"]
         if self.current is not None:
-            self._say()
-        self._say(f"{escaped(rec['file'])}: grasp '{escaped(rec['grasp'])}', path '{escaped(rec['path'])}'")
-        self._say("  ".join(cells).rstrip())
+            self._line()
+        self._line(f"{escaped(rec['file'])}: grasp '{escaped(rec['grasp'])}', path '{escaped(rec['path'])}'")
+        self._line("  ".join(cells).rstrip())
 
     def write(self, rec: dict) -> None:
         if "error" in rec:  # the error line is on stderr; tables carry results only
@@ -82,24 +82,24 @@ class FollowTable:
                 cells += [f"{text:<{len(amplitudes) * (vector + 2) - 2}}", f"{'-':>{self.width}}"]
             else:
                 cells += [self._vector(m[a]) for a in amplitudes] + [self._number(m["conditioning"])]
-        self._say("  ".join(cells).rstrip())
+        self._line("  ".join(cells).rstrip())
 
     def _summary(self, rec):
         s = rec["summary"]
-        self._say(f"summary: duration {s['duration']:.{self.digits}f}, {s['samples']} samples")
+        self._line(f"summary: duration {s['duration']:.{self.digits}f}, {s['samples']} samples")
         for c in s["degenerate"]:
-            self._say(f"  {crossing_text(c, self.names, self.digits)} ({c['method']} degenerate)")
+            self._line(f"  {crossing_text(c, self.names, self.digits)} ({c['method']} degenerate)")
         if not s["degenerate"]:
-            self._say("  no degeneracy along the path")
+            self._line("  no degeneracy along the path")
         smallest = [
             f"{key.replace('_', '-')} {m['value']:.{self.digits}g} at t = {m['t']:.{self.digits}f}"
             for key, m in s["min_conditioning"].items()
             if m is not None and m["value"] == m["value"]  # a failed method may have none (NaN)
         ]
         if smallest:
-            self._say(f"  smallest conditioning: {'; '.join(smallest)}")
+            self._line(f"  smallest conditioning: {'; '.join(smallest)}")
         w = s["first_warning"]
-        self._say(
+        self._line(
             "  no conditioning warning"
             if w is None
             else f"  first warning: {w['method']} at t = {w['t']:.{self.digits}f}"
@@ -107,9 +107,9 @@ class FollowTable:
         if "hand" in s:
             errors, warnings = hand_event_texts(s["hand"], self.digits)
             for text in errors + warnings:
-                self._say(f"  hand: {text}")
+                self._line(f"  hand: {text}")
             if not errors and not warnings:
-                self._say("  hand: every finger follows, within its joint limits and well conditioned")
+                self._line("  hand: every finger follows, within its joint limits and well conditioned")
 
     def close(self) -> None:
         self.out.flush()

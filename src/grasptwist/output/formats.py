@@ -99,7 +99,7 @@ def _npz(out: IO[bytes], kind: str, order: str = "omega-v", hand=None, **_):
 
 
 def _parquet(out: IO[bytes], kind: str, order: str = "omega-v", hand=None, **_):
-    from .parquet import ParquetWriter  # pyarrow only when Parquet is asked for
+    from .parquet_writer import ParquetWriter  # pyarrow only when Parquet is asked for
 
     return ParquetWriter(out, order, hand=hand)
 

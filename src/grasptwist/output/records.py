@@ -25,6 +25,7 @@ from ..engine.degeneracy import (
 )
 from ..model import GraspFileError
 from ..results import CONDITIONING, CULPRIT, KINDS, STATUS, Field
+from . import kind_records
 from .columns import ORDERS, in_order
 from .names import escaped, escaped_each
 
@@ -105,8 +106,6 @@ def _contact_names(block) -> list:
 
 def _written(kind):
     """The record writer a kind names (:attr:`~grasptwist.results.ResultKind.record`)."""
-    from . import kind_records
-
     return getattr(kind_records, kind.record)
 
 

@@ -6,7 +6,7 @@ that draw, so ``import grasptwist.plot`` works without it, and
 on an Agg canvas, never pyplot, so it runs headless and leaves the caller's
 matplotlib backend alone.
 
-:func:`plot_grasp`, :func:`render_grasps` and :func:`render_inputs` take
+:func:`plot_grasp`, :func:`render_grasps` and :func:`render_loaded` take
 objects shaped like :class:`~grasptwist.model.Grasp` (``name, contact_names,
 points, normals, wrist, twists``) and :class:`~grasptwist.model.Twist`
 (``name, screw``).
@@ -16,8 +16,7 @@ from __future__ import annotations
 
 import os
 import re
-from collections.abc import Iterator
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
@@ -36,7 +35,7 @@ __all__ = [
     "plot_grasp",
     "render",
     "render_grasps",
-    "render_inputs",
+    "render_loaded",
     "require_matplotlib",
 ]
 
@@ -157,55 +156,39 @@ class Note:
     error: bool = True
 
 
-def render_inputs(
-    path: str, output, *, twists=(), twist_name: str | None = None, method: str | None = None, max_bytes=None
-) -> Iterator[Path | Note]:
-    """What ``grasptwist plot PATH -o OUTPUT`` draws: read the grasp files, render, report.
+def render_loaded(path: str, output, grasps, *, twist_name: str | None = None, method: str | None = None):
+    """What ``grasptwist plot PATH -o OUTPUT`` draws of the grasps read from ``PATH``.
 
     Yields each image written (a :class:`~pathlib.Path`) and a :class:`Note`
-    for each input that could not be read or drawn; reading comes first, so
-    the notes about files come before the images.
+    for each grasp that could not be drawn.  Reading ``PATH`` (and reporting
+    what could not be read) is the caller's: the command line reads as every
+    command does.
 
     Parameters
     ----------
     path : str
-        A grasp file (``-`` for standard input), or a folder searched like
-        every command's inputs (:func:`grasptwist.io.inputs.expand`).
+        The grasp file or folder the grasps were read from.
     output : str or Path
         For a folder ``path``, the folder that gets one image per grasp and
         twist (:func:`render_grasps`, named across all the folder's grasps; a
         grasp the method cannot draw gives an error note and the others go on).  For a file, the one image, of its
         first grasp (a warning note when it has more).
-    twists : sequence of Twist
-        Draw these instead of the files' twists.
+    grasps : list of Grasp
+        The grasps read, in file order (their twists already replaced by the
+        command line's ``--twist``).
     twist_name : str or None
-        Without ``twists``, which of a single file's twists to draw (default
-        its first).
+        For a single file, which of its twists to draw (default its first).
     method : ``"off-tangent"``, ``"tangent"`` or None (the default per grasp).
-    max_bytes : int or None
-        The grasp-file size cap (None: the loader's default).
 
     Raises
     ------
     MissingMatplotlib
-        Before anything is read.
+        Before anything is drawn.
     TwistNotFound, ValueError
         For a single file: no twist called ``twist_name``; an unknown method,
         the off-tangent method without a wrist, or an unsupported suffix.
     """
-    from ..io.inputs import expand, read
-    from ..model import InputError
-    from ..output.records import diagnostics, error_record
-
     require_matplotlib()
-    grasps = []
-    for item in expand([path]):
-        for entry in read(item, max_bytes) if isinstance(item, str) else [item]:
-            if isinstance(entry, InputError):
-                for line in diagnostics(error_record(entry))[0]:
-                    yield Note(line)
-            else:
-                grasps.append(replace(entry, twists=tuple(twists)) if twists else entry)
     if os.path.isdir(path):
         drawable = []
         for grasp in grasps:
@@ -219,7 +202,7 @@ def render_inputs(
         grasp = grasps[0]
         if len(grasps) > 1:
             yield Note(f"{path}: warning: drawing the first of its {len(grasps)} grasps, '{grasp.name}'", error=False)
-        yield plot_grasp(grasp, output, chosen_twist(grasp, None if twists else twist_name), method=method)
+        yield plot_grasp(grasp, output, chosen_twist(grasp, twist_name), method=method)
 
 
 def _check_suffix(suffix: str):

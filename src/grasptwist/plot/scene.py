@@ -20,6 +20,7 @@ import numpy as np
 
 from ..engine.decompose import contact_velocities, decompose_off_tangent, decompose_tangent
 from ..engine.degeneracy import Status, conditioning_warning, status_message
+from ..engine.hands import finger_states
 from ..engine.screws import J, K, axis_point, cross, dot, field_at, norm, pitch, rigid_motion, unit
 
 __all__ = [
@@ -29,7 +30,7 @@ __all__ = [
     "Marker",
     "Patch",
     "Scene",
-    "Segment",
+    "LinePiece",
     "check_method",
     "default_method",
     "grasp_scene",
@@ -62,7 +63,7 @@ class Marker:
 
 
 @dataclass(frozen=True)
-class Segment:
+class LinePiece:
     """A straight piece of a line (a screw axis) from ``start`` to ``end``, each ``(3,)``."""
 
     start: np.ndarray
@@ -130,7 +131,7 @@ class Scene:
     method: str
     status: int
     markers: tuple[Marker, ...] = ()
-    segments: tuple[Segment, ...] = ()
+    segments: tuple[LinePiece, ...] = ()
     arrows: tuple[Arrow, ...] = ()
     patches: tuple[Patch, ...] = ()
     views: tuple[tuple[str, np.ndarray], ...] = field(default=())
@@ -318,7 +319,7 @@ def scene(
         if isinstance(twist_element, str):
             notes.append(twist_element)
         elif twist_element is not None:
-            (segments if isinstance(twist_element, Segment) else arrows).append(twist_element)
+            (segments if isinstance(twist_element, LinePiece) else arrows).append(twist_element)
         arrows += _velocity_arrows(points, t, r, method, names, size, ok)
     if ok:
         largest = max(float(np.max(np.abs(a))) for _, a in amplitudes)
@@ -390,13 +391,13 @@ def _twist_element(t, centroid, size):
     return seg
 
 
-def _axis_segment(s, centre, half, label, kind) -> Segment:
+def _axis_segment(s, centre, half, label, kind) -> LinePiece:
     """The piece of the axis of screw ``s (6,)`` of half-length ``half``
     centred on the axis point nearest ``centre``."""
     # The axis point nearest the origin, in a frame moved so that `centre` is its origin.
     foot = centre + axis_point(rigid_motion(s, np.eye(3), -centre))
     d = unit(s[:3])
-    return Segment(foot - half * d, foot + half * d, label, kind)
+    return LinePiece(foot - half * d, foot + half * d, label, kind)
 
 
 def _square(p, n, half):
@@ -488,7 +489,7 @@ def grasp_scene(grasp, twist=None, *, twist_name: str | None = None, method: str
     return replace(picture, segments=picture.segments + joints)
 
 
-def joint_segments(hand, positions, half) -> tuple[Segment, ...]:
+def joint_segments(hand, positions, half) -> tuple[LinePiece, ...]:
     """Each finger joint's axis at ``positions``: a segment of half-length ``half``
     through its point (a prismatic joint's along its direction).
 
@@ -498,11 +499,9 @@ def joint_segments(hand, positions, half) -> tuple[Segment, ...]:
     >>> s.label, s.start.tolist(), s.end.tolist()
     ('j', [1.0, 0.0, -0.5], [1.0, 0.0, 0.5])
     """
-    from ..hand import finger_states  # the hand's forward kinematics
-
     out = []
     for finger, state in zip(hand.fingers, finger_states(hand, positions)):
         for joint, screw, point in zip(finger.joints, state.screws, state.points):
             d = unit(screw[:3] if joint.type == "revolute" else screw[3:])
-            out.append(Segment(point - half * d, point + half * d, joint.name, "joint-axis"))
+            out.append(LinePiece(point - half * d, point + half * d, joint.name, "joint-axis"))
     return tuple(out)

@@ -16,10 +16,11 @@ from typing import Any
 
 import numpy as np
 
+from ..engine import hands
 from ..engine.decompose import contact_velocities
 from ..engine.judgements import outward_normals
 from ..engine.screws import direction, twist_at
-from ..io.datasets import Dataset
+from ..io.dataset import Dataset
 from ..model import CONTACT_NAMES, Grasp, GraspFileError, Twist
 from ..results import ALL_METHODS, BY_KEY, KINDS, METHOD_CHOICES, Field, ResultKind, selected
 
@@ -189,7 +190,7 @@ def resolve_arrays(
     :data:`METHODS`.  ``bases=False`` leaves out the basis screws, for
     outputs that do not show them (npz).  ``hands`` (per row a Hand or None)
     with ``joint_screws (N, 3, J, 6)`` and ``joint_limits (N, 3, J)``
-    (:func:`grasptwist.hand.padded`) adds the kinds that need them.
+    (:func:`grasptwist.engine.hands.padded`) adds the kinds that need them.
     ``has_wrist`` (per row) says which rows have a wrist; by default those
     whose wrist is finite.
     """
@@ -310,14 +311,13 @@ def _hand_inputs(grasps) -> dict:
     """The hand keywords of :func:`resolve_arrays` for grasps (none when no grasp has a hand)."""
     if all(g.hand is None for g in grasps):
         return {}
-    from .. import hand  # hands, their kinematics and URDFs only for grasps with one
 
     width = max(len(f.joints) for g in grasps if g.hand is not None for f in g.hand.fingers)
     made = {}  # each grasp's fingers once, whatever its number of twists
     for g in grasps:
         if g.hand is not None and id(g) not in made:
-            states = hand.finger_states(g.hand, g.joint_positions)
-            made[id(g)] = hand.padded(g.hand, [s.screws for s in states], width)
+            states = hands.finger_states(g.hand, g.joint_positions)
+            made[id(g)] = hands.padded(g.hand, [s.screws for s in states], width)
     none = (np.zeros((3, width, 6)), np.full((3, width), np.nan))
     screws, limits = zip(*(made.get(id(g), none) for g in grasps))
     return {"hands": [g.hand for g in grasps], "joint_screws": np.stack(screws), "joint_limits": np.stack(limits)}
@@ -398,11 +398,10 @@ def _rows_hand(ds, hand_of_rows, start, stop, rows, n):
     """The hand keywords of :func:`resolve_arrays` for rows ``start:stop`` of a data set."""
     if hand_of_rows is None:
         return {}
-    from .. import hand
 
     q = None if ds.joint_positions is None else np.asarray(ds.joint_positions[start:stop], dtype=float)[rows]
-    states = hand.finger_states(hand_of_rows, q)
-    screws, limits = hand.padded(hand_of_rows, [s.screws for s in states])
+    states = hands.finger_states(hand_of_rows, q)
+    screws, limits = hands.padded(hand_of_rows, [s.screws for s in states])
     return {
         "hands": [hand_of_rows] * n,
         "joint_screws": np.broadcast_to(screws, (n, *screws.shape[-3:])),

@@ -6,7 +6,7 @@ instantaneous twist (:func:`grasptwist.engine.path.follow`, a chunk of
 samples at a time so that memory stays bounded), then finds the path's
 degeneracies between the samples (:func:`grasptwist.engine.path.degeneracies`).
 A grasp with a hand has its fingers follow the contacts first
-(:func:`grasptwist.hand.track`): each sample's joint rates are the hand
+(:func:`grasptwist.engine.hands.track`): each sample's joint rates are the hand
 result at the integrated joint positions, as ``resolve`` computes it.
 Samples come out as ordinary result :class:`~grasptwist.run.batch.Block`
 objects, so that records, columns and warnings are the ones ``resolve``
@@ -21,9 +21,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from .. import hand
+from ..engine import hands
+from ..engine.hands import HandTrack
 from ..engine.path import PathDegeneracies, Poses, degeneracies, follow
-from ..hand import HandTrack
 from ..io.datasets import DATASET_SUFFIXES
 from ..io.inputs import read
 from ..model import Grasp, GraspFileError, Hand, ObjectPath
@@ -191,7 +191,7 @@ def _path(job, grasp, p):
         yield GraspFileError("too-many-samples", f"path '{p.name}': {exc}", grasp.file, p.line, None)
         return
     tracked = (
-        None if grasp.hand is None else hand.track(grasp.hand, grasp.joint_positions, grasp.points, p.segments, times)
+        None if grasp.hand is None else hands.track(grasp.hand, grasp.joint_positions, grasp.points, p.segments, times)
     )
     for start in range(0, len(times), CHUNK):
         q = None if tracked is None else tracked.positions[start : start + CHUNK]
@@ -214,8 +214,8 @@ def _block(grasp, name, f, bases, method, positions=None) -> Block:
     results = {"off_tangent": f.off_tangent, "tangent": f.tangent}
     results = {k: r for k, r in results.items() if r is not None}
     if positions is not None:  # the hand's joint rates at its integrated positions, as resolve's
-        states = hand.finger_states(grasp.hand, positions)
-        screws, limits = hand.padded(grasp.hand, [s.screws for s in states])
+        states = hands.finger_states(grasp.hand, positions)
+        screws, limits = hands.padded(grasp.hand, [s.screws for s in states])
         inputs = {"joint_screws": screws, "joint_limits": limits, "points": f.points, "twist": f.poses.twist}
         results["hand"] = BY_KEY["hand"].compute({**inputs, **results}, bases)
     block = Block(

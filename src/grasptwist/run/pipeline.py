@@ -29,10 +29,10 @@ from ..output.formats import FORMATS
 from ..output.records import basis_record, check_record, diagnostics, error_record, records, talking_rows
 from .batch import ZERO_TWIST, Block, check_positions, dataset_blocks, resolve
 from .pool import Pool
-from .scratch import owned_prefix, sweep
+from .scratch import owned_prefix, remove_orphans
 from .stream import grasp_stream, is_stream, twist_stream
 
-__all__ = ["Job", "Tuning", "TUNING", "Output", "Spool", "run", "run_group", "blocks", "write_blocks"]
+__all__ = ["Job", "Tuning", "TUNING", "Output", "Spool", "record_outputs", "run_group", "blocks", "write_blocks"]
 
 #: Name stem of the spool folders in /dev/shm.
 SPOOL_STEM = "grasptwist-"
@@ -85,13 +85,16 @@ class Output:
     """The encoded records of one group, with their stderr lines and counts."""
 
     encoded: list = field(default_factory=list)
-    errors: list[str] = field(default_factory=list)
+    errors: list[str] = field(default_factory=list)  # always printed
+    row_errors: list[str] = field(default_factory=list)  # of a data set's or stream's rows: printed like warnings
     warnings: list[str] = field(default_factory=list)
     records: int = 0
     failed: int = 0
+    failed_rows: int = 0  # of ``failed``: rows of a data set or stream
     done: int = 0  # progress: files read, or data-set records made
-    grows: int = 0  # progress: work found beyond the one unit an input was counted as
+    extra_work: int = 0  # progress: work found beyond the one unit an input was counted as
     spool: str | None = None  # a file holding ``encoded`` (see _sealed)
+    rows: bool = False  # records of a data set's or stream's rows: their errors are row_errors
 
     def add(self, rec: dict, encode) -> None:
         self._note(rec)
@@ -107,17 +110,20 @@ class Output:
 
     def _note(self, rec: dict) -> None:
         errors, warnings = diagnostics(rec)
-        self.errors += errors
+        # a whole input that cannot be read (no line: a data set, a stream's file) is never a row
+        row = self.rows and not ("error" in rec and rec["error"]["line"] is None)
+        (self.row_errors if row else self.errors).extend(errors)
         self.warnings += warnings
         self.failed += not rec["ok"]
+        self.failed_rows += row and not rec["ok"]
 
 
-def run(job: Job, paths: Sequence, workers: int = 1, tuning: Tuning = TUNING) -> Iterator[Output]:
+def record_outputs(job: Job, paths: Sequence, workers: int = 1, tuning: Tuning = TUNING) -> Iterator[Output]:
     """Every input's output, in order.  ``paths`` holds file names, ``-``,
     and errors found while listing folders."""
     if job.twists_from is not None:
         twists = twist_stream(paths, job.twists_from, job.method, job.max_bytes, tuning.files_per_group)
-        yield from _streamed(job, twists, tuning)
+        yield from _streamed(job, twists, tuning, files_first=True)  # the grasp files' errors come first
         return
     groups = list(_groups(paths, tuning.files_per_group))
     files = [g for g in groups if not _is_dataset(g)]
@@ -143,15 +149,15 @@ def _alone(job: Job, path: str, workers: int, tuning: Tuning) -> Iterator[Output
     return _streamed(job, grasp_stream(path, twists, job.method, job.max_bytes, tuning.files_per_group), tuning)
 
 
-def _streamed(job: Job, batches, tuning: Tuning) -> Iterator[Output]:
+def _streamed(job: Job, batches, tuning: Tuning, files_first: bool = False) -> Iterator[Output]:
     """An output per batch of a stream (see :mod:`~grasptwist.run.stream`): each
     line's records are written as soon as it is read."""
     done = 1  # the stream is one unit of progress
     for batch in batches:
-        out = Output(done=done)
-        done = 0
+        out = Output(done=done, rows=not files_first)
+        done, files_first = 0, False
         for x in batch:
-            _emit(job, x, out, tuning.records_at_once)
+            _encode_into(job, x, out, tuning.records_at_once)
         yield _sealed(job, out)
 
 
@@ -192,7 +198,7 @@ class Spool:
         if not os.access(shm, os.W_OK):
             yield None
             return
-        sweep(shm, SPOOL_STEM)  # what runs killed by SIGKILL left
+        remove_orphans(shm, SPOOL_STEM)  # what runs killed by SIGKILL left
         folder = None
         try:
             folder = tempfile.mkdtemp(prefix=owned_prefix(SPOOL_STEM), dir=shm)
@@ -238,44 +244,49 @@ def run_group(job: Job, paths: Sequence, tuning: Tuning = TUNING, spool: Spool |
     out = Output(done=len(paths))
     twists = [ZERO_TWIST] if job.kind != "resolve" else job.twists
     for x in resolve(items, twists, job.method):
-        _emit(job, x, out, tuning.records_at_once)
+        _encode_into(job, x, out, tuning.records_at_once)
     return _sealed(job, out, spool)
 
 
-def blocks(job: Job, paths: Sequence, tuning: Tuning = TUNING) -> Iterator[tuple[Block | GraspFileError, int | None]]:
+def blocks(
+    job: Job, paths: Sequence, tuning: Tuning = TUNING
+) -> Iterator[tuple[Block | GraspFileError, int | None, bool]]:
     """Blocks and errors of every input, in order (for writers that take
     blocks, like npz), each with its progress news: None for a group of
     files (one unit a file), else the records a data set holds beyond the
-    one unit it counted as (on its first block; 0 after).  Data sets are
-    resolved without basis screws when the format shows none."""
+    one unit it counted as (on its first block; 0 after); and whether it
+    holds rows of a data set or stream (whose errors stderr prints like
+    warnings).  Data sets are resolved without basis screws when the format
+    shows none."""
     bases = FORMATS[job.fmt].bases
     if job.twists_from is not None:
         batches = twist_stream(paths, job.twists_from, job.method, job.max_bytes, tuning.files_per_group)
-        yield from ((x, None) for batch in batches for x in batch)
+        for k, batch in enumerate(batches):
+            yield from ((x, None, k > 0) for x in batch)  # the first batch: the grasp files' errors
         return
     for g in _groups(paths, tuning.files_per_group):
         if is_stream(g):
             batches = grasp_stream(g, job.twists, job.method, job.max_bytes, tuning.files_per_group)
-            yield from ((x, None) for batch in batches for x in batch)
+            yield from ((x, None, True) for batch in batches for x in batch)
             continue
         if _is_dataset(g):
             try:
                 ds = open_dataset(g, job.extra_point)
-                grows = len(ds) * (len(job.twists) if job.twists else 1) - 1
+                extra_work = len(ds) * (len(job.twists) if job.twists else 1) - 1
                 for block in dataset_blocks(ds, job.twists, job.method, bases=bases, hand_of_rows=job.hand):
-                    yield block, grows
-                    grows = 0
+                    yield block, extra_work, True
+                    extra_work = 0
             except GraspFileError as err:
-                yield err, None
+                yield err, None, False
             continue
         items = []
         for p in g:
             items.extend(read(p, job.max_bytes) if isinstance(p, str) else [p])
         for x in resolve(items, job.twists, job.method):
-            yield x, None
+            yield x, None, False
 
 
-def _emit(job: Job, x, out: Output, at_once: int) -> None:
+def _encode_into(job: Job, x, out: Output, at_once: int) -> None:
     """Records of ``x`` (a block, or an input's error) encoded into ``out``."""
     fmt = FORMATS[job.fmt]
     hand = fmt.hand_options(job.hand)
@@ -302,7 +313,7 @@ def _dataset(job: Job, path: str, workers: int, tuning: Tuning) -> Iterator[Outp
             next(dataset_blocks(ds, None, job.method, hand_of_rows=job.hand))  # raises the no-twist error
     except GraspFileError as err:
         out = Output(done=1)
-        _emit(job, err, out, tuning.records_at_once)
+        _encode_into(job, err, out, tuning.records_at_once)
         yield _sealed(job, out)
         return
     rows = len(ds) * (len(job.twists) if job.twists and job.kind == "resolve" else 1)
@@ -325,7 +336,7 @@ def _counted(parts, rows):
     first = True
     for outs in parts:
         for out in outs:
-            out.done, out.grows = out.records, rows - 1 if first else 0
+            out.done, out.extra_work = out.records, rows - 1 if first else 0
             first = False
             yield out
 
@@ -338,12 +349,12 @@ def _dataset_task(job: Job, ds, rows: tuple[int, int], tuning: Tuning, spool: Sp
     try:
         for block in dataset_blocks(ds, twists, job.method, start=rows[0], stop=rows[1], hand_of_rows=job.hand):
             for start in range(0, len(block), at_once):
-                out = Output()
-                _emit(job, block.part(start, start + at_once), out, at_once)
+                out = Output(rows=True)
+                _encode_into(job, block.part(start, start + at_once), out, at_once)
                 outs.append(_sealed(job, out, spool))
     except GraspFileError as err:  # a damaged .npz member or Parquet row group, found only as it is read
         out = Output()
-        _emit(job, err, out, at_once)
+        _encode_into(job, err, out, at_once)
         outs.append(_sealed(job, out, spool))
     return outs
 
@@ -377,8 +388,8 @@ def write_blocks(job: Job, paths: Sequence, w, tuning: Tuning = TUNING) -> Itera
     (records are built only for the rows that need a line: failed or
     nearly degenerate ones); the caller closes ``w``.
     """
-    for x, grows in blocks(job, paths, tuning):
-        o = Output(done=len(x) if grows is not None else 1, grows=grows or 0)
+    for x, extra_work, rows in blocks(job, paths, tuning):
+        o = Output(done=len(x) if extra_work is not None else 1, extra_work=extra_work or 0, rows=rows)
         if isinstance(x, Block):
             w.write(x)
             talking = np.flatnonzero(talking_rows(x))

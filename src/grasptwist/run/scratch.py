@@ -11,7 +11,7 @@ from __future__ import annotations
 import os
 import shutil
 
-__all__ = ["owned_prefix", "sweep"]
+__all__ = ["owned_prefix", "remove_orphans"]
 
 
 def _host() -> str:
@@ -37,7 +37,7 @@ def _alive(pid: int) -> bool:
     return True
 
 
-def sweep(folder: str, stem: str) -> list[str]:
+def remove_orphans(folder: str, stem: str) -> list[str]:
     """Remove the scratch entries in ``folder`` whose owner process is gone; return their names.
 
     Entries from another host, or whose process id is in use again, are

@@ -30,7 +30,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager, suppress
 from typing import IO
 
-from .scratch import owned_prefix, sweep
+from .scratch import owned_prefix, remove_orphans
 
 __all__ = ["WriteError", "check_target", "opened", "guarded"]
 
@@ -151,7 +151,7 @@ def _errors_named(path: str):
 def _replacing(path: str) -> Iterator[IO[bytes]]:
     folder = os.path.dirname(path)
     prefix = owned_prefix(TEMP_STEM)
-    sweep(folder, TEMP_STEM)  # what runs killed by SIGKILL left
+    remove_orphans(folder, TEMP_STEM)  # what runs killed by SIGKILL left
     try:
         fd, name = _temporary(folder, prefix)
     except OSError as exc:

@@ -1,0 +1,63 @@
+"""The ``grasptwist`` command line (typer).
+
+A thin layer: it parses options (:mod:`.options`), hands files to the
+pipeline (:mod:`grasptwist.run`) and writes what comes back.  One module
+per command (:mod:`.resolve`, :mod:`.basis`, :mod:`.check`, :mod:`.follow`,
+:mod:`.schema`, :mod:`.plot`); stderr lines, their counts and the progress
+bar in :mod:`.diagnostics`; ``-o`` and exit codes in :mod:`.exits`.
+stdout carries data only; every diagnostic goes to stderr as one line
+``path:line:col: error: message``.
+"""
+
+import sys
+
+import typer
+
+from .._version import __version__
+from . import basis, check, follow, plot, resolve, schema
+from .exits import CLICK_ERROR, EXIT_OK, stopped, usage_error
+
+__all__ = ["app", "main"]
+
+app = typer.Typer(
+    name="grasptwist",
+    help="Resolve a desired object twist into finger-tip twists for a three-fingered grasp (screw theory).",
+    no_args_is_help=True,
+    add_completion=True,
+    rich_markup_mode=None,
+    pretty_exceptions_enable=False,
+    context_settings={"help_option_names": ["-h", "--help"]},
+)
+
+
+def _version(value: bool) -> None:
+    if value:
+        sys.stdout.write(f"grasptwist {__version__}\n")
+        raise typer.Exit(EXIT_OK)
+
+
+@app.callback()
+def _root(
+    version: bool = typer.Option(
+        False, "--version", callback=_version, is_eager=True, help="Print the version and exit."
+    ),
+) -> None:
+    """Resolve a desired object twist into finger-tip twists for a three-fingered grasp (screw theory)."""
+
+
+for _command in (resolve.resolve, basis.basis, check.check, follow.follow, schema.schema, plot.plot):
+    app.command()(_command)  # in the order of `grasptwist -h`
+
+
+def main() -> None:
+    """Run the command line (the ``grasptwist`` script is :func:`grasptwist.__main__.main`)."""
+    from ..run.signals import Interrupted, stop_on_signals
+
+    stop_on_signals()
+    try:
+        code = app(standalone_mode=False)
+    except Interrupted as stop:  # while typer parsed the command line
+        sys.exit(stopped(stop))
+    except CLICK_ERROR as exc:
+        sys.exit(usage_error(exc))
+    sys.exit(code if isinstance(code, int) else EXIT_OK)

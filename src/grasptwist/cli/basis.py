@@ -1,0 +1,54 @@
+"""``grasptwist basis``: each grasp's basis screws, their Klein products and conditioning."""
+
+from .diagnostics import Warnings
+from .exits import run_command
+from .options import (
+    ALL,
+    Debug,
+    Digits,
+    Json,
+    MaxBytes,
+    Method,
+    Order,
+    OrderOption,
+    Output,
+    Paths,
+    Quiet,
+    RecordFormat,
+    RecordFormatOption,
+    WarningsOption,
+    Workers,
+)
+from .records import OutputSettings, write_records
+
+__all__ = ["basis"]
+
+
+def basis(
+    paths: Paths,
+    method: Method = ALL,
+    fmt: RecordFormatOption = RecordFormat.table,
+    json_: Json = False,
+    output: Output = None,
+    digits: Digits = 4,
+    order: OrderOption = Order.omega_v,
+    max_bytes: MaxBytes = None,
+    workers: Workers = 0,
+    quiet: Quiet = False,
+    warnings: WarningsOption = Warnings.summary,
+    debug: Debug = False,
+) -> None:
+    """Show each grasp's basis screws Sigma, Psi, Theta, their Klein products and conditioning.
+
+    Example (the paper's eqs. 16-18, with unit Psi):
+
+    \b
+        grasptwist basis grasps/cylinder.yaml --method off-tangent
+    """
+    from ..run.pipeline import Job
+
+    job = Job(
+        kind="basis", method=method.value, order=order.value, fmt="json" if json_ else fmt.value, max_bytes=max_bytes
+    )
+    settings = OutputSettings(output, quiet, warnings, workers, {"digits": digits, "order": order.value})
+    run_command(debug, lambda: write_records(job, paths, settings))

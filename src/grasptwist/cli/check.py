@@ -1,0 +1,46 @@
+"""``grasptwist check``: validate grasp files and report degenerate grasps without resolving."""
+
+from .diagnostics import Warnings
+from .exits import run_command
+from .options import (
+    ALL,
+    Debug,
+    Json,
+    MaxBytes,
+    Method,
+    Output,
+    Paths,
+    Quiet,
+    RecordFormat,
+    RecordFormatOption,
+    WarningsOption,
+    Workers,
+)
+from .records import OutputSettings, write_records
+
+__all__ = ["check"]
+
+
+def check(
+    paths: Paths,
+    method: Method = ALL,
+    fmt: RecordFormatOption = RecordFormat.table,
+    json_: Json = False,
+    output: Output = None,
+    max_bytes: MaxBytes = None,
+    workers: Workers = 0,
+    quiet: Quiet = False,
+    warnings: WarningsOption = Warnings.summary,
+    debug: Debug = False,
+) -> None:
+    """Validate grasp files and report degenerate grasps without resolving; exit 1 if any fails.
+
+    Example, over a folder, listing only the failures:
+
+    \b
+        grasptwist check grasps/ -f jsonl | jq -c 'select(.ok | not)'
+    """
+    from ..run.pipeline import Job
+
+    job = Job(kind="check", method=method.value, fmt="json" if json_ else fmt.value, max_bytes=max_bytes)
+    run_command(debug, lambda: write_records(job, paths, OutputSettings(output, quiet, warnings, workers)))

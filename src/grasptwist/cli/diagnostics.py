@@ -1,0 +1,212 @@
+"""stderr: diagnostic lines (counted, coloured on a terminal, summarised) and the progress bar.
+
+Every diagnostic is one line ``path:line:col: error: message``; stdout
+carries data only.
+"""
+
+from __future__ import annotations
+
+import os
+import sys
+from contextlib import contextmanager
+from enum import Enum
+
+from ..output.formats import names_for
+from ..results import KINDS
+
+__all__ = [
+    "Warnings",
+    "WARNINGS_SHOWN",
+    "TABLE_HINT_AT",
+    "Diagnostics",
+    "to_stderr",
+    "error_code",
+    "summary_line",
+    "warning_kind",
+    "table_hint",
+    "progress_bar",
+]
+
+
+class Warnings(str, Enum):
+    """``--warnings``: which warning lines stderr prints."""
+
+    all = "all"
+    summary = "summary"
+    none = "none"
+
+
+#: Warnings ``--warnings summary`` prints before it only counts them.
+WARNINGS_SHOWN = 20
+
+#: Records of a table from which stderr suggests the machine formats, once.
+TABLE_HINT_AT = 50
+
+
+def to_stderr(line: str) -> None:
+    """One line on stderr; if stderr is gone (a hung-up terminal), there is nobody to tell."""
+    try:
+        sys.stderr.write(line + "\n")
+        sys.stderr.flush()
+    except (OSError, ValueError):
+        pass
+
+
+class Diagnostics:
+    """Diagnostics on stderr: one line each, counted; colour only on a terminal.
+
+    Errors of inputs are all printed; warnings, and the errors of a data
+    set's or stream's rows, as ``--warnings`` asks (``summary``: the first
+    :data:`WARNINGS_SHOWN` of each, then one line counting the rest by kind
+    or code); ``-q`` drops warnings, the table hint and the summary.
+    ``hint`` is the line said once when a table passes :data:`TABLE_HINT_AT`
+    records.
+    """
+
+    def __init__(self, quiet: bool = False, warnings: Warnings = Warnings.summary, hint: str | None = None):
+        self.failed = 0
+        self.failed_rows = 0  # of ``failed``: rows of data sets or streams
+        self.records = 0
+        self.quiet = quiet
+        self.shown = {Warnings.all: None, Warnings.summary: WARNINGS_SHOWN, Warnings.none: 0}[Warnings(warnings)]
+        self.rows_shown = self.shown
+        self.counting = warnings == Warnings.summary
+        self.unshown: dict[str, int] = {}  # warnings not printed, by kind
+        self.rows_unshown: dict[str, int] = {}  # row errors not printed, by code
+        self.hint = None if quiet else hint
+        self.color = sys.stderr.isatty() and not os.environ.get("NO_COLOR")
+
+    def take(self, out) -> None:
+        """Count a pipeline Output and print its lines."""
+        self.records += out.records
+        self.failed += out.failed
+        self.failed_rows += out.failed_rows
+        for line in out.errors:
+            self.say(line, ": error: ", "31")
+        for line in out.row_errors:
+            self.row_error(line)
+        if not self.quiet:
+            for line in out.warnings:
+                self.warn(line)
+        if self.hint and self.records > TABLE_HINT_AT:
+            to_stderr(self.hint)
+            self.hint = None
+
+    def warn(self, line: str) -> None:
+        """Print a warning line, or count it by kind once the first ``shown`` are out."""
+        if self.shown is None or self.shown > 0:
+            self.say(line, ": warning: ", "33")
+            self.shown = None if self.shown is None else self.shown - 1
+        elif self.counting:
+            kind = warning_kind(line)
+            self.unshown[kind] = self.unshown.get(kind, 0) + 1
+
+    def row_error(self, line: str) -> None:
+        """Print the error of a data set's or stream's row, or count it by code once the first are out."""
+        if self.rows_shown is None or self.rows_shown > 0:
+            self.say(line, ": error: ", "31")
+            self.rows_shown = None if self.rows_shown is None else self.rows_shown - 1
+        elif self.counting:
+            code = error_code(line)
+            self.rows_unshown[code] = self.rows_unshown.get(code, 0) + 1
+
+    def say(self, line: str, label: str, colour: str) -> None:
+        """Print one diagnostic line, its label coloured on a terminal."""
+        if self.color:
+            line = line.replace(label, f": \x1b[{colour}m{label[2:-2]}\x1b[0m: ", 1)
+        to_stderr(line)
+
+    def summary(self) -> None:
+        if self.quiet:
+            return
+        if self.rows_unshown:
+            to_stderr(_not_shown(self.rows_unshown, "row error"))
+        if self.unshown:
+            to_stderr(_not_shown(self.unshown, "warning"))
+        to_stderr(summary_line(self.records, self.failed, self.failed_rows))
+
+
+def summary_line(records: int, failed: int, failed_rows: int = 0) -> str:
+    """The closing line: records written and failed; when failed rows of data sets or
+    streams are mixed with other failures (inputs that could not be read, grasps of
+    grasp files), how many of the failed are rows.
+
+    >>> summary_line(1, 0), summary_line(3000, 902, 902), summary_line(3001, 903, 902)
+    ('1 record, 0 failed', '3000 records, 902 failed', '3001 records, 903 failed (902 rows of data sets or streams)')
+    """
+    line = f"{records} record{'' if records == 1 else 's'}, {failed} failed"
+    if 0 < failed_rows < failed:
+        line += f" ({failed_rows} row{'' if failed_rows == 1 else 's'} of data sets or streams)"
+    return line
+
+
+def _not_shown(counts: dict[str, int], what: str) -> str:
+    """The line that counts the ``what`` lines not printed, by kind, most first."""
+    total = sum(counts.values())
+    kinds = ", ".join(f"{n} {kind}" for kind, n in sorted(counts.items(), key=lambda kv: -kv[1]))
+    return f"grasptwist: {total} more {what}{'' if total == 1 else 's'} not shown (--warnings all): {kinds}"
+
+
+#: The labels that start a method's error (``tangent: coincident-contacts: ...``).
+_KIND_LABELS = frozenset(k.label for k in KINDS)
+
+
+def error_code(line: str) -> str:
+    """An error line's code, after the method's label when a method failed.
+
+    >>> error_code("a.npz: grasp '7', twist 't': error: tangent: coincident-contacts: contacts 2 and 3 coincide")
+    'tangent coincident-contacts'
+    >>> error_code("a.jsonl:3:1: error: vector-length: normal needs 3 numbers")
+    'vector-length'
+    """
+    parts = line.rpartition(": error: ")[2].split(": ", 2)
+    return " ".join(parts[:2]) if parts[0] in _KIND_LABELS and len(parts) > 1 else parts[0]
+
+
+def warning_kind(line: str) -> str:
+    """What a warning line is about, without its place and numbers: its message
+    up to the first parenthesis or colon (``tangent basis is nearly degenerate``).
+
+    >>> warning_kind("a.yaml: grasp 'g': warning: tangent basis is nearly degenerate (conditioning 2e-05 < 0.001): ...")
+    'tangent basis is nearly degenerate'
+    """
+    message = line.rpartition(": warning: ")[2]
+    return message.split(" (", 1)[0].split(":", 1)[0].strip()
+
+
+def table_hint(command: str) -> str:
+    """The line that points a reader of a long table to the machine formats."""
+    others = [f for f in names_for(command) if f != "table"]
+    listed = ", ".join(others[:-1]) + f" or {others[-1]}"
+    return f"grasptwist: hint: more than {TABLE_HINT_AT} records: -f {listed} writes them far faster, for programs"
+
+
+@contextmanager
+def progress_bar(inputs: list, command: str, out):
+    """A rich progress bar on stderr, named after ``command``, when it is a
+    terminal and there is more than one input or a data set (whose records
+    are counted as they come); not when the output ``out`` goes to a
+    terminal too, where it shows the progress itself (and a bar would be
+    drawn between its lines).  Yields the function that advances it by a
+    pipeline Output."""
+    from ..io.datasets import DATASET_SUFFIXES
+
+    big = len(inputs) > 1 or any(isinstance(p, str) and p.endswith(DATASET_SUFFIXES) for p in inputs)
+    if not big or not sys.stderr.isatty() or out.isatty():
+        yield lambda output: None
+        return
+    from rich.progress import Progress
+
+    from ..output.table import console
+
+    # the console never wraps: lines printed under the bar (stderr is redirected
+    # through it) stay one line each, folded only by the terminal
+    with Progress(console=console(sys.stderr), transient=True) as bar:
+        task = bar.add_task(f"grasptwist {command}", total=len(inputs))
+
+        def advance(output):
+            if output.extra_work:
+                bar.update(task, total=bar.tasks[0].total + output.extra_work)
+            bar.advance(task, output.done)
+
+        yield advance

@@ -1,0 +1,131 @@
+"""How a command ends: where its records go (``-o``) and the exit status of every way out.
+
+Exit codes: 0 all records ok, 1 some record failed (the others are still
+written in full), 2 usage error, 3 the output could not be written, 4 a
+worker process died, 128 + the signal's number when SIGINT, SIGTERM or
+SIGHUP stopped the run, 141 the reader of stdout went away.
+"""
+
+from __future__ import annotations
+
+import os
+import signal
+import sys
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+
+import typer
+
+from .diagnostics import to_stderr
+
+__all__ = [
+    "EXIT_OK",
+    "EXIT_FAILED",
+    "EXIT_USAGE",
+    "EXIT_WRITE",
+    "EXIT_WORKER",
+    "EXIT_BROKEN_PIPE",
+    "CLICK_ERROR",
+    "output_target",
+    "writable_folder",
+    "drop_stdout",
+    "stopped",
+    "run_command",
+    "usage_error",
+]
+
+EXIT_OK, EXIT_FAILED, EXIT_USAGE, EXIT_WRITE, EXIT_WORKER, EXIT_BROKEN_PIPE = 0, 1, 2, 3, 4, 141
+
+# The base of the usage errors of typer's click (typer 0.2x carries its own copy of click, so it is
+# found from the one typer exports, whichever click that is).
+CLICK_ERROR = next(c for c in typer.BadParameter.__mro__ if c.__name__ == "ClickException")
+
+
+@contextmanager
+def output_target(path: str | None) -> Iterator:
+    """stdout, or ``path`` by the rule of :mod:`grasptwist.run.target`: a file
+    replaced atomically on success only, a pipe or device written through;
+    an unusable ``path`` is a usage error before any work."""
+    from ..run.signals import finishing
+    from ..run.target import check_target, opened
+
+    if path is not None and path != "-":
+        try:
+            check_target(path)
+        except ValueError as exc:
+            raise typer.BadParameter(str(exc), param_hint="-o") from None
+    with opened(path) as out:
+        yield out
+        finishing()  # all written: commit it and end normally, whatever signal comes now
+
+
+def writable_folder(path: str) -> None:
+    """A usage error, before any work, when ``path``'s folder cannot take a file."""
+    folder = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(folder):
+        raise typer.BadParameter(f"cannot write {path}: no folder {os.path.dirname(path) or folder}", param_hint="-o")
+    if not os.access(folder, os.W_OK):
+        raise typer.BadParameter(f"cannot write {path}: the folder is not writable", param_hint="-o")
+
+
+def drop_stdout() -> None:
+    """Send what stdout still buffers to /dev/null: after a failure it must
+    neither block the exit on a stalled reader nor fail a second time."""
+    try:
+        fd = sys.stdout.fileno()
+    except (AttributeError, OSError, ValueError):  # not a real file (tests' capture)
+        return
+    os.dup2(os.open(os.devnull, os.O_WRONLY), fd)
+
+
+def stopped(stop) -> int:
+    """Say which signal stopped the run; the exit status a shell gives for it."""
+    drop_stdout()
+    to_stderr(f"grasptwist: stopped by {stop.name}")
+    return stop.exit_status
+
+
+def run_command(debug: bool, body: Callable[[], int]) -> None:
+    """Run a command's body; turn every way it can end into one line and an exit status."""
+    from ..extras import MissingExtra
+    from ..run.pool import WorkerDied
+    from ..run.signals import Interrupted
+    from ..run.target import WriteError
+
+    try:
+        code = body()
+    except (typer.Exit, typer.Abort, typer.BadParameter):
+        raise  # typer's own ways out: exit codes, usage errors (2)
+    except (Interrupted, KeyboardInterrupt) as exc:  # KeyboardInterrupt: run without main(), as by tests
+        raise typer.Exit(stopped(exc if isinstance(exc, Interrupted) else Interrupted(signal.SIGINT))) from None
+    except BrokenPipeError:
+        # The reader (e.g. `head`) went away: stop quietly with the status of a
+        # Unix filter killed by SIGPIPE, and keep Python's final flush quiet too.
+        drop_stdout()
+        raise typer.Exit(EXIT_BROKEN_PIPE) from None
+    except MissingExtra as exc:  # e.g. -f parquet without pyarrow, found before any output
+        to_stderr(f"grasptwist: error: {exc}")
+        raise typer.Exit(EXIT_USAGE) from None
+    except (WriteError, WorkerDied) as exc:
+        drop_stdout()
+        to_stderr(f"grasptwist: error: {exc}")
+        raise typer.Exit(EXIT_WRITE if isinstance(exc, WriteError) else EXIT_WORKER) from None
+    except Exception as exc:  # noqa: BLE001 - the one place a traceback is turned into a line
+        if debug:
+            raise
+        to_stderr(f"grasptwist: internal error: {type(exc).__name__}: {exc} (rerun with --debug for the traceback)")
+        raise typer.Exit(EXIT_FAILED) from None
+    raise typer.Exit(code)
+
+
+def usage_error(exc) -> int:
+    """One line for a usage error (exit 2), as for every other diagnostic: what is wrong, and
+    where help is, instead of click's four lines of usage, hint, blank and error."""
+    if type(exc).__name__ == "NoArgsIsHelpError":  # `grasptwist` alone: the help is the answer
+        to_stderr(exc.format_message())
+        return exc.exit_code
+    ctx = getattr(exc, "ctx", None)
+    message = " ".join(exc.format_message().split())  # on one line, whatever it quotes
+    where = f" (see '{ctx.command_path} -h')" if ctx is not None else ""
+    to_stderr(f"grasptwist: error: {message}{where}")
+    return exc.exit_code

@@ -1,0 +1,220 @@
+"""The options several commands share, declared once (typer's ``Annotated`` style),
+and how option values become the loader's objects (twists, path segments, a hand).
+
+A command names an option by its alias and gives the default, e.g.
+``digits: Digits = 4``; an option only one command has is declared there.
+"""
+
+from __future__ import annotations
+
+import os
+import re
+import sys
+from enum import Enum
+from typing import Annotated
+
+import typer
+
+from ..output.formats import FORMATS, names_for
+from ..results import ALL_METHODS, KINDS, METHOD_CHOICES
+from .diagnostics import WARNINGS_SHOWN, Warnings
+
+__all__ = [
+    "MethodChoice",
+    "ResolveFormat",
+    "RecordFormat",
+    "FollowFormat",
+    "PlotMethod",
+    "ALL",
+    "ExtraPoint",
+    "Order",
+    "Frame",
+    "Paths",
+    "Method",
+    "Output",
+    "Digits",
+    "OrderOption",
+    "MaxBytes",
+    "Quiet",
+    "WarningsOption",
+    "Debug",
+    "Json",
+    "Workers",
+    "RecordFormatOption",
+    "parse_floats",
+    "twists_option",
+    "segments_option",
+    "hand_option",
+    "not_binary_to_a_terminal",
+]
+
+
+def _choices(name: str, values) -> type[Enum]:
+    """A typer choice type of ``values`` (members named as Python allows: ``off-tangent`` is ``off_tangent``)."""
+    return Enum(name, {v.replace("-", "_"): v for v in values}, type=str)
+
+
+#: ``--method``: the registry's methods, or ``both``.
+MethodChoice = _choices("Method", METHOD_CHOICES)
+#: ``-f`` of each command: from the format registry.
+ResolveFormat = _choices("Format", names_for("resolve"))
+RecordFormat = _choices("RecordFormat", names_for("basis"))
+FollowFormat = _choices("FollowFormat", names_for("follow"))
+#: ``plot --method``: the bases that can be drawn.
+PlotMethod = _choices("PlotMethod", [k.label for k in KINDS if k.method])
+#: The default of ``--method``: every method.
+ALL = MethodChoice(ALL_METHODS)
+
+
+class ExtraPoint(str, Enum):
+    wrist = "wrist"
+    at = "at"
+
+
+class Order(str, Enum):
+    omega_v = "omega-v"
+    v_omega = "v-omega"
+
+
+class Frame(str, Enum):
+    space = "space"
+    body = "body"
+
+
+PATHS_HELP = (
+    "Grasp files (.yaml, .yml, .json; any case), JSON Lines of grasps (.jsonl), data sets (.npz, .npy, .parquet), "
+    "folders of grasp files or - (stdin: YAML, or JSON Lines if it starts with '{')."
+)
+Paths = Annotated[list[str], typer.Argument(metavar="PATH...", help=PATHS_HELP)]
+Method = Annotated[MethodChoice, typer.Option("--method", help="Decomposition(s) to run.")]
+Output = Annotated[
+    str | None, typer.Option("-o", "--output", metavar="FILE", help="Write to FILE (atomically) instead of stdout.")
+]
+Digits = Annotated[
+    int, typer.Option("--digits", min=0, max=17, help="Decimals in tables (JSON and CSV keep full precision).")
+]
+OrderOption = Annotated[
+    Order, typer.Option("--order", help="Order of every printed 6-vector: (omega; v) or (v; omega).")
+]
+MaxBytes = Annotated[
+    int | None,
+    typer.Option("--max-bytes", min=1, help="Refuse grasp files larger than this many bytes (default 1 MiB)."),
+]
+Quiet = Annotated[bool, typer.Option("-q", "--quiet", help="No warnings or summary on stderr (errors still).")]
+WarningsOption = Annotated[
+    Warnings,
+    typer.Option(
+        "--warnings",
+        help="Warnings, and the errors of a data set's or stream's rows, on stderr: all, none, "
+        f"or the first {WARNINGS_SHOWN} of each and a count of the rest by kind.",
+    ),
+]
+Debug = Annotated[bool, typer.Option("--debug", help="Show the Python traceback of an internal error.")]
+Json = Annotated[bool, typer.Option("--json", help="Same as --format json.")]
+Workers = Annotated[
+    int,
+    typer.Option(
+        "-j",
+        "--workers",
+        min=0,
+        help="Processes for big batches (0: every core, used for 256+ files or 4096+ data-set grasps).",
+    ),
+]
+RecordFormatOption = Annotated[
+    RecordFormat, typer.Option("-f", "--format", help="table for people, json or jsonl for programs.")
+]
+
+
+def parse_floats(text: str, n: int, what: str) -> list[float]:
+    """``n`` finite comma-separated numbers of option ``what``, or a usage error."""
+    try:
+        values = [float(x) for x in text.replace(" ", "").split(",")]
+    except ValueError:
+        values = []
+    if len(values) != n or not all(v == v and abs(v) != float("inf") for v in values):
+        raise typer.BadParameter(f"needs {n} finite comma-separated numbers, got {text!r}", param_hint=what)
+    return values
+
+
+def twists_option(texts: list[str] | None, at: str | None, names: list[str] | None = None):
+    """``--twist`` values as loader twists at the origin (``--at`` names the reference point),
+    named by ``names`` (``--twist-name``, one per twist) or as written."""
+    if names and len(names) != len(texts or ()):
+        raise typer.BadParameter(
+            f"give one --twist-name per --twist (got {len(names)} names for {len(texts or ())} twists)",
+            param_hint="--twist-name",
+        )
+    for name in names or ():
+        if not name.strip() or not name.isprintable():
+            raise typer.BadParameter(
+                f"{name!r}: a name is a non-empty line of printable text", param_hint="--twist-name"
+            )
+    if not texts:
+        if at is not None:
+            raise typer.BadParameter("applies to --twist; give at least one --twist", param_hint="--at")
+        return None
+    import numpy as np
+
+    from ..engine.screws import twist_at
+    from ..model import Twist
+
+    point = parse_floats(at, 3, "--at") if at is not None else [0.0, 0.0, 0.0]
+    twists = []
+    for k, text in enumerate(texts):
+        w = parse_floats(text, 6, "--twist")
+        with np.errstate(all="ignore"):
+            screw = twist_at(w[:3], w[3:], point)
+        if not np.isfinite(screw).all():
+            raise typer.BadParameter(f"{text!r} at {at}: the velocity of the origin overflows", param_hint="--twist")
+        twists.append(Twist(name=names[k] if names else text.replace(" ", ""), screw=screw, line=None))
+    return twists
+
+
+def segments_option(twists, durations, frame):
+    """``--twist``/``--duration`` pairs as path segments (None without ``--twist``)."""
+    if not twists and not durations:
+        if frame != "space":
+            raise typer.BadParameter("applies to --twist segments", param_hint="--frame")
+        return None
+    if len(twists or ()) != len(durations or ()):
+        raise typer.BadParameter(
+            f"each --twist needs a --duration: got {len(twists or ())} and {len(durations or ())}",
+            param_hint="--duration",
+        )
+    from ..engine.path import check_segments
+    from ..model import Segment
+
+    segments = [Segment(d, twist=parse_floats(t, 6, "--twist"), frame=frame) for t, d in zip(twists, durations)]
+    try:
+        return check_segments(segments)
+    except ValueError as exc:
+        # the engine names segments[k]; here they are the k+1-th --twist/--duration pair
+        message = re.sub(r"segments\[(\d+)\]\.duration", lambda m: f"--duration number {int(m[1]) + 1}", str(exc))
+        raise typer.BadParameter(message.replace("segments[", "segment ["), param_hint="--duration") from None
+
+
+def hand_option(path: str | None, paths: list[str], fmt: str):
+    """The run's hand: ``--hand``'s, or for CSV and npz of one grasp file, that file's first hand
+    (its joints name the columns; a folder's grasps may each have another)."""
+    from ..model import InputError
+
+    if path is not None:
+        from ..io.grasp_hand import load_hand_file
+
+        try:
+            return load_hand_file(path)[0]
+        except InputError as err:
+            raise typer.BadParameter(f"{err.code}: {err}", param_hint="--hand") from None
+    if not FORMATS[fmt].per_hand or len(paths) != 1 or not paths[0].lower().endswith((".yaml", ".yml", ".json")):
+        return None
+    if not os.path.isfile(paths[0]):
+        return None
+    from ..io.inputs import read
+
+    return next((g.hand for g in read(paths[0]) if getattr(g, "hand", None) is not None), None)
+
+
+def not_binary_to_a_terminal(fmt: str, output: str | None) -> None:
+    """A usage error, before any work, when a binary format (npz, parquet) would go to a terminal."""
+    if FORMATS[fmt].binary and output is None and sys.stdout.isatty():
+        raise typer.BadParameter(f"{fmt} is binary: give -o FILE.{fmt}", param_hint="--format")

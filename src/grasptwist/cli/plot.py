@@ -1,0 +1,112 @@
+"""``grasptwist plot``: draw a grasp, its basis screw axes and the finger-tip velocities."""
+
+import os
+import sys
+from dataclasses import replace
+from typing import Annotated
+
+import typer
+
+from .diagnostics import Diagnostics
+from .exits import EXIT_FAILED, EXIT_OK, run_command, writable_folder
+from .options import Debug, MaxBytes, PlotMethod, twists_option
+
+__all__ = ["plot", "draw_pictures"]
+
+
+def plot(
+    path: Annotated[
+        str, typer.Argument(metavar="PATH", help="A grasp file, or a folder for one image per grasp and twist.")
+    ],
+    output: Annotated[
+        str,
+        typer.Option(
+            "-o",
+            "--output",
+            metavar="FILE|FOLDER",
+            help="The image (.png, .svg or .pdf), or the folder for a folder's images.",
+        ),
+    ],
+    twist: Annotated[
+        str | None,
+        typer.Option("--twist", metavar="W1,W2,W3,V1,V2,V3", help="Draw this twist (omega; v) instead of the file's."),
+    ] = None,
+    twist_name: Annotated[
+        str | None,
+        typer.Option(
+            "--twist-name", metavar="NAME", help="Which of the file's twists to draw (or the name of --twist)."
+        ),
+    ] = None,
+    at: Annotated[
+        str | None,
+        typer.Option("--at", metavar="X,Y,Z", help="Point whose velocity the --twist linear part gives."),
+    ] = None,
+    method: Annotated[
+        PlotMethod | None,
+        typer.Option("--method", help="Basis to draw (default: off-tangent with a wrist, else tangent)."),
+    ] = None,
+    max_bytes: MaxBytes = None,
+    debug: Debug = False,
+) -> None:
+    """Draw a grasp, its basis screw axes and the finger-tip velocities (needs matplotlib: from a clone, pip install '.[plot]').
+
+    Examples: the paper's cylinder spinning about z, and every bundled grasp:
+
+    \b
+        grasptwist plot grasps/cylinder.yaml --twist-name spin-z -o cylinder.png
+        grasptwist plot grasps/ -o pictures/
+    """
+    twists = twists_option([twist] if twist else None, at)
+    if twists and twist_name:
+        twists = [replace(twists[0], name=twist_name)]
+    run_command(
+        debug, lambda: draw_pictures(path, output, twists, twist_name, method.value if method else None, max_bytes)
+    )
+
+
+def draw_pictures(path, output, twists, twist_name, method, max_bytes) -> int:
+    """The body of ``plot``: read ``path`` as every command does, draw by
+    :func:`grasptwist.plot.render_loaded`, report on stderr; the exit status."""
+    from .. import plot as pictures
+    from ..io.datasets import DATASET_SUFFIXES
+    from ..io.inputs import expand, read
+    from ..model import InputError
+    from ..output.records import diagnostics, error_record
+
+    stderr = Diagnostics()
+    if path.endswith(DATASET_SUFFIXES):
+        raise typer.BadParameter(
+            "plot draws grasp files (.yaml, .yml) or folders of them, not data sets", param_hint="PATH"
+        )
+    if not os.path.isdir(path):
+        writable_folder(output)
+
+    def note(line: str, error: bool = True) -> None:
+        stderr.failed += error
+        stderr.say(line, ": error: " if error else ": warning: ", "31" if error else "33")
+
+    try:
+        pictures.require_matplotlib()  # before anything is read
+        grasps = []
+        for item in expand([path]):
+            for entry in read(item, max_bytes) if isinstance(item, str) else [item]:
+                if isinstance(entry, InputError):
+                    for line in diagnostics(error_record(entry))[0]:
+                        note(line)
+                else:
+                    grasps.append(replace(entry, twists=tuple(twists)) if twists else entry)
+        for item in pictures.render_loaded(
+            path, output, grasps, twist_name=None if twists else twist_name, method=method
+        ):
+            if isinstance(item, pictures.Note):
+                note(item.line, item.error)
+            else:
+                sys.stdout.write(f"{item}\n")
+    except pictures.MissingMatplotlib as exc:
+        sys.stderr.write(f"{exc}\n")  # the README's line: "grasptwist plot needs matplotlib: ..."
+        return EXIT_FAILED
+    except pictures.TwistNotFound as exc:
+        raise typer.BadParameter(str(exc), param_hint="--twist-name") from None
+    except ValueError as exc:  # an unknown method or suffix, off-tangent without a wrist
+        raise typer.BadParameter(str(exc)) from None
+    return EXIT_FAILED if stderr.failed else EXIT_OK

@@ -1,0 +1,58 @@
+"""Files in, records out: the body resolve, basis and check share."""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field
+
+from ..output.formats import FORMATS
+from .diagnostics import Diagnostics, Warnings, progress_bar, table_hint
+from .exits import EXIT_FAILED, EXIT_OK, output_target
+
+__all__ = ["OutputSettings", "worker_count", "write_records"]
+
+
+@dataclass(frozen=True)
+class OutputSettings:
+    """What resolve, basis and check take beyond their job: where the records go,
+    how many processes make them, what stderr says, and how tables print numbers."""
+
+    output: str | None
+    quiet: bool
+    warnings: Warnings
+    workers: int
+    table_options: dict = field(default_factory=dict)
+
+
+def worker_count(requested: int) -> int:
+    """Processes: as asked, or every core (the pipeline uses them only for big batches)."""
+    return requested if requested > 0 else min(os.cpu_count() or 1, 8)
+
+
+def write_records(job, paths: list[str], settings: OutputSettings) -> int:
+    """Read ``paths``, write the job's records, report on stderr; the exit status."""
+    from ..io.inputs import expand
+    from ..run.pipeline import record_outputs, write_blocks
+
+    stderr = Diagnostics(settings.quiet, settings.warnings, hint=table_hint(job.kind) if job.fmt == "table" else None)
+    inputs = list(expand(paths))
+    fmt = FORMATS[job.fmt]
+    with output_target(settings.output) as out, progress_bar(inputs, job.kind, out) as advance:
+        w = fmt.open(out, job.kind, **settings.table_options, **fmt.hand_options(job.hand))
+        # block writers (npz) take results here; the others get records encoded where they were made
+        outputs = (
+            write_blocks(job, inputs, w)
+            if fmt.takes_blocks
+            else record_outputs(job, inputs, worker_count(settings.workers))
+        )
+        for o in outputs:
+            for encoded in o.encoded:
+                w.write(encoded)
+            if o.spool:
+                w.write_spooled(o.spool)
+            out.flush()  # a batch streams: each group is out as soon as it is ready
+            stderr.take(o)
+            advance(o)
+        w.close()
+    stderr.summary()
+    return EXIT_FAILED if stderr.failed else EXIT_OK

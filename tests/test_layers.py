@@ -1,0 +1,149 @@
+"""Imports go one way, down the layers of ARCHITECTURE.md, and never in a circle.
+
+An ast walk over src/grasptwist: every ``import`` and ``from ... import``,
+at module level or inside a function (a deferred import may keep start-up
+fast or an optional dependency optional; it never hides a circle).
+"""
+
+import ast
+from pathlib import Path
+
+import pytest
+
+SRC = Path(__file__).resolve().parents[1] / "src"
+PACKAGE = SRC / "grasptwist"
+
+#: Lowest first.  A module may import its own group and any group of a lower layer;
+#: groups of one layer are independent of each other.
+LAYERS = [
+    ["grasptwist.model", "grasptwist.extras", "grasptwist._version"],  # data types, no math
+    ["grasptwist.engine"],  # the math on arrays
+    ["grasptwist.io"],  # files in
+    ["grasptwist.results"],  # the registry of result kinds and their fields
+    ["grasptwist.output", "grasptwist.plot"],  # records and tables out; pictures
+    ["grasptwist.run"],  # batches, workers, streams, the -o target: engine over inputs into outputs
+    ["grasptwist.cli"],  # the command line
+    # the public facades and entry points: nothing inside the package imports them
+    ["grasptwist", "grasptwist.hand", "grasptwist.path", "grasptwist.dask", "grasptwist.__main__"],
+]
+
+#: Beyond the layers: pictures are drawn from the engine's geometry only; reading
+#: files and writing records is the command line's (issue 22).
+FORBIDDEN = {"grasptwist.plot": ("grasptwist.io", "grasptwist.output", "grasptwist.results", "grasptwist.run")}
+
+#: Facades only re-export.
+FACADES = ("grasptwist.hand", "grasptwist.path")
+
+#: Known edges still to go, (importer, imported).
+EXCEPTIONS = {
+    # io/grasp/ package in progress (loader branch)
+    ("grasptwist.io.grasp_file", "grasptwist.io.grasp_hand"),
+    ("grasptwist.io.grasp_hand", "grasptwist.hand"),
+    ("grasptwist.io.urdf", "grasptwist.io.grasp_file"),
+}
+
+
+def module_name(path: Path) -> str:
+    parts = path.relative_to(SRC).with_suffix("").parts
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+MODULES = {module_name(p): p for p in sorted(PACKAGE.rglob("*.py"))}
+
+
+def imports(name: str) -> set[str]:
+    """The package's modules ``name`` imports anywhere in its code."""
+    path = MODULES[name]
+    package = name if path.name == "__init__.py" else name.rpartition(".")[0]
+    found = set()
+    for node in ast.walk(ast.parse(path.read_text(), str(path))):
+        if isinstance(node, ast.Import):
+            found.update(a.name for a in node.names)
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = package.split(".")[: len(package.split(".")) - node.level + 1]
+                target = ".".join(base + ([node.module] if node.module else []))
+            else:
+                target = node.module
+            # `from pkg import module` imports the module; `from module import name`, the module
+            found.update(f"{target}.{a.name}" if f"{target}.{a.name}" in MODULES else target for a in node.names)
+    return {m for m in found if m in MODULES and m != name}
+
+
+GRAPH = {name: imports(name) - {b for a, b in EXCEPTIONS if a == name} for name in MODULES}
+
+
+def group(name: str) -> tuple[int, str]:
+    """The layer and group of a module: its longest matching group."""
+    matches = [
+        (len(g), k, g)
+        for k, layer in enumerate(LAYERS)
+        for g in layer
+        if name == g or (name.startswith(g + ".") and g != "grasptwist")  # the package's own __init__: itself only
+    ]
+    assert matches, f"{name} is in no layer: add it to LAYERS"
+    _, k, g = max(matches)
+    return k, g
+
+
+def test_the_walk_sees_deferred_and_relative_imports():
+    # a deferred import inside a function, a relative `from . import module`, an absolute one
+    assert "grasptwist.run.signals" in imports("grasptwist.__main__")
+    assert "grasptwist.cli" in imports("grasptwist.__main__")
+    assert "grasptwist.cli.basis" in imports("grasptwist.cli")
+    assert "grasptwist.output.parquet_writer" in imports("grasptwist.output.formats")
+    assert group("grasptwist.engine.hands") == (1, "grasptwist.engine")
+    assert group("grasptwist.hand") == (7, "grasptwist.hand")
+
+
+@pytest.mark.parametrize("name", sorted(MODULES))
+def test_imports_go_down_the_layers(name):
+    layer, own = group(name)
+    upward = []
+    for target in sorted(GRAPH[name]):
+        their_layer, theirs = group(target)
+        if theirs == own:
+            continue
+        if their_layer >= layer or theirs in FORBIDDEN.get(own, ()):
+            upward.append(f"{target} ({theirs}, layer {their_layer})")
+    assert not upward, f"{name} ({own}, layer {layer}) imports {', '.join(upward)}"
+
+
+def test_no_import_circles():
+    circles = []
+    state = {}  # name -> 1 on the current path, 2 done
+
+    def visit(name, path):
+        state[name] = 1
+        for target in sorted(GRAPH[name]):
+            if state.get(target) == 1:
+                circles.append(" -> ".join(path[path.index(target) :] + [target]))
+            elif target not in state:
+                visit(target, path + [target])
+        state[name] = 2
+
+    for name in sorted(MODULES):
+        if name not in state:
+            visit(name, [name])
+    assert not circles, "import circles:\n" + "\n".join(circles)
+
+
+@pytest.mark.parametrize("name", FACADES)
+def test_facades_only_re_export(name):
+    tree = ast.parse(MODULES[name].read_text())
+    for node in tree.body:
+        docstring = isinstance(node, ast.Expr) and isinstance(node.value, ast.Constant)
+        all_ = isinstance(node, ast.Assign) and [t.id for t in node.targets if isinstance(t, ast.Name)] == ["__all__"]
+        assert docstring or all_ or isinstance(node, ast.ImportFrom), f"{name}:{node.lineno}: not a re-export"
+
+
+@pytest.mark.parametrize(
+    "name", [n for n, p in MODULES.items() if p.name != "__init__.py" and not p.name.startswith("_")]
+)
+def test_every_module_says_what_is_public(name):
+    # the public API is grasptwist's _EXPORTS; each module marks its own public names
+    tree = ast.parse(MODULES[name].read_text())
+    assert any(
+        isinstance(node, ast.Assign) and any(isinstance(t, ast.Name) and t.id == "__all__" for t in node.targets)
+        for node in tree.body
+    ), f"{name} has no __all__"
