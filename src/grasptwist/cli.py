@@ -20,6 +20,7 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
 from enum import Enum
+from functools import partial
 
 import typer
 
@@ -635,7 +636,7 @@ def plot(
         "-o",
         "--output",
         metavar="FILE|FOLDER",
-        help="The image (.png, .svg or .pdf), or the folder for a folder's images.",
+        help="The image (.png, .svg or .pdf) or interactive view (.html), or the folder for a folder's images.",
     ),
     twist: str | None = typer.Option(
         None, "--twist", metavar="W1,W2,W3,V1,V2,V3", help="Draw this twist (omega; v) instead of the file's."
@@ -649,24 +650,33 @@ def plot(
     method: PlotMethod | None = typer.Option(
         None, "--method", help="Basis to draw (default: off-tangent with a wrist, else tangent)."
     ),
+    js_beside: bool = typer.Option(
+        False, "--js-beside", help="HTML views: write plotly.js once beside them (plotly.min.js), not inside each."
+    ),
+    path_name: str | None = typer.Option(
+        None, "--path", metavar="NAME", help="HTML views: animate this path of the grasp (default: every path)."
+    ),
     max_bytes: int | None = _MAX_BYTES,
     debug: bool = _DEBUG,
 ) -> None:
-    """Draw a grasp, its basis screw axes and the finger-tip velocities (needs matplotlib: from a clone, pip install '.[plot]').
+    """Draw a grasp, its basis screw axes and the finger-tip velocities (needs matplotlib: from a clone, pip install '.[plot]';
+    an interactive .html view needs plotly: pip install '.[html]'). A folder gets HTML views with --js-beside or --path.
 
     Examples: the paper's cylinder spinning about z, and every bundled grasp:
 
     \b
         grasptwist plot grasps/cylinder.yaml --twist-name spin-z -o cylinder.png
         grasptwist plot grasps/ -o pictures/
+        grasptwist plot grasps/trifinger-cube.yaml -o trifinger.html
     """
     twists = _cli_twists([twist] if twist else None, at)
     if twists and twist_name:
         twists = [replace(twists[0], name=twist_name)]
-    _run(debug, lambda: _plot(path, output, twists, twist_name, method.value if method else None, max_bytes))
+    views = {"js_beside": js_beside, "path_name": path_name}
+    _run(debug, lambda: _plot(path, output, twists, twist_name, method.value if method else None, max_bytes, views))
 
 
-def _plot(path, output, twists, twist_name, method, max_bytes) -> int:
+def _plot(path, output, twists, twist_name, method, max_bytes, views) -> int:
     """The body of ``plot``: the drawing and its notes come from plot.render_inputs;
     here only usage errors, stdout and stderr."""
     from . import plot as pictures
@@ -679,16 +689,18 @@ def _plot(path, output, twists, twist_name, method, max_bytes) -> int:
         )
     if not os.path.isdir(path):
         _writable_folder(output)
+    html = output.lower().endswith(pictures.HTML) or (os.path.isdir(path) and any(views.values()))
+    if not html and any(views.values()):
+        raise typer.BadParameter("applies to HTML views (-o FILE.html)", param_hint="--js-beside/--path")
+    draw = partial(pictures.html_inputs, **views) if html else pictures.render_inputs
     try:
-        for item in pictures.render_inputs(
-            path, output, twists=twists, twist_name=twist_name, method=method, max_bytes=max_bytes
-        ):
+        for item in draw(path, output, twists=twists, twist_name=twist_name, method=method, max_bytes=max_bytes):
             if isinstance(item, pictures.Note):
                 stderr.failed += item.error
                 stderr.say(item.line, ": error: " if item.error else ": warning: ", "31" if item.error else "33")
             else:
                 sys.stdout.write(f"{item}\n")
-    except pictures.MissingMatplotlib as exc:
+    except (pictures.MissingMatplotlib, pictures.MissingPlotly) as exc:
         sys.stderr.write(f"{exc}\n")  # the README's line: "grasptwist plot needs matplotlib: ..."
         return EXIT_FAILED
     except pictures.TwistNotFound as exc:

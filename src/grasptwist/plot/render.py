@@ -34,6 +34,7 @@ __all__ = [
     "image_name",
     "image_paths",
     "plot_grasp",
+    "read_grasps",
     "render",
     "render_grasps",
     "render_inputs",
@@ -89,19 +90,20 @@ def image_name(grasp_name: str, twist_name: str | None = None) -> str:
     return safe[0] if twist_name is None else "-".join(safe)
 
 
-def image_paths(grasps, folder, suffix=".png") -> list[tuple[Path, object, object]]:
+def image_paths(grasps, folder, suffix=".png", *, per_twist=True) -> list[tuple[Path, object, object]]:
     """Where :func:`render_grasps` draws each grasp and twist: ``(path, grasp, twist)``.
 
     One entry per twist of each grasp, in order, and one with twist None for a
-    grasp without twists.  Paths are ``folder / (image_name(...) + suffix)``;
+    grasp without twists (or, without ``per_twist``, one per grasp: an HTML
+    page shows them all).  Paths are ``folder / (image_name(...) + suffix)``;
     a name already used (ignoring case, for case-insensitive file systems)
     gets ``-2``, ``-3``...
     """
-    _check_suffix(suffix)
+    _check_suffix(suffix, FORMATS + (".html",))
     folder = Path(folder)
     plan, used = [], set()
     for grasp in grasps:
-        for twist in tuple(grasp.twists) or (None,):
+        for twist in (tuple(grasp.twists) if per_twist else ()) or (None,):
             stem = image_name(grasp.name, None if twist is None else twist.name)
             name, n = stem, 1
             while name.lower() in used:
@@ -193,19 +195,13 @@ def render_inputs(
         For a single file: no twist called ``twist_name``; an unknown method,
         the off-tangent method without a wrist, or an unsupported suffix.
     """
-    from ..io.inputs import expand, read
-    from ..model import InputError
-    from ..output.records import diagnostics, error_record
-
     require_matplotlib()
     grasps = []
-    for item in expand([path]):
-        for entry in read(item, max_bytes) if isinstance(item, str) else [item]:
-            if isinstance(entry, InputError):
-                for line in diagnostics(error_record(entry))[0]:
-                    yield Note(line)
-            else:
-                grasps.append(replace(entry, twists=tuple(twists)) if twists else entry)
+    for item in read_grasps(path, twists, max_bytes):
+        if isinstance(item, Note):
+            yield item
+        else:
+            grasps.append(item)
     if os.path.isdir(path):
         drawable = []
         for grasp in grasps:
@@ -222,9 +218,25 @@ def render_inputs(
         yield plot_grasp(grasp, output, chosen_twist(grasp, None if twists else twist_name), method=method)
 
 
-def _check_suffix(suffix: str):
-    if suffix.lower() not in FORMATS:
-        raise ValueError(f"cannot write {suffix or 'a file without suffix'!r}: use one of {', '.join(FORMATS)}")
+def read_grasps(path: str, twists=(), max_bytes=None) -> Iterator:
+    """The grasps of a file or folder (searched like every command's inputs), ``twists`` in place
+    of their own when given, and a :class:`Note` for each input that cannot be read."""
+    from ..io.inputs import expand, read
+    from ..model import InputError
+    from ..output.records import diagnostics, error_record
+
+    for item in expand([path]):
+        for entry in read(item, max_bytes) if isinstance(item, str) else [item]:
+            if isinstance(entry, InputError):
+                for line in diagnostics(error_record(entry))[0]:
+                    yield Note(line)
+            else:
+                yield replace(entry, twists=tuple(twists)) if twists else entry
+
+
+def _check_suffix(suffix: str, formats=FORMATS):
+    if suffix.lower() not in formats:
+        raise ValueError(f"cannot write {suffix or 'a file without suffix'!r}: use one of {', '.join(formats)}")
 
 
 # --- drawing (matplotlib, imported here only) ----------------------------------
