@@ -30,8 +30,9 @@ def coloured_pixels(png, box) -> int:
 
 
 def page(tmp_path, grasp, *options):
-    from grasptwist.cli import app
     from typer.testing import CliRunner
+
+    from grasptwist.cli import app
 
     out = tmp_path / f"{grasp}.html"
     r = CliRunner().invoke(app, ["plot", str(GRASPS / f"{grasp}.yaml"), "-o", str(out), *options])

@@ -65,7 +65,7 @@ def chromium() -> str | None:
     return CHROMIUM if os.access(CHROMIUM, os.X_OK) else shutil.which("chromium")
 
 
-def capture(page, png, *, size=(1200, 900), timeout=60.0, scroll_to=0) -> Capture:
+def capture(page, png, *, size=(1200, 900), timeout=60.0, scroll_to=0, before=None) -> Capture:
     """Open ``page`` (a local file) in headless Chromium and screenshot it to ``png`` once drawn.
 
     Parameters
@@ -77,6 +77,10 @@ def capture(page, png, *, size=(1200, 900), timeout=60.0, scroll_to=0) -> Captur
         Seconds for the whole visit; a page not drawn by then raises TimeoutError.
     scroll_to : int
         The figure (0-based) scrolled to the top of the window before the screenshot.
+    before : str, optional
+        JavaScript run (and awaited, if a promise) once drawn, before the
+        screenshot: ``figures`` holds the page's plotly divs, e.g.
+        ``Plotly.animate(figures[1], ["10"], {mode: "immediate"})`` shows frame 10.
     """
     import websocket  # websocket-client, in the test extra
 
@@ -96,7 +100,7 @@ def capture(page, png, *, size=(1200, 900), timeout=60.0, scroll_to=0) -> Captur
             target = next(t for t in json.load(answer) if t["type"] == "page")
         ws = websocket.create_connection(target["webSocketDebuggerUrl"], timeout=timeout, suppress_origin=True)
         try:
-            return _visit(_Session(ws, deadline), Path(page).resolve().as_uri(), Path(png), size, scroll_to)
+            return _visit(_Session(ws, deadline), Path(page).resolve().as_uri(), Path(png), size, scroll_to, before)
         finally:
             ws.close()
     finally:
@@ -153,7 +157,7 @@ class _Session:
         return result["result"].get("value")
 
 
-def _visit(session, url, png, size, scroll_to) -> Capture:
+def _visit(session, url, png, size, scroll_to, before) -> Capture:
     for domain in ("Runtime", "Log", "Page"):
         session.call(f"{domain}.enable")
     session.call("Emulation.setDeviceMetricsOverride", width=size[0], height=size[1], deviceScaleFactor=1, mobile=False)
@@ -162,8 +166,11 @@ def _visit(session, url, png, size, scroll_to) -> Capture:
         if time.monotonic() > session.deadline:
             raise TimeoutError(f"{url}: the figures were not drawn in time (errors: {session.errors})")
         time.sleep(0.1)
+    figures = "const figures = document.querySelectorAll('.js-plotly-plot');"
+    if before:
+        session.evaluate(f"(async () => {{ {figures} await ({before}); }})()")
     if scroll_to:
-        session.evaluate(f"document.querySelectorAll('.js-plotly-plot')[{scroll_to}].scrollIntoView()")
+        session.evaluate(f"{{ {figures} figures[{scroll_to}].scrollIntoView(); }}")
         scenes = session.evaluate(_DRAWN)
     session.evaluate(_FRAMES)  # the WebGL canvases painted
     shot = session.call("Page.captureScreenshot", format="png")
