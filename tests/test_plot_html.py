@@ -212,3 +212,40 @@ def test_a_name_cannot_end_the_figures_script_element(tmp_path):
     assert r.exit_code == 0, r.output
     (figure,) = read_figures((tmp_path / "g.html").read_text("utf-8"))
     assert "</script><b>x" in figure["layout"]["title"]["text"].replace("&lt;", "<").replace("&gt;", ">")
+
+
+@pytest.mark.slow
+def test_a_urdf_hands_meshes_are_posed_at_its_joint_positions_touching_the_contacts():
+    pytest.importorskip("yourdfpy")
+    pytest.importorskip("robot_properties_fingers")
+    from grasptwist.io.urdf_meshes import hand_meshes
+    from grasptwist.plot import grasp_page
+    from grasptwist.plot.traces import MESH_NAME
+
+    grasp = load_grasps(GRASPS / "trifinger-cube.yaml")[0]
+    sections, notes = grasp_page(grasp)
+    assert notes == [] and len(sections) == 1  # no paths
+    figure = sections[0][1]
+    (mesh,) = [t for t in figure["data"] if t["name"] == MESH_NAME]
+    vertices = np.array([mesh[c] for c in "xyz"]).T
+    # each fingertip's sphere (radius 10 mm about the tip link's origin) touches its contact
+    for contact in grasp.points:
+        assert np.min(np.linalg.norm(vertices - contact, axis=1)) < 0.003
+    # at the home configuration the tips are elsewhere: the joint positions are what poses them
+    home = np.concatenate([v for v, _ in hand_meshes(grasp.hand, None)])
+    assert max(np.min(np.linalg.norm(home - c, axis=1)) for c in grasp.points) > 0.01
+    assert all(b["args"][0]["visible"][-1] is True for b in figure["layout"]["updatemenus"][0]["buttons"])
+
+
+def test_a_mesh_outside_the_urdfs_folder_is_refused_and_the_chains_drawn_all_the_same(tmp_path):
+    pytest.importorskip("yourdfpy")
+    from grasptwist import hand
+    from grasptwist.io.urdf_meshes import hand_meshes
+    from grasptwist.model import InputError
+
+    folder = Path(__file__).parent / "corpus" / "urdf"
+    toy = hand.load_urdf_hand("mesh-and-xinclude.urdf", ["a_tip", "b_tip"], folder=folder)  # a mesh at /etc/passwd
+    with pytest.raises(InputError, match=r"^mesh-and-xinclude.urdf: mesh '/etc/passwd' resolves outside") as caught:
+        hand_meshes(toy, folder=folder)
+    assert (caught.value.code, caught.value.file) == ("path-outside", "mesh-and-xinclude.urdf")
+    assert hand_meshes(hand.load_urdf_hand("hand.urdf", ["a_tip", "b_tip"], folder=folder), folder=folder) == []

@@ -25,7 +25,7 @@ import orjson
 
 from .render import Note, image_paths, read_grasps
 from .scene import Scene, check_method, default_method, grasp_scene
-from .traces import force_traces, scene_traces
+from .traces import force_traces, mesh_trace, scene_traces
 
 __all__ = [
     "HTML",
@@ -137,7 +137,7 @@ def scene_layout(scene: Scene, units: str | None, cube=None) -> dict:
     return axes | {"aspectmode": "data" if cube is None else "cube", "camera": camera}
 
 
-def twist_figure(grasp, twists=None, *, method: str | None = None, active: int = 0) -> dict:
+def twist_figure(grasp, twists=None, *, method: str | None = None, active: int = 0, meshes=()) -> dict:
     """The figure of a grasp and its twists: a dropdown switches between twists.
 
     Parameters
@@ -149,6 +149,9 @@ def twist_figure(grasp, twists=None, *, method: str | None = None, active: int =
         One method's bases only; default both (the tangent one without a wrist).
     active : int
         The twist shown first.
+    meshes : sequence of (vertices, faces)
+        The hand's link meshes (:func:`grasptwist.io.urdf_meshes.hand_meshes`),
+        one legend entry shown with every twist.
 
     Returns
     -------
@@ -171,6 +174,10 @@ def twist_figure(grasp, twists=None, *, method: str | None = None, active: int =
                 data.append(t)
                 owner.append(k)
         titles.append(view_title(scenes))
+    if len(meshes):
+        data.append(mesh_trace(meshes, half))
+        owner.append(None)
+        shown.append(True)
     layout = {
         "title": {"text": titles[active], "font": {"size": 13}, "x": 0.01, "xanchor": "left"},
         "scene": scene_layout(views[active][0], grasp.units),
@@ -181,7 +188,7 @@ def twist_figure(grasp, twists=None, *, method: str | None = None, active: int =
     if len(items) > 1:
         buttons = []
         for k, t in enumerate(items):
-            visible = [v if o == k else False for v, o in zip(shown, owner)]
+            visible = [v if o in (k, None) else False for v, o in zip(shown, owner)]
             buttons.append(
                 {"label": t.name, "method": "update", "args": [{"visible": visible}, {"title.text": titles[k]}]}
             )
@@ -204,14 +211,24 @@ for (const div of document.querySelectorAll("div.grasptwist-figure")) {
 def grasp_page(grasp, *, twists=None, method=None, active=0, path_name=None, samples=None):
     """The sections of a grasp's page ``[(heading, figure)]`` and a :class:`Note` per path it cannot follow.
 
-    The twists' figure first (:func:`twist_figure`), then one animation per
+    The twists' figure first (:func:`twist_figure`, with a URDF hand's link
+    meshes: a warning note when they cannot be read), then one animation per
     path (:func:`grasptwist.plot.animation.path_figures`; every path of the
     grasp, or the one called ``path_name``).
     """
     from .animation import path_figures
 
-    sections = [(f"{grasp.name}: twists", twist_figure(grasp, twists, method=method, active=active))]
-    notes = []
+    meshes, notes = [], []
+    if grasp.hand is not None and grasp.hand.source is not None:
+        from ..io.urdf_meshes import grasp_folder, hand_meshes
+        from ..model import InputError
+
+        try:
+            meshes = hand_meshes(grasp.hand, grasp.joint_positions, folder=grasp_folder(grasp))
+        except InputError as exc:  # the chains are drawn all the same
+            notes.append(Note(f"{exc.file}: warning: no link meshes: {exc.message}", error=False))
+    figure = twist_figure(grasp, twists, method=method, active=active, meshes=meshes)
+    sections = [(f"{grasp.name}: twists", figure)]
     if grasp.paths or path_name is not None:
         for item in path_figures(grasp, path_name, method=method, samples=samples):
             if isinstance(item, Note):

@@ -15,7 +15,10 @@ import numpy as np
 from ..engine.screws import norm
 from .scene import Scene, legend_text
 
-__all__ = ["COMMON_KINDS", "force_traces", "scene_traces", "slot_name"]
+__all__ = ["COMMON_KINDS", "MESH_NAME", "force_traces", "mesh_trace", "scene_traces", "slot_name"]
+
+#: The legend entry of a hand's link meshes.
+MESH_NAME = "hand (URDF visual meshes)"
 
 #: Kinds the same whichever method is drawn: shown once for all methods.
 COMMON_KINDS = (
@@ -122,6 +125,23 @@ def force_traces(scene: Scene, units: str | None) -> dict[str, list[dict]]:
     whatever it returns after the scene's own traces.
     """
     return {}
+
+
+def mesh_trace(meshes, half) -> dict:
+    """Triangle meshes ``[(vertices (n, 3), faces (m, 3))]`` as one ``mesh3d`` trace, shaded.
+
+    Coordinates are rounded to a millionth of ``half`` (the drawing's
+    half-width): invisible, and it halves the page's share of them.
+    """
+    decimals = 6 - int(np.floor(np.log10(half))) if half > 0 else 6
+    vertices = np.round(np.concatenate([v for v, _ in meshes]), decimals)
+    offsets = np.cumsum([0] + [len(v) for v, _ in meshes[:-1]])
+    faces = np.concatenate([f + o for (_, f), o in zip(meshes, offsets)])
+    trace = {"type": "mesh3d", "name": MESH_NAME, "showlegend": True, "legendgroup": MESH_NAME}
+    trace.update({c: vertices[:, n].tolist() for n, c in enumerate("xyz")})
+    trace.update({c: faces[:, n].tolist() for n, c in enumerate("ijk")})
+    trace.update(color="#b0b0b0", opacity=0.5, hoverinfo="name", flatshading=True)
+    return trace
 
 
 def _shown(arrow, half) -> bool:
