@@ -677,8 +677,8 @@ def plot(
 
 
 def _plot(path, output, twists, twist_name, method, max_bytes, views) -> int:
-    """The body of ``plot``: the drawing and its notes come from plot.render_inputs;
-    here only usage errors, stdout and stderr."""
+    """The body of ``plot``: the drawing and its notes come from plot.render_inputs (or, for
+    HTML views, plot.html_inputs); here only usage errors, stdout and stderr."""
     from . import plot as pictures
     from .io.datasets import DATASET_SUFFIXES
 
@@ -701,7 +701,7 @@ def _plot(path, output, twists, twist_name, method, max_bytes, views) -> int:
             else:
                 sys.stdout.write(f"{item}\n")
     except (pictures.MissingMatplotlib, pictures.MissingPlotly) as exc:
-        sys.stderr.write(f"{exc}\n")  # the README's line: "grasptwist plot needs matplotlib: ..."
+        sys.stderr.write(f"{exc}\n")  # the README's line: "grasptwist plot needs matplotlib: ..." (or plotly)
         return EXIT_FAILED
     except pictures.TwistNotFound as exc:
         raise typer.BadParameter(str(exc), param_hint="--twist-name") from None
