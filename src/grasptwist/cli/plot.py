@@ -24,7 +24,7 @@ def plot(
             "-o",
             "--output",
             metavar="FILE|FOLDER",
-            help="The image (.png, .svg or .pdf), or the folder for a folder's images.",
+            help="The image (.png, .svg or .pdf) or interactive view (.html), or the folder for a folder's images.",
         ),
     ],
     twist: Annotated[
@@ -45,26 +45,74 @@ def plot(
         PlotMethod | None,
         typer.Option("--method", help="Basis to draw (default: off-tangent with a wrist, else tangent)."),
     ] = None,
+    js_beside: Annotated[
+        bool,
+        typer.Option(
+            "--js-beside", help="HTML views: write plotly.js once beside them (plotly.min.js), not inside each."
+        ),
+    ] = False,
+    path_name: Annotated[
+        str | None,
+        typer.Option(
+            "--path", metavar="NAME", help="HTML views: animate this path of the grasp (default: every path)."
+        ),
+    ] = None,
     max_bytes: MaxBytes = None,
     debug: Debug = False,
 ) -> None:
-    """Draw a grasp, its basis screw axes and the finger-tip velocities (needs matplotlib: from a clone, pip install '.[plot]').
+    """Draw a grasp, its basis screw axes and the finger-tip velocities (needs matplotlib: from a clone,
+    pip install -e '.[plot]'; an interactive .html view needs plotly: pip install -e '.[html]').
+    A folder gets HTML views with --js-beside or --path.
 
-    Examples: the paper's cylinder spinning about z, and every bundled grasp:
+    Examples: the paper's cylinder spinning about z, every bundled grasp, and a view to turn in a browser:
 
     \b
         grasptwist plot grasps/cylinder.yaml --twist-name spin-z -o cylinder.png
         grasptwist plot grasps/ -o pictures/
+        grasptwist plot grasps/trifinger-cube.yaml -o trifinger.html
     """
     twists = twists_option([twist] if twist else None, at)
     if twists and twist_name:
         twists = [replace(twists[0], name=twist_name)]
+    views = {"js_beside": js_beside, "path_name": path_name}
     run_command(
-        debug, lambda: draw_pictures(path, output, twists, twist_name, method.value if method else None, max_bytes)
+        debug,
+        lambda: draw_pictures(path, output, twists, twist_name, method.value if method else None, max_bytes, views),
     )
 
 
-def draw_pictures(path, output, twists, twist_name, method, max_bytes) -> int:
+def _page_extras(path_name):
+    """What an HTML page shows beside the grasp (see :func:`grasptwist.plot.html_loaded`): its
+    hand's link meshes and its paths followed as ``follow`` follows them."""
+    from .. import plot as pictures
+    from ..io.urdf_meshes import grasp_folder, hand_meshes
+    from ..model import InputError
+    from ..plot.animation import DEFAULT_SAMPLES
+    from ..run.follow import FollowJob, Samples, Summary, follow_grasp
+
+    def extras(grasp):
+        meshes, followed, notes, chunks = [], [], [], []
+        if grasp.hand is not None and grasp.hand.source is not None:
+            try:
+                meshes = hand_meshes(grasp.hand, grasp.joint_positions, folder=grasp_folder(grasp))
+            except InputError as exc:  # the chains are drawn all the same
+                notes.append(pictures.Note(f"{exc.file}: warning: no link meshes: {exc.message}", error=False))
+        if grasp.paths or path_name is not None:
+            job = FollowJob(method="both", path=path_name, samples=DEFAULT_SAMPLES, bases=False)
+            for item in follow_grasp(job, grasp):
+                if isinstance(item, InputError):
+                    notes.append(pictures.Note(f"{item.file}: error: {item.message}"))
+                elif isinstance(item, Samples):
+                    chunks.append(item)
+                elif isinstance(item, Summary):
+                    followed.append((chunks, item))
+                    chunks = []
+        return meshes, followed, notes
+
+    return extras
+
+
+def draw_pictures(path, output, twists, twist_name, method, max_bytes, views) -> int:
     """The body of ``plot``: read ``path`` as every command does, draw by
     :func:`grasptwist.plot.render_loaded`, report on stderr; the exit status."""
     from .. import plot as pictures
@@ -85,8 +133,11 @@ def draw_pictures(path, output, twists, twist_name, method, max_bytes) -> int:
         stderr.failed += error
         stderr.say(line, ": error: " if error else ": warning: ", "31" if error else "33")
 
+    html = output.lower().endswith(pictures.HTML) or (os.path.isdir(path) and any(views.values()))
+    if not html and any(views.values()):
+        raise typer.BadParameter("applies to HTML views (-o FILE.html)", param_hint="--js-beside/--path")
     try:
-        pictures.require_matplotlib()  # before anything is read
+        (pictures.require_plotly if html else pictures.require_matplotlib)()  # before anything is read
         grasps = []
         for item in expand([path]):
             for entry in read(item, max_bytes) if isinstance(item, str) else [item]:
@@ -95,15 +146,27 @@ def draw_pictures(path, output, twists, twist_name, method, max_bytes) -> int:
                         note(line)
                 else:
                     grasps.append(replace(entry, twists=tuple(twists)) if twists else entry)
-        for item in pictures.render_loaded(
-            path, output, grasps, twist_name=None if twists else twist_name, method=method
-        ):
+        if html:
+            drawn = pictures.html_loaded(
+                path,
+                output,
+                grasps,
+                twist_name=None if twists else twist_name,
+                method=method,
+                js_beside=views["js_beside"],
+                extras=_page_extras(views["path_name"]),
+            )
+        else:
+            drawn = pictures.render_loaded(
+                path, output, grasps, twist_name=None if twists else twist_name, method=method
+            )
+        for item in drawn:
             if isinstance(item, pictures.Note):
                 note(item.line, item.error)
             else:
                 sys.stdout.write(f"{item}\n")
-    except pictures.MissingMatplotlib as exc:
-        sys.stderr.write(f"{exc}\n")  # the README's line: "grasptwist plot needs matplotlib: ..."
+    except (pictures.MissingMatplotlib, pictures.MissingPlotly) as exc:
+        sys.stderr.write(f"{exc}\n")  # "grasptwist plot needs matplotlib: ..." (or plotly)
         return EXIT_FAILED
     except pictures.TwistNotFound as exc:
         raise typer.BadParameter(str(exc), param_hint="--twist-name") from None

@@ -1,5 +1,7 @@
-"""Pictures of a grasp and a twist: the scene as data (:mod:`.scene`), drawn by matplotlib (:mod:`.render`)."""
+"""Pictures of a grasp and a twist: the scene as data (:mod:`.scene`), drawn by matplotlib
+(:mod:`.render`) or as an interactive HTML page (:mod:`.html`, :mod:`.traces`, :mod:`.animation`)."""
 
+from .html import HTML, MissingPlotly, grasp_page, html_loaded, read_figures, require_plotly, twist_figure, write_page
 from .render import (
     FORMATS,
     MissingMatplotlib,
@@ -31,11 +33,13 @@ from .scene import (
 
 __all__ = [
     "FORMATS",
+    "HTML",
     "KINDS",
     "METHODS",
     "Arrow",
     "Marker",
     "MissingMatplotlib",
+    "MissingPlotly",
     "Note",
     "Patch",
     "Scene",
@@ -44,14 +48,20 @@ __all__ = [
     "check_method",
     "chosen_twist",
     "default_method",
+    "grasp_page",
     "grasp_scene",
+    "html_loaded",
     "image_name",
     "image_paths",
     "legend_text",
     "plot_grasp",
+    "read_figures",
     "render",
     "render_grasps",
     "render_loaded",
     "require_matplotlib",
+    "require_plotly",
     "scene",
+    "twist_figure",
+    "write_page",
 ]

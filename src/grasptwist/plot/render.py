@@ -88,19 +88,20 @@ def image_name(grasp_name: str, twist_name: str | None = None) -> str:
     return safe[0] if twist_name is None else "-".join(safe)
 
 
-def image_paths(grasps, folder, suffix=".png") -> list[tuple[Path, object, object]]:
+def image_paths(grasps, folder, suffix=".png", *, per_twist=True) -> list[tuple[Path, object, object]]:
     """Where :func:`render_grasps` draws each grasp and twist: ``(path, grasp, twist)``.
 
     One entry per twist of each grasp, in order, and one with twist None for a
-    grasp without twists.  Paths are ``folder / (image_name(...) + suffix)``;
+    grasp without twists (or, without ``per_twist``, one per grasp: an HTML
+    page shows them all).  Paths are ``folder / (image_name(...) + suffix)``;
     a name already used (ignoring case, for case-insensitive file systems)
     gets ``-2``, ``-3``...
     """
-    _check_suffix(suffix)
+    _check_suffix(suffix, FORMATS + (".html",))
     folder = Path(folder)
     plan, used = [], set()
     for grasp in grasps:
-        for twist in tuple(grasp.twists) or (None,):
+        for twist in (tuple(grasp.twists) if per_twist else ()) or (None,):
             stem = image_name(grasp.name, None if twist is None else twist.name)
             name, n = stem, 1
             while name.lower() in used:
@@ -205,9 +206,9 @@ def render_loaded(path: str, output, grasps, *, twist_name: str | None = None, m
         yield plot_grasp(grasp, output, chosen_twist(grasp, twist_name), method=method)
 
 
-def _check_suffix(suffix: str):
-    if suffix.lower() not in FORMATS:
-        raise ValueError(f"cannot write {suffix or 'a file without suffix'!r}: use one of {', '.join(FORMATS)}")
+def _check_suffix(suffix: str, formats=FORMATS):
+    if suffix.lower() not in formats:
+        raise ValueError(f"cannot write {suffix or 'a file without suffix'!r}: use one of {', '.join(formats)}")
 
 
 # --- drawing (matplotlib, imported here only) ----------------------------------

@@ -33,6 +33,7 @@ __all__ = [
     "LinePiece",
     "check_method",
     "default_method",
+    "finger_links",
     "grasp_scene",
     "joint_segments",
     "legend_text",
@@ -64,12 +65,18 @@ class Marker:
 
 @dataclass(frozen=True)
 class LinePiece:
-    """A straight piece of a line (a screw axis) from ``start`` to ``end``, each ``(3,)``."""
+    """A straight piece of a line (a screw axis) from ``start`` to ``end``, each ``(3,)``.
+
+    A screw's axis also carries the screw's ``pitch`` and, for a basis screw,
+    the ``amplitude`` of its component in the twist (None where that does not apply).
+    """
 
     start: np.ndarray
     end: np.ndarray
     label: str
     kind: str
+    pitch: float | None = None
+    amplitude: float | None = None
 
     @property
     def direction(self) -> np.ndarray:
@@ -182,6 +189,7 @@ KINDS = {
     "psi-part": "part y_j Ψ_j(p_i)",
     "theta-part": "part α_j Θ_j(p_i)",
     "joint-axis": "finger joint axis",
+    "finger-link": "finger (joint to joint to tip)",
 }
 
 
@@ -238,6 +246,8 @@ def scene(
     names=("1", "2", "3"),
     grasp_name: str = "grasp",
     twist_name: str | None = None,
+    all_bases: bool = False,
+    velocity_scale: float | None = None,
 ) -> Scene:
     """The picture of one grasp and twist, as plain data (no matplotlib).
 
@@ -254,6 +264,13 @@ def scene(
         Contact names, used in labels and the status message.
     grasp_name, twist_name : str
         For the title.
+    all_bases : bool
+        Draw every screw of the method's basis: with the tangent method its
+        ``Sigma_i`` axes too (by default only its ``Theta_i``, since the
+        ``Sigma_i`` are the off-tangent method's lines).
+    velocity_scale : float or None
+        Drawn length per unit velocity of every velocity arrow; None fits it
+        to this scene (several scenes drawn together share the smallest).
 
     Returns
     -------
@@ -286,11 +303,11 @@ def scene(
     size = _grasp_size(points)
     if method == "off-tangent":
         r = decompose_off_tangent(points, wrist, t)
-        bases = (("sigma", "Σ", r.sigma), ("psi", "Ψ", r.psi))
+        bases = (("sigma", "Σ", r.sigma, r.x), ("psi", "Ψ", r.psi, r.y))
         amplitudes = (("x", r.x), ("y", r.y))
     else:
         r = decompose_tangent(points, normals, t)
-        bases = (("theta", "Θ", r.theta),)
+        bases = (("theta", "Θ", r.theta, r.alpha),) + ((("sigma", "Σ", r.sigma, r.beta),) if all_bases else ())
         amplitudes = (("α", r.alpha), ("β", r.beta))
     ok = int(r.status) == Status.OK
 
@@ -305,11 +322,11 @@ def scene(
     ]
     segments = []
     if ok:
-        for kind, symbol, basis in bases:
+        for kind, symbol, basis, amplitude in bases:
             for i in range(3):
-                segments.append(
-                    _axis_segment(basis[i], centroid, _AXIS_HALF * size, symbol + _sub(names[i]), f"{kind}-axis")
-                )
+                axis = _axis_segment(basis[i], centroid, _AXIS_HALF * size, symbol + _sub(names[i]), f"{kind}-axis")
+                # an amplitude only means something for a given twist
+                segments.append(replace(axis, amplitude=None if twist is None else float(amplitude[i])))
 
     lines = [f"{grasp_name}" + (f" — {twist_name}" if twist_name else "")]
     notes = []
@@ -320,7 +337,7 @@ def scene(
             notes.append(twist_element)
         elif twist_element is not None:
             (segments if isinstance(twist_element, LinePiece) else arrows).append(twist_element)
-        arrows += _velocity_arrows(points, t, r, method, names, size, ok)
+        arrows += _velocity_arrows(points, t, r, method, names, size, ok, velocity_scale)
     if ok:
         largest = max(float(np.max(np.abs(a))) for _, a in amplitudes)
         amp = "   ".join(f"{n} = {_vec(a, largest)}" for n, a in amplitudes) if twist is not None else "basis only"
@@ -342,7 +359,7 @@ def scene(
     )
 
 
-def _velocity_arrows(points, t, r, method, names, size, ok):
+def _velocity_arrows(points, t, r, method, names, size, ok, scale=None):
     """Contact velocities ``T(p_i)`` and, when the basis is sound, their parts chained tip to tail."""
     velocity = contact_velocities(points, t)
     parts = [[] for _ in range(3)]  # per contact: (vector, label, kind)
@@ -364,7 +381,8 @@ def _velocity_arrows(points, t, r, method, names, size, ok):
     # One length per unit velocity for every arrow, fitted so that the longest
     # drawn chain at any contact is _VELOCITY_LEN of the grasp's size.
     longest = max(max(norm(velocity)), max((sum(float(norm(v)) for v, _, _ in p) for p in parts), default=0.0))
-    scale = _VELOCITY_LEN * size / longest if longest > 0 else 1.0
+    if scale is None:
+        scale = _VELOCITY_LEN * size / longest if longest > 0 else 1.0
     arrows = [Arrow(points[i], velocity[i], f"T(p{_sub(names[i])})", "contact-velocity", scale) for i in range(3)]
     for i in range(3):
         origin = points[i]
@@ -397,7 +415,7 @@ def _axis_segment(s, centre, half, label, kind) -> LinePiece:
     # The axis point nearest the origin, in a frame moved so that `centre` is its origin.
     foot = centre + axis_point(rigid_motion(s, np.eye(3), -centre))
     d = unit(s[:3])
-    return LinePiece(foot - half * d, foot + half * d, label, kind)
+    return LinePiece(foot - half * d, foot + half * d, label, kind, pitch=float(pitch(s)))
 
 
 def _square(p, n, half):
@@ -464,11 +482,22 @@ def _vec(a, ref=0.0) -> str:
 # --- objects from the grasp-file loader ---------------------------------------
 
 
-def grasp_scene(grasp, twist=None, *, twist_name: str | None = None, method: str | None = None) -> Scene:
-    """:func:`scene` for a loaded ``Grasp``.
+def grasp_scene(
+    grasp,
+    twist=None,
+    *,
+    twist_name: str | None = None,
+    method: str | None = None,
+    all_bases=False,
+    links=False,
+    velocity_scale=None,
+) -> Scene:
+    """:func:`scene` for a loaded ``Grasp``, with its hand's joint axes (and, with
+    ``links``, its fingers' chains: :func:`finger_links`).
 
     ``twist`` is a ``Twist`` (its ``name`` and ``screw`` are used), a ``(6,)``
     array (named ``twist_name``), or None for the grasp and its basis only.
+    ``all_bases`` and ``velocity_scale`` are :func:`scene`'s.
     """
     if twist is not None and hasattr(twist, "screw"):
         twist_name = twist_name or twist.name
@@ -482,11 +511,31 @@ def grasp_scene(grasp, twist=None, *, twist_name: str | None = None, method: str
         names=grasp.contact_names,
         grasp_name=grasp.name,
         twist_name=twist_name,
+        all_bases=all_bases,
+        velocity_scale=velocity_scale,
     )
     if grasp.hand is None:
         return picture
     joints = joint_segments(grasp.hand, grasp.joint_positions, _JOINT_HALF * _grasp_size(grasp.points))
-    return replace(picture, segments=picture.segments + joints)
+    chains = finger_links(grasp.hand, grasp.joint_positions, grasp.points) if links else ()
+    return replace(picture, segments=picture.segments + joints + chains)
+
+
+def finger_links(hand, positions, contacts) -> tuple[LinePiece, ...]:
+    """Each finger as its kinematic chain at ``positions``: segments from joint
+    to joint, on to the tip link's origin (URDF fingers) and to its contact.
+
+    >>> from grasptwist.io.grasp_hand import inline_hand
+    >>> h = inline_hand(["a", "b", "c"], [[("j", "revolute", [0, 0, 2], [1, 0, 0], None, 1)]] * 3, None)
+    >>> s = finger_links(h, None, 3 * np.eye(3))[0]  # the joint at (1, 0, 0), its contact at (3, 0, 0)
+    >>> s.label, s.start.tolist(), s.end.tolist()
+    ('a', [1.0, 0.0, 0.0], [3.0, 0.0, 0.0])
+    """
+    out = []
+    for finger, state, contact in zip(hand.fingers, finger_states(hand, positions), contacts):
+        stops = list(state.points) + ([] if state.tip is None else [state.tip[:3, 3]]) + [contact]
+        out += [LinePiece(a, b, finger.name, "finger-link") for a, b in zip(stops[:-1], stops[1:])]
+    return tuple(out)
 
 
 def joint_segments(hand, positions, half) -> tuple[LinePiece, ...]:

@@ -35,6 +35,7 @@ __all__ = [
     "FollowJob",
     "Samples",
     "Summary",
+    "follow_grasp",
     "follow_inputs",
     "write_follow",
     "sample_times",
@@ -141,7 +142,7 @@ def follow_inputs(job: FollowJob, inputs: Iterable) -> Iterator[GraspFileError |
             yield GraspFileError("read-error", "follow reads grasp files, not data sets", item)
         else:
             for entry in read(item, job.max_bytes):
-                yield from _grasp(job, entry) if isinstance(entry, Grasp) else (entry,)
+                yield from follow_grasp(job, entry) if isinstance(entry, Grasp) else (entry,)
 
 
 def write_follow(job: FollowJob, inputs: Iterable, w, fmt: str, order: str = "omega-v") -> Iterator[Output]:
@@ -171,7 +172,8 @@ def write_follow(job: FollowJob, inputs: Iterable, w, fmt: str, order: str = "om
         yield Output(errors=errors, warnings=warnings, records=1, failed=int(not rec["ok"]))
 
 
-def _grasp(job, grasp):
+def follow_grasp(job: FollowJob, grasp: Grasp) -> Iterator[GraspFileError | Samples | Summary]:
+    """Every path of one grasp (or the job's): its samples, then its summary; an error for a path not there."""
     paths = (ObjectPath(COMMAND_LINE, job.segments, None),) if job.segments else grasp.paths
     chosen = [p for p in paths if job.path is None or p.name == job.path]
     if not chosen:
