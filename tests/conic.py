@@ -69,12 +69,17 @@ def closure_margin(points, normals, mu):
     return -float(sol.obj_val)
 
 
+#: A margin (of unit total normal force) above this is strict: Clarabel returns ~1e-12 for a margin
+#: that is 0, e.g. when one cone meets the contacts' plane only at its apex and that finger carries nothing.
+STRICT = 1e-10
+
+
 def closure_friction(points, normals, hi=1e3, iterations=45):
     """The least common ``mu`` with a positive closure margin, by bisection on ``mu``; NaN when none below ``hi``."""
-    if closure_margin(points, normals, hi) <= 0:
+    if closure_margin(points, normals, hi) <= STRICT:
         return np.nan
     lo = 0.0
     for _ in range(iterations):
         mid = 0.5 * (lo + hi)
-        lo, hi = (lo, mid) if closure_margin(points, normals, mid) > 0 else (mid, hi)
+        lo, hi = (lo, mid) if closure_margin(points, normals, mid) > STRICT else (mid, hi)
     return hi

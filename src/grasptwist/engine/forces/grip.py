@@ -89,7 +89,7 @@ def tangent_bases(normals):
 
     >>> b1, b2 = tangent_bases(np.eye(3))
     >>> (b1[2] + 0.0).tolist(), (b2[2] + 0.0).tolist()
-    ([0.0, -1.0, 0.0], [1.0, 0.0, 0.0])
+    ([0.0, 1.0, 0.0], [-1.0, 0.0, 0.0])
     """
     n = np.asarray(normals, dtype=float)
     pick = np.where((np.abs(n[..., 0]) < 0.9)[..., None], [1.0, 0, 0], [0, 1.0, 0])
