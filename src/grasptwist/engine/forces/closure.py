@@ -39,8 +39,7 @@ import numpy as np
 from ..checks import check_normals, check_points
 from ..degeneracy import DEGENERACY_TOL
 from ..screws import cross, dot, norm
-from .grasp_map import ForceStatus, check_friction, geometry
-from .grip import contact_matrices, tangent_bases
+from .grasp_map import ForceStatus, check_friction, contact_matrices, geometry, tangent_bases
 
 __all__ = ["Closure", "force_closure", "closure_test", "epsilon_quality", "BISECTIONS", "MAX_FRICTION"]
 
@@ -129,6 +128,26 @@ def closure_test(rows):
         s = s / s_len[:, None]
         ok = (s_len > _STRICT) & ((rows @ s[..., None])[..., 0] > _STRICT).all(axis=1)
     return ok, s
+
+
+def _own_rows(plane, mu):
+    """The sector rows with each contact's own ``mu_i``, and whether every cone reaches the plane."""
+    reduced2 = mu**2 * plane.cos**2 - plane.sin**2
+    cos_beta = 1 / np.sqrt(1 + np.maximum(reduced2, 0))
+    return plane.rows(cos_beta, np.sqrt(1 - cos_beta**2)), (reduced2 > 0).all(axis=1) & ~np.isnan(mu).any(axis=1)
+
+
+def internal_inside(points, unit, geo, mu):
+    """A unit squeeze strictly inside every cone ``mu`` (``(n, 3)``), NaN where there is none.
+
+    ``points (n, 3, 3)``, unit normals, their :func:`~grasptwist.engine.forces.grasp_map.geometry`
+    (every row non-degenerate) and ``mu (n, 3)``.
+    """
+    with np.errstate(all="ignore"):
+        plane = _Plane(points, unit, geo)
+        rows, reach = _own_rows(plane, mu)
+        ok, s = closure_test(rows)
+    return np.where((ok & reach & (plane.cos > 0).all(axis=1))[:, None], s, np.nan)
 
 
 def _at_theta(plane, theta):
@@ -261,12 +280,8 @@ def _closure_rows(p, n, mu, quality, edges, tol):
             status[rows[none]] = ForceStatus.NO_CLOSURE
             culprit[rows[none]] = np.where(perpendicular.any(axis=1), np.argmax(perpendicular, axis=1), -1)[none]
             if mu is not None:
-                own = mu[rows]
-                reduced2 = own**2 * plane.cos**2 - plane.sin**2
-                cos_beta = 1 / np.sqrt(1 + np.maximum(reduced2, 0))
-                fine = (reduced2 > 0).all(axis=1) & ~np.isnan(own).any(axis=1)
-                ok = closure_test(plane.rows(cos_beta, np.sqrt(1 - cos_beta**2)))[0]
-                closes[rows] = fine & ok & ~none
+                own, reach = _own_rows(plane, mu[rows])
+                closes[rows] = reach & closure_test(own)[0] & ~none
     epsilon = None
     if quality:
         epsilon = np.where(np.isfinite(p).all(axis=(1, 2)) & np.isfinite(n).all(axis=(1, 2)), 0.0, np.nan)

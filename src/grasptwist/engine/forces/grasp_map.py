@@ -45,6 +45,8 @@ __all__ = [
     "manipulating_reference",
     "squeeze_directions",
     "squeeze_forces",
+    "tangent_bases",
+    "contact_matrices",
     "manipulating_forces",
     "ManipulatingForces",
 ]
@@ -376,3 +378,29 @@ def manipulating_forces(points, wrench, *, tol=DEGENERACY_TOL) -> ManipulatingFo
     status[bad] = ForceStatus.NONFINITE_INPUT
     f[bad] = np.nan
     return ManipulatingForces(f, geo.conditioning, status, culprit)
+
+
+def tangent_bases(normals):
+    """Two unit tangents ``(b1, b2)`` at each contact, ``b2 = n x b1``: ``(..., 3, 3) -> 2 x (..., 3, 3)``.
+
+    >>> b1, b2 = tangent_bases(np.eye(3))
+    >>> (b1[2] + 0.0).tolist(), (b2[2] + 0.0).tolist()
+    ([0.0, 1.0, 0.0], [-1.0, 0.0, 0.0])
+    """
+    n = np.asarray(normals, dtype=float)
+    pick = np.where((np.abs(n[..., 0]) < 0.9)[..., None], [1.0, 0, 0], [0, 1.0, 0])
+    b1 = cross(n, pick)
+    b1 = b1 / norm(b1)[..., None]
+    return b1, cross(n, b1)
+
+
+def contact_matrices(e):
+    """``M[..., i, :, l]``: the force on contact ``i`` of a unit squeeze ``l``: ``(..., 3, 3) -> (..., 3, 3, 3)``.
+
+    Squeeze ``l`` pushes contact ``i`` (``i != l``) towards the third contact; ``M[i, :, i] = 0``.
+    """
+    m = np.zeros(e.shape[:-2] + (3, 3, 3))
+    for i in range(3):
+        m[..., i, :, K[i]] = e[..., K[i], :]
+        m[..., i, :, J[i]] = -e[..., J[i], :]
+    return m

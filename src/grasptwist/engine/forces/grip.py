@@ -19,19 +19,21 @@ import numpy as np
 
 from ..checks import check_normals, check_points
 from ..degeneracy import DEGENERACY_TOL
-from ..screws import J, K, cross, dot, norm
-from . import socp
+from ..screws import cross, dot, norm
+from . import closure, socp
 from .grasp_map import (
     ForceStatus,
     _manipulating,
     check_friction,
     check_safety,
     check_wrench,
+    contact_matrices,
     geometry,
     squeeze_forces,
+    tangent_bases,
 )
 
-__all__ = ["Grip", "grip", "contact_matrices", "tangent_bases"]
+__all__ = ["Grip", "grip", "cone_rows"]
 
 #: A wrench reproduced to this, relative to the forces' size, counts as made (frictionless grasps).
 RESIDUAL_TOL = 1e-9
@@ -82,32 +84,6 @@ class Grip:
     def ok(self) -> np.ndarray:
         """``status == 0`` per row."""
         return self.status == ForceStatus.OK
-
-
-def tangent_bases(normals):
-    """Two unit tangents ``(b1, b2)`` at each contact, ``b2 = n x b1``: ``(..., 3, 3) -> 2 x (..., 3, 3)``.
-
-    >>> b1, b2 = tangent_bases(np.eye(3))
-    >>> (b1[2] + 0.0).tolist(), (b2[2] + 0.0).tolist()
-    ([0.0, 1.0, 0.0], [-1.0, 0.0, 0.0])
-    """
-    n = np.asarray(normals, dtype=float)
-    pick = np.where((np.abs(n[..., 0]) < 0.9)[..., None], [1.0, 0, 0], [0, 1.0, 0])
-    b1 = cross(n, pick)
-    b1 = b1 / norm(b1)[..., None]
-    return b1, cross(n, b1)
-
-
-def contact_matrices(e):
-    """``M[..., i, :, l]``: the force on contact ``i`` of a unit squeeze ``l``: ``(..., 3, 3) -> (..., 3, 3, 3)``.
-
-    Squeeze ``l`` pushes contact ``i`` (``i != l``) towards the third contact; ``M[i, :, i] = 0``.
-    """
-    m = np.zeros(e.shape[:-2] + (3, 3, 3))
-    for i in range(3):
-        m[..., i, :, K[i]] = e[..., K[i], :]
-        m[..., i, :, J[i]] = -e[..., J[i], :]
-    return m
 
 
 def _frictionless(nu, w, tol):
@@ -207,7 +183,9 @@ def _grip_rows(p, n, w, mu, s_f, tol):
 
     rest = np.flatnonzero((status == 0) & (scale > 0) & ~frictionless)
     if rest.size:
-        squeeze[rest], fail, blame = _solve(geo.e[rest], unit[rest], fm[rest] / scale[rest, None, None], mu[rest] / s_f)
+        limit = mu[rest] / s_f
+        inside = closure.internal_inside(p[rest], unit[rest], geometry(p[rest], tol), limit)
+        squeeze[rest], fail, blame = _solve(geo.e[rest], unit[rest], fm[rest] / scale[rest, None, None], limit, inside)
         squeeze[rest] *= scale[rest, None]
         status[rest[fail]], culprit[rest[fail]] = ForceStatus.CANNOT_HOLD, blame[fail]
 
@@ -263,12 +241,27 @@ def cone_rows(e, unit, fm, kappa):
     return A, b, A[:, :, 0, :].sum(axis=1)
 
 
-def _solve(e, unit, fm, limit):
-    """The grip's squeezes for rows scaled to order one; failing rows and their culprits."""
+def _solve(e, unit, fm, limit, inside):
+    """The grip's squeezes for rows scaled to order one; failing rows and their culprits.
+
+    ``inside (n, 3)``: a squeeze strictly inside every cone (NaN where the grasp is not
+    force closure with ``limit``); far enough along it is a start for phase II, so
+    phase I runs only for the other rows.
+    """
     with np.errstate(divide="ignore"):
         kappa = np.where(np.isinf(limit), 0.0, 1 / limit)
     A, b, c = cone_rows(e, unit, fm, kappa)
-    x, r = socp.phase_one(A, b)
+    x = np.zeros((len(e), 3))
+    r = np.full(len(e), -1.0)
+    closing = ~np.isnan(inside).any(axis=1)
+    if closing.any():
+        y = np.einsum("nmkd,nd->nmk", A[closing], inside[closing])
+        depth = y[..., 0] - np.sqrt(y[..., 1] ** 2 + y[..., 2] ** 2)  # > 0: strictly inside
+        reach = np.abs(b[closing, :, 0]) + np.sqrt(b[closing, :, 1] ** 2 + b[closing, :, 2] ** 2)
+        x[closing] = ((socp.START_MARGIN + reach) / depth).max(axis=1)[:, None] * inside[closing]
+    other = np.flatnonzero(~closing)
+    if other.size:
+        x[other], r[other] = socp.phase_one(A[other], b[other])
     fail = ~(r < 0)
     s = np.full((len(e), 3), np.nan)
     good = np.flatnonzero(~fail)
@@ -277,10 +270,16 @@ def _solve(e, unit, fm, limit):
     blame = np.full(len(e), -1, np.int8)
     bad = np.flatnonzero(fail)
     if bad.size:
-        # with unlimited friction (half-spaces n.f >= 0) still infeasible: the wrench needs pulling
-        A0, b0, _ = cone_rows(e[bad], unit[bad], fm[bad], np.zeros((bad.size, 3)))
-        _, r0 = socp.phase_one(A0, b0)
         y = np.einsum("nmkd,nd->nmk", A[bad], x[bad]) + b[bad]
-        worst = np.argmax(np.sqrt(y[..., 1] ** 2 + y[..., 2] ** 2) - y[..., 0], axis=1)
-        blame[bad] = np.where(r0 < 0, worst, -1)
+        blame[bad] = np.argmax(np.sqrt(y[..., 1] ** 2 + y[..., 2] ** 2) - y[..., 0], axis=1)
+        # Pulling: infeasible even with unlimited friction (half-spaces n.f >= 0).  When the
+        # squeezes reach every pattern of normal forces (an invertible 3 x 3 map) it never is.
+        normal = A[bad, :, 0, :]
+        scale = np.prod(np.linalg.norm(normal, axis=-1), axis=-1)
+        maybe = np.flatnonzero(~(np.abs(np.linalg.det(normal)) > 1e-9 * scale))
+        if maybe.size:
+            rows = bad[maybe]
+            A0, b0, _ = cone_rows(e[rows], unit[rows], fm[rows], np.zeros((rows.size, 3)))
+            _, r0 = socp.phase_one(A0, b0)
+            blame[rows] = np.where(r0 < 0, blame[rows], -1)
     return s, fail, blame

@@ -16,7 +16,8 @@ with ``x`` of 3 (or 4) numbers: the grip's three squeezes.  The barrier
 to ``t_m + r >= |z_m|`` and ``r >= -1``, from ``x = 0`` and an ``r`` that makes the
 start feasible: a row whose ``r`` ends below 0 has an interior point, one whose ``r``
 stays above the duality gap has none (``cannot-hold``).  **Phase II** then follows the
-central path from there, ``tau = 1, 10, ..., TAU_END``.  The rows are scaled by their
+central path from there, ``tau = 1, 100, ..., TAU_END``, centring roughly
+(``lambda^2 < 0.01``) on the way and a little closer (``1e-4``) at the end.  The rows are scaled by their
 caller so that the numbers are of order one (the wrench's manipulating forces), so
 ``TAU_END = 1e10`` leaves a gap of ``6e-10`` of that scale.
 
@@ -33,9 +34,12 @@ __all__ = ["TAU_END", "phase_one", "minimise"]
 #: The last barrier weight: the objective ends within ``6 / TAU_END`` of the optimum.
 TAU_END = 1e10
 
-_TAUS = 10.0 ** np.arange(0, 11)
+_TAUS = np.array([1.0, 1e2, 1e4, 1e6, 1e8, 1e10])
 _NEWTON_CAP = 40  # per weight; a centred row needs 3-6 after a tenfold increase
-_DONE = 1e-9  # squared Newton decrement below which a row is centred (objective within ~1e-9 / tau)
+# Squared Newton decrement below which a row counts as centred at the last weight: the objective is
+# then within (6 + lambda sqrt(6)) / tau of the optimum (self-concordance), so a rough centre does.
+_DONE = 1e-4
+_ROUGH = 1e-2  # enough centring on the way (the next weight's steps start from near the path)
 _J = np.array([1.0, -1.0, -1.0])
 
 #: Phase I stops a row whose every cone holds ``t - |z| >= START_MARGIN`` (of the row's scale).
@@ -52,7 +56,7 @@ def _inside(y, q):
     return (q > 0).all(axis=-1) & (y[..., 0] > 0).all(axis=-1)
 
 
-def _centre(A, b, c, x, tau, bounded):
+def _centre(A, b, c, x, tau, bounded, done=_ROUGH):
     """Damped Newton on ``tau c^T x + barrier`` until every row is centred (in place on ``x``).
 
     Each step works on the rows not yet centred only.  In phase I (``bounded``) a row
@@ -94,7 +98,7 @@ def _centre(A, b, c, x, tau, bounded):
                 break
             step = np.where(ok, step, step / 2)
         x[rows] = np.where(ok[:, None], trial, xx)
-        going = (lam2 > _DONE) & ok
+        going = (lam2 > done) & ok
         if bounded:
             going &= x[rows, -1] > -START_MARGIN
         rows = rows[going]
@@ -125,7 +129,7 @@ def phase_one(A, b):
         _centre(wide[rows], b[rows], c[rows], xx, tau, bounded=True)
         x[rows] = xx
         r = xx[:, d]
-        rows = rows[(r > -START_MARGIN) & (np.abs(r) <= 7 / tau)]
+        rows = rows[(r > -START_MARGIN) & (np.abs(r) <= 10 / tau)]  # 7 / tau, with room for rough centring
     return x[:, :d], x[:, d]
 
 
@@ -133,5 +137,5 @@ def minimise(A, b, c, x):
     """Follow the central path from the strictly feasible ``x`` to ``TAU_END``; returns ``x (n, d)``."""
     x = x.copy()
     for tau in _TAUS:
-        _centre(A, b, c, x, tau, bounded=False)
+        _centre(A, b, c, x, tau, bounded=False, done=_DONE if tau == _TAUS[-1] else _ROUGH)
     return x
