@@ -21,7 +21,8 @@ common ``mu`` is found by bisection on ``theta = atan(mu)`` between ``max_i phi_
 ``pi/2`` (45 halvings, every row at once).
 
 **Epsilon** (Ferrari-Canny): each cone an ``m``-sided pyramid of edges
-``n_i + mu_i (cos(2 pi k/m) b1_i + sin(2 pi k/m) b2_i)`` (normal component 1), each edge
+``n_i + mu_i (cos(2 pi k/m) b1_i + sin(2 pi k/m) b2_i)`` (normal component 1; ``b1_i`` the
+tangent towards the next contact, so the pyramids turn with the grasp), each edge
 the wrench ``(f; (p_i - g) x f / L)`` with ``g`` the contacts' centroid and ``L`` the
 largest distance from ``g`` to a contact (so epsilon is a force, in units of the normal
 force, unchanged by rigid motions and by scaling); the radius of the largest ball about
@@ -39,7 +40,7 @@ import numpy as np
 from ..checks import check_normals, check_points
 from ..degeneracy import DEGENERACY_TOL
 from ..screws import cross, dot, norm
-from .grasp_map import ForceStatus, check_friction, contact_matrices, geometry, tangent_bases
+from .grasp_map import ForceStatus, check_friction, contact_matrices, geometry
 
 __all__ = ["Closure", "force_closure", "closure_test", "epsilon_quality", "BISECTIONS", "MAX_FRICTION"]
 
@@ -132,9 +133,10 @@ def closure_test(rows):
 
 def _own_rows(plane, mu):
     """The sector rows with each contact's own ``mu_i``, and whether every cone reaches the plane."""
-    reduced2 = mu**2 * plane.cos**2 - plane.sin**2
+    reduced2 = mu**2 * plane.cos**2 - plane.sin**2  # tan^2(beta)
     cos_beta = 1 / np.sqrt(1 + np.maximum(reduced2, 0))
-    return plane.rows(cos_beta, np.sqrt(1 - cos_beta**2)), (reduced2 > 0).all(axis=1) & ~np.isnan(mu).any(axis=1)
+    rows = plane.rows(cos_beta, np.sqrt(np.maximum(reduced2, 0)) * cos_beta)
+    return rows, (reduced2 > 0).all(axis=1) & ~np.isnan(mu).any(axis=1)
 
 
 def internal_inside(points, unit, geo, mu):
@@ -151,8 +153,11 @@ def internal_inside(points, unit, geo, mu):
 
 
 def _at_theta(plane, theta):
-    cos_beta = np.minimum(np.cos(theta)[:, None] / plane.cos, 1.0)
-    return closure_test(plane.rows(cos_beta, np.sqrt(1 - cos_beta**2)))[0]
+    # sin^2(beta) = (sin^2 theta - sin^2 phi) / cos^2 phi, as a product that keeps small angles exact
+    t = theta[:, None]
+    phi = np.arcsin(np.minimum(plane.sin, 1.0))
+    sin_beta = np.sqrt(np.maximum(np.sin(t - phi) * np.sin(t + phi), 0)) / plane.cos
+    return closure_test(plane.rows(np.minimum(np.cos(t) / plane.cos, 1.0), sin_beta))[0]
 
 
 def _least_friction(plane):
@@ -161,7 +166,7 @@ def _least_friction(plane):
     lo = np.arcsin(np.minimum(plane.sin.max(axis=1), 1.0))
     hi = np.full(rows, np.arctan(MAX_FRICTION))
     some = _at_theta(plane, hi)
-    at_lo = _at_theta(plane, lo + 1e-13 * (1 + lo))
+    at_lo = _at_theta(plane, lo + 1e-9)  # then the answer is max tan(phi_i), to 1e-9 rad
     todo = np.flatnonzero(some & ~at_lo)
     a, b = lo[todo], hi[todo]
     for _ in range(BISECTIONS):
@@ -194,7 +199,10 @@ def epsilon_quality(points, normals, friction, cone_edges=8):
     p = np.asarray(points, float)
     n = np.asarray(normals, float)
     n = n / np.linalg.norm(n, axis=-1, keepdims=True)
-    b1, b2 = tangent_bases(n)
+    # the pyramids' first edges towards the next contact, so that epsilon is the grasp's own figure
+    b1 = (p[[1, 2, 0]] - p) - np.einsum("ij,ij->i", p[[1, 2, 0]] - p, n)[:, None] * n
+    b1 /= np.linalg.norm(b1, axis=1, keepdims=True)
+    b2 = np.cross(n, b1)
     angle = 2 * np.pi * np.arange(cone_edges) / cone_edges
     mu = np.broadcast_to(np.asarray(friction, float), (3,))
     f = n[:, None, :] + mu[:, None, None] * (

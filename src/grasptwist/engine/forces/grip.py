@@ -95,7 +95,8 @@ def _frictionless(nu, w, tol):
     k = np.swapaxes(nu, -1, -2)  # (n, 6, 3)
     u, sv, vt = np.linalg.svd(k, full_matrices=False)
     rank3 = sv[:, 2] > tol * sv[:, 0]
-    inv = np.where(rank3[:, None], 1 / sv, np.where(np.arange(3) < 2, 1 / sv, 0.0))
+    with np.errstate(divide="ignore"):
+        inv = np.where(rank3[:, None] | (np.arange(3) < 2), 1 / sv, 0.0)
     lam = np.einsum("nji,nj,nkj,nk->ni", vt, inv, u, w)  # the least-squares lambda
     made = norm_rows(np.einsum("nij,nj->ni", k, lam) - w) <= tol * np.maximum(norm_rows(w), 1e-300)
     z = vt[:, 2]  # the null direction when rank 2: a free squeeze along the normals
