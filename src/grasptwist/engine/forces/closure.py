@@ -51,6 +51,9 @@ BISECTIONS = 45
 MAX_FRICTION = 1e7
 
 _PAIRS = np.array(list(combinations(range(6), 2)))
+
+#: Rows per chunk of the closure test.
+CHUNK = 8192
 _STRICT = 1e-12  # margins of unit rows and directions below this are not strict
 
 
@@ -103,7 +106,8 @@ class _Plane:
         """The six unit rows ``R (n, 6, 3)`` of the sectors with half-angles ``beta_i``."""
         plus = sin_beta[..., None] * self.m - cos_beta[..., None] * self.perp
         minus = sin_beta[..., None] * self.m + cos_beta[..., None] * self.perp
-        r = np.einsum("nikl,nisk->nisl", self.M, np.stack((plus, minus), axis=-2)).reshape(-1, 6, 3)
+        v = np.stack((plus, minus), axis=-2)  # (n, 3, 2 edges, 2 xy)
+        r = (self.M[:, :, None, 0, :] * v[..., 0, None] + self.M[:, :, None, 1, :] * v[..., 1, None]).reshape(-1, 6, 3)
         return r / np.linalg.norm(r, axis=-1, keepdims=True)
 
 
@@ -111,24 +115,43 @@ def closure_test(rows):
     """Whether ``R s > 0`` has a solution, and one (``(n, 6, 3)`` unit rows -> ``(n)`` bool, ``(n, 3)``).
 
     Candidates ``+-(r_a x r_b)``; those inside the closed cone are its extreme rays and
-    their sum is an interior point if there is any.
+    their sum is an interior point if there is any.  Computed components-first in
+    chunks of :data:`CHUNK` rows (the 6 x 15 products of a chunk stay in cache).
 
     >>> ok, s = closure_test(np.array([np.eye(3).tolist() * 2]))
     >>> bool(ok[0]), s[0].round(4).tolist()
     (True, [0.5774, 0.5774, 0.5774])
     """
-    c = np.cross(rows[:, _PAIRS[:, 0]], rows[:, _PAIRS[:, 1]])
-    length = np.linalg.norm(c, axis=-1, keepdims=True)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        c = np.concatenate((c, -c), axis=1) / np.concatenate((length, length), axis=1)
-    dots = np.einsum("nri,nci->nrc", rows, c)
-    inside = (dots >= -_STRICT).all(axis=1) & (np.concatenate((length, length), axis=1)[..., 0] > _STRICT)
-    s = np.where(inside[..., None], np.nan_to_num(c), 0.0).sum(axis=1)
-    s_len = np.linalg.norm(s, axis=-1)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        s = s / s_len[:, None]
-        ok = (s_len > _STRICT) & ((rows @ s[..., None])[..., 0] > _STRICT).all(axis=1)
+    ok = np.empty(len(rows), bool)
+    s = np.empty((len(rows), 3))
+    for start in range(0, len(rows), CHUNK):
+        part = slice(start, start + CHUNK)
+        ok[part], s[part] = _closure_chunk(np.ascontiguousarray(np.moveaxis(rows[part], 0, -1)))
     return ok, s
+
+
+def _closure_chunk(r):
+    """:func:`closure_test` on components-first rows ``(6, 3, n)``."""
+    a, b = r[_PAIRS[:, 0]], r[_PAIRS[:, 1]]  # (15, 3, n)
+    c = np.stack(
+        (
+            a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1],
+            a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2],
+            a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0],
+        )
+    )  # (3, 15, n)
+    length = np.sqrt(c[0] ** 2 + c[1] ** 2 + c[2] ** 2)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        c /= length
+    d = r[:, 0, None] * c[0] + r[:, 1, None] * c[1] + r[:, 2, None] * c[2]  # (6, 15, n)
+    real = length > _STRICT
+    sign = ((d >= -_STRICT).all(axis=0) & real).astype(float) - ((d <= _STRICT).all(axis=0) & real)
+    s = (np.nan_to_num(c) * sign).sum(axis=1)  # (3, n): the sum of the extreme rays found
+    s_len = np.sqrt(s[0] ** 2 + s[1] ** 2 + s[2] ** 2)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        s /= s_len
+        ok = (s_len > _STRICT) & ((r[:, 0] * s[0] + r[:, 1] * s[1] + r[:, 2] * s[2]) > _STRICT).all(axis=0)
+    return ok, s.T
 
 
 def _own_rows(plane, mu):
@@ -169,9 +192,10 @@ def _least_friction(plane):
     at_lo = _at_theta(plane, lo + 1e-9)  # then the answer is max tan(phi_i), to 1e-9 rad
     todo = np.flatnonzero(some & ~at_lo)
     a, b = lo[todo], hi[todo]
+    sub = _subset(plane, todo)
     for _ in range(BISECTIONS):
         mid = 0.5 * (a + b)
-        ok = _at_theta(_subset(plane, todo), mid)
+        ok = _at_theta(sub, mid)
         a, b = np.where(ok, a, mid), np.where(ok, mid, b)
     theta = np.where(at_lo, lo, np.nan)
     theta[todo] = b
