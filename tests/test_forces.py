@@ -144,12 +144,13 @@ def test_a_ball_held_at_its_equator_needs_mg_over_mu_in_total():
     assert gt.grip(EQ, -EQ, np.zeros(6), 0.5).total_normal_force == 0.0
 
 
-def test_the_least_grip_equals_clarabels_and_holds():
-    p, n, w, mu = grasps(40, 4)
+@pytest.mark.parametrize("count", [40, pytest.param(3000, marks=pytest.mark.slow)])
+def test_the_least_grip_equals_clarabels_and_holds(count):
+    p, n, w, mu = grasps(count, 4)
     g = gt.grip(p, n, w, mu, safety=1.2)
-    refs = [least_grip(p[k], n[k], w[k], mu[k], 1.2)[0] for k in range(40)]
+    refs = [least_grip(p[k], n[k], w[k], mu[k], 1.2)[0] for k in range(count)]
     solved = np.array([r is not None for r in refs])
-    assert ((g.status == 0) == solved).all() and solved.sum() >= 20
+    assert ((g.status == 0) == solved).all() and solved.sum() >= count / 2
     ref = np.array([r for r in refs if r is not None])
     assert np.abs(g.total_normal_force[solved] / ref - 1).max() < 1e-6
     ok = g.ok
@@ -206,11 +207,12 @@ def test_example_2_closes_above_one_over_root_two():
     assert c.force_closure.tolist() == [False, True]
 
 
-def test_closure_friction_equals_clarabels():
-    p, n, _, _ = grasps(25, 6, spread=0.6)
+@pytest.mark.parametrize("count", [12, pytest.param(300, marks=pytest.mark.slow)])
+def test_closure_friction_equals_clarabels(count):
+    p, n, _, _ = grasps(count, 6, spread=0.6)
     c = gt.force_closure(p, n)
-    ref = np.array([clarabel_closure_friction(p[k], n[k]) for k in range(25)])
-    assert (np.isnan(ref) == np.isnan(c.closure_friction)).all() and np.isfinite(ref).sum() >= 20
+    ref = np.array([clarabel_closure_friction(p[k], n[k]) for k in range(count)])
+    assert (np.isnan(ref) == np.isnan(c.closure_friction)).all() and np.isfinite(ref).sum() >= 0.6 * count
     ok = np.isfinite(ref)
     assert np.abs(c.closure_friction[ok] / ref[ok] - 1).max() < 1e-6
 

@@ -35,6 +35,10 @@ from .grasp_map import (
 
 __all__ = ["Grip", "grip", "cone_rows"]
 
+#: Rows solved together: enough for numpy's per-call cost to be noise, few enough for the
+#: solver's temporaries to stay in the CPU cache.
+CHUNK = 8192
+
 #: A wrench reproduced to this, relative to the forces' size, counts as made (frictionless grasps).
 RESIDUAL_TOL = 1e-9
 
@@ -184,11 +188,15 @@ def _grip_rows(p, n, w, mu, s_f, tol):
 
     rest = np.flatnonzero((status == 0) & (scale > 0) & ~frictionless)
     if rest.size:
-        limit = mu[rest] / s_f
-        inside = closure.internal_inside(p[rest], unit[rest], geometry(p[rest], tol), limit)
-        squeeze[rest], fail, blame = _solve(geo.e[rest], unit[rest], fm[rest] / scale[rest, None, None], limit, inside)
-        squeeze[rest] *= scale[rest, None]
-        status[rest[fail]], culprit[rest[fail]] = ForceStatus.CANNOT_HOLD, blame[fail]
+        for start in range(0, rest.size, CHUNK):  # chunks whose temporaries stay in cache
+            part = rest[start : start + CHUNK]
+            limit = mu[part] / s_f
+            inside = closure.internal_inside(p[part], unit[part], geometry(p[part], tol), limit)
+            squeeze[part], fail, blame = _solve(
+                geo.e[part], unit[part], fm[part] / scale[part, None, None], limit, inside
+            )
+            squeeze[part] *= scale[part, None]
+            status[part[fail]], culprit[part[fail]] = ForceStatus.CANNOT_HOLD, blame[fail]
 
     bare = np.flatnonzero((status == 0) & (scale > 0) & frictionless)
     if bare.size:
