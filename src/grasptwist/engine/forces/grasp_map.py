@@ -245,7 +245,11 @@ def squeeze_forces(points, squeeze) -> np.ndarray:
     .. math:: f_j \mathrel{+}= s_i e_i, \qquad f_k \mathrel{-}= s_i e_i \qquad (i, j, k \text{ cyclic})
 
     ``s_i > 0`` pushes contacts ``j`` and ``k`` towards each other (compresses the
-    object along the side ``p_j p_k``).  ``(..., 3, 3), (..., 3) -> (..., 3, 3)``.
+    object along the side ``p_j p_k``).  The side is the axis of ``Sigma_i`` (eq. 8), so
+    the two halves are the wrenches ``+-s_i Sigma_i``; each does the power
+    ``+-s_i [Sigma_i | T]`` on a twist ``T``, which vanishes for every ``Sigma_m`` and for
+    ``Psi_m``, ``Theta_m`` with ``m != i`` (lines meeting the side), not for ``Psi_i``,
+    ``Theta_i``.  ``(..., 3, 3), (..., 3) -> (..., 3, 3)``.
 
     >>> p = np.array([[0, 2, 2], [2, 0, 2], [2, 2, 0]], float)
     >>> f = squeeze_forces(p, [1.0, 2.0, 3.0])
