@@ -1,0 +1,13 @@
+"""The force side of the grasp: how hard each finger must press (issue 19).
+
+- ``grasp_map``: the grasp map ``G``, Yoshikawa-Nagai's manipulating forces ``G^+ w``
+  in closed form, the squeezes (internal forces) along the sides of the contact
+  triangle, the status codes and the ``check_*`` validators;
+- ``socp``: a batched barrier method for the three-cone problems (no loop over grasps);
+- ``grip``: the least total normal force that holds a wrench within the friction cones;
+- ``closure``: force closure, the least common friction that gives it, and the
+  Ferrari-Canny ``epsilon``.
+
+Conventions (docs/guide/forces.md): a wrench is ``(force; moment about the origin)``,
+normals point into the object, a finger pushes (``f_i . n_i >= 0``), ``w = G f``.
+"""

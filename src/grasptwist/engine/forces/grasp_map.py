@@ -1,0 +1,410 @@
+r"""The grasp map, the manipulating forces and the squeezes.
+
+Contact ``i`` pushes on the object with a force ``f_i`` at ``p_i``; as a wrench
+``(f_i; p_i x f_i)`` (force; moment about the origin), so the fingers' resultant is
+
+.. math:: w = G f = \sum_i \begin{pmatrix} f_i \\ p_i \times f_i \end{pmatrix}, \qquad G \in \mathbb{R}^{6 \times 9}.
+
+* **Manipulating forces** (Yoshikawa-Nagai, as the paper describes them: pseudo-inverse
+  plus null space): the minimum-norm ``f = G^+ w``.  With ``g`` the contacts' centroid,
+  ``q_i = p_i - g`` and the moment taken about ``g`` (``M_g = M - g x F``), ``G G^T`` is
+  block diagonal, ``diag(3 I, J)`` with ``J = sum_i (|q_i|^2 I - q_i q_i^T)``, so
+
+  .. math:: f_i = \tfrac13 F + \omega \times q_i, \qquad
+            \omega = J^{-1} M_g = \frac{m\,(m \cdot M_g)/t + 3 \sum_i q_i (q_i \cdot M_g)}{|m|^2}
+
+  (``m = (p_2 - p_1) x (p_3 - p_1)``, ``t = sum |q_i|^2``): the forces are the
+  "velocity field" of a rigid twist ``(omega; F/3)`` about the centroid.
+* **Squeezes** (the null space of ``G``): ``squeeze[i]`` pushes contacts ``j`` and
+  ``k`` towards each other along the side ``p_j p_k``, which is the axis of the paper's
+  ``Sigma_i`` (eq. 8): ``f_j = s_i e_i``, ``f_k = -s_i e_i``, ``e_i = (p_k - p_j)/|p_k - p_j|``.
+  As wrenches the two halves are ``+s_i Sigma_i`` and ``-s_i Sigma_i``.
+
+The statuses (:class:`ForceStatus`) share their numbers with the twist engine's
+:class:`~grasptwist.engine.degeneracy.Status` where the condition is the same.
+"""
+
+from __future__ import annotations
+
+from enum import IntEnum
+from typing import NamedTuple
+
+import numpy as np
+
+from ..checks import check_points
+from ..degeneracy import DEGENERACY_TOL
+from ..screws import J, K, cross, dot, norm
+
+__all__ = [
+    "ForceStatus",
+    "force_status_message",
+    "check_wrench",
+    "check_friction",
+    "check_safety",
+    "grasp_map",
+    "manipulating_reference",
+    "squeeze_directions",
+    "squeeze_forces",
+    "tangent_bases",
+    "contact_matrices",
+    "manipulating_forces",
+    "ManipulatingForces",
+]
+
+
+class ForceStatus(IntEnum):
+    """Why a row of a force result has no numbers (0: it has)."""
+
+    OK = 0
+    NONFINITE_INPUT = 1
+    COINCIDENT_CONTACTS = 2
+    COLLINEAR_CONTACTS = 3
+    ZERO_NORMAL = 5
+    CANNOT_HOLD = 20
+    NO_CLOSURE = 21
+    MIXED_FRICTIONLESS = 22
+
+    @property
+    def code(self) -> str:
+        """Kebab-case name for JSON output, e.g. ``cannot-hold``."""
+        return self.name.lower().replace("_", "-")
+
+
+_MESSAGES = {
+    ForceStatus.OK: "ok",
+    ForceStatus.NONFINITE_INPUT: "the input holds NaN or infinity",
+    ForceStatus.COINCIDENT_CONTACTS: "contacts {j} and {k} coincide, so the grasp map has rank < 6",
+    ForceStatus.COLLINEAR_CONTACTS: (
+        "the contacts are collinear, so no finger forces make a moment about their line (rank G < 6)"
+    ),
+    ForceStatus.ZERO_NORMAL: "the normal at contact {i} has zero length",
+    ForceStatus.NO_CLOSURE: "no friction makes the grasp force closure: {why}",
+    ForceStatus.MIXED_FRICTIONLESS: (
+        "contacts with and without friction in one grasp are not solved yet (give every contact mu > 0, or all 0)"
+    ),
+}
+_CANNOT_HOLD = {
+    True: "cannot-hold: the wrench needs a finger to pull (no pushing forces make it, whatever the friction)",
+    False: "cannot-hold: the friction cone at contact {i} is too narrow (mu/safety) for any forces that make the wrench",
+}
+
+
+def force_status_message(status, culprit=-1) -> str:
+    """One sentence for a row's status and culprit (a contact index, or -1).
+
+    For ``cannot-hold`` a culprit of -1 means the wrench needs pulling; for
+    ``no-closure`` a culprit is the contact whose normal is at right angles to
+    the contacts' plane.
+
+    >>> force_status_message(ForceStatus.CANNOT_HOLD, 2)
+    'cannot-hold: the friction cone at contact 3 is too narrow (mu/safety) for any forces that make the wrench'
+    >>> force_status_message(ForceStatus.NO_CLOSURE, 0)
+    "no friction makes the grasp force closure: the normal at contact 1 is at right angles to the contacts' plane"
+    """
+    s = ForceStatus(int(status))
+    c = int(culprit)
+    i, j, k = (c if c >= 0 else 0) + 1, (c + 1) % 3 + 1, (c + 2) % 3 + 1
+    if s == ForceStatus.CANNOT_HOLD:
+        return _CANNOT_HOLD[c < 0].format(i=i)
+    why = (
+        f"the normal at contact {i} is at right angles to the contacts' plane"
+        if c >= 0
+        else "no internal force pushes at all three contacts"
+    )
+    return _MESSAGES[s].format(i=i, j=j, k=k, why=why)
+
+
+# --- validators ------------------------------------------------------------------
+
+_WHAT = {"b": "booleans", "c": "complex numbers"}
+
+
+def _real(a, name):
+    try:
+        a = np.asarray(a)
+    except ValueError:
+        raise ValueError(f"{name} must be real numbers, got a ragged nested sequence") from None
+    if a.dtype.kind not in "fiu":
+        raise ValueError(f"{name} must hold real numbers, got {_WHAT.get(a.dtype.kind, f'dtype {a.dtype}')}")
+    return a.astype(float)
+
+
+def check_wrench(wrench) -> np.ndarray:
+    """The wrench the fingers must exert, ``(force; moment about the origin)``, shape ``(..., 6)``.
+
+    >>> check_wrench([0, 0, 9.81, 0, 0, 0]).shape
+    (6,)
+    >>> check_wrench([0, 0, 9.81])
+    Traceback (most recent call last):
+    ValueError: wrench must have shape (..., 6), got (3,)
+    """
+    a = _real(wrench, "wrench")
+    if a.shape[-1:] != (6,):
+        raise ValueError(f"wrench must have shape (..., 6), got {a.shape}")
+    return a
+
+
+def check_friction(friction) -> np.ndarray:
+    """Friction coefficients ``mu_i >= 0`` (``inf`` allowed), broadcast against ``(..., 3)``.
+
+    The last axis is the contact: a scalar is the same at every contact; one
+    coefficient per grasp for ``N`` grasps is ``friction[:, None]``.  NaN is a
+    row status, a negative value an error.
+
+    >>> check_friction(0.5).tolist()
+    0.5
+    >>> check_friction([0.5, -1, 0.5])
+    Traceback (most recent call last):
+    ValueError: friction must be >= 0, got -1.0
+    >>> check_friction([[0.5, 0.5], [0.5, 0.5]])
+    Traceback (most recent call last):
+    ValueError: friction must broadcast to (..., 3) (one per contact), got (2, 2)
+    """
+    a = _real(friction, "friction")
+    if a.ndim and a.shape[-1] not in (1, 3):
+        raise ValueError(f"friction must broadcast to (..., 3) (one per contact), got {a.shape}")
+    bad = a < 0
+    if bad.any():
+        raise ValueError(f"friction must be >= 0, got {float(a[bad].flat[0])!r}")
+    return a
+
+
+def check_safety(safety) -> float:
+    """The safety factor ``s >= 1`` (finite): the grip keeps every force within ``mu_i / s``.
+
+    >>> check_safety(1.5)
+    1.5
+    >>> check_safety(0.5)
+    Traceback (most recent call last):
+    ValueError: safety must be a finite number >= 1, got 0.5
+    """
+    try:
+        s = float(safety)
+    except (TypeError, ValueError):
+        raise ValueError(f"safety must be a finite number >= 1, got {safety!r}") from None
+    if isinstance(safety, bool) or not np.isfinite(s) or s < 1:
+        raise ValueError(f"safety must be a finite number >= 1, got {safety!r}")
+    return s
+
+
+# --- reference formulas (readable; the tests hold the fast forms to them) -----------
+
+
+def grasp_map(points) -> np.ndarray:
+    r"""The grasp map ``G`` (6 x 9): column block ``i`` is ``[I; [p_i]_x]``.
+
+    .. math:: G = \begin{pmatrix} I & I & I \\ [p_1]_\times & [p_2]_\times & [p_3]_\times \end{pmatrix}
+
+    ``(..., 3, 3) -> (..., 6, 9)``; ``G @ f.reshape(9)`` is the wrench of the forces ``f (3, 3)``.
+
+    >>> G = grasp_map([[0, 2, 2], [2, 0, 2], [2, 2, 0]])
+    >>> (G @ np.array([1.0, 0, 0, 0, 0, 0, 0, 0, 0])).tolist()
+    [1.0, 0.0, 0.0, 0.0, 2.0, -2.0]
+    """
+    p = np.asarray(points, dtype=float)
+    g = np.zeros(p.shape[:-2] + (6, 9))
+    eye = np.eye(3)
+    for i in range(3):
+        g[..., :3, 3 * i : 3 * i + 3] = eye
+        g[..., 3:, 3 * i : 3 * i + 3] = cross(p[..., i, None, :], eye)  # columns p_i x e_c
+        g[..., 3:, 3 * i : 3 * i + 3] = np.swapaxes(g[..., 3:, 3 * i : 3 * i + 3], -1, -2)
+    return g
+
+
+def manipulating_reference(points, wrench) -> np.ndarray:
+    """``G^+ w`` by LAPACK's pseudo-inverse: the definition :func:`manipulating_forces` is tested against.
+
+    ``(..., 3, 3), (..., 6) -> (..., 3, 3)``.
+
+    >>> manipulating_reference([[1, 0, 0], [-0.5, 0.75**0.5, 0], [-0.5, -(0.75**0.5), 0]], [0, 0, 3, 0, 0, 0]).round(6).tolist()
+    [[0.0, 0.0, 1.0], [0.0, 0.0, 1.0], [0.0, 0.0, 1.0]]
+    """
+    w = np.asarray(wrench, dtype=float)
+    f = np.linalg.pinv(grasp_map(points)) @ w[..., None]
+    return f[..., 0].reshape(w.shape[:-1] + (3, 3))
+
+
+def squeeze_directions(points) -> np.ndarray:
+    """Unit vectors ``e_i = (p_k - p_j) / |p_k - p_j|`` along the axis of ``Sigma_i`` (eq. 8).
+
+    ``(..., 3, 3) -> (..., 3, 3)``; a squeeze ``s_i`` is the force ``s_i e_i`` on
+    contact ``j`` and ``-s_i e_i`` on contact ``k``.
+
+    >>> squeeze_directions([[0, 0, 0], [2.0, 0, 0], [0, 2.0, 0]])[0].round(4).tolist()
+    [-0.7071, 0.7071, 0.0]
+    """
+    p = np.asarray(points, dtype=float)
+    d = p[..., K, :] - p[..., J, :]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return d / norm(d)[..., None]
+
+
+def squeeze_forces(points, squeeze) -> np.ndarray:
+    r"""The internal forces of the squeezes ``s``: an element of the null space of ``G``.
+
+    .. math:: f_j \mathrel{+}= s_i e_i, \qquad f_k \mathrel{-}= s_i e_i \qquad (i, j, k \text{ cyclic})
+
+    ``s_i > 0`` pushes contacts ``j`` and ``k`` towards each other (compresses the
+    object along the side ``p_j p_k``).  The side is the axis of ``Sigma_i`` (eq. 8), so
+    the two halves are the wrenches ``+-s_i Sigma_i``; each does the power
+    ``+-s_i [Sigma_i | T]`` on a twist ``T``, which vanishes for every ``Sigma_m`` and for
+    ``Psi_m``, ``Theta_m`` with ``m != i`` (lines meeting the side), not for ``Psi_i``,
+    ``Theta_i``.  ``(..., 3, 3), (..., 3) -> (..., 3, 3)``.
+
+    >>> p = np.array([[0, 2, 2], [2, 0, 2], [2, 2, 0]], float)
+    >>> f = squeeze_forces(p, [1.0, 2.0, 3.0])
+    >>> bool(np.allclose(grasp_map(p) @ f.reshape(9), 0))
+    True
+    """
+    e = squeeze_directions(points)
+    s = np.asarray(squeeze, dtype=float)[..., None]
+    # contact i gets +s_k e_k (it is the j of side k) and -s_j e_j (it is the k of side j)
+    return s[..., K, :] * e[..., K, :] - s[..., J, :] * e[..., J, :]
+
+
+# --- the closed form ------------------------------------------------------------------
+
+
+class Geometry(NamedTuple):
+    """What every force computation needs of the contacts (shapes for a batch ``...``)."""
+
+    centroid: np.ndarray  # (..., 3)
+    q: np.ndarray  # (..., 3, 3) contacts about the centroid
+    m: np.ndarray  # (..., 3) (p2 - p1) x (p3 - p1)
+    t: np.ndarray  # (...) sum |q_i|^2
+    size: np.ndarray  # (...) largest distance from the centroid to a contact
+    conditioning: np.ndarray  # (...)
+    e: np.ndarray  # (..., 3, 3) squeeze directions
+    status: np.ndarray  # (...) int8
+    culprit: np.ndarray  # (...) int8
+
+
+def geometry(points, tol=DEGENERACY_TOL) -> Geometry:
+    """The contacts' frame, conditioning and geometric status (non-finite, coincident, collinear)."""
+    p = np.asarray(points, dtype=float)
+    with np.errstate(all="ignore"):
+        g = p.mean(axis=-2)
+        q = p - g[..., None, :]
+        m = cross(p[..., 1, :] - p[..., 0, :], p[..., 2, :] - p[..., 0, :])
+        q2 = dot(q, q)
+        t = q2.sum(axis=-1)
+        size = np.sqrt(q2.max(axis=-1))
+        sides = norm(p[..., K, :] - p[..., J, :])
+        det = dot(m, m) / 3  # the product of the two in-plane eigenvalues of sum q_i q_i^T
+        lam = 2 * det / (t + np.sqrt(np.maximum(t * t - 4 * det, 0)))  # the smaller one, stably
+        conditioning = np.sqrt(2 * lam / t)
+        status = np.zeros(p.shape[:-2], np.int8)
+        culprit = np.full(p.shape[:-2], -1, np.int8)
+        coincident = sides <= tol * np.sqrt(t)[..., None]
+        worst = np.argmax(coincident, axis=-1).astype(np.int8)
+        status[~(conditioning > tol)] = ForceStatus.COLLINEAR_CONTACTS
+        hit = coincident.any(axis=-1) | ~(t > 0)
+        status[hit] = ForceStatus.COINCIDENT_CONTACTS
+        culprit[hit] = worst[hit]
+        bad = ~np.isfinite(p).all(axis=(-1, -2))
+        status[bad] = ForceStatus.NONFINITE_INPUT
+        culprit[bad] = -1
+        conditioning = np.where(status == 0, conditioning, np.where(bad, np.nan, 0.0))
+    return Geometry(g, q, m, t, size, conditioning, squeeze_directions(p), status, culprit)
+
+
+def _manipulating(geo: Geometry, wrench):
+    """``G^+ w`` in closed form for prepared contacts (NaN where the contacts are degenerate)."""
+    w = np.asarray(wrench, dtype=float)
+    force, moment = w[..., :3], w[..., 3:]
+    with np.errstate(all="ignore"):
+        mg = moment - cross(geo.centroid, force)  # the moment about the centroid
+        spread = 3 * np.sum(geo.q * dot(geo.q, mg[..., None, :])[..., None], axis=-2)
+        omega = (geo.m * (dot(geo.m, mg) / geo.t)[..., None] + spread) / dot(geo.m, geo.m)[..., None]
+        f = force[..., None, :] / 3 + cross(omega[..., None, :], geo.q)
+    return np.where((geo.status == 0)[..., None, None], f, np.nan)
+
+
+class ManipulatingForces(NamedTuple):
+    """Yoshikawa-Nagai's manipulating forces of a batch of (grasp, wrench) rows.
+
+    Attributes
+    ----------
+    force : (..., 3, 3)
+        ``G^+ w``, row ``i`` the force contact ``i`` exerts on the object; NaN
+        where ``status != 0``.
+    conditioning : (...)
+        ``sqrt(lambda_min / mean(lambda))`` of the contacts' second moment
+        ``sum_i q_i q_i^T`` about their centroid (its two in-plane eigenvalues):
+        1 for an equilateral triangle, falling like the offset from a line to 0
+        for collinear contacts.  ``G^+ w`` grows like ``1 / conditioning`` there.
+    status, culprit : (...) int8
+        :class:`ForceStatus` and the contact it is about (or -1).
+    """
+
+    force: np.ndarray
+    conditioning: np.ndarray
+    status: np.ndarray
+    culprit: np.ndarray
+
+
+def manipulating_forces(points, wrench, *, tol=DEGENERACY_TOL) -> ManipulatingForces:
+    r"""The minimum-norm finger forces that exert ``wrench``: ``f = G^+ w`` (Yoshikawa-Nagai).
+
+    .. math:: f_i = \tfrac13 F + \omega \times (p_i - g), \qquad \omega = J^{-1} (M - g \times F)
+
+    (module docstring).  Every other solution of ``G f = w`` is ``f`` plus
+    squeezes (:func:`squeeze_forces`), orthogonal to it.
+
+    Parameters
+    ----------
+    points : (..., 3, 3) array
+    wrench : (..., 6) array, ``(force; moment about the origin)``
+    tol : float
+        Below this conditioning the contacts count as collinear.
+
+    Returns
+    -------
+    ManipulatingForces
+
+    Examples
+    --------
+    Three fingers around a 1 kg ball's equator hold its weight, a third each:
+
+    >>> p = [[1, 0, 0], [-0.5, 0.75**0.5, 0], [-0.5, -(0.75**0.5), 0]]
+    >>> r = manipulating_forces(p, [0, 0, 9.81, 0, 0, 0])
+    >>> r.force[:, 2].round(4).tolist(), round(float(r.conditioning), 6)
+    ([3.27, 3.27, 3.27], 1.0)
+    """
+    p = check_points(points)
+    w = check_wrench(wrench)
+    shape = np.broadcast_shapes(p.shape[:-2], w.shape[:-1])
+    p, w = np.broadcast_to(p, shape + (3, 3)), np.broadcast_to(w, shape + (6,))
+    geo = geometry(p, tol)
+    f = _manipulating(geo, w)
+    status, culprit = geo.status.copy(), geo.culprit.copy()
+    bad = (status == 0) & ~np.isfinite(w).all(axis=-1)
+    status[bad] = ForceStatus.NONFINITE_INPUT
+    f[bad] = np.nan
+    return ManipulatingForces(f, geo.conditioning, status, culprit)
+
+
+def tangent_bases(normals):
+    """Two unit tangents ``(b1, b2)`` at each contact, ``b2 = n x b1``: ``(..., 3, 3) -> 2 x (..., 3, 3)``.
+
+    >>> b1, b2 = tangent_bases(np.eye(3))
+    >>> (b1[2] + 0.0).tolist(), (b2[2] + 0.0).tolist()
+    ([0.0, 1.0, 0.0], [-1.0, 0.0, 0.0])
+    """
+    n = np.asarray(normals, dtype=float)
+    pick = np.where((np.abs(n[..., 0]) < 0.9)[..., None], [1.0, 0, 0], [0, 1.0, 0])
+    b1 = cross(n, pick)
+    b1 = b1 / norm(b1)[..., None]
+    return b1, cross(n, b1)
+
+
+def contact_matrices(e):
+    """``M[..., i, :, l]``: the force on contact ``i`` of a unit squeeze ``l``: ``(..., 3, 3) -> (..., 3, 3, 3)``.
+
+    Squeeze ``l`` pushes contact ``i`` (``i != l``) towards the third contact; ``M[i, :, i] = 0``.
+    """
+    m = np.zeros(e.shape[:-2] + (3, 3, 3))
+    for i in range(3):
+        m[..., i, :, K[i]] = e[..., K[i], :]
+        m[..., i, :, J[i]] = -e[..., J[i], :]
+    return m

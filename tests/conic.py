@@ -1,0 +1,85 @@
+"""An independent conic solver (Clarabel) for the force side: the least grip and the least
+common friction of force closure, one grasp at a time, on the 9 contact-force numbers
+(no squeezes, no planar reduction): what the batched engine is tested and timed against."""
+
+import clarabel
+import numpy as np
+from scipy import sparse
+
+from grasptwist.engine.forces.grasp_map import grasp_map
+from grasptwist.engine.forces.grip import tangent_bases
+
+SETTINGS = {"verbose": False, "tol_gap_abs": 1e-11, "tol_gap_rel": 1e-11, "tol_feas": 1e-11}
+
+
+def _settings():
+    s = clarabel.DefaultSettings()
+    for k, v in SETTINGS.items():
+        setattr(s, k, v)
+    return s
+
+
+def _unit(normals):
+    n = np.asarray(normals, float)
+    return n / np.linalg.norm(n, axis=-1, keepdims=True)
+
+
+def least_grip(points, normals, wrench, friction, safety=1.0):
+    """``(total normal force, forces (3, 3))`` of the least grip, or ``(None, None)`` when infeasible."""
+    n = _unit(normals)
+    mu = np.broadcast_to(np.asarray(friction, float), (3,)) / safety
+    b1, b2 = tangent_bases(n)
+    rows = []
+    for i in range(3):
+        block = np.zeros((3, 9))
+        block[:, 3 * i : 3 * i + 3] = -np.stack((mu[i] * n[i], b1[i], b2[i]))
+        rows.append(block)
+    A = sparse.csc_matrix(np.vstack([grasp_map(points)] + rows))
+    b = np.concatenate((np.asarray(wrench, float), np.zeros(9)))
+    cones = [clarabel.ZeroConeT(6)] + [clarabel.SecondOrderConeT(3)] * 3
+    solver = clarabel.DefaultSolver(sparse.csc_matrix((9, 9)), n.reshape(9), A, b, cones, _settings())
+    sol = solver.solve()
+    if str(sol.status) not in ("Solved", "AlmostSolved"):
+        return None, None
+    return float(sol.obj_val), np.array(sol.x).reshape(3, 3)
+
+
+def closure_margin(points, normals, mu):
+    """The largest ``min_i (mu n_i.f_i - |f_t,i|)`` over internal forces with ``sum_i n_i . f_i = 1``."""
+    n = _unit(normals)
+    b1, b2 = tangent_bases(n)
+    # variables (f (9), t): maximise t s.t. G f = 0, sum n.f = 1, (mu n.f - t, f_t) in SOC
+    eq = np.zeros((7, 10))
+    eq[:6, :9] = grasp_map(points)
+    eq[6, :9] = n.reshape(9)
+    rows = []
+    for i in range(3):
+        block = np.zeros((3, 10))
+        block[:, 3 * i : 3 * i + 3] = -np.stack((mu * n[i], b1[i], b2[i]))
+        block[0, 9] = 1.0
+        rows.append(block)
+    A = sparse.csc_matrix(np.vstack([eq] + rows))
+    b = np.concatenate((np.zeros(6), [1.0], np.zeros(9)))
+    q = np.zeros(10)
+    q[9] = -1.0
+    cones = [clarabel.ZeroConeT(7)] + [clarabel.SecondOrderConeT(3)] * 3
+    sol = clarabel.DefaultSolver(sparse.csc_matrix((10, 10)), q, A, b, cones, _settings()).solve()
+    if str(sol.status) not in ("Solved", "AlmostSolved"):
+        return -np.inf
+    return -float(sol.obj_val)
+
+
+#: A margin (of unit total normal force) above this is strict: Clarabel returns ~1e-12 for a margin
+#: that is 0, e.g. when one cone meets the contacts' plane only at its apex and that finger carries nothing.
+STRICT = 1e-10
+
+
+def closure_friction(points, normals, hi=1e3, iterations=45):
+    """The least common ``mu`` with a positive closure margin, by bisection on ``mu``; NaN when none below ``hi``."""
+    if closure_margin(points, normals, hi) <= STRICT:
+        return np.nan
+    lo = 0.0
+    for _ in range(iterations):
+        mid = 0.5 * (lo + hi)
+        lo, hi = (lo, mid) if closure_margin(points, normals, mid) > STRICT else (mid, hi)
+    return hi
