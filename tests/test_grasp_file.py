@@ -18,8 +18,8 @@ from hypothesis import strategies as st
 
 from conftest import CONTACTS, LOADERS
 from grasptwist.engine import screws
-from grasptwist.io import grasp_file
-from grasptwist.io.grasp_file import (
+from grasptwist.io import grasp
+from grasptwist.io.grasp import (
     DEFAULT_MAX_BYTES,
     MAX_DEPTH,
     MAX_ERRORS,
@@ -730,9 +730,9 @@ def test_error_is_one_line_and_pickles():
 def test_schema_names_the_same_keys_as_the_loader():
     schema = grasp_schema()
     definitions = schema["$defs"]
-    assert tuple(schema["properties"]) == grasp_file.GRASP_KEYS
-    assert tuple(definitions["contact"]["properties"]) == grasp_file.CONTACT_KEYS
-    assert tuple(definitions["twist"]["properties"]) == grasp_file.TWIST_KEYS
+    assert tuple(schema["properties"]) == grasp.GRASP_KEYS
+    assert tuple(definitions["contact"]["properties"]) == grasp.CONTACT_KEYS
+    assert tuple(definitions["twist"]["properties"]) == grasp.TWIST_KEYS
     jsonschema.Draft202012Validator.check_schema(schema)
 
 

@@ -23,8 +23,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from conftest import CONTACTS, LOADERS
-from grasptwist.io import grasp_file
-from grasptwist.io.grasp_file import READING, Grasp, GraspFileError, Reading, read_grasps
+from grasptwist.io.grasp import READING, Grasp, GraspFileError, Reading, read_grasps, reader, text
 
 TESTS = Path(__file__).parent
 FILES = sorted(
@@ -312,7 +311,7 @@ def test_ordinary_grasps_take_the_fast_path(monkeypatch, loader):
     def fail(get_event):
         raise AssertionError("general path taken")
 
-    monkeypatch.setattr(grasp_file, "_compose", fail)
+    monkeypatch.setattr(reader, "compose", fail)
     bundled = sorted((TESTS.parent / "grasps").rglob("*.yaml"))
     # paths and hands are read by the general path only: files with them hold few grasps
     plain = [p for p in bundled if "\npaths:" not in p.read_text("utf-8") and "\nhand:" not in p.read_text("utf-8")]
@@ -331,7 +330,7 @@ def test_capped_read_in_chunks(size, tmp_path, monkeypatch):
     (entry,) = read_grasps(path, max_bytes=cap)
     assert entry.code == expected
     with open(path, "rb") as handle:
-        assert grasp_file._read_capped(handle, cap + 1) == b"#" * min(size, cap + 1)
+        assert text.read_capped(handle, cap + 1) == b"#" * min(size, cap + 1)
     monkeypatch.setattr(sys, "stdin", io.TextIOWrapper(io.BytesIO(b"#" * size)))
     (entry,) = read_grasps("-", max_bytes=cap)
     assert (entry.code, entry.file) == (expected, "<stdin>")

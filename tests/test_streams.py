@@ -26,7 +26,7 @@ from hypothesis import strategies as st
 from typer.testing import CliRunner
 
 from grasptwist.cli import EXIT_USAGE, app
-from grasptwist.io.grasp_file import read_line, read_twist_line
+from grasptwist.io.grasp import read_line, read_twist_line
 from grasptwist.io.lines import numbered_batches
 
 ROOT = Path(__file__).resolve().parents[1]

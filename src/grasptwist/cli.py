@@ -403,7 +403,7 @@ def _hand_option(path: str | None, paths: list[str], fmt: str):
     from .model import InputError
 
     if path is not None:
-        from .io.grasp_hand import load_hand_file
+        from .io.grasp import load_hand_file
 
         try:
             return load_hand_file(path)[0]
@@ -611,7 +611,7 @@ def schema(output: str | None = _OUTPUT, debug: bool = _DEBUG) -> None:
     \b
         grasptwist schema -o grasp.schema.json
     """
-    from .io.grasp_file import grasp_schema
+    from .io.grasp import grasp_schema
     from .output.records import dumps
 
     def job():

@@ -22,7 +22,8 @@ import sys
 from collections.abc import Iterable, Iterator
 
 from ..model import Grasp, GraspFileError
-from .grasp_file import DEFAULT_MAX_BYTES, NOT_REGULAR, read_grasps
+from .grasp import read_grasps
+from .limits import DEFAULT_MAX_BYTES, NOT_REGULAR
 
 __all__ = ["GRASP_SUFFIXES", "STDIN", "expand", "is_grasp_file", "read"]
 

@@ -23,8 +23,9 @@ import sys
 from collections.abc import Iterator
 
 from ..model import Grasp, GraspFileError, Twist
-from .grasp_file import DEFAULT_MAX_BYTES, NOT_REGULAR, read_grasps, read_line, read_twist_line
+from .grasp import read_grasps, read_line, read_twist_line
 from .inputs import STDIN
+from .limits import DEFAULT_MAX_BYTES, NOT_REGULAR
 
 __all__ = ["JSONL_SUFFIX", "is_json_lines", "numbered_batches", "grasp_batches", "twist_batches"]
 

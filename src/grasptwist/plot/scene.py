@@ -492,7 +492,7 @@ def joint_segments(hand, positions, half) -> tuple[Segment, ...]:
     """Each finger joint's axis at ``positions``: a segment of half-length ``half``
     through its point (a prismatic joint's along its direction).
 
-    >>> from grasptwist.io.grasp_hand import inline_hand
+    >>> from grasptwist.io.grasp import inline_hand
     >>> h = inline_hand(["a", "b", "c"], [[("j", "revolute", [0, 0, 2], [1, 0, 0], None, 1)]] * 3, None)
     >>> s = joint_segments(h, None, 0.5)[0]
     >>> s.label, s.start.tolist(), s.end.tolist()

@@ -1,0 +1,92 @@
+"""Problems as values: a located problem (:class:`Reject`) and a document's list of them.
+
+Every check of the loader adds its problems to a :class:`Problems` and goes
+on, so one pass finds them all; each becomes a
+:class:`~grasptwist.model.GraspFileError` when the document is done.
+"""
+
+from __future__ import annotations
+
+import re
+
+from ...model import GraspFileError
+
+__all__ = ["MAX_ERRORS", "Reject", "StreamStop", "Problems", "located", "located_mark", "join"]
+
+MAX_ERRORS = 100
+"""Most problems reported for one file (the first, in file order); one more
+``too-many-errors`` entry says how many were left out."""
+
+
+class Reject(Exception):
+    """Internal: one located problem, turned into a GraspFileError later."""
+
+    def __init__(self, code, path, problem, line=None, column=None):
+        super().__init__(code)
+        self.code = code
+        self.message = f"{path}: {problem}" if path else problem
+        self.line = line
+        self.column = column
+
+    def error(self, file, document):
+        return GraspFileError(self.code, self.message, file, self.line, self.column, document)
+
+
+class StreamStop(Reject):
+    """Internal: a problem after which the rest of the stream is not read."""
+
+
+class Problems:
+    """The problems of one document as they are found: the first ``keep`` of
+    them in file order, and how many there are in all.
+
+    At most ``2 * keep`` are held between trims, so a document with a
+    hundred thousand problems costs no more memory than one with ``keep``.
+    """
+
+    __slots__ = ("keep", "count", "_held")
+
+    def __init__(self, keep):
+        self.keep = keep
+        self.count = 0
+        self._held = []
+
+    def add(self, reject):
+        self.count += 1
+        if self.keep:
+            self._held.append(reject)
+            if len(self._held) >= 2 * self.keep:
+                self._trim()
+
+    def first(self):
+        """The problems kept, in file order (found order among equal positions)."""
+        self._trim()
+        return self._held
+
+    def _trim(self):
+        self._held.sort(key=_position)  # stable: ties stay in the order found
+        del self._held[self.keep :]
+
+
+def _position(reject):
+    return reject.line or 0, reject.column or 0
+
+
+def located(node):
+    """Keyword arguments locating a node (1-based)."""
+    return {"line": node.line, "column": node.column}
+
+
+def located_mark(mark):
+    """Keyword arguments locating a parser mark (0-based) as 1-based."""
+    return {"line": mark.line + 1, "column": mark.column + 1}
+
+
+_SIMPLE_KEY = re.compile(r"[A-Za-z_][A-Za-z0-9_-]*")
+
+
+def join(path, key):
+    """``path.key``, or ``path['key']`` for keys that do not read as names."""
+    if isinstance(key, str) and _SIMPLE_KEY.fullmatch(key):
+        return f"{path}.{key}" if path else key
+    return f"{path}[{key!r}]"
