@@ -174,7 +174,7 @@ _STARTS = {yaml.MappingStartEvent: "mapping", yaml.SequenceStartEvent: "sequence
 _ENDS = (yaml.MappingEndEvent, yaml.SequenceEndEvent)
 
 
-def compose(get_event, problems):
+def compose(get_event, problems, *, value=False):
     """Node tree of one document, read (``get_event()``) up to and including its end event.
 
     Each problem found goes to ``problems`` and composing goes on, so that
@@ -183,10 +183,13 @@ def compose(get_event, problems):
     ``"invalid"`` node, which the checks pass over in silence, and the value
     of a key that is not a string, or is repeated, is skipped.  Raises
     ``StreamStop`` for nesting beyond ``MAX_DEPTH``.
+
+    With ``value``, composes just the value of a top-level key instead (its
+    depth counted from the document's mapping), up to its last event.
     """
     stack = []  # open collections, innermost last: [node, key awaiting its value, tag allowed]
     root = None
-    depth = 0
+    depth = 1 if value else 0
     skip = None  # while a value is skipped: its collections still open
     while True:
         event = get_event()
@@ -235,6 +238,8 @@ def compose(get_event, problems):
         else:  # no other event can occur inside a document
             raise AssertionError(f"unexpected YAML event {event}")
         if not stack:
+            if value:
+                return node
             root = node
             continue
         frame = stack[-1]

@@ -9,18 +9,20 @@ import yaml
 
 from ...engine import screws
 from ...model import Grasp, Twist
-from .compose import PLAIN_WORDS, resolve_plain
+from .compose import PLAIN_WORDS, compose, resolve_plain
+from .document import SECTIONS
+from .problems import Problems, StreamStop
 from .values import NOT_IN_A_NAME, readonly
 
 __all__ = ["Bail", "Parts", "fast_document"]
 
-# --------------------------------------------------------------------------
-# Events -> grasp, for plain valid documents.
-#
 # Nearly every document read is a valid grasp written plainly: no tags,
-# numbers as plain decimal scalars.  ``fast_document`` reads such a document
-# straight from its events into strings and floats, without a node tree or
-# the general checks, and is several times quicker.  At the first thing it
+# numbers as plain decimal scalars.  ``fast_document`` reads such a document's
+# name, units, wrist, contacts and twists straight from its events into
+# strings and floats, without a node tree or the general checks, two to three
+# times quicker (bench/loader.py).  The other sections (paths, a hand: a few
+# per file) are composed and read by their section modules, as on the general
+# path.  At the first thing it
 # does not take for certain (a tag, an alias, a non-decimal or non-finite
 # number, a null, an unknown, repeated or missing key, a wrong count, a
 # repeated or invalid name, deeper nesting than a grasp has, an overflow...)
@@ -50,10 +52,11 @@ _INF = math.inf
 _ZERO = (0.0, 0.0, 0.0)
 
 
-def fast_document(get, keep):
+def fast_document(get, keep, file):
     """A plain valid document's ``Parts``, from the events after its start.
 
     ``get()`` gives the next event; each one read is passed to ``keep``.
+    ``file`` is the grasp file's name (a URDF hand is found from its folder).
     """
     event = get()
     keep(event)
@@ -61,6 +64,7 @@ def fast_document(get, keep):
         raise Bail
     name = units = wrist = contacts = None
     twists = ()
+    composed = {}  # key -> node of the sections composed here
     seen = []
     for key in _fast_keys(get, keep):
         if key in seen:
@@ -76,6 +80,8 @@ def fast_document(get, keep):
             name = _fast_name(get, keep)
         elif key == "units":
             units = _fast_name(get, keep)
+        elif key in _COMPOSED:
+            composed[key] = _value(get, keep)
         else:
             raise Bail
     if contacts is None:
@@ -84,7 +90,49 @@ def fast_document(get, keep):
     keep(event)
     if type(event) is not yaml.DocumentEndEvent:
         raise Bail
-    return Parts(name, units, wrist, contacts, twists)
+    parts = Parts(name, units, wrist, contacts, twists)
+    if composed:
+        parts.sections = _sections(composed, parts, file)
+    return parts
+
+
+# The sections read by their own modules: all but the contacts and twists read here.
+_COMPOSED_SECTIONS = tuple(section for section in SECTIONS if not {"contacts", "twists"} & set(section.keys))
+_COMPOSED = frozenset(key for section in _COMPOSED_SECTIONS for key in section.keys)
+
+
+def _value(get, keep):
+    """The node of the value that comes next, composed as the general path does."""
+
+    def get_kept():
+        event = get()
+        keep(event)
+        return event
+
+    problems = Problems(0)
+    try:
+        node = compose(get_kept, problems, value=True)
+    except StreamStop:  # too deep: the general path stops at the same event, with the place
+        raise Bail from None
+    if problems.count:
+        raise Bail
+    return node
+
+
+def _sections(composed, parts, file):
+    """The Grasp fields of the composed sections, read by their modules (after the contacts)."""
+    contact_names, points, normals = parts.contacts
+    found = {"file": file, "contact_names": contact_names, "points": readonly(points), "normals": readonly(normals)}
+    fields = {}
+    problems = Problems(0)
+    for section in _COMPOSED_SECTIONS:
+        if not composed.keys().isdisjoint(section.keys):
+            read = section.read(composed, found, problems) or {}
+            found.update(read)
+            fields.update(read)
+    if problems.count:
+        raise Bail
+    return fields
 
 
 def _fast_keys(get, keep):
@@ -236,7 +284,7 @@ def _fast_twists(get, keep):
 class Parts:
     """What ``fast_document`` read; ``grasp`` makes it a Grasp."""
 
-    __slots__ = ("name", "units", "wrist", "contacts", "twists")
+    __slots__ = ("name", "units", "wrist", "contacts", "twists", "sections")
 
     def __init__(self, name, units, wrist, contacts, twists):
         self.name = name
@@ -244,6 +292,7 @@ class Parts:
         self.wrist = wrist
         self.contacts = contacts
         self.twists = twists
+        self.sections = {}  # Grasp fields of the composed sections
 
     def grasp(self, *, file, document, name, line):
         contact_names, points, normals = self.contacts
@@ -258,4 +307,5 @@ class Parts:
             wrist=None if self.wrist is None else readonly(self.wrist),
             twists=tuple(Twist(twist, readonly(screw), twist_line) for twist, screw, twist_line in self.twists),
             line=line,
+            **self.sections,
         )

@@ -148,7 +148,7 @@ def read_text(text, file, reading, name=None):
             try:
                 if not reading.fast:
                     raise Bail
-                root = fast_document(get_event, events.append)
+                root = fast_document(get_event, events.append, file)
             except Bail:
                 # The general composer, from the document's first event.
                 problems = Problems(reading.max_errors - entries.reported)
