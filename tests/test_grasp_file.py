@@ -18,7 +18,6 @@ from hypothesis import strategies as st
 
 from conftest import CONTACTS, LOADERS
 from grasptwist.engine import screws
-from grasptwist.io import grasp
 from grasptwist.io.grasp import (
     DEFAULT_MAX_BYTES,
     MAX_DEPTH,
@@ -110,23 +109,6 @@ def test_invalid_fixture_is_rejected_where_its_header_says(path, loader):
     where = f"{path}:{line}:{column}: " if line else f"{path}: "
     assert str(error).startswith(where)
     assert error.file == str(path)
-
-
-@pytest.mark.parametrize("path", FIXTURES, ids=lambda p: p.stem)
-def test_invalid_fixture_against_the_json_schema(path):
-    """``rejects``: the schema catches it too; ``accepts``: a JSON Schema cannot
-    express the rule (only the loader catches it); ``not-data``: no YAML data."""
-    *_, verdict = fixture_header(path)
-    if verdict == "not-data":
-        # located by line and column, or by byte position before the scanner
-        with pytest.raises(yaml.YAMLError, match=r"line \d+, column \d+|position \d+"):
-            list(yaml.safe_load_all(path.read_bytes()))
-        return
-    validator = jsonschema.Draft202012Validator(grasp_schema())
-    documents = list(yaml.safe_load_all(path.read_bytes())) or [None]  # no document reads as null
-    valid = [validator.is_valid(document) for document in documents]
-    assert verdict in ("rejects", "accepts")
-    assert all(valid) == (verdict == "accepts")
 
 
 @pytest.mark.parametrize("path", FIXTURES + sorted(BUNDLED.glob("*.yaml")), ids=lambda p: p.stem)
@@ -725,15 +707,6 @@ def test_error_is_one_line_and_pickles():
     assert (copy.code, copy.message, copy.file, copy.line, copy.column, copy.document, str(copy)) == (
         error.code, error.message, error.file, error.line, error.column, error.document, str(error),
     )  # fmt: skip
-
-
-def test_schema_names_the_same_keys_as_the_loader():
-    schema = grasp_schema()
-    definitions = schema["$defs"]
-    assert tuple(schema["properties"]) == grasp.GRASP_KEYS
-    assert tuple(definitions["contact"]["properties"]) == grasp.CONTACT_KEYS
-    assert tuple(definitions["twist"]["properties"]) == grasp.TWIST_KEYS
-    jsonschema.Draft202012Validator.check_schema(schema)
 
 
 # --------------------------------------------------------------------------
