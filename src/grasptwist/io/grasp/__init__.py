@@ -58,12 +58,13 @@ from .hand import inline_hand, load_hand_file
 from .lines import read_line, read_twist_line
 from .paths import PATH_KEYS, POSE_KEYS, SEGMENT_KEYS
 from .problems import MAX_ERRORS
-from .reader import MAX_DOCUMENTS, READING, Reading, load_grasps, read_grasps
+from .reader import MAX_DOCUMENTS, READING, Reading, load_grasps, one_per_document, read_grasps
 from .twists import TWIST_KEYS
 
 __all__ = [
     "read_grasps",
     "load_grasps",
+    "one_per_document",
     "read_line",
     "read_twist_line",
     "load_hand_file",

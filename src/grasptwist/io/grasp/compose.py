@@ -34,17 +34,19 @@ class Node:
     str, int, float, bool or None, and its ``text`` as written) or
     ``"invalid"`` (refused for its YAML, its problem already reported: a
     forbidden tag, an alias, a tag its text does not fit).
-    ``line``/``column`` are 1-based.
+    ``line``/``column`` are 1-based; ``end`` is ``(line, column)`` just past
+    the node (set when its last event is read).
     """
 
-    __slots__ = ("kind", "value", "text", "line", "column")
+    __slots__ = ("kind", "value", "text", "line", "column", "end")
 
-    def __init__(self, kind, value, mark, text=None):
+    def __init__(self, kind, value, mark, text=None, end=None):
         self.kind = kind
         self.value = value
         self.text = text
         self.line = mark.line + 1
         self.column = mark.column + 1
+        self.end = None if end is None else (end.line + 1, end.column + 1)
 
 
 CORE = "tag:yaml.org,2002:"
@@ -138,11 +140,11 @@ def _scalar(event, stack, problems):
                     kind, _here(stack), f"{text!r} is not a valid {_short_tag(tag)}", **located_mark(event.start_mark)
                 )
             )
-            return Node("invalid", None, event.start_mark, text)
+            return Node("invalid", None, event.start_mark, text, event.end_mark)
     else:
         problems.add(_forbidden_tag(tag, event, _here(stack)))
-        return Node("invalid", None, event.start_mark, text)
-    return Node("scalar", value, event.start_mark, text)
+        return Node("invalid", None, event.start_mark, text, event.end_mark)
+    return Node("scalar", value, event.start_mark, text, event.end_mark)
 
 
 def _forbidden_tag(tag, event, path):
@@ -221,6 +223,7 @@ def compose(get_event, problems, *, value=False):
             continue
         if kind in _ENDS:
             node, _, allowed = stack.pop()
+            node.end = (event.end_mark.line + 1, event.end_mark.column + 1)
             if not allowed:
                 node.kind = "invalid"  # its content was composed for the problems in it
         elif kind is yaml.ScalarEvent:
@@ -234,7 +237,7 @@ def compose(get_event, problems, *, value=False):
                     **located_mark(event.start_mark),
                 )
             )
-            node = Node("invalid", None, event.start_mark)
+            node = Node("invalid", None, event.start_mark, end=event.end_mark)
         else:  # no other event can occur inside a document
             raise AssertionError(f"unexpected YAML event {event}")
         if not stack:

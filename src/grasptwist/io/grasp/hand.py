@@ -352,7 +352,7 @@ def load_hand_file(path, *, max_bytes=DEFAULT_MAX_BYTES):
     fields = read_mapping(root, "", ("hand",), ("hand",), problems)
     hand = read_hand(fields["hand"], None, file, problems) if fields and "hand" in fields else None
     if problems.count:
-        raise problems.first()[0].error(file, 0)
+        raise problems.first()[0][0].error(file, 0)
     return hand
 
 

@@ -102,7 +102,7 @@ def read_twist_line(data, *, file, line, max_bytes=DEFAULT_MAX_BYTES):
                 **located(root),
             )
         )
-    return [_on_line(reject.error(file, None), line) for reject in problems.first()]
+    return [_on_line(reject.error(file, None), line) for reject in problems.first()[0]]
 
 
 def _fast_screw(data):

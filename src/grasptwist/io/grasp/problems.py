@@ -37,35 +37,71 @@ class StreamStop(Reject):
 
 
 class Problems:
-    """The problems of one document as they are found: the first ``keep`` of
-    them in file order, and how many there are in all.
+    """The problems of one document as they are found, reported as a compiler would:
+    in file order, each kind (code) once, with a count of its repeats.
 
-    At most ``2 * keep`` are held between trims, so a document with a
-    hundred thousand problems costs no more memory than one with ``keep``.
+    At most ``2 * keep`` of each kind are held between trims, so a document
+    with a hundred thousand problems costs no more memory than one with a few.
     """
 
-    __slots__ = ("keep", "count", "_held")
+    __slots__ = ("keep", "count", "_held", "_counts")
 
     def __init__(self, keep):
         self.keep = keep
         self.count = 0
         self._held = []
+        self._counts = {}  # code -> problems of that kind found
 
     def add(self, reject):
         self.count += 1
+        self._counts[reject.code] = self._counts.get(reject.code, 0) + 1
         if self.keep:
             self._held.append(reject)
-            if len(self._held) >= 2 * self.keep:
+            if len(self._held) >= 2 * self.keep * len(self._counts):
                 self._trim()
 
+    def drop_within(self, node):
+        """Forget the problems found inside ``node`` (the value of a key reported
+        unknown: what is wrong inside it is no news), so none cascades."""
+        start, end = (node.line, node.column), node.end
+        kept = []
+        for reject in self._held:
+            if start <= _position(reject) < end:
+                self.count -= 1
+                self._counts[reject.code] -= 1
+            else:
+                kept.append(reject)
+        self._held = kept
+
     def first(self):
-        """The problems kept, in file order (found order among equal positions)."""
+        """The problems to report, in file order: the first ``keep`` kinds, each by its first
+        problem, its message counting the rest of its kind; and how many problems they stand for."""
         self._trim()
-        return self._held
+        out, covered, seen = [], 0, set()
+        for reject in self._held:
+            if reject.code in seen:
+                continue
+            seen.add(reject.code)
+            if len(out) == self.keep:
+                break
+            rest = self._counts[reject.code] - 1
+            covered += rest + 1
+            if rest:
+                more = f"{rest} more {reject.code} problem{'s' if rest > 1 else ''} in this document"
+                reject = Reject(reject.code, "", f"{reject.message}; {more}", reject.line, reject.column)
+            out.append(reject)
+        return out, covered
 
     def _trim(self):
         self._held.sort(key=_position)  # stable: ties stay in the order found
-        del self._held[self.keep :]
+        per_code = {}
+        kept = []
+        for reject in self._held:
+            n = per_code.get(reject.code, 0)
+            if n < self.keep:
+                per_code[reject.code] = n + 1
+                kept.append(reject)
+        self._held = kept
 
 
 def _position(reject):

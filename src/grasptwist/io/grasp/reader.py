@@ -23,7 +23,16 @@ from .fast import Bail, Parts, fast_document
 from .problems import MAX_ERRORS, Problems, Reject, StreamStop, located_mark
 from .text import file_text
 
-__all__ = ["MAX_DOCUMENTS", "Reading", "READING", "read_grasps", "load_grasps", "read_text", "stem_name"]
+__all__ = [
+    "MAX_DOCUMENTS",
+    "Reading",
+    "READING",
+    "read_grasps",
+    "load_grasps",
+    "one_per_document",
+    "read_text",
+    "stem_name",
+]
 
 MAX_DOCUMENTS = 10_000
 """Most documents read from one file; the rest of a longer file is refused
@@ -119,6 +128,34 @@ def load_grasps(source, **kw):
     return entries
 
 
+def one_per_document(entries):
+    """``entries`` of :func:`read_grasps` with one error per failed document (the command
+    line's records): its first problem, carrying them all in ``problems``.
+
+    A problem of the whole file stands alone; the file's closing
+    ``too-many-errors`` joins the document before it.
+
+    >>> text = "contacts: [1, 2]\\n---\\nwrist: 1\\n"
+    >>> [(e.code, [p.code for p in e.problems]) for e in one_per_document(read_grasps(text, file="g.yaml"))]
+    [('contact-count', ['contact-count', 'not-a-mapping']), ('missing-key', ['missing-key', 'not-a-list'])]
+    """
+    out = []
+    for entry in entries:
+        last = out[-1] if out else None
+        joins = (
+            isinstance(entry, GraspFileError)
+            and isinstance(last, GraspFileError)
+            and last.file == entry.file
+            and last.document is not None
+            and (entry.document == last.document or entry.code == "too-many-errors")
+        )
+        if joins:
+            out[-1] = GraspFileError(*last.args[:6], (*last.problems, entry))
+        else:
+            out.append(entry)
+    return out
+
+
 # --------------------------------------------------------------------------
 # Stream -> grasps.
 
@@ -198,9 +235,9 @@ class _Entries:
                 root, problems, file=self.file, document=document, name=self._default_name(document), line=line
             )
             if grasp is None:
-                first = problems.first()
+                first, covered = problems.first()
                 self.reported += len(first)
-                self.unreported += problems.count - len(first)
+                self.unreported += problems.count - covered
                 self.entries += [reject.error(self.file, document) for reject in first]
                 return
             named = "name" in root.value

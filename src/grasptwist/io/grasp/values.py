@@ -128,10 +128,10 @@ def read_mapping(node, path, keys, required, problems):
             fields[key] = value
             continue
         unknown += 1
+        problems.drop_within(value)  # the key is wrong: what is inside its value is no news
         if unknown > problems.keep:
-            # After as many unknown keys as can be reported (all before it in
-            # the file) this one's problem never is: count it, spare the rest.
-            problems.count += 1
+            # Only so many are reported (the first, in the file): spare the rest the suggestion.
+            problems.add(Reject("unknown-key", join(path, key), "unknown key", **located(key_node)))
             continue
         # difflib is only needed on this error path.
         from difflib import get_close_matches
