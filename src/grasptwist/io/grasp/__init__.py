@@ -4,8 +4,10 @@ A grasp file holds one grasp per YAML document (see "Grasp files" in README.md
 for the format).  Reading never constructs arbitrary Python objects and
 never lets a parser exception escape: every problem becomes a
 :class:`GraspFileError` that names the file, line, column and field path.
-Every problem of a document is reported, in file order, not just its first
-(at most ``MAX_ERRORS`` per file; one more entry counts the rest).
+Every kind of problem of a document is reported, in file order, not just
+its first: each code once, at its first place, its message counting the
+rest; nothing inside the value of a key reported unknown (at most
+``MAX_ERRORS`` entries per file; one more entry counts the rest).
 
 How the YAML is read, and why
 -----------------------------
@@ -39,14 +41,15 @@ above, which gives every error.  Both paths give the same grasps.
 
 The modules
 -----------
-``text``      size cap, reading, strict decoding (limits in :mod:`grasptwist.io.limits`)
-``compose``   YAML events -> node tree, with the safety rules above
-``problems``  located problems as values, capped per file
-``values``    typed values of nodes (numbers, vectors, names, mappings), shared
-``document``  a document as a whole, and the registry of its sections
-``contacts``, ``twists``, ``paths``, ``hand``: one module per section
-``reader``    files and streams of documents: :func:`read_grasps`
-``lines``     one line of a JSON Lines stream (the stream: :mod:`grasptwist.io.lines`)
+``text``       size cap, reading, strict decoding (the limits: :mod:`grasptwist.io.limits`)
+``compose``    YAML events -> node tree, with the safety rules above
+``problems``   located problems as values: each kind once per document, a file's total capped
+``values``     typed values of nodes (numbers, vectors, names, mappings), shared by the sections
+``document``   a document as a whole, and :data:`SECTIONS`, where a section module is registered
+``contacts``, ``twists``, ``paths``, ``hand``: one module per section of the format
+``fast``       the fast path (bench/loader.py measures what it saves)
+``reader``     a file of documents: :func:`read_grasps`, :func:`one_per_document`
+``lines``      one line of a JSON Lines stream (the stream: :mod:`grasptwist.io.lines`)
 """
 
 from ...model import Grasp, GraspFileError, Twist

@@ -1,4 +1,4 @@
-"""The ``hand:`` key of a grasp file: joint screws given inline, or a URDF.
+"""The ``hand`` section of a grasp file: joint screws given inline, or a URDF.
 
 Two forms (README, "Hands and joint rates"), never mixed:
 
@@ -8,8 +8,8 @@ Two forms (README, "Hands and joint rates"), never mixed:
   ``joint_positions`` and ``fingers``, each naming the ``tip`` link that
   touches its contact.
 
-Checked with the grasp file's own helpers, so problems are located and
-coded like the rest of the format; a URDF's own problems
+Checked with the loader's shared typed-value checks (:mod:`.values`), so
+problems are located and coded like the rest of the format; a URDF's own problems
 (:mod:`grasptwist.io.urdf`) are reported at the ``urdf`` key, the URDF's
 file and line in the message.  Forward kinematics and the length check
 are the engine's (:mod:`grasptwist.engine.kinematics`).
