@@ -7,6 +7,7 @@ the default reading (fast path first) and with ``Reading(fast=False)`` (every
 document through the general composer).  CPU time of this process
 (``time.process_time``), best of the repeats, the two paths interleaved so that
 a loaded machine slows both alike.  The fast path pays where ratio > 1.
+First, the seconds three hostile inputs take (the loader must refuse them at once).
 """
 
 import argparse
@@ -45,11 +46,28 @@ def compare(label, contents, repeats, per_file):
     )
 
 
+# Hostile files the loader must refuse at once (tests/test_grasp_file.py checks what it says).
+HOSTILE = {
+    "billion laughs": 'a: &a ["lol","lol","lol","lol","lol","lol","lol","lol","lol"]\n'
+    + "".join(f"{b}: &{b} [*{a},*{a},*{a},*{a},*{a},*{a},*{a},*{a},*{a}]\n" for a, b in zip("abcdefgh", "bcdefghi")),
+    "1 MiB of '---'": "---\n" * (1 << 18),
+    "100,000 '[' after a bad tag": "bad: !!python/none 1\nx: " + "[" * 100_000 + "\n",
+}
+
+
+def hostile(repeats):
+    """Seconds each hostile input takes (target: well under one)."""
+    for label, text in HOSTILE.items():
+        t = best_of(repeats, read=lambda text=text: read_grasps(text, file="h.yaml"))["read"]
+        print(f"{label:34s} {t:9.3f} s", flush=True)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--files", type=int, default=10_000)
     ap.add_argument("--repeats", type=int, default=5)
     args = ap.parse_args()
+    hostile(args.repeats)
     for path in sorted(glob.glob(os.path.join(HERE, "..", "grasps", "*.yaml"))):
         with open(path, "rb") as f:
             data = f.read()

@@ -5,7 +5,6 @@ import io
 import os
 import pickle
 import sys
-import time
 from dataclasses import replace
 from pathlib import Path
 
@@ -152,9 +151,7 @@ def test_billion_laughs_is_refused_unexpanded_in_two_lines(loader):
     text += "".join(
         f"{b}: &{b} [*{a},*{a},*{a},*{a},*{a},*{a},*{a},*{a},*{a}]\n" for a, b in zip("abcdefgh", "bcdefghi")
     )
-    start = time.perf_counter()
-    errors = read(text, reading=loader)
-    assert time.perf_counter() - start < 1
+    errors = read(text, reading=loader)  # its time: bench/loader.py
     # 72 aliases inside the values of 9 unknown keys: no news once the keys are reported (issue 21: 83 lines)
     assert [(e.code, e.line, e.column) for e in errors] == [("unknown-key", 1, 1), ("missing-key", 1, 1)]
     assert errors[0].message.endswith("; 8 more unknown-key problems in this document")
@@ -631,9 +628,7 @@ def test_messages_that_say_what_to_write(text, message, loader):
 
 
 def test_a_file_of_document_markers_is_cut_short(loader):
-    start = time.perf_counter()
-    entries = read(b"---\n" * (1 << 18), reading=loader)  # 1 MiB: 262,144 empty documents
-    assert time.perf_counter() - start < 2
+    entries = read(b"---\n" * (1 << 18), reading=loader)  # 1 MiB: 262,144 empty documents (its time: bench/loader.py)
     assert where(entries[:2]) == [("empty-document", 2, 1, 0), ("empty-document", 3, 1, 1)]
     assert len(entries) == MAX_ERRORS + 2 == 102
     assert where(entries[-2:]) == [("too-many-documents", 10001, 1, 10000), ("too-many-errors", None, None, None)]
@@ -714,9 +709,7 @@ def test_depth_is_checked_after_a_documents_first_problem(loader):
     # A nesting bomb after a document's first problem still stops the parse
     # at once, and is what is reported for the document it cuts.
     text = "bad: !!python/none 1\nx: " + "[" * 100000 + "\n---\n" + CONTACTS
-    start = time.perf_counter()
-    (error,) = read(text, reading=loader)
-    assert time.perf_counter() - start < 1
+    (error,) = read(text, reading=loader)  # its time: bench/loader.py
     assert (error.code, error.line, error.column) == ("too-deep", 2, 35)
 
 
