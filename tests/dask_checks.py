@@ -131,15 +131,16 @@ def array_equals_the_engine():
 
 
 def readme_block(folder):
-    """The README's Dask example as printed, run in ``folder`` on 3 shards of 3,000 grasps in ``shards/``."""
+    """The docs' Dask example as printed (the python block marked ``runner=dask``), run in ``folder``
+    on 3 shards of 3,000 grasps in ``shards/``."""
     import os
-    import re
+
+    from docs_blocks import all_blocks
 
     save_parquet(folder / "shards", 3000, shards=3)
-    readme = (Path(__file__).parents[1] / "README.md").read_text("utf-8")
-    (code,) = [b for b in re.findall(r"^```python\n(.*?)^```$", readme, flags=re.M | re.S) if "import dask" in b]
+    (block,) = [b for b in all_blocks() if b.lang == "python" and b.options.get("runner") == "dask"]
     os.chdir(folder)
-    exec(compile(code, "README.md", "exec"), {})
+    exec(compile(block.text, block.where, "exec"), {})
     print(f"{pq.read_table(folder / 'results').num_rows} rows in results/")
 
 

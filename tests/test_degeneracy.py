@@ -131,7 +131,17 @@ def test_a_normal_within_tolerance_of_the_plane_is_named_when_no_finer_condition
 
 def test_messages_use_the_contact_names():
     msg = gt.status_message(S.COLLINEAR_CONTACTS, 1, ("thumb", "index", "middle"))
-    assert msg == "the contacts are collinear: index lies on the line through middle and thumb"
+    assert msg.startswith("the contacts are collinear: index lies on the line through middle and thumb; ")
+
+
+#: Words that start the cure every degeneracy message ends with (issue 23: say what would cure it).
+CURES = ("give", "three distinct", "neither method can work until", "move", "tilt", "rescale")
+
+
+@pytest.mark.parametrize("status", [s for s in S if s != S.OK], ids=lambda s: s.code)
+def test_every_degeneracy_message_says_what_would_cure_it(status):
+    message = gt.status_message(status, 0)
+    assert any(cure in message.rsplit(":", 1)[-1] or cure in message.rsplit(";", 1)[-1] for cure in CURES), message
 
 
 @pytest.mark.parametrize("height", [1e-6, 1e-7, 1e-8])

@@ -259,14 +259,6 @@ def test_a_grasp_without_the_path_asked_for_is_a_located_error_and_the_others_st
     assert said in " ".join(r.stderr.split())
 
 
-def test_the_readme_shows_the_cylinders_real_table(monkeypatch):
-    monkeypatch.chdir(GRASPS.parent)
-    readme = (GRASPS.parent / "README.md").read_text("utf-8")
-    shown = readme.split("`grasptwist follow grasps/cylinder.yaml --method off-tangent --samples 5`:\n\n```\n")[1]
-    r = run("follow", "grasps/cylinder.yaml", "--method", "off-tangent", "--samples", 5)
-    assert r.stdout == shown.split("```")[0]
-
-
 def test_without_a_wrist_off_tangent_is_null_and_a_constant_failure_names_the_contacts(tmp_path):
     contacts = (
         "contacts:\n"

@@ -27,6 +27,7 @@ import numpy as np
 import pytest
 from typer.testing import CliRunner
 
+from docs_blocks import ROOT, blocks, commands, pattern
 from grasptwist.cli import app
 from grasptwist.engine.kinematics import forward_kinematics
 from grasptwist.io.grasp import read_grasps
@@ -36,7 +37,6 @@ pytest.importorskip("yourdfpy")
 
 GRASPS = Path(__file__).parent.parent / "grasps"
 HAND = GRASPS / "three-finger-hand.yaml"
-README = (Path(__file__).parent.parent / "README.md").read_text()
 
 
 def run(*args):
@@ -180,9 +180,11 @@ def test_the_bundled_hand_keeps_its_tips_on_the_moving_contacts(samples):
     writer = FollowTable(table)
     for rec in [*recs, summary]:
         writer.write(rec)
-    # the README's excerpt is this command's table (the table writes what the records hold)
-    excerpt = README.split("--samples 3 --method off-tangent` ends\n\n```\n")[1].split("```")[0]
-    assert table.getvalue().decode().endswith(excerpt)
+    # the docs' excerpt of this command's output (its console block runs with -m slow): the table
+    # written from these records (the table writes what the records hold), then the summary line
+    shown = [c for b in blocks(ROOT / "docs/guide/paths.md") if b.lang == "console" for c in commands(b)]
+    (expected,) = [c.expected for c in shown if c.args[:2] == ["follow", "grasps/three-finger-hand.yaml"]]
+    assert pattern(expected).fullmatch(table.getvalue().decode() + f"{len(recs) + 1} records, 0 failed\n")
     assert len(recs) == samples * len(grasp.paths)
     worst = 0.0
     for rec in recs:

@@ -550,17 +550,6 @@ def test_a_grouped_error_pickles_with_its_problems():
     assert (copy.code, str(copy)) == (error.code, str(error)) == (copy.problems[0].code, str(copy.problems[0]))
 
 
-def test_the_readme_shows_what_the_command_prints(tmp_path, monkeypatch):
-    example = (Path(__file__).parent.parent / "README.md").read_text("utf-8").split("For this `pinch.yaml`")[1]
-    text = example.split("```yaml\n")[1].split("```")[0]
-    printed = example.split("```\n")[2]  # the block after the YAML one
-    assert text == THREE_MISTAKES
-    monkeypatch.chdir(tmp_path)
-    Path("pinch.yaml").write_text(text)
-    result, _ = run("resolve", "pinch.yaml")
-    assert (result.exit_code, result.stderr) == (1, printed)
-
-
 def test_the_schema_states_the_units_of_angular_velocity():
     twist = grasp_schema()["$defs"]["twist"]["properties"]
     assert "radians per unit time" in twist["angular"]["description"]

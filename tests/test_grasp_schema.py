@@ -1,4 +1,4 @@
-"""The JSON Schema (io/grasp_schema.json) against the loader, the format's one definition.
+"""The JSON Schema (io/grasp/grasp_schema.json) against the loader, the format's one definition.
 
 Every bundled grasp file and every fixture of tests/invalid_grasps/ and
 tests/corpus/ is read twice: by the loader, and as data (the loader's own

@@ -246,20 +246,6 @@ def test_warnings_all_none_and_quiet(noisy, command):
     assert run(command, *noisy, "--warnings", "sometimes").exit_code == 2
 
 
-def test_the_readme_shows_what_the_quick_start_prints():
-    readme = (ROOT / "README.md").read_text("utf-8")
-    shown = readme.split("What the first prints:\n\n```\n", 1)[1].split("```", 1)[0]
-    p = subprocess.run(
-        COMMAND + ["resolve", "grasps/polyhedron.yaml"],
-        capture_output=True,
-        text=True,
-        cwd=ROOT,
-        env=_env(),
-        timeout=60,
-    )
-    assert p.returncode == 0 and p.stdout == shown
-
-
 def test_a_renderer_may_return_rich_groups_and_renderables():
     from rich.console import Group
     from rich.panel import Panel

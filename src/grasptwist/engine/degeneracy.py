@@ -67,29 +67,39 @@ class Status(IntEnum):
 
 _MESSAGES = {
     Status.OK: "ok",
-    Status.NONFINITE_INPUT: "the input holds NaN or infinity",
-    Status.COINCIDENT_CONTACTS: "contacts {j} and {k} coincide, so Sigma_{n} has no axis",
-    Status.COLLINEAR_CONTACTS: "the contacts are collinear: {i} lies on the line through {j} and {k}",
-    Status.WRIST_COPLANAR: (
-        "the wrist lies in the plane of the contacts, so every [Sigma_i|Psi_i] is 0 (Proposition 1 needs it off the plane)"
+    Status.NONFINITE_INPUT: "the input holds NaN or infinity: give finite numbers",
+    Status.COINCIDENT_CONTACTS: "contacts {j} and {k} coincide, so Sigma_{n} has no axis: three distinct contacts are needed",
+    Status.COLLINEAR_CONTACTS: (
+        "the contacts are collinear: {i} lies on the line through {j} and {k}; "
+        "neither method can work until a contact is moved off that line"
     ),
-    Status.ZERO_NORMAL: "the normal at contact {i} has zero length",
-    Status.NORMALS_RANK_DEFICIENT: "the three normal lines have rank < 3, so the tangent twists are not a three-system",
+    Status.WRIST_COPLANAR: (
+        "the wrist lies in the plane of the contacts, so every [Sigma_i|Psi_i] is 0 (Proposition 1 needs it off the plane): "
+        "move the wrist off that plane, or use the tangent method"
+    ),
+    Status.ZERO_NORMAL: "the normal at contact {i} has zero length: give its direction",
+    Status.NORMALS_RANK_DEFICIENT: (
+        "the three normal lines have rank < 3, so the tangent twists are not a three-system "
+        "(a normal lies in the contacts' plane): tilt a normal out of that plane, or use the off-tangent method"
+    ),
     Status.THETA_NOT_UNIQUE: (
         "Theta_{n} is not unique: the normals at {j} and {k} leave more than one axis through contact {i} "
-        "that keeps them in their tangent planes"
+        "that keeps them in their tangent planes: tilt the normal at {j} or {k} out of the contacts' plane, "
+        "or use the off-tangent method"
     ),
     Status.THETA_SIGMA_ZERO: (
-        "[Theta_{n}|Sigma_{n}] = 0: the axis of Theta_{n} (through contact {i}) meets or is parallel to the line through {j} and {k}"
+        "[Theta_{n}|Sigma_{n}] = 0: the axis of Theta_{n} (through contact {i}) meets or is parallel to the line "
+        "through {j} and {k}: tilt a normal out of the contacts' plane, or use the off-tangent method"
     ),
-    Status.OVERFLOW: "the numbers overflow double precision (coordinates or twist too large)",
+    Status.OVERFLOW: "the numbers overflow double precision (coordinates or twist too large): rescale them",
     Status.NORMAL_IN_CONTACT_PLANE: (
         "the normal at contact {i} lies in the plane of the contacts, so no tangent-plus-Sigma motion "
-        "can move contact {i} along it"
+        "can move contact {i} along it: tilt it out of that plane, or use the off-tangent method"
     ),
     Status.FINGER_CANNOT_FOLLOW: (
         "finger {i} cannot follow its contact: no joint rates move it with the object's velocity there "
-        "(relative residual above 1e-6)"
+        "(relative residual above 1e-6): move the finger away from that pose, or use a method "
+        "whose components it can follow"
     ),
     Status.NO_WRIST: (
         "the grasp has no wrist, and each Psi_i is a line from it: give one "
@@ -112,7 +122,7 @@ def status_message(status, culprit=-1, names=("1", "2", "3")) -> str:
         Contact names to use in the message.
 
     >>> status_message(Status.COINCIDENT_CONTACTS, 0)
-    'contacts 2 and 3 coincide, so Sigma_1 has no axis'
+    'contacts 2 and 3 coincide, so Sigma_1 has no axis: three distinct contacts are needed'
     """
     i = int(culprit) if int(culprit) >= 0 else 0
     return _MESSAGES[Status(int(status))].format(i=names[i], j=names[(i + 1) % 3], k=names[(i + 2) % 3], n=i + 1)

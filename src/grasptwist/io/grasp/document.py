@@ -66,4 +66,4 @@ def grasp_schema():
     import json
     from importlib.resources import files
 
-    return json.loads(files("grasptwist.io").joinpath("grasp_schema.json").read_text("utf-8"))
+    return json.loads(files(__package__).joinpath("grasp_schema.json").read_text("utf-8"))
