@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 import yaml
 
-from grasptwist.io.grasp_file import Reading
+from grasptwist.io.grasp import Reading
 
 # a script run in processes of its own (see its docstring), not a module for --doctest-modules to import
 collect_ignore = ["dask_checks.py"]

@@ -113,8 +113,8 @@ def _walk_finite(value, key):
 
 
 def error_codes(rec):
-    """Every error code in a record: the file's, or each failed method's."""
-    found = [rec["error"]["code"]] if "error" in rec else []
+    """Every error code in a record: each problem of the input's, or each failed method's."""
+    found = [e["code"] for e in rec["errors"]] if "error" in rec else []
     for method in ("off_tangent", "tangent"):
         if isinstance(rec.get(method), dict) and "error" in rec[method]:
             found.append(rec[method]["error"]["code"])

@@ -13,7 +13,7 @@ import yaml
 
 from grasptwist.engine.decompose import decompose_off_tangent, decompose_tangent
 from grasptwist.engine.degeneracy import Status
-from grasptwist.io.grasp_file import grasp_schema, load_grasps
+from grasptwist.io.grasp import grasp_schema, load_grasps
 
 GRASPS = Path(__file__).parent.parent / "grasps"
 BUNDLED = sorted(GRASPS.glob("*.yaml"))

@@ -16,7 +16,7 @@ from typer.testing import CliRunner
 
 import grasptwist as gt
 from grasptwist.cli import app
-from grasptwist.io.grasp_file import grasp_schema
+from grasptwist.io.grasp import grasp_schema
 from grasptwist.output.columns import CSV_COLUMNS
 from grasptwist.output.writers import JsonArray
 from hostile import run_installed

@@ -13,7 +13,7 @@ import pytest
 
 import grasptwist as gt
 from grasptwist.engine.degeneracy import OUTWARD_NORMALS_WARNING
-from grasptwist.io.grasp_file import load_grasps
+from grasptwist.io.grasp import load_grasps
 from hostile import jsonl, run, run_installed
 
 # Example 1's cylinder with its normals tilted out of the contacts' plane (so the tangent method resolves)

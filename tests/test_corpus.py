@@ -151,7 +151,7 @@ def _check_alone(row, path, exit_code, stdout, stderr, seconds, limit):
     if row.code is None:
         assert errors == [] and lines[-1] == summary(row.records, 0)
         return
-    # the errors, one line each (a file's problems one per record, a grasp's one per failed method),
+    # the errors, one line each (a document's problems in one record, a grasp's one per failed method),
     # a line per warning of a record (a method skipped for want of a wrist), then the summary
     failed = [r for r in records if not r["ok"]]
     warned = sum(len(r.get("warnings", ())) for r in records)
@@ -322,15 +322,15 @@ DASHES = b"---\n" * (1 << 18)  # 1 MiB: 262,144 empty documents
 def _dashes_check(folder, files, limit_mb):
     code, stderr, peak = run_measured("resolve", folder, "-f", "jsonl", "-o", "out.jsonl", cwd=folder.parent)
     records = jsonl((folder.parent / "out.jsonl").read_text())
-    # per file: 100 errors, one too-many-documents (at document 10,001), one count of the 9,900 others
-    assert len(records) == 102 * files and code == 1
-    assert [r["error"]["code"] for r in records[-2:]] == ["too-many-documents", "too-many-errors"]
-    assert stderr.splitlines()[-1] == summary(102 * files, 102 * files)
+    # per file: 100 empty documents, one too-many-documents (at document 10,001) with the count of the 9,900 others
+    assert len(records) == 101 * files and code == 1
+    assert [e["code"] for e in records[-1]["errors"]] == ["too-many-documents", "too-many-errors"]
+    assert stderr.splitlines()[-1] == summary(101 * files, 101 * files)
     assert peak < limit_mb, f"{peak:.0f} MB"
 
 
 def test_a_mebibyte_of_document_markers_is_cut_short_in_little_memory(tmp_path):
-    # 0.1: 262,144 records and 1.3 GB; now 102 records and ~40 MB (an interpreter's worth)
+    # 0.1: 262,144 records and 1.3 GB; now 101 records and ~40 MB (an interpreter's worth)
     (tmp_path / "in").mkdir()
     (tmp_path / "in" / "dashes.yaml").write_bytes(DASHES)
     _dashes_check(tmp_path / "in", 1, 150)

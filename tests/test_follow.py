@@ -22,7 +22,7 @@ import yaml
 from typer.testing import CliRunner
 
 from grasptwist.cli import app
-from grasptwist.io.grasp_file import grasp_schema, read_grasps
+from grasptwist.io.grasp import grasp_schema, read_grasps
 from grasptwist.output.follow_records import CSV_HEADER
 
 GRASPS = Path(__file__).parent.parent / "grasps"

@@ -30,7 +30,7 @@ from typer.testing import CliRunner
 from docs_blocks import ROOT, blocks, commands, pattern
 from grasptwist.cli import app
 from grasptwist.engine.kinematics import forward_kinematics
-from grasptwist.io.grasp_file import read_grasps
+from grasptwist.io.grasp import read_grasps
 from grasptwist.output.follow_table import FollowTable
 
 pytest.importorskip("yourdfpy")

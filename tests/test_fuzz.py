@@ -18,7 +18,7 @@ import yaml
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from grasptwist.io.grasp_file import Grasp, GraspFileError, load_grasps, read_grasps
+from grasptwist.io.grasp import Grasp, GraspFileError, load_grasps, read_grasps
 from hostile import assert_no_crash, jsonl, run, summary
 
 # --------------------------------------------------------------------------

@@ -1,16 +1,18 @@
-"""The loader's two paths give the same: the fast one (``_fast_document``,
+"""The loader's two paths give the same: the fast one (``io/grasp/fast.py``,
 plain valid documents straight from the events) and the general one
-(``_compose`` + ``_grasp``, every document, every error).
+(``compose`` + ``read_document``, every document, every error).
 
 Each input is read twice, once as the loader does it and once with the fast
 path switched off, and the entries are compared field by field, arrays bit
 for bit.  The YAML is parsed only once for both (and for every reading of
 the same text in a test): the parser's events are recorded and replayed,
 since parsing is what costs (seconds, for the pure-Python parser on
-corpus/many-contacts.yaml) and both paths read the same events.  Also: the fast path is really taken for ordinary grasps (else the
-loader is slow without failing a test), and the chunked capped read.
+corpus/many-contacts.yaml) and both paths read the same events.  Also: the fast
+path is really taken for every bundled grasp (else the loader is slow without
+failing a test), and the chunked capped read.
 """
 
+import dataclasses
 import io
 import sys
 from dataclasses import replace
@@ -23,8 +25,7 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from conftest import CONTACTS, LOADERS
-from grasptwist.io import grasp_file
-from grasptwist.io.grasp_file import READING, Grasp, GraspFileError, Reading, read_grasps
+from grasptwist.io.grasp import READING, Grasp, GraspFileError, Reading, read_grasps, reader, text
 
 TESTS = Path(__file__).parent
 FILES = sorted(
@@ -39,6 +40,17 @@ def _array(a):
     return None if a is None else (a.dtype.str, a.shape, a.tobytes(), a.flags.writeable, a.flags.c_contiguous)
 
 
+def _fields(value):
+    """Every field of a Grasp (its twists, paths and hand too), arrays as their bytes and flags."""
+    if isinstance(value, np.ndarray):
+        return _array(value)
+    if dataclasses.is_dataclass(value):
+        return (type(value).__name__, *(_fields(getattr(value, f.name)) for f in dataclasses.fields(value)))
+    if isinstance(value, (tuple, list)):
+        return tuple(map(_fields, value))
+    return value
+
+
 def signature(entries):
     out = []
     for e in entries:
@@ -46,11 +58,7 @@ def signature(entries):
             out.append(("error", e.code, e.message, e.file, e.line, e.column, e.document, str(e)))
         else:
             assert type(e) is Grasp
-            twists = tuple((t.name, _array(t.screw), t.line) for t in e.twists)
-            out.append(
-                ("grasp", e.name, e.units, e.file, e.document, e.contact_names, e.line)
-                + (_array(e.points), _array(e.normals), _array(e.wrist), twists)
-            )
+            out.append(_fields(e))
     return out
 
 
@@ -254,6 +262,21 @@ SHAPES = [
     CONTACTS + "name: \x7f\n",
     CONTACTS + "name: \x0b\n",
     CONTACTS + "name: é\x85\x01\n",
+    # sections the fast path has composed and read by their modules: valid, before the
+    # contacts, and with each kind of problem (theirs, the composer's, the stream's)
+    CONTACTS
+    + "paths:\n  - {name: p, segments: [{duration: 1, angular: [0, 0, 1]}, {duration: 2, pose: {rotvec: [0, 0, 1]}}]}\n",
+    "paths: [{frame: body, segments: [{duration: 0.5, screw: [0, 0, 1, 0, 0, 0]}]}]\n" + CONTACTS,
+    CONTACTS + "paths: [{segments: []}]\n",
+    CONTACTS + "paths: [{segments: [{duration: 1, angular: &a [0, 0, 1], linear: *a}]}]\n",
+    CONTACTS + "paths: [{segments: [{duration: 1, angular: !!python/tuple [0, 0, 1]}]}]\n",
+    CONTACTS + "paths: [{segments: [{duration: 1, duration: 2, angular: [0, 0, 1]}]}]\n",
+    CONTACTS + "paths: " + "[" * 40 + "]" * 40 + "\n",
+    CONTACTS + "paths: [{segments: [{duration: 1, angular: [0, 0, 1]}\n",
+    CONTACTS + "paths: []\npaths: []\n",
+    CONTACTS + "hand:\n  fingers:\n" + "    - joints: [{axis: [0, 0, 1], point: [0, 0, 0]}]\n" * 3,
+    CONTACTS + "hand:\n  fingers:\n" + "    - joints: [{axis: [0, 0, 0], point: [0, 0, 0]}]\n" * 3,
+    CONTACTS.replace("[1, 0, 0]", "[1, 0, x]") + "hand: {fingers: [{joints: [{axis: [0, 0, 1]}]}]}\n",
 ]
 
 
@@ -304,20 +327,18 @@ def test_random_documents(docs, parser):
     both_paths("---\n".join(docs), Reading(parser=parser), file="random.yaml")
 
 
-def test_ordinary_grasps_take_the_fast_path(monkeypatch, loader):
-    """Every bundled grasp is read without the general composer (which is
-    several times slower), so a change that sends them there fails here.
-    Files with ``paths:`` (read by ``follow``, a few per run) take the general path."""
+def test_every_bundled_grasp_takes_the_fast_path(monkeypatch, loader):
+    """Every bundled grasp, with its paths and hand, is read without the general
+    path (two to three times slower on a plain grasp, bench/loader.py), so a
+    change that sends them there fails here."""
 
-    def fail(get_event):
+    def fail(*args, **kw):
         raise AssertionError("general path taken")
 
-    monkeypatch.setattr(grasp_file, "_compose", fail)
+    monkeypatch.setattr(reader, "read_document", fail)
     bundled = sorted((TESTS.parent / "grasps").rglob("*.yaml"))
-    # paths and hands are read by the general path only: files with them hold few grasps
-    plain = [p for p in bundled if "\npaths:" not in p.read_text("utf-8") and "\nhand:" not in p.read_text("utf-8")]
-    assert len(plain) >= 3
-    for path in plain:
+    assert len(bundled) == 7
+    for path in bundled:
         for entry in read_grasps(path, reading=loader):
             assert isinstance(entry, Grasp), str(entry)
 
@@ -331,7 +352,7 @@ def test_capped_read_in_chunks(size, tmp_path, monkeypatch):
     (entry,) = read_grasps(path, max_bytes=cap)
     assert entry.code == expected
     with open(path, "rb") as handle:
-        assert grasp_file._read_capped(handle, cap + 1) == b"#" * min(size, cap + 1)
+        assert text.read_capped(handle, cap + 1) == b"#" * min(size, cap + 1)
     monkeypatch.setattr(sys, "stdin", io.TextIOWrapper(io.BytesIO(b"#" * size)))
     (entry,) = read_grasps("-", max_bytes=cap)
     assert (entry.code, entry.file) == (expected, "<stdin>")

@@ -17,7 +17,7 @@ import yaml
 from typer.testing import CliRunner
 
 from grasptwist.cli import app
-from grasptwist.io.grasp_file import grasp_schema, read_grasps
+from grasptwist.io.grasp import grasp_schema, read_grasps
 
 ROOT = Path(__file__).resolve().parents[1]
 CORPUS = ROOT / "tests" / "corpus" / "urdf"

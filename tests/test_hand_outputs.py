@@ -128,7 +128,7 @@ def test_a_bad_hand_file_is_a_usage_error_naming_its_place(tmp_path):
 
 
 def test_the_plot_scene_draws_each_finger_joint_axis():
-    from grasptwist.io.grasp_file import load_grasps
+    from grasptwist.io.grasp import load_grasps
     from grasptwist.plot.scene import grasp_scene
 
     (g,) = load_grasps(THREE)

@@ -34,14 +34,6 @@ FORBIDDEN = {"grasptwist.plot": ("grasptwist.io", "grasptwist.output", "grasptwi
 #: Facades only re-export.
 FACADES = ("grasptwist.hand", "grasptwist.path")
 
-#: Known edges still to go, (importer, imported).
-EXCEPTIONS = {
-    # io/grasp/ package in progress (loader branch)
-    ("grasptwist.io.grasp_file", "grasptwist.io.grasp_hand"),
-    ("grasptwist.io.grasp_hand", "grasptwist.hand"),
-    ("grasptwist.io.urdf", "grasptwist.io.grasp_file"),
-}
-
 
 def module_name(path: Path) -> str:
     parts = path.relative_to(SRC).with_suffix("").parts
@@ -70,7 +62,7 @@ def imports(name: str) -> set[str]:
     return {m for m in found if m in MODULES and m != name}
 
 
-GRAPH = {name: imports(name) - {b for a, b in EXCEPTIONS if a == name} for name in MODULES}
+GRAPH = {name: imports(name) for name in MODULES}
 
 
 def group(name: str) -> tuple[int, str]:

@@ -14,7 +14,7 @@ from grasptwist.cli import app
 from grasptwist.engine.decompose import contact_velocities
 from grasptwist.engine.path import follow
 from grasptwist.engine.screws import cross, pitch
-from grasptwist.io.grasp_file import load_grasps
+from grasptwist.io.grasp import load_grasps
 from grasptwist.plot import read_figures, twist_figure
 
 pytest.importorskip("plotly")

@@ -27,7 +27,7 @@ from typer.testing import CliRunner
 
 from grasptwist.cli import app
 from grasptwist.cli.exits import EXIT_USAGE
-from grasptwist.io.grasp_file import read_line, read_twist_line
+from grasptwist.io.grasp import read_line, read_twist_line
 from grasptwist.io.lines import numbered_batches
 
 ROOT = Path(__file__).resolve().parents[1]

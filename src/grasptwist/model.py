@@ -171,6 +171,9 @@ class InputError(Exception):
         1-based position.
     document : int or None
         0-based document index; None for whole-file errors.
+    problems : tuple of InputError
+        Every problem of the input, this error (its first) included: one
+        record per failed document lists them all.
     """
 
     code: str
@@ -179,16 +182,18 @@ class InputError(Exception):
     line: int | None
     column: int | None
     document: int | None
+    problems: tuple
 
-    def __init__(self, code, message, file, line=None, column=None, document=None):
+    def __init__(self, code, message, file, line=None, column=None, document=None, problems=None):
         # All fields go to args so that errors pickle (multiprocessing).
-        super().__init__(code, message, file, line, column, document)
+        super().__init__(code, message, file, line, column, document, problems)
         self.code = code
         self.message = message
         self.file = file
         self.line = line
         self.column = column
         self.document = document
+        self.problems = (self,) if problems is None else tuple(problems)
 
     def __str__(self):
         where = self.file

@@ -199,7 +199,7 @@ def hand_option(path: str | None, paths: list[str], fmt: str):
     from ..model import InputError
 
     if path is not None:
-        from ..io.grasp_hand import load_hand_file
+        from ..io.grasp import load_hand_file
 
         try:
             return load_hand_file(path)[0]

@@ -14,7 +14,7 @@ def schema(output: Output = None, debug: Debug = False) -> None:
     \b
         grasptwist schema -o grasp.schema.json
     """
-    from ..io.grasp_file import grasp_schema
+    from ..io.grasp import grasp_schema
     from ..output.records import dumps
 
     def write_schema():

@@ -22,7 +22,8 @@ import sys
 from collections.abc import Iterable, Iterator
 
 from ..model import Grasp, GraspFileError
-from .grasp_file import DEFAULT_MAX_BYTES, NOT_REGULAR, read_grasps
+from .grasp import one_per_document, read_grasps
+from .limits import DEFAULT_MAX_BYTES, NOT_REGULAR
 
 __all__ = ["GRASP_SUFFIXES", "STDIN", "expand", "is_grasp_file", "read"]
 
@@ -123,12 +124,13 @@ def _is_file(entry: os.DirEntry) -> bool:
 
 
 def read(path: str, max_bytes: int | None = None) -> list[Grasp | GraspFileError]:
-    """The grasps (or errors) of one file; ``-`` reads standard input."""
+    """The grasps (or errors: one per failed document, every problem in its ``problems``)
+    of one file; ``-`` reads standard input."""
     cap = DEFAULT_MAX_BYTES if max_bytes is None else max_bytes
     if path == STDIN:
         # one byte past the cap is enough for the loader to refuse it
-        return read_grasps(sys.stdin.buffer.read(cap + 1), file="<stdin>", max_bytes=cap)
-    return read_grasps(path, max_bytes=cap)
+        return one_per_document(read_grasps(sys.stdin.buffer.read(cap + 1), file="<stdin>", max_bytes=cap))
+    return one_per_document(read_grasps(path, max_bytes=cap))
 
 
 def _io_error(path: str, why: str) -> GraspFileError:

@@ -23,8 +23,9 @@ import sys
 from collections.abc import Iterator
 
 from ..model import Grasp, GraspFileError, Twist
-from .grasp_file import DEFAULT_MAX_BYTES, NOT_REGULAR, read_grasps, read_line, read_twist_line
+from .grasp import one_per_document, read_grasps, read_line, read_twist_line
 from .inputs import STDIN
+from .limits import DEFAULT_MAX_BYTES, NOT_REGULAR
 
 __all__ = ["JSONL_SUFFIX", "is_json_lines", "numbered_batches", "grasp_batches", "twist_batches"]
 
@@ -149,10 +150,14 @@ def _stream(path, max_bytes, per_batch, read, sniff):
         if sniff:
             json_lines, head = _sniff(handle, cap)
             if not json_lines:
-                yield read_grasps(head + handle.read(max(0, cap + 1 - len(head))), file=file, max_bytes=cap)
+                yield one_per_document(
+                    read_grasps(head + handle.read(max(0, cap + 1 - len(head))), file=file, max_bytes=cap)
+                )
                 return
         for batch in numbered_batches(handle, cap, per_batch, head):
-            yield [entry for n, line in batch for entry in read(line, file=file, line=n, max_bytes=cap)]
+            yield [
+                entry for n, line in batch for entry in one_per_document(read(line, file=file, line=n, max_bytes=cap))
+            ]
     finally:
         if path != STDIN:
             handle.close()

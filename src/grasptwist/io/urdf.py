@@ -48,7 +48,7 @@ import numpy as np
 
 from ..engine.kinematics import chain_from_origins, chain_length
 from ..model import Finger, Hand, InputError, Joint
-from .grasp_file import DEFAULT_MAX_BYTES
+from .limits import DEFAULT_MAX_BYTES
 
 __all__ = ["load_urdf_hand", "resolve_urdf"]
 

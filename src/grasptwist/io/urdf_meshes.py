@@ -20,7 +20,7 @@ from pathlib import Path
 import numpy as np
 
 from ..model import InputError
-from .grasp_file import DEFAULT_MAX_BYTES
+from .limits import DEFAULT_MAX_BYTES
 from .urdf import _library, _parse, _read, resolve_urdf
 
 __all__ = ["MAX_MESH_BYTES", "grasp_folder", "hand_meshes"]

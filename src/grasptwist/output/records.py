@@ -262,17 +262,13 @@ def check_record(block, i: int) -> dict:
 
 
 def error_record(err: GraspFileError) -> dict:
-    """The record of an input that could not be read, validated or paired with a twist."""
-    return {
-        "file": escaped(err.file, controls=False),
-        "ok": False,
-        "error": {
-            "code": err.code,
-            "message": escaped(err.message, controls=False),
-            "line": err.line,
-            "column": err.column,
-        },
-    }
+    """The record of an input that could not be read, validated or paired with a twist:
+    its first problem under ``error``, every problem (that one first) under ``errors``."""
+    errors = [
+        {"code": p.code, "message": escaped(p.message, controls=False), "line": p.line, "column": p.column}
+        for p in err.problems
+    ]
+    return {"file": escaped(err.file, controls=False), "ok": False, "error": errors[0], "errors": errors}
 
 
 def diagnostics(rec: dict) -> tuple[list[str], list[str]]:
@@ -286,9 +282,11 @@ def diagnostics(rec: dict) -> tuple[list[str], list[str]]:
         return [], []
     file = escaped(rec["file"])
     if "error" in rec:
-        err = rec["error"]
-        where = ":".join(str(x) for x in (file, err["line"], err["column"]) if x is not None)
-        return [f"{where}: error: {err['code']}: {escaped(err['message'])}"], []
+        lines = []
+        for err in rec["errors"]:
+            where = ":".join(str(x) for x in (file, err["line"], err["column"]) if x is not None)
+            lines.append(f"{where}: error: {err['code']}: {escaped(err['message'])}")
+        return lines, []
     where = f"{file}: grasp '{escaped(rec['grasp'])}'"
     if "twist" in rec:
         where += f", twist '{escaped(rec['twist']['name'])}'"

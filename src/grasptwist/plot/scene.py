@@ -525,7 +525,7 @@ def finger_links(hand, positions, contacts) -> tuple[LinePiece, ...]:
     """Each finger as its kinematic chain at ``positions``: segments from joint
     to joint, on to the tip link's origin (URDF fingers) and to its contact.
 
-    >>> from grasptwist.io.grasp_hand import inline_hand
+    >>> from grasptwist.io.grasp import inline_hand
     >>> h = inline_hand(["a", "b", "c"], [[("j", "revolute", [0, 0, 2], [1, 0, 0], None, 1)]] * 3, None)
     >>> s = finger_links(h, None, 3 * np.eye(3))[0]  # the joint at (1, 0, 0), its contact at (3, 0, 0)
     >>> s.label, s.start.tolist(), s.end.tolist()
@@ -542,7 +542,7 @@ def joint_segments(hand, positions, half) -> tuple[LinePiece, ...]:
     """Each finger joint's axis at ``positions``: a segment of half-length ``half``
     through its point (a prismatic joint's along its direction).
 
-    >>> from grasptwist.io.grasp_hand import inline_hand
+    >>> from grasptwist.io.grasp import inline_hand
     >>> h = inline_hand(["a", "b", "c"], [[("j", "revolute", [0, 0, 2], [1, 0, 0], None, 1)]] * 3, None)
     >>> s = joint_segments(h, None, 0.5)[0]
     >>> s.label, s.start.tolist(), s.end.tolist()

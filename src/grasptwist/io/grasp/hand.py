@@ -1,4 +1,4 @@
-"""The ``hand:`` key of a grasp file: joint screws given inline, or a URDF.
+"""The ``hand`` section of a grasp file: joint screws given inline, or a URDF.
 
 Two forms (README, "Hands and joint rates"), never mixed:
 
@@ -8,8 +8,8 @@ Two forms (README, "Hands and joint rates"), never mixed:
   ``joint_positions`` and ``fingers``, each naming the ``tip`` link that
   touches its contact.
 
-Checked with the grasp file's own helpers, so problems are located and
-coded like the rest of the format; a URDF's own problems
+Checked with the loader's shared typed-value checks (:mod:`.values`), so
+problems are located and coded like the rest of the format; a URDF's own problems
 (:mod:`grasptwist.io.urdf`) are reported at the ``urdf`` key, the URDF's
 file and line in the message.  Forward kinematics and the length check
 are the engine's (:mod:`grasptwist.engine.kinematics`).
@@ -21,10 +21,27 @@ import os
 from pathlib import Path
 
 import numpy as np
+import yaml
 
-from ..engine.kinematics import chain_length, joint_screw
-from ..model import Finger, Hand, InputError, Joint
-from . import grasp_file as gf
+from ...engine.hands import finger_states, joint_positions
+from ...engine.kinematics import chain_length, joint_screw
+from ...model import Finger, Hand, InputError, Joint
+from ..limits import DEFAULT_MAX_BYTES
+from ..urdf import load_urdf_hand
+from .compose import PARSER, compose, syntax_error
+from .problems import MAX_ERRORS, Problems, Reject, join, located
+from .text import file_text
+from .values import (
+    Section,
+    describe,
+    read_entry_name,
+    read_mapping,
+    read_name,
+    read_number,
+    read_sequence,
+    read_vector,
+    readonly,
+)
 
 __all__ = [
     "load_hand_file",
@@ -33,6 +50,7 @@ __all__ = [
     "URDF_FINGER_KEYS",
     "JOINT_KEYS",
     "JOINT_TYPES",
+    "SECTION",
     "read_hand",
     "inline_hand",
 ]
@@ -50,29 +68,29 @@ def read_hand(node, points, file, problems):
     ``points`` are the contacts (None when they had problems); ``file`` is
     the grasp file, whose folder a relative ``urdf`` path stays inside.
     """
-    fields = gf._mapping(node, "hand", HAND_KEYS, ("fingers",), problems)
+    fields = read_mapping(node, "hand", HAND_KEYS, ("fingers",), problems)
     if fields is None:
         return None
     urdf = "urdf" in fields
     if not urdf and "joint_positions" in fields:
         problems.add(
-            gf._Reject(
+            Reject(
                 "conflicting-keys",
                 "hand.joint_positions",
                 "only with 'urdf' (inline joints are given at their current configuration)",
-                **gf._at(fields["joint_positions"]),
+                **located(fields["joint_positions"]),
             )
         )
-    items = gf._sequence(fields["fingers"], "hand.fingers", problems) if "fingers" in fields else None
+    items = read_sequence(fields["fingers"], "hand.fingers", problems) if "fingers" in fields else None
     if items is None:
         return None
     if len(items) != 3:
         problems.add(
-            gf._Reject(
+            Reject(
                 "finger-count",
                 "hand.fingers",
                 f"expected exactly 3 fingers (one per contact), got {len(items)}",
-                **gf._at(fields["fingers"]),
+                **located(fields["fingers"]),
             )
         )
         return None
@@ -81,20 +99,20 @@ def read_hand(node, points, file, problems):
     names, fingers = {}, []
     for i, item in enumerate(items):
         path = f"hand.fingers[{i}]"
-        finger = gf._mapping(item, path, (*keys, other), required, problems)
+        finger = read_mapping(item, path, (*keys, other), required, problems)
         if finger is None:
             continue
         if other in finger:
             problems.add(
-                gf._Reject(
+                Reject(
                     "conflicting-keys",
                     f"{path}.{other}",
                     "mixes the two forms of a hand: "
                     + ("a URDF hand's fingers name their 'tip' link" if urdf else "'tip' needs 'urdf' in the hand"),
-                    **gf._at(finger[other]),
+                    **located(finger[other]),
                 )
             )
-        gf._entry_name(finger, item, "hand.fingers", i, names, problems)
+        read_entry_name(finger, item, "hand.fingers", i, names, problems)
         fingers.append(finger)
     if problems.count:
         return None
@@ -112,63 +130,61 @@ def read_hand(node, points, file, problems):
 def _joints(node, path, finger, taken, problems):
     """An inline finger's joints as ``(name or None, type, axis, point, limit, line)`` tuples;
     ``taken`` maps the joint names so far (given, or ``<finger>.<k>``) to their paths."""
-    items = gf._sequence(node, path + ".joints", problems)
+    items = read_sequence(node, path + ".joints", problems)
     if items is None:
         return None
     out = []
     for j, item in enumerate(items):
         where = f"{path}.joints[{j}]"
-        fields = gf._mapping(item, where, JOINT_KEYS, ("axis",), problems)
+        fields = read_mapping(item, where, JOINT_KEYS, ("axis",), problems)
         if fields is None:
             continue
-        name = gf._name(fields["name"], where + ".name", problems) if "name" in fields else None
+        name = read_name(fields["name"], where + ".name", problems) if "name" in fields else None
         final = f"{finger}.{j + 1}" if name is None else name
         if final in taken:
             named = "name" in fields
             problems.add(
-                gf._Reject(
+                Reject(
                     "duplicate-name",
                     where + ".name" if named else where,
                     f"duplicate joint name {final!r} (also {taken[final]})",
-                    **gf._at(fields["name"] if named else item),
+                    **located(fields["name"] if named else item),
                 )
             )
         else:
             taken[final] = where
-        kind = gf._name(fields["type"], where + ".type", problems) if "type" in fields else "revolute"
+        kind = read_name(fields["type"], where + ".type", problems) if "type" in fields else "revolute"
         if kind is not None and kind not in JOINT_TYPES:
             problems.add(
-                gf._Reject(
+                Reject(
                     "unsupported-joint",
                     where + ".type",
                     f"expected one of: {', '.join(JOINT_TYPES)}, got {kind!r}",
-                    **gf._at(fields["type"]),
+                    **located(fields["type"]),
                 )
             )
-        axis = gf._vector(fields["axis"], 3, where + ".axis", problems) if "axis" in fields else None
+        axis = read_vector(fields["axis"], 3, where + ".axis", problems) if "axis" in fields else None
         if axis is not None and not any(axis):
             problems.add(
-                gf._Reject("zero-axis", where + ".axis", "a zero vector has no direction", **gf._at(fields["axis"]))
+                Reject("zero-axis", where + ".axis", "a zero vector has no direction", **located(fields["axis"]))
             )
-        point = gf._vector(fields["point"], 3, where + ".point", problems) if "point" in fields else None
+        point = read_vector(fields["point"], 3, where + ".point", problems) if "point" in fields else None
         if "point" not in fields and kind == "revolute":
             problems.add(
-                gf._Reject(
-                    "missing-key", where + ".point", "a revolute joint needs a point on its axis", **gf._at(item)
-                )
+                Reject("missing-key", where + ".point", "a revolute joint needs a point on its axis", **located(item))
             )
         limit = (
-            gf._number(fields["velocity_limit"], where + ".velocity_limit", problems)
+            read_number(fields["velocity_limit"], where + ".velocity_limit", problems)
             if "velocity_limit" in fields
             else None
         )
         if limit is not None and limit <= 0:
             problems.add(
-                gf._Reject(
+                Reject(
                     "invalid-limit",
                     where + ".velocity_limit",
                     f"must be positive, got {limit:g}",
-                    **gf._at(fields["velocity_limit"]),
+                    **located(fields["velocity_limit"]),
                 )
             )
         out.append((name, kind, axis, point, limit, item.line))
@@ -231,47 +247,45 @@ def inline_hand(names, fingers, points):
 
 def _urdf_hand(fields, fingers, names, points, file, problems):
     """The URDF form: load the hand, place its joints, check the contacts are on its tips."""
-    from .. import hand as hands  # the URDF reader is optional: imported only for this form
-
     node = fields["urdf"]
-    reference = gf._name(node, "hand.urdf", problems)
+    reference = read_name(node, "hand.urdf", problems)
     positions = _positions(fields.get("joint_positions"), problems)
-    tips = [gf._name(f["tip"], f"hand.fingers[{i}].tip", problems) for i, f in enumerate(fingers)]
+    tips = [read_name(f["tip"], f"hand.fingers[{i}].tip", problems) for i, f in enumerate(fingers)]
     if problems.count:
         return None
     folder = Path(file).parent if not file.startswith("<") else Path.cwd()
     try:
-        hand = hands.load_urdf_hand(reference, tips, names=names, folder=folder)
+        hand = load_urdf_hand(reference, tips, names=names, folder=folder)
     except InputError as err:
-        problems.add(gf._Reject(err.code, "hand.urdf", str(err), **gf._at(node)))
+        problems.add(Reject(err.code, "hand.urdf", str(err), **located(node)))
         return None
     values = {}
     for name, (value, key_node) in positions.items():
         if name not in hand.joint_names:
             problems.add(
-                gf._Reject(
+                Reject(
                     "unknown-joint",
                     f"hand.joint_positions.{name}",
                     f"not a joint of the hand's fingers ({', '.join(hand.joint_names)})",
-                    **gf._at(key_node),
+                    **located(key_node),
                 )
             )
         values[name] = value
     if problems.count:
         return None
-    q = hands.joint_positions(hand, values)
+    q = joint_positions(hand, values)
     if points is None:  # a hand file: the contacts come with each row
         return hand, q
-    for f, (finger, state) in enumerate(zip(hand.fingers, hands.finger_states(hand, q))):
+    for f, (finger, state) in enumerate(zip(hand.fingers, finger_states(hand, q))):
         distance = float(np.linalg.norm(points[f] - state.tip[:3, 3]))
         if distance > finger.length:
             problems.add(
-                gf._Reject(
+                Reject(
                     "contact-off-finger",
                     f"hand.fingers[{f}].tip",
                     f"contact {f + 1} is {distance:.6g} from the origin of link {finger.tip!r}, farther than "
                     f"finger {finger.name!r} is long ({finger.length:.6g}): are the contacts in the URDF's root frame?",
-                    **gf._at(fingers[f]["tip"]),
+                    **located(fingers[f]["tip"]),
                 )
             )
     return None if problems.count else (hand, q)
@@ -283,23 +297,23 @@ def _positions(node, problems):
         return {}
     if node.kind != "mapping":
         problems.add(
-            gf._Reject(
+            Reject(
                 "not-a-mapping",
                 "hand.joint_positions",
-                f"expected a mapping of joint names to positions, got {gf._describe(node)}",
-                **gf._at(node),
+                f"expected a mapping of joint names to positions, got {describe(node)}",
+                **located(node),
             )
         )
         return {}
     out = {}
     for key, (key_node, value) in node.value.items():
-        number = gf._number(value, gf._join("hand.joint_positions", key), problems)
+        number = read_number(value, join("hand.joint_positions", key), problems)
         if number is not None:
             out[str(key)] = (number, key_node)
     return out
 
 
-def load_hand_file(path, *, max_bytes=gf.DEFAULT_MAX_BYTES):
+def load_hand_file(path, *, max_bytes=DEFAULT_MAX_BYTES):
     """The hand of a YAML file that holds just a ``hand:`` mapping (``--hand``).
 
     Checked like a grasp file's ``hand`` (without contacts, so without
@@ -314,31 +328,36 @@ def load_hand_file(path, *, max_bytes=gf.DEFAULT_MAX_BYTES):
     InputError
         The file's first problem, located and coded like a grasp file's.
     """
-    import yaml
-
     file = os.fspath(path)
-    problems = gf._Problems(gf.MAX_ERRORS)
+    problems = Problems(MAX_ERRORS)
     text = ""
     try:
-        data = gf._read_file(path, max_bytes)
-        if len(data) > max_bytes:
-            raise gf._Reject("too-large", "", f"larger than the size limit of {max_bytes} bytes")
-        text = gf._decode(data)
-        parser = gf.READING.parser(text)
+        text = file_text(path, False, max_bytes)
+        parser = PARSER(text)
         try:
             parser.get_event()  # StreamStartEvent
             if parser.check_event(yaml.StreamEndEvent):
-                raise gf._Reject("empty-document", "", "no YAML document in the file")
+                raise Reject("empty-document", "", "no YAML document in the file")
             parser.get_event()  # DocumentStartEvent
-            root = gf._compose(parser.get_event, problems)
+            root = compose(parser.get_event, problems)
         finally:
             parser.dispose()
-    except gf._Reject as reject:
+    except Reject as reject:
         raise reject.error(file, None) from None
     except yaml.YAMLError as exc:
-        raise gf._syntax_error(exc, text).error(file, 0) from None
-    fields = gf._mapping(root, "", ("hand",), ("hand",), problems)
+        raise syntax_error(exc, text).error(file, 0) from None
+    fields = read_mapping(root, "", ("hand",), ("hand",), problems)
     hand = read_hand(fields["hand"], None, file, problems) if fields and "hand" in fields else None
     if problems.count:
-        raise problems.first()[0].error(file, 0)
+        raise problems.first()[0][0].error(file, 0)
     return hand
+
+
+def _read(fields, found, problems):
+    if "hand" not in fields:
+        return {}
+    hand = read_hand(fields["hand"], found.get("points"), found["file"], problems)
+    return None if hand is None else {"hand": hand[0], "joint_positions": readonly(hand[1])}
+
+
+SECTION = Section(("hand",), _read)

@@ -1,0 +1,65 @@
+"""The ``contacts`` section: the three contact points and their normals."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ...engine import screws
+from .problems import Reject, located
+from .values import Section, read_entry_name, read_mapping, read_sequence, read_vector, readonly, shorten
+
+__all__ = ["CONTACT_KEYS", "SECTION", "read_contacts"]
+
+CONTACT_KEYS = ("name", "point", "normal")
+
+# What contacts look like, for the message when they are not a list.
+_CONTACTS_SHAPE = "a list of 3 contacts like [{point: [x, y, z], normal: [x, y, z]}, ...]"
+
+
+def read_contacts(node, problems):
+    """Names, points and unit normals of the three contacts (None after a problem)."""
+    items = read_sequence(node, "contacts", problems, _CONTACTS_SHAPE, _contacts_hint)
+    if items is None:
+        return None
+    if len(items) != 3:
+        problems.add(
+            Reject("contact-count", "contacts", f"expected exactly 3 contacts, got {len(items)}", **located(node))
+        )
+    names, points, normals = {}, [], []
+    for i, item in enumerate(items):
+        path = f"contacts[{i}]"
+        fields = read_mapping(item, path, CONTACT_KEYS, ("point", "normal"), problems)
+        if fields is None:
+            continue
+        read_entry_name(fields, item, "contacts", i, names, problems)
+        points.append(read_vector(fields["point"], 3, path + ".point", problems) if "point" in fields else None)
+        normal = read_vector(fields["normal"], 3, path + ".normal", problems) if "normal" in fields else None
+        if normal is not None and not any(normal):
+            problems.add(
+                Reject("zero-normal", path + ".normal", "a zero vector has no direction", **located(fields["normal"]))
+            )
+        normals.append(normal)
+    if problems.count:
+        return None
+    normals = [screws.direction3(*n) for n in normals]  # of any finite size: no over- or underflow
+    return tuple(names), readonly(np.array(points)), readonly(normals)
+
+
+def _contacts_hint(node):
+    """What to change when ``contacts`` is a mapping."""
+    if node.kind != "mapping" or not node.value:
+        return ""
+    if set(node.value) & set(CONTACT_KEYS):
+        return "; start each of the three contacts with '- '"
+    name = shorten(str(next(iter(node.value))))
+    return f"; write each as '- name: {name}' with its point and normal under it"
+
+
+def _read(fields, found, problems):
+    contacts = read_contacts(fields["contacts"], problems) if "contacts" in fields else None
+    if contacts is None:
+        return None
+    return dict(zip(("contact_names", "points", "normals"), contacts))
+
+
+SECTION = Section(("contacts",), _read, required=("contacts",))
