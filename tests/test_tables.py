@@ -271,3 +271,41 @@ def test_a_renderer_may_return_rich_groups_and_renderables():
     w.add(lines, Panel(grid))  # rich draws it, the grid inside too
     panel = buf.getvalue().decode()
     assert "│   [/]knuckle   0.2500" in panel and max(len(x) for x in panel.splitlines()) == 40
+
+
+# --------------------------------------------------------------------------
+# Issue 23: one naming of fingers (by contact), in sentences that agree in number
+
+HAND = ROOT / "grasps" / "three-finger-hand.yaml"
+
+
+def test_every_line_names_a_finger_by_its_contact_and_the_hand_table_shows_the_hands_name_once():
+    out = run("resolve", HAND).stdout
+    prose = [line for line in out.splitlines() if "finger" in line and not line.startswith(" ")]
+    assert "finger 3 is moved by: off-tangent Sigma_3 Psi_1 Psi_2; tangent Theta_1 Theta_2 Sigma_3" in prose
+    assert "off-tangent: Sigma part: fingers 1, 2 and 3 each move alone, about the line through the other two." in prose
+    assert any(
+        line.startswith("verdict: not realisable by tangent sliding alone: fingers 1, 2 and 3 must") for line in prose
+    )
+    assert not any(name in line for line in prose for name in ("east", "west", "south"))
+    (row,) = [line.split() for line in out.splitlines() if "south.1" in line]
+    assert row[:3] == ["3", "south", "south.1"]  # finger (its contact), the hand's name, the joint
+
+
+def test_verdicts_use_the_contacts_names_and_agree_in_number():
+    from grasptwist.output.table import OffTangentTable, TangentTable
+
+    names = ["thumb", "index", "middle"]
+    one = {"moves": [[0], [], [], [], [], []], "about_wrist": False}  # Sigma_1 alone
+    two = {"moves": [[], [], [], [1, 2], [0, 2], []], "about_wrist": False}  # Psi_1 and Psi_2
+    assert OffTangentTable.verdict(one, names) == [
+        "off-tangent: Sigma part: finger thumb moves alone, about the line through the other two."
+    ]
+    assert OffTangentTable.verdict(two, names)[0].startswith(
+        "off-tangent: Psi part: fingers thumb and index are each held fixed in turn while"
+    )
+    off = {"in_tangent_planes": False, "moves": [[], [], [], [], [1], []]}  # beta_2 Sigma_2
+    assert TangentTable.verdict(off, names) == [
+        "verdict: not realisable by tangent sliding alone: finger index must also move off its tangent plane "
+        "(the beta_i Sigma_i part)."
+    ]

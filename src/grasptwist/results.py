@@ -174,9 +174,6 @@ class ResultKind:
         writes its objects into a block's records (``(block, records,
         order) -> None``), for an object whose shape depends on the row (a
         hand's joints); None: the object of its ``fields``.
-    culprit_names : callable or None
-        ``(block, row) -> names`` that its culprit indices refer to in
-        messages; None: the row's contact names.
     missing : Status or None
         Why a method cannot run where it does not apply (``no-wrist``):
         its status there.  Asked for by name (``--method``), those rows
@@ -197,7 +194,6 @@ class ResultKind:
     method: bool = True
     needs: tuple[str, ...] = ()
     record: str | None = None
-    culprit_names: Callable[[Any, int], tuple[str, ...]] | None = None
     missing: Status | None = None
 
 
@@ -370,7 +366,6 @@ HAND = ResultKind(
     method=False,
     needs=("joint_screws",),
     record="hand_objects",
-    culprit_names=lambda block, i: tuple(f.name for f in block.hands[i].fingers),
 )
 
 #: Every result kind, in the order records hold them (a kind may use those before it).

@@ -181,27 +181,29 @@ def crossing_text(c: dict, names=("1", "2", "3"), digits: int = 4) -> str:
     return f"from t = {a} to t = {b}: {status_message(_STATUS[c['code']], culprit, names)}"
 
 
-def hand_event_texts(hand: dict, digits: int = 4) -> tuple[list[str], list[str]]:
+def hand_event_texts(hand: dict, names=("1", "2", "3"), digits: int = 4) -> tuple[list[str], list[str]]:
     """A summary's hand events in words: ``(errors, warnings)``, the joint-limit exit and the
-    rank losses (the motion cannot be made), then the fingers' conditioning warnings.
+    rank losses (the motion cannot be made), then the fingers' conditioning warnings.  Finger
+    ``f`` is named by its contact, ``names[f]`` (the records keep the hand's own finger names).
 
     >>> hand_event_texts({"joint_limit": {"finger": "east", "joint": "e2", "t": 0.5},
     ...                   "fingers": [{"name": "east", "rank_loss": None, "first_warning": 0.25}]})
-    (["joint 'e2' of finger 'east' leaves its position limits at t = 0.5000"], ["finger 'east': conditioning below 0.001 from t = 0.2500"])
+    (["joint 'e2' of finger 1 leaves its position limits at t = 0.5000"], ['finger 1: conditioning below 0.001 from t = 0.2500'])
     """
     errors, warnings = [], []
+    fingers = [f["name"] for f in hand["fingers"]]
     if hand["joint_limit"] is not None:
         j = hand["joint_limit"]
+        finger = escaped(names[fingers.index(j["finger"])])
         errors.append(
-            f"joint '{escaped(j['joint'])}' of finger '{escaped(j['finger'])}' leaves its position limits "
-            f"at t = {j['t']:.{digits}f}"
+            f"joint '{escaped(j['joint'])}' of finger {finger} leaves its position limits at t = {j['t']:.{digits}f}"
         )
-    for f in hand["fingers"]:
+    for f, name in zip(hand["fingers"], names):
         if f["rank_loss"] is not None:
-            errors.append(f"finger '{escaped(f['name'])}' loses rank (its Jacobian) at t = {f['rank_loss']:.{digits}f}")
+            errors.append(f"finger {escaped(name)} loses rank (its Jacobian) at t = {f['rank_loss']:.{digits}f}")
         if f["first_warning"] is not None:
             warnings.append(
-                f"finger '{escaped(f['name'])}': conditioning below {CONDITION_WARNING:g} from t = {f['first_warning']:.{digits}f}"
+                f"finger {escaped(name)}: conditioning below {CONDITION_WARNING:g} from t = {f['first_warning']:.{digits}f}"
             )
     return errors, warnings
 
@@ -219,7 +221,7 @@ def diagnostics(rec: dict, names=("1", "2", "3")) -> tuple[list[str], list[str]]
             f"{where}: warning: {w['method']}: conditioning below {CONDITION_WARNING:g} from t = {w['t']:.6g}"
         )
     if "hand" in s:
-        hand_errors, hand_warnings = hand_event_texts(s["hand"], 6)
+        hand_errors, hand_warnings = hand_event_texts(s["hand"], names, 6)
         errors += [f"{where}: error: hand: {text}" for text in hand_errors]
         warnings += [f"{where}: warning: hand: {text}" for text in hand_warnings]
     return errors, warnings

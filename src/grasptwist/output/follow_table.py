@@ -105,7 +105,7 @@ class FollowTable:
             else f"  first warning: {w['method']} at t = {w['t']:.{self.digits}f}"
         )
         if "hand" in s:
-            errors, warnings = hand_event_texts(s["hand"], self.digits)
+            errors, warnings = hand_event_texts(s["hand"], self.names, self.digits)
             for text in errors + warnings:
                 self._line(f"  hand: {text}")
             if not errors and not warnings:

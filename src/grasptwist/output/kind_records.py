@@ -11,7 +11,6 @@ from __future__ import annotations
 import numpy as np
 
 from ..engine.degeneracy import CONDITION_WARNING, Status, status_message
-from ..results import BY_KEY
 
 __all__ = ["hand_objects"]
 
@@ -62,13 +61,12 @@ def hand_objects(block, order, warnings):
             )
             if conditioning < CONDITION_WARNING and r.status[i] == Status.OK:
                 warnings[i].append(
-                    f"hand: finger {finger.name!r} is near a singularity (conditioning {conditioning:.3g} < "
+                    f"hand: finger {names[f]} is near a singularity (conditioning {conditioning:.3g} < "
                     f"{CONDITION_WARNING:g}): its joint rates are large and sensitive"
                 )
         obj = {"fingers": fingers, "velocity_limit_ratio": _number(r.velocity_limit_ratio[i]), "ok": bool(r.ok[i])}
         if not r.ok[i]:
             status = Status(int(r.status[i]))
-            names = BY_KEY["hand"].culprit_names(block, i)  # the culprit is a finger
             obj["error"] = {"code": status.code, "message": status_message(status, r.culprit[i], names)}
         more = {
             key: {"joint_rates": [[_finger_rates(c[f], fi) for f, fi in enumerate(hand.fingers)] for c in parts[i]]}

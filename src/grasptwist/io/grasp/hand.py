@@ -62,11 +62,12 @@ JOINT_KEYS = ("name", "type", "axis", "point", "velocity_limit")
 JOINT_TYPES = ("revolute", "prismatic")
 
 
-def read_hand(node, points, file, problems):
+def read_hand(node, points, file, problems, contact_names=("1", "2", "3")):
     """``(Hand, joint positions)`` of a ``hand`` node, or None after a problem.
 
-    ``points`` are the contacts (None when they had problems); ``file`` is
-    the grasp file, whose folder a relative ``urdf`` path stays inside.
+    ``points`` are the contacts (None when they had problems), named
+    ``contact_names`` (finger ``f`` is named by contact ``f`` in messages);
+    ``file`` is the grasp file, whose folder a relative ``urdf`` path stays inside.
     """
     fields = read_mapping(node, "hand", HAND_KEYS, ("fingers",), problems)
     if fields is None:
@@ -118,7 +119,7 @@ def read_hand(node, points, file, problems):
         return None
     names = list(names)
     if urdf:
-        return _urdf_hand(fields, fingers, names, points, file, problems)
+        return _urdf_hand(fields, fingers, names, (points, contact_names), file, problems)
     taken = {}  # joint names, unique over the hand
     joints = [_joints(f["joints"], f"hand.fingers[{i}]", names[i], taken, problems) for i, f in enumerate(fingers)]
     if problems.count:
@@ -245,8 +246,9 @@ def inline_hand(names, fingers, points):
     return Hand(tuple(out), tuple(joint_names), None, None)
 
 
-def _urdf_hand(fields, fingers, names, points, file, problems):
-    """The URDF form: load the hand, place its joints, check the contacts are on its tips."""
+def _urdf_hand(fields, fingers, names, contacts, file, problems):
+    """The URDF form: load the hand, place its joints, check the contacts ``(points, names)`` are on its tips."""
+    points, contact_names = contacts
     node = fields["urdf"]
     reference = read_name(node, "hand.urdf", problems)
     positions = _positions(fields.get("joint_positions"), problems)
@@ -283,8 +285,9 @@ def _urdf_hand(fields, fingers, names, points, file, problems):
                 Reject(
                     "contact-off-finger",
                     f"hand.fingers[{f}].tip",
-                    f"contact {f + 1} is {distance:.6g} from the origin of link {finger.tip!r}, farther than "
-                    f"finger {finger.name!r} is long ({finger.length:.6g}): are the contacts in the URDF's root frame?",
+                    f"contact {contact_names[f]} is {distance:.6g} from the origin of its finger's tip link "
+                    f"{finger.tip!r}, farther than the finger is long ({finger.length:.6g}): are the contacts in "
+                    "the URDF's root frame?",
                     **located(fingers[f]["tip"]),
                 )
             )
@@ -356,7 +359,8 @@ def load_hand_file(path, *, max_bytes=DEFAULT_MAX_BYTES):
 def _read(fields, found, problems):
     if "hand" not in fields:
         return {}
-    hand = read_hand(fields["hand"], found.get("points"), found["file"], problems)
+    names = found.get("contact_names") or ("1", "2", "3")
+    hand = read_hand(fields["hand"], found.get("points"), found["file"], problems, names)
     return None if hand is None else {"hand": hand[0], "joint_positions": readonly(hand[1])}
 
 
