@@ -63,7 +63,10 @@ def test_off_tangent_asked_for_on_a_grasp_without_wrist_fails_with_no_wrist(file
     [rec] = jsonl(p.stdout)
     assert rec["ok"] is False and rec["wrist"] is None and rec["warnings"] == []
     assert rec["off_tangent"] == {"error": {"code": "no-wrist", "message": NO_WRIST}}
-    assert p.stderr.splitlines() == [f"{where(path)}: error: off-tangent: no-wrist: {NO_WRIST}", "1 record, 1 failed"]
+    assert p.stderr.splitlines() == [
+        f"{where(path)}: error: off-tangent: no-wrist: {NO_WRIST}",
+        "1 record: 1 with a degenerate method (off-tangent: 1 no-wrist), 0 inputs failed",
+    ]
     # the same in CSV, and in npz as the status no-wrist
     p, _ = in_process("resolve", path, "--method", "off-tangent", "-f", "csv")
     [row] = csv.DictReader(io.StringIO(p.stdout))
@@ -85,13 +88,13 @@ def test_check_and_basis_fail_an_off_tangent_asked_for_without_wrist_and_warn_un
     assert rec["off_tangent"]["error"] == {"code": "no-wrist", "message": NO_WRIST}
     assert p.stderr.splitlines() == [
         f"{where(path, None)}: error: off-tangent: no-wrist: {NO_WRIST}",
-        "1 record, 1 failed",
+        "1 record: 1 with a degenerate method (off-tangent: 1 no-wrist), 0 inputs failed",
     ]
     p, _ = cli(command, path, "-f", "jsonl")
     [rec] = jsonl(p.stdout)
     assert p.returncode == 0 and rec["ok"] is True and rec["off_tangent"] is None and rec["warnings"] == [SKIPPED]
     assert rec["tangent"]["conditioning"] == pytest.approx(0.0995058864995588, rel=1e-12)
-    assert p.stderr.splitlines() == [f"{where(path, None)}: warning: {SKIPPED}", "1 record, 0 failed"]
+    assert p.stderr.splitlines() == [f"{where(path, None)}: warning: {SKIPPED}", "1 record: all ok"]
 
 
 def test_under_both_the_skip_is_a_warning_and_the_tangent_result_stays(files):
@@ -101,12 +104,12 @@ def test_under_both_the_skip_is_a_warning_and_the_tangent_result_stays(files):
     assert p.returncode == 0 and rec["ok"] is True and rec["off_tangent"] is None and rec["warnings"] == [SKIPPED]
     with_wrist = jsonl(in_process("resolve", files / "wrist.yaml", "-f", "jsonl")[0].stdout)[0]
     assert rec["tangent"] == with_wrist["tangent"] and with_wrist["warnings"] == []
-    assert p.stderr.splitlines() == [f"{where(path)}: warning: {SKIPPED}", "1 record, 0 failed"]
+    assert p.stderr.splitlines() == [f"{where(path)}: warning: {SKIPPED}", "1 record: all ok"]
     out = files / "r.npz"
     p, _ = run_installed("resolve", path, "-f", "npz", "-o", out)
     with np.load(out) as z:  # skipped: -1, as before
         assert p.returncode == 0 and z["off_tangent_status"].tolist() == [-1] and z["tangent_status"].tolist() == [0]
-    assert p.stderr.splitlines() == [f"{where(path)}: warning: {SKIPPED}", "1 record, 0 failed"]
+    assert p.stderr.splitlines() == [f"{where(path)}: warning: {SKIPPED}", "1 record: all ok"]
 
 
 # --------------------------------------------------------------------------
@@ -123,10 +126,10 @@ def test_outward_normals_get_a_warning_inward_ones_none(files, command, cli):
     twist = "spin" if command == "resolve" else None
     assert p.stderr.splitlines() == [
         f"{where(path, twist)}: warning: {OUTWARD_NORMALS_WARNING}",
-        "1 record, 0 failed",
+        "1 record: all ok",
     ]
     p, _ = in_process(command, files / "wrist.yaml", "-f", "jsonl")
-    assert p.returncode == 0 and jsonl(p.stdout)[0]["warnings"] == [] and p.stderr == "1 record, 0 failed\n"
+    assert p.returncode == 0 and jsonl(p.stdout)[0]["warnings"] == [] and p.stderr == "1 record: all ok\n"
 
 
 def test_outward_normals_warn_in_csv_and_npz_runs_too(files):
@@ -214,7 +217,7 @@ def test_twist_names_that_do_not_pair_are_a_usage_error(files, args, message, in
 def test_plot_help_says_how_to_install_matplotlib_from_a_clone():
     p, _ = run_installed("plot", "--help")
     text = " ".join(p.stdout.split())  # as one line, however the help is wrapped
-    assert p.returncode == 0 and "from a clone, pip install '.[plot]'" in text and "grasptwist[plot]" not in text
+    assert p.returncode == 0 and "from a clone, pip install -e '.[plot]'" in text and "grasptwist[plot]" not in text
 
 
 def test_follow_fails_an_off_tangent_asked_for_without_wrist_as_resolve_does(files):

@@ -90,7 +90,7 @@ def test_a_table_on_an_80_column_terminal_keeps_every_vector_on_one_line(command
     assert code == 0
     assert "\x1b[1m" in shown  # a terminal: colour
     table = ANSI.sub("", shown)
-    assert_fits(table.split("1 record, 0 failed")[0], 80)
+    assert_fits(table.split("1 record: all ok")[0], 80)
     for vector in (PSI_1, SIGMA_2, THETA_3):
         assert vector in table
     # the columns that did not fit come in a part of their own, the first column again
@@ -136,7 +136,7 @@ def test_the_bar_names_the_command_and_error_lines_are_never_wrapped(tmp_path):
     assert len(error) > 80
     # one line, however wide (after the bar's carriage return, on a line of its own)
     assert error in [line.rsplit("\r", 1)[-1] for line in ANSI.sub("", shown).split("\n")]
-    assert shown.endswith("2 records, 1 failed\n")
+    assert shown.endswith("2 records: 0 with a degenerate method, 1 input failed\n")
     assert len(out.read_text().splitlines()) == 2
 
 
@@ -234,7 +234,7 @@ def test_warnings_summary_prints_the_first_then_counts_the_rest_by_kind(noisy):
     assert lines[WARNINGS_SHOWN:] == [
         "grasptwist: 15 more warnings not shown (--warnings all): "
         "10 tangent basis is nearly degenerate, 5 off-tangent basis is nearly degenerate",
-        "35 records, 0 failed",
+        "35 records: all ok",
     ]
 
 
@@ -242,7 +242,7 @@ def test_warnings_summary_prints_the_first_then_counts_the_rest_by_kind(noisy):
 def test_warnings_all_none_and_quiet(noisy, command):
     every = run(command, *noisy, "-f", "jsonl", "--warnings", "all").stderr.splitlines()
     assert len(every) == 36 and sum(": warning: " in x for x in every) == 35
-    assert run(command, *noisy, "-f", "jsonl", "--warnings", "none").stderr == "35 records, 0 failed\n"
+    assert run(command, *noisy, "-f", "jsonl", "--warnings", "none").stderr == "35 records: all ok\n"
     assert run(command, *noisy, "-f", "jsonl", "-q").stderr == ""
     assert run(command, *noisy, "--warnings", "sometimes").exit_code == 2
 
@@ -280,7 +280,7 @@ HAND = ROOT / "grasps" / "three-finger-hand.yaml"
 
 
 def test_every_line_names_a_finger_by_its_contact_and_the_hand_table_shows_the_hands_name_once():
-    out = run("resolve", HAND).stdout
+    out = run("resolve", HAND, env={"COLUMNS": "300"}).stdout
     prose = [line for line in out.splitlines() if "finger" in line and not line.startswith(" ")]
     assert "finger 3 is moved by: off-tangent Sigma_3 Psi_1 Psi_2; tangent Theta_1 Theta_2 Sigma_3" in prose
     assert "off-tangent: Sigma part: fingers 1, 2 and 3 each move alone, about the line through the other two." in prose

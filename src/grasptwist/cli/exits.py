@@ -1,7 +1,8 @@
 """How a command ends: where its records go (``-o``) and the exit status of every way out.
 
-Exit codes: 0 all records ok, 1 some record failed (the others are still
-written in full), 2 usage error, 3 the output could not be written, 4 a
+Exit codes: 0 all records ok, 1 some record not ok (a method degenerate on a
+grasp that was read, or an input that could not be read; the others are
+still written in full), 2 usage error, 3 the output could not be written, 4 a
 worker process died, 128 + the signal's number when SIGINT, SIGTERM or
 SIGHUP stopped the run, 141 the reader of stdout went away.
 """

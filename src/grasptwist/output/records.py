@@ -36,6 +36,7 @@ __all__ = [
     "check_record",
     "error_record",
     "diagnostics",
+    "failure_codes",
     "talking_rows",
     "json_values",
     "present",
@@ -296,6 +297,18 @@ def diagnostics(rec: dict) -> tuple[list[str], list[str]]:
         if isinstance(m := rec.get(k.key), dict) and "error" in m
     ]
     return errors, [f"{where}: warning: {w}" for w in rec["warnings"]]
+
+
+def failure_codes(rec: dict) -> list[tuple[str, str]]:
+    """``(kind label, code)`` of each kind that failed in a record of a grasp that was read
+    (a resolve, basis or check record; the summary of a followed path).
+
+    >>> failure_codes({"ok": False, "off_tangent": {"x": 1}, "tangent": {"error": {"code": "normals-rank-deficient"}}})
+    [('tangent', 'normals-rank-deficient')]
+    """
+    if "summary" in rec:
+        return [(c["method"], c["code"]) for c in rec["summary"]["degenerate"]]
+    return [(k.label, m["error"]["code"]) for k in KINDS if isinstance(m := rec.get(k.key), dict) and "error" in m]
 
 
 def dumps(obj, indent: bool = False) -> bytes:

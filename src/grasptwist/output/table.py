@@ -632,7 +632,7 @@ class HandTable:
 
         ratio = m["velocity_limit_ratio"]
         title = "hand: joint rates" + ("" if ratio is None else f"   velocity-limit ratio {ratio:.3g}")
-        t = _table("finger", "hand's name", "joint", "rate", "rank", "residual", "conditioning", numbers=("rate",))
+        t = _table("finger", "in hand", "joint", "rate", "rank", "residual", "conditioning", numbers=("rate",))
         for f in m["fingers"]:
             for k, (joint, rate) in enumerate(zip(f["joints"], f["joint_rates"])):
                 first = k == 0

@@ -18,11 +18,12 @@ import numpy as np
 
 from ..engine import hands
 from ..engine.decompose import contact_velocities
+from ..engine.degeneracy import Status
 from ..engine.judgements import outward_normals
 from ..engine.screws import direction, twist_at
 from ..io.dataset import Dataset
 from ..model import CONTACT_NAMES, Grasp, GraspFileError, Twist
-from ..results import ALL_METHODS, BY_KEY, KINDS, METHOD_CHOICES, Field, ResultKind, selected
+from ..results import ALL_METHODS, BY_KEY, KINDS, METHOD_CHOICES, STATUS, Field, ResultKind, selected
 
 __all__ = [
     "METHODS",
@@ -129,6 +130,15 @@ class Block:
         for key, r in self.results.items():
             failed |= ~r.ok & self.applies(key)
         return failed
+
+    def failure_codes(self) -> dict[tuple[str, str], int]:
+        """Rows per ``(kind label, status code)`` where a kind that applies failed."""
+        counts = {}
+        for kind in self.kinds():
+            status = self.value(kind.key, STATUS)[~self.results[kind.key].ok & self.applies(kind.key)]
+            for code, n in zip(*np.unique(status, return_counts=True)):
+                counts[(kind.label, Status(int(code)).code)] = int(n)
+        return counts
 
     def part(self, start: int, stop: int) -> Block:
         """Rows ``start:stop`` as a block of their own (views, no copies)."""

@@ -160,7 +160,8 @@ def write_follow(job: FollowJob, inputs: Iterable, w, fmt: str, order: str = "om
             else:
                 for encoded in encoding.samples(item, order):
                     w.write(encoded)
-            yield Output(records=len(item.block), failed=int(item.block.failed_rows().sum()))
+            failed = int(item.block.failed_rows().sum())
+            yield Output(records=len(item.block), failed=failed, degenerate=item.block.failure_codes())
             continue
         rec = error_record(item) if isinstance(item, GraspFileError) else fr.summary_record(item)
         encode = encoding.error if isinstance(item, GraspFileError) else encoding.summary
@@ -169,7 +170,9 @@ def write_follow(job: FollowJob, inputs: Iterable, w, fmt: str, order: str = "om
         errors, warnings = (
             diagnostics(rec) if isinstance(item, GraspFileError) else fr.diagnostics(rec, item.grasp.contact_names)
         )
-        yield Output(errors=errors, warnings=warnings, records=1, failed=int(not rec["ok"]))
+        out = Output(errors=errors, warnings=warnings, records=1)
+        out.count(rec)
+        yield out
 
 
 def follow_grasp(job: FollowJob, grasp: Grasp) -> Iterator[GraspFileError | Samples | Summary]:

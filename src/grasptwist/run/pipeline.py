@@ -26,7 +26,15 @@ from ..io.datasets import DATASET_SUFFIXES, open_dataset
 from ..io.inputs import read
 from ..model import GraspFileError, Hand, Twist
 from ..output.formats import FORMATS
-from ..output.records import basis_record, check_record, diagnostics, error_record, records, talking_rows
+from ..output.records import (
+    basis_record,
+    check_record,
+    diagnostics,
+    error_record,
+    failure_codes,
+    records,
+    talking_rows,
+)
 from .batch import ZERO_TWIST, Block, check_positions, dataset_blocks, resolve
 from .pool import Pool
 from .scratch import owned_prefix, remove_orphans
@@ -89,8 +97,9 @@ class Output:
     row_errors: list[str] = field(default_factory=list)  # of a data set's or stream's rows: printed like warnings
     warnings: list[str] = field(default_factory=list)
     records: int = 0
-    failed: int = 0
-    failed_rows: int = 0  # of ``failed``: rows of a data set or stream
+    failed: int = 0  # records not ok: inputs that failed, and grasps (or rows) with a degenerate method
+    inputs_failed: int = 0  # of ``failed``: inputs (files, documents, lines of a stream) that could not be read
+    degenerate: dict = field(default_factory=dict)  # of the other failed records: per (kind, code), how many
     done: int = 0  # progress: files read, or data-set records made
     extra_work: int = 0  # progress: work found beyond the one unit an input was counted as
     spool: str | None = None  # a file holding ``encoded`` (see _sealed)
@@ -114,8 +123,16 @@ class Output:
         row = self.rows and not ("error" in rec and rec["error"]["line"] is None)
         (self.row_errors if row else self.errors).extend(errors)
         self.warnings += warnings
+        self.count(rec)
+
+    def count(self, rec: dict) -> None:
+        """Count a record that is not ok: an input that failed, or by the codes of its failed kinds."""
         self.failed += not rec["ok"]
-        self.failed_rows += row and not rec["ok"]
+        if "error" in rec:
+            self.inputs_failed += 1
+        elif not rec["ok"]:
+            for code in failure_codes(rec):
+                self.degenerate[code] = self.degenerate.get(code, 0) + 1
 
 
 def record_outputs(job: Job, paths: Sequence, workers: int = 1, tuning: Tuning = TUNING) -> Iterator[Output]:
