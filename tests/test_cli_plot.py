@@ -87,7 +87,7 @@ def test_without_matplotlib_it_says_how_to_install_it(tmp_path, monkeypatch):
     # one line, the word "grasptwist" once at its start (0.1 doubled it: "grasptwist: error: grasptwist plot ...")
     assert (
         r.stderr
-        == "grasptwist plot needs matplotlib: pip install matplotlib (from a clone of grasptwist: pip install '.[plot]')\n"
+        == "grasptwist plot needs matplotlib: pip install matplotlib (from a clone of grasptwist: pip install -e '.[plot]')\n"
     )
 
 

@@ -203,7 +203,7 @@ def test_without_the_urdf_extra_the_bundled_trifinger_says_what_to_install(monke
     monkeypatch.setitem(sys.modules, "yourdfpy", None)  # import yourdfpy -> ImportError
     result = CliRunner().invoke(app, ["resolve", str(TRIFINGER), "-f", "jsonl"])
     assert result.exit_code != 0
-    assert "urdf-unavailable" in result.stderr and "pip install 'grasptwist[urdf]'" in result.stderr
+    assert "urdf-unavailable" in result.stderr and "pip install -e '.[urdf]'" in result.stderr
     assert "Traceback" not in result.stderr
 
 

@@ -239,7 +239,9 @@ def _library(file):
         import yourdfpy
     except ImportError:
         raise InputError(
-            "urdf-unavailable", "reading a URDF needs yourdfpy: pip install 'grasptwist[urdf]'", file
+            "urdf-unavailable",
+            "reading a URDF needs yourdfpy: pip install yourdfpy (from a clone of grasptwist: pip install -e '.[urdf]')",
+            file,
         ) from None
     return yourdfpy
 
