@@ -6,6 +6,7 @@ command (a real subprocess); output contents in process, which is quicker."""
 import csv
 import io
 import json
+from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
@@ -230,3 +231,51 @@ def test_follow_fails_an_off_tangent_asked_for_without_wrist_as_resolve_does(fil
     p, _ = in_process(*args, "-f", "jsonl")
     samples = [r for r in map(json.loads, p.stdout.splitlines()) if "t" in r]
     assert p.returncode == 0 and all(r["off_tangent"] is None and r["warnings"] == [SKIPPED] for r in samples)
+
+
+# --------------------------------------------------------------------------
+# Issue 23: --select picks a file's own twists by name
+
+
+GRASPS = Path(__file__).resolve().parents[1] / "grasps"
+
+
+def test_select_picks_the_files_twists_by_name_in_the_order_given():
+    p, _ = in_process("resolve", GRASPS / "cylinder.yaml", "--select", "lift-z", "--select", "spin-z", "-f", "jsonl")
+    recs = jsonl(p.stdout)
+    assert [r["twist"]["name"] for r in recs] == ["lift-z", "spin-z"]
+    every = {
+        r["twist"]["name"]: r for r in jsonl(in_process("resolve", GRASPS / "cylinder.yaml", "-f", "jsonl")[0].stdout)
+    }
+    assert recs == [every["lift-z"], every["spin-z"]]  # the same records as without --select
+
+
+def test_a_grasp_without_a_selected_twist_is_one_failed_record_listing_its_twists(tmp_path):
+    (tmp_path / "a.yaml").write_text((GRASPS / "cylinder.yaml").read_text())
+    (tmp_path / "b.yaml").write_text((GRASPS / "polyhedron.yaml").read_text())
+    p, _ = in_process("resolve", tmp_path, "--select", "spin-z", "--method", "off-tangent", "-f", "jsonl")
+    good, bad = jsonl(p.stdout)
+    assert p.returncode == 1 and (good["ok"], good["twist"]["name"]) == (True, "spin-z")
+    assert bad["ok"] is False and bad["error"]["code"] == "unknown-twist"
+    assert bad["error"]["message"] == "grasp 'polyhedron' has no twist 'spin-z' (its twists: 'diagonal-spin')"
+    assert p.stderr.splitlines() == [
+        f"{tmp_path / 'b.yaml'}:17:1: error: unknown-twist: {bad['error']['message']}",
+        "2 records: 0 with a degenerate method, 1 input failed",
+    ]
+
+
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["--twist", "0,0,1,0,0,0"], "--twist and --twists-from replace them: give one"),
+        (["--twists-from", "-"], "--twist and --twists-from replace them: give one"),
+    ],
+)
+def test_select_with_twists_of_ones_own_is_a_usage_error(args, message):
+    p, _ = in_process("resolve", GRASPS / "cylinder.yaml", "--select", "spin-z", *args)
+    assert p.returncode == 2 and p.stdout == "" and message in " ".join(p.stderr.split())
+
+
+def test_select_on_a_data_set_is_a_usage_error(tmp_path):
+    p, _ = in_process("resolve", tmp_path / "rows.npz", "--select", "spin-z")
+    assert p.returncode == 2 and "a data set's are not named" in p.stderr

@@ -35,6 +35,7 @@ __all__ = [
     "check_positions",
     "ROWS_PER_BLOCK",
     "NO_TWIST",
+    "UNKNOWN_TWIST",
     "ZERO_TWIST",
     "CONTACT_NAMES",
 ]
@@ -44,6 +45,9 @@ METHODS = METHOD_CHOICES
 
 #: Error code of a grasp that has no twist to resolve.
 NO_TWIST = "no-twist"
+
+#: Error code of a grasp that has no twist of a name ``--select`` gives.
+UNKNOWN_TWIST = "unknown-twist"
 
 #: The twist whose resolution carries just the bases (``basis`` and ``check``).
 ZERO_TWIST = Twist(name="0", screw=np.zeros(6), line=None)
@@ -253,6 +257,7 @@ def resolve(
     twists: Sequence[Twist] | None = None,
     method: str = "both",
     chunk: int = 2048,
+    select: Sequence[str] | None = None,
 ) -> Iterator[Block | GraspFileError]:
     """Resolve every grasp against its twists, in order.
 
@@ -262,15 +267,19 @@ def resolve(
     twists : twists that replace each grasp's own (the command line's ``--twist``).
     method : one of :data:`METHODS`.
     chunk : rows per engine call; a chunk is flushed when full or at the end.
+    select : names of each grasp's own twists to resolve, in this order (``--select``).
 
     Yields
     ------
-    Blocks of consecutive rows and, in their places, the loader's errors and
-    an error with code :data:`NO_TWIST` for each grasp without a twist.
+    Blocks of consecutive rows and, in their places, the loader's errors, an
+    error with code :data:`NO_TWIST` for each grasp without a twist and one
+    with code :data:`UNKNOWN_TWIST` for each grasp without a twist ``select`` names.
     """
     pending: list[Grasp | GraspFileError] = []
     rows = 0
     for item in items:
+        if select is not None and isinstance(item, Grasp):
+            item = selected_twists(item, select)
         pending.append(item)
         if isinstance(item, Grasp):
             rows += len(twists if twists is not None else item.twists)
@@ -331,6 +340,23 @@ def _hand_inputs(grasps) -> dict:
     none = (np.zeros((3, width, 6)), np.full((3, width), np.nan))
     screws, limits = zip(*(made.get(id(g), none) for g in grasps))
     return {"hands": [g.hand for g in grasps], "joint_screws": np.stack(screws), "joint_limits": np.stack(limits)}
+
+
+def selected_twists(grasp: Grasp, names: Sequence[str]) -> Grasp | GraspFileError:
+    """The grasp with its twists named ``names`` only, in that order, or an error with code
+    :data:`UNKNOWN_TWIST` naming those it lacks and those it has."""
+    own = {t.name: t for t in grasp.twists}
+    missing = [n for n in dict.fromkeys(names) if n not in own]
+    if not missing:
+        return replace(grasp, twists=tuple(own[n] for n in dict.fromkeys(names)))
+    has = ", ".join(f"'{n}'" for n in own) or "none"
+    return GraspFileError(
+        code=UNKNOWN_TWIST,
+        message=f"grasp '{grasp.name}' has no twist {', '.join(repr(n) for n in missing)} (its twists: {has})",
+        file=grasp.file,
+        line=grasp.line,
+        column=1,
+    )
 
 
 def _no_twist(grasp: Grasp) -> GraspFileError:

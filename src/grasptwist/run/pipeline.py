@@ -59,6 +59,7 @@ class Job:
     extra_point: str = "wrist"
     hand: Hand | None = None  # --hand: the hand of a data set's rows, whose joints CSV and npz columns name
     twists_from: str | None = None  # a stream of twists (a file or -) for every grasp
+    select: tuple[str, ...] | None = None  # resolve --select: the names of the grasps' own twists to resolve
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -163,7 +164,8 @@ def _alone(job: Job, path: str, workers: int, tuning: Tuning) -> Iterator[Output
     if not is_stream(path):
         return _dataset(job, path, workers, tuning)
     twists = [ZERO_TWIST] if job.kind != "resolve" else job.twists
-    return _streamed(job, grasp_stream(path, twists, job.method, job.max_bytes, tuning.files_per_group), tuning)
+    batches = grasp_stream(path, twists, job.method, job.max_bytes, tuning.files_per_group, job.select)
+    return _streamed(job, batches, tuning)
 
 
 def _streamed(job: Job, batches, tuning: Tuning, files_first: bool = False) -> Iterator[Output]:
@@ -260,7 +262,7 @@ def run_group(job: Job, paths: Sequence, tuning: Tuning = TUNING, spool: Spool |
         items.extend(read(p, job.max_bytes) if isinstance(p, str) else [p])
     out = Output(done=len(paths))
     twists = [ZERO_TWIST] if job.kind != "resolve" else job.twists
-    for x in resolve(items, twists, job.method):
+    for x in resolve(items, twists, job.method, select=job.select):
         _encode_into(job, x, out, tuning.records_at_once)
     return _sealed(job, out, spool)
 
@@ -283,7 +285,7 @@ def blocks(
         return
     for g in _groups(paths, tuning.files_per_group):
         if is_stream(g):
-            batches = grasp_stream(g, job.twists, job.method, job.max_bytes, tuning.files_per_group)
+            batches = grasp_stream(g, job.twists, job.method, job.max_bytes, tuning.files_per_group, job.select)
             yield from ((x, None, True) for batch in batches for x in batch)
             continue
         if _is_dataset(g):
@@ -299,7 +301,7 @@ def blocks(
         items = []
         for p in g:
             items.extend(read(p, job.max_bytes) if isinstance(p, str) else [p])
-        for x in resolve(items, job.twists, job.method):
+        for x in resolve(items, job.twists, job.method, select=job.select):
             yield x, None, False
 
 
