@@ -279,9 +279,3 @@ def test_select_with_twists_of_ones_own_is_a_usage_error(args, message):
 def test_select_on_a_data_set_is_a_usage_error(tmp_path):
     p, _ = in_process("resolve", tmp_path / "rows.npz", "--select", "spin-z")
     assert p.returncode == 2 and "a data set's are not named" in p.stderr
-
-
-def test_grasptwist_alone_prints_its_help_on_stdout_and_succeeds():
-    p, _ = run_installed()
-    assert (p.returncode, p.stderr) == (0, "")
-    assert p.stdout.startswith("Usage: grasptwist [OPTIONS] COMMAND [ARGS]...") and "resolve" in p.stdout
