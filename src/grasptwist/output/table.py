@@ -563,7 +563,8 @@ class CheckTableWriter(_Writer):
     def __init__(self, out, **options):
         super().__init__(out, **options)
         self.kinds = [k for k in KINDS if k.check_fields]  # a kind with nothing to check has no column
-        self.grid = _table(*(k.label for k in self.kinds), "file", "grasp")
+        # a method's cell is "ok (its basis's conditioning)" or the code of its degeneracy
+        self.grid = _table(*(f"{k.label} (conditioning)" for k in self.kinds), "file", "grasp")
         self.widths: list[int] = []
 
     def write(self, encoded: bytes) -> None:
