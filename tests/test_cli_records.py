@@ -214,7 +214,7 @@ def test_twist_names_that_do_not_pair_are_a_usage_error(files, args, message, in
 def test_plot_help_says_how_to_install_matplotlib_from_a_clone():
     p, _ = run_installed("plot", "--help")
     text = " ".join(p.stdout.split())  # as one line, however the help is wrapped
-    assert p.returncode == 0 and "from a clone, pip install '.[plot]'" in text and "grasptwist[plot]" not in text
+    assert p.returncode == 0 and "from a clone, pip install -e '.[plot]'" in text and "grasptwist[plot]" not in text
 
 
 def test_follow_fails_an_off_tangent_asked_for_without_wrist_as_resolve_does(files):
