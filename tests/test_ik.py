@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from grasptwist.engine.degeneracy import Status
-from grasptwist.engine.ik import IK_TOL, chain_ik, contact_off_finger, hand_ik, home_tips, joint_limits
+from grasptwist.engine.ik import IK_TOL, chain_ik, contact_off_finger, hand_ik, home_tips, joint_limits, place_hand
 from grasptwist.engine.kinematics import forward_kinematics
 from grasptwist.io.grasp_file import load_grasps
 
@@ -174,3 +174,19 @@ def test_contact_off_finger_is_the_loaders_check(trifinger):
     far = trifinger.points.copy()
     far[0, 0] += 0.9
     assert contact_off_finger(tips, far, lengths(hand)).tolist() == [True, False, False]
+
+
+def test_place_hand_checks_given_positions_and_solves_missing_ones(trifinger, inline):
+    hand = trifinger.hand
+    far = trifinger.points.copy()
+    far[2, 2] += 0.9
+    checked = place_hand(hand, far, trifinger.joint_positions)
+    assert checked.status.tolist() == [Status.OK, Status.OK, Status.CONTACT_OFF_FINGER]
+    assert checked.tip_error[2] > hand.fingers[2].length
+    np.testing.assert_array_equal(checked.positions, trifinger.joint_positions)
+    centres = trifinger.points - 0.01 * trifinger.normals
+    solved = place_hand(hand, centres, seed=trifinger.joint_positions + 0.05)
+    assert solved.ok and solved.tip_error.max() <= IK_TOL * lengths(hand).min()
+    # an inline hand without tip points: as given, unchecked
+    taken = place_hand(inline.hand, far)
+    assert taken.ok and np.isnan(taken.tip_error).all() and not taken.positions.any()

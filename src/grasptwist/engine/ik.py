@@ -53,6 +53,7 @@ __all__ = [
     "joint_limits",
     "home_tips",
     "contact_off_finger",
+    "place_hand",
 ]
 
 #: A finger reaches its contact when its tip point is within ``IK_TOL`` times
@@ -393,3 +394,61 @@ def contact_off_finger(tip_points, points, lengths):
     [False, True, False]
     """
     return norm(np.asarray(points, dtype=float) - np.asarray(tip_points, dtype=float)) > np.asarray(lengths, float)
+
+
+def place_hand(hand, points, positions=None, *, seed=None, tips=None) -> HandIK:
+    """A batch of hands on their contacts: at given joint positions, checked, or else solved.
+
+    With ``positions``, each finger's tip is checked against its contact
+    (:func:`contact_off_finger`: ``contact-off-finger``, the tip error the
+    distance from the tip to the contact); without, they are solved by
+    :func:`hand_ik` from ``seed``.  A finger given inline has no tip point
+    unless ``tips`` gives one: it is unchecked (tip error NaN), and a hand
+    with such a finger is not solved but taken as given (every joint at 0,
+    the configuration its screws describe).
+
+    Parameters
+    ----------
+    hand : Hand
+    points : (..., 3, 3) array
+    positions : (..., n_joints) array, optional
+    seed : (..., n_joints) array, optional
+    tips : (3, 4, 4) array, optional
+        As for :func:`hand_ik`.
+
+    Returns
+    -------
+    HandIK
+
+    >>> from grasptwist.model import Finger, Hand, Joint
+    >>> s = np.array([[0, 0, 1.0, 0, 0, 0], [0, 0, 1.0, 0, -1.0, 0]])
+    >>> joints = (Joint("a", "revolute", None, None, None, None), Joint("b", "revolute", None, None, None, None))
+    >>> tip = np.eye(4); tip[0, 3] = 2.0
+    >>> f = [Finger(str(i), "tip", joints, s, np.array([[0, 0, 0], [1.0, 0, 0]]), tip, 2.0, (2 * i, 2 * i + 1)) for i in range(3)]
+    >>> h = Hand(tuple(f), ("a0", "b0", "a1", "b1", "a2", "b2"), None, None)
+    >>> r = place_hand(h, [[2.0, 0, 0], [1.0, 0, 0], [-3.0, 0, 0]], np.zeros(6))
+    >>> [Status(int(s)).code for s in r.status], r.tip_error.tolist()
+    (['ok', 'ok', 'contact-off-finger'], [0.0, 1.0, 5.0])
+    """
+    points = np.asarray(points, dtype=float)
+    lead, n = points.shape[:-2], len(hand.joint_names)
+    known = [f.tip_pose is not None or tips is not None for f in hand.fingers]
+    if positions is None and all(known):
+        return hand_ik(hand, points, seed, tips=tips)
+    if positions is None:  # a finger without a tip point: every joint as given
+        positions = np.zeros(lead + (n,))
+    positions = np.broadcast_to(np.asarray(positions, dtype=float), lead + (n,))
+    shape3 = lead + (len(hand.fingers),)
+    tip_error, within, status = np.full(shape3, np.nan), np.ones(shape3, bool), np.zeros(shape3, np.int8)
+    for f, finger in enumerate(hand.fingers):
+        q = positions[..., list(finger.joint_index)]
+        lower, upper = joint_limits(finger)
+        within[..., f] = ((q >= lower) & (q <= upper)).all(axis=-1)
+        if not known[f]:
+            continue
+        home = finger.tip_pose if tips is None else np.asarray(tips, dtype=float)[f]
+        tip = forward_kinematics(finger.screws, finger.points, home, q).tip[..., :3, 3]
+        tip_error[..., f] = norm(points[..., f, :] - tip)
+        off = contact_off_finger(tip, points[..., f, :], finger.length)
+        status[..., f] = np.where(off, Status.CONTACT_OFF_FINGER, Status.OK)
+    return HandIK(np.array(positions), tip_error, within, status)
