@@ -24,11 +24,11 @@ and ``L`` its length.  Each step is projected onto the joint limits and
 accepted only where it shrinks ``|e|`` (else ``mu`` grows tenfold for that
 row); rows stop when converged, a fixed number of iterations at most.  Rows
 that do not reach their contact from the seed start again from fixed
-spread-out seeds within the joints' ranges, and the nearest converged
-solution to the seed wins; rows that reach it from none of them are solved
-once more without limits, to tell ``outside-limits`` (reached, but only
-with a joint outside its limits) from ``unreachable`` (the tip error is then
-the smallest distance found).
+spread-out seeds within the joints' ranges (:func:`spread_seeds`), nearest
+to the seed first, until one reaches it; rows that reach it from none of
+them are solved once more without limits, to tell ``outside-limits``
+(reached, but only with a joint outside its limits) from ``unreachable``
+(the tip error is then the smallest distance found).
 
 Revolute joints without limits are brought within ``pi`` of the seed.
 """
@@ -46,6 +46,8 @@ from .screws import norm
 __all__ = [
     "IK_TOL",
     "IK_ITERATIONS",
+    "IK_SEEDS",
+    "spread_seeds",
     "ChainIK",
     "chain_ik",
     "HandIK",
@@ -64,7 +66,7 @@ IK_TOL = 1e-9
 IK_ITERATIONS = 60
 
 #: Seeds tried, besides the given one, for rows that do not reach their contact from it.
-_SPREAD = 8
+IK_SEEDS = 8
 
 #: The damping's floor ``lambda_0`` (times ``L**2``): keeps the steps bounded at
 #: singular configurations, and slows convergence only where ``sigma_min**2 < 1e-8 L**2``.
@@ -72,6 +74,9 @@ _FLOOR = 1e-8
 
 #: Rows stop iterating when their tip is this close (times ``L``), well inside ``IK_TOL``.
 _DONE = 1e-13
+
+#: A row stops after this many iterations in a row that shrink its error by less than 1 %.
+_STALL = 5
 
 #: Largest joint motion per step (rad; lengths over ``L`` for prismatic joints).
 _MAX_STEP = 0.5
@@ -138,6 +143,7 @@ def chain_ik(home_screws, home_points, home_tip, targets, seeds, lower=None, upp
     screws, tip = _tip(chain, q)
     error = norm(targets - tip)
     mu = np.ones(len(q))
+    slow = np.zeros(len(q), int)  # iterations in a row that shrank the error by less than 1 %
     active = np.flatnonzero(error > _DONE * length)
     for _ in range(iterations):
         if not active.size:
@@ -153,6 +159,7 @@ def chain_ik(home_screws, home_points, home_tip, targets, seeds, lower=None, upp
         trial_screws, trial_tip = _tip(chain, trial)
         trial_error = norm(targets[active] - trial_tip)
         better = trial_error < error[active]
+        slow[active] = np.where(trial_error < 0.99 * error[active], 0, slow[active] + 1)
         took = active[better]
         q[took], screws[took], tip[took], error[took] = (
             trial[better],
@@ -161,8 +168,9 @@ def chain_ik(home_screws, home_points, home_tip, targets, seeds, lower=None, upp
             trial_error[better],
         )
         mu[active] = np.where(better, np.maximum(mu[active] / 10, 1.0), mu[active] * 10)
-        # done: converged, or stuck (no step shrinks the error however damped)
-        active = active[(error[active] > _DONE * length) & (mu[active] < 1e12)]
+        # done: converged, or stuck (no step shrinks the error however damped, or barely any
+        # for _STALL iterations: against a limit, or at a local minimum of the distance)
+        active = active[(error[active] > _DONE * length) & (mu[active] < 1e12) & (slow[active] < _STALL)]
     return ChainIK(q, error)
 
 
@@ -249,15 +257,6 @@ def home_tips(hand, points=None):
     return out
 
 
-def _spread(lower, upper, length, prismatic, count):
-    """``count`` fixed seeds spread over the joints' ranges (``[-pi, pi]`` or ``[-L, L]`` where unlimited)."""
-    wide = np.where(prismatic, length, np.pi)
-    lo = np.where(np.isfinite(lower), lower, -wide)
-    hi = np.where(np.isfinite(upper), upper, wide)
-    unit = np.random.default_rng(20231).random((count, len(lo)))  # fixed: same answers every run
-    return lo + unit * (hi - lo)
-
-
 def _wrap(q, seed, unlimited):
     """Revolute joints without limits within ``pi`` of the seed (the same configuration)."""
     turns = np.round((q - seed) / (2 * np.pi))
@@ -325,51 +324,52 @@ def _finger(chain, target, start, lower, upper, finger, iterations):
     tol = IK_TOL * length
     finite = np.isfinite(target).all(axis=-1)
     target = np.where(finite[:, None], target, 0.0)
-    prismatic = np.array([j.type == "prismatic" for j in finger.joints])
-    unlimited = ~prismatic & ~np.isfinite(lower) & ~np.isfinite(upper)
+    unlimited = np.array([j.type != "prismatic" for j in finger.joints]) & ~np.isfinite(lower) & ~np.isfinite(upper)
+    spread = spread_seeds(finger)
     best = chain_ik(*chain, target, start, lower, upper, iterations=iterations)
-    q, err = best.positions, best.error
-    missed = np.flatnonzero(finite & (err > tol))
-    if missed.size:  # other seeds for the rows that missed; the nearest to the seed that reaches wins
-        seeds = _spread(lower, upper, length, prismatic, _SPREAD)
-        rows = np.repeat(missed, len(seeds))
-        again = chain_ik(*chain, target[rows], np.tile(seeds, (len(missed), 1)), lower, upper, iterations=iterations)
-        aq = again.positions.reshape(len(missed), len(seeds), -1)
-        ae = again.error.reshape(len(missed), len(seeds))
-        far = np.linalg.norm(_wrap(aq, start[missed, None, :], unlimited) - start[missed, None, :], axis=-1)
-        pick = np.argmin(np.where(ae <= tol, far, np.inf), axis=-1)
-        reached = (ae <= tol).any(axis=-1)
-        pick = np.where(reached, pick, np.argmin(ae, axis=-1))
-        closer = ae[np.arange(len(missed)), pick] < err[missed]
-        keep = missed[closer]
-        q[keep] = aq[closer, pick[closer]]
-        err[keep] = ae[closer, pick[closer]]
-    q = _wrap(q, start, unlimited)
+    q, err = best.positions, np.where(finite, best.error, 0.0)
+    _restart(chain, target, start, spread, lower, upper, tol, iterations, q, err)
     status = np.where(err <= tol, Status.OK, Status.UNREACHABLE)
-    limited = np.isfinite(lower).any() or np.isfinite(upper).any()
-    missed = np.flatnonzero(finite & (err > tol))
-    if missed.size and limited:  # reachable outside the limits?
-        seeds = np.concatenate(
-            (
-                start[missed, None, :],
-                np.broadcast_to(_spread(lower, upper, length, prismatic, _SPREAD), (len(missed), _SPREAD, len(lower))),
-            ),
-            axis=1,
-        )
-        k = seeds.shape[1]
-        free = chain_ik(
-            *chain, np.repeat(target[missed], k, axis=0), seeds.reshape(-1, len(lower)), iterations=iterations
-        )
-        fe = free.error.reshape(len(missed), k)
-        pick = np.argmin(fe, axis=-1)
-        outside = fe[np.arange(len(missed)), pick] <= tol
-        rows = missed[outside]
-        q[rows] = _wrap(free.positions.reshape(len(missed), k, -1)[outside, pick[outside]], start[rows], unlimited)
-        err[rows] = fe[outside, pick[outside]]
-        status[rows] = Status.OUTSIDE_LIMITS
+    missed = np.flatnonzero(err > tol)
+    if missed.size and (np.isfinite(lower).any() or np.isfinite(upper).any()):  # reachable outside the limits?
+        free = chain_ik(*chain, target[missed], start[missed], iterations=iterations)
+        fq, fe = free.positions, free.error
+        _restart(chain, target[missed], start[missed], spread, None, None, tol, iterations, fq, fe)
+        outside = fe <= tol
+        q[missed[outside]], err[missed[outside]] = fq[outside], fe[outside]
+        status[missed[outside]] = Status.OUTSIDE_LIMITS
+    q = _wrap(q, start, unlimited)
     inside = ((q >= lower) & (q <= upper)).all(axis=-1)
     status = np.where(finite, status, Status.NONFINITE_INPUT)
     return q, np.where(finite, err, np.nan), inside, status.astype(np.int8)
+
+
+def _restart(chain, target, start, spread, lower, upper, tol, iterations, q, err):
+    """Rows that miss (``err > tol``) start again from the spread seeds, nearest to their own
+    start first, while they miss; each row keeps its best (``q`` and ``err`` updated in place)."""
+    order = np.argsort(np.linalg.norm(spread[None, :, :] - start[:, None, :], axis=-1), axis=-1)
+    for k in range(len(spread)):
+        missed = np.flatnonzero(err > tol)
+        if not missed.size:
+            return
+        got = chain_ik(*chain, target[missed], spread[order[missed, k]], lower, upper, iterations=iterations)
+        better = got.error < err[missed]
+        q[missed[better]], err[missed[better]] = got.positions[better], got.error[better]
+
+
+def spread_seeds(finger, count=IK_SEEDS):
+    """``count`` fixed seeds spread over a finger's joint ranges: its limits, or ``[-pi, pi]`` (revolute)
+    and ``[-L, L]`` (prismatic) where a joint has none; the same every run.
+
+    Returns
+    -------
+    (count, n) array
+    """
+    lower, upper = joint_limits(finger)
+    wide = np.array([finger.length if j.type == "prismatic" else np.pi for j in finger.joints])
+    lo = np.where(np.isfinite(lower), lower, -wide)
+    hi = np.where(np.isfinite(upper), upper, wide)
+    return lo + np.random.default_rng(20231).random((count, len(lo))) * (hi - lo)
 
 
 def contact_off_finger(tip_points, points, lengths):
