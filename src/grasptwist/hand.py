@@ -193,7 +193,7 @@ def _limits(finger, which):
 #: :func:`track` integrates each segment over at least this many intervals (of
 #: ``steps`` Runge-Kutta steps each), however few the samples: the tip's error
 #: and the events' times do not depend on the sampling.
-SEGMENT_INTERVALS = 20
+SEGMENT_INTERVALS = 4
 
 
 def track(hand, positions, points, segments, times, steps=16) -> HandTrack:
