@@ -192,3 +192,19 @@ def test_place_hand_checks_given_positions_and_solves_missing_ones(trifinger, in
     # an inline hand without tip points: as given, unchecked
     taken = place_hand(inline.hand, far)
     assert taken.ok and np.isnan(taken.tip_error).all() and not taken.positions.any()
+
+
+def test_the_guide_page_runs_as_printed(monkeypatch):
+    """docs/guide/inverse-kinematics.md's sessions give the outputs shown."""
+    import doctest
+    import re
+
+    monkeypatch.chdir(Path(__file__).parent.parent)
+    text = (Path(__file__).parent.parent / "docs" / "guide" / "inverse-kinematics.md").read_text("utf-8")
+    sessions = re.findall(r"^```pycon\n(.*?)^```$", text, flags=re.M | re.S)
+    assert sessions
+    for session in sessions:
+        test = doctest.DocTestParser().get_doctest(session, {}, "inverse-kinematics.md", None, 0)
+        runner = doctest.DocTestRunner(optionflags=doctest.ELLIPSIS)
+        runner.run(test)
+        assert runner.summarize(verbose=False).failed == 0
