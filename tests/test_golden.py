@@ -78,7 +78,10 @@ def test_output_matches_the_golden_file(name, monkeypatch):
     "change, golden",
     [
         # the last digit of a joint rate: within the tolerance
-        ('"joint_rates":[[[0.06624605678233438,0.004731861198738165', '"joint_rates":[[[0.06624605678233438,0.004731861198738169'),
+        (
+            '"joint_rates":[[[0.06624605678233438,0.004731861198738165',
+            '"joint_rates":[[[0.06624605678233438,0.004731861198738169',
+        ),
         # a closed-form number, one bit off: never
         ('"x":[-7.870370370370357', '"x":[-7.870370370370358'),
     ],
