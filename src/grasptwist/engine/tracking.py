@@ -85,7 +85,18 @@ class FingerTrack(NamedTuple):
 
 
 def track_finger(
-    home_screws, home_points, home_tip, positions, contact, segments, times, *, lower=None, upper=None, steps=16
+    home_screws,
+    home_points,
+    home_tip,
+    positions,
+    contact,
+    segments,
+    times,
+    *,
+    lower=None,
+    upper=None,
+    steps=16,
+    segment_steps=None,
 ) -> FingerTrack:
     """Follow one contact along a path with one finger (module docstring).
 
@@ -105,6 +116,10 @@ def track_finger(
         Joint position limits (NaN: none).
     steps : int
         Runge-Kutta steps per interval of the grid.
+    segment_steps : int, optional
+        Instead of ``steps``: steps no longer than ``1 / segment_steps`` of
+        their segment, at least one per interval, so that dense samples do not
+        multiply the work and sparse ones cost no accuracy.
 
     Returns
     -------
@@ -181,9 +196,12 @@ def track_finger(
     at = {0.0: q.copy()}
     ends, starts, values = [0.0], [q.copy()], [c]  # every step's end and state there, and the conditioning
     for a, b in zip(grid[:-1], grid[1:]):
-        h = (b - a) / steps
-        for s in range(steps):
-            t0, t1 = a + s * h, (a + (s + 1) * h if s < steps - 1 else b)
+        m = steps
+        if segment_steps is not None:  # round-off must not add a step to an interval of exactly 1/m
+            m = max(1, int(np.ceil(segment_steps * (b - a) / plan.duration[plan.index(a)] * (1 - 1e-12))))
+        h = (b - a) / m
+        for s in range(m):
+            t0, t1 = a + s * h, (a + (s + 1) * h if s < m - 1 else b)
             q1 = step(t0, q, t1 - t0, here)
             events, c, there = assess(t1, q1)
             for e, w in enumerate(events):
