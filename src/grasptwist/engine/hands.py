@@ -152,10 +152,11 @@ def _limits(finger, which):
     return np.array([np.nan if getattr(j, which) is None else getattr(j, which) for j in finger.joints], dtype=float)
 
 
-#: :func:`track` integrates each segment over at least this many intervals (of
-#: ``steps`` Runge-Kutta steps each), however few the samples: the tip's error
-#: and the events' times do not depend on the sampling.
-SEGMENT_INTERVALS = 20
+#: :func:`track` integrates each segment over at least this many intervals, by
+#: Runge-Kutta steps no longer than ``1 / steps`` of an interval (at least one
+#: between samples), however few or many the samples: the tip's error and the
+#: events' times do not depend on the sampling, and dense samples cost one step each.
+SEGMENT_INTERVALS = 4
 
 
 def track(hand, positions, points, segments, times, steps=16) -> HandTrack:
@@ -179,7 +180,8 @@ def track(hand, positions, points, segments, times, steps=16) -> HandTrack:
     times : (T,) array
         Increasing sample times.
     steps : int
-        Runge-Kutta steps per interval between sample times.
+        Runge-Kutta steps per interval of :data:`SEGMENT_INTERVALS`: steps are
+        no longer than ``1 / (SEGMENT_INTERVALS * steps)`` of their segment.
 
     Returns
     -------
@@ -223,7 +225,7 @@ def track(hand, positions, points, segments, times, steps=16) -> HandTrack:
                 grid,
                 lower=_limits(finger, "lower"),
                 upper=_limits(finger, "upper"),
-                steps=steps,
+                segment_steps=SEGMENT_INTERVALS * steps,
             )
         )
         fingers[-1] = fingers[-1]._replace(**{k: getattr(fingers[-1], k)[rows] for k in _PER_SAMPLE})

@@ -353,8 +353,11 @@ def dataset_blocks(
     linear part is the velocity of the row's ``at`` point.  ``bases=False``
     leaves the basis screws out (see :func:`resolve_arrays`).
     ``hand_of_rows`` (a Hand, e.g. from ``--hand``) holds every row: at the
-    data set's ``joint_positions`` (at 0 without them), its joint rates are
-    computed per row.
+    data set's ``joint_positions``, each row's checked (``contact-off-finger``),
+    or without them at joint positions solved per row by inverse kinematics
+    (``unreachable``, ``outside-limits`` where they fail; a hand given inline
+    is at the configuration its screws describe), its joint rates are computed
+    per row.
 
     Raises
     ------
@@ -394,19 +397,39 @@ def check_positions(ds, hand_of_rows) -> None:
         )
 
 
-def _rows_hand(ds, hand_of_rows, start, stop, rows, n):
-    """The hand keywords of :func:`resolve_arrays` for rows ``start:stop`` of a data set."""
+def _rows_hand(ds, hand_of_rows, start, stop, rows, points):
+    """The hand keywords of :func:`resolve_arrays` for rows ``start:stop`` of a data set, and the
+    hand placed on each row's contacts (:func:`~grasptwist.engine.ik.place_hand`: the rows' joint
+    positions checked, or solved for when the data set has none)."""
     if hand_of_rows is None:
-        return {}
+        return {}, None
+    from ..engine.ik import place_hand
 
     q = None if ds.joint_positions is None else np.asarray(ds.joint_positions[start:stop], dtype=float)[rows]
-    states = hands.finger_states(hand_of_rows, q)
+    placed = place_hand(hand_of_rows, points, q)
+    states = hands.finger_states(hand_of_rows, placed.positions)
     screws, limits = hands.padded(hand_of_rows, [s.screws for s in states])
+    n = len(points)
     return {
         "hands": [hand_of_rows] * n,
-        "joint_screws": np.broadcast_to(screws, (n, *screws.shape[-3:])),
+        "joint_screws": screws,
         "joint_limits": np.broadcast_to(limits, (n, *limits.shape)),
-    }
+    }, placed
+
+
+def _placed(block, placed):
+    """``block`` with its hand status, where a hand is not on its contacts, saying so (that
+    finger the culprit): a row's joint rates are only worth what its joint positions are."""
+    if placed is None or "hand" not in block.results:
+        return block
+    r = block.results["hand"]
+    off = ~placed.ok
+    culprit = placed.culprit
+    status = np.take_along_axis(placed.status, np.maximum(culprit, 0)[:, None].astype(np.intp), axis=-1)[:, 0]
+    block.results["hand"] = replace(
+        r, status=np.where(off, status, r.status).astype(np.int8), culprit=np.where(off, culprit, r.culprit)
+    )
+    return block
 
 
 def _dataset_block(ds, given, twists, method, start, stop, k, bases, hand_of_rows=None):
@@ -430,8 +453,10 @@ def _dataset_block(ds, given, twists, method, start, stop, k, bases, hand_of_row
         screw = twist_at(screw[:, :3], screw[:, 3:], at)
     # labels stay a numpy string array: a million Python strings cost more than the engine
     label = _labels(ds.names[start:stop][rows]) if ds.names is not None else index.astype(str)
-    return resolve_arrays(
-        column(ds.points),
+    points = column(ds.points)
+    hand_inputs, placed = _rows_hand(ds, hand_of_rows, start, stop, rows, points)
+    block = resolve_arrays(
+        points,
         # unit normals exactly as the grasp-file loader makes them
         direction(np.asarray(ds.normals[start:stop], dtype=float))[rows],
         column(ds.wrist),
@@ -443,8 +468,9 @@ def _dataset_block(ds, given, twists, method, start, stop, k, bases, hand_of_row
         bases=bases,
         # a data set's wrist column gives every row a wrist: NaN in it is a nonfinite-input, not "no wrist"
         has_wrist=None if ds.wrist is None else np.ones(len(index), bool),
-        **_rows_hand(ds, hand_of_rows, start, stop, rows, len(index)),
+        **hand_inputs,
     )
+    return _placed(block, placed)
 
 
 def _labels(names: np.ndarray) -> np.ndarray:
