@@ -176,3 +176,17 @@ def test_follow_shows_each_samples_positions_and_tip_errors():
     last = samples[-1]["hand"]["fingers"][2]
     want = f"finger south: q {' '.join(f'{v:.4f}' for v in last['joint_positions'])}, tip error {last['tip_error']:.3g}"
     assert lines[-1].endswith(want), lines[-1]
+
+
+@urdf
+def test_a_hand_files_seed_is_refused_not_dropped(tmp_path):
+    (g,) = read_grasps(TRIFINGER)
+    hand_file = tmp_path / "trifinger.yaml"
+    fingers = "".join(f"    - {{tip: {f.tip}}}\n" for f in g.hand.fingers)
+    hand_file.write_text(
+        f"hand:\n  urdf: {g.hand.source}\n  seed: {{finger_upper_to_middle_joint_0: 0.5}}\n  fingers:\n{fingers}",
+        "utf-8",
+    )
+    result = run("resolve", TRIFINGER, "--hand", hand_file)
+    assert result.exit_code == 2
+    assert "conflicting-keys" in result.stderr and "hand.seed: only in a grasp file" in " ".join(result.stderr.split())

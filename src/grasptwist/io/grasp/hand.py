@@ -292,6 +292,16 @@ def _urdf_hand(fields, fingers, names, points, file, problems):
         return None
     q = joint_positions(hand, values)
     if points is None:  # a hand file: the contacts come with each row
+        if "seed" in fields:  # not silently dropped: --hand's rows are solved from home
+            problems.add(
+                Reject(
+                    "conflicting-keys",
+                    "hand.seed",
+                    "only in a grasp file (a data set's rows without joint_positions are solved from every joint at 0)",
+                    **located(fields["seed"]),
+                )
+            )
+            return None
         return hand, q
     placed = place_hand(hand, points, q) if given else place_hand(hand, points, seed=q)
     for f, finger in enumerate(hand.fingers):
