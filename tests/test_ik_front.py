@@ -121,7 +121,8 @@ def test_a_finger_that_cannot_reach_fails_the_grasp_at_its_tip(fixture, code, ma
 
 
 @urdf
-def test_the_table_labels_positions_and_tip_errors(tmp_path):
+def test_the_table_labels_positions_and_tip_errors(tmp_path, monkeypatch):
+    monkeypatch.setenv("COLUMNS", "200")  # one part: narrower, the table splits its columns
     path, _ = without_positions(tmp_path)
     (g,) = read_grasps(path)
     out = run("resolve", path, "--twist", "0,0,0.5,0,0,0").stdout
