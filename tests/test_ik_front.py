@@ -19,6 +19,7 @@ from grasptwist.engine import hands
 from grasptwist.engine.degeneracy import Status
 from grasptwist.engine.ik import IK_TOL, hand_ik
 from grasptwist.io.grasp import read_grasps
+from grasptwist.output.follow_table import FollowTable
 
 ROOT = Path(__file__).resolve().parents[1]
 TRIFINGER = ROOT / "grasps" / "trifinger-cube.yaml"
@@ -116,8 +117,6 @@ def test_a_finger_that_cannot_reach_fails_the_grasp_at_its_tip(fixture, code, ma
         assert Status(int(solved.status[0])) == Status.UNREACHABLE
         assert float(found.group(1)) == pytest.approx(solved.tip_error[0], rel=1e-5)
         assert 0.7 < solved.tip_error[0] < 0.9
-    result = run("check", INVALID / fixture)
-    assert result.exit_code != 0 and f":13:24: error: {code}: hand.fingers[0].tip: " in result.stderr
 
 
 @urdf
@@ -162,6 +161,7 @@ def test_a_data_set_solved_by_ik_carries_its_positions_in_every_format(tmp_path)
 
 def test_follow_shows_each_samples_positions_and_tip_errors():
     recs = jsonl("follow", THREE, "--samples", "5")
+    assert len(recs) == 6
     samples = [r for r in recs if "t" in r]
     (summary,) = [r for r in recs if "summary" in r]
     for s in samples:  # the hand's own positions are the sample's (as the path record gives them)
@@ -171,8 +171,11 @@ def test_follow_shows_each_samples_positions_and_tip_errors():
     # the summary's is the tracker's own error at the samples: the same distance, computed apart
     assert worst == pytest.approx(tracked, rel=1e-6, abs=1e-15)
     assert samples[0]["hand"]["fingers"][0]["tip_error"] == 0.0 and max(worst) < 1e-6
-    table = run("follow", THREE, "--samples", "5").stdout.splitlines()
-    lines = [line for line in table if line.lstrip().startswith("hand  finger")]
+    out = io.BytesIO()  # the table of these records (one path run: a hand's integration costs seconds)
+    writer = FollowTable(out)
+    for rec in recs:
+        writer.write(rec)
+    lines = [line for line in out.getvalue().decode().splitlines() if line.lstrip().startswith("hand  finger")]
     assert len(lines) == 5
     last = samples[-1]["hand"]["fingers"][2]
     want = f"finger south: q {' '.join(f'{v:.4f}' for v in last['joint_positions'])}, tip error {last['tip_error']:.3g}"
