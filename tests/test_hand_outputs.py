@@ -35,10 +35,16 @@ def test_csv_of_a_hand_grasp_has_its_joint_columns():
     rows = list(csv.reader(io.StringIO(result.stdout)))
     header, (row,) = rows[0], rows[1:]
     joints = [f"qdot_{f}_{f}.{k}" for f in ("east", "west", "south") for k in (1, 2, 3)]
-    assert header == CSV_COLUMNS + joints + ["hand_error"]
+    positions = [name.replace("qdot_", "q_", 1) for name in joints]
+    assert header == CSV_COLUMNS + joints + positions + ["hand_error"]
     (rec,) = jsonl("resolve", THREE)
     want = [r for f in rec["hand"]["fingers"] for r in f["joint_rates"]]
     assert [float(row[header.index(name)]) for name in joints] == want
+    # inline joints are given at their configuration: every joint at 0, each tip on its contact
+    assert [float(row[header.index(name)]) for name in positions] == [0.0] * 9
+    assert [(f["joint_positions"], f["tip_error"], f["within_limits"]) for f in rec["hand"]["fingers"]] == [
+        ([0.0, 0.0, 0.0], 0.0, True)
+    ] * 3
     assert want == pytest.approx([-0.14, 0.015, 0.105, 0.14, 0.01, -0.09, -0.1, 0.21, -0.61], abs=1e-12)
 
 

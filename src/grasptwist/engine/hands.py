@@ -21,6 +21,7 @@ __all__ = [
     "finger_states",
     "velocity_limits",
     "padded",
+    "padded_positions",
     "HandTrack",
     "track",
     "SEGMENT_INTERVALS",
@@ -145,6 +146,31 @@ class HandTrack(NamedTuple):
 
     positions: np.ndarray
     fingers: tuple[FingerTrack, ...]
+
+
+def padded_positions(hand, positions, width=None):
+    """A hand's joint positions per finger, ``(..., 3, width)``, NaN in the padding (as :func:`padded`).
+
+    Parameters
+    ----------
+    hand : Hand
+    positions : (..., n_joints) array
+        In ``hand.joint_names`` order.
+    width : int, optional
+        Joints per finger; default the longest finger's.
+
+    >>> from grasptwist.model import Finger, Hand, Joint
+    >>> j = Joint("a", "revolute", None, None, None, None)
+    >>> h = Hand(tuple(Finger(str(f), None, (j,) * (f + 1), None, None, None, 1.0, tuple(range(f * (f + 1) // 2, (f + 1) * (f + 2) // 2))) for f in range(3)), tuple("abcdef"), None, None)
+    >>> padded_positions(h, np.arange(6.0))[1].tolist()
+    [1.0, 2.0, nan]
+    """
+    positions = np.asarray(positions, dtype=float)
+    width = max(len(f.joints) for f in hand.fingers) if width is None else width
+    out = np.full(positions.shape[:-1] + (3, width), np.nan)
+    for f, finger in enumerate(hand.fingers):
+        out[..., f, : len(finger.joints)] = positions[..., list(finger.joint_index)]
+    return out
 
 
 def _limits(finger, which):

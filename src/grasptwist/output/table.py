@@ -599,7 +599,8 @@ WRITERS = {"resolve": TableWriter, "basis": BasisTableWriter, "check": CheckTabl
 
 
 class HandTable:
-    """A hand's joint rates: per finger its joints and their rates, rank, residual, conditioning."""
+    """A hand's joint rates: per finger its joints with their positions and rates, rank, residual,
+    conditioning and tip error."""
 
     skipped = "the grasp has no hand"
 
@@ -613,18 +614,29 @@ class HandTable:
 
         ratio = m["velocity_limit_ratio"]
         title = "hand: joint rates" + ("" if ratio is None else f"   velocity-limit ratio {ratio:.3g}")
-        t = _table("finger", "contact", "joint", "rate", "rank", "residual", "conditioning", numbers=("rate",))
+        # where the hand is (its joint positions given or solved, each tip's distance to its contact)
+        placed = "joint_positions" in m["fingers"][0]
+        where = ("position",) if placed else ()
+        tip = ("tip error",) if placed else ()
+        t = _table(
+            "finger", "contact", "joint", *where, "rate", "rank", "residual", "conditioning", *tip,
+            numbers=("rate", *where),
+        )  # fmt: skip
         for f in m["fingers"]:
+            positions = f.get("joint_positions", ())
             for k, (joint, rate) in enumerate(zip(f["joints"], f["joint_rates"])):
                 first = k == 0
+                error = "-" if f.get("tip_error") is None else f"{f['tip_error']:.2g}"
                 t.add_row(
                     f["name"] if first else "",
                     f["contact"] if first else "",
                     joint,
+                    *((fmt_number(positions[k], d),) if placed else ()),
                     fmt_number(rate, d),
                     str(f["rank"]) if first else "",
                     f"{f['residual']:.2g}" if first else "",
                     f"{f['conditioning']:.3g}" if first else "",
+                    *(((error if first else ""),) if placed else ()),
                 )
         return Group(Text(title, style="bold"), t, *HandTable._moved_by(m, rec))
 

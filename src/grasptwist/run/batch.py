@@ -32,6 +32,7 @@ __all__ = [
     "with_reasons",
     "dataset_blocks",
     "check_positions",
+    "hand_placement",
     "ROWS_PER_BLOCK",
     "NO_TWIST",
     "ZERO_TWIST",
@@ -179,6 +180,7 @@ def resolve_arrays(
     hands=None,
     joint_screws=None,
     joint_limits=None,
+    placement=None,
     has_wrist=None,
 ) -> Block:
     """One block from arrays of rows (a data set, or stacked grasps).
@@ -190,7 +192,8 @@ def resolve_arrays(
     :data:`METHODS`.  ``bases=False`` leaves out the basis screws, for
     outputs that do not show them (npz).  ``hands`` (per row a Hand or None)
     with ``joint_screws (N, 3, J, 6)`` and ``joint_limits (N, 3, J)``
-    (:func:`grasptwist.engine.hands.padded`) adds the kinds that need them.
+    (:func:`grasptwist.engine.hands.padded`) adds the kinds that need them;
+    ``placement`` (:func:`hand_placement`) says where the hands are.
     ``has_wrist`` (per row) says which rows have a wrist; by default those
     whose wrist is finite.
     """
@@ -201,7 +204,7 @@ def resolve_arrays(
     wrist = np.full((n, 3), np.nan) if wrist is None else wrist
     inputs = {"points": points, "normals": normals, "wrist": wrist, "twist": twist}
     if hands is not None:
-        inputs.update(joint_screws=joint_screws, joint_limits=joint_limits)
+        inputs.update(joint_screws=joint_screws, joint_limits=joint_limits, placement=placement)
     results = {}
     for k in kinds:
         if all(name in inputs for name in k.needs):
@@ -312,15 +315,34 @@ def _hand_inputs(grasps) -> dict:
     if all(g.hand is None for g in grasps):
         return {}
 
+    from ..engine.ik import home_tips, place_hand
+
     width = max(len(f.joints) for g in grasps if g.hand is not None for f in g.hand.fingers)
     made = {}  # each grasp's fingers once, whatever its number of twists
     for g in grasps:
         if g.hand is not None and id(g) not in made:
             states = hands.finger_states(g.hand, g.joint_positions)
-            made[id(g)] = hands.padded(g.hand, [s.screws for s in states], width)
-    none = (np.zeros((3, width, 6)), np.full((3, width), np.nan))
-    screws, limits = zip(*(made.get(id(g), none) for g in grasps))
-    return {"hands": [g.hand for g in grasps], "joint_screws": np.stack(screws), "joint_limits": np.stack(limits)}
+            # the loader placed the hand (given and checked, or solved): its tip errors at those positions
+            placed = place_hand(g.hand, g.points, g.joint_positions, tips=home_tips(g.hand, g.points))
+            made[id(g)] = (
+                *hands.padded(g.hand, [s.screws for s in states], width),
+                *hand_placement(g.hand, placed, width),
+            )
+    none = (np.zeros((3, width, 6)), np.full((3, width), np.nan), np.full((3, width), np.nan), np.full(3, np.nan))
+    none += (np.zeros(3, bool),)
+    screws, limits, positions, tip_error, within = (np.stack(a) for a in zip(*(made.get(id(g), none) for g in grasps)))
+    return {
+        "hands": [g.hand for g in grasps],
+        "joint_screws": screws,
+        "joint_limits": limits,
+        "placement": {"joint_positions": positions, "tip_error": tip_error, "within_limits": within},
+    }
+
+
+def hand_placement(hand, placed, width=None) -> tuple:
+    """``(joint positions (..., 3, width), tip error (..., 3), within limits (..., 3))`` of a hand
+    placed (:class:`~grasptwist.engine.ik.HandIK`), as a block's ``placement`` holds them."""
+    return hands.padded_positions(hand, placed.positions, width), placed.tip_error, placed.within_limits
 
 
 def _no_twist(grasp: Grasp) -> GraspFileError:
@@ -410,10 +432,12 @@ def _rows_hand(ds, hand_of_rows, start, stop, rows, points):
     states = hands.finger_states(hand_of_rows, placed.positions)
     screws, limits = hands.padded(hand_of_rows, [s.screws for s in states])
     n = len(points)
+    positions, tip_error, within = hand_placement(hand_of_rows, placed)
     return {
         "hands": [hand_of_rows] * n,
         "joint_screws": screws,
         "joint_limits": np.broadcast_to(limits, (n, *limits.shape)),
+        "placement": {"joint_positions": positions, "tip_error": tip_error, "within_limits": within},
     }, placed
 
 
