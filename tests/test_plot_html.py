@@ -202,7 +202,7 @@ def test_errors(tmp_path, monkeypatch):
     monkeypatch.setitem(sys.modules, "plotly", None)  # makes `import plotly` fail
     r = run("plot", GRASPS / "cylinder.yaml", "-o", out)
     assert r.exit_code == 1
-    assert r.stderr.endswith("needs plotly: pip install plotly (from a clone of grasptwist: pip install '.[html]')\n")
+    assert r.stderr.endswith("needs plotly: pip install plotly (from a clone of grasptwist: pip install -e '.[html]')\n")
 
 
 def test_a_name_cannot_end_the_figures_script_element(tmp_path):
