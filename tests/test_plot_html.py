@@ -48,7 +48,7 @@ def number(text, key):
 @pytest.fixture(scope="module")
 def cylinder_page(tmp_path_factory):
     out = tmp_path_factory.mktemp("html") / "cylinder.html"
-    r = run("plot", GRASPS / "cylinder.yaml", "--select", "spin-z", "-o", out)
+    r = run("plot", GRASPS / "cylinder.yaml", "--twist-name", "spin-z", "-o", out)
     assert r.exit_code == 0, r.output
     assert r.stdout == f"{out}\n"
     return out
@@ -60,7 +60,7 @@ def test_one_page_with_plotly_inside_the_twists_and_every_path(cylinder_page):
     grasp = load_grasps(GRASPS / "cylinder.yaml")[0]
     twists, *paths = read_figures(text)
     assert [len(p["frames"]) for p in paths] == [21] * len(grasp.paths)
-    # the dropdown: one button per twist, the one asked for (--select spin-z) active
+    # the dropdown: one button per twist, the one asked for (--twist-name spin-z) active
     menu = twists["layout"]["updatemenus"][0]
     assert [b["label"] for b in menu["buttons"]] == [t.name for t in grasp.twists]
     assert menu["buttons"][menu["active"]]["label"] == "spin-z"

@@ -229,24 +229,11 @@ def diagnostics(rec: dict, names=("1", "2", "3")) -> tuple[list[str], list[str]]
 
 def csv_header(hand=None) -> bytes:
     """The CSV header of ``follow`` for a run's ``hand`` (None: :data:`CSV_HEADER`): resolve's
-    joint columns in their place, then the joint positions ``q_<finger>_<joint>``."""
+    joint columns (the joint positions ``q_<finger>_<joint>`` among them) in their place."""
     if hand is None:
         return CSV_HEADER
     rest = tuple(c for c in header(hand) if c not in _NOT_IN_CSV)
-    return ",".join(_OWN + rest + _q_names(hand)).encode() + b"\n"
-
-
-def _q_names(hand) -> tuple[str, ...]:
-    return tuple(f"q_{f.name}_{j.name}" for f in hand.fingers for j in f.joints)
-
-
-def _joint_positions(samples, hand) -> np.ndarray:
-    """``(N, n_joints)`` the samples' joint positions in the run's ``hand`` order (NaN: another hand, or none)."""
-    out = np.full((len(samples.block), len(hand.joint_names)), np.nan)
-    own = samples.block.hands[0] if samples.block.hands else None
-    if samples.joint_positions is not None and own is not None and own.joint_names == hand.joint_names:
-        out[:] = samples.joint_positions
-    return out
+    return ",".join(_OWN + rest).encode() + b"\n"
 
 
 def csv_rows(samples, order: str = "omega-v", hand=None) -> list[bytes]:
@@ -263,20 +250,15 @@ def csv_rows(samples, order: str = "omega-v", hand=None) -> list[bytes]:
     own.update({f"position_{a}": position[:, j] for j, a in enumerate("xyz")})
     own.update({f"rotation_{a}": quaternion[:, j] for j, a in enumerate("wxyz")})
     rest = {k: v for k, v in columns(block, order, hand).items() if k not in _NOT_IN_CSV}
-    if hand is not None:
-        rest.update(zip(_q_names(hand), _joint_positions(samples, hand).T))
     return lines({**own, **rest})
 
 
 def path_arrays(samples, order: str = "omega-v", hand=None) -> dict[str, np.ndarray]:
     """The arrays a follow npz adds to a block's: ``t``, ``segment``, ``position`` and ``rotation``
-    (quaternions, w first), and with the run's ``hand`` its ``joint_positions (N, n_joints)``;
-    its ``twist`` is the instantaneous space twist."""
+    (quaternions, w first); its ``twist`` is the instantaneous space twist (the block's, with the
+    run's ``hand``, hold the ``joint_positions (N, n_joints)``)."""
     position, quaternion = _pose(samples)
-    out = {"t": samples.poses.time, "segment": samples.poses.segment, "position": position, "rotation": quaternion}
-    if hand is not None:
-        out["joint_positions"] = _joint_positions(samples, hand)
-    return out
+    return {"t": samples.poses.time, "segment": samples.poses.segment, "position": position, "rotation": quaternion}
 
 
 def csv_error_row(rec: dict, hand=None) -> bytes:

@@ -22,8 +22,20 @@ def _number(x):
 
 
 def _finger_rates(rates, finger):
-    """One finger's rates from the padded ``(..., J)`` row: its own joints only."""
+    """One finger's rates (or positions) from the padded ``(..., J)`` row: its own joints only."""
     return (rates[..., : len(finger.joints)] + 0.0).tolist()
+
+
+def _placement(r, i, f, finger) -> dict:
+    """Where finger ``f`` of row ``i`` is: its ``joint_positions`` (given, solved or tracked), its
+    ``tip_error`` (null: a finger given inline has no tip link) and ``within_limits``."""
+    if r.joint_positions is None:
+        return {}
+    return {
+        "joint_positions": _finger_rates(r.joint_positions[i, f], finger),
+        "tip_error": _number(r.tip_error[i, f]),
+        "within_limits": bool(r.within_limits[i, f]),
+    }
 
 
 def hand_objects(block, order, warnings):
@@ -52,6 +64,7 @@ def hand_objects(block, order, warnings):
                     "contact": names[f],
                     "tip": finger.tip,
                     "joints": [j.name for j in finger.joints],
+                    **_placement(r, i, f, finger),
                     "joint_rates": _finger_rates(r.rates[i, f], finger),
                     "rank": int(r.finger_rank[i, f]),
                     "residual": _number(r.finger_residual[i, f]),

@@ -615,7 +615,8 @@ WRITERS = {"resolve": TableWriter, "basis": BasisTableWriter, "check": CheckTabl
 
 
 class HandTable:
-    """A hand's joint rates: per finger its joints and their rates, rank, residual, conditioning.
+    """A hand's joint rates: per finger its joints with their positions and rates, rank, residual,
+    conditioning and tip error.
 
     A finger is named by its contact, as in every line of the tables; the hand's own name for
     it (TriFinger's ``0``, ``120``, ``240``) is shown once, beside it.
@@ -633,18 +634,29 @@ class HandTable:
 
         ratio = m["velocity_limit_ratio"]
         title = "hand: joint rates" + ("" if ratio is None else f"   velocity-limit ratio {ratio:.3g}")
-        t = _table("finger", "in hand", "joint", "rate", "rank", "residual", "conditioning", numbers=("rate",))
+        # where the hand is (its joint positions given or solved, each tip's distance to its contact)
+        placed = "joint_positions" in m["fingers"][0]
+        where = ("position",) if placed else ()
+        tip = ("tip error",) if placed else ()
+        t = _table(
+            "finger", "in hand", "joint", *where, "rate", "rank", "residual", "conditioning", *tip,
+            numbers=("rate", *where),
+        )  # fmt: skip
         for f in m["fingers"]:
+            positions = f.get("joint_positions", ())
             for k, (joint, rate) in enumerate(zip(f["joints"], f["joint_rates"])):
                 first = k == 0
+                error = "-" if f.get("tip_error") is None else f"{f['tip_error']:.2g}"
                 t.add_row(
                     f["contact"] if first else "",
                     f["name"] if first else "",
                     joint,
+                    *((fmt_number(positions[k], d),) if placed else ()),
                     fmt_number(rate, d),
                     str(f["rank"]) if first else "",
                     f"{f['residual']:.2g}" if first else "",
                     f"{f['conditioning']:.3g}" if first else "",
+                    *(((error if first else ""),) if placed else ()),
                 )
         return Group(Text(title, style="bold"), t, *HandTable._moved_by(m, rec))
 
