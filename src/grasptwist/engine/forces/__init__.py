@@ -3,7 +3,7 @@
 - ``grasp_map``: the grasp map ``G``, Yoshikawa-Nagai's manipulating forces ``G^+ w``
   in closed form, the squeezes (internal forces) along the sides of the contact
   triangle, the status codes and the ``check_*`` validators;
-- ``socp``: a batched barrier method for the three-cone problems (no loop over grasps);
+- ``socp``: a batched primal-dual interior-point method for the three-cone problems (no loop over grasps);
 - ``grip``: the least total normal force that holds a wrench within the friction cones;
 - ``closure``: force closure, the least common friction that gives it, and the
   Ferrari-Canny ``epsilon``.
