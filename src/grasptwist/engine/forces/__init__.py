@@ -5,6 +5,8 @@
   triangle, the status codes and the ``check_*`` validators;
 - ``socp``: a batched primal-dual interior-point method for the three-cone problems (no loop over grasps);
 - ``grip``: the least total normal force that holds a wrench within the friction cones;
+- ``hold``: holding a weight along an object path (gravity fixed in space): the grip at each
+  pose, and the stretches where none exists;
 - ``closure``: force closure, the least common friction that gives it, and the
   Ferrari-Canny ``epsilon``.
 
