@@ -12,6 +12,7 @@ So the tray holds iff ``cos(theta) > 0``, ``|tan(theta)| <= mu`` and the centre 
 pressure lies in the contact triangle.
 """
 
+import json
 import math
 
 import numpy as np
@@ -46,13 +47,14 @@ def test_the_safety_factor_narrows_the_cones():
     assert s.t_start == pytest.approx(math.atan(0.25), abs=1e-6)
 
 
-def test_a_high_centre_of_mass_tips_over_where_its_line_leaves_the_triangle():
+@pytest.mark.parametrize("samples", [5, 7, 13])
+def test_a_high_centre_of_mass_tips_over_where_its_line_leaves_the_triangle(samples):
     # Turning about y moves the centre of pressure to (h tan(theta), 0): it leaves the
     # triangle at the vertex x = 1 (theta = atan(1/h)) going one way and at the side x = -1/2
     # (theta = -atan(1/(2h))) the other; friction 2 is never the limit there.  The centre of
     # mass moves with the tray: with it at the centroid instead nothing tips.
     h = 1.0
-    (s,) = cannot_hold(TRIANGLE, UP, 2.0, 1.0, [0, 0, h], G, turn([0, 1, 0]), np.linspace(0, 2 * math.pi, 13))
+    (s,) = cannot_hold(TRIANGLE, UP, 2.0, 1.0, [0, 0, h], G, turn([0, 1, 0]), np.linspace(0, 2 * math.pi, samples))
     assert s.t_start == pytest.approx(math.atan(1 / h), abs=1e-6)
     assert s.t_end == pytest.approx(2 * math.pi - math.atan(1 / (2 * h)), abs=1e-6)
     assert s.culprit == -1  # beyond the edge a finger would have to pull
@@ -94,3 +96,59 @@ def test_hold_wrench_is_the_loaders_hold():
     r = np.array([[0.0, -1, 0], [1, 0, 0], [0, 0, 1]])
     w = hold_wrench(2.0, [1, 0, 0], [0, 0, -10], r, [0, 0, 5])
     np.testing.assert_allclose(w, [0, 0, 20, 20, 0, 0], atol=1e-12)  # c = (0, 1, 5): -c x (0, 0, -20)
+
+
+TRAY = """\
+name: tray
+units: m
+contacts:
+  - {name: a, point: [1, 0, 0], normal: [0, 0, 1]}
+  - {name: b, point: [-0.5, 0.8660254037844386, 0], normal: [0, 0, 1]}
+  - {name: c, point: [-0.5, -0.8660254037844386, 0], normal: [0, 0, 1]}
+friction: 0.5
+mass: 1
+center_of_mass: [0, 0, 0]
+paths:
+  - name: tilt
+    segments:
+      - angular: [1, 0, 0]
+        duration: 6.283185307179586
+"""
+
+
+def follow_json(tmp_path, text, *args):
+    from typer.testing import CliRunner
+
+    from grasptwist.cli import app
+
+    path = tmp_path / "g.yaml"
+    path.write_text(text)
+    result = CliRunner().invoke(app, ["follow", str(path), "-f", "jsonl", "--method", "tangent", *args])
+    return result, [json.loads(line) for line in result.stdout.splitlines()]
+
+
+def test_follow_carries_the_grip_per_sample_and_the_cannot_hold_stretches_in_its_summary(tmp_path):
+    result, recs = follow_json(tmp_path, TRAY, "--samples", "4")
+    *samples, summary = recs
+    assert result.exit_code == 1  # the tray drops its weight: the path fails, as a degeneracy does
+    held = samples[0]["grip"]
+    assert held["normal_force"] == pytest.approx([9.81 / 3] * 3) and held["safety"] == 1.0
+    assert held["total_normal_force"] == pytest.approx(9.81)
+    assert samples[1]["grip"]["error"] == {  # t = 2 pi / 3: tilted past the vertical
+        "code": "cannot-hold",
+        "message": "cannot-hold: the wrench needs a finger to pull (no pushing forces make it, whatever the friction)",
+        "culprit": None,
+    }
+    (stretch,) = summary["summary"]["cannot_hold"]
+    assert stretch["t_start"] == pytest.approx(math.atan(0.5), abs=1e-6)
+    assert stretch["t_end"] == pytest.approx(2 * math.pi - math.atan(0.5), abs=1e-6)
+    assert stretch["reason"] == "friction" and stretch["culprit"] in ("a", "b", "c")
+    assert summary["ok"] is False
+    assert "error: cannot hold the weight from t = 0.463648 to t = 5.819538" in result.stderr
+
+
+def test_follow_without_a_mass_or_a_friction_has_no_grip_fields(tmp_path):
+    for drop in ("friction: 0.5\n", "mass: 1\ncenter_of_mass: [0, 0, 0]\n"):
+        result, recs = follow_json(tmp_path, TRAY.replace(drop, ""))
+        assert result.exit_code == 0
+        assert all("grip" not in r for r in recs[:-1]) and "cannot_hold" not in recs[-1]["summary"]

@@ -39,8 +39,8 @@ class HoldStretch(NamedTuple):
     t_start, t_end : float
         Where ``cannot-hold`` starts and ends (the path's ends when it holds there).
     culprit : int
-        At ``t_start``: the contact whose friction cone is too narrow, or -1 when the
-        weight needs a finger to pull.
+        Just after ``t_start`` (a millionth of the stretch in): the contact whose friction
+        cone is too narrow, or -1 when the weight needs a finger to pull.
     """
 
     t_start: float
@@ -199,5 +199,6 @@ def cannot_hold(
     stops = dict(zip(closes.tolist(), lo[opens.size :].tolist()))
     t_start = np.array([starts.get(i, 0.0) for i in first.tolist()])
     t_end = np.array([stops.get(k, float(ends[-1])) for k in last.tolist()])
-    culprit = status(t_start).culprit
+    # the reason a little inside (at the located start the grip is within round-off of existing)
+    culprit = status(t_start + 1e-6 * (t_end - t_start)).culprit
     return tuple(HoldStretch(float(a), float(b), int(c)) for a, b, c in zip(t_start, t_end, culprit))

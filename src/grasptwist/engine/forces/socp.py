@@ -63,15 +63,19 @@ def _dot(p, q):
 def _edge(x, d):
     """The largest ``alpha`` with ``x + alpha d`` in the cone (``inf``: none), ``(3, K, n)`` -> ``(n)``.
 
-    ``q(alpha) = (x + alpha d)^T J (x + alpha d) = a alpha^2 + 2 b alpha + c`` with ``c > 0``;
-    the cone is left at the first positive root, which exists when ``a < 0`` or when ``b < 0``
-    with real roots, and is ``c / (sqrt(b^2 - a c) - b)`` in both cases.
+    ``1 / max(0, -lambda_min)`` with ``lambda_min = rho_0 - |rho_1|`` the smaller eigenvalue of
+    ``d`` seen from ``x`` (``P(x^{-1/2}) d`` in the cone's Jordan algebra): with ``xi = x / s``,
+    ``delta = d / s``, ``s = sqrt(x^T J x)``, ``rho_0 = xi^T J delta`` and ``rho_1 = delta_1 -
+    (rho_0 + delta_0) / (xi_0 + 1) xi_1``.  No difference of near-equal squares, so a ray
+    (``x_1 = d_1 = 0``, a half-space's cone) is stopped exactly at its apex.
     """
-    a, b, c = _jdot(d, d), _jdot(x, d), _jdot(x, x)
-    disc = b * b - a * c
-    with np.errstate(divide="ignore", invalid="ignore"):
-        alpha = np.where((a < 0) | ((b < 0) & (disc >= 0)), c / (np.sqrt(np.maximum(disc, 0)) - b), np.inf)
-    return alpha.min(axis=0)
+    s = np.sqrt(_jdot(x, x))
+    xi, delta = x / s, d / s
+    rho0 = _jdot(xi, delta)
+    f = (rho0 + delta[0]) / (xi[0] + 1)
+    t = np.sqrt((delta[1] - f * xi[1]) ** 2 + (delta[2] - f * xi[2]) ** 2) - rho0
+    with np.errstate(divide="ignore"):
+        return np.where(t > 0, 1 / t, np.inf).min(axis=0)
 
 
 def _spd_solve(h, g):
@@ -210,7 +214,8 @@ def phase_one(A, b):
     wide, bw = _layout(wide, bw)
 
     def leave(x, closed, dual):
-        return (x[d] <= -START_MARGIN) | (dual > 0) | (closed & (dual > -np.inf))
+        # the dual bound is good to the residual times the squeezes
+        return (x[d] <= -START_MARGIN) | (dual > _RESIDUAL * (1 + np.abs(x).sum(axis=0))) | (closed & (dual > -np.inf))
 
     x = _iterate(wide, bw, c, x, z, leave)
     return np.ascontiguousarray(x[:d].T), x[d]
