@@ -76,3 +76,52 @@ def test_plot_draws_a_grasp_with_friction(tmp_path):
     g = equator()
     out = plot_grasp(g, tmp_path / "equator.png", forces=_grip_forces(g), size=(600, 300))
     assert out.stat().st_size > 0
+
+
+BOX = """\
+name: box-on-fingertips
+units: m
+contacts:
+  - {name: a, point: [0.1, 0, 0], normal: [0, 0, 1]}
+  - {name: b, point: [-0.05, 0.0866025, 0], normal: [0, 0, 1]}
+  - {name: c, point: [-0.05, -0.0866025, 0], normal: [0, 0, 1]}
+friction: 0.8
+mass: 0.5
+center_of_mass: [0, 0, 0.2]
+paths:
+  - name: tilt
+    segments:
+      - angular: [0, 1, 0]
+        duration: 6.283185307179586
+"""
+
+
+def test_the_animation_draws_each_samples_grip_and_marks_where_the_weight_cannot_be_held():
+    from grasptwist.cli.plot import _page_extras
+    from grasptwist.plot.animation import path_figure
+
+    (g,) = load_grasps(BOX, file="box.yaml")
+    _, followed, _ = _page_extras(None)(g)
+    ((chunks, summary),) = followed
+    figure = path_figure(g, chunks, summary)
+    times = np.concatenate([c.poses.time for c in chunks])
+    force = np.concatenate([c.grip.force for c in chunks])
+    points = np.concatenate([c.block.points for c in chunks])  # moved with the box
+    held = ~((times >= np.arctan(0.5)) & (times <= 2 * np.pi - np.arctan(0.25)))
+    assert held.any() and not held.all()
+    labels = [s["label"] for s in figure["layout"]["sliders"][0]["steps"]]
+    assert [label.startswith("✗") for label in labels] == (~held).tolist()
+    assert "cannot hold the weight: t in [0.4636, 6.038]" in figure["layout"]["annotations"][0]["text"]
+    for k, frame in enumerate(figure["frames"]):
+        shafts = [t for t in frame["data"] if t.get("name") == "grip force f_i" and t["type"] == "scatter3d"]
+        (shaft,) = shafts
+        if not held[k]:
+            assert shaft["x"] == [] and "cannot hold the weight" in frame["layout"]["title"]["text"]
+            continue
+        # each shaft runs from the contact along the engine's force (drawn to a common length)
+        starts = np.array([shaft[c][0::3] for c in "xyz"]).T
+        ends = np.array([shaft[c][1::3] for c in "xyz"]).T
+        np.testing.assert_allclose(starts, points[k])
+        drawn = ends - starts
+        np.testing.assert_allclose(np.cross(drawn, force[k]), 0, atol=1e-12)
+        assert (np.einsum("ij,ij->i", drawn, force[k]) > 0).all()
