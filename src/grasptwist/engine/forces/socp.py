@@ -8,12 +8,13 @@ with ``x`` of 3 or 4 numbers (the grip's squeezes, and phase I's margin), and it
 ``max -sum_m b_m^T z_m`` s.t. ``sum_m A_m^T z_m = c``, ``z_m in Q^3``; the duality gap is
 ``sum_m y_m . z_m``.  A half-space ``a^T x + h >= 0`` is the cone ``(a^T x + h, 0, 0)``.
 
-Both phases start feasible, primal and dual, so every Newton step keeps the equalities and
-only the gap has to close.  Each iteration is Mehrotra's predictor-corrector with
+Both phases start strictly inside the cones, primal and dual; phase II's dual start is
+feasible too (phase I's leaves a residual in the dual equalities, which every step shrinks by
+its length).  Each iteration is Mehrotra's predictor-corrector with
 Nesterov-Todd scaling (the scaling point ``w`` with ``W z = W^{-1} y = lambda``, one per cone,
 ``W = beta (2 v v^T - J)``): an affine step ``lambda o v = -lambda o lambda``, the centring
 weight ``sigma = (mu_aff / mu)^3``, then the corrected step, 0.99 of the way to the cones' edge
-(in closed form: a quadratic in the step per cone).  The Newton system is the 3 x 3 (4 x 4)
+(in closed form per cone: :func:`_edge`).  The Newton system is the 3 x 3 (4 x 4)
 ``H dx = sum_m (W_m^{-1} A_m)^T W_m^{-1} v_m``, solved by elimination on arrays over the rows.
 A row leaves once its gap is below ``GAP`` of its objective's scale (``1 + |c^T x|``): the
 rows are scaled by their caller to order one, so the objective is then that close to the
