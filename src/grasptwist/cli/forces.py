@@ -65,7 +65,9 @@ def forces(
     ] = 8,
     fmt: Annotated[
         ForcesFormat,
-        typer.Option("-f", "--format", help="table for people; json, jsonl, csv or npz (with -o) for programs."),
+        typer.Option(
+            "-f", "--format", help="table for people; json, jsonl, csv, npz or parquet (with -o) for programs."
+        ),
     ] = ForcesFormat.table,
     json_: Json = False,
     output: Output = None,

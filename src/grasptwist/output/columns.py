@@ -34,6 +34,7 @@ __all__ = [
     "FORCE_COLUMNS",
     "FORCE_CSV_COLUMNS",
     "force_columns",
+    "force_typed_header",
     "force_arrays",
     "grip_errors",
 ]
@@ -294,16 +295,35 @@ def grip_errors(block) -> np.ndarray:
     return texts
 
 
-def force_columns(block) -> dict[str, np.ndarray]:
-    """A force block's flat columns, ``name -> (N,)``, in CSV order; masked where they do not hold."""
+_FORCE_STATUSES = ("manipulating_status", "grip_status")
+
+
+def _force_names(column, typed):
+    return (column.name,) if typed and column.name in _FORCE_STATUSES else column.flat
+
+
+def force_typed_header() -> dict[str, str]:
+    """Typed flat outputs of ``forces`` (Parquet): the CSV's columns and the two statuses, ``name -> numpy type``.
+
+    >>> h = force_typed_header()
+    >>> h["grip_status"], h["force_closure"], [n for n in h if n not in FORCE_CSV_COLUMNS]
+    ('i1', '?', ['manipulating_status', 'grip_status'])
+    """
+    return {name: c.dtype for c, _ in FORCE_COLUMNS for name in _force_names(c, True)}
+
+
+def force_columns(block, typed: bool = False) -> dict[str, np.ndarray]:
+    """A force block's flat columns, ``name -> (N,)``, in CSV order (``typed``: of
+    :func:`force_typed_header`, statuses included); masked where they do not hold."""
     n = len(block)
     out = {}
     for column, valid in FORCE_COLUMNS:
-        if not column.flat:
+        names = _force_names(column, typed)
+        if not names:
             continue
         flat = np.asarray(column.get(None, block)).reshape(n, -1)
         mask = None if valid is None else ~np.asarray(valid(block), bool)
-        for j, name in enumerate(column.flat):
+        for j, name in enumerate(names):
             out[name] = flat[:, j] if mask is None else np.ma.masked_array(flat[:, j], mask=mask)
     return out
 

@@ -109,7 +109,7 @@ def _npz(out: IO[bytes], kind: str, order: str = "omega-v", hand=None, **_):
 def _parquet(out: IO[bytes], kind: str, order: str = "omega-v", hand=None, **_):
     from .parquet_writer import ParquetWriter  # pyarrow only when Parquet is asked for
 
-    return ParquetWriter(out, order, hand=hand)
+    return ParquetWriter(out, order, hand=hand, forces=kind == "forces")
 
 
 def _json_rows(block, order):
@@ -140,7 +140,9 @@ FORMATS: dict[str, OutputFormat] = {
         OutputFormat(
             "npz", ("resolve", "follow", "forces"), _npz, binary=True, takes_blocks=True, bases=False, per_hand=True
         ),
-        OutputFormat("parquet", ("resolve",), _parquet, binary=True, takes_blocks=True, bases=False, per_hand=True),
+        OutputFormat(
+            "parquet", ("resolve", "forces"), _parquet, binary=True, takes_blocks=True, bases=False, per_hand=True
+        ),
     )
 }
 

@@ -10,14 +10,15 @@ wrench: only its closure).  No math here: only stacking.
 from __future__ import annotations
 
 from collections.abc import Iterable, Iterator, Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
+from ..engine.screws import direction
 from ..model import Grasp, GraspFileError, Wrench
 from ..results import ForceOptions, ForceResult, compute_forces
 
-__all__ = ["ForceBlock", "force_blocks", "force_arrays"]
+__all__ = ["ForceBlock", "force_blocks", "force_arrays", "force_dataset_blocks"]
 
 
 @dataclass(frozen=True)
@@ -45,6 +46,14 @@ class ForceBlock:
     @property
     def has_friction(self) -> np.ndarray:
         return ~np.isnan(self.friction).any(axis=-1)
+
+    def part(self, start: int, stop: int) -> ForceBlock:
+        """Rows ``start:stop`` as a block of their own (views)."""
+        rows = slice(start, stop)
+        cut = {f.name: getattr(self, f.name)[rows] for f in fields(self) if f.name != "result"}
+        r = self.result
+        result = replace(r, **{f.name: getattr(r, f.name)[rows] for f in fields(r) if f.name != "safety"})
+        return ForceBlock(**cut, result=result)
 
     def failed_rows(self) -> np.ndarray:
         """Rows whose manipulating forces or grip failed."""
@@ -113,3 +122,66 @@ def _stack(rows, friction, options) -> ForceBlock:
         units=[g.units for g in grasps],
         contact_names=[g.contact_names for g in grasps],
     )
+
+
+def force_dataset_blocks(
+    ds, wrenches: Sequence[Wrench] | None, friction: float | None, options: ForceOptions,
+    rows: int = 65536, start: int = 0, stop: int | None = None,
+) -> Iterator[ForceBlock]:  # fmt: skip
+    """The force rows of the grasps ``start:stop`` of a data set, about ``rows`` rows at a time.
+
+    Each grasp is paired with every wrench of ``wrenches`` (the command
+    line's), or else with the data set's own ``wrench`` (one for all rows,
+    or one per row), or else with none (its closure only).  ``friction``
+    (``--friction``) replaces the data set's (one for all, one per row, or
+    one per contact).
+    """
+    k = len(wrenches) if wrenches else 1
+    step = max(1, rows // k)
+    end = len(ds) if stop is None else min(stop, len(ds))
+    for first in range(start, end, step):
+        last = min(end, first + step)
+        index = np.repeat(np.arange(first, last), k)  # grasp, then its wrenches
+        picked = index - first
+        n = len(index)
+        if wrenches:
+            wrench = np.tile(np.stack([w.wrench for w in wrenches]), (last - first, 1))
+            names = [w.name for w in wrenches] * (last - first)
+        elif ds.wrench is not None:
+            own = np.asarray(ds.wrench if ds.wrench.ndim == 1 else ds.wrench[first:last], dtype=float)
+            wrench = np.broadcast_to(own, (n, 6)).copy()
+            names = ["wrench"] * n
+        else:
+            wrench, names = np.full((n, 6), np.nan), [None] * n
+        if friction is not None:
+            mu = np.full((n, 3), float(friction))
+        elif ds.friction is not None:
+            own = np.asarray(ds.friction if ds.friction.ndim == 0 else ds.friction[first:last], dtype=float)
+            own = own if own.ndim != 1 else own[:, None]
+            mu = np.broadcast_to(own if own.ndim == 0 else own[picked], (n, 3)).copy()
+        else:
+            mu = np.full((n, 3), np.nan)
+        labels = ds.names[first:last][picked] if ds.names is not None else index
+        yield force_arrays(
+            np.asarray(ds.points[first:last], dtype=float)[picked],
+            _unit(np.asarray(ds.normals[first:last], dtype=float))[picked],
+            wrench,
+            names,
+            mu,
+            options,
+            file=[ds.path] * n,
+            grasp=_texts(labels),
+            units=[None] * n,
+            contact_names=[("1", "2", "3")] * n,
+        )
+
+
+def _unit(normals):
+    return direction(normals)  # as the grasp-file loader makes them
+
+
+def _texts(labels) -> list:
+    labels = np.asarray(labels)
+    if labels.dtype.kind == "S":
+        return np.char.decode(labels, "utf-8", "surrogateescape").tolist()
+    return labels.astype(str).tolist()

@@ -31,7 +31,7 @@ from ..output.formats import FORMATS
 from ..output.records import basis_record, check_record, diagnostics, error_record, records, talking_rows
 from ..results import ForceOptions, check_closure
 from .batch import ZERO_TWIST, Block, check_positions, dataset_blocks, resolve
-from .forces import ForceBlock, force_blocks
+from .forces import ForceBlock, force_blocks, force_dataset_blocks
 from .pool import Pool
 from .scratch import owned_prefix, remove_orphans
 from .stream import grasp_stream, is_stream, twist_stream
@@ -290,6 +290,16 @@ def blocks(
             batches = grasp_stream(g, job.twists, job.method, job.max_bytes, tuning.files_per_group)
             yield from ((x, None, True) for batch in batches for x in batch)
             continue
+        if _is_dataset(g) and job.kind == "forces":
+            try:
+                ds = open_dataset(g, job.extra_point)
+                extra_work = len(ds) * (len(job.wrenches) if job.wrenches else 1) - 1
+                for block in force_dataset_blocks(ds, job.wrenches, job.friction, job.forces):
+                    yield block, extra_work, True
+                    extra_work = 0
+            except GraspFileError as err:
+                yield err, None, False
+            continue
         if _is_dataset(g):
             try:
                 ds = open_dataset(g, job.extra_point)
@@ -343,7 +353,9 @@ def _dataset(job: Job, path: str, workers: int, tuning: Tuning) -> Iterator[Outp
     try:
         ds = open_dataset(path, job.extra_point)
         check_positions(ds, job.hand)
-        if job.twists is None and ds.twist is None and job.kind == "resolve":
+        if job.kind == "forces":
+            pass  # a data set without wrenches gives each grasp's closure
+        elif job.twists is None and ds.twist is None and job.kind == "resolve":
             next(dataset_blocks(ds, None, job.method, hand_of_rows=job.hand))  # raises the no-twist error
     except GraspFileError as err:
         out = Output(done=1)
@@ -351,6 +363,8 @@ def _dataset(job: Job, path: str, workers: int, tuning: Tuning) -> Iterator[Outp
         yield _sealed(job, out)
         return
     rows = len(ds) * (len(job.twists) if job.twists and job.kind == "resolve" else 1)
+    if job.kind == "forces":
+        rows = len(ds) * (len(job.wrenches) if job.wrenches else 1)
     step = tuning.grasps_per_task
     tasks = [(start, min(len(ds), start + step)) for start in range(0, len(ds), step)]
     if workers > 1 and len(tasks) > 1:
@@ -380,8 +394,12 @@ def _dataset_task(job: Job, ds, rows: tuple[int, int], tuning: Tuning, spool: Sp
     twists = [ZERO_TWIST] if job.kind != "resolve" else job.twists
     at_once = tuning.records_at_once
     outs = []
+    if job.kind == "forces":
+        made = force_dataset_blocks(ds, job.wrenches, job.friction, job.forces, start=rows[0], stop=rows[1])
+    else:
+        made = dataset_blocks(ds, twists, job.method, start=rows[0], stop=rows[1], hand_of_rows=job.hand)
     try:
-        for block in dataset_blocks(ds, twists, job.method, start=rows[0], stop=rows[1], hand_of_rows=job.hand):
+        for block in made:
             for start in range(0, len(block), at_once):
                 out = Output(rows=True)
                 _encode_into(job, block.part(start, start + at_once), out, at_once)
