@@ -4,6 +4,8 @@ import csv
 import io
 import json
 import math
+import shutil
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -14,8 +16,9 @@ from grasptwist.io.grasp import read_grasps
 from grasptwist.output.columns import FORCE_CSV_COLUMNS
 from hostile import jsonl, run
 
-SPHERE = "grasps/sphere.yaml"
-POLYHEDRON = "grasps/polyhedron.yaml"
+ROOT = Path(__file__).parent.parent
+SPHERE = str(ROOT / "grasps/sphere.yaml")
+POLYHEDRON = str(ROOT / "grasps/polyhedron.yaml")
 P = np.array([[1, 0, 0], [-0.5, 0.75**0.5, 0], [-0.5, -(0.75**0.5), 0]])
 
 
@@ -111,8 +114,8 @@ def test_a_wrench_without_friction_has_no_grip_and_says_so():
 
 
 def test_a_folder_with_one_bad_file_reports_it_and_the_rest(tmp_path):
-    (tmp_path / "a.yaml").write_text(open(SPHERE).read())
-    (tmp_path / "b.yaml").write_text(open("tests/invalid_grasps/zero-mass.yaml").read())
+    shutil.copy(SPHERE, tmp_path / "a.yaml")
+    shutil.copy(ROOT / "tests/invalid_grasps/zero-mass.yaml", tmp_path / "b.yaml")
     r, recs = records(tmp_path)
     assert r.exit_code == 1
     assert [rec.get("grasp") for rec in recs] == ["sphere-tripod", "sphere-equator", "sphere-equator", None]
@@ -149,7 +152,7 @@ def test_bad_options_are_usage_errors(args, message):
 
 
 def test_csv_columns_and_values():
-    r, _ = run("forces", SPHERE, "tests/invalid_grasps/zero-mass.yaml", "-f", "csv")
+    r, _ = run("forces", SPHERE, ROOT / "tests/invalid_grasps/zero-mass.yaml", "-f", "csv")
     rows = list(csv.DictReader(io.StringIO(r.stdout)))
     head = r.stdout.splitlines()[0].split(",")
     assert head == FORCE_CSV_COLUMNS
