@@ -136,8 +136,7 @@ def test_follow_carries_the_grip_per_sample_and_the_cannot_hold_stretches_in_its
     assert held["total_normal_force"] == pytest.approx(9.81)
     assert samples[1]["grip"]["error"] == {  # t = 2 pi / 3: tilted past the vertical
         "code": "cannot-hold",
-        "message": "cannot-hold: the wrench needs a finger to pull (no pushing forces make it, whatever the friction)",
-        "culprit": None,
+        "message": "the wrench needs a finger to pull (no pushing forces make it, whatever the friction)",
     }
     (stretch,) = summary["summary"]["cannot_hold"]
     assert stretch["t_start"] == pytest.approx(math.atan(0.5), abs=1e-6)

@@ -1,5 +1,7 @@
 """The grasp file's force keys (io/grasp/forces.py): friction, wrenches, mass, center_of_mass, gravity."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -108,7 +110,7 @@ def test_a_contact_without_friction_beside_others_needs_the_grasps():
 
 
 def test_the_bundled_ball_is_held_by_its_weight():
-    g = read_grasps("grasps/sphere.yaml")[1]
+    g = read_grasps(str(Path(__file__).parent.parent / "grasps/sphere.yaml"))[1]
     assert g.name == "sphere-equator"
     assert g.friction.tolist() == [0.5, 0.5, 0.5]
     assert [(w.name, w.wrench.tolist()) for w in g.wrenches] == [

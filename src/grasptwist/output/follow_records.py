@@ -18,11 +18,13 @@ from typing import NamedTuple
 import numpy as np
 
 from ..engine.degeneracy import CONDITION_WARNING, Status, status_message
-from ..engine.forces.grasp_map import ForceStatus, force_status_message
+from ..engine.forces.grasp_map import ForceStatus
 from ..engine.se3 import matrix_to_quaternion
 from ..results import KINDS
 from .columns import CSV_COLUMNS, columns, header
 from .csv_rows import lines
+from .force_records import GRIP_FIELDS
+from .force_records import _error as grip_error  # the forces record's error object, shared
 from .names import escaped
 from .records import dumps, records
 
@@ -92,29 +94,20 @@ def sample_records(samples, order: str = "omega-v") -> list[dict]:
         if samples.joint_positions is not None:
             new["joint_positions"] = _finger_positions(samples.block.hands[i], samples.joint_positions[i])
         if samples.grip is not None:
-            new["grip"] = grip_record(samples.grip, i, samples.block.contact_names[i])
+            new["grip"] = grip_record(samples.grip, i)
         new["warnings"] = rec["warnings"]
         new["ok"] = rec["ok"]
         out.append(new)
     return out
 
 
-def grip_record(grip, i, names) -> dict:
-    """Row ``i`` of a :class:`~grasptwist.engine.forces.grip.Grip` as a record: the forces
-    (row ``j`` contact ``j``), squeezes, normal and tangential forces, friction used, their
-    total and the safety factor; or ``{"error": {code, message, culprit}}`` (docs/guide/forces.md)."""
-    status = int(grip.status[i])
-    if status != ForceStatus.OK:
-        culprit = int(grip.culprit[i])
-        return {
-            "error": {
-                "code": ForceStatus(status).code,
-                "message": force_status_message(status, culprit),
-                "culprit": names[culprit] if culprit >= 0 else None,
-            }
-        }
-    fields = ("force", "squeeze", "normal_force", "tangential_force", "friction_used", "total_normal_force")
-    return {**{k: getattr(grip, k)[i] + 0.0 for k in fields}, "safety": grip.safety}
+def grip_record(grip, i) -> dict:
+    """Row ``i`` of a :class:`~grasptwist.engine.forces.grip.Grip` as the ``forces`` record's
+    ``grip`` object: the forces (row ``j`` contact ``j``), squeezes, normal and tangential
+    forces, friction used, their total and the safety factor; or ``{"error": {code, message}}``."""
+    if grip.status[i] != ForceStatus.OK:
+        return grip_error(grip.status[i], grip.culprit[i])
+    return {**{k: getattr(grip, k)[i] + 0.0 for k in GRIP_FIELDS}, "safety": grip.safety}
 
 
 def hold_text(c: dict, digits: int = 4) -> str:
