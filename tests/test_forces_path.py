@@ -32,8 +32,13 @@ def turn(axis, duration=2 * math.pi):
     return [Segment(duration, twist=list(axis) + [0, 0, 0])]
 
 
-@pytest.mark.parametrize("samples", [5, 8, 33])
-@pytest.mark.parametrize("mu", [0.5, 1.3])
+SLOW = pytest.mark.slow  # each stretch is some 40 grip solves; one case of each runs by default
+
+
+@pytest.mark.parametrize(
+    "samples, mu",
+    [(8, 0.5), pytest.param(5, 1.3, marks=SLOW), pytest.param(33, 0.5, marks=SLOW), pytest.param(8, 1.3, marks=SLOW)],
+)
 def test_a_tilted_tray_slides_off_at_the_friction_angle(samples, mu):
     times = np.linspace(0, 2 * math.pi, samples)
     (s,) = cannot_hold(TRIANGLE, UP, mu, 1.0, [0, 0, 0], G, turn([1, 0, 0]), times)
@@ -42,12 +47,13 @@ def test_a_tilted_tray_slides_off_at_the_friction_angle(samples, mu):
     assert s.culprit >= 0  # a cone too narrow, not a pull
 
 
+@SLOW
 def test_the_safety_factor_narrows_the_cones():
     (s,) = cannot_hold(TRIANGLE, UP, 0.5, 2.0, [0, 0, 0], G, turn([1, 0, 0]), np.linspace(0, 6, 7), safety=2.0)
     assert s.t_start == pytest.approx(math.atan(0.25), abs=1e-6)
 
 
-@pytest.mark.parametrize("samples", [5, 7, 13])
+@pytest.mark.parametrize("samples", [7, pytest.param(5, marks=SLOW), pytest.param(13, marks=SLOW)])
 def test_a_high_centre_of_mass_tips_over_where_its_line_leaves_the_triangle(samples):
     # Turning about y moves the centre of pressure to (h tan(theta), 0): it leaves the
     # triangle at the vertex x = 1 (theta = atan(1/h)) going one way and at the side x = -1/2
