@@ -17,6 +17,8 @@ from grasptwist.cli import app
 #: Fields of a record that may be null in an ``ok`` record: every other null
 #: would be a NaN that orjson wrote as null.
 NULLABLE = {"units", "wrist", "off_tangent", "tip", "velocity_limit_ratio"}  # tip: inline hands
+# forces records: a grasp without a wrench or a friction, closure without one, epsilon without --quality
+NULLABLE |= {"wrench", "friction", "manipulating", "grip", "force_closure", "closure_friction", "epsilon"}
 
 
 def run(*args, input=None):

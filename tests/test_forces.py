@@ -326,3 +326,21 @@ def test_any_grip_found_makes_the_wrench_within_every_cone_and_beats_no_clarabel
             assert g.total_normal_force[k] == pytest.approx(ref, rel=1e-6)
             assert np.abs(wrench_of(p[k], g.force[k]) - w[k]).max() <= 1e-9 * np.abs(w[k]).max()
             assert (g.friction_used[k] <= mu[k] / safety * (1 + 1e-9)).all()
+
+
+def test_the_interior_point_step_stops_at_the_cones_edge_even_for_a_ray():
+    from grasptwist.engine.forces.socp import _edge
+
+    rng = np.random.default_rng(7)
+    x = rng.normal(size=(3, 1, 500))
+    x[0] = np.hypot(x[1], x[2]) + rng.uniform(0.01, 1, (1, 500))
+    d = 3 * rng.normal(size=(3, 1, 500))
+    alpha = _edge(x, d)
+    hit = np.isfinite(alpha)
+    y = x[:, 0, hit] + alpha[hit] * d[:, 0, hit]
+    np.testing.assert_allclose(y[0], np.hypot(y[1], y[2]), atol=1e-9)  # on the boundary
+    far = x[:, 0, ~hit] + 1e6 * d[:, 0, ~hit]
+    assert hit.any() and (~hit).any() and (far[0] >= np.hypot(far[1], far[2]) - 1e-6).all()  # never leaves
+    # a half-space's cone (t, 0, 0): stopped exactly at t = 0, where a difference of squares loses it
+    ray = _edge(np.array([[[0.3]], [[0.0]], [[0.0]]]), np.array([[[-0.7]], [[0.0]], [[0.0]]]))
+    assert ray[0] == pytest.approx(0.3 / 0.7, rel=1e-15)

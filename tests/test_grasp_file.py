@@ -96,7 +96,7 @@ def test_fixtures_cover_every_rejection():
         "unknown-key", "duplicate-key", "contact-count", "vector-length", "not-a-number", "non-finite",
         "zero-normal", "duplicate-name", "empty-document", "not-a-mapping", "invalid-utf8", "forbidden-tag",
         "alias", "missing-key", "conflicting-keys", "yaml-syntax", "control-character", "not-a-list",
-        "not-a-string", "invalid-name", "invalid-key",
+        "not-a-string", "invalid-name", "invalid-key", "invalid-friction", "invalid-mass",
     }  # fmt: skip
 
 

@@ -177,7 +177,8 @@ def test_a_check_table_is_written_as_its_records_come_in_fixed_columns():
     tangent = lines[1].index("   tangent") + 3
     assert all(row[tangent:].startswith("normals-rank-deficient") for row in rows)
     others = ["-"] * (len([k for k in KINDS if k.check_fields]) - 2)  # checked kinds the record does not hold
-    assert rows[0].split() == ["ok", "(0.5)", "normals-rank-deficient", *others, "rows.npz", "0"]
+    # "-": the record has no closure_friction (the closure mu column)
+    assert rows[0].split() == ["ok", "(0.5)", "normals-rank-deficient", *others, "-", "rows.npz", "0"]
     assert "hand" not in lines[1]  # a kind with nothing to check (the hand) has no column
     assert lines[1].split("   ")[:2] == [
         "  off-tangent (conditioning)",

@@ -17,6 +17,7 @@ EXTRAS = {
     "pandas": ("'dask[dataframe]' distributed", "dask"),
     "dask": ("'dask[dataframe]' distributed", "dask"),
     "distributed": ("'dask[dataframe]' distributed", "dask"),
+    "scipy": ("scipy", "quality"),
 }
 
 

@@ -13,6 +13,7 @@ import numpy as np
 
 __all__ = [
     "Twist",
+    "Wrench",
     "Grasp",
     "Segment",
     "ObjectPath",
@@ -45,6 +46,26 @@ class Twist:
 
     name: str
     screw: np.ndarray
+    line: int | None
+
+
+@dataclass(frozen=True, eq=False)
+class Wrench:
+    """A wrench the fingers must exert on the object, from a grasp file.
+
+    Attributes
+    ----------
+    name : str
+        Its ``name``, or ``"1"``, ``"2"``, ... by position in ``wrenches``;
+        ``"hold"`` for the one that ``mass`` adds.
+    wrench : numpy.ndarray
+        ``(6,)`` read-only ``(force; moment about the origin)``.
+    line : int or None
+        1-based line of its entry in the file (of ``mass`` for ``hold``).
+    """
+
+    name: str
+    wrench: np.ndarray
     line: int | None
 
 
@@ -85,6 +106,17 @@ class Grasp:
     joint_positions : numpy.ndarray or None
         ``(n_joints,)`` the hand's configuration, in ``hand.joint_names``
         order (zeros for joints given inline, at their configuration).
+    friction : numpy.ndarray or None
+        ``(3,)`` Coulomb friction coefficient ``mu_i >= 0`` of each contact
+        (a contact's own ``friction``, else the grasp's); None when not given.
+    wrenches : tuple of Wrench
+        The wrenches the fingers must exert, possibly none; the last is
+        ``hold`` when ``mass`` is given.
+    mass : float or None
+        The object's mass, > 0.
+    center_of_mass, gravity : numpy.ndarray or None
+        ``(3,)`` each, given with ``mass`` (gravity by default
+        ``(0, 0, -9.81)``); None without it.
     """
 
     name: str
@@ -100,6 +132,11 @@ class Grasp:
     paths: tuple[ObjectPath, ...] = ()
     hand: Hand | None = None
     joint_positions: np.ndarray | None = None
+    friction: np.ndarray | None = None
+    wrenches: tuple[Wrench, ...] = ()
+    mass: float | None = None
+    center_of_mass: np.ndarray | None = None
+    gravity: np.ndarray | None = None
 
 
 @dataclass(frozen=True, eq=False)

@@ -14,7 +14,7 @@ import sys
 import typer
 
 from .._version import __version__
-from . import basis, check, follow, plot, resolve, schema
+from . import basis, check, follow, forces, plot, resolve, schema
 from .exits import CLICK_ERROR, EXIT_OK, stopped, usage_error
 
 __all__ = ["app", "main"]
@@ -45,7 +45,7 @@ def _root(
     """Resolve a desired object twist into finger-tip twists for a three-fingered grasp (screw theory)."""
 
 
-for _command in (resolve.resolve, basis.basis, check.check, follow.follow, schema.schema, plot.plot):
+for _command in (resolve.resolve, basis.basis, check.check, follow.follow, forces.forces, schema.schema, plot.plot):
     app.command()(_command)  # in the order of `grasptwist -h`
 
 

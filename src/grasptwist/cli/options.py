@@ -24,6 +24,7 @@ __all__ = [
     "ResolveFormat",
     "RecordFormat",
     "FollowFormat",
+    "ForcesFormat",
     "PlotMethod",
     "ALL",
     "ExtraPoint",
@@ -44,6 +45,7 @@ __all__ = [
     "Select",
     "parse_floats",
     "twists_option",
+    "wrenches_option",
     "segments_option",
     "hand_option",
     "not_binary_to_a_terminal",
@@ -61,6 +63,7 @@ MethodChoice = _choices("Method", METHOD_CHOICES)
 ResolveFormat = _choices("Format", names_for("resolve"))
 RecordFormat = _choices("RecordFormat", names_for("basis"))
 FollowFormat = _choices("FollowFormat", names_for("follow"))
+ForcesFormat = _choices("ForcesFormat", names_for("forces"))
 #: ``plot --method``: the bases that can be drawn.
 PlotMethod = _choices("PlotMethod", [k.label for k in KINDS if k.method])
 #: The default of ``--method``: every method.
@@ -146,19 +149,51 @@ def parse_floats(text: str, n: int, what: str) -> list[float]:
     return values
 
 
-def twists_option(texts: list[str] | None, at: str | None, names: list[str] | None = None):
-    """``--twist`` values as loader twists at the origin (``--at`` names the reference point),
-    named by ``names`` (``--twist-name``, one per twist) or as written."""
+def _names(names, texts, what):
+    """``--twist-name`` / ``--wrench-name`` values: one per vector, each a printable line."""
     if names and len(names) != len(texts or ()):
         raise typer.BadParameter(
-            f"give one --twist-name per --twist (got {len(names)} names for {len(texts or ())} twists)",
-            param_hint="--twist-name",
+            f"give one --{what}-name per --{what} (got {len(names)} names for {len(texts or ())} {what}es)".replace(
+                "twistes", "twists"
+            ),
+            param_hint=f"--{what}-name",
         )
     for name in names or ():
         if not name.strip() or not name.isprintable():
             raise typer.BadParameter(
-                f"{name!r}: a name is a non-empty line of printable text", param_hint="--twist-name"
+                f"{name!r}: a name is a non-empty line of printable text", param_hint=f"--{what}-name"
             )
+
+
+def wrenches_option(texts: list[str] | None, at: str | None, names: list[str] | None = None):
+    """``--wrench`` values (force; moment about ``--at``) as loader wrenches, moments about the
+    origin, named by ``names`` (``--wrench-name``) or as written."""
+    _names(names, texts, "wrench")
+    if not texts:
+        if at is not None:
+            raise typer.BadParameter("applies to --wrench; give at least one --wrench", param_hint="--at")
+        return None
+    import numpy as np
+
+    from ..engine.screws import cross
+    from ..model import Wrench
+
+    point = np.array(parse_floats(at, 3, "--at") if at is not None else [0.0, 0.0, 0.0])
+    wrenches = []
+    for k, text in enumerate(texts):
+        w = np.array(parse_floats(text, 6, "--wrench"))
+        with np.errstate(all="ignore"):
+            wrench = np.concatenate([w[:3], w[3:] + cross(point, w[:3])]) + 0.0  # moment about the origin
+        if not np.isfinite(wrench).all():
+            raise typer.BadParameter(f"{text!r} at {at}: the moment about the origin overflows", param_hint="--wrench")
+        wrenches.append(Wrench(name=names[k] if names else text.replace(" ", ""), wrench=wrench, line=None))
+    return wrenches
+
+
+def twists_option(texts: list[str] | None, at: str | None, names: list[str] | None = None):
+    """``--twist`` values as loader twists at the origin (``--at`` names the reference point),
+    named by ``names`` (``--twist-name``, one per twist) or as written."""
+    _names(names, texts, "twist")
     if not texts:
         if at is not None:
             raise typer.BadParameter("applies to --twist; give at least one --twist", param_hint="--at")

@@ -125,6 +125,19 @@ def _page_extras(path_name):
     return extras
 
 
+def _grip_forces(grasp):
+    """The grip forces drawn with a grasp's friction cones: the engine's least grip for the
+    wrench it holds (``hold``, from its ``mass``, else its first wrench); None without a
+    friction, a wrench or a grip."""
+    from ..engine.forces.grip import grip
+
+    if grasp.friction is None or not grasp.wrenches:
+        return None
+    chosen = {w.name: w for w in grasp.wrenches}.get("hold", grasp.wrenches[0])
+    g = grip(grasp.points, grasp.normals, chosen.wrench, grasp.friction)
+    return g.force if bool(g.ok) else None
+
+
 def draw_pictures(path, output, twists, twist_name, method, max_bytes, views) -> int:
     """The body of ``plot``: read ``path`` as every command does, draw by
     :func:`grasptwist.plot.render_loaded`, report on stderr; the exit status."""
@@ -168,10 +181,11 @@ def draw_pictures(path, output, twists, twist_name, method, max_bytes, views) ->
                 method=method,
                 js_beside=views["js_beside"],
                 extras=_page_extras(views["path_name"]),
+                grips=_grip_forces,
             )
         else:
             drawn = pictures.render_loaded(
-                path, output, grasps, twist_name=None if twists else twist_name, method=method
+                path, output, grasps, twist_name=None if twists else twist_name, method=method, grips=_grip_forces
             )
         for item in drawn:
             if isinstance(item, pictures.Note):

@@ -24,6 +24,8 @@ class Dataset:
     twist: np.ndarray | None  # (N, 6) or (6,)
     names: np.ndarray | None  # (N,)
     joint_positions: np.ndarray | None = None  # (N, n_joints): the hand's configuration per row
+    wrench: np.ndarray | None = None  # (N, 6) or (6,): (force; moment about the origin), grasptwist forces
+    friction: np.ndarray | None = None  # (), (N,) or (N, 3): mu per row or per contact, grasptwist forces
 
     def __len__(self) -> int:
         return len(self.points)

@@ -41,7 +41,7 @@ __all__ = ["DATASET_SUFFIXES", "EXTRA_POINT_ROLES", "Dataset", "Member", "open_d
 
 DATASET_SUFFIXES = (".npz", ".npy", ".parquet")
 EXTRA_POINT_ROLES = ("wrist", "at")
-_NPZ_KEYS = ("points", "normals", "wrist", "twist", "names", "joint_positions")
+_NPZ_KEYS = ("points", "normals", "wrist", "twist", "names", "joint_positions", "wrench", "friction")
 
 #: An ``.npz`` member may inflate to at most this many times its compressed
 #: size (zlib's own limit is about 1,000; real grasp data compresses 1-10
@@ -133,7 +133,17 @@ def _open_npz(path, arrays):
         raise _bad(
             path, f"joint_positions: expected numbers of shape (N, n_joints), got {positions.dtype} {positions.shape}"
         )
+    wrench = arrays.get("wrench")
+    if wrench is not None and not (wrench.shape == (6,) and wrench.dtype.kind in "fiu"):
+        _numeric(path, "wrench", wrench, (6,))
+    friction = arrays.get("friction")
+    if friction is not None and (friction.dtype.kind not in "fiu" or friction.shape[1:] not in ((), (3,))):
+        raise _bad(
+            path, f"friction: expected numbers of shape (), (N,) or (N, 3), got {friction.dtype} {friction.shape}"
+        )
     for key, a in (
+        ("wrench", wrench if wrench is not None and wrench.ndim == 2 else None),
+        ("friction", friction if friction is not None and friction.ndim >= 1 else None),
         ("joint_positions", positions),
         ("normals", normals),
         ("wrist", wrist),
@@ -142,7 +152,7 @@ def _open_npz(path, arrays):
     ):
         if a is not None and len(a) != n:
             raise _bad(path, f"{key}: {len(a)} rows, but points has {n}")
-    return Dataset(path, points, normals, wrist, None, twist, names, positions)
+    return Dataset(path, points, normals, wrist, None, twist, names, positions, wrench, friction)
 
 
 class Member:

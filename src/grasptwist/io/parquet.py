@@ -47,11 +47,32 @@ NORMAL_COLUMNS = _xyz("n")
 WRIST_COLUMNS = ("c_x", "c_y", "c_z")
 #: The twist ``(omega; v)`` at the origin (optional).
 TWIST_COLUMNS = ("w_x", "w_y", "w_z", "v_x", "v_y", "v_z")
+#: The wrench ``(force; moment about the origin)`` (optional; grasptwist forces).
+WRENCH_COLUMNS = ("f_x", "f_y", "f_z", "m_x", "m_y", "m_z")
+#: The friction: one coefficient per row, or one per contact (optional; grasptwist forces).
+FRICTION_COLUMN = ("mu",)
+FRICTION_COLUMNS = ("mu1", "mu2", "mu3")
 #: The grasp's name (optional; else the row index).
 NAME_COLUMN = "name"
 
-_GROUPS = {"points": POINT_COLUMNS, "normals": NORMAL_COLUMNS, "wrist": WRIST_COLUMNS, "twist": TWIST_COLUMNS}
-_SHAPES = {"points": (3, 3), "normals": (3, 3), "wrist": (3,), "twist": (6,)}
+_GROUPS = {
+    "points": POINT_COLUMNS,
+    "normals": NORMAL_COLUMNS,
+    "wrist": WRIST_COLUMNS,
+    "twist": TWIST_COLUMNS,
+    "wrench": WRENCH_COLUMNS,
+    "friction": FRICTION_COLUMNS,
+    "mu": FRICTION_COLUMN,
+}
+_SHAPES = {
+    "points": (3, 3),
+    "normals": (3, 3),
+    "wrist": (3,),
+    "twist": (6,),
+    "wrench": (6,),
+    "friction": (3,),
+    "mu": (),
+}
 
 
 def grasp_table(points, normals, wrist=None, twist=None, names=None):
@@ -126,6 +147,8 @@ def _dataset(path: str, schema, reader):
                 raise _bad(path, f"column {n}: expected numbers, got {t}")
         if found:
             present[key] = names
+    if "mu" in present and "friction" in present:
+        raise _bad(path, "give the friction as mu or as mu1, mu2, mu3, not both")
     labels = None
     if NAME_COLUMN in schema.names:
         t = schema.field(NAME_COLUMN).type
@@ -143,6 +166,8 @@ def _dataset(path: str, schema, reader):
         None,
         arrays.get("twist"),
         labels,
+        wrench=arrays.get("wrench"),
+        friction=arrays.get("friction", arrays.get("mu")),
     )
 
 

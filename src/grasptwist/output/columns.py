@@ -17,6 +17,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..engine.degeneracy import Status, status_message
+from ..engine.forces.grasp_map import ForceStatus, force_status_message
 from ..results import CULPRIT, KINDS, STATUS, Column
 
 __all__ = [
@@ -30,6 +31,12 @@ __all__ = [
     "columns",
     "arrays",
     "error_texts",
+    "FORCE_COLUMNS",
+    "FORCE_CSV_COLUMNS",
+    "force_columns",
+    "force_typed_header",
+    "force_arrays",
+    "grip_errors",
 ]
 
 #: Screw orders for output: the paper's ``(omega; v)`` or ``(v; omega)``.
@@ -219,3 +226,106 @@ def arrays(block, order: str = "omega-v", hand=None) -> dict[str, np.ndarray]:
             if values is not None:
                 out[column.name] = values
     return out
+
+
+# --------------------------------------------------------------------------
+# ``grasptwist forces``: one row per (grasp, wrench) (see run/forces.py).
+# Each group: ``(block) -> (N, ...) values`` and, for flat columns, the rows
+# where they hold (masked elsewhere).
+
+
+def _xyz(prefix, suffix=""):
+    return tuple(f"{prefix}{i}{suffix}_{a}" for i in range(1, 4) for a in "xyz")
+
+
+def _r(name):
+    return lambda _, b: getattr(b.result, name)
+
+
+def _manipulated(b):
+    return b.result.manipulating_status == 0
+
+
+def _gripped(b):
+    return b.result.grip_status == 0
+
+
+#: The force rows' column groups, CSV order; ``valid(block) -> (N,) bool`` rows where the flat values hold.
+FORCE_COLUMNS = (
+    (Column("file", _block(lambda b: b.file), ("file",), dtype="U", only_where_ok=False), None),
+    (Column("grasp", _block(lambda b: b.grasp), ("grasp",), dtype="U", only_where_ok=False), None),
+    (Column("wrench_name", _block(lambda b: np.array([n or "" for n in b.wrench_name], dtype=object)), ("wrench",), dtype="U"), None),
+    (Column("ok", _block(lambda b: ~b.failed_rows()), ("ok",), dtype="?", array=False), None),
+    (Column("error", _block(lambda b: np.full(len(b), "")), ("error",), dtype="U", array=False), None),
+    (Column("wrench", _block(lambda b: b.wrench), ("f_x", "f_y", "f_z", "m_x", "m_y", "m_z")), lambda b: b.has_wrench),
+    (Column("friction", _block(lambda b: b.friction), ("mu1", "mu2", "mu3")), lambda b: b.has_friction),
+    (Column("manipulating", _r("manipulating"), _xyz("fm")), _manipulated),
+    (Column("force", _r("force"), _xyz("f")), _gripped),
+    (Column("squeeze", _r("squeeze"), ("squeeze1", "squeeze2", "squeeze3")), _gripped),
+    (Column("normal_force", _r("normal_force"), ("fn1", "fn2", "fn3")), _gripped),
+    (Column("tangential_force", _r("tangential_force"), ("ft1", "ft2", "ft3")), _gripped),
+    (Column("friction_used", _r("friction_used"), ("friction_used1", "friction_used2", "friction_used3")), _gripped),
+    (Column("total_normal_force", _r("total_normal_force"), ("total_normal_force",)), _gripped),
+    (Column("manipulating_status", _r("manipulating_status"), dtype="i1"), None),
+    (Column("grip_status", _r("grip_status"), dtype="i1"), None),
+    (Column("grip_error", _block(lambda b: grip_errors(b)), ("grip_error",), dtype="U", array=False), None),
+    (Column("force_closure", _r("force_closure"), ("force_closure",), dtype="?"), lambda b: b.has_friction),
+    (Column("closure_friction", _r("closure_friction"), ("closure_friction",)), lambda b: ~np.isnan(b.result.closure_friction)),
+    (Column("epsilon", _r("epsilon"), ("epsilon",)), lambda b: ~np.isnan(b.result.epsilon)),
+)  # fmt: skip
+
+#: The CSV header of ``grasptwist forces``.
+FORCE_CSV_COLUMNS = [name for c, _ in FORCE_COLUMNS for name in c.flat]
+
+
+def grip_errors(block) -> np.ndarray:
+    """``code: message`` where the grip failed, or the manipulating forces did (the contacts' degeneracy)."""
+    r = block.result
+    texts = np.full(len(block), "", dtype=object)
+    for i in np.flatnonzero((r.manipulating_status > 0) | (r.grip_status > 0)):
+        status, culprit = (
+            (r.grip_status[i], r.grip_culprit[i])
+            if r.grip_status[i] > 0
+            else (r.manipulating_status[i], r.manipulating_culprit[i])
+        )
+        s = ForceStatus(int(status))
+        texts[i] = f"{s.code}: {force_status_message(s, culprit).removeprefix(s.code + ': ')}"
+    return texts
+
+
+_FORCE_STATUSES = ("manipulating_status", "grip_status")
+
+
+def _force_names(column, typed):
+    return (column.name,) if typed and column.name in _FORCE_STATUSES else column.flat
+
+
+def force_typed_header() -> dict[str, str]:
+    """Typed flat outputs of ``forces`` (Parquet): the CSV's columns and the two statuses, ``name -> numpy type``.
+
+    >>> h = force_typed_header()
+    >>> h["grip_status"], h["force_closure"], [n for n in h if n not in FORCE_CSV_COLUMNS]
+    ('i1', '?', ['manipulating_status', 'grip_status'])
+    """
+    return {name: c.dtype for c, _ in FORCE_COLUMNS for name in _force_names(c, True)}
+
+
+def force_columns(block, typed: bool = False) -> dict[str, np.ndarray]:
+    """A force block's flat columns, ``name -> (N,)``, in CSV order (``typed``: of
+    :func:`force_typed_header`, statuses included); masked where they do not hold."""
+    n = len(block)
+    out = {}
+    for column, valid in FORCE_COLUMNS:
+        names = _force_names(column, typed)
+        if not names:
+            continue
+        flat = np.asarray(column.get(None, block)).reshape(n, -1)
+        mask = None if valid is None else ~np.asarray(valid(block), bool)
+        for j, name in enumerate(names):
+            out[name] = flat[:, j] if mask is None else np.ma.masked_array(flat[:, j], mask=mask)
+    return out
+
+
+def force_arrays(block) -> dict[str, np.ndarray]:
+    """A force block's arrays as npz stores them (the engine's values, NaN where none)."""
+    return {c.name: c.get(None, block) for c, _ in FORCE_COLUMNS if c.array}

@@ -13,11 +13,20 @@ import io
 
 import numpy as np
 
-from .columns import CSV_COLUMNS, columns, header
+from .columns import CSV_COLUMNS, FORCE_CSV_COLUMNS, columns, force_columns, header
 from .names import escaped_each
 from .records import records, talking_rows
 
-__all__ = ["HEADER", "header_line", "encode_rows", "error_row", "lines"]
+__all__ = [
+    "HEADER",
+    "FORCE_HEADER",
+    "header_line",
+    "encode_rows",
+    "error_row",
+    "lines",
+    "force_rows",
+    "force_error_row",
+]
 
 #: The header line of a run without a hand.
 HEADER = ",".join(CSV_COLUMNS).encode() + b"\n"
@@ -70,3 +79,22 @@ def error_row(rec: dict, hand=None) -> bytes:
     err = rec["error"]
     row = [rec["file"], "", "", "false", f"{err['code']}: {err['message']}"]  # file, grasp, twist, ok, error
     return _lines([row + [""] * (len(header(hand)) - len(row))])[0]
+
+
+#: The header line of ``grasptwist forces``.
+FORCE_HEADER = ",".join(FORCE_CSV_COLUMNS).encode() + b"\n"
+
+
+def force_rows(block) -> tuple[list[bytes], list[dict]]:
+    """The CSV line of each force row, and the records of the rows with something to say."""
+    from .force_records import force_records
+
+    recs = force_records(block)
+    return lines(force_columns(block)), [rec for rec in recs if not rec["ok"] or rec["warnings"]]
+
+
+def force_error_row(rec: dict, hand=None) -> bytes:
+    """The CSV line of an input that failed, under :data:`FORCE_HEADER`."""
+    err = rec["error"]
+    row = [rec["file"], "", "", "false", f"{err['code']}: {err['message']}"]  # file, grasp, wrench, ok, error
+    return _lines([row + [""] * (len(FORCE_CSV_COLUMNS) - len(row))])[0]

@@ -18,10 +18,13 @@ from typing import NamedTuple
 import numpy as np
 
 from ..engine.degeneracy import CONDITION_WARNING, Status, status_message
+from ..engine.forces.grasp_map import ForceStatus
 from ..engine.se3 import matrix_to_quaternion
 from ..results import KINDS
 from .columns import CSV_COLUMNS, columns, header
 from .csv_rows import lines
+from .force_records import GRIP_FIELDS
+from .force_records import _error as grip_error  # the forces record's error object, shared
 from .names import escaped
 from .records import dumps, records
 
@@ -39,6 +42,8 @@ __all__ = [
     "crossing_text",
     "hand_event_texts",
     "hand_summary",
+    "grip_record",
+    "hold_text",
 ]
 
 #: The block columns a follow CSV row leaves out (the path's own replace them).
@@ -88,10 +93,35 @@ def sample_records(samples, order: str = "omega-v") -> list[dict]:
                 new[kind.key] = rec[kind.key]
         if samples.joint_positions is not None:
             new["joint_positions"] = _finger_positions(samples.block.hands[i], samples.joint_positions[i])
+        if samples.grip is not None:
+            new["grip"] = grip_record(samples.grip, i)
         new["warnings"] = rec["warnings"]
         new["ok"] = rec["ok"]
         out.append(new)
     return out
+
+
+def grip_record(grip, i) -> dict:
+    """Row ``i`` of a :class:`~grasptwist.engine.forces.grip.Grip` as the ``forces`` record's
+    ``grip`` object: the forces (row ``j`` contact ``j``), squeezes, normal and tangential
+    forces, friction used, their total and the safety factor; or ``{"error": {code, message}}``."""
+    if grip.status[i] != ForceStatus.OK:
+        return grip_error(grip.status[i], grip.culprit[i])
+    return {**{k: getattr(grip, k)[i] + 0.0 for k in GRIP_FIELDS}, "safety": grip.safety}
+
+
+def hold_text(c: dict, digits: int = 4) -> str:
+    """A ``cannot_hold`` stretch of a summary in words.
+
+    >>> hold_text({"t_start": 0.4636476, "t_end": 5.8195377, "culprit": "thumb", "reason": "friction"})
+    "cannot hold the weight from t = 0.4636 to t = 5.8195: the friction cone at contact 'thumb' is too narrow"
+    """
+    why = (
+        "a finger would have to pull"
+        if c["reason"] == "pulling"
+        else f"the friction cone at contact '{escaped(c['culprit'])}' is too narrow"
+    )
+    return f"cannot hold the weight from t = {c['t_start']:.{digits}f} to t = {c['t_end']:.{digits}f}: {why}"
 
 
 def _finger_positions(hand, positions) -> list[list[float]]:
@@ -153,6 +183,17 @@ def summary_record(summary) -> dict:
         "first_warning": None if first is None else {"method": first[1], "t": first[0]},
     }
     ok = not degenerate
+    if summary.cannot_hold is not None:
+        out["cannot_hold"] = [
+            {
+                "t_start": c.t_start,
+                "t_end": c.t_end,
+                "culprit": names[c.culprit] if c.culprit >= 0 else None,
+                "reason": "friction" if c.culprit >= 0 else "pulling",
+            }
+            for c in summary.cannot_hold
+        ]
+        ok = ok and not summary.cannot_hold  # the object falls
     if summary.hand is not None:
         out["hand"] = hand_summary(summary.grasp, summary.hand)
         # a joint out of its limits, or a finger that cannot follow, stops the motion too
@@ -220,6 +261,7 @@ def diagnostics(rec: dict, names=("1", "2", "3")) -> tuple[list[str], list[str]]
         warnings.append(
             f"{where}: warning: {w['method']}: conditioning below {CONDITION_WARNING:g} from t = {w['t']:.6g}"
         )
+    errors += [f"{where}: error: {hold_text(c, 6)}" for c in s.get("cannot_hold", ())]
     if "hand" in s:
         hand_errors, hand_warnings = hand_event_texts(s["hand"], names, 6)
         errors += [f"{where}: error: hand: {text}" for text in hand_errors]

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from typing import IO
 
-from .follow_records import crossing_text, hand_event_texts
+from .follow_records import crossing_text, hand_event_texts, hold_text
 from .names import escaped
 
 __all__ = ["FollowTable"]
@@ -120,6 +120,11 @@ class FollowTable:
             if w is None
             else f"  first warning: {w['method']} at t = {w['t']:.{self.digits}f}"
         )
+        if "cannot_hold" in s:
+            for c in s["cannot_hold"]:
+                self._line(f"  {hold_text(c, self.digits)}")
+            if not s["cannot_hold"]:
+                self._line("  the weight is held all along the path")
         if "hand" in s:
             errors, warnings = hand_event_texts(s["hand"], self.names, self.digits)
             for text in errors + warnings:

@@ -56,6 +56,10 @@ class OutputFormat:
     per_hand : bool
         Its columns depend on the run's hand (the joints of ``--hand``):
         ``open``, ``encode`` and ``encode_rows`` take ``hand=``.
+    encode_forces, encode_force_error : callable or None
+        For ``forces`` rows when they are not encoded record by record
+        (CSV): ``block -> (encoded rows, records with something to say)``,
+        and ``error record -> encoded``.
     """
 
     name: str
@@ -68,6 +72,8 @@ class OutputFormat:
     takes_blocks: bool = False
     bases: bool = True
     per_hand: bool = False
+    encode_forces: Callable[[Any], tuple[list, list[dict]]] | None = None
+    encode_force_error: Callable[[dict], Any] | None = None
 
     def hand_options(self, hand) -> dict:
         """The keyword arguments that give ``open``/``encode``/``encode_rows`` the run's hand."""
@@ -85,6 +91,8 @@ def _table(out: IO[bytes], kind: str, order: str = "omega-v", **table_options):
 
 
 def _csv(out: IO[bytes], kind: str, hand=None, **_):
+    if kind == "forces":
+        return Lines(out, header=csv_rows.FORCE_HEADER, newline=b"")
     if kind == "follow":
         from .follow_records import csv_header
 
@@ -95,20 +103,20 @@ def _csv(out: IO[bytes], kind: str, hand=None, **_):
 def _npz(out: IO[bytes], kind: str, order: str = "omega-v", hand=None, **_):
     from .npz import NpzWriter
 
-    return NpzWriter(out, order, hand=hand)
+    return NpzWriter(out, order, hand=hand, forces=kind == "forces")
 
 
 def _parquet(out: IO[bytes], kind: str, order: str = "omega-v", hand=None, **_):
     from .parquet_writer import ParquetWriter  # pyarrow only when Parquet is asked for
 
-    return ParquetWriter(out, order, hand=hand)
+    return ParquetWriter(out, order, hand=hand, forces=kind == "forces")
 
 
 def _json_rows(block, order):
     return encode_records(block, order, records, dumps)
 
 
-_ALL = ("resolve", "basis", "check", "follow")
+_ALL = ("resolve", "basis", "check", "follow", "forces")
 
 #: Every output format by name, in the order ``--help`` lists them.
 FORMATS: dict[str, OutputFormat] = {
@@ -120,15 +128,21 @@ FORMATS: dict[str, OutputFormat] = {
         OutputFormat("jsonl", _ALL, lambda out, kind, **_: Lines(out), dumps, _json_rows, join=b"\n".join),
         OutputFormat(
             "csv",
-            ("resolve", "follow"),
+            ("resolve", "follow", "forces"),
             _csv,
             csv_rows.error_row,
             csv_rows.encode_rows,
             join=b"".join,
             per_hand=True,
+            encode_forces=csv_rows.force_rows,
+            encode_force_error=csv_rows.force_error_row,
         ),
-        OutputFormat("npz", ("resolve", "follow"), _npz, binary=True, takes_blocks=True, bases=False, per_hand=True),
-        OutputFormat("parquet", ("resolve",), _parquet, binary=True, takes_blocks=True, bases=False, per_hand=True),
+        OutputFormat(
+            "npz", ("resolve", "follow", "forces"), _npz, binary=True, takes_blocks=True, bases=False, per_hand=True
+        ),
+        OutputFormat(
+            "parquet", ("resolve", "forces"), _parquet, binary=True, takes_blocks=True, bases=False, per_hand=True
+        ),
     )
 }
 

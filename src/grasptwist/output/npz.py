@@ -10,7 +10,8 @@ from typing import IO
 import numpy as np
 
 from ..engine.degeneracy import Status
-from .columns import arrays
+from ..engine.forces.grasp_map import ForceStatus
+from .columns import arrays, force_arrays
 
 __all__ = ["NpzWriter", "SPILL_BYTES"]
 
@@ -18,7 +19,11 @@ __all__ = ["NpzWriter", "SPILL_BYTES"]
 SPILL_BYTES = 512 << 20
 
 #: Label columns stored as an index into a table of their distinct values: ``column: (index, table)``.
-_INDEXED = {"file": ("file_index", "files"), "twist_name": ("twist_index", "twist_names")}
+_INDEXED = {
+    "file": ("file_index", "files"),
+    "twist_name": ("twist_index", "twist_names"),
+    "wrench_name": ("wrench_index", "wrench_names"),
+}
 
 
 class NpzWriter:
@@ -40,8 +45,11 @@ class NpzWriter:
     temporary files; :meth:`close` streams everything into the archive.
     """
 
-    def __init__(self, out: IO[bytes], order: str = "omega-v", spill_bytes: int = SPILL_BYTES, hand=None):
+    def __init__(
+        self, out: IO[bytes], order: str = "omega-v", spill_bytes: int = SPILL_BYTES, hand=None, forces: bool = False
+    ):
         self.out = out
+        self.forces = forces  # blocks of grasptwist forces (columns.FORCE_COLUMNS)
         self.order = order
         self.hand = hand
         self.spill_bytes = spill_bytes
@@ -57,7 +65,8 @@ class NpzWriter:
     def write(self, block, extra: dict | None = None) -> None:
         """Append a block's rows, and ``extra`` arrays over them (``follow``'s times and poses)."""
         cols = {}
-        for name, a in {**arrays(block, self.order, self.hand), **(extra or {})}.items():
+        made = force_arrays(block) if self.forces else arrays(block, self.order, self.hand)
+        for name, a in {**made, **(extra or {})}.items():
             if name in _INDEXED:
                 index, table = _INDEXED[name]
                 cols[index] = self._index(table, a)
@@ -119,7 +128,11 @@ class NpzWriter:
                     np.lib.format.write_array_header_2_0(member, header)
                     for a in self._parts(name):
                         member.write(np.ascontiguousarray(a.astype(dtype, copy=False)).data)
-            tables = {"status_legend": [s.code for s in Status], **{k: list(v) for k, v in self.names.items()}}
+            statuses = ForceStatus if self.forces else Status
+            legend = [""] * (max(statuses) + 1)  # legend[k] names status k (ForceStatus has gaps)
+            for status in statuses:
+                legend[status] = status.code
+            tables = {"status_legend": legend, **{k: list(v) for k, v in self.names.items() if v or not self.forces}}
             if self.hand is not None:
                 tables["joint_names"] = list(self.hand.joint_names)
             for name, values in tables.items():

@@ -17,7 +17,7 @@ from typing import IO
 import numpy as np
 
 from ..extras import require
-from .columns import columns, typed_header
+from .columns import columns, force_columns, force_typed_header, typed_header
 
 __all__ = ["ROW_GROUP_ROWS", "write_options", "schema", "table", "ParquetWriter"]
 
@@ -25,17 +25,21 @@ __all__ = ["ROW_GROUP_ROWS", "write_options", "schema", "table", "ParquetWriter"
 ROW_GROUP_ROWS = 65536
 
 
-def write_options(hand=None) -> dict:
+def _header(hand=None, forces=False) -> dict:
+    return force_typed_header() if forces else typed_header(hand)
+
+
+def write_options(hand=None, forces=False) -> dict:
     """Options of pyarrow's Parquet writer for results: dictionary pages for text
     only (on floats they cost five times the write and save nothing)."""
-    return {"use_dictionary": [name for name, dtype in typed_header(hand).items() if dtype == "U"]}
+    return {"use_dictionary": [name for name, dtype in _header(hand, forces).items() if dtype == "U"]}
 
 
 def _arrow_type(pa, dtype: str):
     return pa.dictionary(pa.int32(), pa.string()) if dtype == "U" else pa.from_numpy_dtype(np.dtype(dtype))
 
 
-def schema(hand=None):
+def schema(hand=None, forces=False):
     """The Arrow schema of results: :func:`~grasptwist.output.columns.typed_header` with their types.
 
     >>> s = schema()
@@ -43,7 +47,7 @@ def schema(hand=None):
     ('bool', 'int8', 'dictionary<values=string, indices=int32, ordered=0>')
     """
     pa = require("pyarrow", "Parquet output")
-    return pa.schema([(name, _arrow_type(pa, dtype)) for name, dtype in typed_header(hand).items()])
+    return pa.schema([(name, _arrow_type(pa, dtype)) for name, dtype in _header(hand, forces).items()])
 
 
 def _array(pa, values, arrow_type):
@@ -56,11 +60,12 @@ def _array(pa, values, arrow_type):
     return pa.array(data, arrow_type, mask=mask)
 
 
-def table(block, order: str = "omega-v", hand=None):
-    """A result block as an Arrow table of :func:`schema` (``hand``: the run's, whose joint columns follow)."""
+def table(block, order: str = "omega-v", hand=None, forces=False):
+    """A result block as an Arrow table of :func:`schema` (``hand``: the run's, whose joint
+    columns follow; ``forces``: a block of ``grasptwist forces``)."""
     pa = require("pyarrow", "Parquet output")
-    s = schema(hand)
-    flat = columns(block, order, hand, typed=True)
+    s = schema(hand, forces)
+    flat = force_columns(block, typed=True) if forces else columns(block, order, hand, typed=True)
     return pa.Table.from_arrays([_array(pa, flat[f.name], f.type) for f in s], schema=s)
 
 
@@ -71,18 +76,21 @@ class ParquetWriter:
     then written as one row group.
     """
 
-    def __init__(self, out: IO[bytes], order: str = "omega-v", row_group_rows: int = ROW_GROUP_ROWS, hand=None):
+    def __init__(
+        self, out: IO[bytes], order: str = "omega-v", row_group_rows: int = ROW_GROUP_ROWS, hand=None, forces=False
+    ):
         pq = require("pyarrow.parquet", "-f parquet")
+        self.forces = forces
         self.order = order
         self.hand = hand
         self.row_group_rows = row_group_rows
         self.pending: list = []
         self.rows = 0
-        self.writer = pq.ParquetWriter(out, schema(hand), **write_options(hand))
+        self.writer = pq.ParquetWriter(out, schema(hand, forces), **write_options(hand, forces))
 
     def write(self, block) -> None:
         """Append a block's rows."""
-        self.pending.append(table(block, self.order, self.hand))
+        self.pending.append(table(block, self.order, self.hand, self.forces))
         self.rows += len(block)
         if self.rows >= self.row_group_rows:
             self._flush()

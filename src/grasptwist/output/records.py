@@ -252,11 +252,18 @@ def basis_record(block, i: int, order: str = "omega-v") -> dict:
     return rec
 
 
-def check_record(block, i: int) -> dict:
-    """Validation and degeneracy verdict of row ``i``'s grasp, per kind."""
+def check_record(block, i: int, closure=None) -> dict:
+    """Validation and degeneracy verdict of row ``i``'s grasp, per kind; with ``closure``
+    (:func:`grasptwist.results.check_closure` of the block) its ``closure_friction`` (null:
+    none) and, where the grasp gives a friction, ``force_closure``."""
     warnings = []
     objects = _row_objects(block, i, lambda k: k.check_fields, "omega-v", warnings, with_failure=(CONDITIONING,))
     rec = {"file": escaped(block.file[i], controls=False), "grasp": escaped(block.grasp[i], controls=False), **objects}
+    if closure is not None:
+        least, verdict = closure
+        rec["closure_friction"] = None if np.isnan(least[i]) else float(least[i])
+        if verdict is not None and verdict[i] is not None:
+            rec["force_closure"] = bool(verdict[i])
     rec["warnings"] = warnings
     rec["ok"] = _methods_ok(rec)
     return rec
@@ -270,6 +277,10 @@ def error_record(err: GraspFileError) -> dict:
         for p in err.problems
     ]
     return {"file": escaped(err.file, controls=False), "ok": False, "error": errors[0], "errors": errors}
+
+
+#: The parts of a ``forces`` record that can fail, as its stderr lines name them.
+FORCE_PARTS = ("manipulating", "grip")
 
 
 def diagnostics(rec: dict) -> tuple[list[str], list[str]]:
@@ -291,10 +302,13 @@ def diagnostics(rec: dict) -> tuple[list[str], list[str]]:
     where = f"{file}: grasp '{escaped(rec['grasp'])}'"
     if "twist" in rec:
         where += f", twist '{escaped(rec['twist']['name'])}'"
+    if rec.get("wrench"):  # a forces record
+        where += f", wrench '{escaped(rec['wrench']['name'])}'"
+    labels = [(k.key, k.label) for k in KINDS] + [(part, part) for part in FORCE_PARTS]
     errors = [
-        f"{where}: error: {k.label}: {m['error']['code']}: {m['error']['message']}"
-        for k in KINDS
-        if isinstance(m := rec.get(k.key), dict) and "error" in m
+        f"{where}: error: {label}: {m['error']['code']}: {m['error']['message']}"
+        for key, label in labels
+        if isinstance(m := rec.get(key), dict) and "error" in m
     ]
     return errors, [f"{where}: warning: {w}" for w in rec["warnings"]]
 

@@ -564,7 +564,7 @@ class CheckTableWriter(_Writer):
         super().__init__(out, **options)
         self.kinds = [k for k in KINDS if k.check_fields]  # a kind with nothing to check has no column
         # a method's cell is "ok (its basis's conditioning)" or the code of its degeneracy
-        self.grid = _table(*(f"{k.label} (conditioning)" for k in self.kinds), "file", "grasp")
+        self.grid = _table(*(f"{k.label} (conditioning)" for k in self.kinds), "closure mu", "file", "grasp")
         self.widths: list[int] = []
 
     def write(self, encoded: bytes) -> None:
@@ -572,7 +572,9 @@ class CheckTableWriter(_Writer):
         if "error" in rec:
             return
         self.count += 1
-        self.grid.add_row(*(_verdict_cell(rec.get(k.key, False)) for k in self.kinds), rec["file"], rec["grasp"])
+        self.grid.add_row(
+            *(_verdict_cell(rec.get(k.key, False)) for k in self.kinds), _closure_cell(rec), rec["file"], rec["grasp"]
+        )
         if self.widths or self.grid.row_count >= SIZING_ROWS:
             self._rows()
 
@@ -602,6 +604,17 @@ class CheckTableWriter(_Writer):
 SIZING_ROWS = 64
 
 
+def _closure_cell(rec):
+    """The least friction for force closure; with the grasp's own friction, whether that closes it."""
+    if "closure_friction" not in rec:
+        return Text("-", style="dim")
+    least = rec["closure_friction"]
+    text = "none" if least is None else f"{least:.3g}"
+    if "force_closure" in rec:
+        text += " closed" if rec["force_closure"] else " open"
+    return Text(text)
+
+
 def _verdict_cell(m):
     if m is False or m is None:
         return Text("skipped" if m is None else "-", style="dim")
@@ -611,7 +624,70 @@ def _verdict_cell(m):
     return Text(m["error"]["code"], style="red")
 
 
-WRITERS = {"resolve": TableWriter, "basis": BasisTableWriter, "check": CheckTableWriter}
+class ForceTableWriter(_Writer):
+    """A forces record: per contact its forces and how close each is to slipping, then the totals and closure.
+
+    Forces in N and moments in N m when the grasp's lengths are in metres
+    (the numbers are as given: N, N m stand for the units of the file)."""
+
+    def show(self, rec: dict, lines: list[str]) -> None:
+        d = self.digits
+        w = rec["wrench"]
+        parts = [self.title(rec)]
+        if w is not None:
+            parts.append(
+                Text.assemble(
+                    "wrench ",
+                    (escaped(w["name"]), "bold"),
+                    f" = force {fmt_vector(w['wrench'][:3], d)} N; moment {fmt_vector(w['wrench'][3:], d)} N m",
+                )
+            )
+        self.flow(lines, *parts)
+        grip, m = rec["grip"], rec["manipulating"]
+        friction = rec["friction"]
+        t = _table("contact", "mu")
+        shown_m = _shown(m)
+        shown_g = _shown(grip)
+        if shown_m:
+            t.add_column("manipulating force (N)")
+        if shown_g:
+            for header in ("grip force (N)", "normal (N)", "tangential (N)", "friction used", "of mu/s"):
+                t.add_column(header, justify="left" if header == "grip force (N)" else "right")
+        for i, c in enumerate(rec["contacts"]):
+            row = [c["name"], "-" if friction is None else fmt_number(friction[i], d)]
+            if shown_m:
+                row.append(fmt_vector(m["force"][i], d))
+            if shown_g:
+                used, limit = grip["friction_used"][i], friction[i] / grip["safety"]
+                row += [
+                    fmt_vector(grip["force"][i], d),
+                    fmt_number(grip["normal_force"][i], d),
+                    fmt_number(grip["tangential_force"][i], d),
+                    fmt_number(used, d),
+                    "-" if limit == 0 else f"{100 * used / limit:.0f}%",
+                ]
+            t.add_row(*row)
+        self.add(lines, t)
+        for name, part in (("manipulating", m), ("grip", grip)):
+            if part is not None and "error" in part:
+                self.add(lines, Text(f"{name}: {part['error']['code']}: {part['error']['message']}", style="red"))
+        if shown_g:
+            self.add(
+                lines,
+                f"total normal force {fmt_number(grip['total_normal_force'], d)} N (safety {grip['safety']:g}); "
+                f"squeezes {fmt_vector(grip['squeeze'], d)} N",
+            )
+        c = rec["closure"]
+        verdict = {True: "yes", False: "no", None: "- (no friction)"}[c["force_closure"]]
+        least = "none" if c["closure_friction"] is None else fmt_number(c["closure_friction"], d)
+        text = f"closure: force closure {verdict}; closure friction {least}"
+        if c["epsilon"] is not None:
+            text += f"; epsilon {fmt_number(c['epsilon'], d)}"
+        self.add(lines, text)
+        self.warnings(lines, rec)
+
+
+WRITERS = {"resolve": TableWriter, "basis": BasisTableWriter, "check": CheckTableWriter, "forces": ForceTableWriter}
 
 
 class HandTable:

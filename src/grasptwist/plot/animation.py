@@ -22,7 +22,7 @@ import numpy as np
 from .figures import bounds, grasp_scenes, methods_of, scene_layout, velocity_scale_of, view_title
 from .traces import force_traces, scene_traces
 
-__all__ = ["DEFAULT_SAMPLES", "degenerate_marks", "path_figure", "path_figures"]
+__all__ = ["DEFAULT_SAMPLES", "degenerate_marks", "hold_marks", "path_figure", "path_figures"]
 
 #: Frames of an animation: follow's default samples over the path, both ends included (a hand's
 #: fingers are tracked between samples, which is most of the cost: about 0.3 s a sample).
@@ -59,9 +59,12 @@ def path_figure(grasp, chunks, summary, *, method=None) -> dict:
         replace(grasp, points=points[k], normals=normals[k], joint_positions=None if joints is None else joints[k])
         for k in range(len(times))
     ]
-    fitted = [grasp_scenes(g, t, methods) for g, t in zip(moved, twists)]
+    forces = _frame_forces(chunks, len(times))
+    fitted = [grasp_scenes(g, t, methods, forces=f) for g, t, f in zip(moved, twists, forces)]
     scale = min((s for s in map(velocity_scale_of, fitted) if s is not None), default=None)
-    frames_scenes = [grasp_scenes(g, t, methods, scale) for g, t in zip(moved, twists)] if scale else fitted
+    frames_scenes = (
+        [grasp_scenes(g, t, methods, scale, f) for g, t, f in zip(moved, twists, forces)] if scale else fitted
+    )
     cube = bounds([s for v in frames_scenes for s in v])
     per_frame = []
     for scenes in frames_scenes:
@@ -72,9 +75,14 @@ def path_figure(grasp, chunks, summary, *, method=None) -> dict:
         per_frame.append(traces)
     slots = _slots(per_frame)
     marks = degenerate_marks(times, summary.found.crossings)
+    dropped = hold_marks(times, summary.cannot_hold or ())
     titles = [
-        f"t = {t:.4g}" + (f" — degenerate: {'; '.join(m)}" if m else "") + "<br>" + view_title(s)
-        for t, m, s in zip(times, marks, frames_scenes)
+        f"t = {t:.4g}"
+        + (f" — degenerate: {'; '.join(m)}" if m else "")
+        + (" — cannot hold the weight" if d else "")
+        + "<br>"
+        + view_title(s)
+        for t, m, d, s in zip(times, marks, dropped, frames_scenes)
     ]
     frames = []
     for k, traces in enumerate(per_frame):
@@ -84,11 +92,11 @@ def path_figure(grasp, chunks, summary, *, method=None) -> dict:
     pause = {"frame": {"duration": 0, "redraw": False}, "mode": "immediate", "transition": {"duration": 0}}
     steps = [
         {
-            "label": ("✗ " if m else "") + f"{t:.3g}",
+            "label": ("✗ " if m or d else "") + f"{t:.3g}",
             "method": "animate",
             "args": [[str(k)], {"frame": {"duration": 0, "redraw": True}, "mode": "immediate"}],
         }
-        for k, (t, m) in enumerate(zip(times, marks))
+        for k, (t, m, d) in enumerate(zip(times, marks, dropped))
     ]
     layout = {
         "title": {"text": titles[0], "font": {"size": 13}, "x": 0.01, "xanchor": "left"},
@@ -122,7 +130,7 @@ def path_figure(grasp, chunks, summary, *, method=None) -> dict:
                 "transition": {"duration": 0},
             }
         ],
-        "annotations": _stretches(summary.found.crossings),
+        "annotations": _stretches(summary.found.crossings, summary.cannot_hold or ()),
     }
     return {"data": _filled(per_frame[0], slots), "layout": layout, "frames": frames}
 
@@ -147,16 +155,49 @@ def degenerate_marks(times, crossings) -> list[list[str]]:
     return marks
 
 
-def _stretches(crossings) -> list[dict]:
-    """A line under the plot naming each degenerate stretch, if any."""
-    if not crossings:
+def hold_marks(times, stretches) -> list[bool]:
+    """For each sample time, whether it lies in a ``cannot-hold`` stretch
+    (:class:`~grasptwist.engine.forces.hold.HoldStretch`).
+
+    >>> from grasptwist.engine.forces.hold import HoldStretch
+    >>> hold_marks([0.0, 0.5, 1.0], [HoldStretch(0.4, 0.9, -1)])
+    [False, True, False]
+    """
+    times = np.asarray(times, dtype=float)
+    inside = np.zeros(times.shape, dtype=bool)
+    for c in stretches:
+        inside |= (times >= c.t_start) & (times <= c.t_end)
+    return inside.tolist()
+
+
+def _frame_forces(chunks, count) -> list:
+    """Each sample's grip forces ``(3, 3)`` from follow's samples (None: no grip there or at all)."""
+    if any(c.grip is None for c in chunks):
+        return [None] * count
+    force = np.concatenate([c.grip.force for c in chunks])
+    return [f if np.isfinite(f).all() else None for f in force]
+
+
+def _stretches(crossings, stretches=()) -> list[dict]:
+    """A line under the plot naming each degenerate stretch and each stretch that cannot hold, if any."""
+    parts = []
+    if crossings:
+        parts.append(
+            "degenerate: "
+            + "; ".join(
+                f"{c.method} ({c.code}) at t = {c.t_start:.4g}"
+                if c.t_start == c.t_end
+                else f"{c.method} ({c.code}) for t in [{c.t_start:.4g}, {c.t_end:.4g}]"
+                for c in crossings
+            )
+        )
+    if stretches:
+        parts.append(
+            "cannot hold the weight: " + "; ".join(f"t in [{c.t_start:.4g}, {c.t_end:.4g}]" for c in stretches)
+        )
+    if not parts:
         return []
-    text = "degenerate: " + "; ".join(
-        f"{c.method} ({c.code}) at t = {c.t_start:.4g}"
-        if c.t_start == c.t_end
-        else f"{c.method} ({c.code}) for t in [{c.t_start:.4g}, {c.t_end:.4g}]"
-        for c in crossings
-    )
+    text = "<br>".join(parts)
     return [{"text": text, "showarrow": False, "xref": "paper", "yref": "paper", "x": 0, "y": 0, "xanchor": "left"}]
 
 

@@ -35,17 +35,19 @@ def methods_of(grasp, method: str | None = None) -> tuple[str, ...]:
     return ("off-tangent", "tangent") if default_method(grasp.wrist) == "off-tangent" else ("tangent",)
 
 
-def grasp_scenes(grasp, twist, methods, velocity_scale=None) -> list[Scene]:
-    """One scene per method of ``grasp`` and ``twist``, every basis screw and the hand's fingers in each.
+def grasp_scenes(grasp, twist, methods, velocity_scale=None, forces=None) -> list[Scene]:
+    """One scene per method of ``grasp`` and ``twist``, every basis screw and the hand's fingers in each
+    (and with a friction its cones and the grip ``forces`` given).
 
     Without ``velocity_scale`` the scenes are drawn again at the smallest of
     their fitted scales, so that every velocity arrow of a view has one scale.
     """
     scenes = [
-        grasp_scene(grasp, twist, method=m, all_bases=True, links=True, velocity_scale=velocity_scale) for m in methods
+        grasp_scene(grasp, twist, method=m, all_bases=True, links=True, velocity_scale=velocity_scale, forces=forces)
+        for m in methods
     ]
     if velocity_scale is None and len(scenes) > 1:
-        return grasp_scenes(grasp, twist, methods, velocity_scale_of(scenes))
+        return grasp_scenes(grasp, twist, methods, velocity_scale_of(scenes), forces)
     return scenes
 
 
@@ -95,7 +97,7 @@ def scene_layout(scene: Scene, units: str | None, cube=None) -> dict:
     return axes | {"aspectmode": "data" if cube is None else "cube", "camera": camera}
 
 
-def twist_figure(grasp, twists=None, *, method: str | None = None, active: int = 0, meshes=()) -> dict:
+def twist_figure(grasp, twists=None, *, method: str | None = None, active: int = 0, meshes=(), forces=None) -> dict:
     """The figure of a grasp and its twists: a dropdown switches between twists.
 
     Parameters
@@ -110,6 +112,8 @@ def twist_figure(grasp, twists=None, *, method: str | None = None, active: int =
     meshes : sequence of (vertices, faces)
         The hand's link meshes (:func:`grasptwist.io.urdf_meshes.hand_meshes`),
         one legend entry shown with every twist.
+    forces : (3, 3) array or None
+        The grip forces drawn with a grasp's friction cones (the engine's, from the caller).
 
     Returns
     -------
@@ -120,7 +124,7 @@ def twist_figure(grasp, twists=None, *, method: str | None = None, active: int =
     """
     methods = methods_of(grasp, method)
     items = list(grasp.twists if twists is None else twists) or [None]
-    views = [grasp_scenes(grasp, t, methods) for t in items]
+    views = [grasp_scenes(grasp, t, methods, forces=forces) for t in items]
     half = bounds([s for v in views for s in v])[1]
     data, owner, shown, titles = [], [], [], []
     for k, scenes in enumerate(views):

@@ -69,11 +69,11 @@ for (const div of document.querySelectorAll("div.grasptwist-figure")) {
 """
 
 
-def grasp_page(grasp, *, twists=None, method=None, active=0, meshes=(), followed=()):
+def grasp_page(grasp, *, twists=None, method=None, active=0, meshes=(), followed=(), forces=None):
     """The sections of a grasp's page ``[(heading, figure)]``: the twists' figure first
     (:func:`twist_figure`, with a URDF hand's link ``meshes``), then one animation per
     followed path (:func:`grasptwist.plot.animation.path_figures`)."""
-    figure = twist_figure(grasp, twists, method=method, active=active, meshes=meshes)
+    figure = twist_figure(grasp, twists, method=method, active=active, meshes=meshes, forces=forces)
     return [(f"{grasp.name}: twists", figure), *path_figures(grasp, followed, method=method)]
 
 
@@ -138,6 +138,7 @@ def html_loaded(
     method: str | None = None,
     js_beside: bool = False,
     extras=None,
+    grips=None,
 ) -> Iterator[Path | Note]:
     """What ``grasptwist plot PATH -o OUTPUT.html`` (or a folder's ``-o FOLDER``) writes for
     ``grasps``, the grasps read from ``path``.
@@ -148,7 +149,8 @@ def html_loaded(
     names them).  ``extras(grasp)`` gives what a page shows beside the grasp
     itself, ``(meshes, followed, notes)``: its hand's link meshes, its followed
     paths for :func:`grasp_page`, and a :class:`Note` for each that could not
-    be had.  Yields each page written and each note.
+    be had; ``grips(grasp)`` the grip forces ``(3, 3)`` drawn with its friction cones (or
+    None).  Yields each page written and each note.
     """
     from .render import chosen_twist
 
@@ -173,5 +175,6 @@ def html_loaded(
             active = grasp.twists.index(chosen_twist(grasp, twist_name))
         meshes, followed, notes = extras(grasp) if extras else ((), (), ())
         yield from notes
-        sections = grasp_page(grasp, method=method, active=active, meshes=meshes, followed=followed)
+        forces = grips(grasp) if grips else None
+        sections = grasp_page(grasp, method=method, active=active, meshes=meshes, followed=followed, forces=forces)
         yield write_page(page, sections, title=f"grasptwist: {grasp.name}", js_beside=js_beside)

@@ -65,13 +65,16 @@ def require_matplotlib():
 # --- files --------------------------------------------------------------------
 
 
-def plot_grasp(grasp, path, twist=None, *, twist_name=None, method=None, size=(1400, 700), dpi=100) -> Path:
+def plot_grasp(
+    grasp, path, twist=None, *, twist_name=None, method=None, size=(1400, 700), dpi=100, forces=None
+) -> Path:
     """Render one grasp and twist to ``path``.
 
     See :func:`~grasptwist.plot.scene.grasp_scene` for ``twist``,
-    ``twist_name`` and ``method``, and :func:`render` for the rest.
+    ``twist_name``, ``method`` and ``forces``, and :func:`render` for the rest.
     """
-    return render(grasp_scene(grasp, twist, twist_name=twist_name, method=method), path, size=size, dpi=dpi)
+    picture = grasp_scene(grasp, twist, twist_name=twist_name, method=method, forces=forces)
+    return render(picture, path, size=size, dpi=dpi)
 
 
 def image_name(grasp_name: str, twist_name: str | None = None) -> str:
@@ -112,11 +115,12 @@ def image_paths(grasps, folder, suffix=".png", *, per_twist=True) -> list[tuple[
     return plan
 
 
-def render_grasps(grasps, folder, *, method=None, suffix=".png", size=(1400, 700), dpi=100) -> list[Path]:
+def render_grasps(grasps, folder, *, method=None, suffix=".png", size=(1400, 700), dpi=100, grips=None) -> list[Path]:
     """One image per grasp and twist in ``folder`` (created if missing), named by :func:`image_paths`.
 
     A grasp without twists is drawn with its basis only; ``method`` None picks
-    :func:`~grasptwist.plot.scene.default_method` per grasp.
+    :func:`~grasptwist.plot.scene.default_method` per grasp; ``grips(grasp)`` gives the grip
+    forces to draw (``(3, 3)`` or None).
 
     Returns
     -------
@@ -125,7 +129,10 @@ def render_grasps(grasps, folder, *, method=None, suffix=".png", size=(1400, 700
     plan = image_paths(grasps, folder, suffix)
     require_matplotlib()
     Path(folder).mkdir(parents=True, exist_ok=True)
-    return [plot_grasp(grasp, path, twist, method=method, size=size, dpi=dpi) for path, grasp, twist in plan]
+    return [
+        plot_grasp(grasp, path, twist, method=method, size=size, dpi=dpi, forces=grips(grasp) if grips else None)
+        for path, grasp, twist in plan
+    ]
 
 
 class TwistNotFound(ValueError):
@@ -157,7 +164,7 @@ class Note:
     error: bool = True
 
 
-def render_loaded(path: str, output, grasps, *, twist_name: str | None = None, method: str | None = None):
+def render_loaded(path: str, output, grasps, *, twist_name: str | None = None, method: str | None = None, grips=None):
     """What ``grasptwist plot PATH -o OUTPUT`` draws of the grasps read from ``PATH``.
 
     Yields each image written (a :class:`~pathlib.Path`) and a :class:`Note`
@@ -180,6 +187,9 @@ def render_loaded(path: str, output, grasps, *, twist_name: str | None = None, m
     twist_name : str or None
         For a single file, which of its twists to draw (default its first).
     method : ``"off-tangent"``, ``"tangent"`` or None (the default per grasp).
+    grips : callable or None
+        ``grips(grasp)``: the grip forces ``(3, 3)`` to draw with a grasp's friction cones
+        (None: cones only); the command line asks the engine for them.
 
     Raises
     ------
@@ -198,12 +208,13 @@ def render_loaded(path: str, output, grasps, *, twist_name: str | None = None, m
                 drawable.append(grasp)
             except ValueError as exc:  # off-tangent asked of a grasp without a wrist
                 yield Note(f"{grasp.file}: grasp '{grasp.name}': error: {exc}")
-        yield from render_grasps(drawable, output, method=method)
+        yield from render_grasps(drawable, output, method=method, grips=grips)
     elif grasps:
         grasp = grasps[0]
         if len(grasps) > 1:
             yield Note(f"{path}: warning: drawing the first of its {len(grasps)} grasps, '{grasp.name}'", error=False)
-        yield plot_grasp(grasp, output, chosen_twist(grasp, twist_name), method=method)
+        forces = grips(grasp) if grips else None
+        yield plot_grasp(grasp, output, chosen_twist(grasp, twist_name), method=method, forces=forces)
 
 
 def _check_suffix(suffix: str, formats=FORMATS):
@@ -230,6 +241,8 @@ _STYLE = {
     "psi-part": {"color": "tab:orange", "lw": 1.4},
     "theta-part": {"color": "tab:green", "lw": 1.4},
     "joint-axis": {"color": "tab:brown", "lw": 2.0, "ls": "-"},
+    "friction-cone": {"color": "tab:olive", "alpha": 0.18},
+    "grip-force": {"color": "tab:pink", "lw": 2.6},
 }
 
 
@@ -288,7 +301,13 @@ def _draw(ax, scene: Scene, view, head: float):
 
     for p in scene.patches:
         st = _STYLE[p.kind]
-        ax.add_collection3d(Poly3DCollection([p.corners], facecolor=st["color"], alpha=st["alpha"], edgecolor="none"))
+        # a cone's patch is a fan from its apex (scene.force_parts), a plane's one polygon
+        polygons = (
+            [[p.corners[0], a, b] for a, b in zip(p.corners[1:-1], p.corners[2:])]
+            if p.kind == "friction-cone"
+            else [p.corners]
+        )
+        ax.add_collection3d(Poly3DCollection(polygons, facecolor=st["color"], alpha=st["alpha"], edgecolor="none"))
     for s in scene.segments:
         st = _STYLE[s.kind]
         ax.plot(*np.transpose([s.start, s.end]), color=st["color"], lw=st["lw"], ls=st["ls"])

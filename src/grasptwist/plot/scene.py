@@ -27,6 +27,7 @@ __all__ = [
     "KINDS",
     "METHODS",
     "Arrow",
+    "FORCE_KINDS",
     "Marker",
     "Patch",
     "Scene",
@@ -34,6 +35,7 @@ __all__ = [
     "check_method",
     "default_method",
     "finger_links",
+    "force_parts",
     "grasp_scene",
     "joint_segments",
     "legend_text",
@@ -49,6 +51,9 @@ _PATCH_HALF = 0.15  # half-side of a tangent-plane square
 _VELOCITY_LEN = 0.45  # the longest chain of velocity arrows at one contact
 _FAR_AXIS = 3.0  # a twist axis further than this from the centroid is not drawn
 _JOINT_HALF = 0.12  # half-length of a finger joint's axis segment
+_CONE_HEIGHT = 0.3  # a friction cone's height along its normal
+_CONE_SIDES = 24  # a cone's rim is drawn as this polygon
+_FORCE_LEN = 0.45  # the largest grip force's drawn length
 
 
 # --- scene data ---------------------------------------------------------------
@@ -190,7 +195,12 @@ KINDS = {
     "theta-part": "part α_j Θ_j(p_i)",
     "joint-axis": "finger joint axis",
     "finger-link": "finger (joint to joint to tip)",
+    "friction-cone": "friction cone (half-angle atan μ_i)",
+    "grip-force": "grip force f_i",
 }
+
+#: The force side's kinds (issue 19): drawn when the grasp has a friction.
+FORCE_KINDS = ("friction-cone", "grip-force")
 
 
 def legend_text(kind: str, method: str) -> str:
@@ -491,9 +501,11 @@ def grasp_scene(
     all_bases=False,
     links=False,
     velocity_scale=None,
+    forces=None,
 ) -> Scene:
     """:func:`scene` for a loaded ``Grasp``, with its hand's joint axes (and, with
-    ``links``, its fingers' chains: :func:`finger_links`).
+    ``links``, its fingers' chains: :func:`finger_links`), and with a ``friction``
+    its friction cones and the grip ``forces (3, 3)`` given (:func:`force_parts`).
 
     ``twist`` is a ``Twist`` (its ``name`` and ``screw`` are used), a ``(6,)``
     array (named ``twist_name``), or None for the grasp and its basis only.
@@ -514,11 +526,70 @@ def grasp_scene(
         all_bases=all_bases,
         velocity_scale=velocity_scale,
     )
+    friction = getattr(grasp, "friction", None)
+    if friction is not None:
+        cones, arrows = force_parts(grasp.points, grasp.normals, friction, forces, grasp.contact_names)
+        picture = replace(picture, patches=picture.patches + cones, arrows=picture.arrows + arrows)
     if grasp.hand is None:
         return picture
     joints = joint_segments(grasp.hand, grasp.joint_positions, _JOINT_HALF * _grasp_size(grasp.points))
     chains = finger_links(grasp.hand, grasp.joint_positions, grasp.points, grasp.contact_names) if links else ()
     return replace(picture, segments=picture.segments + joints + chains)
+
+
+def force_parts(points, normals, friction, forces=None, names=("1", "2", "3")):
+    r"""The friction cones of a grasp and its grip forces, as patches and arrows (geometry only).
+
+    Cone ``i`` has its apex at the contact, its axis along the unit normal ``n_i`` (into the
+    object, where a finger's force points) and the half-angle ``atan(mu_i)``: the patch's
+    corners are the apex, then a rim of :data:`_CONE_SIDES` points
+    ``p_i + h (n_i + mu_i (cos(phi) b_1 + sin(phi) b_2))`` (a fan of triangles from the apex;
+    ``h`` a fixed part of the grasp's size).  A frictionless contact (a ray) or an unlimited
+    friction (a half-space) has no cone.  ``forces (3, 3)``, computed by the engine, become
+    arrows at the contacts with their true vectors, the largest drawn a fixed part of the
+    grasp's size (NaN forces: none).
+
+    Returns
+    -------
+    (tuple of Patch, tuple of Arrow)
+
+    Examples
+    --------
+    >>> p = np.array([[1.0, 0, 0], [-0.5, 0.866, 0], [-0.5, -0.866, 0]])
+    >>> cones, arrows = force_parts(p, -p, 0.5, [[0, 0, 1.0]] * 3)
+    >>> c = cones[0].corners
+    >>> c[0].tolist(), round(float(np.degrees(np.arctan2(np.linalg.norm(np.cross(c[1] - c[0], -p[0])), (c[1] - c[0]) @ -p[0]))), 6)
+    ([1.0, 0.0, 0.0], 26.565051)
+    >>> [a.vector.tolist() for a in arrows][0], arrows[0].kind
+    ([0.0, 0.0, 1.0], 'grip-force')
+    """
+    points, normals = np.asarray(points, dtype=float), np.asarray(normals, dtype=float)
+    mu = np.broadcast_to(np.asarray(friction, dtype=float), (3,))
+    size = _grasp_size(points)
+    n = unit(normals)
+    helper = np.where(np.abs(n[:, :1]) < 0.9, [[1.0, 0, 0]], [[0.0, 1, 0]])
+    b1 = unit(cross(n, helper))
+    b2 = cross(n, b1)
+    phi = np.linspace(0, 2 * np.pi, _CONE_SIDES, endpoint=False)[:, None]
+    h = _CONE_HEIGHT * size
+    cones = []
+    for i in range(3):
+        if not 0 < mu[i] < np.inf:
+            continue
+        rim = points[i] + h * (n[i] + mu[i] * (np.cos(phi) * b1[i] + np.sin(phi) * b2[i]))
+        cones.append(
+            Patch(np.vstack((points[i], rim, rim[:1])), f"cone{_sub(names[i])} μ = {mu[i]:g}", "friction-cone")
+        )
+    arrows = []
+    if forces is not None:
+        f = np.asarray(forces, dtype=float)
+        largest = float(np.max(norm(f))) if np.isfinite(f).all() else 0.0
+        if largest > 0:
+            arrows = [
+                Arrow(points[i], f[i], f"f{_sub(names[i])}", "grip-force", _FORCE_LEN * size / largest)
+                for i in range(3)
+            ]
+    return tuple(c for c in cones if _finite(c.corners)), tuple(arrows)
 
 
 def finger_links(hand, positions, contacts, names=("1", "2", "3")) -> tuple[LinePiece, ...]:

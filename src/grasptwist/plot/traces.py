@@ -13,7 +13,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..engine.screws import norm
-from .scene import Scene, legend_text
+from .scene import FORCE_KINDS, Scene, legend_text
 
 __all__ = ["COMMON_KINDS", "MESH_NAME", "force_traces", "mesh_trace", "scene_traces", "slot_name"]
 
@@ -52,9 +52,11 @@ _STYLE = {
     "theta-part": ("#2ca02c", 4, None),
     "joint-axis": ("#8c564b", 6, None),
     "finger-link": ("#c7a17a", 10, None),
+    "friction-cone": ("#bcbd22", 0, None),
+    "grip-force": ("#e377c2", 6, None),
 }
 _DASHED_METHOD = {"tangent": "dot"}  # the tangent method's Sigma axes are the off-tangent's lines: tell them apart
-_OPACITY = {"tangent-plane": 0.35, "contact-plane": 0.2}
+_OPACITY = {"tangent-plane": 0.35, "contact-plane": 0.2, "friction-cone": 0.25}
 _HEAD = 0.07  # arrow-head length, of the scene's half-width
 _HIDDEN = ("sigma-part", "psi-part", "theta-part", "tangent-plane")  # off at first: toggled in the legend
 
@@ -92,6 +94,8 @@ def scene_traces(scene: Scene, units: str | None, *, common=True, own=True, half
     half = scene.bounds()[1] if half is None else half
     out = {}
     for kind in scene.kinds():
+        if kind in FORCE_KINDS:  # force_traces' own
+            continue
         if (kind in COMMON_KINDS and not common) or (kind not in COMMON_KINDS and not own):
             continue
         name = slot_name(kind, scene.method)
@@ -116,15 +120,27 @@ def scene_traces(scene: Scene, units: str | None, *, common=True, own=True, half
 
 
 def force_traces(scene: Scene, units: str | None) -> dict[str, list[dict]]:
-    """Hook for the force engine (issue 19): friction cones and grip forces, by legend entry.
+    """The force side (issue 19): friction cones and grip forces, by legend entry.
 
-    A scene has no forces yet, so this gives nothing.  Once the scene carries
-    them (contact forces as :class:`~grasptwist.plot.scene.Arrow` of a kind
-    ``"grip-force"``, friction cones as patches of a kind ``"friction-cone"``),
-    return their traces here in :func:`scene_traces`'s form; the figures add
-    whatever it returns after the scene's own traces.
+    A scene's friction cones (patches of kind ``"friction-cone"``, fans from each apex:
+    :func:`~grasptwist.plot.scene.force_parts`) as one mesh, its grip forces (arrows of kind
+    ``"grip-force"``) as :func:`scene_traces` draws arrows; nothing for a grasp without a friction.
     """
-    return {}
+    half = scene.bounds()[1]
+    out = {}
+    for kind in FORCE_KINDS:
+        elements = scene.of_kind(kind)
+        if not elements:
+            continue
+        name = slot_name(kind, None)
+        traces = (
+            [_patches(elements, kind, name)] if kind == "friction-cone" else _arrows(elements, kind, name, units, half)
+        )
+        traces[0]["showlegend"] = True
+        for t in traces:
+            t["legendgroup"] = name
+        out[name] = traces
+    return out
 
 
 def mesh_trace(meshes, half) -> dict:

@@ -87,6 +87,7 @@ class Block:
     hands: list | None = None  # per row its Hand or None; None: no row has one
     bases: bool = True  # False: resolved without the basis screws (fields that need them are left out)
     method: str = ALL_METHODS  # the --method asked for
+    friction: np.ndarray | None = None  # (n, 3) the grasps' friction, NaN rows where none; None: no row has one
     # field values computed so far, by (kind key, Field); a block cut from another keeps its rows of them
     values: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
@@ -170,6 +171,7 @@ _ROW_FIELDS = (
     "has_wrist",
     "velocity",
     "hands",
+    "friction",
 )
 
 
@@ -326,7 +328,10 @@ def _stack(jobs, method) -> Block:
         units=[g.units for g in grasps],
         **_hand_inputs(grasps),
     )
-    return replace(block, contact_names=[g.contact_names for g in grasps])
+    friction = None
+    if any(g.friction is not None for g in grasps):
+        friction = np.stack([nan if g.friction is None else g.friction for g in grasps])
+    return replace(block, contact_names=[g.contact_names for g in grasps], friction=friction)
 
 
 def _hand_inputs(grasps) -> dict:

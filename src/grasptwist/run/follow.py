@@ -5,6 +5,9 @@ the engine moves the grasp along the path and resolves every sample's
 instantaneous twist (:func:`grasptwist.engine.path.follow`, a chunk of
 samples at a time so that memory stays bounded), then finds the path's
 degeneracies between the samples (:func:`grasptwist.engine.path.degeneracies`).
+A grasp with a ``mass`` and a ``friction`` also gets the grip that holds its
+weight at each sample and the stretches where none does
+(:mod:`grasptwist.engine.forces.hold`).
 A grasp with a hand has its fingers follow the contacts first
 (:func:`grasptwist.engine.hands.track`): each sample's joint rates are the hand
 result at the integrated joint positions, as ``resolve`` computes it.
@@ -22,6 +25,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..engine import hands
+from ..engine.forces.grip import Grip
+from ..engine.forces.hold import HoldStretch, cannot_hold, grip_along
 from ..engine.hands import HandTrack
 from ..engine.ik import home_tips, place_hand
 from ..engine.path import PathDegeneracies, Poses, degeneracies, follow
@@ -98,13 +103,16 @@ class Samples:
 
     ``block``'s ``twist_name`` holds the path's name; ``poses`` are the
     samples' times, segments, poses and space twists; ``joint_positions``
-    ``(N, n_joints)`` the hand's integrated joint positions (None: no hand).
+    ``(N, n_joints)`` the hand's integrated joint positions (None: no hand);
+    ``grip`` the grip holding the grasp's weight at each sample (None: the grasp
+    has no ``mass`` or no ``friction``).
     """
 
     path: str
     block: Block
     poses: Poses
     joint_positions: np.ndarray | None = None
+    grip: Grip | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -118,6 +126,7 @@ class Summary:
     found: PathDegeneracies
     labels: tuple[str, ...]  # the methods run
     hand: HandTrack | None = None  # the fingers' tracks, when the grasp has a hand
+    cannot_hold: tuple[HoldStretch, ...] | None = None  # where no grip holds its weight, with mass and friction
 
 
 def sample_times(duration: float, samples: int | None = None, dt: float | None = None) -> np.ndarray:
@@ -199,8 +208,15 @@ def _path(job, grasp, p):
     tracked = (
         None if grasp.hand is None else hands.track(grasp.hand, grasp.joint_positions, grasp.points, p.segments, times)
     )
+    # the weight, gravity fixed in space: needs a mass to hold and a friction to hold it with
+    weight = (
+        None
+        if grasp.mass is None or grasp.friction is None
+        else (grasp.points, grasp.normals, grasp.friction, grasp.mass, grasp.center_of_mass, grasp.gravity, p.segments)
+    )
     for start in range(0, len(times), CHUNK):
         q = None if tracked is None else tracked.positions[start : start + CHUNK]
+        grip = None if weight is None else grip_along(*weight, times[start : start + CHUNK])[1]
         f = follow(
             grasp.points,
             grasp.normals,
@@ -210,9 +226,10 @@ def _path(job, grasp, p):
             method=job.method,
             bases=job.bases,
         )
-        yield Samples(p.name, _block(grasp, p.name, f, job.bases, job.method, q), f.poses, q)
+        yield Samples(p.name, _block(grasp, p.name, f, job.bases, job.method, q), f.poses, q, grip)
     found = degeneracies(grasp.points, grasp.normals, grasp.wrist, p.segments, times)
-    yield Summary(grasp.file, grasp, p.name, len(times), found, labels, tracked)
+    stretches = None if weight is None else cannot_hold(*weight, times)
+    yield Summary(grasp.file, grasp, p.name, len(times), found, labels, tracked, stretches)
 
 
 def _block(grasp, name, f, bases, method, positions=None) -> Block:

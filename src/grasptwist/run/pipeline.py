@@ -24,7 +24,9 @@ import numpy as np
 
 from ..io.datasets import DATASET_SUFFIXES, open_dataset
 from ..io.inputs import read
-from ..model import GraspFileError, Hand, Twist
+from ..io.lines import grasp_batches
+from ..model import GraspFileError, Hand, Twist, Wrench
+from ..output.force_records import force_records
 from ..output.formats import FORMATS
 from ..output.records import (
     basis_record,
@@ -35,7 +37,9 @@ from ..output.records import (
     records,
     talking_rows,
 )
+from ..results import ForceOptions, check_closure
 from .batch import ZERO_TWIST, Block, check_positions, dataset_blocks, resolve
+from .forces import ForceBlock, force_blocks, force_dataset_blocks
 from .pool import Pool
 from .scratch import owned_prefix, remove_orphans
 from .stream import grasp_stream, is_stream, twist_stream
@@ -50,7 +54,7 @@ SPOOL_STEM = "grasptwist-"
 class Job:
     """What a command asks for (everything a worker needs)."""
 
-    kind: str = "resolve"  # resolve, basis or check
+    kind: str = "resolve"  # resolve, basis, check or forces
     twists: tuple[Twist, ...] | None = None
     method: str = "both"
     order: str = "omega-v"
@@ -60,6 +64,9 @@ class Job:
     hand: Hand | None = None  # --hand: the hand of a data set's rows, whose joints CSV and npz columns name
     twists_from: str | None = None  # a stream of twists (a file or -) for every grasp
     select: tuple[str, ...] | None = None  # resolve --select: the names of the grasps' own twists to resolve
+    wrenches: tuple[Wrench, ...] | None = None  # forces: --wrench, replacing the files' wrenches
+    friction: float | None = None  # forces: --friction, replacing the files' friction
+    forces: ForceOptions = field(default_factory=ForceOptions)  # forces: safety, quality, cone edges
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -163,6 +170,8 @@ def _alone(job: Job, path: str, workers: int, tuning: Tuning) -> Iterator[Output
     """The outputs of an input read on its own: a stream, or a data set."""
     if not is_stream(path):
         return _dataset(job, path, workers, tuning)
+    if job.kind == "forces":
+        return _streamed(job, _force_batches(job, path, tuning), tuning)
     twists = [ZERO_TWIST] if job.kind != "resolve" else job.twists
     batches = grasp_stream(path, twists, job.method, job.max_bytes, tuning.files_per_group, job.select)
     return _streamed(job, batches, tuning)
@@ -261,10 +270,20 @@ def run_group(job: Job, paths: Sequence, tuning: Tuning = TUNING, spool: Spool |
     for p in paths:
         items.extend(read(p, job.max_bytes) if isinstance(p, str) else [p])
     out = Output(done=len(paths))
-    twists = [ZERO_TWIST] if job.kind != "resolve" else job.twists
-    for x in resolve(items, twists, job.method, select=job.select):
+    if job.kind == "forces":
+        results = force_blocks(items, job.wrenches, job.friction, job.forces)
+    else:
+        twists = [ZERO_TWIST] if job.kind != "resolve" else job.twists
+        results = resolve(items, twists, job.method, select=job.select)
+    for x in results:
         _encode_into(job, x, out, tuning.records_at_once)
     return _sealed(job, out, spool)
+
+
+def _force_batches(job: Job, path: str, tuning: Tuning):
+    """The force blocks and errors of the grasps of the stream ``path``, a batch of lines at a time."""
+    for batch in grasp_batches(path, job.max_bytes, tuning.files_per_group):
+        yield list(force_blocks(batch, job.wrenches, job.friction, job.forces))
 
 
 def blocks(
@@ -284,9 +303,22 @@ def blocks(
             yield from ((x, None, k > 0) for x in batch)  # the first batch: the grasp files' errors
         return
     for g in _groups(paths, tuning.files_per_group):
+        if is_stream(g) and job.kind == "forces":
+            yield from ((x, None, True) for batch in _force_batches(job, g, tuning) for x in batch)
+            continue
         if is_stream(g):
             batches = grasp_stream(g, job.twists, job.method, job.max_bytes, tuning.files_per_group, job.select)
             yield from ((x, None, True) for batch in batches for x in batch)
+            continue
+        if _is_dataset(g) and job.kind == "forces":
+            try:
+                ds = open_dataset(g, job.extra_point)
+                extra_work = len(ds) * (len(job.wrenches) if job.wrenches else 1) - 1
+                for block in force_dataset_blocks(ds, job.wrenches, job.friction, job.forces):
+                    yield block, extra_work, True
+                    extra_work = 0
+            except GraspFileError as err:
+                yield err, None, False
             continue
         if _is_dataset(g):
             try:
@@ -301,6 +333,9 @@ def blocks(
         items = []
         for p in g:
             items.extend(read(p, job.max_bytes) if isinstance(p, str) else [p])
+        if job.kind == "forces":
+            yield from ((x, None, False) for x in force_blocks(items, job.wrenches, job.friction, job.forces))
+            continue
         for x in resolve(items, job.twists, job.method, select=job.select):
             yield x, None, False
 
@@ -310,16 +345,26 @@ def _encode_into(job: Job, x, out: Output, at_once: int) -> None:
     fmt = FORMATS[job.fmt]
     hand = fmt.hand_options(job.hand)
     encode = partial(fmt.encode, **hand) if hand else fmt.encode
-    if not isinstance(x, Block):
-        out.add(error_record(x), encode)
+    if isinstance(x, ForceBlock):
+        if fmt.encode_forces is not None:
+            out.add_encoded(*fmt.encode_forces(x))
+        else:
+            for rec in force_records(x):
+                out.add(rec, encode)
+    elif not isinstance(x, Block):
+        out.add(error_record(x), fmt.encode_force_error if job.kind == "forces" and fmt.encode_force_error else encode)
     elif job.kind == "resolve":
         # a few thousand records at a time: their floats as Python objects
         # would otherwise fill memory
         for start in range(0, len(x), at_once):
             out.add_encoded(*fmt.encode_rows(x.part(start, start + at_once), job.order, **hand))
-    else:
+    elif job.kind == "basis":
         for i in range(len(x)):
-            out.add(basis_record(x, i, job.order) if job.kind == "basis" else check_record(x, i), encode)
+            out.add(basis_record(x, i, job.order), encode)
+    else:
+        closure = check_closure(x.points, x.normals, x.friction)
+        for i in range(len(x)):
+            out.add(check_record(x, i, closure), encode)
 
 
 def _dataset(job: Job, path: str, workers: int, tuning: Tuning) -> Iterator[Output]:
@@ -328,7 +373,9 @@ def _dataset(job: Job, path: str, workers: int, tuning: Tuning) -> Iterator[Outp
     try:
         ds = open_dataset(path, job.extra_point)
         check_positions(ds, job.hand)
-        if job.twists is None and ds.twist is None and job.kind == "resolve":
+        if job.kind == "forces":
+            pass  # a data set without wrenches gives each grasp's closure
+        elif job.twists is None and ds.twist is None and job.kind == "resolve":
             next(dataset_blocks(ds, None, job.method, hand_of_rows=job.hand))  # raises the no-twist error
     except GraspFileError as err:
         out = Output(done=1)
@@ -336,6 +383,8 @@ def _dataset(job: Job, path: str, workers: int, tuning: Tuning) -> Iterator[Outp
         yield _sealed(job, out)
         return
     rows = len(ds) * (len(job.twists) if job.twists and job.kind == "resolve" else 1)
+    if job.kind == "forces":
+        rows = len(ds) * (len(job.wrenches) if job.wrenches else 1)
     step = tuning.grasps_per_task
     tasks = [(start, min(len(ds), start + step)) for start in range(0, len(ds), step)]
     if workers > 1 and len(tasks) > 1:
@@ -365,8 +414,12 @@ def _dataset_task(job: Job, ds, rows: tuple[int, int], tuning: Tuning, spool: Sp
     twists = [ZERO_TWIST] if job.kind != "resolve" else job.twists
     at_once = tuning.records_at_once
     outs = []
+    if job.kind == "forces":
+        made = force_dataset_blocks(ds, job.wrenches, job.friction, job.forces, start=rows[0], stop=rows[1])
+    else:
+        made = dataset_blocks(ds, twists, job.method, start=rows[0], stop=rows[1], hand_of_rows=job.hand)
     try:
-        for block in dataset_blocks(ds, twists, job.method, start=rows[0], stop=rows[1], hand_of_rows=job.hand):
+        for block in made:
             for start in range(0, len(block), at_once):
                 out = Output(rows=True)
                 _encode_into(job, block.part(start, start + at_once), out, at_once)
@@ -409,7 +462,13 @@ def write_blocks(job: Job, paths: Sequence, w, tuning: Tuning = TUNING) -> Itera
     """
     for x, extra_work, rows in blocks(job, paths, tuning):
         o = Output(done=len(x) if extra_work is not None else 1, extra_work=extra_work or 0, rows=rows)
-        if isinstance(x, Block):
+        if isinstance(x, ForceBlock):
+            w.write(x)
+            for rec in force_records(x):
+                if not rec["ok"] or rec["warnings"]:
+                    o.add(rec, lambda rec: None)
+            o.records = len(x)
+        elif isinstance(x, Block):
             w.write(x)
             talking = np.flatnonzero(talking_rows(x))
             for rec in records(x.take(talking), job.order) if talking.size else []:

@@ -3,8 +3,10 @@
 - ``grasp_map``: the grasp map ``G``, Yoshikawa-Nagai's manipulating forces ``G^+ w``
   in closed form, the squeezes (internal forces) along the sides of the contact
   triangle, the status codes and the ``check_*`` validators;
-- ``socp``: a batched barrier method for the three-cone problems (no loop over grasps);
+- ``socp``: a batched primal-dual interior-point method for the three-cone problems (no loop over grasps);
 - ``grip``: the least total normal force that holds a wrench within the friction cones;
+- ``hold``: holding a weight along an object path (gravity fixed in space): the grip at each
+  pose, and the stretches where none exists;
 - ``closure``: force closure, the least common friction that gives it, and the
   Ferrari-Canny ``epsilon``.
 

@@ -1,73 +1,90 @@
-r"""A batched barrier method for small second-order cone programs: many rows at once, no loop over rows.
+r"""A batched primal-dual interior-point method for small second-order cone programs: many rows at once.
 
 Each row is the problem
 
-.. math:: \min_x\; c^T x \quad \text{s.t.} \quad y_m = A_m x + b_m \in Q^3 = \{(t, z) : t \ge |z|\},\; m = 1, 2, 3
+.. math:: \min_x\; c^T x \quad \text{s.t.} \quad y_m = A_m x + b_m \in Q^3 = \{(t, z) : t \ge |z|\},\; m = 1 .. K
 
-with ``x`` of 3 (or 4) numbers: the grip's three squeezes.  The barrier
-``-sum_m log(t_m^2 - |z_m|^2)`` is self-concordant with parameter 2 per cone, so
+with ``x`` of 3 or 4 numbers (the grip's squeezes, and phase I's margin), and its dual
+``max -sum_m b_m^T z_m`` s.t. ``sum_m A_m^T z_m = c``, ``z_m in Q^3``; the duality gap is
+``sum_m y_m . z_m``.  A half-space ``a^T x + h >= 0`` is the cone ``(a^T x + h, 0, 0)``.
 
-* a *damped Newton* step of length ``1 / (1 + lambda)`` (``lambda`` the Newton
-  decrement) never leaves the cones and needs no line search: every row takes the
-  same arithmetic, which is what lets numpy run them together;
-* after centring at ``tau`` the objective is within ``6 / tau`` of the optimum.
+Both phases start strictly inside the cones, primal and dual; phase II's dual start is
+feasible too (phase I's leaves a residual in the dual equalities, which every step shrinks by
+its length).  Each iteration is Mehrotra's predictor-corrector with
+Nesterov-Todd scaling (the scaling point ``w`` with ``W z = W^{-1} y = lambda``, one per cone,
+``W = beta (2 v v^T - J)``): an affine step ``lambda o v = -lambda o lambda``, the centring
+weight ``sigma = (mu_aff / mu)^3``, then the corrected step, 0.99 of the way to the cones' edge
+(in closed form per cone: :func:`_edge`).  The Newton system is the 3 x 3 (4 x 4)
+``H dx = sum_m (W_m^{-1} A_m)^T W_m^{-1} v_m``, solved by elimination on arrays over the rows.
+A row leaves once its gap is below ``GAP`` of its objective's scale (``1 + |c^T x|``): the
+rows are scaled by their caller to order one, so the objective is then that close to the
+optimum.  It takes 10-25 iterations a row, about a third of the Newton steps of a barrier
+method with damped steps.
 
-**Phase I** finds a strictly feasible point by minimising ``r`` with the cones widened
-to ``t_m + r >= |z_m|`` and ``r >= -1``, from ``x = 0`` and an ``r`` that makes the
-start feasible: a row whose ``r`` ends below 0 has an interior point, one whose ``r``
-stays above the duality gap has none (``cannot-hold``).  **Phase II** then follows the
-central path from there, ``tau = 1, 100, ..., TAU_END``, centring roughly
-(``lambda^2 < 0.01``) on the way and a little closer (``1e-4``) at the end.  The rows are scaled by their
-caller so that the numbers are of order one (the wrench's manipulating forces), so
-``TAU_END = 1e10`` leaves a gap of ``6e-10`` of that scale.
+**Phase I** finds a strictly feasible point by minimising ``r`` with the cones widened to
+``t_m + r >= |z_m|`` and ``r >= -1``, from ``x = 0`` and an ``r`` that makes the start
+feasible, and a dual start that is feasible in ``r``'s column only (the residual of the
+squeezes' columns shrinks step by step).  A row is decided once ``r <= -START_MARGIN``
+(feasible, with room), its dual objective (a lower bound on ``r``, once the residual is
+gone) is above 0 (infeasible: ``cannot-hold``), or its gap has closed (the sign of ``r``
+decides).  An infeasible row whose cones share a boundary direction has ``r -> 0`` only
+far along it: it stops at the cap with ``r > 0``.
 
-Every array is components-first (each number of each row one array over the rows), and each
-Newton step solves its 3 x 3 (4 x 4) systems by elimination on those arrays.
+Every array is components-first: cone vectors ``(3, K, n)`` (component, cone, row), ``A``
+``(3, d, K, n)``, ``x`` ``(d, n)``.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["TAU_END", "phase_one", "minimise"]
+__all__ = ["GAP", "START_MARGIN", "phase_one", "minimise"]
 
-#: The last barrier weight: the objective ends within ``6 / TAU_END`` of the optimum.
-TAU_END = 1e10
-
-_TAUS = np.array([1.0, 1e2, 1e4, 1e6, 1e8, 1e10])
-_NEWTON_CAP = 40  # per weight; a centred row needs 3-6 after a tenfold increase
-# Squared Newton decrement below which a row counts as centred at the last weight: the objective is
-# then within (6 + lambda sqrt(6)) / tau of the optimum (self-concordance), so a rough centre does.
-_DONE = 1e-4
-_ROUGH = 1e-2  # enough centring on the way (the next weight's steps start from near the path)
-_J = np.array([1.0, -1.0, -1.0])
-
-#: Phase I keeps the squeezes within this (of the row's scale): without a bound an infeasible
-#: row whose cones share a boundary direction drifts along it without end.
-BOX = 1e6
+#: A row stops once its duality gap is below this times ``1 + |c^T x|``.
+GAP = 1e-10
 
 #: Phase I stops a row whose every cone holds ``t - |z| >= START_MARGIN`` (of the row's scale).
 START_MARGIN = 0.5
 
-
-def _cones(A, b, x):
-    """``y = A x + b (3 cones, 3, n)`` and ``q = t^2 - |z|^2 (3, n)``, components-first."""
-    y = b + A[:, :, 0] * x[0]
-    for j in range(1, len(x)):
-        y = y + A[:, :, j] * x[j]
-    return y, y[:, 0] ** 2 - y[:, 1] ** 2 - y[:, 2] ** 2
+_RESIDUAL = 1e-9  # a dual residual below this (of the rows' order-one scale) counts as feasible
+_ITERATIONS = 60  # a cap; rows need 10-25
+_EDGE = 0.99  # the fraction of the way to the cones' edge a step goes
+_J = np.array([1.0, -1.0, -1.0])[:, None, None]
 
 
-def _inside(y, q):
-    return (q > 0).all(axis=0) & (y[:, 0] > 0).all(axis=0)
+def _jdot(p, q):
+    """``p^T J q`` per cone: ``(3, K, n)`` -> ``(K, n)``."""
+    return p[0] * q[0] - p[1] * q[1] - p[2] * q[2]
+
+
+def _dot(p, q):
+    return p[0] * q[0] + p[1] * q[1] + p[2] * q[2]
+
+
+def _edge(x, d):
+    """The largest ``alpha`` with ``x + alpha d`` in the cone (``inf``: none), ``(3, K, n)`` -> ``(n)``.
+
+    ``1 / max(0, -lambda_min)`` with ``lambda_min = rho_0 - |rho_1|`` the smaller eigenvalue of
+    ``d`` seen from ``x`` (``P(x^{-1/2}) d`` in the cone's Jordan algebra): with ``xi = x / s``,
+    ``delta = d / s``, ``s = sqrt(x^T J x)``, ``rho_0 = xi^T J delta`` and ``rho_1 = delta_1 -
+    (rho_0 + delta_0) / (xi_0 + 1) xi_1``.  No difference of near-equal squares, so a ray
+    (``x_1 = d_1 = 0``, a half-space's cone) is stopped exactly at its apex.
+    """
+    s = np.sqrt(_jdot(x, x))
+    xi, delta = x / s, d / s
+    rho0 = _jdot(xi, delta)
+    f = (rho0 + delta[0]) / (xi[0] + 1)
+    t = np.sqrt((delta[1] - f * xi[1]) ** 2 + (delta[2] - f * xi[2]) ** 2) - rho0
+    with np.errstate(divide="ignore"):
+        return np.where(t > 0, 1 / t, np.inf).min(axis=0)
 
 
 def _spd_solve(h, g):
-    """``h^-1 g`` for symmetric positive definite ``h (d, d, n)``, ``g (d, n)``: elimination without
-    pivoting, each entry an array over the rows."""
+    """``h^-1 g`` for symmetric positive definite ``h`` (d x d nested lists of arrays over the rows) and
+    ``g (d, n)``: elimination without pivoting."""
     d = len(g)
-    h = [[h[i, j] for j in range(d)] for i in range(d)]
-    g = [g[i] for i in range(d)]
+    h = [list(row) for row in h]
+    g = list(g)
     for k in range(d):
         for i in range(k + 1, d):
             f = h[i][k] / h[k][k]
@@ -83,102 +100,144 @@ def _spd_solve(h, g):
     return np.stack(x)
 
 
-def _centre(A, b, c, x, tau, bounded, done=_ROUGH):
-    """Damped Newton on ``tau c^T x + barrier`` until every row is centred (in place on ``x``).
+def _apply(A, x):
+    """``A x``: ``(3, d, K, n)``, ``(d, n)`` -> ``(3, K, n)``."""
+    out = A[:, 0] * x[0]
+    for j in range(1, len(x)):
+        out += A[:, j] * x[j]
+    return out
 
-    Components-first: ``A (3 cones, 3, d, n)``, ``b (3, 3, n)``, ``c, x (d, n)``.  Each step
-    works on the rows not yet centred only.  In phase I (``bounded``) a row also stops
-    once its margin ``-r`` reaches ``START_MARGIN``: a grasp in force closure has no
-    phase-I minimum (squeezing harder widens every margin without end), and that
-    margin is all phase II needs.
-    """
+
+@np.errstate(divide="ignore", invalid="ignore")
+def _iterate(A, b, c, x, z, leave):
+    """Mehrotra steps on the rows of ``(A, b, c)`` from the strictly feasible primal ``x (d, n)`` and the
+    dual ``z (3, K, n)`` inside the cones (in place), until ``leave(x, closed, dual)`` holds for a row or
+    the cap.  The dual residual ``c - sum_m A_m^T z_m`` shrinks with every step, by the step's
+    length; ``closed`` says the gap is below ``GAP`` of the objective, ``dual`` is the dual objective
+    where that residual is below ``_RESIDUAL``, ``-inf`` elsewhere."""
     d = len(x)
-    P = (A[:, :, :, None] * (_J[None, :, None, None, None] * A[:, :, None, :])).sum(axis=1)  # A_m^T J A_m
+    # A_m^T J A_m, once: the Newton matrix is sum_m (2 g_m g_m^T - A_m^T J A_m) / beta_m^2, g_m = A_m^T J w_m
+    P = [[_jdot(A[:, i], A[:, j]) for j in range(d)] for i in range(d)]
     rows = np.arange(x.shape[1])
-    if bounded:
-        rows = rows[x[-1] > -START_MARGIN]
-    for _ in range(_NEWTON_CAP):
+    K = A.shape[2]
+    for _ in range(_ITERATIONS):
         if not rows.size:
             break
-        a, bb, xx = A[..., rows], b[..., rows], x[:, rows]
-        y, q = _cones(a, bb, xx)
-        u = y * _J[None, :, None] / q[:, None]
-        w = (a * u[:, :, None]).sum(axis=1)  # (3, d, n): A_m^T u_m
-        grad = tau * c[:, rows] - 2 * w.sum(axis=0)
-        hess = (P[..., rows] * (-2 / q)[:, None, None]).sum(axis=0) + 4 * (w[:, :, None] * w[:, None, :]).sum(axis=0)
-        if bounded:  # -log(r + 1) keeps phase I's r above -1, -log(R^2 - |s|^2) the squeezes within R
-            gap = xx[-1] + 1
-            grad[-1] -= 1 / gap
-            hess[-1, -1] += 1 / gap**2
-            room = BOX**2 - (xx[:-1] ** 2).sum(axis=0)
-            grad[:-1] += 2 * xx[:-1] / room
-            for i in range(d - 1):
-                hess[i, i] += 2 / room
-                for j in range(d - 1):
-                    hess[i, j] += 4 * xx[i] * xx[j] / room**2
-        # a ridge far below round-off, for directions that move no cone (a zero Hessian column)
-        ridge = 1e-14 * np.abs(np.stack([hess[i, i] for i in range(d)])).max(axis=0)
+        a, bb, xx, zz = A[..., rows], b[..., rows], x[:, rows], z[..., rows]
+        res = c[:, rows] - np.stack([_dot(a[:, j], zz).sum(axis=0) for j in range(d)])
+        y = bb + _apply(a, xx)
+        # Nesterov-Todd scaling: W z = W^-1 y = lambda, W = beta (2 v v^T - J), w the scaling point
+        ys, zs = np.sqrt(_jdot(y, y)), np.sqrt(_jdot(zz, zz))
+        gamma = np.sqrt((1 + _dot(y, zz) / (ys * zs)) / 2)
+        w = (y / ys + _J * zz / zs) / (2 * gamma)
+        v = w.copy()
+        v[0] += 1
+        v /= np.sqrt(2 * v[0])
+        beta = np.sqrt(ys / zs)
+
+        def w_inv(u, v=v, beta=beta):
+            return _J * (2 * v * _jdot(v, u) - u) / beta
+
+        def w_mul(u, v=v, beta=beta):
+            return beta * (2 * v * _dot(v, u) - _J * u)
+
+        lam = w_mul(zz)
+        g = [_jdot(a[:, j], w) for j in range(d)]
+        scale = 1 / beta**2
+        H = [[None] * d for _ in range(d)]
         for i in range(d):
-            hess[i, i] += ridge
-        dx = _spd_solve(hess, -grad)
-        lam2 = np.maximum(-(grad * dx).sum(axis=0), 0)
-        lam = np.sqrt(lam2)
-        step = np.where(lam > 0.25, 1 / (1 + lam), 1.0)
-        for _halving in range(8):  # a safeguard against round-off at the cones' edge
-            trial = xx + step * dx
-            ok = _inside(*_cones(a, bb, trial))
-            if bounded:
-                ok &= (trial[-1] > -1) & ((trial[:-1] ** 2).sum(axis=0) < BOX**2)
-            if ok.all():
-                break
-            step = np.where(ok, step, step / 2)
-        x[:, rows] = np.where(ok, trial, xx)
-        going = (lam2 > done) & ok
-        if bounded:
-            going &= x[-1, rows] > -START_MARGIN
-        rows = rows[going]
+            for j in range(i + 1):
+                H[i][j] = H[j][i] = ((2 * g[i] * g[j] - P[i][j][:, rows]) * scale).sum(axis=0)
+        ridge = 1e-14 * np.max([H[i][i] for i in range(d)], axis=0)  # directions that move no cone
+        for i in range(d):
+            H[i][i] = H[i][i] + ridge
+
+        def direction(rhs, lam=lam, a=a, H=H, w_inv=w_inv, res=res):
+            # lambda o (W dz + W^-1 dy) = rhs, dy = A dx, sum_m A_m^T dz_m = res
+            l0, l1, l2 = lam
+            u0 = (l0 * rhs[0] - l1 * rhs[1] - l2 * rhs[2]) / _jdot(lam, lam)
+            u = np.stack((u0, (rhs[1] - u0 * l1) / l0, (rhs[2] - u0 * l2) / l0))
+            wu = w_inv(u)
+            dx = _spd_solve(H, [_dot(a[:, j], wu).sum(axis=0) - res[j] for j in range(d)])
+            dy = _apply(a, dx)
+            return dx, dy, w_inv(u - w_inv(dy))
+
+        square = np.stack((_dot(lam, lam), 2 * lam[0] * lam[1], 2 * lam[0] * lam[2]))
+        mu = _dot(y, zz).sum(axis=0) / K
+        dx, dy, dz = direction(-square)
+        step = np.minimum(1.0, np.minimum(_edge(y, dy), _edge(zz, dz)))
+        mu_aff = _dot(y + step * dy, zz + step * dz).sum(axis=0) / K
+        sigma = np.clip(mu_aff / mu, 0, 1) ** 3
+        p, q = w_inv(dy), w_mul(dz)
+        rhs = -square - np.stack((_dot(p, q), p[0] * q[1] + q[0] * p[1], p[0] * q[2] + q[0] * p[2]))
+        rhs[0] += sigma * mu
+        dx, dy, dz = direction(rhs)
+        step = np.minimum(1.0, _EDGE * np.minimum(_edge(y, dy), _edge(zz, dz)))
+        # a row whose step is not finite (round-off at the cones' edge) stops where it is, still inside
+        good = np.isfinite(step) & np.isfinite(dx).all(axis=0) & np.isfinite(dz).all(axis=(0, 1))
+        step = np.where(good, step, 0.0)
+        xx = xx + step * np.where(good, dx, 0.0)
+        zz = zz + step * np.where(good, dz, 0.0)
+        x[:, rows], z[..., rows] = xx, zz
+        gap = _dot(y + step * dy, zz).sum(axis=0)
+        obj = (c[:, rows] * xx).sum(axis=0)
+        feasible = (np.abs(res) * (1 - step)).max(axis=0) <= _RESIDUAL
+        rows = rows[good & ~leave(xx, gap <= GAP * (1 + np.abs(obj)), np.where(feasible, obj - gap, -np.inf))]
     return x
 
 
 def _layout(A, b):
-    """``(n, 3, 3, d)``, ``(n, 3, 3)`` -> components-first ``(3, 3, d, n)``, ``(3, 3, n)``."""
-    return np.ascontiguousarray(np.moveaxis(A, 0, -1)), np.ascontiguousarray(np.moveaxis(b, 0, -1))
+    """``(n, K, 3, d)``, ``(n, K, 3)`` -> components-first ``(3, d, K, n)``, ``(3, K, n)``."""
+    return np.ascontiguousarray(A.transpose(2, 3, 1, 0)), np.ascontiguousarray(b.transpose(2, 1, 0))
 
 
 def phase_one(A, b):
     """A strictly feasible ``x`` per row and the margin ``r`` reached (``r < 0``: feasible).
 
     ``A (n, 3, 3, d)``, ``b (n, 3, 3)`` -> ``x (n, d)``, ``r (n)``.  With ``r < 0``
-    every cone holds ``t_m - |z_m| >= -r > 0`` at ``x``.  A row leaves once it is
-    decided: ``r <= -START_MARGIN``, or centred with ``r`` further than the duality
-    gap from 0 on either side (phase I's barrier has parameter 7: ``7 / tau``, with
-    room for rough centring).
+    every cone holds ``t_m - |z_m| >= -r > 0`` at ``x``.
     """
     n, _, _, d = A.shape
-    wide = np.concatenate((A, np.zeros((n, 3, 3, 1))), axis=-1)
-    wide[:, :, 0, d] = 1.0  # t_m + r
-    wide, bc = _layout(wide, b)
+    wide = np.zeros((n, 4, 3, d + 1))
+    wide[:, :3, :, :d] = A
+    wide[:, :3, 0, d] = 1.0  # t_m + r
+    wide[:, 3, 0, d] = 1.0  # r + 1 >= 0
+    bw = np.zeros((n, 4, 3))
+    bw[:, :3] = b
+    bw[:, 3, 0] = 1.0
     over = np.sqrt(b[..., 1] ** 2 + b[..., 2] ** 2) - b[..., 0]
     x = np.zeros((d + 1, n))
     x[d] = np.maximum(over.max(axis=-1) + 1, 0.0)
+    z = np.zeros((3, 4, n))
+    z[0] = 0.25  # makes the r column of the dual, not yet the squeezes' columns
     c = np.zeros((d + 1, n))
     c[d] = 1.0
-    rows = np.arange(n)
-    for tau in _TAUS:
-        if not rows.size:
-            break
-        xx = x[:, rows]
-        _centre(wide[..., rows], bc[..., rows], c[:, rows], xx, tau, bounded=True)
-        x[:, rows] = xx
-        r = xx[d]
-        rows = rows[(r > -START_MARGIN) & (np.abs(r) <= 10 / tau)]
-    return x[:d].T, x[d]
+    wide, bw = _layout(wide, bw)
+
+    def leave(x, closed, dual):
+        # the dual bound is good to the residual times the squeezes
+        return (x[d] <= -START_MARGIN) | (dual > _RESIDUAL * (1 + np.abs(x).sum(axis=0))) | (closed & (dual > -np.inf))
+
+    x = _iterate(wide, bw, c, x, z, leave)
+    return np.ascontiguousarray(x[:d].T), x[d]
 
 
 def minimise(A, b, c, x):
-    """Follow the central path from the strictly feasible ``x (n, d)`` to ``TAU_END``; returns ``x (n, d)``."""
+    """The optimum from the strictly feasible ``x (n, d)``; returns ``x (n, d)``.
+
+    ``A (n, 3, 3, d)``, ``b (n, 3, 3)``, ``c (n, d)`` with ``c = sum_m A_m^T e`` (``e = (1, 0,
+    0)``: the objective is the sum of the cones' first components, as the grip's is), so
+    ``z_m = e`` is a strictly feasible dual start.
+    """
+    n = len(x)
     A, b = _layout(A, b)
-    x, c = np.ascontiguousarray(x.T), np.ascontiguousarray(c.T)
-    for tau in _TAUS:
-        _centre(A, b, c, x, tau, bounded=False, done=_DONE if tau == _TAUS[-1] else _ROUGH)
+    c = np.ascontiguousarray(c.T)
+    x = np.ascontiguousarray(x.T)
+    z = np.zeros((3, A.shape[2], n))
+    z[0] = 1.0
+
+    def leave(x, closed, dual):
+        return closed & (dual > -np.inf)
+
+    x = _iterate(A, b, c, x, z, leave)
     return x.T

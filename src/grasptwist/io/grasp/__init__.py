@@ -46,7 +46,7 @@ The modules
 ``problems``   located problems as values: each kind once per document, a file's total capped
 ``values``     typed values of nodes (numbers, vectors, names, mappings), shared by the sections
 ``document``   a document as a whole, and :data:`SECTIONS`, where a section module is registered
-``contacts``, ``twists``, ``paths``, ``hand``: one module per section of the format
+``contacts``, ``twists``, ``paths``, ``hand``, ``forces``: one module per section of the format
 ``fast``       the fast path (bench/loader.py measures what it saves)
 ``reader``     a file of documents: :func:`read_grasps`, :func:`one_per_document`
 ``lines``      one line of a JSON Lines stream (the stream: :mod:`grasptwist.io.lines`)
@@ -57,6 +57,7 @@ from ..limits import DEFAULT_MAX_BYTES, NOT_REGULAR
 from .compose import MAX_DEPTH
 from .contacts import CONTACT_KEYS
 from .document import GRASP_KEYS, SECTIONS, grasp_schema
+from .forces import FORCE_KEYS, WRENCH_KEYS
 from .hand import inline_hand, load_hand_file
 from .lines import read_line, read_twist_line
 from .paths import PATH_KEYS, POSE_KEYS, SEGMENT_KEYS
@@ -87,6 +88,8 @@ __all__ = [
     "GRASP_KEYS",
     "CONTACT_KEYS",
     "TWIST_KEYS",
+    "FORCE_KEYS",
+    "WRENCH_KEYS",
     "PATH_KEYS",
     "SEGMENT_KEYS",
     "POSE_KEYS",

@@ -2,22 +2,26 @@
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ...engine import screws
+from .forces import read_friction
 from .problems import Reject, located
 from .values import Section, read_entry_name, read_mapping, read_sequence, read_vector, readonly, shorten
 
 __all__ = ["CONTACT_KEYS", "SECTION", "read_contacts"]
 
-CONTACT_KEYS = ("name", "point", "normal")
+CONTACT_KEYS = ("name", "point", "normal", "friction")
 
 # What contacts look like, for the message when they are not a list.
 _CONTACTS_SHAPE = "a list of 3 contacts like [{point: [x, y, z], normal: [x, y, z]}, ...]"
 
 
 def read_contacts(node, problems):
-    """Names, points and unit normals of the three contacts (None after a problem)."""
+    """Names, points, unit normals and own frictions (None, or NaN where a
+    contact gives none) of the three contacts (None after a problem)."""
     items = read_sequence(node, "contacts", problems, _CONTACTS_SHAPE, _contacts_hint)
     if items is None:
         return None
@@ -25,7 +29,7 @@ def read_contacts(node, problems):
         problems.add(
             Reject("contact-count", "contacts", f"expected exactly 3 contacts, got {len(items)}", **located(node))
         )
-    names, points, normals = {}, [], []
+    names, points, normals, friction = {}, [], [], []
     for i, item in enumerate(items):
         path = f"contacts[{i}]"
         fields = read_mapping(item, path, CONTACT_KEYS, ("point", "normal"), problems)
@@ -39,10 +43,14 @@ def read_contacts(node, problems):
                 Reject("zero-normal", path + ".normal", "a zero vector has no direction", **located(fields["normal"]))
             )
         normals.append(normal)
+        node = fields.get("friction")
+        friction.append(math.nan if node is None else read_friction(node, path + ".friction", problems))
     if problems.count:
         return None
     normals = [screws.direction3(*n) for n in normals]  # of any finite size: no over- or underflow
-    return tuple(names), readonly(np.array(points)), readonly(normals)
+    # The grasp's own ``friction`` fills the NaNs (forces.py).
+    own = None if all(math.isnan(mu) for mu in friction) else readonly(friction)
+    return tuple(names), readonly(np.array(points)), readonly(normals), own
 
 
 def _contacts_hint(node):
@@ -59,7 +67,11 @@ def _read(fields, found, problems):
     contacts = read_contacts(fields["contacts"], problems) if "contacts" in fields else None
     if contacts is None:
         return None
-    return dict(zip(("contact_names", "points", "normals"), contacts))
+    names, points, normals, friction = contacts
+    fields = {"contact_names": names, "points": points, "normals": normals}
+    if friction is not None:
+        fields["friction"] = friction
+    return fields
 
 
 SECTION = Section(("contacts",), _read, required=("contacts",))

@@ -3,7 +3,7 @@
 Each top-level key beyond ``name``, ``units`` and ``wrist`` belongs to a
 *section* (:class:`~.values.Section`): a module of this package that reads
 its keys into fields of the :class:`~grasptwist.model.Grasp`.  A new part
-of the format is a new module with a ``SECTION`` (say ``forces.py``, issue
+of the format is a new module with a ``SECTION`` (as ``forces.py`` did, issue
 19), imported and added to :data:`SECTIONS` below; its keys then join
 :data:`GRASP_KEYS`, the fast path hands them to it, and the JSON Schema must
 list them (tests/test_grasp_schema.py checks both agree).
@@ -13,6 +13,7 @@ from __future__ import annotations
 
 from ...model import Grasp
 from .contacts import SECTION as CONTACTS
+from .forces import SECTION as FORCES
 from .hand import SECTION as HAND
 from .paths import SECTION as PATHS
 from .problems import Reject, located
@@ -22,8 +23,9 @@ from .values import read_mapping, read_name, read_vector, readonly
 __all__ = ["SECTIONS", "GRASP_KEYS", "read_document", "grasp_schema"]
 
 #: The sections of a grasp document, in the order they are read (a later one
-#: sees the fields of the earlier ones: the hand needs the contacts).
-SECTIONS = (CONTACTS, TWISTS, PATHS, HAND)
+#: sees the fields of the earlier ones: the hand needs the contacts, the
+#: forces the contacts' own frictions).
+SECTIONS = (CONTACTS, TWISTS, PATHS, HAND, FORCES)
 
 #: The top-level keys, in the order the values are checked.
 GRASP_KEYS = ("name", "units", "wrist", *(key for section in SECTIONS for key in section.keys))

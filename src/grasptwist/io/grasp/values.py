@@ -203,10 +203,19 @@ def read_vector(node, length, path, problems):
     values = [read_number(item, f"{path}[{i}]", problems) for i, item in enumerate(node.value)]
     if len(values) != length:
         hint = ""
+        wrench = path.startswith("wrenches")
         if length == 3 and len(values) == 6:
-            hint = "; a 6-vector (omega; v) goes under `screw:`"
+            hint = (
+                "; a 6-vector (force; moment) goes under `wrench:`"
+                if wrench
+                else "; a 6-vector (omega; v) goes under `screw:`"
+            )
         elif length == 6 and len(values) == 3:
-            hint = "; a 3-vector goes under `angular:` or `linear:`"
+            hint = (
+                "; a 3-vector goes under `force:` or `moment:`"
+                if wrench
+                else "; a 3-vector goes under `angular:` or `linear:`"
+            )
         problems.add(
             Reject("vector-length", path, f"expected {length} numbers, got {len(values)}{hint}", **located(node))
         )

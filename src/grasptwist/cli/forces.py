@@ -1,0 +1,111 @@
+"""``grasptwist forces``: how hard each finger must press (issue 19)."""
+
+from typing import Annotated
+
+import typer
+
+from .diagnostics import Warnings
+from .exits import run_command
+from .options import (
+    Debug,
+    Digits,
+    ForcesFormat,
+    Json,
+    MaxBytes,
+    Output,
+    Paths,
+    Quiet,
+    WarningsOption,
+    Workers,
+    not_binary_to_a_terminal,
+    wrenches_option,
+)
+from .records import OutputSettings, write_records
+
+__all__ = ["forces"]
+
+
+def forces(
+    paths: Paths,
+    wrench: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--wrench",
+            metavar="F,F,F,M,M,M",
+            help="Wrench the fingers exert on the object (force; moment about --at); repeatable; "
+            "replaces the files' wrenches.",
+        ),
+    ] = None,
+    wrench_name: Annotated[
+        list[str] | None,
+        typer.Option(
+            "--wrench-name",
+            metavar="NAME",
+            help="Name of each --wrench in the records, paired in order (default: the wrench as written).",
+        ),
+    ] = None,
+    at: Annotated[
+        str | None,
+        typer.Option("--at", metavar="X,Y,Z", help="Point the --wrench moments are about (default: the origin)."),
+    ] = None,
+    friction: Annotated[
+        float | None,
+        typer.Option(
+            "--friction", metavar="MU", min=0, help="Friction coefficient of every contact (replaces the files')."
+        ),
+    ] = None,
+    safety: Annotated[
+        float, typer.Option("--safety", metavar="S", min=1, help="Safety factor: forces keep within mu / S.")
+    ] = 1.0,
+    quality: Annotated[
+        bool, typer.Option("--quality", help="Also Ferrari-Canny's epsilon (needs scipy: grasptwist[quality]).")
+    ] = False,
+    cone_edges: Annotated[
+        int, typer.Option("--cone-edges", metavar="M", min=3, help="Sides of each friction pyramid for --quality.")
+    ] = 8,
+    fmt: Annotated[
+        ForcesFormat,
+        typer.Option(
+            "-f", "--format", help="table for people; json, jsonl, csv, npz or parquet (with -o) for programs."
+        ),
+    ] = ForcesFormat.table,
+    json_: Json = False,
+    output: Output = None,
+    digits: Digits = 4,
+    max_bytes: MaxBytes = None,
+    workers: Workers = 0,
+    quiet: Quiet = False,
+    warnings: WarningsOption = Warnings.summary,
+    debug: Debug = False,
+) -> None:
+    """Finger forces that exert each wrench: one record per (grasp, wrench).
+
+    Per contact the manipulating forces (minimum norm), the grip (least total
+    normal force inside the friction cones) and how close each finger is to
+    slipping; per grasp its force closure.  Examples: hold the bundled 1 kg
+    ball; a wrench from the command line with mu 0.8:
+
+    \\b
+        grasptwist forces grasps/sphere.yaml
+        grasptwist forces grasps/polyhedron.yaml --wrench 0,0,1,0,0,0 --friction 0.8 --json
+    """
+    from ..results import ForceOptions
+    from ..run.pipeline import Job
+
+    wrenches = wrenches_option(wrench, at, wrench_name)
+    if quality:
+        from ..extras import require
+
+        require("scipy", "--quality")
+    fmt = ForcesFormat.json if json_ else fmt
+    not_binary_to_a_terminal(fmt.value, output)
+    job = Job(
+        kind="forces",
+        fmt=fmt.value,
+        max_bytes=max_bytes,
+        wrenches=None if wrenches is None else tuple(wrenches),
+        friction=friction,
+        forces=ForceOptions(safety=safety, quality=quality, cone_edges=cone_edges),
+    )
+    settings = OutputSettings(output, quiet, warnings, workers, {"digits": digits})
+    run_command(debug, lambda: write_records(job, paths, settings))

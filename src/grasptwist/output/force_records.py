@@ -1,0 +1,94 @@
+"""Records of ``grasptwist forces``: one per (grasp, wrench), the JSON contract.
+
+Built from a :class:`~grasptwist.run.forces.ForceBlock`'s columns; nothing
+here computes: every number and status comes from the engine.  A part that
+failed holds ``{"error": {"code", "message"}}``, a part that does not apply
+(no wrench, no friction) is ``null``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..engine.forces.grasp_map import ForceStatus, force_status_message
+from .names import escaped, escaped_each
+
+__all__ = ["force_records", "GRIP_FIELDS", "CLOSURE_FIELDS", "NO_FRICTION_WARNING"]
+
+#: The grip object's numbers, in order (then ``safety``).
+GRIP_FIELDS = ("force", "squeeze", "normal_force", "tangential_force", "friction_used", "total_normal_force")
+
+#: The closure object's fields.
+CLOSURE_FIELDS = ("force_closure", "closure_friction", "epsilon")
+
+NO_FRICTION_WARNING = "grip skipped: the grasp has no friction (give 'friction:' in the file or --friction MU)"
+
+
+def _lists(a):
+    """Row lists of ``a`` with no ``-0.0`` (a round-off sign on zero reads oddly)."""
+    with np.errstate(invalid="ignore"):
+        return (a + 0.0).tolist()
+
+
+def _error(status, culprit):
+    s = ForceStatus(int(status))
+    message = force_status_message(s, culprit)
+    # cannot-hold's sentence starts with its code already
+    return {"error": {"code": s.code, "message": message.removeprefix(f"{s.code}: ")}}
+
+
+def _number(x):
+    return None if x != x else x  # NaN -> null
+
+
+def force_records(block) -> list[dict]:
+    """The records of a block's rows."""
+    r = block.result
+    has_wrench, has_friction = block.has_wrench.tolist(), block.has_friction.tolist()
+    points, normals, wrench, friction = (_lists(a) for a in (block.points, block.normals, block.wrench, block.friction))
+    manipulating = _lists(r.manipulating)
+    grip = {name: _lists(getattr(r, name)) for name in GRIP_FIELDS}
+    closure_friction, epsilon = r.closure_friction.tolist(), r.epsilon.tolist()
+    force_closure = r.force_closure.tolist()
+    out = []
+    for i in range(len(block)):
+        names = escaped_each(block.contact_names[i])
+        warnings = []
+        rec = {
+            "file": escaped(block.file[i], controls=False),
+            "grasp": escaped(block.grasp[i], controls=False),
+            "units": block.units[i],
+            "wrench": {"name": escaped(block.wrench_name[i], controls=False), "wrench": wrench[i]}
+            if has_wrench[i]
+            else None,
+            "contacts": [{"name": names[c], "point": points[i][c], "normal": normals[i][c]} for c in range(3)],
+            "friction": friction[i] if has_friction[i] else None,
+        }
+        if not has_wrench[i]:
+            rec["manipulating"] = None
+        elif r.manipulating_status[i]:
+            rec["manipulating"] = _error(r.manipulating_status[i], r.manipulating_culprit[i])
+        else:
+            rec["manipulating"] = {"force": manipulating[i]}
+        if not has_wrench[i]:
+            rec["grip"] = None
+        elif not has_friction[i]:
+            rec["grip"] = None
+            warnings.append(NO_FRICTION_WARNING)
+        elif r.grip_status[i]:
+            rec["grip"] = _error(r.grip_status[i], r.grip_culprit[i])
+        else:
+            rec["grip"] = {name: grip[name][i] for name in GRIP_FIELDS}
+            rec["grip"]["safety"] = r.safety
+        rec["closure"] = {
+            "force_closure": force_closure[i] if has_friction[i] else None,
+            "closure_friction": _number(closure_friction[i]),
+            "epsilon": _number(epsilon[i]),
+        }
+        status = ForceStatus(int(r.closure_status[i]))
+        if status not in (ForceStatus.OK, ForceStatus.NO_CLOSURE):
+            warnings.append(f"closure: {status.code}: {force_status_message(status, r.closure_culprit[i])}")
+        rec["warnings"] = warnings
+        rec["ok"] = not any(isinstance(rec[k], dict) and "error" in rec[k] for k in ("manipulating", "grip"))
+        out.append(rec)
+    return out
