@@ -15,7 +15,7 @@ from grasptwist.plot.browser import capture
 
 ROOT = Path(__file__).resolve().parent.parent
 SHOTS = [  # (image, grasp file, plot options, capture options)
-    ("html-grasp", "box-edge", ["--twist-name", "tip-over-edge"], {}),
+    ("html-grasp", "box-edge", ["--select", "tip-over-edge"], {}),
     ("html-hand", "trifinger-cube", [], {}),
     # the paper's cylinder turning about x, half-way: the contacts' plane passes the wrist
     (

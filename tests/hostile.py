@@ -134,7 +134,19 @@ def assert_no_crash(output):
     assert "internal error" not in output, output[-2000:]
 
 
-def summary(records, failed, rows=0):
-    """The CLI's closing stderr line (``rows``: how many of the failed are rows of data sets or streams)."""
-    line = f"{records} record{'' if records == 1 else 's'}, {failed} failed"
-    return line + (f" ({rows} row{'' if rows == 1 else 's'} of data sets or streams)" if 0 < rows < failed else "")
+def summary(records: list[dict]) -> str:
+    """The CLI's closing stderr line for the JSON ``records`` it wrote: the records of inputs
+    that failed (``error``), and the others that are not ok counted by their failed kinds' codes."""
+    from collections import Counter
+
+    from grasptwist.cli.diagnostics import summary_line
+
+    kinds = (("off-tangent", "off_tangent"), ("tangent", "tangent"), ("hand", "hand"))
+    degenerate = [r for r in records if not r["ok"] and "error" not in r]
+    codes = Counter(
+        (label, r[key]["error"]["code"])
+        for r in degenerate
+        for label, key in kinds
+        if isinstance(r.get(key), dict) and "error" in r[key]
+    )
+    return summary_line(len(records), len(degenerate), sum("error" in r for r in records), codes)

@@ -195,5 +195,5 @@ def test_the_hand_table_names_the_components_that_move_each_finger():
             rates = rec[key]["joint_rates"]  # [component][finger][joint]
             moving = [f"{names[key][c // 3]}_{c % 3 + 1}" for c in range(6) if np.any(rates[c][f])]
             parts.append(f"{label} {' '.join(moving)}")
-        assert f"finger {finger['name']} is moved by: {'; '.join(parts)}" in table
-    assert "finger east is moved by: off-tangent Sigma_1 Psi_2 Psi_3; tangent Theta_2 Theta_3 Sigma_1" in table
+        assert f"finger {finger['contact']} is moved by: {'; '.join(parts)}" in table  # named by its contact
+    assert "finger 1 is moved by: off-tangent Sigma_1 Psi_2 Psi_3; tangent Theta_2 Theta_3 Sigma_1" in table

@@ -24,7 +24,7 @@ def png_size(path):
 
 
 def test_one_grasp_and_twist_to_png_and_svg(tmp_path):
-    r = run("plot", GRASPS / "cylinder.yaml", "--twist-name", "spin-z", "-o", tmp_path / "c.png")
+    r = run("plot", GRASPS / "cylinder.yaml", "--select", "spin-z", "-o", tmp_path / "c.png")
     assert r.exit_code == 0, r.output
     assert r.stdout == f"{tmp_path / 'c.png'}\n"
     assert png_size(tmp_path / "c.png") == (1400, 700)
@@ -68,8 +68,17 @@ def test_a_folder_gives_one_image_per_grasp_and_twist_and_an_error_line_per_bad_
 
 
 def test_usage_errors_exit_2(tmp_path):
-    r = run("plot", GRASPS / "cylinder.yaml", "--twist-name", "nope", "-o", tmp_path / "x.png")
+    r = run("plot", GRASPS / "cylinder.yaml", "--select", "nope", "-o", tmp_path / "x.png")
     assert r.exit_code == 2 and "has no twist 'nope' (it has: sigma-1, spin-z, lift-z)" in r.output
+    for args, message in [
+        (["--select", "spin-z", "--select", "lift-z"], "a picture draws one twist: give one (got 2)"),
+        (["--select", "spin-z", "--twist", "0,0,1,0,0,0"], "--twist replaces them: give one"),
+        (["--select", "spin-z", "--twist-name", "lift-z"], "names --twist only: give the file's twist by --select"),
+    ]:
+        r = run("plot", GRASPS / "cylinder.yaml", *args, "-o", tmp_path / "x.png")
+        assert r.exit_code == 2 and message in " ".join(r.output.split()), r.output
+    r = run("plot", GRASPS, "--select", "spin-z", "-o", tmp_path / "pictures")
+    assert r.exit_code == 2 and "a folder gets every twist" in r.output
     r = run("plot", GRASPS / "cylinder.yaml", "-o", tmp_path / "x.gif")
     assert r.exit_code == 2 and "cannot write '.gif': use one of .png, .svg, .pdf" in r.output
     r = run("plot", tmp_path / "rows.npz", "-o", tmp_path / "x.png")
@@ -87,7 +96,7 @@ def test_without_matplotlib_it_says_how_to_install_it(tmp_path, monkeypatch):
     # one line, the word "grasptwist" once at its start (0.1 doubled it: "grasptwist: error: grasptwist plot ...")
     assert (
         r.stderr
-        == "grasptwist plot needs matplotlib: pip install matplotlib (from a clone of grasptwist: pip install '.[plot]')\n"
+        == "grasptwist plot needs matplotlib: pip install matplotlib (from a clone of grasptwist: pip install -e '.[plot]')\n"
     )
 
 
@@ -99,3 +108,13 @@ def test_the_other_commands_never_import_matplotlib_or_rich_for_machine_output()
     )
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
     assert out.stdout.split() == ["0", "False", "False"]
+
+
+def test_the_old_twist_name_still_picks_a_twist_with_one_deprecation_line(tmp_path):
+    new = run("plot", GRASPS / "cylinder.yaml", "--select", "lift-z", "-o", tmp_path / "new.png")
+    old = run("plot", GRASPS / "cylinder.yaml", "--twist-name", "lift-z", "-o", tmp_path / "old.png")
+    first = run("plot", GRASPS / "cylinder.yaml", "-o", tmp_path / "first.png")  # sigma-1
+    assert new.exit_code == old.exit_code == first.exit_code == 0 and new.stderr == ""
+    assert old.stderr == "grasptwist: warning: plot --twist-name without --twist is deprecated: use --select lift-z\n"
+    drawn = {name: (tmp_path / f"{name}.png").read_bytes() for name in ("new", "old", "first")}
+    assert drawn["old"] == drawn["new"] != drawn["first"]

@@ -6,6 +6,7 @@ command (a real subprocess); output contents in process, which is quicker."""
 import csv
 import io
 import json
+from pathlib import Path
 from types import SimpleNamespace
 
 import numpy as np
@@ -63,7 +64,10 @@ def test_off_tangent_asked_for_on_a_grasp_without_wrist_fails_with_no_wrist(file
     [rec] = jsonl(p.stdout)
     assert rec["ok"] is False and rec["wrist"] is None and rec["warnings"] == []
     assert rec["off_tangent"] == {"error": {"code": "no-wrist", "message": NO_WRIST}}
-    assert p.stderr.splitlines() == [f"{where(path)}: error: off-tangent: no-wrist: {NO_WRIST}", "1 record, 1 failed"]
+    assert p.stderr.splitlines() == [
+        f"{where(path)}: error: off-tangent: no-wrist: {NO_WRIST}",
+        "1 record: 1 with a degenerate method (off-tangent: 1 no-wrist), 0 inputs failed",
+    ]
     # the same in CSV, and in npz as the status no-wrist
     p, _ = in_process("resolve", path, "--method", "off-tangent", "-f", "csv")
     [row] = csv.DictReader(io.StringIO(p.stdout))
@@ -85,13 +89,13 @@ def test_check_and_basis_fail_an_off_tangent_asked_for_without_wrist_and_warn_un
     assert rec["off_tangent"]["error"] == {"code": "no-wrist", "message": NO_WRIST}
     assert p.stderr.splitlines() == [
         f"{where(path, None)}: error: off-tangent: no-wrist: {NO_WRIST}",
-        "1 record, 1 failed",
+        "1 record: 1 with a degenerate method (off-tangent: 1 no-wrist), 0 inputs failed",
     ]
     p, _ = cli(command, path, "-f", "jsonl")
     [rec] = jsonl(p.stdout)
     assert p.returncode == 0 and rec["ok"] is True and rec["off_tangent"] is None and rec["warnings"] == [SKIPPED]
     assert rec["tangent"]["conditioning"] == pytest.approx(0.0995058864995588, rel=1e-12)
-    assert p.stderr.splitlines() == [f"{where(path, None)}: warning: {SKIPPED}", "1 record, 0 failed"]
+    assert p.stderr.splitlines() == [f"{where(path, None)}: warning: {SKIPPED}", "1 record: all ok"]
 
 
 def test_under_both_the_skip_is_a_warning_and_the_tangent_result_stays(files):
@@ -101,12 +105,12 @@ def test_under_both_the_skip_is_a_warning_and_the_tangent_result_stays(files):
     assert p.returncode == 0 and rec["ok"] is True and rec["off_tangent"] is None and rec["warnings"] == [SKIPPED]
     with_wrist = jsonl(in_process("resolve", files / "wrist.yaml", "-f", "jsonl")[0].stdout)[0]
     assert rec["tangent"] == with_wrist["tangent"] and with_wrist["warnings"] == []
-    assert p.stderr.splitlines() == [f"{where(path)}: warning: {SKIPPED}", "1 record, 0 failed"]
+    assert p.stderr.splitlines() == [f"{where(path)}: warning: {SKIPPED}", "1 record: all ok"]
     out = files / "r.npz"
     p, _ = run_installed("resolve", path, "-f", "npz", "-o", out)
     with np.load(out) as z:  # skipped: -1, as before
         assert p.returncode == 0 and z["off_tangent_status"].tolist() == [-1] and z["tangent_status"].tolist() == [0]
-    assert p.stderr.splitlines() == [f"{where(path)}: warning: {SKIPPED}", "1 record, 0 failed"]
+    assert p.stderr.splitlines() == [f"{where(path)}: warning: {SKIPPED}", "1 record: all ok"]
 
 
 # --------------------------------------------------------------------------
@@ -123,10 +127,10 @@ def test_outward_normals_get_a_warning_inward_ones_none(files, command, cli):
     twist = "spin" if command == "resolve" else None
     assert p.stderr.splitlines() == [
         f"{where(path, twist)}: warning: {OUTWARD_NORMALS_WARNING}",
-        "1 record, 0 failed",
+        "1 record: all ok",
     ]
     p, _ = in_process(command, files / "wrist.yaml", "-f", "jsonl")
-    assert p.returncode == 0 and jsonl(p.stdout)[0]["warnings"] == [] and p.stderr == "1 record, 0 failed\n"
+    assert p.returncode == 0 and jsonl(p.stdout)[0]["warnings"] == [] and p.stderr == "1 record: all ok\n"
 
 
 def test_outward_normals_warn_in_csv_and_npz_runs_too(files):
@@ -214,7 +218,7 @@ def test_twist_names_that_do_not_pair_are_a_usage_error(files, args, message, in
 def test_plot_help_says_how_to_install_matplotlib_from_a_clone():
     p, _ = run_installed("plot", "--help")
     text = " ".join(p.stdout.split())  # as one line, however the help is wrapped
-    assert p.returncode == 0 and "from a clone, pip install '.[plot]'" in text and "grasptwist[plot]" not in text
+    assert p.returncode == 0 and "from a clone, pip install -e '.[plot]'" in text and "grasptwist[plot]" not in text
 
 
 def test_follow_fails_an_off_tangent_asked_for_without_wrist_as_resolve_does(files):
@@ -227,3 +231,51 @@ def test_follow_fails_an_off_tangent_asked_for_without_wrist_as_resolve_does(fil
     p, _ = in_process(*args, "-f", "jsonl")
     samples = [r for r in map(json.loads, p.stdout.splitlines()) if "t" in r]
     assert p.returncode == 0 and all(r["off_tangent"] is None and r["warnings"] == [SKIPPED] for r in samples)
+
+
+# --------------------------------------------------------------------------
+# Issue 23: --select picks a file's own twists by name
+
+
+GRASPS = Path(__file__).resolve().parents[1] / "grasps"
+
+
+def test_select_picks_the_files_twists_by_name_in_the_order_given():
+    p, _ = in_process("resolve", GRASPS / "cylinder.yaml", "--select", "lift-z", "--select", "spin-z", "-f", "jsonl")
+    recs = jsonl(p.stdout)
+    assert [r["twist"]["name"] for r in recs] == ["lift-z", "spin-z"]
+    every = {
+        r["twist"]["name"]: r for r in jsonl(in_process("resolve", GRASPS / "cylinder.yaml", "-f", "jsonl")[0].stdout)
+    }
+    assert recs == [every["lift-z"], every["spin-z"]]  # the same records as without --select
+
+
+def test_a_grasp_without_a_selected_twist_is_one_failed_record_listing_its_twists(tmp_path):
+    (tmp_path / "a.yaml").write_text((GRASPS / "cylinder.yaml").read_text())
+    (tmp_path / "b.yaml").write_text((GRASPS / "polyhedron.yaml").read_text())
+    p, _ = in_process("resolve", tmp_path, "--select", "spin-z", "--method", "off-tangent", "-f", "jsonl")
+    good, bad = jsonl(p.stdout)
+    assert p.returncode == 1 and (good["ok"], good["twist"]["name"]) == (True, "spin-z")
+    assert bad["ok"] is False and bad["error"]["code"] == "unknown-twist"
+    assert bad["error"]["message"] == "grasp 'polyhedron' has no twist 'spin-z' (its twists: 'diagonal-spin')"
+    assert p.stderr.splitlines() == [
+        f"{tmp_path / 'b.yaml'}:17:1: error: unknown-twist: {bad['error']['message']}",
+        "2 records: 0 with a degenerate method, 1 input failed",
+    ]
+
+
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["--twist", "0,0,1,0,0,0"], "--twist and --twists-from replace them: give one"),
+        (["--twists-from", "-"], "--twist and --twists-from replace them: give one"),
+    ],
+)
+def test_select_with_twists_of_ones_own_is_a_usage_error(args, message):
+    p, _ = in_process("resolve", GRASPS / "cylinder.yaml", "--select", "spin-z", *args)
+    assert p.returncode == 2 and p.stdout == "" and message in " ".join(p.stderr.split())
+
+
+def test_select_on_a_data_set_is_a_usage_error(tmp_path):
+    p, _ = in_process("resolve", tmp_path / "rows.npz", "--select", "spin-z")
+    assert p.returncode == 2 and "a data set's are not named" in p.stderr

@@ -112,7 +112,11 @@ def test_npz_output_arrays_match_the_records_and_carry_a_status_legend(tmp_path,
     assert z["grasp"][:3].tolist() == ["0", "1", "2"] and z["twist"].shape == (N, 6)
     assert z["files"].tolist() == [str(tmp_path / "set.npz")] and not z["file_index"].any()
     assert z["twist_names"].tolist() == ["twist"] and not z["twist_index"].any()
-    assert "5 records" not in r.stderr and r.stderr.strip().splitlines()[-1] == f"{N} records, 5 failed"
+    assert r.stderr.strip().splitlines()[-1] == (
+        f"{N} records: 5 with a degenerate method (off-tangent: 1 coincident-contacts, 1 collinear-contacts, "
+        "1 wrist-coplanar; tangent: 1 coincident-contacts, 1 collinear-contacts, 1 theta-sigma-zero, 1 zero-normal), "
+        "0 inputs failed"
+    )
 
 
 def test_npy_rows_with_a_wrist_or_a_twist_point(tmp_path, data):
@@ -298,7 +302,7 @@ def test_failed_rows_follow_the_warnings_rule_and_the_files_errors_are_always_pr
     assert [line.split(": grasp ")[1].split(",")[0] for line in row] == [f"'{k}'" for k in range(25)]
     bad = [line for line in said["all"] if line.startswith(f"{failing_rows / 'bad.yaml'}:")]
     assert len(bad) == 1 and ": error: " in bad[0]
-    closing = "31 records, 26 failed (25 rows of data sets or streams)"
+    closing = "31 records: 25 with a degenerate method (tangent: 25 coincident-contacts), 1 input failed"
     assert said["all"][-1] == closing
     # summary: the first 20 rows' errors, the file's error, then the rest counted by code
     assert [line for line in said["summary"] if ": error: " in line] == row[:WARNINGS_SHOWN] + bad

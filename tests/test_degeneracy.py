@@ -100,6 +100,9 @@ def test_status_codes_are_stable_strings():
         "normal-in-contact-plane",
         "finger-cannot-follow",  # a hand's, not a decomposition's
         "no-wrist",
+        "contact-off-finger",  # a hand's, with the two below (inverse kinematics)
+        "unreachable",
+        "outside-limits",
     ]
 
 

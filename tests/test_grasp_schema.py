@@ -37,6 +37,8 @@ NOT_IN_THE_SCHEMA = {
     # the hand's URDF is another file: what it holds is not in the grasp document
     "unknown-joint": "a joint_positions key that is no joint of the URDF",
     "contact-off-finger": "a contact farther from its URDF tip link than the finger is long",
+    "unreachable": "a contact no joint positions of its URDF finger reach (inverse kinematics)",
+    "outside-limits": "a contact its URDF finger reaches only outside its joint limits (inverse kinematics)",
 }
 
 NOT_DATA = object()

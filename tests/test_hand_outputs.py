@@ -35,10 +35,16 @@ def test_csv_of_a_hand_grasp_has_its_joint_columns():
     rows = list(csv.reader(io.StringIO(result.stdout)))
     header, (row,) = rows[0], rows[1:]
     joints = [f"qdot_{f}_{f}.{k}" for f in ("east", "west", "south") for k in (1, 2, 3)]
-    assert header == CSV_COLUMNS + joints + ["hand_error"]
+    positions = [name.replace("qdot_", "q_", 1) for name in joints]
+    assert header == CSV_COLUMNS + joints + positions + ["hand_error"]
     (rec,) = jsonl("resolve", THREE)
     want = [r for f in rec["hand"]["fingers"] for r in f["joint_rates"]]
     assert [float(row[header.index(name)]) for name in joints] == want
+    # inline joints are given at their configuration: every joint at 0, each tip on its contact
+    assert [float(row[header.index(name)]) for name in positions] == [0.0] * 9
+    assert [(f["joint_positions"], f["tip_error"], f["within_limits"]) for f in rec["hand"]["fingers"]] == [
+        ([0.0, 0.0, 0.0], 0.0, True)
+    ] * 3
     assert want == pytest.approx([-0.14, 0.015, 0.105, 0.14, 0.01, -0.09, -0.1, 0.21, -0.61], abs=1e-12)
 
 
@@ -140,3 +146,53 @@ def test_the_plot_scene_draws_each_finger_joint_axis():
     np.testing.assert_allclose(direction / np.linalg.norm(direction), [0, 1, 0], atol=1e-15)
     size = np.linalg.norm(g.points[0] - g.points[1])  # the contact triangle's longest side, sqrt(4.5)
     assert np.linalg.norm(direction) == pytest.approx(0.24 * size)
+
+
+def _rows(tmp_path, trifinger, n=30, seed=4):
+    """A TriFinger data set: contacts at the tip links' origins at random joint positions within
+    the limits, and a hand file of the TriFinger."""
+    rng = np.random.default_rng(seed)
+    q = rng.uniform([-0.3, 0.1, -2.5] * 3, [0.9, 1.4, -0.3] * 3, size=(n, 9))
+    points = np.stack([s.tip[:, :3, 3] for s in hand.finger_states(trifinger, q)], axis=1)
+    hand_file = tmp_path / "trifinger.yaml"
+    fingers = "".join(f"    - {{tip: {f.tip}}}\n" for f in trifinger.fingers)
+    hand_file.write_text(f"hand:\n  urdf: {trifinger.source}\n  fingers:\n{fingers}", "utf-8")
+    return q, points, rng.normal(size=(n, 3, 3)), hand_file
+
+
+@urdf_only
+def test_a_data_set_row_whose_contact_is_off_its_finger_fails(tmp_path, trifinger):
+    """Issue 23: a contact moved 0.9 m from its finger-tip in an npz is contact-off-finger, as in a
+    grasp file, not ok with joint rates of a configuration that does not touch it."""
+    q, points, normals, hand_file = _rows(tmp_path, trifinger, n=3)
+    points[1, 0, 0] += 0.9
+    data = tmp_path / "rows_far.npz"
+    np.savez(data, points=points, normals=normals, twist=[0, 0, 0.5, 0, 0, 0], joint_positions=q)
+    recs = jsonl("resolve", data, "--hand", hand_file)
+    assert [r["hand"]["ok"] for r in recs] == [True, False, True]
+    assert not recs[1]["ok"]
+    assert recs[1]["hand"]["error"]["code"] == "contact-off-finger"
+    assert recs[1]["hand"]["error"]["message"].startswith("contact 1 is farther from its finger's tip")
+
+
+@urdf_only
+def test_a_data_set_without_joint_positions_is_solved_by_inverse_kinematics(tmp_path, trifinger):
+    """Without joint_positions the rows' joint positions are solved, not zeros: the joint rates are
+    the ones at the configurations the contacts came from (each the only one within the limits
+    near home), and a contact no finger reaches is unreachable."""
+    q, points, normals, hand_file = _rows(tmp_path, trifinger)
+    twist = np.array([0.2, -0.1, 0.5, 0.01, 0.0, 0.02])
+    given, solved = tmp_path / "given.npz", tmp_path / "solved.npz"
+    np.savez(given, points=points, normals=normals, twist=twist, joint_positions=q)
+    far = points.copy()
+    far[5, 2] = [0.0, 0.0, 1.5]  # 1.5 m above the table: beyond every finger
+    np.savez(solved, points=far, normals=normals, twist=twist)
+    want, got = jsonl("resolve", given, "--hand", hand_file), jsonl("resolve", solved, "--hand", hand_file)
+    for i, (a, b) in enumerate(zip(want, got)):
+        if i == 5:
+            assert b["hand"]["error"]["code"] == "unreachable" and not b["ok"]
+            assert b["hand"]["error"]["message"].startswith("finger 3's tip cannot reach its contact")
+            continue
+        assert b["hand"]["ok"], b["hand"]
+        rates = [r for f in b["hand"]["fingers"] for r in f["joint_rates"]]
+        assert rates == pytest.approx([r for f in a["hand"]["fingers"] for r in f["joint_rates"]], abs=1e-7)

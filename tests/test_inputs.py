@@ -50,7 +50,7 @@ def test_a_folder_without_grasp_files_is_an_error(tmp_path, content):
     assert result.exit_code == 1
     [record] = jsonl(result.stdout)
     assert (record["ok"], record["error"]["code"]) == (False, "no-grasp-files")
-    assert result.stderr.splitlines() == [f"{tmp_path}: error: no-grasp-files: {message}", summary(1, 1)]
+    assert result.stderr.splitlines() == [f"{tmp_path}: error: no-grasp-files: {message}", summary([record])]
 
 
 def test_only_the_folder_named_must_hold_grasp_files(tmp_path):

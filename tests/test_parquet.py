@@ -240,7 +240,7 @@ def without(*modules):
 
 
 def test_without_pyarrow_parquet_says_how_to_install_it(tmp_path, files):
-    hint = "pip install pyarrow (from a clone of grasptwist: pip install '.[parquet]')"
+    hint = "pip install pyarrow (from a clone of grasptwist: pip install -e '.[parquet]')"
     code = without("pyarrow") + (
         "from typer.testing import CliRunner; from grasptwist.cli import app\n"
         f"r = CliRunner().invoke(app, ['resolve', {str(files / 'set.npz')!r}, '-f', 'parquet', '-o', {str(tmp_path / 'o.parquet')!r}])\n"
@@ -313,7 +313,7 @@ def test_without_dask_grasptwist_dask_says_how_to_install_it():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
     assert out.stdout == (
         "grasptwist.dask needs dask: pip install 'dask[dataframe]' distributed "
-        "(from a clone of grasptwist: pip install '.[dask]')\n"
+        "(from a clone of grasptwist: pip install -e '.[dask]')\n"
     )
 
 

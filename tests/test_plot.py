@@ -311,13 +311,13 @@ def test_import_needs_no_matplotlib_and_says_how_to_install_it():
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
     assert (
         out
-        == "grasptwist plot needs matplotlib: pip install matplotlib (from a clone of grasptwist: pip install '.[plot]')\n"
+        == "grasptwist plot needs matplotlib: pip install matplotlib (from a clone of grasptwist: pip install -e '.[plot]')\n"
     )
 
 
 def test_render_without_matplotlib_raises_missing_matplotlib(monkeypatch, tmp_path):
     monkeypatch.setitem(sys.modules, "matplotlib", None)  # makes `import matplotlib` fail
-    with pytest.raises(plot.MissingMatplotlib, match=r"pip install '\.\[plot\]'"):
+    with pytest.raises(plot.MissingMatplotlib, match=r"pip install -e '\.\[plot\]'"):
         plot.render(make_scene("ex2-tangent"), tmp_path / "x.png")
     assert not (tmp_path / "x.png").exists()
 

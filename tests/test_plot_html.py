@@ -171,7 +171,7 @@ def test_a_hand_shows_its_fingers_and_joint_axes():
     joints = np.concatenate([s.points for s in states])
     for point in joints:  # every joint is on its finger's chain
         assert np.min(np.linalg.norm(segments.reshape(-1, 3) - point, axis=1)) < 1e-9
-    assert set(hover) == {f.name for f in grasp.hand.fingers}
+    assert set(hover) == {f"finger {name}" for name in grasp.contact_names}  # named as everywhere: by contact
     (axes,) = traces(figure, "finger joint axis")
     assert len(pieces(axes)[0]) == len(grasp.hand.joint_names)
 
@@ -202,7 +202,9 @@ def test_errors(tmp_path, monkeypatch):
     monkeypatch.setitem(sys.modules, "plotly", None)  # makes `import plotly` fail
     r = run("plot", GRASPS / "cylinder.yaml", "-o", out)
     assert r.exit_code == 1
-    assert r.stderr.endswith("needs plotly: pip install plotly (from a clone of grasptwist: pip install '.[html]')\n")
+    assert r.stderr.endswith(
+        "needs plotly: pip install plotly (from a clone of grasptwist: pip install -e '.[html]')\n"
+    )
 
 
 def test_a_name_cannot_end_the_figures_script_element(tmp_path):

@@ -115,7 +115,11 @@ def test_each_grasp_line_is_answered_before_the_next_is_written():
     assert json.loads(run.receive())["grasp"] == "<stdin>#4"
     code, stderr = run.finish()
     assert code == 1  # a line failed; the others are all out
-    assert "<stdin>:3:" in stderr and "error: yaml-syntax" in stderr and "3 records, 1 failed" in stderr
+    assert (
+        "<stdin>:3:" in stderr
+        and "error: yaml-syntax" in stderr
+        and "3 records: 0 with a degenerate method, 1 input failed" in stderr
+    )
 
 
 def test_each_twist_line_is_answered_before_the_next_is_written_as_csv():
@@ -300,9 +304,9 @@ def test_a_streams_failed_rows_follow_the_warnings_rule_and_a_missing_stream_is_
     assert said["all"].stdout == said["summary"].stdout == said["none"].stdout  # records unchanged
     gone = [line for line in said["all"].stderr.splitlines() if "gone.jsonl" in line]
     assert len(gone) == 1 and ": error: read-error: " in gone[0]
-    rows = [line for line in said["all"].stderr.splitlines() if "coincident-contacts" in line]
+    rows = [line for line in said["all"].stderr.splitlines() if ": error: tangent: coincident-contacts" in line]
     assert len(rows) == 24 and rows[0].startswith(f"{tmp_path / 'rows.jsonl'}: grasp 'g0'")
-    closing = "26 records, 25 failed (24 rows of data sets or streams)"
+    closing = "26 records: 24 with a degenerate method (tangent: 24 coincident-contacts), 1 input failed"
     summary = said["summary"].stderr.splitlines()
     assert summary == rows[:WARNINGS_SHOWN] + gone + [
         f"grasptwist: {24 - WARNINGS_SHOWN} more row errors not shown (--warnings all): 4 tangent coincident-contacts",

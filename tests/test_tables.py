@@ -90,7 +90,7 @@ def test_a_table_on_an_80_column_terminal_keeps_every_vector_on_one_line(command
     assert code == 0
     assert "\x1b[1m" in shown  # a terminal: colour
     table = ANSI.sub("", shown)
-    assert_fits(table.split("1 record, 0 failed")[0], 80)
+    assert_fits(table.split("1 record: all ok")[0], 80)
     for vector in (PSI_1, SIGMA_2, THETA_3):
         assert vector in table
     # the columns that did not fit come in a part of their own, the first column again
@@ -136,7 +136,7 @@ def test_the_bar_names_the_command_and_error_lines_are_never_wrapped(tmp_path):
     assert len(error) > 80
     # one line, however wide (after the bar's carriage return, on a line of its own)
     assert error in [line.rsplit("\r", 1)[-1] for line in ANSI.sub("", shown).split("\n")]
-    assert shown.endswith("2 records, 1 failed\n")
+    assert shown.endswith("2 records: 0 with a degenerate method, 1 input failed\n")
     assert len(out.read_text().splitlines()) == 2
 
 
@@ -180,6 +180,10 @@ def test_a_check_table_is_written_as_its_records_come_in_fixed_columns():
     # "-": the record has no closure_friction (the closure mu column)
     assert rows[0].split() == ["ok", "(0.5)", "normals-rank-deficient", *others, "-", "rows.npz", "0"]
     assert "hand" not in lines[1]  # a kind with nothing to check (the hand) has no column
+    assert lines[1].split("   ")[:2] == [
+        "  off-tangent (conditioning)",
+        "tangent (conditioning)",
+    ]  # what ok's number is
 
     assert rows[-1].split()[-1] == str(SIZING_ROWS + 499)  # the grasp is last: a longer name shifts nothing
 
@@ -235,7 +239,7 @@ def test_warnings_summary_prints_the_first_then_counts_the_rest_by_kind(noisy):
     assert lines[WARNINGS_SHOWN:] == [
         "grasptwist: 15 more warnings not shown (--warnings all): "
         "10 tangent basis is nearly degenerate, 5 off-tangent basis is nearly degenerate",
-        "35 records, 0 failed",
+        "35 records: all ok",
     ]
 
 
@@ -243,7 +247,7 @@ def test_warnings_summary_prints_the_first_then_counts_the_rest_by_kind(noisy):
 def test_warnings_all_none_and_quiet(noisy, command):
     every = run(command, *noisy, "-f", "jsonl", "--warnings", "all").stderr.splitlines()
     assert len(every) == 36 and sum(": warning: " in x for x in every) == 35
-    assert run(command, *noisy, "-f", "jsonl", "--warnings", "none").stderr == "35 records, 0 failed\n"
+    assert run(command, *noisy, "-f", "jsonl", "--warnings", "none").stderr == "35 records: all ok\n"
     assert run(command, *noisy, "-f", "jsonl", "-q").stderr == ""
     assert run(command, *noisy, "--warnings", "sometimes").exit_code == 2
 
@@ -272,3 +276,41 @@ def test_a_renderer_may_return_rich_groups_and_renderables():
     w.add(lines, Panel(grid))  # rich draws it, the grid inside too
     panel = buf.getvalue().decode()
     assert "│   [/]knuckle   0.2500" in panel and max(len(x) for x in panel.splitlines()) == 40
+
+
+# --------------------------------------------------------------------------
+# Issue 23: one naming of fingers (by contact), in sentences that agree in number
+
+HAND = ROOT / "grasps" / "three-finger-hand.yaml"
+
+
+def test_every_line_names_a_finger_by_its_contact_and_the_hand_table_shows_the_hands_name_once():
+    out = run("resolve", HAND, env={"COLUMNS": "300"}).stdout
+    prose = [line for line in out.splitlines() if "finger" in line and not line.startswith(" ")]
+    assert "finger 3 is moved by: off-tangent Sigma_3 Psi_1 Psi_2; tangent Theta_1 Theta_2 Sigma_3" in prose
+    assert "off-tangent: Sigma part: fingers 1, 2 and 3 each move alone, about the line through the other two." in prose
+    assert any(
+        line.startswith("verdict: not realisable by tangent sliding alone: fingers 1, 2 and 3 must") for line in prose
+    )
+    assert not any(name in line for line in prose for name in ("east", "west", "south"))
+    (row,) = [line.split() for line in out.splitlines() if "south.1" in line]
+    assert row[:3] == ["3", "south", "south.1"]  # finger (its contact), the hand's name, the joint
+
+
+def test_verdicts_use_the_contacts_names_and_agree_in_number():
+    from grasptwist.output.table import OffTangentTable, TangentTable
+
+    names = ["thumb", "index", "middle"]
+    one = {"moves": [[0], [], [], [], [], []], "about_wrist": False}  # Sigma_1 alone
+    two = {"moves": [[], [], [], [1, 2], [0, 2], []], "about_wrist": False}  # Psi_1 and Psi_2
+    assert OffTangentTable.verdict(one, names) == [
+        "off-tangent: Sigma part: finger thumb moves alone, about the line through the other two."
+    ]
+    assert OffTangentTable.verdict(two, names)[0].startswith(
+        "off-tangent: Psi part: fingers thumb and index are each held fixed in turn while"
+    )
+    off = {"in_tangent_planes": False, "moves": [[], [], [], [], [1], []]}  # beta_2 Sigma_2
+    assert TangentTable.verdict(off, names) == [
+        "verdict: not realisable by tangent sliding alone: finger index must also move off its tangent plane "
+        "(the beta_i Sigma_i part)."
+    ]

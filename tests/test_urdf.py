@@ -132,7 +132,9 @@ def test_meshes_and_includes_are_never_opened(monkeypatch):
 
 def test_without_yourdfpy_the_error_says_what_to_install(monkeypatch):
     monkeypatch.setitem(sys.modules, "yourdfpy", None)  # import yourdfpy -> ImportError
-    with pytest.raises(InputError, match=r"grasptwist\[urdf\]") as caught:
+    with pytest.raises(
+        InputError, match=r"pip install yourdfpy \(from a clone of grasptwist: pip install -e '\.\[urdf\]'\)"
+    ) as caught:
         hand.load_urdf_hand(TOY, ["a_tip"])
     assert caught.value.code == "urdf-unavailable"
 

@@ -25,13 +25,13 @@ class MissingExtra(ImportError):
     """An optional dependency is not installed.
 
     >>> str(MissingExtra("-f parquet", "pyarrow"))
-    "-f parquet needs pyarrow: pip install pyarrow (from a clone of grasptwist: pip install '.[parquet]')"
+    "-f parquet needs pyarrow: pip install pyarrow (from a clone of grasptwist: pip install -e '.[parquet]')"
     """
 
     def __init__(self, what: str, module: str):
         package, extra = EXTRAS[module]
         super().__init__(
-            f"{what} needs {module}: pip install {package} (from a clone of grasptwist: pip install '.[{extra}]')"
+            f"{what} needs {module}: pip install {package} (from a clone of grasptwist: pip install -e '.[{extra}]')"
         )
 
 

@@ -32,7 +32,8 @@ npz and the format registry take the new kind from this list.
 from __future__ import annotations
 
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+from functools import partial
 from typing import Any
 
 import numpy as np
@@ -56,6 +57,7 @@ __all__ = [
     "BY_KEY",
     "METHOD_CHOICES",
     "ALL_METHODS",
+    "joint_column_names",
     "selected",
     "ForceOptions",
     "ForceResult",
@@ -181,9 +183,6 @@ class ResultKind:
         writes its objects into a block's records (``(block, records,
         order) -> None``), for an object whose shape depends on the row (a
         hand's joints); None: the object of its ``fields``.
-    culprit_names : callable or None
-        ``(block, row) -> names`` that its culprit indices refer to in
-        messages; None: the row's contact names.
     missing : Status or None
         Why a method cannot run where it does not apply (``no-wrist``):
         its status there.  Asked for by name (``--method``), those rows
@@ -204,7 +203,6 @@ class ResultKind:
     method: bool = True
     needs: tuple[str, ...] = ()
     record: str | None = None
-    culprit_names: Callable[[Any, int], tuple[str, ...]] | None = None
     missing: Status | None = None
 
 
@@ -311,13 +309,15 @@ def _hand_joint_rates(inputs, bases):
     # the kinematics are imported with the first hand: runs without one never load them
     from .engine.kinematics import hand_joint_rates
 
-    return hand_joint_rates(
+    rates = hand_joint_rates(
         inputs["joint_screws"],
         inputs["points"],
         inputs["twist"],
         inputs["joint_limits"],
         _decompositions(inputs) if bases else None,
     )
+    # where the hand is (joint positions, tip errors): records and columns show what the rates are at
+    return rates if inputs.get("placement") is None else replace(rates, **inputs["placement"])
 
 
 def _same_hand(block, hand) -> np.ndarray:
@@ -327,29 +327,43 @@ def _same_hand(block, hand) -> np.ndarray:
     return np.array([h is hand or (h is not None and h.joint_names == hand.joint_names) for h in block.hands])
 
 
-def _joint_rates(r, block, hand) -> np.ndarray:
-    """``(N, total joints)``: each finger's rates in ``hand.joint_names`` order; NaN in rows of another hand."""
-    out = np.full((len(block), len(hand.joint_names)), np.nan)
-    if r is not None:
-        same = _same_hand(block, hand)
-        for f, finger in enumerate(hand.fingers):
-            out[np.ix_(same, finger.joint_index)] = r.rates[same, f, : len(finger.joints)]
-    return out
+def _per_joint(name):
+    """``(N, total joints)`` of the hand result's padded ``(N, 3, J)`` attribute ``name`` (rates,
+    positions): each finger's in ``hand.joint_names`` order; NaN in rows of another hand, or none."""
+
+    def get(r, block, hand):
+        out = np.full((len(block), len(hand.joint_names)), np.nan)
+        values = None if r is None else getattr(r, name)
+        if values is not None:
+            same = _same_hand(block, hand)
+            for f, finger in enumerate(hand.fingers):
+                out[np.ix_(same, finger.joint_index)] = values[same, f, : len(finger.joints)]
+        return out
+
+    return get
 
 
 def _per_finger(name, fill):
     """``(N, 3)`` attribute ``name`` of the hand result, ``fill`` where there is none."""
 
     def get(r, block, hand):
-        if r is None:
+        values = None if r is None else getattr(r, name)
+        if values is None:
             return np.full((len(block), 3), fill)
-        return np.where(block.has_hand[:, None], getattr(r, name), fill)
+        return np.where(block.has_hand[:, None], values, fill)
 
     return get
 
 
-def _qdot_names(hand) -> tuple[str, ...]:
-    return tuple(f"qdot_{f.name}_{j.name}" for f in hand.fingers for j in f.joints)
+def joint_column_names(prefix, hand) -> tuple[str, ...]:
+    """Flat column names of one value per joint of ``hand``: ``<prefix>_<finger>_<joint>``.
+
+    >>> from grasptwist.model import Finger, Hand, Joint
+    >>> f = Finger("a", None, (Joint("j", "revolute", None, None, None, None),), None, None, None, 1.0, (0,))
+    >>> joint_column_names("q", Hand((f, f, f), ("j",), None, None))[:1]
+    ('q_a_j',)
+    """
+    return tuple(f"{prefix}_{f.name}_{j.name}" for f in hand.fingers for j in f.joints)
 
 
 HAND = ResultKind(
@@ -361,7 +375,17 @@ HAND = ResultKind(
     basis_fields=(),
     check_fields=(),
     columns=(
-        Column("joint_rates", _joint_rates, _qdot_names, per_hand=True),
+        Column("joint_rates", _per_joint("rates"), partial(joint_column_names, "qdot"), per_hand=True),
+        # the configuration the rates are at (given, solved or tracked): shown even where the hand failed
+        Column(
+            "joint_positions",
+            _per_joint("joint_positions"),
+            partial(joint_column_names, "q"),
+            only_where_ok=False,
+            per_hand=True,
+        ),
+        Column("tip_error", _per_finger("tip_error", np.nan), per_hand=True),
+        Column("within_limits", _per_finger("within_limits", False), dtype="?", per_hand=True),
         Column("finger_rank", _per_finger("finger_rank", -1), dtype="i8", per_hand=True),
         Column("finger_residual", _per_finger("finger_residual", np.nan), per_hand=True),
         Column("finger_conditioning", _per_finger("finger_conditioning", np.nan), per_hand=True),
@@ -377,7 +401,6 @@ HAND = ResultKind(
     method=False,
     needs=("joint_screws",),
     record="hand_objects",
-    culprit_names=lambda block, i: tuple(f.name for f in block.hands[i].fingers),
 )
 
 #: Every result kind, in the order records hold them (a kind may use those before it).

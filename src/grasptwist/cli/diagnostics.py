@@ -64,8 +64,9 @@ class Diagnostics:
     """
 
     def __init__(self, quiet: bool = False, warnings: Warnings = Warnings.summary, hint: str | None = None):
-        self.failed = 0
-        self.failed_rows = 0  # of ``failed``: rows of data sets or streams
+        self.failed = 0  # records not ok
+        self.inputs_failed = 0  # of ``failed``: inputs that could not be read
+        self.degenerate: dict[tuple[str, str], int] = {}  # the other failed records, per (kind, code)
         self.records = 0
         self.quiet = quiet
         self.shown = {Warnings.all: None, Warnings.summary: WARNINGS_SHOWN, Warnings.none: 0}[Warnings(warnings)]
@@ -80,7 +81,9 @@ class Diagnostics:
         """Count a pipeline Output and print its lines."""
         self.records += out.records
         self.failed += out.failed
-        self.failed_rows += out.failed_rows
+        self.inputs_failed += out.inputs_failed
+        for code, n in out.degenerate.items():
+            self.degenerate[code] = self.degenerate.get(code, 0) + n
         for line in out.errors:
             self.say(line, ": error: ", "31")
         for line in out.row_errors:
@@ -123,21 +126,29 @@ class Diagnostics:
             to_stderr(_not_shown(self.rows_unshown, "row error"))
         if self.unshown:
             to_stderr(_not_shown(self.unshown, "warning"))
-        to_stderr(summary_line(self.records, self.failed, self.failed_rows))
+        to_stderr(summary_line(self.records, self.failed - self.inputs_failed, self.inputs_failed, self.degenerate))
 
 
-def summary_line(records: int, failed: int, failed_rows: int = 0) -> str:
-    """The closing line: records written and failed; when failed rows of data sets or
-    streams are mixed with other failures (inputs that could not be read, grasps of
-    grasp files), how many of the failed are rows.
+def summary_line(records: int, degenerate: int = 0, inputs_failed: int = 0, codes=None) -> str:
+    """The closing line: how many records were written, how many of them hold a degenerate
+    method (a grasp, or a data set's row, that was read: the other methods' results are there)
+    and by which codes, and how many inputs could not be read (each one record).
 
-    >>> summary_line(1, 0), summary_line(3000, 902, 902), summary_line(3001, 903, 902)
-    ('1 record, 0 failed', '3000 records, 902 failed', '3001 records, 903 failed (902 rows of data sets or streams)')
+    >>> summary_line(1), summary_line(4, 0, 1)
+    ('1 record: all ok', '4 records: 0 with a degenerate method, 1 input failed')
+    >>> summary_line(3, 3, 0, {("tangent", "normals-rank-deficient"): 2, ("tangent", "theta-not-unique"): 1})
+    '3 records: 3 with a degenerate method (tangent: 2 normals-rank-deficient, 1 theta-not-unique), 0 inputs failed'
     """
-    line = f"{records} record{'' if records == 1 else 's'}, {failed} failed"
-    if 0 < failed_rows < failed:
-        line += f" ({failed_rows} row{'' if failed_rows == 1 else 's'} of data sets or streams)"
-    return line
+    line = f"{records} record{'' if records == 1 else 's'}: "
+    if not degenerate and not inputs_failed:
+        return line + "all ok"
+    line += f"{degenerate} with a degenerate method"
+    kinds: dict[str, list[str]] = {}
+    for (kind, code), n in sorted((codes or {}).items(), key=lambda kv: (-kv[1], kv[0])):
+        kinds.setdefault(kind, []).append(f"{n} {code}")
+    if kinds:
+        line += " (" + "; ".join(f"{kind}: {', '.join(counts)}" for kind, counts in kinds.items()) + ")"
+    return line + f", {inputs_failed} input{'' if inputs_failed == 1 else 's'} failed"
 
 
 def _not_shown(counts: dict[str, int], what: str) -> str:

@@ -1,7 +1,8 @@
 """How a command ends: where its records go (``-o``) and the exit status of every way out.
 
-Exit codes: 0 all records ok, 1 some record failed (the others are still
-written in full), 2 usage error, 3 the output could not be written, 4 a
+Exit codes: 0 all records ok, 1 some record not ok (a method degenerate on a
+grasp that was read, or an input that could not be read; the others are
+still written in full), 2 usage error, 3 the output could not be written, 4 a
 worker process died, 128 + the signal's number when SIGINT, SIGTERM or
 SIGHUP stopped the run, 141 the reader of stdout went away.
 """
@@ -121,9 +122,9 @@ def run_command(debug: bool, body: Callable[[], int]) -> None:
 def usage_error(exc) -> int:
     """One line for a usage error (exit 2), as for every other diagnostic: what is wrong, and
     where help is, instead of click's four lines of usage, hint, blank and error."""
-    if type(exc).__name__ == "NoArgsIsHelpError":  # `grasptwist` alone: the help is the answer
-        to_stderr(exc.format_message())
-        return exc.exit_code
+    if type(exc).__name__ == "NoArgsIsHelpError":  # `grasptwist` alone: the help is the answer,
+        sys.stdout.write(exc.format_message() + "\n")  # on stdout (`grasptwist | less`), a success
+        return EXIT_OK
     ctx = getattr(exc, "ctx", None)
     message = " ".join(exc.format_message().split())  # on one line, whatever it quotes
     where = f" (see '{ctx.command_path} -h')" if ctx is not None else ""

@@ -42,6 +42,7 @@ __all__ = [
     "Json",
     "Workers",
     "RecordFormatOption",
+    "Select",
     "parse_floats",
     "twists_option",
     "wrenches_option",
@@ -121,6 +122,15 @@ Workers = Annotated[
         "--workers",
         min=0,
         help="Processes for big batches (0: every core, used for 256+ files or 4096+ data-set grasps).",
+    ),
+]
+Select = Annotated[
+    list[str] | None,
+    typer.Option(
+        "--select",
+        metavar="NAME",
+        help="Only the file's twist of this name (repeatable); a grasp without it fails with unknown-twist, "
+        "which lists the twists it has.",
     ),
 ]
 RecordFormatOption = Annotated[

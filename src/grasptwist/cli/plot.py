@@ -7,9 +7,9 @@ from typing import Annotated
 
 import typer
 
-from .diagnostics import Diagnostics
+from .diagnostics import Diagnostics, to_stderr
 from .exits import EXIT_FAILED, EXIT_OK, run_command, writable_folder
-from .options import Debug, MaxBytes, PlotMethod, twists_option
+from .options import Debug, MaxBytes, PlotMethod, Select, twists_option
 
 __all__ = ["plot", "draw_pictures"]
 
@@ -33,10 +33,9 @@ def plot(
     ] = None,
     twist_name: Annotated[
         str | None,
-        typer.Option(
-            "--twist-name", metavar="NAME", help="Which of the file's twists to draw (or the name of --twist)."
-        ),
+        typer.Option("--twist-name", metavar="NAME", help="The name of --twist in the picture."),
     ] = None,
+    select: Select = None,
     at: Annotated[
         str | None,
         typer.Option("--at", metavar="X,Y,Z", help="Point whose velocity the --twist linear part gives."),
@@ -67,17 +66,31 @@ def plot(
     Examples: the paper's cylinder spinning about z, every bundled grasp, and a view to turn in a browser:
 
     \b
-        grasptwist plot grasps/cylinder.yaml --twist-name spin-z -o cylinder.png
+        grasptwist plot grasps/cylinder.yaml --select spin-z -o cylinder.png
         grasptwist plot grasps/ -o pictures/
         grasptwist plot grasps/trifinger-cube.yaml -o trifinger.html
     """
     twists = twists_option([twist] if twist else None, at)
+    if twists and select:
+        raise typer.BadParameter(
+            "--select picks one of the file's twists; --twist replaces them: give one", param_hint="--select"
+        )
     if twists and twist_name:
         twists = [replace(twists[0], name=twist_name)]
+    elif twist_name:  # before --select, --twist-name also picked the file's twist
+        if select:
+            raise typer.BadParameter("names --twist only: give the file's twist by --select", param_hint="--twist-name")
+        to_stderr(f"grasptwist: warning: plot --twist-name without --twist is deprecated: use --select {twist_name}")
+        select = [twist_name]
+    if select and os.path.isdir(path):
+        raise typer.BadParameter("picks a twist of one grasp file; a folder gets every twist", param_hint="--select")
+    if select and len(select) > 1:
+        raise typer.BadParameter(f"a picture draws one twist: give one (got {len(select)})", param_hint="--select")
+    chosen = select[0] if select else None
     views = {"js_beside": js_beside, "path_name": path_name}
     run_command(
         debug,
-        lambda: draw_pictures(path, output, twists, twist_name, method.value if method else None, max_bytes, views),
+        lambda: draw_pictures(path, output, twists, chosen, method.value if method else None, max_bytes, views),
     )
 
 
@@ -169,7 +182,7 @@ def draw_pictures(path, output, twists, twist_name, method, max_bytes, views) ->
         sys.stderr.write(f"{exc}\n")  # "grasptwist plot needs matplotlib: ..." (or plotly)
         return EXIT_FAILED
     except pictures.TwistNotFound as exc:
-        raise typer.BadParameter(str(exc), param_hint="--twist-name") from None
+        raise typer.BadParameter(str(exc), param_hint="--select") from None
     except ValueError as exc:  # an unknown method or suffix, off-tangent without a wrist
         raise typer.BadParameter(str(exc)) from None
     return EXIT_FAILED if stderr.failed else EXIT_OK

@@ -20,6 +20,7 @@ from .options import (
     Paths,
     Quiet,
     ResolveFormat,
+    Select,
     WarningsOption,
     Workers,
     hand_option,
@@ -49,6 +50,7 @@ def resolve(
             help="Name of each --twist in the records, paired in order (default: the twist as written).",
         ),
     ] = None,
+    select: Select = None,
     at: Annotated[
         str | None,
         typer.Option(
@@ -104,13 +106,22 @@ def resolve(
 
     \b
         grasptwist resolve grasps/cylinder.yaml --method off-tangent --twist 0,0,1,0,0,0 --json | jq '.[0].off_tangent.y'
+        grasptwist resolve grasps/cylinder.yaml --select spin-z --method off-tangent
         grasptwist resolve grasps.npz --twist 0,0,1,0,0,0 -f npz -o results.npz
     """
+    from ..io.datasets import DATASET_SUFFIXES
     from ..run.pipeline import Job
 
     twists = twists_option(twist, at, twist_name)
     if twists_from is not None and twists is not None:
         raise typer.BadParameter("give twists by --twist or by --twists-from, not both", param_hint="--twists-from")
+    if select and (twists is not None or twists_from is not None):
+        raise typer.BadParameter(
+            "--select picks the files' own twists; --twist and --twists-from replace them: give one",
+            param_hint="--select",
+        )
+    if select and any(p.endswith(DATASET_SUFFIXES) for p in paths):
+        raise typer.BadParameter("picks a grasp file's named twists; a data set's are not named", param_hint="--select")
     if twists_from == "-" and "-" in paths:
         raise typer.BadParameter("standard input can be read only once", param_hint="--twists-from")
     if extra_point == ExtraPoint.at and at is not None:
@@ -129,6 +140,7 @@ def resolve(
         extra_point=extra_point.value,
         hand=hand_option(hand, paths, fmt.value),
         twists_from=twists_from,
+        select=tuple(select) if select else None,
     )
     settings = OutputSettings(output, quiet, warnings, workers, {"digits": digits, "order": order.value})
     run_command(debug, lambda: write_records(job, paths, settings))

@@ -58,6 +58,9 @@ class Status(IntEnum):
     NORMAL_IN_CONTACT_PLANE = 10
     FINGER_CANNOT_FOLLOW = 11
     NO_WRIST = 12  # set where a grasp has none (see grasptwist.results), never by a decomposition
+    CONTACT_OFF_FINGER = 13  # a hand's: a contact farther from its finger's tip than the finger is long
+    UNREACHABLE = 14  # a hand's inverse kinematics (grasptwist.engine.ik)
+    OUTSIDE_LIMITS = 15
 
     @property
     def code(self) -> str:
@@ -100,6 +103,17 @@ _MESSAGES = {
         "finger {i} cannot follow its contact: no joint rates move it with the object's velocity there "
         "(relative residual above 1e-6): move the finger away from that pose, or use a method "
         "whose components it can follow"
+    ),
+    Status.CONTACT_OFF_FINGER: (
+        "contact {i} is farther from its finger's tip than the finger is long at the row's joint positions: "
+        "give the contacts in the hand's root frame and the joint positions of that row"
+    ),
+    Status.UNREACHABLE: (
+        "finger {i}'s tip cannot reach its contact within the finger's joint limits: move the contact within its reach"
+    ),
+    Status.OUTSIDE_LIMITS: (
+        "finger {i}'s tip reaches its contact only with a joint outside its position limits: "
+        "move the contact, or widen the limits where the hand allows it"
     ),
     Status.NO_WRIST: (
         "the grasp has no wrist, and each Psi_i is a line from it: give one "

@@ -21,6 +21,7 @@ __all__ = [
     "finger_states",
     "velocity_limits",
     "padded",
+    "padded_positions",
     "HandTrack",
     "track",
     "SEGMENT_INTERVALS",
@@ -147,15 +148,41 @@ class HandTrack(NamedTuple):
     fingers: tuple[FingerTrack, ...]
 
 
+def padded_positions(hand, positions, width=None):
+    """A hand's joint positions per finger, ``(..., 3, width)``, NaN in the padding (as :func:`padded`).
+
+    Parameters
+    ----------
+    hand : Hand
+    positions : (..., n_joints) array
+        In ``hand.joint_names`` order.
+    width : int, optional
+        Joints per finger; default the longest finger's.
+
+    >>> from grasptwist.model import Finger, Hand, Joint
+    >>> j = Joint("a", "revolute", None, None, None, None)
+    >>> h = Hand(tuple(Finger(str(f), None, (j,) * (f + 1), None, None, None, 1.0, tuple(range(f * (f + 1) // 2, (f + 1) * (f + 2) // 2))) for f in range(3)), tuple("abcdef"), None, None)
+    >>> padded_positions(h, np.arange(6.0))[1].tolist()
+    [1.0, 2.0, nan]
+    """
+    positions = np.asarray(positions, dtype=float)
+    width = max(len(f.joints) for f in hand.fingers) if width is None else width
+    out = np.full(positions.shape[:-1] + (3, width), np.nan)
+    for f, finger in enumerate(hand.fingers):
+        out[..., f, : len(finger.joints)] = positions[..., list(finger.joint_index)]
+    return out
+
+
 def _limits(finger, which):
     """A finger's lower or upper joint position limits, NaN where none: ``(n,)``."""
     return np.array([np.nan if getattr(j, which) is None else getattr(j, which) for j in finger.joints], dtype=float)
 
 
-#: :func:`track` integrates each segment over at least this many intervals (of
-#: ``steps`` Runge-Kutta steps each), however few the samples: the tip's error
-#: and the events' times do not depend on the sampling.
-SEGMENT_INTERVALS = 20
+#: :func:`track` integrates each segment over at least this many intervals, by
+#: Runge-Kutta steps no longer than ``1 / steps`` of an interval (at least one
+#: between samples), however few or many the samples: the tip's error and the
+#: events' times do not depend on the sampling, and dense samples cost one step each.
+SEGMENT_INTERVALS = 4
 
 
 def track(hand, positions, points, segments, times, steps=16) -> HandTrack:
@@ -179,7 +206,8 @@ def track(hand, positions, points, segments, times, steps=16) -> HandTrack:
     times : (T,) array
         Increasing sample times.
     steps : int
-        Runge-Kutta steps per interval between sample times.
+        Runge-Kutta steps per interval of :data:`SEGMENT_INTERVALS`: steps are
+        no longer than ``1 / (SEGMENT_INTERVALS * steps)`` of their segment.
 
     Returns
     -------
@@ -223,7 +251,7 @@ def track(hand, positions, points, segments, times, steps=16) -> HandTrack:
                 grid,
                 lower=_limits(finger, "lower"),
                 upper=_limits(finger, "upper"),
-                steps=steps,
+                segment_steps=SEGMENT_INTERVALS * steps,
             )
         )
         fingers[-1] = fingers[-1]._replace(**{k: getattr(fingers[-1], k)[rows] for k in _PER_SAMPLE})

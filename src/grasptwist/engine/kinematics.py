@@ -376,6 +376,12 @@ class HandRates:
     status, culprit : (...) int8
         ``finger-cannot-follow`` (or ``nonfinite-input``) and the finger it is
         about (the one with the largest residual), as for the decompositions.
+    joint_positions : (..., 3, J) array or None
+        The configuration the rates are at, each finger's joint positions
+        padded with NaN (:func:`grasptwist.engine.hands.padded_positions`);
+        None when not told.
+    tip_error, within_limits : (..., 3) arrays or None
+        Per finger at that configuration, :class:`grasptwist.engine.ik.HandIK`'s.
     """
 
     rates: np.ndarray
@@ -388,6 +394,9 @@ class HandRates:
     components: dict
     status: np.ndarray
     culprit: np.ndarray
+    joint_positions: np.ndarray | None = None
+    tip_error: np.ndarray | None = None
+    within_limits: np.ndarray | None = None
 
     @property
     def ok(self) -> np.ndarray:
@@ -396,7 +405,7 @@ class HandRates:
 
     def row(self, i):
         """Rows ``i`` of the leading axis, as a result of the same type."""
-        values = {k: v[i] for k, v in vars(self).items() if k != "components"}
+        values = {k: None if v is None else v[i] for k, v in vars(self).items() if k != "components"}
         return HandRates(**values, components={k: v[i] for k, v in self.components.items()})
 
 

@@ -85,7 +85,18 @@ class FingerTrack(NamedTuple):
 
 
 def track_finger(
-    home_screws, home_points, home_tip, positions, contact, segments, times, *, lower=None, upper=None, steps=16
+    home_screws,
+    home_points,
+    home_tip,
+    positions,
+    contact,
+    segments,
+    times,
+    *,
+    lower=None,
+    upper=None,
+    steps=16,
+    segment_steps=None,
 ) -> FingerTrack:
     """Follow one contact along a path with one finger (module docstring).
 
@@ -105,6 +116,10 @@ def track_finger(
         Joint position limits (NaN: none).
     steps : int
         Runge-Kutta steps per interval of the grid.
+    segment_steps : int, optional
+        Instead of ``steps``: steps no longer than ``1 / segment_steps`` of
+        their segment, at least one per interval, so that dense samples do not
+        multiply the work and sparse ones cost no accuracy.
 
     Returns
     -------
@@ -145,13 +160,14 @@ def track_finger(
         point = se3.transform(st.tip[:3, :3], st.tip[:3, 3], local)
         return target, point, st.screws, field_at(pose.twist, target)
 
-    def rates(t, q, gain, k):
-        target, point, screws, velocity = state(t, q, k)
+    def rates(t, q, gain, k, at=None):
+        target, point, screws, velocity = state(t, q, k) if at is None else at
         return joint_rates(screws, point, velocity + gain * (target - point)).rates
 
-    def step(t, q, h):
+    def step(t, q, h, at=None):
+        """One Runge-Kutta step from ``(t, q)``; ``at``: :func:`state` there, when known."""
         gain, k = 0.5 / h, plan.index(t)  # a step never crosses a boundary (the grid holds them)
-        k1 = rates(t, q, gain, k)
+        k1 = rates(t, q, gain, k, at)
         k2 = rates(t + h / 2, q + h / 2 * k1, gain, k)
         k3 = rates(t + h / 2, q + h / 2 * k2, gain, k)
         k4 = rates(t + h, q + h * k3, gain, k)
@@ -159,12 +175,13 @@ def track_finger(
 
     def assess(t, q):
         """What happened at ``(t, q)``: the joint out of its limits, then 0 for a rank loss and
-        0 for a conditioning below the warning level (-1 for nothing); and the conditioning."""
-        target, point, screws, velocity = state(t, q)
-        r = joint_rates(screws, point, velocity)
+        0 for a conditioning below the warning level (-1 for nothing); the conditioning; and
+        :func:`state` there (the next step starts from it: one forward kinematics for both)."""
+        at = state(t, q)
+        r = joint_rates(at[2], at[1], at[3])
         out = np.flatnonzero((q < lower) | (q > upper))
         c = float(r.conditioning)
-        return (int(out[0]) if out.size else -1, int(r.rank < 3) - 1, int(c < CONDITION_WARNING) - 1), c
+        return (int(out[0]) if out.size else -1, int(r.rank < 3) - 1, int(c < CONDITION_WARNING) - 1), c, at
 
     def judge(t, q):
         return assess(t, q)[0]
@@ -174,23 +191,28 @@ def track_finger(
 
     grid = np.unique(np.concatenate((times, plan.start, [plan.end])))
     grid = grid[grid <= times[-1]]
-    events, c = assess(0.0, q)
+    events, c, here = assess(0.0, q)
     first = [(0.0, w) if w >= 0 else None for w in events]
     at = {0.0: q.copy()}
     ends, starts, values = [0.0], [q.copy()], [c]  # every step's end and state there, and the conditioning
     for a, b in zip(grid[:-1], grid[1:]):
-        h = (b - a) / steps
-        for s in range(steps):
-            t0, t1 = a + s * h, (a + (s + 1) * h if s < steps - 1 else b)
-            q1 = step(t0, q, t1 - t0)
-            events, c = assess(t1, q1)
+        m = steps
+        if segment_steps is not None:  # round-off must not add a step to an interval of exactly 1/m
+            m = max(1, int(np.ceil(segment_steps * (b - a) / plan.duration[plan.index(a)] * (1 - 1e-12))))
+        h = (b - a) / m
+        for s in range(m):
+            t0, t1 = a + s * h, (a + (s + 1) * h if s < m - 1 else b)
+            q1 = step(t0, q, t1 - t0, here)
+            events, c, there = assess(t1, q1)
             for e, w in enumerate(events):
                 if first[e] is None and w >= 0:
-                    first[e] = _locate(lambda t, e=e, t0=t0, q=q: judge(t, step(t0, q, t - t0))[e], t0, t1)
+                    first[e] = _locate(
+                        lambda t, e=e, t0=t0, q=q, here=here: judge(t, step(t0, q, t - t0, here))[e], t0, t1
+                    )
             ends.append(t1)
             starts.append(q1)
             values.append(c)
-            q = q1
+            q, here = q1, there
         at[float(b)] = q.copy()
 
     def reached(t):

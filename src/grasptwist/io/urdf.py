@@ -97,7 +97,11 @@ def _package_folder(package, reference):
     # A dotted name would import its parent package (running its code) to find it.
     spec = find_spec(package) if package.isidentifier() else None
     if spec is None or not spec.submodule_search_locations:
-        raise InputError("package-not-found", f"no installed Python package {package!r}", reference)
+        # the distribution's name is the package's with '-' for '_' (robot_properties_fingers: robot-properties-fingers)
+        hint = package.replace("_", "-")
+        raise InputError(
+            "package-not-found", f"no installed Python package {package!r} (pip install {hint})", reference
+        )
     return Path(next(iter(spec.submodule_search_locations))).resolve()
 
 
@@ -239,7 +243,9 @@ def _library(file):
         import yourdfpy
     except ImportError:
         raise InputError(
-            "urdf-unavailable", "reading a URDF needs yourdfpy: pip install 'grasptwist[urdf]'", file
+            "urdf-unavailable",
+            "reading a URDF needs yourdfpy: pip install yourdfpy (from a clone of grasptwist: pip install -e '.[urdf]')",
+            file,
         ) from None
     return yourdfpy
 

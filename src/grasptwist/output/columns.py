@@ -18,7 +18,7 @@ import numpy as np
 
 from ..engine.degeneracy import Status, status_message
 from ..engine.forces.grasp_map import ForceStatus, force_status_message
-from ..results import BY_KEY, CULPRIT, KINDS, STATUS, Column
+from ..results import CULPRIT, KINDS, STATUS, Column
 
 __all__ = [
     "ORDERS",
@@ -163,11 +163,9 @@ def error_texts(block, key: str) -> np.ndarray:
     if key not in block.results:
         return texts
     status, culprit = block.value(key, STATUS), block.value(key, CULPRIT)
-    named = BY_KEY[key].culprit_names
     for i in np.flatnonzero((status != Status.OK) & block.applies(key)):
         s = Status(int(status[i]))
-        names = block.contact_names[i] if named is None else named(block, i)
-        texts[i] = f"{s.code}: {status_message(s, culprit[i], names)}"
+        texts[i] = f"{s.code}: {status_message(s, culprit[i], block.contact_names[i])}"  # a finger is its contact
     return texts
 
 

@@ -181,27 +181,29 @@ def crossing_text(c: dict, names=("1", "2", "3"), digits: int = 4) -> str:
     return f"from t = {a} to t = {b}: {status_message(_STATUS[c['code']], culprit, names)}"
 
 
-def hand_event_texts(hand: dict, digits: int = 4) -> tuple[list[str], list[str]]:
+def hand_event_texts(hand: dict, names=("1", "2", "3"), digits: int = 4) -> tuple[list[str], list[str]]:
     """A summary's hand events in words: ``(errors, warnings)``, the joint-limit exit and the
-    rank losses (the motion cannot be made), then the fingers' conditioning warnings.
+    rank losses (the motion cannot be made), then the fingers' conditioning warnings.  Finger
+    ``f`` is named by its contact, ``names[f]`` (the records keep the hand's own finger names).
 
     >>> hand_event_texts({"joint_limit": {"finger": "east", "joint": "e2", "t": 0.5},
     ...                   "fingers": [{"name": "east", "rank_loss": None, "first_warning": 0.25}]})
-    (["joint 'e2' of finger 'east' leaves its position limits at t = 0.5000"], ["finger 'east': conditioning below 0.001 from t = 0.2500"])
+    (["joint 'e2' of finger 1 leaves its position limits at t = 0.5000"], ['finger 1: conditioning below 0.001 from t = 0.2500'])
     """
     errors, warnings = [], []
+    fingers = [f["name"] for f in hand["fingers"]]
     if hand["joint_limit"] is not None:
         j = hand["joint_limit"]
+        finger = escaped(names[fingers.index(j["finger"])])
         errors.append(
-            f"joint '{escaped(j['joint'])}' of finger '{escaped(j['finger'])}' leaves its position limits "
-            f"at t = {j['t']:.{digits}f}"
+            f"joint '{escaped(j['joint'])}' of finger {finger} leaves its position limits at t = {j['t']:.{digits}f}"
         )
-    for f in hand["fingers"]:
+    for f, name in zip(hand["fingers"], names):
         if f["rank_loss"] is not None:
-            errors.append(f"finger '{escaped(f['name'])}' loses rank (its Jacobian) at t = {f['rank_loss']:.{digits}f}")
+            errors.append(f"finger {escaped(name)} loses rank (its Jacobian) at t = {f['rank_loss']:.{digits}f}")
         if f["first_warning"] is not None:
             warnings.append(
-                f"finger '{escaped(f['name'])}': conditioning below {CONDITION_WARNING:g} from t = {f['first_warning']:.{digits}f}"
+                f"finger {escaped(name)}: conditioning below {CONDITION_WARNING:g} from t = {f['first_warning']:.{digits}f}"
             )
     return errors, warnings
 
@@ -219,7 +221,7 @@ def diagnostics(rec: dict, names=("1", "2", "3")) -> tuple[list[str], list[str]]
             f"{where}: warning: {w['method']}: conditioning below {CONDITION_WARNING:g} from t = {w['t']:.6g}"
         )
     if "hand" in s:
-        hand_errors, hand_warnings = hand_event_texts(s["hand"], 6)
+        hand_errors, hand_warnings = hand_event_texts(s["hand"], names, 6)
         errors += [f"{where}: error: hand: {text}" for text in hand_errors]
         warnings += [f"{where}: warning: hand: {text}" for text in hand_warnings]
     return errors, warnings
@@ -227,24 +229,11 @@ def diagnostics(rec: dict, names=("1", "2", "3")) -> tuple[list[str], list[str]]
 
 def csv_header(hand=None) -> bytes:
     """The CSV header of ``follow`` for a run's ``hand`` (None: :data:`CSV_HEADER`): resolve's
-    joint columns in their place, then the joint positions ``q_<finger>_<joint>``."""
+    joint columns (the joint positions ``q_<finger>_<joint>`` among them) in their place."""
     if hand is None:
         return CSV_HEADER
     rest = tuple(c for c in header(hand) if c not in _NOT_IN_CSV)
-    return ",".join(_OWN + rest + _q_names(hand)).encode() + b"\n"
-
-
-def _q_names(hand) -> tuple[str, ...]:
-    return tuple(f"q_{f.name}_{j.name}" for f in hand.fingers for j in f.joints)
-
-
-def _joint_positions(samples, hand) -> np.ndarray:
-    """``(N, n_joints)`` the samples' joint positions in the run's ``hand`` order (NaN: another hand, or none)."""
-    out = np.full((len(samples.block), len(hand.joint_names)), np.nan)
-    own = samples.block.hands[0] if samples.block.hands else None
-    if samples.joint_positions is not None and own is not None and own.joint_names == hand.joint_names:
-        out[:] = samples.joint_positions
-    return out
+    return ",".join(_OWN + rest).encode() + b"\n"
 
 
 def csv_rows(samples, order: str = "omega-v", hand=None) -> list[bytes]:
@@ -261,20 +250,15 @@ def csv_rows(samples, order: str = "omega-v", hand=None) -> list[bytes]:
     own.update({f"position_{a}": position[:, j] for j, a in enumerate("xyz")})
     own.update({f"rotation_{a}": quaternion[:, j] for j, a in enumerate("wxyz")})
     rest = {k: v for k, v in columns(block, order, hand).items() if k not in _NOT_IN_CSV}
-    if hand is not None:
-        rest.update(zip(_q_names(hand), _joint_positions(samples, hand).T))
     return lines({**own, **rest})
 
 
 def path_arrays(samples, order: str = "omega-v", hand=None) -> dict[str, np.ndarray]:
     """The arrays a follow npz adds to a block's: ``t``, ``segment``, ``position`` and ``rotation``
-    (quaternions, w first), and with the run's ``hand`` its ``joint_positions (N, n_joints)``;
-    its ``twist`` is the instantaneous space twist."""
+    (quaternions, w first); its ``twist`` is the instantaneous space twist (the block's, with the
+    run's ``hand``, hold the ``joint_positions (N, n_joints)``)."""
     position, quaternion = _pose(samples)
-    out = {"t": samples.poses.time, "segment": samples.poses.segment, "position": position, "rotation": quaternion}
-    if hand is not None:
-        out["joint_positions"] = _joint_positions(samples, hand)
-    return out
+    return {"t": samples.poses.time, "segment": samples.poses.segment, "position": position, "rotation": quaternion}
 
 
 def csv_error_row(rec: dict, hand=None) -> bytes:

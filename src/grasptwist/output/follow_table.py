@@ -4,7 +4,8 @@ Plain fixed-width text, written as the records come (one line per sample),
 so a long path streams and needs no memory; it reads the records only (see
 :mod:`grasptwist.output.follow_records`).  Each sample line holds the time,
 the segment, the pose (position, quaternion w first), and per method its
-amplitudes and conditioning, or the code of its failure.
+amplitudes and conditioning, or the code of its failure; with a hand, a
+line under it holds each finger's joint positions and tip error.
 """
 
 from __future__ import annotations
@@ -83,6 +84,21 @@ class FollowTable:
             else:
                 cells += [self._vector(m[a]) for a in amplitudes] + [self._number(m["conditioning"])]
         self._line("  ".join(cells).rstrip())
+        if isinstance(rec.get("hand"), dict):
+            self._hand_line(rec["hand"])
+
+    def _hand_line(self, hand) -> None:
+        """Under a sample, where its fingers are: each one's joint positions and tip error."""
+        parts = []
+        for f in hand["fingers"]:
+            if "joint_positions" not in f:
+                continue
+            error = "-" if f["tip_error"] is None else f"{f['tip_error']:.3g}"
+            limits = "" if f["within_limits"] else " (outside its limits)"
+            q = " ".join(f"{v:.{self.digits}f}" for v in f["joint_positions"])
+            parts.append(f"finger {escaped(f['contact'])}: q {q}{limits}, tip error {error}")
+        if parts:
+            self._line(f"{'':>{self.width}}  hand  " + "; ".join(parts))
 
     def _summary(self, rec):
         s = rec["summary"]
@@ -105,7 +121,7 @@ class FollowTable:
             else f"  first warning: {w['method']} at t = {w['t']:.{self.digits}f}"
         )
         if "hand" in s:
-            errors, warnings = hand_event_texts(s["hand"], self.digits)
+            errors, warnings = hand_event_texts(s["hand"], self.names, self.digits)
             for text in errors + warnings:
                 self._line(f"  hand: {text}")
             if not errors and not warnings:

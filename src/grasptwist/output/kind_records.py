@@ -11,7 +11,6 @@ from __future__ import annotations
 import numpy as np
 
 from ..engine.degeneracy import CONDITION_WARNING, Status, status_message
-from ..results import BY_KEY
 
 __all__ = ["hand_objects"]
 
@@ -23,8 +22,20 @@ def _number(x):
 
 
 def _finger_rates(rates, finger):
-    """One finger's rates from the padded ``(..., J)`` row: its own joints only."""
+    """One finger's rates (or positions) from the padded ``(..., J)`` row: its own joints only."""
     return (rates[..., : len(finger.joints)] + 0.0).tolist()
+
+
+def _placement(r, i, f, finger) -> dict:
+    """Where finger ``f`` of row ``i`` is: its ``joint_positions`` (given, solved or tracked), its
+    ``tip_error`` (null: a finger given inline has no tip link) and ``within_limits``."""
+    if r.joint_positions is None:
+        return {}
+    return {
+        "joint_positions": _finger_rates(r.joint_positions[i, f], finger),
+        "tip_error": _number(r.tip_error[i, f]),
+        "within_limits": bool(r.within_limits[i, f]),
+    }
 
 
 def hand_objects(block, order, warnings):
@@ -53,6 +64,7 @@ def hand_objects(block, order, warnings):
                     "contact": names[f],
                     "tip": finger.tip,
                     "joints": [j.name for j in finger.joints],
+                    **_placement(r, i, f, finger),
                     "joint_rates": _finger_rates(r.rates[i, f], finger),
                     "rank": int(r.finger_rank[i, f]),
                     "residual": _number(r.finger_residual[i, f]),
@@ -62,13 +74,12 @@ def hand_objects(block, order, warnings):
             )
             if conditioning < CONDITION_WARNING and r.status[i] == Status.OK:
                 warnings[i].append(
-                    f"hand: finger {finger.name!r} is near a singularity (conditioning {conditioning:.3g} < "
+                    f"hand: finger {names[f]} is near a singularity (conditioning {conditioning:.3g} < "
                     f"{CONDITION_WARNING:g}): its joint rates are large and sensitive"
                 )
         obj = {"fingers": fingers, "velocity_limit_ratio": _number(r.velocity_limit_ratio[i]), "ok": bool(r.ok[i])}
         if not r.ok[i]:
             status = Status(int(r.status[i]))
-            names = BY_KEY["hand"].culprit_names(block, i)  # the culprit is a finger
             obj["error"] = {"code": status.code, "message": status_message(status, r.culprit[i], names)}
         more = {
             key: {"joint_rates": [[_finger_rates(c[f], fi) for f, fi in enumerate(hand.fingers)] for c in parts[i]]}

@@ -36,6 +36,7 @@ __all__ = [
     "check_record",
     "error_record",
     "diagnostics",
+    "failure_codes",
     "talking_rows",
     "json_values",
     "present",
@@ -310,6 +311,21 @@ def diagnostics(rec: dict) -> tuple[list[str], list[str]]:
         if isinstance(m := rec.get(key), dict) and "error" in m
     ]
     return errors, [f"{where}: warning: {w}" for w in rec["warnings"]]
+
+
+def failure_codes(rec: dict) -> list[tuple[str, str]]:
+    """``(kind label, code)`` of each kind that failed in a record of a grasp that was read
+    (a resolve, basis, check or forces record; the summary of a followed path).
+
+    >>> failure_codes({"ok": False, "off_tangent": {"x": 1}, "tangent": {"error": {"code": "normals-rank-deficient"}}})
+    [('tangent', 'normals-rank-deficient')]
+    """
+    if "summary" in rec:
+        return [(c["method"], c["code"]) for c in rec["summary"]["degenerate"]]
+    labels = [(k.key, k.label) for k in KINDS] + [(part, part) for part in FORCE_PARTS]
+    return [
+        (label, m["error"]["code"]) for key, label in labels if isinstance(m := rec.get(key), dict) and "error" in m
+    ]
 
 
 def dumps(obj, indent: bool = False) -> bytes:

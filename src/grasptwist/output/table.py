@@ -416,6 +416,18 @@ def _fingers(names, moves, components) -> list[str]:
     return [names[i] for i, c in enumerate(components) if moves[c]]
 
 
+def _finger_list(names: list[str]) -> str:
+    """Fingers named in prose (a finger is named by its contact).
+
+    >>> _finger_list(["1"]), _finger_list(["1", "2"]), _finger_list(["thumb", "index", "middle"])
+    ('finger 1', 'fingers 1 and 2', 'fingers thumb, index and middle')
+    """
+    names = [escaped(n) for n in names]
+    if len(names) == 1:
+        return f"finger {names[0]}"
+    return f"fingers {', '.join(names[:-1])} and {names[-1]}"
+
+
 def _products(title, names, table, d, conditioning) -> list:
     """A title line and a 3x3 table of Klein products."""
     t = _table("", *names, numbers=names)
@@ -465,13 +477,15 @@ class OffTangentTable:
         held = _fingers(names, m["moves"], (3, 4, 5))  # Psi_i holds finger i
         moved = _fingers(names, m["moves"], (0, 1, 2))  # Sigma_i moves finger i alone
         if held:
+            each = "is held fixed" if len(held) == 1 else "are each held fixed in turn"
             lines.append(
-                f"off-tangent: Psi part: finger(s) {', '.join(held)} each held fixed in turn while the object "
+                f"off-tangent: Psi part: {_finger_list(held)} {each} while the object "
                 "turns about the line from the wrist through it."
             )
         if moved:
+            each = "moves alone" if len(moved) == 1 else "each move alone"
             lines.append(
-                f"off-tangent: Sigma part: finger(s) {', '.join(moved)} each moved alone, about the line through the other two."
+                f"off-tangent: Sigma part: {_finger_list(moved)} {each}, about the line through the other two."
             )
         if m["about_wrist"]:
             lines.append("off-tangent: the twist is a rotation about the wrist: the wrist alone could make it.")
@@ -512,9 +526,10 @@ class TangentTable:
         if m["in_tangent_planes"]:
             return ["verdict: tangent sliding alone realises this twist (every beta_i = 0)."]
         off = _fingers(names, m["moves"], (3, 4, 5))  # beta_i Sigma_i moves finger i off its plane
+        planes = "its tangent plane" if len(off) == 1 else "their tangent planes"
         return [
             "verdict: not realisable by tangent sliding alone: "
-            f"finger(s) {', '.join(off)} must also move off their tangent planes (the beta_i Sigma_i part)."
+            f"{_finger_list(off)} must also move off {planes} (the beta_i Sigma_i part)."
         ]
 
     @staticmethod
@@ -548,7 +563,8 @@ class CheckTableWriter(_Writer):
     def __init__(self, out, **options):
         super().__init__(out, **options)
         self.kinds = [k for k in KINDS if k.check_fields]  # a kind with nothing to check has no column
-        self.grid = _table(*(k.label for k in self.kinds), "closure mu", "file", "grasp")
+        # a method's cell is "ok (its basis's conditioning)" or the code of its degeneracy
+        self.grid = _table(*(f"{k.label} (conditioning)" for k in self.kinds), "closure mu", "file", "grasp")
         self.widths: list[int] = []
 
     def write(self, encoded: bytes) -> None:
@@ -675,13 +691,18 @@ WRITERS = {"resolve": TableWriter, "basis": BasisTableWriter, "check": CheckTabl
 
 
 class HandTable:
-    """A hand's joint rates: per finger its joints and their rates, rank, residual, conditioning."""
+    """A hand's joint rates: per finger its joints with their positions and rates, rank, residual,
+    conditioning and tip error.
+
+    A finger is named by its contact, as in every line of the tables; the hand's own name for
+    it (TriFinger's ``0``, ``120``, ``240``) is shown once, beside it.
+    """
 
     skipped = "the grasp has no hand"
 
     @staticmethod
     def contact_columns(m, d) -> list:
-        return [("finger", [f["name"] for f in m["fingers"]])]
+        return []
 
     @staticmethod
     def resolve(m, names, d, rec):
@@ -689,18 +710,29 @@ class HandTable:
 
         ratio = m["velocity_limit_ratio"]
         title = "hand: joint rates" + ("" if ratio is None else f"   velocity-limit ratio {ratio:.3g}")
-        t = _table("finger", "contact", "joint", "rate", "rank", "residual", "conditioning", numbers=("rate",))
+        # where the hand is (its joint positions given or solved, each tip's distance to its contact)
+        placed = "joint_positions" in m["fingers"][0]
+        where = ("position",) if placed else ()
+        tip = ("tip error",) if placed else ()
+        t = _table(
+            "finger", "in hand", "joint", *where, "rate", "rank", "residual", "conditioning", *tip,
+            numbers=("rate", *where),
+        )  # fmt: skip
         for f in m["fingers"]:
+            positions = f.get("joint_positions", ())
             for k, (joint, rate) in enumerate(zip(f["joints"], f["joint_rates"])):
                 first = k == 0
+                error = "-" if f.get("tip_error") is None else f"{f['tip_error']:.2g}"
                 t.add_row(
-                    f["name"] if first else "",
                     f["contact"] if first else "",
+                    f["name"] if first else "",
                     joint,
+                    *((fmt_number(positions[k], d),) if placed else ()),
                     fmt_number(rate, d),
                     str(f["rank"]) if first else "",
                     f"{f['residual']:.2g}" if first else "",
                     f"{f['conditioning']:.3g}" if first else "",
+                    *(((error if first else ""),) if placed else ()),
                 )
         return Group(Text(title, style="bold"), t, *HandTable._moved_by(m, rec))
 
@@ -716,7 +748,7 @@ class HandTable:
                 for label, render, r in methods
                 if _shown(r)
             ]
-            lines.append(Text(f"finger {escaped(finger['name'])} is moved by: {'; '.join(parts)}"))
+            lines.append(Text(f"finger {escaped(finger['contact'])} is moved by: {'; '.join(parts)}"))
         return lines
 
     @staticmethod

@@ -42,9 +42,7 @@ __all__ = [
 HTML = ".html"
 #: plotly.js's file name beside the pages (``js_beside``).
 JS_NAME = "plotly.min.js"
-INSTALL_HINT = (
-    "grasptwist plot -o FILE.html needs plotly: pip install plotly (from a clone of grasptwist: pip install '.[html]')"
-)
+INSTALL_HINT = "grasptwist plot -o FILE.html needs plotly: pip install plotly (from a clone of grasptwist: pip install -e '.[html]')"
 _CONFIG = {"displaylogo": False, "responsive": True}
 
 

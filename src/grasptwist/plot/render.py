@@ -42,7 +42,7 @@ __all__ = [
 #: Image formats, by file suffix.
 FORMATS = (".png", ".svg", ".pdf")
 INSTALL_HINT = (
-    "grasptwist plot needs matplotlib: pip install matplotlib (from a clone of grasptwist: pip install '.[plot]')"
+    "grasptwist plot needs matplotlib: pip install matplotlib (from a clone of grasptwist: pip install -e '.[plot]')"
 )
 
 

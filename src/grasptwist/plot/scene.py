@@ -517,24 +517,25 @@ def grasp_scene(
     if grasp.hand is None:
         return picture
     joints = joint_segments(grasp.hand, grasp.joint_positions, _JOINT_HALF * _grasp_size(grasp.points))
-    chains = finger_links(grasp.hand, grasp.joint_positions, grasp.points) if links else ()
+    chains = finger_links(grasp.hand, grasp.joint_positions, grasp.points, grasp.contact_names) if links else ()
     return replace(picture, segments=picture.segments + joints + chains)
 
 
-def finger_links(hand, positions, contacts) -> tuple[LinePiece, ...]:
+def finger_links(hand, positions, contacts, names=("1", "2", "3")) -> tuple[LinePiece, ...]:
     """Each finger as its kinematic chain at ``positions``: segments from joint
-    to joint, on to the tip link's origin (URDF fingers) and to its contact.
+    to joint, on to the tip link's origin (URDF fingers) and to its contact,
+    labelled by that contact's name (``names``), as every output names a finger.
 
     >>> from grasptwist.io.grasp import inline_hand
     >>> h = inline_hand(["a", "b", "c"], [[("j", "revolute", [0, 0, 2], [1, 0, 0], None, 1)]] * 3, None)
     >>> s = finger_links(h, None, 3 * np.eye(3))[0]  # the joint at (1, 0, 0), its contact at (3, 0, 0)
     >>> s.label, s.start.tolist(), s.end.tolist()
-    ('a', [1.0, 0.0, 0.0], [3.0, 0.0, 0.0])
+    ('finger 1', [1.0, 0.0, 0.0], [3.0, 0.0, 0.0])
     """
     out = []
-    for finger, state, contact in zip(hand.fingers, finger_states(hand, positions), contacts):
+    for name, state, contact in zip(names, finger_states(hand, positions), contacts):
         stops = list(state.points) + ([] if state.tip is None else [state.tip[:3, 3]]) + [contact]
-        out += [LinePiece(a, b, finger.name, "finger-link") for a, b in zip(stops[:-1], stops[1:])]
+        out += [LinePiece(a, b, f"finger {name}", "finger-link") for a, b in zip(stops[:-1], stops[1:])]
     return tuple(out)
 
 

@@ -18,11 +18,12 @@ import numpy as np
 
 from ..engine import hands
 from ..engine.decompose import contact_velocities
+from ..engine.degeneracy import Status
 from ..engine.judgements import outward_normals
 from ..engine.screws import direction, twist_at
 from ..io.dataset import Dataset
 from ..model import CONTACT_NAMES, Grasp, GraspFileError, Twist
-from ..results import ALL_METHODS, BY_KEY, KINDS, METHOD_CHOICES, Field, ResultKind, selected
+from ..results import ALL_METHODS, BY_KEY, KINDS, METHOD_CHOICES, STATUS, Field, ResultKind, selected
 
 __all__ = [
     "METHODS",
@@ -32,8 +33,10 @@ __all__ = [
     "with_reasons",
     "dataset_blocks",
     "check_positions",
+    "hand_placement",
     "ROWS_PER_BLOCK",
     "NO_TWIST",
+    "UNKNOWN_TWIST",
     "ZERO_TWIST",
     "CONTACT_NAMES",
 ]
@@ -43,6 +46,9 @@ METHODS = METHOD_CHOICES
 
 #: Error code of a grasp that has no twist to resolve.
 NO_TWIST = "no-twist"
+
+#: Error code of a grasp that has no twist of a name ``--select`` gives.
+UNKNOWN_TWIST = "unknown-twist"
 
 #: The twist whose resolution carries just the bases (``basis`` and ``check``).
 ZERO_TWIST = Twist(name="0", screw=np.zeros(6), line=None)
@@ -131,6 +137,15 @@ class Block:
             failed |= ~r.ok & self.applies(key)
         return failed
 
+    def failure_codes(self) -> dict[tuple[str, str], int]:
+        """Rows per ``(kind label, status code)`` where a kind that applies failed."""
+        counts = {}
+        for kind in self.kinds():
+            status = self.value(kind.key, STATUS)[~self.results[kind.key].ok & self.applies(kind.key)]
+            for code, n in zip(*np.unique(status, return_counts=True)):
+                counts[(kind.label, Status(int(code)).code)] = int(n)
+        return counts
+
     def part(self, start: int, stop: int) -> Block:
         """Rows ``start:stop`` as a block of their own (views, no copies)."""
         return self.take(slice(start, stop))
@@ -181,6 +196,7 @@ def resolve_arrays(
     hands=None,
     joint_screws=None,
     joint_limits=None,
+    placement=None,
     has_wrist=None,
 ) -> Block:
     """One block from arrays of rows (a data set, or stacked grasps).
@@ -192,7 +208,8 @@ def resolve_arrays(
     :data:`METHODS`.  ``bases=False`` leaves out the basis screws, for
     outputs that do not show them (npz).  ``hands`` (per row a Hand or None)
     with ``joint_screws (N, 3, J, 6)`` and ``joint_limits (N, 3, J)``
-    (:func:`grasptwist.engine.hands.padded`) adds the kinds that need them.
+    (:func:`grasptwist.engine.hands.padded`) adds the kinds that need them;
+    ``placement`` (:func:`hand_placement`) says where the hands are.
     ``has_wrist`` (per row) says which rows have a wrist; by default those
     whose wrist is finite.
     """
@@ -203,7 +220,7 @@ def resolve_arrays(
     wrist = np.full((n, 3), np.nan) if wrist is None else wrist
     inputs = {"points": points, "normals": normals, "wrist": wrist, "twist": twist}
     if hands is not None:
-        inputs.update(joint_screws=joint_screws, joint_limits=joint_limits)
+        inputs.update(joint_screws=joint_screws, joint_limits=joint_limits, placement=placement)
     results = {}
     for k in kinds:
         if all(name in inputs for name in k.needs):
@@ -245,6 +262,7 @@ def resolve(
     twists: Sequence[Twist] | None = None,
     method: str = "both",
     chunk: int = 2048,
+    select: Sequence[str] | None = None,
 ) -> Iterator[Block | GraspFileError]:
     """Resolve every grasp against its twists, in order.
 
@@ -254,15 +272,19 @@ def resolve(
     twists : twists that replace each grasp's own (the command line's ``--twist``).
     method : one of :data:`METHODS`.
     chunk : rows per engine call; a chunk is flushed when full or at the end.
+    select : names of each grasp's own twists to resolve, in this order (``--select``).
 
     Yields
     ------
-    Blocks of consecutive rows and, in their places, the loader's errors and
-    an error with code :data:`NO_TWIST` for each grasp without a twist.
+    Blocks of consecutive rows and, in their places, the loader's errors, an
+    error with code :data:`NO_TWIST` for each grasp without a twist and one
+    with code :data:`UNKNOWN_TWIST` for each grasp without a twist ``select`` names.
     """
     pending: list[Grasp | GraspFileError] = []
     rows = 0
     for item in items:
+        if select is not None and isinstance(item, Grasp):
+            item = selected_twists(item, select)
         pending.append(item)
         if isinstance(item, Grasp):
             rows += len(twists if twists is not None else item.twists)
@@ -317,15 +339,51 @@ def _hand_inputs(grasps) -> dict:
     if all(g.hand is None for g in grasps):
         return {}
 
+    from ..engine.ik import home_tips, place_hand
+
     width = max(len(f.joints) for g in grasps if g.hand is not None for f in g.hand.fingers)
     made = {}  # each grasp's fingers once, whatever its number of twists
     for g in grasps:
         if g.hand is not None and id(g) not in made:
             states = hands.finger_states(g.hand, g.joint_positions)
-            made[id(g)] = hands.padded(g.hand, [s.screws for s in states], width)
-    none = (np.zeros((3, width, 6)), np.full((3, width), np.nan))
-    screws, limits = zip(*(made.get(id(g), none) for g in grasps))
-    return {"hands": [g.hand for g in grasps], "joint_screws": np.stack(screws), "joint_limits": np.stack(limits)}
+            # the loader placed the hand (given and checked, or solved): its tip errors at those positions
+            placed = place_hand(g.hand, g.points, g.joint_positions, tips=home_tips(g.hand, g.points))
+            made[id(g)] = (
+                *hands.padded(g.hand, [s.screws for s in states], width),
+                *hand_placement(g.hand, placed, width),
+            )
+    none = (np.zeros((3, width, 6)), np.full((3, width), np.nan), np.full((3, width), np.nan), np.full(3, np.nan))
+    none += (np.zeros(3, bool),)
+    screws, limits, positions, tip_error, within = (np.stack(a) for a in zip(*(made.get(id(g), none) for g in grasps)))
+    return {
+        "hands": [g.hand for g in grasps],
+        "joint_screws": screws,
+        "joint_limits": limits,
+        "placement": {"joint_positions": positions, "tip_error": tip_error, "within_limits": within},
+    }
+
+
+def hand_placement(hand, placed, width=None) -> tuple:
+    """``(joint positions (..., 3, width), tip error (..., 3), within limits (..., 3))`` of a hand
+    placed (:class:`~grasptwist.engine.ik.HandIK`), as a block's ``placement`` holds them."""
+    return hands.padded_positions(hand, placed.positions, width), placed.tip_error, placed.within_limits
+
+
+def selected_twists(grasp: Grasp, names: Sequence[str]) -> Grasp | GraspFileError:
+    """The grasp with its twists named ``names`` only, in that order, or an error with code
+    :data:`UNKNOWN_TWIST` naming those it lacks and those it has."""
+    own = {t.name: t for t in grasp.twists}
+    missing = [n for n in dict.fromkeys(names) if n not in own]
+    if not missing:
+        return replace(grasp, twists=tuple(own[n] for n in dict.fromkeys(names)))
+    has = ", ".join(f"'{n}'" for n in own) or "none"
+    return GraspFileError(
+        code=UNKNOWN_TWIST,
+        message=f"grasp '{grasp.name}' has no twist {', '.join(repr(n) for n in missing)} (its twists: {has})",
+        file=grasp.file,
+        line=grasp.line,
+        column=1,
+    )
 
 
 def _no_twist(grasp: Grasp) -> GraspFileError:
@@ -358,8 +416,11 @@ def dataset_blocks(
     linear part is the velocity of the row's ``at`` point.  ``bases=False``
     leaves the basis screws out (see :func:`resolve_arrays`).
     ``hand_of_rows`` (a Hand, e.g. from ``--hand``) holds every row: at the
-    data set's ``joint_positions`` (at 0 without them), its joint rates are
-    computed per row.
+    data set's ``joint_positions``, each row's checked (``contact-off-finger``),
+    or without them at joint positions solved per row by inverse kinematics
+    (``unreachable``, ``outside-limits`` where they fail; a hand given inline
+    is at the configuration its screws describe), its joint rates are computed
+    per row.
 
     Raises
     ------
@@ -399,19 +460,41 @@ def check_positions(ds, hand_of_rows) -> None:
         )
 
 
-def _rows_hand(ds, hand_of_rows, start, stop, rows, n):
-    """The hand keywords of :func:`resolve_arrays` for rows ``start:stop`` of a data set."""
+def _rows_hand(ds, hand_of_rows, start, stop, rows, points):
+    """The hand keywords of :func:`resolve_arrays` for rows ``start:stop`` of a data set, and the
+    hand placed on each row's contacts (:func:`~grasptwist.engine.ik.place_hand`: the rows' joint
+    positions checked, or solved for when the data set has none)."""
     if hand_of_rows is None:
-        return {}
+        return {}, None
+    from ..engine.ik import place_hand
 
     q = None if ds.joint_positions is None else np.asarray(ds.joint_positions[start:stop], dtype=float)[rows]
-    states = hands.finger_states(hand_of_rows, q)
+    placed = place_hand(hand_of_rows, points, q)
+    states = hands.finger_states(hand_of_rows, placed.positions)
     screws, limits = hands.padded(hand_of_rows, [s.screws for s in states])
+    n = len(points)
+    positions, tip_error, within = hand_placement(hand_of_rows, placed)
     return {
         "hands": [hand_of_rows] * n,
-        "joint_screws": np.broadcast_to(screws, (n, *screws.shape[-3:])),
+        "joint_screws": screws,
         "joint_limits": np.broadcast_to(limits, (n, *limits.shape)),
-    }
+        "placement": {"joint_positions": positions, "tip_error": tip_error, "within_limits": within},
+    }, placed
+
+
+def _placed(block, placed):
+    """``block`` with its hand status, where a hand is not on its contacts, saying so (that
+    finger the culprit): a row's joint rates are only worth what its joint positions are."""
+    if placed is None or "hand" not in block.results:
+        return block
+    r = block.results["hand"]
+    off = ~placed.ok
+    culprit = placed.culprit
+    status = np.take_along_axis(placed.status, np.maximum(culprit, 0)[:, None].astype(np.intp), axis=-1)[:, 0]
+    block.results["hand"] = replace(
+        r, status=np.where(off, status, r.status).astype(np.int8), culprit=np.where(off, culprit, r.culprit)
+    )
+    return block
 
 
 def _dataset_block(ds, given, twists, method, start, stop, k, bases, hand_of_rows=None):
@@ -435,8 +518,10 @@ def _dataset_block(ds, given, twists, method, start, stop, k, bases, hand_of_row
         screw = twist_at(screw[:, :3], screw[:, 3:], at)
     # labels stay a numpy string array: a million Python strings cost more than the engine
     label = _labels(ds.names[start:stop][rows]) if ds.names is not None else index.astype(str)
-    return resolve_arrays(
-        column(ds.points),
+    points = column(ds.points)
+    hand_inputs, placed = _rows_hand(ds, hand_of_rows, start, stop, rows, points)
+    block = resolve_arrays(
+        points,
         # unit normals exactly as the grasp-file loader makes them
         direction(np.asarray(ds.normals[start:stop], dtype=float))[rows],
         column(ds.wrist),
@@ -448,8 +533,9 @@ def _dataset_block(ds, given, twists, method, start, stop, k, bases, hand_of_row
         bases=bases,
         # a data set's wrist column gives every row a wrist: NaN in it is a nonfinite-input, not "no wrist"
         has_wrist=None if ds.wrist is None else np.ones(len(index), bool),
-        **_rows_hand(ds, hand_of_rows, start, stop, rows, len(index)),
+        **hand_inputs,
     )
+    return _placed(block, placed)
 
 
 def _labels(names: np.ndarray) -> np.ndarray:

@@ -23,12 +23,13 @@ import numpy as np
 
 from ..engine import hands
 from ..engine.hands import HandTrack
+from ..engine.ik import home_tips, place_hand
 from ..engine.path import PathDegeneracies, Poses, degeneracies, follow
 from ..io.datasets import DATASET_SUFFIXES
 from ..io.inputs import read
 from ..model import Grasp, GraspFileError, Hand, ObjectPath
 from ..results import BY_KEY, selected
-from .batch import Block, with_reasons
+from .batch import Block, hand_placement, with_reasons
 from .pipeline import Output
 
 __all__ = [
@@ -160,7 +161,8 @@ def write_follow(job: FollowJob, inputs: Iterable, w, fmt: str, order: str = "om
             else:
                 for encoded in encoding.samples(item, order):
                     w.write(encoded)
-            yield Output(records=len(item.block), failed=int(item.block.failed_rows().sum()))
+            failed = int(item.block.failed_rows().sum())
+            yield Output(records=len(item.block), failed=failed, degenerate=item.block.failure_codes())
             continue
         rec = error_record(item) if isinstance(item, GraspFileError) else fr.summary_record(item)
         encode = encoding.error if isinstance(item, GraspFileError) else encoding.summary
@@ -169,7 +171,9 @@ def write_follow(job: FollowJob, inputs: Iterable, w, fmt: str, order: str = "om
         errors, warnings = (
             diagnostics(rec) if isinstance(item, GraspFileError) else fr.diagnostics(rec, item.grasp.contact_names)
         )
-        yield Output(errors=errors, warnings=warnings, records=1, failed=int(not rec["ok"]))
+        out = Output(errors=errors, warnings=warnings, records=1)
+        out.count(rec)
+        yield out
 
 
 def follow_grasp(job: FollowJob, grasp: Grasp) -> Iterator[GraspFileError | Samples | Summary]:
@@ -218,7 +222,11 @@ def _block(grasp, name, f, bases, method, positions=None) -> Block:
     if positions is not None:  # the hand's joint rates at its integrated positions, as resolve's
         states = hands.finger_states(grasp.hand, positions)
         screws, limits = hands.padded(grasp.hand, [s.screws for s in states])
+        # where each finger's tip is against its moving contact (the tracker's error), in the records
+        placed = place_hand(grasp.hand, f.points, positions, tips=home_tips(grasp.hand, grasp.points))
+        placement = dict(zip(("joint_positions", "tip_error", "within_limits"), hand_placement(grasp.hand, placed)))
         inputs = {"joint_screws": screws, "joint_limits": limits, "points": f.points, "twist": f.poses.twist}
+        inputs["placement"] = placement
         results["hand"] = BY_KEY["hand"].compute({**inputs, **results}, bases)
     block = Block(
         file=[grasp.file] * n,

@@ -28,7 +28,15 @@ from ..io.lines import grasp_batches
 from ..model import GraspFileError, Hand, Twist, Wrench
 from ..output.force_records import force_records
 from ..output.formats import FORMATS
-from ..output.records import basis_record, check_record, diagnostics, error_record, records, talking_rows
+from ..output.records import (
+    basis_record,
+    check_record,
+    diagnostics,
+    error_record,
+    failure_codes,
+    records,
+    talking_rows,
+)
 from ..results import ForceOptions, check_closure
 from .batch import ZERO_TWIST, Block, check_positions, dataset_blocks, resolve
 from .forces import ForceBlock, force_blocks, force_dataset_blocks
@@ -55,6 +63,7 @@ class Job:
     extra_point: str = "wrist"
     hand: Hand | None = None  # --hand: the hand of a data set's rows, whose joints CSV and npz columns name
     twists_from: str | None = None  # a stream of twists (a file or -) for every grasp
+    select: tuple[str, ...] | None = None  # resolve --select: the names of the grasps' own twists to resolve
     wrenches: tuple[Wrench, ...] | None = None  # forces: --wrench, replacing the files' wrenches
     friction: float | None = None  # forces: --friction, replacing the files' friction
     forces: ForceOptions = field(default_factory=ForceOptions)  # forces: safety, quality, cone edges
@@ -96,8 +105,9 @@ class Output:
     row_errors: list[str] = field(default_factory=list)  # of a data set's or stream's rows: printed like warnings
     warnings: list[str] = field(default_factory=list)
     records: int = 0
-    failed: int = 0
-    failed_rows: int = 0  # of ``failed``: rows of a data set or stream
+    failed: int = 0  # records not ok: inputs that failed, and grasps (or rows) with a degenerate method
+    inputs_failed: int = 0  # of ``failed``: inputs (files, documents, lines of a stream) that could not be read
+    degenerate: dict = field(default_factory=dict)  # of the other failed records: per (kind, code), how many
     done: int = 0  # progress: files read, or data-set records made
     extra_work: int = 0  # progress: work found beyond the one unit an input was counted as
     spool: str | None = None  # a file holding ``encoded`` (see _sealed)
@@ -121,8 +131,16 @@ class Output:
         row = self.rows and not ("error" in rec and rec["error"]["line"] is None)
         (self.row_errors if row else self.errors).extend(errors)
         self.warnings += warnings
+        self.count(rec)
+
+    def count(self, rec: dict) -> None:
+        """Count a record that is not ok: an input that failed, or by the codes of its failed kinds."""
         self.failed += not rec["ok"]
-        self.failed_rows += row and not rec["ok"]
+        if "error" in rec:
+            self.inputs_failed += 1
+        elif not rec["ok"]:
+            for code in failure_codes(rec):
+                self.degenerate[code] = self.degenerate.get(code, 0) + 1
 
 
 def record_outputs(job: Job, paths: Sequence, workers: int = 1, tuning: Tuning = TUNING) -> Iterator[Output]:
@@ -155,7 +173,8 @@ def _alone(job: Job, path: str, workers: int, tuning: Tuning) -> Iterator[Output
     if job.kind == "forces":
         return _streamed(job, _force_batches(job, path, tuning), tuning)
     twists = [ZERO_TWIST] if job.kind != "resolve" else job.twists
-    return _streamed(job, grasp_stream(path, twists, job.method, job.max_bytes, tuning.files_per_group), tuning)
+    batches = grasp_stream(path, twists, job.method, job.max_bytes, tuning.files_per_group, job.select)
+    return _streamed(job, batches, tuning)
 
 
 def _streamed(job: Job, batches, tuning: Tuning, files_first: bool = False) -> Iterator[Output]:
@@ -254,7 +273,8 @@ def run_group(job: Job, paths: Sequence, tuning: Tuning = TUNING, spool: Spool |
     if job.kind == "forces":
         results = force_blocks(items, job.wrenches, job.friction, job.forces)
     else:
-        results = resolve(items, [ZERO_TWIST] if job.kind != "resolve" else job.twists, job.method)
+        twists = [ZERO_TWIST] if job.kind != "resolve" else job.twists
+        results = resolve(items, twists, job.method, select=job.select)
     for x in results:
         _encode_into(job, x, out, tuning.records_at_once)
     return _sealed(job, out, spool)
@@ -287,7 +307,7 @@ def blocks(
             yield from ((x, None, True) for batch in _force_batches(job, g, tuning) for x in batch)
             continue
         if is_stream(g):
-            batches = grasp_stream(g, job.twists, job.method, job.max_bytes, tuning.files_per_group)
+            batches = grasp_stream(g, job.twists, job.method, job.max_bytes, tuning.files_per_group, job.select)
             yield from ((x, None, True) for batch in batches for x in batch)
             continue
         if _is_dataset(g) and job.kind == "forces":
@@ -316,7 +336,7 @@ def blocks(
         if job.kind == "forces":
             yield from ((x, None, False) for x in force_blocks(items, job.wrenches, job.friction, job.forces))
             continue
-        for x in resolve(items, job.twists, job.method):
+        for x in resolve(items, job.twists, job.method, select=job.select):
             yield x, None, False
 
 

@@ -29,10 +29,11 @@ def is_stream(path) -> bool:
     return isinstance(path, str) and (path == STDIN or is_json_lines(path))
 
 
-def grasp_stream(path: str, twists, method: str, max_bytes: int | None, per_batch: int) -> Iterator[list]:
-    """The resolved rows (blocks) and errors of the grasps of the stream ``path``, a batch of lines at a time."""
+def grasp_stream(path: str, twists, method: str, max_bytes: int | None, per_batch: int, select=None) -> Iterator[list]:
+    """The resolved rows (blocks) and errors of the grasps of the stream ``path``, a batch of lines at a
+    time (``select``: the names of their own twists to resolve)."""
     for batch in grasp_batches(path, max_bytes, per_batch):
-        yield list(resolve(batch, twists, method))
+        yield list(resolve(batch, twists, method, select=select))
 
 
 def twist_stream(

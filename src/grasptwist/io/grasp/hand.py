@@ -6,13 +6,15 @@ Two forms (README, "Hands and joint rates"), never mixed:
   ``point``, ``velocity_limit``) at the current configuration;
 * URDF: ``urdf`` (a path relative to the grasp file, or ``package://``),
   ``joint_positions`` and ``fingers``, each naming the ``tip`` link that
-  touches its contact.
+  touches its contact.  Without ``joint_positions``, they are solved by
+  inverse kinematics from ``seed`` (else every joint at 0): each finger's
+  tip link origin on its contact.
 
 Checked with the loader's shared typed-value checks (:mod:`.values`), so
 problems are located and coded like the rest of the format; a URDF's own problems
 (:mod:`grasptwist.io.urdf`) are reported at the ``urdf`` key, the URDF's
-file and line in the message.  Forward kinematics and the length check
-are the engine's (:mod:`grasptwist.engine.kinematics`).
+file and line in the message.  Forward kinematics, the inverse kinematics
+and the contact-off-finger check are the engine's (:mod:`grasptwist.engine.ik`).
 """
 
 from __future__ import annotations
@@ -23,7 +25,9 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from ...engine.hands import finger_states, joint_positions
+from ...engine.degeneracy import Status
+from ...engine.hands import joint_positions
+from ...engine.ik import place_hand
 from ...engine.kinematics import chain_length, joint_screw
 from ...model import Finger, Hand, InputError, Joint
 from ..limits import DEFAULT_MAX_BYTES
@@ -55,14 +59,14 @@ __all__ = [
     "inline_hand",
 ]
 
-HAND_KEYS = ("urdf", "joint_positions", "fingers")
+HAND_KEYS = ("urdf", "joint_positions", "seed", "fingers")
 INLINE_FINGER_KEYS = ("name", "joints")
 URDF_FINGER_KEYS = ("name", "tip")
 JOINT_KEYS = ("name", "type", "axis", "point", "velocity_limit")
 JOINT_TYPES = ("revolute", "prismatic")
 
 
-def read_hand(node, points, file, problems):
+def read_hand(node, points, file, problems, contact_names=("1", "2", "3")):
     """``(Hand, joint positions)`` of a ``hand`` node, or None after a problem.
 
     ``points`` are the contacts (None when they had problems); ``file`` is
@@ -72,13 +76,23 @@ def read_hand(node, points, file, problems):
     if fields is None:
         return None
     urdf = "urdf" in fields
-    if not urdf and "joint_positions" in fields:
+    for key in ("joint_positions", "seed"):
+        if not urdf and key in fields:
+            problems.add(
+                Reject(
+                    "conflicting-keys",
+                    f"hand.{key}",
+                    "only with 'urdf' (inline joints are given at their current configuration)",
+                    **located(fields[key]),
+                )
+            )
+    if "seed" in fields and "joint_positions" in fields:
         problems.add(
             Reject(
                 "conflicting-keys",
-                "hand.joint_positions",
-                "only with 'urdf' (inline joints are given at their current configuration)",
-                **located(fields["joint_positions"]),
+                "hand.seed",
+                "only without 'joint_positions' (the seed is where inverse kinematics starts from)",
+                **located(fields["seed"]),
             )
         )
     items = read_sequence(fields["fingers"], "hand.fingers", problems) if "fingers" in fields else None
@@ -118,7 +132,7 @@ def read_hand(node, points, file, problems):
         return None
     names = list(names)
     if urdf:
-        return _urdf_hand(fields, fingers, names, points, file, problems)
+        return _urdf_hand(fields, fingers, names, (points, contact_names), file, problems)
     taken = {}  # joint names, unique over the hand
     joints = [_joints(f["joints"], f"hand.fingers[{i}]", names[i], taken, problems) for i, f in enumerate(fingers)]
     if problems.count:
@@ -245,11 +259,16 @@ def inline_hand(names, fingers, points):
     return Hand(tuple(out), tuple(joint_names), None, None)
 
 
-def _urdf_hand(fields, fingers, names, points, file, problems):
-    """The URDF form: load the hand, place its joints, check the contacts are on its tips."""
+def _urdf_hand(fields, fingers, names, contacts, file, problems):
+    """The URDF form: load the hand, then its joints at ``joint_positions`` with the contacts
+    ``(points, names)`` checked on its tips, or else at joint positions solved from ``seed``
+    (engine's ``place_hand``)."""
+    points, contact_names = contacts
     node = fields["urdf"]
     reference = read_name(node, "hand.urdf", problems)
-    positions = _positions(fields.get("joint_positions"), problems)
+    given = "joint_positions" in fields
+    key = "joint_positions" if given else "seed"
+    positions = _positions(fields.get(key), key, problems)
     tips = [read_name(f["tip"], f"hand.fingers[{i}].tip", problems) for i, f in enumerate(fingers)]
     if problems.count:
         return None
@@ -265,7 +284,7 @@ def _urdf_hand(fields, fingers, names, points, file, problems):
             problems.add(
                 Reject(
                     "unknown-joint",
-                    f"hand.joint_positions.{name}",
+                    f"hand.{key}.{name}",
                     f"not a joint of the hand's fingers ({', '.join(hand.joint_names)})",
                     **located(key_node),
                 )
@@ -275,41 +294,71 @@ def _urdf_hand(fields, fingers, names, points, file, problems):
         return None
     q = joint_positions(hand, values)
     if points is None:  # a hand file: the contacts come with each row
-        return hand, q
-    for f, (finger, state) in enumerate(zip(hand.fingers, finger_states(hand, q))):
-        distance = float(np.linalg.norm(points[f] - state.tip[:3, 3]))
-        if distance > finger.length:
+        if "seed" in fields:  # not silently dropped: --hand's rows are solved from home
             problems.add(
                 Reject(
-                    "contact-off-finger",
+                    "conflicting-keys",
+                    "hand.seed",
+                    "only in a grasp file (a data set's rows without joint_positions are solved from every joint at 0)",
+                    **located(fields["seed"]),
+                )
+            )
+            return None
+        return hand, q
+    placed = place_hand(hand, points, q) if given else place_hand(hand, points, seed=q)
+    for f, finger in enumerate(hand.fingers):
+        status = Status(int(placed.status[f]))
+        if status != Status.OK:
+            problems.add(
+                Reject(
+                    status.code,
                     f"hand.fingers[{f}].tip",
-                    f"contact {f + 1} is {distance:.6g} from the origin of link {finger.tip!r}, farther than "
-                    f"finger {finger.name!r} is long ({finger.length:.6g}): are the contacts in the URDF's root frame?",
+                    _placement_message(status, contact_names[f], finger, float(placed.tip_error[f])),
                     **located(fingers[f]["tip"]),
                 )
             )
-    return None if problems.count else (hand, q)
+    return None if problems.count else (hand, placed.positions)
 
 
-def _positions(node, problems):
-    """``{joint: (position, key node)}`` of ``joint_positions`` (empty when not given)."""
+def _placement_message(status, name, finger, distance):
+    """Why the finger of contact ``name`` (named by it, as everywhere) is not on its contact, with the
+    distance from its tip link's origin."""
+    if status == Status.CONTACT_OFF_FINGER:
+        return (
+            f"contact {name} is {distance:.6g} from the origin of its finger's tip link {finger.tip!r}, farther "
+            f"than the finger is long ({finger.length:.6g}): are the contacts in the URDF's root frame?"
+        )
+    if status == Status.OUTSIDE_LIMITS:
+        return (
+            f"finger {name} reaches its contact only with a joint outside its limits: "
+            "move the contact, or give joint_positions"
+        )
+    return (
+        f"finger {name} cannot reach its contact: the origin of its tip link {finger.tip!r} comes "
+        f"no closer than {distance:.6g} (the finger is {finger.length:.6g} long): "
+        "are the contacts in the URDF's root frame?"
+    )
+
+
+def _positions(node, key, problems):
+    """``{joint: (position, key node)}`` of ``joint_positions`` or ``seed`` (``key``; empty when not given)."""
     if node is None or node.kind == "invalid":
         return {}
     if node.kind != "mapping":
         problems.add(
             Reject(
                 "not-a-mapping",
-                "hand.joint_positions",
+                f"hand.{key}",
                 f"expected a mapping of joint names to positions, got {describe(node)}",
                 **located(node),
             )
         )
         return {}
     out = {}
-    for key, (key_node, value) in node.value.items():
-        number = read_number(value, join("hand.joint_positions", key), problems)
+    for name, (key_node, value) in node.value.items():
+        number = read_number(value, join(f"hand.{key}", name), problems)
         if number is not None:
-            out[str(key)] = (number, key_node)
+            out[str(name)] = (number, key_node)
     return out
 
 
@@ -356,7 +405,8 @@ def load_hand_file(path, *, max_bytes=DEFAULT_MAX_BYTES):
 def _read(fields, found, problems):
     if "hand" not in fields:
         return {}
-    hand = read_hand(fields["hand"], found.get("points"), found["file"], problems)
+    names = found.get("contact_names") or ("1", "2", "3")
+    hand = read_hand(fields["hand"], found.get("points"), found["file"], problems, names)
     return None if hand is None else {"hand": hand[0], "joint_positions": readonly(hand[1])}
 
 
