@@ -783,7 +783,8 @@ def test_pyyaml_dumped_grasps_load_back(documents):
             default_names = [str(k + 1) for k in range(3)]
             names = tuple(c.get("name", d) for c, d in zip(doc["contacts"], default_names))
             if len(set(names)) < 3:  # an explicit name equal to another's default
-                assert [e.code for e in mine] == ["duplicate-name"] * (3 - len(set(names)))
+                # one entry: a document reports each kind of problem once, counting the rest
+                assert [e.code for e in mine] == ["duplicate-name"]
                 continue
             (grasp,) = mine
             assert isinstance(grasp, Grasp), str(grasp)

@@ -315,14 +315,17 @@ def diagnostics(rec: dict) -> tuple[list[str], list[str]]:
 
 def failure_codes(rec: dict) -> list[tuple[str, str]]:
     """``(kind label, code)`` of each kind that failed in a record of a grasp that was read
-    (a resolve, basis or check record; the summary of a followed path).
+    (a resolve, basis, check or forces record; the summary of a followed path).
 
     >>> failure_codes({"ok": False, "off_tangent": {"x": 1}, "tangent": {"error": {"code": "normals-rank-deficient"}}})
     [('tangent', 'normals-rank-deficient')]
     """
     if "summary" in rec:
         return [(c["method"], c["code"]) for c in rec["summary"]["degenerate"]]
-    return [(k.label, m["error"]["code"]) for k in KINDS if isinstance(m := rec.get(k.key), dict) and "error" in m]
+    labels = [(k.key, k.label) for k in KINDS] + [(part, part) for part in FORCE_PARTS]
+    return [
+        (label, m["error"]["code"]) for key, label in labels if isinstance(m := rec.get(key), dict) and "error" in m
+    ]
 
 
 def dumps(obj, indent: bool = False) -> bytes:
