@@ -284,6 +284,7 @@ def test_every_help_has_an_example(command):
     assert r.exit_code == 0 and ("grasptwist " + command) in r.stdout
 
 
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_installed_entry_point_in_a_subprocess(files):
     exe = Path(sys.executable).parent / "grasptwist"
     cmd = [str(exe)] if exe.exists() else [sys.executable, "-m", "grasptwist"]
@@ -322,6 +323,7 @@ def test_two_workers_write_exactly_what_one_writes(files):
     assert len(one.stdout.splitlines()) == 2 + 1 + 2 * (more - 1) + 1  # poly, cyl, good files x 2 twists, the bad one
 
 
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_a_progress_bar_on_a_terminal(files):
     import pty
 
@@ -368,6 +370,7 @@ def test_what_a_new_user_ran_into(files, tmp_path):
     assert r.exit_code == 1 and "-: error: read-error: cannot read: standard input can be read only once" in r.stderr
 
 
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_a_reader_that_goes_away_ends_the_run_quietly_with_141(files):
     exe = Path(sys.executable).parent / "grasptwist"
     cmd = [str(exe)] if exe.exists() else [sys.executable, "-m", "grasptwist"]

@@ -23,6 +23,7 @@ def png_size(path):
     return int.from_bytes(data[16:20], "big"), int.from_bytes(data[20:24], "big")
 
 
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_one_grasp_and_twist_to_png_and_svg(tmp_path):
     r = run("plot", GRASPS / "cylinder.yaml", "--select", "spin-z", "-o", tmp_path / "c.png")
     assert r.exit_code == 0, r.output
@@ -34,6 +35,7 @@ def test_one_grasp_and_twist_to_png_and_svg(tmp_path):
     assert r.exit_code == 0 and (tmp_path / "p.svg").read_text().lstrip().startswith("<?xml")
 
 
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_a_folder_gives_one_image_per_grasp_and_twist_and_an_error_line_per_bad_input(tmp_path):
     # one good grasp (drawn once: the drawing itself is tested in test_plot), one the method
     # cannot draw, one file that cannot be read
@@ -110,6 +112,7 @@ def test_the_other_commands_never_import_matplotlib_or_rich_for_machine_output()
     assert out.stdout.split() == ["0", "False", "False"]
 
 
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_the_old_twist_name_still_picks_a_twist_with_one_deprecation_line(tmp_path):
     new = run("plot", GRASPS / "cylinder.yaml", "--select", "lift-z", "-o", tmp_path / "new.png")
     old = run("plot", GRASPS / "cylinder.yaml", "--twist-name", "lift-z", "-o", tmp_path / "old.png")

@@ -81,6 +81,7 @@ def test_off_tangent_asked_for_on_a_grasp_without_wrist_fails_with_no_wrist(file
 
 
 @pytest.mark.parametrize("command, cli", [("check", run_installed), ("basis", in_process)])
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_check_and_basis_fail_an_off_tangent_asked_for_without_wrist_and_warn_under_both(files, command, cli):
     path = files / "nowrist.yaml"
     p, _ = cli(command, path, "--method", "off-tangent", "-f", "jsonl")
@@ -98,6 +99,7 @@ def test_check_and_basis_fail_an_off_tangent_asked_for_without_wrist_and_warn_un
     assert p.stderr.splitlines() == [f"{where(path, None)}: warning: {SKIPPED}", "1 record: all ok"]
 
 
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_under_both_the_skip_is_a_warning_and_the_tangent_result_stays(files):
     path = files / "nowrist.yaml"
     p, _ = run_installed("resolve", path, "-f", "jsonl")

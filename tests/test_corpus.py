@@ -178,6 +178,7 @@ INSTALLED = ["alias-bomb.yaml", "deep-20000.yaml", "far-above-cap.yaml", "binary
 
 
 @pytest.mark.parametrize("corpus_file", INSTALLED, indirect=True)
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_hostile_files_through_the_installed_command(corpus_file, tmp_path):
     row = BY_NAME[corpus_file.name]
     proc, _ = run_installed("resolve", corpus_file, "-f", "jsonl", cwd=tmp_path)
@@ -235,6 +236,7 @@ def mixed(tmp_path):
     (folder / "locked.yaml").chmod(0o644)
 
 
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_a_mixed_folder_gives_each_file_exactly_what_it_gives_alone(mixed):
     folder, root_reads = mixed
     result, _ = run("resolve", folder, "-f", "jsonl")
@@ -323,6 +325,7 @@ def _dashes_check(folder, files, limit_mb):
     assert peak < limit_mb, f"{peak:.0f} MB"
 
 
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_a_mebibyte_of_document_markers_is_cut_short_in_little_memory(tmp_path):
     # 0.1: 262,144 records and 1.3 GB; now 101 records and ~40 MB (an interpreter's worth)
     (tmp_path / "in").mkdir()

@@ -25,6 +25,7 @@ def check(name, *args) -> list[str]:
     return out.stdout.splitlines()
 
 
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_sharded_parquet_named_twists_and_arrays_on_the_synchronous_scheduler(tmp_path):
     # resolve_dataframe over 3 Parquet shards equals `grasptwist resolve shards -f parquet` bit for bit
     assert check("the_default_run", tmp_path) == [

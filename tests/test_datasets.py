@@ -62,6 +62,7 @@ def comparable(rec):
     return out
 
 
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_npz_gives_the_same_records_as_one_yaml_file_per_grasp(tmp_path, data):
     points, normals, wrist, twist = data
     np.savez(
@@ -245,6 +246,7 @@ def test_a_data_set_over_two_workers_gives_the_same_output(tmp_path, data):
     assert two == one and len(one[0].splitlines()) == N
 
 
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_workers_spool_through_the_kernel_to_pipes_and_files(tmp_path, data):
     import subprocess
     import sys

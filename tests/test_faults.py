@@ -226,6 +226,7 @@ def test_a_symlink_stays_and_its_target_gets_the_output(tmp_path):
     assert (tmp_path / "target.jsonl").read_bytes() == (tmp_path / "new.jsonl").read_bytes()
 
 
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_dev_stdout_is_written_through(tmp_path):
     out = tmp_path / "out.jsonl"
     with open(out, "wb") as f:
@@ -292,6 +293,7 @@ def test_a_stop_signal_ends_a_parallel_run_cleanly(tmp_path, rows, sig, group, t
     assert_no_debris(run, tmp_path)
 
 
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_a_stop_signal_removes_the_npz_spill(tmp_path, rows):
     # the npz format with a spill threshold of 1 MiB instead of 512 MiB, so that a small data set spills
     launcher = (
@@ -309,6 +311,7 @@ def test_a_stop_signal_removes_the_npz_spill(tmp_path, rows):
     assert_no_debris(run, tmp_path)
 
 
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_sigkill_of_the_parent_takes_its_workers_and_leaves_no_output(tmp_path, rows):
     run = Run(tmp_path, "resolve", rows, *TWIST, "-f", "jsonl", "-j", "2", "-o", tmp_path / "out.jsonl")
     run.wait_started()
@@ -358,6 +361,7 @@ def test_a_pool_reports_a_dead_worker_and_a_task_that_raised():
     assert "Traceback" in failed.value.__notes__[0]
 
 
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_a_data_set_shrinking_under_a_parallel_run_is_a_bus_error_not_a_hang(tmp_path, rows):
     victim = tmp_path / "victim.npy"
     shutil.copy(rows, victim)
@@ -371,6 +375,7 @@ def test_a_data_set_shrinking_under_a_parallel_run_is_a_bus_error_not_a_hang(tmp
     assert_no_debris(run, tmp_path)
 
 
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_a_file_swapped_for_a_fifo_after_the_listing_is_a_read_error_not_a_hang(tmp_path):
     folder = tmp_path / "grasps"
     folder.mkdir()
@@ -399,6 +404,7 @@ def test_a_file_swapped_for_a_fifo_after_the_listing_is_a_read_error_not_a_hang(
 # 5. Backpressure: a slow reader stops the workers; the spool is bounded
 
 
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_a_reader_that_stops_reading_stops_the_workers(tmp_path, rows):
     small = tmp_path / "small.npy"
     np.save(small, np.load(rows, mmap_mode="r")[: 8 * TUNING.grasps_per_task])  # 8 tasks
@@ -418,6 +424,7 @@ def test_a_reader_that_stops_reading_stops_the_workers(tmp_path, rows):
 
 
 @ROOT_ONLY
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_a_small_dev_shm_sends_the_output_by_pipe_instead(tmp_path, rows):
     # Docker gives containers 64 MB; 4 MB leaves a spool budget of 1 MB, less than one output
     mount = 'mount -t tmpfs -o size=4m tmpfs /dev/shm && exec "$@"'
@@ -463,7 +470,7 @@ def test_a_spool_holds_at_most_its_share_per_worker(tmp_path):
 # 6. Small hostile files stay small in memory
 
 
-@pytest.mark.parametrize("files", [4, pytest.param(16, marks=pytest.mark.slow)])
+@pytest.mark.parametrize("files", [pytest.param(4, marks=pytest.mark.slow), pytest.param(16, marks=pytest.mark.slow)])
 def test_mebibytes_of_document_markers_in_a_folder_take_little_memory(tmp_path, files):
     # 0.1: 262,144 records and error lines per file, 20.4 GB for the folder of sixteen
     (tmp_path / "in").mkdir()
@@ -494,6 +501,7 @@ def bomb(tmp_path_factory) -> Path:
     return path
 
 
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_an_npz_zip_bomb_is_refused_unread_and_costs_no_other_record(tmp_path, bomb):
     # 0.1 inflated every member whole: 2.85 GB and 12.7 s for the 2.8 MB bomb, MemoryError under a limit
     code, stderr, peak = run_measured("resolve", bomb, POLY, "-f", "jsonl", "-o", "out.jsonl", cwd=tmp_path)
@@ -509,7 +517,9 @@ def test_an_npz_zip_bomb_is_refused_unread_and_costs_no_other_record(tmp_path, b
 
 
 @pytest.mark.parametrize(
-    "save", [pytest.param(np.savez, marks=pytest.mark.slow), np.savez_compressed], ids=["stored", "compressed"]
+    "save",
+    [pytest.param(np.savez, marks=pytest.mark.slow), pytest.param(np.savez_compressed, marks=pytest.mark.slow)],
+    ids=["stored", "compressed"],
 )
 def test_npz_members_are_read_a_block_at_a_time_with_the_same_records(tmp_path, rows, save):
     data = np.load(rows, mmap_mode="r")[: 3 * TUNING.grasps_per_task]  # three tasks for two workers
@@ -641,6 +651,7 @@ def deep_tree(tmp_path):
     os.close(fd)
 
 
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_a_folder_2000_levels_deep(deep_tree):
     # 0.1: internal error: RecursionError after 11 s, and no records, not even for top.yaml
     # relative to the tree's parent the deepest path has ~4,000 characters, within PATH_MAX

@@ -113,6 +113,7 @@ NORMALS = ["[-1, 0, 0]", "[1, 0, 0]", "[0, 1, 0]"]
 
 
 @pytest.mark.parametrize("samples", [2])
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_the_first_joint_limit_exit_is_located_where_the_turntable_puts_it(tmp_path, samples):
     # the object turns at 0.5: the first joints are at 0.5 t; finger f1's leaves 0.6 at t = 1.2, f0's 0.9 at 1.8
     g = _grasp(tmp_path, _turntable([0.9, 0.6, 3.0]), NORMALS, SPIN)
@@ -140,6 +141,7 @@ def test_the_first_joint_limit_exit_is_located_where_the_turntable_puts_it(tmp_p
 
 
 @pytest.mark.parametrize("samples", [3])
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_the_rank_loss_and_the_conditioning_warning_are_located_between_samples(tmp_path, samples):
     g = _grasp(tmp_path, _flat(), NORMALS, SLIDE)
     r = run("follow", g, "--samples", samples, "-f", "jsonl")
@@ -168,6 +170,7 @@ def _tips(grasp, rec):
 
 
 @pytest.mark.parametrize("samples", [3])
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_the_bundled_hand_keeps_its_tips_on_the_moving_contacts(samples):
     (grasp,) = read_grasps(HAND)
     size = max(np.linalg.norm(grasp.points[i] - grasp.points[j]) for i, j in ((0, 1), (1, 2), (0, 2)))
@@ -207,6 +210,7 @@ def test_a_grasp_without_a_hand_has_no_hand_fields():
     assert math.isfinite(summary["summary"]["duration"])
 
 
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_csv_carries_resolves_joint_columns_and_the_joint_positions(tmp_path):
     g = _grasp(tmp_path, _turntable([3.0, 3.0, 3.0]), NORMALS, SPIN)
     rows = list(csv.DictReader(io.StringIO(run("follow", g, "--samples", 3, "-f", "csv").stdout)))

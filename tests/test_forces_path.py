@@ -54,6 +54,7 @@ def test_the_safety_factor_narrows_the_cones():
 
 
 @pytest.mark.parametrize("samples", [7, pytest.param(5, marks=SLOW), pytest.param(13, marks=SLOW)])
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_a_high_centre_of_mass_tips_over_where_its_line_leaves_the_triangle(samples):
     # Turning about y moves the centre of pressure to (h tan(theta), 0): it leaves the
     # triangle at the vertex x = 1 (theta = atan(1/h)) going one way and at the side x = -1/2

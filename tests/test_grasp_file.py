@@ -112,6 +112,7 @@ def test_invalid_fixture_is_rejected_where_its_header_says(path, loader):
 
 
 @pytest.mark.parametrize("path", FIXTURES + sorted(BUNDLED.glob("*.yaml")), ids=lambda p: p.stem)
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_both_parsers_give_identical_results(path):
     if len(LOADERS) < 2:
         pytest.skip("libyaml not available")
@@ -770,6 +771,7 @@ document = st.fixed_dictionaries(
 
 @settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(st.lists(document, min_size=1, max_size=3))
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_pyyaml_dumped_grasps_load_back(documents):
     text = yaml.safe_dump_all(documents, allow_unicode=True)
     validator = jsonschema.Draft202012Validator(grasp_schema())

@@ -138,7 +138,8 @@ def _file_cases():
     either parser, read twice) is left to the long run."""
     for path in FILES:
         for parser in LOADERS:
-            slow = path.stat().st_size >= BIG  # a big file read twice per parser: seconds, for the long run
+            # a big file read twice per parser, or a hand solved by inverse kinematics twice: seconds, for the long run
+            slow = path.stat().st_size >= BIG or path.name.startswith("hand-")
             name = f"{parser.__name__}-{path.parent.name}/{path.name}"
             yield pytest.param(path, parser, id=name, marks=[pytest.mark.slow] if slow else [])
 
@@ -323,6 +324,7 @@ def documents(draw):
 
 @settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(st.lists(documents(), min_size=1, max_size=3), st.sampled_from(LOADERS))
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_random_documents(docs, parser):
     both_paths("---\n".join(docs), Reading(parser=parser), file="random.yaml")
 

@@ -91,6 +91,7 @@ def loader_codes(path):
     return codes
 
 
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_the_files_cover_valid_invalid_and_unstated_rules():
     refused = [bool(loader_codes(path)) for path in FILES]
     assert refused.count(False) >= 15  # the bundled grasps and the corpus's engine cases
@@ -98,7 +99,12 @@ def test_the_files_cover_valid_invalid_and_unstated_rules():
     assert set().union(*(c for path in FILES for c in loader_codes(path).values())) >= {"non-finite", "duplicate-name"}
 
 
-@pytest.mark.parametrize("path", FILES, ids=lambda p: f"{p.parent.name}/{p.stem}")
+@pytest.mark.parametrize(
+    "path",
+    # the 10,000-contact file takes seconds: the long run's
+    [pytest.param(p, marks=pytest.mark.slow) if p.stem == "many-contacts" else p for p in FILES],
+    ids=lambda p: f"{p.parent.name}/{p.stem}",
+)
 def test_the_schema_and_the_loader_give_each_document_the_same_verdict(path, validator):
     codes = loader_codes(path)
     docs = documents(path)

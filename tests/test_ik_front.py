@@ -159,6 +159,7 @@ def test_a_data_set_solved_by_ik_carries_its_positions_in_every_format(tmp_path)
     )
 
 
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_follow_shows_each_samples_positions_and_tip_errors():
     recs = jsonl("follow", THREE, "--samples", "5")
     assert len(recs) == 6

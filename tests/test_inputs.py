@@ -116,6 +116,7 @@ def test_an_undecodable_file_name_is_read_and_named_safely(tmp_path):
     assert {e.file for e in entries} == {path}
 
 
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_an_undecodable_file_name_costs_no_good_record(tmp_path):
     shutil.copyfile(BUNDLED / "sphere.yaml", tmp_path / "good.yaml")
     with open(os.fsencode(tmp_path) + b"/b\xff.yaml", "wb") as f:

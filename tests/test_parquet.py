@@ -274,6 +274,7 @@ def test_resolving_grasp_files_never_imports_pyarrow_dask_or_pandas():
     assert out.stdout.split() == ["0", "False", "False", "False", "False"]
 
 
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_a_stop_signal_leaves_no_parquet_file_and_no_debris(tmp_path):
     import os
     import signal

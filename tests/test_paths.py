@@ -91,6 +91,7 @@ def test_the_batch_holds_every_status_of_each_method(batch):
     assert len(p) > SMALL_BATCH
 
 
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_one_row_at_a_time_gives_the_chunked_paths_bits(batch):
     p, n, c, t = batch
     chunked = gt.resolve(p, n, c, t)

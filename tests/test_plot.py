@@ -328,6 +328,7 @@ def test_an_unsupported_format_is_refused_before_drawing(tmp_path):
     assert not list(tmp_path.iterdir())
 
 
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_one_png_of_the_requested_size_and_one_svg_headless(tmp_path):
     """The smoke test of drawing; what is drawn is checked on the scene above."""
     pytest.importorskip("matplotlib")
@@ -360,6 +361,7 @@ def loaded(*paths):
     return [g for p in paths for g in read(str(p))]
 
 
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_render_loaded_of_a_folder_reports_what_it_cannot_draw(tmp_path):
     pytest.importorskip("matplotlib")
     folder = tmp_path / "in"

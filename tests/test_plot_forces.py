@@ -96,6 +96,7 @@ paths:
 """
 
 
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_the_animation_draws_each_samples_grip_and_marks_where_the_weight_cannot_be_held():
     from grasptwist.cli.plot import _page_extras
     from grasptwist.plot.animation import path_figure

@@ -122,6 +122,7 @@ def test_each_grasp_line_is_answered_before_the_next_is_written():
     )
 
 
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_each_twist_line_is_answered_before_the_next_is_written_as_csv():
     run = Filter("resolve", POLY, "--twists-from", "-", "-f", "csv")
     run.send("[0, 0, 1, 0, 0, 0]")
@@ -153,6 +154,7 @@ def test_a_stop_signal_ends_a_waiting_stream_cleanly(signum):
     assert stderr.splitlines() == [f"grasptwist: stopped by {signal.Signals(signum).name}"]
 
 
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_standard_input_has_no_size_limit_only_its_lines_have():
     big = "x" * 5000  # names this long make 220 lines more than 1 MiB
     lines = [grasp_line(f"{big}{i}") for i in range(220)]

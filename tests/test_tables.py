@@ -85,6 +85,7 @@ def assert_fits(text: str, columns: int):
 
 
 @pytest.mark.parametrize("command", ["resolve", "basis"])
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_a_table_on_an_80_column_terminal_keeps_every_vector_on_one_line(command):
     code, shown = in_terminal([command, POLY])
     assert code == 0
@@ -97,6 +98,7 @@ def test_a_table_on_an_80_column_terminal_keeps_every_vector_on_one_line(command
     assert re.search(r"^  i   Psi_i", table, re.M)
 
 
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_columns_sets_the_width_of_a_piped_table_and_no_columns_means_no_limit():
     narrow = piped(["resolve", POLY], COLUMNS="80").stdout
     assert_fits(narrow, 80)
@@ -124,6 +126,7 @@ def test_digits_and_order_still_shape_the_table():
 # 12.7 The progress bar: names its command, leaves error lines whole
 
 
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_the_bar_names_the_command_and_error_lines_are_never_wrapped(tmp_path):
     long_name = "a-grasp-file-whose-name-alone-is-wider-than-the-terminal-it-is-checked-on.yaml"
     (tmp_path / long_name).write_text("contacts: [\n")
@@ -140,6 +143,7 @@ def test_the_bar_names_the_command_and_error_lines_are_never_wrapped(tmp_path):
     assert len(out.read_text().splitlines()) == 2
 
 
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_no_bar_when_the_table_itself_is_on_the_terminal(tmp_path):
     for name in ("a.yaml", "b.yaml"):
         (tmp_path / name).write_text(POLY.read_text())

@@ -51,6 +51,7 @@ def test_the_tip_stays_on_a_contact_that_moves_and_turns_and_the_elbow_follows_t
 
 
 @pytest.mark.parametrize("samples", [2, 3, 11])
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_the_first_exit_from_a_joint_limit_is_located_between_samples(samples):
     # the elbow opens as the contact moves away: it passes 1.9 rad where r^2 = 2 + 2 cos 1.9
     exact = (math.sqrt(2 + 2 * math.cos(1.9)) - 1) / 0.3
