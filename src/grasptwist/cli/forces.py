@@ -85,7 +85,7 @@ def forces(
     slipping; per grasp its force closure.  Examples: hold the bundled 1 kg
     ball; a wrench from the command line with mu 0.8:
 
-    \\b
+    \b
         grasptwist forces grasps/sphere.yaml
         grasptwist forces grasps/polyhedron.yaml --wrench 0,0,1,0,0,0 --friction 0.8 --json
     """
