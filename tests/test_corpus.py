@@ -162,7 +162,13 @@ def _check_alone(row, path, exit_code, stdout, stderr):
 
 
 @pytest.mark.parametrize(
-    "corpus_file, row", [pytest.param(r.file, r, id=r.file) for r in ROWS], indirect=["corpus_file"]
+    "corpus_file, row",
+    # the 10,000-contact file takes seconds: the long run's
+    [
+        pytest.param(r.file, r, id=r.file, marks=[pytest.mark.slow] if r.file == "many-contacts.yaml" else [])
+        for r in ROWS
+    ],
+    indirect=["corpus_file"],
 )
 def test_each_hostile_file_alone(corpus_file, row):
     result, _ = run("resolve", corpus_file, "-f", "jsonl")

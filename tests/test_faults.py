@@ -274,7 +274,11 @@ def test_temporary_files_of_killed_runs_are_removed_by_the_next_run(tmp_path):
 
 @pytest.mark.parametrize(
     ("sig", "group", "to_file"),
-    [(signal.SIGINT, True, False), (signal.SIGTERM, False, True), (signal.SIGHUP, True, True)],
+    [
+        (signal.SIGINT, True, False),
+        (signal.SIGTERM, False, True),
+        pytest.param(signal.SIGHUP, True, True, marks=pytest.mark.slow),
+    ],
     ids=["INT-to-a-stalled-pipe", "TERM", "HUP"],
 )
 def test_a_stop_signal_ends_a_parallel_run_cleanly(tmp_path, rows, sig, group, to_file):

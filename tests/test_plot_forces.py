@@ -69,6 +69,7 @@ def test_force_traces_draw_the_cones_and_forces_and_scene_traces_leave_them_out(
     assert force_traces(bare, "m") == {} and not bare.of_kind("friction-cone")
 
 
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_plot_draws_a_grasp_with_friction(tmp_path):
     pytest.importorskip("matplotlib")
     from grasptwist.plot.render import plot_grasp
