@@ -11,9 +11,11 @@ fixed time.
 from __future__ import annotations
 
 import base64
+import contextlib
 import json
 import os
 import shutil
+import signal
 import subprocess
 import tempfile
 import time
@@ -88,10 +90,16 @@ def capture(page, png, *, size=(1200, 900), timeout=60.0, scroll_to=0, before=No
     if exe is None:
         raise FileNotFoundError(f"no Chromium at {CHROMIUM} (apt-get install chromium)")
     profile = tempfile.mkdtemp(prefix="grasptwist-chromium-")
+    # Chromium's own temporary files (org.chromium.Chromium.*) go inside the profile, and its
+    # helper processes share a session with it, so that nothing of a visit outlives it.
+    scratch = Path(profile) / "tmp"
+    scratch.mkdir()
     proc = subprocess.Popen(
         [exe, *_FLAGS, f"--user-data-dir={profile}", f"--window-size={size[0]},{size[1]}", "about:blank"],
         stdout=subprocess.DEVNULL,
         stderr=subprocess.DEVNULL,
+        env={**os.environ, "TMPDIR": str(scratch)},
+        start_new_session=True,
     )
     deadline = time.monotonic() + timeout
     try:
@@ -104,13 +112,20 @@ def capture(page, png, *, size=(1200, 900), timeout=60.0, scroll_to=0, before=No
         finally:
             ws.close()
     finally:
-        proc.terminate()
-        try:
-            proc.wait(10)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-            proc.wait()
+        _end(proc)
         shutil.rmtree(profile, ignore_errors=True)
+
+
+def _end(proc):
+    """Chromium and every helper process it started (its session), ended and reaped."""
+    for sig, wait in ((signal.SIGTERM, 10), (signal.SIGKILL, None)):
+        with contextlib.suppress(ProcessLookupError):  # the whole session is already gone
+            os.killpg(proc.pid, sig)
+        try:
+            proc.wait(wait)
+            return
+        except subprocess.TimeoutExpired:
+            continue
 
 
 def _port(file, deadline, proc) -> int:
