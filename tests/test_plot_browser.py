@@ -7,6 +7,7 @@ extra's websocket-client; skipped, saying so, without them.  One page by default
 start and plotly.js's 5 MB parse: several seconds on a busy machine), the rest with -m slow.
 """
 
+import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -40,8 +41,16 @@ def page(tmp_path, grasp, *options):
     return out
 
 
+def chromium_leftovers():
+    """What a Chromium visit could leave in the temporary folder: its profile, its own files."""
+    tmp = Path(tempfile.gettempdir())
+    return {*tmp.glob("org.chromium.Chromium.*"), *tmp.glob("grasptwist-chromium-*")}
+
+
 def test_a_grasp_page_is_drawn_without_javascript_errors(tmp_path):
+    before = chromium_leftovers()
     shot = capture(page(tmp_path, "box-edge"), tmp_path / "box-edge.png", size=(1000, 800))
+    assert chromium_leftovers() <= before  # no debris of the visit
     assert shot.errors == []
     (box,) = shot.scenes
     assert box[2] > 500 and box[3] > 400  # the plot area fills most of the window
