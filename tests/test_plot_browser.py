@@ -65,7 +65,8 @@ def test_a_path_animation_and_a_urdf_hand_are_drawn_too(tmp_path):
     assert shot.errors == [] and len(shot.scenes) == 2
     assert coloured_pixels(shot.png, shot.scenes[1]) > 1000
     shot = capture(page(tmp_path, "trifinger-cube", "--js-beside"), tmp_path / "t.png")
-    assert shot.errors == [] and coloured_pixels(shot.png, shot.scenes[0]) > 1000
+    # the hand's grey meshes hide most of the coloured axes; a blank or failed canvas has none
+    assert shot.errors == [] and coloured_pixels(shot.png, shot.scenes[0]) > 100
 
 
 @pytest.mark.slow
