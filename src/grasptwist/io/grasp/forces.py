@@ -14,13 +14,13 @@ import numpy as np
 
 from ...engine import screws
 from ...model import Wrench
-from .problems import Reject, join, located
+from .problems import Reject, located
 from .values import (
     Section,
-    misspelt,
     read_entry_name,
     read_mapping,
     read_number,
+    read_screw_parts,
     read_sequence,
     read_vector,
     readonly,
@@ -59,7 +59,7 @@ def read_wrenches(node, problems):
         if fields is None:
             continue
         read_entry_name(fields, item, "wrenches", i, names, problems)
-        parts.append(_wrench_parts(fields, item, path, problems))
+        parts.append(read_screw_parts(fields, item, path, problems, ("wrench", "force", "moment")))
     if problems.count or not items:
         return None if problems.count else ()
     force, moment, at = np.array(parts).transpose(1, 0, 2)
@@ -78,31 +78,6 @@ def read_wrenches(node, problems):
     if problems.count:
         return None
     return [(name, w, item.line) for name, w, item in zip(names, wrench, items)]
-
-
-def _wrench_parts(fields, item, path, problems):
-    """``(force, moment, at)`` of one wrench entry, zeros where not given (None after a problem)."""
-    zero = [0.0, 0.0, 0.0]
-    if "wrench" in fields:
-        for other in ("force", "moment", "at"):
-            if other in fields:
-                problems.add(
-                    Reject(
-                        "conflicting-keys",
-                        join(path, other),
-                        "cannot be combined with 'wrench' (give wrench, or force/moment/at)",
-                        **located(fields[other]),
-                    )
-                )
-        wrench = read_vector(fields["wrench"], 6, join(path, "wrench"), problems)
-        return None if wrench is None else (wrench[:3], wrench[3:], zero)
-    if "force" not in fields and "moment" not in fields and not misspelt(item, ("wrench", "force", "moment")):
-        problems.add(Reject("missing-key", path, "needs 'wrench', or 'force' and/or 'moment'", **located(item)))
-    parts = [
-        read_vector(fields[key], 3, join(path, key), problems) if key in fields else zero
-        for key in ("force", "moment", "at")
-    ]
-    return None if None in parts else parts
 
 
 def _read_hold(fields, problems):

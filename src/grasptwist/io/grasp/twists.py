@@ -6,8 +6,8 @@ import numpy as np
 
 from ...engine import screws
 from ...model import Twist
-from .problems import Reject, join, located
-from .values import Section, misspelt, read_entry_name, read_mapping, read_sequence, read_vector, readonly
+from .problems import Reject, located
+from .values import Section, read_entry_name, read_mapping, read_screw_parts, read_sequence, readonly
 
 __all__ = ["TWIST_KEYS", "SECTION", "read_twists", "twist_parts"]
 
@@ -48,27 +48,7 @@ def read_twists(node, problems):
 
 def twist_parts(fields, item, path, problems):
     """``(angular, linear, at)`` of one twist entry, zeros where not given (None after a problem)."""
-    zero = [0.0, 0.0, 0.0]
-    if "screw" in fields:
-        for other in ("angular", "linear", "at"):
-            if other in fields:
-                problems.add(
-                    Reject(
-                        "conflicting-keys",
-                        join(path, other),
-                        "cannot be combined with 'screw' (give screw, or angular/linear/at)",
-                        **located(fields[other]),
-                    )
-                )
-        screw = read_vector(fields["screw"], 6, join(path, "screw"), problems)
-        return None if screw is None else (screw[:3], screw[3:], zero)
-    if "angular" not in fields and "linear" not in fields and not misspelt(item, ("screw", "angular", "linear")):
-        problems.add(Reject("missing-key", path, "needs 'screw', or 'angular' and/or 'linear'", **located(item)))
-    parts = [
-        read_vector(fields[key], 3, join(path, key), problems) if key in fields else zero
-        for key in ("angular", "linear", "at")
-    ]
-    return None if None in parts else parts
+    return read_screw_parts(fields, item, path, problems, ("screw", "angular", "linear"))
 
 
 def _read(fields, found, problems):

@@ -28,6 +28,7 @@ __all__ = [
     "read_entry_name",
     "read_vector",
     "read_number",
+    "read_screw_parts",
     "readonly",
     "NOT_IN_A_NAME",
 ]
@@ -245,3 +246,32 @@ def readonly(values):
     array = np.array(values, dtype=float)
     array.setflags(write=False)
     return array
+
+
+def read_screw_parts(fields, item, path, problems, keys):
+    """``(first, second, at)`` halves of a screw entry given either whole or by its parts, zeros
+    where not given (None after a problem): ``keys`` names the whole and its two halves, e.g.
+    ``("screw", "angular", "linear")`` for a twist or ``("wrench", "force", "moment")`` for a
+    wrench; ``at`` is the point the second half is given about (the origin when absent)."""
+    whole, first, second = keys
+    zero = [0.0, 0.0, 0.0]
+    if whole in fields:
+        for other in (first, second, "at"):
+            if other in fields:
+                problems.add(
+                    Reject(
+                        "conflicting-keys",
+                        join(path, other),
+                        f"cannot be combined with '{whole}' (give {whole}, or {first}/{second}/at)",
+                        **located(fields[other]),
+                    )
+                )
+        vector = read_vector(fields[whole], 6, join(path, whole), problems)
+        return None if vector is None else (vector[:3], vector[3:], zero)
+    if first not in fields and second not in fields and not misspelt(item, keys):
+        problems.add(Reject("missing-key", path, f"needs '{whole}', or '{first}' and/or '{second}'", **located(item)))
+    parts = [
+        read_vector(fields[key], 3, join(path, key), problems) if key in fields else zero
+        for key in (first, second, "at")
+    ]
+    return None if None in parts else parts
