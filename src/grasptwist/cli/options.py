@@ -129,8 +129,8 @@ Select = Annotated[
     typer.Option(
         "--select",
         metavar="NAME",
-        help="Only the file's twist of this name (repeatable); a grasp without it fails with unknown-twist, "
-        "which lists the twists it has.",
+        help="Only the file's twist of this name (repeatable); a name the file has no twist of is an error "
+        "that lists the twists it has.",
     ),
 ]
 RecordFormatOption = Annotated[
