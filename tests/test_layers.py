@@ -139,3 +139,57 @@ def test_every_module_says_what_is_public(name):
         isinstance(node, ast.Assign) and any(isinstance(t, ast.Name) and t.id == "__all__" for t in node.targets)
         for node in tree.body
     ), f"{name} has no __all__"
+
+
+#: Where commands and their families are named: the registry (issue 28).
+REGISTRY = "grasptwist.run.families"
+
+
+def _command_names() -> set[str]:
+    """The registry's command names, read from its source (no import: this file only reads)."""
+    tree = ast.parse(MODULES[REGISTRY].read_text())
+    names = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Call) and getattr(node.func, "id", None) == "Command":
+            first = node.args[0] if node.args else next((k.value for k in node.keywords if k.arg == "name"), None)
+            if isinstance(first, ast.Constant) and isinstance(first.value, str):
+                names.add(first.value)
+    return names
+
+
+COMMAND_NAMES = _command_names()
+
+
+def branches_on_a_name(tree: ast.AST) -> list[tuple[int, str]]:
+    """``(line, text)`` of each comparison with a command's name (``kind == "forces"``,
+    ``job.kind != "resolve"``, ``kind in ("basis", "check")``) and each mapping keyed by commands
+    (``{"resolve": TableWriter, "basis": ...}``; one such key is a name that is also a function's)."""
+
+    def named(node) -> bool:
+        if isinstance(node, ast.Constant):
+            return node.value in COMMAND_NAMES
+        if isinstance(node, ast.Tuple | ast.List | ast.Set):
+            return any(named(e) for e in node.elts)
+        return False
+
+    found = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Compare) and any(named(c) for c in (node.left, *node.comparators)):
+            found.append((node.lineno, ast.unparse(node)))
+        elif isinstance(node, ast.Dict) and sum(k is not None and named(k) for k in node.keys) > 1:
+            found.append((node.lineno, ast.unparse(node)[:60]))
+    return found
+
+
+def test_the_walk_finds_branches_on_a_command_name():
+    assert {"resolve", "basis", "check", "follow", "forces"} <= COMMAND_NAMES
+    code = 'if job.kind == "forces": pass\nx = kind != "resolve"\ny = k in ("basis", "x")\nw = {"check": 1, "basis": 2}\n'
+    assert [line for line, _ in branches_on_a_name(ast.parse(code))] == [1, 2, 3, 4]
+    assert not branches_on_a_name(ast.parse('f.kind == "fingers"\nCOMMANDS["forces"].formats\n{"resolve": ".api"}'))
+
+
+@pytest.mark.parametrize("name", sorted(n for n in MODULES if n != REGISTRY))
+def test_no_layer_branches_on_a_command_name(name):
+    # every layer loops over the registry (run/families.py); looking a command up there is fine
+    found = branches_on_a_name(ast.parse(MODULES[name].read_text()))
+    assert not found, f"{name} branches on a command's name: " + "; ".join(f"line {n}: {t}" for n, t in found)

@@ -4,10 +4,10 @@ import numpy as np
 import pytest
 
 import grasptwist as gt
-from grasptwist.cli.plot import _grip_forces
 from grasptwist.io.grasp import load_grasps
 from grasptwist.plot.scene import force_parts, grasp_scene
 from grasptwist.plot.traces import force_traces, scene_traces
+from grasptwist.run.pictures import grip_forces as _grip_forces
 
 P = np.array([[1.0, 0, 0], [-0.5, 0.75**0.5, 0], [-0.5, -(0.75**0.5), 0]])
 
@@ -99,8 +99,8 @@ paths:
 
 @pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_the_animation_draws_each_samples_grip_and_marks_where_the_weight_cannot_be_held():
-    from grasptwist.cli.plot import _page_extras
     from grasptwist.plot.animation import path_figure
+    from grasptwist.run.pictures import page_extras as _page_extras
 
     (g,) = load_grasps(BOX, file="box.yaml")
     _, followed, _ = _page_extras(None)(g)

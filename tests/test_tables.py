@@ -24,8 +24,9 @@ from typer.testing import CliRunner
 
 from grasptwist.cli import app
 from grasptwist.cli.diagnostics import TABLE_HINT_AT, WARNINGS_SHOWN
-from grasptwist.output.table import SIZING_ROWS, WRITERS
+from grasptwist.output.table import SIZING_ROWS, CheckTableWriter
 from grasptwist.results import KINDS
+from grasptwist.run.families import COMMANDS
 
 ROOT = Path(__file__).resolve().parents[1]
 POLY = ROOT / "grasps" / "polyhedron.yaml"
@@ -171,7 +172,7 @@ def _check_record(i: int) -> bytes:
 
 def test_a_check_table_is_written_as_its_records_come_in_fixed_columns():
     buf = io.BytesIO()
-    w = WRITERS["check"](buf)
+    w = CheckTableWriter(buf, contributions=COMMANDS["check"].contributions)
     for i in range(SIZING_ROWS + 500):
         w.write(_check_record(i))
     lines = buf.getvalue().decode().splitlines()

@@ -41,9 +41,6 @@ import numpy as np
 from .engine import judgements
 from .engine.decompose import decompose_off_tangent, decompose_tangent
 from .engine.degeneracy import Status
-from .engine.forces.closure import force_closure
-from .engine.forces.grasp_map import manipulating_forces
-from .engine.forces.grip import grip
 from .engine.screws import klein_table
 
 __all__ = [
@@ -59,10 +56,6 @@ __all__ = [
     "ALL_METHODS",
     "joint_column_names",
     "selected",
-    "ForceOptions",
-    "ForceResult",
-    "compute_forces",
-    "check_closure",
 ]
 
 #: How a field's values are written (see :class:`Field`).
@@ -425,120 +418,3 @@ def selected(method: str) -> tuple[ResultKind, ...]:
     if method not in METHOD_CHOICES:
         raise ValueError(f"method must be one of {METHOD_CHOICES}, got {method!r}")
     return tuple(k for k in KINDS if not k.method or method in (ALL_METHODS, k.label))
-
-
-# --------------------------------------------------------------------------
-# The force kind (issue 19): one row per (grasp, wrench), not per (grasp,
-# twist), so it is not one of KINDS (whose blocks carry twists and contact
-# velocities); ``grasptwist forces`` runs it through the same pipeline, and
-# its records and columns are described by FORCES below.
-
-
-@dataclass(frozen=True)
-class ForceOptions:
-    """What ``grasptwist forces`` asks of every row beyond its inputs."""
-
-    safety: float = 1.0
-    quality: bool = False
-    cone_edges: int = 8
-
-
-@dataclass(frozen=True)
-class ForceResult:
-    """The force side of ``N`` rows, each array over the rows.
-
-    ``manipulating_status`` is -1 where the row has no wrench, ``grip_status``
-    -1 where it has no wrench or no friction; their numbers are NaN there and
-    where they failed.  ``closure_friction`` is NaN where no friction gives
-    closure, ``force_closure`` and ``epsilon`` are meaningful only where the
-    row has a friction (``epsilon``: and quality was asked for).
-    """
-
-    manipulating: np.ndarray  # (N, 3, 3)
-    manipulating_status: np.ndarray  # (N,) int8
-    manipulating_culprit: np.ndarray
-    force: np.ndarray  # (N, 3, 3)
-    squeeze: np.ndarray  # (N, 3)
-    normal_force: np.ndarray
-    tangential_force: np.ndarray
-    friction_used: np.ndarray
-    total_normal_force: np.ndarray  # (N,)
-    grip_status: np.ndarray
-    grip_culprit: np.ndarray
-    closure_friction: np.ndarray
-    force_closure: np.ndarray  # (N,) bool
-    epsilon: np.ndarray
-    closure_status: np.ndarray
-    closure_culprit: np.ndarray
-    safety: float
-
-
-def compute_forces(points, normals, wrench, has_wrench, friction, has_friction, options: ForceOptions) -> ForceResult:
-    """The engine's force results for ``N`` rows (NaN wrench / friction rows where there is none).
-
-    The engine is called once per kind of row (with and without a wrench, a
-    friction), never once per row.
-    """
-    n = len(points)
-    out = {
-        "manipulating": np.full((n, 3, 3), np.nan),
-        "manipulating_status": np.full(n, -1, np.int8),
-        "manipulating_culprit": np.full(n, -1, np.int8),
-        "force": np.full((n, 3, 3), np.nan),
-        "squeeze": np.full((n, 3), np.nan),
-        "normal_force": np.full((n, 3), np.nan),
-        "tangential_force": np.full((n, 3), np.nan),
-        "friction_used": np.full((n, 3), np.nan),
-        "total_normal_force": np.full(n, np.nan),
-        "grip_status": np.full(n, -1, np.int8),
-        "grip_culprit": np.full(n, -1, np.int8),
-        "closure_friction": np.full(n, np.nan),
-        "force_closure": np.zeros(n, bool),
-        "epsilon": np.full(n, np.nan),
-        "closure_status": np.zeros(n, np.int8),
-        "closure_culprit": np.full(n, -1, np.int8),
-    }
-    w = np.flatnonzero(has_wrench)
-    if w.size:
-        m = manipulating_forces(points[w], wrench[w])
-        out["manipulating"][w], out["manipulating_status"][w], out["manipulating_culprit"][w] = (
-            m.force,
-            m.status,
-            m.culprit,
-        )
-    g = np.flatnonzero(has_wrench & has_friction)
-    if g.size:
-        r = grip(points[g], normals[g], wrench[g], friction[g], options.safety)
-        for name in ("force", "squeeze", "normal_force", "tangential_force", "friction_used", "total_normal_force"):
-            out[name][g] = getattr(r, name)
-        out["grip_status"][g], out["grip_culprit"][g] = r.status, r.culprit
-    for rows, mu in ((np.flatnonzero(has_friction), friction), (np.flatnonzero(~has_friction), None)):
-        if not rows.size:
-            continue
-        quality = options.quality and mu is not None
-        c = force_closure(
-            points[rows],
-            normals[rows],
-            None if mu is None else mu[rows],
-            quality=quality,
-            cone_edges=options.cone_edges,
-        )
-        out["closure_friction"][rows], out["closure_status"][rows], out["closure_culprit"][rows] = (
-            c.closure_friction,
-            c.status,
-            c.culprit,
-        )
-        if mu is not None:
-            out["force_closure"][rows] = c.force_closure
-        if quality:
-            out["epsilon"][rows] = c.epsilon
-    return ForceResult(safety=float(options.safety), **out)
-
-
-def check_closure(points, normals, friction) -> tuple[np.ndarray, np.ndarray | None]:
-    """``grasptwist check``'s force side: per row the closure friction (NaN: none) and, where
-    ``friction`` (``(N, 3)``, NaN rows where none; or None) gives one, force closure with it."""
-    n = len(points)
-    has = np.zeros(n, bool) if friction is None else ~np.isnan(friction).any(axis=-1)
-    result = compute_forces(points, normals, np.full((n, 6), np.nan), np.zeros(n, bool), friction, has, ForceOptions())
-    return result.closure_friction, np.where(has, result.force_closure, None) if has.any() else None

@@ -45,10 +45,16 @@ def basis(
     \b
         grasptwist basis grasps/cylinder.yaml --method off-tangent
     """
+    from ..run.batch import TwistOptions
+    from ..run.families import COMMANDS
     from ..run.pipeline import Job
 
     job = Job(
-        kind="basis", method=method.value, order=order.value, fmt="json" if json_ else fmt.value, max_bytes=max_bytes
+        command=COMMANDS["basis"],
+        fmt="json" if json_ else fmt.value,
+        max_bytes=max_bytes,
+        order=order.value,
+        options=TwistOptions(method=method.value),
     )
     settings = OutputSettings(output, quiet, warnings, workers, {"digits": digits, "order": order.value})
     run_command(debug, lambda: write_records(job, paths, settings))

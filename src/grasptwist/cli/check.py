@@ -40,7 +40,14 @@ def check(
     \b
         grasptwist check grasps/ -f jsonl | jq -c 'select(.ok | not)'
     """
+    from ..run.batch import TwistOptions
+    from ..run.families import COMMANDS
     from ..run.pipeline import Job
 
-    job = Job(kind="check", method=method.value, fmt="json" if json_ else fmt.value, max_bytes=max_bytes)
+    job = Job(
+        command=COMMANDS["check"],
+        fmt="json" if json_ else fmt.value,
+        max_bytes=max_bytes,
+        options=TwistOptions(method=method.value),
+    )
     run_command(debug, lambda: write_records(job, paths, OutputSettings(output, quiet, warnings, workers)))

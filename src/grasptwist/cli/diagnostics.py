@@ -11,7 +11,6 @@ import sys
 from contextlib import contextmanager
 from enum import Enum
 
-from ..output.formats import names_for
 from ..results import KINDS
 
 __all__ = [
@@ -185,25 +184,30 @@ def warning_kind(line: str) -> str:
     return message.split(" (", 1)[0].split(":", 1)[0].strip()
 
 
-def table_hint(command: str) -> str:
-    """The line that points a reader of a long table to the machine formats."""
-    others = [f for f in names_for(command) if f != "table"]
+def table_hint(formats) -> str:
+    """The line that points a reader of a long table to the machine formats (of a command's ``formats``).
+
+    >>> table_hint(("table", "json", "jsonl"))
+    'grasptwist: hint: more than 50 records: -f json or jsonl writes them far faster, for programs'
+    """
+    others = [f for f in formats if f != "table"]
     listed = ", ".join(others[:-1]) + f" or {others[-1]}"
     return f"grasptwist: hint: more than {TABLE_HINT_AT} records: -f {listed} writes them far faster, for programs"
 
 
 @contextmanager
-def progress_bar(inputs: list, command: str, out):
+def progress_bar(inputs: list, command: str, out, shown: bool = True):
     """A rich progress bar on stderr, named after ``command``, when it is a
     terminal and there is more than one input or a data set (whose records
     are counted as they come); not when the output ``out`` goes to a
     terminal too, where it shows the progress itself (and a bar would be
-    drawn between its lines).  Yields the function that advances it by a
-    pipeline Output."""
+    drawn between its lines), nor when not ``shown`` (a command whose
+    outputs do not count the inputs done).  Yields the function that
+    advances it by a pipeline Output."""
     from ..io.datasets import DATASET_SUFFIXES
 
     big = len(inputs) > 1 or any(isinstance(p, str) and p.endswith(DATASET_SUFFIXES) for p in inputs)
-    if not big or not sys.stderr.isatty() or out.isatty():
+    if not shown or not big or not sys.stderr.isatty() or out.isatty():
         yield lambda output: None
         return
     from rich.progress import Progress

@@ -4,9 +4,8 @@ from typing import Annotated
 
 import typer
 
-from ..output.formats import FORMATS
-from .diagnostics import Diagnostics
-from .exits import EXIT_FAILED, EXIT_OK, output_target, run_command
+from .diagnostics import Warnings
+from .exits import run_command
 from .options import (
     ALL,
     Debug,
@@ -24,8 +23,9 @@ from .options import (
     not_binary_to_a_terminal,
     segments_option,
 )
+from .records import OutputSettings, write_records
 
-__all__ = ["follow", "write_follow_records"]
+__all__ = ["follow"]
 
 
 def follow(
@@ -84,7 +84,9 @@ def follow(
         grasptwist follow grasps/cylinder.yaml --method off-tangent --samples 5
         grasptwist follow grasps/polyhedron.yaml --twist 0,0,1,0,0,0 --duration 1.5708 --twist 0,0,0,0,0,1 --duration 1 -f jsonl
     """
-    from ..run.follow import FollowJob
+    from ..run.families import COMMANDS
+    from ..run.follow import FollowOptions
+    from ..run.pipeline import Job
 
     segments = segments_option(twist, duration, frame.value)
     if segments and path is not None:
@@ -97,32 +99,13 @@ def follow(
         raise typer.BadParameter(f"must be a finite number > 0, got {dt}", param_hint="--dt")
     fmt = FollowFormat.json if json_ else fmt
     not_binary_to_a_terminal(fmt.value, output)
-    job = FollowJob(
-        method=method.value,
-        path=path,
-        segments=segments,
-        samples=samples,
-        dt=dt,
+    job = Job(
+        command=COMMANDS["follow"],
+        fmt=fmt.value,
         max_bytes=max_bytes,
-        bases=FORMATS[fmt.value].bases,
+        order=order.value,
         hand=hand_option(None, paths, fmt.value),
+        options=FollowOptions(method=method.value, path=path, segments=segments, samples=samples, dt=dt),
     )
-    run_command(
-        debug, lambda: write_follow_records(job, paths, output, quiet, fmt.value, digits=digits, order=order.value)
-    )
-
-
-def write_follow_records(job, paths: list[str], output, quiet: bool, fmt: str, **table_options) -> int:
-    """The body of follow: records out, counts and diagnostics on stderr; the exit status."""
-    from ..io.inputs import expand
-    from ..run.follow import write_follow
-
-    stderr = Diagnostics(quiet)
-    with output_target(output) as out:
-        w = FORMATS[fmt].open(out, "follow", **table_options, **FORMATS[fmt].hand_options(job.hand))
-        for o in write_follow(job, expand(paths), w, fmt, table_options.get("order", "omega-v")):
-            out.flush()
-            stderr.take(o)
-        w.close()
-    stderr.summary()
-    return EXIT_FAILED if stderr.failed else EXIT_OK
+    settings = OutputSettings(output, quiet, Warnings.summary, 1, {"digits": digits, "order": order.value})
+    run_command(debug, lambda: write_records(job, paths, settings))

@@ -89,7 +89,8 @@ def forces(
         grasptwist forces grasps/sphere.yaml
         grasptwist forces grasps/polyhedron.yaml --wrench 0,0,1,0,0,0 --friction 0.8 --json
     """
-    from ..results import ForceOptions
+    from ..run.families import COMMANDS
+    from ..run.forces import ForceOptions
     from ..run.pipeline import Job
 
     wrenches = wrenches_option(wrench, at, wrench_name)
@@ -100,12 +101,16 @@ def forces(
     fmt = ForcesFormat.json if json_ else fmt
     not_binary_to_a_terminal(fmt.value, output)
     job = Job(
-        kind="forces",
+        command=COMMANDS["forces"],
         fmt=fmt.value,
         max_bytes=max_bytes,
-        wrenches=None if wrenches is None else tuple(wrenches),
-        friction=friction,
-        forces=ForceOptions(safety=safety, quality=quality, cone_edges=cone_edges),
+        options=ForceOptions(
+            wrenches=None if wrenches is None else tuple(wrenches),
+            friction=friction,
+            safety=safety,
+            quality=quality,
+            cone_edges=cone_edges,
+        ),
     )
     settings = OutputSettings(output, quiet, warnings, workers, {"digits": digits})
     run_command(debug, lambda: write_records(job, paths, settings))

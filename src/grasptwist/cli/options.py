@@ -15,8 +15,9 @@ from typing import Annotated
 
 import typer
 
-from ..output.formats import FORMATS, names_for
+from ..output.formats import FORMATS
 from ..results import ALL_METHODS, KINDS, METHOD_CHOICES
+from ..run.families import COMMANDS
 from .diagnostics import WARNINGS_SHOWN, Warnings
 
 __all__ = [
@@ -60,10 +61,10 @@ def _choices(name: str, values) -> type[Enum]:
 #: ``--method``: the registry's methods, or ``both``.
 MethodChoice = _choices("Method", METHOD_CHOICES)
 #: ``-f`` of each command: from the format registry.
-ResolveFormat = _choices("Format", names_for("resolve"))
-RecordFormat = _choices("RecordFormat", names_for("basis"))
-FollowFormat = _choices("FollowFormat", names_for("follow"))
-ForcesFormat = _choices("ForcesFormat", names_for("forces"))
+ResolveFormat = _choices("Format", COMMANDS["resolve"].formats)
+RecordFormat = _choices("RecordFormat", COMMANDS["basis"].formats)
+FollowFormat = _choices("FollowFormat", COMMANDS["follow"].formats)
+ForcesFormat = _choices("ForcesFormat", COMMANDS["forces"].formats)
 #: ``plot --method``: the bases that can be drawn.
 PlotMethod = _choices("PlotMethod", [k.label for k in KINDS if k.method])
 #: The default of ``--method``: every method.

@@ -94,58 +94,12 @@ def plot(
     )
 
 
-def _page_extras(path_name):
-    """What an HTML page shows beside the grasp (see :func:`grasptwist.plot.html_loaded`): its
-    hand's link meshes and its paths followed as ``follow`` follows them."""
-    from .. import plot as pictures
-    from ..io.urdf_meshes import grasp_folder, hand_meshes
-    from ..model import InputError
-    from ..plot.animation import DEFAULT_SAMPLES
-    from ..run.follow import FollowJob, Samples, Summary, follow_grasp
-
-    def extras(grasp):
-        meshes, followed, notes, chunks = [], [], [], []
-        if grasp.hand is not None and grasp.hand.source is not None:
-            try:
-                meshes = hand_meshes(grasp.hand, grasp.joint_positions, folder=grasp_folder(grasp))
-            except InputError as exc:  # the chains are drawn all the same
-                notes.append(pictures.Note(f"{exc.file}: warning: no link meshes: {exc.message}", error=False))
-        if grasp.paths or path_name is not None:
-            job = FollowJob(method="both", path=path_name, samples=DEFAULT_SAMPLES, bases=False)
-            for item in follow_grasp(job, grasp):
-                if isinstance(item, InputError):
-                    notes.append(pictures.Note(f"{item.file}: error: {item.message}"))
-                elif isinstance(item, Samples):
-                    chunks.append(item)
-                elif isinstance(item, Summary):
-                    followed.append((chunks, item))
-                    chunks = []
-        return meshes, followed, notes
-
-    return extras
-
-
-def _grip_forces(grasp):
-    """The grip forces drawn with a grasp's friction cones: the engine's least grip for the
-    wrench it holds (``hold``, from its ``mass``, else its first wrench); None without a
-    friction, a wrench or a grip."""
-    from ..engine.forces.grip import grip
-
-    if grasp.friction is None or not grasp.wrenches:
-        return None
-    chosen = {w.name: w for w in grasp.wrenches}.get("hold", grasp.wrenches[0])
-    g = grip(grasp.points, grasp.normals, chosen.wrench, grasp.friction)
-    return g.force if bool(g.ok) else None
-
-
 def draw_pictures(path, output, twists, twist_name, method, max_bytes, views) -> int:
-    """The body of ``plot``: read ``path`` as every command does, draw by
-    :func:`grasptwist.plot.render_loaded`, report on stderr; the exit status."""
+    """The body of ``plot``: the command line's checks, then :func:`grasptwist.run.pictures.draw`;
+    notes on stderr, the pictures' names on stdout; the exit status."""
     from .. import plot as pictures
     from ..io.datasets import DATASET_SUFFIXES
-    from ..io.inputs import expand, read
-    from ..model import InputError
-    from ..output.records import diagnostics, error_record
+    from ..run.pictures import draw
 
     stderr = Diagnostics()
     if path.endswith(DATASET_SUFFIXES):
@@ -154,42 +108,14 @@ def draw_pictures(path, output, twists, twist_name, method, max_bytes, views) ->
         )
     if not os.path.isdir(path):
         writable_folder(output)
-
-    def note(line: str, error: bool = True) -> None:
-        stderr.failed += error
-        stderr.say(line, ": error: " if error else ": warning: ", "31" if error else "33")
-
     html = output.lower().endswith(pictures.HTML) or (os.path.isdir(path) and any(views.values()))
     if not html and any(views.values()):
         raise typer.BadParameter("applies to HTML views (-o FILE.html)", param_hint="--js-beside/--path")
     try:
-        (pictures.require_plotly if html else pictures.require_matplotlib)()  # before anything is read
-        grasps = []
-        for item in expand([path]):
-            for entry in read(item, max_bytes) if isinstance(item, str) else [item]:
-                if isinstance(entry, InputError):
-                    for line in diagnostics(error_record(entry))[0]:
-                        note(line)
-                else:
-                    grasps.append(replace(entry, twists=tuple(twists)) if twists else entry)
-        if html:
-            drawn = pictures.html_loaded(
-                path,
-                output,
-                grasps,
-                twist_name=None if twists else twist_name,
-                method=method,
-                js_beside=views["js_beside"],
-                extras=_page_extras(views["path_name"]),
-                grips=_grip_forces,
-            )
-        else:
-            drawn = pictures.render_loaded(
-                path, output, grasps, twist_name=None if twists else twist_name, method=method, grips=_grip_forces
-            )
-        for item in drawn:
+        for item in draw(path, output, twists, twist_name, method, max_bytes, html, views):
             if isinstance(item, pictures.Note):
-                note(item.line, item.error)
+                stderr.failed += item.error
+                stderr.say(item.line, ": error: " if item.error else ": warning: ", "31" if item.error else "33")
             else:
                 sys.stdout.write(f"{item}\n")
     except (pictures.MissingMatplotlib, pictures.MissingPlotly) as exc:

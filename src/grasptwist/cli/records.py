@@ -1,4 +1,4 @@
-"""Files in, records out: the body resolve, basis and check share."""
+"""Files in, records out: the one loop that writes the records of every command."""
 
 from __future__ import annotations
 
@@ -14,7 +14,7 @@ __all__ = ["OutputSettings", "worker_count", "write_records"]
 
 @dataclass(frozen=True)
 class OutputSettings:
-    """What resolve, basis and check take beyond their job: where the records go,
+    """What a command takes beyond its job: where the records go,
     how many processes make them, what stderr says, and how tables print numbers."""
 
     output: str | None
@@ -32,20 +32,17 @@ def worker_count(requested: int) -> int:
 def write_records(job, paths: list[str], settings: OutputSettings) -> int:
     """Read ``paths``, write the job's records, report on stderr; the exit status."""
     from ..io.inputs import expand
-    from ..run.pipeline import record_outputs, write_blocks
+    from ..run.pipeline import outputs
 
-    stderr = Diagnostics(settings.quiet, settings.warnings, hint=table_hint(job.kind) if job.fmt == "table" else None)
+    counted = job.family.tells_progress
+    hint = table_hint(job.command.formats) if job.fmt == "table" and counted else None
+    stderr = Diagnostics(settings.quiet, settings.warnings, hint=hint)
     inputs = list(expand(paths))
     fmt = FORMATS[job.fmt]
-    with output_target(settings.output) as out, progress_bar(inputs, job.kind, out) as advance:
-        w = fmt.open(out, job.kind, **settings.table_options, **fmt.hand_options(job.hand))
-        # block writers (npz) take results here; the others get records encoded where they were made
-        outputs = (
-            write_blocks(job, inputs, w)
-            if fmt.takes_blocks
-            else record_outputs(job, inputs, worker_count(settings.workers))
-        )
-        for o in outputs:
+    with output_target(settings.output) as out, progress_bar(inputs, job.command.name, out, counted) as advance:
+        w = fmt.open(out, job, **settings.table_options)
+        # block writers (npz) take results in the run; the others get records encoded where they were made
+        for o in outputs(job, inputs, w, worker_count(settings.workers)):
             for encoded in o.encoded:
                 w.write(encoded)
             if o.spool:

@@ -110,6 +110,8 @@ def resolve(
         grasptwist resolve grasps.npz --twist 0,0,1,0,0,0 -f npz -o results.npz
     """
     from ..io.datasets import DATASET_SUFFIXES
+    from ..run.batch import TwistOptions
+    from ..run.families import COMMANDS
     from ..run.pipeline import Job
 
     twists = twists_option(twist, at, twist_name)
@@ -131,16 +133,18 @@ def resolve(
     fmt = ResolveFormat.json if json_ else fmt
     not_binary_to_a_terminal(fmt.value, output)
     job = Job(
-        kind="resolve",
-        twists=None if twists is None else tuple(twists),
-        method=method.value,
-        order=order.value,
+        command=COMMANDS["resolve"],
         fmt=fmt.value,
         max_bytes=max_bytes,
+        order=order.value,
         extra_point=extra_point.value,
         hand=hand_option(hand, paths, fmt.value),
-        twists_from=twists_from,
-        select=tuple(select) if select else None,
+        options=TwistOptions(
+            twists=None if twists is None else tuple(twists),
+            method=method.value,
+            twists_from=twists_from,
+            select=tuple(select) if select else None,
+        ),
     )
     settings = OutputSettings(output, quiet, warnings, workers, {"digits": digits, "order": order.value})
     run_command(debug, lambda: write_records(job, paths, settings))

@@ -14,6 +14,11 @@ them empty, Parquet as nulls.
 
 from __future__ import annotations
 
+from collections.abc import Callable
+from dataclasses import dataclass
+from enum import IntEnum
+from typing import Any
+
 import numpy as np
 
 from ..engine.degeneracy import Status, status_message
@@ -21,6 +26,7 @@ from ..engine.forces.grasp_map import ForceStatus, force_status_message
 from ..results import CULPRIT, KINDS, STATUS, Column
 
 __all__ = [
+    "ColumnSet",
     "ORDERS",
     "in_order",
     "BLOCK_COLUMNS",
@@ -38,6 +44,43 @@ __all__ = [
     "force_arrays",
     "grip_errors",
 ]
+
+
+@dataclass(frozen=True)
+class ColumnSet:
+    """A family's rows as columns: the CSV header and lines, Parquet's typed columns, npz's arrays.
+
+    Every function takes the run's ``hand`` (whose joints name columns of
+    the twist and path families; the others ignore it).
+
+    Attributes
+    ----------
+    header : callable
+        ``hand -> bytes``: the CSV header line.
+    flat : callable
+        ``(rows, order, hand, typed=False) -> {name: (N,) array}``: the flat
+        columns in header order (``typed``: of ``typed_header``), masked where
+        they do not hold.
+    arrays : callable
+        ``(rows, order, hand) -> {name: (N, ...) array}``: what npz stores.
+    error_row : callable
+        ``(error record, hand) -> bytes``: the CSV line of an input that failed.
+    statuses : IntEnum
+        The statuses npz's ``status_legend`` names.
+    typed_header : callable or None
+        ``hand -> {name: numpy type}``: Parquet's columns (None: no Parquet).
+    name_tables : bool
+        npz writes its tables of distinct names even when empty.
+    """
+
+    header: Callable[[Any], bytes]
+    flat: Callable[..., dict]
+    arrays: Callable[..., dict]
+    error_row: Callable[[dict, Any], bytes]
+    statuses: type[IntEnum]
+    typed_header: Callable[[Any], dict] | None = None
+    name_tables: bool = True
+
 
 #: Screw orders for output: the paper's ``(omega; v)`` or ``(v; omega)``.
 ORDERS = ("omega-v", "v-omega")

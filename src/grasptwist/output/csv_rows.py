@@ -13,18 +13,15 @@ import io
 
 import numpy as np
 
-from .columns import CSV_COLUMNS, FORCE_CSV_COLUMNS, columns, force_columns, header
+from .columns import CSV_COLUMNS, FORCE_CSV_COLUMNS, header
 from .names import escaped_each
-from .records import records, talking_rows
 
 __all__ = [
     "HEADER",
     "FORCE_HEADER",
     "header_line",
-    "encode_rows",
     "error_row",
     "lines",
-    "force_rows",
     "force_error_row",
 ]
 
@@ -62,13 +59,6 @@ def _lines(rows) -> list[bytes]:
     return [whole[a:b].encode() for a, b in zip([0] + ends, ends)]
 
 
-def encode_rows(block, order: str, hand=None) -> tuple[list[bytes], list[dict]]:
-    """The CSV line of each row, and the records of the rows with something to say."""
-    cells = [_cells(a) for a in columns(block, order, hand).values()]
-    talking = np.flatnonzero(talking_rows(block))
-    return _lines(zip(*cells)), records(block.take(talking), order) if talking.size else []
-
-
 def lines(named: dict) -> list[bytes]:
     """The CSV line of each row of flat columns ``name -> (N,)`` array (masked: empty cells)."""
     return _lines(zip(*(_cells(a) for a in named.values())))
@@ -83,14 +73,6 @@ def error_row(rec: dict, hand=None) -> bytes:
 
 #: The header line of ``grasptwist forces``.
 FORCE_HEADER = ",".join(FORCE_CSV_COLUMNS).encode() + b"\n"
-
-
-def force_rows(block) -> tuple[list[bytes], list[dict]]:
-    """The CSV line of each force row, and the records of the rows with something to say."""
-    from .force_records import force_records
-
-    recs = force_records(block)
-    return lines(force_columns(block)), [rec for rec in recs if not rec["ok"] or rec["warnings"]]
 
 
 def force_error_row(rec: dict, hand=None) -> bytes:

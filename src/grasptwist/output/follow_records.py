@@ -21,7 +21,7 @@ from ..engine.degeneracy import CONDITION_WARNING, Status, status_message
 from ..engine.forces.grasp_map import ForceStatus
 from ..engine.se3 import matrix_to_quaternion
 from ..results import KINDS
-from .columns import CSV_COLUMNS, columns, header
+from .columns import CSV_COLUMNS, arrays, columns, header
 from .csv_rows import lines
 from .force_records import GRIP_FIELDS
 from .force_records import _error as grip_error  # the forces record's error object, shared
@@ -38,7 +38,8 @@ __all__ = [
     "csv_header",
     "encodings",
     "csv_rows",
-    "path_arrays",
+    "sample_columns",
+    "sample_arrays",
     "crossing_text",
     "hand_event_texts",
     "hand_summary",
@@ -278,8 +279,8 @@ def csv_header(hand=None) -> bytes:
     return ",".join(_OWN + rest).encode() + b"\n"
 
 
-def csv_rows(samples, order: str = "omega-v", hand=None) -> list[bytes]:
-    """The CSV line of each sample (header :func:`csv_header` of the run's ``hand``)."""
+def sample_columns(samples, order: str = "omega-v", hand=None, typed: bool = False) -> dict[str, np.ndarray]:
+    """The flat columns of each sample, in the order of :func:`csv_header` of the run's ``hand``."""
     block = samples.block
     position, quaternion = _pose(samples)
     own = {
@@ -292,15 +293,21 @@ def csv_rows(samples, order: str = "omega-v", hand=None) -> list[bytes]:
     own.update({f"position_{a}": position[:, j] for j, a in enumerate("xyz")})
     own.update({f"rotation_{a}": quaternion[:, j] for j, a in enumerate("wxyz")})
     rest = {k: v for k, v in columns(block, order, hand).items() if k not in _NOT_IN_CSV}
-    return lines({**own, **rest})
+    return {**own, **rest}
 
 
-def path_arrays(samples, order: str = "omega-v", hand=None) -> dict[str, np.ndarray]:
-    """The arrays a follow npz adds to a block's: ``t``, ``segment``, ``position`` and ``rotation``
-    (quaternions, w first); its ``twist`` is the instantaneous space twist (the block's, with the
-    run's ``hand``, hold the ``joint_positions (N, n_joints)``)."""
+def csv_rows(samples, order: str = "omega-v", hand=None) -> list[bytes]:
+    """The CSV line of each sample (header :func:`csv_header` of the run's ``hand``)."""
+    return lines(sample_columns(samples, order, hand))
+
+
+def sample_arrays(samples, order: str = "omega-v", hand=None) -> dict[str, np.ndarray]:
+    """The arrays a follow npz holds: the block's (with the run's ``hand``, the
+    ``joint_positions (N, n_joints)``), its ``twist`` the instantaneous space twist, then
+    ``t``, ``segment``, ``position`` and ``rotation`` (quaternions, w first)."""
     position, quaternion = _pose(samples)
-    return {"t": samples.poses.time, "segment": samples.poses.segment, "position": position, "rotation": quaternion}
+    path = {"t": samples.poses.time, "segment": samples.poses.segment, "position": position, "rotation": quaternion}
+    return {**arrays(samples.block, order, hand), **path}
 
 
 def csv_error_row(rec: dict, hand=None) -> bytes:
@@ -332,7 +339,7 @@ def encodings(hand=None) -> dict:
         "json": Encoding(_json_samples, dumps, dumps),
         "jsonl": Encoding(_json_samples, dumps, dumps),
         "csv": Encoding(partial(csv_rows, hand=hand), None, partial(csv_error_row, hand=hand)),
-        "npz": Encoding(None, None, None),  # takes the blocks, with path_arrays
+        "npz": Encoding(None, None, None),  # takes the samples (sample_arrays)
     }
 
 

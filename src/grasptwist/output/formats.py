@@ -1,25 +1,34 @@
-"""The output formats, described once: what each writes, for which commands, and how.
+"""The output formats, described once: what each writes and how, for any command.
 
-The command line offers, per command, the formats whose ``commands`` name
-it, and runs a command by looking its format up in :data:`FORMATS` rather
-than comparing names.  A format either encodes records where they are
-made (in worker processes too) and writes the encoded bytes in order
-(``json``, ``jsonl``, ``csv``, ``table``), or takes whole result blocks in
-the writing process (``npz``, ``parquet``: ``takes_blocks``).
+A format either encodes records where they are made (in worker processes
+too) and writes the encoded bytes in order (``json``, ``jsonl``, ``csv``,
+``table``), or takes whole result blocks in the writing process (``npz``,
+``parquet``: ``takes_blocks``).  Which formats a command offers, and what
+its records, columns and table are, is the command's entry in the family
+registry (:mod:`grasptwist.run.families`); a format reads them from the
+run's job, never from the command's name:
+
+* ``job.command.records(block, job)``: the records of a block's rows;
+  ``job.command.json_rows`` a faster way to their JSON (or None);
+  ``job.command.talking(block, job)`` the records with something for stderr;
+* ``job.command.table``: its table writer, ``"module.Class"`` in this package,
+  and ``job.command.contributions``: the columns other families add to it;
+* ``job.family.columns``: its :class:`~grasptwist.output.columns.ColumnSet`;
+* ``job.order``, ``job.hand``: the screw order and the run's hand.
 """
 
 from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from importlib import import_module
 from typing import IO, Any
 
 from . import csv_rows
-from .json_rows import encode_records
-from .records import dumps, records
+from .records import dumps
 from .writers import JsonArray, Lines
 
-__all__ = ["OutputFormat", "FORMATS", "names_for"]
+__all__ = ["OutputFormat", "FORMATS", "json_rows", "csv_lines"]
 
 
 @dataclass(frozen=True)
@@ -30,19 +39,14 @@ class OutputFormat:
     ----------
     name : str
         Its ``-f`` value.
-    commands : tuple of str
-        The commands that offer it (``resolve``, ``basis``, ``check``,
-        ``follow``; how ``follow`` encodes its records in each format is in
-        :data:`grasptwist.output.follow_records.ENCODINGS`).
     open : callable
-        ``(out, kind, order, **table_options) -> writer`` with ``write`` and
-        ``close``; ``kind`` is the command.
-    encode : callable or None
-        ``record -> encoded`` for records built one at a time (inputs that
-        failed; ``basis`` and ``check`` records).
-    encode_rows : callable or None
-        ``(block, order) -> (encoded rows, records with something to say)``
-        for ``resolve`` rows, a block at a time.
+        ``(out, job, order, **table_options) -> writer`` with ``write`` and
+        ``close``.
+    rows : callable or None
+        ``(block, job) -> (encoded rows, records with something to say)``,
+        a block at a time.
+    error : callable or None
+        ``(error record, job) -> encoded``: an input that failed.
     join : callable or None
         ``list of encoded -> bytes``, one write for many records; None when
         the writer takes records one by one.
@@ -54,103 +58,74 @@ class OutputFormat:
     bases : bool
         It shows basis screws (False: resolve without them, a third less work).
     per_hand : bool
-        Its columns depend on the run's hand (the joints of ``--hand``):
-        ``open``, ``encode`` and ``encode_rows`` take ``hand=``.
-    encode_forces, encode_force_error : callable or None
-        For ``forces`` rows when they are not encoded record by record
-        (CSV): ``block -> (encoded rows, records with something to say)``,
-        and ``error record -> encoded``.
+        Its columns depend on the run's hand (the joints of ``--hand``).
     """
 
     name: str
-    commands: tuple[str, ...]
     open: Callable[..., Any]
-    encode: Callable[[dict], Any] | None = None
-    encode_rows: Callable[[Any, str], tuple[list, list[dict]]] | None = None
+    rows: Callable[[Any, Any], tuple[list, list[dict]]] | None = None
+    error: Callable[[dict, Any], Any] | None = None
     join: Callable[[list], bytes] | None = None
     binary: bool = False
     takes_blocks: bool = False
     bases: bool = True
     per_hand: bool = False
-    encode_forces: Callable[[Any], tuple[list, list[dict]]] | None = None
-    encode_force_error: Callable[[dict], Any] | None = None
-
-    def hand_options(self, hand) -> dict:
-        """The keyword arguments that give ``open``/``encode``/``encode_rows`` the run's hand."""
-        return {"hand": hand} if self.per_hand else {}
 
 
-def _table(out: IO[bytes], kind: str, order: str = "omega-v", **table_options):
-    if kind == "follow":  # plain text, its own module (no rich)
-        from .follow_table import FollowTable
-
-        return FollowTable(out, order=order, **table_options)
-    from . import table  # rich is imported only for people-facing output
-
-    return table.WRITERS[kind](out, order=order, **table_options)
+def _table(out: IO[bytes], job, order: str = "omega-v", **table_options):
+    # rich is imported only for people-facing output: the writer is named, not imported
+    module, name = job.command.table.rsplit(".", 1)
+    writer = getattr(import_module(f".{module}", __package__), name)
+    return writer(out, order=order, contributions=job.command.contributions, **table_options)
 
 
-def _csv(out: IO[bytes], kind: str, hand=None, **_):
-    if kind == "forces":
-        return Lines(out, header=csv_rows.FORCE_HEADER, newline=b"")
-    if kind == "follow":
-        from .follow_records import csv_header
-
-        return Lines(out, header=csv_header(hand), newline=b"")
-    return Lines(out, header=csv_rows.header_line(hand), newline=b"")
+def _csv(out: IO[bytes], job, **_):
+    return Lines(out, header=job.family.columns.header(job.hand), newline=b"")
 
 
-def _npz(out: IO[bytes], kind: str, order: str = "omega-v", hand=None, **_):
+def _npz(out: IO[bytes], job, order: str = "omega-v", **_):
     from .npz import NpzWriter
 
-    return NpzWriter(out, order, hand=hand, forces=kind == "forces")
+    return NpzWriter(out, order, hand=job.hand, columns=job.family.columns)
 
 
-def _parquet(out: IO[bytes], kind: str, order: str = "omega-v", hand=None, **_):
+def _parquet(out: IO[bytes], job, order: str = "omega-v", **_):
     from .parquet_writer import ParquetWriter  # pyarrow only when Parquet is asked for
 
-    return ParquetWriter(out, order, hand=hand, forces=kind == "forces")
+    return ParquetWriter(out, order, hand=job.hand, columns=job.family.columns)
 
 
-def _json_rows(block, order):
-    return encode_records(block, order, records, dumps)
+def json_rows(block, job) -> tuple[list[bytes], list[dict]]:
+    """The JSON of each row's record, and the records with something to say."""
+    if job.command.json_rows is not None:
+        return job.command.json_rows(block, job)
+    recs = job.command.records(block, job)
+    return [dumps(rec) for rec in recs], [rec for rec in recs if not rec["ok"] or rec["warnings"]]
 
 
-_ALL = ("resolve", "basis", "check", "follow", "forces")
+def csv_lines(block, job) -> tuple[list[bytes], list[dict]]:
+    """The CSV line of each row (the family's columns), and the records with something to say."""
+    return csv_rows.lines(job.family.columns.flat(block, job.order, job.hand)), job.command.talking(block, job)
+
+
+def _json_error(rec, job):
+    return dumps(rec)
+
+
+def _csv_error(rec, job):
+    return job.family.columns.error_row(rec, job.hand)
+
 
 #: Every output format by name, in the order ``--help`` lists them.
 FORMATS: dict[str, OutputFormat] = {
     f.name: f
     for f in (
         # table records travel as JSON (a worker's records cost the parent far less to take than as objects)
-        OutputFormat("table", _ALL, _table, dumps, _json_rows),
-        OutputFormat("json", _ALL, lambda out, kind, **_: JsonArray(out), dumps, _json_rows, join=b",\n".join),
-        OutputFormat("jsonl", _ALL, lambda out, kind, **_: Lines(out), dumps, _json_rows, join=b"\n".join),
-        OutputFormat(
-            "csv",
-            ("resolve", "follow", "forces"),
-            _csv,
-            csv_rows.error_row,
-            csv_rows.encode_rows,
-            join=b"".join,
-            per_hand=True,
-            encode_forces=csv_rows.force_rows,
-            encode_force_error=csv_rows.force_error_row,
-        ),
-        OutputFormat(
-            "npz", ("resolve", "follow", "forces"), _npz, binary=True, takes_blocks=True, bases=False, per_hand=True
-        ),
-        OutputFormat(
-            "parquet", ("resolve", "forces"), _parquet, binary=True, takes_blocks=True, bases=False, per_hand=True
-        ),
+        OutputFormat("table", _table, json_rows, _json_error),
+        OutputFormat("json", lambda out, job, **_: JsonArray(out), json_rows, _json_error, join=b",\n".join),
+        OutputFormat("jsonl", lambda out, job, **_: Lines(out), json_rows, _json_error, join=b"\n".join),
+        OutputFormat("csv", _csv, csv_lines, _csv_error, join=b"".join, per_hand=True),
+        OutputFormat("npz", _npz, binary=True, takes_blocks=True, bases=False, per_hand=True),
+        OutputFormat("parquet", _parquet, binary=True, takes_blocks=True, bases=False, per_hand=True),
     )
 }
-
-
-def names_for(command: str) -> list[str]:
-    """The ``-f`` values ``command`` offers.
-
-    >>> names_for("check")
-    ['table', 'json', 'jsonl']
-    """
-    return [f.name for f in FORMATS.values() if command in f.commands]

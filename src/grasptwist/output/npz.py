@@ -9,9 +9,8 @@ from typing import IO
 
 import numpy as np
 
-from ..engine.degeneracy import Status
-from ..engine.forces.grasp_map import ForceStatus
-from .columns import arrays, force_arrays
+from .column_sets import TWIST_COLUMNS
+from .columns import ColumnSet
 
 __all__ = ["NpzWriter", "SPILL_BYTES"]
 
@@ -46,10 +45,15 @@ class NpzWriter:
     """
 
     def __init__(
-        self, out: IO[bytes], order: str = "omega-v", spill_bytes: int = SPILL_BYTES, hand=None, forces: bool = False
+        self,
+        out: IO[bytes],
+        order: str = "omega-v",
+        spill_bytes: int = SPILL_BYTES,
+        hand=None,
+        columns: ColumnSet = TWIST_COLUMNS,
     ):
         self.out = out
-        self.forces = forces  # blocks of grasptwist forces (columns.FORCE_COLUMNS)
+        self.columns = columns  # the arrays of the family's rows
         self.order = order
         self.hand = hand
         self.spill_bytes = spill_bytes
@@ -62,11 +66,10 @@ class NpzWriter:
         self.rows = 0
         self.tmp = None
 
-    def write(self, block, extra: dict | None = None) -> None:
-        """Append a block's rows, and ``extra`` arrays over them (``follow``'s times and poses)."""
+    def write(self, block) -> None:
+        """Append a block's rows."""
         cols = {}
-        made = force_arrays(block) if self.forces else arrays(block, self.order, self.hand)
-        for name, a in {**made, **(extra or {})}.items():
+        for name, a in self.columns.arrays(block, self.order, self.hand).items():
             if name in _INDEXED:
                 index, table = _INDEXED[name]
                 cols[index] = self._index(table, a)
@@ -128,11 +131,12 @@ class NpzWriter:
                     np.lib.format.write_array_header_2_0(member, header)
                     for a in self._parts(name):
                         member.write(np.ascontiguousarray(a.astype(dtype, copy=False)).data)
-            statuses = ForceStatus if self.forces else Status
+            statuses = self.columns.statuses
             legend = [""] * (max(statuses) + 1)  # legend[k] names status k (ForceStatus has gaps)
             for status in statuses:
                 legend[status] = status.code
-            tables = {"status_legend": legend, **{k: list(v) for k, v in self.names.items() if v or not self.forces}}
+            tables = {k: list(v) for k, v in self.names.items() if v or self.columns.name_tables}
+            tables = {"status_legend": legend, **tables}
             if self.hand is not None:
                 tables["joint_names"] = list(self.hand.joint_names)
             for name, values in tables.items():

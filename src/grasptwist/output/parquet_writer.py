@@ -17,7 +17,8 @@ from typing import IO
 import numpy as np
 
 from ..extras import require
-from .columns import columns, force_columns, force_typed_header, typed_header
+from .column_sets import TWIST_COLUMNS
+from .columns import ColumnSet
 
 __all__ = ["ROW_GROUP_ROWS", "write_options", "schema", "table", "ParquetWriter"]
 
@@ -25,21 +26,17 @@ __all__ = ["ROW_GROUP_ROWS", "write_options", "schema", "table", "ParquetWriter"
 ROW_GROUP_ROWS = 65536
 
 
-def _header(hand=None, forces=False) -> dict:
-    return force_typed_header() if forces else typed_header(hand)
-
-
-def write_options(hand=None, forces=False) -> dict:
+def write_options(hand=None, columns: ColumnSet = TWIST_COLUMNS) -> dict:
     """Options of pyarrow's Parquet writer for results: dictionary pages for text
     only (on floats they cost five times the write and save nothing)."""
-    return {"use_dictionary": [name for name, dtype in _header(hand, forces).items() if dtype == "U"]}
+    return {"use_dictionary": [name for name, dtype in columns.typed_header(hand).items() if dtype == "U"]}
 
 
 def _arrow_type(pa, dtype: str):
     return pa.dictionary(pa.int32(), pa.string()) if dtype == "U" else pa.from_numpy_dtype(np.dtype(dtype))
 
 
-def schema(hand=None, forces=False):
+def schema(hand=None, columns: ColumnSet = TWIST_COLUMNS):
     """The Arrow schema of results: :func:`~grasptwist.output.columns.typed_header` with their types.
 
     >>> s = schema()
@@ -47,7 +44,7 @@ def schema(hand=None, forces=False):
     ('bool', 'int8', 'dictionary<values=string, indices=int32, ordered=0>')
     """
     pa = require("pyarrow", "Parquet output")
-    return pa.schema([(name, _arrow_type(pa, dtype)) for name, dtype in _header(hand, forces).items()])
+    return pa.schema([(name, _arrow_type(pa, dtype)) for name, dtype in columns.typed_header(hand).items()])
 
 
 def _array(pa, values, arrow_type):
@@ -60,12 +57,12 @@ def _array(pa, values, arrow_type):
     return pa.array(data, arrow_type, mask=mask)
 
 
-def table(block, order: str = "omega-v", hand=None, forces=False):
+def table(block, order: str = "omega-v", hand=None, columns: ColumnSet = TWIST_COLUMNS):
     """A result block as an Arrow table of :func:`schema` (``hand``: the run's, whose joint
-    columns follow; ``forces``: a block of ``grasptwist forces``)."""
+    columns follow; ``columns``: its family's)."""
     pa = require("pyarrow", "Parquet output")
-    s = schema(hand, forces)
-    flat = force_columns(block, typed=True) if forces else columns(block, order, hand, typed=True)
+    s = schema(hand, columns)
+    flat = columns.flat(block, order, hand, typed=True)
     return pa.Table.from_arrays([_array(pa, flat[f.name], f.type) for f in s], schema=s)
 
 
@@ -77,20 +74,25 @@ class ParquetWriter:
     """
 
     def __init__(
-        self, out: IO[bytes], order: str = "omega-v", row_group_rows: int = ROW_GROUP_ROWS, hand=None, forces=False
+        self,
+        out: IO[bytes],
+        order: str = "omega-v",
+        row_group_rows: int = ROW_GROUP_ROWS,
+        hand=None,
+        columns: ColumnSet = TWIST_COLUMNS,
     ):
         pq = require("pyarrow.parquet", "-f parquet")
-        self.forces = forces
+        self.columns = columns
         self.order = order
         self.hand = hand
         self.row_group_rows = row_group_rows
         self.pending: list = []
         self.rows = 0
-        self.writer = pq.ParquetWriter(out, schema(hand, forces), **write_options(hand, forces))
+        self.writer = pq.ParquetWriter(out, schema(hand, columns), **write_options(hand, columns))
 
     def write(self, block) -> None:
         """Append a block's rows."""
-        self.pending.append(table(block, self.order, self.hand, self.forces))
+        self.pending.append(table(block, self.order, self.hand, self.columns))
         self.rows += len(block)
         if self.rows >= self.row_group_rows:
             self._flush()

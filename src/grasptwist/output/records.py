@@ -252,18 +252,14 @@ def basis_record(block, i: int, order: str = "omega-v") -> dict:
     return rec
 
 
-def check_record(block, i: int, closure=None) -> dict:
-    """Validation and degeneracy verdict of row ``i``'s grasp, per kind; with ``closure``
-    (:func:`grasptwist.results.check_closure` of the block) its ``closure_friction`` (null:
-    none) and, where the grasp gives a friction, ``force_closure``."""
+def check_record(block, i: int, contributed: dict | None = None) -> dict:
+    """Validation and degeneracy verdict of row ``i``'s grasp, per kind, then the fields other
+    families ``contributed`` to the row (the wrench family's closure: see
+    :data:`grasptwist.run.families.COMMANDS`)."""
     warnings = []
     objects = _row_objects(block, i, lambda k: k.check_fields, "omega-v", warnings, with_failure=(CONDITIONING,))
     rec = {"file": escaped(block.file[i], controls=False), "grasp": escaped(block.grasp[i], controls=False), **objects}
-    if closure is not None:
-        least, verdict = closure
-        rec["closure_friction"] = None if np.isnan(least[i]) else float(least[i])
-        if verdict is not None and verdict[i] is not None:
-            rec["force_closure"] = bool(verdict[i])
+    rec.update(contributed or {})
     rec["warnings"] = warnings
     rec["ok"] = _methods_ok(rec)
     return rec

@@ -44,10 +44,11 @@ __all__ = [
     "TableWriter",
     "BasisTableWriter",
     "CheckTableWriter",
+    "ForceTableWriter",
+    "closure_cell",
     "OffTangentTable",
     "TangentTable",
     "Grid",
-    "WRITERS",
     "console",
     "output_width",
     "fmt_number",
@@ -253,8 +254,11 @@ class _Writer:
         color: bool | None = None,
         width: int | None = None,
         order: str = "omega-v",
+        contributions=(),
     ):
         self.out = out
+        # what other families add to a command's records: a column each, where a table has columns
+        self.contributions = contributions
         self.text = out if isinstance(out, io.TextIOBase) else None
         self.color = _colour(out, color)
         self.width = output_width(out, width)
@@ -563,8 +567,10 @@ class CheckTableWriter(_Writer):
     def __init__(self, out, **options):
         super().__init__(out, **options)
         self.kinds = [k for k in KINDS if k.check_fields]  # a kind with nothing to check has no column
+        self.cells = [globals()[c.cell] for c in self.contributions]  # named, as a kind's renderer is
         # a method's cell is "ok (its basis's conditioning)" or the code of its degeneracy
-        self.grid = _table(*(f"{k.label} (conditioning)" for k in self.kinds), "closure mu", "file", "grasp")
+        headers = (*(f"{k.label} (conditioning)" for k in self.kinds), *(c.header for c in self.contributions))
+        self.grid = _table(*headers, "file", "grasp")
         self.widths: list[int] = []
 
     def write(self, encoded: bytes) -> None:
@@ -573,7 +579,10 @@ class CheckTableWriter(_Writer):
             return
         self.count += 1
         self.grid.add_row(
-            *(_verdict_cell(rec.get(k.key, False)) for k in self.kinds), _closure_cell(rec), rec["file"], rec["grasp"]
+            *(_verdict_cell(rec.get(k.key, False)) for k in self.kinds),
+            *(cell(rec) for cell in self.cells),
+            rec["file"],
+            rec["grasp"],
         )
         if self.widths or self.grid.row_count >= SIZING_ROWS:
             self._rows()
@@ -604,7 +613,7 @@ class CheckTableWriter(_Writer):
 SIZING_ROWS = 64
 
 
-def _closure_cell(rec):
+def closure_cell(rec):
     """The least friction for force closure; with the grasp's own friction, whether that closes it."""
     if "closure_friction" not in rec:
         return Text("-", style="dim")
@@ -685,9 +694,6 @@ class ForceTableWriter(_Writer):
             text += f"; epsilon {fmt_number(c['epsilon'], d)}"
         self.add(lines, text)
         self.warnings(lines, rec)
-
-
-WRITERS = {"resolve": TableWriter, "basis": BasisTableWriter, "check": CheckTableWriter, "forces": ForceTableWriter}
 
 
 class HandTable:

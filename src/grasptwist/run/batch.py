@@ -27,6 +27,7 @@ from ..results import ALL_METHODS, BY_KEY, KINDS, METHOD_CHOICES, STATUS, Field,
 
 __all__ = [
     "METHODS",
+    "TwistOptions",
     "Block",
     "resolve",
     "resolve_arrays",
@@ -52,6 +53,23 @@ UNKNOWN_TWIST = "unknown-twist"
 
 #: The twist whose resolution carries just the bases (``basis`` and ``check``).
 ZERO_TWIST = Twist(name="0", screw=np.zeros(6), line=None)
+
+
+@dataclass(frozen=True)
+class TwistOptions:
+    """The twist family's options: which twists each grasp's rows take, by which methods.
+
+    ``twists`` (``--twist``) replace each grasp's own (``basis`` and ``check``
+    fix them to :data:`ZERO_TWIST`: a row per grasp); ``twists_from``
+    (``--twists-from``, a file or ``-``) gives them one per line instead;
+    ``select`` (``--select``) picks the grasps' own by name.
+    """
+
+    twists: tuple[Twist, ...] | None = None
+    method: str = "both"
+    twists_from: str | None = None
+    select: tuple[str, ...] | None = None
+
 
 #: Key of :meth:`Block.outward`'s verdicts among a block's computed values.
 OUTWARD = (None, "outward_normals")

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 from collections.abc import Iterable, Iterator
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 import numpy as np
 
@@ -32,18 +32,21 @@ from ..engine.ik import home_tips, place_hand
 from ..engine.path import PathDegeneracies, Poses, degeneracies, follow
 from ..io.datasets import DATASET_SUFFIXES
 from ..io.inputs import read
-from ..model import Grasp, GraspFileError, Hand, ObjectPath
+from ..model import Grasp, GraspFileError, ObjectPath
+from ..output import follow_records as fr
+from ..output.formats import FORMATS
+from ..output.records import diagnostics, error_record
 from ..results import BY_KEY, selected
 from .batch import Block, hand_placement, with_reasons
-from .pipeline import Output
+from .outputs import Output
 
 __all__ = [
-    "FollowJob",
+    "FollowOptions",
     "Samples",
     "Summary",
     "follow_grasp",
     "follow_inputs",
-    "write_follow",
+    "follow_outputs",
     "sample_times",
     "NO_PATH",
     "COMMAND_LINE",
@@ -64,8 +67,8 @@ CHUNK = 4096
 
 
 @dataclass(frozen=True)
-class FollowJob:
-    """What ``follow`` was asked.
+class FollowOptions:
+    """The path family's options: what ``follow`` was asked beyond what every command shares.
 
     Attributes
     ----------
@@ -79,12 +82,8 @@ class FollowJob:
         Samples per path, evenly spaced, both ends included.
     dt : float or None
         Time step between samples instead (the path's end is a sample too).
-    max_bytes : int or None
-        Size cap of a grasp file.
     bases : bool
-        Keep the basis screws (formats that show them).
-    hand : Hand or None
-        The run's hand, whose joints name the CSV and npz joint columns.
+        Keep the basis screws (formats that show them; :func:`follow_outputs` sets it from the format).
     """
 
     method: str = "both"
@@ -92,9 +91,7 @@ class FollowJob:
     segments: tuple | None = None
     samples: int | None = None
     dt: float | None = None
-    max_bytes: int | None = None
     bases: bool = True
-    hand: Hand | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -113,6 +110,9 @@ class Samples:
     poses: Poses
     joint_positions: np.ndarray | None = None
     grip: Grip | None = None
+
+    def __len__(self) -> int:
+        return len(self.block)
 
 
 @dataclass(frozen=True, eq=False)
@@ -143,8 +143,9 @@ def sample_times(duration: float, samples: int | None = None, dt: float | None =
     return np.append(np.arange(count) * dt, duration)
 
 
-def follow_inputs(job: FollowJob, inputs: Iterable) -> Iterator[GraspFileError | Samples | Summary]:
-    """Every path of every grasp of ``inputs`` (paths or the errors of ``expand``), in order."""
+def follow_inputs(job, inputs: Iterable) -> Iterator[GraspFileError | Samples | Summary]:
+    """Every path of every grasp of ``inputs`` (paths or the errors of ``expand``), in order;
+    ``job`` a :class:`~grasptwist.run.pipeline.Job` of the path family."""
     for item in inputs:
         if isinstance(item, GraspFileError):
             yield item
@@ -152,41 +153,39 @@ def follow_inputs(job: FollowJob, inputs: Iterable) -> Iterator[GraspFileError |
             yield GraspFileError("read-error", "follow reads grasp files, not data sets", item)
         else:
             for entry in read(item, job.max_bytes):
-                yield from follow_grasp(job, entry) if isinstance(entry, Grasp) else (entry,)
+                yield from follow_grasp(job.options, entry) if isinstance(entry, Grasp) else (entry,)
 
 
-def write_follow(job: FollowJob, inputs: Iterable, w, fmt: str, order: str = "omega-v") -> Iterator[Output]:
-    """Follow every path and write its records to ``w`` in format ``fmt``; per input error,
-    sample chunk and summary, the :class:`~grasptwist.run.pipeline.Output` of its counts and
-    stderr lines (a path's lines are its summary's: samples are counted, not told)."""
-    from ..output import follow_records as fr
-    from ..output.records import diagnostics, error_record
-
-    encoding = fr.encodings(job.hand)[fmt]
+def follow_outputs(job, inputs: Iterable, w, workers: int = 1, tuning=None) -> Iterator[Output]:
+    """Follow every path: per input error, sample chunk and summary, the
+    :class:`~grasptwist.run.outputs.Output` of its encoded records (a block format's
+    samples go to ``w`` here), counts and stderr lines (a path's lines are its summary's:
+    samples are counted, not told).  One process: a path's samples come in order."""
+    fmt = FORMATS[job.fmt]
+    job = replace(job, options=replace(job.options, bases=fmt.bases))
+    encoding = fr.encodings(job.hand)[job.fmt]
     for item in follow_inputs(job, inputs):
         if isinstance(item, Samples):
-            if encoding.samples is None:
-                w.write(item.block, fr.path_arrays(item, order, job.hand))
+            encoded = []
+            if fmt.takes_blocks:
+                w.write(item)
             else:
-                for encoded in encoding.samples(item, order):
-                    w.write(encoded)
+                encoded = list(encoding.samples(item, job.order))
             failed = int(item.block.failed_rows().sum())
-            yield Output(records=len(item.block), failed=failed, degenerate=item.block.failure_codes())
+            yield Output(encoded=encoded, records=len(item), failed=failed, degenerate=item.block.failure_codes())
             continue
-        rec = error_record(item) if isinstance(item, GraspFileError) else fr.summary_record(item)
-        encode = encoding.error if isinstance(item, GraspFileError) else encoding.summary
-        if encode is not None:
-            w.write(encode(rec))
-        errors, warnings = (
-            diagnostics(rec) if isinstance(item, GraspFileError) else fr.diagnostics(rec, item.grasp.contact_names)
-        )
-        out = Output(errors=errors, warnings=warnings, records=1)
+        error = isinstance(item, GraspFileError)
+        rec = error_record(item) if error else fr.summary_record(item)
+        encode = encoding.error if error else encoding.summary
+        errors, warnings = diagnostics(rec) if error else fr.diagnostics(rec, item.grasp.contact_names)
+        out = Output(encoded=[] if encode is None else [encode(rec)], errors=errors, warnings=warnings, records=1)
         out.count(rec)
         yield out
 
 
-def follow_grasp(job: FollowJob, grasp: Grasp) -> Iterator[GraspFileError | Samples | Summary]:
-    """Every path of one grasp (or the job's): its samples, then its summary; an error for a path not there."""
+def follow_grasp(job: FollowOptions, grasp: Grasp) -> Iterator[GraspFileError | Samples | Summary]:
+    """Every path of one grasp (or the options' own): its samples, then its summary; an error for a path not
+    there."""
     paths = (ObjectPath(COMMAND_LINE, job.segments, None),) if job.segments else grasp.paths
     chosen = [p for p in paths if job.path is None or p.name == job.path]
     if not chosen:

@@ -1,24 +1,170 @@
-"""Run the force engine over many (grasp, wrench) rows at once (``grasptwist forces``).
+"""Run the force engine over many (grasp, wrench) rows at once: the wrench family's compute.
 
 Like :mod:`.batch` for twists: grasps and loader errors come in file order,
 their rows are stacked into a :class:`ForceBlock` per group and the engine
-is called once per block (:func:`grasptwist.results.compute_forces`); the
+is called once per block and kind of row (:func:`compute_forces`); the
 errors stay in their places.  A grasp without a wrench gets one row (no
-wrench: only its closure).  No math here: only stacking.
+wrench: only its closure).  The family's contribution to ``check`` records,
+each grasp's closure, is :func:`closure_fields`.  No math here: only
+stacking and routing rows to the engine.
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterable, Iterator, Sequence
+from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
+from ..engine.forces.closure import force_closure
+from ..engine.forces.grasp_map import manipulating_forces
+from ..engine.forces.grip import grip
 from ..engine.screws import direction
 from ..model import Grasp, GraspFileError, Wrench
-from ..results import ForceOptions, ForceResult, compute_forces
 
-__all__ = ["ForceBlock", "force_blocks", "force_arrays", "force_dataset_blocks"]
+__all__ = [
+    "ForceOptions",
+    "ForceResult",
+    "compute_forces",
+    "closure_fields",
+    "ForceBlock",
+    "force_blocks",
+    "force_arrays",
+    "force_dataset_blocks",
+    "rows_per_grasp",
+]
+
+
+@dataclass(frozen=True)
+class ForceOptions:
+    """The wrench family's options: what ``grasptwist forces`` asks of every row beyond its inputs.
+
+    ``wrenches`` (``--wrench``) replace each grasp's own, ``friction``
+    (``--friction``) its friction; ``safety``, ``quality`` and ``cone_edges``
+    go to the engine.
+    """
+
+    wrenches: tuple[Wrench, ...] | None = None
+    friction: float | None = None
+    safety: float = 1.0
+    quality: bool = False
+    cone_edges: int = 8
+
+
+@dataclass(frozen=True)
+class ForceResult:
+    """The force side of ``N`` rows, each array over the rows.
+
+    ``manipulating_status`` is -1 where the row has no wrench, ``grip_status``
+    -1 where it has no wrench or no friction; their numbers are NaN there and
+    where they failed.  ``closure_friction`` is NaN where no friction gives
+    closure, ``force_closure`` and ``epsilon`` are meaningful only where the
+    row has a friction (``epsilon``: and quality was asked for).
+    """
+
+    manipulating: np.ndarray  # (N, 3, 3)
+    manipulating_status: np.ndarray  # (N,) int8
+    manipulating_culprit: np.ndarray
+    force: np.ndarray  # (N, 3, 3)
+    squeeze: np.ndarray  # (N, 3)
+    normal_force: np.ndarray
+    tangential_force: np.ndarray
+    friction_used: np.ndarray
+    total_normal_force: np.ndarray  # (N,)
+    grip_status: np.ndarray
+    grip_culprit: np.ndarray
+    closure_friction: np.ndarray
+    force_closure: np.ndarray  # (N,) bool
+    epsilon: np.ndarray
+    closure_status: np.ndarray
+    closure_culprit: np.ndarray
+    safety: float
+
+
+def compute_forces(points, normals, wrench, has_wrench, friction, has_friction, options: ForceOptions) -> ForceResult:
+    """The engine's force results for ``N`` rows (NaN wrench / friction rows where there is none).
+
+    The engine is called once per kind of row (with and without a wrench, a
+    friction), never once per row.
+    """
+    n = len(points)
+    out = {
+        "manipulating": np.full((n, 3, 3), np.nan),
+        "manipulating_status": np.full(n, -1, np.int8),
+        "manipulating_culprit": np.full(n, -1, np.int8),
+        "force": np.full((n, 3, 3), np.nan),
+        "squeeze": np.full((n, 3), np.nan),
+        "normal_force": np.full((n, 3), np.nan),
+        "tangential_force": np.full((n, 3), np.nan),
+        "friction_used": np.full((n, 3), np.nan),
+        "total_normal_force": np.full(n, np.nan),
+        "grip_status": np.full(n, -1, np.int8),
+        "grip_culprit": np.full(n, -1, np.int8),
+        "closure_friction": np.full(n, np.nan),
+        "force_closure": np.zeros(n, bool),
+        "epsilon": np.full(n, np.nan),
+        "closure_status": np.zeros(n, np.int8),
+        "closure_culprit": np.full(n, -1, np.int8),
+    }
+    w = np.flatnonzero(has_wrench)
+    if w.size:
+        m = manipulating_forces(points[w], wrench[w])
+        out["manipulating"][w], out["manipulating_status"][w], out["manipulating_culprit"][w] = (
+            m.force,
+            m.status,
+            m.culprit,
+        )
+    g = np.flatnonzero(has_wrench & has_friction)
+    if g.size:
+        r = grip(points[g], normals[g], wrench[g], friction[g], options.safety)
+        for name in ("force", "squeeze", "normal_force", "tangential_force", "friction_used", "total_normal_force"):
+            out[name][g] = getattr(r, name)
+        out["grip_status"][g], out["grip_culprit"][g] = r.status, r.culprit
+    for rows, mu in ((np.flatnonzero(has_friction), friction), (np.flatnonzero(~has_friction), None)):
+        if not rows.size:
+            continue
+        quality = options.quality and mu is not None
+        c = force_closure(
+            points[rows],
+            normals[rows],
+            None if mu is None else mu[rows],
+            quality=quality,
+            cone_edges=options.cone_edges,
+        )
+        out["closure_friction"][rows], out["closure_status"][rows], out["closure_culprit"][rows] = (
+            c.closure_friction,
+            c.status,
+            c.culprit,
+        )
+        if mu is not None:
+            out["force_closure"][rows] = c.force_closure
+        if quality:
+            out["epsilon"][rows] = c.epsilon
+    return ForceResult(safety=float(options.safety), **out)
+
+
+def closure_fields(block) -> list[dict]:
+    """The wrench family's contribution to ``check`` records: per row of a twist block its
+    ``closure_friction`` (the least friction for force closure; None: none does) and, where the
+    grasp gives a friction, ``force_closure`` with it."""
+    n = len(block)
+    friction = block.friction
+    has = np.zeros(n, bool) if friction is None else ~np.isnan(friction).any(axis=-1)
+    result = compute_forces(
+        block.points, block.normals, np.full((n, 6), np.nan), np.zeros(n, bool), friction, has, ForceOptions()
+    )
+    least = result.closure_friction.tolist()
+    verdict = result.force_closure.tolist()
+    return [
+        {"closure_friction": None if least[i] != least[i] else least[i]}
+        | ({"force_closure": verdict[i]} if has[i] else {})
+        for i in range(n)
+    ]
+
+
+def rows_per_grasp(options: ForceOptions) -> int:
+    """Rows each grasp gives when the command line names the wrenches (else at least one)."""
+    return len(options.wrenches) if options.wrenches else 1
 
 
 @dataclass(frozen=True)
@@ -81,33 +227,30 @@ def force_arrays(points, normals, wrench, wrench_name, friction, options: ForceO
 
 
 def force_blocks(
-    items: Iterable[Grasp | GraspFileError],
-    wrenches: Sequence[Wrench] | None,
-    friction: float | None,
-    options: ForceOptions,
+    items: Iterable[Grasp | GraspFileError], options: ForceOptions
 ) -> Iterator[ForceBlock | GraspFileError]:
-    """Every grasp's rows (one per wrench: ``wrenches``, the command line's, replace
-    each grasp's own) in one block per run of consecutive grasps, the loader's
-    errors in their places.  ``friction`` (``--friction``) replaces the grasps' own."""
+    """Every grasp's rows (one per wrench: the options' ``wrenches``, the command line's, replace
+    each grasp's own) in one block per run of consecutive grasps, the loader's errors in their
+    places.  The options' ``friction`` (``--friction``) replaces the grasps' own."""
     rows = []
     for item in items:
         if isinstance(item, Grasp):
-            own = wrenches if wrenches is not None else item.wrenches
+            own = options.wrenches if options.wrenches is not None else item.wrenches
             rows += [(item, w) for w in own] or [(item, None)]
             continue
         if rows:
-            yield _stack(rows, friction, options)
+            yield _stack(rows, options)
             rows = []
         yield item
     if rows:
-        yield _stack(rows, friction, options)
+        yield _stack(rows, options)
 
 
-def _stack(rows, friction, options) -> ForceBlock:
+def _stack(rows, options) -> ForceBlock:
     grasps = [g for g, _ in rows]
     nan3, nan6 = np.full(3, np.nan), np.full(6, np.nan)
-    if friction is not None:
-        mu = np.full((len(rows), 3), float(friction))
+    if options.friction is not None:
+        mu = np.full((len(rows), 3), float(options.friction))
     else:
         mu = np.stack([nan3 if g.friction is None else g.friction for g in grasps])
     return force_arrays(
@@ -125,18 +268,18 @@ def _stack(rows, friction, options) -> ForceBlock:
 
 
 def force_dataset_blocks(
-    ds, wrenches: Sequence[Wrench] | None, friction: float | None, options: ForceOptions,
-    rows: int = 65536, start: int = 0, stop: int | None = None,
-) -> Iterator[ForceBlock]:  # fmt: skip
+    ds, options: ForceOptions, rows: int = 65536, start: int = 0, stop: int | None = None
+) -> Iterator[ForceBlock]:
     """The force rows of the grasps ``start:stop`` of a data set, about ``rows`` rows at a time.
 
-    Each grasp is paired with every wrench of ``wrenches`` (the command
-    line's), or else with the data set's own ``wrench`` (one for all rows,
-    or one per row), or else with none (its closure only).  ``friction``
-    (``--friction``) replaces the data set's (one for all, one per row, or
-    one per contact).
+    Each grasp is paired with every wrench of the options' ``wrenches`` (the
+    command line's), or else with the data set's own ``wrench`` (one for all
+    rows, or one per row), or else with none (its closure only).  The
+    options' ``friction`` (``--friction``) replaces the data set's (one for
+    all, one per row, or one per contact).
     """
-    k = len(wrenches) if wrenches else 1
+    wrenches, friction = options.wrenches, options.friction
+    k = rows_per_grasp(options)
     step = max(1, rows // k)
     end = len(ds) if stop is None else min(stop, len(ds))
     for first in range(start, end, step):

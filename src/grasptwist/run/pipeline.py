@@ -1,9 +1,13 @@
 """Inputs to encoded output, a group of files at a time, on one or more processes.
 
-A command is a :class:`Job`.  :func:`run` splits its inputs into groups of
-grasp files (and data sets, each a stream of row blocks), turns each group
-into records, their diagnostics and their encoded bytes with
-:func:`run_group`, and yields the results in input order.  With several
+A command is a :class:`Job`: what every command shares, and the options of
+its family of rows (:mod:`grasptwist.run.families`).  :func:`outputs` runs
+any command.  For the families that go by groups (twist and wrench rows),
+:func:`record_outputs` splits the inputs into groups of grasp files (and
+data sets, each a stream of row blocks), turns each group into records,
+their diagnostics and their encoded bytes with :func:`run_group`, and
+yields the results in input order; the family says how a group's grasps
+become blocks, and its command how blocks become records.  With several
 workers the groups of files (or a data set's rows) are spread over a
 :class:`~grasptwist.run.pool.Pool`; everything a worker sends back is already
 encoded, so the parent only writes.  How big a group or a task is, and how
@@ -17,34 +21,35 @@ import shutil
 import tempfile
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from functools import partial
-
-import numpy as np
+from typing import Any
 
 from ..io.datasets import DATASET_SUFFIXES, open_dataset
 from ..io.inputs import read
 from ..io.lines import grasp_batches
-from ..model import GraspFileError, Hand, Twist, Wrench
-from ..output.force_records import force_records
+from ..model import GraspFileError, Hand
 from ..output.formats import FORMATS
-from ..output.records import (
-    basis_record,
-    check_record,
-    diagnostics,
-    error_record,
-    failure_codes,
-    records,
-    talking_rows,
-)
-from ..results import ForceOptions, check_closure
-from .batch import ZERO_TWIST, Block, check_positions, dataset_blocks, resolve
-from .forces import ForceBlock, force_blocks, force_dataset_blocks
+from ..output.records import error_record
+from .batch import check_positions
+from .families import COMMANDS, Command
+from .outputs import Output
 from .pool import Pool
 from .scratch import owned_prefix, remove_orphans
-from .stream import grasp_stream, is_stream, twist_stream
+from .stream import is_stream
 
-__all__ = ["Job", "Tuning", "TUNING", "Output", "Spool", "record_outputs", "run_group", "blocks", "write_blocks"]
+__all__ = [
+    "Job",
+    "Tuning",
+    "TUNING",
+    "Output",
+    "Spool",
+    "outputs",
+    "record_outputs",
+    "run_group",
+    "blocks",
+    "write_blocks",
+]
 
 #: Name stem of the spool folders in /dev/shm.
 SPOOL_STEM = "grasptwist-"
@@ -52,21 +57,26 @@ SPOOL_STEM = "grasptwist-"
 
 @dataclass(frozen=True, kw_only=True)
 class Job:
-    """What a command asks for (everything a worker needs)."""
+    """What a command asks for (everything a worker needs): what every command shares, and
+    ``options``, its family's own (None: the family's defaults; the options a command fixes,
+    like ``basis``'s zero twist, are applied here)."""
 
-    kind: str = "resolve"  # resolve, basis, check or forces
-    twists: tuple[Twist, ...] | None = None
-    method: str = "both"
-    order: str = "omega-v"
+    command: Command = field(default_factory=lambda: COMMANDS["resolve"])
     fmt: str = "jsonl"
     max_bytes: int | None = None
+    order: str = "omega-v"
     extra_point: str = "wrist"
     hand: Hand | None = None  # --hand: the hand of a data set's rows, whose joints CSV and npz columns name
-    twists_from: str | None = None  # a stream of twists (a file or -) for every grasp
-    select: tuple[str, ...] | None = None  # resolve --select: the names of the grasps' own twists to resolve
-    wrenches: tuple[Wrench, ...] | None = None  # forces: --wrench, replacing the files' wrenches
-    friction: float | None = None  # forces: --friction, replacing the files' friction
-    forces: ForceOptions = field(default_factory=ForceOptions)  # forces: safety, quality, cone edges
+    options: Any = None
+
+    def __post_init__(self):
+        options = self.options if self.options is not None else self.command.family.options()
+        object.__setattr__(self, "options", replace(options, **self.command.fixed))
+
+    @property
+    def family(self):
+        """The family of the command's rows."""
+        return self.command.family
 
 
 @dataclass(frozen=True, kw_only=True)
@@ -96,59 +106,22 @@ class Tuning:
 TUNING = Tuning()
 
 
-@dataclass
-class Output:
-    """The encoded records of one group, with their stderr lines and counts."""
-
-    encoded: list = field(default_factory=list)
-    errors: list[str] = field(default_factory=list)  # always printed
-    row_errors: list[str] = field(default_factory=list)  # of a data set's or stream's rows: printed like warnings
-    warnings: list[str] = field(default_factory=list)
-    records: int = 0
-    failed: int = 0  # records not ok: inputs that failed, and grasps (or rows) with a degenerate method
-    inputs_failed: int = 0  # of ``failed``: inputs (files, documents, lines of a stream) that could not be read
-    degenerate: dict = field(default_factory=dict)  # of the other failed records: per (kind, code), how many
-    done: int = 0  # progress: files read, or data-set records made
-    extra_work: int = 0  # progress: work found beyond the one unit an input was counted as
-    spool: str | None = None  # a file holding ``encoded`` (see _sealed)
-    rows: bool = False  # records of a data set's or stream's rows: their errors are row_errors
-
-    def add(self, rec: dict, encode) -> None:
-        self._note(rec)
-        self.records += 1
-        self.encoded.append(encode(rec))
-
-    def add_encoded(self, texts: list[bytes], talking: list[dict]) -> None:
-        """Records already encoded; ``talking`` are those with errors or warnings."""
-        for rec in talking:
-            self._note(rec)
-        self.records += len(texts)
-        self.encoded += texts
-
-    def _note(self, rec: dict) -> None:
-        errors, warnings = diagnostics(rec)
-        # a whole input that cannot be read (no line: a data set, a stream's file) is never a row
-        row = self.rows and not ("error" in rec and rec["error"]["line"] is None)
-        (self.row_errors if row else self.errors).extend(errors)
-        self.warnings += warnings
-        self.count(rec)
-
-    def count(self, rec: dict) -> None:
-        """Count a record that is not ok: an input that failed, or by the codes of its failed kinds."""
-        self.failed += not rec["ok"]
-        if "error" in rec:
-            self.inputs_failed += 1
-        elif not rec["ok"]:
-            for code in failure_codes(rec):
-                self.degenerate[code] = self.degenerate.get(code, 0) + 1
+def outputs(job: Job, inputs: Sequence, w, workers: int = 1, tuning: Tuning = TUNING) -> Iterator[Output]:
+    """Every input's outputs, in order, for any command: by its family's own way (``follow``'s
+    paths), or by groups of files and data sets; a block format's rows go to ``w`` here."""
+    if job.family.outputs is not None:
+        return job.family.outputs(job, inputs, w, workers, tuning)
+    if FORMATS[job.fmt].takes_blocks:
+        return write_blocks(job, inputs, w, tuning)
+    return record_outputs(job, inputs, workers, tuning)
 
 
 def record_outputs(job: Job, paths: Sequence, workers: int = 1, tuning: Tuning = TUNING) -> Iterator[Output]:
     """Every input's output, in order.  ``paths`` holds file names, ``-``,
     and errors found while listing folders."""
-    if job.twists_from is not None:
-        twists = twist_stream(paths, job.twists_from, job.method, job.max_bytes, tuning.files_per_group)
-        yield from _streamed(job, twists, tuning, files_first=True)  # the grasp files' errors come first
+    beside = job.family.beside(job, paths, tuning)
+    if beside is not None:
+        yield from _streamed(job, beside, tuning, files_first=True)  # the grasp files' errors come first
         return
     groups = list(_groups(paths, tuning.files_per_group))
     files = [g for g in groups if not _is_dataset(g)]
@@ -170,11 +143,14 @@ def _alone(job: Job, path: str, workers: int, tuning: Tuning) -> Iterator[Output
     """The outputs of an input read on its own: a stream, or a data set."""
     if not is_stream(path):
         return _dataset(job, path, workers, tuning)
-    if job.kind == "forces":
-        return _streamed(job, _force_batches(job, path, tuning), tuning)
-    twists = [ZERO_TWIST] if job.kind != "resolve" else job.twists
-    batches = grasp_stream(path, twists, job.method, job.max_bytes, tuning.files_per_group, job.select)
-    return _streamed(job, batches, tuning)
+    return _streamed(job, _stream_batches(job, path, tuning), tuning)
+
+
+def _stream_batches(job: Job, path: str, tuning: Tuning):
+    """The blocks and errors of the grasps of the stream ``path``, a batch of lines at a time
+    (each batch's records are written as soon as it is read)."""
+    for batch in grasp_batches(path, job.max_bytes, tuning.files_per_group):
+        yield list(job.family.rows(batch, job))
 
 
 def _streamed(job: Job, batches, tuning: Tuning, files_first: bool = False) -> Iterator[Output]:
@@ -265,30 +241,22 @@ def _sealed(job: Job, out: Output, spool: Spool | None = None) -> Output:
 
 
 def run_group(job: Job, paths: Sequence, tuning: Tuning = TUNING, spool: Spool | None = None) -> Output:
-    """Read a group of grasp files and resolve them into one encoded :class:`Output`."""
-    items = []
-    for p in paths:
-        items.extend(read(p, job.max_bytes) if isinstance(p, str) else [p])
+    """Read a group of grasp files and turn them into one encoded :class:`Output`."""
     out = Output(done=len(paths))
-    if job.kind == "forces":
-        results = force_blocks(items, job.wrenches, job.friction, job.forces)
-    else:
-        twists = [ZERO_TWIST] if job.kind != "resolve" else job.twists
-        results = resolve(items, twists, job.method, select=job.select)
-    for x in results:
+    for x in job.family.rows(_read(job, paths), job):
         _encode_into(job, x, out, tuning.records_at_once)
     return _sealed(job, out, spool)
 
 
-def _force_batches(job: Job, path: str, tuning: Tuning):
-    """The force blocks and errors of the grasps of the stream ``path``, a batch of lines at a time."""
-    for batch in grasp_batches(path, job.max_bytes, tuning.files_per_group):
-        yield list(force_blocks(batch, job.wrenches, job.friction, job.forces))
+def _read(job: Job, paths: Sequence) -> list:
+    """The grasps and errors of a group of files (and errors found listing folders), in order."""
+    items = []
+    for p in paths:
+        items.extend(read(p, job.max_bytes) if isinstance(p, str) else [p])
+    return items
 
 
-def blocks(
-    job: Job, paths: Sequence, tuning: Tuning = TUNING
-) -> Iterator[tuple[Block | GraspFileError, int | None, bool]]:
+def blocks(job: Job, paths: Sequence, tuning: Tuning = TUNING) -> Iterator[tuple[Any, int | None, bool]]:
     """Blocks and errors of every input, in order (for writers that take
     blocks, like npz), each with its progress news: None for a group of
     files (one unit a file), else the records a data set holds beyond the
@@ -297,74 +265,37 @@ def blocks(
     warnings).  Data sets are resolved without basis screws when the format
     shows none."""
     bases = FORMATS[job.fmt].bases
-    if job.twists_from is not None:
-        batches = twist_stream(paths, job.twists_from, job.method, job.max_bytes, tuning.files_per_group)
-        for k, batch in enumerate(batches):
+    beside = job.family.beside(job, paths, tuning)
+    if beside is not None:
+        for k, batch in enumerate(beside):
             yield from ((x, None, k > 0) for x in batch)  # the first batch: the grasp files' errors
         return
     for g in _groups(paths, tuning.files_per_group):
-        if is_stream(g) and job.kind == "forces":
-            yield from ((x, None, True) for batch in _force_batches(job, g, tuning) for x in batch)
-            continue
         if is_stream(g):
-            batches = grasp_stream(g, job.twists, job.method, job.max_bytes, tuning.files_per_group, job.select)
-            yield from ((x, None, True) for batch in batches for x in batch)
-            continue
-        if _is_dataset(g) and job.kind == "forces":
+            yield from ((x, None, True) for batch in _stream_batches(job, g, tuning) for x in batch)
+        elif _is_dataset(g):
             try:
                 ds = open_dataset(g, job.extra_point)
-                extra_work = len(ds) * (len(job.wrenches) if job.wrenches else 1) - 1
-                for block in force_dataset_blocks(ds, job.wrenches, job.friction, job.forces):
+                extra_work = len(ds) * job.family.per_grasp(job.options) - 1
+                for block in job.family.dataset(ds, job, 0, None, bases):
                     yield block, extra_work, True
                     extra_work = 0
             except GraspFileError as err:
                 yield err, None, False
-            continue
-        if _is_dataset(g):
-            try:
-                ds = open_dataset(g, job.extra_point)
-                extra_work = len(ds) * (len(job.twists) if job.twists else 1) - 1
-                for block in dataset_blocks(ds, job.twists, job.method, bases=bases, hand_of_rows=job.hand):
-                    yield block, extra_work, True
-                    extra_work = 0
-            except GraspFileError as err:
-                yield err, None, False
-            continue
-        items = []
-        for p in g:
-            items.extend(read(p, job.max_bytes) if isinstance(p, str) else [p])
-        if job.kind == "forces":
-            yield from ((x, None, False) for x in force_blocks(items, job.wrenches, job.friction, job.forces))
-            continue
-        for x in resolve(items, job.twists, job.method, select=job.select):
-            yield x, None, False
+        else:
+            yield from ((x, None, False) for x in job.family.rows(_read(job, g), job))
 
 
 def _encode_into(job: Job, x, out: Output, at_once: int) -> None:
-    """Records of ``x`` (a block, or an input's error) encoded into ``out``."""
+    """Records of ``x`` (a block, or an input's error) encoded into ``out``, by the command's
+    records and the format's encoding."""
     fmt = FORMATS[job.fmt]
-    hand = fmt.hand_options(job.hand)
-    encode = partial(fmt.encode, **hand) if hand else fmt.encode
-    if isinstance(x, ForceBlock):
-        if fmt.encode_forces is not None:
-            out.add_encoded(*fmt.encode_forces(x))
-        else:
-            for rec in force_records(x):
-                out.add(rec, encode)
-    elif not isinstance(x, Block):
-        out.add(error_record(x), fmt.encode_force_error if job.kind == "forces" and fmt.encode_force_error else encode)
-    elif job.kind == "resolve":
-        # a few thousand records at a time: their floats as Python objects
-        # would otherwise fill memory
-        for start in range(0, len(x), at_once):
-            out.add_encoded(*fmt.encode_rows(x.part(start, start + at_once), job.order, **hand))
-    elif job.kind == "basis":
-        for i in range(len(x)):
-            out.add(basis_record(x, i, job.order), encode)
-    else:
-        closure = check_closure(x.points, x.normals, x.friction)
-        for i in range(len(x)):
-            out.add(check_record(x, i, closure), encode)
+    if not isinstance(x, job.family.block):
+        out.add(error_record(x), partial(fmt.error, job=job))
+        return
+    # a few thousand records at a time: their floats as Python objects would otherwise fill memory
+    for start in range(0, len(x), at_once):
+        out.add_encoded(*fmt.rows(x.part(start, start + at_once), job))
 
 
 def _dataset(job: Job, path: str, workers: int, tuning: Tuning) -> Iterator[Output]:
@@ -373,18 +304,13 @@ def _dataset(job: Job, path: str, workers: int, tuning: Tuning) -> Iterator[Outp
     try:
         ds = open_dataset(path, job.extra_point)
         check_positions(ds, job.hand)
-        if job.kind == "forces":
-            pass  # a data set without wrenches gives each grasp's closure
-        elif job.twists is None and ds.twist is None and job.kind == "resolve":
-            next(dataset_blocks(ds, None, job.method, hand_of_rows=job.hand))  # raises the no-twist error
+        job.family.check_dataset(ds, job)
     except GraspFileError as err:
         out = Output(done=1)
         _encode_into(job, err, out, tuning.records_at_once)
         yield _sealed(job, out)
         return
-    rows = len(ds) * (len(job.twists) if job.twists and job.kind == "resolve" else 1)
-    if job.kind == "forces":
-        rows = len(ds) * (len(job.wrenches) if job.wrenches else 1)
+    rows = len(ds) * job.family.per_grasp(job.options)
     step = tuning.grasps_per_task
     tasks = [(start, min(len(ds), start + step)) for start in range(0, len(ds), step)]
     if workers > 1 and len(tasks) > 1:
@@ -411,13 +337,9 @@ def _counted(parts, rows):
 
 def _dataset_task(job: Job, ds, rows: tuple[int, int], tuning: Tuning, spool: Spool | None = None) -> list[Output]:
     """Records of the data set's grasps ``rows``, in outputs of ``tuning.records_at_once``."""
-    twists = [ZERO_TWIST] if job.kind != "resolve" else job.twists
     at_once = tuning.records_at_once
     outs = []
-    if job.kind == "forces":
-        made = force_dataset_blocks(ds, job.wrenches, job.friction, job.forces, start=rows[0], stop=rows[1])
-    else:
-        made = dataset_blocks(ds, twists, job.method, start=rows[0], stop=rows[1], hand_of_rows=job.hand)
+    made = job.family.dataset(ds, job, rows[0], rows[1], FORMATS[job.fmt].bases)
     try:
         for block in made:
             for start in range(0, len(block), at_once):
@@ -462,16 +384,9 @@ def write_blocks(job: Job, paths: Sequence, w, tuning: Tuning = TUNING) -> Itera
     """
     for x, extra_work, rows in blocks(job, paths, tuning):
         o = Output(done=len(x) if extra_work is not None else 1, extra_work=extra_work or 0, rows=rows)
-        if isinstance(x, ForceBlock):
+        if isinstance(x, job.family.block):
             w.write(x)
-            for rec in force_records(x):
-                if not rec["ok"] or rec["warnings"]:
-                    o.add(rec, lambda rec: None)
-            o.records = len(x)
-        elif isinstance(x, Block):
-            w.write(x)
-            talking = np.flatnonzero(talking_rows(x))
-            for rec in records(x.take(talking), job.order) if talking.size else []:
+            for rec in job.command.talking(x, job):
                 o.add(rec, lambda rec: None)
             o.records = len(x)
         else:

@@ -17,7 +17,7 @@ from ..io.lines import grasp_batches, is_json_lines, twist_batches
 from ..model import Grasp, GraspFileError, Twist
 from .batch import Block, resolve
 
-__all__ = ["is_stream", "grasp_stream", "twist_stream"]
+__all__ = ["is_stream", "twist_stream"]
 
 
 def is_stream(path) -> bool:
@@ -27,13 +27,6 @@ def is_stream(path) -> bool:
     [True, True, False]
     """
     return isinstance(path, str) and (path == STDIN or is_json_lines(path))
-
-
-def grasp_stream(path: str, twists, method: str, max_bytes: int | None, per_batch: int, select=None) -> Iterator[list]:
-    """The resolved rows (blocks) and errors of the grasps of the stream ``path``, a batch of lines at a
-    time (``select``: the names of their own twists to resolve)."""
-    for batch in grasp_batches(path, max_bytes, per_batch):
-        yield list(resolve(batch, twists, method, select=select))
 
 
 def twist_stream(
