@@ -30,6 +30,7 @@ from grasptwist.io.grasp import (
     one_per_document,
     read_grasps,
 )
+from grasptwist.run import placement
 from hostile import jsonl, run
 from hostile import summary as summary_line
 
@@ -103,7 +104,7 @@ def test_fixtures_cover_every_rejection():
 @pytest.mark.parametrize("path", FIXTURES, ids=lambda p: p.stem)
 def test_invalid_fixture_is_rejected_where_its_header_says(path, loader):
     code, line, column, _ = fixture_header(path)
-    entries = read_grasps(path, reading=loader)
+    entries = placement.read_grasps(path, reading=loader)  # a hand's fixtures: placed on their contacts
     error = next(e for e in entries if isinstance(e, GraspFileError))
     assert (error.code, error.line, error.column) == (code, line, column)
     where = f"{path}:{line}:{column}: " if line else f"{path}: "

@@ -17,7 +17,8 @@ import yaml
 from typer.testing import CliRunner
 
 from grasptwist.cli import app
-from grasptwist.io.grasp import grasp_schema, read_grasps
+from grasptwist.io.grasp import grasp_schema
+from grasptwist.run.placement import read_grasps  # the hand placed on its contacts, as every command reads it
 
 ROOT = Path(__file__).resolve().parents[1]
 CORPUS = ROOT / "tests" / "corpus" / "urdf"

@@ -18,8 +18,8 @@ from grasptwist.cli import app
 from grasptwist.engine import hands
 from grasptwist.engine.degeneracy import Status
 from grasptwist.engine.ik import IK_TOL, hand_ik
-from grasptwist.io.grasp import read_grasps
 from grasptwist.output.follow_table import FollowTable
+from grasptwist.run.placement import read_grasps
 
 ROOT = Path(__file__).resolve().parents[1]
 TRIFINGER = ROOT / "grasps" / "trifinger-cube.yaml"

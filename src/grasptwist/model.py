@@ -23,6 +23,7 @@ __all__ = [
     "Joint",
     "Finger",
     "Hand",
+    "HandPlacement",
 ]
 
 #: Contact names of a grasp that does not name its contacts.
@@ -105,7 +106,9 @@ class Grasp:
         The hand whose fingers touch the contacts, finger ``f`` contact ``f``.
     joint_positions : numpy.ndarray or None
         ``(n_joints,)`` the hand's configuration, in ``hand.joint_names``
-        order (zeros for joints given inline, at their configuration).
+        order (zeros for joints given inline, at their configuration); while
+        ``placement`` is pending, what the file gives: the positions to check,
+        or the seed to solve from.
     friction : numpy.ndarray or None
         ``(3,)`` Coulomb friction coefficient ``mu_i >= 0`` of each contact
         (a contact's own ``friction``, else the grasp's); None when not given.
@@ -117,6 +120,10 @@ class Grasp:
     center_of_mass, gravity : numpy.ndarray or None
         ``(3,)`` each, given with ``mass`` (gravity by default
         ``(0, 0, -9.81)``); None without it.
+    placement : HandPlacement or None
+        A URDF hand not yet placed on the contacts, as the file gives it (the
+        loader only reads: :func:`grasptwist.run.placement.place` checks or
+        solves the joint positions); None once placed, or for an inline hand.
     """
 
     name: str
@@ -137,6 +144,26 @@ class Grasp:
     mass: float | None = None
     center_of_mass: np.ndarray | None = None
     gravity: np.ndarray | None = None
+    placement: HandPlacement | None = None
+
+
+@dataclass(frozen=True)
+class HandPlacement:
+    """Where a grasp file puts its URDF hand, as the file says it (nothing solved yet).
+
+    Attributes
+    ----------
+    given : bool
+        The file gives ``joint_positions`` (checked against the contacts);
+        else the grasp's joint positions are the ``seed`` that inverse
+        kinematics starts from.
+    tips : tuple of (int, int)
+        ``(line, column)`` of each finger's ``tip`` in the file: where a finger
+        that cannot be put on its contact is reported.
+    """
+
+    given: bool
+    tips: tuple[tuple[int | None, int | None], ...]
 
 
 @dataclass(frozen=True, eq=False)

@@ -255,7 +255,7 @@ def hand_option(path: str | None, paths: list[str], fmt: str):
         return None
     if not os.path.isfile(paths[0]):
         return None
-    from ..io.inputs import read
+    from ..run.placement import read
 
     return next((g.hand for g in read(paths[0]) if getattr(g, "hand", None) is not None), None)
 

@@ -31,7 +31,6 @@ from ..engine.hands import HandTrack
 from ..engine.ik import home_tips, place_hand
 from ..engine.path import PathDegeneracies, Poses, degeneracies, follow
 from ..io.datasets import DATASET_SUFFIXES
-from ..io.inputs import read
 from ..model import Grasp, GraspFileError, ObjectPath
 from ..output import follow_records as fr
 from ..output.formats import FORMATS
@@ -39,6 +38,7 @@ from ..output.records import diagnostics, error_record
 from ..results import BY_KEY, selected
 from .batch import Block, hand_placement, with_reasons
 from .outputs import Output
+from .placement import read
 
 __all__ = [
     "FollowOptions",

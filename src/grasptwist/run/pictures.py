@@ -14,12 +14,13 @@ from dataclasses import replace
 
 from .. import plot as pictures
 from ..engine.forces.grip import grip
-from ..io.inputs import expand, read
+from ..io.inputs import expand
 from ..io.urdf_meshes import grasp_folder, hand_meshes
 from ..model import Grasp, InputError
 from ..output.records import diagnostics, error_record
 from ..plot.animation import DEFAULT_SAMPLES
 from .follow import FollowOptions, Samples, Summary, follow_grasp
+from .placement import read
 
 __all__ = ["draw", "read_grasps", "page_extras", "grip_forces"]
 

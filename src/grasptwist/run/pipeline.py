@@ -26,7 +26,6 @@ from functools import partial
 from typing import Any
 
 from ..io.datasets import DATASET_SUFFIXES, open_dataset
-from ..io.inputs import read
 from ..io.lines import grasp_batches
 from ..model import GraspFileError, Hand
 from ..output.formats import FORMATS
@@ -34,6 +33,7 @@ from ..output.records import error_record
 from .batch import check_positions
 from .families import COMMANDS, Command
 from .outputs import Output
+from .placement import placed, read
 from .pool import Pool
 from .scratch import owned_prefix, remove_orphans
 from .stream import is_stream
@@ -150,7 +150,7 @@ def _stream_batches(job: Job, path: str, tuning: Tuning):
     """The blocks and errors of the grasps of the stream ``path``, a batch of lines at a time
     (each batch's records are written as soon as it is read)."""
     for batch in grasp_batches(path, job.max_bytes, tuning.files_per_group):
-        yield list(job.family.rows(batch, job))
+        yield list(job.family.rows(placed(batch), job))
 
 
 def _streamed(job: Job, batches, tuning: Tuning, files_first: bool = False) -> Iterator[Output]:

@@ -12,10 +12,11 @@ from __future__ import annotations
 
 from collections.abc import Iterator, Sequence
 
-from ..io.inputs import STDIN, read
+from ..io.inputs import STDIN
 from ..io.lines import grasp_batches, is_json_lines, twist_batches
 from ..model import Grasp, GraspFileError, Twist
 from .batch import Block, resolve
+from .placement import placed, read
 
 __all__ = ["is_stream", "twist_stream"]
 
@@ -68,5 +69,5 @@ def _items(path, max_bytes, per_batch):
     if not isinstance(path, str):
         return [path]
     if is_stream(path):
-        return [item for batch in grasp_batches(path, max_bytes, per_batch) for item in batch]
+        return [item for batch in grasp_batches(path, max_bytes, per_batch) for item in placed(batch)]
     return read(path, max_bytes)

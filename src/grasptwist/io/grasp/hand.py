@@ -13,8 +13,12 @@ Two forms (README, "Hands and joint rates"), never mixed:
 Checked with the loader's shared typed-value checks (:mod:`.values`), so
 problems are located and coded like the rest of the format; a URDF's own problems
 (:mod:`grasptwist.io.urdf`) are reported at the ``urdf`` key, the URDF's
-file and line in the message.  Forward kinematics, the inverse kinematics
-and the contact-off-finger check are the engine's (:mod:`grasptwist.engine.ik`).
+file and line in the message.  The loader only reads: a URDF hand comes
+with its :class:`~grasptwist.model.HandPlacement` (positions given or a
+seed, and where each finger's ``tip`` stood), and the run layer puts it on
+the contacts (:func:`grasptwist.run.placement.place`: the engine's inverse
+kinematics and contact-off-finger check), reporting a finger that cannot
+be placed at its ``tip``.
 """
 
 from __future__ import annotations
@@ -25,11 +29,9 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from ...engine.degeneracy import Status
 from ...engine.hands import joint_positions
-from ...engine.ik import place_hand
 from ...engine.kinematics import chain_length, joint_screw
-from ...model import Finger, Hand, InputError, Joint
+from ...model import Finger, Hand, HandPlacement, InputError, Joint
 from ..limits import DEFAULT_MAX_BYTES
 from ..urdf import load_urdf_hand
 from .compose import PARSER, compose, syntax_error
@@ -66,11 +68,15 @@ JOINT_KEYS = ("name", "type", "axis", "point", "velocity_limit")
 JOINT_TYPES = ("revolute", "prismatic")
 
 
-def read_hand(node, points, file, problems, contact_names=("1", "2", "3")):
-    """``(Hand, joint positions)`` of a ``hand`` node, or None after a problem.
+def read_hand(node, points, file, problems):
+    """``(Hand, joint positions, placement)`` of a ``hand`` node, or None after a problem.
 
-    ``points`` are the contacts (None when they had problems); ``file`` is
-    the grasp file, whose folder a relative ``urdf`` path stays inside.
+    ``points`` are the contacts (None: a hand file, whose rows bring their own);
+    ``file`` is the grasp file, whose folder a relative ``urdf`` path stays
+    inside.  A URDF hand of a grasp file comes with its
+    :class:`~grasptwist.model.HandPlacement` (the positions are then the ones
+    given, or the seed), to be put on its contacts by the run layer; else the
+    placement is None.
     """
     fields = read_mapping(node, "hand", HAND_KEYS, ("fingers",), problems)
     if fields is None:
@@ -132,13 +138,13 @@ def read_hand(node, points, file, problems, contact_names=("1", "2", "3")):
         return None
     names = list(names)
     if urdf:
-        return _urdf_hand(fields, fingers, names, (points, contact_names), file, problems)
+        return _urdf_hand(fields, fingers, names, points is None, file, problems)
     taken = {}  # joint names, unique over the hand
     joints = [_joints(f["joints"], f"hand.fingers[{i}]", names[i], taken, problems) for i, f in enumerate(fingers)]
     if problems.count:
         return None
     hand = inline_hand(names, joints, points)
-    return hand, np.zeros(len(hand.joint_names))
+    return hand, np.zeros(len(hand.joint_names)), None
 
 
 def _joints(node, path, finger, taken, problems):
@@ -259,11 +265,10 @@ def inline_hand(names, fingers, points):
     return Hand(tuple(out), tuple(joint_names), None, None)
 
 
-def _urdf_hand(fields, fingers, names, contacts, file, problems):
-    """The URDF form: load the hand, then its joints at ``joint_positions`` with the contacts
-    ``(points, names)`` checked on its tips, or else at joint positions solved from ``seed``
-    (engine's ``place_hand``)."""
-    points, contact_names = contacts
+def _urdf_hand(fields, fingers, names, hand_file, file, problems):
+    """The URDF form: load the hand, with its ``joint_positions`` (checked on the contacts later)
+    or ``seed`` (solved from later) and where each finger's tip stands in the file; in a hand file
+    (``hand_file``), at its joint positions."""
     node = fields["urdf"]
     reference = read_name(node, "hand.urdf", problems)
     given = "joint_positions" in fields
@@ -293,7 +298,7 @@ def _urdf_hand(fields, fingers, names, contacts, file, problems):
     if problems.count:
         return None
     q = joint_positions(hand, values)
-    if points is None:  # a hand file: the contacts come with each row
+    if hand_file:  # the contacts come with each row
         if "seed" in fields:  # not silently dropped: --hand's rows are solved from home
             problems.add(
                 Reject(
@@ -304,40 +309,9 @@ def _urdf_hand(fields, fingers, names, contacts, file, problems):
                 )
             )
             return None
-        return hand, q
-    placed = place_hand(hand, points, q) if given else place_hand(hand, points, seed=q)
-    for f, finger in enumerate(hand.fingers):
-        status = Status(int(placed.status[f]))
-        if status != Status.OK:
-            problems.add(
-                Reject(
-                    status.code,
-                    f"hand.fingers[{f}].tip",
-                    _placement_message(status, contact_names[f], finger, float(placed.tip_error[f])),
-                    **located(fingers[f]["tip"]),
-                )
-            )
-    return None if problems.count else (hand, placed.positions)
-
-
-def _placement_message(status, name, finger, distance):
-    """Why the finger of contact ``name`` (named by it, as everywhere) is not on its contact, with the
-    distance from its tip link's origin."""
-    if status == Status.CONTACT_OFF_FINGER:
-        return (
-            f"contact {name} is {distance:.6g} from the origin of its finger's tip link {finger.tip!r}, farther "
-            f"than the finger is long ({finger.length:.6g}): are the contacts in the URDF's root frame?"
-        )
-    if status == Status.OUTSIDE_LIMITS:
-        return (
-            f"finger {name} reaches its contact only with a joint outside its limits: "
-            "move the contact, or give joint_positions"
-        )
-    return (
-        f"finger {name} cannot reach its contact: the origin of its tip link {finger.tip!r} comes "
-        f"no closer than {distance:.6g} (the finger is {finger.length:.6g} long): "
-        "are the contacts in the URDF's root frame?"
-    )
+        return hand, q, None
+    tips = tuple((f["tip"].line, f["tip"].column) for f in fingers)
+    return hand, q, HandPlacement(given=given, tips=tips)
 
 
 def _positions(node, key, problems):
@@ -399,15 +373,16 @@ def load_hand_file(path, *, max_bytes=DEFAULT_MAX_BYTES):
     hand = read_hand(fields["hand"], None, file, problems) if fields and "hand" in fields else None
     if problems.count:
         raise problems.first()[0][0].error(file, 0)
-    return hand
+    return hand[:2]
 
 
 def _read(fields, found, problems):
     if "hand" not in fields:
         return {}
-    names = found.get("contact_names") or ("1", "2", "3")
-    hand = read_hand(fields["hand"], found.get("points"), found["file"], problems, names)
-    return None if hand is None else {"hand": hand[0], "joint_positions": readonly(hand[1])}
+    hand = read_hand(fields["hand"], found.get("points"), found["file"], problems)
+    if hand is None:
+        return None
+    return {"hand": hand[0], "joint_positions": readonly(hand[1]), "placement": hand[2]}
 
 
 SECTION = Section(("hand",), _read)

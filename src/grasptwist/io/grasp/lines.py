@@ -150,5 +150,8 @@ def _line_node(text, problems):
 def _on_line(entry, line):
     """An entry read from one line's text, placed at ``line`` of the stream."""
     if isinstance(entry, Grasp):
-        return replace(entry, line=line, document=line - 1, twists=tuple(replace(t, line=line) for t in entry.twists))
+        p = entry.placement  # a hand's fingers are reported where their tips stand: on this line
+        placement = p if p is None else replace(p, tips=tuple((line, column) for _, column in p.tips))
+        twists = tuple(replace(t, line=line) for t in entry.twists)
+        return replace(entry, line=line, document=line - 1, twists=twists, placement=placement)
     return GraspFileError(entry.code, entry.message, entry.file, line, entry.column, line - 1)

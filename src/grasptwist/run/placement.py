@@ -1,0 +1,84 @@
+"""Hands put on their contacts: the inverse kinematics the loader leaves to the run.
+
+The loader only reads (:mod:`grasptwist.io.grasp.hand`): a grasp whose URDF
+hand is not yet on its contacts carries a :class:`~grasptwist.model.HandPlacement`,
+the joint positions the file gives (to check) or its seed (to solve from),
+and where each finger's ``tip`` stood in the file.  :func:`place` runs the
+engine (:func:`grasptwist.engine.ik.place_hand`) and gives the grasp at its
+placed joint positions, or its error: each finger that cannot be put on
+its contact (``contact-off-finger``, ``unreachable``, ``outside-limits``)
+located at its ``tip``, coded and worded as a loader's problem.  Every
+reader of grasps in the run layer goes through :func:`placed`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import replace
+
+from ..engine.degeneracy import Status
+from ..engine.ik import place_hand
+from ..io import grasp as loader
+from ..io import inputs
+from ..io.grasp.problems import MAX_ERRORS, Problems, Reject
+from ..io.grasp.values import readonly
+from ..model import Grasp, GraspFileError
+
+__all__ = ["place", "placed", "read", "read_grasps"]
+
+
+def place(grasp: Grasp) -> Grasp | GraspFileError:
+    """``grasp`` with its hand on its contacts (its joint positions checked, or solved from the
+    seed), or the error of the fingers that cannot be; a grasp with nothing to place as it is."""
+    p = grasp.placement
+    if p is None:
+        return grasp
+    hand, q = grasp.hand, grasp.joint_positions
+    solved = place_hand(hand, grasp.points, q) if p.given else place_hand(hand, grasp.points, seed=q)
+    problems = Problems(MAX_ERRORS)
+    for f, finger in enumerate(hand.fingers):
+        status = Status(int(solved.status[f]))
+        if status != Status.OK:
+            message = _placement_message(status, grasp.contact_names[f], finger, float(solved.tip_error[f]))
+            line, column = p.tips[f]
+            problems.add(Reject(status.code, f"hand.fingers[{f}].tip", message, line, column))
+    if problems.count:
+        errors = [reject.error(grasp.file, grasp.document) for reject in problems.first()[0]]
+        return GraspFileError(*errors[0].args[:6], errors)  # one per document, as the reader gives them
+    return replace(grasp, joint_positions=readonly(solved.positions), placement=None)
+
+
+def placed(items: Iterable) -> list:
+    """Read grasps and errors with every hand placed (:func:`place`), in order."""
+    return [place(item) if isinstance(item, Grasp) else item for item in items]
+
+
+def read(path, max_bytes: int | None = None) -> list:
+    """The grasps and errors of one input (:func:`grasptwist.io.inputs.read`), hands placed."""
+    return placed(inputs.read(path, max_bytes))
+
+
+def read_grasps(source, **kw) -> list:
+    """:func:`grasptwist.io.grasp.read_grasps` with every hand placed: the grasps and, one
+    entry per problem, the errors of a grasp file (a path or its bytes)."""
+    return [p for e in placed(loader.read_grasps(source, **kw)) for p in getattr(e, "problems", (e,))]
+
+
+def _placement_message(status, name, finger, distance):
+    """Why the finger of contact ``name`` (named by it, as everywhere) is not on its contact, with the
+    distance from its tip link's origin."""
+    if status == Status.CONTACT_OFF_FINGER:
+        return (
+            f"contact {name} is {distance:.6g} from the origin of its finger's tip link {finger.tip!r}, farther "
+            f"than the finger is long ({finger.length:.6g}): are the contacts in the URDF's root frame?"
+        )
+    if status == Status.OUTSIDE_LIMITS:
+        return (
+            f"finger {name} reaches its contact only with a joint outside its limits: "
+            "move the contact, or give joint_positions"
+        )
+    return (
+        f"finger {name} cannot reach its contact: the origin of its tip link {finger.tip!r} comes "
+        f"no closer than {distance:.6g} (the finger is {finger.length:.6g} long): "
+        "are the contacts in the URDF's root frame?"
+    )
