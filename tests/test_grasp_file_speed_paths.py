@@ -2,9 +2,14 @@
 plain valid documents straight from the events) and the general one
 (``compose`` + ``read_document``, every document, every error).
 
-Each input is read twice, once as the loader does it and once with the fast
-path switched off, and the entries are compared field by field, arrays bit
-for bit.  The YAML is parsed only once for both (and for every reading of
+A property over generated grasp documents (:func:`documents`: every section,
+flow and block style, several documents, and the mutations a fast path must
+hand over at), whose hand-picked corner cases are its explicit examples: the
+numbers and names at every place they stand, and documents of odd shapes
+(:data:`CORNERS`); and every bundled, invalid and corpus file.  Each input
+is read twice, once as the loader does it and once with the fast path
+switched off, and the entries are compared field by field, arrays bit for
+bit.  The YAML is parsed only once for both (and for every reading of
 the same text in a test): the parser's events are recorded and replayed,
 since parsing is what costs (seconds, for the pure-Python parser on
 corpus/many-contacts.yaml) and both paths read the same events.  Also: the fast
@@ -21,7 +26,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 import yaml
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
 from conftest import CONTACTS, LOADERS
@@ -133,24 +138,25 @@ def both_paths(source, reading=READING, **kw):
 BIG = 1 << 16
 
 
-def _file_cases():
-    """Each file with each parser; a big file (corpus/many-contacts.yaml: seconds with
-    either parser, read twice) is left to the long run."""
-    for path in FILES:
-        for parser in LOADERS:
-            # a big file read twice per parser, a hand solved by inverse kinematics twice, or the pure
-            # parser on what libyaml's run already covers: the long run's
-            slow = path.stat().st_size >= BIG or path.name.startswith("hand-") or parser is not LOADERS[-1]
-            name = f"{parser.__name__}-{path.parent.name}/{path.name}"
-            yield pytest.param(path, parser, id=name, marks=[pytest.mark.slow] if slow else [])
+def _small(path):
+    return path.stat().st_size < BIG
 
 
-@pytest.mark.parametrize("path, parser", list(_file_cases()))
-def test_files_read_the_same_both_ways(path, parser):
-    reading = Reading(parser=parser)
-    both_paths(path, reading)
-    if path.stat().st_size < BIG:  # content under another name: every small file checks that
+def test_files_read_the_same_both_ways():
+    """Every small file, with libyaml's parser (the pure one in the long run), under its own
+    name and as content under another."""
+    reading = Reading(parser=LOADERS[-1])
+    for path in filter(_small, FILES):
+        both_paths(path, reading)
         both_paths(path.read_bytes(), reading, file="other/name.yaml")
+
+
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
+@pytest.mark.parametrize("parser", LOADERS)
+def test_every_file_reads_the_same_both_ways_with_each_parser(parser):
+    """Big files too (corpus/many-contacts.yaml: seconds with either parser, read twice)."""
+    for path in FILES:
+        both_paths(path, Reading(parser=parser))
 
 
 # Values at which the fast path must hand over, or where its arithmetic must
@@ -168,31 +174,24 @@ NAMES = [
 ]  # fmt: skip
 
 
-@pytest.mark.parametrize("number", NUMBERS)
-def test_numbers_everywhere(number, loader):
+def _number_places(number):
+    """Documents with ``number`` in each place a number stands: a point, a normal, the wrist,
+    a twist's angular, linear, at and screw; first, middle and last in its vector."""
     for vector in (f"[{number}, 0, 0]", f"[1, {number}, 2]", f"[0, 0, {number}]"):
-        both_paths(CONTACTS.replace("[1, 0, 0]", vector, 1), file="g.yaml", reading=loader)
-        both_paths(CONTACTS.replace("[-1, 0, 0]", vector, 1), file="g.yaml", reading=loader)
-        both_paths(f"wrist: {vector}\n" + CONTACTS, file="g.yaml", reading=loader)
+        yield CONTACTS.replace("[1, 0, 0]", vector, 1)
+        yield CONTACTS.replace("[-1, 0, 0]", vector, 1)
+        yield f"wrist: {vector}\n" + CONTACTS
         for twist in (f"angular: {vector}", f"linear: {vector}", f"at: {vector}\n    angular: [1, 1, 1]"):
-            both_paths(CONTACTS + f"twists:\n  - {twist}\n", file="g.yaml", reading=loader)
-        both_paths(CONTACTS + f"twists:\n  - screw: [1, 2, 3, {vector[1:-1]}]\n", file="g.yaml", reading=loader)
+            yield CONTACTS + f"twists:\n  - {twist}\n"
+        yield CONTACTS + f"twists:\n  - screw: [1, 2, 3, {vector[1:-1]}]\n"
 
 
-@pytest.mark.parametrize("name", NAMES)
-def test_names_everywhere(name, loader):
-    both_paths(f"name: {name}\n" + CONTACTS, file="g.yaml", reading=loader)
-    both_paths(f"units: {name}\n" + CONTACTS, file="g.yaml", reading=loader)
-    both_paths(
-        CONTACTS.replace("  - point: [1, 0, 0]", f"  - name: {name}\n    point: [1, 0, 0]"),
-        file="g.yaml",
-        reading=loader,
-    )
-    both_paths(
-        CONTACTS + f"twists:\n  - name: {name}\n    angular: [0, 0, 1]\n  - linear: [1, 0, 0]\n",
-        file="g.yaml",
-        reading=loader,
-    )
+def _name_places(name):
+    """Documents with ``name`` in each place a name stands: the grasp's, the units, a contact's, a twist's."""
+    yield f"name: {name}\n" + CONTACTS
+    yield f"units: {name}\n" + CONTACTS
+    yield CONTACTS.replace("  - point: [1, 0, 0]", f"  - name: {name}\n    point: [1, 0, 0]")
+    yield CONTACTS + f"twists:\n  - name: {name}\n    angular: [0, 0, 1]\n  - linear: [1, 0, 0]\n"
 
 
 SHAPES = [
@@ -282,12 +281,6 @@ SHAPES = [
 ]
 
 
-@pytest.mark.parametrize("text", SHAPES, ids=range(len(SHAPES)))
-def test_shapes(text, loader):
-    both_paths(text, file="dir/shape.yaml", reading=loader)
-    both_paths(text.encode("utf-8", "surrogatepass"), reading=loader)
-
-
 finite = st.floats(allow_nan=False, allow_infinity=False)
 extreme = st.sampled_from([0.0, -0.0, 1e-310, -5e-324, 1e200, -1e200, 1.7976931348623157e308, 3.0, -0.5])
 number = st.one_of(
@@ -297,36 +290,118 @@ number = st.one_of(
     st.sampled_from(NUMBERS),
 )
 vector = st.lists(number, min_size=3, max_size=3).map(lambda v: "[" + ", ".join(v) + "]")
+name = st.one_of(st.sampled_from(NAMES + ["g", "h"]), st.text(st.characters(codec="utf-8"), max_size=6).map(repr))
+
+#: Changes to a document's text after which a fast path must hand over (or read on, the same).
+MUTATIONS = [
+    lambda t: t,
+    lambda t: t + "extra: 1\n",
+    lambda t: t + "name: x\nname: y\n",
+    lambda t: "&top " + t,
+    lambda t: t.replace("point", "'point'", 1),
+    lambda t: t.replace("normal:", "normal: !!seq", 1),
+    lambda t: t.replace("contacts:", "!!str contacts:", 1),
+    lambda t: t + "wrist: *a\n",
+    lambda t: t + "]\n",
+    lambda t: t + "\tx: 1\n",
+    lambda t: "\ufeff" + t,
+    lambda t: t.replace("\n", "  # é\n", 1),
+    lambda t: t + "? [a]\n: 1\n",
+]
+
+
+def _contact(draw, flow):
+    fields = [("point", draw(vector)), ("normal", draw(vector))]
+    if draw(st.integers(0, 4)) == 0:
+        fields.insert(draw(st.integers(0, 2)), ("name", draw(name)))
+    if flow:
+        return "  - {" + ", ".join(f"{k}: {v}" for k, v in fields) + "}"
+    return "\n".join(f"  {'-' if i == 0 else ' '} {k}: {v}" for i, (k, v) in enumerate(fields))
+
+
+def _twist(draw):
+    named = [f"name: {draw(name)}"] if draw(st.integers(0, 3)) == 0 else []
+    if draw(st.booleans()):
+        parts = [*named, f"screw: [{', '.join(draw(st.lists(number, min_size=6, max_size=6)))}]"]
+    else:
+        keys = draw(st.lists(st.sampled_from(["angular", "linear", "at"]), min_size=1, max_size=3, unique=True))
+        parts = [*named, *(f"{key}: {draw(vector)}" for key in keys)]
+    return "\n".join(f"  {'-' if i == 0 else ' '} {part}" for i, part in enumerate(parts))
 
 
 @st.composite
 def documents(draw):
+    """A grasp document: a name, units and wrist or not, contacts (three, or a wrong count) in
+    block or flow style, twists, a path, an inline hand, then one of :data:`MUTATIONS`."""
     lines = []
-    if draw(st.booleans()):
-        lines.append(f"name: {draw(st.sampled_from(NAMES + ['g', 'h']))}")
-    if draw(st.booleans()):
-        lines.append(f"wrist: {draw(vector)}")
+    for key, value in (("name", name), ("units", name), ("wrist", vector)):
+        if draw(st.booleans()):
+            lines.append(f"{key}: {draw(value)}")
+    flow = draw(st.booleans())
     lines.append("contacts:")
-    for _ in range(3):
-        lines.append(f"  - point: {draw(vector)}")
-        lines.append(f"    normal: {draw(vector)}")
+    lines += [_contact(draw, flow) for _ in range(draw(st.sampled_from([3, 3, 3, 2, 4])))]
     twists = draw(st.integers(0, 3))
     if twists:
         lines.append("twists:")
-    for _ in range(twists):
-        if draw(st.booleans()):
-            six = ", ".join(draw(st.lists(number, min_size=6, max_size=6)))
-            lines.append(f"  - screw: [{six}]")
-        else:
-            keys = draw(st.lists(st.sampled_from(["angular", "linear", "at"]), min_size=1, max_size=3, unique=True))
-            lines += [f"  {'-' if i == 0 else ' '} {key}: {draw(vector)}" for i, key in enumerate(keys)]
-    return "\n".join(lines) + "\n"
+    lines += [_twist(draw) for _ in range(twists)]
+    if draw(st.integers(0, 3)) == 0:
+        lines.append(f"paths: [{{name: p, segments: [{{duration: {draw(number)}, angular: {draw(vector)}}}]}}]")
+    if draw(st.integers(0, 5)) == 0:
+        lines.append("hand:\n  fingers:\n" + f"    - joints: [{{axis: {draw(vector)}, point: [0, 0, 0]}}]\n" * 3)
+    text = "\n".join(lines) + "\n"
+    if draw(st.booleans()):
+        text = text.replace("\n", "\n", 1)
+    return draw(st.sampled_from(MUTATIONS))(text)
 
 
-@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+def _examples(cases, **strategies):
+    """A property over ``strategies`` and the parsers, with every value of ``cases`` (each with
+    each parser) among its explicit examples: the hand-picked values are always tried."""
+    (key,) = strategies
+
+    def decorate(test):
+        for case in cases:
+            for parser in LOADERS:
+                test = example(**{key: case}, parser=parser)(test)
+        return given(**strategies, parser=st.sampled_from(LOADERS))(test)
+
+    return decorate
+
+
+_SETTINGS = settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+
+
+@_SETTINGS
+@_examples(NUMBERS, number=number)
+def test_a_number_reads_the_same_both_ways_wherever_it_stands(number, parser):
+    for doc in _number_places(number):
+        both_paths(doc, Reading(parser=parser), file="g.yaml")
+
+
+@_SETTINGS
+@_examples(NAMES, name=name)
+def test_a_name_reads_the_same_both_ways_wherever_it_stands(name, parser):
+    for doc in _name_places(name):
+        both_paths(doc, Reading(parser=parser), file="g.yaml")
+
+
+@_SETTINGS
+@_examples(SHAPES, doc=documents())
+def test_a_document_of_any_shape_reads_the_same_both_ways(doc, parser):
+    both_paths(doc, Reading(parser=parser), file="dir/shape.yaml")
+    both_paths(doc.encode("utf-8", "surrogatepass"), Reading(parser=parser))
+
+
+@settings(max_examples=100, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(st.lists(documents(), min_size=1, max_size=3), st.sampled_from(LOADERS))
+def test_streams_of_documents_read_the_same_both_ways(docs, parser):
+    both_paths("---\n".join(docs), Reading(parser=parser), file="dir/random.yaml")
+
+
 @pytest.mark.slow  # over a second: docs/reference/development.md, Test time
-def test_random_documents(docs, parser):
+@settings(max_examples=2000, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(st.lists(documents(), min_size=1, max_size=3), st.sampled_from(LOADERS))
+def test_many_more_documents_read_the_same_both_ways(docs, parser):
     both_paths("---\n".join(docs), Reading(parser=parser), file="random.yaml")
 
 
