@@ -399,7 +399,7 @@ def test_streams_of_documents_read_the_same_both_ways(docs, parser):
 
 
 @pytest.mark.slow  # over a second: docs/reference/development.md, Test time
-@settings(max_examples=2000, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=500, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(st.lists(documents(), min_size=1, max_size=3), st.sampled_from(LOADERS))
 def test_many_more_documents_read_the_same_both_ways(docs, parser):
     both_paths("---\n".join(docs), Reading(parser=parser), file="random.yaml")

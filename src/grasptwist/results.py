@@ -26,7 +26,9 @@ How to add a result kind
    that ``table`` names.
 
 Nothing else in the output layer changes: records, the JSON template, CSV,
-npz and the format registry take the new kind from this list.
+npz and the format registry take the new kind from this list.  A new kind
+of *row* (not a (grasp, twist) row: a wrench's, a path's sample) is a family
+of its own instead: :mod:`grasptwist.run.families` says how to add one.
 """
 
 from __future__ import annotations
