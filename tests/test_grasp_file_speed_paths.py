@@ -355,15 +355,14 @@ def documents(draw):
 
 
 def _examples(cases, **strategies):
-    """A property over ``strategies`` and the parsers, with every value of ``cases`` (each with
-    each parser) among its explicit examples: the hand-picked values are always tried."""
+    """A property over ``strategies``, run with each parser, with every value of ``cases`` among
+    its explicit examples: the hand-picked values are always tried."""
     (key,) = strategies
 
     def decorate(test):
         for case in cases:
-            for parser in LOADERS:
-                test = example(**{key: case}, parser=parser)(test)
-        return given(**strategies, parser=st.sampled_from(LOADERS))(test)
+            test = example(**{key: case})(test)
+        return pytest.mark.parametrize("parser", LOADERS, ids=lambda p: p.__name__)(given(**strategies)(test))
 
     return decorate
 
@@ -392,7 +391,7 @@ def test_a_document_of_any_shape_reads_the_same_both_ways(doc, parser):
     both_paths(doc.encode("utf-8", "surrogatepass"), Reading(parser=parser))
 
 
-@settings(max_examples=100, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=50, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(st.lists(documents(), min_size=1, max_size=3), st.sampled_from(LOADERS))
 def test_streams_of_documents_read_the_same_both_ways(docs, parser):
     both_paths("---\n".join(docs), Reading(parser=parser), file="dir/random.yaml")
