@@ -7,7 +7,6 @@ A command names an option by its alias and gives the default, e.g.
 
 from __future__ import annotations
 
-import os
 import re
 import sys
 from enum import Enum
@@ -240,24 +239,15 @@ def segments_option(twists, durations, frame):
 
 
 def hand_option(path: str | None, paths: list[str], fmt: str):
-    """The run's hand: ``--hand``'s, or for CSV and npz of one grasp file, that file's first hand
-    (its joints name the columns; a folder's grasps may each have another)."""
+    """The run's hand (:func:`grasptwist.run.placement.run_hand`); a ``--hand`` file that cannot be
+    read is a usage error."""
     from ..model import InputError
+    from ..run.placement import run_hand
 
-    if path is not None:
-        from ..io.grasp import load_hand_file
-
-        try:
-            return load_hand_file(path)[0]
-        except InputError as err:
-            raise typer.BadParameter(f"{err.code}: {err}", param_hint="--hand") from None
-    if not FORMATS[fmt].per_hand or len(paths) != 1 or not paths[0].lower().endswith((".yaml", ".yml", ".json")):
-        return None
-    if not os.path.isfile(paths[0]):
-        return None
-    from ..run.placement import read
-
-    return next((g.hand for g in read(paths[0]) if getattr(g, "hand", None) is not None), None)
+    try:
+        return run_hand(path, paths, FORMATS[fmt].per_hand)
+    except InputError as err:
+        raise typer.BadParameter(f"{err.code}: {err}", param_hint="--hand") from None
 
 
 def not_binary_to_a_terminal(fmt: str, output: str | None) -> None:

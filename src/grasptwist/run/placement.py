@@ -13,6 +13,7 @@ reader of grasps in the run layer goes through :func:`placed`.
 
 from __future__ import annotations
 
+import os
 from collections.abc import Iterable
 from dataclasses import replace
 
@@ -22,9 +23,9 @@ from ..io import grasp as loader
 from ..io import inputs
 from ..io.grasp.problems import MAX_ERRORS, Problems, Reject
 from ..io.grasp.values import readonly
-from ..model import Grasp, GraspFileError
+from ..model import Grasp, GraspFileError, Hand
 
-__all__ = ["place", "placed", "read", "read_grasps"]
+__all__ = ["place", "placed", "read", "read_grasps", "run_hand"]
 
 
 def place(grasp: Grasp) -> Grasp | GraspFileError:
@@ -56,6 +57,25 @@ def placed(items: Iterable) -> list:
 def read(path, max_bytes: int | None = None) -> list:
     """The grasps and errors of one input (:func:`grasptwist.io.inputs.read`), hands placed."""
     return placed(inputs.read(path, max_bytes))
+
+
+def run_hand(path: str | None, paths: list[str], per_hand: bool) -> Hand | None:
+    """The run's hand: the one of ``path`` (``--hand``, a file holding just ``hand:``), or for a
+    format whose columns a hand's joints name (``per_hand``) of one grasp file, that file's first
+    hand (a folder's grasps may each have another); None without.
+
+    Raises
+    ------
+    InputError
+        The ``--hand`` file's first problem.
+    """
+    if path is not None:
+        return loader.load_hand_file(path)[0]
+    if not per_hand or len(paths) != 1 or not paths[0].lower().endswith((".yaml", ".yml", ".json")):
+        return None
+    if not os.path.isfile(paths[0]):
+        return None
+    return next((g.hand for g in read(paths[0]) if getattr(g, "hand", None) is not None), None)
 
 
 def read_grasps(source, **kw) -> list:
