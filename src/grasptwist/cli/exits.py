@@ -12,7 +12,7 @@ from __future__ import annotations
 import os
 import signal
 import sys
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 
 import typer
@@ -27,8 +27,8 @@ __all__ = [
     "EXIT_WORKER",
     "EXIT_BROKEN_PIPE",
     "CLICK_ERROR",
+    "checked_output",
     "output_target",
-    "writable_folder",
     "drop_stdout",
     "stopped",
     "run_command",
@@ -42,31 +42,29 @@ EXIT_OK, EXIT_FAILED, EXIT_USAGE, EXIT_WRITE, EXIT_WORKER, EXIT_BROKEN_PIPE = 0,
 CLICK_ERROR = next(c for c in typer.BadParameter.__mro__ if c.__name__ == "ClickException")
 
 
+def checked_output(path: str | None, inputs: Iterable = ()):
+    """How ``path`` (None: stdout) is written (a :class:`grasptwist.run.target.Target`);
+    a usage error, before any work, when it cannot be the output: among other
+    reasons when it is one of ``inputs``, the paths the run reads."""
+    from ..run.target import check_target
+
+    try:
+        return check_target(path, inputs)
+    except ValueError as exc:
+        raise typer.BadParameter(str(exc), param_hint=None if path is None else "-o") from None
+
+
 @contextmanager
-def output_target(path: str | None) -> Iterator:
+def output_target(path: str | None, inputs: Iterable = ()) -> Iterator:
     """stdout, or ``path`` by the rule of :mod:`grasptwist.run.target`: a file
     replaced atomically on success only, a pipe or device written through;
-    an unusable ``path`` is a usage error before any work."""
+    checked by :func:`checked_output` first."""
     from ..run.signals import finishing
-    from ..run.target import check_target, opened
+    from ..run.target import opened
 
-    if path is not None and path != "-":
-        try:
-            check_target(path)
-        except ValueError as exc:
-            raise typer.BadParameter(str(exc), param_hint="-o") from None
-    with opened(path) as out:
+    with opened(checked_output(path, inputs)) as out:
         yield out
         finishing()  # all written: commit it and end normally, whatever signal comes now
-
-
-def writable_folder(path: str) -> None:
-    """A usage error, before any work, when ``path``'s folder cannot take a file."""
-    folder = os.path.dirname(os.path.abspath(path))
-    if not os.path.isdir(folder):
-        raise typer.BadParameter(f"cannot write {path}: no folder {os.path.dirname(path) or folder}", param_hint="-o")
-    if not os.access(folder, os.W_OK):
-        raise typer.BadParameter(f"cannot write {path}: the folder is not writable", param_hint="-o")
 
 
 def drop_stdout() -> None:

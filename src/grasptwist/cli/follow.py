@@ -118,9 +118,10 @@ def write_follow_records(job, paths: list[str], output, quiet: bool, fmt: str, *
     from ..run.follow import write_follow
 
     stderr = Diagnostics(quiet)
-    with output_target(output) as out:
+    inputs = list(expand(paths))
+    with output_target(output, inputs) as out:
         w = FORMATS[fmt].open(out, "follow", **table_options, **FORMATS[fmt].hand_options(job.hand))
-        for o in write_follow(job, expand(paths), w, fmt, table_options.get("order", "omega-v")):
+        for o in write_follow(job, inputs, w, fmt, table_options.get("order", "omega-v")):
             out.flush()
             stderr.take(o)
         w.close()

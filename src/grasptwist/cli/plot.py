@@ -8,7 +8,7 @@ from typing import Annotated
 import typer
 
 from .diagnostics import Diagnostics, to_stderr
-from .exits import EXIT_FAILED, EXIT_OK, run_command, writable_folder
+from .exits import EXIT_FAILED, EXIT_OK, checked_output, run_command
 from .options import Debug, MaxBytes, PlotMethod, Select, twists_option
 
 __all__ = ["plot", "draw_pictures"]
@@ -146,14 +146,19 @@ def draw_pictures(path, output, twists, twist_name, method, max_bytes, views) ->
     from ..io.inputs import expand, read
     from ..model import InputError
     from ..output.records import diagnostics, error_record
+    from ..run.target import opened
 
     stderr = Diagnostics()
     if path.endswith(DATASET_SUFFIXES):
         raise typer.BadParameter(
             "plot draws grasp files (.yaml, .yml) or folders of them, not data sets", param_hint="PATH"
         )
-    if not os.path.isdir(path):
-        writable_folder(output)
+    inputs = list(expand([path]))
+    if not os.path.isdir(path) or not output:  # a folder's -o is the folder its images go to
+        checked_output(output, inputs)
+
+    def opener(image):  # each image as -o writes a file: replaced atomically, never an input
+        return opened(str(image), inputs)
 
     def note(line: str, error: bool = True) -> None:
         stderr.failed += error
@@ -165,7 +170,7 @@ def draw_pictures(path, output, twists, twist_name, method, max_bytes, views) ->
     try:
         (pictures.require_plotly if html else pictures.require_matplotlib)()  # before anything is read
         grasps = []
-        for item in expand([path]):
+        for item in inputs:
             for entry in read(item, max_bytes) if isinstance(item, str) else [item]:
                 if isinstance(entry, InputError):
                     for line in diagnostics(error_record(entry))[0]:
@@ -182,10 +187,17 @@ def draw_pictures(path, output, twists, twist_name, method, max_bytes, views) ->
                 js_beside=views["js_beside"],
                 extras=_page_extras(views["path_name"]),
                 grips=_grip_forces,
+                opener=opener,
             )
         else:
             drawn = pictures.render_loaded(
-                path, output, grasps, twist_name=None if twists else twist_name, method=method, grips=_grip_forces
+                path,
+                output,
+                grasps,
+                twist_name=None if twists else twist_name,
+                method=method,
+                grips=_grip_forces,
+                opener=opener,
             )
         for item in drawn:
             if isinstance(item, pictures.Note):

@@ -22,6 +22,7 @@ class OutputSettings:
     warnings: Warnings
     workers: int
     table_options: dict = field(default_factory=dict)
+    reads: tuple = ()  # files read besides the paths (--twists-from, --hand): never the output either
 
 
 def worker_count(requested: int) -> int:
@@ -37,7 +38,10 @@ def write_records(job, paths: list[str], settings: OutputSettings) -> int:
     stderr = Diagnostics(settings.quiet, settings.warnings, hint=table_hint(job.kind) if job.fmt == "table" else None)
     inputs = list(expand(paths))
     fmt = FORMATS[job.fmt]
-    with output_target(settings.output) as out, progress_bar(inputs, job.kind, out) as advance:
+    with (
+        output_target(settings.output, [*inputs, *settings.reads]) as out,
+        progress_bar(inputs, job.kind, out) as advance,
+    ):
         w = fmt.open(out, job.kind, **settings.table_options, **fmt.hand_options(job.hand))
         # block writers (npz) take results here; the others get records encoded where they were made
         outputs = (

@@ -142,5 +142,6 @@ def resolve(
         twists_from=twists_from,
         select=tuple(select) if select else None,
     )
-    settings = OutputSettings(output, quiet, warnings, workers, {"digits": digits, "order": order.value})
+    table_options = {"digits": digits, "order": order.value}
+    settings = OutputSettings(output, quiet, warnings, workers, table_options, reads=(twists_from, hand))
     run_command(debug, lambda: write_records(job, paths, settings))

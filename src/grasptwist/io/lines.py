@@ -19,11 +19,11 @@ from __future__ import annotations
 
 import os
 import stat
-import sys
 from collections.abc import Iterator
 
 from ..model import Grasp, GraspFileError, Twist
 from .grasp import one_per_document, read_grasps, read_line, read_twist_line
+from .grasp.text import standard_input
 from .inputs import STDIN
 from .limits import DEFAULT_MAX_BYTES, NOT_REGULAR
 
@@ -141,7 +141,7 @@ def _stream(path, max_bytes, per_batch, read, sniff):
     cap = DEFAULT_MAX_BYTES if max_bytes is None else max_bytes
     file = "<stdin>" if path == STDIN else path
     try:
-        handle = sys.stdin.buffer if path == STDIN else _opened(path)
+        handle = standard_input() if path == STDIN else _opened(path)
     except OSError as exc:
         yield [GraspFileError("read-error", f"cannot read: {exc.strerror or exc}", file)]
         return

@@ -40,7 +40,7 @@ from ..output.records import (
 from ..results import ForceOptions, check_closure
 from .batch import ZERO_TWIST, Block, check_positions, dataset_blocks, resolve
 from .forces import ForceBlock, force_blocks, force_dataset_blocks
-from .pool import Pool
+from .pool import Pool, pool_size
 from .scratch import owned_prefix, remove_orphans
 from .stream import grasp_stream, is_stream, twist_stream
 
@@ -194,6 +194,7 @@ def _parallel(task, count: int, workers: int, tuning: Tuning) -> Iterator[Iterat
     """``task(spool, i)`` for ``i < count`` on a pool of forked workers, in
     order; the workers share the parent's open files and data sets, and
     leave their encoded output in a :class:`Spool`."""
+    workers = pool_size(workers, count)  # never a process with nothing to do
     with (
         Spool.opened(workers, tuning.spool_bytes) as spool,
         Pool(partial(task, spool), workers, tuning.in_flight) as pool,
