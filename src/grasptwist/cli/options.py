@@ -121,7 +121,8 @@ Workers = Annotated[
         "-j",
         "--workers",
         min=0,
-        help="Processes for big batches (0: every core, used for 256+ files or 4096+ data-set grasps).",
+        help="Processes for big batches (0: every core, used for 256+ files or 4096+ data-set grasps); "
+        "never more than the tasks, 4 per core or 64.",
     ),
 ]
 Select = Annotated[
