@@ -15,7 +15,7 @@ import typer
 
 from .._version import __version__
 from . import basis, check, follow, forces, plot, resolve, schema
-from .exits import CLICK_ERROR, EXIT_OK, stopped, usage_error
+from .exits import CLICK_ERROR, EXIT_OK, EXIT_WRITE, failed, stopped, to_stdout, usage_error
 
 __all__ = ["app", "main"]
 
@@ -32,7 +32,7 @@ app = typer.Typer(
 
 def _version(value: bool) -> None:
     if value:
-        sys.stdout.write(f"grasptwist {__version__}\n")
+        to_stdout(f"grasptwist {__version__}\n")
         raise typer.Exit(EXIT_OK)
 
 
@@ -52,12 +52,16 @@ for _command in (resolve.resolve, basis.basis, check.check, follow.follow, force
 def main() -> None:
     """Run the command line (the ``grasptwist`` script is :func:`grasptwist.__main__.main`)."""
     from ..run.signals import Interrupted, stop_on_signals
+    from ..run.target import WriteError
 
     stop_on_signals()
     try:
-        code = app(standalone_mode=False)
+        try:
+            code = app(standalone_mode=False)
+        except CLICK_ERROR as exc:
+            code = usage_error(exc)
     except Interrupted as stop:  # while typer parsed the command line
-        sys.exit(stopped(stop))
-    except CLICK_ERROR as exc:
-        sys.exit(usage_error(exc))
+        code = stopped(stop)
+    except WriteError as exc:  # the version or the help on a closed stdout
+        code = failed(exc, EXIT_WRITE)
     sys.exit(code if isinstance(code, int) else EXIT_OK)

@@ -30,6 +30,8 @@ __all__ = [
     "checked_output",
     "output_target",
     "drop_stdout",
+    "failed",
+    "to_stdout",
     "stopped",
     "run_command",
     "usage_error",
@@ -77,6 +79,22 @@ def drop_stdout() -> None:
     os.dup2(os.open(os.devnull, os.O_WRONLY), fd)
 
 
+def to_stdout(text: str) -> None:
+    """Text that is not records (the help, the version) on stdout, written as records
+    are: a closed stdout is a :class:`~grasptwist.run.target.WriteError`."""
+    from ..run.target import opened
+
+    with opened(None) as out:
+        out.write(text.encode())
+
+
+def failed(exc: Exception, code: int) -> int:
+    """Say in one line why the run could not go on (a write error, a dead worker); ``code``."""
+    drop_stdout()
+    to_stderr(f"grasptwist: error: {exc}")
+    return code
+
+
 def stopped(stop) -> int:
     """Say which signal stopped the run; the exit status a shell gives for it."""
     drop_stdout()
@@ -106,9 +124,7 @@ def run_command(debug: bool, body: Callable[[], int]) -> None:
         to_stderr(f"grasptwist: error: {exc}")
         raise typer.Exit(EXIT_USAGE) from None
     except (WriteError, WorkerDied) as exc:
-        drop_stdout()
-        to_stderr(f"grasptwist: error: {exc}")
-        raise typer.Exit(EXIT_WRITE if isinstance(exc, WriteError) else EXIT_WORKER) from None
+        raise typer.Exit(failed(exc, EXIT_WRITE if isinstance(exc, WriteError) else EXIT_WORKER)) from None
     except Exception as exc:  # noqa: BLE001 - the one place a traceback is turned into a line
         if debug:
             raise
@@ -121,7 +137,7 @@ def usage_error(exc) -> int:
     """One line for a usage error (exit 2), as for every other diagnostic: what is wrong, and
     where help is, instead of click's four lines of usage, hint, blank and error."""
     if type(exc).__name__ == "NoArgsIsHelpError":  # `grasptwist` alone: the help is the answer,
-        sys.stdout.write(exc.format_message() + "\n")  # on stdout (`grasptwist | less`), a success
+        to_stdout(exc.format_message() + "\n")  # on stdout (`grasptwist | less`), a success
         return EXIT_OK
     ctx = getattr(exc, "ctx", None)
     message = " ".join(exc.format_message().split())  # on one line, whatever it quotes

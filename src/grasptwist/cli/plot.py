@@ -199,11 +199,12 @@ def draw_pictures(path, output, twists, twist_name, method, max_bytes, views) ->
                 grips=_grip_forces,
                 opener=opener,
             )
-        for item in drawn:
-            if isinstance(item, pictures.Note):
-                note(item.line, item.error)
-            else:
-                sys.stdout.write(f"{item}\n")
+        with opened(None) as listing:  # a closed stdout is a write error before anything is drawn
+            for item in drawn:
+                if isinstance(item, pictures.Note):
+                    note(item.line, item.error)
+                else:
+                    listing.write(os.fsencode(f"{item}\n"))
     except (pictures.MissingMatplotlib, pictures.MissingPlotly) as exc:
         sys.stderr.write(f"{exc}\n")  # "grasptwist plot needs matplotlib: ..." (or plotly)
         return EXIT_FAILED
