@@ -20,6 +20,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+import yaml
 from typer.testing import CliRunner
 
 from grasptwist.cli import app
@@ -82,8 +83,6 @@ def inputs(tmp_path):
     rng = np.random.default_rng(3)
     np.savez(tmp_path / "ds.npz", points=rng.normal(size=(5, 3, 3)), normals=np.tile(np.eye(3), (5, 1, 1)))
     (tmp_path / "t.jsonl").write_text("[0, 0, 1, 0, 0, 0]\n")
-    import yaml
-
     hand = yaml.safe_load(HAND_GRASP.read_text())["hand"]
     (tmp_path / "hand.yaml").write_text(yaml.safe_dump({"hand": hand}))
     return tmp_path

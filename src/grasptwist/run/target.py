@@ -98,8 +98,8 @@ def check_target(path: str | None, inputs: Iterable = ()) -> Target:
         target, info = Target("stdout", STDOUT, STDOUT), _descriptor_stat(1)
     elif not path:
         raise ValueError("cannot write '': the file name is empty")
-    elif _descriptor(path) is not None:
-        target, info = Target("through", path, path), _descriptor_stat(_descriptor(path))
+    elif (fd := _descriptor(path)) is not None:
+        target, info = Target("through", path, path), _descriptor_stat(fd)
     else:
         target, info = _by_type(path)
     if info is not None and stat.S_ISREG(info.st_mode):
@@ -197,7 +197,7 @@ def opened(path: str | None | Target, inputs: Iterable = ()) -> Iterator[IO[byte
     """
     target = path if isinstance(path, Target) else check_target(path, inputs)
     if target.how == "stdout":
-        if sys.stdout is None:
+        if _closed_at_start(1):
             raise WriteError(STDOUT, OSError(errno.EBADF, "it is closed"))
         with _errors_named(STDOUT):
             out = guarded(sys.stdout.buffer, STDOUT)
