@@ -681,7 +681,7 @@ class ForceTableWriter(_Writer):
         c = rec["closure"]
         verdict = {True: "yes", False: "no", None: "- (no friction)"}[c["force_closure"]]
         least = "none" if c["closure_friction"] is None else fmt_number(c["closure_friction"], d)
-        judged = "" if c["safety"] == 1 else f" (with mu/{c['safety']:g})"
+        judged = "" if c["safety"] == 1 or c["force_closure"] is None else f" (with mu/{c['safety']:g})"
         text = f"closure{judged}: force closure {verdict}; closure friction {least}"
         if c["epsilon"] is not None:
             text += f"; epsilon {fmt_number(c['epsilon'], d)}"
