@@ -371,3 +371,17 @@ def test_a_negative_friction_in_a_data_set_is_one_error_record_and_the_other_inp
         "sphere-equator",
         "sphere-equator",
     ]
+
+
+def test_a_negative_mu_in_a_parquet_data_set_is_one_error_record(tmp_path):
+    pytest.importorskip("pyarrow")
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    from grasptwist.io.parquet import grasp_table
+
+    grasps = np.stack([P, 2 * P])
+    pq.write_table(grasp_table(grasps, -grasps).append_column("mu", pa.array([0.5, -2.0])), tmp_path / "neg.parquet")
+    r, recs = records(tmp_path / "neg.parquet", POLYHEDRON)
+    assert r.exit_code == 1 and [rec.get("grasp") for rec in recs] == [None, "polyhedron"]
+    assert recs[0]["error"]["message"].startswith("friction: row 1: -2.0 must be >= 0")
