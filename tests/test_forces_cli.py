@@ -288,6 +288,20 @@ def test_an_antipodal_pair_beside_a_good_file_gives_both_their_records_with_epsi
                                [0, 0, 1, 0, 0, 0], atol=1e-9)  # fmt: skip
 
 
+def test_antipodal_and_coincident_contacts_through_forces_and_check(tmp_path):
+    (tmp_path / "a.yaml").write_text(ANTIPODAL)
+    r, _ = run("check", tmp_path / "a.yaml", "-f", "jsonl")
+    (rec,) = jsonl(r.stdout)
+    # the contacts' plane has the normal (0, 1, -3) / sqrt(10): the third normal leaves it at
+    # sin(phi) = 1 / sqrt(10), so the least friction is tan(phi) = 1/3 (the pair squeezes within it)
+    assert rec["force_closure"] is True and rec["closure_friction"] == pytest.approx(1 / 3, abs=1e-9)
+    (tmp_path / "same.yaml").write_text(ANTIPODAL.replace("[-0.03, 0, 0]", "[0.03, 0, 0]"))
+    r, (rec,) = records(tmp_path / "same.yaml", "--quality")
+    assert r.exit_code == 1 and "internal error" not in r.stderr
+    assert rec["grip"]["error"]["code"] == rec["manipulating"]["error"]["code"] == "coincident-contacts"
+    assert rec["closure"] == {"force_closure": False, "closure_friction": None, "epsilon": 0.0, "safety": 1.0}
+
+
 def test_closure_is_judged_with_the_friction_the_safety_factor_leaves():
     # the tripod closes above mu = 0.4663: with mu 0.6 it does, with 0.6 / 2 it does not
     for safety, closes in (("1", True), ("2", False)):
