@@ -13,13 +13,18 @@ import grasptwist as gt
 from conic import closure_friction as clarabel_closure_friction
 from conic import least_grip
 from grasptwist.engine import formulas
-from grasptwist.engine.forces.closure import epsilon_quality
-from grasptwist.engine.forces.grasp_map import manipulating_reference, squeeze_directions
+from grasptwist.engine.forces.closure import check_cone_edges, epsilon_quality, first_edges
+from grasptwist.engine.forces.grasp_map import checked_grip, manipulating_reference, squeeze_directions
+from grasptwist.engine.forces.hold import grip_along
 from grasptwist.engine.screws import field_at, klein, rigid_motion
+from grasptwist.model import Segment
 
 EQ = np.array([[1, 0, 0], [-0.5, 0.75**0.5, 0], [-0.5, -(0.75**0.5), 0]])  # a ball's equator, radius 1
 EX2 = np.array([[0, 2, 2], [2, 0, 2], [2, 2, 0]], float)  # the paper's Example 2
 G = 9.81
+# the bundled ball's tripod (grasps/sphere.yaml): force closure above mu = 0.4663
+TRIPOD = np.array([[0.0, 0.031721, -0.014792], [-0.027471, -0.01586, -0.014792], [0.027471, -0.01586, -0.014792]])
+TRIPOD_N = np.array([[0.0, -0.906305, 0.422624], [0.784886, 0.453143, 0.422629], [-0.784886, 0.453143, 0.422629]])
 
 
 def grasps(n, seed, spread=0.35):
@@ -307,8 +312,83 @@ def test_check_safety(value):
 def test_force_closure_arguments():
     with pytest.raises(ValueError, match=r"^quality=True needs the grasp's friction"):
         gt.force_closure(EQ, -EQ, quality=True)
-    with pytest.raises(ValueError, match=r"^cone_edges must be an integer >= 3, got 2$"):
+    with pytest.raises(ValueError, match=r"^cone_edges must be an integer from 3 to 64, got 2$"):
         gt.force_closure(EQ, -EQ, 0.5, quality=True, cone_edges=2)
+
+
+@pytest.mark.parametrize("value", [2, 65, 10**9, 3.5, float("nan"), float("inf"), True, "8", None])
+def test_check_cone_edges(value):
+    with pytest.raises(ValueError, match=r"^cone_edges must be an integer from 3 to 64, got "):
+        check_cone_edges(value)
+    assert check_cone_edges(64) == 64 and check_cone_edges(3.0) == 3
+
+
+# --- antipodal, coplanar and coincident contacts; huge friction; overflow (issues 26, 27) --------
+
+ANTIPODAL = np.array([[0.03, 0, 0], [-0.03, 0, 0], [0, 0.03, 0.01]])  # the next contact on the normal's line
+ANTIPODAL_N = np.array([[-1.0, 0, 0], [1, 0, 0], [0, -1, 0]])
+
+
+def test_an_antipodal_pair_has_an_epsilon_that_turns_with_the_grasp_and_never_raises_in_a_batch():
+    c = gt.force_closure(ANTIPODAL, ANTIPODAL_N, 0.6, quality=True)
+    assert c.status == 0 and c.force_closure and c.epsilon > 0.05
+    # the pyramids' first edges follow the grasp: a rigid motion leaves epsilon as it is
+    q, _ = np.linalg.qr(np.random.default_rng(3).normal(size=(3, 3)))
+    rot = q * np.sign(np.linalg.det(q))
+    moved = gt.force_closure(ANTIPODAL @ rot.T + [1, -2, 0.5], ANTIPODAL_N @ rot.T, 0.6, quality=True)
+    assert moved.epsilon == pytest.approx(float(c.epsilon), rel=1e-9)
+    # the first edge of contact 1 points at contact 3 (its next contact lies on its normal's line)
+    b1 = first_edges(ANTIPODAL, ANTIPODAL_N)
+    np.testing.assert_allclose(b1[0], unit(np.array([0, 0.03, 0.01])), atol=1e-15)
+    # one such row among many: every row computed, each as alone
+    p, n, _, mu = grasps(30, 5)
+    p[17], n[17], mu[17] = ANTIPODAL, ANTIPODAL_N, 0.6
+    batch = gt.force_closure(p, n, mu, quality=True)
+    assert batch.epsilon[17] == pytest.approx(float(c.epsilon), rel=1e-12)
+    assert np.isfinite(batch.epsilon).all() and (batch.status[batch.force_closure] == 0).all()
+
+
+def test_antipodal_coplanar_and_coincident_contacts_through_every_force_function():
+    lift = [0, 0, 1.0, 0, 0, 0]
+    m = gt.manipulating_forces(ANTIPODAL, lift)
+    np.testing.assert_allclose(gt.grasp_map(ANTIPODAL) @ m.force.reshape(9), lift, atol=1e-12)
+    g = gt.grip(ANTIPODAL, ANTIPODAL_N, lift, 0.6)
+    assert g.status == 0 and (g.friction_used <= 0.6 + 1e-9).all()
+    np.testing.assert_allclose(gt.grasp_map(ANTIPODAL) @ g.force.reshape(9), lift, atol=1e-9)
+    # coplanar: the normals in the contacts' plane (the ball's equator)
+    c = gt.force_closure(EQ, -EQ, 0.5, quality=True)
+    assert c.status == 0 and c.closure_friction == pytest.approx(0, abs=1e-9) and c.epsilon > 0
+    # coincident: a status, NaN numbers and epsilon 0, never an exception
+    same = np.array([[1.0, 0, 0], [1, 0, 0], [0, 1, 0]])
+    c = gt.force_closure(same, -same, 0.5, quality=True)
+    assert (int(c.status), int(c.culprit), float(c.epsilon), bool(c.force_closure)) == (2, 2, 0.0, False)
+    assert gt.grip(same, -same, lift, 0.5).status == 2 == gt.manipulating_forces(same, lift).status
+    _, held = grip_along(ANTIPODAL, ANTIPODAL_N, 0.6, 0.1, [0, 0, 0], [0, 0, -G], [Segment(1.0, twist=[0] * 6)], [0, 1])
+    assert held.status.tolist() == [0, 0]
+
+
+def test_huge_and_infinite_friction_mean_what_they_say():
+    # the ball's tripod closes above mu = 0.4663; every friction above it closes it, however large
+    tripod = gt.force_closure(TRIPOD, TRIPOD_N, [[0.3], [0.5], [10], [1e200], [np.inf]], quality=True)
+    assert tripod.force_closure.tolist() == [False, True, True, True, True]
+    assert tripod.closure_friction == pytest.approx([0.46632] * 5, abs=1e-5)
+    # epsilon grows like mu (the pyramids' tangential wrenches): per unit of mu the same at 1e10 and 1e200
+    big = gt.force_closure(TRIPOD, TRIPOD_N, 1e10, quality=True).epsilon
+    assert tripod.epsilon[3] / 1e200 == pytest.approx(float(big) / 1e10, rel=1e-6)
+    assert np.isnan(tripod.epsilon[4])  # an infinite cone has no finite pyramid
+    g = gt.grip(TRIPOD, TRIPOD_N, [[0, 0, G, 0, 0, 0]] * 2, [[1e200], [np.inf]])
+    assert g.status.tolist() == [0, 0] and g.total_normal_force[0] == pytest.approx(g.total_normal_force[1], rel=1e-6)
+
+
+def test_an_overflowing_result_is_a_status_never_an_ok_row_with_infinity():
+    m = gt.manipulating_forces(EQ, [[1e308, 0, 0, 0, 0, 1e308], [0, 0, G, 0, 0, 0]])
+    assert m.status.tolist() == [9, 0] and np.isnan(m.force[0]).all() and np.isfinite(m.force[1]).all()
+    assert gt.force_status_message(9).startswith("the result overflows double precision")
+    g = checked_grip(gt.grip(EQ, -EQ, [[0, 0, 9.81e300, 0, 0, 0], [0, 0, G, 0, 0, 0], [0] * 6], 0.5))
+    assert g.status.tolist() == [9, 0, 0] and np.isnan(g.total_normal_force[0])
+    assert g.total_normal_force[1] == pytest.approx(2 * G) and g.friction_used[2].tolist() == [0.0] * 3
+    _, held = grip_along(EQ, -EQ, 0.5, 1e300, [0, 0, 0], [0, 0, -G], [Segment(1.0, twist=[0] * 6)], [0])
+    assert held.status.tolist() == [9]
 
 
 # --- properties -------------------------------------------------------------------------------------

@@ -42,7 +42,7 @@ from .engine import judgements
 from .engine.decompose import decompose_off_tangent, decompose_tangent
 from .engine.degeneracy import Status
 from .engine.forces.closure import force_closure
-from .engine.forces.grasp_map import manipulating_forces
+from .engine.forces.grasp_map import checked_grip, manipulating_forces
 from .engine.forces.grip import grip
 from .engine.screws import klein_table
 
@@ -451,7 +451,8 @@ class ForceResult:
     -1 where it has no wrench or no friction; their numbers are NaN there and
     where they failed.  ``closure_friction`` is NaN where no friction gives
     closure, ``force_closure`` and ``epsilon`` are meaningful only where the
-    row has a friction (``epsilon``: and quality was asked for).
+    row has a friction (``epsilon``: and quality was asked for), and are judged
+    with ``friction / safety``, the friction the grip may use.
     """
 
     manipulating: np.ndarray  # (N, 3, 3)
@@ -508,11 +509,13 @@ def compute_forces(points, normals, wrench, has_wrench, friction, has_friction, 
         )
     g = np.flatnonzero(has_wrench & has_friction)
     if g.size:
-        r = grip(points[g], normals[g], wrench[g], friction[g], options.safety)
+        r = checked_grip(grip(points[g], normals[g], wrench[g], friction[g], options.safety))
         for name in ("force", "squeeze", "normal_force", "tangential_force", "friction_used", "total_normal_force"):
             out[name][g] = getattr(r, name)
         out["grip_status"][g], out["grip_culprit"][g] = r.status, r.culprit
-    for rows, mu in ((np.flatnonzero(has_friction), friction), (np.flatnonzero(~has_friction), None)):
+    # closure and epsilon with the friction the forces may use, as the grip's (issue 31)
+    usable = None if friction is None else friction / options.safety
+    for rows, mu in ((np.flatnonzero(has_friction), usable), (np.flatnonzero(~has_friction), None)):
         if not rows.size:
             continue
         quality = options.quality and mu is not None

@@ -225,8 +225,10 @@ class Member:
         return np.frombuffer(data, self.dtype).reshape((stop - start, *self.shape[1:]))
 
     def __array__(self, dtype=None, copy=None):
-        """Every row: only for the members a run reads whole, one ``twist (6,)``."""
-        return self[:] if dtype is None else self[:].astype(dtype)
+        """Every row: only for the members a run reads whole, one ``twist (6,)`` or ``friction ()``."""
+        # a 0-d member (one value for every row) is read as one row of its own shape
+        whole = self[:] if self.shape else Member(self.path, self.name, (1,), self.dtype, self.offset)[:].reshape(())
+        return whole if dtype is None else whole.astype(dtype)
 
     def _file(self):
         pid = os.getpid()

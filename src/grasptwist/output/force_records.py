@@ -18,8 +18,8 @@ __all__ = ["force_records", "GRIP_FIELDS", "CLOSURE_FIELDS", "NO_FRICTION_WARNIN
 #: The grip object's numbers, in order (then ``safety``).
 GRIP_FIELDS = ("force", "squeeze", "normal_force", "tangential_force", "friction_used", "total_normal_force")
 
-#: The closure object's fields.
-CLOSURE_FIELDS = ("force_closure", "closure_friction", "epsilon")
+#: The closure object's fields (``force_closure`` and ``epsilon`` judged with ``mu / safety``).
+CLOSURE_FIELDS = ("force_closure", "closure_friction", "epsilon", "safety")
 
 NO_FRICTION_WARNING = "grip skipped: the grasp has no friction (give 'friction:' in the file or --friction MU)"
 
@@ -84,6 +84,7 @@ def force_records(block) -> list[dict]:
             "force_closure": force_closure[i] if has_friction[i] else None,
             "closure_friction": _number(closure_friction[i]),
             "epsilon": _number(epsilon[i]),
+            "safety": r.safety,
         }
         status = ForceStatus(int(r.closure_status[i]))
         if status not in (ForceStatus.OK, ForceStatus.NO_CLOSURE):

@@ -627,8 +627,8 @@ def _verdict_cell(m):
 class ForceTableWriter(_Writer):
     """A forces record: per contact its forces and how close each is to slipping, then the totals and closure.
 
-    Forces in N and moments in N m when the grasp's lengths are in metres
-    (the numbers are as given: N, N m stand for the units of the file)."""
+    Forces in N, moments in N times the file's length unit (``units``; ``N m`` with
+    metres, ``N mm`` with millimetres, ``N length`` when the file names none)."""
 
     def show(self, rec: dict, lines: list[str]) -> None:
         d = self.digits
@@ -639,7 +639,8 @@ class ForceTableWriter(_Writer):
                 Text.assemble(
                     "wrench ",
                     (escaped(w["name"]), "bold"),
-                    f" = force {fmt_vector(w['wrench'][:3], d)} N; moment {fmt_vector(w['wrench'][3:], d)} N m",
+                    f" = force {fmt_vector(w['wrench'][:3], d)} N; moment {fmt_vector(w['wrench'][3:], d)} "
+                    f"N {escaped(rec['units'] or 'length')}",
                 )
             )
         self.flow(lines, *parts)
@@ -680,7 +681,8 @@ class ForceTableWriter(_Writer):
         c = rec["closure"]
         verdict = {True: "yes", False: "no", None: "- (no friction)"}[c["force_closure"]]
         least = "none" if c["closure_friction"] is None else fmt_number(c["closure_friction"], d)
-        text = f"closure: force closure {verdict}; closure friction {least}"
+        judged = "" if c["safety"] == 1 or c["force_closure"] is None else f" (with mu/{c['safety']:g})"
+        text = f"closure{judged}: force closure {verdict}; closure friction {least}"
         if c["epsilon"] is not None:
             text += f"; epsilon {fmt_number(c['epsilon'], d)}"
         self.add(lines, text)

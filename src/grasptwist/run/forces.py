@@ -161,6 +161,7 @@ def force_dataset_blocks(
             mu = np.broadcast_to(own if own.ndim == 0 else own[picked], (n, 3)).copy()
         else:
             mu = np.full((n, 3), np.nan)
+        _check_rows_friction(ds.path, mu, index, end)
         labels = ds.names[first:last][picked] if ds.names is not None else index
         yield force_arrays(
             np.asarray(ds.points[first:last], dtype=float)[picked],
@@ -173,6 +174,20 @@ def force_dataset_blocks(
             grasp=_texts(labels),
             units=[None] * n,
             contact_names=[("1", "2", "3")] * n,
+        )
+
+
+def _check_rows_friction(path, mu, index, end):
+    """A negative friction in a data set's rows: its input error (the rows from its block on,
+    to the end of the part being run, get that one error record; other files keep theirs)."""
+    bad = (mu < 0).any(axis=1)
+    if bad.any():
+        row = int(np.argmax(bad))
+        raise GraspFileError(
+            code="bad-dataset",
+            message=f"friction: row {index[row]}: {float(mu[row][mu[row] < 0][0])!r} must be >= 0 "
+            f"(rows {index[0]} to {end - 1} not computed)",
+            file=path,
         )
 
 

@@ -26,6 +26,7 @@ The statuses (:class:`ForceStatus`) share their numbers with the twist engine's
 
 from __future__ import annotations
 
+from dataclasses import replace
 from enum import IntEnum
 from typing import NamedTuple
 
@@ -41,6 +42,8 @@ __all__ = [
     "check_wrench",
     "check_friction",
     "check_safety",
+    "nonfinite_result",
+    "checked_grip",
     "grasp_map",
     "manipulating_reference",
     "squeeze_directions",
@@ -60,6 +63,7 @@ class ForceStatus(IntEnum):
     COINCIDENT_CONTACTS = 2
     COLLINEAR_CONTACTS = 3
     ZERO_NORMAL = 5
+    NONFINITE_RESULT = 9
     CANNOT_HOLD = 20
     NO_CLOSURE = 21
     MIXED_FRICTIONLESS = 22
@@ -78,6 +82,9 @@ _MESSAGES = {
         "the contacts are collinear, so no finger forces make a moment about their line (rank G < 6)"
     ),
     ForceStatus.ZERO_NORMAL: "the normal at contact {i} has zero length",
+    ForceStatus.NONFINITE_RESULT: (
+        "the result overflows double precision (a force is infinite or NaN): rescale the wrench, mass or coordinates"
+    ),
     ForceStatus.NO_CLOSURE: "no friction makes the grasp force closure: {why}",
     ForceStatus.MIXED_FRICTIONLESS: (
         "contacts with and without friction in one grasp are not solved yet (give every contact mu > 0, or all 0)"
@@ -185,6 +192,56 @@ def check_safety(safety) -> float:
     if isinstance(safety, bool) or not np.isfinite(s) or s < 1:
         raise ValueError(f"safety must be a finite number >= 1, got {safety!r}")
     return s
+
+
+def nonfinite_result(status, *parts) -> np.ndarray:
+    """``status`` with ``nonfinite-result`` where a row is ok but a part of its result is NaN or infinite.
+
+    The one place an ok row's numbers are held to be finite (huge wrenches, masses or
+    coordinates overflow inside the formulas).  ``status (...)``; each part ``(..., *)``
+    with the same leading axes.
+
+    >>> nonfinite_result(np.array([0, 0, 20]), np.array([[1.0, 2.0], [1.0, np.inf], [np.nan, 0.0]])).tolist()
+    [0, 9, 20]
+    """
+    out = np.array(status, copy=True)
+    bad = np.zeros(out.shape, bool)
+    for part in parts:
+        part = np.asarray(part)
+        bad |= ~np.isfinite(part.reshape(out.shape + (-1,))).all(axis=-1)
+    out[(out == ForceStatus.OK) & bad] = ForceStatus.NONFINITE_RESULT
+    return out
+
+
+#: The numbers of a grip (:class:`~grasptwist.engine.forces.grip.Grip`) held finite on its ok rows.
+GRIP_NUMBERS = ("force", "squeeze", "normal_force", "tangential_force", "friction_used", "total_normal_force")
+
+
+def checked_grip(g):
+    """A grip whose ok rows are finite: ``nonfinite-result`` (and NaN numbers) where they are not.
+
+    Where a force has no tangential part (no wrench: no force at all) it uses no
+    friction, ``friction_used = 0`` rather than ``0 / 0``.  Every caller of
+    :func:`~grasptwist.engine.forces.grip.grip` that reports rows passes its result
+    through here.
+
+    >>> from grasptwist.engine.forces.grip import grip
+    >>> p = [[1, 0, 0], [-0.5, 0.75**0.5, 0], [-0.5, -(0.75**0.5), 0]]
+    >>> g = checked_grip(grip(p, -np.array(p), [[0, 0, 0, 0, 0, 0], [0, 0, 1e308, 0, 0, 1e308]], 0.5))
+    >>> g.status.tolist(), g.friction_used[0].tolist()
+    ([0, 9], [0.0, 0.0, 0.0])
+    """
+    ok = (g.status == ForceStatus.OK)[..., None]
+    used = np.where(ok & (g.tangential_force == 0), 0.0, g.friction_used)
+    status = nonfinite_result(
+        g.status, *(used if name == "friction_used" else getattr(g, name) for name in GRIP_NUMBERS)
+    )
+    failed = status != ForceStatus.OK
+    numbers = {name: getattr(g, name) for name in GRIP_NUMBERS} | {"friction_used": used}
+    numbers = {
+        k: np.where(failed.reshape(failed.shape + (1,) * (v.ndim - failed.ndim)), np.nan, v) for k, v in numbers.items()
+    }
+    return replace(g, status=status, **numbers)
 
 
 # --- reference formulas (readable; the tests hold the fast forms to them) -----------
@@ -378,9 +435,9 @@ def manipulating_forces(points, wrench, *, tol=DEGENERACY_TOL) -> ManipulatingFo
     geo = geometry(p, tol)
     f = _manipulating(geo, w)
     status, culprit = geo.status.copy(), geo.culprit.copy()
-    bad = (status == 0) & ~np.isfinite(w).all(axis=-1)
-    status[bad] = ForceStatus.NONFINITE_INPUT
-    f[bad] = np.nan
+    status[(status == 0) & ~np.isfinite(w).all(axis=-1)] = ForceStatus.NONFINITE_INPUT
+    status = nonfinite_result(status, f)
+    f[status != 0] = np.nan
     return ManipulatingForces(f, geo.conditioning, status, culprit)
 
 
