@@ -127,6 +127,7 @@ class Summary:
     labels: tuple[str, ...]  # the methods run
     hand: HandTrack | None = None  # the fingers' tracks, when the grasp has a hand
     cannot_hold: tuple[HoldStretch, ...] | None = None  # where no grip holds its weight, with mass and friction
+    tip_error: np.ndarray | None = None  # (3,) with a hand: each finger's largest tip error at the samples
 
 
 def sample_times(duration: float, samples: int | None = None, dt: float | None = None) -> np.ndarray:
@@ -214,6 +215,7 @@ def _path(job, grasp, p):
         if grasp.mass is None or grasp.friction is None
         else (grasp.points, grasp.normals, grasp.friction, grasp.mass, grasp.center_of_mass, grasp.gravity, p.segments)
     )
+    largest = None  # each finger's largest tip error at the samples, as their records give it
     for start in range(0, len(times), CHUNK):
         q = None if tracked is None else tracked.positions[start : start + CHUNK]
         grip = None if weight is None else grip_along(*weight, times[start : start + CHUNK])[1]
@@ -226,10 +228,14 @@ def _path(job, grasp, p):
             method=job.method,
             bases=job.bases,
         )
-        yield Samples(p.name, _block(grasp, p.name, f, job.bases, job.method, q), f.poses, q, grip)
+        block = _block(grasp, p.name, f, job.bases, job.method, q)
+        if tracked is not None:
+            seen = block.results["hand"].tip_error.max(axis=0)
+            largest = seen if largest is None else np.maximum(largest, seen)
+        yield Samples(p.name, block, f.poses, q, grip)
     found = degeneracies(grasp.points, grasp.normals, grasp.wrist, p.segments, times)
     stretches = None if weight is None else cannot_hold(*weight, times)
-    yield Summary(grasp.file, grasp, p.name, len(times), found, labels, tracked, stretches)
+    yield Summary(grasp.file, grasp, p.name, len(times), found, labels, tracked, stretches, largest)
 
 
 def _block(grasp, name, f, bases, method, positions=None) -> Block:
