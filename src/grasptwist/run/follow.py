@@ -267,6 +267,9 @@ def _block(grasp, name, f, bases, method, positions=None) -> Block:
         bases=bases,
         hands=None if positions is None else [grasp.hand] * n,
         method=method,
+        center_of_mass=None
+        if grasp.center_of_mass is None
+        else f.poses.rotation @ grasp.center_of_mass + f.poses.position,
     )
     return with_reasons(block)  # a method asked for by name that cannot run fails, as in resolve
 
