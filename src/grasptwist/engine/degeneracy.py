@@ -26,6 +26,7 @@ __all__ = [
     "conditioning_warning",
     "skipped_warning",
     "outward_normals_warning",
+    "radians_warning",
 ]
 
 #: A dimensionless measure at or below this makes the grasp degenerate.
@@ -199,4 +200,21 @@ def outward_normals_warning(outward, names=("1", "2", "3"), center=False) -> str
     return (
         f"outward-normals: the normals at contacts {', '.join(which[:-1])} and {which[-1]} point away from {away}, "
         "but normals point into the object: flip them, unless the fingers push outward from inside a hollow"
+    )
+
+
+def radians_warning(rotvec, line=None, column=None) -> str:
+    """The warning for a rotation vector over pi (:func:`~grasptwist.engine.judgements.rotation_over_pi`),
+    with where it is written; it starts with its code.
+
+    >>> radians_warning([0, 0, 90], 10, 24)
+    'rotation-over-pi: rotation of 90 (rotvec [0, 0, 90], line 10, column 24) is over pi: rotations are in radians (this one is a turn of 116.6 degrees)'
+    """
+    r = np.asarray(rotvec, dtype=float)
+    angle = float(np.sqrt(r @ r))
+    turn = np.degrees(abs((angle + np.pi) % (2 * np.pi) - np.pi))  # the rotation's own angle, in [0, 180]
+    where = "".join(f", {name} {n}" for name, n in (("line", line), ("column", column)) if n is not None)
+    return (
+        f"rotation-over-pi: rotation of {angle:g} (rotvec [{', '.join(f'{x:g}' for x in r)}]{where}) is over pi: "
+        f"rotations are in radians (this one is a turn of {turn:.1f} degrees)"
     )

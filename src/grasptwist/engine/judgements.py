@@ -1,6 +1,6 @@
 """Judgements on a resolved twist: which fingers each component moves, and
 whether the twist is a rotation about the wrist; and on a grasp: which of
-its normals look outward.
+its normals look outward; and on a path: whether a rotation looks given in degrees.
 
 These are engine outputs like the amplitudes: pure functions on result
 arrays, batched over any leading shape, whose answers the records carry
@@ -29,7 +29,16 @@ import numpy as np
 from .degeneracy import IN_PLANE_TOL
 from .screws import dot
 
-__all__ = ["ALONE", "ALL_BUT", "active", "off_tangent_moves", "tangent_moves", "about_wrist", "outward_contacts"]
+__all__ = [
+    "ALONE",
+    "ALL_BUT",
+    "active",
+    "off_tangent_moves",
+    "tangent_moves",
+    "about_wrist",
+    "outward_contacts",
+    "rotation_over_pi",
+]
 
 #: ``ALONE[i, f]``: the basis screw ``Sigma_i`` moves finger ``f`` (``f == i`` only).
 ALONE = np.eye(3, dtype=bool)
@@ -245,3 +254,29 @@ def _cosines(a, b):
     """The cosines between the vectors ``a`` and ``b`` (last axis), NaN where one is zero or NaN."""
     with np.errstate(all="ignore"):  # NaN input: no verdict; lengths beyond 1e150 overflow to none either
         return dot(a, b) / np.sqrt(dot(a, a) * dot(b, b))
+
+
+def rotation_over_pi(rotvec):
+    """Whether a rotation vector turns by more than pi: most likely degrees taken for radians.
+
+    .. math:: \\lvert r \\rvert > \\pi
+
+    A rotation vector ``r`` turns by ``|r|`` radians about ``r``; beyond pi
+    it is the rotation by ``|r| - 2 pi k`` for some ``k``, so a pose target
+    given by it is reached by the shorter turn (``[0, 0, 90]`` turns 116.6
+    degrees).  Nobody writes a half turn and more that way on purpose.
+
+    Parameters
+    ----------
+    rotvec : (..., 3) array
+
+    Returns
+    -------
+    (...) bool
+        False where the vector is NaN.
+
+    >>> rotation_over_pi([[0, 0, 90], [0, 0, np.pi], [0, 3, 2]]).tolist()
+    [True, False, True]
+    """
+    r = np.asarray(rotvec, dtype=float)
+    return np.sqrt(dot(r, r)) > np.pi

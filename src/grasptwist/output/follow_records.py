@@ -204,6 +204,7 @@ def summary_record(summary) -> dict:
         "grasp": escaped(summary.grasp.name, controls=False),
         "path": escaped(summary.path, controls=False),
         "summary": out,
+        "warnings": list(summary.warnings),
         "ok": ok,
     }
 
@@ -262,6 +263,7 @@ def diagnostics(rec: dict, names=("1", "2", "3")) -> tuple[list[str], list[str]]
         warnings.append(
             f"{where}: warning: {w['method']}: conditioning below {CONDITION_WARNING:g} from t = {w['t']:.6g}"
         )
+    warnings += [f"{where}: warning: {w}" for w in rec.get("warnings", ())]
     errors += [f"{where}: error: {hold_text(c, 6)}" for c in s.get("cannot_hold", ())]
     if "hand" in s:
         hand_errors, hand_warnings = hand_event_texts(s["hand"], names, 6)
