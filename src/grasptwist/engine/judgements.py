@@ -240,20 +240,20 @@ def outward_contacts(points, normals, center=None, tol=IN_PLANE_TOL):
     [True, True, True]
     """
     points, normals = np.asarray(points, dtype=float), np.asarray(normals, dtype=float)
-    others = points[..., [[1, 2], [2, 0], [0, 1]], :] - points[..., None, :]  # (..., i, j, xyz): p_j - p_i
-    cos = _cosines(normals[..., None, :], others)
-    out = ~(cos > tol).any(axis=-1) & (cos < -tol).any(axis=-1)
-    if center is None:
-        return out
-    center = np.asarray(center, dtype=float)[..., None, :]
-    away = _cosines(normals, center - points) < -tol
-    return np.where(np.isnan(center).any(axis=-1), out, away)
-
-
-def _cosines(a, b):
-    """The cosines between the vectors ``a`` and ``b`` (last axis), NaN where one is zero or NaN."""
     with np.errstate(all="ignore"):  # NaN input: no verdict; lengths beyond 1e150 overflow to none either
-        return dot(a, b) / np.sqrt(dot(a, a) * dot(b, b))
+        n_len = np.sqrt(dot(normals, normals))
+        side = np.roll(points, -1, axis=-2) - points  # side i: p_{i+1} - p_i, so p_{i-1} - p_i is -side (i-1)
+        side_len = np.sqrt(dot(side, side))
+        ahead, behind = dot(normals, side), -dot(normals, np.roll(side, 1, axis=-2))
+        ahead_tol, behind_tol = tol * n_len * side_len, tol * n_len * np.roll(side_len, 1, axis=-1)
+        inside = (ahead > ahead_tol) | (behind > behind_tol)
+        out = ~inside & ((ahead < -ahead_tol) | (behind < -behind_tol))
+        if center is None:
+            return out
+        center = np.asarray(center, dtype=float)[..., None, :]
+        toward = center - points
+        away = dot(normals, toward) < -tol * n_len * np.sqrt(dot(toward, toward))
+    return np.where(np.isnan(center).any(axis=-1), out, away)
 
 
 def rotation_over_pi(rotvec):
