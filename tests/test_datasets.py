@@ -115,7 +115,8 @@ def test_npz_output_arrays_match_the_records_and_carry_a_status_legend(tmp_path,
     assert z["twist_names"].tolist() == ["twist"] and not z["twist_index"].any()
     assert r.stderr.strip().splitlines()[-1] == (
         f"{N} records: 5 with a degenerate method (off-tangent: 1 coincident-contacts, 1 collinear-contacts, "
-        "1 wrist-coplanar; tangent: 1 coincident-contacts, 1 collinear-contacts, 1 theta-sigma-zero, 1 zero-normal), "
+        "1 wrist-coplanar; tangent: 1 coincident-contacts, 1 collinear-contacts, 1 normal-in-contact-plane, "
+        "1 zero-normal), "
         "0 inputs failed"
     )
 

@@ -44,8 +44,8 @@ DEGENERATE = [
     (EX2, [[1, 0, 0], [0, 0, 0], [0, 0, 1]], UP, TWIST),  # zero normal
     (EX1, -EX1, UP, TWIST),  # normal lines of rank 2
     ([[-1, 0, 0], [1, 0, 0], [0, 1, 0.5]], [[1, 0, 0], [-1, 0, 0], [0, -1, 0]], UP, TWIST),  # antipodal pinch
-    (RIGHT, [[0, 0, 1], [1, 0, 0], [0, 0, 1]], UP, TWIST),  # Theta_1 not unique
-    (RIGHT, [[0, 0, 1], [0, 1, 0], [1, 0, 1]], UP, TWIST),  # [Theta_1|Sigma_1] = 0
+    (RIGHT, [[0, 0, 1], [0, 1, 0], [1, 0, 0]], UP, TWIST),  # Theta_1 not unique
+    (RIGHT, [[0, 0, 1], [0, 1, 1.5e-9], [1, 0, 1]], UP, TWIST),  # [Theta_1|Sigma_1] = 0
     (RIGHT, [[0, 0, 1], [0, 0, 1], [1, 0.3, 0]], UP, TWIST),  # a normal exactly in the contacts' plane
 ]
 

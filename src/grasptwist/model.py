@@ -163,6 +163,10 @@ class Segment:
         A pose target's position ``x``; None for a twist.
     rotation : array-like (3, 3) or None
         A pose target's rotation matrix ``R``; None for a twist.
+    rotvec : array-like of 3 or None
+        The rotation vector (radians) a pose target's ``R`` was given by, as
+        written, and ``line``, ``column``, where (1-based): kept to judge its
+        size (:func:`grasptwist.engine.judgements.rotation_over_pi`).
     """
 
     duration: float
@@ -170,6 +174,9 @@ class Segment:
     frame: str = "space"
     position: np.ndarray | None = None
     rotation: np.ndarray | None = None
+    rotvec: np.ndarray | None = None
+    line: int | None = None
+    column: int | None = None
 
 
 @dataclass(frozen=True, eq=False)

@@ -269,14 +269,17 @@ def check_segments(segments) -> tuple[Segment, ...]:
         if s.twist is not None:
             if s.frame not in FRAMES:
                 raise ValueError(f"{where}.frame must be 'space' or 'body', got {s.frame!r}")
-            checked.append(Segment(duration, twist=_finite(s.twist, (6,), f"{where}.twist"), frame=s.frame))
+            checked.append(replace(s, duration=duration, twist=_finite(s.twist, (6,), f"{where}.twist")))
             continue
         if s.position is None or s.rotation is None:
             raise ValueError(f"{where} needs a twist or a pose target (both position and rotation)")
         rotation = _finite(s.rotation, (3, 3), f"{where}.rotation")
         if not (np.abs(rotation.T @ rotation - np.eye(3)).max() <= _ROTATION_TOL and np.linalg.det(rotation) > 0):
             raise ValueError(f"{where}.rotation must be a rotation matrix (orthonormal, determinant +1)")
-        checked.append(Segment(duration, position=_finite(s.position, (3,), f"{where}.position"), rotation=rotation))
+        # replace: what a segment carries besides (the rotation vector it was given by) stays
+        checked.append(
+            replace(s, duration=duration, position=_finite(s.position, (3,), f"{where}.position"), rotation=rotation)
+        )
     if not checked:
         raise ValueError("segments must hold at least one segment")
     return tuple(checked)

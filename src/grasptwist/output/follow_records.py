@@ -129,11 +129,12 @@ def _finger_positions(hand, positions) -> list[list[float]]:
     return [(positions[list(f.joint_index)] + 0.0).tolist() for f in hand.fingers]
 
 
-def hand_summary(grasp, tracked) -> dict:
+def hand_summary(grasp, tracked, tip_error) -> dict:
     """The ``hand`` object of a path's summary: the first time a joint leaves its position
-    limits, and per finger its own first events and largest tip error (README "Paths")."""
+    limits, and per finger its own first events and ``tip_error``, its largest at the samples
+    (the samples' records give each: a summary that says less than they do would hide it)."""
     fingers, first = [], None
-    for finger, track in zip(grasp.hand.fingers, tracked.fingers):
+    for finger, track, error in zip(grasp.hand.fingers, tracked.fingers, tip_error.tolist()):
         exit_ = None
         if track.limit_exit is not None:
             t, j = track.limit_exit
@@ -146,7 +147,7 @@ def hand_summary(grasp, tracked) -> dict:
                 "joint_limit": exit_,
                 "rank_loss": track.rank_loss,
                 "first_warning": track.warning,
-                "tip_error": float(track.error.max()),
+                "tip_error": error,
             }
         )
     return {"joint_limit": first, "fingers": fingers}
@@ -195,7 +196,7 @@ def summary_record(summary) -> dict:
         ]
         ok = ok and not summary.cannot_hold  # the object falls
     if summary.hand is not None:
-        out["hand"] = hand_summary(summary.grasp, summary.hand)
+        out["hand"] = hand_summary(summary.grasp, summary.hand, summary.tip_error)
         # a joint out of its limits, or a finger that cannot follow, stops the motion too
         ok = ok and out["hand"]["joint_limit"] is None and all(f["rank_loss"] is None for f in out["hand"]["fingers"])
     return {
@@ -203,6 +204,7 @@ def summary_record(summary) -> dict:
         "grasp": escaped(summary.grasp.name, controls=False),
         "path": escaped(summary.path, controls=False),
         "summary": out,
+        "warnings": list(summary.warnings),
         "ok": ok,
     }
 
@@ -261,6 +263,7 @@ def diagnostics(rec: dict, names=("1", "2", "3")) -> tuple[list[str], list[str]]
         warnings.append(
             f"{where}: warning: {w['method']}: conditioning below {CONDITION_WARNING:g} from t = {w['t']:.6g}"
         )
+    warnings += [f"{where}: warning: {w}" for w in rec.get("warnings", ())]
     errors += [f"{where}: error: {hold_text(c, 6)}" for c in s.get("cannot_hold", ())]
     if "hand" in s:
         hand_errors, hand_warnings = hand_event_texts(s["hand"], names, 6)

@@ -12,6 +12,7 @@ import numpy as np
 
 from ..engine.forces.grasp_map import ForceStatus, force_status_message
 from .names import escaped, escaped_each
+from .records import outward_warning
 
 __all__ = ["force_records", "GRIP_FIELDS", "CLOSURE_FIELDS", "NO_FRICTION_WARNING"]
 
@@ -50,10 +51,11 @@ def force_records(block) -> list[dict]:
     grip = {name: _lists(getattr(r, name)) for name in GRIP_FIELDS}
     closure_friction, epsilon = r.closure_friction.tolist(), r.epsilon.tolist()
     force_closure = r.force_closure.tolist()
+    outward = block.outward().any(axis=-1).tolist()
     out = []
     for i in range(len(block)):
         names = escaped_each(block.contact_names[i])
-        warnings = []
+        warnings = [outward_warning(block, i)] if outward[i] else []
         rec = {
             "file": escaped(block.file[i], controls=False),
             "grasp": escaped(block.grasp[i], controls=False),

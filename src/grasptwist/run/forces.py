@@ -14,6 +14,7 @@ from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
+from ..engine.judgements import outward_contacts
 from ..engine.screws import direction
 from ..model import Grasp, GraspFileError, Wrench
 from ..results import ForceOptions, ForceResult, compute_forces
@@ -35,6 +36,7 @@ class ForceBlock:
     wrench: np.ndarray  # (n, 6), NaN rows where there is none
     friction: np.ndarray  # (n, 3), NaN rows where there is none
     result: ForceResult
+    center_of_mass: np.ndarray | None = None  # (n, 3), NaN rows where none; None: no row has one
 
     def __len__(self) -> int:
         return len(self.grasp)
@@ -50,18 +52,27 @@ class ForceBlock:
     def part(self, start: int, stop: int) -> ForceBlock:
         """Rows ``start:stop`` as a block of their own (views)."""
         rows = slice(start, stop)
-        cut = {f.name: getattr(self, f.name)[rows] for f in fields(self) if f.name != "result"}
+        cut = {f.name: getattr(self, f.name)[rows] for f in fields(self) if getattr(self, f.name) is not None}
+        del cut["result"]
         r = self.result
         result = replace(r, **{f.name: getattr(r, f.name)[rows] for f in fields(r) if f.name != "safety"})
         return ForceBlock(**cut, result=result)
+
+    def outward(self) -> np.ndarray:
+        """Per row and contact ``(n, 3)``: does its normal point out of the object
+        (:func:`~grasptwist.engine.judgements.outward_contacts`, as for resolve's blocks)?"""
+        return outward_contacts(self.points, self.normals, self.center_of_mass)
 
     def failed_rows(self) -> np.ndarray:
         """Rows whose manipulating forces or grip failed."""
         return (self.result.manipulating_status > 0) | (self.result.grip_status > 0)
 
 
-def force_arrays(points, normals, wrench, wrench_name, friction, options: ForceOptions, **labels) -> ForceBlock:
-    """One block from arrays of rows (``wrench`` and ``friction`` NaN rows where there is none)."""
+def force_arrays(
+    points, normals, wrench, wrench_name, friction, options: ForceOptions, center_of_mass=None, **labels
+) -> ForceBlock:
+    """One block from arrays of rows (``wrench``, ``friction`` and ``center_of_mass`` NaN rows where
+    there is none; ``center_of_mass`` None: no row has one)."""
     n = len(points)
     has_friction = ~np.isnan(friction).any(axis=-1)
     has_wrench = np.array([name is not None for name in wrench_name], dtype=bool)
@@ -77,6 +88,7 @@ def force_arrays(points, normals, wrench, wrench_name, friction, options: ForceO
         wrench=wrench,
         friction=friction,
         result=result,
+        center_of_mass=center_of_mass,
     )
 
 
@@ -117,6 +129,9 @@ def _stack(rows, friction, options) -> ForceBlock:
         [None if w is None else w.name for _, w in rows],
         mu,
         options,
+        None
+        if all(g.center_of_mass is None for g in grasps)
+        else np.stack([nan3 if g.center_of_mass is None else g.center_of_mass for g in grasps]),
         file=[g.file for g in grasps],
         grasp=[g.name for g in grasps],
         units=[g.units for g in grasps],
