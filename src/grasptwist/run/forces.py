@@ -52,8 +52,11 @@ class ForceBlock:
     def part(self, start: int, stop: int) -> ForceBlock:
         """Rows ``start:stop`` as a block of their own (views)."""
         rows = slice(start, stop)
-        cut = {f.name: getattr(self, f.name)[rows] for f in fields(self) if getattr(self, f.name) is not None}
-        del cut["result"]
+        cut = {
+            f.name: getattr(self, f.name)[rows]
+            for f in fields(self)
+            if f.name != "result" and getattr(self, f.name) is not None
+        }
         r = self.result
         result = replace(r, **{f.name: getattr(r, f.name)[rows] for f in fields(r) if f.name != "safety"})
         return ForceBlock(**cut, result=result)
