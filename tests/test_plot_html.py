@@ -1,6 +1,7 @@
 """The interactive HTML view (`plot -o FILE.html`): the figures embedded in the page, read back,
 hold the engine's numbers; the command's files, options and errors."""
 
+import json
 import re
 import sys
 from pathlib import Path
@@ -214,6 +215,27 @@ def test_a_name_cannot_end_the_figures_script_element(tmp_path):
     assert r.exit_code == 0, r.output
     (figure,) = read_figures((tmp_path / "g.html").read_text("utf-8"))
     assert "</script><b>x" in figure["layout"]["title"]["text"].replace("&lt;", "<").replace("&gt;", ">")
+
+
+HOSTILE_NAME = "<!--<script>"
+
+
+def hostile_names_page(tmp_path):
+    """A page of box-edge with its thumb named ``<!--<script>``, which once made an HTML parser
+    take the rest of the page for script text (nothing drew)."""
+    source = (GRASPS / "box-edge.yaml").read_text().replace("name: thumb", f"name: '{HOSTILE_NAME}'", 1)
+    (tmp_path / "g.yaml").write_text(source)
+    r = run("plot", tmp_path / "g.yaml", "-o", tmp_path / "g.html")
+    assert r.exit_code == 0, r.output
+    return tmp_path / "g.html"
+
+
+def test_a_comment_and_script_opening_in_a_name_stay_in_the_figures_json(tmp_path):
+    text = hostile_names_page(tmp_path).read_text("utf-8")
+    (block,) = re.findall(r'<script type="application/json" id="figure-0-json">(.*?)</script>', text, flags=re.S)
+    assert "<" not in block  # no "<!--", "<script" or "</" for the HTML parser to act on
+    (figure,) = read_figures(text)
+    assert any(HOSTILE_NAME in json.dumps(t, ensure_ascii=False) for t in figure["data"])  # the name as written
 
 
 @pytest.mark.slow
