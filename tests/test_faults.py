@@ -518,8 +518,8 @@ def test_an_npz_zip_bomb_is_refused_unread_and_costs_no_other_record(tmp_path, b
     print(f"npz bomb: peak {peak:.0f} MB")
     assert code == 1 and peak < 150
     assert stderr.splitlines()[0] == (
-        f"{bomb}: error: bad-dataset: points: declares 72,000,128 bytes in "
-        f"{zipfile.ZipFile(bomb).getinfo('points.npy').compress_size:,} compressed "
+        f"{bomb}: error: bad-dataset: points: declares 72,000,128 bytes decoded from "
+        f"{zipfile.ZipFile(bomb).getinfo('points.npy').compress_size:,} "
         f"(over {MAX_INFLATION} times): refused unread, as a likely zip bomb"
     )
     records = jsonl((tmp_path / "out.jsonl").read_text())

@@ -35,6 +35,7 @@ import numpy as np
 
 from ..model import GraspFileError
 from .dataset import Dataset
+from .limits import MAX_INFLATION, check_inflation
 from .parquet import open_parquet
 
 __all__ = ["DATASET_SUFFIXES", "EXTRA_POINT_ROLES", "Dataset", "Member", "open_dataset", "MAX_INFLATION"]
@@ -42,14 +43,6 @@ __all__ = ["DATASET_SUFFIXES", "EXTRA_POINT_ROLES", "Dataset", "Member", "open_d
 DATASET_SUFFIXES = (".npz", ".npy", ".parquet")
 EXTRA_POINT_ROLES = ("wrist", "at")
 _NPZ_KEYS = ("points", "normals", "wrist", "twist", "names", "joint_positions", "wrench", "friction")
-
-#: An ``.npz`` member may inflate to at most this many times its compressed
-#: size (zlib's own limit is about 1,000; real grasp data compresses 1-10
-#: times) ...
-MAX_INFLATION = 100
-#: ... once it declares more than this many bytes: smaller members (one
-#: twist, repeated names) may compress as much as they like.
-INFLATION_FLOOR = 64 << 20
 
 
 def _bad(path, message) -> GraspFileError:
@@ -69,7 +62,7 @@ def open_dataset(path: str, extra_point: str = "wrist") -> Dataset:
         return open_parquet(path)
     try:
         if path.endswith(".npy"):
-            return _open_npy(path, np.load(path, mmap_mode="r", allow_pickle=False), extra_point)
+            return _open_npy(path, _npy(path), extra_point)
         with zipfile.ZipFile(path) as zf:
             members = {}
             for info in zf.infolist():
@@ -82,6 +75,20 @@ def open_dataset(path: str, extra_point: str = "wrist") -> Dataset:
     # zipfile: RuntimeError for an encrypted member, NotImplementedError for an unknown compression
     except (OSError, ValueError, EOFError, zipfile.BadZipFile, NotImplementedError, RuntimeError) as exc:
         raise GraspFileError(code="read-error", message=f"cannot read as a numpy file: {exc}", file=path) from None
+
+
+_NPY_MAGIC = b"\x93NUMPY"
+
+
+def _npy(path):
+    """The array of a ``.npy`` file, memory-mapped; anything else (numpy would open an ``.npz``
+    named ``.npy`` as an archive) is ``bad-dataset``."""
+    with open(path, "rb") as f:
+        start = f.read(len(_NPY_MAGIC))
+    if start != _NPY_MAGIC:
+        hint = " (it is a zip archive: an .npz named .npy?)" if start.startswith(b"PK") else ""
+        raise _bad(path, f"not a .npy file: it does not start with numpy's {_NPY_MAGIC!r}{hint}")
+    return np.load(path, mmap_mode="r", allow_pickle=False)
 
 
 def _numeric(path, name, a, tail):
@@ -180,12 +187,10 @@ class Member:
             times, when its header's shape and type do not match its size, or
             when it holds Python objects or is stored column-major.
         """
-        if info.file_size > INFLATION_FLOOR and info.file_size > MAX_INFLATION * info.compress_size:
-            raise _bad(
-                path,
-                f"{key}: declares {info.file_size:,} bytes in {info.compress_size:,} compressed "
-                f"(over {MAX_INFLATION} times): refused unread, as a likely zip bomb",
-            )
+        try:
+            check_inflation(info.file_size, info.compress_size, "zip bomb")
+        except ValueError as exc:
+            raise _bad(path, f"{key}: {exc}") from None
         with zf.open(info) as f:
             version = np.lib.format.read_magic(f)
             read_header = (

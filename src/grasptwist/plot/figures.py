@@ -46,8 +46,9 @@ def grasp_scenes(grasp, twist, methods, velocity_scale=None, forces=None) -> lis
         grasp_scene(grasp, twist, method=m, all_bases=True, links=True, velocity_scale=velocity_scale, forces=forces)
         for m in methods
     ]
-    if velocity_scale is None and len(scenes) > 1:
-        return grasp_scenes(grasp, twist, methods, velocity_scale_of(scenes), forces)
+    shared = velocity_scale_of(scenes) if velocity_scale is None and len(scenes) > 1 else None
+    if shared is not None:  # None: no arrow drawn (a zero twist), nothing to share
+        return grasp_scenes(grasp, twist, methods, shared, forces)
     return scenes
 
 

@@ -103,7 +103,7 @@ def write_page(path, sections, *, title: str, js_beside: bool = False, opener=No
     body = []
     for n, (heading, figure) in enumerate(sections):
         text = orjson.dumps(figure | {"config": _CONFIG}, option=orjson.OPT_SERIALIZE_NUMPY).decode()
-        text = text.replace("</", "<\\/")  # "</" cannot end the element early: JSON reads "<\/" as "</"
+        text = script_json(text)
         body.append(
             f"<h2>{html.escape(heading)}</h2>\n"
             f'<div id="figure-{n}" class="grasptwist-figure" style="height:85vh"></div>\n'
@@ -118,6 +118,21 @@ def write_page(path, sections, *, title: str, js_beside: bool = False, opener=No
     with opener(path) as f:
         f.write(page.encode("utf-8"))
     return path
+
+
+def script_json(text: str) -> str:
+    """JSON ``text`` made safe inside a ``<script>`` element: every ``<`` written ``\\u003c``.
+
+    An HTML parser reads a script element's text for ``</script``, and after
+    ``<!--`` followed by ``<script`` for a second ``</script>`` before the
+    first ends it; one rule for every ``<`` leaves it nothing to find.
+    Outside strings JSON has no ``<``, and in a string ``\\u003c`` reads
+    back as ``<``.
+
+    >>> script_json('{"name": "<!--<script></script>"}')
+    '{"name": "\\\\u003c!--\\\\u003cscript>\\\\u003c/script>"}'
+    """
+    return text.replace("<", "\\u003c")
 
 
 def read_figures(text: str) -> list[dict]:
