@@ -47,9 +47,14 @@ CLICK_ERROR = next(c for c in typer.BadParameter.__mro__ if c.__name__ == "Click
 def checked_output(path: str | None, inputs: Iterable = ()):
     """How ``path`` (None: stdout) is written (a :class:`grasptwist.run.target.Target`);
     a usage error, before any work, when it cannot be the output: among other
-    reasons when it is one of ``inputs``, the paths the run reads."""
+    reasons when it is one of ``inputs``, the paths the run reads. A standard input
+    closed by the shell (``<&-``) among ``inputs`` is, like a closed stdout, exit 3
+    before any work."""
     from ..run.target import check_target
 
+    inputs = list(inputs)
+    if sys.stdin is None and any(str(p) == "-" for p in inputs):  # Python found descriptor 0 closed
+        raise typer.Exit(failed(Exception("cannot read standard input: it is closed"), EXIT_WRITE))
     try:
         return check_target(path, inputs)
     except ValueError as exc:
