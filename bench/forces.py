@@ -49,7 +49,7 @@ def main():
     p, n, w, mu = grasps(args.n)
 
     t0 = time.perf_counter()
-    g = gt.grip(p, n, w, mu, SAFETY)
+    g = gt.grip(p, n, w, mu, safety=SAFETY)
     t1 = time.perf_counter()
     c = gt.force_closure(p, n, mu)
     t2 = time.perf_counter()

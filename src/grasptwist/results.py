@@ -508,7 +508,7 @@ def compute_forces(points, normals, wrench, has_wrench, friction, has_friction, 
         )
     g = np.flatnonzero(has_wrench & has_friction)
     if g.size:
-        r = grip(points[g], normals[g], wrench[g], friction[g], options.safety)
+        r = grip(points[g], normals[g], wrench[g], friction[g], safety=options.safety)
         for name in ("force", "squeeze", "normal_force", "tangential_force", "friction_used", "total_normal_force"):
             out[name][g] = getattr(r, name)
         out["grip_status"][g], out["grip_culprit"][g] = r.status, r.culprit

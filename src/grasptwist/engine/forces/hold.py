@@ -122,7 +122,7 @@ def grip_along(
     moved = se3.transform(poses.rotation[..., None, :, :], poses.position[..., None, :], p)
     turned = np.einsum("...ij,kj->...ki", poses.rotation, n)
     wrench = hold_wrench(mass, center_of_mass, gravity, poses.rotation, poses.position)
-    return poses, grip(moved, turned, wrench, friction, safety, tol=tol)
+    return poses, grip(moved, turned, wrench, friction, safety=safety, tol=tol)
 
 
 def cannot_hold(

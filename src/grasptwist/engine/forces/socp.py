@@ -192,10 +192,13 @@ def _layout(A, b):
 
 
 def phase_one(A, b):
-    """A strictly feasible ``x`` per row and the margin ``r`` reached (``r < 0``: feasible).
+    """A strictly feasible ``x`` per row, the margin ``r`` reached (``r < 0``: feasible) and the dual.
 
-    ``A (n, 3, 3, d)``, ``b (n, 3, 3)`` -> ``x (n, d)``, ``r (n)``.  With ``r < 0``
-    every cone holds ``t_m - |z_m| >= -r > 0`` at ``x``.
+    ``A (n, 3, 3, d)``, ``b (n, 3, 3)`` -> ``x (n, d)``, ``r (n)``, ``z (n, 3, 3)``.  With
+    ``r < 0`` every cone holds ``t_m - |z_m| >= -r > 0`` at ``x``.  Where ``r > 0`` the cones'
+    dual ``z_m`` (inside ``Q^3``, ``sum_m A_m^T z_m = 0`` to the residual) has
+    ``-sum_m b_m . z_m > 0``: a proof that no ``x`` puts every ``A_m x + b_m`` in its cone
+    (Farkas).
     """
     n, _, _, d = A.shape
     wide = np.zeros((n, 4, 3, d + 1))
@@ -219,15 +222,17 @@ def phase_one(A, b):
         return (x[d] <= -START_MARGIN) | (dual > _RESIDUAL * (1 + np.abs(x).sum(axis=0))) | (closed & (dual > -np.inf))
 
     x = _iterate(wide, bw, c, x, z, leave)
-    return np.ascontiguousarray(x[:d].T), x[d]
+    return np.ascontiguousarray(x[:d].T), x[d], np.ascontiguousarray(z[:, :3].transpose(2, 1, 0))
 
 
 def minimise(A, b, c, x):
-    """The optimum from the strictly feasible ``x (n, d)``; returns ``x (n, d)``.
+    """The optimum from the strictly feasible ``x (n, d)``; returns ``x (n, d)`` and the dual ``z (n, 3, 3)``.
 
     ``A (n, 3, 3, d)``, ``b (n, 3, 3)``, ``c (n, d)`` with ``c = sum_m A_m^T e`` (``e = (1, 0,
     0)``: the objective is the sum of the cones' first components, as the grip's is), so
-    ``z_m = e`` is a strictly feasible dual start.
+    ``z_m = e`` is a strictly feasible dual start.  The dual stays feasible
+    (``sum_m A_m^T z_m = c`` to round-off); the gap ``sum_m y_m . z_m`` is below ``GAP``
+    of the objective's scale where a row closed.
     """
     n = len(x)
     A, b = _layout(A, b)
@@ -240,4 +245,4 @@ def minimise(A, b, c, x):
         return closed & (dual > -np.inf)
 
     x = _iterate(A, b, c, x, z, leave)
-    return x.T
+    return x.T, z.transpose(2, 1, 0)
