@@ -93,8 +93,10 @@ class Grip:
         The duality gap ``total_normal_force - w . dual`` (0 at the optimum, to round-off).
     certificate : (..., 6)
         NaN where the grip holds; for ``cannot-hold`` (and collinear contacts asked for a
-        moment about their line) a unit ``y`` with ``y . w > 0`` and ``y . G_i f <= 0`` for
+        moment about their line) a ``y`` with ``y . w > 0`` and ``y . G_i f <= 0`` for
         every admissible ``f`` of every contact: a proof that no grip exists (Farkas).
+        Scaled to ``|(y_F, L y_M)| = 1``, ``L`` the largest distance from the contacts'
+        centroid to a contact (:func:`load_words` puts it in words).
     """
 
     force: np.ndarray
@@ -194,20 +196,30 @@ def _twist_through_line(cmap, d):
     return lam
 
 
-def _unit(y):
+def _unit(y, size):
+    """``y`` scaled to ``|(y_F, L y_M)| = 1`` (``L`` the grasp's size: force and moment parts compare)."""
     with np.errstate(all="ignore"):
-        return y / np.linalg.norm(y, axis=-1, keepdims=True)
+        length = np.sqrt(dot(y[:, :3], y[:, :3]) + size**2 * dot(y[:, 3:], y[:, 3:]))
+        return y / length[:, None]
 
 
-def load_words(certificate) -> str:
-    """The load a ``cannot-hold`` grip cannot resist, in words: ``-y`` of its certificate ``y``.
+def load_words(certificate, points) -> str:
+    r"""The load a ``cannot-hold`` grip cannot resist, in words, from its certificate ``y``.
 
-    >>> load_words([0, 0, 1, 0, 0, 0])
+    The load ``(-y_F; -L^2 y_M)`` (``L`` the largest distance from the contacts' centroid
+    to a contact) has ``y . load < 0``: the fingers, whose wrenches all have
+    ``y . G f <= 0``, cannot balance it.  Its force is of order one and its moment of
+    order ``L``: a force with a lever arm on the grasp's scale.
+
+    >>> load_words([0, 0, 1, 0, 0, 0], [[1, 0, 0], [-0.5, 0.75**0.5, 0], [-0.5, -(0.75**0.5), 0]])
     'cannot resist a force along (0, 0, -1) with a moment (0, 0, 0) about the origin'
     """
-    y = -np.asarray(certificate, dtype=float)
-    y = np.round(y / np.linalg.norm(y), 3) + 0.0  # + 0.0: no -0
-    force, moment = (", ".join(f"{v:.3g}" for v in part) for part in (y[:3], y[3:]))
+    y = np.asarray(certificate, dtype=float)
+    p = np.asarray(points, dtype=float)
+    size = np.sqrt(((p - p.mean(axis=0)) ** 2).sum(axis=1).max())
+    load = -np.concatenate((y[:3], size**2 * y[3:]))
+    load = np.round(load / np.sqrt(y[:3] @ y[:3] + size**2 * (y[3:] @ y[3:])), 3) + 0.0  # + 0.0: no -0
+    force, moment = (", ".join(f"{v:.3g}" for v in part) for part in (load[:3], load[3:]))
     return f"cannot resist a force along ({force}) with a moment ({moment}) about the origin"
 
 
@@ -417,7 +429,7 @@ class _Prepared:
             squeeze[todo] = _squeezes_of(geo.e[todo], force[todo] - fm[todo])
         ok = status == 0
         force[~ok], squeeze[~ok], dual[~ok] = np.nan, np.nan, np.nan
-        certificate = _unit(certificate)
+        certificate = _unit(certificate, geo.size)
         with np.errstate(all="ignore"):
             fn = dot(force, unit)
             ft = norm(force - fn[..., None] * unit)
