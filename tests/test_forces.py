@@ -485,3 +485,19 @@ def test_collinear_contacts_agree_with_clarabel():
         if ref is not None:
             assert float(g.total_normal_force[k]) == pytest.approx(ref, rel=1e-6)
     assert g.ok.any()
+
+
+def test_one_grasp_in_floats_follows_the_batched_solver_step_for_step():
+    """One grasp goes through engine/forces/one.py (Python floats), a batch through socp.py (numpy): the
+    same method, so the same verdicts, culprits, optimum and certificates, on held and refused rows alike."""
+    p, n, w, mu = grasps(40, 18)
+    batch = gt.grip(p, n, w, mu, safety=1.4)
+    assert batch.ok.sum() >= 10 and (~batch.ok).sum() >= 10
+    for k in range(40):
+        one = gt.grip(p[k], n[k], w[k], mu[k], safety=1.4)
+        assert (int(one.status), int(one.culprit)) == (batch.status[k], batch.culprit[k])
+        for name in ("total_normal_force", "force"):
+            np.testing.assert_allclose(getattr(one, name), getattr(batch, name)[k], rtol=1e-7, atol=1e-9)
+        # multipliers are as well conditioned as the optimum is sharp: the proofs are what must hold (above)
+        for name in ("dual", "certificate"):
+            np.testing.assert_allclose(getattr(one, name), getattr(batch, name)[k], rtol=1e-4, atol=1e-6)

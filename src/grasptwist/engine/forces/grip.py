@@ -32,7 +32,7 @@ import numpy as np
 from ..checks import check_normals, check_points
 from ..degeneracy import DEGENERACY_TOL
 from ..screws import cross, dot, norm
-from . import closure, socp
+from . import closure, one, socp
 from .grasp_map import (
     ForceStatus,
     _manipulating,
@@ -356,6 +356,7 @@ class _Prepared:
             p[self.plane], self.unit[self.plane], _rows(geo, self.plane), limit[: self.plane.size]
         )
         self.maps = (contact_matrices(geo.e[self.plane]), _line_matrices(self.cmap))
+        self.one = _one_row(self.frame, self.maps[0], self.inside) if len(p) == 1 and self.plane.size else None
 
     def repeat(self, k):
         """This one grasp as ``k`` rows (for ``k`` wrenches)."""
@@ -371,6 +372,7 @@ class _Prepared:
         new.inside = np.repeat(self.inside, k, axis=0)
         new.maps = tuple(None if m is None else np.repeat(m, k, axis=0) for m in self.maps)
         new.cmap = None if self.cmap is None else type(self.cmap)(*(np.repeat(a, k, axis=0) for a in self.cmap))
+        new.one = None
         return new
 
     def solve(self, w):
@@ -402,7 +404,10 @@ class _Prepared:
                 r = group[part]
                 frame, m = self.frame[k + part], maps[part]
                 inside = np.full((part.size, 4), np.nan) if on_line else self.inside[part]
-                s, z, fail, blame = _solve(frame, m, fm[r] / scale[r, None, None], inside)
+                if self.one is not None:  # one grasp: numpy's cost per call is all there is, so floats
+                    s, z, fail, blame = _solve_floats(self.one, frame, fm[r] / scale[r, None, None])
+                else:
+                    s, z, fail, blame = _solve(frame, m, fm[r] / scale[r, None, None], inside)
                 force[r] = fm[r] + scale[r, None, None] * np.einsum("nixl,nl->nix", m, s)
                 u = np.einsum("nikx,nik->nix", frame, z)  # the cones' multipliers as forces' duals
                 if on_line:
@@ -449,6 +454,34 @@ class _Prepared:
                 "gap": total - np.einsum("ni,ni->n", w, dual),
                 "certificate": certificate,
             }
+
+
+def _one_row(frame, m, inside):
+    """What :func:`one.solve` needs of one grasp's row (with friction, not collinear), as lists of floats."""
+    A, _, c = _cones(frame, m, np.zeros((1, 3, 3)))
+    rays = frame * np.array([1.0, 0.0, 0.0])[:, None]
+    normal = A[0, :, 0, :]
+    regular = abs(np.linalg.det(normal)) > 1e-9 * np.prod(np.linalg.norm(normal, axis=-1))
+    start = None
+    if not np.isnan(inside[0]).any():
+        y = A[0] @ inside[0]
+        start = (inside[0].tolist(), (y[:, 0] - np.sqrt(y[:, 1] ** 2 + y[:, 2] ** 2)).tolist())
+    A_list = A[0].tolist()
+    return {
+        "A": A_list,
+        "c": c[0].tolist(),
+        "P": one.newton_matrices(A_list),
+        "inside": start,
+        "regular": bool(regular),
+        "rays": _cones(rays, m, np.zeros((1, 3, 3)))[0][0].tolist(),
+    }
+
+
+def _solve_floats(row, frame, fm):
+    """:func:`_solve` for one row through :func:`one.solve`, with :func:`_solve`'s shapes."""
+    b = np.einsum("nikx,nix->nik", frame, fm)[0].tolist()
+    s, z, fail, blame = one.solve(row["A"], b, row["c"], row["P"], row["inside"], row["regular"], row["rays"])
+    return np.array([s]), np.array([z]), np.array([fail]), np.array([blame], np.int8)
 
 
 def _rows(named, rows):
