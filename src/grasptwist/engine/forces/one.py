@@ -42,6 +42,17 @@ def newton_matrices(A):
 def _solve(h, g):
     """``h^-1 g`` by elimination without pivoting (``h`` symmetric positive definite; copied)."""
     d = len(g)
+    if d == 3:  # the grip's squeezes: the same elimination, written out
+        (h00, h01, h02), (h10, h11, h12), (h20, h21, h22) = h
+        g0, g1, g2 = g
+        f1, f2 = h10 / h00, h20 / h00
+        h11, h12, g1 = h11 - f1 * h01, h12 - f1 * h02, g1 - f1 * g0
+        h21, h22, g2 = h21 - f2 * h01, h22 - f2 * h02, g2 - f2 * g0
+        f = h21 / h11
+        h22, g2 = h22 - f * h12, g2 - f * g1
+        x2 = g2 / h22
+        x1 = (g1 - h12 * x2) / h11
+        return [(g0 - h01 * x1 - h02 * x2) / h00, x1, x2]
     h = [row[:] for row in h]
     g = g[:]
     for k in range(d):
