@@ -503,3 +503,23 @@ def test_one_grasp_in_floats_follows_the_batched_solver_step_for_step():
         # multipliers are as well conditioned as the optimum is sharp: the proofs are what must hold (above)
         for name in ("dual", "certificate"):
             np.testing.assert_allclose(getattr(one, name), getattr(batch, name)[k], rtol=1e-4, atol=1e-6)
+
+
+@pytest.mark.parametrize(
+    "points",
+    [EQ, np.array([[0, 0, 0], [0.05, 0, 0], [0.1, 0, 0.0]])],
+    ids=["tray", "rod-end"],
+)
+def test_a_wrench_on_the_edge_of_what_the_fingers_exert_is_held(points):
+    """A push along the third finger's normal, at that finger, with every normal up: only that finger can
+    make it, the other two carry exactly nothing (no grip strictly inside the cones exists, so phase I alone
+    cannot decide).  Phase I's multipliers say which contacts are bare; the rest is solved without them."""
+    up = np.array([[0, 0, 1.0]] * 3)
+    w = np.concatenate((up[2], np.cross(points[2], up[2])))
+    g = gt.grip(points, up, w, 0.5)
+    assert g.ok and float(g.total_normal_force) == pytest.approx(1.0, rel=1e-9)
+    np.testing.assert_allclose(g.force, [[0, 0, 0], [0, 0, 0], [0, 0, 1]], atol=1e-9)
+    assert (_dual_cone_excess(up[None] - _field(g.dual[None], points[None]), up[None], 0.5) <= 1e-9).all()
+    assert abs(float(g.gap)) < 1e-9 and np.isnan(g.certificate).all()
+    one = gt.prepare_grip(points, up, 0.5).grip(w)  # the floats path too
+    assert one.ok and float(one.total_normal_force) == pytest.approx(1.0, rel=1e-9)

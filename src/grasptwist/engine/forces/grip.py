@@ -419,6 +419,18 @@ class _Prepared:
                 dual[r], y = through(unit[r] - u), -through(u)
                 status[r[fail]], culprit[r[fail]] = ForceStatus.CANNOT_HOLD, blame[fail]
                 certificate[r[fail]] = y[fail]
+                # on the edge of what the fingers can exert (y . w = 0): the contacts y forbids carry nothing
+                edge = np.flatnonzero(fail & ~(np.einsum("ni,ni->n", y, w[r]) > _EDGE_OF_HOLD * norm(y) * norm(w[r])))
+                for i in edge:
+                    found = _on_the_edge(frame[i], m[i], fm[r[i]] / scale[r[i]], z[i])
+                    if found is None:
+                        continue
+                    s_i, z_i, bare = found
+                    force[r[i]] = fm[r[i]] + scale[r[i]] * (m[i] @ s_i)
+                    if not on_line:
+                        squeeze[r[i]] = scale[r[i]] * s_i
+                    dual[r[i]] = _edge_dual(frame[i], p[r[i]], unit[r[i]], z_i, y[i], bare)
+                    status[r[i]], culprit[r[i]], certificate[r[i]] = 0, -1, np.nan
         todo = self.bare[(status[self.bare] == 0) & (scale[self.bare] > 0)]
         if todo.size:
             nu = np.concatenate((unit[todo], cross(p[todo], unit[todo])), axis=-1)
@@ -482,6 +494,76 @@ def _solve_floats(row, frame, fm):
     b = np.einsum("nikx,nix->nik", frame, fm)[0].tolist()
     s, z, fail, blame = one.solve(row["A"], b, row["c"], row["P"], row["inside"], row["regular"], row["rays"])
     return np.array([s]), np.array([z]), np.array([fail]), np.array([blame], np.int8)
+
+
+#: A certificate with ``y . w`` at most this of ``|y| |w|`` proves nothing: the wrench is on the edge.
+_EDGE_OF_HOLD = 1e-8
+
+
+def _dual_cone_margin(v, frame):
+    """``v_n - (mu/s) |v_t|`` per contact (``> 0``: inside the dual cone), ``v (3, 3)`` in xyz."""
+    kappa = np.linalg.norm(frame[:, 1], axis=-1)
+    vn = dot(v, frame[:, 0])
+    return vn - np.linalg.norm(v - vn[:, None] * frame[:, 0], axis=-1) / kappa
+
+
+def _on_the_edge(frame, m, fm, z):
+    r"""The grip of one row whose phase I ended on the edge (``r -> 0``, its ``y . w = 0``): facial reduction.
+
+    Phase I's multipliers ``z_i`` give ``-G_i^T y``; where that lies strictly inside the
+    dual cone, ``0 = y . w = -sum_i u_i . f_i`` forces ``f_i = 0``.  The other contacts'
+    cones are then solved over the internal forces that leave those contacts bare.  Returns
+    the internal-force coordinates and the kept cones' multipliers (``(3, 3)``, zero at
+    the bare contacts), or None (no contact is forced bare, infinite friction, or the
+    smaller problem has no strictly feasible point either).
+    """
+    if not (np.linalg.norm(frame[:, 1], axis=-1) > 0).all():
+        return None
+    bare = z[:, 0] - np.hypot(z[:, 1], z[:, 2]) > 1e-6 * np.abs(z).max()
+    if not bare.any() or bare.all():
+        return None
+    d = m.shape[-1]
+    mz, rhs = m[bare].reshape(-1, d), -fm[bare].reshape(-1)
+    s0 = np.linalg.lstsq(mz, rhs, rcond=None)[0]
+    if np.abs(mz @ s0 - rhs).max() > 1e-9 * max(np.abs(fm).max(), 1.0):
+        return None
+    _, sv, vt = np.linalg.svd(mz)
+    free = vt[int((sv > 1e-12 * sv[0]).sum()) :].T  # (d, d'): internal forces that leave the bare contacts bare
+    kept = ~bare
+    A = frame[kept] @ m[kept]  # (k, 3, d)
+    b = np.einsum("ikx,ix->ik", frame[kept], fm[kept] + m[kept] @ s0)
+    multipliers = np.zeros((3, 3))
+    if not free.shape[1]:
+        if not (b[:, 0] >= np.hypot(b[:, 1], b[:, 2]) - 1e-12 * np.abs(b).max()).all():
+            return None
+        return s0, multipliers, bare  # one grip only: every kept cone's multiplier 0 closes the gap
+    reduced = A @ free
+    x, r, _ = socp.phase_one(reduced[None], b[None])
+    if not r[0] < 0:
+        return None
+    t, zk = socp.minimise(reduced[None], b[None], reduced[:, 0, :].sum(axis=0)[None], x)
+    multipliers[kept] = zk[0]
+    return s0 + free @ t[0], multipliers, bare
+
+
+def _edge_dual(frame, p, unit, z, y, bare):
+    """The dual of an edge row: the kept contacts' twist, plus enough of ``y`` for the bare contacts' cones.
+
+    ``n_i - G_i^T lambda`` must lie in every dual cone; ``-G_i^T y`` is strictly inside at a
+    bare contact and on the edge at a kept one, and ``y . w = 0``: adding ``alpha y`` keeps
+    the kept cones and the objective and, ``alpha`` large enough, brings in the bare ones.
+    """
+    u = np.einsum("ikx,ik->ix", frame, z)
+    rows = np.concatenate([np.hstack((np.eye(3), -_skew(q))) for q in p])  # G_i^T: lambda -> lambda_F + lambda_M x p_i
+    kept = np.repeat(~bare, 3)
+    lam = np.linalg.lstsq(rows[kept], (unit - u).reshape(-1)[kept], rcond=None)[0]
+    need = -_dual_cone_margin(unit - (rows @ lam).reshape(3, 3), frame)[bare]
+    gain = _dual_cone_margin((rows @ -y).reshape(3, 3), frame)[bare]
+    return lam + np.max(np.maximum(need, 0) / gain) * y
+
+
+def _skew(q):
+    return np.array([[0, -q[2], q[1]], [q[2], 0, -q[0]], [-q[1], q[0], 0]])
 
 
 def _rows(named, rows):
