@@ -4,6 +4,8 @@ Numbers are checked against LAPACK's pseudo-inverse, against Clarabel (an indepe
 solver on the nine contact-force numbers, tests/conic.py) and against cases worked by hand.
 """
 
+import warnings
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -523,3 +525,21 @@ def test_a_wrench_on_the_edge_of_what_the_fingers_exert_is_held(points):
     assert abs(float(g.gap)) < 1e-9 and np.isnan(g.certificate).all()
     one = gt.prepare_grip(points, up, 0.5).grip(w)  # the floats path too
     assert one.ok and float(one.total_normal_force) == pytest.approx(1.0, rel=1e-9)
+
+
+def test_collinear_frictionless_contacts_stay_unsolved_and_a_batch_of_odd_rows_never_warns():
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        g = gt.grip(
+            np.stack((LINE, LINE, LINE, EQ)),
+            np.stack((ACROSS, ACROSS, [[0, 0, 0.0]] * 3, [[0, 0, 1.0]] * 3)),
+            [[0, 0, 1, 0, 0, 0], [0, 0, np.nan, 0, 0, 0], [0, 0, 1, 0, 0, 0], [0, 0, -1, 0, 0, 0]],
+            np.array([[0.0] * 3, [0.5] * 3, [0.5] * 3, [np.inf] * 3]),
+        )
+    assert g.status.tolist() == [
+        gt.ForceStatus.COLLINEAR_CONTACTS,
+        gt.ForceStatus.NONFINITE_INPUT,
+        gt.ForceStatus.ZERO_NORMAL,
+        gt.ForceStatus.CANNOT_HOLD,
+    ]
+    assert np.isnan(g.certificate[:3]).all() and g.certificate[3] @ [0, 0, -1, 0, 0, 0] > 0

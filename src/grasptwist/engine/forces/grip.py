@@ -339,6 +339,7 @@ class _Prepared:
         status[(status == 0) & bad] = ForceStatus.NONFINITE_INPUT
         self.frictionless = (mu == 0).all(axis=1)
         status[(status == 0) & (mu == 0).any(axis=1) & ~self.frictionless] = ForceStatus.MIXED_FRICTIONLESS
+        status[line & (status == 0) & self.frictionless] = ForceStatus.COLLINEAR_CONTACTS  # not solved there
         self.status, self.culprit = status, culprit
         self.line = line & (status == 0)
         self.plane = np.flatnonzero((status == 0) & ~self.line & ~self.frictionless)
