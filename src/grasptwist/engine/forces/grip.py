@@ -46,7 +46,7 @@ from .grasp_map import (
     tangent_bases,
 )
 
-__all__ = ["Grip", "grip", "prepare_grip", "PreparedGrip", "cone_rows", "load_words"]
+__all__ = ["Grip", "grip", "prepare_grip", "PreparedGrip", "load_words"]
 
 #: Rows solved together: enough for numpy's per-call cost to be noise, few enough for the
 #: solver's temporaries to stay in the CPU cache.
@@ -583,17 +583,6 @@ def _squeezes_of(e, internal):
     """The squeezes ``s`` with ``squeeze_forces(s) = internal`` (least squares over the 9 numbers)."""
     m = contact_matrices(e).reshape(len(e), 9, 3)
     return (np.linalg.pinv(m) @ internal.reshape(len(e), 9)[..., None])[..., 0]
-
-
-def cone_rows(e, unit, fm, kappa):
-    """The cones ``y_i = A_i s + b_i`` of the grip in the squeezes: ``y_i = (n.f_i, kappa_i b1.f_i, kappa_i b2.f_i)``.
-
-    ``kappa_i = safety / mu_i`` (0 for infinite friction).  Returns ``A (n, 3, 3, 3)``,
-    ``b (n, 3, 3)`` and the objective ``c (n, 3)`` (``sum_i n_i . f_i`` minus a constant).
-    """
-    b1, b2 = tangent_bases(unit)
-    frame = np.stack((unit, kappa[..., None] * b1, kappa[..., None] * b2), axis=-2)  # (n, 3 contacts, 3, 3)
-    return _cones(frame, contact_matrices(e), fm)
 
 
 def _cones(frame, m, fm):
