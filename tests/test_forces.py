@@ -4,6 +4,8 @@ Numbers are checked against LAPACK's pseudo-inverse, against Clarabel (an indepe
 solver on the nine contact-force numbers, tests/conic.py) and against cases worked by hand.
 """
 
+import warnings
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -81,10 +83,11 @@ def test_conditioning_is_one_for_an_equilateral_triangle_and_falls_like_the_offs
     ids=["collinear", "coincident", "nan"],
 )
 def test_degenerate_contacts_get_a_status_and_nan_never_an_exception(points, status, culprit):
-    r = gt.manipulating_forces(points, [1, 0, 0, 0, 0, 1])
+    # a moment about x: about the collinear contacts' line, which no finger force makes
+    r = gt.manipulating_forces(points, [1, 0, 0, 1, 0, 1])
     assert (int(r.status), int(r.culprit)) == (status, culprit)
     assert np.isnan(r.force).all()
-    g = gt.grip(points, [[1, 0, 0]] * 3, [1, 0, 0, 0, 0, 1], 0.5)
+    g = gt.grip(points, [[1, 0, 0]] * 3, [1, 0, 0, 1, 0, 1], 0.5)
     assert int(g.status) == status and np.isnan(g.force).all()
     assert int(gt.force_closure(points, [[1, 0, 0]] * 3).status) == status
 
@@ -398,7 +401,7 @@ def test_an_overflowing_result_is_a_status_never_an_ok_row_with_infinity():
 @given(seed=st.integers(0, 2**32 - 1), spread=st.floats(0.0, 1.0), safety=st.floats(1.0, 3.0))
 def test_any_grip_found_makes_the_wrench_within_every_cone_and_beats_no_clarabel_grip(seed, spread, safety):
     p, n, w, mu = grasps(4, seed, spread)
-    g = gt.grip(p, n, w, mu, safety)
+    g = gt.grip(p, n, w, mu, safety=safety)
     for k in range(4):
         ref, _ = least_grip(p[k], n[k], w[k], mu[k], safety)
         assert g.ok[k] == (ref is not None)
@@ -424,3 +427,199 @@ def test_the_interior_point_step_stops_at_the_cones_edge_even_for_a_ray():
     # a half-space's cone (t, 0, 0): stopped exactly at t = 0, where a difference of squares loses it
     ray = _edge(np.array([[[0.3]], [[0.0]], [[0.0]]]), np.array([[[-0.7]], [[0.0]], [[0.0]]]))
     assert ray[0] == pytest.approx(0.3 / 0.7, rel=1e-15)
+
+
+# --- certificates, the prepared grip, collinear contacts (issue 29, issue 26 item 2.6) ---------------
+
+
+def _field(lam, p):
+    """``G_i^T lambda = lambda_F + lambda_M x p_i`` for every contact: ``(n, 6), (n, 3, 3) -> (n, 3, 3)``."""
+    return lam[:, None, :3] + np.cross(lam[:, None, 3:], p)
+
+
+def _dual_cone_excess(z, n, limit):
+    """``limit |z_t| - z_n`` per contact (``<= 0``: in the dual cone)."""
+    zn = np.einsum("nij,nij->ni", z, n)
+    return limit * np.linalg.norm(z - zn[..., None] * n, axis=-1) - zn
+
+
+@pytest.mark.parametrize("seed", [11, 12, 13])
+def test_every_grip_carries_a_certificate_that_numpy_alone_verifies(seed):
+    """Held: n_i - G_i^T dual in the dual cone and total - w . dual = gap near 0 (weak duality makes the total
+    optimal); cannot-hold: y . w > 0 and -G_i^T y in the dual cone (no admissible forces have a component along y)."""
+    p, n, w, mu = grasps(400, seed)
+    g = gt.grip(p, n, w, mu, safety=1.3)
+    u, limit = unit(n), mu / 1.3
+    ok, bad = g.ok, g.status == gt.ForceStatus.CANNOT_HOLD
+    assert ok.sum() > 100 and bad.sum() > 50 and (ok | bad).all()
+    assert np.isnan(g.certificate[ok]).all() and np.isfinite(g.dual[ok]).all() and np.isnan(g.dual[bad]).all()
+    total = g.total_normal_force[ok]
+    assert (_dual_cone_excess(u[ok] - _field(g.dual[ok], p[ok]), u[ok], limit[ok]) <= 1e-6 * total[:, None]).all()
+    assert np.abs(g.gap[ok] - (total - np.einsum("ni,ni->n", w[ok], g.dual[ok]))).max() < 1e-9 * total.max()
+    assert np.median(np.abs(g.gap[ok]) / total) < 1e-9 and (np.abs(g.gap[ok]) <= 1e-4 * total).all()
+    y = g.certificate[bad]
+    size = np.linalg.norm(p - p.mean(axis=1, keepdims=True), axis=-1).max(axis=1)[bad, None]
+    assert np.linalg.norm(np.concatenate((y[:, :3], size * y[:, 3:]), axis=1), axis=1) == pytest.approx(1, rel=1e-12)
+    assert (np.einsum("ni,ni->n", y, w[bad]) > 0).all()
+    assert (_dual_cone_excess(-_field(y, p[bad]), u[bad], limit[bad]) <= 1e-6).all()
+
+
+def test_the_dual_is_the_grips_sensitivity_to_the_wrench():
+    p, n, w, mu = grasps(60, 14)
+    g = gt.grip(p, n, w, mu)
+    dw = np.random.default_rng(15).normal(size=(60, 6)) * 1e-6
+    moved = gt.grip(p, n, w + dw, mu)
+    both = g.ok & moved.ok
+    predicted = np.einsum("ni,ni->n", g.dual[both], dw[both])
+    change = moved.total_normal_force[both] - g.total_normal_force[both]
+    assert both.sum() > 20
+    assert np.abs(change - predicted).max() < 1e-3 * np.abs(dw).max() * np.abs(g.dual[both]).max()
+
+
+def test_the_equator_ball_needs_one_over_mu_more_grip_per_newton_of_lift():
+    g = gt.grip(EQ, -EQ, [0, 0, G, 0, 0, 0], 0.5)
+    assert g.dual[:3] == pytest.approx([0, 0, 2.0], abs=1e-6) and abs(float(g.gap)) < 1e-8
+
+
+def test_a_tray_pushed_down_is_refused_with_the_upward_load_it_cannot_resist():
+    down = gt.grip(EQ, [[0, 0, 1]] * 3, [0, 0, -1, 0, 0, 0], 0.5)
+    y = down.certificate
+    assert y @ [0, 0, -1, 0, 0, 0] > 0 and np.isnan(down.dual).all()
+    assert (
+        gt.engine.forces.grip.load_words(y, EQ)
+        == "cannot resist a force along (0, 0, 1) with a moment (0, 0, 0) about the origin"
+    )
+
+
+def test_frictionless_grips_carry_certificates_too():
+    held = gt.grip(EQ, -EQ, [*EQ[0], 0, 0, 0], 0.0)  # rank 2 normal lines, contact 1 idle
+    assert float(held.gap) == pytest.approx(0.0, abs=1e-9)
+    nu = np.concatenate((-EQ, np.cross(EQ, -EQ)), axis=1)
+    assert (nu @ held.dual <= 1 + 1e-9).all()
+    lift = gt.grip(EQ, -EQ, [0, 0, G, 0, 0, 0], 0.0)  # out of the normals' span
+    assert lift.certificate @ [0, 0, G, 0, 0, 0] > 0 and (nu @ lift.certificate <= 1e-12).all()
+    up = [[0, 0, 1.0]] * 3  # a tray on three finger-tips: rank 3 normal lines, pressing it down needs pulling
+    pull = gt.grip(EQ, up, [0, 0, -1, 0, 0, 0], 0.0)
+    assert (int(pull.status), int(pull.culprit)) == (gt.ForceStatus.CANNOT_HOLD, -1)
+    lines = np.concatenate((up, np.cross(EQ, up)), axis=1)
+    assert pull.certificate @ [0, 0, -1, 0, 0, 0] > 0 and (lines @ pull.certificate <= 1e-12).all()
+
+
+def test_safety_is_keyword_only():
+    with pytest.raises(TypeError):
+        gt.grip(EQ, -EQ, [0, 0, G, 0, 0, 0], 0.5, 2.0)
+
+
+def test_a_prepared_grip_gives_what_grip_gives():
+    p, n, w, mu = grasps(30, 16)
+    for k in range(6):
+        hand = gt.prepare_grip(p[k], n[k], mu[k], safety=1.2)
+        many = hand.grip(w)
+        direct = gt.grip(p[k], n[k], w, mu[k], safety=1.2)
+        one = hand.grip(w[k])
+        assert (many.status == direct.status).all() and int(one.status) == direct.status[k]
+        for name in ("total_normal_force", "force", "dual", "certificate"):
+            # the same solver on the same rows; batches of other shapes may round their last bits otherwise
+            np.testing.assert_allclose(getattr(many, name), getattr(direct, name), rtol=1e-7, atol=1e-9)
+            np.testing.assert_allclose(getattr(one, name), getattr(direct, name)[k], rtol=1e-7, atol=1e-9)
+        held = many.ok  # the gap is round-off: both near 0, not equal
+        assert (np.abs(many.gap[held]) < 1e-6 * many.total_normal_force[held]).all()
+
+
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        ((np.zeros((2, 3, 3)), np.ones((2, 3, 3)), 0.5), r"^prepare_grip takes one grasp: points and normals \(3, 3\)"),
+        ((EQ, -EQ, [[0.5] * 3] * 2), r"^prepare_grip takes one grasp: friction a scalar or \(3,\), got \(2, 3\)$"),
+    ],
+)
+def test_prepare_grip_arguments(args, message):
+    with pytest.raises(ValueError, match=message):
+        gt.prepare_grip(*args)
+
+
+LINE = np.array([[-0.05, 0, 0], [0.05, 0, 0], [0, 0, 0.0]])  # three contacts on the x axis
+ACROSS = np.array([[1, 0, 0], [-1, 0, 0], [0, 0, 1.0]])  # two squeeze along the line, the third pushes up
+
+
+def test_collinear_contacts_exert_every_wrench_in_the_grasp_maps_range():
+    """Issue 26, item 2.6: a push along the third contact's normal, at that contact, is held by that finger
+    alone (1 N of normal force); a moment about the contacts' line is not in G's range, and its certificate
+    says so (y . w > 0, y . G f = 0 for every f)."""
+    push = np.concatenate(([0, 0, 1.0], np.cross(LINE[2], [0, 0, 1.0])))
+    g = gt.grip(LINE, ACROSS, push, 0.5)
+    assert g.ok and float(g.total_normal_force) == pytest.approx(1.0, rel=1e-8)
+    assert np.abs(wrench_of(LINE, g.force) - push).max() < 1e-9 and np.isnan(g.squeeze).all()
+    assert abs(float(g.gap)) < 1e-8 and int(gt.manipulating_forces(LINE, push).status) == 0
+    twist = gt.grip(LINE, ACROSS, [0, 0, 0, 0.01, 0, 0], 0.5)
+    assert int(twist.status) == gt.ForceStatus.COLLINEAR_CONTACTS
+    y = twist.certificate
+    assert y @ [0, 0, 0, 0.01, 0, 0] > 0 and np.abs(y @ gt.grasp_map(LINE)).max() < 1e-12
+
+
+def test_collinear_contacts_agree_with_clarabel():
+    rng = np.random.default_rng(17)
+    normals = unit(ACROSS + rng.normal(0, 0.3, (20, 3, 3)))
+    forces = rng.normal(size=(20, 3, 3))
+    w = wrench_of(LINE, forces)  # in the range of G by construction
+    g = gt.grip(LINE, normals, w, 0.8)
+    for k in range(20):
+        ref, _ = least_grip(LINE, normals[k], w[k], 0.8)
+        assert g.ok[k] == (ref is not None)
+        if ref is not None:
+            assert float(g.total_normal_force[k]) == pytest.approx(ref, rel=1e-6)
+    assert g.ok.any()
+
+
+def test_one_grasp_in_floats_follows_the_batched_solver_step_for_step():
+    """One grasp goes through engine/forces/one.py (Python floats), a batch through socp.py (numpy): the
+    same method, so the same verdicts, culprits, optimum and certificates, on held and refused rows alike."""
+    p, n, w, mu = grasps(40, 18)
+    batch = gt.grip(p, n, w, mu, safety=1.4)
+    assert batch.ok.sum() >= 10 and (~batch.ok).sum() >= 10
+    for k in range(40):
+        one = gt.grip(p[k], n[k], w[k], mu[k], safety=1.4)
+        assert (int(one.status), int(one.culprit)) == (batch.status[k], batch.culprit[k])
+        for name in ("total_normal_force", "force"):
+            np.testing.assert_allclose(getattr(one, name), getattr(batch, name)[k], rtol=1e-7, atol=1e-9)
+        # multipliers are as well conditioned as the optimum is sharp: the proofs are what must hold (above)
+        for name in ("dual", "certificate"):
+            np.testing.assert_allclose(getattr(one, name), getattr(batch, name)[k], rtol=1e-4, atol=1e-6)
+
+
+@pytest.mark.parametrize(
+    "points",
+    [EQ, np.array([[0, 0, 0], [0.05, 0, 0], [0.1, 0, 0.0]])],
+    ids=["tray", "rod-end"],
+)
+def test_a_wrench_on_the_edge_of_what_the_fingers_exert_is_held(points):
+    """A push along the third finger's normal, at that finger, with every normal up: only that finger can
+    make it, the other two carry exactly nothing (no grip strictly inside the cones exists, so phase I alone
+    cannot decide).  Phase I's multipliers say which contacts are bare; the rest is solved without them."""
+    up = np.array([[0, 0, 1.0]] * 3)
+    w = np.concatenate((up[2], np.cross(points[2], up[2])))
+    g = gt.grip(points, up, w, 0.5)
+    assert g.ok and float(g.total_normal_force) == pytest.approx(1.0, rel=1e-9)
+    np.testing.assert_allclose(g.force, [[0, 0, 0], [0, 0, 0], [0, 0, 1]], atol=1e-9)
+    assert (_dual_cone_excess(up[None] - _field(g.dual[None], points[None]), up[None], 0.5) <= 1e-9).all()
+    assert abs(float(g.gap)) < 1e-9 and np.isnan(g.certificate).all()
+    one = gt.prepare_grip(points, up, 0.5).grip(w)  # the floats path too
+    assert one.ok and float(one.total_normal_force) == pytest.approx(1.0, rel=1e-9)
+
+
+def test_collinear_frictionless_contacts_stay_unsolved_and_a_batch_of_odd_rows_never_warns():
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        g = gt.grip(
+            np.stack((LINE, LINE, LINE, EQ)),
+            np.stack((ACROSS, ACROSS, [[0, 0, 0.0]] * 3, [[0, 0, 1.0]] * 3)),
+            [[0, 0, 1, 0, 0, 0], [0, 0, np.nan, 0, 0, 0], [0, 0, 1, 0, 0, 0], [0, 0, -1, 0, 0, 0]],
+            np.array([[0.0] * 3, [0.5] * 3, [0.5] * 3, [np.inf] * 3]),
+        )
+    assert g.status.tolist() == [
+        gt.ForceStatus.COLLINEAR_CONTACTS,
+        gt.ForceStatus.NONFINITE_INPUT,
+        gt.ForceStatus.ZERO_NORMAL,
+        gt.ForceStatus.CANNOT_HOLD,
+    ]
+    assert np.isnan(g.certificate[:3]).all() and g.certificate[3] @ [0, 0, -1, 0, 0, 0] > 0

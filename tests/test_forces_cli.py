@@ -107,6 +107,34 @@ def test_cannot_hold_is_a_failed_record_with_its_reason(tmp_path):
     assert rec["grip"]["error"]["code"] == "cannot-hold"
     assert "needs a finger to pull" in rec["grip"]["error"]["message"]
     assert f"{tray}: grasp 'tray', wrench 'pull': error: grip: cannot-hold: " in r.stderr
+    # the proof: y . w > 0, and no finger pushing up (f_z >= 0, in its cone) has y . G f > 0
+    y = np.array(rec["grip"]["error"]["certificate"])
+    assert y @ [0, 0, -1, 0, 0, 0] > 0 and np.abs(y[3:]).max() < 1e-9 and y[2] < 0
+    assert "; it cannot resist a force along (0, 0, 1) with a moment (0, 0, 0) about the origin" in r.stderr
+
+
+def test_a_held_record_carries_its_dual_and_gap():
+    _, recs = records(SPHERE)
+    grip = by(recs, "sphere-equator", "hold")["grip"]
+    # one more newton of lift costs 1 / mu = 2 N of grip: the dual is d total / d w
+    assert grip["dual"][:3] == pytest.approx([0, 0, 2], abs=1e-6) and abs(grip["gap"]) < 1e-8
+
+
+def test_collinear_contacts_hold_a_push_along_a_normal_at_its_contact(tmp_path):
+    """Issue 26, item 2.6: three contacts on a line; the third pushes up at its own point alone."""
+    line = tmp_path / "line.yaml"
+    line.write_text(
+        "friction: 0.5\ncontacts:\n  - {point: [-0.05, 0, 0], normal: [1, 0, 0]}\n"
+        "  - {point: [0.05, 0, 0], normal: [-1, 0, 0]}\n  - {point: [0, 0, 0], normal: [0, 0, 1]}\n"
+    )
+    r, recs = records(line, "--wrench", "0,0,1,0,0,0", "--at", "0,0,0")
+    (rec,) = recs
+    assert r.exit_code == 0 and rec["ok"], r.stderr
+    assert rec["grip"]["total_normal_force"] == pytest.approx(1.0, rel=1e-8)
+    r, recs = records(line, "--wrench", "0,0,0,1,0,0")  # a moment about the line itself
+    assert r.exit_code == 1 and recs[0]["grip"]["error"]["code"] == "collinear-contacts"
+    y = np.array(recs[0]["grip"]["error"]["certificate"])
+    assert y[3] > 0 and np.abs(y @ grasp_map(np.array([[-0.05, 0, 0], [0.05, 0, 0], [0, 0, 0]]))).max() < 1e-9
 
 
 def test_a_wrench_without_friction_has_no_grip_and_says_so():

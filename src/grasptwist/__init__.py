@@ -47,6 +47,8 @@ _EXPORTS = {
     "check_safety": ".engine.forces.grasp_map",
     "grip": ".engine.forces.grip",
     "Grip": ".engine.forces.grip",
+    "prepare_grip": ".engine.forces.grip",
+    "PreparedGrip": ".engine.forces.grip",
     "force_closure": ".engine.forces.closure",
     "Closure": ".engine.forces.closure",
     "hand": ".hand",

@@ -42,7 +42,7 @@ from .engine import judgements
 from .engine.decompose import decompose_off_tangent, decompose_tangent
 from .engine.degeneracy import Status
 from .engine.forces.closure import force_closure
-from .engine.forces.grasp_map import checked_grip, manipulating_forces
+from .engine.forces.grasp_map import manipulating_forces
 from .engine.forces.grip import grip
 from .engine.screws import klein_table
 
@@ -466,6 +466,9 @@ class ForceResult:
     total_normal_force: np.ndarray  # (N,)
     grip_status: np.ndarray
     grip_culprit: np.ndarray
+    dual: np.ndarray  # (N, 6) the grip's certificate of optimality (NaN where it failed)
+    gap: np.ndarray  # (N,)
+    certificate: np.ndarray  # (N, 6) where no grip exists: the Farkas direction (else NaN)
     closure_friction: np.ndarray
     force_closure: np.ndarray  # (N,) bool
     epsilon: np.ndarray
@@ -493,6 +496,9 @@ def compute_forces(points, normals, wrench, has_wrench, friction, has_friction, 
         "total_normal_force": np.full(n, np.nan),
         "grip_status": np.full(n, -1, np.int8),
         "grip_culprit": np.full(n, -1, np.int8),
+        "dual": np.full((n, 6), np.nan),
+        "gap": np.full(n, np.nan),
+        "certificate": np.full((n, 6), np.nan),
         "closure_friction": np.full(n, np.nan),
         "force_closure": np.zeros(n, bool),
         "epsilon": np.full(n, np.nan),
@@ -509,8 +515,18 @@ def compute_forces(points, normals, wrench, has_wrench, friction, has_friction, 
         )
     g = np.flatnonzero(has_wrench & has_friction)
     if g.size:
-        r = checked_grip(grip(points[g], normals[g], wrench[g], friction[g], options.safety))
-        for name in ("force", "squeeze", "normal_force", "tangential_force", "friction_used", "total_normal_force"):
+        r = grip(points[g], normals[g], wrench[g], friction[g], safety=options.safety)
+        for name in (
+            "force",
+            "squeeze",
+            "normal_force",
+            "tangential_force",
+            "friction_used",
+            "total_normal_force",
+            "dual",
+            "gap",
+            "certificate",
+        ):
             out[name][g] = getattr(r, name)
         out["grip_status"][g], out["grip_culprit"][g] = r.status, r.culprit
     # closure and epsilon with the friction the forces may use, as the grip's (issue 31)

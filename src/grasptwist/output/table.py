@@ -676,7 +676,8 @@ class ForceTableWriter(_Writer):
             self.add(
                 lines,
                 f"total normal force {fmt_number(grip['total_normal_force'], d)} N (safety {grip['safety']:g}); "
-                f"squeezes {fmt_vector(grip['squeeze'], d)} N",
+                + ("no squeezes (collinear contacts)" if grip["squeeze"] is None else "")
+                + (f"squeezes {fmt_vector(grip['squeeze'], d)} N" if grip["squeeze"] is not None else ""),
             )
         c = rec["closure"]
         verdict = {True: "yes", False: "no", None: "- (no friction)"}[c["force_closure"]]

@@ -52,6 +52,7 @@ __all__ = [
     "contact_matrices",
     "manipulating_forces",
     "ManipulatingForces",
+    "collinear_manipulating",
 ]
 
 
@@ -214,28 +215,39 @@ def nonfinite_result(status, *parts) -> np.ndarray:
 
 
 #: The numbers of a grip (:class:`~grasptwist.engine.forces.grip.Grip`) held finite on its ok rows.
-GRIP_NUMBERS = ("force", "squeeze", "normal_force", "tangential_force", "friction_used", "total_normal_force")
+GRIP_NUMBERS = (
+    "force",
+    "squeeze",
+    "normal_force",
+    "tangential_force",
+    "friction_used",
+    "total_normal_force",
+    "dual",
+    "gap",
+)
 
 
 def checked_grip(g):
     """A grip whose ok rows are finite: ``nonfinite-result`` (and NaN numbers) where they are not.
 
-    Where a force has no tangential part (no wrench: no force at all) it uses no
-    friction, ``friction_used = 0`` rather than ``0 / 0``.  Every caller of
-    :func:`~grasptwist.engine.forces.grip.grip` that reports rows passes its result
-    through here.
+    Where a force has no tangential part (no wrench: no force at all; a bare contact
+    whose tangential force is round-off, below ``1e-12`` of the row's largest force) it
+    uses no friction, ``friction_used = 0`` rather than ``0 / 0`` or ``1e-18 / 0``.
+    :func:`~grasptwist.engine.forces.grip.grip` returns its result through here.
 
     >>> from grasptwist.engine.forces.grip import grip
     >>> p = [[1, 0, 0], [-0.5, 0.75**0.5, 0], [-0.5, -(0.75**0.5), 0]]
-    >>> g = checked_grip(grip(p, -np.array(p), [[0, 0, 0, 0, 0, 0], [0, 0, 1e308, 0, 0, 1e308]], 0.5))
+    >>> g = grip(p, -np.array(p), [[0, 0, 0, 0, 0, 0], [0, 0, 1e308, 0, 0, 1e308]], 0.5)
     >>> g.status.tolist(), g.friction_used[0].tolist()
     ([0, 9], [0.0, 0.0, 0.0])
     """
     ok = (g.status == ForceStatus.OK)[..., None]
-    used = np.where(ok & (g.tangential_force == 0), 0.0, g.friction_used)
-    status = nonfinite_result(
-        g.status, *(used if name == "friction_used" else getattr(g, name) for name in GRIP_NUMBERS)
-    )
+    # a bare contact's tangential force is round-off of the row's forces, not friction used
+    scale = np.max(np.abs(g.force), axis=(-2, -1), initial=0.0)[..., None]
+    used = np.where(ok & (g.tangential_force <= 1e-12 * scale), 0.0, g.friction_used)
+    # a squeeze is NaN by definition on collinear contacts (their internal forces are not three squeezes)
+    checked = (name for name in GRIP_NUMBERS if name != "squeeze")
+    status = nonfinite_result(g.status, *(used if name == "friction_used" else getattr(g, name) for name in checked))
     failed = status != ForceStatus.OK
     numbers = {name: getattr(g, name) for name in GRIP_NUMBERS} | {"friction_used": used}
     numbers = {
@@ -377,6 +389,51 @@ def _manipulating(geo: Geometry, wrench):
     return np.where((geo.status == 0)[..., None, None], f, np.nan)
 
 
+class CollinearMap(NamedTuple):
+    """The grasp map of collinear contacts (rank 5), its moment rows divided by the grasp's size ``L``.
+
+    ``u (n, 6, 5)``, ``s (n, 5)``, ``v (n, 9, 5)``: the thin SVD of ``D G`` with
+    ``D = diag(1, 1, 1, 1/L, 1/L, 1/L)`` (forces and moments compare); ``null (n, 9, 4)``
+    the internal forces: pushes along the line and pairs across it.
+    """
+
+    u: np.ndarray
+    s: np.ndarray
+    v: np.ndarray
+    null: np.ndarray
+    size: np.ndarray
+
+
+def collinear_map(points, size) -> CollinearMap:
+    """:class:`CollinearMap` of ``points (n, 3, 3)`` with ``size (n)``."""
+    g = grasp_map(points)
+    g[:, 3:] /= size[:, None, None]
+    u, s, vt = np.linalg.svd(g)
+    return CollinearMap(u[..., :5], s[:, :5], np.swapaxes(vt[:, :5], -1, -2), np.swapaxes(vt[:, 5:], -1, -2), size)
+
+
+def _scaled(wrench, size):
+    return np.concatenate((wrench[..., :3], wrench[..., 3:] / size[:, None]), axis=-1)
+
+
+def collinear_manipulating(cmap: CollinearMap, wrench, tol=1e-9):
+    r"""``G^+ w`` for collinear contacts, and where ``w`` is out of ``G``'s range the part that is.
+
+    Returns ``force (n, 3, 3)`` (NaN where ``w`` is out of range), ``made (n)`` bool and
+    ``y (n, 6)``: ``y = D r`` with ``r`` the part of ``D w`` outside the range, so
+    ``y . w = |r|^2 > 0`` and ``y . G f = 0`` for every ``f``: the moment about the
+    contacts' line that no finger force makes (zero where ``made``).
+    """
+    dw = _scaled(wrench, cmap.size)
+    coef = np.einsum("nji,nj->ni", cmap.u, dw)
+    r = dw - np.einsum("nji,ni->nj", cmap.u, coef)
+    with np.errstate(all="ignore"):
+        made = np.linalg.norm(r, axis=-1) <= tol * np.linalg.norm(dw, axis=-1)
+        f = np.einsum("nji,ni->nj", cmap.v, coef / cmap.s).reshape(-1, 3, 3)
+    y = _scaled(r, cmap.size)
+    return np.where(made[:, None, None], f, np.nan), made, np.where(made[:, None], 0.0, y)
+
+
 class ManipulatingForces(NamedTuple):
     """Yoshikawa-Nagai's manipulating forces of a batch of (grasp, wrench) rows.
 
@@ -391,7 +448,9 @@ class ManipulatingForces(NamedTuple):
         1 for an equilateral triangle, falling like the offset from a line to 0
         for collinear contacts.  ``G^+ w`` grows like ``1 / conditioning`` there.
     status, culprit : (...) int8
-        :class:`ForceStatus` and the contact it is about (or -1).
+        :class:`ForceStatus` and the contact it is about (or -1).  Collinear contacts
+        (conditioning 0) are ``collinear-contacts`` only when the wrench has a moment about
+        their line, which no finger force makes; otherwise ``force`` is ``G^+ w``.
     """
 
     force: np.ndarray
@@ -435,6 +494,13 @@ def manipulating_forces(points, wrench, *, tol=DEGENERACY_TOL) -> ManipulatingFo
     geo = geometry(p, tol)
     f = _manipulating(geo, w)
     status, culprit = geo.status.copy(), geo.culprit.copy()
+    line = np.flatnonzero(status.reshape(-1) == ForceStatus.COLLINEAR_CONTACTS)
+    if line.size:  # rank 5: G^+ w still makes w when w has no moment about the contacts' line
+        flat = (p.reshape(-1, 3, 3)[line], w.reshape(-1, 6)[line])
+        lf, made, _ = collinear_manipulating(collinear_map(flat[0], geo.size.reshape(-1)[line]), flat[1])
+        made &= np.isfinite(flat[1]).all(axis=-1)
+        f.reshape(-1, 3, 3)[line[made]] = lf[made]
+        status.reshape(-1)[line[made]] = ForceStatus.OK
     status[(status == 0) & ~np.isfinite(w).all(axis=-1)] = ForceStatus.NONFINITE_INPUT
     status = nonfinite_result(status, f)
     f[status != 0] = np.nan

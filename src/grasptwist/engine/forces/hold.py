@@ -22,7 +22,7 @@ from .. import se3
 from ..degeneracy import DEGENERACY_TOL
 from ..path import Poses, check_segments, integrate
 from ..screws import cross
-from .grasp_map import ForceStatus, checked_grip
+from .grasp_map import ForceStatus
 from .grip import Grip, grip
 
 __all__ = ["HoldStretch", "hold_wrench", "grip_along", "cannot_hold", "PRECISION"]
@@ -122,7 +122,7 @@ def grip_along(
     moved = se3.transform(poses.rotation[..., None, :, :], poses.position[..., None, :], p)
     turned = np.einsum("...ij,kj->...ki", poses.rotation, n)
     wrench = hold_wrench(mass, center_of_mass, gravity, poses.rotation, poses.position)
-    return poses, checked_grip(grip(moved, turned, wrench, friction, safety, tol=tol))
+    return poses, grip(moved, turned, wrench, friction, safety=safety, tol=tol)
 
 
 def cannot_hold(
