@@ -4,8 +4,8 @@ Run: ``python bench/forces.py [--n 100000] [--loop 2000] [--epsilon 200]``.
 
 Grasps: three contacts near a unit ball's equator, normals towards its centre tilted at
 random, one friction per grasp (0.4..1), the wrench that holds a 0.2..2 kg weight plus a
-disturbing moment.  The engine does ``gt.grip`` (least total normal force, safety 1.5) and
-``gt.force_closure`` (closure friction and the verdict with the grasp's friction, no
+disturbing moment.  The engine does ``gt.forces.grip`` (least total normal force, safety 1.5) and
+``gt.forces.force_closure`` (closure friction and the verdict with the grasp's friction, no
 epsilon) for all ``n`` at once.  The loop does the same with Clarabel for the first
 ``--loop`` grasps and is scaled to ``n``: the least grip is one solve on the nine
 contact-force numbers; the closure friction is a bisection on ``mu`` of closure-margin
@@ -49,9 +49,9 @@ def main():
     p, n, w, mu = grasps(args.n)
 
     t0 = time.perf_counter()
-    g = gt.grip(p, n, w, mu, SAFETY)
+    g = gt.forces.grip(p, n, w, mu, SAFETY)
     t1 = time.perf_counter()
-    c = gt.force_closure(p, n, mu)
+    c = gt.forces.force_closure(p, n, mu)
     t2 = time.perf_counter()
     engine_grip, engine_closure = t1 - t0, t2 - t1
     held = g.ok.mean()
@@ -94,7 +94,7 @@ def main():
 
     m = args.epsilon
     t0 = time.perf_counter()
-    e = gt.force_closure(p[:m], n[:m], mu[:m], quality=True)
+    e = gt.forces.force_closure(p[:m], n[:m], mu[:m], quality=True)
     t1 = time.perf_counter()
     print(
         f"epsilon (quality=True, 8 edges), {m} grasps: {1e3 * (t1 - t0) / m:.2f} ms a grasp; "

@@ -44,7 +44,7 @@ def test_the_bundled_ball_is_held_with_m_g_over_mu_as_the_engine_says():
     assert grip["normal_force"] == pytest.approx([6.54] * 3, rel=1e-5)
     assert grip["safety"] == 1.0
     g = read_grasps(SPHERE)[1]
-    engine = gt.grip(g.points, g.normals, g.wrenches[-1].wrench, g.friction)
+    engine = gt.forces.grip(g.points, g.normals, g.wrenches[-1].wrench, g.friction)
     np.testing.assert_allclose(grip["force"], engine.force, rtol=0, atol=1e-12)
     np.testing.assert_allclose(grip["squeeze"], engine.squeeze, rtol=0, atol=1e-12)
     np.testing.assert_allclose(hold["manipulating"]["force"], [[0, 0, 3.27]] * 3, atol=1e-12)
@@ -81,11 +81,11 @@ def test_command_line_wrench_friction_safety_and_quality():
     # moment about the origin of (1, 0, 0) at (0, 0, 1): (0, 0, 1) x (1, 0, 0) = (0, 1, 0)
     assert push["wrench"]["wrench"] == [1.0, 0.0, 0.0, 0.0, 1.0, 0.0]
     g = read_grasps(POLYHEDRON)[0]
-    engine = gt.grip(g.points, g.normals, [1, 0, 0, 0, 1, 0], 0.8, safety=1.1)
+    engine = gt.forces.grip(g.points, g.normals, [1, 0, 0, 0, 1, 0], 0.8, safety=1.1)
     assert push["grip"]["total_normal_force"] == pytest.approx(float(engine.total_normal_force), rel=1e-12)
     assert push["grip"]["safety"] == 1.1
     assert max(push["grip"]["friction_used"]) <= 0.8 / 1.1 + 1e-9
-    c = gt.force_closure(g.points, g.normals, 0.8, quality=True)
+    c = gt.forces.force_closure(g.points, g.normals, 0.8, quality=True)
     assert up["closure"]["force_closure"] is True
     assert up["closure"]["epsilon"] == pytest.approx(float(c.epsilon), rel=1e-9) and up["closure"]["epsilon"] > 0
 
@@ -196,7 +196,7 @@ def test_npz_and_parquet_data_sets_in_and_out(tmp_path):
         z["wrench"].shape == (4, 6) and z["force"].shape == (4, 3, 3) and z["friction"][3].tolist() == [0.1, 0.1, 0.2]
     )
     assert z["grip_status"].tolist()[:2] == [0, 0] and list(z["status_legend"][[0, 20]]) == ["ok", "cannot-hold"]
-    engine = gt.grip(P, -P, [0, 0, 1, 0, 0, 0], [0.1, 0.1, 0.2])
+    engine = gt.forces.grip(P, -P, [0, 0, 1, 0, 0, 0], [0.1, 0.1, 0.2])
     assert z["total_normal_force"][3] == pytest.approx(float(engine.total_normal_force), rel=1e-12)
     r, _ = run("forces", tmp_path / "in.npz", "-f", "parquet", "-o", tmp_path / "out.parquet")
     out = pq.read_table(tmp_path / "out.parquet")

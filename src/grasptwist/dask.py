@@ -70,7 +70,7 @@ def _resolve_partition(df, twists, method: str, order: str, file: str):
     return _frame(pa.concat_tables([table(b, order) for b in blocks] or [schema().empty_table()]))
 
 
-def resolve_dataframe(ddf, twists: Mapping[str, object] | None = None, method="both", order="omega-v", file=""):
+def resolve_dataframe(ddf, twists: Mapping[str, object] | None = None, *, method="both", order="omega-v", file=""):
     """Resolve every row of a Dask DataFrame of grasps, lazily, partition by partition.
 
     Parameters
@@ -130,7 +130,7 @@ def _resolve_rows(rows: np.ndarray, has_wrist: bool, method: str, order: str, dt
     return out
 
 
-def result_dtype(method: str = "both", order: str = "omega-v") -> np.dtype:
+def result_dtype(*, method: str = "both", order: str = "omega-v") -> np.dtype:
     """The record type of :func:`resolve_array`: one field per npz array (``x (3,)``, ``tangent_status``, ...).
 
     >>> result_dtype()["off_tangent_status"], result_dtype()["x"].shape
@@ -143,7 +143,7 @@ def result_dtype(method: str = "both", order: str = "omega-v") -> np.dtype:
     return np.dtype([(k, np.asarray(v).dtype, np.shape(v)[1:]) for k, v in fields if k not in _LABELS])
 
 
-def resolve_array(points, normals, wrist, twist, method="both", order="omega-v"):
+def resolve_array(points, normals, wrist, twist, *, method="both", order="omega-v"):
     """Resolve dask arrays of grasps chunked by rows, lazily, chunk by chunk.
 
     Parameters
@@ -166,7 +166,7 @@ def resolve_array(points, normals, wrist, twist, method="both", order="omega-v")
     rows = points.chunks[0]
     parts = [points.reshape(n, 9), normals.reshape(n, 9), *([] if wrist is None else [wrist]), twist]
     stacked = da.concatenate([da.asarray(p, dtype=float).rechunk({0: rows, 1: -1}) for p in parts], axis=1)
-    dtype = result_dtype(method, order)
+    dtype = result_dtype(method=method, order=order)
     return stacked.rechunk({1: -1}).map_blocks(
         _resolve_rows, wrist is not None, method, order, dtype, dtype=dtype, drop_axis=1
     )

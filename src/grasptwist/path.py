@@ -21,10 +21,11 @@ from .engine.path import (
     integrate,
 )
 from .engine.tracking import FingerTrack, track_finger
-from .model import Segment
+from .model import ObjectPath, Segment
 
 __all__ = [
     "Segment",
+    "ObjectPath",
     "integrate",
     "follow",
     "degeneracies",

@@ -277,7 +277,8 @@ def decompose_off_tangent(points, wrist, twist, *, tol=DEGENERACY_TOL, bases=Tru
     points : (..., 3, 3) array
     wrist : (..., 3) array
         The point ``c`` (centre of the wrist's spherical joint).
-    twist : (..., 6) array, ``(omega; v)`` with ``v`` at the origin.
+    twist : (..., 6) array
+        ``(omega; v)`` with ``v`` at the origin.
     tol : float
         Relative tolerance of the degeneracy tests (see :mod:`grasptwist.engine.degeneracy`).
     bases : bool
@@ -315,7 +316,8 @@ def decompose_tangent(points, normals, twist, *, tol=DEGENERACY_TOL, bases=True)
     points : (..., 3, 3) array
     normals : (..., 3, 3) array
         Surface normals at the contacts, any non-zero length (normalised here).
-    twist : (..., 6) array, ``(omega; v)`` with ``v`` at the origin.
+    twist : (..., 6) array
+        ``(omega; v)`` with ``v`` at the origin.
     tol : float
         Relative tolerance of the degeneracy tests.
     bases : bool
@@ -363,9 +365,18 @@ def resolve(points, normals, wrist, twist, *, tol=DEGENERACY_TOL, bases=True) ->
     The same numbers, bit for bit, as :func:`decompose_off_tangent`,
     :func:`decompose_tangent` and :func:`contact_velocities` called
     separately, for less: the contact triangle and the contact velocities are
-    computed once.  Arguments as for those; ``wrist`` may be None (then
-    ``off_tangent`` is None).  For many twists on one grasp see
-    :func:`~grasptwist.engine.prepared.prepare`.
+    computed once.  For many twists on one grasp see :func:`prepare`.
+
+    Parameters
+    ----------
+    points, normals : (..., 3, 3) array
+        The contacts and their normals (any non-zero length), as for those.
+    wrist : (..., 3) array or None
+        None: no off-tangent result (``off_tangent`` is None).
+    twist : (..., 6) array
+        ``(omega; v)`` with ``v`` at the origin.
+    tol, bases
+        As for :func:`decompose_off_tangent`.
 
     Returns
     -------

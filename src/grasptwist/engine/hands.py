@@ -185,7 +185,7 @@ def _limits(finger, which):
 SEGMENT_INTERVALS = 4
 
 
-def track(hand, positions, points, segments, times, steps=16) -> HandTrack:
+def track(hand, positions, points, segments, times, *, steps=16) -> HandTrack:
     """Every finger keeping its tip on its contact while the object follows a path.
 
     Finger ``f`` follows contact ``f`` by :func:`grasptwist.path.track_finger`

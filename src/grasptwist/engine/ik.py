@@ -263,7 +263,7 @@ def _wrap(q, seed, unlimited):
     return np.where(unlimited, q - 2 * np.pi * turns, q)
 
 
-def hand_ik(hand, points, seed=None, *, tips=None, iterations=IK_ITERATIONS) -> HandIK:
+def hand_ik(hand, points, *, seed=None, tips=None, iterations=IK_ITERATIONS) -> HandIK:
     """Joint positions that put every finger's tip point on its contact (module docstring).
 
     Parameters
@@ -434,7 +434,7 @@ def place_hand(hand, points, positions=None, *, seed=None, tips=None) -> HandIK:
     lead, n = points.shape[:-2], len(hand.joint_names)
     known = [f.tip_pose is not None or tips is not None for f in hand.fingers]
     if positions is None and all(known):
-        return hand_ik(hand, points, seed, tips=tips)
+        return hand_ik(hand, points, seed=seed, tips=tips)
     if positions is None:  # a finger without a tip point: every joint as given
         positions = np.zeros(lead + (n,))
     positions = np.broadcast_to(np.asarray(positions, dtype=float), lead + (n,))

@@ -42,6 +42,7 @@ __all__ = [
     "scene",
 ]
 
+#: The decompositions a scene can show, as the command line spells them.
 METHODS = ("off-tangent", "tangent")
 
 # Lengths drawn relative to the grasp's size (the longest side of the contact triangle).
@@ -251,8 +252,8 @@ def scene(
     normals,
     wrist,
     twist=None,
-    method: str | None = None,
     *,
+    method: str | None = None,
     names=("1", "2", "3"),
     grasp_name: str = "grasp",
     twist_name: str | None = None,
@@ -519,7 +520,7 @@ def grasp_scene(
         grasp.normals,
         grasp.wrist,
         twist,
-        method,
+        method=method,
         names=grasp.contact_names,
         grasp_name=grasp.name,
         twist_name=twist_name,

@@ -242,7 +242,7 @@ def epsilon_quality(points, normals, friction, cone_edges=8):
     return float(max(0.0, np.min(-hull.equations[:, -1])))
 
 
-def force_closure(points, normals, friction=None, quality=False, cone_edges=8, *, tol=DEGENERACY_TOL) -> Closure:
+def force_closure(points, normals, friction=None, *, quality=False, cone_edges=8, tol=DEGENERACY_TOL) -> Closure:
     r"""Force closure of each grasp: the least common friction, the verdict with ``friction``, epsilon.
 
     Parameters

@@ -89,21 +89,36 @@ _CANNOT_HOLD = {
 }
 
 
-def force_status_message(status, culprit=-1) -> str:
+def force_status_message(status, culprit=-1, names=("1", "2", "3")) -> str:
     """One sentence for a row's status and culprit (a contact index, or -1).
 
-    For ``cannot-hold`` a culprit of -1 means the wrench needs pulling; for
-    ``no-closure`` a culprit is the contact whose normal is at right angles to
-    the contacts' plane.
+    The force side's :func:`grasptwist.status_message`, with the same arguments
+    (public as :func:`grasptwist.forces.status_message`).
 
+    Parameters
+    ----------
+    status : int or ForceStatus
+    culprit : int
+        Contact index 0..2 the condition is about, or -1.  For ``cannot-hold``
+        -1 means the wrench needs pulling; for ``no-closure`` a culprit is the
+        contact whose normal is at right angles to the contacts' plane.
+    names : sequence of 3 str
+        Contact names to use in the message.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
     >>> force_status_message(ForceStatus.CANNOT_HOLD, 2)
     'cannot-hold: the friction cone at contact 3 is too narrow (mu/safety) for any forces that make the wrench'
-    >>> force_status_message(ForceStatus.NO_CLOSURE, 0)
-    "no friction makes the grasp force closure: the normal at contact 1 is at right angles to the contacts' plane"
+    >>> force_status_message(ForceStatus.NO_CLOSURE, 0, ("thumb", "index", "middle"))
+    "no friction makes the grasp force closure: the normal at contact thumb is at right angles to the contacts' plane"
     """
     s = ForceStatus(int(status))
     c = int(culprit)
-    i, j, k = (c if c >= 0 else 0) + 1, (c + 1) % 3 + 1, (c + 2) % 3 + 1
+    i, j, k = names[c if c >= 0 else 0], names[(c + 1) % 3], names[(c + 2) % 3]
     if s == ForceStatus.CANNOT_HOLD:
         return _CANNOT_HOLD[c < 0].format(i=i)
     why = (

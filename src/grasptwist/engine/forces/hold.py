@@ -84,7 +84,7 @@ def hold_wrench(mass, center_of_mass, gravity, rotation=None, position=None) -> 
 
 
 def grip_along(
-    points, normals, friction, mass, center_of_mass, gravity, segments, times, safety=1.0, *, tol=DEGENERACY_TOL
+    points, normals, friction, mass, center_of_mass, gravity, segments, times, *, safety=1.0, tol=DEGENERACY_TOL
 ) -> tuple[Poses, Grip]:
     """The grip that holds the weight at each time of a path.
 
@@ -122,7 +122,7 @@ def grip_along(
     moved = se3.transform(poses.rotation[..., None, :, :], poses.position[..., None, :], p)
     turned = np.einsum("...ij,kj->...ki", poses.rotation, n)
     wrench = hold_wrench(mass, center_of_mass, gravity, poses.rotation, poses.position)
-    return poses, grip(moved, turned, wrench, friction, safety, tol=tol)
+    return poses, grip(moved, turned, wrench, friction, safety=safety, tol=tol)
 
 
 def cannot_hold(
@@ -134,8 +134,8 @@ def cannot_hold(
     gravity,
     segments,
     times=None,
-    safety=1.0,
     *,
+    safety=1.0,
     tol=DEGENERACY_TOL,
 ) -> tuple[HoldStretch, ...]:
     """Every stretch of a path where no grip holds the weight, its ends located between samples.
@@ -175,7 +175,9 @@ def cannot_hold(
     nodes = np.unique(np.concatenate((ends, extra)))
 
     def status(t):
-        return grip_along(points, normals, friction, mass, center_of_mass, gravity, segments, t, safety, tol=tol)[1]
+        return grip_along(
+            points, normals, friction, mass, center_of_mass, gravity, segments, t, safety=safety, tol=tol
+        )[1]
 
     at = status(nodes)
     fails = at.status == ForceStatus.CANNOT_HOLD

@@ -1,0 +1,211 @@
+"""The public API (docs/api/index.rst, ARCHITECTURE.md "The public API"): the core and one module per
+topic, each public name in one place and in the API reference, options keyword-only, moved names
+warning, the docs' examples importing only public names, and the reference building from the
+docstrings without a warning."""
+
+import ast
+import doctest
+import importlib
+import inspect
+import re
+import sys
+
+import pytest
+
+import grasptwist as gt
+from docs_blocks import ROOT, all_blocks
+
+API = ROOT / "docs" / "api"
+
+#: The public modules: the core and its topics.
+PUBLIC = [
+    "grasptwist",
+    "grasptwist.screws",
+    "grasptwist.hand",
+    "grasptwist.forces",
+    "grasptwist.path",
+    "grasptwist.pictures",
+    "grasptwist.dask",
+]
+TOPICS = {m.rpartition(".")[2]: m for m in PUBLIC[1:]}
+
+
+def module(name):
+    return importlib.import_module(name)
+
+
+def public_names():
+    """``(module, name, object)`` of every name in every public module's ``__all__``."""
+    return [(m, n, getattr(module(m), n)) for m in PUBLIC for n in module(m).__all__]
+
+
+def test_the_core_has_a_module_per_topic():
+    assert sorted(TOPICS) == sorted(n for n in gt.__all__ if inspect.ismodule(getattr(gt, n)))
+    for topic, name in TOPICS.items():
+        assert getattr(gt, topic) is module(name)
+
+
+def documented():
+    """``module.name`` of every ``auto...`` directive of docs/api/*.rst, the modules of ``automodule``."""
+    names = set()
+    for page in sorted(API.glob("*.rst")):
+        current = None
+        for kind, target in re.findall(r"^\.\. (currentmodule|auto\w+):: (\S+)", page.read_text(), re.M):
+            if kind in ("currentmodule", "automodule"):
+                current = target
+            if kind != "currentmodule":
+                names.add(target if kind == "automodule" or "." in target else f"{current}.{target}")
+    return names
+
+
+def test_every_public_name_is_in_the_api_reference_and_nothing_else_is():
+    want = {m if inspect.ismodule(o) else f"{m}.{n}" for m, n, o in public_names()} | set(PUBLIC)
+    have = documented()
+    assert sorted(want - have) == [], "public but not in docs/api/*.rst"
+    assert sorted(have - want) == [], "in docs/api/*.rst but not in a public module's __all__"
+
+
+def test_each_public_function_and_class_has_one_home():
+    homes = {}
+    for m, n, o in public_names():
+        if inspect.isfunction(o) or inspect.isclass(o):
+            homes.setdefault(id(o), []).append(f"{m}.{n}")
+    assert [h for h in homes.values() if len(h) > 1] == []
+
+
+def test_dir_of_the_core_shows_its_public_names_only():
+    import grasptwist.cli  # noqa: F401 (binds the internal subpackages as the core's attributes)
+
+    assert dir(gt) == sorted([*gt.__all__, "__version__"])
+    assert "import_module" not in dir(gt) and "engine" not in dir(gt)
+    with pytest.raises(AttributeError, match="module 'grasptwist' has no attribute 'nothing'"):
+        gt.nothing  # noqa: B018
+
+
+@pytest.mark.parametrize("old", sorted(gt._MOVED))
+def test_a_name_moved_out_of_the_core_warns_and_is_its_new_home(old):
+    topic, new = gt._MOVED[old]
+    with pytest.warns(
+        DeprecationWarning, match=rf"^grasptwist\.{old} is deprecated since 0\.4: use grasptwist\.{topic}\.{new}$"
+    ):
+        value = getattr(gt, old)
+    assert value is getattr(module(TOPICS[topic]), new)
+    assert old not in gt.__all__ and old not in dir(gt)
+
+
+def test_the_0_1_loader_path_warns_and_gives_the_core_loader():
+    sys.modules.pop("grasptwist.io.grasp_file", None)
+    with pytest.warns(
+        DeprecationWarning, match=r"grasptwist\.io\.grasp_file is deprecated since 0\.4: .*gt\.load_grasps"
+    ):
+        shim = importlib.import_module("grasptwist.io.grasp_file")
+    assert shim.load_grasps is gt.load_grasps and shim.GraspFileError is gt.GraspFileError
+
+
+#: Parameters with a default that are data, not options: they may be given by position.
+DATA = {
+    "grasptwist.status_message": {"culprit", "names"},
+    "grasptwist.forces.status_message": {"culprit", "names"},
+    "grasptwist.prepare": {"wrist"},
+    "grasptwist.grasp_table": {"wrist", "twist", "names"},
+    "grasptwist.forces.force_closure": {"friction"},
+    # the grip's safety becomes keyword-only with issue 29 (grip(..., *, safety))
+    "grasptwist.forces.grip": {"safety"},
+    "grasptwist.forces.hold_wrench": {"rotation", "position"},  # the object's pose
+    "grasptwist.forces.cannot_hold": {"times"},
+    "grasptwist.hand.finger_states": {"positions"},
+    "grasptwist.hand.place_hand": {"positions"},
+    "grasptwist.hand.home_tips": {"points"},
+    "grasptwist.hand.joint_screw": {"prismatic"},  # per joint, an array like the axes
+    "grasptwist.path.degeneracies": {"times"},
+    "grasptwist.screws.exp": {"t"},
+    "grasptwist.pictures.scene": {"twist"},
+    "grasptwist.pictures.grasp_scene": {"twist"},
+    "grasptwist.pictures.plot_grasp": {"twist"},
+    "grasptwist.pictures.twist_figure": {"twists"},
+    "grasptwist.pictures.image_name": {"twist_name"},
+    "grasptwist.dask.resolve_dataframe": {"twists"},
+}
+
+
+def test_options_are_keyword_only():
+    positional = []
+    for m, n, o in public_names():
+        if not inspect.isfunction(o):
+            continue
+        for p in inspect.signature(o).parameters.values():
+            if p.default is not p.empty and p.kind != p.KEYWORD_ONLY and p.name not in DATA.get(f"{m}.{n}", ()):
+                positional.append(f"{m}.{n}({p.name}=...)")
+    assert positional == []
+
+
+def test_the_data_parameters_above_are_parameters_of_public_functions():
+    functions = {f"{m}.{n}": o for m, n, o in public_names() if inspect.isfunction(o)}
+    stale = [f"{k}({p})" for k, ps in DATA.items() for p in ps if p not in inspect.signature(functions[k]).parameters]
+    assert stale == []
+
+
+def code_of(block):
+    """A ``python`` block's code, or a ``pycon`` session's input lines."""
+    if block.lang == "python":
+        return block.text
+    return "".join(e.source for e in doctest.DocTestParser().get_examples(block.text))
+
+
+def grasptwist_names(code):
+    """``(line, what)`` of every import of grasptwist and attribute of a public module in ``code``."""
+    tree = ast.parse(code)
+    bound = {}  # local name -> public module
+    found = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            for a in node.names:
+                if a.name.split(".")[0] == "grasptwist":
+                    found.append((node.lineno, a.name))
+                    bound[a.asname or a.name] = a.name
+        elif isinstance(node, ast.ImportFrom) and (node.module or "").split(".")[0] == "grasptwist":
+            for a in node.names:
+                found.append((node.lineno, f"{node.module}.{a.name}"))
+                if f"{node.module}.{a.name}" in PUBLIC:
+                    bound[a.asname or a.name] = f"{node.module}.{a.name}"
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Attribute):
+            chain = [node.attr]
+            value = node.value
+            while isinstance(value, ast.Attribute):
+                chain.insert(0, value.attr)
+                value = value.value
+            if isinstance(value, ast.Name) and value.id in bound:
+                found.append((node.lineno, ".".join([bound[value.id], *chain])))
+    return found
+
+
+def is_public(dotted):
+    """Whether ``grasptwist.a.b...`` names a public module, a name in one's ``__all__``, or an
+    attribute of such a name (``gt.Status.OK``)."""
+    parts = dotted.split(".")
+    for k in range(len(parts), 0, -1):
+        head = ".".join(parts[:k])
+        if head in PUBLIC:
+            return k == len(parts) or parts[k] in module(head).__all__
+    return False
+
+
+def test_an_import_of_an_internal_module_in_a_docs_example_is_found():
+    code = "import grasptwist as gt\nfrom grasptwist.engine.ik import hand_ik\nfrom grasptwist import forces\ngt.grip\nforces.grip\n"
+    assert [w for _, w in grasptwist_names(code) if not is_public(w)] == [
+        "grasptwist.engine.ik.hand_ik",
+        "grasptwist.grip",
+    ]
+
+
+def test_the_docs_examples_use_only_public_names():
+    internal = []
+    for block in all_blocks():
+        if block.lang in ("python", "pycon"):
+            internal += [
+                f"{block.where}+{line - 1}: {what}"
+                for line, what in grasptwist_names(code_of(block))
+                if not is_public(what)
+            ]
+    assert internal == []
