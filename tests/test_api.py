@@ -8,6 +8,7 @@ import doctest
 import importlib
 import inspect
 import re
+import subprocess
 import sys
 
 import pytest
@@ -209,3 +210,36 @@ def test_the_docs_examples_use_only_public_names():
                 if not is_public(what)
             ]
     assert internal == []
+
+
+# --- the reference, built ----------------------------------------------------------------------
+
+
+def test_the_api_reference_builds_without_warnings_and_has_every_public_name(tmp_path):
+    pytest.importorskip("sphinx", reason="the docs extra builds the API reference: pip install -e '.[docs]'")
+    pytest.importorskip("numpydoc", reason="the docs extra builds the API reference: pip install -e '.[docs]'")
+    out = tmp_path / "html"
+    build = [sys.executable, "-m", "sphinx", "-W", "--keep-going", "-q", "-j", "1", "-b", "html", str(API), str(out)]
+    p = subprocess.run(build, capture_output=True, text=True, timeout=120)
+    assert p.returncode == 0, p.stderr
+    assert p.stderr == ""
+    anchors = set()
+    for page in out.glob("*.html"):
+        anchors |= set(re.findall(r'<dt class="sig sig-object py" id="([\w.]+)"', page.read_text("utf-8")))
+    want = {f"{m}.{n}" for m, n, o in public_names() if not inspect.ismodule(o)}
+    assert sorted(want - anchors) == []
+
+
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
+def test_a_bad_docstring_fails_the_build(tmp_path):
+    """The build test can fail: numpydoc says of an unknown section on stderr, which the build test
+    requires empty (it is a Python warning, which Sphinx's -W does not turn into an error)."""
+    pytest.importorskip("sphinx", reason="the docs extra builds the API reference: pip install -e '.[docs]'")
+    pytest.importorskip("numpydoc", reason="the docs extra builds the API reference: pip install -e '.[docs]'")
+    (tmp_path / "bad.py").write_text('def f(x):\n    """Do.\n\n    Parametres\n    ----------\n    x : int\n    """\n')
+    (tmp_path / "src").mkdir()
+    (tmp_path / "src" / "conf.py").write_text('extensions = ["sphinx.ext.autodoc", "numpydoc"]\n')
+    (tmp_path / "src" / "index.rst").write_text("Bad\n===\n\n.. autofunction:: bad.f\n")
+    build = [sys.executable, "-m", "sphinx", "-W", "-q", "-b", "html", str(tmp_path / "src"), str(tmp_path / "out")]
+    p = subprocess.run(build, capture_output=True, text=True, timeout=60, env={"PYTHONPATH": str(tmp_path), "PATH": ""})
+    assert "Unknown section Parametres" in p.stderr
