@@ -1,7 +1,7 @@
 """The engine over Dask collections, unchanged: data sets beyond one machine.
 
 :func:`resolve_dataframe` maps a Dask DataFrame with the columns of a
-Parquet data set (see the README, "Data sets of arrays") to a Dask
+Parquet data set (see docs/guide/data-sets.md, "Parquet") to a Dask
 DataFrame with the columns ``-f parquet`` writes, one partition at a time
 (``map_partitions`` with an explicit ``meta``): each partition goes through
 the same reader, blocks and columns as ``grasptwist resolve data.parquet -f

@@ -200,7 +200,8 @@ class InputError(Exception):
     Attributes
     ----------
     code : str
-        Stable kebab-case code (tables in README.md, "Grasp files" and "Exit codes and diagnostics").
+        Stable kebab-case code (the tables of docs/guide/grasp-files.md, "Errors", and
+        docs/guide/command-line.md, "Exit codes and diagnostics").
     message : str
         What is wrong, starting with the field path when there is one.
     file : str

@@ -5,7 +5,7 @@
   only contact ``i`` and ``Psi_i`` (the line from the wrist ``c`` through
   ``p_i``) keeps contact ``i`` fixed.
 * :func:`decompose_tangent` -- Proposition 2 (eqs. 19-27) and its extension
-  to any twist (README, "The tangent method beyond the paper"): ``T = sum
+  to any twist (docs/reference/conventions.md, "The tangent method beyond the paper"): ``T = sum
   alpha_i Theta_i + sum beta_i Sigma_i``, where ``Theta_i`` keeps contact
   ``i`` fixed and the other two sliding in their tangent planes.  ``beta =
   0`` exactly when ``T`` moves every contact in its tangent plane.
@@ -218,7 +218,7 @@ class TangentResult(_Result):
         Tangent amplitudes, eq. 27.
     beta : (..., 3)
         Off-plane remainder amplitudes, ``beta_i = [R|Theta_i]/[Sigma_i|Theta_i]``
-        with ``R = T - sum alpha_i Theta_i`` (README, "The tangent method
+        with ``R = T - sum alpha_i Theta_i`` (docs/reference/conventions.md, "The tangent method
         beyond the paper").  Zero when ``T`` keeps every contact in its
         tangent plane.
     normal_velocity : (..., 3)
@@ -292,7 +292,7 @@ def decompose_off_tangent(points, wrist, twist, *, tol=DEGENERACY_TOL, bases=Tru
 
     Examples
     --------
-    Paper Example 1b, a spin about z (corrected values: README, "Conventions"):
+    Paper Example 1b, a spin about z (corrected values: docs/reference/conventions.md):
 
     >>> p = [[1, 0, 0], [-0.5, 0.866, 0], [-0.5, -0.866, 0]]
     >>> r = decompose_off_tangent(p, [0, 0, 1], [0, 0, 1, 0, 0, 0])

@@ -1,6 +1,6 @@
 """Parquet data sets in: flat number columns, read a row group at a time.
 
-Columns (see the README, "Data sets of arrays"): ``p1_x p1_y p1_z ...
+Columns (see docs/guide/data-sets.md, "Parquet"): ``p1_x p1_y p1_z ...
 p3_z`` (the contact points) and ``n1_x ... n3_z`` (their normals); optional
 ``c_x c_y c_z`` (the wrist), ``w_x w_y w_z v_x v_y v_z`` (the twist ``(omega; v)``) and ``name``
 (text or integers).  Numbers may be any float or integer type; nulls read
