@@ -15,19 +15,12 @@ import pytest
 
 import grasptwist as gt
 from docs_blocks import ROOT, all_blocks
+from test_layers import LAYERS
 
 API = ROOT / "docs" / "api"
 
-#: The public modules: the core and its topics.
-PUBLIC = [
-    "grasptwist",
-    "grasptwist.screws",
-    "grasptwist.hand",
-    "grasptwist.forces",
-    "grasptwist.path",
-    "grasptwist.pictures",
-    "grasptwist.dask",
-]
+#: The public modules: the core and its topics (the last layer of test_layers.py, less the script).
+PUBLIC = [m for m in LAYERS[-1] if m != "grasptwist.__main__"]
 TOPICS = {m.rpartition(".")[2]: m for m in PUBLIC[1:]}
 
 
@@ -41,6 +34,7 @@ def public_names():
 
 
 def test_the_core_has_a_module_per_topic():
+    assert sorted(TOPICS) == ["dask", "forces", "hand", "path", "pictures", "screws"]
     assert sorted(TOPICS) == sorted(n for n in gt.__all__ if inspect.ismodule(getattr(gt, n)))
     for topic, name in TOPICS.items():
         assert getattr(gt, topic) is module(name)
