@@ -94,19 +94,8 @@ def _index(a, i):
 
 @dataclass(frozen=True, eq=False)
 class _Result:
-    """What both results share: per-row status, conditioning and inputs, row
-    access and the lazily computed residual.
-
-    Attributes
-    ----------
-    status, culprit : (...) int8
-        :class:`~grasptwist.engine.degeneracy.Status` of each row and the contact it
-        is about (0..2, or -1).
-    conditioning : (...)
-        The method's dimensionless conditioning figure (see each result).
-    points, twist : (..., 3, 3), (..., 6)
-        The inputs, broadcast to the batch shape.
-    """
+    """What both results share: per-row status, conditioning and inputs (each result's
+    Attributes list them), row access and the lazily computed residual."""
 
     status: np.ndarray
     culprit: np.ndarray
@@ -184,9 +173,11 @@ class OffTangentResult(_Result):
     conditioning : (...)
         ``min_i |[Sigma_i|Psi_i]| / size`` (dimensionless; size = longest
         side of the contact triangle).
-
-    ``status``, ``culprit``, ``points``, ``twist`` and ``residual`` are as in
-    every result (``_Result``).
+    status, culprit : (...) int8
+        The :class:`~grasptwist.Status` of each row and the contact it is about
+        (0..2, or -1).
+    points, twist : (..., 3, 3), (..., 6)
+        The inputs, broadcast to the batch shape.
     """
 
     sigma: np.ndarray
@@ -218,9 +209,9 @@ class TangentResult(_Result):
         Tangent amplitudes, eq. 27.
     beta : (..., 3)
         Off-plane remainder amplitudes, ``beta_i = [R|Theta_i]/[Sigma_i|Theta_i]``
-        with ``R = T - sum alpha_i Theta_i`` (docs/reference/conventions.md, "The tangent method
-        beyond the paper").  Zero when ``T`` keeps every contact in its
-        tangent plane.
+        with ``R = T - sum alpha_i Theta_i`` (docs/reference/conventions.md,
+        "The tangent method beyond the paper").  Zero when ``T`` keeps every
+        contact in its tangent plane.
     normal_velocity : (..., 3)
         ``[T | nu_i] = T(p_i) . n_i`` with unit normals.
     in_tangent_planes : (...) bool
@@ -230,9 +221,11 @@ class TangentResult(_Result):
         The smaller of ``min_i |[Theta_i|Sigma_i]| / size`` and of
         ``min_i |sin|`` of the angle between normal ``i`` and the contacts'
         plane; both go to 0 at every degenerate grasp.
-
-    ``status``, ``culprit``, ``points``, ``twist`` and ``residual`` are as in
-    every result (``_Result``).
+    status, culprit : (...) int8
+        The :class:`~grasptwist.Status` of each row and the contact it is about
+        (0..2, or -1).
+    points, twist : (..., 3, 3), (..., 6)
+        The inputs, broadcast to the batch shape.
     """
 
     theta: np.ndarray
