@@ -33,6 +33,8 @@ numpydoc_xref_param_type = False
 autodoc_member_order = "bysource"
 autodoc_typehints = "none"  # numpydoc's "Parameters" say the shapes; signatures stay short
 add_module_names = False
+# every cross-reference in a public docstring lands on a public name of this reference
+nitpicky = True
 
 
 def _defined_in(facade: str, name: str) -> str:

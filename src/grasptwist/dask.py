@@ -9,8 +9,8 @@ parquet``, so the values are the command line's, bit for bit.
 :func:`resolve_array` maps dask arrays of points, normals, wrists and
 twists chunked by rows (``map_blocks``) to a dask array of records whose
 fields are the npz arrays.  Neither computes anything until asked: run
-them on any Dask scheduler, e.g. a :class:`distributed.LocalCluster` or a
-cluster's :class:`distributed.Client`.
+them on any Dask scheduler, e.g. a ``distributed.LocalCluster`` or a
+cluster's ``distributed.Client``.
 
 Dask, distributed, pandas and pyarrow are the extra ``grasptwist[dask]``
 (imported when these functions run, not with this module).  For example
@@ -106,7 +106,7 @@ def to_parquet(results, folder: str, **options):
     """Write :func:`resolve_dataframe`'s results as a folder of Parquet shards (one per partition).
 
     The files are those of ``-f parquet`` (same columns, types and writer
-    options); ``options`` go to :meth:`dask.dataframe.DataFrame.to_parquet`
+    options); ``options`` go to ``dask.dataframe.DataFrame.to_parquet()``
     (e.g. ``storage_options`` for an object store).  Computes the results.
     """
     from .output.parquet_writer import schema, write_options

@@ -12,13 +12,13 @@ into words.
 >>> round(float(g.total_normal_force), 6), forces.Status(int(g.status)).code
 (19.62, 'ok')
 
-The math is in :mod:`grasptwist.engine.forces`.
+The math is in ``grasptwist.engine.forces``.
 """
 
 from .engine.forces.closure import Closure, force_closure
-from .engine.forces.grasp_map import ForceStatus as Status
 from .engine.forces.grasp_map import (
     ManipulatingForces,
+    Status,
     check_friction,
     check_safety,
     check_wrench,

@@ -1,9 +1,9 @@
 """Hands, joint rates and inverse kinematics: the public entry points.
 
 A hand is three fingers, each a serial chain of joint screws in the grasp's
-frame (:class:`Hand`).  The math lives in :mod:`grasptwist.engine.kinematics`,
-:mod:`grasptwist.engine.hands` and :mod:`grasptwist.engine.ik`, URDF reading in
-:mod:`grasptwist.io.urdf`; this module gathers them.
+frame (:class:`Hand`).  The math lives in ``grasptwist.engine.kinematics``,
+``grasptwist.engine.hands`` and ``grasptwist.engine.ik``, URDF reading in
+``grasptwist.io.urdf``; this module gathers them.
 
 >>> import numpy as np
 >>> from grasptwist import hand

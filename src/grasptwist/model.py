@@ -146,7 +146,7 @@ class Segment:
     Poses are the object's rigid motion from its start, ``p -> R p + x``
     (identity at ``t = 0``), in the grasp frame.  Checked by
     :func:`grasptwist.path.check_segments`; the math is in
-    :mod:`grasptwist.engine.path`.
+    ``grasptwist.engine.path``.
 
     Attributes
     ----------
@@ -191,8 +191,8 @@ class ObjectPath:
     line: int | None
 
 
-class InputError(Exception):
-    """An input (a grasp file or one document of it, a data set, a path) that cannot be used.
+class GraspFileError(Exception):
+    """An input (a grasp file or one document of it, a data set, a path, a URDF) that cannot be used.
 
     ``str(error)`` is one printable line, ``file:line:column: message``
     (``:line:column`` left out when unknown).
@@ -209,7 +209,7 @@ class InputError(Exception):
         1-based position.
     document : int or None
         0-based document index; None for whole-file errors.
-    problems : tuple of InputError
+    problems : tuple of GraspFileError
         Every problem of the input, this error (its first) included: one
         record per failed document lists them all.
     """
@@ -242,8 +242,9 @@ class InputError(Exception):
         return f"{where}: {self.message}"
 
 
-#: The name the Python API has always used for a grasp file's errors.
-GraspFileError = InputError
+#: The layers' name for it: any input, not only a grasp file (the Python API has always
+#: called it GraspFileError, which the reference documents).
+InputError = GraspFileError
 
 
 @dataclass(frozen=True, eq=False)
@@ -276,7 +277,7 @@ class Finger:
     """A finger: a serial chain of joints at its home configuration (every joint at 0).
 
     Arrays are read-only, in the hand's root frame (the grasp's frame).
-    :func:`grasptwist.engine.kinematics.forward_kinematics` moves them to
+    :func:`~grasptwist.hand.forward_kinematics` moves them to
     other joint positions.
 
     Attributes
@@ -297,7 +298,7 @@ class Finger:
         From the first joint through the others to the tip link's origin: a
         contact farther than this from the tip is a frame mix-up.
     joint_index : tuple of int
-        Position of each joint in :attr:`Hand.joint_names`.
+        Position of each joint in ``Hand.joint_names``.
     """
 
     name: str

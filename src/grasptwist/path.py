@@ -5,7 +5,7 @@
 >>> integrate([Segment(1.0, twist=[0, 0, 0, 1, 0, 0])], [0.5]).position.tolist()
 [[0.5, 0.0, 0.0]]
 
-The math is in :mod:`grasptwist.engine.path`; rigid motions in :mod:`grasptwist.engine.se3`.
+The math is in ``grasptwist.engine.path``; rigid motions in ``grasptwist.engine.se3``.
 """
 
 from .engine.path import (

@@ -17,7 +17,7 @@ writes them as one HTML page (the extra ``grasptwist[html]``).
 grasp: T = (0, 0, 1; 0, 0, 0)
 off-tangent: x = (0, 0, 0)   y = (-0.471, -0.471, -0.471)
 
-The code is in :mod:`grasptwist.plot` (internal).
+The code is in ``grasptwist.plot`` (internal).
 """
 
 from .plot.figures import twist_figure

@@ -14,7 +14,7 @@ broadcast.  A pose is a pair ``(R, x)`` acting on points as ``p -> R p + x``.
 >>> translation.round(12).tolist()
 [2.0, 0.0, 0.0]
 
-The math is in :mod:`grasptwist.engine.screws` and :mod:`grasptwist.engine.se3`.
+The math is in ``grasptwist.engine.screws`` and ``grasptwist.engine.se3``.
 """
 
 from .engine.screws import (

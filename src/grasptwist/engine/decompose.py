@@ -273,7 +273,7 @@ def decompose_off_tangent(points, wrist, twist, *, tol=DEGENERACY_TOL, bases=Tru
     twist : (..., 6) array
         ``(omega; v)`` with ``v`` at the origin.
     tol : float
-        Relative tolerance of the degeneracy tests (see :mod:`grasptwist.engine.degeneracy`).
+        Relative tolerance of the degeneracy tests (see ``grasptwist.engine.degeneracy``).
     bases : bool
         False leaves out the basis screws (``sigma``, ``psi`` are None, and
         so cannot give components or a residual): a third less work and

@@ -400,8 +400,8 @@ def place_hand(hand, points, positions=None, *, seed=None, tips=None) -> HandIK:
     """A batch of hands on their contacts: at given joint positions, checked, or else solved.
 
     With ``positions``, each finger's tip is checked against its contact
-    (:func:`contact_off_finger`: ``contact-off-finger``, the tip error the
-    distance from the tip to the contact); without, they are solved by
+    (``contact-off-finger`` when a contact is farther from its tip than the
+    finger is long; the tip error the distance from the tip to the contact); without, they are solved by
     :func:`hand_ik` from ``seed``.  A finger given inline has no tip point
     unless ``tips`` gives one: it is unchecked (tip error NaN), and a hand
     with such a finger is not solved but taken as given (every joint at 0,

@@ -1,7 +1,7 @@
 """Finger kinematics: joint screws, the finger Jacobian at a contact, joint rates.
 
 A finger is a serial chain.  At a configuration, each of its joints is a screw
-in the grasp's frame, ``(omega; v)`` as in :mod:`grasptwist.engine.screws`:
+in the grasp's frame, ``(omega; v)`` as in ``grasptwist.engine.screws``:
 
 * a revolute joint through the point ``a`` along the unit vector ``d`` is the
   unit line ``(d; a x d)``; per unit rate it moves a point ``p`` of the links
@@ -178,7 +178,7 @@ class JointRates:
         ``sigma_3 / sigma_1`` of ``J`` (its smallest over its largest singular
         value) when the rank is 3, else 0.  Dimensionless: the rates can reach
         ``|V| / (conditioning sigma_1)``, ``sigma_1`` being about the finger's
-        length; below :data:`~grasptwist.engine.degeneracy.CONDITION_WARNING`
+        length; below :data:`~grasptwist.CONDITION_WARNING`
         that is worth a warning.
 
     The arrays are read-only (broadcast views).

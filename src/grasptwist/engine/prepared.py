@@ -112,7 +112,7 @@ class PreparedGrasp:
         Returns
         -------
         Resolution
-            What :func:`~grasptwist.engine.decompose.resolve` gives for this
+            What :func:`~grasptwist.resolve` gives for this
             grasp and twist: the same statuses, bases and Klein products,
             and amplitudes and velocities equal but for the last few units
             in the last place (the matrix product adds the same terms in
@@ -215,7 +215,7 @@ def prepare(points, normals, wrist=None, *, tol=DEGENERACY_TOL) -> PreparedGrasp
     -------
     PreparedGrasp
         Its :meth:`~PreparedGrasp.resolve` gives, for any twist, what
-        :func:`~grasptwist.engine.decompose.resolve` gives on this grasp.
+        :func:`~grasptwist.resolve` gives on this grasp.
 
     Examples
     --------

@@ -277,7 +277,7 @@ def load_urdf_hand(urdf, tips, *, names=None, folder=None, max_bytes=DEFAULT_MAX
     Parameters
     ----------
     urdf : str or os.PathLike
-        ``package://PKG/path`` or a path (see :func:`resolve_urdf`).
+        ``package://PKG/path`` (``PKG`` an installed Python package) or a path.
     tips : sequence of str
         The link touching each contact, in contact order.
     names : sequence of str, optional

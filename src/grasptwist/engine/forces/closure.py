@@ -72,7 +72,7 @@ class Closure:
         Ferrari-Canny's epsilon with the grasp's own friction (``quality=True``); 0
         outside force closure.
     status, culprit : (...) int8
-        :class:`~grasptwist.engine.forces.grasp_map.ForceStatus`; ``no-closure`` with
+        :class:`~grasptwist.forces.Status`; ``no-closure`` with
         the contact whose normal is at right angles to the contacts' plane, or -1.
     """
 

@@ -66,10 +66,10 @@ class Grip:
     conditioning : (...)
         As :class:`~grasptwist.engine.forces.grasp_map.ManipulatingForces`.
     status, culprit : (...) int8
-        :class:`~grasptwist.engine.forces.grasp_map.ForceStatus`; for
+        :class:`~grasptwist.forces.Status`; for
         ``cannot-hold`` the culprit is the contact whose cone is too narrow, or
         -1 when the wrench needs pulling
-        (:func:`~grasptwist.engine.forces.grasp_map.force_status_message`).
+        (:func:`~grasptwist.forces.status_message`).
     """
 
     force: np.ndarray

@@ -143,7 +143,7 @@ def cannot_hold(
     The grip's status is evaluated at the samples ``times`` and the segments' ends; each
     run of ``cannot-hold`` is widened to where it starts and ends by bisection between
     its first (last) node and the held node before (after) it, every end at once, to
-    :data:`PRECISION` of the shortest segment's duration.  A stretch shorter than the
+    ``1e-10`` (``PRECISION``) of the shortest segment's duration.  A stretch shorter than the
     sampling, between two held nodes, is not seen.  A grasp the grip cannot solve at
     all (degenerate contacts, ``status`` other than ``cannot-hold``) has no stretches:
     the path's degeneracies report it.

@@ -136,7 +136,7 @@ def load_grasps(source, *, file=None, max_bytes=DEFAULT_MAX_BYTES, reading=READI
     --------
     >>> load_grasps(b"contacts: []\\n", file="g.yaml")
     Traceback (most recent call last):
-    grasptwist.model.InputError: g.yaml:1:11: contacts: expected exactly 3 contacts, got 0
+    grasptwist.model.GraspFileError: g.yaml:1:11: contacts: expected exactly 3 contacts, got 0
     """
     entries = read_grasps(source, file=file, max_bytes=max_bytes, reading=reading)
     for entry in entries:
