@@ -210,6 +210,25 @@ def test_the_docs_examples_use_only_public_names():
     assert internal == []
 
 
+def members(obj):
+    """A public class's own public methods and properties (what ``:members:`` shows)."""
+    return [
+        v for k, v in vars(obj).items() if not k.startswith("_") and (inspect.isfunction(v) or isinstance(v, property))
+    ]
+
+
+def test_a_doctest_after_a_docstring_section_is_under_examples():
+    # numpydoc reads a doctest below "Returns" or "Raises" as part of that section
+    section = re.compile(r"^(Parameters|Returns|Raises|Attributes)\n-+$", re.M)
+    strays = []
+    for m, n, o in public_names():
+        for thing in [o, *(members(o) if inspect.isclass(o) else [])]:
+            doc = inspect.getdoc(thing) or ""
+            if section.search(doc) and ">>>" in doc and not re.search(r"^Examples\n-+$", doc, re.M):
+                strays.append(f"{m}.{n}" + ("" if thing is o else f" ({getattr(thing, '__name__', 'property')})"))
+    assert strays == []
+
+
 # --- the reference, built ----------------------------------------------------------------------
 
 

@@ -66,6 +66,9 @@ def setup(app):
     app.connect("autodoc-process-docstring", _constant_docs)
 
 
-# a public function or class without a docstring fails the build (the project's summaries start
-# with a formula or a name in code, so numpydoc's capital-letter and period checks stay off)
-numpydoc_validation_checks = {"GL08"}
+# a public function or class without a docstring (GL08), or a "Parameters" entry that is no
+# parameter (PR02: prose or a doctest read as one), fails the build.  The project's summaries
+# start with a formula or a name in code, so numpydoc's capital-letter and period checks stay
+# off; constants are documented by their `#:` comments, not by their type's docstring.
+numpydoc_validation_checks = {"GL08", "PR02"}
+numpydoc_validation_exclude = {r"\.[A-Z][A-Z_]+$"}

@@ -81,6 +81,8 @@ def contact_velocities(points, twist):
     -------
     (..., 3, 3) array, row ``i`` the velocity of contact ``i``.
 
+    Examples
+    --------
     >>> contact_velocities([[1.0, 0, 0], [0, 1, 0], [0, 0, 1]], [0, 0, 1.0, 0, 0, 0]).tolist()
     [[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 0.0]]
     """
@@ -125,6 +127,8 @@ class _Result:
         ValueError
             For a result of one grasp and one twist, which has no rows.
 
+        Examples
+        --------
         Paper Example 1 with two twists (a spin about z, a lift along z):
 
         >>> p = [[1, 0, 0], [-0.5, 0.866, 0], [-0.5, -0.866, 0]]

@@ -47,6 +47,8 @@ def joint_positions(hand, values):
     ValueError
         A name that is none of the hand's joints.
 
+    Examples
+    --------
     >>> from grasptwist.model import Hand
     >>> joint_positions(Hand((), ("a", "b"), None, None), {"b": 0.5}).tolist()
     [0.0, 0.5]
@@ -213,6 +215,8 @@ def track(hand, positions, points, segments, times, *, steps=16) -> HandTrack:
     -------
     HandTrack
 
+    Examples
+    --------
     >>> from grasptwist.model import Finger, Hand, Joint, Segment
     >>> slides = np.hstack((np.zeros((3, 3)), np.eye(3)))  # a Cartesian finger follows anything
     >>> f = Finger("1", None, tuple(Joint(n, "prismatic", None, None, None, None) for n in "xyz"), slides, np.zeros((3, 3)), None, 1.0, (0, 1, 2))

@@ -284,6 +284,8 @@ def hand_ik(hand, points, *, seed=None, tips=None, iterations=IK_ITERATIONS) -> 
     -------
     HandIK
 
+    Examples
+    --------
     A hand of three 2-link planar fingers (links 1 and 1), each reaching a
     point at distance ``sqrt 2`` (reached) or 3 (beyond its length 2, by 1):
 
@@ -420,6 +422,8 @@ def place_hand(hand, points, positions=None, *, seed=None, tips=None) -> HandIK:
     -------
     HandIK
 
+    Examples
+    --------
     >>> from grasptwist.model import Finger, Hand, Joint
     >>> s = np.array([[0, 0, 1.0, 0, 0, 0], [0, 0, 1.0, 0, -1.0, 0]])
     >>> joints = (Joint("a", "revolute", None, None, None, None), Joint("b", "revolute", None, None, None, None))

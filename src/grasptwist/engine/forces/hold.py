@@ -98,6 +98,9 @@ def grip_along(
     segments : sequence of Segment
     times : (T,) array-like
     safety : float
+        As for :func:`grip`.
+    tol : float
+        Degeneracy tolerance of the contacts.
 
     Returns
     -------
@@ -150,7 +153,10 @@ def cannot_hold(
 
     Parameters
     ----------
-    As :func:`grip_along`; ``times`` None: the segments' ends only.
+    points, normals, friction, mass, center_of_mass, gravity, segments, safety, tol
+        As for :func:`grip_along`.
+    times : (T,) array-like or None
+        The samples; None: the segments' ends only.
 
     Returns
     -------
