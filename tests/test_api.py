@@ -210,6 +210,19 @@ def test_the_docs_examples_use_only_public_names():
     assert internal == []
 
 
+def test_the_public_docstrings_examples_use_only_public_names():
+    # the reference shows them: a reader copies `from grasptwist.hand import Hand`, not the layer it lives in
+    internal = []
+    docs = [(m, module(m).__doc__) for m in PUBLIC]
+    for m, n, o in public_names():
+        if not inspect.ismodule(o):
+            docs += [(f"{m}.{n}", inspect.getdoc(x)) for x in [o, *(members(o) if inspect.isclass(o) else [])]]
+    for where, doc in docs:
+        code = "".join(e.source for e in doctest.DocTestParser().get_examples(doc or ""))
+        internal += [f"{where}: {what}" for _, what in grasptwist_names(code) if not is_public(what)]
+    assert internal == []
+
+
 def members(obj):
     """A public class's own public methods and properties (what ``:members:`` shows)."""
     return [

@@ -49,7 +49,7 @@ def joint_positions(hand, values):
 
     Examples
     --------
-    >>> from grasptwist.model import Hand
+    >>> from grasptwist.hand import Hand
     >>> joint_positions(Hand((), ("a", "b"), None, None), {"b": 0.5}).tolist()
     [0.0, 0.5]
     """
@@ -89,7 +89,7 @@ def finger_states(hand, positions=None):
 def velocity_limits(finger):
     """A finger's joint velocity limits, NaN for a joint without one: ``(n,)``.
 
-    >>> from grasptwist.model import Finger, Joint
+    >>> from grasptwist.hand import Finger, Joint
     >>> j = [Joint("a", "revolute", 2.0, None, None, None), Joint("b", "revolute", None, None, None, None)]
     >>> velocity_limits(Finger("1", None, tuple(j), None, None, None, 1.0, (0, 1))).tolist()
     [2.0, nan]
@@ -217,7 +217,8 @@ def track(hand, positions, points, segments, times, *, steps=16) -> HandTrack:
 
     Examples
     --------
-    >>> from grasptwist.model import Finger, Hand, Joint, Segment
+    >>> from grasptwist.hand import Finger, Hand, Joint
+    >>> from grasptwist.path import Segment
     >>> slides = np.hstack((np.zeros((3, 3)), np.eye(3)))  # a Cartesian finger follows anything
     >>> f = Finger("1", None, tuple(Joint(n, "prismatic", None, None, None, None) for n in "xyz"), slides, np.zeros((3, 3)), None, 1.0, (0, 1, 2))
     >>> h = Hand((f, f, f), ("x", "y", "z"), None, None)

@@ -289,7 +289,7 @@ def hand_ik(hand, points, *, seed=None, tips=None, iterations=IK_ITERATIONS) -> 
     A hand of three 2-link planar fingers (links 1 and 1), each reaching a
     point at distance ``sqrt 2`` (reached) or 3 (beyond its length 2, by 1):
 
-    >>> from grasptwist.model import Finger, Hand, Joint
+    >>> from grasptwist.hand import Finger, Hand, Joint
     >>> s = np.array([[0, 0, 1.0, 0, 0, 0], [0, 0, 1.0, 0, -1.0, 0]])
     >>> joints = (Joint("a", "revolute", None, None, None, None), Joint("b", "revolute", None, None, None, None))
     >>> tip = np.eye(4); tip[0, 3] = 2.0
@@ -424,7 +424,7 @@ def place_hand(hand, points, positions=None, *, seed=None, tips=None) -> HandIK:
 
     Examples
     --------
-    >>> from grasptwist.model import Finger, Hand, Joint
+    >>> from grasptwist.hand import Finger, Hand, Joint
     >>> s = np.array([[0, 0, 1.0, 0, 0, 0], [0, 0, 1.0, 0, -1.0, 0]])
     >>> joints = (Joint("a", "revolute", None, None, None, None), Joint("b", "revolute", None, None, None, None))
     >>> tip = np.eye(4); tip[0, 3] = 2.0

@@ -113,7 +113,7 @@ def grip_along(
     ``mu = 0.5``: level, each contact takes a third; tilted by ``atan(0.5)`` about x, every
     contact uses all of its friction; past it, the weight slides off.
 
-    >>> from grasptwist.model import Segment
+    >>> from grasptwist.path import Segment
     >>> p = [[1, 0, 0], [-0.5, 0.75**0.5, 0], [-0.5, -(0.75**0.5), 0]]
     >>> turn = [Segment(1.0, twist=[1, 0, 0, 0, 0, 0])]
     >>> poses, g = grip_along(p, [[0, 0, 1]] * 3, 0.5, 1.0, [0, 0, 0], [0, 0, -9.81], turn, [0, np.arctan(0.5) - 1e-9, 0.5])
@@ -168,7 +168,7 @@ def cannot_hold(
     The tray of :func:`grip_along` turned a full turn about x: it holds until it is
     tilted by ``atan(mu)``, and again from ``2 pi - atan(mu)``.
 
-    >>> from grasptwist.model import Segment
+    >>> from grasptwist.path import Segment
     >>> p = [[1, 0, 0], [-0.5, 0.75**0.5, 0], [-0.5, -(0.75**0.5), 0]]
     >>> turn = [Segment(2 * np.pi, twist=[1, 0, 0, 0, 0, 0])]
     >>> (s,) = cannot_hold(p, [[0, 0, 1]] * 3, 0.5, 1.0, [0, 0, 0], [0, 0, -9.81], turn, np.linspace(0, 2 * np.pi, 9))
