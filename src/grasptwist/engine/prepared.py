@@ -43,9 +43,9 @@ class PreparedGrasp:
 
     Attributes
     ----------
-    points, normals, wrist
-        The grasp (read-only; ``wrist`` may be None).
-    off_tangent, tangent
+    points, normals, wrist : (3, 3), (3, 3), (3,) or None
+        The grasp (read-only).
+    off_tangent, tangent : OffTangentResult or None, TangentResult
         The results for the zero twist: the bases, their Klein products,
         the conditioning, status and culprit (``off_tangent`` is None
         without a wrist).
