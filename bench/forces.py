@@ -10,7 +10,7 @@ disturbing moment; safety 1.5.  Baselines are Clarabel through its own Python AP
 - **single calls** (medians of wall time): ``gt.grip`` on one grasp, a prepared grasp's
   ``.grip(wrench)`` for new wrenches, and one Clarabel solve with its set-up;
 - **batched** (CPU time a grasp): ``gt.grip`` on ``n`` grasps at once against a loop of
-  Clarabel solves over the first ``--loop`` grasps, scaled; ``gt.force_closure``'s closure
+  Clarabel solves over the first ``--loop`` grasps, scaled; ``gt.forces.force_closure``'s closure
   friction against a bisection of Clarabel closure-margin solves (``--closure-loop``);
   Ferrari-Canny epsilon against the bare ``scipy.spatial.ConvexHull`` calls it makes;
 - **agreement** on the loop's grasps: verdicts, total normal force, closure friction;
@@ -76,7 +76,7 @@ def single(p, n, w, mu, count):
 def batched(p, n, w, mu, k, kc):
     size = len(p)
     g, t_grip = cpu(lambda: gt.grip(p, n, w, mu, safety=SAFETY))
-    c, t_closure = cpu(lambda: gt.force_closure(p, n, mu))
+    c, t_closure = cpu(lambda: gt.forces.force_closure(p, n, mu))
     refs, t_loop = cpu(lambda: [least_grip(p[i], n[i], w[i], mu[i], SAFETY)[0] for i in range(k)])
     ref_closure, t_bisect = cpu(lambda: np.array([closure_friction(p[i], n[i]) for i in range(kc)]))
     per = (t_loop / k, t_bisect / kc)
@@ -99,7 +99,7 @@ def batched(p, n, w, mu, k, kc):
         f"max rel diff {rel:.1e}; closure friction max rel diff {crel:.1e}, none-ness "
         f"{(np.isnan(c.closure_friction[:kc]) == ~finite).mean():.2%}"
     )
-    ok, bad = g.ok, g.status == gt.ForceStatus.CANNOT_HOLD
+    ok, bad = g.ok, g.status == gt.forces.Status.CANNOT_HOLD
     made = np.concatenate((g.force[ok].sum(axis=1), np.cross(p[ok], g.force[ok]).sum(axis=1)), axis=1)
     gap = np.abs(g.gap[ok]) / g.total_normal_force[ok]
     yw = np.einsum("ni,ni->n", g.certificate[bad], w[bad])
@@ -127,7 +127,7 @@ def epsilon(p, n, mu, m):
 
     scipy.spatial.ConvexHull = timed
     try:
-        e, t_engine = cpu(lambda: gt.force_closure(p[:m], n[:m], mu[:m], quality=True))
+        e, t_engine = cpu(lambda: gt.forces.force_closure(p[:m], n[:m], mu[:m], quality=True))
     finally:
         scipy.spatial.ConvexHull = hull
     hulls = len(spent)

@@ -57,7 +57,7 @@ def wrench_of(points, forces):
 def test_manipulating_forces_are_the_pseudo_inverse_and_make_the_wrench():
     p, _, w, _ = grasps(200, 1)
     p = p * 3 + 5  # away from the origin: the closed form works about the centroid
-    r = gt.manipulating_forces(p, w)
+    r = gt.forces.manipulating_forces(p, w)
     assert (r.status == 0).all()
     ref = manipulating_reference(p, w)
     assert np.abs(r.force - ref).max() <= 1e-12 * np.abs(ref).max()
@@ -65,47 +65,47 @@ def test_manipulating_forces_are_the_pseudo_inverse_and_make_the_wrench():
 
 
 def test_conditioning_is_one_for_an_equilateral_triangle_and_falls_like_the_offset_from_a_line():
-    assert gt.manipulating_forces(EQ, np.zeros(6)).conditioning == pytest.approx(1.0, abs=1e-15)
+    assert gt.forces.manipulating_forces(EQ, np.zeros(6)).conditioning == pytest.approx(1.0, abs=1e-15)
     offsets = np.array([1e-2, 1e-4, 1e-6])
     p = np.zeros((3, 3, 3))
     p[:, 1, 0], p[:, 2, 0], p[:, 2, 1] = 1.0, 2.0, offsets
-    c = gt.manipulating_forces(p, np.zeros(6)).conditioning
+    c = gt.forces.manipulating_forces(p, np.zeros(6)).conditioning
     assert c / offsets == pytest.approx(np.full(3, c[0] / offsets[0]), rel=1e-3)  # linear in the offset
 
 
 @pytest.mark.parametrize(
     "points, status, culprit",
     [
-        ([[0, 0, 0], [1, 0, 0], [2, 0, 0]], gt.ForceStatus.COLLINEAR_CONTACTS, -1),
-        ([[0, 0, 0], [1, 0, 0], [1, 0, 0]], gt.ForceStatus.COINCIDENT_CONTACTS, 0),
-        ([[0, 0, 0], [1, 0, np.nan], [0, 1, 0]], gt.ForceStatus.NONFINITE_INPUT, -1),
+        ([[0, 0, 0], [1, 0, 0], [2, 0, 0]], gt.forces.Status.COLLINEAR_CONTACTS, -1),
+        ([[0, 0, 0], [1, 0, 0], [1, 0, 0]], gt.forces.Status.COINCIDENT_CONTACTS, 0),
+        ([[0, 0, 0], [1, 0, np.nan], [0, 1, 0]], gt.forces.Status.NONFINITE_INPUT, -1),
     ],
     ids=["collinear", "coincident", "nan"],
 )
 def test_degenerate_contacts_get_a_status_and_nan_never_an_exception(points, status, culprit):
     # a moment about x: about the collinear contacts' line, which no finger force makes
-    r = gt.manipulating_forces(points, [1, 0, 0, 1, 0, 1])
+    r = gt.forces.manipulating_forces(points, [1, 0, 0, 1, 0, 1])
     assert (int(r.status), int(r.culprit)) == (status, culprit)
     assert np.isnan(r.force).all()
     g = gt.grip(points, [[1, 0, 0]] * 3, [1, 0, 0, 1, 0, 1], 0.5)
     assert int(g.status) == status and np.isnan(g.force).all()
-    assert int(gt.force_closure(points, [[1, 0, 0]] * 3).status) == status
+    assert int(gt.forces.force_closure(points, [[1, 0, 0]] * 3).status) == status
 
 
 def test_squeezes_span_the_null_space_and_are_orthogonal_to_the_manipulating_forces():
     p, _, w, _ = grasps(50, 2)
     s = np.random.default_rng(0).normal(size=(50, 3))
-    f = gt.squeeze_forces(p, s)
+    f = gt.forces.squeeze_forces(p, s)
     assert np.abs(wrench_of(p, f)).max() < 1e-13
-    assert np.abs(np.einsum("nij,nij->n", f, gt.manipulating_forces(p, w).force)).max() < 1e-12
+    assert np.abs(np.einsum("nij,nij->n", f, gt.forces.manipulating_forces(p, w).force)).max() < 1e-12
     # three independent squeezes: the null space of the 6 x 9 grasp map, which has rank 6
-    basis = np.stack([gt.squeeze_forces(p, e).reshape(50, 9) for e in np.eye(3)], axis=-1)
+    basis = np.stack([gt.forces.squeeze_forces(p, e).reshape(50, 9) for e in np.eye(3)], axis=-1)
     assert (np.linalg.matrix_rank(basis) == 3).all()
-    assert (np.linalg.matrix_rank(gt.grasp_map(p)) == 6).all()
+    assert (np.linalg.matrix_rank(gt.forces.grasp_map(p)) == 6).all()
 
 
 def test_a_positive_squeeze_pushes_its_two_fingers_towards_each_other():
-    f = gt.squeeze_forces(EQ, [1.0, 0, 0])  # along the side through contacts 2 and 3
+    f = gt.forces.squeeze_forces(EQ, [1.0, 0, 0])  # along the side through contacts 2 and 3
     assert np.allclose(f[0], 0)
     assert f[1] @ (EQ[2] - EQ[1]) > 0 and f[2] @ (EQ[1] - EQ[2]) > 0
     assert (np.einsum("ij,ij->i", f, -EQ)[1:] > 0).all()  # inward normals: both fingers push
@@ -120,7 +120,7 @@ def test_a_squeeze_half_is_the_wrench_along_sigma_and_does_no_work_on_the_other_
     e = squeeze_directions(p)
     for i in range(3):
         j = (i + 1) % 3
-        half = gt.squeeze_forces(p, np.eye(3)[i])[:, j]  # the force on contact j of a unit squeeze i
+        half = gt.forces.squeeze_forces(p, np.eye(3)[i])[:, j]  # the force on contact j of a unit squeeze i
         wrench = np.concatenate((half, np.cross(p[:, j], half)), axis=-1)
         assert np.abs(wrench - sigma[:, i]).max() < 1e-12
         assert np.abs(e[:, i] - sigma[:, i, :3]).max() < 1e-12
@@ -130,7 +130,7 @@ def test_a_squeeze_half_is_the_wrench_along_sigma_and_does_no_work_on_the_other_
             for prod in products:
                 assert (np.abs(prod).max() < 1e-12) if m != i else (np.abs(prod).min() > 1e-6)
     twist = np.random.default_rng(1).normal(size=(30, 6))
-    f = gt.squeeze_forces(p, [1.0, 0, 0])
+    f = gt.forces.squeeze_forces(p, [1.0, 0, 0])
     power = np.einsum("nk,nk->n", f[:, 1], field_at(twist, p[:, 1]))
     assert np.abs(power - klein(sigma[:, 0], twist)).max() < 1e-12
     assert np.abs(power + np.einsum("nk,nk->n", f[:, 2], field_at(twist, p[:, 2]))).max() < 1e-12
@@ -165,7 +165,8 @@ def test_the_least_grip_equals_clarabels_and_holds(count):
     assert np.abs(wrench_of(p[ok], g.force[ok]) - w[ok]).max() <= 1e-9 * np.abs(w).max()
     assert (g.friction_used[ok] <= mu[ok] / 1.2 * (1 + 1e-9)).all() and (g.normal_force[ok] > 0).all()
     assert (
-        np.abs(g.force - g.manipulating - gt.squeeze_forces(p, g.squeeze))[ok].max() < 1e-12 * np.abs(g.force[ok]).max()
+        np.abs(g.force - g.manipulating - gt.forces.squeeze_forces(p, g.squeeze))[ok].max()
+        < 1e-12 * np.abs(g.force[ok]).max()
     )
     assert g.safety == 1.2
 
@@ -177,21 +178,21 @@ def test_frictionless_contacts_hold_only_what_the_normals_make():
     assert g.ok and g.total_normal_force == pytest.approx(2.0, rel=1e-12)
     assert g.normal_force == pytest.approx([0, 1, 1], abs=1e-12)
     lift = gt.grip(EQ, -EQ, [0, 0, G, 0, 0, 0], 0.0)
-    assert int(lift.status) == gt.ForceStatus.CANNOT_HOLD and int(lift.culprit) >= 0
+    assert int(lift.status) == gt.forces.Status.CANNOT_HOLD and int(lift.culprit) >= 0
     mixed = gt.grip(EQ, -EQ, [0, 0, G, 0, 0, 0], [0.0, 0.5, 0.5])
-    assert int(mixed.status) == gt.ForceStatus.MIXED_FRICTIONLESS
+    assert int(mixed.status) == gt.forces.Status.MIXED_FRICTIONLESS
 
 
 def test_cannot_hold_says_which_cone_or_that_the_wrench_needs_pulling():
     # fingers under a tray (normals up): pressing the tray down needs them to pull
     down = gt.grip(EQ, [[0, 0, 1]] * 3, [0, 0, -1, 0, 0, 0], 0.5)
-    assert (int(down.status), int(down.culprit)) == (gt.ForceStatus.CANNOT_HOLD, -1)
-    assert "pull" in gt.force_status_message(down.status, down.culprit)
+    assert (int(down.status), int(down.culprit)) == (gt.forces.Status.CANNOT_HOLD, -1)
+    assert "pull" in gt.forces.status_message(down.status, down.culprit)
     # Example 2 below its closure friction cannot lift the polyhedron off the three faces' common corner
     far = gt.grip(EX2, np.eye(3), [-1, -1, -1, 0, 0, 0], 0.3)
-    assert int(far.status) == gt.ForceStatus.CANNOT_HOLD and int(far.culprit) >= 0
+    assert int(far.status) == gt.forces.Status.CANNOT_HOLD and int(far.culprit) >= 0
     assert least_grip(EX2, np.eye(3), [-1, -1, -1, 0, 0, 0], 0.3)[0] is None
-    assert "cone at contact" in gt.force_status_message(far.status, far.culprit)
+    assert "cone at contact" in gt.forces.status_message(far.status, far.culprit)
 
 
 def test_a_batch_gives_each_row_what_it_gives_alone():
@@ -210,7 +211,7 @@ def test_a_batch_gives_each_row_what_it_gives_alone():
 def test_example_2_closes_above_one_over_root_two():
     """The projected normals meet at the contacts' centroid and each normal makes atan(1/sqrt(2)) with the
     contacts' plane x + y + z = 4: the cones reach the plane only for mu > tan(phi) = 1/sqrt(2)."""
-    c = gt.force_closure(EX2, np.eye(3), friction=[[0.7], [0.71]])
+    c = gt.forces.force_closure(EX2, np.eye(3), friction=[[0.7], [0.71]])
     assert c.closure_friction == pytest.approx(np.full(2, 0.5**0.5), rel=1e-12)
     assert c.force_closure.tolist() == [False, True]
 
@@ -218,7 +219,7 @@ def test_example_2_closes_above_one_over_root_two():
 @pytest.mark.parametrize("count", [10, pytest.param(300, marks=pytest.mark.slow)])
 def test_closure_friction_equals_clarabels(count):
     p, n, _, _ = grasps(count, 6, spread=0.6)
-    c = gt.force_closure(p, n)
+    c = gt.forces.force_closure(p, n)
     ref = np.array([clarabel_closure_friction(p[k], n[k]) for k in range(count)])
     assert (np.isnan(ref) == np.isnan(c.closure_friction)).all() and np.isfinite(ref).sum() >= 0.6 * count
     ok = np.isfinite(ref)
@@ -230,14 +231,14 @@ def test_a_normal_in_the_contacts_plane_is_ideal_for_closure_but_degenerate_for_
     tangent method cannot move a contact along such a normal; normals at right angles to the plane are the
     tangent method's best case and never close (internal forces lie in the plane)."""
     twist = [0, 0, 1, 0, 0, 0]
-    assert gt.force_closure(EQ, -EQ).closure_friction <= 1e-12
+    assert gt.forces.force_closure(EQ, -EQ).closure_friction <= 1e-12
     # three coplanar normal lines through one point: rank 2, the first of the in-plane failures it checks
     assert int(gt.decompose_tangent(EQ, -EQ, twist).status) == gt.Status.NORMALS_RANK_DEFICIENT
     up = [[0, 0, 1]] * 3
     tangent = gt.decompose_tangent(EQ, up, twist)
     assert int(tangent.status) == gt.Status.OK and float(tangent.conditioning) > 0.5
-    c = gt.force_closure(EQ, up, friction=10.0)
-    assert (int(c.status), int(c.culprit)) == (gt.ForceStatus.NO_CLOSURE, 0)
+    c = gt.forces.force_closure(EQ, up, friction=10.0)
+    assert (int(c.status), int(c.culprit)) == (gt.forces.Status.NO_CLOSURE, 0)
     assert np.isnan(c.closure_friction) and not c.force_closure
 
 
@@ -245,11 +246,11 @@ def test_two_fingers_squeezing_with_the_third_idle_is_not_closure():
     # contact 3's normal is steep (tan phi = 3): below mu = 3 only contacts 1 and 2 can squeeze
     n = -EQ.copy()
     n[2] = unit(n[2] + [0, 0, 3])
-    assert gt.force_closure(EQ, n).closure_friction == pytest.approx(3.0, rel=1e-9)
+    assert gt.forces.force_closure(EQ, n).closure_friction == pytest.approx(3.0, rel=1e-9)
 
 
 def test_epsilon_is_zero_outside_closure_and_grows_with_friction():
-    c = gt.force_closure(EX2, np.eye(3), friction=[[0.6], [0.8], [1.2]], quality=True)
+    c = gt.forces.force_closure(EX2, np.eye(3), friction=[[0.6], [0.8], [1.2]], quality=True)
     assert c.epsilon[0] == 0 and 0 < c.epsilon[1] < c.epsilon[2]
     assert epsilon_quality(EQ, -EQ, [0.0] * 3) == 0.0  # flat hull (Qhull's error): no closure
 
@@ -269,8 +270,8 @@ def test_every_figure_is_unchanged_by_rigid_motions_and_scaling():
     assert np.abs(b.total_normal_force[ok] / a.total_normal_force[ok] - 1).max() < 1e-6
     assert np.abs(b.manipulating - a.manipulating @ rot.T)[ok].max() < 1e-9 * np.abs(a.manipulating).max()
     assert np.abs(b.conditioning - a.conditioning).max() < 1e-12
-    ca = gt.force_closure(p, n, mu, quality=True)
-    cb = gt.force_closure(p2, n2, mu, quality=True)
+    ca = gt.forces.force_closure(p, n, mu, quality=True)
+    cb = gt.forces.force_closure(p2, n2, mu, quality=True)
     assert np.abs(cb.closure_friction / ca.closure_friction - 1).max() < 1e-9
     assert (ca.force_closure == cb.force_closure).all()
     assert np.abs(cb.epsilon - ca.epsilon).max() < 1e-9
@@ -290,7 +291,7 @@ def test_every_figure_is_unchanged_by_rigid_motions_and_scaling():
 )
 def test_check_wrench(value, message):
     with pytest.raises(ValueError, match=message):
-        gt.check_wrench(value)
+        gt.forces.check_wrench(value)
 
 
 @pytest.mark.parametrize(
@@ -303,20 +304,20 @@ def test_check_wrench(value, message):
 )
 def test_check_friction(value, message):
     with pytest.raises(ValueError, match=message):
-        gt.check_friction(value)
+        gt.forces.check_friction(value)
 
 
 @pytest.mark.parametrize("value", [0.99, float("nan"), float("inf"), "x", True, None])
 def test_check_safety(value):
     with pytest.raises(ValueError, match=r"^safety must be a finite number >= 1, got "):
-        gt.check_safety(value)
+        gt.forces.check_safety(value)
 
 
 def test_force_closure_arguments():
     with pytest.raises(ValueError, match=r"^quality=True needs the grasp's friction"):
-        gt.force_closure(EQ, -EQ, quality=True)
+        gt.forces.force_closure(EQ, -EQ, quality=True)
     with pytest.raises(ValueError, match=r"^cone_edges must be an integer from 3 to 64, got 2$"):
-        gt.force_closure(EQ, -EQ, 0.5, quality=True, cone_edges=2)
+        gt.forces.force_closure(EQ, -EQ, 0.5, quality=True, cone_edges=2)
 
 
 @pytest.mark.parametrize("value", [2, 65, 10**9, 3.5, float("nan"), float("inf"), True, "8", None])
@@ -333,12 +334,12 @@ ANTIPODAL_N = np.array([[-1.0, 0, 0], [1, 0, 0], [0, -1, 0]])
 
 
 def test_an_antipodal_pair_has_an_epsilon_that_turns_with_the_grasp_and_never_raises_in_a_batch():
-    c = gt.force_closure(ANTIPODAL, ANTIPODAL_N, 0.6, quality=True)
+    c = gt.forces.force_closure(ANTIPODAL, ANTIPODAL_N, 0.6, quality=True)
     assert c.status == 0 and c.force_closure and c.epsilon > 0.05
     # the pyramids' first edges follow the grasp: a rigid motion leaves epsilon as it is
     q, _ = np.linalg.qr(np.random.default_rng(3).normal(size=(3, 3)))
     rot = q * np.sign(np.linalg.det(q))
-    moved = gt.force_closure(ANTIPODAL @ rot.T + [1, -2, 0.5], ANTIPODAL_N @ rot.T, 0.6, quality=True)
+    moved = gt.forces.force_closure(ANTIPODAL @ rot.T + [1, -2, 0.5], ANTIPODAL_N @ rot.T, 0.6, quality=True)
     assert moved.epsilon == pytest.approx(float(c.epsilon), rel=1e-9)
     # the first edge of contact 1 points at contact 3 (its next contact lies on its normal's line)
     b1 = first_edges(ANTIPODAL, ANTIPODAL_N)
@@ -346,37 +347,37 @@ def test_an_antipodal_pair_has_an_epsilon_that_turns_with_the_grasp_and_never_ra
     # one such row among many: every row computed, each as alone
     p, n, _, mu = grasps(30, 5)
     p[17], n[17], mu[17] = ANTIPODAL, ANTIPODAL_N, 0.6
-    batch = gt.force_closure(p, n, mu, quality=True)
+    batch = gt.forces.force_closure(p, n, mu, quality=True)
     assert batch.epsilon[17] == pytest.approx(float(c.epsilon), rel=1e-12)
     assert np.isfinite(batch.epsilon).all() and (batch.status[batch.force_closure] == 0).all()
 
 
 def test_antipodal_coplanar_and_coincident_contacts_through_every_force_function():
     lift = [0, 0, 1.0, 0, 0, 0]
-    m = gt.manipulating_forces(ANTIPODAL, lift)
-    np.testing.assert_allclose(gt.grasp_map(ANTIPODAL) @ m.force.reshape(9), lift, atol=1e-12)
+    m = gt.forces.manipulating_forces(ANTIPODAL, lift)
+    np.testing.assert_allclose(gt.forces.grasp_map(ANTIPODAL) @ m.force.reshape(9), lift, atol=1e-12)
     g = gt.grip(ANTIPODAL, ANTIPODAL_N, lift, 0.6)
     assert g.status == 0 and (g.friction_used <= 0.6 + 1e-9).all()
-    np.testing.assert_allclose(gt.grasp_map(ANTIPODAL) @ g.force.reshape(9), lift, atol=1e-9)
+    np.testing.assert_allclose(gt.forces.grasp_map(ANTIPODAL) @ g.force.reshape(9), lift, atol=1e-9)
     # coplanar: the normals in the contacts' plane (the ball's equator)
-    c = gt.force_closure(EQ, -EQ, 0.5, quality=True)
+    c = gt.forces.force_closure(EQ, -EQ, 0.5, quality=True)
     assert c.status == 0 and c.closure_friction == pytest.approx(0, abs=1e-9) and c.epsilon > 0
     # coincident: a status, NaN numbers and epsilon 0, never an exception
     same = np.array([[1.0, 0, 0], [1, 0, 0], [0, 1, 0]])
-    c = gt.force_closure(same, -same, 0.5, quality=True)
+    c = gt.forces.force_closure(same, -same, 0.5, quality=True)
     assert (int(c.status), int(c.culprit), float(c.epsilon), bool(c.force_closure)) == (2, 2, 0.0, False)
-    assert gt.grip(same, -same, lift, 0.5).status == 2 == gt.manipulating_forces(same, lift).status
+    assert gt.grip(same, -same, lift, 0.5).status == 2 == gt.forces.manipulating_forces(same, lift).status
     _, held = grip_along(ANTIPODAL, ANTIPODAL_N, 0.6, 0.1, [0, 0, 0], [0, 0, -G], [Segment(1.0, twist=[0] * 6)], [0, 1])
     assert held.status.tolist() == [0, 0]
 
 
 def test_huge_and_infinite_friction_mean_what_they_say():
     # the ball's tripod closes above mu = 0.4663; every friction above it closes it, however large
-    tripod = gt.force_closure(TRIPOD, TRIPOD_N, [[0.3], [0.5], [10], [1e200], [np.inf]], quality=True)
+    tripod = gt.forces.force_closure(TRIPOD, TRIPOD_N, [[0.3], [0.5], [10], [1e200], [np.inf]], quality=True)
     assert tripod.force_closure.tolist() == [False, True, True, True, True]
     assert tripod.closure_friction == pytest.approx([0.46632] * 5, abs=1e-5)
     # epsilon grows like mu (the pyramids' tangential wrenches): per unit of mu the same at 1e10 and 1e200
-    big = gt.force_closure(TRIPOD, TRIPOD_N, 1e10, quality=True).epsilon
+    big = gt.forces.force_closure(TRIPOD, TRIPOD_N, 1e10, quality=True).epsilon
     assert tripod.epsilon[3] / 1e200 == pytest.approx(float(big) / 1e10, rel=1e-6)
     assert np.isnan(tripod.epsilon[4])  # an infinite cone has no finite pyramid
     g = gt.grip(TRIPOD, TRIPOD_N, [[0, 0, G, 0, 0, 0]] * 2, [[1e200], [np.inf]])
@@ -384,9 +385,9 @@ def test_huge_and_infinite_friction_mean_what_they_say():
 
 
 def test_an_overflowing_result_is_a_status_never_an_ok_row_with_infinity():
-    m = gt.manipulating_forces(EQ, [[1e308, 0, 0, 0, 0, 1e308], [0, 0, G, 0, 0, 0]])
+    m = gt.forces.manipulating_forces(EQ, [[1e308, 0, 0, 0, 0, 1e308], [0, 0, G, 0, 0, 0]])
     assert m.status.tolist() == [9, 0] and np.isnan(m.force[0]).all() and np.isfinite(m.force[1]).all()
-    assert gt.force_status_message(9).startswith("the result overflows double precision")
+    assert gt.forces.status_message(9).startswith("the result overflows double precision")
     g = checked_grip(gt.grip(EQ, -EQ, [[0, 0, 9.81e300, 0, 0, 0], [0, 0, G, 0, 0, 0], [0] * 6], 0.5))
     assert g.status.tolist() == [9, 0, 0] and np.isnan(g.total_normal_force[0])
     assert g.total_normal_force[1] == pytest.approx(2 * G) and g.friction_used[2].tolist() == [0.0] * 3
@@ -450,7 +451,7 @@ def test_every_grip_carries_a_certificate_that_numpy_alone_verifies(seed):
     p, n, w, mu = grasps(400, seed)
     g = gt.grip(p, n, w, mu, safety=1.3)
     u, limit = unit(n), mu / 1.3
-    ok, bad = g.ok, g.status == gt.ForceStatus.CANNOT_HOLD
+    ok, bad = g.ok, g.status == gt.forces.Status.CANNOT_HOLD
     assert ok.sum() > 100 and bad.sum() > 50 and (ok | bad).all()
     assert np.isnan(g.certificate[ok]).all() and np.isfinite(g.dual[ok]).all() and np.isnan(g.dual[bad]).all()
     total = g.total_normal_force[ok]
@@ -500,7 +501,7 @@ def test_frictionless_grips_carry_certificates_too():
     assert lift.certificate @ [0, 0, G, 0, 0, 0] > 0 and (nu @ lift.certificate <= 1e-12).all()
     up = [[0, 0, 1.0]] * 3  # a tray on three finger-tips: rank 3 normal lines, pressing it down needs pulling
     pull = gt.grip(EQ, up, [0, 0, -1, 0, 0, 0], 0.0)
-    assert (int(pull.status), int(pull.culprit)) == (gt.ForceStatus.CANNOT_HOLD, -1)
+    assert (int(pull.status), int(pull.culprit)) == (gt.forces.Status.CANNOT_HOLD, -1)
     lines = np.concatenate((up, np.cross(EQ, up)), axis=1)
     assert pull.certificate @ [0, 0, -1, 0, 0, 0] > 0 and (lines @ pull.certificate <= 1e-12).all()
 
@@ -550,11 +551,11 @@ def test_collinear_contacts_exert_every_wrench_in_the_grasp_maps_range():
     g = gt.grip(LINE, ACROSS, push, 0.5)
     assert g.ok and float(g.total_normal_force) == pytest.approx(1.0, rel=1e-8)
     assert np.abs(wrench_of(LINE, g.force) - push).max() < 1e-9 and np.isnan(g.squeeze).all()
-    assert abs(float(g.gap)) < 1e-8 and int(gt.manipulating_forces(LINE, push).status) == 0
+    assert abs(float(g.gap)) < 1e-8 and int(gt.forces.manipulating_forces(LINE, push).status) == 0
     twist = gt.grip(LINE, ACROSS, [0, 0, 0, 0.01, 0, 0], 0.5)
-    assert int(twist.status) == gt.ForceStatus.COLLINEAR_CONTACTS
+    assert int(twist.status) == gt.forces.Status.COLLINEAR_CONTACTS
     y = twist.certificate
-    assert y @ [0, 0, 0, 0.01, 0, 0] > 0 and np.abs(y @ gt.grasp_map(LINE)).max() < 1e-12
+    assert y @ [0, 0, 0, 0.01, 0, 0] > 0 and np.abs(y @ gt.forces.grasp_map(LINE)).max() < 1e-12
 
 
 def test_collinear_contacts_agree_with_clarabel():
@@ -617,9 +618,9 @@ def test_collinear_frictionless_contacts_stay_unsolved_and_a_batch_of_odd_rows_n
             np.array([[0.0] * 3, [0.5] * 3, [0.5] * 3, [np.inf] * 3]),
         )
     assert g.status.tolist() == [
-        gt.ForceStatus.COLLINEAR_CONTACTS,
-        gt.ForceStatus.NONFINITE_INPUT,
-        gt.ForceStatus.ZERO_NORMAL,
-        gt.ForceStatus.CANNOT_HOLD,
+        gt.forces.Status.COLLINEAR_CONTACTS,
+        gt.forces.Status.NONFINITE_INPUT,
+        gt.forces.Status.ZERO_NORMAL,
+        gt.forces.Status.CANNOT_HOLD,
     ]
     assert np.isnan(g.certificate[:3]).all() and g.certificate[3] @ [0, 0, -1, 0, 0, 0] > 0

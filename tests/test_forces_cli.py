@@ -90,7 +90,7 @@ def test_command_line_wrench_friction_safety_and_quality():
     assert push["grip"]["total_normal_force"] == pytest.approx(float(engine.total_normal_force), rel=1e-12)
     assert push["grip"]["safety"] == 1.1
     assert max(push["grip"]["friction_used"]) <= 0.8 / 1.1 + 1e-9
-    c = gt.force_closure(g.points, g.normals, 0.8 / 1.1, quality=True)  # judged with mu / safety
+    c = gt.forces.force_closure(g.points, g.normals, 0.8 / 1.1, quality=True)  # judged with mu / safety
     assert up["closure"]["force_closure"] is True and up["closure"]["safety"] == 1.1
     assert up["closure"]["epsilon"] == pytest.approx(float(c.epsilon), rel=1e-9) and up["closure"]["epsilon"] > 0
 

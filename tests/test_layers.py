@@ -24,7 +24,16 @@ LAYERS = [
     ["grasptwist.run"],  # batches, workers, streams, the -o target: engine over inputs into outputs
     ["grasptwist.cli"],  # the command line
     # the public facades and entry points: nothing inside the package imports them
-    ["grasptwist", "grasptwist.hand", "grasptwist.path", "grasptwist.dask", "grasptwist.__main__"],
+    [
+        "grasptwist",
+        "grasptwist.screws",
+        "grasptwist.hand",
+        "grasptwist.forces",
+        "grasptwist.path",
+        "grasptwist.pictures",
+        "grasptwist.dask",
+        "grasptwist.__main__",
+    ],
 ]
 
 #: Beyond the layers: pictures are drawn from the engine's geometry only; reading
@@ -32,7 +41,7 @@ LAYERS = [
 FORBIDDEN = {"grasptwist.plot": ("grasptwist.io", "grasptwist.output", "grasptwist.results", "grasptwist.run")}
 
 #: Facades only re-export.
-FACADES = ("grasptwist.hand", "grasptwist.path")
+FACADES = ("grasptwist.screws", "grasptwist.hand", "grasptwist.forces", "grasptwist.path", "grasptwist.pictures")
 
 
 def module_name(path: Path) -> str:

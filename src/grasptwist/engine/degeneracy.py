@@ -136,6 +136,8 @@ def status_message(status, culprit=-1, names=("1", "2", "3")) -> str:
     names : sequence of 3 str
         Contact names to use in the message.
 
+    Examples
+    --------
     >>> status_message(Status.COINCIDENT_CONTACTS, 0)
     'contacts 2 and 3 coincide, so Sigma_1 has no axis: three distinct contacts are needed'
     """

@@ -243,6 +243,8 @@ def check_segments(segments) -> tuple[Segment, ...]:
     ValueError
         Naming the bad field, e.g. ``segments[1].duration``.
 
+    Examples
+    --------
     >>> check_segments([Segment(2.0, twist=[0, 0, 1, 0, 0, 0])])[0].twist.tolist()
     [0.0, 0.0, 1.0, 0.0, 0.0, 0.0]
     >>> check_segments([Segment(0.0, twist=[0, 0, 1, 0, 0, 0])])

@@ -43,9 +43,9 @@ class PreparedGrasp:
 
     Attributes
     ----------
-    points, normals, wrist
-        The grasp (read-only; ``wrist`` may be None).
-    off_tangent, tangent
+    points, normals, wrist : (3, 3), (3, 3), (3,) or None
+        The grasp (read-only).
+    off_tangent, tangent : OffTangentResult or None, TangentResult
         The results for the zero twist: the bases, their Klein products,
         the conditioning, status and culprit (``off_tangent`` is None
         without a wrist).
@@ -112,7 +112,7 @@ class PreparedGrasp:
         Returns
         -------
         Resolution
-            What :func:`~grasptwist.engine.decompose.resolve` gives for this
+            What :func:`~grasptwist.resolve` gives for this
             grasp and twist: the same statuses, bases and Klein products,
             and amplitudes and velocities equal but for the last few units
             in the last place (the matrix product adds the same terms in
@@ -215,7 +215,7 @@ def prepare(points, normals, wrist=None, *, tol=DEGENERACY_TOL) -> PreparedGrasp
     -------
     PreparedGrasp
         Its :meth:`~PreparedGrasp.resolve` gives, for any twist, what
-        :func:`~grasptwist.engine.decompose.resolve` gives on this grasp.
+        :func:`~grasptwist.resolve` gives on this grasp.
 
     Examples
     --------

@@ -103,7 +103,7 @@ def track_finger(
     Parameters
     ----------
     home_screws, home_points, home_tip
-        The finger at home, as :func:`.kinematics.forward_kinematics` takes
+        The finger at home, as :func:`~grasptwist.hand.forward_kinematics` takes
         them (``home_tip`` the tip link's ``(4, 4)`` pose).
     positions : (n,) array
         Joint positions at ``t = 0``, where the tip touches ``contact``.

@@ -1,6 +1,6 @@
 """Parquet data sets in: flat number columns, read a row group at a time.
 
-Columns (see the README, "Data sets of arrays"): ``p1_x p1_y p1_z ...
+Columns (see docs/guide/data-sets.md, "Parquet"): ``p1_x p1_y p1_z ...
 p3_z`` (the contact points) and ``n1_x ... n3_z`` (their normals); optional
 ``c_x c_y c_z`` (the wrist), ``w_x w_y w_z v_x v_y v_z`` (the twist ``(omega; v)``) and ``name``
 (text or integers).  Numbers may be any float or integer type; nulls read
@@ -87,6 +87,25 @@ _SHAPES = {
 def grasp_table(points, normals, wrist=None, twist=None, names=None):
     """Grasps as an Arrow table with the columns above: what ``pyarrow.parquet.write_table`` makes a data set of.
 
+    Needs pyarrow (the extra ``grasptwist[parquet]``).
+
+    Parameters
+    ----------
+    points, normals : (N, 3, 3) array_like
+        Contact points and normals: columns ``p1_x ... p3_z``, ``n1_x ... n3_z``.
+    wrist : (N, 3) array_like, optional
+        Columns ``c_x c_y c_z``; without them no row has a wrist.
+    twist : (N, 6) array_like, optional
+        ``(omega; v)``, columns ``w_x ... v_z``; without them the command's ``--twist``.
+    names : sequence of N str or int, optional
+        Column ``name``; without it a row is named by its index.
+
+    Returns
+    -------
+    pyarrow.Table
+
+    Examples
+    --------
     >>> t = grasp_table(np.zeros((2, 3, 3)), np.ones((2, 3, 3)), twist=np.zeros((2, 6)), names=["a", "b"])
     >>> t.num_rows, t.column_names[:2], t.column_names[-7:]
     (2, ['p1_x', 'p1_y'], ['w_x', 'w_y', 'w_z', 'v_x', 'v_y', 'v_z', 'name'])

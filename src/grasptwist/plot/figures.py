@@ -111,8 +111,8 @@ def twist_figure(grasp, twists=None, *, method: str | None = None, active: int =
     active : int
         The twist shown first.
     meshes : sequence of (vertices, faces)
-        The hand's link meshes (:func:`grasptwist.io.urdf_meshes.hand_meshes`),
-        one legend entry shown with every twist.
+        The hand's link meshes (a URDF hand's, as the ``plot`` command reads
+        them), one legend entry shown with every twist.
     forces : (3, 3) array or None
         The grip forces drawn with a grasp's friction cones (the engine's, from the caller).
 

@@ -72,7 +72,7 @@ for (const div of document.querySelectorAll("div.grasptwist-figure")) {
 def grasp_page(grasp, *, twists=None, method=None, active=0, meshes=(), followed=(), forces=None):
     """The sections of a grasp's page ``[(heading, figure)]``: the twists' figure first
     (:func:`twist_figure`, with a URDF hand's link ``meshes``), then one animation per
-    followed path (:func:`grasptwist.plot.animation.path_figures`)."""
+    path of ``followed``."""
     figure = twist_figure(grasp, twists, method=method, active=active, meshes=meshes, forces=forces)
     return [(f"{grasp.name}: twists", figure), *path_figures(grasp, followed, method=method)]
 
@@ -81,10 +81,10 @@ def write_page(path, sections, *, title: str, js_beside: bool = False, opener=No
     """Write an HTML page of figures ``[(heading, figure)]`` to ``path``.
 
     plotly.js goes inside the page, or with ``js_beside`` into
-    :data:`JS_NAME` beside it (written once: an up-to-date copy is left
+    ``plotly.min.js`` beside it (written once: an up-to-date copy is left
     alone) and the page refers to it.  Each figure's JSON is in an element
     :func:`read_figures` reads back.  ``opener`` opens each file, as for
-    :func:`grasptwist.plot.render.render`.
+    ``grasptwist.plot.render.render``.
     """
     from plotly.offline import get_plotlyjs  # plotly is needed for its plotly.js only
 

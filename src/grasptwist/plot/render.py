@@ -78,7 +78,7 @@ def plot_grasp(
 ) -> Path:
     """Render one grasp and twist to ``path``.
 
-    See :func:`~grasptwist.plot.scene.grasp_scene` for ``twist``,
+    See :func:`~grasptwist.pictures.grasp_scene` for ``twist``,
     ``twist_name``, ``method`` and ``forces``, and :func:`render` for the rest.
     """
     picture = grasp_scene(grasp, twist, twist_name=twist_name, method=method, forces=forces)
@@ -126,10 +126,10 @@ def image_paths(grasps, folder, suffix=".png", *, per_twist=True) -> list[tuple[
 def render_grasps(
     grasps, folder, *, method=None, suffix=".png", size=(1400, 700), dpi=100, grips=None, opener=None
 ) -> list[Path]:
-    """One image per grasp and twist in ``folder`` (created if missing), named by :func:`image_paths`.
+    """One image per grasp and twist in ``folder`` (created if missing), named by :func:`image_name`.
 
     A grasp without twists is drawn with its basis only; ``method`` None picks
-    :func:`~grasptwist.plot.scene.default_method` per grasp; ``grips(grasp)`` gives the grip
+    off-tangent for a grasp with a wrist, else tangent; ``grips(grasp)`` gives the grip
     forces to draw (``(3, 3)`` or None); ``opener`` as for :func:`render`.
 
     Returns
@@ -280,7 +280,7 @@ def render(scene: Scene, path, *, size=(1400, 700), dpi=100, opener=None) -> Pat
         text larger relative to the picture.
     opener : callable or None
         ``opener(path)``: a binary file to write, as a context manager
-        (default :func:`opened_for_writing`; the command line's replaces the
+        (default ``opened_for_writing``; the command line's replaces the
         file atomically when the block ends without an error).
 
     Returns

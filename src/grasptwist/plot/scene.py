@@ -5,7 +5,7 @@ into a :class:`Scene`: labelled points, segments (screw axes), arrows (normals
 and velocities) and plane patches, each with a *kind* that the renderer
 (:mod:`grasptwist.plot.render`) styles and the legend names.  Every number in
 it comes from the engine (:mod:`grasptwist.engine.decompose`,
-:mod:`grasptwist.engine.screws`), so tests check the geometry, not pixels.
+``grasptwist.engine.screws``), so tests check the geometry, not pixels.
 
 Velocity arrows keep their true vectors; the scene also gives the one length
 per unit velocity (``Arrow.scale``) that draws them all at a common scale
@@ -42,6 +42,7 @@ __all__ = [
     "scene",
 ]
 
+#: The decompositions a scene can show, as the command line spells them.
 METHODS = ("off-tangent", "tangent")
 
 # Lengths drawn relative to the grasp's size (the longest side of the contact triangle).
@@ -251,8 +252,8 @@ def scene(
     normals,
     wrist,
     twist=None,
-    method: str | None = None,
     *,
+    method: str | None = None,
     names=("1", "2", "3"),
     grasp_name: str = "grasp",
     twist_name: str | None = None,
@@ -269,7 +270,8 @@ def scene(
         Needed by the off-tangent method.
     twist : (6,) array ``(omega; v)`` or None
         None draws the grasp and its basis axes only.
-    method : ``"off-tangent"``, ``"tangent"`` or None (:func:`default_method`).
+    method : ``"off-tangent"``, ``"tangent"`` or None
+        None: off-tangent with a wrist, else tangent.
     names : 3 str
         Contact names, used in labels and the status message.
     grasp_name, twist_name : str
@@ -300,7 +302,7 @@ def scene(
     Raises
     ------
     ValueError
-        Unknown method, or the off-tangent method without a wrist (:func:`check_method`).
+        Unknown method, or the off-tangent method without a wrist.
     """
     method = check_method(method, wrist)
     points = np.asarray(points, dtype=float)
@@ -504,8 +506,8 @@ def grasp_scene(
     forces=None,
 ) -> Scene:
     """:func:`scene` for a loaded ``Grasp``, with its hand's joint axes (and, with
-    ``links``, its fingers' chains: :func:`finger_links`), and with a ``friction``
-    its friction cones and the grip ``forces (3, 3)`` given (:func:`force_parts`).
+    ``links``, its fingers' chains from joint to joint to tip), and with a ``friction``
+    its friction cones and the grip ``forces (3, 3)`` given.
 
     ``twist`` is a ``Twist`` (its ``name`` and ``screw`` are used), a ``(6,)``
     array (named ``twist_name``), or None for the grasp and its basis only.
@@ -519,7 +521,7 @@ def grasp_scene(
         grasp.normals,
         grasp.wrist,
         twist,
-        method,
+        method=method,
         names=grasp.contact_names,
         grasp_name=grasp.name,
         twist_name=twist_name,

@@ -92,7 +92,7 @@ class Closure:
         Ferrari-Canny's epsilon with the grasp's own friction (``quality=True``); 0
         outside force closure.
     status, culprit : (...) int8
-        :class:`~grasptwist.engine.forces.grasp_map.ForceStatus`; ``no-closure`` with
+        :class:`~grasptwist.forces.Status`; ``no-closure`` with
         the contact whose normal is at right angles to the contacts' plane, or -1.
     """
 
@@ -236,7 +236,7 @@ def _subset(plane, rows):
 
 
 def check_cone_edges(cone_edges) -> int:
-    """The edges of each friction pyramid of epsilon: an integer from 3 to :data:`MAX_CONE_EDGES`.
+    """The edges of each friction pyramid of epsilon: an integer from 3 to ``MAX_CONE_EDGES`` (64).
 
     >>> check_cone_edges(8)
     8
@@ -311,7 +311,7 @@ def epsilon_quality(points, normals, friction, cone_edges=8):
     return float(max(0.0, np.min(-hull.equations[:, -1]))) * k
 
 
-def force_closure(points, normals, friction=None, quality=False, cone_edges=8, *, tol=DEGENERACY_TOL) -> Closure:
+def force_closure(points, normals, friction=None, *, quality=False, cone_edges=8, tol=DEGENERACY_TOL) -> Closure:
     r"""Force closure of each grasp: the least common friction, the verdict with ``friction``, epsilon.
 
     Parameters
@@ -323,7 +323,7 @@ def force_closure(points, normals, friction=None, quality=False, cone_edges=8, *
         Also compute Ferrari-Canny's ``epsilon`` (needs ``friction`` and scipy;
         one Qhull call per grasp).
     cone_edges : int
-        Edges of each friction pyramid for ``epsilon`` (3 to :data:`MAX_CONE_EDGES`).
+        Edges of each friction pyramid for ``epsilon`` (3 to ``MAX_CONE_EDGES`` (64)).
     tol : float
         Degeneracy tolerance of the contacts.
 

@@ -20,7 +20,7 @@ Contact ``i`` pushes on the object with a force ``f_i`` at ``p_i``; as a wrench
   ``Sigma_i`` (eq. 8): ``f_j = s_i e_i``, ``f_k = -s_i e_i``, ``e_i = (p_k - p_j)/|p_k - p_j|``.
   As wrenches the two halves are ``+s_i Sigma_i`` and ``-s_i Sigma_i``.
 
-The statuses (:class:`ForceStatus`) share their numbers with the twist engine's
+The statuses (:class:`~grasptwist.forces.Status`) share their numbers with the twist engine's
 :class:`~grasptwist.engine.degeneracy.Status` where the condition is the same.
 """
 
@@ -37,6 +37,7 @@ from ..degeneracy import DEGENERACY_TOL
 from ..screws import J, K, cross, dot, norm
 
 __all__ = [
+    "Status",
     "ForceStatus",
     "force_status_message",
     "check_wrench",
@@ -56,7 +57,7 @@ __all__ = [
 ]
 
 
-class ForceStatus(IntEnum):
+class Status(IntEnum):
     """Why a row of a force result has no numbers (0: it has)."""
 
     OK = 0
@@ -74,6 +75,9 @@ class ForceStatus(IntEnum):
         """Kebab-case name for JSON output, e.g. ``cannot-hold``."""
         return self.name.lower().replace("_", "-")
 
+
+#: The layers' name for it, beside the twist engine's :class:`~grasptwist.Status`.
+ForceStatus = Status
 
 _MESSAGES = {
     ForceStatus.OK: "ok",
@@ -97,21 +101,37 @@ _CANNOT_HOLD = {
 }
 
 
-def force_status_message(status, culprit=-1) -> str:
+def force_status_message(status, culprit=-1, names=("1", "2", "3")) -> str:
     """One sentence for a row's status and culprit (a contact index, or -1).
 
-    For ``cannot-hold`` a culprit of -1 means the wrench needs pulling; for
-    ``no-closure`` a culprit is the contact whose normal is at right angles to
-    the contacts' plane.
+    The force side's :func:`grasptwist.status_message`, with the same arguments
+    (public as :func:`grasptwist.forces.status_message`).
 
-    >>> force_status_message(ForceStatus.CANNOT_HOLD, 2)
+    Parameters
+    ----------
+    status : int or Status
+    culprit : int
+        Contact index 0..2 the condition is about, or -1.  For ``cannot-hold``
+        -1 means the wrench needs pulling; for ``no-closure`` a culprit is the
+        contact whose normal is at right angles to the contacts' plane.
+    names : sequence of 3 str
+        Contact names to use in the message.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> from grasptwist import forces
+    >>> forces.status_message(forces.Status.CANNOT_HOLD, 2)
     'cannot-hold: the friction cone at contact 3 is too narrow (mu/safety) for any forces that make the wrench'
-    >>> force_status_message(ForceStatus.NO_CLOSURE, 0)
-    "no friction makes the grasp force closure: the normal at contact 1 is at right angles to the contacts' plane"
+    >>> forces.status_message(forces.Status.NO_CLOSURE, 0, ("thumb", "index", "middle"))
+    "no friction makes the grasp force closure: the normal at contact thumb is at right angles to the contacts' plane"
     """
     s = ForceStatus(int(status))
     c = int(culprit)
-    i, j, k = (c if c >= 0 else 0) + 1, (c + 1) % 3 + 1, (c + 2) % 3 + 1
+    i, j, k = names[c if c >= 0 else 0], names[(c + 1) % 3], names[(c + 2) % 3]
     if s == ForceStatus.CANNOT_HOLD:
         return _CANNOT_HOLD[c < 0].format(i=i)
     why = (
@@ -448,7 +468,7 @@ class ManipulatingForces(NamedTuple):
         1 for an equilateral triangle, falling like the offset from a line to 0
         for collinear contacts.  ``G^+ w`` grows like ``1 / conditioning`` there.
     status, culprit : (...) int8
-        :class:`ForceStatus` and the contact it is about (or -1).  Collinear contacts
+        :class:`~grasptwist.forces.Status` and the contact it is about (or -1).  Collinear contacts
         (conditioning 0) are ``collinear-contacts`` only when the wrench has a moment about
         their line, which no finger force makes; otherwise ``force`` is ``G^+ w``.
     """

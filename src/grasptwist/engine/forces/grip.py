@@ -81,10 +81,10 @@ class Grip:
     conditioning : (...)
         As :class:`~grasptwist.engine.forces.grasp_map.ManipulatingForces`.
     status, culprit : (...) int8
-        :class:`~grasptwist.engine.forces.grasp_map.ForceStatus`; for
+        :class:`~grasptwist.forces.Status`; for
         ``cannot-hold`` the culprit is the contact whose cone is too narrow, or
         -1 when the wrench needs pulling
-        (:func:`~grasptwist.engine.forces.grasp_map.force_status_message`).
+        (:func:`~grasptwist.forces.status_message`).
     dual : (..., 6)
         The wrench's multiplier ``lambda`` (a twist: ``G_i^T lambda = lambda_F + lambda_M x p_i``):
         ``n_i - G_i^T lambda`` lies in contact ``i``'s dual cone
@@ -97,7 +97,7 @@ class Grip:
         moment about their line) a ``y`` with ``y . w > 0`` and ``y . G_i f <= 0`` for
         every admissible ``f`` of every contact: a proof that no grip exists (Farkas).
         Scaled to ``|(y_F, L y_M)| = 1``, ``L`` the largest distance from the contacts'
-        centroid to a contact (:func:`load_words` puts it in words).
+        centroid to a contact (``load_words`` puts it in words).
     """
 
     force: np.ndarray
@@ -274,7 +274,7 @@ def grip(points, normals, wrench, friction, *, safety=1.0, tol=DEGENERACY_TOL) -
 
 
 class PreparedGrip:
-    """One grasp with its friction and safety, ready to grip any number of wrenches (:func:`prepare_grip`).
+    """One grasp with its friction and safety, ready to grip any number of wrenches (:func:`~grasptwist.forces.prepare_grip`).
 
     Attributes
     ----------
@@ -301,11 +301,11 @@ class PreparedGrip:
 
 
 def prepare_grip(points, normals, friction, *, safety=1.0, tol=DEGENERACY_TOL) -> PreparedGrip:
-    """One grasp's part of :func:`grip` done once, for a control loop whose wrench changes.
+    """One grasp's part of :func:`~grasptwist.forces.grip` done once, for a control loop whose wrench changes.
 
     ``points, normals (3, 3)``, ``friction`` scalar or ``(3,)``.  The geometry, the cones'
     frames, the squeezes' map and an internal force inside every cone do not depend on the
-    wrench; ``.grip(wrench)`` does the rest and gives what :func:`grip` gives.
+    wrench; ``.grip(wrench)`` does the rest and gives what :func:`~grasptwist.forces.grip` gives.
 
     >>> p = [[1, 0, 0], [-0.5, 0.75**0.5, 0], [-0.5, -(0.75**0.5), 0]]
     >>> hand = prepare_grip(p, -np.array(p), 0.5, safety=2)
