@@ -35,7 +35,6 @@ import numpy as np
 
 from ..model import GraspFileError
 from .dataset import Dataset
-from .parquet import open_parquet
 
 __all__ = ["DATASET_SUFFIXES", "EXTRA_POINT_ROLES", "Dataset", "Member", "open_dataset", "MAX_INFLATION"]
 
@@ -66,6 +65,8 @@ def open_dataset(path: str, extra_point: str = "wrist") -> Dataset:
         arrays do not have the documented names, shapes or a numeric type.
     """
     if path.endswith(".parquet"):
+        from .parquet import open_parquet  # only when a Parquet file is read (its docstring)
+
         return open_parquet(path)
     try:
         if path.endswith(".npy"):
