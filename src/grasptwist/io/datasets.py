@@ -27,14 +27,17 @@ results as arrays.
 from __future__ import annotations
 
 import os
-import zipfile
 import zlib
 from math import prod
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..model import GraspFileError
 from .dataset import Dataset
+
+if TYPE_CHECKING:  # zipfile is imported where an .npz is read (see open_dataset)
+    import zipfile
 
 __all__ = ["DATASET_SUFFIXES", "EXTRA_POINT_ROLES", "Dataset", "Member", "open_dataset", "MAX_INFLATION"]
 
@@ -68,6 +71,8 @@ def open_dataset(path: str, extra_point: str = "wrist") -> Dataset:
         from .parquet import open_parquet  # only when a Parquet file is read (its docstring)
 
         return open_parquet(path)
+    import zipfile  # only when an .npz is read: it costs every other run's start-up 11 million instructions
+
     try:
         if path.endswith(".npy"):
             return _open_npy(path, np.load(path, mmap_mode="r", allow_pickle=False), extra_point)
@@ -214,6 +219,8 @@ class Member:
         start, stop, _ = rows.indices(len(self))
         stop = max(start, stop)
         row = prod(self.shape[1:]) * self.dtype.itemsize
+        import zipfile  # loaded by open_dataset already
+
         try:
             f = self._file()
             f.seek(self.offset + start * row)
@@ -230,6 +237,8 @@ class Member:
         return self[:] if dtype is None else self[:].astype(dtype)
 
     def _file(self):
+        import zipfile  # loaded by open_dataset already
+
         pid = os.getpid()
         if self._open is None or self._open[0] != pid:
             zf = zipfile.ZipFile(self.path)

@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import os
 import shutil
-import tempfile
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -224,6 +223,8 @@ class Spool:
         if not os.access(shm, os.W_OK):
             yield None
             return
+        import tempfile  # with the first worker pool: a run of one process never needs it (bench/startup.py)
+
         remove_orphans(shm, SPOOL_STEM)  # what runs killed by SIGKILL left
         folder = None
         try:
@@ -239,6 +240,8 @@ class Spool:
         self._mine = [(path, size) for path, size in self._mine if os.path.exists(path)]
         if sum(size for _, size in self._mine) + len(blob) > self.share:
             return None
+        import tempfile  # loaded by opened() already
+
         fd, path = tempfile.mkstemp(dir=self.folder)
         try:
             with os.fdopen(fd, "wb") as f:
