@@ -338,7 +338,7 @@ def test_figures_under_the_noise_floor_print_as_under_it_and_zero_has_no_sign():
 
 def _hand_table(record: dict) -> str:
     buf = io.BytesIO()
-    w = WRITERS["resolve"](buf)
+    w = WRITERS["resolve"](buf, color=False, width=300)  # whatever COLUMNS says: one part, rows whole
     w.write(orjson.dumps(record))
     w.close()
     return buf.getvalue().decode()
