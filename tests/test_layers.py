@@ -6,6 +6,10 @@ fast or an optional dependency optional; it never hides a circle).
 """
 
 import ast
+import json
+import os
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -148,3 +152,67 @@ def test_every_module_says_what_is_public(name):
         isinstance(node, ast.Assign) and any(isinstance(t, ast.Name) and t.id == "__all__" for t in node.targets)
         for node in tree.body
     ), f"{name} has no __all__"
+
+
+# --------------------------------------------------------------------------
+# Issue 26.4: start-up pays for what the command and format in hand use (bench/startup.py times it)
+
+#: Modules a one-file JSON ``resolve`` never needs: the force side, the hand's kinematics and
+#: inverse kinematics, URDF reading, tables (rich) and pictures.
+NOT_FOR_JSON_RESOLVE = (
+    "grasptwist.engine.forces",
+    "grasptwist.run.forces",
+    "grasptwist.output.force_records",
+    "grasptwist.engine.ik",
+    "grasptwist.engine.kinematics",
+    "grasptwist.engine.hands",
+    "grasptwist.io.urdf",
+    "grasptwist.output.table",
+    "grasptwist.output.follow_table",
+    "grasptwist.plot",
+    "rich",
+    "matplotlib",
+    "scipy",
+)
+
+#: Runs ``grasptwist ARGS`` as the script does, one command line after another in one
+#: process, printing after each the modules loaded so far (JSON, on stderr).
+_IMPORTED = """
+import json, sys
+from grasptwist.__main__ import main
+for args in json.loads(sys.argv[1]):
+    sys.argv = ["grasptwist", *args]
+    try:
+        main()
+    except SystemExit:
+        pass
+    sys.stderr.write("\\nMODULES " + json.dumps(sorted(sys.modules)) + "\\n")
+"""
+
+
+def _loaded(*command_lines) -> list[set[str]]:
+    root = Path(__file__).resolve().parents[1]
+    proc = subprocess.run(
+        [sys.executable, "-c", _IMPORTED, json.dumps(command_lines)],
+        capture_output=True, text=True, cwd=root, timeout=60, env={**os.environ, "NO_COLOR": "1"},
+    )  # fmt: skip
+    found = [set(json.loads(line[8:])) for line in proc.stderr.splitlines() if line.startswith("MODULES ")]
+    assert len(found) == len(command_lines), proc.stderr
+    return found
+
+
+def _among(modules: set[str], names) -> list[str]:
+    return sorted(m for m in modules for n in names if m == n or m.startswith(n + "."))
+
+
+def test_a_json_resolve_of_one_file_imports_no_force_hand_table_or_plot_module():
+    json_run, forces_run, table_run = _loaded(
+        ["resolve", "grasps/polyhedron.yaml", "--format", "json"],
+        ["forces", "grasps/sphere.yaml", "--format", "json"],
+        ["resolve", "grasps/three-finger-hand.yaml"],
+    )
+    assert "grasptwist.engine.decompose" in json_run and "orjson" in json_run  # it did run
+    assert _among(json_run, NOT_FOR_JSON_RESOLVE) == []
+    # the names are right: the commands that need these modules load them
+    assert {"grasptwist.engine.forces.grip", "grasptwist.run.forces"} <= forces_run
+    assert {"grasptwist.output.table", "rich", "grasptwist.engine.kinematics"} <= table_run

@@ -41,9 +41,6 @@ import numpy as np
 from .engine import judgements
 from .engine.decompose import decompose_off_tangent, decompose_tangent
 from .engine.degeneracy import Status
-from .engine.forces.closure import force_closure
-from .engine.forces.grasp_map import manipulating_forces
-from .engine.forces.grip import grip
 from .engine.screws import klein_table
 
 __all__ = [
@@ -483,6 +480,11 @@ def compute_forces(points, normals, wrench, has_wrench, friction, has_friction, 
     The engine is called once per kind of row (with and without a wrench, a
     friction), never once per row.
     """
+    # the force engine loads with the first force run: resolve and basis never pay for it (bench/startup.py)
+    from .engine.forces.closure import force_closure
+    from .engine.forces.grasp_map import manipulating_forces
+    from .engine.forces.grip import grip
+
     n = len(points)
     out = {
         "manipulating": np.full((n, 3, 3), np.nan),

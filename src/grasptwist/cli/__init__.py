@@ -17,17 +17,13 @@ from .._version import __version__
 from . import basis, check, follow, forces, plot, resolve, schema
 from .exits import CLICK_ERROR, EXIT_OK, EXIT_WRITE, failed, stopped, to_stdout, usage_error
 
-__all__ = ["app", "main"]
+__all__ = ["app", "app_for", "COMMANDS", "main"]
 
-app = typer.Typer(
-    name="grasptwist",
-    help="Resolve a desired object twist into finger-tip twists for a three-fingered grasp (screw theory).",
-    no_args_is_help=True,
-    add_completion=True,
-    rich_markup_mode=None,
-    pretty_exceptions_enable=False,
-    context_settings={"help_option_names": ["-h", "--help"]},
-)
+#: The commands by name, in the order of ``grasptwist -h``.
+COMMANDS = {
+    f.__name__: f
+    for f in (resolve.resolve, basis.basis, check.check, follow.follow, forces.forces, schema.schema, plot.plot)
+}
 
 
 def _version(value: bool) -> None:
@@ -36,7 +32,6 @@ def _version(value: bool) -> None:
         raise typer.Exit(EXIT_OK)
 
 
-@app.callback()
 def _root(
     version: bool = typer.Option(
         False, "--version", callback=_version, is_eager=True, help="Print the version and exit."
@@ -45,8 +40,39 @@ def _root(
     """Resolve a desired object twist into finger-tip twists for a three-fingered grasp (screw theory)."""
 
 
-for _command in (resolve.resolve, basis.basis, check.check, follow.follow, forces.forces, schema.schema, plot.plot):
-    app.command()(_command)  # in the order of `grasptwist -h`
+def _app(commands) -> typer.Typer:
+    """The ``grasptwist`` command group holding ``commands``."""
+    made = typer.Typer(
+        name="grasptwist",
+        help="Resolve a desired object twist into finger-tip twists for a three-fingered grasp (screw theory).",
+        no_args_is_help=True,
+        add_completion=True,
+        rich_markup_mode=None,
+        pretty_exceptions_enable=False,
+        context_settings={"help_option_names": ["-h", "--help"]},
+    )
+    made.callback()(_root)
+    for command in commands:
+        made.command()(command)
+    return made
+
+
+#: Every command (``grasptwist -h``, completion, tests).
+app = _app(COMMANDS.values())
+
+
+def app_for(args: list[str]) -> typer.Typer:
+    """The group a command line needs: typer builds the options of every command it holds
+    before it runs one (about 10 ms for seven), so a line naming a command (the first word
+    not an option: the group's own options take no value) holds that one alone.
+
+    >>> app_for(["-h"]) is app_for([]) is app_for(["fly", "a.yaml"]) is app
+    True
+    >>> [c.callback.__name__ for c in app_for(["--debug", "check", "a.yaml"]).registered_commands]
+    ['check']
+    """
+    name = next((a for a in args if not a.startswith("-")), None)
+    return _app([COMMANDS[name]]) if name in COMMANDS else app
 
 
 def main() -> None:
@@ -57,7 +83,7 @@ def main() -> None:
     stop_on_signals()
     try:
         try:
-            code = app(standalone_mode=False)
+            code = app_for(sys.argv[1:])(standalone_mode=False)
         except CLICK_ERROR as exc:
             code = usage_error(exc)
     except Interrupted as stop:  # while typer parsed the command line

@@ -331,7 +331,7 @@ def decompose_tangent(points, normals, twist, *, tol=DEGENERACY_TOL, bases=True)
 
     >>> p = [[0, 2, 2], [2, 0, 2], [2, 2, 0]]
     >>> r = decompose_tangent(p, np.eye(3), [0.57735, 0.57735, 0.57735, 0, 0, 0])
-    >>> np.round(r.alpha, 4).tolist(), np.round(r.beta, 4).tolist(), bool(r.in_tangent_planes)
+    >>> np.round(r.alpha, 4).tolist(), (np.round(r.beta, 4) + 0.0).tolist(), bool(r.in_tangent_planes)
     ([0.5774, 0.5774, 0.5774], [0.0, 0.0, 0.0], True)
     """
     inputs = {"points": check_points(points), "normals": check_normals(normals), "twist": check_twist(twist)}

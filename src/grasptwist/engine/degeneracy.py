@@ -22,6 +22,7 @@ __all__ = [
     "DEGENERACY_TOL",
     "CONDITION_WARNING",
     "IN_PLANE_TOL",
+    "NOISE_FLOOR",
     "status_message",
     "conditioning_warning",
     "skipped_warning",
@@ -33,6 +34,12 @@ __all__ = [
 #: Amplitudes carry a relative error of about ``1e-16 / conditioning``, so at
 #: the threshold they still have about 6 correct digits.
 DEGENERACY_TOL = 1e-9
+
+#: A figure computed to double precision (a residual, a tip's distance to its
+#: contact, a conditioning) below this is round-off: each processor's BLAS
+#: kernel gives other digits there, and may give ``0.0`` or ``-0.0``, so what
+#: people read shows it as below this and no more (``output/numbers.py``).
+NOISE_FLOOR = 1e-12
 
 #: A conditioning figure below this is worth a warning: amplitudes may be
 #: more than a thousand times the twist's own size.

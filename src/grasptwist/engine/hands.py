@@ -223,7 +223,7 @@ def track(hand, positions, points, segments, times, *, steps=16) -> HandTrack:
     >>> f = Finger("1", None, tuple(Joint(n, "prismatic", None, None, None, None) for n in "xyz"), slides, np.zeros((3, 3)), None, 1.0, (0, 1, 2))
     >>> h = Hand((f, f, f), ("x", "y", "z"), None, None)
     >>> t = track(h, None, np.eye(3), [Segment(1.0, twist=[0, 0, 0, 0.5, 0, 0])], [0.0, 1.0], steps=1)
-    >>> t.positions[-1].round(12).tolist()
+    >>> (t.positions[-1].round(12) + 0.0).tolist()
     [0.5, 0.0, 0.0]
     """
     q0 = np.zeros(len(hand.joint_names)) if positions is None else np.asarray(positions, dtype=float)

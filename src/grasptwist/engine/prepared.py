@@ -225,7 +225,7 @@ def prepare(points, normals, wrist=None, *, tol=DEGENERACY_TOL) -> PreparedGrasp
     >>> g = prepare([[0, 2, 2], [2, 0, 2], [2, 2, 0]], np.eye(3))
     >>> np.round(g.resolve([0.57735, 0.57735, 0.57735, 0, 0, 0]).tangent.alpha, 4).tolist()
     [0.5774, 0.5774, 0.5774]
-    >>> g.resolve([0, 0, 0, 0, 0, 1]).tangent.beta.round(4).tolist()
+    >>> (g.resolve([0, 0, 0, 0, 0, 1]).tangent.beta.round(4) + 0.0).tolist()
     [0.0, 0.0, 0.7071]
     >>> flat = prepare([[1, 0, 0], [-0.5, 0.866, 0], [-0.5, -0.866, 0]], np.eye(3), [0, 0, 0])
     >>> Status(int(flat.resolve([0, 0, 1, 0, 0, 0]).off_tangent.status)).code

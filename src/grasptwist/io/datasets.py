@@ -27,16 +27,18 @@ results as arrays.
 from __future__ import annotations
 
 import os
-import zipfile
 import zlib
 from math import prod
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..model import GraspFileError
 from .dataset import Dataset
 from .limits import MAX_INFLATION, check_inflation
-from .parquet import open_parquet
+
+if TYPE_CHECKING:  # zipfile is imported where an .npz is read (see open_dataset)
+    import zipfile
 
 __all__ = ["DATASET_SUFFIXES", "EXTRA_POINT_ROLES", "Dataset", "Member", "open_dataset", "MAX_INFLATION"]
 
@@ -59,7 +61,11 @@ def open_dataset(path: str, extra_point: str = "wrist") -> Dataset:
         arrays do not have the documented names, shapes or a numeric type.
     """
     if path.endswith(".parquet"):
+        from .parquet import open_parquet  # only when a Parquet file is read (its docstring)
+
         return open_parquet(path)
+    import zipfile  # only when an .npz is read: it costs every other run's start-up 11 million instructions
+
     try:
         if path.endswith(".npy"):
             return _open_npy(path, _npy(path), extra_point)
@@ -218,6 +224,8 @@ class Member:
         start, stop, _ = rows.indices(len(self))
         stop = max(start, stop)
         row = prod(self.shape[1:]) * self.dtype.itemsize
+        import zipfile  # loaded by open_dataset already
+
         try:
             f = self._file()
             f.seek(self.offset + start * row)
@@ -236,6 +244,8 @@ class Member:
         return whole if dtype is None else whole.astype(dtype)
 
     def _file(self):
+        import zipfile  # loaded by open_dataset already
+
         pid = os.getpid()
         if self._open is None or self._open[0] != pid:
             zf = zipfile.ZipFile(self.path)

@@ -19,7 +19,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ..engine.decompose import contact_velocities, decompose_off_tangent, decompose_tangent
-from ..engine.degeneracy import Status, conditioning_warning, status_message
+from ..engine.degeneracy import NOISE_FLOOR, Status, conditioning_warning, status_message
 from ..engine.hands import finger_states
 from ..engine.screws import J, K, axis_point, cross, dot, field_at, norm, pitch, rigid_motion, unit
 
@@ -480,14 +480,14 @@ def _sub(name: str) -> str:
 def _vec(a, ref=0.0) -> str:
     """``(a, b, c)`` with 3 significant digits.
 
-    Entries below 1e-12 of the largest of ``a`` and ``ref`` are round-off and
+    Entries below ``NOISE_FLOOR`` (1e-12) of the largest of ``a`` and ``ref`` are round-off and
     shown as 0 (and ``-0`` as ``0``).
 
     >>> _vec([1.0, -2e-17, -0.0]), _vec([8e-17, 0, 0], ref=0.6)
     ('(1, 0, 0)', '(0, 0, 0)')
     """
     a = np.asarray(a, dtype=float).ravel()
-    a = np.where(np.abs(a) <= 1e-12 * max(float(np.max(np.abs(a), initial=0.0)), ref), 0.0, a)
+    a = np.where(np.abs(a) <= NOISE_FLOOR * max(float(np.max(np.abs(a), initial=0.0)), ref), 0.0, a)
     return "(" + ", ".join(f"{x + 0.0:.3g}" for x in a) + ")"
 
 

@@ -16,7 +16,6 @@ from typing import Any
 
 import numpy as np
 
-from ..engine import hands
 from ..engine.decompose import contact_velocities
 from ..engine.degeneracy import Status
 from ..engine.judgements import outward_contacts
@@ -346,6 +345,8 @@ def _hand_inputs(grasps) -> dict:
     if all(g.hand is None for g in grasps):
         return {}
 
+    # the hand math loads with the first hand: runs without one never pay for it (bench/startup.py)
+    from ..engine import hands
     from ..engine.ik import home_tips, place_hand
 
     width = max(len(f.joints) for g in grasps if g.hand is not None for f in g.hand.fingers)
@@ -373,6 +374,8 @@ def _hand_inputs(grasps) -> dict:
 def hand_placement(hand, placed, width=None) -> tuple:
     """``(joint positions (..., 3, width), tip error (..., 3), within limits (..., 3))`` of a hand
     placed (:class:`~grasptwist.engine.ik.HandIK`), as a block's ``placement`` holds them."""
+    from ..engine import hands
+
     return hands.padded_positions(hand, placed.positions, width), placed.tip_error, placed.within_limits
 
 
@@ -473,6 +476,7 @@ def _rows_hand(ds, hand_of_rows, start, stop, rows, points):
     positions checked, or solved for when the data set has none)."""
     if hand_of_rows is None:
         return {}, None
+    from ..engine import hands
     from ..engine.ik import place_hand
 
     q = None if ds.joint_positions is None else np.asarray(ds.joint_positions[start:stop], dtype=float)[rows]

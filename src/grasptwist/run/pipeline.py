@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import os
 import shutil
-import tempfile
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field
@@ -26,7 +25,6 @@ from ..io.datasets import DATASET_SUFFIXES, open_dataset
 from ..io.inputs import read
 from ..io.lines import grasp_batches
 from ..model import GraspFileError, Hand, Twist, Wrench
-from ..output.force_records import force_records
 from ..output.formats import FORMATS
 from ..output.records import (
     basis_record,
@@ -39,7 +37,6 @@ from ..output.records import (
 )
 from ..results import ForceOptions, check_closure
 from .batch import ZERO_TWIST, Block, check_positions, dataset_blocks, resolve
-from .forces import ForceBlock, force_blocks, force_dataset_blocks
 from .pool import Pool, pool_size
 from .scratch import owned_prefix, remove_orphans
 from .stream import grasp_stream, is_stream, twist_stream
@@ -227,6 +224,8 @@ class Spool:
         if not os.access(shm, os.W_OK):
             yield None
             return
+        import tempfile  # with the first worker pool: a run of one process never needs it (bench/startup.py)
+
         remove_orphans(shm, SPOOL_STEM)  # what runs killed by SIGKILL left
         folder = None
         try:
@@ -242,6 +241,8 @@ class Spool:
         self._mine = [(path, size) for path, size in self._mine if os.path.exists(path)]
         if sum(size for _, size in self._mine) + len(blob) > self.share:
             return None
+        import tempfile  # loaded by opened() already
+
         fd, path = tempfile.mkstemp(dir=self.folder)
         try:
             with os.fdopen(fd, "wb") as f:
@@ -272,7 +273,7 @@ def run_group(job: Job, paths: Sequence, tuning: Tuning = TUNING, spool: Spool |
         items.extend(read(p, job.max_bytes) if isinstance(p, str) else [p])
     out = Output(done=len(paths))
     if job.kind == "forces":
-        results = force_blocks(items, job.wrenches, job.friction, job.forces)
+        results = _force_run().force_blocks(items, job.wrenches, job.friction, job.forces)
     else:
         twists = [ZERO_TWIST] if job.kind != "resolve" else job.twists
         results = resolve(items, twists, job.method, select=job.select)
@@ -281,10 +282,23 @@ def run_group(job: Job, paths: Sequence, tuning: Tuning = TUNING, spool: Spool |
     return _sealed(job, out, spool)
 
 
+def _force_run():
+    """The force side of a run (:mod:`.forces`), loaded by the first ``forces`` job: a resolve,
+    basis or check run never imports it, nor the force engine (bench/startup.py)."""
+    from . import forces
+
+    return forces
+
+
+def _is_forces(job: Job, x) -> bool:
+    """Whether ``x``, a block or an input's error, is a block of forces (:class:`.forces.ForceBlock`)."""
+    return job.kind == "forces" and not isinstance(x, GraspFileError)
+
+
 def _force_batches(job: Job, path: str, tuning: Tuning):
     """The force blocks and errors of the grasps of the stream ``path``, a batch of lines at a time."""
     for batch in grasp_batches(path, job.max_bytes, tuning.files_per_group):
-        yield list(force_blocks(batch, job.wrenches, job.friction, job.forces))
+        yield list(_force_run().force_blocks(batch, job.wrenches, job.friction, job.forces))
 
 
 def blocks(
@@ -315,7 +329,7 @@ def blocks(
             try:
                 ds = open_dataset(g, job.extra_point)
                 extra_work = len(ds) * (len(job.wrenches) if job.wrenches else 1) - 1
-                for block in force_dataset_blocks(ds, job.wrenches, job.friction, job.forces):
+                for block in _force_run().force_dataset_blocks(ds, job.wrenches, job.friction, job.forces):
                     yield block, extra_work, True
                     extra_work = 0
             except GraspFileError as err:
@@ -335,7 +349,9 @@ def blocks(
         for p in g:
             items.extend(read(p, job.max_bytes) if isinstance(p, str) else [p])
         if job.kind == "forces":
-            yield from ((x, None, False) for x in force_blocks(items, job.wrenches, job.friction, job.forces))
+            yield from (
+                (x, None, False) for x in _force_run().force_blocks(items, job.wrenches, job.friction, job.forces)
+            )
             continue
         for x in resolve(items, job.twists, job.method, select=job.select):
             yield x, None, False
@@ -346,10 +362,12 @@ def _encode_into(job: Job, x, out: Output, at_once: int) -> None:
     fmt = FORMATS[job.fmt]
     hand = fmt.hand_options(job.hand)
     encode = partial(fmt.encode, **hand) if hand else fmt.encode
-    if isinstance(x, ForceBlock):
+    if _is_forces(job, x):
         if fmt.encode_forces is not None:
             out.add_encoded(*fmt.encode_forces(x))
         else:
+            from ..output.force_records import force_records
+
             for rec in force_records(x):
                 out.add(rec, encode)
     elif not isinstance(x, Block):
@@ -416,7 +434,9 @@ def _dataset_task(job: Job, ds, rows: tuple[int, int], tuning: Tuning, spool: Sp
     at_once = tuning.records_at_once
     outs = []
     if job.kind == "forces":
-        made = force_dataset_blocks(ds, job.wrenches, job.friction, job.forces, start=rows[0], stop=rows[1])
+        made = _force_run().force_dataset_blocks(
+            ds, job.wrenches, job.friction, job.forces, start=rows[0], stop=rows[1]
+        )
     else:
         made = dataset_blocks(ds, twists, job.method, start=rows[0], stop=rows[1], hand_of_rows=job.hand)
     try:
@@ -463,7 +483,9 @@ def write_blocks(job: Job, paths: Sequence, w, tuning: Tuning = TUNING) -> Itera
     """
     for x, extra_work, rows in blocks(job, paths, tuning):
         o = Output(done=len(x) if extra_work is not None else 1, extra_work=extra_work or 0, rows=rows)
-        if isinstance(x, ForceBlock):
+        if _is_forces(job, x):
+            from ..output.force_records import force_records
+
             w.write(x)
             for rec in force_records(x):
                 if not rec["ok"] or rec["warnings"]:

@@ -305,7 +305,7 @@ def manipulating_reference(points, wrench) -> np.ndarray:
 
     ``(..., 3, 3), (..., 6) -> (..., 3, 3)``.
 
-    >>> manipulating_reference([[1, 0, 0], [-0.5, 0.75**0.5, 0], [-0.5, -(0.75**0.5), 0]], [0, 0, 3, 0, 0, 0]).round(6).tolist()
+    >>> (manipulating_reference([[1, 0, 0], [-0.5, 0.75**0.5, 0], [-0.5, -(0.75**0.5), 0]], [0, 0, 3, 0, 0, 0]).round(6) + 0.0).tolist()
     [[0.0, 0.0, 1.0], [0.0, 0.0, 1.0], [0.0, 0.0, 1.0]]
     """
     w = np.asarray(wrench, dtype=float)

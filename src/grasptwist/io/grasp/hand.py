@@ -26,12 +26,8 @@ import numpy as np
 import yaml
 
 from ...engine.degeneracy import Status
-from ...engine.hands import joint_positions
-from ...engine.ik import place_hand
-from ...engine.kinematics import chain_length, joint_screw
 from ...model import Finger, Hand, InputError, Joint
 from ..limits import DEFAULT_MAX_BYTES
-from ..urdf import load_urdf_hand
 from .compose import PARSER, compose, syntax_error
 from .problems import MAX_ERRORS, Problems, Reject, join, located
 from .text import file_text
@@ -231,6 +227,9 @@ def inline_hand(names, fingers, points):
     >>> h.joint_names, h.fingers[0].screws.tolist(), h.fingers[1].length
     (('a.1', 'b.1', 'c.1'), [[0.0, 0.0, 1.0, 0.0, 0.0, 0.0]], 1.0)
     """
+    # a hand's kinematics load with the first hand: grasp files without one never pay for them
+    from ...engine.kinematics import chain_length, joint_screw
+
     out, joint_names = [], []
     contacts = [None] * 3 if points is None else np.asarray(points, dtype=float)
     for name, joints, contact in zip(names, fingers, contacts, strict=True):
@@ -263,6 +262,11 @@ def _urdf_hand(fields, fingers, names, contacts, file, problems):
     """The URDF form: load the hand, then its joints at ``joint_positions`` with the contacts
     ``(points, names)`` checked on its tips, or else at joint positions solved from ``seed``
     (engine's ``place_hand``)."""
+    # URDF reading and inverse kinematics load with the first such hand (bench/startup.py)
+    from ...engine.hands import joint_positions
+    from ...engine.ik import place_hand
+    from ..urdf import load_urdf_hand
+
     points, contact_names = contacts
     node = fields["urdf"]
     reference = read_name(node, "hand.urdf", problems)

@@ -154,7 +154,7 @@ def one_per_document(entries):
 
     >>> text = "contacts: [1, 2]\\n---\\nwrist: 1\\n"
     >>> [(e.code, [p.code for p in e.problems]) for e in one_per_document(read_grasps(text, file="g.yaml"))]
-    [('contact-count', ['contact-count', 'not-a-mapping']), ('missing-key', ['missing-key', 'not-a-list'])]
+    [('contact-count', ['contact-count', 'not-a-mapping', 'not-a-mapping']), ('missing-key', ['missing-key', 'not-a-list'])]
     """
     out = []
     for entry in entries:
