@@ -95,7 +95,7 @@ def test_the_walk_sees_deferred_and_relative_imports():
     # a deferred import inside a function, a relative `from . import module`, an absolute one
     assert "grasptwist.run.signals" in imports("grasptwist.__main__")
     assert "grasptwist.cli" in imports("grasptwist.__main__")
-    assert "grasptwist.cli.basis" in imports("grasptwist.cli")
+    assert "grasptwist.engine.kernels" in imports("grasptwist.engine.decompose")
     assert "grasptwist.output.parquet_writer" in imports("grasptwist.output.formats")
     assert group("grasptwist.engine.hands") == (1, "grasptwist.engine")
     assert group("grasptwist.hand") == (7, "grasptwist.hand")

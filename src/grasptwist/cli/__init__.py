@@ -9,21 +9,25 @@ stdout carries data only; every diagnostic goes to stderr as one line
 ``path:line:col: error: message``.
 """
 
+import importlib
 import sys
 
 import typer
 
 from .._version import __version__
-from . import basis, check, follow, forces, plot, resolve, schema
 from .exits import CLICK_ERROR, EXIT_OK, EXIT_WRITE, failed, stopped, to_stdout, usage_error
 
-__all__ = ["app", "app_for", "COMMANDS", "main"]
+__all__ = ["app", "app_for", "command", "COMMANDS", "main"]
 
-#: The commands by name, in the order of ``grasptwist -h``.
-COMMANDS = {
-    f.__name__: f
-    for f in (resolve.resolve, basis.basis, check.check, follow.follow, forces.forces, schema.schema, plot.plot)
-}
+#: The commands by name, in the order of ``grasptwist -h``: each is the function of the same
+#: name in the module of the same name, imported only when a command line needs it (a run of
+#: one command does not pay for the others' modules at start-up).
+COMMANDS = ("resolve", "basis", "check", "follow", "forces", "schema", "plot")
+
+
+def command(name: str):
+    """The function of command ``name`` (one of :data:`COMMANDS`)."""
+    return getattr(importlib.import_module(f".{name}", __name__), name)
 
 
 def _version(value: bool) -> None:
@@ -57,8 +61,15 @@ def _app(commands) -> typer.Typer:
     return made
 
 
-#: Every command (``grasptwist -h``, completion, tests).
-app = _app(COMMANDS.values())
+_every = []  # the group of every command, made once when first asked for
+
+
+def __getattr__(name: str):
+    if name == "app":  # every command (``grasptwist -h``, completion, tests)
+        if not _every:
+            _every.append(_app([command(c) for c in COMMANDS]))
+        return _every[0]
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
 def app_for(args: list[str]) -> typer.Typer:
@@ -66,13 +77,14 @@ def app_for(args: list[str]) -> typer.Typer:
     before it runs one (about 10 ms for seven), so a line naming a command (the first word
     not an option: the group's own options take no value) holds that one alone.
 
+    >>> from grasptwist.cli import app
     >>> app_for(["-h"]) is app_for([]) is app_for(["fly", "a.yaml"]) is app
     True
     >>> [c.callback.__name__ for c in app_for(["--debug", "check", "a.yaml"]).registered_commands]
     ['check']
     """
     name = next((a for a in args if not a.startswith("-")), None)
-    return _app([COMMANDS[name]]) if name in COMMANDS else app
+    return _app([command(name)]) if name in COMMANDS else __getattr__("app")
 
 
 def main() -> None:
