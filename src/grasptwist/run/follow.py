@@ -31,7 +31,7 @@ from ..engine.forces.hold import HoldStretch, cannot_hold, grip_along
 from ..engine.hands import HandTrack
 from ..engine.ik import home_tips, place_hand
 from ..engine.judgements import rotation_over_pi
-from ..engine.path import PathDegeneracies, Poses, degeneracies, follow
+from ..engine.path import PathDegeneracies, Poses, degeneracies, follow, pose_overflowed
 from ..io.datasets import DATASET_SUFFIXES
 from ..io.inputs import read
 from ..model import Grasp, GraspFileError, Hand, ObjectPath
@@ -260,7 +260,8 @@ def _block(grasp, name, f, bases, method, positions=None) -> Block:
         placement = dict(zip(("joint_positions", "tip_error", "within_limits"), hand_placement(grasp.hand, placed)))
         inputs = {"joint_screws": screws, "joint_limits": limits, "points": f.points, "twist": f.poses.twist}
         inputs["placement"] = placement
-        results["hand"] = BY_KEY["hand"].compute({**inputs, **results}, bases)
+        # where the pose overflows, the hand's rates are no result of the path either (as the methods')
+        results["hand"] = pose_overflowed(BY_KEY["hand"].compute({**inputs, **results}, bases), f.overflowed)
     block = Block(
         file=[grasp.file] * n,
         grasp=[grasp.name] * n,
