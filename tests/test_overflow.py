@@ -117,6 +117,14 @@ def test_a_huge_duration_of_no_motion_is_all_ok():
     assert records[-1]["summary"]["degenerate"] == []
 
 
+def test_a_grip_along_the_path_says_nonfinite_pose_where_the_methods_do():
+    code, records, _ = run("follow", SPHERE, "--twist", "0,0,1e308,0,0,0", "--duration", "1", "--samples", "3")
+    held = [r for r in records if r.get("grasp") == "sphere-equator" and "grip" in r]  # it has mass and friction
+    assert code == EXIT_FAILED and len(held) == 3
+    assert "error" not in held[0]["grip"]
+    assert [r["grip"]["error"]["code"] for r in held[1:]] == [POSE, POSE]
+
+
 @pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_a_hand_follows_into_the_overflow_with_the_same_status():
     code, records, _ = run("follow", HAND, "--twist", "0,0,1e308,0,0,0", "--duration", "1", "--samples", "3")

@@ -232,6 +232,7 @@ def _path(job, grasp, p):
             bases=job.bases,
         )
         block = _block(grasp, p.name, f, job.bases, job.method, q)
+        grip = None if grip is None else pose_overflowed(grip, f.overflowed)  # as the methods say there
         if tracked is not None:
             seen = block.results["hand"].tip_error.max(axis=0)
             largest = seen if largest is None else np.maximum(largest, seen)
