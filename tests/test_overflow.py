@@ -159,11 +159,12 @@ def test_a_rotation_vector_of_1e308_and_durations_that_overflow_are_located(tmp_
     [
         ["resolve", POLY, "--twist", ",".join(["1e308"] * 6)],
         ["resolve", POLY, "--twist", "1e308,0,0,0,0,1e308", "--method", "tangent"],
+        ["resolve", SPHERE, "--twist", "0,0,1e308,0,0,0"],  # the tripod's record is ok: its residual a number
         ["forces", POLY, "--wrench", ",".join(["1e308"] * 6), "--friction", "0.5"],
         ["forces", SPHERE, "--wrench", "1e308,0,0,0,0,1e308", "--quality"],
         ["follow", SPHERE, "--twist", "0,0,0,1e308,0,0", "--duration", "10"],
     ],
-    ids=["resolve", "resolve-tangent", "forces", "forces-quality", "follow-translation"],
+    ids=["resolve", "resolve-tangent", "resolve-ok-residual", "forces", "forces-quality", "follow-translation"],
 )
 def test_absurd_options_give_statuses_not_warnings(args):
     code, records, _ = run(*args)
