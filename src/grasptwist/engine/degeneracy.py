@@ -118,7 +118,8 @@ _MESSAGES = {
         "move the contact, or widen the limits where the hand allows it"
     ),
     Status.NONFINITE_POSE: (
-        "the object's pose overflows double precision here (a rotation or a distance beyond about 1e154): "
+        "the object's pose overflows double precision here (a turn through more than about 1e154 radians, "
+        "a distance or a twist beyond 1.8e308): "
         "rescale the twist or shorten the path"
     ),
     Status.NO_WRIST: (
