@@ -20,6 +20,7 @@ from grasptwist.cli import app
 from grasptwist.cli.exits import EXIT_FAILED, EXIT_OK, EXIT_USAGE
 from grasptwist.engine.degeneracy import Status
 from grasptwist.path import Segment, degeneracies, follow
+from hostile import run_installed
 
 ROOT = Path(__file__).resolve().parents[1]
 POLY = str(ROOT / "grasps" / "polyhedron.yaml")
@@ -34,6 +35,7 @@ HUGE = """\
 name: huge
 wrist: [1e300, -1e300, 1e300]
 mass: 1e300
+center_of_mass: [0, 0, 0]
 friction: 0.5
 contacts:
   - {point: [0, 1e300, 1e300], normal: [1e300, 0, 0]}
@@ -178,6 +180,23 @@ def test_a_file_of_huge_numbers_gives_statuses_not_warnings(tmp_path, command):
     code, records, _ = run(command, tmp_path / "huge.yaml")
     assert code == EXIT_FAILED
     assert records and not any(r["ok"] for r in records)
+
+
+@pytest.mark.parametrize(
+    "args",
+    [
+        ["follow", "--twist", "0,0,1e308,0,0,0", "--duration", "1"],
+        ["check", "-j", "2"],
+    ],
+    ids=["follow", "check-j2"],
+)
+def test_stderr_of_a_real_process_carries_only_grasptwist_lines(tmp_path, args):
+    """The runs as a user makes them: no numpy warning, its file or its line, on stderr."""
+    (tmp_path / "huge.yaml").write_text(HUGE)
+    done, _ = run_installed(args[0], tmp_path / "huge.yaml", POLY, *args[1:], "-f", "jsonl")
+    assert done.returncode == EXIT_FAILED
+    assert all(line.startswith((str(tmp_path), POLY)) or " records: " in line for line in done.stderr.splitlines())
+    assert "Warning" not in done.stderr and "error: tangent: " in done.stderr
 
 
 def test_the_engine_marks_overflowed_poses_and_the_summary_agrees():
