@@ -110,6 +110,7 @@ def test_status_codes_are_stable_strings():
         "contact-off-finger",  # a hand's, with the two below (inverse kinematics)
         "unreachable",
         "outside-limits",
+        "nonfinite-pose",  # a path's: where the object's pose overflows
     ]
 
 

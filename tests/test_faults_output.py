@@ -263,6 +263,30 @@ def test_closed_and_read_only_standard_streams_are_one_line(tmp_path, args, redi
     assert done.stdout == ""  # nothing was done
 
 
+@pytest.mark.parametrize(("grasp", "code"), [(POLY, EXIT_OK), (ROOT / "grasps" / "sphere.yaml", EXIT_FAILED)])
+def test_a_closed_stderr_drops_the_diagnostics_and_keeps_the_exit_status(tmp_path, grasp, code):
+    """``2>&-``: the records complete on stdout, the exit status the run's own (0, or 1 for the
+    sphere's degenerate equator grasp), not 1 for the diagnostics that had nowhere to go."""
+    done = shell(tmp_path, "2>&-", "resolve", grasp, "-f", "jsonl")
+    expected = invoke("resolve", grasp, "-f", "jsonl")
+    assert (done.returncode, expected.exit_code) == (code, code)
+    assert done.stdout == expected.stdout and done.stdout.count("\n") >= 1
+    assert ('"ok":false' in done.stdout) == (code == EXIT_FAILED)
+
+
+def test_a_closed_stderr_leaves_an_output_file_its_records_only(tmp_path):
+    """Descriptor 2 is held by /dev/null, so the output file gets another."""
+    done = shell(tmp_path, "2>&-", "resolve", POLY, "-f", "jsonl", "-o", "out.jsonl")
+    assert done.returncode == EXIT_OK
+    assert (tmp_path / "out.jsonl").read_text() == invoke("resolve", POLY, "-f", "jsonl").stdout
+
+
+def test_a_closed_stderr_is_no_output(tmp_path):
+    """``-o /dev/stderr`` on a closed stderr is refused as closed (exit 3), as ``-o /dev/stdout`` is."""
+    done = shell(tmp_path, "2>&-", "resolve", POLY, "-o", "/dev/stderr")
+    assert (done.returncode, done.stdout) == (EXIT_WRITE, "")
+
+
 def test_closed_streams_in_process(monkeypatch):
     monkeypatch.setattr(sys, "stdout", None)
     with pytest.raises(WriteError, match=r"^cannot write standard output: it is closed$"), opened(None):

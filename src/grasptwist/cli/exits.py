@@ -109,13 +109,18 @@ def stopped(stop) -> int:
 
 def run_command(debug: bool, body: Callable[[], int]) -> None:
     """Run a command's body; turn every way it can end into one line and an exit status."""
+    import numpy as np
+
     from ..extras import MissingExtra
     from ..run.pool import WorkerDied
     from ..run.signals import Interrupted
     from ..run.target import WriteError
 
     try:
-        code = body()
+        # numpy's RuntimeWarnings (overflow, invalid) would reach stderr with a file and a line of
+        # ours; the engine turns what overflows into a status, so the run needs none of them
+        with np.errstate(all="ignore"):
+            code = body()
     except (typer.Exit, typer.Abort, typer.BadParameter):
         raise  # typer's own ways out: exit codes, usage errors (2)
     except (Interrupted, KeyboardInterrupt) as exc:  # KeyboardInterrupt: run without main(), as by tests

@@ -1,7 +1,6 @@
 """``grasptwist plot``: draw a grasp, its basis screw axes and the finger-tip velocities."""
 
 import os
-import sys
 from dataclasses import replace
 from typing import Annotated
 
@@ -206,7 +205,7 @@ def draw_pictures(path, output, twists, twist_name, method, max_bytes, views) ->
                 else:
                     listing.write(os.fsencode(f"{item}\n"))
     except (pictures.MissingMatplotlib, pictures.MissingPlotly) as exc:
-        sys.stderr.write(f"{exc}\n")  # "grasptwist plot needs matplotlib: ..." (or plotly)
+        to_stderr(str(exc))  # "grasptwist plot needs matplotlib: ..." (or plotly)
         return EXIT_FAILED
     except pictures.TwistNotFound as exc:
         raise typer.BadParameter(str(exc), param_hint="--select") from None

@@ -152,12 +152,21 @@ class _Result:
         """``max_i |R(p_i)| / max_i |T(p_i)|``, ``R`` = the sum of the components minus ``T``.
 
         Computed on first access from the returned screws and amplitudes;
-        NaN in failed rows, 0 for the zero twist.
+        NaN in failed rows, 0 for the zero twist.  The twist and the components
+        are scaled by ``2^-e``, ``e`` the exponent of the twist's largest entry:
+        exactly, so the ratio has the bits it has unscaled, but the components'
+        sum stays finite for a twist near ``1e308`` (an ok row's residual is a number).
+
+        >>> p = [[1, 0, 0], [-0.5, 0.866, 0], [-0.5, -0.866, 0]]
+        >>> float(decompose_off_tangent(p, [0, 0, 1], [0, 0, 1e308, 0, 0, 0]).residual) < 1e-15
+        True
         """
         with np.errstate(all="ignore"):  # failed rows hold NaN, overflowed ones inf
-            r = sum(a.sum(axis=-2) for a in self.components()) - self.twist
+            e = -np.frexp(np.max(np.abs(self.twist), axis=-1))[1]
+            r = sum(np.ldexp(a, e[..., None, None]).sum(axis=-2) for a in self.components())
+            r = r - np.ldexp(self.twist, e[..., None])
             err = np.max(norm(field_at(r[..., None, :], self.points)), axis=-1)
-            ref = np.max(norm(field_at(self.twist[..., None, :], self.points)), axis=-1)
+            ref = np.max(norm(field_at(np.ldexp(self.twist, e[..., None])[..., None, :], self.points)), axis=-1)
             return np.where(ref > 0, err / np.where(ref > 0, ref, 1.0), err)
 
 

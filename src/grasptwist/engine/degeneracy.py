@@ -69,6 +69,7 @@ class Status(IntEnum):
     CONTACT_OFF_FINGER = 13  # a hand's: a contact farther from its finger's tip than the finger is long
     UNREACHABLE = 14  # a hand's inverse kinematics (grasptwist.engine.ik)
     OUTSIDE_LIMITS = 15
+    NONFINITE_POSE = 16  # a path's: its pose at a sample overflows (grasptwist.engine.path), never a decomposition's
 
     @property
     def code(self) -> str:
@@ -122,6 +123,11 @@ _MESSAGES = {
     Status.OUTSIDE_LIMITS: (
         "finger {i}'s tip reaches its contact only with a joint outside its position limits: "
         "move the contact, or widen the limits where the hand allows it"
+    ),
+    Status.NONFINITE_POSE: (
+        "the object's pose overflows double precision here (a turn through more than about 1e154 radians, "
+        "a distance or a twist beyond 1.8e308): "
+        "rescale the twist or shorten the path"
     ),
     Status.NO_WRIST: (
         "the grasp has no wrist, and each Psi_i is a line from it: give one "

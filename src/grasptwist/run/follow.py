@@ -31,7 +31,7 @@ from ..engine.forces.hold import HoldStretch, cannot_hold, grip_along
 from ..engine.hands import HandTrack
 from ..engine.ik import home_tips, place_hand
 from ..engine.judgements import rotation_over_pi
-from ..engine.path import PathDegeneracies, Poses, degeneracies, follow
+from ..engine.path import PathDegeneracies, Poses, degeneracies, follow, pose_overflowed
 from ..io.datasets import DATASET_SUFFIXES
 from ..io.inputs import read
 from ..model import Grasp, GraspFileError, Hand, ObjectPath
@@ -232,6 +232,7 @@ def _path(job, grasp, p):
             bases=job.bases,
         )
         block = _block(grasp, p.name, f, job.bases, job.method, q)
+        grip = None if grip is None else pose_overflowed(grip, f.overflowed)  # as the methods say there
         if tracked is not None:
             seen = block.results["hand"].tip_error.max(axis=0)
             largest = seen if largest is None else np.maximum(largest, seen)
@@ -260,7 +261,8 @@ def _block(grasp, name, f, bases, method, positions=None) -> Block:
         placement = dict(zip(("joint_positions", "tip_error", "within_limits"), hand_placement(grasp.hand, placed)))
         inputs = {"joint_screws": screws, "joint_limits": limits, "points": f.points, "twist": f.poses.twist}
         inputs["placement"] = placement
-        results["hand"] = BY_KEY["hand"].compute({**inputs, **results}, bases)
+        # where the pose overflows, the hand's rates are no result of the path either (as the methods')
+        results["hand"] = pose_overflowed(BY_KEY["hand"].compute({**inputs, **results}, bases), f.overflowed)
     block = Block(
         file=[grasp.file] * n,
         grasp=[grasp.name] * n,

@@ -66,6 +66,7 @@ class Status(IntEnum):
     COLLINEAR_CONTACTS = 3
     ZERO_NORMAL = 5
     NONFINITE_RESULT = 9
+    NONFINITE_POSE = 16  # along a path: the pose overflows (grasptwist.engine.path.pose_overflowed)
     CANNOT_HOLD = 20
     NO_CLOSURE = 21
     MIXED_FRICTIONLESS = 22
@@ -90,6 +91,7 @@ _MESSAGES = {
     ForceStatus.NONFINITE_RESULT: (
         "the result overflows double precision (a force is infinite or NaN): rescale the wrench, mass or coordinates"
     ),
+    ForceStatus.NONFINITE_POSE: "the object's pose overflows double precision here: rescale the twist or shorten the path",
     ForceStatus.NO_CLOSURE: "no friction makes the grasp force closure: {why}",
     ForceStatus.MIXED_FRICTIONLESS: (
         "contacts with and without friction in one grasp are not solved yet (give every contact mu > 0, or all 0)"

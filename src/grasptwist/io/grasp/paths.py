@@ -62,7 +62,11 @@ def _segments(node, path, frame, problems):
         return None
     from ...engine.path import check_segments
 
-    return check_segments(segments)
+    try:
+        return check_segments(segments)
+    except ValueError as exc:  # what only the whole path shows: its durations adding up beyond 1.8e308
+        problems.add(Reject("invalid-duration", path, str(exc), **located(node)))
+        return None
 
 
 def _segment(item, path, frame, problems):
@@ -151,8 +155,18 @@ def _pose(node, path, problems):
     elif "rotvec" in fields:
         rotvec = read_vector(fields["rotvec"], 3, path + ".rotvec", problems)
         if rotvec is not None:
-            rotation = se3.rotvec_to_matrix(rotvec)
+            with np.errstate(over="ignore", invalid="ignore"):
+                rotation = se3.rotvec_to_matrix(rotvec)
             given = {"rotvec": np.array(rotvec), **located(fields["rotvec"])}
+            if not np.isfinite(rotation).all():
+                problems.add(
+                    Reject(
+                        "non-finite",
+                        path + ".rotvec",
+                        "the rotation overflows double precision (an angle beyond about 1e154 radians)",
+                        **located(fields["rotvec"]),
+                    )
+                )
     if position is None or problems.count:
         return None
     return np.array(position), rotation, given
