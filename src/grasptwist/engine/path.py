@@ -161,7 +161,7 @@ class FollowResult:
     tangent : TangentResult or None
         The engine's Proposition 2 on every moved grasp (None when not asked for).
     overflowed : (T..., G...) bool array
-        Where the pose overflows double precision (:func:`pose_overflowed`):
+        Where the pose overflows double precision (``pose_overflowed``):
         both results say ``nonfinite-pose`` there.
     """
 
