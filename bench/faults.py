@@ -8,7 +8,7 @@ bounds (memory, time to stop, spool size), so a loaded machine shows the
 same order of magnitude.
 
 (a) hostile files: the corpus one at a time (median and slowest), 1 MiB of
-    ``---`` lines, sixteen such files in one folder, the 2.8 MB ``.npz`` zip
+    ``---`` lines, sixteen such files in one folder, one 50 MB JSON line, the 2.8 MB ``.npz`` zip
     bomb (``zeros((40_000_000, 3, 3))``) beside a good file, and an honest
     compressed ``.npz`` of 10^6 grasps (232 MB compressed);
 (b) stopping: SIGTERM, SIGINT to the group, and SIGKILL of one worker,
@@ -81,6 +81,9 @@ def hostile(tmp: Path):
     print(f"1 MiB of '---' lines: {s:.2f} s, peak {peak:.0f} MB")
     s, peak, _ = measured("resolve", tmp / "dashes", "-f", "jsonl", "-o", tmp / "out.jsonl")
     print(f"sixteen such files in one folder: {s:.2f} s, peak {peak:.0f} MB")
+    (tmp / "long.jsonl").write_bytes(b'{"name": "' + b"x" * 50_000_000 + b'"}\n')
+    s, peak, _ = measured("resolve", tmp / "long.jsonl", "--max-bytes", 10**8, "-f", "jsonl")
+    print(f"one 50 MB line with --max-bytes 1e8: {s:.2f} s, peak {peak:.0f} MB")
     np.savez_compressed(tmp / "bomb.npz", points=np.zeros((40_000_000, 3, 3)))
     size = (tmp / "bomb.npz").stat().st_size
     s, peak, code = measured("resolve", tmp / "bomb.npz", ROOT / "grasps" / "polyhedron.yaml", "-f", "jsonl")

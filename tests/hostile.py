@@ -19,6 +19,7 @@ from grasptwist.cli import app
 NULLABLE = {"units", "wrist", "off_tangent", "tip", "velocity_limit_ratio"}  # tip: inline hands
 # forces records: a grasp without a wrench or a friction, closure without one, epsilon without --quality
 NULLABLE |= {"wrench", "friction", "manipulating", "grip", "force_closure", "closure_friction", "epsilon"}
+NULLABLE |= {"squeeze"}  # a grip on collinear contacts, whose internal forces are not three squeezes
 
 
 def run(*args, input=None):

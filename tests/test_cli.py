@@ -407,3 +407,32 @@ def test_no_command_prints_the_help_on_stdout_and_succeeds():
     done, _ = run_installed()  # so that `grasptwist | less` shows it
     assert (done.returncode, done.stderr) == (0, "")
     assert done.stdout.startswith("Usage: grasptwist [OPTIONS] COMMAND") and "resolve" in done.stdout
+
+
+@pytest.mark.parametrize(
+    ("text", "limit"),
+    [("1e8", 100_000_000), ("4096", 4096), ("1", 1), ("2.5e3", 2500)],
+)
+def test_max_bytes_takes_a_whole_number_in_exponent_form_too(tmp_path, text, limit):
+    grasp = tmp_path / "g.yaml"
+    grasp.write_text(POLY)
+    r = run("resolve", grasp, "-f", "json", "--max-bytes", text)
+    if grasp.stat().st_size <= limit:
+        assert r.exit_code == 0 and [rec["ok"] for rec in json.loads(r.stdout)] == [True, True]
+    else:
+        assert r.exit_code == 1 and json.loads(r.stdout)[0]["error"]["code"] == "too-large"
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("0", "expected a whole number of bytes, at least 1, got '0'"),
+        ("1.5", "expected a whole number of bytes, at least 1, got '1.5'"),
+        ("-3", "expected a whole number of bytes, at least 1, got '-3'"),
+        ("nan", "expected a whole number of bytes, at least 1, got 'nan'"),
+        ("lots", "expected a whole number of bytes (e.g. 1048576 or 1e6), got 'lots'"),
+    ],
+)
+def test_max_bytes_refuses_what_is_no_byte_count(text, message):
+    r = run("resolve", "-", "--max-bytes", text, input=POLY)
+    assert r.exit_code == 2 and message in " ".join(r.stderr.split())

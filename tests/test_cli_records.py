@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 import grasptwist as gt
-from grasptwist.engine.degeneracy import OUTWARD_NORMALS_WARNING
+from grasptwist.engine.degeneracy import outward_normals_warning
 from grasptwist.io.grasp import load_grasps
 from hostile import jsonl, run, run_installed
 
@@ -29,6 +29,8 @@ twists:
 """
 NO_WRIST = gt.status_message(gt.Status.NO_WRIST)
 SKIPPED = f"off-tangent skipped: no-wrist: {NO_WRIST}"
+#: Every normal of ``outward.yaml`` points away from the other contacts.
+OUTWARD = outward_normals_warning([True] * 3)
 
 
 @pytest.fixture
@@ -125,12 +127,11 @@ def test_outward_normals_get_a_warning_inward_ones_none(files, command, cli):
     p, _ = cli(command, path, "-f", "jsonl")
     [rec] = jsonl(p.stdout)
     assert p.returncode == 0 and rec["ok"] is True
-    assert rec["warnings"] == [OUTWARD_NORMALS_WARNING] and rec["warnings"][0].startswith("outward-normals: ")
+    assert rec["warnings"] == [OUTWARD] and rec["warnings"][0].startswith(
+        "outward-normals: the normals at contacts 1, "
+    )
     twist = "spin" if command == "resolve" else None
-    assert p.stderr.splitlines() == [
-        f"{where(path, twist)}: warning: {OUTWARD_NORMALS_WARNING}",
-        "1 record: all ok",
-    ]
+    assert p.stderr.splitlines() == [f"{where(path, twist)}: warning: {OUTWARD}", "1 record: all ok"]
     p, _ = in_process(command, files / "wrist.yaml", "-f", "jsonl")
     assert p.returncode == 0 and jsonl(p.stdout)[0]["warnings"] == [] and p.stderr == "1 record: all ok\n"
 
@@ -138,7 +139,43 @@ def test_outward_normals_get_a_warning_inward_ones_none(files, command, cli):
 def test_outward_normals_warn_in_csv_and_npz_runs_too(files):
     for fmt in ("csv", "npz"):
         p, _ = in_process("resolve", files / "outward.yaml", "-f", fmt, "-o", files / f"r.{fmt}")
-        assert p.returncode == 0 and f"warning: {OUTWARD_NORMALS_WARNING}" in p.stderr
+        assert p.returncode == 0 and f"warning: {OUTWARD}" in p.stderr
+
+
+# issue 26: a cube held on three faces, the normal at the south face reversed; it went unnoticed,
+# and forces reported force closure with that finger pulling
+CUBE = """\
+name: cube
+units: m
+wrist: [0, 0, 0.2]
+friction: 0.6
+{weight}contacts:
+  - {{name: east, point: [0.03, 0.005, 0], normal: [-1, 0, 0]}}
+  - {{name: west, point: [-0.03, 0, 0.005], normal: [1, 0, 0]}}
+  - {{name: south, point: [0, -0.03, 0.01], normal: [0, {sign}1, 0]}}
+twists:
+  - {{name: spin, angular: [0, 0, 1]}}
+wrenches:
+  - {{name: push, force: [0, 0, -1]}}
+"""
+
+
+@pytest.mark.parametrize("weight", ["", "mass: 0.1\ncenter_of_mass: [0, 0, 0]\n"], ids=["contacts", "centre"])
+@pytest.mark.parametrize("command", ["check", "resolve", "forces"])
+def test_one_reversed_normal_is_named_by_every_command(tmp_path, command, weight):
+    path = tmp_path / "cube.yaml"
+    path.write_text(CUBE.format(weight=weight, sign="-"))
+    p, _ = in_process(command, path, "-f", "jsonl")
+    recs = jsonl(p.stdout)
+    expected = outward_normals_warning([False, False, True], ("east", "west", "south"), center=bool(weight))
+    assert expected.startswith("outward-normals: the normal at contact south points away from the ")
+    assert ("centre of mass" in expected) == bool(weight)
+    assert p.returncode == 0 and all(rec["warnings"][0] == expected for rec in recs)
+    lines = [line for line in p.stderr.splitlines() if "outward-normals" in line]
+    assert len(lines) == len(recs) and all(line.endswith(f"warning: {expected}") for line in lines)
+    path.write_text(CUBE.format(weight=weight, sign=""))  # the same grasp, the normal into the cube
+    p, _ = in_process(command, path, "-f", "jsonl")
+    assert p.returncode == 0 and "outward-normals" not in p.stdout + p.stderr
 
 
 # --------------------------------------------------------------------------

@@ -1,6 +1,7 @@
 """Array data sets: .npz and .npy in, JSONL/CSV/npz out, equal to the per-file path."""
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -115,7 +116,8 @@ def test_npz_output_arrays_match_the_records_and_carry_a_status_legend(tmp_path,
     assert z["twist_names"].tolist() == ["twist"] and not z["twist_index"].any()
     assert r.stderr.strip().splitlines()[-1] == (
         f"{N} records: 5 with a degenerate method (off-tangent: 1 coincident-contacts, 1 collinear-contacts, "
-        "1 wrist-coplanar; tangent: 1 coincident-contacts, 1 collinear-contacts, 1 theta-sigma-zero, 1 zero-normal), "
+        "1 wrist-coplanar; tangent: 1 coincident-contacts, 1 collinear-contacts, 1 normal-in-contact-plane, "
+        "1 zero-normal), "
         "0 inputs failed"
     )
 
@@ -321,3 +323,28 @@ def test_failed_rows_follow_the_warnings_rule_and_the_files_errors_are_always_pr
     else:
         for key in written["all"]:
             np.testing.assert_array_equal(written["all"][key], written["none"][key])
+
+
+def test_an_npz_named_npy_is_one_error_record_and_the_others_keep_theirs(tmp_path):
+    # 0.3: internal error: AttributeError ('NpzFile' object has no attribute 'ndim'), every record lost
+    np.savez(tmp_path / "a.npz", points=np.zeros((2, 3, 3)), normals=np.ones((2, 3, 3)))
+    (tmp_path / "a.npz").rename(tmp_path / "renamed.npy")
+    (tmp_path / "text.npy").write_text("p1_x,p1_y\n")
+    grasp = Path(__file__).parent.parent / "grasps" / "polyhedron.yaml"
+    r = CliRunner().invoke(app, ["resolve", str(tmp_path / "renamed.npy"), str(tmp_path / "text.npy"), str(grasp)])
+    assert r.exit_code == 1 and "internal error" not in r.output
+    prefix = "error: bad-dataset: not a .npy file: it does not start with numpy's b'\\x93NUMPY'"
+    assert r.stderr.splitlines()[:2] == [
+        f"{tmp_path / 'renamed.npy'}: {prefix} (it is a zip archive: an .npz named .npy?)",
+        f"{tmp_path / 'text.npy'}: {prefix}",
+    ]
+    assert "polyhedron" in r.stdout  # the grasp file's records
+
+
+def test_check_inflation_refuses_only_large_and_highly_compressed_input():
+    from grasptwist.io.limits import INFLATION_FLOOR, MAX_INFLATION, check_inflation
+
+    check_inflation(INFLATION_FLOOR, 1, "zip bomb")  # small: any ratio
+    check_inflation(INFLATION_FLOOR + 1, (INFLATION_FLOOR + 1) // MAX_INFLATION + 1, "zip bomb")  # large, ratio below
+    with pytest.raises(ValueError, match=r"^declares 67,108,865 bytes decoded from 671,088 \(over 100 times\): "):
+        check_inflation(INFLATION_FLOOR + 1, (INFLATION_FLOOR + 1) // MAX_INFLATION, "zip bomb")

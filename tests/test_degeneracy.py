@@ -3,6 +3,8 @@ grasps still resolve; a batch keeps its good rows exactly as they are alone."""
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 import grasptwist as gt
 from conftest import in_plane
@@ -55,10 +57,15 @@ def tan(points, normals, twist=TWIST):
             -1,
             "rank",
         ),
-        # the normal at 2 points along p1 p2: any axis through p1 in the plane x = const keeps p2 tangent
-        (lambda: tan(RIGHT, [[0, 0, 1], [1, 0, 0], [0, 0, 1]]), S.THETA_NOT_UNIQUE, 0, "Theta_1 is not unique"),
-        # Theta_1 along y through p1 meets the line p2 p3 at p3
-        (lambda: tan(RIGHT, [[0, 0, 1], [0, 1, 0], [1, 0, 1]]), S.THETA_SIGMA_ZERO, 0, "[Theta_1|Sigma_1] = 0"),
+        # the normals at 2 and 3 in the plane: any axis through p1 in it keeps both tangent
+        (lambda: tan(RIGHT, [[0, 0, 1], [0, 1, 0], [1, 0, 0]]), S.THETA_NOT_UNIQUE, 0, "Theta_1 is not unique"),
+        # the normal at 2 points along p1 p2 (so Theta_1 is not unique either): it alone is the cause
+        (lambda: tan(RIGHT, [[0, 0, 1], [1, 0, 0], [0, 0, 1]]), S.NORMAL_IN_CONTACT_PLANE, 1, "normal at contact 2"),
+        # the normal at 2 in the plane makes Theta_1 (along y through p1) meet the line p2 p3 at p3:
+        # the normal is named, not contact 1 (issue 26)
+        (lambda: tan(RIGHT, [[0, 0, 1], [0, 1, 0], [1, 0, 1]]), S.NORMAL_IN_CONTACT_PLANE, 1, "normal at contact 2"),
+        # ... and just outside the tolerance (1.5e-9), Theta_1 still is within it
+        (lambda: tan(RIGHT, [[0, 0, 1], [0, 1, 1.5e-9], [1, 0, 1]]), S.THETA_SIGMA_ZERO, 0, "[Theta_1|Sigma_1] = 0"),
         (lambda: tan(EX2 * 1e200, np.eye(3), [1e200, 1e200, 1e200, 0, 0, 0]), S.OVERFLOW, -1, "overflow"),
     ],
 )
@@ -103,6 +110,7 @@ def test_status_codes_are_stable_strings():
         "contact-off-finger",  # a hand's, with the two below (inverse kinematics)
         "unreachable",
         "outside-limits",
+        "nonfinite-pose",  # a path's: where the object's pose overflows
     ]
 
 
@@ -116,6 +124,24 @@ def test_the_tangent_method_fails_exactly_when_a_normal_lies_in_the_contact_plan
     assert set(np.unique(flat.status)) <= specific
     tilted = gt.decompose_tangent(points, in_plane(points, normals, which, 1e-4), twist)
     assert tilted.ok.all() and (tilted.conditioning < gt.CONDITION_WARNING).all()
+
+
+@settings(max_examples=25, deadline=None)
+@given(st.integers(0, 2**32 - 1), st.sampled_from([1e-6, 1.0, 1e6]))
+def test_one_normal_in_the_plane_is_named_and_tilting_it_cures_the_grasp(seed, scale):
+    # issue 26: a tangent grasp with one normal in the contacts' plane was blamed on another
+    # contact (theta-sigma-zero through the contact its axis goes through); tilting that one did nothing
+    rng = np.random.default_rng(seed)
+    points, normals, _, twist = grasps(rng, 50, scale=scale, offset=rng.normal(size=3) * scale)
+    which = rng.integers(0, 3, 50)
+    flat = in_plane(points, normals, which, 0.0)
+    r = tan(points, flat, twist)
+    assert (r.status == S.NORMAL_IN_CONTACT_PLANE).all()
+    np.testing.assert_array_equal(r.culprit, which)
+    for other in (1, 2):  # tilting another contact's normal leaves it degenerate
+        elsewhere = in_plane(points, flat, (which + other) % 3, 0.1)  # another normal: 0.1 off the plane
+        assert not tan(points, elsewhere, twist).ok.any()
+    assert tan(points, in_plane(points, normals, which, 0.1), twist).ok.all()  # tilting the culprit cures it
 
 
 def test_a_normal_within_tolerance_of_the_plane_is_named_when_no_finer_condition_fires():

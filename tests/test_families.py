@@ -8,9 +8,10 @@ from pathlib import Path
 import pytest
 
 from grasptwist.output.formats import FORMATS
-from grasptwist.run.batch import ZERO_TWIST, TwistOptions
+from grasptwist.run.batch import ZERO_TWIST
 from grasptwist.run.families import COMMANDS, FAMILIES, WRENCH, Command
-from grasptwist.run.forces import ForceOptions, closure_fields
+from grasptwist.run.forces import closure_fields
+from grasptwist.run.options import ForceOptions, TwistOptions
 from grasptwist.run.pipeline import Job, outputs
 
 GRASPS = Path(__file__).resolve().parents[1] / "grasps"
@@ -30,7 +31,7 @@ def test_every_command_offers_only_formats_its_family_can_write():
         assert command.family in FAMILIES
         assert list(command.formats) == [f for f in FORMATS if f in command.formats]  # in --help's order
         if "parquet" in command.formats:
-            assert command.family.columns.typed_header is not None, command.name
+            assert command.family.columns().typed_header is not None, command.name
     with pytest.raises(ValueError, match="no output format"):
         Command("x", WRENCH, ("yaml",), lambda block, job: [], "table.TableWriter")
 

@@ -23,6 +23,7 @@ import signal
 import stat
 import subprocess
 import sys
+import tempfile
 import threading
 import time
 import zipfile
@@ -275,14 +276,17 @@ def test_temporary_files_of_killed_runs_are_removed_by_the_next_run(tmp_path):
 @pytest.mark.parametrize(
     ("sig", "group", "to_file"),
     [
-        (signal.SIGINT, True, False),
-        (signal.SIGTERM, False, True),
-        pytest.param(signal.SIGHUP, True, True, marks=pytest.mark.slow),
+        (signal.SIGINT, True, None),
+        (signal.SIGTERM, False, "tmp"),
+        pytest.param(signal.SIGHUP, True, "tmp", marks=pytest.mark.slow),
+        # a regular file in /dev/shm is replaced as anywhere else, never truncated first (issue 27)
+        pytest.param(signal.SIGTERM, False, "shm", marks=pytest.mark.slow),
     ],
-    ids=["INT-to-a-stalled-pipe", "TERM", "HUP"],
+    ids=["INT-to-a-stalled-pipe", "TERM", "HUP", "TERM-to-a-file-in-dev-shm"],
 )
 def test_a_stop_signal_ends_a_parallel_run_cleanly(tmp_path, rows, sig, group, to_file):
-    out = tmp_path / "out.jsonl"
+    folder = Path(tempfile.mkdtemp(prefix="grasptwist-test-", dir="/dev/shm")) if to_file == "shm" else tmp_path
+    out = folder / "out.jsonl"
     out.write_text("old\n")
     # the pipe is not read until the run has ended: the run is stuck writing to it (0.1 could hang here)
     target = ("-o", out) if to_file else ()
@@ -294,7 +298,9 @@ def test_a_stop_signal_ends_a_parallel_run_cleanly(tmp_path, rows, sig, group, t
     assert code == 128 + sig
     assert run.said() == [f"grasptwist: stopped by {sig.name}"]  # no traceback from any process
     assert out.read_text() == "old\n"
-    assert_no_debris(run, tmp_path)
+    assert_no_debris(run, folder)
+    if to_file == "shm":
+        shutil.rmtree(folder)
 
 
 @pytest.mark.slow  # over a second: docs/reference/development.md, Test time
@@ -512,8 +518,8 @@ def test_an_npz_zip_bomb_is_refused_unread_and_costs_no_other_record(tmp_path, b
     print(f"npz bomb: peak {peak:.0f} MB")
     assert code == 1 and peak < 150
     assert stderr.splitlines()[0] == (
-        f"{bomb}: error: bad-dataset: points: declares 72,000,128 bytes in "
-        f"{zipfile.ZipFile(bomb).getinfo('points.npy').compress_size:,} compressed "
+        f"{bomb}: error: bad-dataset: points: declares 72,000,128 bytes decoded from "
+        f"{zipfile.ZipFile(bomb).getinfo('points.npy').compress_size:,} "
         f"(over {MAX_INFLATION} times): refused unread, as a likely zip bomb"
     )
     records = jsonl((tmp_path / "out.jsonl").read_text())

@@ -150,7 +150,7 @@ def test_sample_records_have_the_issue_fields_and_resolve_method_fields():
     assert start["tangent"]["error"]["code"] == "normals-rank-deficient"
     resolved = json.loads(run("resolve", CYLINDER, "--twist", "1,0,0,0,0,0", "--json").stdout)[0]
     assert start["off_tangent"] == resolved["off_tangent"] and start["tangent"] == resolved["tangent"]
-    assert list(summary) == ["file", "grasp", "path", "summary", "ok"]
+    assert list(summary) == ["file", "grasp", "path", "summary", "warnings", "ok"]
     s = summary["summary"]
     assert list(s) == ["duration", "samples", "min_conditioning", "degenerate", "first_warning"]
     assert [(c["method"], c["code"], c["t_start"], c["t_end"]) for c in s["degenerate"]][0] == (
@@ -297,3 +297,45 @@ def test_the_table_escapes_a_file_name_that_would_drive_the_terminal(tmp_path):
     name.write_bytes(CYLINDER.read_bytes())
     out = run("follow", name, "--samples", 2, "--method", "off-tangent").stdout
     assert "\x1b" not in out and f"{tmp_path}/cyl\\x1b[31m.yaml: grasp 'cylinder', path 'turn-x'" in out
+
+
+# issue 26: rotvec [0, 0, 90] (degrees, surely) turned the object 116.6 degrees without a word
+DEGREES = """\
+name: turned
+wrist: [0, 0, 1]
+contacts:
+  - {point: [1, 0, 0], normal: [-1, 0, 0.3]}
+  - {point: [-0.5, 0.866, 0], normal: [0.5, -0.866, 0.2]}
+  - {point: [-0.5, -0.866, 0], normal: [0.5, 0.866, 0.1]}
+paths:
+  - name: turn
+    segments:
+      - pose: {rotvec: [0, 0, 90]}
+        duration: 1
+      - pose: {rotvec: [0, 0, 3.141592653589793]}
+        duration: 1
+      - pose: {position: [0, 0, 0.5], rotvec: [3, 2, 0]}
+        duration: 1
+      - pose: {rotation: [0, 0, 0, 1]}
+        duration: 1
+"""
+
+
+def test_a_rotation_vector_over_pi_is_a_warning_naming_the_value_and_its_place(tmp_path):
+    path = tmp_path / "turned.yaml"
+    path.write_text(DEGREES)
+    r = run("follow", path, "--samples", 2, "--method", "tangent", "-f", "jsonl")
+    assert r.exit_code == 0, r.output
+    summary = json.loads(r.stdout.splitlines()[-1])
+    assert summary["ok"] and summary["warnings"] == [
+        "rotation-over-pi: rotation of 90 (rotvec [0, 0, 90], line 10, column 24) is over pi: "
+        "rotations are in radians (this one is a turn of 116.6 degrees)",
+        "rotation-over-pi: rotation of 3.60555 (rotvec [3, 2, 0], line 14, column 47) is over pi: "
+        "rotations are in radians (this one is a turn of 153.4 degrees)",
+    ]  # a half turn (pi) and a quaternion are not
+    assert r.stderr.splitlines()[:2] == [
+        f"{path}: grasp 'turned', path 'turn': warning: {w}" for w in summary["warnings"]
+    ]
+    # a path without one has none
+    summary = json.loads(run("follow", POLYHEDRON, "--samples", 2, "-f", "jsonl").stdout.splitlines()[-1])
+    assert summary["warnings"] == []

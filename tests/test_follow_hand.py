@@ -74,11 +74,19 @@ def _urdf(fingers):
     return '<robot name="test">' + "".join(links + joints) + "</robot>"
 
 
-def _grasp(tmp_path, fingers, normals, path):
+def _grasp(tmp_path, fingers, normals, path, radius=0.0):
+    """The grasp file of a URDF hand whose tips touch their contacts, or, with ``radius``, spheres
+    of that radius about the tips do: the contacts ``radius`` along the normal from the tips."""
     (tmp_path / "hand.urdf").write_text(_urdf(fingers))
-    contacts = "".join(f"  - {{point: {list(c)}, normal: {n}}}\n" for (_, _, c), n in zip(fingers, normals))
+    contacts = "".join(
+        f"  - {{point: {(np.array(c) + radius * np.array(json.loads(n))).tolist()}, normal: {n}}}\n"
+        for (_, _, c), n in zip(fingers, normals)
+    )
     tips = "".join(f"    - {{name: {name}, tip: {name}_tip}}\n" for name, _, _ in fingers)
-    doc = f"wrist: [0, 0, 3]\ncontacts:\n{contacts}hand:\n  urdf: hand.urdf\n  fingers:\n{tips}paths:\n{path}"
+    # at joint positions 0 each tip link is where _urdf puts it (else the loader would solve them)
+    home = "".join(f"    {name}_j{k}: 0\n" for name, chain, _ in fingers for k in range(len(chain))) if radius else ""
+    home = "  joint_positions:\n" + home if home else ""
+    doc = f"wrist: [0, 0, 3]\ncontacts:\n{contacts}hand:\n  urdf: hand.urdf\n{home}  fingers:\n{tips}paths:\n{path}"
     (tmp_path / "g.yaml").write_text(doc)
     return tmp_path / "g.yaml"
 
@@ -138,6 +146,18 @@ def test_the_first_joint_limit_exit_is_located_where_the_turntable_puts_it(tmp_p
     for rec in [*recs, summary]:
         writer.write(rec)
     assert "  hand: joint 'f1_j0' of finger 2 leaves its position limits at t = 1.2000\n" in table.getvalue().decode()
+
+
+def test_the_summary_tip_error_is_the_largest_of_the_samples(tmp_path):
+    # sphere tips: every sample's tip link origin is the radius, 0.01, from its contact; the summary
+    # said the tracker's drift instead (5e-9), contradicting the records it sums up (issue 26)
+    g = _grasp(tmp_path, _turntable([3.0] * 3), NORMALS, SPIN, radius=0.01)
+    r = run("follow", g, "--samples", 2, "-f", "jsonl")
+    assert r.exit_code == 0, r.output
+    *recs, summary = jsonl(r.stdout)
+    samples = np.array([[f["tip_error"] for f in rec["hand"]["fingers"]] for rec in recs])
+    np.testing.assert_allclose(samples, 0.01, rtol=1e-6)
+    assert [f["tip_error"] for f in summary["summary"]["hand"]["fingers"]] == samples.max(axis=0).tolist()
 
 
 @pytest.mark.parametrize("samples", [3])

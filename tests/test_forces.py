@@ -4,6 +4,8 @@ Numbers are checked against LAPACK's pseudo-inverse, against Clarabel (an indepe
 solver on the nine contact-force numbers, tests/conic.py) and against cases worked by hand.
 """
 
+import warnings
+
 import numpy as np
 import pytest
 from hypothesis import given, settings
@@ -13,13 +15,18 @@ import grasptwist as gt
 from conic import closure_friction as clarabel_closure_friction
 from conic import least_grip
 from grasptwist.engine import formulas
-from grasptwist.engine.forces.closure import epsilon_quality
-from grasptwist.engine.forces.grasp_map import manipulating_reference, squeeze_directions
+from grasptwist.engine.forces.closure import check_cone_edges, epsilon_quality, first_edges
+from grasptwist.engine.forces.grasp_map import checked_grip, manipulating_reference, squeeze_directions
+from grasptwist.engine.forces.hold import grip_along
 from grasptwist.engine.screws import field_at, klein, rigid_motion
+from grasptwist.model import Segment
 
 EQ = np.array([[1, 0, 0], [-0.5, 0.75**0.5, 0], [-0.5, -(0.75**0.5), 0]])  # a ball's equator, radius 1
 EX2 = np.array([[0, 2, 2], [2, 0, 2], [2, 2, 0]], float)  # the paper's Example 2
 G = 9.81
+# the bundled ball's tripod (grasps/sphere.yaml): force closure above mu = 0.4663
+TRIPOD = np.array([[0.0, 0.031721, -0.014792], [-0.027471, -0.01586, -0.014792], [0.027471, -0.01586, -0.014792]])
+TRIPOD_N = np.array([[0.0, -0.906305, 0.422624], [0.784886, 0.453143, 0.422629], [-0.784886, 0.453143, 0.422629]])
 
 
 def grasps(n, seed, spread=0.35):
@@ -50,7 +57,7 @@ def wrench_of(points, forces):
 def test_manipulating_forces_are_the_pseudo_inverse_and_make_the_wrench():
     p, _, w, _ = grasps(200, 1)
     p = p * 3 + 5  # away from the origin: the closed form works about the centroid
-    r = gt.manipulating_forces(p, w)
+    r = gt.forces.manipulating_forces(p, w)
     assert (r.status == 0).all()
     ref = manipulating_reference(p, w)
     assert np.abs(r.force - ref).max() <= 1e-12 * np.abs(ref).max()
@@ -58,46 +65,47 @@ def test_manipulating_forces_are_the_pseudo_inverse_and_make_the_wrench():
 
 
 def test_conditioning_is_one_for_an_equilateral_triangle_and_falls_like_the_offset_from_a_line():
-    assert gt.manipulating_forces(EQ, np.zeros(6)).conditioning == pytest.approx(1.0, abs=1e-15)
+    assert gt.forces.manipulating_forces(EQ, np.zeros(6)).conditioning == pytest.approx(1.0, abs=1e-15)
     offsets = np.array([1e-2, 1e-4, 1e-6])
     p = np.zeros((3, 3, 3))
     p[:, 1, 0], p[:, 2, 0], p[:, 2, 1] = 1.0, 2.0, offsets
-    c = gt.manipulating_forces(p, np.zeros(6)).conditioning
+    c = gt.forces.manipulating_forces(p, np.zeros(6)).conditioning
     assert c / offsets == pytest.approx(np.full(3, c[0] / offsets[0]), rel=1e-3)  # linear in the offset
 
 
 @pytest.mark.parametrize(
     "points, status, culprit",
     [
-        ([[0, 0, 0], [1, 0, 0], [2, 0, 0]], gt.ForceStatus.COLLINEAR_CONTACTS, -1),
-        ([[0, 0, 0], [1, 0, 0], [1, 0, 0]], gt.ForceStatus.COINCIDENT_CONTACTS, 0),
-        ([[0, 0, 0], [1, 0, np.nan], [0, 1, 0]], gt.ForceStatus.NONFINITE_INPUT, -1),
+        ([[0, 0, 0], [1, 0, 0], [2, 0, 0]], gt.forces.Status.COLLINEAR_CONTACTS, -1),
+        ([[0, 0, 0], [1, 0, 0], [1, 0, 0]], gt.forces.Status.COINCIDENT_CONTACTS, 0),
+        ([[0, 0, 0], [1, 0, np.nan], [0, 1, 0]], gt.forces.Status.NONFINITE_INPUT, -1),
     ],
     ids=["collinear", "coincident", "nan"],
 )
 def test_degenerate_contacts_get_a_status_and_nan_never_an_exception(points, status, culprit):
-    r = gt.manipulating_forces(points, [1, 0, 0, 0, 0, 1])
+    # a moment about x: about the collinear contacts' line, which no finger force makes
+    r = gt.forces.manipulating_forces(points, [1, 0, 0, 1, 0, 1])
     assert (int(r.status), int(r.culprit)) == (status, culprit)
     assert np.isnan(r.force).all()
-    g = gt.grip(points, [[1, 0, 0]] * 3, [1, 0, 0, 0, 0, 1], 0.5)
+    g = gt.grip(points, [[1, 0, 0]] * 3, [1, 0, 0, 1, 0, 1], 0.5)
     assert int(g.status) == status and np.isnan(g.force).all()
-    assert int(gt.force_closure(points, [[1, 0, 0]] * 3).status) == status
+    assert int(gt.forces.force_closure(points, [[1, 0, 0]] * 3).status) == status
 
 
 def test_squeezes_span_the_null_space_and_are_orthogonal_to_the_manipulating_forces():
     p, _, w, _ = grasps(50, 2)
     s = np.random.default_rng(0).normal(size=(50, 3))
-    f = gt.squeeze_forces(p, s)
+    f = gt.forces.squeeze_forces(p, s)
     assert np.abs(wrench_of(p, f)).max() < 1e-13
-    assert np.abs(np.einsum("nij,nij->n", f, gt.manipulating_forces(p, w).force)).max() < 1e-12
+    assert np.abs(np.einsum("nij,nij->n", f, gt.forces.manipulating_forces(p, w).force)).max() < 1e-12
     # three independent squeezes: the null space of the 6 x 9 grasp map, which has rank 6
-    basis = np.stack([gt.squeeze_forces(p, e).reshape(50, 9) for e in np.eye(3)], axis=-1)
+    basis = np.stack([gt.forces.squeeze_forces(p, e).reshape(50, 9) for e in np.eye(3)], axis=-1)
     assert (np.linalg.matrix_rank(basis) == 3).all()
-    assert (np.linalg.matrix_rank(gt.grasp_map(p)) == 6).all()
+    assert (np.linalg.matrix_rank(gt.forces.grasp_map(p)) == 6).all()
 
 
 def test_a_positive_squeeze_pushes_its_two_fingers_towards_each_other():
-    f = gt.squeeze_forces(EQ, [1.0, 0, 0])  # along the side through contacts 2 and 3
+    f = gt.forces.squeeze_forces(EQ, [1.0, 0, 0])  # along the side through contacts 2 and 3
     assert np.allclose(f[0], 0)
     assert f[1] @ (EQ[2] - EQ[1]) > 0 and f[2] @ (EQ[1] - EQ[2]) > 0
     assert (np.einsum("ij,ij->i", f, -EQ)[1:] > 0).all()  # inward normals: both fingers push
@@ -112,7 +120,7 @@ def test_a_squeeze_half_is_the_wrench_along_sigma_and_does_no_work_on_the_other_
     e = squeeze_directions(p)
     for i in range(3):
         j = (i + 1) % 3
-        half = gt.squeeze_forces(p, np.eye(3)[i])[:, j]  # the force on contact j of a unit squeeze i
+        half = gt.forces.squeeze_forces(p, np.eye(3)[i])[:, j]  # the force on contact j of a unit squeeze i
         wrench = np.concatenate((half, np.cross(p[:, j], half)), axis=-1)
         assert np.abs(wrench - sigma[:, i]).max() < 1e-12
         assert np.abs(e[:, i] - sigma[:, i, :3]).max() < 1e-12
@@ -122,7 +130,7 @@ def test_a_squeeze_half_is_the_wrench_along_sigma_and_does_no_work_on_the_other_
             for prod in products:
                 assert (np.abs(prod).max() < 1e-12) if m != i else (np.abs(prod).min() > 1e-6)
     twist = np.random.default_rng(1).normal(size=(30, 6))
-    f = gt.squeeze_forces(p, [1.0, 0, 0])
+    f = gt.forces.squeeze_forces(p, [1.0, 0, 0])
     power = np.einsum("nk,nk->n", f[:, 1], field_at(twist, p[:, 1]))
     assert np.abs(power - klein(sigma[:, 0], twist)).max() < 1e-12
     assert np.abs(power + np.einsum("nk,nk->n", f[:, 2], field_at(twist, p[:, 2]))).max() < 1e-12
@@ -157,7 +165,8 @@ def test_the_least_grip_equals_clarabels_and_holds(count):
     assert np.abs(wrench_of(p[ok], g.force[ok]) - w[ok]).max() <= 1e-9 * np.abs(w).max()
     assert (g.friction_used[ok] <= mu[ok] / 1.2 * (1 + 1e-9)).all() and (g.normal_force[ok] > 0).all()
     assert (
-        np.abs(g.force - g.manipulating - gt.squeeze_forces(p, g.squeeze))[ok].max() < 1e-12 * np.abs(g.force[ok]).max()
+        np.abs(g.force - g.manipulating - gt.forces.squeeze_forces(p, g.squeeze))[ok].max()
+        < 1e-12 * np.abs(g.force[ok]).max()
     )
     assert g.safety == 1.2
 
@@ -169,21 +178,21 @@ def test_frictionless_contacts_hold_only_what_the_normals_make():
     assert g.ok and g.total_normal_force == pytest.approx(2.0, rel=1e-12)
     assert g.normal_force == pytest.approx([0, 1, 1], abs=1e-12)
     lift = gt.grip(EQ, -EQ, [0, 0, G, 0, 0, 0], 0.0)
-    assert int(lift.status) == gt.ForceStatus.CANNOT_HOLD and int(lift.culprit) >= 0
+    assert int(lift.status) == gt.forces.Status.CANNOT_HOLD and int(lift.culprit) >= 0
     mixed = gt.grip(EQ, -EQ, [0, 0, G, 0, 0, 0], [0.0, 0.5, 0.5])
-    assert int(mixed.status) == gt.ForceStatus.MIXED_FRICTIONLESS
+    assert int(mixed.status) == gt.forces.Status.MIXED_FRICTIONLESS
 
 
 def test_cannot_hold_says_which_cone_or_that_the_wrench_needs_pulling():
     # fingers under a tray (normals up): pressing the tray down needs them to pull
     down = gt.grip(EQ, [[0, 0, 1]] * 3, [0, 0, -1, 0, 0, 0], 0.5)
-    assert (int(down.status), int(down.culprit)) == (gt.ForceStatus.CANNOT_HOLD, -1)
-    assert "pull" in gt.force_status_message(down.status, down.culprit)
+    assert (int(down.status), int(down.culprit)) == (gt.forces.Status.CANNOT_HOLD, -1)
+    assert "pull" in gt.forces.status_message(down.status, down.culprit)
     # Example 2 below its closure friction cannot lift the polyhedron off the three faces' common corner
     far = gt.grip(EX2, np.eye(3), [-1, -1, -1, 0, 0, 0], 0.3)
-    assert int(far.status) == gt.ForceStatus.CANNOT_HOLD and int(far.culprit) >= 0
+    assert int(far.status) == gt.forces.Status.CANNOT_HOLD and int(far.culprit) >= 0
     assert least_grip(EX2, np.eye(3), [-1, -1, -1, 0, 0, 0], 0.3)[0] is None
-    assert "cone at contact" in gt.force_status_message(far.status, far.culprit)
+    assert "cone at contact" in gt.forces.status_message(far.status, far.culprit)
 
 
 def test_a_batch_gives_each_row_what_it_gives_alone():
@@ -202,7 +211,7 @@ def test_a_batch_gives_each_row_what_it_gives_alone():
 def test_example_2_closes_above_one_over_root_two():
     """The projected normals meet at the contacts' centroid and each normal makes atan(1/sqrt(2)) with the
     contacts' plane x + y + z = 4: the cones reach the plane only for mu > tan(phi) = 1/sqrt(2)."""
-    c = gt.force_closure(EX2, np.eye(3), friction=[[0.7], [0.71]])
+    c = gt.forces.force_closure(EX2, np.eye(3), friction=[[0.7], [0.71]])
     assert c.closure_friction == pytest.approx(np.full(2, 0.5**0.5), rel=1e-12)
     assert c.force_closure.tolist() == [False, True]
 
@@ -210,7 +219,7 @@ def test_example_2_closes_above_one_over_root_two():
 @pytest.mark.parametrize("count", [10, pytest.param(300, marks=pytest.mark.slow)])
 def test_closure_friction_equals_clarabels(count):
     p, n, _, _ = grasps(count, 6, spread=0.6)
-    c = gt.force_closure(p, n)
+    c = gt.forces.force_closure(p, n)
     ref = np.array([clarabel_closure_friction(p[k], n[k]) for k in range(count)])
     assert (np.isnan(ref) == np.isnan(c.closure_friction)).all() and np.isfinite(ref).sum() >= 0.6 * count
     ok = np.isfinite(ref)
@@ -222,14 +231,14 @@ def test_a_normal_in_the_contacts_plane_is_ideal_for_closure_but_degenerate_for_
     tangent method cannot move a contact along such a normal; normals at right angles to the plane are the
     tangent method's best case and never close (internal forces lie in the plane)."""
     twist = [0, 0, 1, 0, 0, 0]
-    assert gt.force_closure(EQ, -EQ).closure_friction <= 1e-12
+    assert gt.forces.force_closure(EQ, -EQ).closure_friction <= 1e-12
     # three coplanar normal lines through one point: rank 2, the first of the in-plane failures it checks
     assert int(gt.decompose_tangent(EQ, -EQ, twist).status) == gt.Status.NORMALS_RANK_DEFICIENT
     up = [[0, 0, 1]] * 3
     tangent = gt.decompose_tangent(EQ, up, twist)
     assert int(tangent.status) == gt.Status.OK and float(tangent.conditioning) > 0.5
-    c = gt.force_closure(EQ, up, friction=10.0)
-    assert (int(c.status), int(c.culprit)) == (gt.ForceStatus.NO_CLOSURE, 0)
+    c = gt.forces.force_closure(EQ, up, friction=10.0)
+    assert (int(c.status), int(c.culprit)) == (gt.forces.Status.NO_CLOSURE, 0)
     assert np.isnan(c.closure_friction) and not c.force_closure
 
 
@@ -237,11 +246,11 @@ def test_two_fingers_squeezing_with_the_third_idle_is_not_closure():
     # contact 3's normal is steep (tan phi = 3): below mu = 3 only contacts 1 and 2 can squeeze
     n = -EQ.copy()
     n[2] = unit(n[2] + [0, 0, 3])
-    assert gt.force_closure(EQ, n).closure_friction == pytest.approx(3.0, rel=1e-9)
+    assert gt.forces.force_closure(EQ, n).closure_friction == pytest.approx(3.0, rel=1e-9)
 
 
 def test_epsilon_is_zero_outside_closure_and_grows_with_friction():
-    c = gt.force_closure(EX2, np.eye(3), friction=[[0.6], [0.8], [1.2]], quality=True)
+    c = gt.forces.force_closure(EX2, np.eye(3), friction=[[0.6], [0.8], [1.2]], quality=True)
     assert c.epsilon[0] == 0 and 0 < c.epsilon[1] < c.epsilon[2]
     assert epsilon_quality(EQ, -EQ, [0.0] * 3) == 0.0  # flat hull (Qhull's error): no closure
 
@@ -261,8 +270,8 @@ def test_every_figure_is_unchanged_by_rigid_motions_and_scaling():
     assert np.abs(b.total_normal_force[ok] / a.total_normal_force[ok] - 1).max() < 1e-6
     assert np.abs(b.manipulating - a.manipulating @ rot.T)[ok].max() < 1e-9 * np.abs(a.manipulating).max()
     assert np.abs(b.conditioning - a.conditioning).max() < 1e-12
-    ca = gt.force_closure(p, n, mu, quality=True)
-    cb = gt.force_closure(p2, n2, mu, quality=True)
+    ca = gt.forces.force_closure(p, n, mu, quality=True)
+    cb = gt.forces.force_closure(p2, n2, mu, quality=True)
     assert np.abs(cb.closure_friction / ca.closure_friction - 1).max() < 1e-9
     assert (ca.force_closure == cb.force_closure).all()
     assert np.abs(cb.epsilon - ca.epsilon).max() < 1e-9
@@ -282,7 +291,7 @@ def test_every_figure_is_unchanged_by_rigid_motions_and_scaling():
 )
 def test_check_wrench(value, message):
     with pytest.raises(ValueError, match=message):
-        gt.check_wrench(value)
+        gt.forces.check_wrench(value)
 
 
 @pytest.mark.parametrize(
@@ -295,20 +304,95 @@ def test_check_wrench(value, message):
 )
 def test_check_friction(value, message):
     with pytest.raises(ValueError, match=message):
-        gt.check_friction(value)
+        gt.forces.check_friction(value)
 
 
 @pytest.mark.parametrize("value", [0.99, float("nan"), float("inf"), "x", True, None])
 def test_check_safety(value):
     with pytest.raises(ValueError, match=r"^safety must be a finite number >= 1, got "):
-        gt.check_safety(value)
+        gt.forces.check_safety(value)
 
 
 def test_force_closure_arguments():
     with pytest.raises(ValueError, match=r"^quality=True needs the grasp's friction"):
-        gt.force_closure(EQ, -EQ, quality=True)
-    with pytest.raises(ValueError, match=r"^cone_edges must be an integer >= 3, got 2$"):
-        gt.force_closure(EQ, -EQ, 0.5, quality=True, cone_edges=2)
+        gt.forces.force_closure(EQ, -EQ, quality=True)
+    with pytest.raises(ValueError, match=r"^cone_edges must be an integer from 3 to 64, got 2$"):
+        gt.forces.force_closure(EQ, -EQ, 0.5, quality=True, cone_edges=2)
+
+
+@pytest.mark.parametrize("value", [2, 65, 10**9, 3.5, float("nan"), float("inf"), True, "8", None])
+def test_check_cone_edges(value):
+    with pytest.raises(ValueError, match=r"^cone_edges must be an integer from 3 to 64, got "):
+        check_cone_edges(value)
+    assert check_cone_edges(64) == 64 and check_cone_edges(3.0) == 3
+
+
+# --- antipodal, coplanar and coincident contacts; huge friction; overflow (issues 26, 27) --------
+
+ANTIPODAL = np.array([[0.03, 0, 0], [-0.03, 0, 0], [0, 0.03, 0.01]])  # the next contact on the normal's line
+ANTIPODAL_N = np.array([[-1.0, 0, 0], [1, 0, 0], [0, -1, 0]])
+
+
+def test_an_antipodal_pair_has_an_epsilon_that_turns_with_the_grasp_and_never_raises_in_a_batch():
+    c = gt.forces.force_closure(ANTIPODAL, ANTIPODAL_N, 0.6, quality=True)
+    assert c.status == 0 and c.force_closure and c.epsilon > 0.05
+    # the pyramids' first edges follow the grasp: a rigid motion leaves epsilon as it is
+    q, _ = np.linalg.qr(np.random.default_rng(3).normal(size=(3, 3)))
+    rot = q * np.sign(np.linalg.det(q))
+    moved = gt.forces.force_closure(ANTIPODAL @ rot.T + [1, -2, 0.5], ANTIPODAL_N @ rot.T, 0.6, quality=True)
+    assert moved.epsilon == pytest.approx(float(c.epsilon), rel=1e-9)
+    # the first edge of contact 1 points at contact 3 (its next contact lies on its normal's line)
+    b1 = first_edges(ANTIPODAL, ANTIPODAL_N)
+    np.testing.assert_allclose(b1[0], unit(np.array([0, 0.03, 0.01])), atol=1e-15)
+    # one such row among many: every row computed, each as alone
+    p, n, _, mu = grasps(30, 5)
+    p[17], n[17], mu[17] = ANTIPODAL, ANTIPODAL_N, 0.6
+    batch = gt.forces.force_closure(p, n, mu, quality=True)
+    assert batch.epsilon[17] == pytest.approx(float(c.epsilon), rel=1e-12)
+    assert np.isfinite(batch.epsilon).all() and (batch.status[batch.force_closure] == 0).all()
+
+
+def test_antipodal_coplanar_and_coincident_contacts_through_every_force_function():
+    lift = [0, 0, 1.0, 0, 0, 0]
+    m = gt.forces.manipulating_forces(ANTIPODAL, lift)
+    np.testing.assert_allclose(gt.forces.grasp_map(ANTIPODAL) @ m.force.reshape(9), lift, atol=1e-12)
+    g = gt.grip(ANTIPODAL, ANTIPODAL_N, lift, 0.6)
+    assert g.status == 0 and (g.friction_used <= 0.6 + 1e-9).all()
+    np.testing.assert_allclose(gt.forces.grasp_map(ANTIPODAL) @ g.force.reshape(9), lift, atol=1e-9)
+    # coplanar: the normals in the contacts' plane (the ball's equator)
+    c = gt.forces.force_closure(EQ, -EQ, 0.5, quality=True)
+    assert c.status == 0 and c.closure_friction == pytest.approx(0, abs=1e-9) and c.epsilon > 0
+    # coincident: a status, NaN numbers and epsilon 0, never an exception
+    same = np.array([[1.0, 0, 0], [1, 0, 0], [0, 1, 0]])
+    c = gt.forces.force_closure(same, -same, 0.5, quality=True)
+    assert (int(c.status), int(c.culprit), float(c.epsilon), bool(c.force_closure)) == (2, 2, 0.0, False)
+    assert gt.grip(same, -same, lift, 0.5).status == 2 == gt.forces.manipulating_forces(same, lift).status
+    _, held = grip_along(ANTIPODAL, ANTIPODAL_N, 0.6, 0.1, [0, 0, 0], [0, 0, -G], [Segment(1.0, twist=[0] * 6)], [0, 1])
+    assert held.status.tolist() == [0, 0]
+
+
+def test_huge_and_infinite_friction_mean_what_they_say():
+    # the ball's tripod closes above mu = 0.4663; every friction above it closes it, however large
+    tripod = gt.forces.force_closure(TRIPOD, TRIPOD_N, [[0.3], [0.5], [10], [1e200], [np.inf]], quality=True)
+    assert tripod.force_closure.tolist() == [False, True, True, True, True]
+    assert tripod.closure_friction == pytest.approx([0.46632] * 5, abs=1e-5)
+    # epsilon grows like mu (the pyramids' tangential wrenches): per unit of mu the same at 1e10 and 1e200
+    big = gt.forces.force_closure(TRIPOD, TRIPOD_N, 1e10, quality=True).epsilon
+    assert tripod.epsilon[3] / 1e200 == pytest.approx(float(big) / 1e10, rel=1e-6)
+    assert np.isnan(tripod.epsilon[4])  # an infinite cone has no finite pyramid
+    g = gt.grip(TRIPOD, TRIPOD_N, [[0, 0, G, 0, 0, 0]] * 2, [[1e200], [np.inf]])
+    assert g.status.tolist() == [0, 0] and g.total_normal_force[0] == pytest.approx(g.total_normal_force[1], rel=1e-6)
+
+
+def test_an_overflowing_result_is_a_status_never_an_ok_row_with_infinity():
+    m = gt.forces.manipulating_forces(EQ, [[1e308, 0, 0, 0, 0, 1e308], [0, 0, G, 0, 0, 0]])
+    assert m.status.tolist() == [9, 0] and np.isnan(m.force[0]).all() and np.isfinite(m.force[1]).all()
+    assert gt.forces.status_message(9).startswith("the result overflows double precision")
+    g = checked_grip(gt.grip(EQ, -EQ, [[0, 0, 9.81e300, 0, 0, 0], [0, 0, G, 0, 0, 0], [0] * 6], 0.5))
+    assert g.status.tolist() == [9, 0, 0] and np.isnan(g.total_normal_force[0])
+    assert g.total_normal_force[1] == pytest.approx(2 * G) and g.friction_used[2].tolist() == [0.0] * 3
+    _, held = grip_along(EQ, -EQ, 0.5, 1e300, [0, 0, 0], [0, 0, -G], [Segment(1.0, twist=[0] * 6)], [0])
+    assert held.status.tolist() == [9]
 
 
 # --- properties -------------------------------------------------------------------------------------
@@ -318,7 +402,7 @@ def test_force_closure_arguments():
 @given(seed=st.integers(0, 2**32 - 1), spread=st.floats(0.0, 1.0), safety=st.floats(1.0, 3.0))
 def test_any_grip_found_makes_the_wrench_within_every_cone_and_beats_no_clarabel_grip(seed, spread, safety):
     p, n, w, mu = grasps(4, seed, spread)
-    g = gt.grip(p, n, w, mu, safety)
+    g = gt.grip(p, n, w, mu, safety=safety)
     for k in range(4):
         ref, _ = least_grip(p[k], n[k], w[k], mu[k], safety)
         assert g.ok[k] == (ref is not None)
@@ -344,3 +428,199 @@ def test_the_interior_point_step_stops_at_the_cones_edge_even_for_a_ray():
     # a half-space's cone (t, 0, 0): stopped exactly at t = 0, where a difference of squares loses it
     ray = _edge(np.array([[[0.3]], [[0.0]], [[0.0]]]), np.array([[[-0.7]], [[0.0]], [[0.0]]]))
     assert ray[0] == pytest.approx(0.3 / 0.7, rel=1e-15)
+
+
+# --- certificates, the prepared grip, collinear contacts (issue 29, issue 26 item 2.6) ---------------
+
+
+def _field(lam, p):
+    """``G_i^T lambda = lambda_F + lambda_M x p_i`` for every contact: ``(n, 6), (n, 3, 3) -> (n, 3, 3)``."""
+    return lam[:, None, :3] + np.cross(lam[:, None, 3:], p)
+
+
+def _dual_cone_excess(z, n, limit):
+    """``limit |z_t| - z_n`` per contact (``<= 0``: in the dual cone)."""
+    zn = np.einsum("nij,nij->ni", z, n)
+    return limit * np.linalg.norm(z - zn[..., None] * n, axis=-1) - zn
+
+
+@pytest.mark.parametrize("seed", [11, 12, 13])
+def test_every_grip_carries_a_certificate_that_numpy_alone_verifies(seed):
+    """Held: n_i - G_i^T dual in the dual cone and total - w . dual = gap near 0 (weak duality makes the total
+    optimal); cannot-hold: y . w > 0 and -G_i^T y in the dual cone (no admissible forces have a component along y)."""
+    p, n, w, mu = grasps(400, seed)
+    g = gt.grip(p, n, w, mu, safety=1.3)
+    u, limit = unit(n), mu / 1.3
+    ok, bad = g.ok, g.status == gt.forces.Status.CANNOT_HOLD
+    assert ok.sum() > 100 and bad.sum() > 50 and (ok | bad).all()
+    assert np.isnan(g.certificate[ok]).all() and np.isfinite(g.dual[ok]).all() and np.isnan(g.dual[bad]).all()
+    total = g.total_normal_force[ok]
+    assert (_dual_cone_excess(u[ok] - _field(g.dual[ok], p[ok]), u[ok], limit[ok]) <= 1e-6 * total[:, None]).all()
+    assert np.abs(g.gap[ok] - (total - np.einsum("ni,ni->n", w[ok], g.dual[ok]))).max() < 1e-9 * total.max()
+    assert np.median(np.abs(g.gap[ok]) / total) < 1e-9 and (np.abs(g.gap[ok]) <= 1e-4 * total).all()
+    y = g.certificate[bad]
+    size = np.linalg.norm(p - p.mean(axis=1, keepdims=True), axis=-1).max(axis=1)[bad, None]
+    assert np.linalg.norm(np.concatenate((y[:, :3], size * y[:, 3:]), axis=1), axis=1) == pytest.approx(1, rel=1e-12)
+    assert (np.einsum("ni,ni->n", y, w[bad]) > 0).all()
+    assert (_dual_cone_excess(-_field(y, p[bad]), u[bad], limit[bad]) <= 1e-6).all()
+
+
+def test_the_dual_is_the_grips_sensitivity_to_the_wrench():
+    p, n, w, mu = grasps(60, 14)
+    g = gt.grip(p, n, w, mu)
+    dw = np.random.default_rng(15).normal(size=(60, 6)) * 1e-6
+    moved = gt.grip(p, n, w + dw, mu)
+    both = g.ok & moved.ok
+    predicted = np.einsum("ni,ni->n", g.dual[both], dw[both])
+    change = moved.total_normal_force[both] - g.total_normal_force[both]
+    assert both.sum() > 20
+    assert np.abs(change - predicted).max() < 1e-3 * np.abs(dw).max() * np.abs(g.dual[both]).max()
+
+
+def test_the_equator_ball_needs_one_over_mu_more_grip_per_newton_of_lift():
+    g = gt.grip(EQ, -EQ, [0, 0, G, 0, 0, 0], 0.5)
+    assert g.dual[:3] == pytest.approx([0, 0, 2.0], abs=1e-6) and abs(float(g.gap)) < 1e-8
+
+
+def test_a_tray_pushed_down_is_refused_with_the_upward_load_it_cannot_resist():
+    down = gt.grip(EQ, [[0, 0, 1]] * 3, [0, 0, -1, 0, 0, 0], 0.5)
+    y = down.certificate
+    assert y @ [0, 0, -1, 0, 0, 0] > 0 and np.isnan(down.dual).all()
+    assert (
+        gt.engine.forces.grip.load_words(y, EQ)
+        == "cannot resist a force along (0, 0, 1) with a moment (0, 0, 0) about the origin"
+    )
+
+
+def test_frictionless_grips_carry_certificates_too():
+    held = gt.grip(EQ, -EQ, [*EQ[0], 0, 0, 0], 0.0)  # rank 2 normal lines, contact 1 idle
+    assert float(held.gap) == pytest.approx(0.0, abs=1e-9)
+    nu = np.concatenate((-EQ, np.cross(EQ, -EQ)), axis=1)
+    assert (nu @ held.dual <= 1 + 1e-9).all()
+    lift = gt.grip(EQ, -EQ, [0, 0, G, 0, 0, 0], 0.0)  # out of the normals' span
+    assert lift.certificate @ [0, 0, G, 0, 0, 0] > 0 and (nu @ lift.certificate <= 1e-12).all()
+    up = [[0, 0, 1.0]] * 3  # a tray on three finger-tips: rank 3 normal lines, pressing it down needs pulling
+    pull = gt.grip(EQ, up, [0, 0, -1, 0, 0, 0], 0.0)
+    assert (int(pull.status), int(pull.culprit)) == (gt.forces.Status.CANNOT_HOLD, -1)
+    lines = np.concatenate((up, np.cross(EQ, up)), axis=1)
+    assert pull.certificate @ [0, 0, -1, 0, 0, 0] > 0 and (lines @ pull.certificate <= 1e-12).all()
+
+
+def test_safety_is_keyword_only():
+    with pytest.raises(TypeError):
+        gt.grip(EQ, -EQ, [0, 0, G, 0, 0, 0], 0.5, 2.0)
+
+
+def test_a_prepared_grip_gives_what_grip_gives():
+    p, n, w, mu = grasps(30, 16)
+    for k in range(6):
+        hand = gt.prepare_grip(p[k], n[k], mu[k], safety=1.2)
+        many = hand.grip(w)
+        direct = gt.grip(p[k], n[k], w, mu[k], safety=1.2)
+        one = hand.grip(w[k])
+        assert (many.status == direct.status).all() and int(one.status) == direct.status[k]
+        for name in ("total_normal_force", "force", "dual", "certificate"):
+            # the same solver on the same rows; batches of other shapes may round their last bits otherwise
+            np.testing.assert_allclose(getattr(many, name), getattr(direct, name), rtol=1e-7, atol=1e-9)
+            np.testing.assert_allclose(getattr(one, name), getattr(direct, name)[k], rtol=1e-7, atol=1e-9)
+        held = many.ok  # the gap is round-off: both near 0, not equal
+        assert (np.abs(many.gap[held]) < 1e-6 * many.total_normal_force[held]).all()
+
+
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        ((np.zeros((2, 3, 3)), np.ones((2, 3, 3)), 0.5), r"^prepare_grip takes one grasp: points and normals \(3, 3\)"),
+        ((EQ, -EQ, [[0.5] * 3] * 2), r"^prepare_grip takes one grasp: friction a scalar or \(3,\), got \(2, 3\)$"),
+    ],
+)
+def test_prepare_grip_arguments(args, message):
+    with pytest.raises(ValueError, match=message):
+        gt.prepare_grip(*args)
+
+
+LINE = np.array([[-0.05, 0, 0], [0.05, 0, 0], [0, 0, 0.0]])  # three contacts on the x axis
+ACROSS = np.array([[1, 0, 0], [-1, 0, 0], [0, 0, 1.0]])  # two squeeze along the line, the third pushes up
+
+
+def test_collinear_contacts_exert_every_wrench_in_the_grasp_maps_range():
+    """Issue 26, item 2.6: a push along the third contact's normal, at that contact, is held by that finger
+    alone (1 N of normal force); a moment about the contacts' line is not in G's range, and its certificate
+    says so (y . w > 0, y . G f = 0 for every f)."""
+    push = np.concatenate(([0, 0, 1.0], np.cross(LINE[2], [0, 0, 1.0])))
+    g = gt.grip(LINE, ACROSS, push, 0.5)
+    assert g.ok and float(g.total_normal_force) == pytest.approx(1.0, rel=1e-8)
+    assert np.abs(wrench_of(LINE, g.force) - push).max() < 1e-9 and np.isnan(g.squeeze).all()
+    assert abs(float(g.gap)) < 1e-8 and int(gt.forces.manipulating_forces(LINE, push).status) == 0
+    twist = gt.grip(LINE, ACROSS, [0, 0, 0, 0.01, 0, 0], 0.5)
+    assert int(twist.status) == gt.forces.Status.COLLINEAR_CONTACTS
+    y = twist.certificate
+    assert y @ [0, 0, 0, 0.01, 0, 0] > 0 and np.abs(y @ gt.forces.grasp_map(LINE)).max() < 1e-12
+
+
+def test_collinear_contacts_agree_with_clarabel():
+    rng = np.random.default_rng(17)
+    normals = unit(ACROSS + rng.normal(0, 0.3, (20, 3, 3)))
+    forces = rng.normal(size=(20, 3, 3))
+    w = wrench_of(LINE, forces)  # in the range of G by construction
+    g = gt.grip(LINE, normals, w, 0.8)
+    for k in range(20):
+        ref, _ = least_grip(LINE, normals[k], w[k], 0.8)
+        assert g.ok[k] == (ref is not None)
+        if ref is not None:
+            assert float(g.total_normal_force[k]) == pytest.approx(ref, rel=1e-6)
+    assert g.ok.any()
+
+
+def test_one_grasp_in_floats_follows_the_batched_solver_step_for_step():
+    """One grasp goes through engine/forces/one.py (Python floats), a batch through socp.py (numpy): the
+    same method, so the same verdicts, culprits, optimum and certificates, on held and refused rows alike."""
+    p, n, w, mu = grasps(40, 18)
+    batch = gt.grip(p, n, w, mu, safety=1.4)
+    assert batch.ok.sum() >= 10 and (~batch.ok).sum() >= 10
+    for k in range(40):
+        one = gt.grip(p[k], n[k], w[k], mu[k], safety=1.4)
+        assert (int(one.status), int(one.culprit)) == (batch.status[k], batch.culprit[k])
+        for name in ("total_normal_force", "force"):
+            np.testing.assert_allclose(getattr(one, name), getattr(batch, name)[k], rtol=1e-7, atol=1e-9)
+        # multipliers are as well conditioned as the optimum is sharp: the proofs are what must hold (above)
+        for name in ("dual", "certificate"):
+            np.testing.assert_allclose(getattr(one, name), getattr(batch, name)[k], rtol=1e-4, atol=1e-6)
+
+
+@pytest.mark.parametrize(
+    "points",
+    [EQ, np.array([[0, 0, 0], [0.05, 0, 0], [0.1, 0, 0.0]])],
+    ids=["tray", "rod-end"],
+)
+def test_a_wrench_on_the_edge_of_what_the_fingers_exert_is_held(points):
+    """A push along the third finger's normal, at that finger, with every normal up: only that finger can
+    make it, the other two carry exactly nothing (no grip strictly inside the cones exists, so phase I alone
+    cannot decide).  Phase I's multipliers say which contacts are bare; the rest is solved without them."""
+    up = np.array([[0, 0, 1.0]] * 3)
+    w = np.concatenate((up[2], np.cross(points[2], up[2])))
+    g = gt.grip(points, up, w, 0.5)
+    assert g.ok and float(g.total_normal_force) == pytest.approx(1.0, rel=1e-9)
+    np.testing.assert_allclose(g.force, [[0, 0, 0], [0, 0, 0], [0, 0, 1]], atol=1e-9)
+    assert (_dual_cone_excess(up[None] - _field(g.dual[None], points[None]), up[None], 0.5) <= 1e-9).all()
+    assert abs(float(g.gap)) < 1e-9 and np.isnan(g.certificate).all()
+    one = gt.prepare_grip(points, up, 0.5).grip(w)  # the floats path too
+    assert one.ok and float(one.total_normal_force) == pytest.approx(1.0, rel=1e-9)
+
+
+def test_collinear_frictionless_contacts_stay_unsolved_and_a_batch_of_odd_rows_never_warns():
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        g = gt.grip(
+            np.stack((LINE, LINE, LINE, EQ)),
+            np.stack((ACROSS, ACROSS, [[0, 0, 0.0]] * 3, [[0, 0, 1.0]] * 3)),
+            [[0, 0, 1, 0, 0, 0], [0, 0, np.nan, 0, 0, 0], [0, 0, 1, 0, 0, 0], [0, 0, -1, 0, 0, 0]],
+            np.array([[0.0] * 3, [0.5] * 3, [0.5] * 3, [np.inf] * 3]),
+        )
+    assert g.status.tolist() == [
+        gt.forces.Status.COLLINEAR_CONTACTS,
+        gt.forces.Status.NONFINITE_INPUT,
+        gt.forces.Status.ZERO_NORMAL,
+        gt.forces.Status.CANNOT_HOLD,
+    ]
+    assert np.isnan(g.certificate[:3]).all() and g.certificate[3] @ [0, 0, -1, 0, 0, 0] > 0

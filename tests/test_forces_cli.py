@@ -54,7 +54,12 @@ def test_the_bundled_ball_is_held_with_m_g_over_mu_as_the_engine_says():
     assert all(u <= 0.5 + 1e-9 for u in grip["friction_used"])
     split = np.array(hold["manipulating"]["force"]) + squeeze_forces(g.points, np.array(grip["squeeze"]))
     np.testing.assert_allclose(split, f, atol=1e-12)
-    assert hold["closure"] == {"force_closure": True, "closure_friction": pytest.approx(0, abs=1e-9), "epsilon": None}
+    assert hold["closure"] == {
+        "force_closure": True,
+        "closure_friction": pytest.approx(0, abs=1e-9),
+        "epsilon": None,
+        "safety": 1.0,
+    }
     turn = by(recs, "sphere-equator", "turn-z")
     # 0.01 N m about the vertical: |f_t| = 0.01 / (3 r) at each finger, f_n = |f_t| / mu
     assert turn["grip"]["total_normal_force"] == pytest.approx(0.01 / (0.035 * 0.5), rel=1e-5)
@@ -85,8 +90,8 @@ def test_command_line_wrench_friction_safety_and_quality():
     assert push["grip"]["total_normal_force"] == pytest.approx(float(engine.total_normal_force), rel=1e-12)
     assert push["grip"]["safety"] == 1.1
     assert max(push["grip"]["friction_used"]) <= 0.8 / 1.1 + 1e-9
-    c = gt.force_closure(g.points, g.normals, 0.8, quality=True)
-    assert up["closure"]["force_closure"] is True
+    c = gt.forces.force_closure(g.points, g.normals, 0.8 / 1.1, quality=True)  # judged with mu / safety
+    assert up["closure"]["force_closure"] is True and up["closure"]["safety"] == 1.1
     assert up["closure"]["epsilon"] == pytest.approx(float(c.epsilon), rel=1e-9) and up["closure"]["epsilon"] > 0
 
 
@@ -102,6 +107,34 @@ def test_cannot_hold_is_a_failed_record_with_its_reason(tmp_path):
     assert rec["grip"]["error"]["code"] == "cannot-hold"
     assert "needs a finger to pull" in rec["grip"]["error"]["message"]
     assert f"{tray}: grasp 'tray', wrench 'pull': error: grip: cannot-hold: " in r.stderr
+    # the proof: y . w > 0, and no finger pushing up (f_z >= 0, in its cone) has y . G f > 0
+    y = np.array(rec["grip"]["error"]["certificate"])
+    assert y @ [0, 0, -1, 0, 0, 0] > 0 and np.abs(y[3:]).max() < 1e-9 and y[2] < 0
+    assert "; it cannot resist a force along (0, 0, 1) with a moment (0, 0, 0) about the origin" in r.stderr
+
+
+def test_a_held_record_carries_its_dual_and_gap():
+    _, recs = records(SPHERE)
+    grip = by(recs, "sphere-equator", "hold")["grip"]
+    # one more newton of lift costs 1 / mu = 2 N of grip: the dual is d total / d w
+    assert grip["dual"][:3] == pytest.approx([0, 0, 2], abs=1e-6) and abs(grip["gap"]) < 1e-8
+
+
+def test_collinear_contacts_hold_a_push_along_a_normal_at_its_contact(tmp_path):
+    """Issue 26, item 2.6: three contacts on a line; the third pushes up at its own point alone."""
+    line = tmp_path / "line.yaml"
+    line.write_text(
+        "friction: 0.5\ncontacts:\n  - {point: [-0.05, 0, 0], normal: [1, 0, 0]}\n"
+        "  - {point: [0.05, 0, 0], normal: [-1, 0, 0]}\n  - {point: [0, 0, 0], normal: [0, 0, 1]}\n"
+    )
+    r, recs = records(line, "--wrench", "0,0,1,0,0,0", "--at", "0,0,0")
+    (rec,) = recs
+    assert r.exit_code == 0 and rec["ok"], r.stderr
+    assert rec["grip"]["total_normal_force"] == pytest.approx(1.0, rel=1e-8)
+    r, recs = records(line, "--wrench", "0,0,0,1,0,0")  # a moment about the line itself
+    assert r.exit_code == 1 and recs[0]["grip"]["error"]["code"] == "collinear-contacts"
+    y = np.array(recs[0]["grip"]["error"]["certificate"])
+    assert y[3] > 0 and np.abs(y @ grasp_map(np.array([[-0.05, 0, 0], [0.05, 0, 0], [0, 0, 0]]))).max() < 1e-9
 
 
 def test_a_wrench_without_friction_has_no_grip_and_says_so():
@@ -233,3 +266,164 @@ def test_check_reports_closure_friction_beside_the_methods():
     table, _ = run("check", POLYHEDRON)
     head, *rows = [line for line in table.stdout.splitlines() if line.strip() and "─" not in line]
     assert "closure mu" in head and "0.707" in rows[0]
+
+
+# --- units, antipodal pairs, safety, huge friction, overflow, bad options and data sets (issues 26, 27)
+
+MM = """name: mm
+units: mm
+friction: 0.5
+mass: 1
+center_of_mass: [5, 0, 100]
+contacts:
+  - {point: [35, 0, 0], normal: [-1, 0, 0]}
+  - {point: [-17.5, 30.31, 0], normal: [0.5, -0.866, 0]}
+  - {point: [-17.5, -30.31, 0], normal: [0.5, 0.866, 0]}
+"""
+ANTIPODAL = """name: antipodal
+friction: 0.6
+contacts:
+  - {point: [0.03, 0, 0], normal: [-1, 0, 0]}
+  - {point: [-0.03, 0, 0], normal: [1, 0, 0]}
+  - {point: [0, 0.03, 0.01], normal: [0, -1, 0]}
+wrenches: [{name: up, force: [0, 0, 1]}]
+"""
+
+
+def test_moments_carry_the_files_length_unit_and_gravity_is_in_metres_per_second_squared(tmp_path):
+    (tmp_path / "mm.yaml").write_text(MM)
+    (tmp_path / "bare.yaml").write_text(MM.replace("units: mm\n", ""))
+    r, recs = records(tmp_path / "mm.yaml")
+    (rec,) = recs
+    # 1 kg: 9.81 N whatever the length unit (gravity is not converted); the moment -c x m g in N mm
+    assert rec["units"] == "mm" and rec["wrench"]["wrench"] == pytest.approx([0, 0, 9.81, 0, -49.05, 0], abs=1e-12)
+    table, _ = run("forces", tmp_path / "mm.yaml", "--digits", "2")
+    assert "wrench hold = force (0.00, 0.00, 9.81) N; moment (0.00, -49.05, 0.00) N mm" in table.stdout
+    table, _ = run("forces", tmp_path / "bare.yaml", "--digits", "2")
+    assert "moment (0.00, -49.05, 0.00) N length" in table.stdout
+
+
+def test_an_antipodal_pair_beside_a_good_file_gives_both_their_records_with_epsilon(tmp_path):
+    (tmp_path / "a.yaml").write_text(ANTIPODAL)
+    shutil.copy(SPHERE, tmp_path / "b.yaml")
+    r, recs = records(tmp_path, "--quality")
+    assert r.exit_code == 0, r.stderr
+    assert [rec["grasp"] for rec in recs] == ["antipodal", "sphere-tripod", "sphere-equator", "sphere-equator"]
+    anti = recs[0]
+    assert anti["ok"] and anti["closure"]["force_closure"] is True and anti["closure"]["epsilon"] > 0.05
+    f = np.array(anti["grip"]["force"])
+    np.testing.assert_allclose(grasp_map(np.array([c["point"] for c in anti["contacts"]])) @ f.reshape(9),
+                               [0, 0, 1, 0, 0, 0], atol=1e-9)  # fmt: skip
+
+
+def test_antipodal_and_coincident_contacts_through_forces_and_check(tmp_path):
+    (tmp_path / "a.yaml").write_text(ANTIPODAL)
+    r, _ = run("check", tmp_path / "a.yaml", "-f", "jsonl")
+    (rec,) = jsonl(r.stdout)
+    # the contacts' plane has the normal (0, 1, -3) / sqrt(10): the third normal leaves it at
+    # sin(phi) = 1 / sqrt(10), so the least friction is tan(phi) = 1/3 (the pair squeezes within it)
+    assert rec["force_closure"] is True and rec["closure_friction"] == pytest.approx(1 / 3, abs=1e-9)
+    (tmp_path / "same.yaml").write_text(ANTIPODAL.replace("[-0.03, 0, 0]", "[0.03, 0, 0]"))
+    r, (rec,) = records(tmp_path / "same.yaml", "--quality")
+    assert r.exit_code == 1 and "internal error" not in r.stderr
+    assert rec["grip"]["error"]["code"] == rec["manipulating"]["error"]["code"] == "coincident-contacts"
+    assert rec["closure"] == {"force_closure": False, "closure_friction": None, "epsilon": 0.0, "safety": 1.0}
+
+
+def test_closure_is_judged_with_the_friction_the_safety_factor_leaves():
+    # the tripod closes above mu = 0.4663: with mu 0.6 it does, with 0.6 / 2 it does not
+    for safety, closes in (("1", True), ("2", False)):
+        r, (rec, *_) = records(SPHERE, "--friction", "0.6", "--safety", safety)
+        assert rec["closure"]["force_closure"] is closes and rec["closure"]["safety"] == float(safety)
+        assert rec["closure"]["closure_friction"] == pytest.approx(0.4663, abs=1e-4)
+    table, _ = run("forces", SPHERE, "--friction", "0.6", "--safety", "2", "--digits", "2")
+    assert "closure (with mu/2): force closure no; closure friction 0.47" in table.stdout
+
+
+def test_huge_and_infinite_friction_close_a_grasp_whose_closure_friction_is_finite(tmp_path):
+    for mu in ("1e200", "inf"):
+        r, (rec, *_) = records(SPHERE, "--friction", mu)
+        assert r.exit_code == 0 and rec["closure"]["force_closure"] is True, mu
+    (tmp_path / "f.yaml").write_text(Path(SPHERE).read_text().split("---")[0] + "friction: 1e200\n")
+    r, (rec,) = records(tmp_path / "f.yaml")
+    assert rec["friction"] == [1e200] * 3 and rec["closure"]["force_closure"] is True
+
+
+def _numbers(x):
+    if isinstance(x, dict):
+        return [n for v in x.values() for n in _numbers(v)]
+    if isinstance(x, list):
+        return [n for v in x for n in _numbers(v)]
+    return [x]
+
+
+def test_an_overflowing_result_is_a_nonfinite_result_record_never_ok_with_nulls(tmp_path):
+    r, recs = records(SPHERE, "--friction", "0.5", "--wrench", "1e308,0,0,0,0,1e308", "--wrench", "0,0,0,0,0,0")
+    assert r.exit_code == 1
+    big, still = recs[:2]
+    assert not big["ok"] and big["grip"]["error"]["code"] == big["manipulating"]["error"]["code"] == "nonfinite-result"
+    assert still["ok"] and still["grip"]["friction_used"] == [0.0] * 3  # no force uses no friction
+    (tmp_path / "heavy.yaml").write_text(
+        ANTIPODAL.replace("wrenches: [{name: up, force: [0, 0, 1]}]", "mass: 1e300\ncenter_of_mass: [0, 0, 0]")
+    )
+    r, (heavy,) = records(tmp_path / "heavy.yaml")
+    assert r.exit_code == 1 and heavy["grip"]["error"]["code"] == "nonfinite-result" and not heavy["ok"]
+    assert "nonfinite-result: the result overflows double precision" in r.stderr
+    _, recs = records(SPHERE, "--friction", "0.5", "--wrench", "1e300,0,0,0,0,0", "--wrench", "0,0,9.81,0,0,0")
+    for rec in recs:  # an ok record holds only finite numbers
+        assert not rec["ok"] or None not in _numbers({k: rec[k] for k in ("manipulating", "grip", "wrench")})
+
+
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["--friction", "nan"], "Invalid value for '--friction': must be a number >= 0 (inf: no limit), got nan"),
+        (["--safety", "nan"], "Invalid value for '--safety': safety must be a finite number >= 1, got nan"),
+        (["--safety", "inf"], "Invalid value for '--safety': safety must be a finite number >= 1, got inf"),
+        (["--quality", "--cone-edges", "1000000000"], "cone_edges must be an integer from 3 to 64, got 1000000000"),
+    ],
+)
+def test_absurd_option_values_are_usage_errors(args, message):
+    r, _ = run("forces", SPHERE, *args)
+    assert r.exit_code == 2 and r.stdout == "" and message in " ".join(r.stderr.split())
+
+
+def test_one_friction_for_every_row_of_an_npz(tmp_path):
+    grasps = np.stack([P, 2 * P])
+    np.savez(
+        tmp_path / "in.npz", points=grasps, normals=-grasps, wrench=[0, 0, 9.81, 0, 0, 0], friction=np.float64(0.5)
+    )
+    r, recs = records(tmp_path / "in.npz")
+    assert r.exit_code == 0, r.stderr
+    assert [rec["friction"] for rec in recs] == [[0.5] * 3] * 2
+    assert [rec["grip"]["total_normal_force"] for rec in recs] == pytest.approx([19.62] * 2, rel=1e-6)
+
+
+def test_a_negative_friction_in_a_data_set_is_one_error_record_and_the_other_inputs_keep_theirs(tmp_path):
+    grasps = np.stack([P, 2 * P])
+    np.savez(tmp_path / "neg.npz", points=grasps, normals=-grasps, friction=[0.5, -1.0])
+    r, recs = records(tmp_path / "neg.npz", SPHERE)
+    assert r.exit_code == 1
+    (bad,) = [rec for rec in recs if rec["file"] == str(tmp_path / "neg.npz")]
+    assert bad["error"]["code"] == "bad-dataset" and bad["error"]["message"].startswith(
+        "friction: row 1: -1.0 must be >= 0"
+    )
+    assert [rec["grasp"] for rec in recs if rec["file"] == SPHERE] == [
+        "sphere-tripod",
+        "sphere-equator",
+        "sphere-equator",
+    ]
+
+
+def test_a_negative_mu_in_a_parquet_data_set_is_one_error_record(tmp_path):
+    pytest.importorskip("pyarrow")
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    from grasptwist.io.parquet import grasp_table
+
+    grasps = np.stack([P, 2 * P])
+    pq.write_table(grasp_table(grasps, -grasps).append_column("mu", pa.array([0.5, -2.0])), tmp_path / "neg.parquet")
+    r, recs = records(tmp_path / "neg.parquet", POLYHEDRON)
+    assert r.exit_code == 1 and [rec.get("grasp") for rec in recs] == [None, "polyhedron"]
+    assert recs[0]["error"]["message"].startswith("friction: row 1: -2.0 must be >= 0")

@@ -98,7 +98,7 @@ def test_a_data_set_with_joint_positions_and_a_hand_file(tmp_path, trifinger):
         rates = d["joint_rates"]
         for f, s in enumerate(states):
             # an independent least-squares solve on the Jacobian at each row
-            jac = gt.finger_jacobian(s.screws, points[:, f])
+            jac = gt.hand.finger_jacobian(s.screws, points[:, f])
             velocity = twist[3:] + np.cross(twist[:3], points[:, f])
             want = np.stack([np.linalg.lstsq(j, v, rcond=None)[0] for j, v in zip(jac, velocity)])
             np.testing.assert_allclose(rates[:, 3 * f : 3 * f + 3], want, atol=1e-9)

@@ -9,7 +9,7 @@ import pytest
 from grasptwist.engine.degeneracy import Status
 from grasptwist.engine.ik import IK_TOL, chain_ik, contact_off_finger, hand_ik, home_tips, joint_limits, place_hand
 from grasptwist.engine.kinematics import forward_kinematics
-from grasptwist.io.grasp_file import load_grasps
+from grasptwist.io.grasp import load_grasps
 
 GRASPS = Path(__file__).parent.parent / "grasps"
 
@@ -74,7 +74,7 @@ def test_trifinger_file_positions_are_found_again_from_a_nearby_seed(trifinger):
     hand = trifinger.hand
     centres = trifinger.points - 0.01 * trifinger.normals
     seed = trifinger.joint_positions + 0.1 * np.resize([1, -1, 1], 9)
-    r = hand_ik(hand, centres, seed)
+    r = hand_ik(hand, centres, seed=seed)
     assert r.ok
     np.testing.assert_allclose(r.positions, trifinger.joint_positions, atol=1e-8)
 
@@ -101,7 +101,7 @@ def test_the_solution_nearest_the_seed_is_chosen(inline):
     _, q = reachable(hand, tips, np.random.default_rng(8), 50, 0.8)
     q[:, 2::3] = np.where(np.abs(q[:, 2::3]) < 0.3, 0.5, q[:, 2::3])  # a clearly bent elbow
     targets = tip_points(hand, q, tips)
-    r = hand_ik(hand, targets, q + 0.05, tips=tips)
+    r = hand_ik(hand, targets, seed=q + 0.05, tips=tips)
     assert r.ok.all()
     np.testing.assert_allclose(r.positions, q, atol=1e-7)
 

@@ -81,7 +81,7 @@ def test_the_seed_is_where_the_solution_starts(tmp_path):
     seed = {k: round(v, 1) for k, v in yaml.safe_load(TRIFINGER.read_text("utf-8"))["hand"]["joint_positions"].items()}
     seeded, _ = without_positions(tmp_path / "..", seed=seed)
     (g,) = read_grasps(seeded)
-    want = hand_ik(g.hand, g.points, [seed[name] for name in g.hand.joint_names])
+    want = hand_ik(g.hand, g.points, seed=[seed[name] for name in g.hand.joint_names])
     np.testing.assert_array_equal(g.joint_positions, want.positions)
     # the file's positions are 1 cm (the sphere's radius) from the contacts: the solution is near them
     assert np.abs(g.joint_positions - list(file_positions.values())).max() < 0.1
@@ -113,7 +113,7 @@ def test_a_finger_that_cannot_reach_fails_the_grasp_at_its_tip(fixture, code, ma
         (g,) = read_grasps(TRIFINGER)
         seed = [doc["hand"]["seed"].get(name, 0.0) for name in g.hand.joint_names]
         points = np.array([c["point"] for c in doc["contacts"]])
-        solved = hand_ik(g.hand, points, seed)
+        solved = hand_ik(g.hand, points, seed=seed)
         assert Status(int(solved.status[0])) == Status.UNREACHABLE
         assert float(found.group(1)) == pytest.approx(solved.tip_error[0], rel=1e-5)
         assert 0.7 < solved.tip_error[0] < 0.9

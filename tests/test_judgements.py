@@ -6,8 +6,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import grasptwist as gt
-from grasp_gen import grasps
-from grasptwist.engine.judgements import about_wrist, active, off_tangent_moves, outward_normals, tangent_moves
+from grasp_gen import grasps, rotation
+from grasptwist.engine.judgements import about_wrist, active, off_tangent_moves, outward_contacts, tangent_moves
 
 N = 300
 
@@ -93,32 +93,69 @@ def test_a_failed_row_moves_nothing():
     assert active([np.nan, 1.0]).tolist() == [False, False]  # NaN in a row: its maximum is unknown
 
 
-def test_normals_leaning_inward_are_not_outward_and_reversed_they_all_are(batch):
+def test_normals_leaning_inward_are_not_outward(batch):
     points, normals, _, _ = batch  # each normal within 60 degrees of centroid - p_i
-    assert not outward_normals(points, normals).any()
-    assert outward_normals(points, -normals).all()
-    flipped = -normals.copy()
-    flipped[:, 1] *= -1  # one normal back inward: not every normal points away
-    assert not outward_normals(points, flipped).any()
+    assert not outward_contacts(points, normals).any()
+    assert not outward_contacts(points, normals, center=points.mean(axis=1)).any()
+
+
+def _sphere(seed, scale, shift, n=20):
+    """``n`` grasps of three points on a sphere (a convex object), its centre, and the outward unit normals."""
+    rng = np.random.default_rng(seed)
+    centre = rng.normal(size=3)
+    on = gt.screws.unit(rng.normal(size=(n, 3, 3)))
+    return rng, (centre + on) * scale + shift, centre * scale + shift, on
 
 
 @settings(max_examples=50, deadline=None)
 @given(st.integers(0, 2**32 - 1), st.sampled_from([1e-6, 1.0, 1e6]), st.floats(-1e3, 1e3))
-def test_on_a_sphere_the_surface_normals_are_judged_by_their_sign_at_any_scale_and_place(seed, scale, shift):
+def test_on_a_sphere_each_reversed_normal_is_named_at_any_scale_and_place(seed, scale, shift):
+    rng, points, centre, on = _sphere(seed, scale, shift)
+    # a convex object: the inward normal -on_i has every other point and the centre on its inner side
+    for center in (None, np.broadcast_to(centre, (20, 3))):
+        assert not outward_contacts(points, -on, center).any()
+        assert outward_contacts(points, on, center).all()
+        # one normal reversed (issue 26: the judgement was of all three at once): that contact alone
+        which = rng.integers(0, 3, 20)
+        one = -on.copy()
+        one[np.arange(20), which] *= -1
+        np.testing.assert_array_equal(outward_contacts(points, one, center), np.arange(3) == which[:, None])
+
+
+@settings(max_examples=30, deadline=None)
+@given(st.integers(0, 2**32 - 1))
+def test_the_verdicts_do_not_change_under_a_rigid_motion(seed):
     rng = np.random.default_rng(seed)
-    centre = rng.normal(size=3)
-    on = gt.screws.unit(rng.normal(size=(20, 3, 3)))  # 20 grasps of three points on the unit sphere
-    points = (centre + on) * scale + shift
-    # a convex object: the inward normal -on_i has every other point on its inner side
-    assert not outward_normals(points, -on).any()
-    assert outward_normals(points, on).all()
+    points, normals, _, _ = grasps(rng, 200)
+    normals = np.where(rng.random((200, 3, 1)) < 0.3, -normals, normals)  # some reversed
+    center = points.mean(axis=1) + rng.normal(size=(200, 3)) * 0.3
+    center[::3] = np.nan  # rows without a centre of mass: judged by the other contacts
+    r, t = rotation(rng), rng.normal(size=3) * 10
+    for c in (None, center):
+        before = outward_contacts(points, normals, c)
+        moved = outward_contacts(points @ r.T + t, normals @ r.T, None if c is None else c @ r.T + t)
+        np.testing.assert_array_equal(moved, before)
+        assert before.any() and not before.all()
 
 
-def test_a_normal_at_right_angles_to_the_centroid_or_nan_is_not_outward():
+def test_the_centre_of_mass_decides_where_given_the_other_contacts_elsewhere():
+    # a cube's three faces, the normal at the south face reversed (issue 26's grasp)
+    p = np.array([[0.03, 0.005, 0], [-0.03, 0, 0.005], [0, -0.03, 0.01]])
+    n = np.array([[-1.0, 0, 0], [1, 0, 0], [0, -1, 0]])
+    assert outward_contacts(p, n).tolist() == [False, False, True]
+    assert outward_contacts(p, n, [0.0, 0, 0]).tolist() == [False, False, True]
+    # a centre of mass beyond the south and east faces (an odd object): south is then inward, east not
+    assert outward_contacts(p, n, [0.1, -0.1, 0]).tolist() == [True, False, False]
+    assert outward_contacts(p, n, [[np.nan] * 3]).tolist() == [[False, False, True]]
+
+
+def test_a_normal_at_right_angles_or_nan_is_not_outward():
     p = np.array([[1.0, 0, 0], [-0.5, 0.866, 0], [-0.5, -0.866, 0]])
-    tangent = np.array([[0.0, 1, 0], p[1], p[2]])  # contact 1's normal is perpendicular to g - p_1
-    assert outward_normals(p, p).item() and not outward_normals(p, tangent).item()
-    assert not outward_normals(p, np.full((3, 3), np.nan)).item()
+    up = np.array([[0.0, 0, 1], p[1], p[2]])  # contact 1's normal is perpendicular to every p_j - p_1
+    assert outward_contacts(p, p).all() and outward_contacts(p, up).tolist() == [False, True, True]
+    assert outward_contacts(p, up, [0.0, 0, 0]).tolist() == [False, True, True]
+    assert not outward_contacts(p, np.full((3, 3), np.nan)).any()
+    assert not outward_contacts(p, -p, p[0]).any()  # a centre of mass at contact 1: no direction there
 
 
 def test_reversed_normals_change_only_the_sign_of_the_normal_velocities(batch):

@@ -6,6 +6,10 @@ fast or an optional dependency optional; it never hides a circle).
 """
 
 import ast
+import json
+import os
+import subprocess
+import sys
 from pathlib import Path
 
 import pytest
@@ -24,7 +28,16 @@ LAYERS = [
     ["grasptwist.run"],  # batches, workers, streams, the -o target: engine over inputs into outputs
     ["grasptwist.cli"],  # the command line
     # the public facades and entry points: nothing inside the package imports them
-    ["grasptwist", "grasptwist.hand", "grasptwist.path", "grasptwist.dask", "grasptwist.__main__"],
+    [
+        "grasptwist",
+        "grasptwist.screws",
+        "grasptwist.hand",
+        "grasptwist.forces",
+        "grasptwist.path",
+        "grasptwist.pictures",
+        "grasptwist.dask",
+        "grasptwist.__main__",
+    ],
 ]
 
 #: Beyond the layers: pictures are drawn from the engine's geometry only; reading
@@ -32,7 +45,7 @@ LAYERS = [
 FORBIDDEN = {"grasptwist.plot": ("grasptwist.io", "grasptwist.output", "grasptwist.results", "grasptwist.run")}
 
 #: Facades only re-export.
-FACADES = ("grasptwist.hand", "grasptwist.path")
+FACADES = ("grasptwist.screws", "grasptwist.hand", "grasptwist.forces", "grasptwist.path", "grasptwist.pictures")
 
 
 def module_name(path: Path) -> str:
@@ -82,7 +95,7 @@ def test_the_walk_sees_deferred_and_relative_imports():
     # a deferred import inside a function, a relative `from . import module`, an absolute one
     assert "grasptwist.run.signals" in imports("grasptwist.__main__")
     assert "grasptwist.cli" in imports("grasptwist.__main__")
-    assert "grasptwist.cli.basis" in imports("grasptwist.cli")
+    assert "grasptwist.engine.kernels" in imports("grasptwist.engine.decompose")
     assert "grasptwist.output.parquet_writer" in imports("grasptwist.output.formats")
     assert group("grasptwist.engine.hands") == (1, "grasptwist.engine")
     assert group("grasptwist.hand") == (7, "grasptwist.hand")
@@ -198,8 +211,73 @@ def test_the_walk_finds_branches_on_a_command_name():
     assert not branches_on_a_name(ast.parse('f.kind == "fingers"\nCOMMANDS["forces"].formats\n{"resolve": ".api"}'))
 
 
-@pytest.mark.parametrize("name", sorted(n for n in MODULES if n != REGISTRY))
+@pytest.mark.parametrize("name", sorted(n for n in MODULES if n != REGISTRY and group(n)[0] < len(LAYERS) - 1))
 def test_no_layer_branches_on_a_command_name(name):
-    # every layer loops over the registry (run/families.py); looking a command up there is fine
+    # the public modules (the last group) name API functions, some called like a command (gt.resolve)
+    # every layer loops over the registry (run/families.py); looking a command up there is fine;
     found = branches_on_a_name(ast.parse(MODULES[name].read_text()))
     assert not found, f"{name} branches on a command's name: " + "; ".join(f"line {n}: {t}" for n, t in found)
+
+
+# --------------------------------------------------------------------------
+# Issue 26.4: start-up pays for what the command and format in hand use (bench/startup.py times it)
+
+#: Modules a one-file JSON ``resolve`` never needs: the force side, the hand's kinematics and
+#: inverse kinematics, URDF reading, tables (rich) and pictures.
+NOT_FOR_JSON_RESOLVE = (
+    "grasptwist.engine.forces",
+    "grasptwist.run.forces",
+    "grasptwist.output.force_records",
+    "grasptwist.engine.ik",
+    "grasptwist.engine.kinematics",
+    "grasptwist.engine.hands",
+    "grasptwist.io.urdf",
+    "grasptwist.output.table",
+    "grasptwist.output.follow_table",
+    "grasptwist.plot",
+    "rich",
+    "matplotlib",
+    "scipy",
+)
+
+#: Runs ``grasptwist ARGS`` as the script does, one command line after another in one
+#: process, printing after each the modules loaded so far (JSON, on stderr).
+_IMPORTED = """
+import json, sys
+from grasptwist.__main__ import main
+for args in json.loads(sys.argv[1]):
+    sys.argv = ["grasptwist", *args]
+    try:
+        main()
+    except SystemExit:
+        pass
+    sys.stderr.write("\\nMODULES " + json.dumps(sorted(sys.modules)) + "\\n")
+"""
+
+
+def _loaded(*command_lines) -> list[set[str]]:
+    root = Path(__file__).resolve().parents[1]
+    proc = subprocess.run(
+        [sys.executable, "-c", _IMPORTED, json.dumps(command_lines)],
+        capture_output=True, text=True, cwd=root, timeout=60, env={**os.environ, "NO_COLOR": "1"},
+    )  # fmt: skip
+    found = [set(json.loads(line[8:])) for line in proc.stderr.splitlines() if line.startswith("MODULES ")]
+    assert len(found) == len(command_lines), proc.stderr
+    return found
+
+
+def _among(modules: set[str], names) -> list[str]:
+    return sorted(m for m in modules for n in names if m == n or m.startswith(n + "."))
+
+
+def test_a_json_resolve_of_one_file_imports_no_force_hand_table_or_plot_module():
+    json_run, forces_run, table_run = _loaded(
+        ["resolve", "grasps/polyhedron.yaml", "--format", "json"],
+        ["forces", "grasps/sphere.yaml", "--format", "json"],
+        ["resolve", "grasps/three-finger-hand.yaml"],
+    )
+    assert "grasptwist.engine.decompose" in json_run and "orjson" in json_run  # it did run
+    assert _among(json_run, NOT_FOR_JSON_RESOLVE) == []
+    # the names are right: the commands that need these modules load them
+    assert {"grasptwist.engine.forces.grip", "grasptwist.run.forces"} <= forces_run
+    assert {"grasptwist.output.table", "rich", "grasptwist.engine.kinematics"} <= table_run

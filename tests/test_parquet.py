@@ -5,6 +5,7 @@ import io
 import json
 import subprocess
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -14,6 +15,7 @@ import grasptwist as gt
 from grasp_gen import grasps
 from grasptwist.cli import app
 from grasptwist.io import parquet
+from grasptwist.model import GraspFileError
 from grasptwist.output.columns import CSV_COLUMNS, TYPED_COLUMNS
 from grasptwist.output.parquet_writer import ParquetWriter, table
 from grasptwist.run.batch import resolve_arrays
@@ -331,3 +333,163 @@ def test_a_hands_joint_columns_flow_to_parquet(tmp_path):
     ] * len(rows)
     joints = [c for c in rows[0] if c.startswith("qdot_")]
     assert len(joints) == 9 and all(table.column(c).to_pylist() == [float(r[c]) for r in rows] for c in joints)
+
+
+# --------------------------------------------------------------------------
+# Hostile Parquet: footers that lie, bombs, failed checksums, values a float cannot hold
+
+
+def zigzag_varint(n: int) -> bytes:
+    """``n >= 0`` as Thrift's compact protocol writes an i64: zigzag, then 7 bits a byte."""
+    n, out = 2 * n, bytearray()
+    while True:
+        out.append(n & 0x7F | (0x80 if n >> 7 else 0))
+        n >>= 7
+        if not n:
+            return bytes(out)
+
+
+def declaring(data: bytes, rows: int, new: int, which=None) -> bytes:
+    """A Parquet file's bytes whose footer says ``new`` where it said ``rows`` (the file's row
+    count, then each column chunk's value count, then the row group's), at the places ``which``
+    (their order; None: all).  Each is field 3 or 5 after field 2 or 4: header byte 0x16."""
+    import struct
+
+    (length,) = struct.unpack("<i", data[-8:-4])
+    old = b"\x16" + zigzag_varint(rows)
+    parts = data[-8 - length : -8].split(old)
+    said = [b"\x16" + zigzag_varint(new) if which is None or k in which else old for k in range(len(parts) - 1)]
+    footer = b"".join(p + s for p, s in zip(parts, [*said, b""]))
+    return data[: -8 - length] + footer + struct.pack("<i", len(footer)) + b"PAR1"
+
+
+def small_table(rows=50, seed=3, **columns):
+    rng = np.random.default_rng(seed)
+    cols = {n: rng.normal(size=rows) for n in (*parquet.POINT_COLUMNS, *parquet.NORMAL_COLUMNS)}
+    return pa.table({**cols, **columns})
+
+
+def footer_lies(tmp_path, new, which):
+    buf = io.BytesIO()
+    pq.write_table(small_table(), buf, write_statistics=False)
+    data = buf.getvalue()
+    assert data.count(b"\x16" + zigzag_varint(50)) == 2 + 18  # the file's and the row group's, each column's
+    (tmp_path / "lies.parquet").write_bytes(declaring(data, 50, new, which))
+    return tmp_path / "lies.parquet"
+
+
+def resolved_beside_a_good_file(tmp_path, bad, files):
+    """``resolve BAD set.parquet``: exit 1, the one error line of BAD, and the good file's records all there."""
+    r = run("resolve", bad, files / "set.parquet", "--twist", "0,0,1,0,0,0", "-f", "jsonl")
+    records = [json.loads(x) for x in r.stdout.splitlines()]
+    assert r.exit_code == 1 and "Traceback" not in r.output and "internal error" not in r.output
+    [line] = [x for x in r.stderr.splitlines() if x.startswith(f"{bad}: ")]
+    assert [rec["file"] for rec in records] == [str(bad)] + [str(files / "set.parquet")] * N
+    assert records[0]["error"]["code"] == "bad-dataset"
+    return line.removeprefix(f"{bad}: error: bad-dataset: ")
+
+
+@pytest.mark.parametrize(
+    ("new", "which", "said"),
+    [
+        (60, {0}, "the footer declares 60 rows, its row groups 50"),
+        (60, {19}, "the footer declares 50 rows, its row groups 60"),
+        (60, {0, 19}, "row group 0: declares 60 rows, its column p1_x 50"),
+        (40, {0, 19}, "row group 0: declares 40 rows, its column p1_x 50"),
+        (60, {1}, "row group 0: declares 50 rows, its column p1_x 60"),
+        (60, None, "row group 0: declares 60 rows, holds 50"),  # every count agrees: found as it is read
+    ],
+    ids=["file", "row-group", "both", "both-fewer", "column", "all"],
+)
+def test_a_footer_whose_row_counts_lie_is_one_error_record(tmp_path, files, new, which, said):
+    # 0.3: 50 records, or an internal error that lost every record of the run
+    assert resolved_beside_a_good_file(tmp_path, footer_lies(tmp_path, new, which), files) == said
+
+
+def test_a_footer_declaring_10_to_the_15_rows_is_refused_unread(tmp_path):
+    # 0.3: past 500 MB within 2 s (a task list for 10^15 rows)
+    path = footer_lies(tmp_path, 10**15, None)
+    with pytest.raises(GraspFileError, match=f"its 18 columns read declares {10**15 * 18 * 8:,} bytes decoded from"):
+        parquet.open_parquet(str(path))
+
+
+def zeros_bomb(tmp_path, rows=4_000_000):
+    """The issue's decompression bomb: one row group of ``rows`` rows of zeros in a few hundred kB
+    (one zero-filled buffer, never written to, shared by the columns: nearly no memory here)."""
+    zeros = pa.array(np.zeros(rows))
+    names = (*parquet.POINT_COLUMNS, *parquet.NORMAL_COLUMNS)
+    path = tmp_path / "zeros.parquet"
+    pq.write_table(pa.table(dict.fromkeys(names, zeros)), path, row_group_size=rows, compression="zstd")
+    return path
+
+
+def test_a_decompression_bomb_is_refused_from_its_footer(tmp_path):
+    path = zeros_bomb(tmp_path, rows=1_000_000)  # 144 MB: over the 64 MiB any file may decode to
+    size = path.stat().st_size
+    assert size < 1_000_000
+    with pytest.raises(GraspFileError, match="refused unread, as a likely decompression bomb") as err:
+        parquet.open_parquet(str(path))
+    assert str(err.value).endswith(
+        f"its 18 columns read declares {1_000_000 * 18 * 8:,} bytes decoded from {size:,} (over 100 times): "
+        "refused unread, as a likely decompression bomb"
+    )
+
+
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
+@pytest.mark.parametrize("bomb", ["zeros", "rows"])
+def test_parquet_bombs_cost_little_memory_and_no_other_record(tmp_path, bomb):
+    from hostile import jsonl, run_measured
+
+    path = zeros_bomb(tmp_path) if bomb == "zeros" else footer_lies(tmp_path, 10**15, None)
+    grasp = Path(__file__).parent.parent / "grasps" / "polyhedron.yaml"
+    code, stderr, peak = run_measured("resolve", path, grasp, "-f", "jsonl", "-o", "out.jsonl", cwd=tmp_path)
+    print(f"parquet {bomb} bomb: peak {peak:.0f} MB")
+    assert code == 1 and peak < 200  # 0.3: past 500 MB within 2 s
+    assert stderr.splitlines()[0].startswith(f"{path}: error: bad-dataset: its 18 columns read declares ")
+    records = jsonl((tmp_path / "out.jsonl").read_text())
+    assert [r["file"] for r in records] == [str(path), str(grasp)] and records[1]["ok"]
+    assert sorted(p.name for p in tmp_path.iterdir()) == sorted([path.name, "out.jsonl"])
+
+
+def test_a_page_whose_checksum_fails_is_one_error_record(tmp_path, files):
+    # 0.3 did not look at checksums: 50 ok records, one of them with a changed number
+    path = tmp_path / "damaged.parquet"
+    pq.write_table(small_table(), path, write_page_checksum=True, use_dictionary=False, compression="none")
+    chunk = pq.ParquetFile(path).metadata.row_group(0).column(0)
+    data = bytearray(path.read_bytes())
+    data[chunk.data_page_offset + chunk.total_compressed_size - 4] ^= 0x10  # in p1_x's last value
+    path.write_bytes(bytes(data))
+    assert resolved_beside_a_good_file(tmp_path, path, files).startswith("row group 0: cannot read: ")
+
+
+@pytest.mark.parametrize(
+    ("columns", "said"),
+    [
+        ({"p1_x": pa.array(2**53 + np.arange(50, dtype=np.int64))}, "column p1_x: an integer beyond 2^53 in rows 0-49"),
+        ({"c_z": pa.array(np.ones(50))}, None),  # the wrist's other columns missing: a known error
+    ],
+    ids=["beyond-2^53", "missing"],
+)
+def test_values_a_float_cannot_hold_are_one_error_record(tmp_path, files, columns, said):
+    pq.write_table(small_table(**columns), tmp_path / "odd.parquet")
+    line = resolved_beside_a_good_file(tmp_path, tmp_path / "odd.parquet", files)
+    assert line.startswith(said or "missing column(s) c_x, c_y (the wrist)")
+
+
+def test_a_column_given_twice_is_one_error_record(tmp_path, files):
+    # 0.3: internal error: KeyError, and every record of the run lost
+    table = small_table().append_column("p2_y", pa.array(np.zeros(50)))
+    pq.write_table(table, tmp_path / "twice.parquet")
+    line = resolved_beside_a_good_file(tmp_path, tmp_path / "twice.parquet", files)
+    assert line == "column(s) p2_y given more than once"
+
+
+def test_rows_are_read_in_bounded_batches_forward_and_back(tmp_path, monkeypatch):
+    monkeypatch.setattr(parquet, "BATCH_ROWS", 16)
+    table = small_table(rows=300)
+    pq.write_table(table, tmp_path / "set.parquet", row_group_size=70)
+    ds = parquet.open_parquet(str(tmp_path / "set.parquet"))
+    want = np.stack([table.column(n).to_numpy() for n in parquet.POINT_COLUMNS], axis=-1).reshape(300, 3, 3)
+    for start, stop in [(0, 5), (3, 90), (90, 91), (60, 300), (10, 20), (295, 400), (0, 300)]:
+        np.testing.assert_array_equal(ds.points[start:stop], want[start:stop])
+        assert ds.points.reader.cursor.batch.num_rows <= 16

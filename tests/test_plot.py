@@ -42,7 +42,7 @@ CASES = {
 
 def make_scene(case, **kw):
     points, normals, wrist, twist, method = CASES[case]
-    return plot.scene(points, normals, wrist, twist, method, **kw)
+    return plot.scene(points, normals, wrist, twist, method=method, **kw)
 
 
 def grasp_size(points):
@@ -198,7 +198,7 @@ def test_pure_translation_draws_an_arrow_and_a_far_axis_a_note():
 
 
 def test_degenerate_grasp_keeps_the_grasp_and_says_why_in_the_title():
-    sc = plot.scene(EX1, -EX1, [0.2, 0.1, 0], SPIN_Z, "off-tangent", names=("thumb", "index", "middle"))
+    sc = plot.scene(EX1, -EX1, [0.2, 0.1, 0], SPIN_Z, method="off-tangent", names=("thumb", "index", "middle"))
     assert sc.status == Status.WRIST_COPLANAR
     assert sc.title.splitlines()[1] == (
         "off-tangent: degenerate — " + gt.status_message(Status.WRIST_COPLANAR, -1, ("thumb", "index", "middle"))
@@ -207,7 +207,7 @@ def test_degenerate_grasp_keeps_the_grasp_and_says_why_in_the_title():
     assert not [a for a in sc.arrows if a.kind.endswith("-part")]
     assert [m.label for m in sc.of_kind("contact")] == ["thumb", "index", "middle"]
     assert len(sc.of_kind("contact-velocity")) == 3
-    collinear = plot.scene([[0, 0, 0], [1, 0, 0], [2, 0, 0]], np.eye(3), None, None, "tangent")
+    collinear = plot.scene([[0, 0, 0], [1, 0, 0], [2, 0, 0]], np.eye(3), None, None, method="tangent")
     assert collinear.status == Status.COLLINEAR_CONTACTS and "collinear" in collinear.title
     assert not collinear.segments
 
@@ -247,9 +247,9 @@ def test_check_method_picks_the_default_and_refuses_what_cannot_be_drawn():
     assert plot.check_method(None, EX1_WRIST) == "off-tangent"
     assert plot.check_method("tangent", EX1_WRIST) == "tangent"
     with pytest.raises(ValueError, match="the off-tangent method needs a wrist point"):
-        plot.scene(EX2, np.eye(3), None, SPIN_Z, "off-tangent")
+        plot.scene(EX2, np.eye(3), None, SPIN_Z, method="off-tangent")
     with pytest.raises(ValueError, match="unknown method 'sideways': choose one of off-tangent, tangent"):
-        plot.scene(EX2, np.eye(3), None, SPIN_Z, "sideways")
+        plot.scene(EX2, np.eye(3), None, SPIN_Z, method="sideways")
 
 
 def test_views_look_down_the_contact_plane_normal_from_the_wrist_side():
@@ -261,7 +261,7 @@ def test_views_look_down_the_contact_plane_normal_from_the_wrist_side():
     (_, below) = plot.scene(EX1, -EX1, -EX1_WRIST, SPIN_Z).views[1]
     np.testing.assert_allclose(below, [0, 0, -1], atol=1e-12)
     # Example 2's plane x + y + z = 4 seen from the wrist at the origin
-    (_, oblique), (_, tilted) = plot.scene(EX2, np.eye(3), [0, 0, 0], None, "tangent").views
+    (_, oblique), (_, tilted) = plot.scene(EX2, np.eye(3), [0, 0, 0], None, method="tangent").views
     np.testing.assert_allclose(tilted, -np.ones(3) / np.sqrt(3), atol=1e-12)
     assert screws.dot(oblique, tilted) == pytest.approx(np.cos(tilt))
     assert oblique[2] > 0  # the oblique view leans upwards

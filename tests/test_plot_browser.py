@@ -75,3 +75,12 @@ def test_a_javascript_error_is_caught(tmp_path):
     out.write_text(out.read_text("utf-8").replace("</body>", "<script>notAFunction()</script></body>"), "utf-8")
     shot = capture(out, tmp_path / "e.png")
     assert any("notAFunction is not defined" in e for e in shot.errors)
+
+
+@pytest.mark.slow
+def test_a_page_with_a_comment_and_script_opening_in_a_name_is_drawn(tmp_path):
+    from test_plot_html import hostile_names_page
+
+    shot = capture(hostile_names_page(tmp_path), tmp_path / "h.png")
+    assert shot.errors == [] and len(shot.scenes) == 1  # 0.3: nothing drew, the page's script was swallowed
+    assert coloured_pixels(shot.png, shot.scenes[0]) > 1000

@@ -45,14 +45,14 @@ def test_the_force_arrows_are_the_engines_grip_forces():
     g = equator()
     forces = _grip_forces(g)
     hold = {w.name: w.wrench for w in g.wrenches}["hold"]
-    expected = gt.grip(g.points, g.normals, hold, g.friction).force
+    expected = gt.forces.grip(g.points, g.normals, hold, g.friction).force
     picture = grasp_scene(g, forces=forces)
     arrows = picture.of_kind("grip-force")
     assert [a.origin.tolist() for a in arrows] == g.points.tolist()
     np.testing.assert_allclose([a.vector for a in arrows], expected, rtol=1e-12)
     # the ball's weight, m g / 3 by friction at each finger, pressed with m g / (3 mu)
     np.testing.assert_allclose([a.vector[2] for a in arrows], 9.81 / 3, rtol=1e-9)
-    np.testing.assert_allclose(gt.grip(g.points, g.normals, hold, 0.5).normal_force, 9.81 / 1.5, rtol=1e-9)
+    np.testing.assert_allclose(gt.forces.grip(g.points, g.normals, hold, 0.5).normal_force, 9.81 / 1.5, rtol=1e-9)
 
 
 def test_force_traces_draw_the_cones_and_forces_and_scene_traces_leave_them_out():

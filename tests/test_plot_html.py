@@ -1,6 +1,7 @@
 """The interactive HTML view (`plot -o FILE.html`): the figures embedded in the page, read back,
 hold the engine's numbers; the command's files, options and errors."""
 
+import json
 import re
 import sys
 from pathlib import Path
@@ -216,6 +217,27 @@ def test_a_name_cannot_end_the_figures_script_element(tmp_path):
     assert "</script><b>x" in figure["layout"]["title"]["text"].replace("&lt;", "<").replace("&gt;", ">")
 
 
+HOSTILE_NAME = "<!--<script>"
+
+
+def hostile_names_page(tmp_path):
+    """A page of box-edge with its thumb named ``<!--<script>``, which once made an HTML parser
+    take the rest of the page for script text (nothing drew)."""
+    source = (GRASPS / "box-edge.yaml").read_text().replace("name: thumb", f"name: '{HOSTILE_NAME}'", 1)
+    (tmp_path / "g.yaml").write_text(source)
+    r = run("plot", tmp_path / "g.yaml", "-o", tmp_path / "g.html")
+    assert r.exit_code == 0, r.output
+    return tmp_path / "g.html"
+
+
+def test_a_comment_and_script_opening_in_a_name_stay_in_the_figures_json(tmp_path):
+    text = hostile_names_page(tmp_path).read_text("utf-8")
+    (block,) = re.findall(r'<script type="application/json" id="figure-0-json">(.*?)</script>', text, flags=re.S)
+    assert "<" not in block  # no "<!--", "<script" or "</" for the HTML parser to act on
+    (figure,) = read_figures(text)
+    assert any(HOSTILE_NAME in json.dumps(t, ensure_ascii=False) for t in figure["data"])  # the name as written
+
+
 @pytest.mark.slow
 def test_a_urdf_hands_meshes_are_posed_at_its_joint_positions_touching_the_contacts():
     pytest.importorskip("yourdfpy")
@@ -252,3 +274,108 @@ def test_a_mesh_outside_the_urdfs_folder_is_refused_and_the_chains_drawn_all_the
         hand_meshes(toy, folder=folder)
     assert (caught.value.code, caught.value.file) == ("path-outside", "mesh-and-xinclude.urdf")
     assert hand_meshes(hand.load_urdf_hand("hand.urdf", ["a_tip", "b_tip"], folder=folder), folder=folder) == []
+
+
+def hand_with_mesh(folder, mesh: str):
+    """The toy hand of the URDF tests with a visual mesh file ``mesh`` (in ``folder``) on one link."""
+    from grasptwist import hand
+
+    source = (Path(__file__).parent / "corpus" / "urdf" / "hand.urdf").read_text()
+    visual = f'<link name="a1"><visual><geometry><mesh filename="{mesh}"/></geometry></visual></link>'
+    (folder / "h.urdf").write_text(source.replace('<link name="a1"/>', visual))
+    return hand.load_urdf_hand("h.urdf", ["a_tip", "b_tip"], folder=folder)
+
+
+MALFORMED_MESHES = {
+    "bad.ply": b"ply\nformat binary_little_endian 1.0\nelement vertex 100\nproperty float x\nend_header\n\x00\x01",
+    "bad.glb": b"glTF\x02\x00\x00\x00\x40\x00\x00\x00\x10\x00\x00\x00JSON{}xx",
+    "bad.dae": b"<?xml version='1.0'?><COLLADA><library_geometries/></COLLADA>",
+}
+
+
+@pytest.mark.parametrize("name", MALFORMED_MESHES)
+def test_a_malformed_mesh_is_an_input_error_naming_it(tmp_path, name):
+    # 0.3: internal error (ValueError, JSONDecodeError, AttributeError from the mesh readers)
+    pytest.importorskip("yourdfpy")
+    from grasptwist.io.urdf_meshes import hand_meshes
+    from grasptwist.model import InputError
+
+    (tmp_path / name).write_bytes(MALFORMED_MESHES[name])
+    with pytest.raises(InputError, match=rf"^h.urdf: mesh '{re.escape(name)}': cannot read: ") as caught:
+        hand_meshes(hand_with_mesh(tmp_path, name), folder=tmp_path)
+    assert caught.value.code == "read-error"
+
+
+def write_zeros(f, mib: int):
+    for _ in range(mib):
+        f.write(bytes(1 << 20))
+
+
+@pytest.mark.parametrize("kind", ["zip", "gz", "bz2"])
+def test_a_mesh_archive_that_inflates_past_the_cap_is_refused_before_it_is_inflated(tmp_path, kind, monkeypatch):
+    # 0.3 passed a 6 MB zip inflating to 1.2 GB (the file's size was checked): 2.5 GB resident, 7.5 s
+    pytest.importorskip("yourdfpy")
+    import bz2
+    import gzip
+    import zipfile
+
+    from grasptwist.io import urdf_meshes
+    from grasptwist.model import InputError
+
+    monkeypatch.setattr(urdf_meshes, "MAX_MESH_BYTES", 4 << 20)  # the rule, at a size quick to make
+    path = tmp_path / {"zip": "m.zip", "gz": "m.stl.gz", "bz2": "m.stl.bz2"}[kind]
+    if kind == "zip":
+        with zipfile.ZipFile(path, "w", zipfile.ZIP_DEFLATED) as zf, zf.open("m.stl", "w") as f:
+            write_zeros(f, 5)
+    else:
+        with (gzip if kind == "gz" else bz2).open(path, "wb") as f:
+            write_zeros(f, 5)
+    size = path.stat().st_size
+    assert size < 50_000
+    monkeypatch.setattr("trimesh.load", lambda *a, **k: pytest.fail("the mesh library was given the archive"))
+    with pytest.raises(InputError, match=rf"^h.urdf: mesh '{path.name}': decodes to more than 4194304 bytes") as caught:
+        urdf_meshes.hand_meshes(hand_with_mesh(tmp_path, path.name), folder=tmp_path)
+    assert caught.value.code == "too-large" and caught.value.message.endswith(f"({size:,} compressed)")
+
+
+def test_an_honest_zipped_mesh_is_read(tmp_path):
+    pytest.importorskip("yourdfpy")
+    import zipfile
+
+    import trimesh
+
+    from grasptwist.io.urdf_meshes import hand_meshes
+
+    with zipfile.ZipFile(tmp_path / "box.zip", "w", zipfile.ZIP_DEFLATED) as zf:
+        zf.writestr("box.stl", trimesh.creation.box().export(file_type="stl"))
+    [(vertices, faces)] = hand_meshes(hand_with_mesh(tmp_path, "box.zip"), folder=tmp_path)
+    assert vertices.shape == (8, 3) and faces.shape == (12, 3)
+
+
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
+def test_plot_draws_a_page_without_a_malformed_mesh_with_a_warning(tmp_path):
+    pytest.importorskip("yourdfpy")
+    from test_follow_hand import NORMALS, SPIN, _grasp, _turntable
+
+    grasp = _grasp(tmp_path, _turntable([0.9, 0.6, 3.0]), NORMALS, SPIN)
+    urdf = (tmp_path / "hand.urdf").read_text()
+    visual = '<link name="f0_l0"><visual><geometry><mesh filename="bad.ply"/></geometry></visual></link>'
+    (tmp_path / "hand.urdf").write_text(urdf.replace('<link name="f0_l0"/>', visual))
+    (tmp_path / "bad.ply").write_bytes(MALFORMED_MESHES["bad.ply"])
+    r = run("plot", grasp, "-o", tmp_path / "g.html")
+    assert r.exit_code == 0 and "internal error" not in r.output, r.output
+    assert "hand.urdf: warning: no link meshes: mesh 'bad.ply': cannot read: " in r.stderr
+    from grasptwist.plot.traces import MESH_NAME
+
+    figures = read_figures((tmp_path / "g.html").read_text("utf-8"))
+    assert figures and not any(t["name"] == MESH_NAME for t in figures[0]["data"])
+    assert any(t["name"].startswith("finger") for t in figures[0]["data"])  # the chains, drawn all the same
+
+
+def test_a_grasp_without_twists_is_drawn(tmp_path):
+    # 0.3: internal error: RecursionError (no velocity arrow to share a scale with between the methods)
+    source = (GRASPS / "box-edge.yaml").read_text()
+    (tmp_path / "g.yaml").write_text(source[: source.index("twists:")])
+    r = run("plot", tmp_path / "g.yaml", "-o", tmp_path / "g.html")
+    assert r.exit_code == 0, r.output
+    assert len(read_figures((tmp_path / "g.html").read_text("utf-8"))) == 1

@@ -66,6 +66,7 @@ R.KINDS += (SPEED,)
 R.BY_KEY["speed"] = SPEED
 R.METHOD_CHOICES += ("speed",)
 
+import grasptwist.output.numbers as N
 import grasptwist.output.table as T
 
 
@@ -74,7 +75,7 @@ class SpeedTable:
 
     @staticmethod
     def contact_columns(m, d):
-        return [("speed", [T.fmt_number(v, d) for v in m["speed"]])]
+        return [("speed", [N.fmt_number(v, d) for v in m["speed"]])]
 
     @staticmethod
     def resolve(m, names, d, rec):

@@ -295,6 +295,46 @@ def test_lines_are_the_same_however_the_stream_is_cut(lines, cuts, per_batch):
     assert got == want and all(0 < len(b) <= per_batch for b in batches)
 
 
+class Repeated:
+    """A stream whose ``read1`` hands out ``piece`` ``times`` times, then ``tail``."""
+
+    def __init__(self, piece, times, tail):
+        self.piece, self.times, self.tail = piece, times, tail
+
+    def read1(self, n):
+        if self.times:
+            self.times -= 1
+            return self.piece
+        tail, self.tail = self.tail, b""
+        return tail
+
+
+@pytest.mark.parametrize("max_bytes", [1 << 30, 1 << 20])
+def test_a_long_line_in_small_pieces_is_assembled_once(max_bytes):
+    # 16 MiB in 65,536 pieces: adding each piece to the line so far (0.3, quadratic) copies 550 GB,
+    # minutes of work; joined once it is 16 MiB of copying (bench/faults.py times a 50 MB line)
+    piece, times = b"x" * 256, 1 << 16
+    batches = list(numbered_batches(Repeated(piece, times, b"\n[1]\n"), max_bytes, 64))
+    (n, line), last = (entry for batch in batches for entry in batch)
+    assert n == 1 and last == (2, b"[1]")
+    assert line == (piece * times if max_bytes > len(piece) * times else piece * (max_bytes // 256) + b"x")
+
+
+@pytest.mark.parametrize(
+    ("stream", "json_lines"),
+    [
+        (Repeated(b" \n" * 128, 1 << 16, b'{"a": 1}'), True),  # 16 MiB of blanks first, looked at once each
+        (Chunks([b"\xef", b"\xbb\xbf \n", b"{}"]), True),  # a BOM cut by the pipe
+        (Chunks([b"\xef\xbb\xbf", b"name: x"]), False),
+        (Chunks([b"\xefx{"]), False),  # not a BOM: a YAML file (whose decoding then refuses it)
+    ],
+)
+def test_stdin_is_sniffed_past_any_blanks_and_a_bom(stream, json_lines):
+    from grasptwist.io.lines import _sniff
+
+    assert _sniff(stream, 1 << 30)[0] is json_lines
+
+
 def test_a_streams_failed_rows_follow_the_warnings_rule_and_a_missing_stream_is_always_said(tmp_path):
     from grasptwist.cli.diagnostics import WARNINGS_SHOWN
 

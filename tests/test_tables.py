@@ -24,7 +24,7 @@ from typer.testing import CliRunner
 
 from grasptwist.cli import app
 from grasptwist.cli.diagnostics import TABLE_HINT_AT, WARNINGS_SHOWN
-from grasptwist.output.table import SIZING_ROWS, CheckTableWriter
+from grasptwist.output.table import SIZING_ROWS, CheckTableWriter, TableWriter
 from grasptwist.results import KINDS
 from grasptwist.run.families import COMMANDS
 
@@ -319,3 +319,45 @@ def test_verdicts_use_the_contacts_names_and_agree_in_number():
         "verdict: not realisable by tangent sliding alone: finger index must also move off its tangent plane "
         "(the beta_i Sigma_i part)."
     ]
+
+
+# --------------------------------------------------------------------------
+# Issue 26.1: what people read never shows digits below round-off, which differ from CPU to CPU
+
+
+def test_figures_under_the_noise_floor_print_as_under_it_and_zero_has_no_sign():
+    from grasptwist.output.numbers import fmt_figure, fmt_number, fmt_vector
+
+    assert fmt_figure(3e-16, 2) == fmt_figure(6.1e-16, 2) == fmt_figure(0.0, 2) == fmt_figure(-0.0, 2) == "< 1e-12"
+    assert fmt_figure(-4e-17) == "< 1e-12"
+    assert fmt_figure(2.5e-12, 2) == "2.5e-12"  # above the floor: the figure itself
+    assert fmt_figure(0.32375) == "0.324"
+    assert fmt_number(-0.0, 4) == fmt_number(-4e-17, 4) == "0.0000"
+    assert fmt_number(-0.00005001, 4) == "-0.0001"
+    assert fmt_vector([-0.0, 1e-17, -1e-17], 4) == "(0.0000, 0.0000, 0.0000)"
+
+
+def _hand_table(record: dict) -> str:
+    buf = io.BytesIO()
+    w = TableWriter(buf, color=False, width=300)  # whatever COLUMNS says: one part, rows whole
+    w.write(orjson.dumps(record))
+    w.close()
+    return buf.getvalue().decode()
+
+
+def test_a_table_is_the_same_whatever_the_round_off():
+    # one record as two processors could compute it: the same but for the digits under the noise
+    rec = orjson.loads(run("resolve", HAND, "-f", "json").stdout)[0]
+    assert [f["tip_error"] for f in rec["hand"]["fingers"]] == [0.0, 0.0, 0.0]  # an inline hand: on its contacts
+    other = orjson.loads(orjson.dumps(rec))
+    for f, noise in zip(other["hand"]["fingers"], (3e-16, 6.1e-16, -0.0)):
+        f["residual"] += noise
+        f["tip_error"] = noise
+        f["joint_positions"] = [-0.0 if q == 0 else q for q in f["joint_positions"]]  # a zero come out -0.0
+    assert other != rec
+    ours, theirs = _hand_table(rec), _hand_table(other)
+    assert ours == theirs
+    (row,) = [line.split() for line in ours.splitlines() if "south.1" in line]
+    # residual, conditioning, tip error: no digits under the noise
+    assert row[-5:] == ["<", "1e-12", "0.382", "<", "1e-12"]
+    assert "-0.0000" not in ours

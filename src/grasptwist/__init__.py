@@ -1,6 +1,11 @@
 """grasptwist: resolve an object twist into finger-tip twists of a three-fingered grasp.
 
-The engine (pure numpy, batched over leading axes):
+The core: the twist decompositions (pure numpy, batched over leading axes),
+their statuses, and grasp files.  One public module per topic holds the rest:
+:mod:`grasptwist.screws` (screw algebra), :mod:`grasptwist.hand` (hands, joint
+rates, inverse kinematics), :mod:`grasptwist.forces`, :mod:`grasptwist.path`,
+:mod:`grasptwist.pictures` and :mod:`grasptwist.dask`.  Every other module is
+internal (``docs/api/index.rst`` says which).
 
 >>> import grasptwist as gt
 >>> r = gt.decompose_off_tangent([[1, 0, 0], [-0.5, 0.866, 0], [-0.5, -0.866, 0]], [0, 0, 1], [0, 0, 0, 0, 0, 1])
@@ -8,65 +13,101 @@ The engine (pure numpy, batched over leading axes):
 [0.6667, 0.6667, 0.6667]
 """
 
-from importlib import import_module
+import importlib as _importlib
+import warnings as _warnings
 
 from ._version import __version__ as __version__
 
 #: Public name -> the module defining it; imported on first use, so that the
 #: command line can handle signals before numpy is imported.
 _EXPORTS = {
-    "screws": ".engine.screws",
+    # the decompositions
     "decompose_off_tangent": ".engine.decompose",
     "decompose_tangent": ".engine.decompose",
+    "resolve": ".engine.decompose",
     "contact_velocities": ".engine.decompose",
     "OffTangentResult": ".engine.decompose",
     "TangentResult": ".engine.decompose",
+    "Resolution": ".engine.decompose",
+    "prepare": ".engine.prepared",
+    "PreparedGrasp": ".engine.prepared",
+    # statuses and tolerances
     "Status": ".engine.degeneracy",
     "status_message": ".engine.degeneracy",
     "DEGENERACY_TOL": ".engine.degeneracy",
     "CONDITION_WARNING": ".engine.degeneracy",
-    "resolve": ".engine.decompose",
-    "Resolution": ".engine.decompose",
-    "prepare": ".engine.prepared",
-    "PreparedGrasp": ".engine.prepared",
+    # the engine's argument checks
     "check_points": ".engine.checks",
     "check_normals": ".engine.checks",
     "check_wrist": ".engine.checks",
     "check_twist": ".engine.checks",
-    "finger_jacobian": ".engine.kinematics",
-    "joint_rates": ".engine.kinematics",
-    "JointRates": ".engine.kinematics",
-    "manipulating_forces": ".engine.forces.grasp_map",
-    "ManipulatingForces": ".engine.forces.grasp_map",
-    "squeeze_forces": ".engine.forces.grasp_map",
-    "grasp_map": ".engine.forces.grasp_map",
-    "ForceStatus": ".engine.forces.grasp_map",
-    "force_status_message": ".engine.forces.grasp_map",
-    "check_wrench": ".engine.forces.grasp_map",
-    "check_friction": ".engine.forces.grasp_map",
-    "check_safety": ".engine.forces.grasp_map",
+    # grasp files
+    "read_grasps": ".io.grasp",
+    "load_grasps": ".io.grasp",
+    "read_line": ".io.grasp",
+    "read_twist_line": ".io.grasp",
+    "grasp_schema": ".io.grasp",
+    "GraspFileError": ".model",
+    "Grasp": ".model",
+    "Twist": ".model",
+    "Wrench": ".model",
+    "grasp_table": ".io.parquet",
+    # the grip, where issue 29 names it (a control loop's one call; also in grasptwist.forces)
     "grip": ".engine.forces.grip",
     "Grip": ".engine.forces.grip",
-    "force_closure": ".engine.forces.closure",
-    "Closure": ".engine.forces.closure",
+    "prepare_grip": ".engine.forces.grip",
+    "PreparedGrip": ".engine.forces.grip",
+    # the topics
+    "screws": ".screws",
     "hand": ".hand",
+    "forces": ".forces",
     "path": ".path",
+    "pictures": ".pictures",
+    "dask": ".dask",
 }
 
 #: Names above that are modules themselves.
-_MODULES = {"screws", "hand", "path"}
+_MODULES = {"screws", "hand", "forces", "path", "pictures", "dask"}
+
+#: 0.3's names that moved to a topic module: old name -> (topic, name there).
+#: They still work, with a DeprecationWarning naming their new place.
+_MOVED = {
+    "finger_jacobian": ("hand", "finger_jacobian"),
+    "joint_rates": ("hand", "joint_rates"),
+    "JointRates": ("hand", "JointRates"),
+    "force_closure": ("forces", "force_closure"),
+    "Closure": ("forces", "Closure"),
+    "manipulating_forces": ("forces", "manipulating_forces"),
+    "ManipulatingForces": ("forces", "ManipulatingForces"),
+    "squeeze_forces": ("forces", "squeeze_forces"),
+    "grasp_map": ("forces", "grasp_map"),
+    "ForceStatus": ("forces", "Status"),
+    "force_status_message": ("forces", "status_message"),
+    "check_wrench": ("forces", "check_wrench"),
+    "check_friction": ("forces", "check_friction"),
+    "check_safety": ("forces", "check_safety"),
+}
 
 __all__ = list(_EXPORTS)
 
 
 def __getattr__(name: str):
+    if name in _MOVED:
+        topic, new = _MOVED[name]
+        _warnings.warn(
+            f"grasptwist.{name} is deprecated since 0.4: use grasptwist.{topic}.{new}",
+            DeprecationWarning,
+            stacklevel=2,
+        )
+        return getattr(__getattr__(topic), new)
     if name not in _EXPORTS:
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
-    module = import_module(_EXPORTS[name], __name__)
+    module = _importlib.import_module(_EXPORTS[name], __name__)
     value = module if name in _MODULES else getattr(module, name)
     globals()[name] = value
     return value
 
 
 def __dir__():
-    return sorted({*globals(), *_EXPORTS})
+    # the public names only: not the subpackages that importing them binds here (engine, io, ...)
+    return sorted([*__all__, "__version__"])

@@ -1,7 +1,7 @@
 """The engine over Dask collections, unchanged: data sets beyond one machine.
 
 :func:`resolve_dataframe` maps a Dask DataFrame with the columns of a
-Parquet data set (see the README, "Data sets of arrays") to a Dask
+Parquet data set (see docs/guide/data-sets.md, "Parquet") to a Dask
 DataFrame with the columns ``-f parquet`` writes, one partition at a time
 (``map_partitions`` with an explicit ``meta``): each partition goes through
 the same reader, blocks and columns as ``grasptwist resolve data.parquet -f
@@ -9,8 +9,8 @@ parquet``, so the values are the command line's, bit for bit.
 :func:`resolve_array` maps dask arrays of points, normals, wrists and
 twists chunked by rows (``map_blocks``) to a dask array of records whose
 fields are the npz arrays.  Neither computes anything until asked: run
-them on any Dask scheduler, e.g. a :class:`distributed.LocalCluster` or a
-cluster's :class:`distributed.Client`.
+them on any Dask scheduler, e.g. a ``distributed.LocalCluster`` or a
+cluster's ``distributed.Client``.
 
 Dask, distributed, pandas and pyarrow are the extra ``grasptwist[dask]``
 (imported when these functions run, not with this module).  For example
@@ -70,7 +70,7 @@ def _resolve_partition(df, twists, method: str, order: str, file: str):
     return _frame(pa.concat_tables([table(b, order) for b in blocks] or [schema().empty_table()]))
 
 
-def resolve_dataframe(ddf, twists: Mapping[str, object] | None = None, method="both", order="omega-v", file=""):
+def resolve_dataframe(ddf, twists: Mapping[str, object] | None = None, *, method="both", order="omega-v", file=""):
     """Resolve every row of a Dask DataFrame of grasps, lazily, partition by partition.
 
     Parameters
@@ -106,7 +106,7 @@ def to_parquet(results, folder: str, **options):
     """Write :func:`resolve_dataframe`'s results as a folder of Parquet shards (one per partition).
 
     The files are those of ``-f parquet`` (same columns, types and writer
-    options); ``options`` go to :meth:`dask.dataframe.DataFrame.to_parquet`
+    options); ``options`` go to ``dask.dataframe.DataFrame.to_parquet()``
     (e.g. ``storage_options`` for an object store).  Computes the results.
     """
     from .output.parquet_writer import schema, write_options
@@ -130,7 +130,7 @@ def _resolve_rows(rows: np.ndarray, has_wrist: bool, method: str, order: str, dt
     return out
 
 
-def result_dtype(method: str = "both", order: str = "omega-v") -> np.dtype:
+def result_dtype(*, method: str = "both", order: str = "omega-v") -> np.dtype:
     """The record type of :func:`resolve_array`: one field per npz array (``x (3,)``, ``tangent_status``, ...).
 
     >>> result_dtype()["off_tangent_status"], result_dtype()["x"].shape
@@ -143,7 +143,7 @@ def result_dtype(method: str = "both", order: str = "omega-v") -> np.dtype:
     return np.dtype([(k, np.asarray(v).dtype, np.shape(v)[1:]) for k, v in fields if k not in _LABELS])
 
 
-def resolve_array(points, normals, wrist, twist, method="both", order="omega-v"):
+def resolve_array(points, normals, wrist, twist, *, method="both", order="omega-v"):
     """Resolve dask arrays of grasps chunked by rows, lazily, chunk by chunk.
 
     Parameters
@@ -166,7 +166,7 @@ def resolve_array(points, normals, wrist, twist, method="both", order="omega-v")
     rows = points.chunks[0]
     parts = [points.reshape(n, 9), normals.reshape(n, 9), *([] if wrist is None else [wrist]), twist]
     stacked = da.concatenate([da.asarray(p, dtype=float).rechunk({0: rows, 1: -1}) for p in parts], axis=1)
-    dtype = result_dtype(method, order)
+    dtype = result_dtype(method=method, order=order)
     return stacked.rechunk({1: -1}).map_blocks(
         _resolve_rows, wrist is not None, method, order, dtype, dtype=dtype, drop_axis=1
     )

@@ -1,9 +1,9 @@
-"""Hands and joint rates: the public entry points.
+"""Hands, joint rates and inverse kinematics: the public entry points.
 
 A hand is three fingers, each a serial chain of joint screws in the grasp's
-frame (:class:`~grasptwist.model.Hand`).  The math lives in
-:mod:`grasptwist.engine.kinematics` and :mod:`grasptwist.engine.hands`, URDF reading in :mod:`grasptwist.io.urdf`;
-this module gathers them.
+frame (:class:`Hand`).  The math lives in ``grasptwist.engine.kinematics``,
+``grasptwist.engine.hands`` and ``grasptwist.engine.ik``, URDF reading in
+``grasptwist.io.urdf``; this module gathers them.
 
 >>> import numpy as np
 >>> from grasptwist import hand
@@ -21,10 +21,10 @@ from .engine.hands import (
     HandTrack,
     finger_states,
     joint_positions,
-    padded,
     track,
     velocity_limits,
 )
+from .engine.ik import IK_TOL, HandIK, hand_ik, home_tips, place_hand
 from .engine.kinematics import (
     FOLLOW_TOL,
     OFF_TANGENT_FIXED,
@@ -40,7 +40,8 @@ from .engine.kinematics import (
     velocity_limit_ratio,
 )
 from .io.urdf import load_urdf_hand
-from .model import Finger, Hand, Joint
+from .model import Finger, Hand, HandPlacement, Joint
+from .run.placement import place_grasp
 
 __all__ = [
     "Hand",
@@ -50,7 +51,6 @@ __all__ = [
     "joint_positions",
     "finger_states",
     "velocity_limits",
-    "padded",
     "HandTrack",
     "track",
     "SEGMENT_INTERVALS",
@@ -62,6 +62,13 @@ __all__ = [
     "forward_kinematics",
     "JointRates",
     "ChainState",
+    "hand_ik",
+    "place_hand",
+    "place_grasp",
+    "HandPlacement",
+    "home_tips",
+    "HandIK",
+    "IK_TOL",
     "RANK_TOL",
     "FOLLOW_TOL",
     "OFF_TANGENT_FIXED",

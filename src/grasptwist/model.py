@@ -122,7 +122,7 @@ class Grasp:
         ``(0, 0, -9.81)``); None without it.
     placement : HandPlacement or None
         A URDF hand not yet placed on the contacts, as the file gives it (the
-        loader only reads: :func:`grasptwist.run.placement.place` checks or
+        loader only reads: :func:`grasptwist.hand.place_grasp` checks or
         solves the joint positions); None once placed, or for an inline hand.
     """
 
@@ -173,7 +173,7 @@ class Segment:
     Poses are the object's rigid motion from its start, ``p -> R p + x``
     (identity at ``t = 0``), in the grasp frame.  Checked by
     :func:`grasptwist.path.check_segments`; the math is in
-    :mod:`grasptwist.engine.path`.
+    ``grasptwist.engine.path``.
 
     Attributes
     ----------
@@ -190,6 +190,10 @@ class Segment:
         A pose target's position ``x``; None for a twist.
     rotation : array-like (3, 3) or None
         A pose target's rotation matrix ``R``; None for a twist.
+    rotvec : array-like of 3 or None
+        The rotation vector (radians) a pose target's ``R`` was given by, as
+        written, and ``line``, ``column``, where (1-based): kept to judge its
+        size (``grasptwist.engine.judgements.rotation_over_pi``).
     """
 
     duration: float
@@ -197,6 +201,9 @@ class Segment:
     frame: str = "space"
     position: np.ndarray | None = None
     rotation: np.ndarray | None = None
+    rotvec: np.ndarray | None = None
+    line: int | None = None
+    column: int | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -218,8 +225,8 @@ class ObjectPath:
     line: int | None
 
 
-class InputError(Exception):
-    """An input (a grasp file or one document of it, a data set, a path) that cannot be used.
+class GraspFileError(Exception):
+    """An input (a grasp file or one document of it, a data set, a path, a URDF) that cannot be used.
 
     ``str(error)`` is one printable line, ``file:line:column: message``
     (``:line:column`` left out when unknown).
@@ -227,7 +234,8 @@ class InputError(Exception):
     Attributes
     ----------
     code : str
-        Stable kebab-case code (tables in README.md, "Grasp files" and "Exit codes and diagnostics").
+        Stable kebab-case code (the tables of docs/guide/grasp-files.md, "Errors", and
+        docs/guide/command-line.md, "Exit codes and diagnostics").
     message : str
         What is wrong, starting with the field path when there is one.
     file : str
@@ -235,7 +243,7 @@ class InputError(Exception):
         1-based position.
     document : int or None
         0-based document index; None for whole-file errors.
-    problems : tuple of InputError
+    problems : tuple of GraspFileError
         Every problem of the input, this error (its first) included: one
         record per failed document lists them all.
     """
@@ -268,8 +276,9 @@ class InputError(Exception):
         return f"{where}: {self.message}"
 
 
-#: The name the Python API has always used for a grasp file's errors.
-GraspFileError = InputError
+#: The layers' name for it: any input, not only a grasp file (the Python API has always
+#: called it GraspFileError, which the reference documents).
+InputError = GraspFileError
 
 
 @dataclass(frozen=True, eq=False)
@@ -302,7 +311,7 @@ class Finger:
     """A finger: a serial chain of joints at its home configuration (every joint at 0).
 
     Arrays are read-only, in the hand's root frame (the grasp's frame).
-    :func:`grasptwist.engine.kinematics.forward_kinematics` moves them to
+    :func:`~grasptwist.hand.forward_kinematics` moves them to
     other joint positions.
 
     Attributes
@@ -323,7 +332,7 @@ class Finger:
         From the first joint through the others to the tip link's origin: a
         contact farther than this from the tip is a frame mix-up.
     joint_index : tuple of int
-        Position of each joint in :attr:`Hand.joint_names`.
+        Position of each joint in ``Hand.joint_names``.
     """
 
     name: str

@@ -5,7 +5,7 @@
 >>> integrate([Segment(1.0, twist=[0, 0, 0, 1, 0, 0])], [0.5]).position.tolist()
 [[0.5, 0.0, 0.0]]
 
-The math is in :mod:`grasptwist.engine.path`; rigid motions in :mod:`grasptwist.engine.se3`.
+The math is in ``grasptwist.engine.path``; rigid motions in ``grasptwist.engine.se3``.
 """
 
 from .engine.path import (
@@ -21,10 +21,11 @@ from .engine.path import (
     integrate,
 )
 from .engine.tracking import FingerTrack, track_finger
-from .model import Segment
+from .model import ObjectPath, Segment
 
 __all__ = [
     "Segment",
+    "ObjectPath",
     "integrate",
     "follow",
     "degeneracies",

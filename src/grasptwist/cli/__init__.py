@@ -9,34 +9,33 @@ stdout carries data only; every diagnostic goes to stderr as one line
 ``path:line:col: error: message``.
 """
 
+import importlib
 import sys
 
 import typer
 
 from .._version import __version__
-from . import basis, check, follow, forces, plot, resolve, schema
-from .exits import CLICK_ERROR, EXIT_OK, stopped, usage_error
+from .exits import CLICK_ERROR, EXIT_OK, EXIT_WRITE, failed, stopped, to_stdout, usage_error
 
-__all__ = ["app", "main"]
+__all__ = ["app", "app_for", "command", "COMMANDS", "main"]
 
-app = typer.Typer(
-    name="grasptwist",
-    help="Resolve a desired object twist into finger-tip twists for a three-fingered grasp (screw theory).",
-    no_args_is_help=True,
-    add_completion=True,
-    rich_markup_mode=None,
-    pretty_exceptions_enable=False,
-    context_settings={"help_option_names": ["-h", "--help"]},
-)
+#: The commands by name, in the order of ``grasptwist -h``: each is the function of the same
+#: name in the module of the same name, imported only when a command line needs it (a run of
+#: one command does not pay for the others' modules at start-up).
+COMMANDS = ("resolve", "basis", "check", "follow", "forces", "schema", "plot")
+
+
+def command(name: str):
+    """The function of command ``name`` (one of :data:`COMMANDS`)."""
+    return getattr(importlib.import_module(f".{name}", __name__), name)
 
 
 def _version(value: bool) -> None:
     if value:
-        sys.stdout.write(f"grasptwist {__version__}\n")
+        to_stdout(f"grasptwist {__version__}\n")
         raise typer.Exit(EXIT_OK)
 
 
-@app.callback()
 def _root(
     version: bool = typer.Option(
         False, "--version", callback=_version, is_eager=True, help="Print the version and exit."
@@ -45,19 +44,62 @@ def _root(
     """Resolve a desired object twist into finger-tip twists for a three-fingered grasp (screw theory)."""
 
 
-for _command in (resolve.resolve, basis.basis, check.check, follow.follow, forces.forces, schema.schema, plot.plot):
-    app.command()(_command)  # in the order of `grasptwist -h`
+def _app(commands) -> typer.Typer:
+    """The ``grasptwist`` command group holding ``commands``."""
+    made = typer.Typer(
+        name="grasptwist",
+        help="Resolve a desired object twist into finger-tip twists for a three-fingered grasp (screw theory).",
+        no_args_is_help=True,
+        add_completion=True,
+        rich_markup_mode=None,
+        pretty_exceptions_enable=False,
+        context_settings={"help_option_names": ["-h", "--help"]},
+    )
+    made.callback()(_root)
+    for command in commands:
+        made.command()(command)
+    return made
+
+
+_every = []  # the group of every command, made once when first asked for
+
+
+def __getattr__(name: str):
+    if name == "app":  # every command (``grasptwist -h``, completion, tests)
+        if not _every:
+            _every.append(_app([command(c) for c in COMMANDS]))
+        return _every[0]
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def app_for(args: list[str]) -> typer.Typer:
+    """The group a command line needs: typer builds the options of every command it holds
+    before it runs one (about 10 ms for seven), so a line naming a command (the first word
+    not an option: the group's own options take no value) holds that one alone.
+
+    >>> from grasptwist.cli import app
+    >>> app_for(["-h"]) is app_for([]) is app_for(["fly", "a.yaml"]) is app
+    True
+    >>> [c.callback.__name__ for c in app_for(["--debug", "check", "a.yaml"]).registered_commands]
+    ['check']
+    """
+    name = next((a for a in args if not a.startswith("-")), None)
+    return _app([command(name)]) if name in COMMANDS else __getattr__("app")
 
 
 def main() -> None:
     """Run the command line (the ``grasptwist`` script is :func:`grasptwist.__main__.main`)."""
     from ..run.signals import Interrupted, stop_on_signals
+    from ..run.target import WriteError
 
     stop_on_signals()
     try:
-        code = app(standalone_mode=False)
+        try:
+            code = app_for(sys.argv[1:])(standalone_mode=False)
+        except CLICK_ERROR as exc:
+            code = usage_error(exc)
     except Interrupted as stop:  # while typer parsed the command line
-        sys.exit(stopped(stop))
-    except CLICK_ERROR as exc:
-        sys.exit(usage_error(exc))
+        code = stopped(stop)
+    except WriteError as exc:  # the version or the help on a closed stdout
+        code = failed(exc, EXIT_WRITE)
     sys.exit(code if isinstance(code, int) else EXIT_OK)

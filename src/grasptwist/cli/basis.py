@@ -45,8 +45,8 @@ def basis(
     \b
         grasptwist basis grasps/cylinder.yaml --method off-tangent
     """
-    from ..run.batch import TwistOptions
     from ..run.families import COMMANDS
+    from ..run.options import TwistOptions
     from ..run.pipeline import Job
 
     job = Job(

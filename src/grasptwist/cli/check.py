@@ -40,8 +40,8 @@ def check(
     \b
         grasptwist check grasps/ -f jsonl | jq -c 'select(.ok | not)'
     """
-    from ..run.batch import TwistOptions
     from ..run.families import COMMANDS
+    from ..run.options import TwistOptions
     from ..run.pipeline import Job
 
     job = Job(

@@ -43,12 +43,19 @@ TABLE_HINT_AT = 50
 
 
 def to_stderr(line: str) -> None:
-    """One line on stderr; if stderr is gone (a hung-up terminal), there is nobody to tell."""
+    """One line on stderr; if stderr is gone (a hung-up terminal, or closed by the shell,
+    ``2>&-``: ``sys.stderr`` is None), there is nobody to tell."""
+    if sys.stderr is None:
+        return
     try:
         sys.stderr.write(line + "\n")
         sys.stderr.flush()
     except (OSError, ValueError):
         pass
+
+
+def _stderr_is_terminal() -> bool:
+    return sys.stderr is not None and sys.stderr.isatty()
 
 
 class Diagnostics:
@@ -74,7 +81,7 @@ class Diagnostics:
         self.unshown: dict[str, int] = {}  # warnings not printed, by kind
         self.rows_unshown: dict[str, int] = {}  # row errors not printed, by code
         self.hint = None if quiet else hint
-        self.color = sys.stderr.isatty() and not os.environ.get("NO_COLOR")
+        self.color = _stderr_is_terminal() and not os.environ.get("NO_COLOR")
 
     def take(self, out) -> None:
         """Count a pipeline Output and print its lines."""
@@ -207,7 +214,7 @@ def progress_bar(inputs: list, command: str, out, shown: bool = True):
     from ..io.datasets import DATASET_SUFFIXES
 
     big = len(inputs) > 1 or any(isinstance(p, str) and p.endswith(DATASET_SUFFIXES) for p in inputs)
-    if not shown or not big or not sys.stderr.isatty() or out.isatty():
+    if not shown or not big or not _stderr_is_terminal() or out.isatty():
         yield lambda output: None
         return
     from rich.progress import Progress

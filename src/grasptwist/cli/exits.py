@@ -12,7 +12,7 @@ from __future__ import annotations
 import os
 import signal
 import sys
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from contextlib import contextmanager
 
 import typer
@@ -27,9 +27,11 @@ __all__ = [
     "EXIT_WORKER",
     "EXIT_BROKEN_PIPE",
     "CLICK_ERROR",
+    "checked_output",
     "output_target",
-    "writable_folder",
     "drop_stdout",
+    "failed",
+    "to_stdout",
     "stopped",
     "run_command",
     "usage_error",
@@ -42,31 +44,34 @@ EXIT_OK, EXIT_FAILED, EXIT_USAGE, EXIT_WRITE, EXIT_WORKER, EXIT_BROKEN_PIPE = 0,
 CLICK_ERROR = next(c for c in typer.BadParameter.__mro__ if c.__name__ == "ClickException")
 
 
+def checked_output(path: str | None, inputs: Iterable = ()):
+    """How ``path`` (None: stdout) is written (a :class:`grasptwist.run.target.Target`);
+    a usage error, before any work, when it cannot be the output: among other
+    reasons when it is one of ``inputs``, the paths the run reads. A standard input
+    closed by the shell (``<&-``) among ``inputs`` is, like a closed stdout, exit 3
+    before any work."""
+    from ..run.target import check_target
+
+    inputs = list(inputs)
+    if sys.stdin is None and any(str(p) == "-" for p in inputs):  # Python found descriptor 0 closed
+        raise typer.Exit(failed(Exception("cannot read standard input: it is closed"), EXIT_WRITE))
+    try:
+        return check_target(path, inputs)
+    except ValueError as exc:
+        raise typer.BadParameter(str(exc), param_hint=None if path is None else "-o") from None
+
+
 @contextmanager
-def output_target(path: str | None) -> Iterator:
+def output_target(path: str | None, inputs: Iterable = ()) -> Iterator:
     """stdout, or ``path`` by the rule of :mod:`grasptwist.run.target`: a file
     replaced atomically on success only, a pipe or device written through;
-    an unusable ``path`` is a usage error before any work."""
+    checked by :func:`checked_output` first."""
     from ..run.signals import finishing
-    from ..run.target import check_target, opened
+    from ..run.target import opened
 
-    if path is not None and path != "-":
-        try:
-            check_target(path)
-        except ValueError as exc:
-            raise typer.BadParameter(str(exc), param_hint="-o") from None
-    with opened(path) as out:
+    with opened(checked_output(path, inputs)) as out:
         yield out
         finishing()  # all written: commit it and end normally, whatever signal comes now
-
-
-def writable_folder(path: str) -> None:
-    """A usage error, before any work, when ``path``'s folder cannot take a file."""
-    folder = os.path.dirname(os.path.abspath(path))
-    if not os.path.isdir(folder):
-        raise typer.BadParameter(f"cannot write {path}: no folder {os.path.dirname(path) or folder}", param_hint="-o")
-    if not os.access(folder, os.W_OK):
-        raise typer.BadParameter(f"cannot write {path}: the folder is not writable", param_hint="-o")
 
 
 def drop_stdout() -> None:
@@ -79,6 +84,22 @@ def drop_stdout() -> None:
     os.dup2(os.open(os.devnull, os.O_WRONLY), fd)
 
 
+def to_stdout(text: str) -> None:
+    """Text that is not records (the help, the version) on stdout, written as records
+    are: a closed stdout is a :class:`~grasptwist.run.target.WriteError`."""
+    from ..run.target import opened
+
+    with opened(None) as out:
+        out.write(text.encode())
+
+
+def failed(exc: Exception, code: int) -> int:
+    """Say in one line why the run could not go on (a write error, a dead worker); ``code``."""
+    drop_stdout()
+    to_stderr(f"grasptwist: error: {exc}")
+    return code
+
+
 def stopped(stop) -> int:
     """Say which signal stopped the run; the exit status a shell gives for it."""
     drop_stdout()
@@ -88,13 +109,18 @@ def stopped(stop) -> int:
 
 def run_command(debug: bool, body: Callable[[], int]) -> None:
     """Run a command's body; turn every way it can end into one line and an exit status."""
+    import numpy as np
+
     from ..extras import MissingExtra
     from ..run.pool import WorkerDied
     from ..run.signals import Interrupted
     from ..run.target import WriteError
 
     try:
-        code = body()
+        # numpy's RuntimeWarnings (overflow, invalid) would reach stderr with a file and a line of
+        # ours; the engine turns what overflows into a status, so the run needs none of them
+        with np.errstate(all="ignore"):
+            code = body()
     except (typer.Exit, typer.Abort, typer.BadParameter):
         raise  # typer's own ways out: exit codes, usage errors (2)
     except (Interrupted, KeyboardInterrupt) as exc:  # KeyboardInterrupt: run without main(), as by tests
@@ -108,9 +134,7 @@ def run_command(debug: bool, body: Callable[[], int]) -> None:
         to_stderr(f"grasptwist: error: {exc}")
         raise typer.Exit(EXIT_USAGE) from None
     except (WriteError, WorkerDied) as exc:
-        drop_stdout()
-        to_stderr(f"grasptwist: error: {exc}")
-        raise typer.Exit(EXIT_WRITE if isinstance(exc, WriteError) else EXIT_WORKER) from None
+        raise typer.Exit(failed(exc, EXIT_WRITE if isinstance(exc, WriteError) else EXIT_WORKER)) from None
     except Exception as exc:  # noqa: BLE001 - the one place a traceback is turned into a line
         if debug:
             raise
@@ -123,7 +147,7 @@ def usage_error(exc) -> int:
     """One line for a usage error (exit 2), as for every other diagnostic: what is wrong, and
     where help is, instead of click's four lines of usage, hint, blank and error."""
     if type(exc).__name__ == "NoArgsIsHelpError":  # `grasptwist` alone: the help is the answer,
-        sys.stdout.write(exc.format_message() + "\n")  # on stdout (`grasptwist | less`), a success
+        to_stdout(exc.format_message() + "\n")  # on stdout (`grasptwist | less`), a success
         return EXIT_OK
     ctx = getattr(exc, "ctx", None)
     message = " ".join(exc.format_message().split())  # on one line, whatever it quotes

@@ -85,7 +85,7 @@ def follow(
         grasptwist follow grasps/polyhedron.yaml --twist 0,0,1,0,0,0 --duration 1.5708 --twist 0,0,0,0,0,1 --duration 1 -f jsonl
     """
     from ..run.families import COMMANDS
-    from ..run.follow import FollowOptions
+    from ..run.options import FollowOptions
     from ..run.pipeline import Job
 
     segments = segments_option(twist, duration, frame.value)

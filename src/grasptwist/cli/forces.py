@@ -25,6 +25,31 @@ from .records import OutputSettings, write_records
 __all__ = ["forces"]
 
 
+def _friction(value: float | None) -> float | None:
+    """NaN is no coefficient: refused as a negative one is (``inf``, no limit, is one)."""
+    if value is not None and value != value:
+        raise typer.BadParameter("must be a number >= 0 (inf: no limit), got nan")
+    return value
+
+
+def _safety(value: float) -> float:
+    from ..engine.forces.grasp_map import check_safety  # the force engine loads only when forces runs
+
+    try:
+        return check_safety(value)
+    except ValueError as err:
+        raise typer.BadParameter(str(err)) from None
+
+
+def _cone_edges(value: int) -> int:
+    from ..engine.forces.closure import check_cone_edges
+
+    try:
+        return check_cone_edges(value)
+    except ValueError as err:
+        raise typer.BadParameter(str(err)) from None
+
+
 def forces(
     paths: Paths,
     wrench: Annotated[
@@ -51,17 +76,33 @@ def forces(
     friction: Annotated[
         float | None,
         typer.Option(
-            "--friction", metavar="MU", min=0, help="Friction coefficient of every contact (replaces the files')."
+            "--friction",
+            metavar="MU",
+            min=0,
+            callback=_friction,
+            help="Friction coefficient of every contact (replaces the files'; inf: no limit).",
         ),
     ] = None,
     safety: Annotated[
-        float, typer.Option("--safety", metavar="S", min=1, help="Safety factor: forces keep within mu / S.")
+        float,
+        typer.Option(
+            "--safety",
+            metavar="S",
+            callback=_safety,
+            help="Safety factor >= 1: forces keep within mu / S, closure is judged with it.",
+        ),
     ] = 1.0,
     quality: Annotated[
         bool, typer.Option("--quality", help="Also Ferrari-Canny's epsilon (needs scipy: grasptwist[quality]).")
     ] = False,
     cone_edges: Annotated[
-        int, typer.Option("--cone-edges", metavar="M", min=3, help="Sides of each friction pyramid for --quality.")
+        int,
+        typer.Option(
+            "--cone-edges",
+            metavar="M",
+            callback=_cone_edges,
+            help="Sides of each friction pyramid for --quality (3 to 64).",
+        ),
     ] = 8,
     fmt: Annotated[
         ForcesFormat,
@@ -90,7 +131,7 @@ def forces(
         grasptwist forces grasps/polyhedron.yaml --wrench 0,0,1,0,0,0 --friction 0.8 --json
     """
     from ..run.families import COMMANDS
-    from ..run.forces import ForceOptions
+    from ..run.options import ForceOptions
     from ..run.pipeline import Job
 
     wrenches = wrenches_option(wrench, at, wrench_name)

@@ -100,9 +100,31 @@ Digits = Annotated[
 OrderOption = Annotated[
     Order, typer.Option("--order", help="Order of every printed 6-vector: (omega; v) or (v; omega).")
 ]
+
+
+def byte_count(text: str) -> int:
+    """A whole number of bytes, written as an integer or in exponent form (``1e8``), at least 1.
+
+    >>> byte_count("1e8"), byte_count("4096")
+    (100000000, 4096)
+    """
+    try:
+        value = float(text)
+    except ValueError:
+        raise typer.BadParameter(f"expected a whole number of bytes (e.g. 1048576 or 1e6), got {text!r}") from None
+    if not (value >= 1 and value == int(value) and value < 2**63):
+        raise typer.BadParameter(f"expected a whole number of bytes, at least 1, got {text!r}")
+    return int(value)
+
+
 MaxBytes = Annotated[
     int | None,
-    typer.Option("--max-bytes", min=1, help="Refuse grasp files larger than this many bytes (default 1 MiB)."),
+    typer.Option(
+        "--max-bytes",
+        parser=byte_count,
+        metavar="BYTES",
+        help="Refuse grasp files larger than this many bytes (default 1 MiB; 1e8 is 100 MB).",
+    ),
 ]
 Quiet = Annotated[bool, typer.Option("-q", "--quiet", help="No warnings or summary on stderr (errors still).")]
 WarningsOption = Annotated[
@@ -121,7 +143,8 @@ Workers = Annotated[
         "-j",
         "--workers",
         min=0,
-        help="Processes for big batches (0: every core, used for 256+ files or 4096+ data-set grasps).",
+        help="Processes for big batches (0: every core, used for 256+ files or 4096+ data-set grasps); "
+        "never more than the tasks, 4 per core or 64.",
     ),
 ]
 Select = Annotated[

@@ -1,14 +1,13 @@
 """``grasptwist plot``: draw a grasp, its basis screw axes and the finger-tip velocities."""
 
 import os
-import sys
 from dataclasses import replace
 from typing import Annotated
 
 import typer
 
 from .diagnostics import Diagnostics, to_stderr
-from .exits import EXIT_FAILED, EXIT_OK, run_command, writable_folder
+from .exits import EXIT_FAILED, EXIT_OK, checked_output, run_command
 from .options import Debug, MaxBytes, PlotMethod, Select, twists_option
 
 __all__ = ["plot", "draw_pictures"]
@@ -95,31 +94,51 @@ def plot(
 
 
 def draw_pictures(path, output, twists, twist_name, method, max_bytes, views) -> int:
-    """The body of ``plot``: the command line's checks, then :func:`grasptwist.run.pictures.draw`;
+    """The body of ``plot``: the command line's checks, then the run's reading
+    (:func:`grasptwist.run.pictures.read_grasps`) and drawing (:func:`grasptwist.run.pictures.draw`);
     notes on stderr, the pictures' names on stdout; the exit status."""
     from .. import plot as pictures
     from ..io.datasets import DATASET_SUFFIXES
-    from ..run.pictures import draw
+    from ..io.inputs import expand
+    from ..run.pictures import draw, read_grasps
+    from ..run.target import opened
 
     stderr = Diagnostics()
     if path.endswith(DATASET_SUFFIXES):
         raise typer.BadParameter(
             "plot draws grasp files (.yaml, .yml) or folders of them, not data sets", param_hint="PATH"
         )
-    if not os.path.isdir(path):
-        writable_folder(output)
+    inputs = list(expand([path]))
+    if not os.path.isdir(path) or not output:  # a folder's -o is the folder its images go to
+        checked_output(output, inputs)
+
+    def opener(image):  # each image as -o writes a file: replaced atomically, never an input
+        return opened(str(image), inputs)
+
+    def note(line: str, error: bool = True) -> None:
+        stderr.failed += error
+        stderr.say(line, ": error: " if error else ": warning: ", "31" if error else "33")
+
     html = output.lower().endswith(pictures.HTML) or (os.path.isdir(path) and any(views.values()))
     if not html and any(views.values()):
         raise typer.BadParameter("applies to HTML views (-o FILE.html)", param_hint="--js-beside/--path")
     try:
-        for item in draw(path, output, twists, twist_name, method, max_bytes, html, views):
+        (pictures.require_plotly if html else pictures.require_matplotlib)()  # before anything is read
+        grasps = []
+        for item in read_grasps(inputs, twists, max_bytes):
             if isinstance(item, pictures.Note):
-                stderr.failed += item.error
-                stderr.say(item.line, ": error: " if item.error else ": warning: ", "31" if item.error else "33")
+                note(item.line, item.error)
             else:
-                sys.stdout.write(f"{item}\n")
+                grasps.append(item)
+        drawn = draw(path, output, grasps, None if twists else twist_name, method, html, views, opener)
+        with opened(None) as listing:  # a closed stdout is a write error before anything is drawn
+            for item in drawn:
+                if isinstance(item, pictures.Note):
+                    note(item.line, item.error)
+                else:
+                    listing.write(os.fsencode(f"{item}\n"))
     except (pictures.MissingMatplotlib, pictures.MissingPlotly) as exc:
-        sys.stderr.write(f"{exc}\n")  # "grasptwist plot needs matplotlib: ..." (or plotly)
+        to_stderr(str(exc))  # "grasptwist plot needs matplotlib: ..." (or plotly)
         return EXIT_FAILED
     except pictures.TwistNotFound as exc:
         raise typer.BadParameter(str(exc), param_hint="--select") from None

@@ -22,6 +22,7 @@ class OutputSettings:
     warnings: Warnings
     workers: int
     table_options: dict = field(default_factory=dict)
+    reads: tuple = ()  # files read besides the paths (--twists-from, --hand): never the output either
 
 
 def worker_count(requested: int) -> int:
@@ -39,7 +40,10 @@ def write_records(job, paths: list[str], settings: OutputSettings) -> int:
     stderr = Diagnostics(settings.quiet, settings.warnings, hint=hint)
     inputs = list(expand(paths))
     fmt = FORMATS[job.fmt]
-    with output_target(settings.output) as out, progress_bar(inputs, job.command.name, out, counted) as advance:
+    with (
+        output_target(settings.output, [*inputs, *settings.reads]) as out,
+        progress_bar(inputs, job.command.name, out, counted) as advance,
+    ):
         w = fmt.open(out, job, **settings.table_options)
         # block writers (npz) take results in the run; the others get records encoded where they were made
         for o in outputs(job, inputs, w, worker_count(settings.workers)):

@@ -110,8 +110,8 @@ def resolve(
         grasptwist resolve grasps.npz --twist 0,0,1,0,0,0 -f npz -o results.npz
     """
     from ..io.datasets import DATASET_SUFFIXES
-    from ..run.batch import TwistOptions
     from ..run.families import COMMANDS
+    from ..run.options import TwistOptions
     from ..run.pipeline import Job
 
     twists = twists_option(twist, at, twist_name)
@@ -146,5 +146,6 @@ def resolve(
             select=tuple(select) if select else None,
         ),
     )
-    settings = OutputSettings(output, quiet, warnings, workers, {"digits": digits, "order": order.value})
+    table_options = {"digits": digits, "order": order.value}
+    settings = OutputSettings(output, quiet, warnings, workers, table_options, reads=(twists_from, hand))
     run_command(debug, lambda: write_records(job, paths, settings))

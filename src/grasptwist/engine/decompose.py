@@ -5,7 +5,7 @@
   only contact ``i`` and ``Psi_i`` (the line from the wrist ``c`` through
   ``p_i``) keeps contact ``i`` fixed.
 * :func:`decompose_tangent` -- Proposition 2 (eqs. 19-27) and its extension
-  to any twist (README, "The tangent method beyond the paper"): ``T = sum
+  to any twist (docs/reference/conventions.md, "The tangent method beyond the paper"): ``T = sum
   alpha_i Theta_i + sum beta_i Sigma_i``, where ``Theta_i`` keeps contact
   ``i`` fixed and the other two sliding in their tangent planes.  ``beta =
   0`` exactly when ``T`` moves every contact in its tangent plane.
@@ -81,6 +81,8 @@ def contact_velocities(points, twist):
     -------
     (..., 3, 3) array, row ``i`` the velocity of contact ``i``.
 
+    Examples
+    --------
     >>> contact_velocities([[1.0, 0, 0], [0, 1, 0], [0, 0, 1]], [0, 0, 1.0, 0, 0, 0]).tolist()
     [[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 0.0]]
     """
@@ -94,19 +96,8 @@ def _index(a, i):
 
 @dataclass(frozen=True, eq=False)
 class _Result:
-    """What both results share: per-row status, conditioning and inputs, row
-    access and the lazily computed residual.
-
-    Attributes
-    ----------
-    status, culprit : (...) int8
-        :class:`~grasptwist.engine.degeneracy.Status` of each row and the contact it
-        is about (0..2, or -1).
-    conditioning : (...)
-        The method's dimensionless conditioning figure (see each result).
-    points, twist : (..., 3, 3), (..., 6)
-        The inputs, broadcast to the batch shape.
-    """
+    """What both results share: per-row status, conditioning and inputs (each result's
+    Attributes list them), row access and the lazily computed residual."""
 
     status: np.ndarray
     culprit: np.ndarray
@@ -136,6 +127,8 @@ class _Result:
         ValueError
             For a result of one grasp and one twist, which has no rows.
 
+        Examples
+        --------
         Paper Example 1 with two twists (a spin about z, a lift along z):
 
         >>> p = [[1, 0, 0], [-0.5, 0.866, 0], [-0.5, -0.866, 0]]
@@ -159,12 +152,21 @@ class _Result:
         """``max_i |R(p_i)| / max_i |T(p_i)|``, ``R`` = the sum of the components minus ``T``.
 
         Computed on first access from the returned screws and amplitudes;
-        NaN in failed rows, 0 for the zero twist.
+        NaN in failed rows, 0 for the zero twist.  The twist and the components
+        are scaled by ``2^-e``, ``e`` the exponent of the twist's largest entry:
+        exactly, so the ratio has the bits it has unscaled, but the components'
+        sum stays finite for a twist near ``1e308`` (an ok row's residual is a number).
+
+        >>> p = [[1, 0, 0], [-0.5, 0.866, 0], [-0.5, -0.866, 0]]
+        >>> float(decompose_off_tangent(p, [0, 0, 1], [0, 0, 1e308, 0, 0, 0]).residual) < 1e-15
+        True
         """
         with np.errstate(all="ignore"):  # failed rows hold NaN, overflowed ones inf
-            r = sum(a.sum(axis=-2) for a in self.components()) - self.twist
+            e = -np.frexp(np.max(np.abs(self.twist), axis=-1))[1]
+            r = sum(np.ldexp(a, e[..., None, None]).sum(axis=-2) for a in self.components())
+            r = r - np.ldexp(self.twist, e[..., None])
             err = np.max(norm(field_at(r[..., None, :], self.points)), axis=-1)
-            ref = np.max(norm(field_at(self.twist[..., None, :], self.points)), axis=-1)
+            ref = np.max(norm(field_at(np.ldexp(self.twist, e[..., None])[..., None, :], self.points)), axis=-1)
             return np.where(ref > 0, err / np.where(ref > 0, ref, 1.0), err)
 
 
@@ -184,9 +186,11 @@ class OffTangentResult(_Result):
     conditioning : (...)
         ``min_i |[Sigma_i|Psi_i]| / size`` (dimensionless; size = longest
         side of the contact triangle).
-
-    ``status``, ``culprit``, ``points``, ``twist`` and ``residual`` are as in
-    every result (``_Result``).
+    status, culprit : (...) int8
+        The :class:`~grasptwist.Status` of each row and the contact it is about
+        (0..2, or -1).
+    points, twist : (..., 3, 3), (..., 6)
+        The inputs, broadcast to the batch shape.
     """
 
     sigma: np.ndarray
@@ -218,9 +222,9 @@ class TangentResult(_Result):
         Tangent amplitudes, eq. 27.
     beta : (..., 3)
         Off-plane remainder amplitudes, ``beta_i = [R|Theta_i]/[Sigma_i|Theta_i]``
-        with ``R = T - sum alpha_i Theta_i`` (README, "The tangent method
-        beyond the paper").  Zero when ``T`` keeps every contact in its
-        tangent plane.
+        with ``R = T - sum alpha_i Theta_i`` (docs/reference/conventions.md,
+        "The tangent method beyond the paper").  Zero when ``T`` keeps every
+        contact in its tangent plane.
     normal_velocity : (..., 3)
         ``[T | nu_i] = T(p_i) . n_i`` with unit normals.
     in_tangent_planes : (...) bool
@@ -230,9 +234,11 @@ class TangentResult(_Result):
         The smaller of ``min_i |[Theta_i|Sigma_i]| / size`` and of
         ``min_i |sin|`` of the angle between normal ``i`` and the contacts'
         plane; both go to 0 at every degenerate grasp.
-
-    ``status``, ``culprit``, ``points``, ``twist`` and ``residual`` are as in
-    every result (``_Result``).
+    status, culprit : (...) int8
+        The :class:`~grasptwist.Status` of each row and the contact it is about
+        (0..2, or -1).
+    points, twist : (..., 3, 3), (..., 6)
+        The inputs, broadcast to the batch shape.
     """
 
     theta: np.ndarray
@@ -277,9 +283,10 @@ def decompose_off_tangent(points, wrist, twist, *, tol=DEGENERACY_TOL, bases=Tru
     points : (..., 3, 3) array
     wrist : (..., 3) array
         The point ``c`` (centre of the wrist's spherical joint).
-    twist : (..., 6) array, ``(omega; v)`` with ``v`` at the origin.
+    twist : (..., 6) array
+        ``(omega; v)`` with ``v`` at the origin.
     tol : float
-        Relative tolerance of the degeneracy tests (see :mod:`grasptwist.engine.degeneracy`).
+        Relative tolerance of the degeneracy tests (see ``grasptwist.engine.degeneracy``).
     bases : bool
         False leaves out the basis screws (``sigma``, ``psi`` are None, and
         so cannot give components or a residual): a third less work and
@@ -291,7 +298,7 @@ def decompose_off_tangent(points, wrist, twist, *, tol=DEGENERACY_TOL, bases=Tru
 
     Examples
     --------
-    Paper Example 1b, a spin about z (corrected values: README, "Conventions"):
+    Paper Example 1b, a spin about z (corrected values: docs/reference/conventions.md):
 
     >>> p = [[1, 0, 0], [-0.5, 0.866, 0], [-0.5, -0.866, 0]]
     >>> r = decompose_off_tangent(p, [0, 0, 1], [0, 0, 1, 0, 0, 0])
@@ -315,7 +322,8 @@ def decompose_tangent(points, normals, twist, *, tol=DEGENERACY_TOL, bases=True)
     points : (..., 3, 3) array
     normals : (..., 3, 3) array
         Surface normals at the contacts, any non-zero length (normalised here).
-    twist : (..., 6) array, ``(omega; v)`` with ``v`` at the origin.
+    twist : (..., 6) array
+        ``(omega; v)`` with ``v`` at the origin.
     tol : float
         Relative tolerance of the degeneracy tests.
     bases : bool
@@ -332,7 +340,7 @@ def decompose_tangent(points, normals, twist, *, tol=DEGENERACY_TOL, bases=True)
 
     >>> p = [[0, 2, 2], [2, 0, 2], [2, 2, 0]]
     >>> r = decompose_tangent(p, np.eye(3), [0.57735, 0.57735, 0.57735, 0, 0, 0])
-    >>> np.round(r.alpha, 4).tolist(), np.round(r.beta, 4).tolist(), bool(r.in_tangent_planes)
+    >>> np.round(r.alpha, 4).tolist(), (np.round(r.beta, 4) + 0.0).tolist(), bool(r.in_tangent_planes)
     ([0.5774, 0.5774, 0.5774], [0.0, 0.0, 0.0], True)
     """
     inputs = {"points": check_points(points), "normals": check_normals(normals), "twist": check_twist(twist)}
@@ -363,9 +371,18 @@ def resolve(points, normals, wrist, twist, *, tol=DEGENERACY_TOL, bases=True) ->
     The same numbers, bit for bit, as :func:`decompose_off_tangent`,
     :func:`decompose_tangent` and :func:`contact_velocities` called
     separately, for less: the contact triangle and the contact velocities are
-    computed once.  Arguments as for those; ``wrist`` may be None (then
-    ``off_tangent`` is None).  For many twists on one grasp see
-    :func:`~grasptwist.engine.prepared.prepare`.
+    computed once.  For many twists on one grasp see :func:`prepare`.
+
+    Parameters
+    ----------
+    points, normals : (..., 3, 3) array
+        The contacts and their normals (any non-zero length), as for those.
+    wrist : (..., 3) array or None
+        None: no off-tangent result (``off_tangent`` is None).
+    twist : (..., 6) array
+        ``(omega; v)`` with ``v`` at the origin.
+    tol, bases
+        As for :func:`decompose_off_tangent`.
 
     Returns
     -------

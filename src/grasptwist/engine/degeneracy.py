@@ -22,16 +22,24 @@ __all__ = [
     "DEGENERACY_TOL",
     "CONDITION_WARNING",
     "IN_PLANE_TOL",
+    "NOISE_FLOOR",
     "status_message",
     "conditioning_warning",
     "skipped_warning",
-    "OUTWARD_NORMALS_WARNING",
+    "outward_normals_warning",
+    "radians_warning",
 ]
 
 #: A dimensionless measure at or below this makes the grasp degenerate.
 #: Amplitudes carry a relative error of about ``1e-16 / conditioning``, so at
 #: the threshold they still have about 6 correct digits.
 DEGENERACY_TOL = 1e-9
+
+#: A figure computed to double precision (a residual, a tip's distance to its
+#: contact, a conditioning) below this is round-off: each processor's BLAS
+#: kernel gives other digits there, and may give ``0.0`` or ``-0.0``, so what
+#: people read shows it as below this and no more (``output/numbers.py``).
+NOISE_FLOOR = 1e-12
 
 #: A conditioning figure below this is worth a warning: amplitudes may be
 #: more than a thousand times the twist's own size.
@@ -61,6 +69,7 @@ class Status(IntEnum):
     CONTACT_OFF_FINGER = 13  # a hand's: a contact farther from its finger's tip than the finger is long
     UNREACHABLE = 14  # a hand's inverse kinematics (grasptwist.engine.ik)
     OUTSIDE_LIMITS = 15
+    NONFINITE_POSE = 16  # a path's: its pose at a sample overflows (grasptwist.engine.path), never a decomposition's
 
     @property
     def code(self) -> str:
@@ -115,6 +124,11 @@ _MESSAGES = {
         "finger {i}'s tip reaches its contact only with a joint outside its position limits: "
         "move the contact, or widen the limits where the hand allows it"
     ),
+    Status.NONFINITE_POSE: (
+        "the object's pose overflows double precision here (a turn through more than about 1e154 radians, "
+        "a distance or a twist beyond 1.8e308): "
+        "rescale the twist or shorten the path"
+    ),
     Status.NO_WRIST: (
         "the grasp has no wrist, and each Psi_i is a line from it: give one "
         "('wrist: [x, y, z]' in a grasp file, a 'wrist' array in a data set)"
@@ -135,6 +149,8 @@ def status_message(status, culprit=-1, names=("1", "2", "3")) -> str:
     names : sequence of 3 str
         Contact names to use in the message.
 
+    Examples
+    --------
     >>> status_message(Status.COINCIDENT_CONTACTS, 0)
     'contacts 2 and 3 coincide, so Sigma_1 has no axis: three distinct contacts are needed'
     """
@@ -169,10 +185,51 @@ def skipped_warning(status, method: str) -> str:
     return f"{method} skipped: {s.code}: {status_message(s)}"
 
 
-#: The warning for a grasp whose normals all point away from the other
-#: contacts (:func:`~grasptwist.engine.judgements.outward_normals`); it
-#: starts with its code.
-OUTWARD_NORMALS_WARNING = (
-    "outward-normals: every normal points away from the other contacts (n_i . (g - p_i) < 0, g their centroid), "
-    "but normals point into the object: flip them, unless the fingers push outward from inside a hollow"
-)
+def outward_normals_warning(outward, names=("1", "2", "3"), center=False) -> str | None:
+    """The warning for normals that point out of the object, naming their contacts; None when none does.
+
+    ``outward`` is :func:`~grasptwist.engine.judgements.outward_contacts`'s
+    row, judged against the centre of mass when ``center`` (the grasp gives
+    one), else against the other contacts.  It starts with its code.
+
+    >>> outward_normals_warning([False, False, True], ("east", "west", "south"))[:82]
+    'outward-normals: the normal at contact south points away from the other contacts ('
+    >>> outward_normals_warning([True, True, True], center=True)[:80]
+    'outward-normals: the normals at contacts 1, 2 and 3 point away from the centre o'
+    >>> outward_normals_warning([False] * 3) is None
+    True
+    """
+    which = [name for name, out in zip(names, outward) if out]
+    if not which:
+        return None
+    away = (
+        "the centre of mass (n . (c - p) < 0, c the grasp's center_of_mass)"
+        if center
+        else "the other contacts (n . (p_j - p) < 0: they lie behind the tangent plane)"
+    )
+    if len(which) == 1:
+        return (
+            f"outward-normals: the normal at contact {which[0]} points away from {away}, "
+            "but normals point into the object: flip it, unless that finger pushes outward from inside a hollow"
+        )
+    return (
+        f"outward-normals: the normals at contacts {', '.join(which[:-1])} and {which[-1]} point away from {away}, "
+        "but normals point into the object: flip them, unless the fingers push outward from inside a hollow"
+    )
+
+
+def radians_warning(rotvec, line=None, column=None) -> str:
+    """The warning for a rotation vector over pi (:func:`~grasptwist.engine.judgements.rotation_over_pi`),
+    with where it is written; it starts with its code.
+
+    >>> radians_warning([0, 0, 90], 10, 24)
+    'rotation-over-pi: rotation of 90 (rotvec [0, 0, 90], line 10, column 24) is over pi: rotations are in radians (this one is a turn of 116.6 degrees)'
+    """
+    r = np.asarray(rotvec, dtype=float)
+    angle = float(np.sqrt(r @ r))
+    turn = np.degrees(abs((angle + np.pi) % (2 * np.pi) - np.pi))  # the rotation's own angle, in [0, 180]
+    where = "".join(f", {name} {n}" for name, n in (("line", line), ("column", column)) if n is not None)
+    return (
+        f"rotation-over-pi: rotation of {angle:g} (rotvec [{', '.join(f'{x:g}' for x in r)}]{where}) is over pi: "
+        f"rotations are in radians (this one is a turn of {turn:.1f} degrees)"
+    )

@@ -47,7 +47,9 @@ def joint_positions(hand, values):
     ValueError
         A name that is none of the hand's joints.
 
-    >>> from grasptwist.model import Hand
+    Examples
+    --------
+    >>> from grasptwist.hand import Hand
     >>> joint_positions(Hand((), ("a", "b"), None, None), {"b": 0.5}).tolist()
     [0.0, 0.5]
     """
@@ -87,7 +89,7 @@ def finger_states(hand, positions=None):
 def velocity_limits(finger):
     """A finger's joint velocity limits, NaN for a joint without one: ``(n,)``.
 
-    >>> from grasptwist.model import Finger, Joint
+    >>> from grasptwist.hand import Finger, Joint
     >>> j = [Joint("a", "revolute", 2.0, None, None, None), Joint("b", "revolute", None, None, None, None)]
     >>> velocity_limits(Finger("1", None, tuple(j), None, None, None, 1.0, (0, 1))).tolist()
     [2.0, nan]
@@ -185,7 +187,7 @@ def _limits(finger, which):
 SEGMENT_INTERVALS = 4
 
 
-def track(hand, positions, points, segments, times, steps=16) -> HandTrack:
+def track(hand, positions, points, segments, times, *, steps=16) -> HandTrack:
     """Every finger keeping its tip on its contact while the object follows a path.
 
     Finger ``f`` follows contact ``f`` by :func:`grasptwist.path.track_finger`
@@ -213,12 +215,15 @@ def track(hand, positions, points, segments, times, steps=16) -> HandTrack:
     -------
     HandTrack
 
-    >>> from grasptwist.model import Finger, Hand, Joint, Segment
+    Examples
+    --------
+    >>> from grasptwist.hand import Finger, Hand, Joint
+    >>> from grasptwist.path import Segment
     >>> slides = np.hstack((np.zeros((3, 3)), np.eye(3)))  # a Cartesian finger follows anything
     >>> f = Finger("1", None, tuple(Joint(n, "prismatic", None, None, None, None) for n in "xyz"), slides, np.zeros((3, 3)), None, 1.0, (0, 1, 2))
     >>> h = Hand((f, f, f), ("x", "y", "z"), None, None)
     >>> t = track(h, None, np.eye(3), [Segment(1.0, twist=[0, 0, 0, 0.5, 0, 0])], [0.0, 1.0], steps=1)
-    >>> t.positions[-1].round(12).tolist()
+    >>> (t.positions[-1].round(12) + 0.0).tolist()
     [0.5, 0.0, 0.0]
     """
     q0 = np.zeros(len(hand.joint_names)) if positions is None else np.asarray(positions, dtype=float)

@@ -263,7 +263,7 @@ def _wrap(q, seed, unlimited):
     return np.where(unlimited, q - 2 * np.pi * turns, q)
 
 
-def hand_ik(hand, points, seed=None, *, tips=None, iterations=IK_ITERATIONS) -> HandIK:
+def hand_ik(hand, points, *, seed=None, tips=None, iterations=IK_ITERATIONS) -> HandIK:
     """Joint positions that put every finger's tip point on its contact (module docstring).
 
     Parameters
@@ -284,10 +284,12 @@ def hand_ik(hand, points, seed=None, *, tips=None, iterations=IK_ITERATIONS) -> 
     -------
     HandIK
 
+    Examples
+    --------
     A hand of three 2-link planar fingers (links 1 and 1), each reaching a
     point at distance ``sqrt 2`` (reached) or 3 (beyond its length 2, by 1):
 
-    >>> from grasptwist.model import Finger, Hand, Joint
+    >>> from grasptwist.hand import Finger, Hand, Joint
     >>> s = np.array([[0, 0, 1.0, 0, 0, 0], [0, 0, 1.0, 0, -1.0, 0]])
     >>> joints = (Joint("a", "revolute", None, None, None, None), Joint("b", "revolute", None, None, None, None))
     >>> tip = np.eye(4); tip[0, 3] = 2.0
@@ -400,8 +402,8 @@ def place_hand(hand, points, positions=None, *, seed=None, tips=None) -> HandIK:
     """A batch of hands on their contacts: at given joint positions, checked, or else solved.
 
     With ``positions``, each finger's tip is checked against its contact
-    (:func:`contact_off_finger`: ``contact-off-finger``, the tip error the
-    distance from the tip to the contact); without, they are solved by
+    (``contact-off-finger`` when a contact is farther from its tip than the
+    finger is long; the tip error the distance from the tip to the contact); without, they are solved by
     :func:`hand_ik` from ``seed``.  A finger given inline has no tip point
     unless ``tips`` gives one: it is unchecked (tip error NaN), and a hand
     with such a finger is not solved but taken as given (every joint at 0,
@@ -420,7 +422,9 @@ def place_hand(hand, points, positions=None, *, seed=None, tips=None) -> HandIK:
     -------
     HandIK
 
-    >>> from grasptwist.model import Finger, Hand, Joint
+    Examples
+    --------
+    >>> from grasptwist.hand import Finger, Hand, Joint
     >>> s = np.array([[0, 0, 1.0, 0, 0, 0], [0, 0, 1.0, 0, -1.0, 0]])
     >>> joints = (Joint("a", "revolute", None, None, None, None), Joint("b", "revolute", None, None, None, None))
     >>> tip = np.eye(4); tip[0, 3] = 2.0
@@ -434,7 +438,7 @@ def place_hand(hand, points, positions=None, *, seed=None, tips=None) -> HandIK:
     lead, n = points.shape[:-2], len(hand.joint_names)
     known = [f.tip_pose is not None or tips is not None for f in hand.fingers]
     if positions is None and all(known):
-        return hand_ik(hand, points, seed, tips=tips)
+        return hand_ik(hand, points, seed=seed, tips=tips)
     if positions is None:  # a finger without a tip point: every joint as given
         positions = np.zeros(lead + (n,))
     positions = np.broadcast_to(np.asarray(positions, dtype=float), lead + (n,))

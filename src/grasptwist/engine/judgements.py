@@ -1,6 +1,6 @@
 """Judgements on a resolved twist: which fingers each component moves, and
-whether the twist is a rotation about the wrist; and on a grasp: whether
-its normals look outward.
+whether the twist is a rotation about the wrist; and on a grasp: which of
+its normals look outward; and on a path: whether a rotation looks given in degrees.
 
 These are engine outputs like the amplitudes: pure functions on result
 arrays, batched over any leading shape, whose answers the records carry
@@ -29,7 +29,16 @@ import numpy as np
 from .degeneracy import IN_PLANE_TOL
 from .screws import dot
 
-__all__ = ["ALONE", "ALL_BUT", "active", "off_tangent_moves", "tangent_moves", "about_wrist", "outward_normals"]
+__all__ = [
+    "ALONE",
+    "ALL_BUT",
+    "active",
+    "off_tangent_moves",
+    "tangent_moves",
+    "about_wrist",
+    "outward_contacts",
+    "rotation_over_pi",
+]
 
 #: ``ALONE[i, f]``: the basis screw ``Sigma_i`` moves finger ``f`` (``f == i`` only).
 ALONE = np.eye(3, dtype=bool)
@@ -177,47 +186,97 @@ def about_wrist(x, y, tol=IN_PLANE_TOL):
     return ~moves[..., :3, :].any(axis=(-2, -1)) & moves[..., 3:, :].any(axis=(-2, -1))
 
 
-def outward_normals(points, normals, tol=IN_PLANE_TOL):
-    """Whether every normal points away from the other contacts (outward, on a convex object).
+def outward_contacts(points, normals, center=None, tol=IN_PLANE_TOL):
+    """Which normals point out of the object: away from its centre of mass, or else from the other contacts.
 
-    Grasp files give normals pointing into the object.  On a convex object
-    the other contacts then lie on the inner side of each contact's tangent
-    plane, so a grasp whose three normals all point away from the contacts'
-    centroid ``g`` most likely has them reversed (or the fingers push
-    outward from inside a hollow, the one grasp where that is meant):
+    Grasp files give normals pointing into the object.  Where the centre of
+    mass ``c`` is known it lies inside the object, on the inner side of each
+    contact's tangent plane on a convex object, so contact ``i``'s normal
+    points outward when
 
     .. math::
 
-        \\hat n_i \\cdot \\widehat{(g - p_i)} < -\\mathrm{tol}
-        \\quad \\text{for } i = 1, 2, 3, \\qquad g = \\tfrac13 \\textstyle\\sum_j p_j
+        \\hat n_i \\cdot \\widehat{(c - p_i)} < -\\mathrm{tol}.
 
-    It is a test of the cosine between the two, so the same for a grasp
-    scaled or moved anywhere (lengths from about 1e-150 to 1e150), and
-    normals at right angles to ``g - p_i`` (within ``tol``) do not count as
-    outward.
+    Without it, the other contacts stand in for the object: on a convex
+    object they lie on the inner side of the tangent plane too, so the normal
+    points outward when no other contact lies on its inner side and one lies
+    on its outer side:
+
+    .. math::
+
+        \\max_{j \\ne i} \\hat n_i \\cdot \\widehat{(p_j - p_i)} \\le \\mathrm{tol}, \\qquad
+        \\min_{j \\ne i} \\hat n_i \\cdot \\widehat{(p_j - p_i)} < -\\mathrm{tol}.
+
+    Each is a test of cosines, so the same for a grasp scaled or moved
+    anywhere (lengths from about 1e-150 to 1e150), and directions at right
+    angles within ``tol`` count as neither side.  Fingers pushing outward
+    from inside a hollow (or a handle) are the grasps where an outward
+    normal is meant.
 
     Parameters
     ----------
     points, normals : (..., 3, 3) arrays
         Contacts (contact, xyz) and their normals (any non-zero length).
+    center : (..., 3) array, optional
+        The centre of mass; NaN rows (or None) where there is none.
     tol : float
-        Cosines down to ``-tol`` are round-off.
+        Cosines within ``tol`` of 0 are round-off.
+
+    Returns
+    -------
+    (..., 3) bool
+        False where an input is NaN or a cosine has no direction (a contact at the centre of mass).
+
+    Examples
+    --------
+    Paper Example 1 (normals into the cylinder), then the same with the normal at contact 2 reversed,
+    then judged by a centre of mass below contact 1:
+
+    >>> p = np.array([[1.0, 0, 0], [-0.5, 0.866, 0], [-0.5, -0.866, 0]])
+    >>> outward_contacts(p, -p).tolist(), outward_contacts(p, -p * [[1], [-1], [1]]).tolist()
+    ([False, False, False], [False, True, False])
+    >>> outward_contacts(p, [[0, 0, 1.0], [0, 0, 1], [0, 0, 1]], center=[1.0, 0, -1]).tolist()
+    [True, True, True]
+    """
+    points, normals = np.asarray(points, dtype=float), np.asarray(normals, dtype=float)
+    with np.errstate(all="ignore"):  # NaN input: no verdict; lengths beyond 1e150 overflow to none either
+        n_len = np.sqrt(dot(normals, normals))
+        side = np.roll(points, -1, axis=-2) - points  # side i: p_{i+1} - p_i, so p_{i-1} - p_i is -side (i-1)
+        side_len = np.sqrt(dot(side, side))
+        ahead, behind = dot(normals, side), -dot(normals, np.roll(side, 1, axis=-2))
+        ahead_tol, behind_tol = tol * n_len * side_len, tol * n_len * np.roll(side_len, 1, axis=-1)
+        inside = (ahead > ahead_tol) | (behind > behind_tol)
+        out = ~inside & ((ahead < -ahead_tol) | (behind < -behind_tol))
+        if center is None:
+            return out
+        center = np.asarray(center, dtype=float)[..., None, :]
+        toward = center - points
+        away = dot(normals, toward) < -tol * n_len * np.sqrt(dot(toward, toward))
+    return np.where(np.isnan(center).any(axis=-1), out, away)
+
+
+def rotation_over_pi(rotvec):
+    """Whether a rotation vector turns by more than pi: most likely degrees taken for radians.
+
+    .. math:: \\lvert r \\rvert > \\pi
+
+    A rotation vector ``r`` turns by ``|r|`` radians about ``r``; beyond pi
+    it is the rotation by ``|r| - 2 pi k`` for some ``k``, so a pose target
+    given by it is reached by the shorter turn (``[0, 0, 90]`` turns 116.6
+    degrees).  Nobody writes a half turn and more that way on purpose.
+
+    Parameters
+    ----------
+    rotvec : (..., 3) array
 
     Returns
     -------
     (...) bool
-        False where a contact is at the centroid (its cosine is 0) or an input is NaN.
+        False where the vector is NaN.
 
-    Examples
-    --------
-    Paper Example 1 (normals into the cylinder), then the same reversed:
-
-    >>> p = np.array([[1.0, 0, 0], [-0.5, 0.866, 0], [-0.5, -0.866, 0]])
-    >>> outward_normals(p, -p).item(), outward_normals(p, p).item()
-    (False, True)
+    >>> rotation_over_pi([[0, 0, 90], [0, 0, np.pi], [0, 3, 2]]).tolist()
+    [True, False, True]
     """
-    points, normals = np.asarray(points, dtype=float), np.asarray(normals, dtype=float)
-    toward = points.mean(axis=-2, keepdims=True) - points
-    with np.errstate(all="ignore"):  # NaN input: no verdict; lengths beyond 1e150 overflow to none either
-        lengths = np.sqrt(dot(normals, normals) * dot(toward, toward))
-        return np.all(dot(normals, toward) < -tol * lengths, axis=-1)
+    r = np.asarray(rotvec, dtype=float)
+    return np.sqrt(dot(r, r)) > np.pi

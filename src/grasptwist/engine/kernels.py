@@ -42,7 +42,12 @@ The tangent method is degenerate exactly when some normal lies in the
 contacts' plane (``m . n_i = 0``): a normal line set of rank < 3, a
 ``Theta_i`` that is not unique, and ``[Theta_i|Sigma_i] = 0`` each imply it
 (README, "Degenerate grasps").  So the kernel gates on ``m . n_i`` and then
-names the specific condition.
+names the specific condition: the normal lines' rank < 3 (a grasp-wide
+condition); else exactly one normal in the plane, named (tilting it is the
+cure; ``[Theta_j|Sigma_j] = 0`` follows from it for some ``j``, whose axis
+passes through another contact); else a ``Theta_i`` that is not unique (two
+or three normals in the plane); else ``[Theta_i|Sigma_i]`` within the
+tolerance with every normal just outside it.
 
 Plain floats raise ``ZeroDivisionError`` where numpy returns ``inf`` or
 ``NaN``: that happens only for an exactly degenerate grasp, which the caller
@@ -368,6 +373,14 @@ def tangent(points, normals, twist, ops, tol, bases=True, shared=None):
             None,
             degenerate,
         ),
+        # one normal in the plane is the cause of the two conditions below, and names the contact
+        # whose normal to tilt; they may blame another contact (the one their axis goes through)
+        (
+            Status.NORMAL_IN_CONTACT_PLANE,
+            lambda rows: _just_one(at(plane_sine, rows), tol, ops),
+            lambda rows: ops.argmin3(at(plane_sine, rows)),
+            degenerate,
+        ),
         (
             Status.THETA_NOT_UNIQUE,
             lambda rows: ops.not_(_all_above(uniqueness(rows), tol)),
@@ -384,6 +397,16 @@ def tangent(points, normals, twist, ops, tol, bases=True, shared=None):
         (Status.NONFINITE_INPUT, bad_twist, None, None),
     ]
     return values, checks
+
+
+def _just_one(sines, tol, ops):
+    """Whether exactly one of three sines is ``<= tol`` (NaN counts as ``<= tol``).
+
+    >>> _just_one((0.5, 1e-12, 0.3), 1e-9, FLOATS), _just_one((0.0, 0.0, 0.3), 1e-9, FLOATS)
+    (True, False)
+    """
+    a, b, c = (ops.not_(s > tol) for s in sines)
+    return (a ^ b ^ c) & ops.not_(a & b & c)
 
 
 def _rank_deficient(p, n, size, tol, ops):

@@ -73,7 +73,7 @@ segment, which is negligible.
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, fields, replace
 from typing import NamedTuple
 
 import numpy as np
@@ -94,6 +94,7 @@ __all__ = [
     "check_segments",
     "integrate",
     "follow",
+    "pose_overflowed",
     "degeneracies",
 ]
 
@@ -159,6 +160,9 @@ class FollowResult:
         wrist or when not asked for).
     tangent : TangentResult or None
         The engine's Proposition 2 on every moved grasp (None when not asked for).
+    overflowed : (T..., G...) bool array
+        Where the pose overflows double precision (``pose_overflowed``):
+        both results say ``nonfinite-pose`` there.
     """
 
     poses: Poses
@@ -168,6 +172,7 @@ class FollowResult:
     velocities: np.ndarray
     off_tangent: OffTangentResult | None
     tangent: TangentResult | None
+    overflowed: np.ndarray
 
 
 class Crossing(NamedTuple):
@@ -243,6 +248,8 @@ def check_segments(segments) -> tuple[Segment, ...]:
     ValueError
         Naming the bad field, e.g. ``segments[1].duration``.
 
+    Examples
+    --------
     >>> check_segments([Segment(2.0, twist=[0, 0, 1, 0, 0, 0])])[0].twist.tolist()
     [0.0, 0.0, 1.0, 0.0, 0.0, 0.0]
     >>> check_segments([Segment(0.0, twist=[0, 0, 1, 0, 0, 0])])
@@ -269,16 +276,21 @@ def check_segments(segments) -> tuple[Segment, ...]:
         if s.twist is not None:
             if s.frame not in FRAMES:
                 raise ValueError(f"{where}.frame must be 'space' or 'body', got {s.frame!r}")
-            checked.append(Segment(duration, twist=_finite(s.twist, (6,), f"{where}.twist"), frame=s.frame))
+            checked.append(replace(s, duration=duration, twist=_finite(s.twist, (6,), f"{where}.twist")))
             continue
         if s.position is None or s.rotation is None:
             raise ValueError(f"{where} needs a twist or a pose target (both position and rotation)")
         rotation = _finite(s.rotation, (3, 3), f"{where}.rotation")
         if not (np.abs(rotation.T @ rotation - np.eye(3)).max() <= _ROTATION_TOL and np.linalg.det(rotation) > 0):
             raise ValueError(f"{where}.rotation must be a rotation matrix (orthonormal, determinant +1)")
-        checked.append(Segment(duration, position=_finite(s.position, (3,), f"{where}.position"), rotation=rotation))
+        # replace: what a segment carries besides (the rotation vector it was given by) stays
+        checked.append(
+            replace(s, duration=duration, position=_finite(s.position, (3,), f"{where}.position"), rotation=rotation)
+        )
     if not checked:
         raise ValueError("segments must hold at least one segment")
+    if not math.isfinite(sum(s.duration for s in checked)):
+        raise ValueError("segments' durations add up beyond double precision (1.8e308)")
     return tuple(checked)
 
 
@@ -449,12 +461,61 @@ def follow(points, normals, wrist, segments, times, *, method="both", bases=Fals
         for k in np.unique(segment[rows]):
             these = i + np.flatnonzero(segment[rows] == k)
             flat[2][these] = _carry(rotation[these], at_rest[k], np.empty((len(these),) + grasps + (3, 3)))
+    overflowed = _overflowed(
+        poses, np.concatenate((points, normals), axis=-2), np.concatenate((moved, turned), axis=-2)
+    )
     off = tan = None
     if method != "tangent" and wrist is not None:
-        off = decompose_off_tangent(moved, wrist, twist, bases=bases)
+        off = pose_overflowed(decompose_off_tangent(moved, wrist, twist, bases=bases), overflowed)
     if method != "off-tangent":
         tan = _carried(decompose_tangent(points, normals, body, bases=bases).row(poses.segment), poses, moved, twist)
-    return FollowResult(poses, moved, turned, wrist, velocities, off, tan)
+        tan = pose_overflowed(tan, overflowed)
+    return FollowResult(poses, moved, turned, wrist, velocities, off, tan, overflowed)
+
+
+def _overflowed(poses, rest, moved):
+    """Where a pose overflows: its rotation, position or twist is not finite, or a point
+    finite at rest is not once moved.  ``poses (T...)``, ``rest (G..., n, 3)``,
+    ``moved (T..., G..., n, 3) -> (T..., G...)`` bool."""
+    lead = poses.time.shape
+    pose = np.isfinite(poses.rotation).all(axis=(-2, -1)) & np.isfinite(poses.position).all(axis=-1)
+    pose &= np.isfinite(poses.twist).all(axis=-1)
+    lost = ~np.isfinite(moved).all(axis=(-2, -1)) & np.isfinite(rest).all(axis=(-2, -1))
+    return ~pose.reshape(lead + (1,) * (lost.ndim - len(lead))) | lost
+
+
+def pose_overflowed(result, overflowed):
+    """``result`` (a dataclass of per-row arrays with ``status`` and ``culprit``) with the rows
+    where ``overflowed`` marked ``nonfinite-pose``: no culprit, NaN numbers.
+
+    A pose that overflows double precision (a turn through more than about
+    ``1e154`` radians, a distance beyond ``1e308``) moves the grasp to NaN,
+    and whatever the engine would make of that, or of the grasp at rest
+    carried there, is not a result of the path.
+
+    Parameters
+    ----------
+    result : OffTangentResult, TangentResult or HandRates
+        Rows ``(...)``.
+    overflowed : (...) bool array
+
+    >>> p = [[1, 0, 0], [-0.5, 0.866, 0], [-0.5, -0.866, 0]]
+    >>> r = pose_overflowed(decompose_tangent(p, [[0, 0, 1]] * 3, [[0, 0, 1, 0, 0, 0]] * 2), np.array([False, True]))
+    >>> [Status(s).code for s in r.status], np.isnan(r.alpha).all(axis=-1).tolist()
+    (['ok', 'nonfinite-pose'], [False, True])
+    """
+    if not overflowed.any():
+        return result
+    changed = {
+        "status": np.where(overflowed, np.int8(Status.NONFINITE_POSE), result.status),
+        "culprit": np.where(overflowed, np.int8(-1), result.culprit),
+    }
+    for f in fields(result):
+        value = getattr(result, f.name)
+        if f.name not in changed and isinstance(value, np.ndarray) and value.dtype.kind == "f":
+            where = overflowed.reshape(overflowed.shape + (1,) * (value.ndim - overflowed.ndim))
+            changed[f.name] = np.where(where, np.nan, value)
+    return replace(result, **changed)
 
 
 def _carry(rotation, vectors, out, translation=None):
@@ -525,20 +586,61 @@ def degeneracies(points, normals, wrist, segments, times=None, *, tol=DEGENERACY
     """
     points = _finite_or_any(points, (3, 3), "points")
     normals = _finite_or_any(normals, (3, 3), "normals")
-    plan = _plan(segments)
-    extra = np.empty(0) if times is None else _times(times, plan.end).ravel()
+    whole = _plan(segments)
+    extra = np.empty(0) if times is None else _times(times, whole.end).ravel()
+    # the analysis below is of the stretch where the pose is finite; the rest is nonfinite-pose
+    plan, overflow = _finite_part(whole, points, normals, extra)
+    extra = extra[extra <= plan.end]
     zero = np.zeros(6)
     found = _Found(plan.end)
     found.constant("tangent", decompose_tangent(points, normals, zero, tol=tol, bases=False))
+    methods = ["tangent"]
     if wrist is not None:
+        methods.append("off-tangent")
         wrist = _finite_or_any(wrist, (3,), "wrist")
         start = decompose_off_tangent(points, wrist, zero, tol=tol, bases=False)
-        if start.status in (Status.OK, Status.WRIST_COPLANAR):
+        if start.status in (Status.OK, Status.WRIST_COPLANAR) and plan.end > 0:
             _wrist_crossings(plan, points, wrist, extra, tol, found)
-        else:  # a failure of the contacts alone, the same all along
+        else:  # a failure of the contacts alone, the same all along (or no finite stretch to follow)
             found.constant("off-tangent", start)
+    if overflow is not None:
+        found.crossings += [Crossing(m, Status.NONFINITE_POSE.code, overflow, whole.end, -1) for m in methods]
     crossings = tuple(sorted(found.crossings, key=lambda c: (c.t_start, c.t_end, c.method)))
-    return PathDegeneracies(plan.end, crossings, found.minimum, found.warning)
+    return PathDegeneracies(whole.end, crossings, found.minimum, found.warning)
+
+
+def _finite_part(plan, points, normals, extra):
+    """``(the plan up to the last time its pose is finite, the first time it is not or None)``,
+    the change located between the segments' ends and the times ``extra`` by bisection
+    (a pose overflows once the turn or the distance has grown too large, and stays so)."""
+    rest = np.concatenate((points, normals))
+
+    def overflowed(t):
+        pose = _poses(plan, np.asarray(t, dtype=float))
+        r = pose.rotation[..., None, :, :]
+        moved = np.concatenate((se3.transform(r, pose.position[..., None, :], points), se3.rotate(r, normals)), -2)
+        return _overflowed(pose, rest, moved)
+
+    nodes = np.unique(np.concatenate((plan.start, [plan.end], extra)))
+    bad = overflowed(nodes)
+    if not bad.any():
+        return plan, None
+    first = int(np.argmax(bad))
+    if first == 0:  # already at the start (a pose target's twist overflows)
+        return _until(plan, 0.0), 0.0
+    lo, hi = _bisect(plan, overflowed, nodes[first - 1], nodes[first])
+    return _until(plan, float(lo)), float(hi)
+
+
+def _until(plan, end):
+    """``plan`` cut at time ``end``: the segments that start before it (the first one at
+    least), the last of them shortened to end there."""
+    k = max(1, int(np.searchsorted(plan.start, end, side="left")))
+    duration = plan.duration[:k].copy()
+    duration[-1] = end - plan.start[k - 1]
+    cut = (plan.start, plan.rotation, plan.position, plan.body, plan.space)
+    start, rotation, position, body, space = (a[:k] for a in cut)
+    return _Plan(start, duration, end, rotation, position, body, space)
 
 
 def _finite_or_any(a, shape, name):
@@ -619,20 +721,25 @@ class _Signed:
         return ~(np.abs(self(t)) > self.tol)
 
     def bisect(self, test, lo, hi):
-        """Shrink brackets ``[lo, hi]``, ``test`` False at ``lo`` and True at ``hi``, to ``_PRECISION``
-        of the shorter of their ends' segments; all brackets at once, one engine call per step."""
-        lo, hi = np.array(lo, dtype=float), np.array(hi, dtype=float)
-        eps = _PRECISION * np.minimum(self.plan.duration[self.plan.index(lo)], self.plan.duration[self.plan.index(hi)])
-        for _ in range(int(np.max(np.ceil(np.log2(np.maximum((hi - lo) / eps, 1))), initial=0))):
-            mid = 0.5 * (lo + hi)
-            up = test(mid)
-            lo, hi = np.where(up, lo, mid), np.where(up, mid, hi)
-        return lo, hi
+        """:func:`_bisect` on this path."""
+        return _bisect(self.plan, test, lo, hi)
 
     def root(self, lo, hi, sign_hi):
         """The sign change in each ``[lo, hi]`` (``sign_hi`` the sign at ``hi``), to ``_PRECISION``."""
         a, b = self.bisect(lambda t: np.sign(self(t)) == sign_hi, lo, hi)
         return 0.5 * (a + b)
+
+
+def _bisect(plan, test, lo, hi):
+    """Shrink brackets ``[lo, hi]``, ``test`` False at ``lo`` and True at ``hi``, to ``_PRECISION``
+    of the shorter of their ends' segments; all brackets at once, one engine call per step."""
+    lo, hi = np.array(lo, dtype=float), np.array(hi, dtype=float)
+    eps = _PRECISION * np.minimum(plan.duration[plan.index(lo)], plan.duration[plan.index(hi)])
+    for _ in range(int(np.max(np.ceil(np.log2(np.maximum((hi - lo) / eps, 1))), initial=0))):
+        mid = 0.5 * (lo + hi)
+        up = test(mid)
+        lo, hi = np.where(up, lo, mid), np.where(up, mid, hi)
+    return lo, hi
 
 
 def _wrist_crossings(plan, points, wrist, extra, tol, found):

@@ -43,9 +43,9 @@ class PreparedGrasp:
 
     Attributes
     ----------
-    points, normals, wrist
-        The grasp (read-only; ``wrist`` may be None).
-    off_tangent, tangent
+    points, normals, wrist : (3, 3), (3, 3), (3,) or None
+        The grasp (read-only).
+    off_tangent, tangent : OffTangentResult or None, TangentResult
         The results for the zero twist: the bases, their Klein products,
         the conditioning, status and culprit (``off_tangent`` is None
         without a wrist).
@@ -112,7 +112,7 @@ class PreparedGrasp:
         Returns
         -------
         Resolution
-            What :func:`~grasptwist.engine.decompose.resolve` gives for this
+            What :func:`~grasptwist.resolve` gives for this
             grasp and twist: the same statuses, bases and Klein products,
             and amplitudes and velocities equal but for the last few units
             in the last place (the matrix product adds the same terms in
@@ -215,7 +215,7 @@ def prepare(points, normals, wrist=None, *, tol=DEGENERACY_TOL) -> PreparedGrasp
     -------
     PreparedGrasp
         Its :meth:`~PreparedGrasp.resolve` gives, for any twist, what
-        :func:`~grasptwist.engine.decompose.resolve` gives on this grasp.
+        :func:`~grasptwist.resolve` gives on this grasp.
 
     Examples
     --------
@@ -225,7 +225,7 @@ def prepare(points, normals, wrist=None, *, tol=DEGENERACY_TOL) -> PreparedGrasp
     >>> g = prepare([[0, 2, 2], [2, 0, 2], [2, 2, 0]], np.eye(3))
     >>> np.round(g.resolve([0.57735, 0.57735, 0.57735, 0, 0, 0]).tangent.alpha, 4).tolist()
     [0.5774, 0.5774, 0.5774]
-    >>> g.resolve([0, 0, 0, 0, 0, 1]).tangent.beta.round(4).tolist()
+    >>> (g.resolve([0, 0, 0, 0, 0, 1]).tangent.beta.round(4) + 0.0).tolist()
     [0.0, 0.0, 0.7071]
     >>> flat = prepare([[1, 0, 0], [-0.5, 0.866, 0], [-0.5, -0.866, 0]], np.eye(3), [0, 0, 0])
     >>> Status(int(flat.resolve([0, 0, 1, 0, 0, 0]).off_tangent.status)).code

@@ -97,6 +97,8 @@ def norm(a):
 def unit(a):
     """``a / |a|`` over the last axis; a zero vector gives NaN (no warning).
 
+    ``(..., k) -> (..., k)``.
+
     >>> unit([0.0, 0.0, 2.0]).tolist()
     [0.0, 0.0, 1.0]
     """

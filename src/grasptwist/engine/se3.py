@@ -141,8 +141,8 @@ def inverse(rotation, translation):
     """The inverse pose ``(R^T, -R^T x)``.
 
     >>> r, x = inverse(rotvec_to_matrix([0, 0, np.pi / 2]), [1.0, 0, 0])
-    >>> x.round(12).tolist()
-    [-0.0, 1.0, -0.0]
+    >>> (x.round(12) + 0.0).tolist()  # + 0.0: no round-off sign on zero
+    [0.0, 1.0, 0.0]
     """
     rt = np.swapaxes(_shaped(rotation, (3, 3), "rotation"), -1, -2)
     return rt, -rotate(rt, translation)

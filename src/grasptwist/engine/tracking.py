@@ -103,7 +103,7 @@ def track_finger(
     Parameters
     ----------
     home_screws, home_points, home_tip
-        The finger at home, as :func:`.kinematics.forward_kinematics` takes
+        The finger at home, as :func:`~grasptwist.hand.forward_kinematics` takes
         them (``home_tip`` the tip link's ``(4, 4)`` pose).
     positions : (n,) array
         Joint positions at ``t = 0``, where the tip touches ``contact``.
@@ -137,7 +137,7 @@ def track_finger(
     >>> start = forward_kinematics(screws, [[0, 0, 0], [0, 0, 0], [1.0, 0, 0]], tip, q0).tip[:3, 3]
     >>> track = track_finger(screws, [[0, 0, 0], [0, 0, 0], [1.0, 0, 0]], tip, q0, start,
     ...                      [Segment(1.0, twist=[0, 0, 0, 0.2, 0, 0])], [0.0, 1.0])
-    >>> bool(track.error.max() < 1e-6), track.positions[-1].round(6).tolist()  # elbow: cos q3 = (1.2^2 - 2) / 2
+    >>> bool(track.error.max() < 1e-6), (track.positions[-1].round(6) + 0.0).tolist()  # elbow: cos q3 = (1.2^2 - 2) / 2
     (True, [0.0, -0.927295, 1.85459])
     """
     plan = _plan(segments)

@@ -27,29 +27,24 @@ results as arrays.
 from __future__ import annotations
 
 import os
-import zipfile
 import zlib
 from math import prod
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from ..model import GraspFileError
 from .dataset import Dataset
-from .parquet import open_parquet
+from .limits import MAX_INFLATION, check_inflation
+
+if TYPE_CHECKING:  # zipfile is imported where an .npz is read (see open_dataset)
+    import zipfile
 
 __all__ = ["DATASET_SUFFIXES", "EXTRA_POINT_ROLES", "Dataset", "Member", "open_dataset", "MAX_INFLATION"]
 
 DATASET_SUFFIXES = (".npz", ".npy", ".parquet")
 EXTRA_POINT_ROLES = ("wrist", "at")
 _NPZ_KEYS = ("points", "normals", "wrist", "twist", "names", "joint_positions", "wrench", "friction")
-
-#: An ``.npz`` member may inflate to at most this many times its compressed
-#: size (zlib's own limit is about 1,000; real grasp data compresses 1-10
-#: times) ...
-MAX_INFLATION = 100
-#: ... once it declares more than this many bytes: smaller members (one
-#: twist, repeated names) may compress as much as they like.
-INFLATION_FLOOR = 64 << 20
 
 
 def _bad(path, message) -> GraspFileError:
@@ -66,10 +61,14 @@ def open_dataset(path: str, extra_point: str = "wrist") -> Dataset:
         arrays do not have the documented names, shapes or a numeric type.
     """
     if path.endswith(".parquet"):
+        from .parquet import open_parquet  # only when a Parquet file is read (its docstring)
+
         return open_parquet(path)
+    import zipfile  # only when an .npz is read: it costs every other run's start-up 11 million instructions
+
     try:
         if path.endswith(".npy"):
-            return _open_npy(path, np.load(path, mmap_mode="r", allow_pickle=False), extra_point)
+            return _open_npy(path, _npy(path), extra_point)
         with zipfile.ZipFile(path) as zf:
             members = {}
             for info in zf.infolist():
@@ -82,6 +81,20 @@ def open_dataset(path: str, extra_point: str = "wrist") -> Dataset:
     # zipfile: RuntimeError for an encrypted member, NotImplementedError for an unknown compression
     except (OSError, ValueError, EOFError, zipfile.BadZipFile, NotImplementedError, RuntimeError) as exc:
         raise GraspFileError(code="read-error", message=f"cannot read as a numpy file: {exc}", file=path) from None
+
+
+_NPY_MAGIC = b"\x93NUMPY"
+
+
+def _npy(path):
+    """The array of a ``.npy`` file, memory-mapped; anything else (numpy would open an ``.npz``
+    named ``.npy`` as an archive) is ``bad-dataset``."""
+    with open(path, "rb") as f:
+        start = f.read(len(_NPY_MAGIC))
+    if start != _NPY_MAGIC:
+        hint = " (it is a zip archive: an .npz named .npy?)" if start.startswith(b"PK") else ""
+        raise _bad(path, f"not a .npy file: it does not start with numpy's {_NPY_MAGIC!r}{hint}")
+    return np.load(path, mmap_mode="r", allow_pickle=False)
 
 
 def _numeric(path, name, a, tail):
@@ -180,12 +193,10 @@ class Member:
             times, when its header's shape and type do not match its size, or
             when it holds Python objects or is stored column-major.
         """
-        if info.file_size > INFLATION_FLOOR and info.file_size > MAX_INFLATION * info.compress_size:
-            raise _bad(
-                path,
-                f"{key}: declares {info.file_size:,} bytes in {info.compress_size:,} compressed "
-                f"(over {MAX_INFLATION} times): refused unread, as a likely zip bomb",
-            )
+        try:
+            check_inflation(info.file_size, info.compress_size, "zip bomb")
+        except ValueError as exc:
+            raise _bad(path, f"{key}: {exc}") from None
         with zf.open(info) as f:
             version = np.lib.format.read_magic(f)
             read_header = (
@@ -213,6 +224,8 @@ class Member:
         start, stop, _ = rows.indices(len(self))
         stop = max(start, stop)
         row = prod(self.shape[1:]) * self.dtype.itemsize
+        import zipfile  # loaded by open_dataset already
+
         try:
             f = self._file()
             f.seek(self.offset + start * row)
@@ -225,10 +238,14 @@ class Member:
         return np.frombuffer(data, self.dtype).reshape((stop - start, *self.shape[1:]))
 
     def __array__(self, dtype=None, copy=None):
-        """Every row: only for the members a run reads whole, one ``twist (6,)``."""
-        return self[:] if dtype is None else self[:].astype(dtype)
+        """Every row: only for the members a run reads whole, one ``twist (6,)`` or ``friction ()``."""
+        # a 0-d member (one value for every row) is read as one row of its own shape
+        whole = self[:] if self.shape else Member(self.path, self.name, (1,), self.dtype, self.offset)[:].reshape(())
+        return whole if dtype is None else whole.astype(dtype)
 
     def _file(self):
+        import zipfile  # loaded by open_dataset already
+
         pid = os.getpid()
         if self._open is None or self._open[0] != pid:
             zf = zipfile.ZipFile(self.path)

@@ -1,8 +1,12 @@
-"""The grasp loader's import path in grasptwist 0.1 and 0.2 (``from grasptwist.io.grasp_file import read_grasps``), kept so that scripts written for them go on working.
+"""The grasp loader's import path in grasptwist 0.1 and 0.2 (``from grasptwist.io.grasp_file import read_grasps``).
 
-A facade: it only re-exports the public API of :mod:`grasptwist.io.grasp`,
-where the loader lives; nothing inside grasptwist imports it.
+Deprecated since 0.4: importing it warns.  The loader's public names are in the
+core, ``import grasptwist as gt``: ``gt.read_grasps``, ``gt.load_grasps``,
+``gt.read_line``, ``gt.read_twist_line``, ``gt.grasp_schema``, ``gt.Grasp``,
+``gt.Twist``, ``gt.GraspFileError``.  Nothing inside grasptwist imports this module.
 """
+
+import warnings
 
 from .grasp import (
     DEFAULT_MAX_BYTES,
@@ -37,3 +41,10 @@ __all__ = [
     "load_grasps",
     "grasp_schema",
 ]
+
+warnings.warn(
+    "grasptwist.io.grasp_file is deprecated since 0.4: use grasptwist's own names, "
+    "e.g. `import grasptwist as gt; gt.load_grasps(...)` (gt.read_grasps, gt.GraspFileError, ...)",
+    DeprecationWarning,
+    stacklevel=2,
+)

@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import errno
 import os
-import sys
 from collections.abc import Iterable, Iterator
 
 from ..model import Grasp, GraspFileError
@@ -127,9 +126,6 @@ def read(path: str, max_bytes: int | None = None) -> list[Grasp | GraspFileError
     """The grasps (or errors: one per failed document, every problem in its ``problems``)
     of one file; ``-`` reads standard input."""
     cap = DEFAULT_MAX_BYTES if max_bytes is None else max_bytes
-    if path == STDIN:
-        # one byte past the cap is enough for the loader to refuse it
-        return one_per_document(read_grasps(sys.stdin.buffer.read(cap + 1), file="<stdin>", max_bytes=cap))
     return one_per_document(read_grasps(path, max_bytes=cap))
 
 

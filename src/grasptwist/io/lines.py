@@ -19,11 +19,11 @@ from __future__ import annotations
 
 import os
 import stat
-import sys
 from collections.abc import Iterator
 
 from ..model import Grasp, GraspFileError, Twist
 from .grasp import one_per_document, read_grasps, read_line, read_twist_line
+from .grasp.text import standard_input
 from .inputs import STDIN
 from .limits import DEFAULT_MAX_BYTES, NOT_REGULAR
 
@@ -59,13 +59,21 @@ def numbered_batches(handle, max_bytes: int, per_batch: int, head: bytes = b"") 
     >>> list(numbered_batches(io.BytesIO(b'{"a": 1}\\n\\n[1, 2]\\n' + b"x" * 9), 8, 64))
     [[(1, b'{"a": 1}'), (3, b'[1, 2]'), (4, b'xxxxxxxxx')]]
     """
-    number, pending, skipping = 0, b"", False
+    # The line not yet ended is held as the pieces it came in and joined once, when it ends:
+    # adding each piece to the bytes so far would copy a long line once per piece (quadratic).
+    number, held, size, skipping = 0, [], 0, False
     chunk, ended = head, False
     while True:
-        *lines, pending = (pending + chunk).split(b"\n")
-        if ended and pending:
-            lines.append(pending)
-            pending = b""
+        *lines, rest = chunk.split(b"\n")
+        if lines:
+            lines[0] = b"".join((*held, lines[0]))
+            held, size = [], 0
+        if rest:
+            held.append(rest)
+            size += len(rest)
+        if ended and held:
+            lines.append(b"".join(held))
+            held, size = [], 0
         batch = []
         for line in lines:
             if skipping:  # the end of a line already refused
@@ -74,12 +82,12 @@ def numbered_batches(handle, max_bytes: int, per_batch: int, head: bytes = b"") 
             number += 1
             if line.strip():
                 batch.append((number, line[: max_bytes + 1]))
-        if not skipping and len(pending) > max_bytes:
+        if not skipping and size > max_bytes:
             number += 1
-            batch.append((number, pending[: max_bytes + 1]))
+            batch.append((number, b"".join(held)[: max_bytes + 1]))
             skipping = True
         if skipping:
-            pending = b""
+            held, size = [], 0
         for start in range(0, len(batch), per_batch):
             yield batch[start : start + per_batch]
         if ended:
@@ -90,17 +98,22 @@ def numbered_batches(handle, max_bytes: int, per_batch: int, head: bytes = b"") 
 
 def _sniff(handle, max_bytes: int) -> tuple[bool, bytes]:
     """Whether ``handle`` holds JSON Lines (its first non-blank character is ``{``),
-    and the bytes read to tell."""
-    head = b""
+    and the bytes read to tell (each looked at once, however many blank ones come first)."""
+    head, blank = bytearray(), 0  # head[:blank] is known to be a BOM and blanks
     while len(head) <= max_bytes:
         chunk = handle.read1(_CHUNK)
         if not chunk:
             break
         head += chunk
-        text = head.removeprefix(_BOM).lstrip()
+        if not blank:
+            if len(head) < len(_BOM) and _BOM.startswith(head):  # the rest of a BOM may follow
+                continue
+            blank = len(_BOM) if head.startswith(_BOM) else 0
+        text = head[blank:].lstrip()
         if text:
-            return text[:1] == b"{", head
-    return False, head
+            return text[:1] == b"{", bytes(head)
+        blank = len(head)
+    return False, bytes(head)
 
 
 def _opened(path: str):
@@ -141,7 +154,7 @@ def _stream(path, max_bytes, per_batch, read, sniff):
     cap = DEFAULT_MAX_BYTES if max_bytes is None else max_bytes
     file = "<stdin>" if path == STDIN else path
     try:
-        handle = sys.stdin.buffer if path == STDIN else _opened(path)
+        handle = standard_input() if path == STDIN else _opened(path)
     except OSError as exc:
         yield [GraspFileError("read-error", f"cannot read: {exc.strerror or exc}", file)]
         return

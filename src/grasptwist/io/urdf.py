@@ -277,7 +277,7 @@ def load_urdf_hand(urdf, tips, *, names=None, folder=None, max_bytes=DEFAULT_MAX
     Parameters
     ----------
     urdf : str or os.PathLike
-        ``package://PKG/path`` or a path (see :func:`resolve_urdf`).
+        ``package://PKG/path`` (``PKG`` an installed Python package) or a path.
     tips : sequence of str
         The link touching each contact, in contact order.
     names : sequence of str, optional
@@ -293,9 +293,11 @@ def load_urdf_hand(urdf, tips, *, names=None, folder=None, max_bytes=DEFAULT_MAX
 
     Raises
     ------
-    InputError
-        With one of the codes in this module's table.
+    GraspFileError
+        With one of the codes of the URDF's errors (docs/guide/hands.md).
 
+    Examples
+    --------
     >>> hand = load_urdf_hand("package://robot_properties_fingers/urdf/pro/trifingerpro.urdf",
     ...                       ["finger_tip_link_0", "finger_tip_link_120", "finger_tip_link_240"])
     >>> hand.root, len(hand.joint_names), [j.name for j in hand.fingers[0].joints]  # doctest: +NORMALIZE_WHITESPACE

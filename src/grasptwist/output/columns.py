@@ -22,7 +22,6 @@ from typing import Any
 import numpy as np
 
 from ..engine.degeneracy import Status, status_message
-from ..engine.forces.grasp_map import ForceStatus, force_status_message
 from ..results import CULPRIT, KINDS, STATUS, Column
 
 __all__ = [
@@ -323,6 +322,8 @@ FORCE_CSV_COLUMNS = [name for c, _ in FORCE_COLUMNS for name in c.flat]
 
 def grip_errors(block) -> np.ndarray:
     """``code: message`` where the grip failed, or the manipulating forces did (the contacts' degeneracy)."""
+    from ..engine.forces.grasp_map import ForceStatus, force_status_message  # with the first force run
+
     r = block.result
     texts = np.full(len(block), "", dtype=object)
     for i in np.flatnonzero((r.manipulating_status > 0) | (r.grip_status > 0)):

@@ -21,7 +21,7 @@ from ..engine.degeneracy import CONDITION_WARNING, Status, status_message
 from ..engine.forces.grasp_map import ForceStatus
 from ..engine.se3 import matrix_to_quaternion
 from ..results import KINDS
-from .columns import CSV_COLUMNS, arrays, columns, header
+from .columns import CSV_COLUMNS, ColumnSet, arrays, columns, header
 from .csv_rows import lines
 from .force_records import GRIP_FIELDS
 from .force_records import _error as grip_error  # the forces record's error object, shared
@@ -29,6 +29,7 @@ from .names import escaped
 from .records import dumps, records
 
 __all__ = [
+    "PATH_COLUMNS",
     "ENCODINGS",
     "Encoding",
     "sample_records",
@@ -130,11 +131,12 @@ def _finger_positions(hand, positions) -> list[list[float]]:
     return [(positions[list(f.joint_index)] + 0.0).tolist() for f in hand.fingers]
 
 
-def hand_summary(grasp, tracked) -> dict:
+def hand_summary(grasp, tracked, tip_error) -> dict:
     """The ``hand`` object of a path's summary: the first time a joint leaves its position
-    limits, and per finger its own first events and largest tip error (README "Paths")."""
+    limits, and per finger its own first events and ``tip_error``, its largest at the samples
+    (the samples' records give each: a summary that says less than they do would hide it)."""
     fingers, first = [], None
-    for finger, track in zip(grasp.hand.fingers, tracked.fingers):
+    for finger, track, error in zip(grasp.hand.fingers, tracked.fingers, tip_error.tolist()):
         exit_ = None
         if track.limit_exit is not None:
             t, j = track.limit_exit
@@ -147,7 +149,7 @@ def hand_summary(grasp, tracked) -> dict:
                 "joint_limit": exit_,
                 "rank_loss": track.rank_loss,
                 "first_warning": track.warning,
-                "tip_error": float(track.error.max()),
+                "tip_error": error,
             }
         )
     return {"joint_limit": first, "fingers": fingers}
@@ -196,7 +198,7 @@ def summary_record(summary) -> dict:
         ]
         ok = ok and not summary.cannot_hold  # the object falls
     if summary.hand is not None:
-        out["hand"] = hand_summary(summary.grasp, summary.hand)
+        out["hand"] = hand_summary(summary.grasp, summary.hand, summary.tip_error)
         # a joint out of its limits, or a finger that cannot follow, stops the motion too
         ok = ok and out["hand"]["joint_limit"] is None and all(f["rank_loss"] is None for f in out["hand"]["fingers"])
     return {
@@ -204,6 +206,7 @@ def summary_record(summary) -> dict:
         "grasp": escaped(summary.grasp.name, controls=False),
         "path": escaped(summary.path, controls=False),
         "summary": out,
+        "warnings": list(summary.warnings),
         "ok": ok,
     }
 
@@ -262,6 +265,7 @@ def diagnostics(rec: dict, names=("1", "2", "3")) -> tuple[list[str], list[str]]
         warnings.append(
             f"{where}: warning: {w['method']}: conditioning below {CONDITION_WARNING:g} from t = {w['t']:.6g}"
         )
+    warnings += [f"{where}: warning: {w}" for w in rec.get("warnings", ())]
     errors += [f"{where}: error: {hold_text(c, 6)}" for c in s.get("cannot_hold", ())]
     if "hand" in s:
         hand_errors, hand_warnings = hand_event_texts(s["hand"], names, 6)
@@ -345,3 +349,13 @@ def encodings(hand=None) -> dict:
 
 #: :func:`encodings` of a run without a hand.
 ENCODINGS = encodings()
+
+
+#: The path family's columns (``follow`` samples: the path's own, then resolve's; no Parquet).
+PATH_COLUMNS = ColumnSet(
+    header=csv_header,
+    flat=sample_columns,
+    arrays=sample_arrays,
+    error_row=csv_error_row,
+    statuses=Status,
+)

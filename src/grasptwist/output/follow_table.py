@@ -14,6 +14,7 @@ from typing import IO
 
 from .follow_records import crossing_text, hand_event_texts, hold_text
 from .names import escaped
+from .numbers import fmt_figure, fmt_number
 
 __all__ = ["FollowTable"]
 
@@ -32,7 +33,7 @@ class FollowTable:
         self.names = ("1", "2", "3")  # its contacts' names
 
     def _number(self, v) -> str:
-        return "-" if v is None else f"{v:{self.width}.{self.digits}f}"
+        return "-" if v is None else f"{fmt_number(v, self.digits):>{self.width}}"
 
     def _vector(self, v) -> str:
         return " ".join(self._number(float(a)) for a in v)
@@ -93,9 +94,9 @@ class FollowTable:
         for f in hand["fingers"]:
             if "joint_positions" not in f:
                 continue
-            error = "-" if f["tip_error"] is None else f"{f['tip_error']:.3g}"
+            error = fmt_figure(f["tip_error"])
             limits = "" if f["within_limits"] else " (outside its limits)"
-            q = " ".join(f"{v:.{self.digits}f}" for v in f["joint_positions"])
+            q = " ".join(fmt_number(v, self.digits) for v in f["joint_positions"])
             parts.append(f"finger {escaped(f['contact'])}: q {q}{limits}, tip error {error}")
         if parts:
             self._line(f"{'':>{self.width}}  hand  " + "; ".join(parts))
@@ -108,7 +109,7 @@ class FollowTable:
         if not s["degenerate"]:
             self._line("  no degeneracy along the path")
         smallest = [
-            f"{key.replace('_', '-')} {m['value']:.{self.digits}g} at t = {m['t']:.{self.digits}f}"
+            f"{key.replace('_', '-')} {fmt_figure(m['value'], self.digits)} at t = {fmt_number(m['t'], self.digits)}"
             for key, m in s["min_conditioning"].items()
             if m is not None and m["value"] == m["value"]  # a failed method may have none (NaN)
         ]

@@ -11,15 +11,19 @@ from __future__ import annotations
 import numpy as np
 
 from ..engine.forces.grasp_map import ForceStatus, force_status_message
+from ..engine.forces.grip import load_words
+from .columns import ColumnSet, force_arrays, force_columns, force_typed_header
+from .csv_rows import FORCE_HEADER, force_error_row
 from .names import escaped, escaped_each
+from .records import outward_warning
 
-__all__ = ["force_records", "GRIP_FIELDS", "CLOSURE_FIELDS", "NO_FRICTION_WARNING"]
+__all__ = ["WRENCH_COLUMNS", "force_records", "GRIP_FIELDS", "CLOSURE_FIELDS", "NO_FRICTION_WARNING"]
 
-#: The grip object's numbers, in order (then ``safety``).
+#: The grip object's numbers, in order (then ``safety``, ``dual`` and ``gap``: its certificate).
 GRIP_FIELDS = ("force", "squeeze", "normal_force", "tangential_force", "friction_used", "total_normal_force")
 
-#: The closure object's fields.
-CLOSURE_FIELDS = ("force_closure", "closure_friction", "epsilon")
+#: The closure object's fields (``force_closure`` and ``epsilon`` judged with ``mu / safety``).
+CLOSURE_FIELDS = ("force_closure", "closure_friction", "epsilon", "safety")
 
 NO_FRICTION_WARNING = "grip skipped: the grasp has no friction (give 'friction:' in the file or --friction MU)"
 
@@ -37,6 +41,15 @@ def _error(status, culprit):
     return {"error": {"code": s.code, "message": message.removeprefix(f"{s.code}: ")}}
 
 
+def _grip_error(status, culprit, certificate, points):
+    """The grip's error object; with a Farkas ``certificate`` (where one exists) in numbers and in words."""
+    rec = _error(status, culprit)
+    if certificate is not None:
+        rec["error"]["message"] += f"; it {load_words(certificate, points)}"
+        rec["error"]["certificate"] = certificate
+    return rec
+
+
 def _number(x):
     return None if x != x else x  # NaN -> null
 
@@ -47,13 +60,15 @@ def force_records(block) -> list[dict]:
     has_wrench, has_friction = block.has_wrench.tolist(), block.has_friction.tolist()
     points, normals, wrench, friction = (_lists(a) for a in (block.points, block.normals, block.wrench, block.friction))
     manipulating = _lists(r.manipulating)
-    grip = {name: _lists(getattr(r, name)) for name in GRIP_FIELDS}
+    grip = {name: _lists(getattr(r, name)) for name in GRIP_FIELDS + ("dual", "gap")}
+    certificate = [None if c[0] != c[0] else c for c in _lists(r.certificate)]
     closure_friction, epsilon = r.closure_friction.tolist(), r.epsilon.tolist()
     force_closure = r.force_closure.tolist()
+    outward = block.outward().any(axis=-1).tolist()
     out = []
     for i in range(len(block)):
         names = escaped_each(block.contact_names[i])
-        warnings = []
+        warnings = [outward_warning(block, i)] if outward[i] else []
         rec = {
             "file": escaped(block.file[i], controls=False),
             "grasp": escaped(block.grasp[i], controls=False),
@@ -76,14 +91,18 @@ def force_records(block) -> list[dict]:
             rec["grip"] = None
             warnings.append(NO_FRICTION_WARNING)
         elif r.grip_status[i]:
-            rec["grip"] = _error(r.grip_status[i], r.grip_culprit[i])
+            rec["grip"] = _grip_error(r.grip_status[i], r.grip_culprit[i], certificate[i], points[i])
         else:
             rec["grip"] = {name: grip[name][i] for name in GRIP_FIELDS}
+            if rec["grip"]["squeeze"][0] != rec["grip"]["squeeze"][0]:  # collinear contacts: no three squeezes
+                rec["grip"]["squeeze"] = None
             rec["grip"]["safety"] = r.safety
+            rec["grip"]["dual"], rec["grip"]["gap"] = grip["dual"][i], grip["gap"][i]
         rec["closure"] = {
             "force_closure": force_closure[i] if has_friction[i] else None,
             "closure_friction": _number(closure_friction[i]),
             "epsilon": _number(epsilon[i]),
+            "safety": r.safety,
         }
         status = ForceStatus(int(r.closure_status[i]))
         if status not in (ForceStatus.OK, ForceStatus.NO_CLOSURE):
@@ -92,3 +111,15 @@ def force_records(block) -> list[dict]:
         rec["ok"] = not any(isinstance(rec[k], dict) and "error" in rec[k] for k in ("manipulating", "grip"))
         out.append(rec)
     return out
+
+
+#: The wrench family's columns (``forces`` rows): no joints; npz's tables of names only where there are names.
+WRENCH_COLUMNS = ColumnSet(
+    header=lambda hand=None: FORCE_HEADER,
+    flat=lambda block, order="omega-v", hand=None, typed=False: force_columns(block, typed),
+    arrays=lambda block, order="omega-v", hand=None: force_arrays(block),
+    error_row=lambda rec, hand=None: force_error_row(rec),
+    statuses=ForceStatus,
+    typed_header=lambda hand=None: force_typed_header(),
+    name_tables=False,
+)

@@ -13,7 +13,7 @@ run's job, never from the command's name:
   ``job.command.talking(block, job)`` the records with something for stderr;
 * ``job.command.table``: its table writer, ``"module.Class"`` in this package,
   and ``job.command.contributions``: the columns other families add to it;
-* ``job.family.columns``: its :class:`~grasptwist.output.columns.ColumnSet`;
+* ``job.family.columns()``: its :class:`~grasptwist.output.columns.ColumnSet`;
 * ``job.order``, ``job.hand``: the screw order and the run's hand.
 """
 
@@ -80,19 +80,19 @@ def _table(out: IO[bytes], job, order: str = "omega-v", **table_options):
 
 
 def _csv(out: IO[bytes], job, **_):
-    return Lines(out, header=job.family.columns.header(job.hand), newline=b"")
+    return Lines(out, header=job.family.columns().header(job.hand), newline=b"")
 
 
 def _npz(out: IO[bytes], job, order: str = "omega-v", **_):
     from .npz import NpzWriter
 
-    return NpzWriter(out, order, hand=job.hand, columns=job.family.columns)
+    return NpzWriter(out, order, hand=job.hand, columns=job.family.columns())
 
 
 def _parquet(out: IO[bytes], job, order: str = "omega-v", **_):
     from .parquet_writer import ParquetWriter  # pyarrow only when Parquet is asked for
 
-    return ParquetWriter(out, order, hand=job.hand, columns=job.family.columns)
+    return ParquetWriter(out, order, hand=job.hand, columns=job.family.columns())
 
 
 def json_rows(block, job) -> tuple[list[bytes], list[dict]]:
@@ -105,7 +105,7 @@ def json_rows(block, job) -> tuple[list[bytes], list[dict]]:
 
 def csv_lines(block, job) -> tuple[list[bytes], list[dict]]:
     """The CSV line of each row (the family's columns), and the records with something to say."""
-    return csv_rows.lines(job.family.columns.flat(block, job.order, job.hand)), job.command.talking(block, job)
+    return csv_rows.lines(job.family.columns().flat(block, job.order, job.hand)), job.command.talking(block, job)
 
 
 def _json_error(rec, job):
@@ -113,7 +113,7 @@ def _json_error(rec, job):
 
 
 def _csv_error(rec, job):
-    return job.family.columns.error_row(rec, job.hand)
+    return job.family.columns().error_row(rec, job.hand)
 
 
 #: Every output format by name, in the order ``--help`` lists them.

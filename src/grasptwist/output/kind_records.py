@@ -11,6 +11,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..engine.degeneracy import CONDITION_WARNING, Status, status_message
+from .numbers import fmt_figure
 
 __all__ = ["hand_objects"]
 
@@ -74,7 +75,7 @@ def hand_objects(block, order, warnings):
             )
             if conditioning < CONDITION_WARNING and r.status[i] == Status.OK:
                 warnings[i].append(
-                    f"hand: finger {names[f]} is near a singularity (conditioning {conditioning:.3g} < "
+                    f"hand: finger {names[f]} is near a singularity (conditioning {fmt_figure(conditioning)} < "
                     f"{CONDITION_WARNING:g}): its joint rates are large and sensitive"
                 )
         obj = {"fingers": fingers, "velocity_limit_ratio": _number(r.velocity_limit_ratio[i]), "ok": bool(r.ok[i])}

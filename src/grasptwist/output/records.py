@@ -17,9 +17,9 @@ import orjson
 
 from ..engine.degeneracy import (
     CONDITION_WARNING,
-    OUTWARD_NORMALS_WARNING,
     Status,
     conditioning_warning,
+    outward_normals_warning,
     skipped_warning,
     status_message,
 )
@@ -32,6 +32,7 @@ from .names import escaped, escaped_each
 __all__ = [
     "ORDERS",
     "records",
+    "outward_warning",
     "basis_record",
     "check_record",
     "error_record",
@@ -52,7 +53,9 @@ def records(block, order: str = "omega-v") -> list[dict]:
     views of contiguous rows, which orjson writes without making a Python
     float of each.  Consumers that need lists call ``.tolist()``.
     """
-    warnings = [[OUTWARD_NORMALS_WARNING] if out else [] for out in block.outward().tolist()]
+    warnings = [[] for _ in range(len(block))]
+    for i in np.flatnonzero(block.outward().any(axis=-1)):
+        warnings[i].append(outward_warning(block, i))
     objects = [(k.key, _kind_rows(block, k, order, warnings)) for k in block.kinds() if k.record is None]
     written = [(k.key, _written(k)(block, order, warnings)) for k in block.kinds() if k.record is not None]
     ok = (~block.failed_rows()).tolist()
@@ -97,6 +100,14 @@ def records(block, order: str = "omega-v") -> list[dict]:
         rec["ok"] = ok[i]
         out.append(rec)
     return out
+
+
+def outward_warning(block, i: int) -> str | None:
+    """Row ``i``'s warning naming the contacts whose normals point out of the object
+    (:meth:`~grasptwist.run.batch.Block.outward`), or None; a :class:`~grasptwist.run.forces.ForceBlock`
+    does too."""
+    center = block.center_of_mass is not None and not np.isnan(block.center_of_mass[i]).any()
+    return outward_normals_warning(block.outward()[i].tolist(), escaped_each(block.contact_names[i]), center)
 
 
 def _contact_names(block) -> list:
@@ -176,7 +187,7 @@ def _kind_rows(block, kind, order, warnings):
 
 def talking_rows(block) -> np.ndarray:
     """Rows whose record has something for stderr: a failed or skipped kind, or a warning."""
-    talk = block.outward().copy()
+    talk = block.outward().any(axis=-1)
     for kind in block.kinds():
         ok = block.value(kind.key, STATUS) == Status.OK
         applies = block.applies(kind.key)
@@ -213,8 +224,8 @@ def _row_objects(block, i, fields_of, order, warnings, with_failure=()):
     """Row ``i``'s object of every kind computed, from the fields ``fields_of(kind)``;
     a failed kind's object is its error plus the fields ``with_failure(kind)``."""
     out = {}
-    if block.outward()[i]:
-        warnings.append(OUTWARD_NORMALS_WARNING)
+    if block.outward()[i].any():
+        warnings.append(outward_warning(block, i))
     for kind in block.kinds():
         key = kind.key
         if kind.record is not None:  # a resolve-only kind (a hand's joint rates)

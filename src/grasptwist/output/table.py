@@ -1,8 +1,8 @@
 """Tables for people, laid out as plain lines from output records.
 
 Imported only when a table is asked for, so that machine formats never pay
-for rich's import.  Numbers are rounded to ``digits`` decimals here and only
-here; records keep full precision.  Each result kind has a renderer class
+for rich's import.  Numbers are rounded by :mod:`.numbers` (``digits`` decimals; no digits
+below the noise); records keep full precision.  Each result kind has a renderer class
 (named by its registry entry's ``table``) giving its extra contact columns,
 its ``resolve`` table, its verdict sentences and its ``basis`` tables; the
 verdicts only print what the records say (``moves``, ``about_wrist``,
@@ -24,7 +24,6 @@ columns, each repeating the first column, so that no vector is ever cut.
 from __future__ import annotations
 
 import contextlib
-import functools
 import io
 import os
 import textwrap
@@ -39,6 +38,7 @@ from rich.text import Text
 from ..engine.degeneracy import CONDITION_WARNING
 from ..results import KINDS
 from .names import escaped
+from .numbers import fmt_figure, fmt_number, fmt_vector
 
 __all__ = [
     "TableWriter",
@@ -51,8 +51,6 @@ __all__ = [
     "Grid",
     "console",
     "output_width",
-    "fmt_number",
-    "fmt_vector",
 ]
 
 
@@ -100,40 +98,6 @@ def output_width(out: IO, width: int | None = None) -> int | None:
         return os.get_terminal_size(out.fileno()).columns or None if out.isatty() else None
     except (AttributeError, OSError, ValueError):  # not a real file (tests' buffers)
         return None
-
-
-def fmt_number(v, digits: int) -> str:
-    """``v`` with ``digits`` decimals; no ``-0``; ``-`` for a missing value.
-
-    >>> fmt_number(-0.00001, 4), fmt_number(2.5, 0), fmt_number(None, 3)
-    ('0.0000', '2', '-')
-    """
-    if v is None:
-        return "-"
-    s = f"{v:.{digits}f}"
-    return s[1:] if s[0] == "-" and not s.strip("-0.") else s
-
-
-def fmt_vector(v, digits: int) -> str:
-    """A 3-vector as ``(a, b, c)`` or a screw as ``(a, b, c; d, e, f)``; no ``-0``.
-
-    >>> fmt_vector([1, 0, -0.00001, 0, -0.5, 2], 1)
-    '(1.0, 0.0, 0.0; 0.0, -0.5, 2.0)'
-    """
-    v = tuple(v)
-    form, negative_zero, zero = _vector_format(digits, len(v))
-    return (form % v).replace(negative_zero, zero)
-
-
-@functools.cache
-def _vector_format(digits: int, n: int) -> tuple[str, str, str]:
-    """The %-format of an ``n``-vector (a screw's halves split by ``;``), and
-    zero printed with and without a sign: with exactly ``digits`` decimals,
-    ``-0.00`` in a vector can only be a whole number, a negative zero."""
-    number = f"%.{digits}f"
-    form = f"({', '.join([number] * 3)}; {', '.join([number] * 3)})" if n == 6 else f"({', '.join([number] * n)})"
-    zero = number % 0.0
-    return form, "-" + zero, zero
 
 
 class Grid:
@@ -437,7 +401,7 @@ def _products(title, names, table, d, conditioning) -> list:
     t = _table("", *names, numbers=names)
     for i, n in enumerate(names):
         t.add_row(n, *(fmt_number(v, d) for v in table[i]))
-    return [Text(f"{title}   conditioning {conditioning:.3g}", style="bold"), t]
+    return [Text(f"{title}   conditioning {fmt_figure(conditioning)}", style="bold"), t]
 
 
 def _screws(names, d, *columns):
@@ -463,7 +427,7 @@ class OffTangentTable:
         t = _table(
             "i", "x_i", "y_i", "Sigma_i (moves finger i only)", "Psi_i (keeps finger i fixed)", numbers=("x_i", "y_i")
         )
-        t.title = Text(f"off-tangent (Proposition 1)   conditioning {m['conditioning']:.3g}", style="bold")
+        t.title = Text(f"off-tangent (Proposition 1)   conditioning {fmt_figure(m['conditioning'])}", style="bold")
         for i, n in enumerate(names):
             t.add_row(
                 n,
@@ -519,7 +483,9 @@ class TangentTable:
         t = _table(
             "i", "alpha_i", "beta_i", "Theta_i (keeps finger i fixed, others slide)", numbers=("alpha_i", "beta_i")
         )
-        t.title = Text(f"tangent (Proposition 2 + off-plane rest)   conditioning {m['conditioning']:.3g}", style="bold")
+        t.title = Text(
+            f"tangent (Proposition 2 + off-plane rest)   conditioning {fmt_figure(m['conditioning'])}", style="bold"
+        )
         for i, n in enumerate(names):
             t.add_row(n, fmt_number(m["alpha"][i], d), fmt_number(m["beta"][i], d), fmt_vector(m["theta"][i], d))
         return t
@@ -618,7 +584,7 @@ def closure_cell(rec):
     if "closure_friction" not in rec:
         return Text("-", style="dim")
     least = rec["closure_friction"]
-    text = "none" if least is None else f"{least:.3g}"
+    text = "none" if least is None else fmt_figure(least)
     if "force_closure" in rec:
         text += " closed" if rec["force_closure"] else " open"
     return Text(text)
@@ -629,15 +595,15 @@ def _verdict_cell(m):
         return Text("skipped" if m is None else "-", style="dim")
     if "error" not in m:
         style = "yellow" if m["conditioning"] < CONDITION_WARNING else "green"
-        return Text(f"ok ({m['conditioning']:.3g})", style=style)
+        return Text(f"ok ({fmt_figure(m['conditioning'])})", style=style)
     return Text(m["error"]["code"], style="red")
 
 
 class ForceTableWriter(_Writer):
     """A forces record: per contact its forces and how close each is to slipping, then the totals and closure.
 
-    Forces in N and moments in N m when the grasp's lengths are in metres
-    (the numbers are as given: N, N m stand for the units of the file)."""
+    Forces in N, moments in N times the file's length unit (``units``; ``N m`` with
+    metres, ``N mm`` with millimetres, ``N length`` when the file names none)."""
 
     def show(self, rec: dict, lines: list[str]) -> None:
         d = self.digits
@@ -648,7 +614,8 @@ class ForceTableWriter(_Writer):
                 Text.assemble(
                     "wrench ",
                     (escaped(w["name"]), "bold"),
-                    f" = force {fmt_vector(w['wrench'][:3], d)} N; moment {fmt_vector(w['wrench'][3:], d)} N m",
+                    f" = force {fmt_vector(w['wrench'][:3], d)} N; moment {fmt_vector(w['wrench'][3:], d)} "
+                    f"N {escaped(rec['units'] or 'length')}",
                 )
             )
         self.flow(lines, *parts)
@@ -684,12 +651,14 @@ class ForceTableWriter(_Writer):
             self.add(
                 lines,
                 f"total normal force {fmt_number(grip['total_normal_force'], d)} N (safety {grip['safety']:g}); "
-                f"squeezes {fmt_vector(grip['squeeze'], d)} N",
+                + ("no squeezes (collinear contacts)" if grip["squeeze"] is None else "")
+                + (f"squeezes {fmt_vector(grip['squeeze'], d)} N" if grip["squeeze"] is not None else ""),
             )
         c = rec["closure"]
         verdict = {True: "yes", False: "no", None: "- (no friction)"}[c["force_closure"]]
         least = "none" if c["closure_friction"] is None else fmt_number(c["closure_friction"], d)
-        text = f"closure: force closure {verdict}; closure friction {least}"
+        judged = "" if c["safety"] == 1 or c["force_closure"] is None else f" (with mu/{c['safety']:g})"
+        text = f"closure{judged}: force closure {verdict}; closure friction {least}"
         if c["epsilon"] is not None:
             text += f"; epsilon {fmt_number(c['epsilon'], d)}"
         self.add(lines, text)
@@ -715,7 +684,7 @@ class HandTable:
         from rich.console import Group
 
         ratio = m["velocity_limit_ratio"]
-        title = "hand: joint rates" + ("" if ratio is None else f"   velocity-limit ratio {ratio:.3g}")
+        title = "hand: joint rates" + ("" if ratio is None else f"   velocity-limit ratio {fmt_figure(ratio)}")
         # where the hand is (its joint positions given or solved, each tip's distance to its contact)
         placed = "joint_positions" in m["fingers"][0]
         where = ("position",) if placed else ()
@@ -728,7 +697,7 @@ class HandTable:
             positions = f.get("joint_positions", ())
             for k, (joint, rate) in enumerate(zip(f["joints"], f["joint_rates"])):
                 first = k == 0
-                error = "-" if f.get("tip_error") is None else f"{f['tip_error']:.2g}"
+                error = fmt_figure(f.get("tip_error"), 2)
                 t.add_row(
                     f["contact"] if first else "",
                     f["name"] if first else "",
@@ -736,8 +705,8 @@ class HandTable:
                     *((fmt_number(positions[k], d),) if placed else ()),
                     fmt_number(rate, d),
                     str(f["rank"]) if first else "",
-                    f"{f['residual']:.2g}" if first else "",
-                    f"{f['conditioning']:.3g}" if first else "",
+                    fmt_figure(f["residual"], 2) if first else "",
+                    fmt_figure(f["conditioning"]) if first else "",
                     *(((error if first else ""),) if placed else ()),
                 )
         return Group(Text(title, style="bold"), t, *HandTable._moved_by(m, rec))
@@ -762,7 +731,7 @@ class HandTable:
         """Fingers at their velocity limits."""
         ratio = m["velocity_limit_ratio"]
         if ratio is not None and ratio > 1:
-            return [f"hand: the joint rates exceed their velocity limits: slow the twist down by {ratio:.3g}."]
+            return [f"hand: the joint rates exceed their velocity limits: slow the twist down by {fmt_figure(ratio)}."]
         return []
 
     @staticmethod

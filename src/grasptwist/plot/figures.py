@@ -46,8 +46,9 @@ def grasp_scenes(grasp, twist, methods, velocity_scale=None, forces=None) -> lis
         grasp_scene(grasp, twist, method=m, all_bases=True, links=True, velocity_scale=velocity_scale, forces=forces)
         for m in methods
     ]
-    if velocity_scale is None and len(scenes) > 1:
-        return grasp_scenes(grasp, twist, methods, velocity_scale_of(scenes), forces)
+    shared = velocity_scale_of(scenes) if velocity_scale is None and len(scenes) > 1 else None
+    if shared is not None:  # None: no arrow drawn (a zero twist), nothing to share
+        return grasp_scenes(grasp, twist, methods, shared, forces)
     return scenes
 
 
@@ -110,8 +111,8 @@ def twist_figure(grasp, twists=None, *, method: str | None = None, active: int =
     active : int
         The twist shown first.
     meshes : sequence of (vertices, faces)
-        The hand's link meshes (:func:`grasptwist.io.urdf_meshes.hand_meshes`),
-        one legend entry shown with every twist.
+        The hand's link meshes (a URDF hand's, as the ``plot`` command reads
+        them), one legend entry shown with every twist.
     forces : (3, 3) array or None
         The grip forces drawn with a grasp's friction cones (the engine's, from the caller).
 

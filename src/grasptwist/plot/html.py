@@ -24,7 +24,7 @@ import orjson
 
 from .animation import path_figures
 from .figures import twist_figure
-from .render import Note, image_paths
+from .render import Note, image_paths, opened_for_writing
 from .scene import check_method
 
 __all__ = [
@@ -72,48 +72,67 @@ for (const div of document.querySelectorAll("div.grasptwist-figure")) {
 def grasp_page(grasp, *, twists=None, method=None, active=0, meshes=(), followed=(), forces=None):
     """The sections of a grasp's page ``[(heading, figure)]``: the twists' figure first
     (:func:`twist_figure`, with a URDF hand's link ``meshes``), then one animation per
-    followed path (:func:`grasptwist.plot.animation.path_figures`)."""
+    path of ``followed``."""
     figure = twist_figure(grasp, twists, method=method, active=active, meshes=meshes, forces=forces)
     return [(f"{grasp.name}: twists", figure), *path_figures(grasp, followed, method=method)]
 
 
-def write_page(path, sections, *, title: str, js_beside: bool = False) -> Path:
+def write_page(path, sections, *, title: str, js_beside: bool = False, opener=None) -> Path:
     """Write an HTML page of figures ``[(heading, figure)]`` to ``path``.
 
     plotly.js goes inside the page, or with ``js_beside`` into
-    :data:`JS_NAME` beside it (written once: an up-to-date copy is left
+    ``plotly.min.js`` beside it (written once: an up-to-date copy is left
     alone) and the page refers to it.  Each figure's JSON is in an element
-    :func:`read_figures` reads back.
+    :func:`read_figures` reads back.  ``opener`` opens each file, as for
+    ``grasptwist.plot.render.render``.
     """
     from plotly.offline import get_plotlyjs  # plotly is needed for its plotly.js only
 
     require_plotly()
     path = Path(path)
     js = get_plotlyjs()
+    opener = opener or opened_for_writing
     if js_beside:
         beside = path.parent / JS_NAME
         if not beside.is_file() or beside.read_text("utf-8") != js:
-            beside.write_text(js, "utf-8")
+            with opener(beside) as f:
+                f.write(js.encode("utf-8"))
         script = f'<script src="{JS_NAME}"></script>'
     else:
         script = f"<script>{js}</script>"
     body = []
     for n, (heading, figure) in enumerate(sections):
         text = orjson.dumps(figure | {"config": _CONFIG}, option=orjson.OPT_SERIALIZE_NUMPY).decode()
-        text = text.replace("</", "<\\/")  # "</" cannot end the element early: JSON reads "<\/" as "</"
+        text = script_json(text)
         body.append(
             f"<h2>{html.escape(heading)}</h2>\n"
             f'<div id="figure-{n}" class="grasptwist-figure" style="height:85vh"></div>\n'
             f'<script type="application/json" id="figure-{n}-json">{text}</script>'
         )
-    path.write_text(
+    page = (
         "<!DOCTYPE html>\n<html><head><meta charset='utf-8'>"
         f"<title>{html.escape(title)}</title>"
         "<style>body{font-family:sans-serif;margin:0 1em}h2{font-size:1.1em;margin:0.6em 0 0}</style>\n"
-        f"{script}</head><body>\n" + "\n".join(body) + f"\n<script>{_SCRIPT}</script>\n</body></html>\n",
-        "utf-8",
+        f"{script}</head><body>\n" + "\n".join(body) + f"\n<script>{_SCRIPT}</script>\n</body></html>\n"
     )
+    with opener(path) as f:
+        f.write(page.encode("utf-8"))
     return path
+
+
+def script_json(text: str) -> str:
+    """JSON ``text`` made safe inside a ``<script>`` element: every ``<`` written ``\\u003c``.
+
+    An HTML parser reads a script element's text for ``</script``, and after
+    ``<!--`` followed by ``<script`` for a second ``</script>`` before the
+    first ends it; one rule for every ``<`` leaves it nothing to find.
+    Outside strings JSON has no ``<``, and in a string ``\\u003c`` reads
+    back as ``<``.
+
+    >>> script_json('{"name": "<!--<script></script>"}')
+    '{"name": "\\\\u003c!--\\\\u003cscript>\\\\u003c/script>"}'
+    """
+    return text.replace("<", "\\u003c")
 
 
 def read_figures(text: str) -> list[dict]:
@@ -139,6 +158,7 @@ def html_loaded(
     js_beside: bool = False,
     extras=None,
     grips=None,
+    opener=None,
 ) -> Iterator[Path | Note]:
     """What ``grasptwist plot PATH -o OUTPUT.html`` (or a folder's ``-o FOLDER``) writes for
     ``grasps``, the grasps read from ``path``.
@@ -150,7 +170,7 @@ def html_loaded(
     itself, ``(meshes, followed, notes)``: its hand's link meshes, its followed
     paths for :func:`grasp_page`, and a :class:`Note` for each that could not
     be had; ``grips(grasp)`` the grip forces ``(3, 3)`` drawn with its friction cones (or
-    None).  Yields each page written and each note.
+    None); ``opener`` opens each file (:func:`write_page`).  Yields each page written and each note.
     """
     from .render import chosen_twist
 
@@ -177,4 +197,4 @@ def html_loaded(
         yield from notes
         forces = grips(grasp) if grips else None
         sections = grasp_page(grasp, method=method, active=active, meshes=meshes, followed=followed, forces=forces)
-        yield write_page(page, sections, title=f"grasptwist: {grasp.name}", js_beside=js_beside)
+        yield write_page(page, sections, title=f"grasptwist: {grasp.name}", js_beside=js_beside, opener=opener)

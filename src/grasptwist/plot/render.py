@@ -32,6 +32,7 @@ __all__ = [
     "chosen_twist",
     "image_name",
     "image_paths",
+    "opened_for_writing",
     "plot_grasp",
     "render",
     "render_grasps",
@@ -65,16 +66,23 @@ def require_matplotlib():
 # --- files --------------------------------------------------------------------
 
 
+def opened_for_writing(path):
+    """How a picture is written unless the caller says otherwise: ``path`` opened
+    for writing in binary (the command line passes its own opener, which replaces
+    a file atomically)."""
+    return open(path, "wb")  # noqa: SIM115 - a context manager for the caller's `with`
+
+
 def plot_grasp(
-    grasp, path, twist=None, *, twist_name=None, method=None, size=(1400, 700), dpi=100, forces=None
+    grasp, path, twist=None, *, twist_name=None, method=None, size=(1400, 700), dpi=100, forces=None, opener=None
 ) -> Path:
     """Render one grasp and twist to ``path``.
 
-    See :func:`~grasptwist.plot.scene.grasp_scene` for ``twist``,
+    See :func:`~grasptwist.pictures.grasp_scene` for ``twist``,
     ``twist_name``, ``method`` and ``forces``, and :func:`render` for the rest.
     """
     picture = grasp_scene(grasp, twist, twist_name=twist_name, method=method, forces=forces)
-    return render(picture, path, size=size, dpi=dpi)
+    return render(picture, path, size=size, dpi=dpi, opener=opener)
 
 
 def image_name(grasp_name: str, twist_name: str | None = None) -> str:
@@ -115,12 +123,14 @@ def image_paths(grasps, folder, suffix=".png", *, per_twist=True) -> list[tuple[
     return plan
 
 
-def render_grasps(grasps, folder, *, method=None, suffix=".png", size=(1400, 700), dpi=100, grips=None) -> list[Path]:
-    """One image per grasp and twist in ``folder`` (created if missing), named by :func:`image_paths`.
+def render_grasps(
+    grasps, folder, *, method=None, suffix=".png", size=(1400, 700), dpi=100, grips=None, opener=None
+) -> list[Path]:
+    """One image per grasp and twist in ``folder`` (created if missing), named by :func:`image_name`.
 
     A grasp without twists is drawn with its basis only; ``method`` None picks
-    :func:`~grasptwist.plot.scene.default_method` per grasp; ``grips(grasp)`` gives the grip
-    forces to draw (``(3, 3)`` or None).
+    off-tangent for a grasp with a wrist, else tangent; ``grips(grasp)`` gives the grip
+    forces to draw (``(3, 3)`` or None); ``opener`` as for :func:`render`.
 
     Returns
     -------
@@ -130,7 +140,9 @@ def render_grasps(grasps, folder, *, method=None, suffix=".png", size=(1400, 700
     require_matplotlib()
     Path(folder).mkdir(parents=True, exist_ok=True)
     return [
-        plot_grasp(grasp, path, twist, method=method, size=size, dpi=dpi, forces=grips(grasp) if grips else None)
+        plot_grasp(
+            grasp, path, twist, method=method, size=size, dpi=dpi, forces=grips(grasp) if grips else None, opener=opener
+        )
         for path, grasp, twist in plan
     ]
 
@@ -164,7 +176,9 @@ class Note:
     error: bool = True
 
 
-def render_loaded(path: str, output, grasps, *, twist_name: str | None = None, method: str | None = None, grips=None):
+def render_loaded(
+    path: str, output, grasps, *, twist_name: str | None = None, method: str | None = None, grips=None, opener=None
+):
     """What ``grasptwist plot PATH -o OUTPUT`` draws of the grasps read from ``PATH``.
 
     Yields each image written (a :class:`~pathlib.Path`) and a :class:`Note`
@@ -190,6 +204,8 @@ def render_loaded(path: str, output, grasps, *, twist_name: str | None = None, m
     grips : callable or None
         ``grips(grasp)``: the grip forces ``(3, 3)`` to draw with a grasp's friction cones
         (None: cones only); the command line asks the engine for them.
+    opener : callable or None
+        How each image file is opened, as for :func:`render`.
 
     Raises
     ------
@@ -208,13 +224,13 @@ def render_loaded(path: str, output, grasps, *, twist_name: str | None = None, m
                 drawable.append(grasp)
             except ValueError as exc:  # off-tangent asked of a grasp without a wrist
                 yield Note(f"{grasp.file}: grasp '{grasp.name}': error: {exc}")
-        yield from render_grasps(drawable, output, method=method, grips=grips)
+        yield from render_grasps(drawable, output, method=method, grips=grips, opener=opener)
     elif grasps:
         grasp = grasps[0]
         if len(grasps) > 1:
             yield Note(f"{path}: warning: drawing the first of its {len(grasps)} grasps, '{grasp.name}'", error=False)
         forces = grips(grasp) if grips else None
-        yield plot_grasp(grasp, output, chosen_twist(grasp, twist_name), method=method, forces=forces)
+        yield plot_grasp(grasp, output, chosen_twist(grasp, twist_name), method=method, forces=forces, opener=opener)
 
 
 def _check_suffix(suffix: str, formats=FORMATS):
@@ -246,7 +262,7 @@ _STYLE = {
 }
 
 
-def render(scene: Scene, path, *, size=(1400, 700), dpi=100) -> Path:
+def render(scene: Scene, path, *, size=(1400, 700), dpi=100, opener=None) -> Path:
     """Draw ``scene`` to ``path`` in two 3D views side by side.
 
     The format follows the suffix (``.png``, ``.svg``, ``.pdf``).  Drawing
@@ -262,6 +278,10 @@ def render(scene: Scene, path, *, size=(1400, 700), dpi=100) -> Path:
     dpi : float
         Pixels per inch: font sizes are in points, so a higher dpi makes the
         text larger relative to the picture.
+    opener : callable or None
+        ``opener(path)``: a binary file to write, as a context manager
+        (default ``opened_for_writing``; the command line's replaces the
+        file atomically when the block ends without an error).
 
     Returns
     -------
@@ -291,7 +311,8 @@ def render(scene: Scene, path, *, size=(1400, 700), dpi=100) -> Path:
     handles = [_legend_handle(k, scene.method) for k in scene.kinds()]
     fig.legend(handles=handles, loc="lower center", ncol=min(len(handles), 7), fontsize=8, frameon=False)
     fig.subplots_adjust(left=0.0, right=1.0, top=0.9, bottom=0.1, wspace=0.0)
-    fig.savefig(path, dpi=dpi)
+    with (opener or opened_for_writing)(path) as f:
+        fig.savefig(f, dpi=dpi, format=path.suffix[1:].lower())
     return path
 
 

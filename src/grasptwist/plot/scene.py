@@ -5,7 +5,7 @@ into a :class:`Scene`: labelled points, segments (screw axes), arrows (normals
 and velocities) and plane patches, each with a *kind* that the renderer
 (:mod:`grasptwist.plot.render`) styles and the legend names.  Every number in
 it comes from the engine (:mod:`grasptwist.engine.decompose`,
-:mod:`grasptwist.engine.screws`), so tests check the geometry, not pixels.
+``grasptwist.engine.screws``), so tests check the geometry, not pixels.
 
 Velocity arrows keep their true vectors; the scene also gives the one length
 per unit velocity (``Arrow.scale``) that draws them all at a common scale
@@ -19,7 +19,7 @@ from dataclasses import dataclass, field, replace
 import numpy as np
 
 from ..engine.decompose import contact_velocities, decompose_off_tangent, decompose_tangent
-from ..engine.degeneracy import Status, conditioning_warning, status_message
+from ..engine.degeneracy import NOISE_FLOOR, Status, conditioning_warning, status_message
 from ..engine.hands import finger_states
 from ..engine.screws import J, K, axis_point, cross, dot, field_at, norm, pitch, rigid_motion, unit
 
@@ -42,6 +42,7 @@ __all__ = [
     "scene",
 ]
 
+#: The decompositions a scene can show, as the command line spells them.
 METHODS = ("off-tangent", "tangent")
 
 # Lengths drawn relative to the grasp's size (the longest side of the contact triangle).
@@ -251,8 +252,8 @@ def scene(
     normals,
     wrist,
     twist=None,
-    method: str | None = None,
     *,
+    method: str | None = None,
     names=("1", "2", "3"),
     grasp_name: str = "grasp",
     twist_name: str | None = None,
@@ -269,7 +270,8 @@ def scene(
         Needed by the off-tangent method.
     twist : (6,) array ``(omega; v)`` or None
         None draws the grasp and its basis axes only.
-    method : ``"off-tangent"``, ``"tangent"`` or None (:func:`default_method`).
+    method : ``"off-tangent"``, ``"tangent"`` or None
+        None: off-tangent with a wrist, else tangent.
     names : 3 str
         Contact names, used in labels and the status message.
     grasp_name, twist_name : str
@@ -300,7 +302,7 @@ def scene(
     Raises
     ------
     ValueError
-        Unknown method, or the off-tangent method without a wrist (:func:`check_method`).
+        Unknown method, or the off-tangent method without a wrist.
     """
     method = check_method(method, wrist)
     points = np.asarray(points, dtype=float)
@@ -478,14 +480,14 @@ def _sub(name: str) -> str:
 def _vec(a, ref=0.0) -> str:
     """``(a, b, c)`` with 3 significant digits.
 
-    Entries below 1e-12 of the largest of ``a`` and ``ref`` are round-off and
+    Entries below ``NOISE_FLOOR`` (1e-12) of the largest of ``a`` and ``ref`` are round-off and
     shown as 0 (and ``-0`` as ``0``).
 
     >>> _vec([1.0, -2e-17, -0.0]), _vec([8e-17, 0, 0], ref=0.6)
     ('(1, 0, 0)', '(0, 0, 0)')
     """
     a = np.asarray(a, dtype=float).ravel()
-    a = np.where(np.abs(a) <= 1e-12 * max(float(np.max(np.abs(a), initial=0.0)), ref), 0.0, a)
+    a = np.where(np.abs(a) <= NOISE_FLOOR * max(float(np.max(np.abs(a), initial=0.0)), ref), 0.0, a)
     return "(" + ", ".join(f"{x + 0.0:.3g}" for x in a) + ")"
 
 
@@ -504,8 +506,8 @@ def grasp_scene(
     forces=None,
 ) -> Scene:
     """:func:`scene` for a loaded ``Grasp``, with its hand's joint axes (and, with
-    ``links``, its fingers' chains: :func:`finger_links`), and with a ``friction``
-    its friction cones and the grip ``forces (3, 3)`` given (:func:`force_parts`).
+    ``links``, its fingers' chains from joint to joint to tip), and with a ``friction``
+    its friction cones and the grip ``forces (3, 3)`` given.
 
     ``twist`` is a ``Twist`` (its ``name`` and ``screw`` are used), a ``(6,)``
     array (named ``twist_name``), or None for the grasp and its basis only.
@@ -519,7 +521,7 @@ def grasp_scene(
         grasp.normals,
         grasp.wrist,
         twist,
-        method,
+        method=method,
         names=grasp.contact_names,
         grasp_name=grasp.name,
         twist_name=twist_name,

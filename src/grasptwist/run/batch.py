@@ -16,10 +16,9 @@ from typing import Any
 
 import numpy as np
 
-from ..engine import hands
 from ..engine.decompose import contact_velocities
 from ..engine.degeneracy import Status
-from ..engine.judgements import outward_normals
+from ..engine.judgements import outward_contacts
 from ..engine.screws import direction, twist_at
 from ..io.dataset import Dataset
 from ..model import CONTACT_NAMES, Grasp, GraspFileError, Twist
@@ -27,7 +26,6 @@ from ..results import ALL_METHODS, BY_KEY, KINDS, METHOD_CHOICES, STATUS, Field,
 
 __all__ = [
     "METHODS",
-    "TwistOptions",
     "Block",
     "resolve",
     "resolve_arrays",
@@ -55,24 +53,8 @@ UNKNOWN_TWIST = "unknown-twist"
 ZERO_TWIST = Twist(name="0", screw=np.zeros(6), line=None)
 
 
-@dataclass(frozen=True)
-class TwistOptions:
-    """The twist family's options: which twists each grasp's rows take, by which methods.
-
-    ``twists`` (``--twist``) replace each grasp's own (``basis`` and ``check``
-    fix them to :data:`ZERO_TWIST`: a row per grasp); ``twists_from``
-    (``--twists-from``, a file or ``-``) gives them one per line instead;
-    ``select`` (``--select``) picks the grasps' own by name.
-    """
-
-    twists: tuple[Twist, ...] | None = None
-    method: str = "both"
-    twists_from: str | None = None
-    select: tuple[str, ...] | None = None
-
-
 #: Key of :meth:`Block.outward`'s verdicts among a block's computed values.
-OUTWARD = (None, "outward_normals")
+OUTWARD = (None, "outward_contacts")
 
 #: Rows per engine call on a data set: bounded memory, long vectors.
 ROWS_PER_BLOCK = 65536
@@ -106,6 +88,9 @@ class Block:
     bases: bool = True  # False: resolved without the basis screws (fields that need them are left out)
     method: str = ALL_METHODS  # the --method asked for
     friction: np.ndarray | None = None  # (n, 3) the grasps' friction, NaN rows where none; None: no row has one
+    center_of_mass: np.ndarray | None = (
+        None  # (n, 3) the grasps' centre of mass, NaN rows where none; None: no row has one
+    )
     # field values computed so far, by (kind key, Field); a block cut from another keeps its rows of them
     values: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
@@ -141,11 +126,12 @@ class Block:
         return np.isfinite(self.wrist).all(axis=-1)
 
     def outward(self) -> np.ndarray:
-        """Per row: do all the normals point away from the other contacts
-        (:func:`~grasptwist.engine.judgements.outward_normals`)?  Judged once per block."""
+        """Per row and contact ``(n, 3)``: does its normal point out of the object, away from the
+        centre of mass or else from the other contacts
+        (:func:`~grasptwist.engine.judgements.outward_contacts`)?  Judged once per block."""
         got = self.values.get(OUTWARD)
         if got is None:
-            got = self.values[OUTWARD] = outward_normals(self.points, self.normals)
+            got = self.values[OUTWARD] = outward_contacts(self.points, self.normals, self.center_of_mass)
         return got
 
     def failed_rows(self) -> np.ndarray:
@@ -190,6 +176,7 @@ _ROW_FIELDS = (
     "velocity",
     "hands",
     "friction",
+    "center_of_mass",
 )
 
 
@@ -346,10 +333,12 @@ def _stack(jobs, method) -> Block:
         units=[g.units for g in grasps],
         **_hand_inputs(grasps),
     )
-    friction = None
+    friction = center = None
     if any(g.friction is not None for g in grasps):
         friction = np.stack([nan if g.friction is None else g.friction for g in grasps])
-    return replace(block, contact_names=[g.contact_names for g in grasps], friction=friction)
+    if any(g.center_of_mass is not None for g in grasps):
+        center = np.stack([nan if g.center_of_mass is None else g.center_of_mass for g in grasps])
+    return replace(block, contact_names=[g.contact_names for g in grasps], friction=friction, center_of_mass=center)
 
 
 def _hand_inputs(grasps) -> dict:
@@ -357,6 +346,8 @@ def _hand_inputs(grasps) -> dict:
     if all(g.hand is None for g in grasps):
         return {}
 
+    # the hand math loads with the first hand: runs without one never pay for it (bench/startup.py)
+    from ..engine import hands
     from ..engine.ik import home_tips, place_hand
 
     width = max(len(f.joints) for g in grasps if g.hand is not None for f in g.hand.fingers)
@@ -384,6 +375,8 @@ def _hand_inputs(grasps) -> dict:
 def hand_placement(hand, placed, width=None) -> tuple:
     """``(joint positions (..., 3, width), tip error (..., 3), within limits (..., 3))`` of a hand
     placed (:class:`~grasptwist.engine.ik.HandIK`), as a block's ``placement`` holds them."""
+    from ..engine import hands
+
     return hands.padded_positions(hand, placed.positions, width), placed.tip_error, placed.within_limits
 
 
@@ -484,6 +477,7 @@ def _rows_hand(ds, hand_of_rows, start, stop, rows, points):
     positions checked, or solved for when the data set has none)."""
     if hand_of_rows is None:
         return {}, None
+    from ..engine import hands
     from ..engine.ik import place_hand
 
     q = None if ds.joint_positions is None else np.asarray(ds.joint_positions[start:stop], dtype=float)[rows]

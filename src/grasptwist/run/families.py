@@ -20,23 +20,25 @@ How to add a family
 -------------------
 Say, grasps synthesised on an object's surface (``grasptwist synthesise``):
 
-1. Compute its rows in ``run/``: a module with its options (a frozen
-   dataclass whose defaults are a command line without options), its block
-   type (``__len__`` and ``part(start, stop)``; anything else a family
-   yields is an input's error, written as an error record) and ``rows(items,
-   job)``: read grasps and errors in, blocks and errors out, in order.  The
-   math stays in ``engine/``.  Rows of a data set: ``dataset(ds, job,
-   start, stop, bases)`` and ``per_grasp(options)``; else leave them None.
-   A family that is not cut into groups of files (``follow``: its paths
-   stream in order) gives ``outputs`` instead.
-2. Its columns: a :class:`~grasptwist.output.columns.ColumnSet` in
-   :mod:`grasptwist.output.column_sets` (CSV header and lines, npz arrays,
-   Parquet's typed columns), and its records in an ``output/`` module.
-3. Register a :class:`Family` here, and a :class:`Command` per command that
+1. Its options in :mod:`.options`: a frozen dataclass whose defaults are
+   a command line without options (``rows_per_grasp()`` if it reads data sets).
+2. Compute its rows in a module of ``run/``: its block type (``__len__`` and
+   ``part(start, stop)``) and ``rows(items, job)``: read grasps and errors
+   in, blocks and errors (:class:`~grasptwist.model.InputError`, written as
+   error records) out, in order.  The math stays in ``engine/``.  Rows of a
+   data set: ``dataset(ds, job, start, stop, bases)``.  A family that is not
+   cut into groups of files (``follow``: its paths stream in order) gives
+   ``outputs`` instead.
+3. Its columns: a :class:`~grasptwist.output.columns.ColumnSet` beside its
+   records in an ``output/`` module (CSV header and lines, npz arrays,
+   Parquet's typed columns).
+4. Register a :class:`Family` here, and a :class:`Command` per command that
    shows it: its records, its table writer (a class in
    :mod:`grasptwist.output`, named), its formats, what it adds to other
-   commands (a :class:`Contribution`).
-4. A module in ``cli/`` declaring the command's options, building the
+   commands (a :class:`Contribution`).  Its compute, records and columns are
+   reached through small functions that import them when first called, so
+   that other commands never load them.
+5. A module in ``cli/`` declaring the command's options, building the
    :class:`~grasptwist.run.pipeline.Job` of ``COMMANDS[name]`` and calling
    :func:`grasptwist.cli.records.write_records`; the formats, the table, the
    progress bar, stderr and the exit status follow from the registry.
@@ -51,16 +53,11 @@ from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
-from ..output import follow_records
-from ..output.column_sets import PATH_COLUMNS, TWIST_COLUMNS, WRENCH_COLUMNS
-from ..output.columns import ColumnSet
-from ..output.force_records import force_records
 from ..output.formats import FORMATS
 from ..output.json_rows import encode_records
 from ..output.records import basis_record, check_record, dumps, records, talking_rows
-from .batch import ZERO_TWIST, Block, TwistOptions, dataset_blocks, resolve
-from .follow import FollowOptions, Samples, follow_outputs
-from .forces import ForceBlock, ForceOptions, closure_fields, force_blocks, force_dataset_blocks, rows_per_grasp
+from .batch import ZERO_TWIST, dataset_blocks, resolve
+from .options import FollowOptions, ForceOptions, TwistOptions
 from .stream import twist_stream
 
 __all__ = ["Family", "Contribution", "Command", "FAMILIES", "COMMANDS", "TWIST", "WRENCH", "PATH", "CLOSURE"]
@@ -75,19 +72,18 @@ class Family:
     name : str
         What its rows are (``twist``, ``wrench``, ``path``).
     options : type
-        Its options: a frozen dataclass, defaults when called without arguments.
-    block : type
-        Its blocks of results; anything else its compute yields is an input's error.
-    columns : ColumnSet
-        Its rows as CSV, npz and Parquet columns.
+        Its options (:mod:`.options`): a frozen dataclass, defaults when called without arguments.
+    columns : callable
+        ``() -> ColumnSet``: its rows as CSV, npz and Parquet columns (loaded when a format
+        writes columns).
     rows : callable or None
         ``(items, job) -> blocks and errors``: a group's read grasps and loader
-        errors (a group of files, a stream's batch of lines), in order.
+        errors (a group of files, a stream's batch of lines), in order; anything
+        but an :class:`~grasptwist.model.InputError` is a block (``__len__``,
+        ``part(start, stop)``).
     dataset : callable or None
         ``(ds, job, start, stop, bases) -> blocks``: the rows of a data set's grasps
-        ``start:stop`` (``stop`` None: to its end).
-    per_grasp : callable
-        ``options -> int``: rows each grasp of a data set gives.
+        ``start:stop`` (``stop`` None: to its end), ``options.rows_per_grasp()`` each.
     check_dataset : callable
         ``(ds, job) -> None``: raises the data set's error before any row.
     beside : callable
@@ -104,11 +100,9 @@ class Family:
 
     name: str
     options: type
-    block: type
-    columns: ColumnSet
+    columns: Callable[[], Any]
     rows: Callable[[list, Any], Iterator] | None = None
     dataset: Callable[..., Iterator] | None = None
-    per_grasp: Callable[[Any], int] = lambda options: 1
     check_dataset: Callable[[Any, Any], None] = lambda ds, job: None
     beside: Callable[..., Any] = lambda job, paths, tuning: None
     outputs: Callable[..., Iterator] | None = None
@@ -185,6 +179,10 @@ class Command:
             raise ValueError(f"{self.name}: no output format {unknown}")
 
 
+# Each family's compute, records and columns load with its first run, through the
+# small functions below: a JSON resolve never imports the force engine, follow's
+# paths or the hand's kinematics (tests/test_layers.py, bench/startup.py).
+
 # -- twist rows ---------------------------------------------------------------
 
 
@@ -210,41 +208,80 @@ def _twists_beside(job, paths, tuning):
     return twist_stream(paths, o.twists_from, o.method, job.max_bytes, tuning.files_per_group)
 
 
+def _twist_columns():
+    from ..output.column_sets import TWIST_COLUMNS  # CSV, npz and Parquet only
+
+    return TWIST_COLUMNS
+
+
 TWIST = Family(
     name="twist",
     options=TwistOptions,
-    block=Block,
-    columns=TWIST_COLUMNS,
+    columns=_twist_columns,
     rows=_twist_rows,
     dataset=_twist_dataset,
-    per_grasp=lambda options: len(options.twists) if options.twists else 1,
     check_dataset=_twist_check,
     beside=_twists_beside,
 )
 
 # -- wrench rows --------------------------------------------------------------
 
+
+def _wrench_rows(items, job):
+    from .forces import force_blocks  # the force engine, with the first force run
+
+    return force_blocks(items, job.options)
+
+
+def _wrench_dataset(ds, job, start, stop, bases):
+    from .forces import force_dataset_blocks
+
+    return force_dataset_blocks(ds, job.options, start=start, stop=stop)
+
+
+def _wrench_columns():
+    from ..output.force_records import WRENCH_COLUMNS
+
+    return WRENCH_COLUMNS
+
+
+def _closure(block):
+    from .forces import closure_fields  # check's closure: the force engine, with the first check
+
+    return closure_fields(block)
+
+
 WRENCH = Family(
     name="wrench",
     options=ForceOptions,
-    block=ForceBlock,
-    columns=WRENCH_COLUMNS,
-    rows=lambda items, job: force_blocks(items, job.options),
-    dataset=lambda ds, job, start, stop, bases: force_dataset_blocks(ds, job.options, start=start, stop=stop),
-    per_grasp=rows_per_grasp,
+    columns=_wrench_columns,
+    rows=_wrench_rows,
+    dataset=_wrench_dataset,
 )
 
 #: The wrench family's part of ``check`` records: each grasp's closure.
-CLOSURE = Contribution(WRENCH, closure_fields, "closure mu", "closure_cell")
+CLOSURE = Contribution(WRENCH, _closure, "closure mu", "closure_cell")
 
 # -- path samples -------------------------------------------------------------
+
+
+def _path_outputs(job, inputs, w, workers, tuning):
+    from .follow import follow_outputs  # paths, a hand's tracking and the weight's grip, with the first follow
+
+    return follow_outputs(job, inputs, w, workers, tuning)
+
+
+def _path_columns():
+    from ..output.follow_records import PATH_COLUMNS
+
+    return PATH_COLUMNS
+
 
 PATH = Family(
     name="path",
     options=FollowOptions,
-    block=Samples,
-    columns=PATH_COLUMNS,
-    outputs=follow_outputs,
+    columns=_path_columns,
+    outputs=_path_outputs,
     tells_progress=False,
 )
 
@@ -276,6 +313,18 @@ def _check_records(block, job):
     return [check_record(block, i, {k: v for part in added for k, v in part[i].items()}) for i in range(len(block))]
 
 
+def _sample_records(samples, job):
+    from ..output.follow_records import sample_records
+
+    return sample_records(samples, job.order)
+
+
+def _force_records(block, job):
+    from ..output.force_records import force_records
+
+    return force_records(block)
+
+
 _RECORDS = ("table", "json", "jsonl")
 _ROWS = (*_RECORDS, "csv", "npz", "parquet")
 
@@ -302,13 +351,7 @@ COMMANDS: dict[str, Command] = {
             contributions=(CLOSURE,),
             fixed={"twists": (ZERO_TWIST,)},
         ),
-        Command(
-            "follow",
-            PATH,
-            (*_RECORDS, "csv", "npz"),
-            lambda samples, job: follow_records.sample_records(samples, job.order),
-            "follow_table.FollowTable",
-        ),
-        Command("forces", WRENCH, _ROWS, lambda block, job: force_records(block), "table.ForceTableWriter"),
+        Command("follow", PATH, (*_RECORDS, "csv", "npz"), _sample_records, "follow_table.FollowTable"),
+        Command("forces", WRENCH, _ROWS, _force_records, "table.ForceTableWriter"),
     )
 }

@@ -25,11 +25,13 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..engine import hands
+from ..engine.degeneracy import radians_warning
 from ..engine.forces.grip import Grip
 from ..engine.forces.hold import HoldStretch, cannot_hold, grip_along
 from ..engine.hands import HandTrack
 from ..engine.ik import home_tips, place_hand
-from ..engine.path import PathDegeneracies, Poses, degeneracies, follow
+from ..engine.judgements import rotation_over_pi
+from ..engine.path import PathDegeneracies, Poses, degeneracies, follow, pose_overflowed
 from ..io.datasets import DATASET_SUFFIXES
 from ..model import Grasp, GraspFileError, ObjectPath
 from ..output import follow_records as fr
@@ -37,11 +39,11 @@ from ..output.formats import FORMATS
 from ..output.records import diagnostics, error_record
 from ..results import BY_KEY, selected
 from .batch import Block, hand_placement, with_reasons
+from .options import FollowOptions
 from .outputs import Output
 from .placement import read
 
 __all__ = [
-    "FollowOptions",
     "Samples",
     "Summary",
     "follow_grasp",
@@ -64,34 +66,6 @@ MAX_SAMPLES = 1_000_000
 
 #: Samples per engine call.
 CHUNK = 4096
-
-
-@dataclass(frozen=True)
-class FollowOptions:
-    """The path family's options: what ``follow`` was asked beyond what every command shares.
-
-    Attributes
-    ----------
-    method : str
-        A ``--method`` value.
-    path : str or None
-        Follow only the paths of this name.
-    segments : tuple of Segment or None
-        The command line's path, replacing the files'.
-    samples : int or None
-        Samples per path, evenly spaced, both ends included.
-    dt : float or None
-        Time step between samples instead (the path's end is a sample too).
-    bases : bool
-        Keep the basis screws (formats that show them; :func:`follow_outputs` sets it from the format).
-    """
-
-    method: str = "both"
-    path: str | None = None
-    segments: tuple | None = None
-    samples: int | None = None
-    dt: float | None = None
-    bases: bool = True
 
 
 @dataclass(frozen=True, eq=False)
@@ -127,6 +101,8 @@ class Summary:
     labels: tuple[str, ...]  # the methods run
     hand: HandTrack | None = None  # the fingers' tracks, when the grasp has a hand
     cannot_hold: tuple[HoldStretch, ...] | None = None  # where no grip holds its weight, with mass and friction
+    tip_error: np.ndarray | None = None  # (3,) with a hand: each finger's largest tip error at the samples
+    warnings: tuple[str, ...] = ()  # about the path as given: rotation vectors over pi
 
 
 def sample_times(duration: float, samples: int | None = None, dt: float | None = None) -> np.ndarray:
@@ -213,6 +189,7 @@ def _path(job, grasp, p):
         if grasp.mass is None or grasp.friction is None
         else (grasp.points, grasp.normals, grasp.friction, grasp.mass, grasp.center_of_mass, grasp.gravity, p.segments)
     )
+    largest = None  # each finger's largest tip error at the samples, as their records give it
     for start in range(0, len(times), CHUNK):
         q = None if tracked is None else tracked.positions[start : start + CHUNK]
         grip = None if weight is None else grip_along(*weight, times[start : start + CHUNK])[1]
@@ -225,10 +202,22 @@ def _path(job, grasp, p):
             method=job.method,
             bases=job.bases,
         )
-        yield Samples(p.name, _block(grasp, p.name, f, job.bases, job.method, q), f.poses, q, grip)
+        block = _block(grasp, p.name, f, job.bases, job.method, q)
+        grip = None if grip is None else pose_overflowed(grip, f.overflowed)  # as the methods say there
+        if tracked is not None:
+            seen = block.results["hand"].tip_error.max(axis=0)
+            largest = seen if largest is None else np.maximum(largest, seen)
+        yield Samples(p.name, block, f.poses, q, grip)
     found = degeneracies(grasp.points, grasp.normals, grasp.wrist, p.segments, times)
     stretches = None if weight is None else cannot_hold(*weight, times)
-    yield Summary(grasp.file, grasp, p.name, len(times), found, labels, tracked, stretches)
+    yield Summary(grasp.file, grasp, p.name, len(times), found, labels, tracked, stretches, largest, _radians(p))
+
+
+def _radians(path) -> tuple[str, ...]:
+    """A warning per pose target of ``path`` given by a rotation vector over pi (degrees, most likely)."""
+    given = [s for s in path.segments if s.rotvec is not None]
+    over = rotation_over_pi([s.rotvec for s in given]) if given else ()
+    return tuple(radians_warning(s.rotvec, s.line, s.column) for s, bad in zip(given, over) if bad)
 
 
 def _block(grasp, name, f, bases, method, positions=None) -> Block:
@@ -243,7 +232,8 @@ def _block(grasp, name, f, bases, method, positions=None) -> Block:
         placement = dict(zip(("joint_positions", "tip_error", "within_limits"), hand_placement(grasp.hand, placed)))
         inputs = {"joint_screws": screws, "joint_limits": limits, "points": f.points, "twist": f.poses.twist}
         inputs["placement"] = placement
-        results["hand"] = BY_KEY["hand"].compute({**inputs, **results}, bases)
+        # where the pose overflows, the hand's rates are no result of the path either (as the methods')
+        results["hand"] = pose_overflowed(BY_KEY["hand"].compute({**inputs, **results}, bases), f.overflowed)
     block = Block(
         file=[grasp.file] * n,
         grasp=[grasp.name] * n,
@@ -260,6 +250,9 @@ def _block(grasp, name, f, bases, method, positions=None) -> Block:
         bases=bases,
         hands=None if positions is None else [grasp.hand] * n,
         method=method,
+        center_of_mass=None
+        if grasp.center_of_mass is None
+        else f.poses.rotation @ grasp.center_of_mass + f.poses.position,
     )
     return with_reasons(block)  # a method asked for by name that cannot run fails, as in resolve
 

@@ -19,11 +19,12 @@ import numpy as np
 from ..engine.forces.closure import force_closure
 from ..engine.forces.grasp_map import manipulating_forces
 from ..engine.forces.grip import grip
+from ..engine.judgements import outward_contacts
 from ..engine.screws import direction
-from ..model import Grasp, GraspFileError, Wrench
+from ..model import Grasp, GraspFileError
+from .options import ForceOptions
 
 __all__ = [
-    "ForceOptions",
     "ForceResult",
     "compute_forces",
     "closure_fields",
@@ -31,24 +32,7 @@ __all__ = [
     "force_blocks",
     "force_arrays",
     "force_dataset_blocks",
-    "rows_per_grasp",
 ]
-
-
-@dataclass(frozen=True)
-class ForceOptions:
-    """The wrench family's options: what ``grasptwist forces`` asks of every row beyond its inputs.
-
-    ``wrenches`` (``--wrench``) replace each grasp's own, ``friction``
-    (``--friction``) its friction; ``safety``, ``quality`` and ``cone_edges``
-    go to the engine.
-    """
-
-    wrenches: tuple[Wrench, ...] | None = None
-    friction: float | None = None
-    safety: float = 1.0
-    quality: bool = False
-    cone_edges: int = 8
 
 
 @dataclass(frozen=True)
@@ -59,7 +43,8 @@ class ForceResult:
     -1 where it has no wrench or no friction; their numbers are NaN there and
     where they failed.  ``closure_friction`` is NaN where no friction gives
     closure, ``force_closure`` and ``epsilon`` are meaningful only where the
-    row has a friction (``epsilon``: and quality was asked for).
+    row has a friction (``epsilon``: and quality was asked for), and are judged
+    with ``friction / safety``, the friction the grip may use.
     """
 
     manipulating: np.ndarray  # (N, 3, 3)
@@ -73,6 +58,9 @@ class ForceResult:
     total_normal_force: np.ndarray  # (N,)
     grip_status: np.ndarray
     grip_culprit: np.ndarray
+    dual: np.ndarray  # (N, 6) the grip's certificate of optimality (NaN where it failed)
+    gap: np.ndarray  # (N,)
+    certificate: np.ndarray  # (N, 6) where no grip exists: the Farkas direction (else NaN)
     closure_friction: np.ndarray
     force_closure: np.ndarray  # (N,) bool
     epsilon: np.ndarray
@@ -100,6 +88,9 @@ def compute_forces(points, normals, wrench, has_wrench, friction, has_friction, 
         "total_normal_force": np.full(n, np.nan),
         "grip_status": np.full(n, -1, np.int8),
         "grip_culprit": np.full(n, -1, np.int8),
+        "dual": np.full((n, 6), np.nan),
+        "gap": np.full(n, np.nan),
+        "certificate": np.full((n, 6), np.nan),
         "closure_friction": np.full(n, np.nan),
         "force_closure": np.zeros(n, bool),
         "epsilon": np.full(n, np.nan),
@@ -116,11 +107,23 @@ def compute_forces(points, normals, wrench, has_wrench, friction, has_friction, 
         )
     g = np.flatnonzero(has_wrench & has_friction)
     if g.size:
-        r = grip(points[g], normals[g], wrench[g], friction[g], options.safety)
-        for name in ("force", "squeeze", "normal_force", "tangential_force", "friction_used", "total_normal_force"):
+        r = grip(points[g], normals[g], wrench[g], friction[g], safety=options.safety)
+        for name in (
+            "force",
+            "squeeze",
+            "normal_force",
+            "tangential_force",
+            "friction_used",
+            "total_normal_force",
+            "dual",
+            "gap",
+            "certificate",
+        ):
             out[name][g] = getattr(r, name)
         out["grip_status"][g], out["grip_culprit"][g] = r.status, r.culprit
-    for rows, mu in ((np.flatnonzero(has_friction), friction), (np.flatnonzero(~has_friction), None)):
+    # closure and epsilon with the friction the forces may use, as the grip's (issue 31)
+    usable = None if friction is None else friction / options.safety
+    for rows, mu in ((np.flatnonzero(has_friction), usable), (np.flatnonzero(~has_friction), None)):
         if not rows.size:
             continue
         quality = options.quality and mu is not None
@@ -162,11 +165,6 @@ def closure_fields(block) -> list[dict]:
     ]
 
 
-def rows_per_grasp(options: ForceOptions) -> int:
-    """Rows each grasp gives when the command line names the wrenches (else at least one)."""
-    return len(options.wrenches) if options.wrenches else 1
-
-
 @dataclass(frozen=True)
 class ForceBlock:
     """Consecutive (grasp, wrench) rows and their force results, as columns."""
@@ -181,6 +179,7 @@ class ForceBlock:
     wrench: np.ndarray  # (n, 6), NaN rows where there is none
     friction: np.ndarray  # (n, 3), NaN rows where there is none
     result: ForceResult
+    center_of_mass: np.ndarray | None = None  # (n, 3), NaN rows where none; None: no row has one
 
     def __len__(self) -> int:
         return len(self.grasp)
@@ -196,18 +195,30 @@ class ForceBlock:
     def part(self, start: int, stop: int) -> ForceBlock:
         """Rows ``start:stop`` as a block of their own (views)."""
         rows = slice(start, stop)
-        cut = {f.name: getattr(self, f.name)[rows] for f in fields(self) if f.name != "result"}
+        cut = {
+            f.name: getattr(self, f.name)[rows]
+            for f in fields(self)
+            if f.name != "result" and getattr(self, f.name) is not None
+        }
         r = self.result
         result = replace(r, **{f.name: getattr(r, f.name)[rows] for f in fields(r) if f.name != "safety"})
         return ForceBlock(**cut, result=result)
+
+    def outward(self) -> np.ndarray:
+        """Per row and contact ``(n, 3)``: does its normal point out of the object
+        (:func:`~grasptwist.engine.judgements.outward_contacts`, as for resolve's blocks)?"""
+        return outward_contacts(self.points, self.normals, self.center_of_mass)
 
     def failed_rows(self) -> np.ndarray:
         """Rows whose manipulating forces or grip failed."""
         return (self.result.manipulating_status > 0) | (self.result.grip_status > 0)
 
 
-def force_arrays(points, normals, wrench, wrench_name, friction, options: ForceOptions, **labels) -> ForceBlock:
-    """One block from arrays of rows (``wrench`` and ``friction`` NaN rows where there is none)."""
+def force_arrays(
+    points, normals, wrench, wrench_name, friction, options: ForceOptions, center_of_mass=None, **labels
+) -> ForceBlock:
+    """One block from arrays of rows (``wrench``, ``friction`` and ``center_of_mass`` NaN rows where
+    there is none; ``center_of_mass`` None: no row has one)."""
     n = len(points)
     has_friction = ~np.isnan(friction).any(axis=-1)
     has_wrench = np.array([name is not None for name in wrench_name], dtype=bool)
@@ -223,6 +234,7 @@ def force_arrays(points, normals, wrench, wrench_name, friction, options: ForceO
         wrench=wrench,
         friction=friction,
         result=result,
+        center_of_mass=center_of_mass,
     )
 
 
@@ -260,6 +272,9 @@ def _stack(rows, options) -> ForceBlock:
         [None if w is None else w.name for _, w in rows],
         mu,
         options,
+        None
+        if all(g.center_of_mass is None for g in grasps)
+        else np.stack([nan3 if g.center_of_mass is None else g.center_of_mass for g in grasps]),
         file=[g.file for g in grasps],
         grasp=[g.name for g in grasps],
         units=[g.units for g in grasps],
@@ -279,7 +294,7 @@ def force_dataset_blocks(
     all, one per row, or one per contact).
     """
     wrenches, friction = options.wrenches, options.friction
-    k = rows_per_grasp(options)
+    k = options.rows_per_grasp()
     step = max(1, rows // k)
     end = len(ds) if stop is None else min(stop, len(ds))
     for first in range(start, end, step):
@@ -304,6 +319,7 @@ def force_dataset_blocks(
             mu = np.broadcast_to(own if own.ndim == 0 else own[picked], (n, 3)).copy()
         else:
             mu = np.full((n, 3), np.nan)
+        _check_rows_friction(ds.path, mu, index, end)
         labels = ds.names[first:last][picked] if ds.names is not None else index
         yield force_arrays(
             np.asarray(ds.points[first:last], dtype=float)[picked],
@@ -316,6 +332,20 @@ def force_dataset_blocks(
             grasp=_texts(labels),
             units=[None] * n,
             contact_names=[("1", "2", "3")] * n,
+        )
+
+
+def _check_rows_friction(path, mu, index, end):
+    """A negative friction in a data set's rows: its input error (the rows from its block on,
+    to the end of the part being run, get that one error record; other files keep theirs)."""
+    bad = (mu < 0).any(axis=1)
+    if bad.any():
+        row = int(np.argmax(bad))
+        raise GraspFileError(
+            code="bad-dataset",
+            message=f"friction: row {index[row]}: {float(mu[row][mu[row] < 0][0])!r} must be >= 0 "
+            f"(rows {index[0]} to {end - 1} not computed)",
+            file=path,
         )
 
 

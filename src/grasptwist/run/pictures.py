@@ -14,21 +14,21 @@ from dataclasses import replace
 
 from .. import plot as pictures
 from ..engine.forces.grip import grip
-from ..io.inputs import expand
 from ..io.urdf_meshes import grasp_folder, hand_meshes
 from ..model import Grasp, InputError
 from ..output.records import diagnostics, error_record
 from ..plot.animation import DEFAULT_SAMPLES
-from .follow import FollowOptions, Samples, Summary, follow_grasp
+from .follow import Samples, Summary, follow_grasp
+from .options import FollowOptions
 from .placement import read
 
 __all__ = ["draw", "read_grasps", "page_extras", "grip_forces"]
 
 
-def read_grasps(path: str, twists, max_bytes: int | None) -> Iterator[Grasp | pictures.Note]:
-    """The grasps of ``path`` (a file or a folder), read as every command reads them, with
-    ``twists`` (the command line's) in place of their own; an input's errors as notes."""
-    for item in expand([path]):
+def read_grasps(inputs, twists, max_bytes: int | None) -> Iterator[Grasp | pictures.Note]:
+    """The grasps of ``inputs`` (files, and the errors of listing a folder), read as every command
+    reads them, with ``twists`` (the command line's) in place of their own; an input's errors as notes."""
+    for item in inputs:
         for entry in read(item, max_bytes) if isinstance(item, str) else [item]:
             if isinstance(entry, InputError):
                 yield from (pictures.Note(line) for line in diagnostics(error_record(entry))[0])
@@ -73,36 +73,29 @@ def grip_forces(grasp):
     return g.force if bool(g.ok) else None
 
 
-def draw(path, output, twists, twist_name, method, max_bytes, html: bool, views) -> Iterator[pictures.Note | str]:
-    """Draw the grasps of ``path`` into ``output`` (``html``: interactive pages, with ``views``'
-    ``js_beside`` and ``path_name``): the notes of what could not be read or drawn, and the
-    name of each picture written, in order.
+def draw(path, output, grasps, twist_name, method, html: bool, views, opener) -> Iterator[pictures.Note | str]:
+    """Draw ``grasps`` (of ``path``) into ``output`` (``html``: interactive pages, with ``views``'
+    ``js_beside`` and ``path_name``), each file written by ``opener``: the notes of what could not
+    be drawn, and the name of each picture written, in order, as they are drawn.
 
     Raises
     ------
-    MissingMatplotlib, MissingPlotly
-        Before anything is read.
     TwistNotFound, ValueError
         ``twist_name`` is not a twist of the file; an unknown method or suffix.
     """
-    (pictures.require_plotly if html else pictures.require_matplotlib)()
-    grasps = []
-    for item in read_grasps(path, twists, max_bytes):
-        if isinstance(item, pictures.Note):
-            yield item
-        else:
-            grasps.append(item)
-    chosen = None if twists else twist_name
     if html:
         yield from pictures.html_loaded(
             path,
             output,
             grasps,
-            twist_name=chosen,
+            twist_name=twist_name,
             method=method,
             js_beside=views["js_beside"],
             extras=page_extras(views["path_name"]),
             grips=grip_forces,
+            opener=opener,
         )
     else:
-        yield from pictures.render_loaded(path, output, grasps, twist_name=chosen, method=method, grips=grip_forces)
+        yield from pictures.render_loaded(
+            path, output, grasps, twist_name=twist_name, method=method, grips=grip_forces, opener=opener
+        )

@@ -18,7 +18,6 @@ from __future__ import annotations
 
 import os
 import shutil
-import tempfile
 from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
@@ -34,7 +33,7 @@ from .batch import check_positions
 from .families import COMMANDS, Command
 from .outputs import Output
 from .placement import placed, read
-from .pool import Pool
+from .pool import Pool, pool_size
 from .scratch import owned_prefix, remove_orphans
 from .stream import is_stream
 
@@ -173,6 +172,7 @@ def _parallel(task, count: int, workers: int, tuning: Tuning) -> Iterator[Iterat
     """``task(spool, i)`` for ``i < count`` on a pool of forked workers, in
     order; the workers share the parent's open files and data sets, and
     leave their encoded output in a :class:`Spool`."""
+    workers = pool_size(workers, count)  # never a process with nothing to do
     with (
         Spool.opened(workers, tuning.spool_bytes) as spool,
         Pool(partial(task, spool), workers, tuning.in_flight) as pool,
@@ -205,6 +205,8 @@ class Spool:
         if not os.access(shm, os.W_OK):
             yield None
             return
+        import tempfile  # with the first worker pool: a run of one process never needs it (bench/startup.py)
+
         remove_orphans(shm, SPOOL_STEM)  # what runs killed by SIGKILL left
         folder = None
         try:
@@ -220,6 +222,8 @@ class Spool:
         self._mine = [(path, size) for path, size in self._mine if os.path.exists(path)]
         if sum(size for _, size in self._mine) + len(blob) > self.share:
             return None
+        import tempfile  # loaded by opened() already
+
         fd, path = tempfile.mkstemp(dir=self.folder)
         try:
             with os.fdopen(fd, "wb") as f:
@@ -279,7 +283,7 @@ def blocks(job: Job, paths: Sequence, tuning: Tuning = TUNING) -> Iterator[tuple
         elif _is_dataset(g):
             try:
                 ds = open_dataset(g, job.extra_point)
-                extra_work = len(ds) * job.family.per_grasp(job.options) - 1
+                extra_work = len(ds) * job.options.rows_per_grasp() - 1
                 for block in job.family.dataset(ds, job, 0, None, bases):
                     yield block, extra_work, True
                     extra_work = 0
@@ -293,7 +297,7 @@ def _encode_into(job: Job, x, out: Output, at_once: int) -> None:
     """Records of ``x`` (a block, or an input's error) encoded into ``out``, by the command's
     records and the format's encoding."""
     fmt = FORMATS[job.fmt]
-    if not isinstance(x, job.family.block):
+    if isinstance(x, GraspFileError):
         out.add(error_record(x), partial(fmt.error, job=job))
         return
     # a few thousand records at a time: their floats as Python objects would otherwise fill memory
@@ -313,7 +317,7 @@ def _dataset(job: Job, path: str, workers: int, tuning: Tuning) -> Iterator[Outp
         _encode_into(job, err, out, tuning.records_at_once)
         yield _sealed(job, out)
         return
-    rows = len(ds) * job.family.per_grasp(job.options)
+    rows = len(ds) * job.options.rows_per_grasp()
     step = tuning.grasps_per_task
     tasks = [(start, min(len(ds), start + step)) for start in range(0, len(ds), step)]
     if workers > 1 and len(tasks) > 1:
@@ -387,7 +391,7 @@ def write_blocks(job: Job, paths: Sequence, w, tuning: Tuning = TUNING) -> Itera
     """
     for x, extra_work, rows in blocks(job, paths, tuning):
         o = Output(done=len(x) if extra_work is not None else 1, extra_work=extra_work or 0, rows=rows)
-        if isinstance(x, job.family.block):
+        if not isinstance(x, GraspFileError):
             w.write(x)
             for rec in job.command.talking(x, job):
                 o.add(rec, lambda rec: None)

@@ -3,7 +3,7 @@
 The loader only reads (:mod:`grasptwist.io.grasp.hand`): a grasp whose URDF
 hand is not yet on its contacts carries a :class:`~grasptwist.model.HandPlacement`,
 the joint positions the file gives (to check) or its seed (to solve from),
-and where each finger's ``tip`` stood in the file.  :func:`place` runs the
+and where each finger's ``tip`` stood in the file.  :func:`place_grasp` runs the
 engine (:func:`grasptwist.engine.ik.place_hand`) and gives the grasp at its
 placed joint positions, or its error: each finger that cannot be put on
 its contact (``contact-off-finger``, ``unreachable``, ``outside-limits``)
@@ -18,22 +18,47 @@ from collections.abc import Iterable
 from dataclasses import replace
 
 from ..engine.degeneracy import Status
-from ..engine.ik import place_hand
 from ..io import grasp as loader
 from ..io import inputs
 from ..io.grasp.problems import MAX_ERRORS, Problems, Reject
 from ..io.grasp.values import readonly
 from ..model import Grasp, GraspFileError, Hand
 
-__all__ = ["place", "placed", "read", "read_grasps", "run_hand"]
+__all__ = ["place_grasp", "placed", "read", "read_grasps", "run_hand"]
 
 
-def place(grasp: Grasp) -> Grasp | GraspFileError:
-    """``grasp`` with its hand on its contacts (its joint positions checked, or solved from the
-    seed), or the error of the fingers that cannot be; a grasp with nothing to place as it is."""
+def place_grasp(grasp: Grasp) -> Grasp | GraspFileError:
+    """A grasp with its URDF hand put on its contacts, as every command reads it.
+
+    The loader only reads (:func:`grasptwist.read_grasps`): a URDF hand comes at the
+    ``joint_positions`` its file gives, or at its ``seed``, with ``grasp.placement`` saying
+    which.  Here the given positions are checked against the contacts (forward kinematics), or
+    positions are solved from the seed (inverse kinematics).
+
+    Parameters
+    ----------
+    grasp : Grasp
+        As read; one without a pending placement (no hand, an inline hand, placed) is returned as it is.
+
+    Returns
+    -------
+    Grasp or GraspFileError
+        The grasp at its checked or solved joint positions (``placement`` None), or the error of
+        its document: ``contact-off-finger``, ``unreachable`` or ``outside-limits`` located at
+        each failing finger's ``tip`` in the file, every such problem in its ``problems``.
+
+    Examples
+    --------
+    >>> import grasptwist as gt
+    >>> (g,) = gt.read_grasps("grasps/three-finger-hand.yaml")  # an inline hand: nothing to place
+    >>> gt.hand.place_grasp(g) is g
+    True
+    """
     p = grasp.placement
     if p is None:
         return grasp
+    from ..engine.ik import place_hand  # inverse kinematics loads with the first URDF hand
+
     hand, q = grasp.hand, grasp.joint_positions
     solved = place_hand(hand, grasp.points, q) if p.given else place_hand(hand, grasp.points, seed=q)
     problems = Problems(MAX_ERRORS)
@@ -50,8 +75,8 @@ def place(grasp: Grasp) -> Grasp | GraspFileError:
 
 
 def placed(items: Iterable) -> list:
-    """Read grasps and errors with every hand placed (:func:`place`), in order."""
-    return [place(item) if isinstance(item, Grasp) else item for item in items]
+    """Read grasps and errors with every hand placed (:func:`place_grasp`), in order."""
+    return [place_grasp(item) if isinstance(item, Grasp) else item for item in items]
 
 
 def read(path, max_bytes: int | None = None) -> list:

@@ -5,6 +5,10 @@ everything it needs) and reads the results back in task order.  Each worker
 holds at most ``in_flight`` tasks not yet consumed, so a slow reader stops
 the workers instead of letting them run ahead without limit.
 
+A pool never starts more processes than it has tasks, nor more than
+:func:`pool_size`'s cap (4 per core, at most :data:`MAX_WORKERS`), however
+many are asked for: each costs a fork, three descriptors and its memory.
+
 Faults end a run instead of hanging it: a worker that dies (killed, out of
 memory, a bus error on a memory-mapped file) raises :class:`WorkerDied` in
 the parent as soon as the parent next waits; workers ignore SIGINT, SIGTERM
@@ -22,9 +26,26 @@ from typing import Any
 
 from .signals import STOP_SIGNALS, signals_blocked
 
-__all__ = ["Pool", "WorkerDied", "WorkerFailed"]
+__all__ = ["MAX_WORKERS", "Pool", "WorkerDied", "WorkerFailed", "pool_size"]
 
 _PR_SET_PDEATHSIG = 1
+
+#: The most processes a pool starts, whatever the machine.
+MAX_WORKERS = 64
+
+
+def pool_size(workers: int, tasks: int | None = None) -> int:
+    """How many processes a pool asked for ``workers`` starts for ``tasks`` tasks
+    (None: not known yet): at least one, at most ``tasks``, and at most 4 per
+    core and :data:`MAX_WORKERS`, beyond which more processes only queue for
+    the cores.
+
+    >>> pool_size(10_000, tasks=3), pool_size(2, tasks=100), pool_size(0)
+    (3, 2, 1)
+    """
+    cap = min(MAX_WORKERS, 4 * (os.cpu_count() or 1))
+    return max(1, min(workers, cap, workers if tasks is None else tasks))
+
 
 #: What a signal that kills a worker usually means.
 _CAUSES = {
@@ -53,7 +74,8 @@ class WorkerFailed(Exception):
 
 
 class Pool:
-    """``workers`` forked processes running ``task(i)``; results in order by :meth:`results`.
+    """Forked processes running ``task(i)`` (``workers`` of them, capped by
+    :func:`pool_size`); results in order by :meth:`results`.
 
     Use as a context manager: leaving it normally lets the workers exit;
     leaving it by an exception (a signal, a dead worker) kills them.
@@ -69,7 +91,7 @@ class Pool:
         self._in_flight = max(1, in_flight)
         self._workers: list[_Worker] = []
         try:
-            for _ in range(max(1, workers)):
+            for _ in range(pool_size(workers)):
                 here, there = Pipe()
                 # the child closes the parent's ends it inherits: a copy there would hide their end-of-file
                 self._workers.append(_Worker.fork(task, there, [w.conn for w in self._workers] + [here]))
@@ -77,6 +99,11 @@ class Pool:
         except BaseException:
             self.close(wait=False)
             raise
+
+    @property
+    def size(self) -> int:
+        """The number of worker processes."""
+        return len(self._workers)
 
     def results(self, count: int) -> Iterator[Any]:
         """``task(0)``, ..., ``task(count - 1)``, in order; a task is sent only

@@ -1,20 +1,28 @@
 """Where output goes: a file replaced atomically, or a pipe or device written through.
 
-The rule for an output path (``-o``):
+The rule for an output path (``-o``), decided by :func:`check_target` before any work:
 
-* a new path or a regular file is written to a temporary file in the same
-  folder, which takes the path's name only when the run succeeds, so a
-  failed or interrupted run leaves the path as it was.  The temporary file
-  has no name at all where the system allows it (Linux ``O_TMPFILE``, named
-  by ``linkat`` at the end); elsewhere it is ``.grasptwist-<host>-<pid>-*.tmp``,
-  which the next run writing to that folder removes if its owner is gone;
-* a symbolic link is followed: its target obeys this rule, the link stays;
-* a FIFO, a character device (a terminal, ``/dev/null``) and anything under
-  ``/dev`` or ``/proc`` (``/dev/stdout``) are opened and written through, as
-  a shell's ``>`` does, never replaced;
-* a folder, a block device, a socket, a link loop or a path in a missing
-  folder is refused (:func:`check_target` raises ValueError) before any work.
+* the empty name, a folder, a block device (a disk), a socket, a link loop
+  and a path in a missing or read-only folder are refused (ValueError);
+* so is a regular file that is one of the run's inputs, found by its
+  device and inode (through symbolic and hard links, and for standard
+  output and ``-`` too), so that a run never replaces what it reads;
+* a name of one of the process's own descriptors (``/dev/stdout``,
+  ``/dev/fd/N``, ``/proc/self/fd/N``) is that descriptor as it is, written
+  through; it must be open for writing, else :class:`WriteError`;
+* a FIFO and a character device (a terminal, ``/dev/null``) are opened and
+  written through, as a shell's ``>`` does, never replaced;
+* a new path or a regular file, wherever it is (``/dev/shm`` too), is
+  written to a temporary file in the same folder, which takes the path's
+  name, and the permission bits of the file it replaces, only when the run
+  succeeds, so a failed or interrupted run leaves the path as it was.  The
+  temporary file has no name at all where the system allows it (Linux
+  ``O_TMPFILE``, named by ``linkat`` at the end); elsewhere it is
+  ``.grasptwist-<host>-<pid>-*.tmp``, which the next run writing to that
+  folder removes if its owner is gone.  A symbolic link is followed: its
+  target obeys this rule, the link stays.
 
+Standard output is checked the same way: closed, it is a :class:`WriteError`.
 Every failure to write, including the final rename, is one
 :class:`WriteError` naming the path and the system's reason.
 """
@@ -26,13 +34,13 @@ import os
 import re
 import stat
 import sys
-from collections.abc import Iterator
+from collections.abc import Iterable, Iterator
 from contextlib import contextmanager, suppress
-from typing import IO
+from typing import IO, NamedTuple
 
 from .scratch import owned_prefix, remove_orphans
 
-__all__ = ["WriteError", "check_target", "opened", "guarded"]
+__all__ = ["STDOUT", "Target", "WriteError", "check_target", "opened", "guarded"]
 
 #: How errors name standard output.
 STDOUT = "standard output"
@@ -43,6 +51,9 @@ TEMP_STEM = ".grasptwist-"
 #: Errors that only writing can raise: an OSError with one of these and no
 #: file name (``write``, ``sendfile``), met while output is written, is a write error.
 WRITE_ERRNOS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EIO, errno.EROFS})
+
+#: Names of the process's own descriptors: group 1 a standard stream's name, group 2 a number.
+_DESCRIPTOR = re.compile(r"/dev/(stdin|stdout|stderr)|/(?:dev|proc/self)/fd/(\d+)")
 
 
 class WriteError(Exception):
@@ -58,29 +69,60 @@ class WriteError(Exception):
         super().__init__(f"cannot write {path}: {self.reason}")
 
 
-def check_target(path: str) -> tuple[str, str]:
-    """How ``path`` is written: ``("replace", file)`` for a file replaced
-    atomically (``file`` is ``path`` with its links followed), or
-    ``("through", path)`` for a pipe or device.
+class Target(NamedTuple):
+    """An output checked by :func:`check_target`: ``how`` it is written
+    (``"stdout"``, ``"through"`` or ``"replace"``), the ``path`` as given
+    and the ``file`` written (for ``"replace"``, ``path`` with its links followed)."""
+
+    how: str
+    path: str
+    file: str
+
+
+def check_target(path: str | None, inputs: Iterable = ()) -> Target:
+    """How ``path`` (None or ``-``: standard output) is written, by the rule
+    above; ``inputs`` are the paths the run reads (``-``: standard input;
+    other entries, like the errors of a folder's listing, are skipped).
 
     Raises
     ------
     ValueError
-        Naming ``path`` and why it cannot be an output.
+        Naming ``path`` and why it cannot be the output.
+
+    >>> check_target("")
+    Traceback (most recent call last):
+    ...
+    ValueError: cannot write '': the file name is empty
     """
-    if os.path.abspath(path).startswith(("/dev/", "/proc/")):
-        return "through", path
+    if path is None or path == "-":
+        target, info = Target("stdout", STDOUT, STDOUT), _descriptor_stat(1)
+    elif not path:
+        raise ValueError("cannot write '': the file name is empty")
+    elif (fd := _descriptor(path)) is not None:
+        target, info = Target("through", path, path), _descriptor_stat(fd)
+    else:
+        target, info = _by_type(path)
+    if info is not None and stat.S_ISREG(info.st_mode):
+        _not_an_input(target.path, info, inputs)
+    return target
+
+
+def _by_type(path: str) -> tuple[Target, os.stat_result | None]:
+    """How the file ``path`` is written, by its type; and its status (None for a new file)."""
     try:
-        mode = os.stat(path).st_mode
+        info = os.stat(path)
     except FileNotFoundError:
-        mode = None  # a new file (or the missing target of a link)
+        info = None  # a new file (or the missing target of a link)
     except OSError as exc:  # a link loop, a file where a folder should be, no permission
         raise ValueError(f"cannot write {path}: {exc.strerror}") from None
-    if mode is not None and stat.S_ISDIR(mode):
+    mode = info.st_mode if info is not None else stat.S_IFREG
+    if stat.S_ISDIR(mode):
         raise ValueError(f"cannot write {path}: it is a folder; give a file name")
-    if mode is not None and (stat.S_ISFIFO(mode) or stat.S_ISCHR(mode)):
-        return "through", path
-    if mode is not None and not stat.S_ISREG(mode):
+    if stat.S_ISBLK(mode):
+        raise ValueError(f"cannot write {path}: it is a block device (a disk); give a file name")
+    if stat.S_ISFIFO(mode) or stat.S_ISCHR(mode):
+        return Target("through", path, path), None
+    if not stat.S_ISREG(mode):
         raise ValueError(f"cannot write {path}: not a regular file, a pipe or a character device")
     real = os.path.realpath(path)
     folder = os.path.dirname(real)
@@ -89,14 +131,62 @@ def check_target(path: str) -> tuple[str, str]:
         raise ValueError(f"cannot write {path}: no folder {shown or folder}")
     if not os.access(folder, os.W_OK):
         raise ValueError(f"cannot write {path}: the folder is not writable")
-    return "replace", real
+    return Target("replace", path, real), info
+
+
+def _not_an_input(shown: str, info: os.stat_result, inputs: Iterable) -> None:
+    """A ValueError when the regular file of status ``info`` is one of ``inputs``."""
+    for p in inputs:
+        if not isinstance(p, str):
+            continue
+        try:
+            read = _descriptor_stat(0) if p == "-" else os.stat(p)
+        except OSError:  # a path the run cannot read either: it says so itself
+            continue
+        if read is not None and (read.st_dev, read.st_ino) == (info.st_dev, info.st_ino):
+            what = "the file standard input reads, an input" if p == "-" else f"the input {p}"
+            raise ValueError(f"cannot write {shown}: it is {what} (the same file); give another file name")
+
+
+def _descriptor(path: str) -> int | None:
+    """The descriptor a name like ``/dev/stdout`` or ``/dev/fd/3`` stands for, or None.
+
+    >>> _descriptor("/dev/stdout"), _descriptor("/dev/fd/3"), _descriptor("/dev/shm/out.jsonl")
+    (1, 3, None)
+    """
+    match = _DESCRIPTOR.fullmatch(os.path.abspath(path))
+    if match is None:
+        return None
+    return ("stdin", "stdout", "stderr").index(match[1]) if match[1] else int(match[2])
+
+
+def _descriptor_stat(fd: int) -> os.stat_result | None:
+    """The status of the open descriptor ``fd``; None if it is closed (opening it says so),
+    or is a standard stream the process does not use as such (tests capture them)."""
+    if fd < 3:
+        stream = (sys.stdin, sys.stdout, sys.stderr)[fd]
+        try:
+            if stream is None or stream.fileno() != fd:
+                return None
+        except (OSError, ValueError, AttributeError):
+            return None
+    try:
+        return os.fstat(fd)
+    except OSError:
+        return None
+
+
+def _closed_at_start(fd: int) -> bool:
+    """Whether ``fd`` is a standard stream the shell closed (``>&-``): Python then has no
+    object for it, and the number may since have been given to some other file."""
+    return fd < 3 and (sys.stdin, sys.stdout, sys.stderr)[fd] is None
 
 
 @contextmanager
-def opened(path: str | None) -> Iterator[IO[bytes]]:
+def opened(path: str | None | Target, inputs: Iterable = ()) -> Iterator[IO[bytes]]:
     """``path`` open for writing (and reading back, for zip archives) by the
     rule above, or stdout for None or ``-``; the output is committed when
-    the block ends normally.
+    the block ends normally.  ``path`` may be a :class:`Target` already checked.
 
     Raises
     ------
@@ -105,35 +195,51 @@ def opened(path: str | None) -> Iterator[IO[bytes]]:
     WriteError
         When opening, writing or committing fails.
     """
-    if path is None or path == "-":
+    target = path if isinstance(path, Target) else check_target(path, inputs)
+    if target.how == "stdout":
+        if _closed_at_start(1):
+            raise WriteError(STDOUT, OSError(errno.EBADF, "it is closed"))
         with _errors_named(STDOUT):
             out = guarded(sys.stdout.buffer, STDOUT)
             yield out
             out.flush()
         return
-    how, real = check_target(path)
-    if how == "through":
-        try:
-            raw = _open_through(path)
-        except OSError as exc:
-            raise WriteError(path, exc) from None
-        with _errors_named(path):
+    if target.how == "through":
+        raw = _open_through(target.path)
+        with _errors_named(target.path):
             with raw:
-                yield guarded(raw, path)
+                yield guarded(raw, target.path)
             return
-    with _errors_named(path), _replacing(real) as f:
-        yield guarded(f, path)
+    with _errors_named(target.path), _replacing(target.file) as f:
+        yield guarded(f, target.path)
 
 
 def _open_through(path: str) -> IO[bytes]:
     """A pipe or device opened for writing; a name of one of our own file
     descriptors (``/dev/stdout``, ``/dev/fd/N``) is that descriptor as it is
     (reopening would truncate a file the shell opened for appending)."""
-    match = re.fullmatch(r"/dev/(stdout|stderr)|/(?:dev|proc/self)/fd/(\d+)", os.path.abspath(path))
-    if match:
-        fd = {"stdout": 1, "stderr": 2}.get(match[1]) or int(match[2])
-        return os.fdopen(os.dup(fd), "wb")
-    return open(path, "wb")  # noqa: SIM115 - the caller closes it; a FIFO waits for its reader, as with `>`
+    fd = _descriptor(path)
+    try:
+        if fd is None:
+            return open(path, "wb")  # noqa: SIM115 - the caller closes it; a FIFO waits for its reader, as with `>`
+        return os.fdopen(os.dup(_writable(fd)), "wb")
+    except OSError as exc:
+        raise WriteError(path, exc) from None
+
+
+def _writable(fd: int) -> int:
+    """``fd``, if it is open for writing; else an OSError saying why not."""
+    import fcntl
+
+    try:
+        flags = None if _closed_at_start(fd) else fcntl.fcntl(fd, fcntl.F_GETFL)
+    except OSError:
+        flags = None
+    if flags is None:
+        raise OSError(errno.EBADF, "it is closed")
+    if flags & os.O_ACCMODE == os.O_RDONLY:
+        raise OSError(errno.EBADF, "it is open for reading only")
+    return fd
 
 
 @contextmanager
@@ -153,7 +259,12 @@ def _replacing(path: str) -> Iterator[IO[bytes]]:
     prefix = owned_prefix(TEMP_STEM)
     remove_orphans(folder, TEMP_STEM)  # what runs killed by SIGKILL left
     try:
-        fd, name = _temporary(folder, prefix)
+        # the permission bits of the file replaced (set-id bits have no business on new content)
+        mode = stat.S_IMODE(os.stat(path).st_mode) & 0o777
+    except OSError:
+        mode = None  # a new file
+    try:
+        fd, name = _temporary(folder, prefix, mode)
     except OSError as exc:
         raise WriteError(path, exc) from None
     try:
@@ -176,17 +287,28 @@ def _replacing(path: str) -> Iterator[IO[bytes]]:
         raise
 
 
-def _temporary(folder: str, prefix: str) -> tuple[int, str | None]:
-    """A new file in ``folder`` readable as an ordinary output (mode 0666 less
-    the umask): unnamed when the system can name it later, else named."""
+def _temporary(folder: str, prefix: str, mode: int | None) -> tuple[int, str | None]:
+    """A new file in ``folder`` with the permission bits ``mode`` (None: those of
+    a new file, 0666 less the umask): unnamed when the system can name it later,
+    else named."""
     if _can_name_unnamed(folder, prefix):
-        return os.open(folder, os.O_TMPFILE | os.O_RDWR | os.O_CLOEXEC, 0o666), None
-    import tempfile
+        fd, name = os.open(folder, os.O_TMPFILE | os.O_RDWR | os.O_CLOEXEC, 0o666), None
+    else:
+        import tempfile
 
-    fd, name = tempfile.mkstemp(prefix=prefix, suffix=".tmp", dir=folder)
-    umask = os.umask(0)
-    os.umask(umask)
-    os.fchmod(fd, 0o666 & ~umask)  # mkstemp makes it private; the output is an ordinary file
+        fd, name = tempfile.mkstemp(prefix=prefix, suffix=".tmp", dir=folder)
+        if mode is None:  # mkstemp makes it private; the output is an ordinary file
+            umask = os.umask(0)
+            os.umask(umask)
+            mode = 0o666 & ~umask
+    try:
+        if mode is not None:
+            os.fchmod(fd, mode)
+    except OSError:
+        os.close(fd)
+        if name is not None:
+            os.unlink(name)
+        raise
     return fd, name
 
 

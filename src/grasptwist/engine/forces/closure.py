@@ -22,12 +22,15 @@ common ``mu`` is found by bisection on ``theta = atan(mu)`` between ``max_i phi_
 
 **Epsilon** (Ferrari-Canny): each cone an ``m``-sided pyramid of edges
 ``n_i + mu_i (cos(2 pi k/m) b1_i + sin(2 pi k/m) b2_i)`` (normal component 1; ``b1_i`` the
-tangent towards the next contact, so the pyramids turn with the grasp), each edge
+tangent towards the next contact, or towards the other one when the next lies on the
+normal's line, so the pyramids turn with the grasp), each edge
 the wrench ``(f; (p_i - g) x f / L)`` with ``g`` the contacts' centroid and ``L`` the
 largest distance from ``g`` to a contact (so epsilon is a force, in units of the normal
 force, unchanged by rigid motions and by scaling); the radius of the largest ball about
 the origin inside the hull of those ``3 m`` wrenches and the origin (Qhull, through
-``scipy.spatial.ConvexHull``, one grasp at a time).
+``scipy.spatial.ConvexHull``, one grasp at a time).  The wrenches are divided by the
+largest ``mu_i`` (when above 1) before the hull and the radius multiplied back, so a huge
+friction gives a finite epsilon; an infinite one has no finite pyramid (epsilon NaN).
 """
 
 from __future__ import annotations
@@ -40,15 +43,32 @@ import numpy as np
 from ..checks import check_normals, check_points
 from ..degeneracy import DEGENERACY_TOL
 from ..screws import cross, dot, norm
-from .grasp_map import ForceStatus, check_friction, contact_matrices, geometry
+from .grasp_map import ForceStatus, check_friction, contact_matrices, geometry, tangent_bases
 
-__all__ = ["Closure", "force_closure", "closure_test", "epsilon_quality", "BISECTIONS", "MAX_FRICTION"]
+__all__ = [
+    "Closure",
+    "check_cone_edges",
+    "force_closure",
+    "closure_test",
+    "epsilon_quality",
+    "BISECTIONS",
+    "MAX_FRICTION",
+    "MAX_CONE_EDGES",
+]
 
 #: Halvings of ``atan(mu)``: ``pi/2 / 2**45 = 4.5e-14`` rad.
 BISECTIONS = 45
 
 #: A grasp that needs more common friction than this has none (``closure_friction`` NaN).
 MAX_FRICTION = 1e7
+
+#: The most edges a friction pyramid of epsilon may have: Qhull's time grows steeply with
+#: them (one grasp: 0.2 s at 32 edges, 2 s at 64, 30 s at 128 on a 2-core machine).
+MAX_CONE_EDGES = 64
+
+#: A first pyramid edge towards a contact whose offset is within this (relative) of the
+#: normal's line would point along round-off: the other contact's direction is taken.
+_ON_LINE = 1e-6
 
 _PAIRS = np.array(list(combinations(range(6), 2)))
 
@@ -72,7 +92,7 @@ class Closure:
         Ferrari-Canny's epsilon with the grasp's own friction (``quality=True``); 0
         outside force closure.
     status, culprit : (...) int8
-        :class:`~grasptwist.engine.forces.grasp_map.ForceStatus`; ``no-closure`` with
+        :class:`~grasptwist.forces.Status`; ``no-closure`` with
         the contact whose normal is at right angles to the contacts' plane, or -1.
     """
 
@@ -93,6 +113,7 @@ class _Plane:
         y = cross(nu, x)
         self.sin = np.abs(dot(unit, nu[:, None, :]))
         self.cos = np.sqrt(np.maximum(1 - self.sin**2, 0))
+        self.phi = np.arcsin(np.minimum(self.sin, 1.0))  # each normal's angle to the plane
         proj = unit - dot(unit, nu[:, None, :])[..., None] * nu[:, None, :]
         m2 = np.stack((dot(proj, x[:, None, :]), dot(proj, y[:, None, :])), axis=-1)
         self.m = m2 / np.linalg.norm(m2, axis=-1, keepdims=True)  # (n, 3, 2)
@@ -155,11 +176,13 @@ def _closure_chunk(r):
 
 
 def _own_rows(plane, mu):
-    """The sector rows with each contact's own ``mu_i``, and whether every cone reaches the plane."""
-    reduced2 = mu**2 * plane.cos**2 - plane.sin**2  # tan^2(beta)
-    cos_beta = 1 / np.sqrt(1 + np.maximum(reduced2, 0))
-    rows = plane.rows(cos_beta, np.sqrt(np.maximum(reduced2, 0)) * cos_beta)
-    return rows, (reduced2 > 0).all(axis=1) & ~np.isnan(mu).any(axis=1)
+    """The sector rows with each contact's own ``mu_i``, and whether every cone reaches the plane.
+
+    Through the angles ``theta_i = atan(mu_i)``, so a huge or infinite ``mu_i`` is a
+    sector of half-angle up to a right angle (a half-plane), never ``inf / inf``.
+    """
+    theta = np.arctan(mu)
+    return _sector_rows(plane, theta), (theta > plane.phi).all(axis=1) & ~np.isnan(mu).any(axis=1)
 
 
 def internal_inside(points, unit, geo, mu):
@@ -175,18 +198,21 @@ def internal_inside(points, unit, geo, mu):
     return np.where((ok & reach & (plane.cos > 0).all(axis=1))[:, None], s, np.nan)
 
 
-def _at_theta(plane, theta):
+def _sector_rows(plane, theta):
+    """The six rows of the sectors of the cones of half-angle ``theta`` (``(n, 1)`` or ``(n, 3)``)."""
     # sin^2(beta) = (sin^2 theta - sin^2 phi) / cos^2 phi, as a product that keeps small angles exact
-    t = theta[:, None]
-    phi = np.arcsin(np.minimum(plane.sin, 1.0))
-    sin_beta = np.sqrt(np.maximum(np.sin(t - phi) * np.sin(t + phi), 0)) / plane.cos
-    return closure_test(plane.rows(np.minimum(np.cos(t) / plane.cos, 1.0), sin_beta))[0]
+    sin_beta = np.sqrt(np.maximum(np.sin(theta - plane.phi) * np.sin(theta + plane.phi), 0)) / plane.cos
+    return plane.rows(np.minimum(np.cos(theta) / plane.cos, 1.0), sin_beta)
+
+
+def _at_theta(plane, theta):
+    return closure_test(_sector_rows(plane, theta[:, None]))[0]
 
 
 def _least_friction(plane):
     """Bisection on ``theta = atan(mu)``: ``(n)`` least common friction, NaN where none."""
     rows = len(plane.cos)
-    lo = np.arcsin(np.minimum(plane.sin.max(axis=1), 1.0))
+    lo = plane.phi.max(axis=1)
     hi = np.full(rows, np.arctan(MAX_FRICTION))
     some = _at_theta(plane, hi)
     at_lo = _at_theta(plane, lo + 1e-9)  # then the answer is max tan(phi_i), to 1e-9 rad
@@ -209,10 +235,51 @@ def _subset(plane, rows):
     return sub
 
 
+def check_cone_edges(cone_edges) -> int:
+    """The edges of each friction pyramid of epsilon: an integer from 3 to ``MAX_CONE_EDGES`` (64).
+
+    >>> check_cone_edges(8)
+    8
+    >>> check_cone_edges(1000000000)
+    Traceback (most recent call last):
+    ValueError: cone_edges must be an integer from 3 to 64, got 1000000000
+    """
+    number = isinstance(cone_edges, (int, np.integer, float, np.floating)) and not isinstance(cone_edges, bool)
+    # the range first: NaN and infinity fail it before int() sees them
+    if not (number and 3 <= cone_edges <= MAX_CONE_EDGES and cone_edges == int(cone_edges)):
+        raise ValueError(f"cone_edges must be an integer from 3 to {MAX_CONE_EDGES}, got {cone_edges!r}")
+    return int(cone_edges)
+
+
+def first_edges(points, normals):
+    """The unit tangent ``b1_i`` of each pyramid's first edge: ``(3, 3), (3, 3) unit -> (3, 3)``.
+
+    Towards the next contact (so that the pyramids turn with the grasp); when the next
+    contact lies on the normal's line (an antipodal pair), towards the other one; when
+    both do, any tangent.  Any tangent is a valid first edge: the choice only turns the
+    pyramid about its normal.
+
+    >>> p = np.array([[1.0, 0, 0], [-1, 0, 0], [0, 1, 0]])
+    >>> (first_edges(p, -p) + 0.0).tolist()
+    [[0.0, 1.0, 0.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0]]
+    """
+    p, n = np.asarray(points, float), np.asarray(normals, float)
+    choices = []
+    for other in ([1, 2, 0], [2, 0, 1]):
+        d = p[other] - p
+        t = d - np.einsum("ij,ij->i", d, n)[:, None] * n
+        with np.errstate(invalid="ignore", divide="ignore"):
+            choices.append((np.linalg.norm(t, axis=1) > _ON_LINE * np.linalg.norm(d, axis=1), t))
+    (next_ok, towards_next), (other_ok, towards_other) = choices
+    b1 = np.where(next_ok[:, None], towards_next, np.where(other_ok[:, None], towards_other, tangent_bases(n)[0]))
+    return b1 / np.linalg.norm(b1, axis=1, keepdims=True)
+
+
 def epsilon_quality(points, normals, friction, cone_edges=8):
     """Ferrari-Canny epsilon of one grasp (module docstring); 0 when the hull is flat or misses the origin.
 
-    ``(3, 3), (3, 3), (3,)`` -> float.  Needs scipy (the ``quality`` extra).
+    ``(3, 3), (3, 3), (3,)`` -> float; NaN when a friction is infinite (no finite
+    pyramid).  Needs scipy (the ``quality`` extra).
 
     >>> p = np.array([[1, 0, 0], [-0.5, 0.75**0.5, 0], [-0.5, -(0.75**0.5), 0]])
     >>> round(epsilon_quality(p, -p, [0.5, 0.5, 0.5]), 4)
@@ -223,13 +290,15 @@ def epsilon_quality(points, normals, friction, cone_edges=8):
     p = np.asarray(points, float)
     n = np.asarray(normals, float)
     n = n / np.linalg.norm(n, axis=-1, keepdims=True)
-    # the pyramids' first edges towards the next contact, so that epsilon is the grasp's own figure
-    b1 = (p[[1, 2, 0]] - p) - np.einsum("ij,ij->i", p[[1, 2, 0]] - p, n)[:, None] * n
-    b1 /= np.linalg.norm(b1, axis=1, keepdims=True)
+    mu = np.broadcast_to(np.asarray(friction, float), (3,))
+    if not np.isfinite(mu).all():
+        return float("nan")
+    b1 = first_edges(p, n)
     b2 = np.cross(n, b1)
     angle = 2 * np.pi * np.arange(cone_edges) / cone_edges
-    mu = np.broadcast_to(np.asarray(friction, float), (3,))
-    f = n[:, None, :] + mu[:, None, None] * (
+    # edges divided by k (the radius is multiplied back): a huge mu stays within range
+    k = max(1.0, float(mu.max()))
+    f = n[:, None, :] / k + (mu / k)[:, None, None] * (
         np.cos(angle)[:, None] * b1[:, None, :] + np.sin(angle)[:, None] * b2[:, None, :]
     )
     q = p - p.mean(axis=0)
@@ -239,10 +308,10 @@ def epsilon_quality(points, normals, friction, cone_edges=8):
         hull = ConvexHull(np.vstack((np.zeros(6), wrenches)))
     except QhullError:  # the wrenches do not span six dimensions: no closure
         return 0.0
-    return float(max(0.0, np.min(-hull.equations[:, -1])))
+    return float(max(0.0, np.min(-hull.equations[:, -1]))) * k
 
 
-def force_closure(points, normals, friction=None, quality=False, cone_edges=8, *, tol=DEGENERACY_TOL) -> Closure:
+def force_closure(points, normals, friction=None, *, quality=False, cone_edges=8, tol=DEGENERACY_TOL) -> Closure:
     r"""Force closure of each grasp: the least common friction, the verdict with ``friction``, epsilon.
 
     Parameters
@@ -254,7 +323,7 @@ def force_closure(points, normals, friction=None, quality=False, cone_edges=8, *
         Also compute Ferrari-Canny's ``epsilon`` (needs ``friction`` and scipy;
         one Qhull call per grasp).
     cone_edges : int
-        Edges of each friction pyramid for ``epsilon`` (at least 3).
+        Edges of each friction pyramid for ``epsilon`` (3 to ``MAX_CONE_EDGES`` (64)).
     tol : float
         Degeneracy tolerance of the contacts.
 
@@ -281,12 +350,11 @@ def force_closure(points, normals, friction=None, quality=False, cone_edges=8, *
         mu = np.broadcast_to(mu if mu.ndim else mu[None], shape + (3,)).reshape(-1, 3)
     if quality and mu is None:
         raise ValueError("quality=True needs the grasp's friction (friction=MU) for the pyramids' edges")
-    if int(cone_edges) != cone_edges or cone_edges < 3:
-        raise ValueError(f"cone_edges must be an integer >= 3, got {cone_edges!r}")
+    cone_edges = check_cone_edges(cone_edges)
     size = int(np.prod(shape))
     p = np.broadcast_to(p, shape + (3, 3)).reshape(size, 3, 3)
     n = np.broadcast_to(n, shape + (3, 3)).reshape(size, 3, 3)
-    out = _closure_rows(p, n, mu, quality, int(cone_edges), tol)
+    out = _closure_rows(p, n, mu, quality, cone_edges, tol)
     return Closure(**{k: None if v is None else v.reshape(shape) for k, v in out.items()})
 
 

@@ -20,12 +20,13 @@ Contact ``i`` pushes on the object with a force ``f_i`` at ``p_i``; as a wrench
   ``Sigma_i`` (eq. 8): ``f_j = s_i e_i``, ``f_k = -s_i e_i``, ``e_i = (p_k - p_j)/|p_k - p_j|``.
   As wrenches the two halves are ``+s_i Sigma_i`` and ``-s_i Sigma_i``.
 
-The statuses (:class:`ForceStatus`) share their numbers with the twist engine's
+The statuses (:class:`~grasptwist.forces.Status`) share their numbers with the twist engine's
 :class:`~grasptwist.engine.degeneracy.Status` where the condition is the same.
 """
 
 from __future__ import annotations
 
+from dataclasses import replace
 from enum import IntEnum
 from typing import NamedTuple
 
@@ -36,11 +37,14 @@ from ..degeneracy import DEGENERACY_TOL
 from ..screws import J, K, cross, dot, norm
 
 __all__ = [
+    "Status",
     "ForceStatus",
     "force_status_message",
     "check_wrench",
     "check_friction",
     "check_safety",
+    "nonfinite_result",
+    "checked_grip",
     "grasp_map",
     "manipulating_reference",
     "squeeze_directions",
@@ -49,10 +53,11 @@ __all__ = [
     "contact_matrices",
     "manipulating_forces",
     "ManipulatingForces",
+    "collinear_manipulating",
 ]
 
 
-class ForceStatus(IntEnum):
+class Status(IntEnum):
     """Why a row of a force result has no numbers (0: it has)."""
 
     OK = 0
@@ -60,6 +65,8 @@ class ForceStatus(IntEnum):
     COINCIDENT_CONTACTS = 2
     COLLINEAR_CONTACTS = 3
     ZERO_NORMAL = 5
+    NONFINITE_RESULT = 9
+    NONFINITE_POSE = 16  # along a path: the pose overflows (grasptwist.engine.path.pose_overflowed)
     CANNOT_HOLD = 20
     NO_CLOSURE = 21
     MIXED_FRICTIONLESS = 22
@@ -70,6 +77,9 @@ class ForceStatus(IntEnum):
         return self.name.lower().replace("_", "-")
 
 
+#: The layers' name for it, beside the twist engine's :class:`~grasptwist.Status`.
+ForceStatus = Status
+
 _MESSAGES = {
     ForceStatus.OK: "ok",
     ForceStatus.NONFINITE_INPUT: "the input holds NaN or infinity",
@@ -78,6 +88,10 @@ _MESSAGES = {
         "the contacts are collinear, so no finger forces make a moment about their line (rank G < 6)"
     ),
     ForceStatus.ZERO_NORMAL: "the normal at contact {i} has zero length",
+    ForceStatus.NONFINITE_RESULT: (
+        "the result overflows double precision (a force is infinite or NaN): rescale the wrench, mass or coordinates"
+    ),
+    ForceStatus.NONFINITE_POSE: "the object's pose overflows double precision here: rescale the twist or shorten the path",
     ForceStatus.NO_CLOSURE: "no friction makes the grasp force closure: {why}",
     ForceStatus.MIXED_FRICTIONLESS: (
         "contacts with and without friction in one grasp are not solved yet (give every contact mu > 0, or all 0)"
@@ -89,21 +103,37 @@ _CANNOT_HOLD = {
 }
 
 
-def force_status_message(status, culprit=-1) -> str:
+def force_status_message(status, culprit=-1, names=("1", "2", "3")) -> str:
     """One sentence for a row's status and culprit (a contact index, or -1).
 
-    For ``cannot-hold`` a culprit of -1 means the wrench needs pulling; for
-    ``no-closure`` a culprit is the contact whose normal is at right angles to
-    the contacts' plane.
+    The force side's :func:`grasptwist.status_message`, with the same arguments
+    (public as :func:`grasptwist.forces.status_message`).
 
-    >>> force_status_message(ForceStatus.CANNOT_HOLD, 2)
+    Parameters
+    ----------
+    status : int or Status
+    culprit : int
+        Contact index 0..2 the condition is about, or -1.  For ``cannot-hold``
+        -1 means the wrench needs pulling; for ``no-closure`` a culprit is the
+        contact whose normal is at right angles to the contacts' plane.
+    names : sequence of 3 str
+        Contact names to use in the message.
+
+    Returns
+    -------
+    str
+
+    Examples
+    --------
+    >>> from grasptwist import forces
+    >>> forces.status_message(forces.Status.CANNOT_HOLD, 2)
     'cannot-hold: the friction cone at contact 3 is too narrow (mu/safety) for any forces that make the wrench'
-    >>> force_status_message(ForceStatus.NO_CLOSURE, 0)
-    "no friction makes the grasp force closure: the normal at contact 1 is at right angles to the contacts' plane"
+    >>> forces.status_message(forces.Status.NO_CLOSURE, 0, ("thumb", "index", "middle"))
+    "no friction makes the grasp force closure: the normal at contact thumb is at right angles to the contacts' plane"
     """
     s = ForceStatus(int(status))
     c = int(culprit)
-    i, j, k = (c if c >= 0 else 0) + 1, (c + 1) % 3 + 1, (c + 2) % 3 + 1
+    i, j, k = names[c if c >= 0 else 0], names[(c + 1) % 3], names[(c + 2) % 3]
     if s == ForceStatus.CANNOT_HOLD:
         return _CANNOT_HOLD[c < 0].format(i=i)
     why = (
@@ -187,6 +217,67 @@ def check_safety(safety) -> float:
     return s
 
 
+def nonfinite_result(status, *parts) -> np.ndarray:
+    """``status`` with ``nonfinite-result`` where a row is ok but a part of its result is NaN or infinite.
+
+    The one place an ok row's numbers are held to be finite (huge wrenches, masses or
+    coordinates overflow inside the formulas).  ``status (...)``; each part ``(..., *)``
+    with the same leading axes.
+
+    >>> nonfinite_result(np.array([0, 0, 20]), np.array([[1.0, 2.0], [1.0, np.inf], [np.nan, 0.0]])).tolist()
+    [0, 9, 20]
+    """
+    out = np.array(status, copy=True)
+    bad = np.zeros(out.shape, bool)
+    for part in parts:
+        part = np.asarray(part)
+        bad |= ~np.isfinite(part.reshape(out.shape + (-1,))).all(axis=-1)
+    out[(out == ForceStatus.OK) & bad] = ForceStatus.NONFINITE_RESULT
+    return out
+
+
+#: The numbers of a grip (:class:`~grasptwist.engine.forces.grip.Grip`) held finite on its ok rows.
+GRIP_NUMBERS = (
+    "force",
+    "squeeze",
+    "normal_force",
+    "tangential_force",
+    "friction_used",
+    "total_normal_force",
+    "dual",
+    "gap",
+)
+
+
+def checked_grip(g):
+    """A grip whose ok rows are finite: ``nonfinite-result`` (and NaN numbers) where they are not.
+
+    Where a force has no tangential part (no wrench: no force at all; a bare contact
+    whose tangential force is round-off, below ``1e-12`` of the row's largest force) it
+    uses no friction, ``friction_used = 0`` rather than ``0 / 0`` or ``1e-18 / 0``.
+    :func:`~grasptwist.engine.forces.grip.grip` returns its result through here.
+
+    >>> from grasptwist.engine.forces.grip import grip
+    >>> p = [[1, 0, 0], [-0.5, 0.75**0.5, 0], [-0.5, -(0.75**0.5), 0]]
+    >>> g = grip(p, -np.array(p), [[0, 0, 0, 0, 0, 0], [0, 0, 1e308, 0, 0, 1e308]], 0.5)
+    >>> g.status.tolist(), g.friction_used[0].tolist()
+    ([0, 9], [0.0, 0.0, 0.0])
+    """
+    ok = (g.status == ForceStatus.OK)[..., None]
+    # a bare contact's tangential force is round-off of the row's forces, not friction used
+    scale = np.max(np.abs(g.force), axis=(-2, -1), initial=0.0)[..., None]
+    used = np.where(ok & (g.tangential_force <= 1e-12 * scale), 0.0, g.friction_used)
+    # a squeeze is NaN by definition on collinear contacts (their internal forces are not three squeezes)
+    checked = (name for name in GRIP_NUMBERS if name != "squeeze")
+    status = nonfinite_result(g.status, *(used if name == "friction_used" else getattr(g, name) for name in checked))
+    failed = status != ForceStatus.OK
+    numbers = {name: getattr(g, name) for name in GRIP_NUMBERS} | {"friction_used": used}
+    numbers = {
+        k: np.where(failed.reshape(failed.shape + (1,) * (v.ndim - failed.ndim)), np.nan, v) for k, v in numbers.items()
+    }
+    return replace(g, status=status, **numbers)
+
+
 # --- reference formulas (readable; the tests hold the fast forms to them) -----------
 
 
@@ -216,7 +307,7 @@ def manipulating_reference(points, wrench) -> np.ndarray:
 
     ``(..., 3, 3), (..., 6) -> (..., 3, 3)``.
 
-    >>> manipulating_reference([[1, 0, 0], [-0.5, 0.75**0.5, 0], [-0.5, -(0.75**0.5), 0]], [0, 0, 3, 0, 0, 0]).round(6).tolist()
+    >>> (manipulating_reference([[1, 0, 0], [-0.5, 0.75**0.5, 0], [-0.5, -(0.75**0.5), 0]], [0, 0, 3, 0, 0, 0]).round(6) + 0.0).tolist()
     [[0.0, 0.0, 1.0], [0.0, 0.0, 1.0], [0.0, 0.0, 1.0]]
     """
     w = np.asarray(wrench, dtype=float)
@@ -320,6 +411,51 @@ def _manipulating(geo: Geometry, wrench):
     return np.where((geo.status == 0)[..., None, None], f, np.nan)
 
 
+class CollinearMap(NamedTuple):
+    """The grasp map of collinear contacts (rank 5), its moment rows divided by the grasp's size ``L``.
+
+    ``u (n, 6, 5)``, ``s (n, 5)``, ``v (n, 9, 5)``: the thin SVD of ``D G`` with
+    ``D = diag(1, 1, 1, 1/L, 1/L, 1/L)`` (forces and moments compare); ``null (n, 9, 4)``
+    the internal forces: pushes along the line and pairs across it.
+    """
+
+    u: np.ndarray
+    s: np.ndarray
+    v: np.ndarray
+    null: np.ndarray
+    size: np.ndarray
+
+
+def collinear_map(points, size) -> CollinearMap:
+    """:class:`CollinearMap` of ``points (n, 3, 3)`` with ``size (n)``."""
+    g = grasp_map(points)
+    g[:, 3:] /= size[:, None, None]
+    u, s, vt = np.linalg.svd(g)
+    return CollinearMap(u[..., :5], s[:, :5], np.swapaxes(vt[:, :5], -1, -2), np.swapaxes(vt[:, 5:], -1, -2), size)
+
+
+def _scaled(wrench, size):
+    return np.concatenate((wrench[..., :3], wrench[..., 3:] / size[:, None]), axis=-1)
+
+
+def collinear_manipulating(cmap: CollinearMap, wrench, tol=1e-9):
+    r"""``G^+ w`` for collinear contacts, and where ``w`` is out of ``G``'s range the part that is.
+
+    Returns ``force (n, 3, 3)`` (NaN where ``w`` is out of range), ``made (n)`` bool and
+    ``y (n, 6)``: ``y = D r`` with ``r`` the part of ``D w`` outside the range, so
+    ``y . w = |r|^2 > 0`` and ``y . G f = 0`` for every ``f``: the moment about the
+    contacts' line that no finger force makes (zero where ``made``).
+    """
+    dw = _scaled(wrench, cmap.size)
+    coef = np.einsum("nji,nj->ni", cmap.u, dw)
+    r = dw - np.einsum("nji,ni->nj", cmap.u, coef)
+    with np.errstate(all="ignore"):
+        made = np.linalg.norm(r, axis=-1) <= tol * np.linalg.norm(dw, axis=-1)
+        f = np.einsum("nji,ni->nj", cmap.v, coef / cmap.s).reshape(-1, 3, 3)
+    y = _scaled(r, cmap.size)
+    return np.where(made[:, None, None], f, np.nan), made, np.where(made[:, None], 0.0, y)
+
+
 class ManipulatingForces(NamedTuple):
     """Yoshikawa-Nagai's manipulating forces of a batch of (grasp, wrench) rows.
 
@@ -334,7 +470,9 @@ class ManipulatingForces(NamedTuple):
         1 for an equilateral triangle, falling like the offset from a line to 0
         for collinear contacts.  ``G^+ w`` grows like ``1 / conditioning`` there.
     status, culprit : (...) int8
-        :class:`ForceStatus` and the contact it is about (or -1).
+        :class:`~grasptwist.forces.Status` and the contact it is about (or -1).  Collinear contacts
+        (conditioning 0) are ``collinear-contacts`` only when the wrench has a moment about
+        their line, which no finger force makes; otherwise ``force`` is ``G^+ w``.
     """
 
     force: np.ndarray
@@ -378,9 +516,16 @@ def manipulating_forces(points, wrench, *, tol=DEGENERACY_TOL) -> ManipulatingFo
     geo = geometry(p, tol)
     f = _manipulating(geo, w)
     status, culprit = geo.status.copy(), geo.culprit.copy()
-    bad = (status == 0) & ~np.isfinite(w).all(axis=-1)
-    status[bad] = ForceStatus.NONFINITE_INPUT
-    f[bad] = np.nan
+    line = np.flatnonzero(status.reshape(-1) == ForceStatus.COLLINEAR_CONTACTS)
+    if line.size:  # rank 5: G^+ w still makes w when w has no moment about the contacts' line
+        flat = (p.reshape(-1, 3, 3)[line], w.reshape(-1, 6)[line])
+        lf, made, _ = collinear_manipulating(collinear_map(flat[0], geo.size.reshape(-1)[line]), flat[1])
+        made &= np.isfinite(flat[1]).all(axis=-1)
+        f.reshape(-1, 3, 3)[line[made]] = lf[made]
+        status.reshape(-1)[line[made]] = ForceStatus.OK
+    status[(status == 0) & ~np.isfinite(w).all(axis=-1)] = ForceStatus.NONFINITE_INPUT
+    status = nonfinite_result(status, f)
+    f[status != 0] = np.nan
     return ManipulatingForces(f, geo.conditioning, status, culprit)
 
 

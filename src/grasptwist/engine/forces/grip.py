@@ -9,31 +9,45 @@ a second-order cone program in the three squeezes (``s_f`` the safety factor), s
 for every row together by :mod:`~grasptwist.engine.forces.socp`.  Frictionless grasps
 (``mu = 0`` at every contact: the cones are rays) are solved in closed form instead:
 ``f_i = lambda_i n_i`` with ``sum lambda_i nu_i = w`` (``nu_i`` the normal lines).
+Collinear contacts (``rank G = 5``) are solved when the wrench lies in the range of ``G``
+(no moment about the contacts' line), over the four internal forces of such a grasp.
+
+**Certificates.**  The dual of the grip is ``max w . lambda`` s.t.
+``n_i - G_i^T lambda`` in the dual cone ``K_i* = {z : (mu_i / s_f) |z_t| <= z_n}``
+(``G_i^T lambda = lambda_F + lambda_M x p_i``).  The solver's cone multipliers ``z_i``
+give ``u_i = F_i^T z_i`` (``F_i`` the cone's frame), and ``lambda`` is the twist whose
+field at the contacts is ``n_i - u_i`` (least squares, in closed form about the
+centroid).  ``total - w . lambda`` is the duality gap, and ``lambda = d total / d w``.
+Where no grip exists, phase I's multipliers give ``y`` with ``y . w > 0`` and
+``-G_i^T y`` in ``K_i*``: no forces within the cones have a component along ``y``.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import partial
 
 import numpy as np
 
 from ..checks import check_normals, check_points
 from ..degeneracy import DEGENERACY_TOL
 from ..screws import cross, dot, norm
-from . import closure, socp
+from . import closure, one, socp
 from .grasp_map import (
     ForceStatus,
     _manipulating,
     check_friction,
     check_safety,
     check_wrench,
+    checked_grip,
+    collinear_manipulating,
+    collinear_map,
     contact_matrices,
     geometry,
-    squeeze_forces,
     tangent_bases,
 )
 
-__all__ = ["Grip", "grip", "cone_rows"]
+__all__ = ["Grip", "grip", "prepare_grip", "PreparedGrip", "load_words"]
 
 #: Rows solved together: enough for numpy's per-call cost to be noise, few enough for the
 #: solver's temporaries to stay in the CPU cache.
@@ -55,7 +69,8 @@ class Grip:
     manipulating : (..., 3, 3)
         ``G^+ w`` (NaN only for degenerate contacts).
     squeeze : (..., 3)
-        The squeezes along the sides opposite each contact (positive: compression).
+        The squeezes along the sides opposite each contact (positive: compression);
+        NaN for collinear contacts, whose internal forces are not three squeezes.
     normal_force, tangential_force : (..., 3)
         ``f_i . n_i`` and ``|f_i - (f_i . n_i) n_i|``.
     friction_used : (...,  3)
@@ -66,10 +81,23 @@ class Grip:
     conditioning : (...)
         As :class:`~grasptwist.engine.forces.grasp_map.ManipulatingForces`.
     status, culprit : (...) int8
-        :class:`~grasptwist.engine.forces.grasp_map.ForceStatus`; for
+        :class:`~grasptwist.forces.Status`; for
         ``cannot-hold`` the culprit is the contact whose cone is too narrow, or
         -1 when the wrench needs pulling
-        (:func:`~grasptwist.engine.forces.grasp_map.force_status_message`).
+        (:func:`~grasptwist.forces.status_message`).
+    dual : (..., 6)
+        The wrench's multiplier ``lambda`` (a twist: ``G_i^T lambda = lambda_F + lambda_M x p_i``):
+        ``n_i - G_i^T lambda`` lies in contact ``i``'s dual cone
+        ``(mu_i / safety) |z_t| <= z_n``, and it is the sensitivity ``d total / d w``.
+        NaN where ``status != 0``.
+    gap : (...)
+        The duality gap ``total_normal_force - w . dual`` (0 at the optimum, to round-off).
+    certificate : (..., 6)
+        NaN where the grip holds; for ``cannot-hold`` (and collinear contacts asked for a
+        moment about their line) a ``y`` with ``y . w > 0`` and ``y . G_i f <= 0`` for
+        every admissible ``f`` of every contact: a proof that no grip exists (Farkas).
+        Scaled to ``|(y_F, L y_M)| = 1``, ``L`` the largest distance from the contacts'
+        centroid to a contact (``load_words`` puts it in words).
     """
 
     force: np.ndarray
@@ -83,6 +111,9 @@ class Grip:
     conditioning: np.ndarray
     status: np.ndarray
     culprit: np.ndarray
+    dual: np.ndarray
+    gap: np.ndarray
+    certificate: np.ndarray
 
     @property
     def ok(self) -> np.ndarray:
@@ -90,36 +121,110 @@ class Grip:
         return self.status == ForceStatus.OK
 
 
+def norm_rows(a):
+    return np.sqrt(np.einsum("ni,ni->n", a, a))
+
+
 def _frictionless(nu, w, tol):
     """``f_i = lambda_i n_i`` with ``sum lambda_i nu_i = w``, ``lambda >= 0``, least ``sum lambda``.
 
     ``nu (n, 3, 6)`` unit normal lines, ``w (n, 6)`` scaled to order one.  Returns
-    ``lam (n, 3)`` (NaN where none exists), ``needs_pulling (n)``, ``culprit (n)``.
+    ``lam (n, 3)`` (NaN where none exists), ``needs_pulling (n)``, ``unmade (n)``, the dual
+    ``(n, 6)`` (``nu_i . dual <= 1``, equal where ``lam_i > 0``) and the certificate ``(n, 6)``
+    (``nu_i . y <= 0`` for every ``i``, ``w . y > 0``) where it fails.
     """
     k = np.swapaxes(nu, -1, -2)  # (n, 6, 3)
     u, sv, vt = np.linalg.svd(k, full_matrices=False)
     rank3 = sv[:, 2] > tol * sv[:, 0]
     with np.errstate(divide="ignore"):
         inv = np.where(rank3[:, None] | (np.arange(3) < 2), 1 / sv, 0.0)
-    lam = np.einsum("nji,nj,nkj,nk->ni", vt, inv, u, w)  # the least-squares lambda
-    made = norm_rows(np.einsum("nij,nj->ni", k, lam) - w) <= tol * np.maximum(norm_rows(w), 1e-300)
+    pinv_t = np.einsum("nji,ni,nik->njk", u, inv, vt)  # (N^T)^+ = U S^-1 V^T: (n, 6, 3)
+    lam0 = np.einsum("nji,nj->ni", pinv_t, w)  # the least-squares lambda
+    residual = np.einsum("nij,nj->ni", k, lam0) - w
+    made = norm_rows(residual) <= tol * np.maximum(norm_rows(w), 1e-300)
     z = vt[:, 2]  # the null direction when rank 2: a free squeeze along the normals
     z = np.where((z.sum(axis=1) < 0)[:, None], -z, z)
     with np.errstate(divide="ignore", invalid="ignore"):
-        bound = np.where(z > tol, -lam / z, -np.inf).max(axis=1)  # lam + t z >= 0 from below
-        upper = np.where(z < -tol, -lam / z, np.inf).min(axis=1)
+        low = np.where(z > tol, -lam0 / z, -np.inf)  # lam + t z >= 0 from below
+        high = np.where(z < -tol, -lam0 / z, np.inf)
+    bound, upper = low.max(axis=1), high.min(axis=1)
     t = np.where(rank3, 0.0, bound)
-    lam = np.where(rank3[:, None], lam, lam + t[:, None] * z)
+    lam = np.where(rank3[:, None], lam0, lam0 + t[:, None] * z)
     pushes = np.where(rank3, (lam >= -tol).all(axis=1), (bound <= upper) & np.isfinite(bound))
     lam = np.where((made & pushes)[:, None], np.maximum(lam, 0), np.nan)
-    return lam, made & ~pushes, ~made
+    # the dual: nu_i . dual = a_i, a_i = 1 where lam_i > 0; rank 2 needs z . a = 0 (a on the idle one)
+    active = lam > tol * np.nanmax(np.abs(lam), axis=1, initial=0.0)[:, None]
+    idle = np.argmin(np.where(active, np.inf, -np.abs(z)), axis=1)  # the idle contact with the largest |z|
+    rows = np.arange(len(w))
+    a = np.ones((len(w), 3))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        fix = (z.sum(axis=1) - z[rows, idle]) / z[rows, idle]
+    a[rows, idle] = np.where(rank3, 1.0, -fix)
+    dual = np.einsum("njk,nk->nj", pinv_t, a)
+    # the certificates: the unmade part; one negative lambda (rank 3); two bounds that cross (rank 2)
+    first = np.argmin(lam0, axis=1)
+    b = np.zeros((len(w), 3))
+    b[rows, first] = -1.0
+    lo, hi = np.argmax(low, axis=1), np.argmin(high, axis=1)
+    c = np.zeros((len(w), 3))
+    c[rows, lo] -= np.abs(z[rows, hi])
+    c[rows, hi] -= np.abs(z[rows, lo])
+    flat = (np.abs(z) <= tol) & (lam0 < -tol)  # a contact the free squeeze does not move, pulling
+    c = np.where(flat.any(axis=1)[:, None], -flat.astype(float), c)
+    y = np.einsum("njk,nk->nj", pinv_t, np.where(rank3[:, None], b, c))
+    y = np.where(made[:, None], y, -residual)
+    return lam, made & ~pushes, ~made, dual, y
 
 
-def norm_rows(a):
-    return np.sqrt(np.einsum("ni,ni->n", a, a))
+def _twist_through(geo, d):
+    """The twist ``lambda (n, 6)`` whose field ``lambda_F + lambda_M x p_i`` is nearest ``d_i`` (least squares).
+
+    About the centroid the normal equations split: ``v = mean(d)``, ``J omega = sum q_i x d_i``,
+    ``J^-1`` in closed form as in :func:`~grasptwist.engine.forces.grasp_map.manipulating_forces`.
+    """
+    v = d.mean(axis=-2)
+    x = cross(geo.q, d).sum(axis=-2)
+    spread = 3 * np.sum(geo.q * dot(geo.q, x[..., None, :])[..., None], axis=-2)
+    omega = (geo.m * (dot(geo.m, x) / geo.t)[..., None] + spread) / dot(geo.m, geo.m)[..., None]
+    return np.concatenate((v - cross(omega, geo.centroid), omega), axis=-1)
 
 
-def grip(points, normals, wrench, friction, safety=1.0, *, tol=DEGENERACY_TOL) -> Grip:
+def _twist_through_line(cmap, d):
+    """:func:`_twist_through` for collinear contacts (rank 5), through the SVD of ``D G``."""
+    coef = np.einsum("nji,nj->ni", cmap.v, d.reshape(-1, 9)) / cmap.s
+    lam = np.einsum("nji,ni->nj", cmap.u, coef)
+    lam[:, 3:] /= cmap.size[:, None]
+    return lam
+
+
+def _unit(y, size):
+    """``y`` scaled to ``|(y_F, L y_M)| = 1`` (``L`` the grasp's size: force and moment parts compare)."""
+    with np.errstate(all="ignore"):
+        length = np.sqrt(dot(y[:, :3], y[:, :3]) + size**2 * dot(y[:, 3:], y[:, 3:]))
+        return y / length[:, None]
+
+
+def load_words(certificate, points) -> str:
+    r"""The load a ``cannot-hold`` grip cannot resist, in words, from its certificate ``y``.
+
+    The load ``(-y_F; -L^2 y_M)`` (``L`` the largest distance from the contacts' centroid
+    to a contact) has ``y . load < 0``: the fingers, whose wrenches all have
+    ``y . G f <= 0``, cannot balance it.  Its force is of order one and its moment of
+    order ``L``: a force with a lever arm on the grasp's scale.
+
+    >>> load_words([0, 0, 1, 0, 0, 0], [[1, 0, 0], [-0.5, 0.75**0.5, 0], [-0.5, -(0.75**0.5), 0]])
+    'cannot resist a force along (0, 0, -1) with a moment (0, 0, 0) about the origin'
+    """
+    y = np.asarray(certificate, dtype=float)
+    p = np.asarray(points, dtype=float)
+    size = np.sqrt(((p - p.mean(axis=0)) ** 2).sum(axis=1).max())
+    load = -np.concatenate((y[:3], size**2 * y[3:]))
+    load = np.round(load / np.sqrt(y[:3] @ y[:3] + size**2 * (y[3:] @ y[3:])), 3) + 0.0  # + 0.0: no -0
+    force, moment = (", ".join(f"{v:.3g}" for v in part) for part in (load[:3], load[3:]))
+    return f"cannot resist a force along ({force}) with a moment ({moment}) about the origin"
+
+
+def grip(points, normals, wrench, friction, *, safety=1.0, tol=DEGENERACY_TOL) -> Grip:
     r"""The finger forces that exert ``wrench`` with the least total normal force, inside every cone.
 
     Parameters
@@ -131,7 +236,7 @@ def grip(points, normals, wrench, friction, safety=1.0, *, tol=DEGENERACY_TOL) -
         (to hold a weight ``m g``: ``(-m g; -c x m g)``, ``c`` the centre of mass).
     friction : scalar or (..., 3) array
         ``mu_i`` per contact (last axis), ``>= 0``, ``inf`` for no limit.
-    safety : float
+    safety : float, keyword-only
         ``s >= 1``: the forces keep within ``mu_i / s``.
     tol : float
         Degeneracy tolerance of the contacts (as the twist engine's).
@@ -139,17 +244,22 @@ def grip(points, normals, wrench, friction, safety=1.0, *, tol=DEGENERACY_TOL) -
     Returns
     -------
     Grip
+        With the optimum's certificate (``dual``, ``gap``) or the proof that none exists
+        (``certificate``).
 
     Examples
     --------
     A 1 kg ball held at its equator with ``mu = 0.5``: each finger carries a third
-    of the weight by friction, ``f_n = m g / (3 mu)``, in total ``m g / mu``:
+    of the weight by friction, ``f_n = m g / (3 mu)``, in total ``m g / mu``; the
+    dual says that one more newton of lift costs ``1 / mu = 2`` N of grip:
 
     >>> p = [[1, 0, 0], [-0.5, 0.75**0.5, 0], [-0.5, -(0.75**0.5), 0]]
     >>> n = -np.array(p)
     >>> g = grip(p, n, [0, 0, 9.81, 0, 0, 0], 0.5)
     >>> round(float(g.total_normal_force), 6), g.friction_used.round(6).tolist()
     (19.62, [0.5, 0.5, 0.5])
+    >>> round(float(g.dual[2]), 6), bool(abs(g.gap) < 1e-8)
+    (2.0, True)
     """
     p, n, w = check_points(points), check_normals(normals), check_wrench(wrench)
     mu = check_friction(friction)
@@ -158,76 +268,316 @@ def grip(points, normals, wrench, friction, safety=1.0, *, tol=DEGENERACY_TOL) -
     p, n, w = (np.broadcast_to(a, shape + a.shape[-t:]) for a, t in ((p, 2), (n, 2), (w, 1)))
     mu = np.broadcast_to(mu if mu.ndim else mu[None], shape + (3,))
     size = int(np.prod(shape))
-    flat = [a.reshape((size,) + a.shape[len(shape) :]) for a in (p, n, w, mu)]
-    out = _grip_rows(*flat, s_f, tol)
-    out = {k: v.reshape(shape + v.shape[1:]) for k, v in out.items()}
-    return Grip(safety=s_f, **out)
+    flat = [a.reshape((size,) + a.shape[len(shape) :]) for a in (p, n, mu)]
+    out = _Prepared(*flat, s_f, tol).solve(w.reshape(size, 6))
+    return checked_grip(Grip(safety=s_f, **{k: v.reshape(shape + v.shape[1:]) for k, v in out.items()}))
 
 
-def _grip_rows(p, n, w, mu, s_f, tol):
-    rows = len(p)
-    geo = geometry(p, tol)
-    status, culprit = geo.status.copy(), geo.culprit.copy()
-    with np.errstate(all="ignore"):
-        length = norm(n)
-        unit = n / length[..., None]
-        fm = _manipulating(geo, w)
-    zero = ~(length > 0)
-    todo = status == 0
-    hit = todo & zero.any(axis=1)
-    status[hit], culprit[hit] = ForceStatus.ZERO_NORMAL, np.argmax(zero, axis=1)[hit]
-    bad = ~(np.isfinite(n).all(axis=(1, 2)) & np.isfinite(w).all(axis=1) & ~np.isnan(mu).any(axis=1))
-    status[(status == 0) & bad] = ForceStatus.NONFINITE_INPUT
-    frictionless = (mu == 0).all(axis=1)
-    status[(status == 0) & (mu == 0).any(axis=1) & ~frictionless] = ForceStatus.MIXED_FRICTIONLESS
+class PreparedGrip:
+    """One grasp with its friction and safety, ready to grip any number of wrenches (:func:`~grasptwist.forces.prepare_grip`).
 
-    squeeze = np.full((rows, 3), np.nan)
-    scale = np.abs(fm).max(axis=(1, 2))
-    still = (status == 0) & (scale == 0)  # no wrench: no force at all is the least
-    squeeze[still] = 0.0
+    Attributes
+    ----------
+    points, normals, friction : arrays
+        The grasp (read-only), ``friction`` broadcast to ``(3,)``.
+    safety : float
+    """
 
-    rest = np.flatnonzero((status == 0) & (scale > 0) & ~frictionless)
-    if rest.size:
-        for start in range(0, rest.size, CHUNK):  # chunks whose temporaries stay in cache
-            part = rest[start : start + CHUNK]
-            limit = mu[part] / s_f
-            inside = closure.internal_inside(p[part], unit[part], geometry(p[part], tol), limit)
-            squeeze[part], fail, blame = _solve(
-                geo.e[part], unit[part], fm[part] / scale[part, None, None], limit, inside
-            )
-            squeeze[part] *= scale[part, None]
-            status[part[fail]], culprit[part[fail]] = ForceStatus.CANNOT_HOLD, blame[fail]
+    def __init__(self, points, normals, friction, safety, tol):
+        self.points, self.normals, self.friction, self.safety = points, normals, friction, safety
+        self._prepared = _Prepared(points[None], normals[None], friction[None], safety, tol)
 
-    bare = np.flatnonzero((status == 0) & (scale > 0) & frictionless)
-    if bare.size:
-        nu = np.concatenate((unit[bare], cross(p[bare], unit[bare])), axis=-1)
-        lam, pulling, unmade = _frictionless(nu, w[bare] / scale[bare, None], tol)
-        fail = pulling | unmade
-        ft = norm(fm[bare] - dot(fm[bare], unit[bare])[..., None] * unit[bare])
-        status[bare[fail]] = ForceStatus.CANNOT_HOLD
-        culprit[bare[fail]] = np.where(pulling, -1, np.argmax(ft, axis=1))[fail]
-        f = lam[..., None] * unit[bare] * scale[bare, None, None]
-        # the squeezes of these forces: project f - G^+ w on the squeeze directions
-        squeeze[bare] = _squeezes_of(geo.e[bare], f - fm[bare])
+    def grip(self, wrench) -> Grip:
+        """The same :class:`Grip` as ``grip(points, normals, wrench, friction, safety=safety)``.
 
-    ok = status == 0
-    squeeze[~ok] = np.nan
-    with np.errstate(all="ignore"):
-        force = fm + squeeze_forces(p, squeeze)
-        fn = dot(force, unit)
-        ft = norm(force - fn[..., None] * unit)
-        return {
-            "force": force,
-            "manipulating": fm,
-            "squeeze": squeeze,
-            "normal_force": fn,
-            "tangential_force": ft,
-            "friction_used": ft / fn,
-            "total_normal_force": fn.sum(axis=-1),
-            "conditioning": geo.conditioning,
-            "status": status,
-            "culprit": culprit,
-        }
+        ``wrench (..., 6)``: any number of wrenches on this grasp.
+        """
+        w = check_wrench(wrench)
+        rows = w.reshape(-1, 6)
+        prepared = self._prepared if len(rows) == 1 else self._prepared.repeat(len(rows))
+        out = prepared.solve(rows)
+        shape = w.shape[:-1]
+        return checked_grip(Grip(safety=self.safety, **{k: v.reshape(shape + v.shape[1:]) for k, v in out.items()}))
+
+
+def prepare_grip(points, normals, friction, *, safety=1.0, tol=DEGENERACY_TOL) -> PreparedGrip:
+    """One grasp's part of :func:`~grasptwist.forces.grip` done once, for a control loop whose wrench changes.
+
+    ``points, normals (3, 3)``, ``friction`` scalar or ``(3,)``.  The geometry, the cones'
+    frames, the squeezes' map and an internal force inside every cone do not depend on the
+    wrench; ``.grip(wrench)`` does the rest and gives what :func:`~grasptwist.forces.grip` gives.
+
+    >>> p = [[1, 0, 0], [-0.5, 0.75**0.5, 0], [-0.5, -(0.75**0.5), 0]]
+    >>> hand = prepare_grip(p, -np.array(p), 0.5, safety=2)
+    >>> round(float(hand.grip([0, 0, 9.81, 0, 0, 0]).total_normal_force), 6)
+    39.24
+    """
+    p, n = check_points(points), check_normals(normals)
+    if p.shape != (3, 3) or n.shape != (3, 3):
+        raise ValueError(f"prepare_grip takes one grasp: points and normals (3, 3), got {p.shape} and {n.shape}")
+    mu = np.broadcast_to(check_friction(friction), (3,)) if np.ndim(friction) <= 1 else None
+    if mu is None:
+        raise ValueError(f"prepare_grip takes one grasp: friction a scalar or (3,), got {np.shape(friction)}")
+    return PreparedGrip(p, n, mu.astype(float), check_safety(safety), tol)
+
+
+class _Prepared:
+    """The wrench-free part of the grip of ``n`` rows: statuses, cones, squeeze maps, starts."""
+
+    def __init__(self, p, n, mu, s_f, tol):
+        self.p, self.mu, self.s_f, self.tol = p, mu, s_f, tol
+        geo = self.geo = geometry(p, tol)
+        status, culprit = geo.status.copy(), geo.culprit.copy()
+        line = status == ForceStatus.COLLINEAR_CONTACTS
+        status[line] = 0  # solved below when the wrench has no moment about the line
+        with np.errstate(all="ignore"):
+            length = norm(n)
+            self.unit = n / length[..., None]
+        zero = ~(length > 0)
+        hit = (status == 0) & zero.any(axis=1)
+        status[hit], culprit[hit] = ForceStatus.ZERO_NORMAL, np.argmax(zero, axis=1)[hit]
+        bad = ~(np.isfinite(n).all(axis=(1, 2)) & ~np.isnan(mu).any(axis=1))
+        status[(status == 0) & bad] = ForceStatus.NONFINITE_INPUT
+        self.frictionless = (mu == 0).all(axis=1)
+        status[(status == 0) & (mu == 0).any(axis=1) & ~self.frictionless] = ForceStatus.MIXED_FRICTIONLESS
+        status[line & (status == 0) & self.frictionless] = ForceStatus.COLLINEAR_CONTACTS  # not solved there
+        self.status, self.culprit = status, culprit
+        self.line = line & (status == 0)
+        self.plane = np.flatnonzero((status == 0) & ~self.line & ~self.frictionless)
+        self.lines = np.flatnonzero(self.line)
+        self.cmap = collinear_map(p[self.lines], geo.size[self.lines]) if self.lines.size else None
+        self.bare = np.flatnonzero((status == 0) & self.frictionless & ~self.line)
+        # the cones and the squeezes' (internal forces') map of the rows with friction
+        rows = np.concatenate((self.plane, self.lines))
+        limit = mu[rows] / s_f
+        with np.errstate(divide="ignore"):
+            kappa = np.where(np.isinf(limit), 0.0, 1 / limit)
+        b1, b2 = tangent_bases(self.unit[rows])
+        self.frame = np.stack((self.unit[rows], kappa[..., None] * b1, kappa[..., None] * b2), axis=-2)
+        self.inside = closure.internal_inside(
+            p[self.plane], self.unit[self.plane], _rows(geo, self.plane), limit[: self.plane.size]
+        )
+        self.maps = (contact_matrices(geo.e[self.plane]), _line_matrices(self.cmap))
+        self.one = _one_row(self.frame, self.maps[0], self.inside) if len(p) == 1 and self.plane.size else None
+
+    def repeat(self, k):
+        """This one grasp as ``k`` rows (for ``k`` wrenches)."""
+        new = object.__new__(_Prepared)
+        new.__dict__.update(self.__dict__)
+        many = {"p", "mu", "unit", "status", "culprit", "frictionless", "line"}
+        for name in many:
+            new.__dict__[name] = np.repeat(getattr(self, name), k, axis=0)
+        new.geo = type(self.geo)(*(np.repeat(a, k, axis=0) for a in self.geo))
+        for name in ("plane", "lines", "bare"):
+            new.__dict__[name] = np.arange(k) if getattr(self, name).size else np.arange(0)
+        new.frame = np.repeat(self.frame, k, axis=0)
+        new.inside = np.repeat(self.inside, k, axis=0)
+        new.maps = tuple(None if m is None else np.repeat(m, k, axis=0) for m in self.maps)
+        new.cmap = None if self.cmap is None else type(self.cmap)(*(np.repeat(a, k, axis=0) for a in self.cmap))
+        new.one = None
+        return new
+
+    def solve(self, w):
+        """The grip's columns for wrenches ``w (n, 6)``, one per row."""
+        geo, p, unit = self.geo, self.p, self.unit
+        rows = len(p)
+        status, culprit = self.status.copy(), self.culprit.copy()
+        status[(status == 0) & ~np.isfinite(w).all(axis=1)] = ForceStatus.NONFINITE_INPUT
+        with np.errstate(all="ignore"):
+            fm = _manipulating(geo, w)
+        force = np.full((rows, 3, 3), np.nan)
+        squeeze = np.full((rows, 3), np.nan)
+        dual = np.full((rows, 6), np.nan)
+        certificate = np.full((rows, 6), np.nan)
+        if self.lines.size:
+            lf, made, y = collinear_manipulating(self.cmap, w[self.lines])
+            fm[self.lines] = lf
+            out = self.lines[~made & (status[self.lines] == 0)]
+            status[out], certificate[out] = ForceStatus.COLLINEAR_CONTACTS, y[~made & (status[self.lines] == 0)]
+        scale = np.abs(fm).max(axis=(1, 2))
+        still = (status == 0) & (scale == 0)  # no wrench: no force at all is the least
+        force[still], dual[still] = 0.0, 0.0
+        squeeze[still & ~self.line] = 0.0
+        groups = ((self.plane, 0, self.maps[0], False), (self.lines, self.plane.size, self.maps[1], True))
+        for group, k, maps, on_line in groups:
+            todo = np.flatnonzero((status[group] == 0) & (scale[group] > 0))
+            for start in range(0, todo.size, CHUNK):  # chunks whose temporaries stay in cache
+                part = todo[start : start + CHUNK]
+                r = group[part]
+                frame, m = self.frame[k + part], maps[part]
+                inside = np.full((part.size, 4), np.nan) if on_line else self.inside[part]
+                if self.one is not None:  # one grasp: numpy's cost per call is all there is, so floats
+                    s, z, fail, blame = _solve_floats(self.one, frame, fm[r] / scale[r, None, None])
+                else:
+                    s, z, fail, blame = _solve(frame, m, fm[r] / scale[r, None, None], inside)
+                force[r] = fm[r] + scale[r, None, None] * np.einsum("nixl,nl->nix", m, s)
+                u = np.einsum("nikx,nik->nix", frame, z)  # the cones' multipliers as forces' duals
+                if on_line:
+                    through = partial(_twist_through_line, _rows(self.cmap, part))
+                else:
+                    through = partial(_twist_through, _rows(geo, r))
+                    squeeze[r] = scale[r, None] * s
+                # phase II's multipliers: the twist through n_i - u_i; phase I's (fail): -G_i^T y = u_i
+                dual[r], y = through(unit[r] - u), -through(u)
+                status[r[fail]], culprit[r[fail]] = ForceStatus.CANNOT_HOLD, blame[fail]
+                certificate[r[fail]] = y[fail]
+                # on the edge of what the fingers can exert (y . w = 0): the contacts y forbids carry nothing
+                edge = np.flatnonzero(fail & ~(np.einsum("ni,ni->n", y, w[r]) > _EDGE_OF_HOLD * norm(y) * norm(w[r])))
+                for i in edge:
+                    found = _on_the_edge(frame[i], m[i], fm[r[i]] / scale[r[i]], z[i])
+                    if found is None:
+                        continue
+                    s_i, z_i, bare = found
+                    force[r[i]] = fm[r[i]] + scale[r[i]] * (m[i] @ s_i)
+                    if not on_line:
+                        squeeze[r[i]] = scale[r[i]] * s_i
+                    dual[r[i]] = _edge_dual(frame[i], p[r[i]], unit[r[i]], z_i, y[i], bare)
+                    status[r[i]], culprit[r[i]], certificate[r[i]] = 0, -1, np.nan
+        todo = self.bare[(status[self.bare] == 0) & (scale[self.bare] > 0)]
+        if todo.size:
+            nu = np.concatenate((unit[todo], cross(p[todo], unit[todo])), axis=-1)
+            lam, pulling, unmade, lam_dual, y = _frictionless(nu, w[todo] / scale[todo, None], self.tol)
+            fail = pulling | unmade
+            ft = norm(fm[todo] - dot(fm[todo], unit[todo])[..., None] * unit[todo])
+            status[todo[fail]] = ForceStatus.CANNOT_HOLD
+            culprit[todo[fail]] = np.where(pulling, -1, np.argmax(ft, axis=1))[fail]
+            certificate[todo[fail]] = y[fail]
+            force[todo] = lam[..., None] * unit[todo] * scale[todo, None, None]
+            dual[todo] = lam_dual
+            # the squeezes of these forces: project f - G^+ w on the squeeze directions
+            squeeze[todo] = _squeezes_of(geo.e[todo], force[todo] - fm[todo])
+        ok = status == 0
+        force[~ok], squeeze[~ok], dual[~ok] = np.nan, np.nan, np.nan
+        certificate = _unit(certificate, geo.size)
+        with np.errstate(all="ignore"):
+            fn = dot(force, unit)
+            ft = norm(force - fn[..., None] * unit)
+            total = fn.sum(axis=-1)
+            return {
+                "force": force,
+                "manipulating": fm,
+                "squeeze": squeeze,
+                "normal_force": fn,
+                "tangential_force": ft,
+                "friction_used": ft / fn,
+                "total_normal_force": total,
+                "conditioning": geo.conditioning,
+                "status": status,
+                "culprit": culprit,
+                "dual": dual,
+                "gap": total - np.einsum("ni,ni->n", w, dual),
+                "certificate": certificate,
+            }
+
+
+def _one_row(frame, m, inside):
+    """What :func:`one.solve` needs of one grasp's row (with friction, not collinear), as lists of floats."""
+    A, _, c = _cones(frame, m, np.zeros((1, 3, 3)))
+    rays = frame * np.array([1.0, 0.0, 0.0])[:, None]
+    normal = A[0, :, 0, :]
+    regular = abs(np.linalg.det(normal)) > 1e-9 * np.prod(np.linalg.norm(normal, axis=-1))
+    start = None
+    if not np.isnan(inside[0]).any():
+        y = A[0] @ inside[0]
+        start = (inside[0].tolist(), (y[:, 0] - np.sqrt(y[:, 1] ** 2 + y[:, 2] ** 2)).tolist())
+    A_list = A[0].tolist()
+    return {
+        "A": A_list,
+        "c": c[0].tolist(),
+        "P": one.newton_matrices(A_list),
+        "inside": start,
+        "regular": bool(regular),
+        "rays": _cones(rays, m, np.zeros((1, 3, 3)))[0][0].tolist(),
+    }
+
+
+def _solve_floats(row, frame, fm):
+    """:func:`_solve` for one row through :func:`one.solve`, with :func:`_solve`'s shapes."""
+    b = np.einsum("nikx,nix->nik", frame, fm)[0].tolist()
+    s, z, fail, blame = one.solve(row["A"], b, row["c"], row["P"], row["inside"], row["regular"], row["rays"])
+    return np.array([s]), np.array([z]), np.array([fail]), np.array([blame], np.int8)
+
+
+#: A certificate with ``y . w`` at most this of ``|y| |w|`` proves nothing: the wrench is on the edge.
+_EDGE_OF_HOLD = 1e-8
+
+
+def _dual_cone_margin(v, frame):
+    """``v_n - (mu/s) |v_t|`` per contact (``> 0``: inside the dual cone), ``v (3, 3)`` in xyz."""
+    kappa = np.linalg.norm(frame[:, 1], axis=-1)
+    vn = dot(v, frame[:, 0])
+    return vn - np.linalg.norm(v - vn[:, None] * frame[:, 0], axis=-1) / kappa
+
+
+def _on_the_edge(frame, m, fm, z):
+    r"""The grip of one row whose phase I ended on the edge (``r -> 0``, its ``y . w = 0``): facial reduction.
+
+    Phase I's multipliers ``z_i`` give ``-G_i^T y``; where that lies strictly inside the
+    dual cone, ``0 = y . w = -sum_i u_i . f_i`` forces ``f_i = 0``.  The other contacts'
+    cones are then solved over the internal forces that leave those contacts bare.  Returns
+    the internal-force coordinates and the kept cones' multipliers (``(3, 3)``, zero at
+    the bare contacts), or None (no contact is forced bare, infinite friction, or the
+    smaller problem has no strictly feasible point either).
+    """
+    if not (np.linalg.norm(frame[:, 1], axis=-1) > 0).all():
+        return None
+    bare = z[:, 0] - np.hypot(z[:, 1], z[:, 2]) > 1e-6 * np.abs(z).max()
+    if not bare.any() or bare.all():
+        return None
+    d = m.shape[-1]
+    mz, rhs = m[bare].reshape(-1, d), -fm[bare].reshape(-1)
+    s0 = np.linalg.lstsq(mz, rhs, rcond=None)[0]
+    if np.abs(mz @ s0 - rhs).max() > 1e-9 * max(np.abs(fm).max(), 1.0):
+        return None
+    _, sv, vt = np.linalg.svd(mz)
+    free = vt[int((sv > 1e-12 * sv[0]).sum()) :].T  # (d, d'): internal forces that leave the bare contacts bare
+    kept = ~bare
+    A = frame[kept] @ m[kept]  # (k, 3, d)
+    b = np.einsum("ikx,ix->ik", frame[kept], fm[kept] + m[kept] @ s0)
+    multipliers = np.zeros((3, 3))
+    if not free.shape[1]:
+        if not (b[:, 0] >= np.hypot(b[:, 1], b[:, 2]) - 1e-12 * np.abs(b).max()).all():
+            return None
+        return s0, multipliers, bare  # one grip only: every kept cone's multiplier 0 closes the gap
+    reduced = A @ free
+    x, r, _ = socp.phase_one(reduced[None], b[None])
+    if not r[0] < 0:
+        return None
+    t, zk = socp.minimise(reduced[None], b[None], reduced[:, 0, :].sum(axis=0)[None], x)
+    multipliers[kept] = zk[0]
+    return s0 + free @ t[0], multipliers, bare
+
+
+def _edge_dual(frame, p, unit, z, y, bare):
+    """The dual of an edge row: the kept contacts' twist, plus enough of ``y`` for the bare contacts' cones.
+
+    ``n_i - G_i^T lambda`` must lie in every dual cone; ``-G_i^T y`` is strictly inside at a
+    bare contact and on the edge at a kept one, and ``y . w = 0``: adding ``alpha y`` keeps
+    the kept cones and the objective and, ``alpha`` large enough, brings in the bare ones.
+    """
+    u = np.einsum("ikx,ik->ix", frame, z)
+    rows = np.concatenate([np.hstack((np.eye(3), -_skew(q))) for q in p])  # G_i^T: lambda -> lambda_F + lambda_M x p_i
+    kept = np.repeat(~bare, 3)
+    lam = np.linalg.lstsq(rows[kept], (unit - u).reshape(-1)[kept], rcond=None)[0]
+    need = -_dual_cone_margin(unit - (rows @ lam).reshape(3, 3), frame)[bare]
+    gain = _dual_cone_margin((rows @ -y).reshape(3, 3), frame)[bare]
+    return lam + np.max(np.maximum(need, 0) / gain) * y
+
+
+def _skew(q):
+    return np.array([[0, -q[2], q[1]], [q[2], 0, -q[0]], [-q[1], q[0], 0]])
+
+
+def _rows(named, rows):
+    """A NamedTuple of arrays over rows, at ``rows``."""
+    return type(named)(*(a[rows] for a in named))
+
+
+def _line_matrices(cmap):
+    """The internal forces of collinear contacts as ``M (n, 3, 3, 4)`` (contact, xyz, column), or None."""
+    if cmap is None:
+        return None
+    return cmap.null.reshape(-1, 3, 3, 4)
 
 
 def _squeezes_of(e, internal):
@@ -236,32 +586,44 @@ def _squeezes_of(e, internal):
     return (np.linalg.pinv(m) @ internal.reshape(len(e), 9)[..., None])[..., 0]
 
 
-def cone_rows(e, unit, fm, kappa):
-    """The cones ``y_i = A_i s + b_i`` of the grip in the squeezes: ``y_i = (n.f_i, kappa_i b1.f_i, kappa_i b2.f_i)``.
-
-    ``kappa_i = safety / mu_i`` (0 for infinite friction).  Returns ``A (n, 3, 3, 3)``,
-    ``b (n, 3, 3)`` and the objective ``c (n, 3)`` (``sum_i n_i . f_i`` minus a constant).
-    """
-    b1, b2 = tangent_bases(unit)
-    frame = np.stack((unit, kappa[..., None] * b1, kappa[..., None] * b2), axis=-2)  # (n, 3 contacts, 3, 3)
-    m = contact_matrices(e)  # (n, 3, 3, 3): contact, xyz, squeeze
+def _cones(frame, m, fm):
+    """``A = F M``, ``b = F f_m`` and ``c = sum_i A_i[0]`` from the cones' frames ``F`` and the internal forces' map ``M``."""
     A = frame @ m
     b = np.einsum("nikx,nix->nik", frame, fm)
     return A, b, A[:, :, 0, :].sum(axis=1)
 
 
-def _solve(e, unit, fm, limit, inside):
-    """The grip's squeezes for rows scaled to order one; failing rows and their culprits.
+def _dual_polish(A, b, c, s, z):
+    """``z`` moved to ``sum_m A_m^T z_m = c`` again (the solver keeps it to round-off of its large final steps).
 
-    ``inside (n, 3)``: a squeeze strictly inside every cone (NaN where the grasp is not
-    force closure with ``limit``); far enough along it is a start for phase II, so
-    phase I runs only for the other rows.
+    The correction ``dz_m = omega_m A_m delta`` with ``omega_m = |z_m| / |y_m|`` goes to the cones
+    whose multipliers carry the optimum (``y_m`` on the edge, ``z_m`` large), not to idle ones
+    (``z_m`` near 0), so every ``z_m`` stays in its cone to round-off.
     """
-    with np.errstate(divide="ignore"):
-        kappa = np.where(np.isinf(limit), 0.0, 1 / limit)
-    A, b, c = cone_rows(e, unit, fm, kappa)
-    x = np.zeros((len(e), 3))
-    r = np.full(len(e), -1.0)
+    y = np.einsum("nmkd,nd->nmk", A, s) + b
+    res = c - np.einsum("nmkd,nmk->nd", A, z)
+    omega = np.linalg.norm(z, axis=-1) / np.maximum(np.linalg.norm(y, axis=-1), 1e-300)
+    h = np.einsum("nm,nmkd,nmke->nde", omega, A, A)
+    with np.errstate(all="ignore"):
+        delta = np.linalg.solve(h + 1e-300 * np.eye(A.shape[-1]), res[..., None])[..., 0]
+        dz = omega[..., None] * np.einsum("nmkd,nd->nmk", A, delta)
+    return np.where(np.isfinite(dz).all(axis=(1, 2))[:, None, None], z + dz, z)
+
+
+def _solve(frame, m, fm, inside):
+    """The grip's internal-force coordinates for rows scaled to order one, the cones' multipliers,
+    failing rows and their culprits.
+
+    ``inside (n, d)``: internal-force coordinates strictly inside every cone (NaN where
+    the grasp is not force closure with its limit); far enough along it is a start for
+    phase II, so phase I runs only for the other rows.  The multipliers ``z (n, 3, 3)`` are
+    phase II's where the grip exists, phase I's (a proof that none does) where it fails.
+    """
+    A, b, c = _cones(frame, m, fm)
+    n, d = len(fm), m.shape[-1]
+    x = np.zeros((n, d))
+    r = np.full(n, -1.0)
+    z = np.zeros((n, 3, 3))
     closing = ~np.isnan(inside).any(axis=1)
     if closing.any():
         y = np.einsum("nmkd,nd->nmk", A[closing], inside[closing])
@@ -270,13 +632,14 @@ def _solve(e, unit, fm, limit, inside):
         x[closing] = ((socp.START_MARGIN + reach) / depth).max(axis=1)[:, None] * inside[closing]
     other = np.flatnonzero(~closing)
     if other.size:
-        x[other], r[other] = socp.phase_one(A[other], b[other])
+        x[other], r[other], z[other] = socp.phase_one(A[other], b[other])
     fail = ~(r < 0)
-    s = np.full((len(e), 3), np.nan)
+    s = np.full((n, d), np.nan)
     good = np.flatnonzero(~fail)
     if good.size:
-        s[good] = socp.minimise(A[good], b[good], c[good], x[good])
-    blame = np.full(len(e), -1, np.int8)
+        s[good], z[good] = socp.minimise(A[good], b[good], c[good], x[good])
+        z[good] = _dual_polish(A[good], b[good], c[good], s[good], z[good])
+    blame = np.full(n, -1, np.int8)
     bad = np.flatnonzero(fail)
     if bad.size:
         y = np.einsum("nmkd,nd->nmk", A[bad], x[bad]) + b[bad]
@@ -284,11 +647,14 @@ def _solve(e, unit, fm, limit, inside):
         # Pulling: infeasible even with unlimited friction (half-spaces n.f >= 0).  When the
         # squeezes reach every pattern of normal forces (an invertible 3 x 3 map) it never is.
         normal = A[bad, :, 0, :]
-        scale = np.prod(np.linalg.norm(normal, axis=-1), axis=-1)
-        maybe = np.flatnonzero(~(np.abs(np.linalg.det(normal)) > 1e-9 * scale))
+        maybe = np.arange(bad.size)
+        if d == 3:
+            scale = np.prod(np.linalg.norm(normal, axis=-1), axis=-1)
+            maybe = np.flatnonzero(~(np.abs(np.linalg.det(normal)) > 1e-9 * scale))
         if maybe.size:
             rows = bad[maybe]
-            A0, b0, _ = cone_rows(e[rows], unit[rows], fm[rows], np.zeros((rows.size, 3)))
-            _, r0 = socp.phase_one(A0, b0)
+            ray = frame[rows] * np.array([1.0, 0.0, 0.0])[:, None]  # the cones with no friction limit
+            A0, b0, _ = _cones(ray, m[rows], fm[rows])
+            r0 = socp.phase_one(A0, b0)[1]
             blame[rows] = np.where(r0 < 0, blame[rows], -1)
-    return s, fail, blame
+    return s, z, fail, blame

@@ -84,7 +84,7 @@ def hold_wrench(mass, center_of_mass, gravity, rotation=None, position=None) -> 
 
 
 def grip_along(
-    points, normals, friction, mass, center_of_mass, gravity, segments, times, safety=1.0, *, tol=DEGENERACY_TOL
+    points, normals, friction, mass, center_of_mass, gravity, segments, times, *, safety=1.0, tol=DEGENERACY_TOL
 ) -> tuple[Poses, Grip]:
     """The grip that holds the weight at each time of a path.
 
@@ -98,6 +98,9 @@ def grip_along(
     segments : sequence of Segment
     times : (T,) array-like
     safety : float
+        As for :func:`grip`.
+    tol : float
+        Degeneracy tolerance of the contacts.
 
     Returns
     -------
@@ -110,7 +113,7 @@ def grip_along(
     ``mu = 0.5``: level, each contact takes a third; tilted by ``atan(0.5)`` about x, every
     contact uses all of its friction; past it, the weight slides off.
 
-    >>> from grasptwist.model import Segment
+    >>> from grasptwist.path import Segment
     >>> p = [[1, 0, 0], [-0.5, 0.75**0.5, 0], [-0.5, -(0.75**0.5), 0]]
     >>> turn = [Segment(1.0, twist=[1, 0, 0, 0, 0, 0])]
     >>> poses, g = grip_along(p, [[0, 0, 1]] * 3, 0.5, 1.0, [0, 0, 0], [0, 0, -9.81], turn, [0, np.arctan(0.5) - 1e-9, 0.5])
@@ -122,7 +125,7 @@ def grip_along(
     moved = se3.transform(poses.rotation[..., None, :, :], poses.position[..., None, :], p)
     turned = np.einsum("...ij,kj->...ki", poses.rotation, n)
     wrench = hold_wrench(mass, center_of_mass, gravity, poses.rotation, poses.position)
-    return poses, grip(moved, turned, wrench, friction, safety, tol=tol)
+    return poses, grip(moved, turned, wrench, friction, safety=safety, tol=tol)
 
 
 def cannot_hold(
@@ -134,8 +137,8 @@ def cannot_hold(
     gravity,
     segments,
     times=None,
-    safety=1.0,
     *,
+    safety=1.0,
     tol=DEGENERACY_TOL,
 ) -> tuple[HoldStretch, ...]:
     """Every stretch of a path where no grip holds the weight, its ends located between samples.
@@ -143,14 +146,17 @@ def cannot_hold(
     The grip's status is evaluated at the samples ``times`` and the segments' ends; each
     run of ``cannot-hold`` is widened to where it starts and ends by bisection between
     its first (last) node and the held node before (after) it, every end at once, to
-    :data:`PRECISION` of the shortest segment's duration.  A stretch shorter than the
+    ``1e-10`` (``PRECISION``) of the shortest segment's duration.  A stretch shorter than the
     sampling, between two held nodes, is not seen.  A grasp the grip cannot solve at
     all (degenerate contacts, ``status`` other than ``cannot-hold``) has no stretches:
     the path's degeneracies report it.
 
     Parameters
     ----------
-    As :func:`grip_along`; ``times`` None: the segments' ends only.
+    points, normals, friction, mass, center_of_mass, gravity, segments, safety, tol
+        As for :func:`grip_along`.
+    times : (T,) array-like or None
+        The samples; None: the segments' ends only.
 
     Returns
     -------
@@ -162,7 +168,7 @@ def cannot_hold(
     The tray of :func:`grip_along` turned a full turn about x: it holds until it is
     tilted by ``atan(mu)``, and again from ``2 pi - atan(mu)``.
 
-    >>> from grasptwist.model import Segment
+    >>> from grasptwist.path import Segment
     >>> p = [[1, 0, 0], [-0.5, 0.75**0.5, 0], [-0.5, -(0.75**0.5), 0]]
     >>> turn = [Segment(2 * np.pi, twist=[1, 0, 0, 0, 0, 0])]
     >>> (s,) = cannot_hold(p, [[0, 0, 1]] * 3, 0.5, 1.0, [0, 0, 0], [0, 0, -9.81], turn, np.linspace(0, 2 * np.pi, 9))
@@ -175,7 +181,9 @@ def cannot_hold(
     nodes = np.unique(np.concatenate((ends, extra)))
 
     def status(t):
-        return grip_along(points, normals, friction, mass, center_of_mass, gravity, segments, t, safety, tol=tol)[1]
+        return grip_along(
+            points, normals, friction, mass, center_of_mass, gravity, segments, t, safety=safety, tol=tol
+        )[1]
 
     at = status(nodes)
     fails = at.status == ForceStatus.CANNOT_HOLD

@@ -192,23 +192,26 @@ def _layout(A, b):
 
 
 def phase_one(A, b):
-    """A strictly feasible ``x`` per row and the margin ``r`` reached (``r < 0``: feasible).
+    """A strictly feasible ``x`` per row, the margin ``r`` reached (``r < 0``: feasible) and the dual.
 
-    ``A (n, 3, 3, d)``, ``b (n, 3, 3)`` -> ``x (n, d)``, ``r (n)``.  With ``r < 0``
-    every cone holds ``t_m - |z_m| >= -r > 0`` at ``x``.
+    ``A (n, K, 3, d)``, ``b (n, K, 3)`` -> ``x (n, d)``, ``r (n)``, ``z (n, K, 3)``.  With
+    ``r < 0`` every cone holds ``t_m - |z_m| >= -r > 0`` at ``x``.  Where ``r > 0`` the cones'
+    dual ``z_m`` (inside ``Q^3``, ``sum_m A_m^T z_m = 0`` to the residual) has
+    ``-sum_m b_m . z_m > 0``: a proof that no ``x`` puts every ``A_m x + b_m`` in its cone
+    (Farkas).
     """
-    n, _, _, d = A.shape
-    wide = np.zeros((n, 4, 3, d + 1))
-    wide[:, :3, :, :d] = A
-    wide[:, :3, 0, d] = 1.0  # t_m + r
-    wide[:, 3, 0, d] = 1.0  # r + 1 >= 0
-    bw = np.zeros((n, 4, 3))
-    bw[:, :3] = b
-    bw[:, 3, 0] = 1.0
+    n, K, _, d = A.shape
+    wide = np.zeros((n, K + 1, 3, d + 1))
+    wide[:, :K, :, :d] = A
+    wide[:, :K, 0, d] = 1.0  # t_m + r
+    wide[:, K, 0, d] = 1.0  # r + 1 >= 0
+    bw = np.zeros((n, K + 1, 3))
+    bw[:, :K] = b
+    bw[:, K, 0] = 1.0
     over = np.sqrt(b[..., 1] ** 2 + b[..., 2] ** 2) - b[..., 0]
     x = np.zeros((d + 1, n))
     x[d] = np.maximum(over.max(axis=-1) + 1, 0.0)
-    z = np.zeros((3, 4, n))
+    z = np.zeros((3, K + 1, n))
     z[0] = 0.25  # makes the r column of the dual, not yet the squeezes' columns
     c = np.zeros((d + 1, n))
     c[d] = 1.0
@@ -219,15 +222,17 @@ def phase_one(A, b):
         return (x[d] <= -START_MARGIN) | (dual > _RESIDUAL * (1 + np.abs(x).sum(axis=0))) | (closed & (dual > -np.inf))
 
     x = _iterate(wide, bw, c, x, z, leave)
-    return np.ascontiguousarray(x[:d].T), x[d]
+    return np.ascontiguousarray(x[:d].T), x[d], np.ascontiguousarray(z[:, :K].transpose(2, 1, 0))
 
 
 def minimise(A, b, c, x):
-    """The optimum from the strictly feasible ``x (n, d)``; returns ``x (n, d)``.
+    """The optimum from the strictly feasible ``x (n, d)``; returns ``x (n, d)`` and the dual ``z (n, 3, 3)``.
 
     ``A (n, 3, 3, d)``, ``b (n, 3, 3)``, ``c (n, d)`` with ``c = sum_m A_m^T e`` (``e = (1, 0,
     0)``: the objective is the sum of the cones' first components, as the grip's is), so
-    ``z_m = e`` is a strictly feasible dual start.
+    ``z_m = e`` is a strictly feasible dual start.  The dual stays feasible
+    (``sum_m A_m^T z_m = c`` to round-off); the gap ``sum_m y_m . z_m`` is below ``GAP``
+    of the objective's scale where a row closed.
     """
     n = len(x)
     A, b = _layout(A, b)
@@ -240,4 +245,4 @@ def minimise(A, b, c, x):
         return closed & (dual > -np.inf)
 
     x = _iterate(A, b, c, x, z, leave)
-    return x.T
+    return x.T, z.transpose(2, 1, 0)

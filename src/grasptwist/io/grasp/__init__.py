@@ -4,10 +4,10 @@ A grasp file holds one grasp per YAML document (see "Grasp files" in README.md
 for the format).  Reading never constructs arbitrary Python objects and
 never lets a parser exception escape: every problem becomes a
 :class:`GraspFileError` that names the file, line, column and field path.
-Every kind of problem of a document is reported, in file order, not just
-its first: each code once, at its first place, its message counting the
-rest; nothing inside the value of a key reported unknown (at most
-``MAX_ERRORS`` entries per file; one more entry counts the rest).
+Every problem of a document is reported, in file order, not just its
+first: each at its own place, four misspelt keys as four entries; nothing
+inside the value of a key reported unknown (at most ``MAX_ERRORS`` entries
+per file; one more entry counts the rest).
 
 How the YAML is read, and why
 -----------------------------
@@ -43,7 +43,7 @@ The modules
 -----------
 ``text``       size cap, reading, strict decoding (the limits: :mod:`grasptwist.io.limits`)
 ``compose``    YAML events -> node tree, with the safety rules above
-``problems``   located problems as values: each kind once per document, a file's total capped
+``problems``   located problems as values: every one, in file order, a file's total capped
 ``values``     typed values of nodes (numbers, vectors, names, mappings), shared by the sections
 ``document``   a document as a whole, and :data:`SECTIONS`, where a section module is registered
 ``contacts``, ``twists``, ``paths``, ``hand``, ``forces``: one module per section of the format

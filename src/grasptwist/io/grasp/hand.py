@@ -29,11 +29,8 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from ...engine.hands import joint_positions
-from ...engine.kinematics import chain_length, joint_screw
 from ...model import Finger, Hand, HandPlacement, InputError, Joint
 from ..limits import DEFAULT_MAX_BYTES
-from ..urdf import load_urdf_hand
 from .compose import PARSER, compose, syntax_error
 from .problems import MAX_ERRORS, Problems, Reject, join, located
 from .text import file_text
@@ -237,6 +234,9 @@ def inline_hand(names, fingers, points):
     >>> h.joint_names, h.fingers[0].screws.tolist(), h.fingers[1].length
     (('a.1', 'b.1', 'c.1'), [[0.0, 0.0, 1.0, 0.0, 0.0, 0.0]], 1.0)
     """
+    # a hand's kinematics load with the first hand: grasp files without one never pay for them
+    from ...engine.kinematics import chain_length, joint_screw
+
     out, joint_names = [], []
     contacts = [None] * 3 if points is None else np.asarray(points, dtype=float)
     for name, joints, contact in zip(names, fingers, contacts, strict=True):
@@ -269,6 +269,10 @@ def _urdf_hand(fields, fingers, names, hand_file, file, problems):
     """The URDF form: load the hand, with its ``joint_positions`` (checked on the contacts later)
     or ``seed`` (solved from later) and where each finger's tip stands in the file; in a hand file
     (``hand_file``), at its joint positions."""
+    # URDF reading loads with the first such hand (bench/startup.py)
+    from ...engine.hands import joint_positions
+    from ..urdf import load_urdf_hand
+
     node = fields["urdf"]
     reference = read_name(node, "hand.urdf", problems)
     given = "joint_positions" in fields

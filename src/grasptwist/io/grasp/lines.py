@@ -55,6 +55,8 @@ def read_twist_line(data, *, file, line, max_bytes=DEFAULT_MAX_BYTES):
     -------
     Twist or list of GraspFileError
 
+    Examples
+    --------
     >>> read_twist_line(b"[0, 0, 1, 0, 0, 0.5]", file="-", line=3).screw.tolist()
     [0.0, 0.0, 1.0, 0.0, 0.0, 0.5]
     >>> t = read_twist_line(b'{"name": "spin", "angular": [0, 0, 1], "at": [1, 0, 0]}', file="-", line=4)

@@ -62,7 +62,11 @@ def _segments(node, path, frame, problems):
         return None
     from ...engine.path import check_segments
 
-    return check_segments(segments)
+    try:
+        return check_segments(segments)
+    except ValueError as exc:  # what only the whole path shows: its durations adding up beyond 1.8e308
+        problems.add(Reject("invalid-duration", path, str(exc), **located(node)))
+        return None
 
 
 def _segment(item, path, frame, problems):
@@ -82,7 +86,7 @@ def _segment(item, path, frame, problems):
             fields, path, ("screw", "angular", "linear", "at"), "'pose' (give a twist or a pose target)", problems
         )
         pose = _pose(fields["pose"], path + ".pose", problems)
-        return None if pose is None else Segment(duration, position=pose[0], rotation=pose[1])
+        return None if pose is None else Segment(duration, position=pose[0], rotation=pose[1], **pose[2])
     if not {"screw", "angular", "linear"} & set(fields):
         problems.add(
             Reject(
@@ -123,15 +127,16 @@ def _conflicts(fields, path, others, what, problems):
 
 
 def _pose(node, path, problems):
-    """``(position, rotation matrix)`` of a pose target: position default zero, rotation a
-    quaternion ``(w, x, y, z)`` or a rotation vector, default none."""
+    """``(position, rotation matrix, given)`` of a pose target: position default zero, rotation a
+    quaternion ``(w, x, y, z)`` or a rotation vector, default none; ``given`` the rotation vector
+    as written and where (the :class:`~grasptwist.model.Segment` keywords), if one was."""
     from ...engine import se3
 
     fields = read_mapping(node, path, POSE_KEYS, (), problems)
     if fields is None:
         return None
     position = read_vector(fields["position"], 3, path + ".position", problems) if "position" in fields else [0.0] * 3
-    rotation = np.eye(3)
+    rotation, given = np.eye(3), {}
     if "rotation" in fields:
         _conflicts(fields, path, ("rotvec",), "'rotation' (give a quaternion or a rotation vector)", problems)
         quaternion = read_vector(fields["rotation"], 4, path + ".rotation", problems)
@@ -150,10 +155,21 @@ def _pose(node, path, problems):
     elif "rotvec" in fields:
         rotvec = read_vector(fields["rotvec"], 3, path + ".rotvec", problems)
         if rotvec is not None:
-            rotation = se3.rotvec_to_matrix(rotvec)
+            with np.errstate(over="ignore", invalid="ignore"):
+                rotation = se3.rotvec_to_matrix(rotvec)
+            given = {"rotvec": np.array(rotvec), **located(fields["rotvec"])}
+            if not np.isfinite(rotation).all():
+                problems.add(
+                    Reject(
+                        "non-finite",
+                        path + ".rotvec",
+                        "the rotation overflows double precision (an angle beyond about 1e154 radians)",
+                        **located(fields["rotvec"]),
+                    )
+                )
     if position is None or problems.count:
         return None
-    return np.array(position), rotation
+    return np.array(position), rotation, given
 
 
 def _read(fields, found, problems):

@@ -38,70 +38,50 @@ class StreamStop(Reject):
 
 class Problems:
     """The problems of one document as they are found, reported as a compiler would:
-    in file order, each kind (code) once, with a count of its repeats.
+    every one with its own position, in file order, the first ``keep`` of them (the
+    file's limit, :data:`MAX_ERRORS`) and a count of all.
 
-    At most ``2 * keep`` of each kind are held between trims, so a document
-    with a hundred thousand problems costs no more memory than one with a few.
+    At most ``2 * keep`` are held between trims, so a document with a hundred
+    thousand problems costs no more memory than one with a few.
+
+    >>> problems = Problems(2)
+    >>> for line in (5, 1, 3):
+    ...     problems.add(Reject("unknown-key", "", "unknown key", line, 1))
+    >>> [r.line for r in problems.first()[0]], problems.first()[1], problems.count
+    ([1, 3], 2, 3)
     """
 
-    __slots__ = ("keep", "count", "_held", "_counts")
+    __slots__ = ("keep", "count", "_held")
 
     def __init__(self, keep):
         self.keep = keep
         self.count = 0
         self._held = []
-        self._counts = {}  # code -> problems of that kind found
 
     def add(self, reject):
         self.count += 1
-        self._counts[reject.code] = self._counts.get(reject.code, 0) + 1
         if self.keep:
             self._held.append(reject)
-            if len(self._held) >= 2 * self.keep * len(self._counts):
+            if len(self._held) >= 2 * self.keep:
                 self._trim()
 
     def drop_within(self, node):
         """Forget the problems found inside ``node`` (the value of a key reported
         unknown: what is wrong inside it is no news), so none cascades."""
         start, end = (node.line, node.column), node.end
-        kept = []
-        for reject in self._held:
-            if start <= _position(reject) < end:
-                self.count -= 1
-                self._counts[reject.code] -= 1
-            else:
-                kept.append(reject)
+        kept = [reject for reject in self._held if not start <= _position(reject) < end]
+        self.count -= len(self._held) - len(kept)
         self._held = kept
 
     def first(self):
-        """The problems to report, in file order: the first ``keep`` kinds, each by its first
-        problem, its message counting the rest of its kind; and how many problems they stand for."""
+        """The problems to report, the first ``keep`` in file order, and how many problems they stand
+        for (one each: the rest are counted by the file's ``too-many-errors`` entry)."""
         self._trim()
-        out, covered, seen = [], 0, set()
-        for reject in self._held:
-            if reject.code in seen:
-                continue
-            seen.add(reject.code)
-            if len(out) == self.keep:
-                break
-            rest = self._counts[reject.code] - 1
-            covered += rest + 1
-            if rest:
-                more = f"{rest} more {reject.code} problem{'s' if rest > 1 else ''} in this document"
-                reject = Reject(reject.code, "", f"{reject.message}; {more}", reject.line, reject.column)
-            out.append(reject)
-        return out, covered
+        return list(self._held), len(self._held)
 
     def _trim(self):
         self._held.sort(key=_position)  # stable: ties stay in the order found
-        per_code = {}
-        kept = []
-        for reject in self._held:
-            n = per_code.get(reject.code, 0)
-            if n < self.keep:
-                per_code[reject.code] = n + 1
-                kept.append(reject)
-        self._held = kept
+        del self._held[self.keep :]
 
 
 def _position(reject):

@@ -119,9 +119,26 @@ def read_grasps(source, *, file=None, max_bytes=DEFAULT_MAX_BYTES, reading=READI
     return read_text(text, file, reading)
 
 
-def load_grasps(source, **kw):
-    """Like :func:`read_grasps`, but raise its first :class:`GraspFileError`."""
-    entries = read_grasps(source, **kw)
+def load_grasps(source, *, file=None, max_bytes=DEFAULT_MAX_BYTES, reading=READING):
+    """Like :func:`read_grasps`, but raise its first :class:`GraspFileError`.
+
+    Returns
+    -------
+    list of Grasp
+        Every grasp of the file, in file order.
+
+    Raises
+    ------
+    GraspFileError
+        The first problem :func:`read_grasps` finds.
+
+    Examples
+    --------
+    >>> load_grasps(b"contacts: []\\n", file="g.yaml")
+    Traceback (most recent call last):
+    grasptwist.model.GraspFileError: g.yaml:1:11: contacts: expected exactly 3 contacts, got 0
+    """
+    entries = read_grasps(source, file=file, max_bytes=max_bytes, reading=reading)
     for entry in entries:
         if isinstance(entry, GraspFileError):
             raise entry
@@ -137,7 +154,7 @@ def one_per_document(entries):
 
     >>> text = "contacts: [1, 2]\\n---\\nwrist: 1\\n"
     >>> [(e.code, [p.code for p in e.problems]) for e in one_per_document(read_grasps(text, file="g.yaml"))]
-    [('contact-count', ['contact-count', 'not-a-mapping']), ('missing-key', ['missing-key', 'not-a-list'])]
+    [('contact-count', ['contact-count', 'not-a-mapping', 'not-a-mapping']), ('missing-key', ['missing-key', 'not-a-list'])]
     """
     out = []
     for entry in entries:

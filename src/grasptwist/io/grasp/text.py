@@ -11,7 +11,7 @@ import sys
 from ..limits import NOT_REGULAR
 from .problems import Reject
 
-__all__ = ["encode", "read_file", "read_capped", "decode", "file_text"]
+__all__ = ["encode", "read_file", "read_capped", "decode", "file_text", "standard_input"]
 
 
 def encode(content):
@@ -24,6 +24,14 @@ def encode(content):
         raise Reject("invalid-utf8", "", f"not valid Unicode at character {exc.start}") from None
 
 
+def standard_input():
+    """Standard input, as bytes; an OSError when the shell closed it (``<&-``), which
+    readers report as they report any input they cannot read."""
+    if sys.stdin is None:  # Python found descriptor 0 closed when it started
+        raise OSError(errno.EBADF, "standard input is closed")
+    return sys.stdin.buffer
+
+
 def read_file(path, max_bytes):
     """At most ``max_bytes + 1`` bytes of a regular file, or of stdin for ``"-"``.
 
@@ -34,7 +42,7 @@ def read_file(path, max_bytes):
     """
     try:
         if isinstance(path, str) and path == "-":
-            return read_capped(sys.stdin.buffer, max_bytes + 1)
+            return read_capped(standard_input(), max_bytes + 1)
         fd = os.open(path, os.O_RDONLY | os.O_NONBLOCK | getattr(os, "O_CLOEXEC", 0))
         with open(fd, "rb") as handle:
             mode = os.fstat(fd).st_mode

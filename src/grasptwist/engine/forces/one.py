@@ -1,0 +1,284 @@
+r"""The interior-point method of :mod:`~grasptwist.engine.forces.socp` for one row, in Python floats.
+
+For one grasp numpy's cost per call (a microsecond or more, on arrays of three numbers)
+is all there is: an iteration of the batched method makes some 300 numpy calls.  This is
+the same method, step for step (Mehrotra's predictor-corrector with Nesterov-Todd
+scaling, 0.99 of the way to the cones' edge, the same stopping rules), on lists of
+floats: a few hundred multiplications an iteration.  ``tests/test_forces.py`` holds it to
+the batched solver on random rows (the verdicts, and the optimum to ``1e-9``).
+
+A row is ``A[m][k][j]`` (cone ``m``, component ``k``, unknown ``j``), ``b[m][k]``,
+``c[j]``; the unknowns ``x[j]`` and the cones' multipliers ``z[m][k]`` are lists updated in place.
+"""
+
+from __future__ import annotations
+
+import math
+
+from .socp import _EDGE, _ITERATIONS, _RESIDUAL, GAP, START_MARGIN
+
+__all__ = ["phase_one", "minimise", "newton_matrices", "solve"]
+
+
+def _edge(x, d):
+    """The largest ``alpha`` with ``x + alpha d`` in the cone (``inf``: none), as :func:`socp._edge`."""
+    s = math.sqrt(x[0] * x[0] - x[1] * x[1] - x[2] * x[2])
+    x0, x1, x2 = x[0] / s, x[1] / s, x[2] / s
+    d0, d1, d2 = d[0] / s, d[1] / s, d[2] / s
+    rho0 = x0 * d0 - x1 * d1 - x2 * d2
+    f = (rho0 + d0) / (x0 + 1)
+    t = math.hypot(d1 - f * x1, d2 - f * x2) - rho0
+    return 1 / t if t > 0 else math.inf
+
+
+def newton_matrices(A):
+    """``P_m[i][j] = A_m[:, i]^T J A_m[:, j]`` per cone: the part of the Newton matrix that stays."""
+    d = len(A[0][0])
+    return [
+        [[a[0][i] * a[0][j] - a[1][i] * a[1][j] - a[2][i] * a[2][j] for j in range(d)] for i in range(d)] for a in A
+    ]
+
+
+def _solve(h, g):
+    """``h^-1 g`` by elimination without pivoting (``h`` symmetric positive definite; copied)."""
+    d = len(g)
+    if d == 3:  # the grip's squeezes: the same elimination, written out
+        (h00, h01, h02), (h10, h11, h12), (h20, h21, h22) = h
+        g0, g1, g2 = g
+        f1, f2 = h10 / h00, h20 / h00
+        h11, h12, g1 = h11 - f1 * h01, h12 - f1 * h02, g1 - f1 * g0
+        h21, h22, g2 = h21 - f2 * h01, h22 - f2 * h02, g2 - f2 * g0
+        f = h21 / h11
+        h22, g2 = h22 - f * h12, g2 - f * g1
+        x2 = g2 / h22
+        x1 = (g1 - h12 * x2) / h11
+        return [(g0 - h01 * x1 - h02 * x2) / h00, x1, x2]
+    h = [row[:] for row in h]
+    g = g[:]
+    for k in range(d):
+        for i in range(k + 1, d):
+            f = h[i][k] / h[k][k]
+            for j in range(k + 1, d):
+                h[i][j] -= f * h[k][j]
+            g[i] -= f * g[k]
+    x = [0.0] * d
+    for i in reversed(range(d)):
+        v = g[i]
+        for j in range(i + 1, d):
+            v -= h[i][j] * x[j]
+        x[i] = v / h[i][i]
+    return x
+
+
+def _iterate(A, b, c, x, z, P, leave):
+    """:func:`socp._iterate` for one row; ``leave(x, closed, dual)`` ends it.  Returns False when a step
+    was not finite (the row stops where it is, as the batched method's does)."""
+    AT = [[tuple(a[k][j] for k in range(3)) for j in range(len(x))] for a in A]  # columns: A_m[:, j]
+    for _ in range(_ITERATIONS):
+        try:
+            done = _step(AT, b, c, x, z, P, leave)
+        except (ValueError, ZeroDivisionError, OverflowError):  # round-off at the cones' edge, as NaN is in numpy
+            done = None
+        if done is None:
+            return False
+        if done:
+            return True
+    return True
+
+
+def _times(AT, b, x):
+    """``A_m x + b_m`` per cone (``b`` None: ``A_m x``)."""
+    out = []
+    for m, cols in enumerate(AT):
+        r0, r1, r2 = (0.0, 0.0, 0.0) if b is None else b[m]
+        for (a0, a1, a2), xj in zip(cols, x):
+            r0 += a0 * xj
+            r1 += a1 * xj
+            r2 += a2 * xj
+        out.append((r0, r1, r2))
+    return out
+
+
+def _transposed(AT, u, first):
+    """``first - sum_m A_m^T u_m``."""
+    out = list(first)
+    for cols, (u0, u1, u2) in zip(AT, u):
+        for j, (a0, a1, a2) in enumerate(cols):
+            out[j] -= a0 * u0 + a1 * u1 + a2 * u2
+    return out
+
+
+def _w_inv(v, beta, u):
+    v0, v1, v2 = v
+    t = 2 * (v0 * u[0] - v1 * u[1] - v2 * u[2])
+    return ((t * v0 - u[0]) / beta, (u[1] - t * v1) / beta, (u[2] - t * v2) / beta)
+
+
+def _w_mul(v, beta, u):
+    v0, v1, v2 = v
+    t = 2 * (v0 * u[0] + v1 * u[1] + v2 * u[2])
+    return (beta * (t * v0 - u[0]), beta * (t * v1 + u[1]), beta * (t * v2 + u[2]))
+
+
+def _step(AT, b, c, x, z, P, leave):
+    """One iteration of :func:`_iterate`: True when ``leave`` says so, None when the step is not finite."""
+    K, d = len(AT), len(x)
+    res = _transposed(AT, z, c)
+    y = _times(AT, b, x)
+    V, B, L, G = [], [], [], []
+    for (y0, y1, y2), (z0, z1, z2), cols in zip(y, z, AT):
+        ys = math.sqrt(y0 * y0 - y1 * y1 - y2 * y2)
+        zs = math.sqrt(z0 * z0 - z1 * z1 - z2 * z2)
+        twice = 2 * math.sqrt((1 + (y0 * z0 + y1 * z1 + y2 * z2) / (ys * zs)) / 2)
+        w0, w1, w2 = (y0 / ys + z0 / zs) / twice, (y1 / ys - z1 / zs) / twice, (y2 / ys - z2 / zs) / twice
+        r = math.sqrt(2 * (w0 + 1))
+        v0, v1, v2 = (w0 + 1) / r, w1 / r, w2 / r
+        beta = math.sqrt(ys / zs)
+        vz = 2 * (v0 * z0 + v1 * z1 + v2 * z2)
+        L.append((beta * (v0 * vz - z0), beta * (v1 * vz + z1), beta * (v2 * vz + z2)))
+        G.append([a0 * w0 - a1 * w1 - a2 * w2 for a0, a1, a2 in cols])
+        V.append((v0, v1, v2))
+        B.append(1 / (beta * beta))
+    H = [[0.0] * d for _ in range(d)]
+    for i in range(d):
+        for j in range(i + 1):
+            h = 0.0
+            for g, p, scale in zip(G, P, B):
+                h += (2 * g[i] * g[j] - p[i][j]) * scale
+            H[i][j] = H[j][i] = h
+    ridge = 1e-14 * max(H[i][i] for i in range(d))
+    for i in range(d):
+        H[i][i] += ridge
+    B = [1 / math.sqrt(scale) for scale in B]
+
+    def direction(rhs):
+        U, WU = [], []
+        for (l0, l1, l2), (r0, r1, r2), v, beta in zip(L, rhs, V, B):
+            u0 = (l0 * r0 - l1 * r1 - l2 * r2) / (l0 * l0 - l1 * l1 - l2 * l2)
+            u = (u0, (r1 - u0 * l1) / l0, (r2 - u0 * l2) / l0)
+            U.append(u)
+            WU.append(_w_inv(v, beta, u))
+        dx = _solve(H, [-g for g in _transposed(AT, WU, res)])
+        dy = _times(AT, None, dx)
+        dz = []
+        for u, q, v, beta in zip(U, dy, V, B):
+            q = _w_inv(v, beta, q)
+            dz.append(_w_inv(v, beta, (u[0] - q[0], u[1] - q[1], u[2] - q[2])))
+        return dx, dy, dz
+
+    square = [(q0 * q0 + q1 * q1 + q2 * q2, 2 * q0 * q1, 2 * q0 * q2) for q0, q1, q2 in L]
+    mu = sum(ym[0] * zm[0] + ym[1] * zm[1] + ym[2] * zm[2] for ym, zm in zip(y, z)) / K
+    dx, dy, dz = direction([(-s0, -s1, -s2) for s0, s1, s2 in square])
+    step = min(1.0, *(_edge(ym, dm) for ym, dm in zip(y, dy)), *(_edge(zm, dm) for zm, dm in zip(z, dz)))
+    mu_aff = 0.0
+    for ym, zm, dym, dzm in zip(y, z, dy, dz):
+        for k in range(3):
+            mu_aff += (ym[k] + step * dym[k]) * (zm[k] + step * dzm[k])
+    sigma = min(max(mu_aff / K / mu, 0.0), 1.0) ** 3
+    rhs = []
+    for dym, dzm, (s0, s1, s2), v, beta in zip(dy, dz, square, V, B):
+        p, q = _w_inv(v, beta, dym), _w_mul(v, beta, dzm)
+        rhs.append(
+            (
+                -s0 - (p[0] * q[0] + p[1] * q[1] + p[2] * q[2]) + sigma * mu,
+                -s1 - (p[0] * q[1] + q[0] * p[1]),
+                -s2 - (p[0] * q[2] + q[0] * p[2]),
+            )
+        )
+    dx, dy, dz = direction(rhs)
+    step = min(1.0, _EDGE * min(*(_edge(ym, dm) for ym, dm in zip(y, dy)), *(_edge(zm, dm) for zm, dm in zip(z, dz))))
+    if not (math.isfinite(step) and all(map(math.isfinite, dx)) and all(math.isfinite(v) for t in dz for v in t)):
+        return None
+    for j in range(d):
+        x[j] += step * dx[j]
+    gap = 0.0
+    for m in range(K):
+        zm = z[m] = [z[m][k] + step * dz[m][k] for k in range(3)]
+        ym, dym = y[m], dy[m]
+        gap += (ym[0] + step * dym[0]) * zm[0] + (ym[1] + step * dym[1]) * zm[1] + (ym[2] + step * dym[2]) * zm[2]
+    obj = sum(cj * xj for cj, xj in zip(c, x))
+    feasible = max(abs(r) for r in res) * (1 - step) <= _RESIDUAL
+    return leave(x, gap <= GAP * (1 + abs(obj)), obj - gap if feasible else -math.inf)
+
+
+def phase_one(A, b):
+    """:func:`socp.phase_one` for one row: ``(x, r, z)`` (``z`` of the three cones)."""
+    d = len(A[0][0])
+    wide = [[row[:] + [1.0 if k == 0 else 0.0] for k, row in enumerate(a)] for a in A]
+    wide.append([[0.0] * d + [1.0], [0.0] * (d + 1), [0.0] * (d + 1)])
+    bw = [list(bm) for bm in b] + [[1.0, 0.0, 0.0]]
+    over = max(math.hypot(bm[1], bm[2]) - bm[0] for bm in b)
+    x = [0.0] * d + [max(over + 1, 0.0)]
+    z = [[0.25, 0.0, 0.0] for _ in range(4)]
+    c = [0.0] * d + [1.0]
+
+    def leave(x, closed, dual):
+        return x[d] <= -START_MARGIN or dual > _RESIDUAL * (1 + sum(abs(v) for v in x)) or (closed and dual > -math.inf)
+
+    _iterate(wide, bw, c, x, z, newton_matrices(wide), leave)
+    return x[:d], x[d], z[:3]
+
+
+def minimise(A, b, c, x, P):
+    """:func:`socp.minimise` for one row from the strictly feasible ``x``: ``(x, z)``; ``P`` of :func:`newton_matrices`."""
+    z = [[1.0, 0.0, 0.0] for _ in A]
+    x = list(x)
+
+    def leave(x, closed, dual):
+        return closed and dual > -math.inf
+
+    _iterate(A, b, c, x, z, P, leave)
+    return x, z
+
+
+def _cone_value(a, bm, x):
+    return [bm[k] + sum(a[k][j] * x[j] for j in range(len(x))) for k in range(3)]
+
+
+def _dual_polish(A, b, c, x, z):
+    """``grip._dual_polish`` for one row."""
+    d = len(x)
+    y = [_cone_value(A[m], b[m], x) for m in range(len(A))]
+    res = [c[j] - sum(A[m][k][j] * z[m][k] for m in range(len(A)) for k in range(3)) for j in range(d)]
+    omega = [
+        math.sqrt(sum(v * v for v in z[m])) / max(math.sqrt(sum(v * v for v in y[m])), 1e-300) for m in range(len(A))
+    ]
+    h = [
+        [sum(omega[m] * A[m][k][i] * A[m][k][j] for m in range(len(A)) for k in range(3)) for j in range(d)]
+        for i in range(d)
+    ]
+    try:
+        delta = _solve(h, res)
+    except ZeroDivisionError:
+        return z
+    dz = [[omega[m] * sum(A[m][k][j] * delta[j] for j in range(d)) for k in range(3)] for m in range(len(A))]
+    if not all(math.isfinite(v) for t in dz for v in t):
+        return z
+    return [[z[m][k] + dz[m][k] for k in range(3)] for m in range(len(A))]
+
+
+def solve(A, b, c, P, inside, normal_det, rays):
+    """``grip._solve`` for one row of lists: ``(s, z, fail, blame)``.
+
+    ``inside``: the unknowns of an internal force strictly inside every cone, or None;
+    ``normal_det``: whether the squeezes reach every pattern of normal forces (so no
+    wrench needs pulling); ``rays``: the row's ``A`` with unlimited friction (the
+    cones' first rows), for the pulling test.
+    """
+    d = len(c)
+    x, r, z = None, -1.0, None
+    if inside is not None:
+        reach = max(
+            (START_MARGIN + abs(b[m][0]) + math.hypot(b[m][1], b[m][2])) / depth for m, depth in enumerate(inside[1])
+        )
+        x = [reach * v for v in inside[0]]
+    else:
+        x, r, z = phase_one(A, b)
+    if not r < 0:
+        y = [_cone_value(A[m], b[m], x) for m in range(3)]
+        blame = max(range(3), key=lambda m: math.hypot(y[m][1], y[m][2]) - y[m][0])
+        if not normal_det and phase_one(rays, [[bm[0], 0.0, 0.0] for bm in b])[1] >= 0:
+            blame = -1
+        return [math.nan] * d, z, True, blame
+    s, z = minimise(A, b, c, x, P)
+    return s, _dual_polish(A, b, c, s, z), False, -1

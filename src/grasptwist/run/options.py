@@ -1,0 +1,89 @@
+"""Each family's options (:mod:`.families`): what a command asks of its rows beyond what every
+command shares, defaults being a command line without options.  Apart from the families'
+compute so that a run loads only its own family's (a JSON ``resolve`` never imports the force
+engine).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from ..model import Twist, Wrench
+
+__all__ = ["TwistOptions", "ForceOptions", "FollowOptions"]
+
+
+def _count(given) -> int:
+    """Rows per grasp of a data set: one per value the command line gives, else one (the data set's own)."""
+    return len(given) if given else 1
+
+
+@dataclass(frozen=True)
+class TwistOptions:
+    """The twist family's options: which twists each grasp's rows take, by which methods.
+
+    ``twists`` (``--twist``) replace each grasp's own (``basis`` and ``check``
+    fix them to :data:`ZERO_TWIST`: a row per grasp); ``twists_from``
+    (``--twists-from``, a file or ``-``) gives them one per line instead;
+    ``select`` (``--select``) picks the grasps' own by name.
+
+    >>> TwistOptions().rows_per_grasp(), TwistOptions(twists=(None, None)).rows_per_grasp()
+    (1, 2)
+    """
+
+    twists: tuple[Twist, ...] | None = None
+    method: str = "both"
+    twists_from: str | None = None
+    select: tuple[str, ...] | None = None
+
+    def rows_per_grasp(self) -> int:
+        """Rows each grasp of a data set gives: one per twist of the command line, else its own."""
+        return _count(self.twists)
+
+
+@dataclass(frozen=True)
+class ForceOptions:
+    """The wrench family's options: what ``grasptwist forces`` asks of every row beyond its inputs.
+
+    ``wrenches`` (``--wrench``) replace each grasp's own, ``friction``
+    (``--friction``) its friction; ``safety``, ``quality`` and ``cone_edges``
+    go to the engine.
+    """
+
+    wrenches: tuple[Wrench, ...] | None = None
+    friction: float | None = None
+    safety: float = 1.0
+    quality: bool = False
+    cone_edges: int = 8
+
+    def rows_per_grasp(self) -> int:
+        """Rows each grasp of a data set gives: one per wrench of the command line, else its own (or none)."""
+        return _count(self.wrenches)
+
+
+@dataclass(frozen=True)
+class FollowOptions:
+    """The path family's options: what ``follow`` was asked beyond what every command shares.
+
+    Attributes
+    ----------
+    method : str
+        A ``--method`` value.
+    path : str or None
+        Follow only the paths of this name.
+    segments : tuple of Segment or None
+        The command line's path, replacing the files'.
+    samples : int or None
+        Samples per path, evenly spaced, both ends included.
+    dt : float or None
+        Time step between samples instead (the path's end is a sample too).
+    bases : bool
+        Keep the basis screws (formats that show them; :func:`follow_outputs` sets it from the format).
+    """
+
+    method: str = "both"
+    path: str | None = None
+    segments: tuple | None = None
+    samples: int | None = None
+    dt: float | None = None
+    bases: bool = True
