@@ -17,7 +17,7 @@ from dataclasses import dataclass, fields, replace
 import numpy as np
 
 from ..engine.forces.closure import force_closure
-from ..engine.forces.grasp_map import manipulating_forces
+from ..engine.forces.grasp_map import GRIP_NUMBERS, manipulating_forces
 from ..engine.forces.grip import grip
 from ..engine.judgements import outward_contacts
 from ..engine.screws import direction
@@ -108,17 +108,7 @@ def compute_forces(points, normals, wrench, has_wrench, friction, has_friction, 
     g = np.flatnonzero(has_wrench & has_friction)
     if g.size:
         r = grip(points[g], normals[g], wrench[g], friction[g], safety=options.safety)
-        for name in (
-            "force",
-            "squeeze",
-            "normal_force",
-            "tangential_force",
-            "friction_used",
-            "total_normal_force",
-            "dual",
-            "gap",
-            "certificate",
-        ):
+        for name in (*GRIP_NUMBERS, "certificate"):
             out[name][g] = getattr(r, name)
         out["grip_status"][g], out["grip_culprit"][g] = r.status, r.culprit
     # closure and epsilon with the friction the forces may use, as the grip's (issue 31)
