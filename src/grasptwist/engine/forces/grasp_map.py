@@ -45,6 +45,7 @@ __all__ = [
     "check_safety",
     "nonfinite_result",
     "checked_grip",
+    "GRIP_NUMBERS",
     "grasp_map",
     "manipulating_reference",
     "squeeze_directions",
