@@ -174,16 +174,20 @@ NAMES = [
 ]  # fmt: skip
 
 
-def _number_places(number):
-    """Documents with ``number`` in each place a number stands: a point, a normal, the wrist,
-    a twist's angular, linear, at and screw; first, middle and last in its vector."""
-    for vector in (f"[{number}, 0, 0]", f"[1, {number}, 2]", f"[0, 0, {number}]"):
-        yield CONTACTS.replace("[1, 0, 0]", vector, 1)
-        yield CONTACTS.replace("[-1, 0, 0]", vector, 1)
-        yield f"wrist: {vector}\n" + CONTACTS
-        for twist in (f"angular: {vector}", f"linear: {vector}", f"at: {vector}\n    angular: [1, 1, 1]"):
-            yield CONTACTS + f"twists:\n  - {twist}\n"
-        yield CONTACTS + f"twists:\n  - screw: [1, 2, 3, {vector[1:-1]}]\n"
+#: Where in a vector a number stands: first, middle, last.
+SLOTS = ("[{}, 0, 0]", "[1, {}, 2]", "[0, 0, {}]")
+
+
+def _number_places(number, slot):
+    """Documents with ``number`` at ``slot`` of each vector a number stands in: a point, a
+    normal, the wrist, a twist's angular, linear, at and screw."""
+    vector = slot.format(number)
+    yield CONTACTS.replace("[1, 0, 0]", vector, 1)
+    yield CONTACTS.replace("[-1, 0, 0]", vector, 1)
+    yield f"wrist: {vector}\n" + CONTACTS
+    for twist in (f"angular: {vector}", f"linear: {vector}", f"at: {vector}\n    angular: [1, 1, 1]"):
+        yield CONTACTS + f"twists:\n  - {twist}\n"
+    yield CONTACTS + f"twists:\n  - screw: [1, 2, 3, {vector[1:-1]}]\n"
 
 
 def _name_places(name):
@@ -372,8 +376,9 @@ _SETTINGS = settings(max_examples=25, deadline=None, suppress_health_check=[Heal
 
 @_SETTINGS
 @_examples(NUMBERS, number=number)
-def test_a_number_reads_the_same_both_ways_wherever_it_stands(number, parser):
-    for doc in _number_places(number):
+@pytest.mark.parametrize("slot", SLOTS)
+def test_a_number_reads_the_same_both_ways_wherever_it_stands(number, slot, parser):
+    for doc in _number_places(number, slot):
         both_paths(doc, Reading(parser=parser), file="g.yaml")
 
 
