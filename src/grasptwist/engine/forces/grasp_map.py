@@ -400,7 +400,8 @@ def geometry(points, tol=DEGENERACY_TOL) -> Geometry:
         status[bad] = ForceStatus.NONFINITE_INPUT
         culprit[over | bad] = -1
         conditioning = np.where(status == 0, conditioning, np.where(bad | over, np.nan, 0.0))
-    return Geometry(g, q, m, t, size, conditioning, squeeze_directions(p), status, culprit)
+        squeezes = squeeze_directions(p)
+    return Geometry(g, q, m, t, size, conditioning, squeezes, status, culprit)
 
 
 def _manipulating(geo: Geometry, wrench):
