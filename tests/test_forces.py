@@ -624,3 +624,18 @@ def test_collinear_frictionless_contacts_stay_unsolved_and_a_batch_of_odd_rows_n
         gt.forces.Status.CANNOT_HOLD,
     ]
     assert np.isnan(g.certificate[:3]).all() and g.certificate[3] @ [0, 0, -1, 0, 0, 0] > 0
+
+
+def test_contacts_whose_spread_overflows_are_an_overflow_not_coincident():
+    """Finite contacts near 1e300 apart: their size overflows, which once read as coincident contacts."""
+    p = np.array([[1, 0, 0], [-0.5, 0.75**0.5, 0], [-0.5, -(0.75**0.5), 0]])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # and quietly: no numpy warning reaches a library caller
+        m = gt.forces.manipulating_forces(1e300 * p, [0, 0, 1, 0, 0, 0])
+        g = gt.grip(1e300 * p, -p, [0, 0, 1, 0, 0, 0], 0.5)
+        c = gt.forces.force_closure(1e300 * p, -p, 0.5, quality=True)
+    code = gt.forces.Status.NONFINITE_RESULT
+    assert (int(m.status), int(m.culprit), int(g.status), int(c.status)) == (code, -1, code, code)
+    assert np.isnan(m.force).all() and np.isnan(m.conditioning)
+    # the same grasp at a sane scale is fine
+    assert int(gt.forces.manipulating_forces(p, [0, 0, 1, 0, 0, 0]).status) == 0

@@ -393,11 +393,16 @@ def geometry(points, tol=DEGENERACY_TOL) -> Geometry:
         hit = coincident.any(axis=-1) | ~(t > 0)
         status[hit] = ForceStatus.COINCIDENT_CONTACTS
         culprit[hit] = worst[hit]
+        # finite contacts whose spread overflows (coordinates near 1e154 and beyond) have no
+        # geometry to judge: an overflow, not the coincident contacts an infinite size would mimic
+        over = ~np.isfinite(t)
+        status[over] = ForceStatus.NONFINITE_RESULT
         bad = ~np.isfinite(p).all(axis=(-1, -2))
         status[bad] = ForceStatus.NONFINITE_INPUT
-        culprit[bad] = -1
-        conditioning = np.where(status == 0, conditioning, np.where(bad, np.nan, 0.0))
-    return Geometry(g, q, m, t, size, conditioning, squeeze_directions(p), status, culprit)
+        culprit[over | bad] = -1
+        conditioning = np.where(status == 0, conditioning, np.where(bad | over, np.nan, 0.0))
+        squeezes = squeeze_directions(p)
+    return Geometry(g, q, m, t, size, conditioning, squeezes, status, culprit)
 
 
 def _manipulating(geo: Geometry, wrench):
