@@ -32,7 +32,7 @@ import numpy as np
 from ..checks import check_normals, check_points
 from ..degeneracy import DEGENERACY_TOL
 from ..screws import cross, dot, norm
-from . import closure, one, socp
+from . import closure, compiled, one, socp
 from .grasp_map import (
     ForceStatus,
     _manipulating,
@@ -268,9 +268,46 @@ def grip(points, normals, wrench, friction, *, safety=1.0, tol=DEGENERACY_TOL) -
     p, n, w = (np.broadcast_to(a, shape + a.shape[-t:]) for a, t in ((p, 2), (n, 2), (w, 1)))
     mu = np.broadcast_to(mu if mu.ndim else mu[None], shape + (3,))
     size = int(np.prod(shape))
-    flat = [a.reshape((size,) + a.shape[len(shape) :]) for a in (p, n, mu)]
-    out = _Prepared(*flat, s_f, tol).solve(w.reshape(size, 6))
-    return checked_grip(Grip(safety=s_f, **{k: v.reshape(shape + v.shape[1:]) for k, v in out.items()}))
+    flat = [a.reshape((size,) + a.shape[len(shape) :]) for a in (p, n, mu, w)]
+    return _grip_of(flat, s_f, tol, shape)
+
+
+def _grip_of(rows, s_f, tol, shape, prepared=None):
+    """The :class:`Grip` of ``rows = (p, n, mu, w)`` flat over rows, shaped ``shape``.
+
+    Compiled (:mod:`~grasptwist.engine.forces.compiled`) where numba is there: the kernel takes
+    the rows it can, the numpy path (``prepared``, else a :class:`_Prepared` of those rows) the others.
+    """
+    fast = compiled.kernel()
+    if fast is None:
+        prepared = prepared or _Prepared(*rows[:3], s_f, tol)
+        out, checked = prepared.solve(rows[3]), False
+    else:
+        out, rest = _compiled_rows(fast, rows, s_f, tol)
+        if rest.size:
+            more = _Prepared(*(a[rest] for a in rows[:3]), s_f, tol).solve(rows[3][rest])
+            for key, value in more.items():
+                out[key][rest] = value
+        checked = not rest.size
+    g = Grip(safety=s_f, **{k: v.reshape(shape + v.shape[1:]) for k, v in out.items()})
+    return g if checked else checked_grip(g)
+
+
+def _compiled_rows(fast, rows, s_f, tol):
+    """The grip's columns by :func:`kernel.grip_rows`, and the rows it leaves to the numpy path."""
+    p, n, mu, w = (np.ascontiguousarray(a, dtype=float) for a in rows)
+    size = len(p)
+    limit = np.ascontiguousarray(np.broadcast_to(mu / s_f, (size, 3)))
+    numbers = np.empty((size, fast.WIDTH))
+    codes = np.empty((size, 3), np.int8)
+    fast.grip_rows(p, n, limit, w, float(tol), numbers, codes)
+    out, at = {}, 0
+    for name, width in fast.COLUMNS:
+        part = numbers[:, at : at + width]
+        out[name] = part[:, 0] if width == 1 else part.reshape(size, 3, 3) if width == 9 else part
+        at += width
+    out["status"], out["culprit"] = codes[:, 0], codes[:, 1]
+    return out, np.flatnonzero(codes[:, 2] == 0)
 
 
 class PreparedGrip:
@@ -286,6 +323,7 @@ class PreparedGrip:
     def __init__(self, points, normals, friction, safety, tol):
         self.points, self.normals, self.friction, self.safety = points, normals, friction, safety
         self._prepared = _Prepared(points[None], normals[None], friction[None], safety, tol)
+        self._rows = (points[None], normals[None], friction[None])
 
     def grip(self, wrench) -> Grip:
         """The same :class:`Grip` as ``grip(points, normals, wrench, friction, safety=safety)``.
@@ -294,10 +332,10 @@ class PreparedGrip:
         """
         w = check_wrench(wrench)
         rows = w.reshape(-1, 6)
-        prepared = self._prepared if len(rows) == 1 else self._prepared.repeat(len(rows))
-        out = prepared.solve(rows)
-        shape = w.shape[:-1]
-        return checked_grip(Grip(safety=self.safety, **{k: v.reshape(shape + v.shape[1:]) for k, v in out.items()}))
+        k = len(rows)
+        prepared = self._prepared if k == 1 else self._prepared.repeat(k)
+        grasp = (self._rows if k == 1 else tuple(np.repeat(a, k, axis=0) for a in self._rows)) + (rows,)
+        return _grip_of(grasp, self.safety, self._prepared.tol, w.shape[:-1], prepared)
 
 
 def prepare_grip(points, normals, friction, *, safety=1.0, tol=DEGENERACY_TOL) -> PreparedGrip:
