@@ -280,34 +280,36 @@ def _grip_of(rows, s_f, tol, shape, prepared=None):
     """
     fast = compiled.kernel()
     if fast is None:
-        prepared = prepared or _Prepared(*rows[:3], s_f, tol)
-        out, checked = prepared.solve(rows[3]), False
-    else:
-        out, rest = _compiled_rows(fast, rows, s_f, tol)
-        if rest.size:
-            more = _Prepared(*(a[rest] for a in rows[:3]), s_f, tol).solve(rows[3][rest])
-            for key, value in more.items():
-                out[key][rest] = value
-        checked = not rest.size
-    g = Grip(safety=s_f, **{k: v.reshape(shape + v.shape[1:]) for k, v in out.items()})
-    return g if checked else checked_grip(g)
-
-
-def _compiled_rows(fast, rows, s_f, tol):
-    """The grip's columns by :func:`kernel.grip_rows`, and the rows it leaves to the numpy path."""
+        out = (prepared or _Prepared(*rows[:3], s_f, tol)).solve(rows[3])
+        return checked_grip(Grip(safety=s_f, **{k: v.reshape(shape + v.shape[1:]) for k, v in out.items()}))
     p, n, mu, w = (np.ascontiguousarray(a, dtype=float) for a in rows)
-    size = len(p)
-    limit = np.ascontiguousarray(np.broadcast_to(mu / s_f, (size, 3)))
+    limit = np.ascontiguousarray(np.broadcast_to(mu / s_f, (len(p), 3)))
+    return _compiled_grip(fast, (p, n, limit, w), s_f, tol, shape, lambda rest: (p[rest], n[rest], mu[rest]))
+
+
+def _compiled_grip(fast, rows, s_f, tol, shape, others):
+    """The :class:`Grip` of :func:`kernel.grip_rows` on ``rows = (p, n, limit, w)`` (C-contiguous floats).
+
+    The rows it leaves go to the numpy path, on the grasps ``others(rest) = (p, n, mu)``.  Every
+    field is a view of one array the kernel filled.
+    """
+    size = len(rows[0])
     numbers = np.empty((size, fast.WIDTH))
     codes = np.empty((size, 3), np.int8)
-    fast.grip_rows(p, n, limit, w, float(tol), numbers, codes)
+    fast.grip_rows(*rows, tol, numbers, codes)
     out, at = {}, 0
     for name, width in fast.COLUMNS:
-        part = numbers[:, at : at + width]
-        out[name] = part[:, 0] if width == 1 else part.reshape(size, 3, 3) if width == 9 else part
+        out[name] = numbers[:, at : at + width]
         at += width
-    out["status"], out["culprit"] = codes[:, 0], codes[:, 1]
-    return out, np.flatnonzero(codes[:, 2] == 0)
+    out["status"], out["culprit"] = codes[:, :1], codes[:, 1:2]
+    rest = np.flatnonzero(codes[:, 2] == 0) if size > 1 or not codes[0, 2] else ()
+    if len(rest):
+        more = _Prepared(*others(rest), s_f, tol).solve(rows[3][rest])
+        for name, value in more.items():
+            out[name][rest] = value.reshape(len(rest), -1)
+    tails = {1: (), 3: (3,), 6: (6,), 9: (3, 3)}
+    g = Grip(safety=s_f, **{k: v.reshape(shape + tails[v.shape[1]]) for k, v in out.items()})
+    return checked_grip(g) if len(rest) else g
 
 
 class PreparedGrip:
@@ -324,6 +326,8 @@ class PreparedGrip:
         self.points, self.normals, self.friction, self.safety = points, normals, friction, safety
         self._prepared = _Prepared(points[None], normals[None], friction[None], safety, tol)
         self._rows = (points[None], normals[None], friction[None])
+        self._limit = np.ascontiguousarray(friction[None] / safety)
+        self._tol = float(tol)
 
     def grip(self, wrench) -> Grip:
         """The same :class:`Grip` as ``grip(points, normals, wrench, friction, safety=safety)``.
@@ -333,6 +337,11 @@ class PreparedGrip:
         w = check_wrench(wrench)
         rows = w.reshape(-1, 6)
         k = len(rows)
+        fast = compiled.kernel()
+        if fast is not None and k == 1:  # a control loop's call: no more numpy than the Grip's views
+            p, n, _ = grasp = self._rows
+            rows = (p, n, self._limit, np.ascontiguousarray(rows))
+            return _compiled_grip(fast, rows, self.safety, self._tol, w.shape[:-1], lambda rest: grasp)
         prepared = self._prepared if k == 1 else self._prepared.repeat(k)
         grasp = (self._rows if k == 1 else tuple(np.repeat(a, k, axis=0) for a in self._rows)) + (rows,)
         return _grip_of(grasp, self.safety, self._prepared.tol, w.shape[:-1], prepared)
@@ -356,7 +365,7 @@ def prepare_grip(points, normals, friction, *, safety=1.0, tol=DEGENERACY_TOL) -
     mu = np.broadcast_to(check_friction(friction), (3,)) if np.ndim(friction) <= 1 else None
     if mu is None:
         raise ValueError(f"prepare_grip takes one grasp: friction a scalar or (3,), got {np.shape(friction)}")
-    return PreparedGrip(p, n, mu.astype(float), check_safety(safety), tol)
+    return PreparedGrip(np.ascontiguousarray(p), np.ascontiguousarray(n), mu.astype(float), check_safety(safety), tol)
 
 
 class _Prepared:
@@ -460,7 +469,9 @@ class _Prepared:
                 status[r[fail]], culprit[r[fail]] = ForceStatus.CANNOT_HOLD, blame[fail]
                 certificate[r[fail]] = y[fail]
                 # on the edge of what the fingers can exert (y . w = 0): the contacts y forbids carry nothing
-                edge = np.flatnonzero(fail & ~(np.einsum("ni,ni->n", y, w[r]) > _EDGE_OF_HOLD * norm(y) * norm(w[r])))
+                with np.errstate(over="ignore"):  # a huge wrench: its row is nonfinite-result, not a warning
+                    held = np.einsum("ni,ni->n", y, w[r]) > _EDGE_OF_HOLD * norm(y) * norm(w[r])
+                edge = np.flatnonzero(fail & ~held)
                 for i in edge:
                     found = _on_the_edge(frame[i], m[i], fm[r[i]] / scale[r[i]], z[i])
                     if found is None:

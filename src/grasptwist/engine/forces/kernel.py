@@ -20,7 +20,7 @@ from numba import njit
 
 from .socp import _EDGE, _ITERATIONS, _RESIDUAL, GAP, START_MARGIN
 
-_JIT = {"cache": True, "error_model": "numpy", "fastmath": {"arcp", "contract"}}
+_JIT = {"cache": True, "error_model": "numpy", "fastmath": False}
 
 
 @njit(**_JIT)
