@@ -674,6 +674,14 @@ def test_the_compiled_grip_follows_the_numpy_path():
     np.testing.assert_allclose(g.dual, reference.dual, rtol=1e-4, atol=1e-4)
     for name in ("force", "dual", "certificate", "gap", "total_normal_force"):
         assert (np.isnan(getattr(g, name)) == np.isnan(getattr(reference, name))).all()
+    hand = gt.prepare_grip(p[20], n[20], mu[20], safety=1.3)  # a control loop's call: its own short way
+    with compiled.numpy_path():
+        alone = hand.grip(w[20])
+    fast = hand.grip(w[20])
+    for name in ("force", "dual", "status", "culprit", "total_normal_force", "gap", "squeeze", "certificate"):
+        a, b = getattr(fast, name), getattr(alone, name)
+        assert (type(a), a.shape, a.dtype) == (type(b), b.shape, b.dtype)
+    assert fast.total_normal_force == pytest.approx(float(alone.total_normal_force), rel=1e-9)
 
 
 def test_importing_grasptwist_imports_no_numba():

@@ -298,7 +298,7 @@ def _compiled_grip(fast, rows, s_f, tol, shape, others):
     codes = np.empty((size, 3), np.int8)
     fast.grip_rows(*rows, tol, numbers, codes)
     out, at = {}, 0
-    for name, width in fast.COLUMNS:
+    for name, width in compiled.COLUMNS:
         out[name] = numbers[:, at : at + width]
         at += width
     out["status"], out["culprit"] = codes[:, :1], codes[:, 1:2]
@@ -307,9 +307,23 @@ def _compiled_grip(fast, rows, s_f, tol, shape, others):
         more = _Prepared(*others(rest), s_f, tol).solve(rows[3][rest])
         for name, value in more.items():
             out[name][rest] = value.reshape(len(rest), -1)
-    tails = {1: (), 3: (3,), 6: (6,), 9: (3, 3)}
-    g = Grip(safety=s_f, **{k: v.reshape(shape + tails[v.shape[1]]) for k, v in out.items()})
+    g = Grip(safety=s_f, **{k: v.reshape(shape + _TAILS[v.shape[1]]) for k, v in out.items()})
     return checked_grip(g) if len(rest) else g
+
+
+_TAILS = {1: (), 3: (3,), 6: (6,), 9: (3, 3)}
+
+
+def _views():
+    """``(name, start, stop, shape or None)`` of one row's fields in :func:`kernel.grip_rows`' numbers."""
+    out, at = [], 0
+    for name, width in compiled.COLUMNS:
+        out.append((name, at, at + width, None if width in (3, 6) else _TAILS[width]))
+        at += width
+    return tuple(out)
+
+
+_VIEWS = _views()
 
 
 class PreparedGrip:
@@ -338,10 +352,19 @@ class PreparedGrip:
         rows = w.reshape(-1, 6)
         k = len(rows)
         fast = compiled.kernel()
-        if fast is not None and k == 1:  # a control loop's call: no more numpy than the Grip's views
-            p, n, _ = grasp = self._rows
-            rows = (p, n, self._limit, np.ascontiguousarray(rows))
-            return _compiled_grip(fast, rows, self.safety, self._tol, w.shape[:-1], lambda rest: grasp)
+        if fast is not None and w.ndim == 1:  # a control loop's call: the kernel and the Grip's views, no more
+            numbers = np.empty((1, fast.WIDTH))
+            codes = np.empty((1, 3), np.int8)
+            fast.grip_rows(
+                self._rows[0], self._rows[1], self._limit, np.ascontiguousarray(rows), self._tol, numbers, codes
+            )
+            if codes[0, 2]:
+                flat, codes = numbers[0], codes[0]
+                fields = {name: flat[a:b] if tail is None else flat[a:b].reshape(tail) for name, a, b, tail in _VIEWS}
+                fields.update(status=codes[0, ...], culprit=codes[1, ...], safety=self.safety)
+                g = object.__new__(Grip)  # the frozen dataclass's __init__ was a tenth of the call
+                g.__dict__.update(fields)
+                return g
         prepared = self._prepared if k == 1 else self._prepared.repeat(k)
         grasp = (self._rows if k == 1 else tuple(np.repeat(a, k, axis=0) for a in self._rows)) + (rows,)
         return _grip_of(grasp, self.safety, self._prepared.tol, w.shape[:-1], prepared)

@@ -14,13 +14,15 @@ zero is ``inf`` or NaN, which ends a row's iterations as a non-finite step does 
 from __future__ import annotations
 
 import math
+from itertools import accumulate
 
 import numpy as np
 from numba import njit
 
+from .compiled import COLUMNS
 from .socp import _EDGE, _ITERATIONS, _RESIDUAL, GAP, START_MARGIN
 
-_JIT = {"cache": True, "error_model": "numpy", "fastmath": False}
+_JIT = {"cache": True, "error_model": "numpy", "fastmath": {"arcp", "contract"}}
 
 
 @njit(**_JIT)
@@ -389,21 +391,8 @@ def _solve_row(A, b, inside, s, z, ws, rw):
     return False, -1
 
 
-#: Columns of :func:`grip_rows`' numbers: the :class:`~grasptwist.engine.forces.grip.Grip` fields in order.
-COLUMNS = (
-    ("force", 9),
-    ("manipulating", 9),
-    ("squeeze", 3),
-    ("normal_force", 3),
-    ("tangential_force", 3),
-    ("friction_used", 3),
-    ("total_normal_force", 1),
-    ("conditioning", 1),
-    ("dual", 6),
-    ("gap", 1),
-    ("certificate", 6),
-)
-_F, _FM, _S, _FN, _FT, _USED, _TOTAL, _COND, _DUAL, _GAP, _CERT, WIDTH = 0, 9, 18, 21, 24, 27, 30, 31, 32, 38, 39, 45
+# where each of compiled.COLUMNS starts, and the row's width
+_F, _FM, _S, _FN, _FT, _USED, _TOTAL, _COND, _DUAL, _GAP, _CERT, WIDTH = accumulate((w for _, w in COLUMNS), initial=0)
 _JJ, _KK = (1, 2, 0), (2, 0, 1)  # screws.J, screws.K: side i joins contacts J[i] and K[i]
 
 
@@ -519,8 +508,8 @@ def _internal_inside(p, unit, mv, e, limit, out):
 @njit(**_JIT)
 def grip_rows(p, n, limit, w, tol, out, codes):
     """The whole grip of the rows numpy's :class:`grip._Prepared` solves by cones (three distinct,
-    non-collinear contacts, friction at each): ``out (n, WIDTH)`` (:data:`COLUMNS`) and ``codes (n, 3)``
-    int8 (status, culprit, plain).  ``plain = 0`` leaves a row to the numpy path: any other kind of
+    non-collinear contacts, friction at each): ``out (n, WIDTH)`` (the fields of
+    :data:`compiled.COLUMNS`) and ``codes (n, 3)`` int8 (status, culprit, plain).  ``plain = 0`` leaves a row to the numpy path: any other kind of
     row, a non-finite number, a wrench on the edge of what the fingers exert.  ``limit (n, 3)`` is
     ``mu / safety``.
     """
