@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import importlib.util
 import os
+import warnings
 from contextlib import contextmanager
 
 __all__ = ["kernel", "numpy_path", "COLUMNS"]
@@ -43,8 +44,12 @@ def kernel():
         if importlib.util.find_spec("numba") is None:
             _state["on"] = False
             return None
-        from . import kernel as module
-
+        try:
+            from . import kernel as module
+        except (ImportError, RuntimeError, OSError) as error:  # e.g. no directory numba may cache in
+            _state["on"] = False
+            warnings.warn(f"the compiled grip is unavailable ({error}); the numpy path is used", stacklevel=3)
+            return None
         _state["module"] = module
     return _state["module"]
 
