@@ -4,6 +4,10 @@ Numbers are checked against LAPACK's pseudo-inverse, against Clarabel (an indepe
 solver on the nine contact-force numbers, tests/conic.py) and against cases worked by hand.
 """
 
+import importlib.util
+import os
+import subprocess
+import sys
 import warnings
 
 import numpy as np
@@ -686,8 +690,23 @@ def test_the_compiled_grip_follows_the_numpy_path():
 
 def test_importing_grasptwist_imports_no_numba():
     """The compiled kernel is loaded on the first grip, never at import (the CLI's start-up stays short)."""
-    import subprocess
-    import sys
-
     code = "import sys, grasptwist, grasptwist.cli; assert 'numba' not in sys.modules, 'numba imported'"
     assert subprocess.run([sys.executable, "-c", code], capture_output=True, text=True).returncode == 0
+    # GRASPTWIST_NUMBA=0: the numpy path, numba never loaded even by a grip
+    code = "import sys, grasptwist as gt; gt.grip(*{args}); assert 'numba' not in sys.modules, 'numba imported'"
+    args = (EQ.tolist(), (-EQ).tolist(), [0, 0, 1, 0, 0, 0], 0.5)
+    env = dict(os.environ, GRASPTWIST_NUMBA="0")
+    done = subprocess.run([sys.executable, "-c", code.format(args=args)], capture_output=True, text=True, env=env)
+    assert done.returncode == 0, done.stderr
+
+
+def test_a_numba_that_cannot_load_the_kernel_leaves_the_numpy_path_with_a_warning(monkeypatch):
+    import grasptwist.engine.forces as package
+
+    monkeypatch.setitem(sys.modules, "grasptwist.engine.forces.kernel", None)  # the import fails
+    monkeypatch.delattr(package, "kernel", raising=False)  # (as it does where numba was never loaded)
+    monkeypatch.setattr(compiled, "_state", {"on": True, "module": None})
+    monkeypatch.setattr(importlib.util, "find_spec", lambda name: object())  # as if numba were installed
+    with pytest.warns(UserWarning, match=r"^the compiled grip is unavailable \(.*\); the numpy path is used$"):
+        g = gt.grip(EQ, -EQ, [0, 0, G, 0, 0, 0], 0.5)
+    assert g.total_normal_force == pytest.approx(G / 0.5, rel=1e-9) and compiled.kernel() is None
