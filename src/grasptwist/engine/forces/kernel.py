@@ -19,23 +19,15 @@ from itertools import accumulate
 import numpy as np
 from numba import njit
 
+from . import one
 from .compiled import COLUMNS
 from .socp import _EDGE, _ITERATIONS, _RESIDUAL, GAP, START_MARGIN
 
 _JIT = {"cache": True, "error_model": "numpy", "fastmath": {"arcp", "contract"}}
 
 
-@njit(**_JIT)
-def _edge(x0, x1, x2, d0, d1, d2):
-    """The largest ``alpha`` with ``x + alpha d`` in the cone (``inf``: none), as ``socp._edge``."""
-    s = math.sqrt(x0 * x0 - x1 * x1 - x2 * x2)
-    x0, x1, x2 = x0 / s, x1 / s, x2 / s
-    d0, d1, d2 = d0 / s, d1 / s, d2 / s
-    rho0 = x0 * d0 - x1 * d1 - x2 * d2
-    f = (rho0 + d0) / (x0 + 1)
-    e1, e2 = d1 - f * x1, d2 - f * x2
-    t = math.sqrt(e1 * e1 + e2 * e2) - rho0
-    return 1 / t if t > 0 else math.inf
+# the scalar pieces are one.py's functions, compiled: the two paths share them line for line
+_edge, _scaling, _w_inv, _w_mul = (njit(**_JIT)(f) for f in (one.edge, one.scaling, one.w_inv, one.w_mul))
 
 
 @njit(**_JIT)
@@ -55,15 +47,14 @@ def _spd_solve(H, g, d, out):
 
 
 @njit(**_JIT)
-def _w_inv(v, beta, u0, u1, u2):
-    t = 2 * (v[0] * u0 - v[1] * u1 - v[2] * u2)
-    return (t * v[0] - u0) / beta, (u1 - t * v[1]) / beta, (u2 - t * v[2]) / beta
-
-
-@njit(**_JIT)
-def _w_mul(v, beta, u0, u1, u2):
-    t = 2 * (v[0] * u0 + v[1] * u1 + v[2] * u2)
-    return beta * (t * v[0] - u0), beta * (t * v[1] + u1), beta * (t * v[2] + u2)
+def _apply(A, x, d, K, out):
+    """``out_m = A_m x`` for the ``K`` cones."""
+    for m in range(K):
+        for k in range(3):
+            t = 0.0
+            for j in range(d):
+                t += A[m, k, j] * x[j]
+            out[m, k] = t
 
 
 @njit(**_JIT)
@@ -74,7 +65,7 @@ def _direction(A, L, V, beta, rhs, res, H, d, K, U, WU, g, Hw, dx, dy, dz):
         r0, r1, r2 = rhs[m, 0], rhs[m, 1], rhs[m, 2]
         u0 = (l0 * r0 - l1 * r1 - l2 * r2) / (l0 * l0 - l1 * l1 - l2 * l2)
         U[m, 0], U[m, 1], U[m, 2] = u0, (r1 - u0 * l1) / l0, (r2 - u0 * l2) / l0
-        WU[m, 0], WU[m, 1], WU[m, 2] = _w_inv(V[m], beta[m], U[m, 0], U[m, 1], U[m, 2])
+        WU[m, 0], WU[m, 1], WU[m, 2] = _w_inv(V[m, 0], V[m, 1], V[m, 2], beta[m], U[m, 0], U[m, 1], U[m, 2])
     for j in range(d):
         t = res[j]
         for m in range(K):
@@ -83,14 +74,12 @@ def _direction(A, L, V, beta, rhs, res, H, d, K, U, WU, g, Hw, dx, dy, dz):
         for i in range(d):
             Hw[j, i] = H[j, i]
     _spd_solve(Hw, g, d, dx)
+    _apply(A, dx, d, K, dy)
     for m in range(K):
-        for k in range(3):
-            t = 0.0
-            for j in range(d):
-                t += A[m, k, j] * dx[j]
-            dy[m, k] = t
-        q0, q1, q2 = _w_inv(V[m], beta[m], dy[m, 0], dy[m, 1], dy[m, 2])
-        dz[m, 0], dz[m, 1], dz[m, 2] = _w_inv(V[m], beta[m], U[m, 0] - q0, U[m, 1] - q1, U[m, 2] - q2)
+        q0, q1, q2 = _w_inv(V[m, 0], V[m, 1], V[m, 2], beta[m], dy[m, 0], dy[m, 1], dy[m, 2])
+        dz[m, 0], dz[m, 1], dz[m, 2] = _w_inv(
+            V[m, 0], V[m, 1], V[m, 2], beta[m], U[m, 0] - q0, U[m, 1] - q1, U[m, 2] - q2
+        )
 
 
 @njit(**_JIT)
@@ -110,17 +99,9 @@ def _iterate(A, b, c, x, z, P, phase_one, d, K, ws):
                 for j in range(d):
                     t += A[m, k, j] * x[j]
                 y[m, k] = t
-            y0, y1, y2 = y[m, 0], y[m, 1], y[m, 2]
-            z0, z1, z2 = z[m, 0], z[m, 1], z[m, 2]
-            ys = math.sqrt(y0 * y0 - y1 * y1 - y2 * y2)
-            zs = math.sqrt(z0 * z0 - z1 * z1 - z2 * z2)
-            twice = 2 * math.sqrt((1 + (y0 * z0 + y1 * z1 + y2 * z2) / (ys * zs)) / 2)
-            w0, w1, w2 = (y0 / ys + z0 / zs) / twice, (y1 / ys - z1 / zs) / twice, (y2 / ys - z2 / zs) / twice
-            r = math.sqrt(2 * (w0 + 1))
-            v0, v1, v2 = (w0 + 1) / r, w1 / r, w2 / r
-            bt = math.sqrt(ys / zs)
-            vz = 2 * (v0 * z0 + v1 * z1 + v2 * z2)
-            L[m, 0], L[m, 1], L[m, 2] = bt * (v0 * vz - z0), bt * (v1 * vz + z1), bt * (v2 * vz + z2)
+            w0, w1, w2, v0, v1, v2, bt, L[m, 0], L[m, 1], L[m, 2] = _scaling(
+                y[m, 0], y[m, 1], y[m, 2], z[m, 0], z[m, 1], z[m, 2]
+            )
             for j in range(d):
                 G[m, j] = A[m, 0, j] * w0 - A[m, 1, j] * w1 - A[m, 2, j] * w2
             V[m, 0], V[m, 1], V[m, 2] = v0, v1, v2
@@ -156,8 +137,8 @@ def _iterate(A, b, c, x, z, P, phase_one, d, K, ws):
                 mu_aff += (y[m, k] + step * dy[m, k]) * (z[m, k] + step * dz[m, k])
         sigma = min(max(mu_aff / K / mu, 0.0), 1.0) ** 3
         for m in range(K):
-            p0, p1, p2 = _w_inv(V[m], beta[m], dy[m, 0], dy[m, 1], dy[m, 2])
-            q0, q1, q2 = _w_mul(V[m], beta[m], dz[m, 0], dz[m, 1], dz[m, 2])
+            p0, p1, p2 = _w_inv(V[m, 0], V[m, 1], V[m, 2], beta[m], dy[m, 0], dy[m, 1], dy[m, 2])
+            q0, q1, q2 = _w_mul(V[m, 0], V[m, 1], V[m, 2], beta[m], dz[m, 0], dz[m, 1], dz[m, 2])
             rhs[m, 0] = -square[m, 0] - (p0 * q0 + p1 * q1 + p2 * q2) + sigma * mu
             rhs[m, 1] = -square[m, 1] - (p0 * q1 + q0 * p1)
             rhs[m, 2] = -square[m, 2] - (p0 * q2 + q0 * p2)
@@ -307,12 +288,10 @@ def _dual_polish(A, b, c, x, z, rw):
             h[i, j] = t
         h[i, i] += 1e-300
     _spd_solve(h, res, d, delta)
+    _apply(A, delta, d, K, dz)
     for m in range(K):
         for k in range(3):
-            t = 0.0
-            for j in range(d):
-                t += A[m, k, j] * delta[j]
-            dz[m, k] = omega[m] * t
+            dz[m, k] *= omega[m]
             if not math.isfinite(dz[m, k]):
                 return
     for m in range(K):
