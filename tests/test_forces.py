@@ -662,14 +662,19 @@ def test_the_compiled_grip_follows_the_numpy_path():
     w[6] = 0.0  # no wrench: no force
     n[7, 1] = 0.0  # a zero normal
     p[8, 1] = p[8, 0]  # coincident
+    w[9] = [0, 0, 1e308, 0, 0, 1e308]  # nonfinite-result: G^+ w overflows
     with compiled.numpy_path():
         reference = gt.grip(p, n, w, mu, safety=1.3)
     g = gt.grip(p, n, w, mu, safety=1.3)
     codes = np.empty((300, 3), np.int8)
     kernel.grip_rows(p, n, mu / 1.3, w, 1e-9, np.empty((300, kernel.WIDTH)), codes)
-    assert codes[:9, 2].tolist() == [0, 0, 0, 0, 0, 0, 1, 0, 0] and codes[9:, 2].mean() > 0.9  # all but the odd ones
+    assert codes[:10, 2].tolist() == [0, 0, 0, 0, 0, 0, 1, 0, 0, 0] and codes[10:, 2].mean() > 0.9  # not the odd ones
     assert (g.status == reference.status).all() and (g.culprit == reference.culprit).all()
-    assert g.ok.sum() > 100 and (g.status == gt.ForceStatus.CANNOT_HOLD).sum() > 50
+    assert (
+        g.status[9] == gt.ForceStatus.NONFINITE_RESULT
+        and g.ok.sum() > 100
+        and (g.status == gt.ForceStatus.CANNOT_HOLD).sum() > 50
+    )
     ok = reference.ok
     np.testing.assert_allclose(g.total_normal_force[ok], reference.total_normal_force[ok], rtol=1e-9, atol=0)
     np.testing.assert_allclose(g.force, reference.force, rtol=1e-6, atol=1e-6 * np.abs(reference.force[ok]).max())

@@ -15,23 +15,8 @@ import os
 import warnings
 from contextlib import contextmanager
 
-__all__ = ["kernel", "numpy_path", "COLUMNS"]
+__all__ = ["kernel", "numpy_path"]
 
-#: The row of numbers :func:`kernel.grip_rows` fills: the :class:`~grasptwist.engine.forces.grip.Grip`
-#: fields in this order, of these widths.
-COLUMNS = (
-    ("force", 9),
-    ("manipulating", 9),
-    ("squeeze", 3),
-    ("normal_force", 3),
-    ("tangential_force", 3),
-    ("friction_used", 3),
-    ("total_normal_force", 1),
-    ("conditioning", 1),
-    ("dual", 6),
-    ("gap", 1),
-    ("certificate", 6),
-)
 
 _state = {"on": os.environ.get("GRASPTWIST_NUMBA", "1") != "0", "module": None}
 

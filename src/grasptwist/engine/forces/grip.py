@@ -34,6 +34,7 @@ from ..degeneracy import DEGENERACY_TOL
 from ..screws import cross, dot, norm
 from . import closure, compiled, one, socp
 from .grasp_map import (
+    GRIP_COLUMNS,
     ForceStatus,
     _manipulating,
     check_friction,
@@ -298,7 +299,7 @@ def _compiled_grip(fast, rows, s_f, tol, shape, others):
     codes = np.empty((size, 3), np.int8)
     fast.grip_rows(*rows, tol, numbers, codes)
     out, at = {}, 0
-    for name, width in compiled.COLUMNS:
+    for name, width in GRIP_COLUMNS:
         out[name] = numbers[:, at : at + width]
         at += width
     out["status"], out["culprit"] = codes[:, :1], codes[:, 1:2]
@@ -317,7 +318,7 @@ _TAILS = {1: (), 3: (3,), 6: (6,), 9: (3, 3)}
 def _views():
     """``(name, start, stop, shape or None)`` of one row's fields in :func:`kernel.grip_rows`' numbers."""
     out, at = [], 0
-    for name, width in compiled.COLUMNS:
+    for name, width in GRIP_COLUMNS:
         out.append((name, at, at + width, None if width in (3, 6) else _TAILS[width]))
         at += width
     return tuple(out)

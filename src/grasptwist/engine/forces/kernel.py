@@ -20,8 +20,10 @@ import numpy as np
 from numba import njit
 
 from . import one
-from .compiled import COLUMNS
+from .grasp_map import GRIP_COLUMNS
 from .socp import _EDGE, _ITERATIONS, _RESIDUAL, GAP, START_MARGIN
+
+__all__ = ["grip_rows", "WIDTH"]
 
 _JIT = {"cache": True, "error_model": "numpy", "fastmath": {"arcp", "contract"}}
 
@@ -370,8 +372,10 @@ def _solve_row(A, b, inside, s, z, ws, rw):
     return False, -1
 
 
-# where each of compiled.COLUMNS starts, and the row's width
-_F, _FM, _S, _FN, _FT, _USED, _TOTAL, _COND, _DUAL, _GAP, _CERT, WIDTH = accumulate((w for _, w in COLUMNS), initial=0)
+# where each of grasp_map.GRIP_COLUMNS starts, and the row's width
+_F, _FM, _S, _FN, _FT, _USED, _TOTAL, _COND, _DUAL, _GAP, _CERT, WIDTH = accumulate(
+    (w for _, w in GRIP_COLUMNS), initial=0
+)
 _JJ, _KK = (1, 2, 0), (2, 0, 1)  # screws.J, screws.K: side i joins contacts J[i] and K[i]
 
 
@@ -487,10 +491,12 @@ def _internal_inside(p, unit, mv, e, limit, out):
 @njit(**_JIT)
 def grip_rows(p, n, limit, w, tol, out, codes):
     """The whole grip of the rows numpy's :class:`grip._Prepared` solves by cones (three distinct,
-    non-collinear contacts, friction at each): ``out (n, WIDTH)`` (the fields of
-    :data:`compiled.COLUMNS`) and ``codes (n, 3)`` int8 (status, culprit, plain).  ``plain = 0`` leaves a row to the numpy path: any other kind of
-    row, a non-finite number, a wrench on the edge of what the fingers exert.  ``limit (n, 3)`` is
-    ``mu / safety``.
+    non-collinear contacts, friction at each).
+
+    ``out (n, WIDTH)``: the fields of :data:`grasp_map.GRIP_COLUMNS`; ``codes (n, 3)`` int8: status,
+    culprit, plain.  ``plain = 0`` leaves a row to the numpy path: any other kind of row, a
+    non-finite number (input, or an overflow on the way), a wrench on the edge of what the fingers
+    exert.  ``limit (n, 3)`` is ``mu / safety``.
     """
     ws, rw = _workspace(), _row_workspace()
     q, mv, g = np.empty((3, 3)), np.empty(3), np.empty(3)
@@ -558,6 +564,9 @@ def grip_rows(p, n, limit, w, tol, out, codes):
             for k in range(3):
                 o[_FM + 3 * i + k] = fm[i, k]
                 scale = max(scale, abs(fm[i, k]))
+                plain = plain and math.isfinite(fm[i, k])
+        if not plain:  # overflow: nonfinite-result, said by the numpy path
+            continue
         o[_COND] = conditioning
         for k in range(6):
             o[_CERT + k] = math.nan
@@ -648,6 +657,7 @@ def grip_rows(p, n, limit, w, tol, out, codes):
             total += fn
             finite = finite and math.isfinite(fn) and math.isfinite(ft) and math.isfinite(o[_USED + i])
         o[_TOTAL] = total
+        finite = finite and math.isfinite(total)
         gap = total
         for k in range(6):
             gap -= w[r, k] * o[_DUAL + k]
