@@ -1,14 +1,17 @@
-r"""The grip's interior-point method compiled by numba: :mod:`~grasptwist.engine.forces.one`'s
-steps, one row after another, on fixed-size arrays (imported only through
-:mod:`~grasptwist.engine.forces.compiled`, which compiles it on first use).
+r"""The grip compiled by numba, a whole row at a time (imported only through
+:mod:`~grasptwist.engine.forces.compiled`, which loads it at the first grip).
 
-The same method step for step as :mod:`~grasptwist.engine.forces.socp` (Mehrotra's
-predictor-corrector with Nesterov-Todd scaling, 0.99 of the way to the cones' edge, the same
-stopping rules, the same phase I, dual polish and culprits), so the numpy path stays the
-reference: ``tests/test_forces.py`` holds the two to the same verdicts and totals to
-``1e-9``.  A row is ``A[m, k, j]`` (cone ``m``, component ``k``, unknown ``j``),
-``b[m, k]``, ``c[j]``; ``d`` unknowns, ``K`` cones.  numpy's error model: a division by
-zero is ``inf`` or NaN, which ends a row's iterations as a non-finite step does in numpy.
+:func:`grip_rows` does for each row what the numpy path does for the rows it solves by cones:
+the geometry and ``G^+ w`` (:mod:`~grasptwist.engine.forces.grasp_map`), the cones and a start
+inside them (:func:`~grasptwist.engine.forces.closure.internal_inside`), the interior-point
+method of :mod:`~grasptwist.engine.forces.socp` step for step (Mehrotra's predictor-corrector
+with Nesterov-Todd scaling, 0.99 of the way to the cones' edge, the same stopping rules, phase
+I, dual polish and culprits; its scalar pieces are :mod:`~grasptwist.engine.forces.one`'s
+functions, compiled), then the dual or the certificate and the figures.  The numpy path stays
+the reference: ``tests/test_forces.py`` holds the two to the same verdicts and totals to
+``1e-9``.  A row of the method is ``A[m, k, j]`` (cone ``m``, component ``k``, unknown ``j``),
+``b[m, k]``, ``c[j]``; ``d`` unknowns, ``K`` cones.  numpy's error model: a division by zero
+is ``inf`` or NaN, which ends a row's iterations as a non-finite step does in numpy.
 """
 
 from __future__ import annotations
@@ -20,6 +23,7 @@ import numpy as np
 from numba import njit
 
 from . import one
+from .closure import _PAIRS, _STRICT
 from .grasp_map import GRIP_COLUMNS
 from .socp import _EDGE, _ITERATIONS, _RESIDUAL, GAP, START_MARGIN
 
@@ -414,10 +418,6 @@ def _omega(q, mv, t, x0, x1, x2, out):
     out[3], out[4], out[5] = (mv[0] * mx + 3 * s0) / mm, (mv[1] * mx + 3 * s1) / mm, (mv[2] * mx + 3 * s2) / mm
 
 
-_STRICT = 1e-12  # closure._STRICT
-_PAIR = np.array([(a, c) for a in range(6) for c in range(a + 1, 6)])
-
-
 @njit(**_JIT)
 def _internal_inside(p, unit, mv, e, limit, out):
     """``closure.internal_inside`` for one row: a unit squeeze strictly inside every cone into ``out (3)``,
@@ -466,8 +466,8 @@ def _internal_inside(p, unit, mv, e, limit, out):
             for sq in range(3):
                 rows[2 * i + edge, sq] /= length
     s0 = s1 = s2 = 0.0
-    for pair in range(15):  # closure._PAIRS, in its order
-        a, c = _PAIR[pair]
+    for pair in range(len(_PAIRS)):  # in closure_test's order
+        a, c = _PAIRS[pair]
         c0, c1, c2 = _cross(rows[a, 0], rows[a, 1], rows[a, 2], rows[c, 0], rows[c, 1], rows[c, 2])
         length = math.sqrt(c0 * c0 + c1 * c1 + c2 * c2)
         if not length > _STRICT:
