@@ -316,10 +316,12 @@ _TAILS = {1: (), 3: (3,), 6: (6,), 9: (3, 3)}
 
 
 def _views():
-    """``(name, start, stop, shape or None)`` of one row's fields in :func:`kernel.grip_rows`' numbers."""
+    """``(name, index, shape or None)`` of one row's fields in :func:`kernel.grip_rows`' numbers
+    (``[at, ...]``: a 0-d view of one number, the cheapest there is)."""
     out, at = [], 0
     for name, width in GRIP_COLUMNS:
-        out.append((name, at, at + width, None if width in (3, 6) else _TAILS[width]))
+        index = (at, Ellipsis) if width == 1 else slice(at, at + width)
+        out.append((name, index, (3, 3) if width == 9 else None))
         at += width
     return tuple(out)
 
@@ -356,12 +358,10 @@ class PreparedGrip:
         if fast is not None and w.ndim == 1:  # a control loop's call: the kernel and the Grip's views, no more
             numbers = np.empty((1, fast.WIDTH))
             codes = np.empty((1, 3), np.int8)
-            fast.grip_rows(
-                self._rows[0], self._rows[1], self._limit, np.ascontiguousarray(rows), self._tol, numbers, codes
-            )
+            fast.grip_rows(self._rows[0], self._rows[1], self._limit, rows, self._tol, numbers, codes)  # w: a copy
             if codes[0, 2]:
                 flat, codes = numbers[0], codes[0]
-                fields = {name: flat[a:b] if tail is None else flat[a:b].reshape(tail) for name, a, b, tail in _VIEWS}
+                fields = {name: flat[at] if tail is None else flat[at].reshape(tail) for name, at, tail in _VIEWS}
                 fields.update(status=codes[0, ...], culprit=codes[1, ...], safety=self.safety)
                 g = object.__new__(Grip)  # the frozen dataclass's __init__ was a tenth of the call
                 g.__dict__.update(fields)
