@@ -249,6 +249,23 @@ GRIP_NUMBERS = (
 )
 
 
+#: A grip row as the compiled kernel fills it (:func:`~grasptwist.engine.forces.kernel.grip_rows`): the
+#: :class:`~grasptwist.engine.forces.grip.Grip` fields in this order, of these widths.
+GRIP_COLUMNS = (
+    ("force", 9),
+    ("manipulating", 9),
+    ("squeeze", 3),
+    ("normal_force", 3),
+    ("tangential_force", 3),
+    ("friction_used", 3),
+    ("total_normal_force", 1),
+    ("conditioning", 1),
+    ("dual", 6),
+    ("gap", 1),
+    ("certificate", 6),
+)
+
+
 def checked_grip(g):
     """A grip whose ok rows are finite: ``nonfinite-result`` (and NaN numbers) where they are not.
 
@@ -307,7 +324,8 @@ def manipulating_reference(points, wrench) -> np.ndarray:
 
     ``(..., 3, 3), (..., 6) -> (..., 3, 3)``.
 
-    >>> (manipulating_reference([[1, 0, 0], [-0.5, 0.75**0.5, 0], [-0.5, -(0.75**0.5), 0]], [0, 0, 3, 0, 0, 0]).round(6) + 0.0).tolist()
+    >>> f = manipulating_reference([[1, 0, 0], [-0.5, 0.75**0.5, 0], [-0.5, -(0.75**0.5), 0]], [0, 0, 3, 0, 0, 0])
+    >>> (f.round(6) + 0.0).tolist()  # + 0.0: no -0 (LAPACK's sign of a zero differs between CPUs)
     [[0.0, 0.0, 1.0], [0.0, 0.0, 1.0], [0.0, 0.0, 1.0]]
     """
     w = np.asarray(wrench, dtype=float)
