@@ -44,6 +44,7 @@ __all__ = [
     "hand_summary",
     "grip_record",
     "hold_text",
+    "unjudged_text",
 ]
 
 #: The block columns a follow CSV row leaves out (the path's own replace them).
@@ -124,6 +125,16 @@ def hold_text(c: dict, digits: int = 4) -> str:
     return f"cannot hold the weight from t = {c['t_start']:.{digits}f} to t = {c['t_end']:.{digits}f}: {why}"
 
 
+def unjudged_text(u: dict, digits: int = 4) -> str:
+    """A ``hold_unjudged`` stretch of a summary in words.
+
+    >>> unjudged_text({"t_start": 5.8e-11, "t_end": 1.0, "code": "nonfinite-pose"})
+    'cannot judge whether the weight is held from t = 0.0000 to t = 1.0000: the grip fails there (nonfinite-pose)'
+    """
+    a, b = f"{u['t_start']:.{digits}f}", f"{u['t_end']:.{digits}f}"
+    return f"cannot judge whether the weight is held from t = {a} to t = {b}: the grip fails there ({u['code']})"
+
+
 def _finger_positions(hand, positions) -> list[list[float]]:
     """Per finger of ``hand``, its joints' positions from a ``(n_joints,)`` row in ``hand.joint_names`` order."""
     return [(positions[list(f.joint_index)] + 0.0).tolist() for f in hand.fingers]
@@ -194,7 +205,11 @@ def summary_record(summary) -> dict:
             }
             for c in summary.cannot_hold
         ]
-        ok = ok and not summary.cannot_hold  # the object falls
+        out["hold_unjudged"] = [
+            {"t_start": u.t_start, "t_end": u.t_end, "code": ForceStatus(u.status).code} for u in summary.unjudged
+        ]
+        # the object falls, or no one knows whether it does
+        ok = ok and not summary.cannot_hold and not summary.unjudged
     if summary.hand is not None:
         out["hand"] = hand_summary(summary.grasp, summary.hand, summary.tip_error)
         # a joint out of its limits, or a finger that cannot follow, stops the motion too
@@ -265,6 +280,7 @@ def diagnostics(rec: dict, names=("1", "2", "3")) -> tuple[list[str], list[str]]
         )
     warnings += [f"{where}: warning: {w}" for w in rec.get("warnings", ())]
     errors += [f"{where}: error: {hold_text(c, 6)}" for c in s.get("cannot_hold", ())]
+    errors += [f"{where}: error: {unjudged_text(u, 6)}" for u in s.get("hold_unjudged", ())]
     if "hand" in s:
         hand_errors, hand_warnings = hand_event_texts(s["hand"], names, 6)
         errors += [f"{where}: error: hand: {text}" for text in hand_errors]

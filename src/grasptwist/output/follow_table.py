@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from typing import IO
 
-from .follow_records import crossing_text, hand_event_texts, hold_text
+from .follow_records import crossing_text, hand_event_texts, hold_text, unjudged_text
 from .names import escaped
 from .numbers import fmt_figure, fmt_number
 
@@ -124,7 +124,9 @@ class FollowTable:
         if "cannot_hold" in s:
             for c in s["cannot_hold"]:
                 self._line(f"  {hold_text(c, self.digits)}")
-            if not s["cannot_hold"]:
+            for u in s["hold_unjudged"]:
+                self._line(f"  {unjudged_text(u, self.digits)}")
+            if not s["cannot_hold"] and not s["hold_unjudged"]:
                 self._line("  the weight is held all along the path")
         if "hand" in s:
             errors, warnings = hand_event_texts(s["hand"], self.names, self.digits)
