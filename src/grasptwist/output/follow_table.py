@@ -103,7 +103,7 @@ class FollowTable:
 
     def _summary(self, rec):
         s = rec["summary"]
-        self._line(f"summary: duration {s['duration']:.{self.digits}f}, {s['samples']} samples")
+        self._line(f"summary: duration {fmt_number(s['duration'], self.digits)}, {s['samples']} samples")
         for c in s["degenerate"]:
             self._line(f"  {crossing_text(c, self.names, self.digits)} ({c['method']} degenerate)")
         if not s["degenerate"]:
@@ -119,7 +119,7 @@ class FollowTable:
         self._line(
             "  no conditioning warning"
             if w is None
-            else f"  first warning: {w['method']} at t = {w['t']:.{self.digits}f}"
+            else f"  first warning: {w['method']} at t = {fmt_number(w['t'], self.digits)}"
         )
         if "cannot_hold" in s:
             for c in s["cannot_hold"]:
