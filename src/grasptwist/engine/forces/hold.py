@@ -171,8 +171,8 @@ def cannot_hold(
     its first (last) node and the held node before (after) it, every end at once, to
     ``1e-10`` (``PRECISION``) of the shortest segment's duration.  A stretch shorter than the
     sampling, between two held nodes, is not seen.  A grasp the grip cannot solve at
-    all (degenerate contacts, ``status`` other than ``cannot-hold``) has no stretches:
-    :func:`hold_verdicts` reports those, and the path's degeneracies say why.
+    all (degenerate contacts, ``status`` other than ``cannot-hold``) has no stretches: a
+    path's summary lists those as ``hold_unjudged``, and its degeneracies say why.
 
     Parameters
     ----------
