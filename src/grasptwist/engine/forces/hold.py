@@ -203,17 +203,7 @@ def cannot_hold(
 
 
 def hold_verdicts(
-    points,
-    normals,
-    friction,
-    mass,
-    center_of_mass,
-    gravity,
-    segments,
-    times=None,
-    *,
-    safety=1.0,
-    tol=DEGENERACY_TOL,
+    points, normals, friction, mass, center_of_mass, gravity, segments, times=None, *, safety=1.0, tol=DEGENERACY_TOL
 ) -> tuple[tuple[HoldStretch, ...], tuple[Unjudged, ...]]:
     """Where the weight is not held along a path, and where that cannot be judged.
 
