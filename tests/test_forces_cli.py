@@ -349,7 +349,8 @@ def test_huge_and_infinite_friction_close_a_grasp_whose_closure_friction_is_fini
     assert rec["friction"] == [1e200] * 3 and rec["closure"]["force_closure"] is True
 
 
-def test_an_infinite_friction_is_null_in_a_record_and_inf_in_a_table(tmp_path):
+def test_an_infinite_friction_is_null_in_a_record_and_inf_in_a_table(tmp_path, monkeypatch):
+    monkeypatch.delenv("COLUMNS", raising=False)  # not a terminal: the table in one part, rows whole
     r, recs = records(SPHERE, "--friction", "inf")
     assert r.exit_code == 0 and [rec["friction"] for rec in recs] == [[None] * 3] * 3  # no infinity in JSON
     hold = by(recs, "sphere-equator", "hold")
