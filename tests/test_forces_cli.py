@@ -355,6 +355,8 @@ def test_an_infinite_friction_is_null_in_a_record_and_inf_in_a_table(tmp_path, m
     assert r.exit_code == 0 and [rec["friction"] for rec in recs] == [[None] * 3] * 3  # no infinity in JSON
     hold = by(recs, "sphere-equator", "hold")
     assert hold["ok"] and hold["grip"]["total_normal_force"] < 1e-9  # no limit: the weight hangs on friction alone
+    flat, _ = run("forces", SPHERE, "--friction", "inf", "-f", "csv")
+    assert [[row[f"mu{i}"] for i in (1, 2, 3)] for row in csv.DictReader(io.StringIO(flat.stdout))] == [["inf"] * 3] * 3
     table, _ = run("forces", SPHERE, "--friction", "inf", "--digits", "2")
     assert table.exit_code == 0 and "internal error" not in table.stderr, table.stderr
     rows = [
