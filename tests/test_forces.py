@@ -354,6 +354,13 @@ def test_check_cone_edges(value):
     assert check_cone_edges(64) == 64 and check_cone_edges(3.0) == 3
 
 
+def test_the_most_cone_edges_is_public_where_the_forces_guide_names_it():
+    edges = gt.forces.MAX_CONE_EDGES
+    assert edges == 64 and check_cone_edges(edges) == edges
+    with pytest.raises(ValueError, match=rf"^cone_edges must be an integer from 3 to {edges}, got {edges + 1}$"):
+        check_cone_edges(edges + 1)
+
+
 # --- antipodal, coplanar and coincident contacts; huge friction; overflow (issues 26, 27) --------
 
 ANTIPODAL = np.array([[0.03, 0, 0], [-0.03, 0, 0], [0, 0.03, 0.01]])  # the next contact on the normal's line
