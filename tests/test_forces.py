@@ -419,14 +419,36 @@ def test_huge_and_infinite_friction_mean_what_they_say():
 
 
 def test_an_overflowing_result_is_a_status_never_an_ok_row_with_infinity():
-    m = gt.forces.manipulating_forces(EQ, [[1e308, 0, 0, 0, 0, 1e308], [0, 0, G, 0, 0, 0]])
+    # a moment of 1e308 N m on fingers 1 mm from the centre: forces of 3e310 N, beyond a double
+    m = gt.forces.manipulating_forces(EQ / 1000, [[0, 0, 0, 0, 0, 1e308], [0, 0, G, 0, 0, 0]])
     assert m.status.tolist() == [9, 0] and np.isnan(m.force[0]).all() and np.isfinite(m.force[1]).all()
     assert gt.forces.status_message(9).startswith("the result overflows double precision")
-    g = checked_grip(gt.grip(EQ, -EQ, [[0, 0, 9.81e300, 0, 0, 0], [0, 0, G, 0, 0, 0], [0] * 6], 0.5))
-    assert g.status.tolist() == [9, 0, 0] and np.isnan(g.total_normal_force[0])
+    g = checked_grip(
+        gt.grip(EQ, -EQ, [[0, 0, 1e308, 0, 0, 0], [0, 0, G, 0, 0, 0], [0] * 6, [0, 0, G * 1e300] + [0] * 3], 0.5)
+    )
+    assert g.status.tolist() == [9, 0, 0, 0] and np.isnan(g.total_normal_force[0])  # 2e308 is beyond a double
     assert g.total_normal_force[1] == pytest.approx(2 * G) and g.friction_used[2].tolist() == [0.0] * 3
-    _, held = grip_along(EQ, -EQ, 0.5, 1e300, [0, 0, 0], [0, 0, -G], [Segment(1.0, twist=[0] * 6)], [0])
+    # a huge grip that is still a double is solved scaled: no overflow of the solver's squares
+    assert g.total_normal_force[3] == pytest.approx(2 * G * 1e300, rel=1e-9) and g.dual[3] == pytest.approx(g.dual[1])
+    _, held = grip_along(EQ, -EQ, 0.5, 1e307, [0, 0, 0], [0, 0, -G], [Segment(1.0, twist=[0] * 6)], [0])
     assert held.status.tolist() == [9]
+
+
+@pytest.mark.parametrize("scale", [1e-200, 1e-100, 1e120, 1e155, 1e300, 1e307])
+def test_the_grip_scales_with_the_wrench_over_the_whole_range_of_doubles(scale, grip_path):
+    """grip(k w) = k grip(w): wrenches beyond 1e100 (or below 1e-100) are solved scaled by a power of two."""
+    p, n, w, mu = grasps(30, 8)
+    w = w / np.abs(w).max(axis=1, keepdims=True)
+    one, big = gt.grip(p, n, w, mu, safety=1.2), gt.grip(p, n, scale * w, mu, safety=1.2)
+    assert (big.status == one.status).all() and one.ok.sum() >= 10
+    ok = one.ok
+    np.testing.assert_allclose(big.total_normal_force[ok] / scale, one.total_normal_force[ok], rtol=1e-9)
+    np.testing.assert_allclose(big.force[ok] / scale, one.force[ok], rtol=1e-6, atol=1e-9)
+    np.testing.assert_allclose(big.dual[ok], one.dual[ok], rtol=1e-6, atol=1e-9)
+    hand = gt.prepare_grip(p[0], n[0], mu[0], safety=1.2)
+    assert float(hand.grip(scale * w[0]).total_normal_force) == pytest.approx(
+        float(big.total_normal_force[0]), rel=1e-9, nan_ok=True
+    )
 
 
 # --- properties -------------------------------------------------------------------------------------

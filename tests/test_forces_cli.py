@@ -379,17 +379,22 @@ def _numbers(x):
 
 
 def test_an_overflowing_result_is_a_nonfinite_result_record_never_ok_with_nulls(tmp_path):
-    r, recs = records(SPHERE, "--friction", "0.5", "--wrench", "1e308,0,0,0,0,1e308", "--wrench", "0,0,0,0,0,0")
+    # a moment of 1.7e308 N m on fingers 3 cm from the centre: forces near 2e309 N, beyond a double
+    r, recs = records(SPHERE, "--friction", "0.5", "--wrench", "0,0,0,0,0,1.7e308", "--wrench", "0,0,0,0,0,0")
     assert r.exit_code == 1
     big, still = recs[:2]
     assert not big["ok"] and big["grip"]["error"]["code"] == big["manipulating"]["error"]["code"] == "nonfinite-result"
     assert still["ok"] and still["grip"]["friction_used"] == [0.0] * 3  # no force uses no friction
     (tmp_path / "heavy.yaml").write_text(
-        ANTIPODAL.replace("wrenches: [{name: up, force: [0, 0, 1]}]", "mass: 1e300\ncenter_of_mass: [0, 0, 0]")
+        ANTIPODAL.replace("wrenches: [{name: up, force: [0, 0, 1]}]", "mass: 1.5e307\ncenter_of_mass: [0, 0, 0]")
     )
     r, (heavy,) = records(tmp_path / "heavy.yaml")
     assert r.exit_code == 1 and heavy["grip"]["error"]["code"] == "nonfinite-result" and not heavy["ok"]
     assert "nonfinite-result: the result overflows double precision" in r.stderr
+    # 1e300 kg: a grip of some 1e301 N is still a double, and an ok record of finite numbers
+    (tmp_path / "heavy.yaml").write_text((tmp_path / "heavy.yaml").read_text().replace("1.5e307", "1e300"))
+    r, (heavy,) = records(tmp_path / "heavy.yaml")
+    assert r.exit_code == 0 and heavy["ok"] and 1e300 < heavy["grip"]["total_normal_force"] < 1e303
     _, recs = records(SPHERE, "--friction", "0.5", "--wrench", "1e300,0,0,0,0,0", "--wrench", "0,0,9.81,0,0,0")
     for rec in recs:  # an ok record holds only finite numbers
         assert not rec["ok"] or None not in _numbers({k: rec[k] for k in ("manipulating", "grip", "wrench")})

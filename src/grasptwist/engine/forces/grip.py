@@ -24,7 +24,7 @@ Where no grip exists, phase I's multipliers give ``y`` with ``y . w > 0`` and
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import partial
 
 import numpy as np
@@ -35,6 +35,7 @@ from ..screws import cross, dot, norm
 from . import closure, compiled, one, socp
 from .grasp_map import (
     GRIP_COLUMNS,
+    WRENCH_SCALED_BEYOND,
     ForceStatus,
     _manipulating,
     check_friction,
@@ -46,6 +47,7 @@ from .grasp_map import (
     contact_matrices,
     geometry,
     tangent_bases,
+    wrench_scales,
 )
 
 __all__ = ["Grip", "grip", "prepare_grip", "PreparedGrip", "load_words"]
@@ -273,12 +275,29 @@ def grip(points, normals, wrench, friction, *, safety=1.0, tol=DEGENERACY_TOL) -
     return _grip_of(flat, s_f, tol, shape)
 
 
+#: The grip's fields that scale with the wrench (the grip is positively homogeneous in it:
+#: ``grip(k w) = k grip(w)`` for ``k > 0``); the others (``friction_used``, ``dual``,
+#: ``certificate``, ``conditioning``) do not change.
+LINEAR_FIELDS = ("force", "manipulating", "squeeze", "normal_force", "tangential_force", "total_normal_force", "gap")
+
+
 def _grip_of(rows, s_f, tol, shape, prepared=None):
     """The :class:`Grip` of ``rows = (p, n, mu, w)`` flat over rows, shaped ``shape``.
 
     Compiled (:mod:`~grasptwist.engine.forces.compiled`) where numba is there: the kernel takes
     the rows it can, the numpy path (``prepared``, else a :class:`_Prepared` of those rows) the others.
+    A wrench beyond :data:`WRENCH_SCALED_BEYOND` is solved scaled (:func:`wrench_scales`) and its
+    grip scaled back, so that only a grip that is itself beyond a double is ``nonfinite-result``.
     """
+    k = wrench_scales(rows[3])
+    if (k != 1).any():
+        g = _grip_of((*rows[:3], rows[3] / k[:, None]), s_f, tol, shape, prepared)
+        k = k.reshape(shape)
+        with np.errstate(over="ignore", invalid="ignore"):
+            scaled = {
+                f: getattr(g, f) * k.reshape(k.shape + (1,) * (getattr(g, f).ndim - k.ndim)) for f in LINEAR_FIELDS
+            }
+        return checked_grip(replace(g, **scaled))
     fast = compiled.kernel()
     if fast is None:
         out = (prepared or _Prepared(*rows[:3], s_f, tol)).solve(rows[3])
@@ -355,7 +374,9 @@ class PreparedGrip:
         rows = w.reshape(-1, 6)
         k = len(rows)
         fast = compiled.kernel()
-        if fast is not None and w.ndim == 1:  # a control loop's call: the kernel and the Grip's views, no more
+        low, high = WRENCH_SCALED_BEYOND
+        largest = float(np.abs(rows).max())  # a wrench to scale first goes the general way
+        if fast is not None and w.ndim == 1 and (largest == 0 or low <= largest <= high):  # a control loop's call
             numbers = np.empty((1, fast.WIDTH))
             codes = np.empty((1, 3), np.int8)
             fast.grip_rows(self._rows[0], self._rows[1], self._limit, rows, self._tol, numbers, codes)  # w: a copy
