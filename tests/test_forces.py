@@ -718,7 +718,7 @@ def test_the_compiled_grip_follows_the_numpy_path(compiled_path):
     w[6] = 0.0  # no wrench: no force
     n[7, 1] = 0.0  # a zero normal
     p[8, 1] = p[8, 0]  # coincident
-    w[9] = [0, 0, 1e308, 0, 0, 1e308]  # nonfinite-result: G^+ w overflows
+    w[9] = [0, 0, 1e308, 0, 0, 1e308]  # solved scaled by a power of two, on the numpy path
     with compiled.numpy_path():
         reference = gt.grip(p, n, w, mu, safety=1.3)
     g = gt.grip(p, n, w, mu, safety=1.3)
@@ -726,11 +726,7 @@ def test_the_compiled_grip_follows_the_numpy_path(compiled_path):
     kernel.grip_rows(p, n, mu / 1.3, w, 1e-9, np.empty((300, kernel.WIDTH)), codes)
     assert codes[:10, 2].tolist() == [0, 0, 0, 0, 0, 0, 1, 0, 0, 0] and codes[10:, 2].mean() > 0.9  # not the odd ones
     assert (g.status == reference.status).all() and (g.culprit == reference.culprit).all()
-    assert (
-        g.status[9] == gt.forces.Status.NONFINITE_RESULT
-        and g.ok.sum() > 100
-        and (g.status == gt.forces.Status.CANNOT_HOLD).sum() > 50
-    )
+    assert g.ok.sum() > 100 and (g.status == gt.forces.Status.CANNOT_HOLD).sum() > 50 and not g.ok[9]
     ok = reference.ok
     np.testing.assert_allclose(g.total_normal_force[ok], reference.total_normal_force[ok], rtol=1e-9, atol=0)
     np.testing.assert_allclose(g.force, reference.force, rtol=1e-6, atol=1e-6 * np.abs(reference.force[ok]).max())
