@@ -16,9 +16,14 @@ disturbing moment; safety 1.5.  Baselines are Clarabel through its own Python AP
 - **agreement** on the loop's grasps: verdicts, total normal force, closure friction;
   on all: the wrench reproduced, the largest friction used over the cone's, and the
   certificates (dual gap, Farkas ``y . w > 0``).
+
+The grip's figures come twice where numba is installed (the ``fast`` extra): compiled, then on
+the numpy path (``GRASPTWIST_NUMBA=0``'s), with the two held to each other.  The compiled
+kernel is loaded (or compiled, on a fresh install) before any timing; that first call is printed.
 """
 
 import argparse
+import contextlib
 import pathlib
 import statistics
 import sys
@@ -27,6 +32,7 @@ import time
 import numpy as np
 
 import grasptwist as gt
+from grasptwist.engine.forces import compiled
 
 sys.path.insert(0, str(pathlib.Path(__file__).resolve().parents[1] / "tests"))
 from conic import closure_friction, least_grip  # noqa: E402
@@ -62,28 +68,48 @@ def cpu(call):
     return out, time.process_time() - t
 
 
+def paths():
+    """``(name, context)`` of the grip's paths: compiled first where numba is installed, then numpy."""
+    out = [("numpy", compiled.numpy_path)]
+    if compiled.kernel() is not None:
+        out.insert(0, ("compiled", contextlib.nullcontext))
+    return out
+
+
 def single(p, n, w, mu, count):
-    one = median_us(lambda i: gt.grip(p[i], n[i], w[i], mu[i], safety=SAFETY), count)
-    hand = gt.prepare_grip(p[0], n[0], mu[0], safety=SAFETY)
-    prepared = median_us(lambda i: hand.grip(w[i]), count)
     clarabel = median_us(lambda i: least_grip(p[i], n[i], w[i], mu[i], SAFETY), count)
-    print(
-        f"single calls (median of {count}): gt.grip {one:.0f} us, prepared .grip(wrench) {prepared:.0f} us, "
-        f"Clarabel direct {clarabel:.0f} us; gt.grip is {clarabel / one:.2f}x Clarabel, prepared {clarabel / prepared:.2f}x"
-    )
+    for name, path in paths():
+        with path():
+            one = median_us(lambda i: gt.grip(p[i], n[i], w[i], mu[i], safety=SAFETY), count)
+            hand = gt.prepare_grip(p[0], n[0], mu[0], safety=SAFETY)
+            prepared = median_us(lambda i, hand=hand: hand.grip(w[i]), count)
+        print(
+            f"single calls, {name} (median of {count}): gt.grip {one:.0f} us, prepared .grip(wrench) {prepared:.0f} us, "
+            f"Clarabel direct {clarabel:.0f} us; gt.grip is {clarabel / one:.2f}x Clarabel, prepared {clarabel / prepared:.2f}x"
+        )
 
 
 def batched(p, n, w, mu, k, kc):
     size = len(p)
-    g, t_grip = cpu(lambda: gt.grip(p, n, w, mu, safety=SAFETY))
-    c, t_closure = cpu(lambda: gt.forces.force_closure(p, n, mu))
     refs, t_loop = cpu(lambda: [least_grip(p[i], n[i], w[i], mu[i], SAFETY)[0] for i in range(k)])
     ref_closure, t_bisect = cpu(lambda: np.array([closure_friction(p[i], n[i]) for i in range(kc)]))
     per = (t_loop / k, t_bisect / kc)
-    print(
-        f"grip, {size} grasps: engine {1e6 * t_grip / size:.1f} us a grasp (CPU), Clarabel loop ({k} grasps) "
-        f"{1e6 * per[0]:.0f} us a grasp: {per[0] * size / t_grip:.0f}x; held {g.ok.mean():.1%}"
-    )
+    grips = {}
+    for name, path in paths():
+        with path():
+            grips[name], t_grip = cpu(lambda: gt.grip(p, n, w, mu, safety=SAFETY))
+        print(
+            f"grip, {size} grasps, {name}: {1e6 * t_grip / size:.1f} us a grasp (CPU), Clarabel loop ({k} grasps) "
+            f"{1e6 * per[0]:.0f} us a grasp: {per[0] * size / t_grip:.0f}x; held {grips[name].ok.mean():.1%}"
+        )
+    if len(grips) == 2:
+        a, b = grips["compiled"], grips["numpy"]
+        ok = b.ok
+        print(
+            f"compiled against numpy, all {size}: same status and culprit {((a.status == b.status) & (a.culprit == b.culprit)).mean():.3%}, "
+            f"total normal force max rel diff {np.abs(a.total_normal_force[ok] / b.total_normal_force[ok] - 1).max():.1e}"
+        )
+    c, t_closure = cpu(lambda: gt.forces.force_closure(p, n, mu))
     print(
         f"closure friction, {size} grasps: engine {1e6 * t_closure / size:.1f} us a grasp (CPU), Clarabel bisection "
         f"({kc} grasps, 46 solves each) {1e3 * per[1]:.1f} ms a grasp: {per[1] * size / t_closure:.0f}x; "
@@ -91,24 +117,25 @@ def batched(p, n, w, mu, k, kc):
     )
     solved = np.array([r is not None for r in refs])
     ref = np.array([r for r in refs if r is not None])
-    rel = np.abs(g.total_normal_force[:k][solved] / ref - 1).max()
     finite = np.isfinite(ref_closure)
     crel = np.abs(c.closure_friction[:kc][finite] / ref_closure[finite] - 1).max()
     print(
-        f"agreement on the loops' grasps: held/cannot-hold {(g.ok[:k] == solved).mean():.2%}, total normal force "
-        f"max rel diff {rel:.1e}; closure friction max rel diff {crel:.1e}, none-ness "
+        f"closure friction against Clarabel's on the loop's grasps: max rel diff {crel:.1e}, none-ness "
         f"{(np.isnan(c.closure_friction[:kc]) == ~finite).mean():.2%}"
     )
-    ok, bad = g.ok, g.status == gt.forces.Status.CANNOT_HOLD
-    made = np.concatenate((g.force[ok].sum(axis=1), np.cross(p[ok], g.force[ok]).sum(axis=1)), axis=1)
-    gap = np.abs(g.gap[ok]) / g.total_normal_force[ok]
-    yw = np.einsum("ni,ni->n", g.certificate[bad], w[bad])
-    print(
-        f"all {size}: wrench reproduced to {np.abs(made - w[ok]).max() / np.abs(w).max():.1e} (relative), largest "
-        f"friction_used / (mu / safety) {(g.friction_used[ok] / (mu[ok] / SAFETY)).max():.12f}; dual gap / total: "
-        f"median {np.median(gap):.1e}, largest {gap.max():.1e}; Farkas y . w > 0 on {(yw > 0).mean():.2%} of "
-        f"{bad.sum()} cannot-hold"
-    )
+    for name, g in grips.items():
+        rel = np.abs(g.total_normal_force[:k][solved] / ref - 1).max()
+        ok, bad = g.ok, g.status == gt.forces.Status.CANNOT_HOLD
+        made = np.concatenate((g.force[ok].sum(axis=1), np.cross(p[ok], g.force[ok]).sum(axis=1)), axis=1)
+        gap = np.abs(g.gap[ok]) / g.total_normal_force[ok]
+        yw = np.einsum("ni,ni->n", g.certificate[bad], w[bad])
+        print(
+            f"{name}: against Clarabel on the loop's grasps held/cannot-hold {(g.ok[:k] == solved).mean():.2%}, total "
+            f"normal force max rel diff {rel:.1e}; all {size}: wrench reproduced to "
+            f"{np.abs(made - w[ok]).max() / np.abs(w).max():.1e} (relative), largest friction_used / (mu / safety) "
+            f"{(g.friction_used[ok] / (mu[ok] / SAFETY)).max():.12f}; dual gap / total: median {np.median(gap):.1e}, "
+            f"largest {gap.max():.1e}; Farkas y . w > 0 on {(yw > 0).mean():.2%} of {bad.sum()} cannot-hold"
+        )
 
 
 def epsilon(p, n, mu, m):
@@ -147,6 +174,9 @@ def main():
     ap.add_argument("--epsilon", type=int, default=200)
     args = ap.parse_args()
     p, n, w, mu = grasps(args.n)
+    _, first = cpu(lambda: gt.grip(p[:2], n[:2], w[:2], mu[:2], safety=SAFETY))
+    if compiled.kernel() is not None:
+        print(f"first grip (numba loads its cached kernel, or compiles it on a fresh install): {first:.2f} s (CPU)")
     single(p, n, w, mu, args.single)
     batched(p, n, w, mu, args.loop, args.closure_loop)
     epsilon(p, n, mu, args.epsilon)

@@ -1,10 +1,17 @@
 """Fixtures shared by the loader's tests."""
 
-import numpy as np
-import pytest
-import yaml
+import os
 
-from grasptwist.io.grasp import Reading
+# The grip's numpy path in every test and subprocess: numba's kernel (the `fast` extra) costs
+# some 16 s of compiling per process on a fresh clone, so the tests that hold it to the numpy
+# path (tests/test_forces.py, `compiled`) are `slow` and switch it on themselves.
+os.environ.setdefault("GRASPTWIST_NUMBA", "0")
+
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
+import yaml  # noqa: E402
+
+from grasptwist.io.grasp import Reading  # noqa: E402
 
 # a script run in processes of its own (see its docstring), not a module for --doctest-modules to import
 collect_ignore = ["dask_checks.py"]

@@ -102,6 +102,24 @@ def test_the_0_1_loader_path_warns_and_gives_the_core_loader():
     assert shim.load_grasps is gt.load_grasps and shim.GraspFileError is gt.GraspFileError
 
 
+def test_the_version_is_the_one_the_deprecations_and_the_package_say():
+    import tomllib
+
+    from typer.testing import CliRunner
+
+    from grasptwist.cli import app
+
+    with pytest.warns(DeprecationWarning) as said:
+        gt.grasp_map  # noqa: B018
+    since = re.search(r"deprecated since (\d+)\.(\d+)", str(said[0].message)).groups()
+    version = tuple(int(n) for n in gt.__version__.split("."))
+    assert version[:2] >= tuple(map(int, since))  # a release that deprecates is at least that release
+    pyproject = tomllib.loads((ROOT / "pyproject.toml").read_text())
+    assert pyproject["project"]["version"] == gt.__version__ == "0.4.0"
+    r = CliRunner().invoke(app, ["--version"])
+    assert (r.exit_code, r.stdout) == (0, "grasptwist 0.4.0\n")
+
+
 #: Parameters with a default that are data, not options: they may be given by position.
 DATA = {
     "grasptwist.status_message": {"culprit", "names"},

@@ -129,6 +129,59 @@ def test_a_copy_of_an_input_is_another_file_and_is_replaced(inputs, monkeypatch)
     assert Path("a.yaml").read_bytes() == POLY.read_bytes()
 
 
+WAYS_TO_WRITE = {
+    "resolve": ["resolve", "a.yaml", "-f", "jsonl"],
+    "forces": ["forces", "a.yaml", "-f", "jsonl"],
+    "follow": ["follow", "a.yaml", "--twist", "0,0,1,0,0,0", "--duration", "1"],
+    "check-a-folder": ["check", "dir"],
+    "plot": ["plot", "a.yaml"],
+}
+
+
+@pytest.mark.parametrize("args", WAYS_TO_WRITE.values(), ids=WAYS_TO_WRITE.keys())
+@pytest.mark.parametrize("name", ["a.yaml", "dir/sub/p.yaml", "out.jsonl"], ids=["an-input", "in-a-folder", "new"])
+def test_a_dot_dot_after_a_missing_folder_is_a_missing_folder(inputs, monkeypatch, args, name):
+    # The system resolves "nosuch/.." as given: no such folder, as a shell's `>` says. Read as
+    # text it would be "" and the run would replace a.yaml, or write a file `>` cannot open.
+    monkeypatch.chdir(inputs)
+    before = snapshot(inputs)
+    output = f"nosuch/../{name}"
+    folder = os.path.dirname(output)
+    assert usage_line(*args, "-o", output) == f"Invalid value for -o: cannot write {output}: no folder {folder}"
+    assert snapshot(inputs) == before
+
+
+@pytest.mark.parametrize("output", ["dir/sub/../../a.yaml", "linked/../../a.yaml"], ids=["real-folders", "linked"])
+def test_a_dot_dot_after_a_real_folder_is_resolved_by_the_system(inputs, monkeypatch, output):
+    monkeypatch.chdir(inputs)
+    Path("linked").symlink_to("dir/sub")  # linked/.. is dir, not the current folder
+    before = snapshot(inputs)
+    assert usage_line("resolve", "a.yaml", "-o", output) == (
+        f"Invalid value for -o: cannot write {output}: it is the input a.yaml (the same file); give another file name"
+    )
+    assert snapshot(inputs) == before
+
+
+def test_a_new_file_past_a_linked_folder_is_where_the_system_puts_it(inputs, monkeypatch):
+    monkeypatch.chdir(inputs)
+    Path("linked").symlink_to("dir/sub")
+    Path("dir/sub/link.jsonl").symlink_to("../../dir/new.jsonl")  # dangling, relative to dir/sub
+    assert invoke("resolve", "a.yaml", "-f", "jsonl", "-o", "linked/../out.jsonl").exit_code == EXIT_OK
+    assert invoke("resolve", "a.yaml", "-f", "jsonl", "-o", "linked/link.jsonl").exit_code == EXIT_OK
+    # linked/.. is dir (not "." as text would have it); the link's target is found from dir/sub
+    for written in ("dir/out.jsonl", "dir/new.jsonl"):
+        assert Path(written).read_text().startswith('{"file":"a.yaml"')
+    assert not Path("out.jsonl").exists() and not Path("new.jsonl").exists()
+    assert os.readlink("dir/sub/link.jsonl") == "../../dir/new.jsonl"  # the link stays
+
+
+def test_a_descriptor_name_past_a_missing_folder_is_no_descriptor(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    with pytest.raises(ValueError, match=r"^cannot write /dev/nosuch/\.\./stdout: no folder /dev/nosuch/\.\.$"):
+        check_target("/dev/nosuch/../stdout")
+    assert check_target("/dev/fd/../fd/1").how == "through"  # /dev/fd/.. is /proc/self, and its fd/1 a descriptor
+
+
 @pytest.mark.parametrize(
     ("redirect", "line"),
     [

@@ -4,6 +4,10 @@ Numbers are checked against LAPACK's pseudo-inverse, against Clarabel (an indepe
 solver on the nine contact-force numbers, tests/conic.py) and against cases worked by hand.
 """
 
+import importlib.util
+import os
+import subprocess
+import sys
 import warnings
 
 import numpy as np
@@ -15,6 +19,7 @@ import grasptwist as gt
 from conic import closure_friction as clarabel_closure_friction
 from conic import least_grip
 from grasptwist.engine import formulas
+from grasptwist.engine.forces import compiled
 from grasptwist.engine.forces.closure import check_cone_edges, epsilon_quality, first_edges
 from grasptwist.engine.forces.grasp_map import checked_grip, manipulating_reference, squeeze_directions
 from grasptwist.engine.forces.hold import grip_along
@@ -44,6 +49,28 @@ def grasps(n, seed, spread=0.35):
 
 def unit(n):
     return n / np.linalg.norm(n, axis=-1, keepdims=True)
+
+
+@pytest.fixture
+def compiled_path(monkeypatch):
+    """The grip compiled (numba, when installed), which conftest.py switches off for the default run."""
+    pytest.importorskip("numba")
+    monkeypatch.setitem(compiled._state, "on", True)
+
+
+# over a second: docs/reference/development.md, Test time (numba compiles its kernel once per process, ~16 s cold)
+COMPILED = pytest.param("compiled", marks=pytest.mark.slow)
+
+
+@pytest.fixture(params=["numpy", COMPILED])
+def grip_path(request):
+    """Each grip of the test on the numpy path (the reference), then compiled (numba, with ``-m slow``)."""
+    if request.param == "numpy":
+        with compiled.numpy_path():
+            yield request.param
+    else:
+        request.getfixturevalue("compiled_path")
+        yield request.param
 
 
 def wrench_of(points, forces):
@@ -153,7 +180,7 @@ def test_a_ball_held_at_its_equator_needs_mg_over_mu_in_total():
 
 
 @pytest.mark.parametrize("count", [40, pytest.param(3000, marks=pytest.mark.slow)])
-def test_the_least_grip_equals_clarabels_and_holds(count):
+def test_the_least_grip_equals_clarabels_and_holds(count, grip_path):
     p, n, w, mu = grasps(count, 4)
     g = gt.grip(p, n, w, mu, safety=1.2)
     refs = [least_grip(p[k], n[k], w[k], mu[k], 1.2)[0] for k in range(count)]
@@ -327,6 +354,13 @@ def test_check_cone_edges(value):
     assert check_cone_edges(64) == 64 and check_cone_edges(3.0) == 3
 
 
+def test_the_most_cone_edges_is_public_where_the_forces_guide_names_it():
+    edges = gt.forces.MAX_CONE_EDGES
+    assert edges == 64 and check_cone_edges(edges) == edges
+    with pytest.raises(ValueError, match=rf"^cone_edges must be an integer from 3 to {edges}, got {edges + 1}$"):
+        check_cone_edges(edges + 1)
+
+
 # --- antipodal, coplanar and coincident contacts; huge friction; overflow (issues 26, 27) --------
 
 ANTIPODAL = np.array([[0.03, 0, 0], [-0.03, 0, 0], [0, 0.03, 0.01]])  # the next contact on the normal's line
@@ -385,14 +419,36 @@ def test_huge_and_infinite_friction_mean_what_they_say():
 
 
 def test_an_overflowing_result_is_a_status_never_an_ok_row_with_infinity():
-    m = gt.forces.manipulating_forces(EQ, [[1e308, 0, 0, 0, 0, 1e308], [0, 0, G, 0, 0, 0]])
+    # a moment of 1e308 N m on fingers 1 mm from the centre: forces of 3e310 N, beyond a double
+    m = gt.forces.manipulating_forces(EQ / 1000, [[0, 0, 0, 0, 0, 1e308], [0, 0, G, 0, 0, 0]])
     assert m.status.tolist() == [9, 0] and np.isnan(m.force[0]).all() and np.isfinite(m.force[1]).all()
     assert gt.forces.status_message(9).startswith("the result overflows double precision")
-    g = checked_grip(gt.grip(EQ, -EQ, [[0, 0, 9.81e300, 0, 0, 0], [0, 0, G, 0, 0, 0], [0] * 6], 0.5))
-    assert g.status.tolist() == [9, 0, 0] and np.isnan(g.total_normal_force[0])
+    g = checked_grip(
+        gt.grip(EQ, -EQ, [[0, 0, 1e308, 0, 0, 0], [0, 0, G, 0, 0, 0], [0] * 6, [0, 0, G * 1e300] + [0] * 3], 0.5)
+    )
+    assert g.status.tolist() == [9, 0, 0, 0] and np.isnan(g.total_normal_force[0])  # 2e308 is beyond a double
     assert g.total_normal_force[1] == pytest.approx(2 * G) and g.friction_used[2].tolist() == [0.0] * 3
-    _, held = grip_along(EQ, -EQ, 0.5, 1e300, [0, 0, 0], [0, 0, -G], [Segment(1.0, twist=[0] * 6)], [0])
+    # a huge grip that is still a double is solved scaled: no overflow of the solver's squares
+    assert g.total_normal_force[3] == pytest.approx(2 * G * 1e300, rel=1e-9) and g.dual[3] == pytest.approx(g.dual[1])
+    _, held = grip_along(EQ, -EQ, 0.5, 1e307, [0, 0, 0], [0, 0, -G], [Segment(1.0, twist=[0] * 6)], [0])
     assert held.status.tolist() == [9]
+
+
+@pytest.mark.parametrize("scale", [1e-200, 1e-100, 1e120, 1e155, 1e300, 1e307])
+def test_the_grip_scales_with_the_wrench_over_the_whole_range_of_doubles(scale, grip_path):
+    """grip(k w) = k grip(w): wrenches beyond 1e100 (or below 1e-100) are solved scaled by a power of two."""
+    p, n, w, mu = grasps(30, 8)
+    w = w / np.abs(w).max(axis=1, keepdims=True)
+    one, big = gt.grip(p, n, w, mu, safety=1.2), gt.grip(p, n, scale * w, mu, safety=1.2)
+    assert (big.status == one.status).all() and one.ok.sum() >= 10
+    ok = one.ok
+    np.testing.assert_allclose(big.total_normal_force[ok] / scale, one.total_normal_force[ok], rtol=1e-9)
+    np.testing.assert_allclose(big.force[ok] / scale, one.force[ok], rtol=1e-6, atol=1e-9)
+    np.testing.assert_allclose(big.dual[ok], one.dual[ok], rtol=1e-6, atol=1e-9)
+    hand = gt.prepare_grip(p[0], n[0], mu[0], safety=1.2)
+    assert float(hand.grip(scale * w[0]).total_normal_force) == pytest.approx(
+        float(big.total_normal_force[0]), rel=1e-9, nan_ok=True
+    )
 
 
 # --- properties -------------------------------------------------------------------------------------
@@ -403,6 +459,9 @@ def test_an_overflowing_result_is_a_status_never_an_ok_row_with_infinity():
 def test_any_grip_found_makes_the_wrench_within_every_cone_and_beats_no_clarabel_grip(seed, spread, safety):
     p, n, w, mu = grasps(4, seed, spread)
     g = gt.grip(p, n, w, mu, safety=safety)
+    with compiled.numpy_path():
+        reference = gt.grip(p, n, w, mu, safety=safety)
+    assert (g.status == reference.status).all()
     for k in range(4):
         ref, _ = least_grip(p[k], n[k], w[k], mu[k], safety)
         assert g.ok[k] == (ref is not None)
@@ -445,7 +504,7 @@ def _dual_cone_excess(z, n, limit):
 
 
 @pytest.mark.parametrize("seed", [11, 12, 13])
-def test_every_grip_carries_a_certificate_that_numpy_alone_verifies(seed):
+def test_every_grip_carries_a_certificate_that_numpy_alone_verifies(seed, grip_path):
     """Held: n_i - G_i^T dual in the dual cone and total - w . dual = gap near 0 (weak duality makes the total
     optimal); cannot-hold: y . w > 0 and -G_i^T y in the dual cone (no admissible forces have a component along y)."""
     p, n, w, mu = grasps(400, seed)
@@ -511,7 +570,7 @@ def test_safety_is_keyword_only():
         gt.grip(EQ, -EQ, [0, 0, G, 0, 0, 0], 0.5, 2.0)
 
 
-def test_a_prepared_grip_gives_what_grip_gives():
+def test_a_prepared_grip_gives_what_grip_gives(grip_path):
     p, n, w, mu = grasps(30, 16)
     for k in range(6):
         hand = gt.prepare_grip(p[k], n[k], mu[k], safety=1.2)
@@ -576,10 +635,12 @@ def test_one_grasp_in_floats_follows_the_batched_solver_step_for_step():
     """One grasp goes through engine/forces/one.py (Python floats), a batch through socp.py (numpy): the
     same method, so the same verdicts, culprits, optimum and certificates, on held and refused rows alike."""
     p, n, w, mu = grasps(40, 18)
-    batch = gt.grip(p, n, w, mu, safety=1.4)
+    with compiled.numpy_path():
+        batch = gt.grip(p, n, w, mu, safety=1.4)
     assert batch.ok.sum() >= 10 and (~batch.ok).sum() >= 10
     for k in range(40):
-        one = gt.grip(p[k], n[k], w[k], mu[k], safety=1.4)
+        with compiled.numpy_path():
+            one = gt.grip(p[k], n[k], w[k], mu[k], safety=1.4)
         assert (int(one.status), int(one.culprit)) == (batch.status[k], batch.culprit[k])
         for name in ("total_normal_force", "force"):
             np.testing.assert_allclose(getattr(one, name), getattr(batch, name)[k], rtol=1e-7, atol=1e-9)
@@ -604,7 +665,8 @@ def test_a_wrench_on_the_edge_of_what_the_fingers_exert_is_held(points):
     np.testing.assert_allclose(g.force, [[0, 0, 0], [0, 0, 0], [0, 0, 1]], atol=1e-9)
     assert (_dual_cone_excess(up[None] - _field(g.dual[None], points[None]), up[None], 0.5) <= 1e-9).all()
     assert abs(float(g.gap)) < 1e-9 and np.isnan(g.certificate).all()
-    one = gt.prepare_grip(points, up, 0.5).grip(w)  # the floats path too
+    with compiled.numpy_path():
+        one = gt.prepare_grip(points, up, 0.5).grip(w)  # the floats path too
     assert one.ok and float(one.total_normal_force) == pytest.approx(1.0, rel=1e-9)
 
 
@@ -639,3 +701,69 @@ def test_contacts_whose_spread_overflows_are_an_overflow_not_coincident():
     assert np.isnan(m.force).all() and np.isnan(m.conditioning)
     # the same grasp at a sane scale is fine
     assert int(gt.forces.manipulating_forces(p, [0, 0, 1, 0, 0, 0]).status) == 0
+
+
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time (numba's compile)
+def test_the_compiled_grip_follows_the_numpy_path(compiled_path):
+    """numba's kernel (engine/forces/kernel.py) is the numpy path's method step for step: the same verdicts and
+    culprits, totals to 1e-9, forces to their sharpness; the rows it leaves (degenerate, collinear, frictionless,
+    non-finite, on the edge) go to the numpy path within the same batch."""
+    from grasptwist.engine.forces import kernel
+
+    p, n, w, mu = grasps(300, 19)
+    p[:3], n[:3], mu[:3] = LINE, ACROSS, 0.5  # collinear, and a wrench with a moment about the line
+    mu[3] = 0.0  # frictionless
+    mu[4, 0] = 0.0  # mixed
+    w[5, 2] = np.nan
+    w[6] = 0.0  # no wrench: no force
+    n[7, 1] = 0.0  # a zero normal
+    p[8, 1] = p[8, 0]  # coincident
+    w[9] = [0, 0, 1e308, 0, 0, 1e308]  # solved scaled by a power of two, on the numpy path
+    with compiled.numpy_path():
+        reference = gt.grip(p, n, w, mu, safety=1.3)
+    g = gt.grip(p, n, w, mu, safety=1.3)
+    codes = np.empty((300, 3), np.int8)
+    kernel.grip_rows(p, n, mu / 1.3, w, 1e-9, np.empty((300, kernel.WIDTH)), codes)
+    assert codes[:10, 2].tolist() == [0, 0, 0, 0, 0, 0, 1, 0, 0, 0] and codes[10:, 2].mean() > 0.9  # not the odd ones
+    assert (g.status == reference.status).all() and (g.culprit == reference.culprit).all()
+    assert g.ok.sum() > 100 and (g.status == gt.forces.Status.CANNOT_HOLD).sum() > 50 and not g.ok[9]
+    ok = reference.ok
+    np.testing.assert_allclose(g.total_normal_force[ok], reference.total_normal_force[ok], rtol=1e-9, atol=0)
+    np.testing.assert_allclose(g.force, reference.force, rtol=1e-6, atol=1e-6 * np.abs(reference.force[ok]).max())
+    for name in ("manipulating", "conditioning", "squeeze", "normal_force", "friction_used", "certificate"):
+        np.testing.assert_allclose(getattr(g, name), getattr(reference, name), rtol=1e-5, atol=1e-6)
+    np.testing.assert_allclose(g.dual, reference.dual, rtol=1e-4, atol=1e-4)
+    for name in ("force", "dual", "certificate", "gap", "total_normal_force"):
+        assert (np.isnan(getattr(g, name)) == np.isnan(getattr(reference, name))).all()
+    hand = gt.prepare_grip(p[20], n[20], mu[20], safety=1.3)  # a control loop's call: its own short way
+    with compiled.numpy_path():
+        alone = hand.grip(w[20])
+    fast = hand.grip(w[20])
+    for name in ("force", "dual", "status", "culprit", "total_normal_force", "gap", "squeeze", "certificate"):
+        a, b = getattr(fast, name), getattr(alone, name)
+        assert (type(a), a.shape, a.dtype) == (type(b), b.shape, b.dtype)
+    assert fast.total_normal_force == pytest.approx(float(alone.total_normal_force), rel=1e-9)
+
+
+def test_importing_grasptwist_imports_no_numba():
+    """The compiled kernel is loaded on the first grip, never at import (the CLI's start-up stays short)."""
+    code = "import sys, grasptwist, grasptwist.cli; assert 'numba' not in sys.modules, 'numba imported'"
+    assert subprocess.run([sys.executable, "-c", code], capture_output=True, text=True).returncode == 0
+    # GRASPTWIST_NUMBA=0: the numpy path, numba never loaded even by a grip
+    code = "import sys, grasptwist as gt; gt.grip(*{args}); assert 'numba' not in sys.modules, 'numba imported'"
+    args = (EQ.tolist(), (-EQ).tolist(), [0, 0, 1, 0, 0, 0], 0.5)
+    env = dict(os.environ, GRASPTWIST_NUMBA="0")
+    done = subprocess.run([sys.executable, "-c", code.format(args=args)], capture_output=True, text=True, env=env)
+    assert done.returncode == 0, done.stderr
+
+
+def test_a_numba_that_cannot_load_the_kernel_leaves_the_numpy_path_with_a_warning(monkeypatch):
+    import grasptwist.engine.forces as package
+
+    monkeypatch.setitem(sys.modules, "grasptwist.engine.forces.kernel", None)  # the import fails
+    monkeypatch.delattr(package, "kernel", raising=False)  # (as it does where numba was never loaded)
+    monkeypatch.setattr(compiled, "_state", {"on": True, "module": None})
+    monkeypatch.setattr(importlib.util, "find_spec", lambda name: object())  # as if numba were installed
+    with pytest.warns(UserWarning, match=r"^the compiled grip is unavailable \(.*\); the numpy path is used$"):
+        g = gt.grip(EQ, -EQ, [0, 0, G, 0, 0, 0], 0.5)
+    assert g.total_normal_force == pytest.approx(G / 0.5, rel=1e-9) and compiled.kernel() is None

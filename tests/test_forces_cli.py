@@ -349,6 +349,27 @@ def test_huge_and_infinite_friction_close_a_grasp_whose_closure_friction_is_fini
     assert rec["friction"] == [1e200] * 3 and rec["closure"]["force_closure"] is True
 
 
+def test_an_infinite_friction_is_null_in_a_record_and_inf_in_a_table(tmp_path, monkeypatch):
+    monkeypatch.delenv("COLUMNS", raising=False)  # not a terminal: the table in one part, rows whole
+    r, recs = records(SPHERE, "--friction", "inf")
+    assert r.exit_code == 0 and [rec["friction"] for rec in recs] == [[None] * 3] * 3  # no infinity in JSON
+    hold = by(recs, "sphere-equator", "hold")
+    assert hold["ok"] and hold["grip"]["total_normal_force"] < 1e-9  # no limit: the weight hangs on friction alone
+    flat, _ = run("forces", SPHERE, "--friction", "inf", "-f", "csv")
+    assert [[row[f"mu{i}"] for i in (1, 2, 3)] for row in csv.DictReader(io.StringIO(flat.stdout))] == [["inf"] * 3] * 3
+    table, _ = run("forces", SPHERE, "--friction", "inf", "--digits", "2")
+    assert table.exit_code == 0 and "internal error" not in table.stderr, table.stderr
+    rows = [
+        line.split() for line in table.stdout.splitlines() if line.split()[:1] in (["thumb"], ["index"], ["middle"])
+    ]
+    assert len(rows) == 9 and all(row[1] == "inf" for row in rows)  # mu, for the closure-only record too
+    assert [row[-1] for row in rows[3:]] == ["0%"] * 6  # no share of an unlimited friction is used
+    (tmp_path / "f.yaml").write_text(Path(SPHERE).read_text().split("---")[0] + "friction: .inf\n")
+    r, (rec,) = records(tmp_path / "f.yaml")  # a file's numbers are finite: no limit is --friction inf
+    assert r.exit_code == 1 and rec["error"]["code"] == "non-finite" and rec["error"]["line"] == 45  # the line added
+    assert rec["error"]["message"] == "friction: expected a finite number, got .inf"
+
+
 def _numbers(x):
     if isinstance(x, dict):
         return [n for v in x.values() for n in _numbers(v)]
@@ -358,17 +379,22 @@ def _numbers(x):
 
 
 def test_an_overflowing_result_is_a_nonfinite_result_record_never_ok_with_nulls(tmp_path):
-    r, recs = records(SPHERE, "--friction", "0.5", "--wrench", "1e308,0,0,0,0,1e308", "--wrench", "0,0,0,0,0,0")
+    # a moment of 1.7e308 N m on fingers 3 cm from the centre: forces near 2e309 N, beyond a double
+    r, recs = records(SPHERE, "--friction", "0.5", "--wrench", "0,0,0,0,0,1.7e308", "--wrench", "0,0,0,0,0,0")
     assert r.exit_code == 1
     big, still = recs[:2]
     assert not big["ok"] and big["grip"]["error"]["code"] == big["manipulating"]["error"]["code"] == "nonfinite-result"
     assert still["ok"] and still["grip"]["friction_used"] == [0.0] * 3  # no force uses no friction
     (tmp_path / "heavy.yaml").write_text(
-        ANTIPODAL.replace("wrenches: [{name: up, force: [0, 0, 1]}]", "mass: 1e300\ncenter_of_mass: [0, 0, 0]")
+        ANTIPODAL.replace("wrenches: [{name: up, force: [0, 0, 1]}]", "mass: 1.5e307\ncenter_of_mass: [0, 0, 0]")
     )
     r, (heavy,) = records(tmp_path / "heavy.yaml")
     assert r.exit_code == 1 and heavy["grip"]["error"]["code"] == "nonfinite-result" and not heavy["ok"]
     assert "nonfinite-result: the result overflows double precision" in r.stderr
+    # 1e300 kg: a grip of some 1e301 N is still a double, and an ok record of finite numbers
+    (tmp_path / "heavy.yaml").write_text((tmp_path / "heavy.yaml").read_text().replace("1.5e307", "1e300"))
+    r, (heavy,) = records(tmp_path / "heavy.yaml")
+    assert r.exit_code == 0 and heavy["ok"] and 1e300 < heavy["grip"]["total_normal_force"] < 1e303
     _, recs = records(SPHERE, "--friction", "0.5", "--wrench", "1e300,0,0,0,0,0", "--wrench", "0,0,9.81,0,0,0")
     for rec in recs:  # an ok record holds only finite numbers
         assert not rec["ok"] or None not in _numbers({k: rec[k] for k in ("manipulating", "grip", "wrench")})

@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 
 from grasptwist.engine.forces.grasp_map import ForceStatus
-from grasptwist.engine.forces.hold import cannot_hold, grip_along, hold_wrench
+from grasptwist.engine.forces.hold import cannot_hold, grip_along, hold_verdicts, hold_wrench
 from grasptwist.io.grasp import load_grasps
 from grasptwist.model import Segment
 
@@ -149,6 +149,7 @@ def test_follow_carries_the_grip_per_sample_and_the_cannot_hold_stretches_in_its
     assert stretch["t_start"] == pytest.approx(math.atan(0.5), abs=1e-6)
     assert stretch["t_end"] == pytest.approx(2 * math.pi - math.atan(0.5), abs=1e-6)
     assert stretch["reason"] == "friction" and stretch["culprit"] in ("a", "b", "c")
+    assert summary["summary"]["hold_unjudged"] == []  # the grip has its verdict everywhere
     assert summary["ok"] is False
     assert "error: cannot hold the weight from t = 0.463648 to t = 5.819538" in result.stderr
 
@@ -157,4 +158,61 @@ def test_follow_without_a_mass_or_a_friction_has_no_grip_fields(tmp_path):
     for drop in ("friction: 0.5\n", "mass: 1\ncenter_of_mass: [0, 0, 0]\n"):
         result, recs = follow_json(tmp_path, TRAY.replace(drop, ""))
         assert result.exit_code == 0
-        assert all("grip" not in r for r in recs[:-1]) and "cannot_hold" not in recs[-1]["summary"]
+        assert all("grip" not in r for r in recs[:-1])
+        assert "cannot_hold" not in recs[-1]["summary"] and "hold_unjudged" not in recs[-1]["summary"]
+
+
+def test_where_the_grip_fails_otherwise_the_weight_is_unjudged_not_held():
+    # a full turn about x (the tray slides off between atan(mu) and 2 pi - atan(mu)), then a
+    # spin at 1e300 rad/s, whose pose overflows at once: cannot-hold and unjudged, each located
+    path = turn([1, 0, 0]) + [Segment(1.0, twist=[0, 0, 1e300, 0, 0, 0])]
+    times = np.linspace(0, 2 * math.pi + 1, 9)
+    with np.errstate(over="ignore", invalid="ignore"):
+        (falls,), (unknown,) = hold_verdicts(TRIANGLE, UP, 0.5, 1.0, [0, 0, 0], G, path, times)
+        assert cannot_hold(TRIANGLE, UP, 0.5, 1.0, [0, 0, 0], G, path, times) == (falls,)
+        _, g = grip_along(TRIANGLE, UP, 0.5, 1.0, [0, 0, 0], G, path, times[-2:])
+    assert falls.t_start == pytest.approx(math.atan(0.5), abs=1e-6)
+    assert falls.t_end == pytest.approx(2 * math.pi - math.atan(0.5), abs=1e-6)
+    assert unknown.status == ForceStatus.NONFINITE_POSE and unknown.t_end == 2 * math.pi + 1
+    assert unknown.t_start == pytest.approx(2 * math.pi, abs=1e-6)
+    assert g.status.tolist() == [ForceStatus.NONFINITE_POSE] * 2  # the grip itself says why
+    # degenerate contacts: no grip anywhere, so no verdict anywhere (and no stretch it cannot hold)
+    same = np.array([TRIANGLE[0], TRIANGLE[0], TRIANGLE[2]])
+    assert hold_verdicts(same, UP, 0.5, 1.0, [0, 0, 0], G, turn([1, 0, 0]), times[:3]) == (
+        (),
+        ((0.0, 2 * math.pi, ForceStatus.COINCIDENT_CONTACTS),),
+    )
+
+
+CUBE = """\
+name: cube-mm
+units: mm
+contacts:
+  - {name: tx, point: [30, 5, -5], normal: [-1, 0, 0]}
+  - {name: ty, point: [-5, 30, 5], normal: [0, -1, 0]}
+  - {name: tz, point: [5, -5, 30], normal: [0, 0, -1]}
+friction: 0.8
+mass: 0.2
+center_of_mass: [0, 0, 0]
+"""
+
+
+def test_follow_never_says_the_weight_is_held_where_the_pose_overflows(tmp_path):
+    args = ["--twist", "0,0,1e308,0,0,0", "--duration", "1", "--samples", "3"]
+    result, recs = follow_json(tmp_path, CUBE, *args)
+    *samples, summary = recs
+    assert result.exit_code == 1 and summary["ok"] is False
+    assert [r["grip"].get("error", {}).get("code") for r in samples] == [None, "nonfinite-pose", "nonfinite-pose"]
+    assert summary["summary"]["cannot_hold"] == []
+    (unknown,) = summary["summary"]["hold_unjudged"]
+    assert unknown == {"t_start": pytest.approx(0, abs=1e-9), "t_end": 1.0, "code": "nonfinite-pose"}
+    line = "cannot judge whether the weight is held from t = 0.000000 to t = 1.000000: the grip fails there (nonfinite-pose)"
+    assert f"g.yaml: grasp 'cube-mm', path 'command-line': error: {line}" in result.stderr
+    from typer.testing import CliRunner
+
+    from grasptwist.cli import app
+
+    table = CliRunner().invoke(app, ["follow", str(tmp_path / "g.yaml"), *args])
+    assert table.exit_code == 1 and "held all along" not in table.stdout
+    summary_lines = table.stdout.split("summary:")[1].splitlines()
+    assert summary_lines[-1] == f"  {line.replace('000000', '0000')}"

@@ -30,6 +30,7 @@ from grasptwist.run.families import COMMANDS
 
 ROOT = Path(__file__).resolve().parents[1]
 POLY = ROOT / "grasps" / "polyhedron.yaml"
+SPHERE = ROOT / "grasps" / "sphere.yaml"
 EXE = Path(sys.executable).parent / "grasptwist"
 COMMAND = [str(EXE)] if EXE.exists() else [sys.executable, "-m", "grasptwist"]
 ANSI = re.compile(r"\x1b\[[0-9;?]*[A-Za-z]")
@@ -335,6 +336,33 @@ def test_figures_under_the_noise_floor_print_as_under_it_and_zero_has_no_sign():
     assert fmt_number(-0.0, 4) == fmt_number(-4e-17, 4) == "0.0000"
     assert fmt_number(-0.00005001, 4) == "-0.0001"
     assert fmt_vector([-0.0, 1e-17, -1e-17], 4) == "(0.0000, 0.0000, 0.0000)"
+
+
+def test_huge_numbers_print_in_exponent_form_and_the_rest_as_before():
+    from grasptwist.output.numbers import EXPONENT_FROM, fmt_number, fmt_vector
+
+    assert fmt_number(1e300, 4) == "1.0000e+300" and fmt_number(-9.81e300, 2) == "-9.81e+300"
+    assert fmt_number(12.5, 4) == "12.5000" and fmt_number(-0.0, 4) == "0.0000"
+    assert fmt_number(999999.5, 1) == "999999.5" and fmt_number(EXPONENT_FROM, 1) == "1.0e+06"
+    assert fmt_number(float("inf"), 4) == "inf" and fmt_number(-float("inf"), 4) == "-inf"
+    assert fmt_vector([0, -0.0, 9.81e300], 4) == "(0.0000, 0.0000, 9.8100e+300)"
+    assert fmt_vector([1e7, 0, 0, -0.0, 0, 2], 1) == "(1.0e+07, 0.0, 0.0; 0.0, 0.0, 2.0)"
+
+
+def test_tables_and_stderr_lines_show_huge_values_in_exponent_form(tmp_path):
+    (tmp_path / "heavy.yaml").write_text(SPHERE.read_text().replace("\nmass: 1\n", "\nmass: 1e300\n"))
+    r = run("forces", tmp_path / "heavy.yaml")
+    assert "wrench hold = force (0.0000, 0.0000, 9.8100e+300) N" in r.stdout
+    r = run("forces", SPHERE, "--friction", "1e300")
+    (row, *_) = [line.split() for line in r.stdout.splitlines() if line.split()[:1] == ["thumb"]]
+    assert row[1] == "1.0000e+300"
+    r = run("follow", tmp_path / "heavy.yaml", "--twist", "0,0,1,0,0,0", "--duration", "9e297", "--samples", "3")
+    lines = r.stdout.splitlines()
+    last = lines.index("summary: duration 9.0000e+297, 3 samples") - 1
+    assert lines[last].startswith("9.0000e+297    0")  # the last sample's time
+    assert "to t = 9.000000e+297: " in r.stderr
+    # nothing in fixed point as many digits long as the number is large
+    assert not re.search(r"\d{12}", r.stdout + r.stderr), re.search(r"\d{12}", r.stdout + r.stderr)
 
 
 def _hand_table(record: dict) -> str:

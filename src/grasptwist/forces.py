@@ -15,7 +15,7 @@ into words.
 The math is in ``grasptwist.engine.forces``.
 """
 
-from .engine.forces.closure import Closure, force_closure
+from .engine.forces.closure import MAX_CONE_EDGES, Closure, force_closure
 from .engine.forces.grasp_map import (
     ManipulatingForces,
     Status,
@@ -37,6 +37,7 @@ __all__ = [
     "PreparedGrip",
     "force_closure",
     "Closure",
+    "MAX_CONE_EDGES",
     "manipulating_forces",
     "ManipulatingForces",
     "squeeze_forces",

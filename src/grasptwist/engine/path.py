@@ -95,6 +95,7 @@ __all__ = [
     "integrate",
     "follow",
     "pose_overflowed",
+    "overflowing",
     "degeneracies",
 ]
 
@@ -461,7 +462,7 @@ def follow(points, normals, wrist, segments, times, *, method="both", bases=Fals
         for k in np.unique(segment[rows]):
             these = i + np.flatnonzero(segment[rows] == k)
             flat[2][these] = _carry(rotation[these], at_rest[k], np.empty((len(these),) + grasps + (3, 3)))
-    overflowed = _overflowed(
+    overflowed = overflowing(
         poses, np.concatenate((points, normals), axis=-2), np.concatenate((moved, turned), axis=-2)
     )
     off = tan = None
@@ -473,7 +474,7 @@ def follow(points, normals, wrist, segments, times, *, method="both", bases=Fals
     return FollowResult(poses, moved, turned, wrist, velocities, off, tan, overflowed)
 
 
-def _overflowed(poses, rest, moved):
+def overflowing(poses, rest, moved):
     """Where a pose overflows: its rotation, position or twist is not finite, or a point
     finite at rest is not once moved.  ``poses (T...)``, ``rest (G..., n, 3)``,
     ``moved (T..., G..., n, 3) -> (T..., G...)`` bool."""
@@ -619,7 +620,7 @@ def _finite_part(plan, points, normals, extra):
         pose = _poses(plan, np.asarray(t, dtype=float))
         r = pose.rotation[..., None, :, :]
         moved = np.concatenate((se3.transform(r, pose.position[..., None, :], points), se3.rotate(r, normals)), -2)
-        return _overflowed(pose, rest, moved)
+        return overflowing(pose, rest, moved)
 
     nodes = np.unique(np.concatenate((plan.start, [plan.end], extra)))
     bad = overflowed(nodes)

@@ -26,6 +26,7 @@ from .csv_rows import lines
 from .force_records import GRIP_FIELDS
 from .force_records import _error as grip_error  # the forces record's error object, shared
 from .names import escaped
+from .numbers import fmt_number
 from .records import dumps, records
 
 __all__ = [
@@ -46,6 +47,7 @@ __all__ = [
     "hand_summary",
     "grip_record",
     "hold_text",
+    "unjudged_text",
 ]
 
 #: The block columns a follow CSV row leaves out (the path's own replace them).
@@ -123,7 +125,18 @@ def hold_text(c: dict, digits: int = 4) -> str:
         if c["reason"] == "pulling"
         else f"the friction cone at contact '{escaped(c['culprit'])}' is too narrow"
     )
-    return f"cannot hold the weight from t = {c['t_start']:.{digits}f} to t = {c['t_end']:.{digits}f}: {why}"
+    a, b = fmt_number(c["t_start"], digits), fmt_number(c["t_end"], digits)
+    return f"cannot hold the weight from t = {a} to t = {b}: {why}"
+
+
+def unjudged_text(u: dict, digits: int = 4) -> str:
+    """A ``hold_unjudged`` stretch of a summary in words.
+
+    >>> unjudged_text({"t_start": 5.8e-11, "t_end": 1.0, "code": "nonfinite-pose"})
+    'cannot judge whether the weight is held from t = 0.0000 to t = 1.0000: the grip fails there (nonfinite-pose)'
+    """
+    a, b = fmt_number(u["t_start"], digits), fmt_number(u["t_end"], digits)
+    return f"cannot judge whether the weight is held from t = {a} to t = {b}: the grip fails there ({u['code']})"
 
 
 def _finger_positions(hand, positions) -> list[list[float]]:
@@ -196,7 +209,11 @@ def summary_record(summary) -> dict:
             }
             for c in summary.cannot_hold
         ]
-        ok = ok and not summary.cannot_hold  # the object falls
+        out["hold_unjudged"] = [
+            {"t_start": u.t_start, "t_end": u.t_end, "code": ForceStatus(u.status).code} for u in summary.unjudged
+        ]
+        # the object falls, or no one knows whether it does
+        ok = ok and not summary.cannot_hold and not summary.unjudged
     if summary.hand is not None:
         out["hand"] = hand_summary(summary.grasp, summary.hand, summary.tip_error)
         # a joint out of its limits, or a finger that cannot follow, stops the motion too
@@ -217,7 +234,7 @@ def crossing_text(c: dict, names=("1", "2", "3"), digits: int = 4) -> str:
     >>> crossing_text({"method": "off-tangent", "code": "wrist-coplanar", "t_start": 1.5707963, "t_end": 1.5707963})
     "the wrist crosses the contacts' plane at t = 1.5708"
     """
-    a, b = f"{c['t_start']:.{digits}f}", f"{c['t_end']:.{digits}f}"
+    a, b = fmt_number(c["t_start"], digits), fmt_number(c["t_end"], digits)
     if c["code"] == Status.WRIST_COPLANAR.code:
         if c["t_start"] == c["t_end"]:
             return f"the wrist crosses the contacts' plane at t = {a}"
@@ -241,14 +258,16 @@ def hand_event_texts(hand: dict, names=("1", "2", "3"), digits: int = 4) -> tupl
         j = hand["joint_limit"]
         finger = escaped(names[fingers.index(j["finger"])])
         errors.append(
-            f"joint '{escaped(j['joint'])}' of finger {finger} leaves its position limits at t = {j['t']:.{digits}f}"
+            f"joint '{escaped(j['joint'])}' of finger {finger} leaves its position limits at t = {fmt_number(j['t'], digits)}"
         )
     for f, name in zip(hand["fingers"], names):
         if f["rank_loss"] is not None:
-            errors.append(f"finger {escaped(name)} loses rank (its Jacobian) at t = {f['rank_loss']:.{digits}f}")
+            errors.append(
+                f"finger {escaped(name)} loses rank (its Jacobian) at t = {fmt_number(f['rank_loss'], digits)}"
+            )
         if f["first_warning"] is not None:
             warnings.append(
-                f"finger {escaped(name)}: conditioning below {CONDITION_WARNING:g} from t = {f['first_warning']:.{digits}f}"
+                f"finger {escaped(name)}: conditioning below {CONDITION_WARNING:g} from t = {fmt_number(f['first_warning'], digits)}"
             )
     return errors, warnings
 
@@ -267,6 +286,7 @@ def diagnostics(rec: dict, names=("1", "2", "3")) -> tuple[list[str], list[str]]
         )
     warnings += [f"{where}: warning: {w}" for w in rec.get("warnings", ())]
     errors += [f"{where}: error: {hold_text(c, 6)}" for c in s.get("cannot_hold", ())]
+    errors += [f"{where}: error: {unjudged_text(u, 6)}" for u in s.get("hold_unjudged", ())]
     if "hand" in s:
         hand_errors, hand_warnings = hand_event_texts(s["hand"], names, 6)
         errors += [f"{where}: error: hand: {text}" for text in hand_errors]

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from typing import IO
 
-from .follow_records import crossing_text, hand_event_texts, hold_text
+from .follow_records import crossing_text, hand_event_texts, hold_text, unjudged_text
 from .names import escaped
 from .numbers import fmt_figure, fmt_number
 
@@ -103,7 +103,7 @@ class FollowTable:
 
     def _summary(self, rec):
         s = rec["summary"]
-        self._line(f"summary: duration {s['duration']:.{self.digits}f}, {s['samples']} samples")
+        self._line(f"summary: duration {fmt_number(s['duration'], self.digits)}, {s['samples']} samples")
         for c in s["degenerate"]:
             self._line(f"  {crossing_text(c, self.names, self.digits)} ({c['method']} degenerate)")
         if not s["degenerate"]:
@@ -119,12 +119,14 @@ class FollowTable:
         self._line(
             "  no conditioning warning"
             if w is None
-            else f"  first warning: {w['method']} at t = {w['t']:.{self.digits}f}"
+            else f"  first warning: {w['method']} at t = {fmt_number(w['t'], self.digits)}"
         )
         if "cannot_hold" in s:
             for c in s["cannot_hold"]:
                 self._line(f"  {hold_text(c, self.digits)}")
-            if not s["cannot_hold"]:
+            for u in s["hold_unjudged"]:
+                self._line(f"  {unjudged_text(u, self.digits)}")
+            if not s["cannot_hold"] and not s["hold_unjudged"]:
                 self._line("  the weight is held all along the path")
         if "hand" in s:
             errors, warnings = hand_event_texts(s["hand"], self.names, self.digits)

@@ -16,31 +16,44 @@ import math
 
 from ..engine.degeneracy import NOISE_FLOOR
 
-__all__ = ["fmt_number", "fmt_vector", "fmt_figure", "UNDER_NOISE"]
+__all__ = ["fmt_number", "fmt_vector", "fmt_figure", "UNDER_NOISE", "EXPONENT_FROM"]
 
 #: How a figure under the noise floor prints.
 UNDER_NOISE = f"< {NOISE_FLOOR:g}"
 
+#: From this size on a number prints in exponent form, ``1.0000e+300``: in fixed point it
+#: would be as many digits long as it is large (and show digits below the noise).
+EXPONENT_FROM = 1e6
+
 
 def fmt_number(v, digits: int) -> str:
-    """``v`` with ``digits`` decimals; no ``-0``; ``-`` for a missing value.
+    """``v`` with ``digits`` decimals, in exponent form from :data:`EXPONENT_FROM` on;
+    no ``-0``; ``-`` for a missing value.
 
     >>> fmt_number(-0.00001, 4), fmt_number(-0.0, 4), fmt_number(2.5, 0), fmt_number(None, 3)
     ('0.0000', '0.0000', '2', '-')
+    >>> fmt_number(12.5, 4), fmt_number(1e300, 4), fmt_number(-2.5e6, 2), fmt_number(float("inf"), 4)
+    ('12.5000', '1.0000e+300', '-2.50e+06', 'inf')
     """
     if v is None:
         return "-"
+    if abs(v) >= EXPONENT_FROM:
+        return f"{v:.{digits}e}"
     s = f"{v:.{digits}f}"
     return s[1:] if s[0] == "-" and not s.strip("-0.") else s
 
 
 def fmt_vector(v, digits: int) -> str:
-    """A 3-vector as ``(a, b, c)`` or a screw as ``(a, b, c; d, e, f)``; no ``-0``.
+    """A 3-vector as ``(a, b, c)`` or a screw as ``(a, b, c; d, e, f)``, each part as
+    :func:`fmt_number` prints it; no ``-0``.
 
-    >>> fmt_vector([1, 0, -0.00001, 0, -0.5, 2], 1)
-    '(1.0, 0.0, 0.0; 0.0, -0.5, 2.0)'
+    >>> fmt_vector([1, 0, -0.00001, 0, -0.5, 2], 1), fmt_vector([1e300, -0.0, 2], 2)
+    ('(1.0, 0.0, 0.0; 0.0, -0.5, 2.0)', '(1.00e+300, 0.00, 2.00)')
     """
     v = tuple(v)
+    if any(abs(x) >= EXPONENT_FROM for x in v):  # rare: each part its own form
+        parts = [fmt_number(x, digits) for x in v]
+        return f"({', '.join(parts[:3])}; {', '.join(parts[3:])})" if len(v) == 6 else f"({', '.join(parts)})"
     form, negative_zero, zero = _vector_format(digits, len(v))
     return (form % v).replace(negative_zero, zero)
 

@@ -25,6 +25,7 @@ from __future__ import annotations
 
 import contextlib
 import io
+import math
 import os
 import textwrap
 from typing import IO
@@ -599,6 +600,16 @@ def _verdict_cell(m):
     return Text(m["error"]["code"], style="red")
 
 
+def _coefficient(mu: float | None) -> float:
+    """A contact's friction coefficient from a record, where an infinite one (no limit)
+    is ``null``, as every infinity is (the output contract).
+
+    >>> _coefficient(0.5), _coefficient(None)
+    (0.5, inf)
+    """
+    return math.inf if mu is None else mu
+
+
 class ForceTableWriter(_Writer):
     """A forces record: per contact its forces and how close each is to slipping, then the totals and closure.
 
@@ -630,11 +641,12 @@ class ForceTableWriter(_Writer):
             for header in ("grip force (N)", "normal (N)", "tangential (N)", "friction used", "of mu/s"):
                 t.add_column(header, justify="left" if header == "grip force (N)" else "right")
         for i, c in enumerate(rec["contacts"]):
-            row = [c["name"], "-" if friction is None else fmt_number(friction[i], d)]
+            mu = None if friction is None else _coefficient(friction[i])
+            row = [c["name"], fmt_number(mu, d)]
             if shown_m:
                 row.append(fmt_vector(m["force"][i], d))
             if shown_g:
-                used, limit = grip["friction_used"][i], friction[i] / grip["safety"]
+                used, limit = grip["friction_used"][i], mu / grip["safety"]  # no limit: 0% of it used
                 row += [
                     fmt_vector(grip["force"][i], d),
                     fmt_number(grip["normal_force"][i], d),

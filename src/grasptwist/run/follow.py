@@ -27,7 +27,7 @@ import numpy as np
 from ..engine import hands
 from ..engine.degeneracy import radians_warning
 from ..engine.forces.grip import Grip
-from ..engine.forces.hold import HoldStretch, cannot_hold, grip_along
+from ..engine.forces.hold import HoldStretch, Unjudged, grip_along, hold_verdicts
 from ..engine.hands import HandTrack
 from ..engine.ik import home_tips, place_hand
 from ..engine.judgements import rotation_over_pi
@@ -101,6 +101,7 @@ class Summary:
     labels: tuple[str, ...]  # the methods run
     hand: HandTrack | None = None  # the fingers' tracks, when the grasp has a hand
     cannot_hold: tuple[HoldStretch, ...] | None = None  # where no grip holds its weight, with mass and friction
+    unjudged: tuple[Unjudged, ...] | None = None  # where the grip fails otherwise: held or not is unknown there
     tip_error: np.ndarray | None = None  # (3,) with a hand: each finger's largest tip error at the samples
     warnings: tuple[str, ...] = ()  # about the path as given: rotation vectors over pi
 
@@ -203,14 +204,15 @@ def _path(job, grasp, p):
             bases=job.bases,
         )
         block = _block(grasp, p.name, f, job.bases, job.method, q)
-        grip = None if grip is None else pose_overflowed(grip, f.overflowed)  # as the methods say there
         if tracked is not None:
             seen = block.results["hand"].tip_error.max(axis=0)
             largest = seen if largest is None else np.maximum(largest, seen)
         yield Samples(p.name, block, f.poses, q, grip)
     found = degeneracies(grasp.points, grasp.normals, grasp.wrist, p.segments, times)
-    stretches = None if weight is None else cannot_hold(*weight, times)
-    yield Summary(grasp.file, grasp, p.name, len(times), found, labels, tracked, stretches, largest, _radians(p))
+    stretches, unjudged = (None, None) if weight is None else hold_verdicts(*weight, times)
+    yield Summary(
+        grasp.file, grasp, p.name, len(times), found, labels, tracked, stretches, unjudged, largest, _radians(p)
+    )
 
 
 def _radians(path) -> tuple[str, ...]:

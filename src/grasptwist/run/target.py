@@ -3,7 +3,9 @@
 The rule for an output path (``-o``), decided by :func:`check_target` before any work:
 
 * the empty name, a folder, a block device (a disk), a socket, a link loop
-  and a path in a missing or read-only folder are refused (ValueError);
+  and a path in a missing or read-only folder are refused (ValueError); a
+  path is the system's, never tidied as text (``r/nosuch/../a.yaml`` is in
+  the missing folder ``r/nosuch/..``, as for a shell's ``>``);
 * so is a regular file that is one of the run's inputs, found by its
   device and inode (through symbolic and hard links, and for standard
   output and ``-`` too), so that a run never replaces what it reads;
@@ -54,6 +56,9 @@ WRITE_ERRNOS = frozenset({errno.ENOSPC, errno.EDQUOT, errno.EFBIG, errno.EIO, er
 
 #: Names of the process's own descriptors: group 1 a standard stream's name, group 2 a number.
 _DESCRIPTOR = re.compile(r"/dev/(stdin|stdout|stderr)|/(?:dev|proc/self)/fd/(\d+)")
+
+#: Links followed in a row at most, as Linux does (MAXSYMLINKS): a loop made after the check ends.
+_MAX_LINKS = 40
 
 
 class WriteError(Exception):
@@ -124,14 +129,38 @@ def _by_type(path: str) -> tuple[Target, os.stat_result | None]:
         return Target("through", path, path), None
     if not stat.S_ISREG(mode):
         raise ValueError(f"cannot write {path}: not a regular file, a pipe or a character device")
-    real = os.path.realpath(path)
-    folder = os.path.dirname(real)
+    file = _link_followed(path)
+    folder = _folder(file)
     if not os.path.isdir(folder):
-        shown = os.path.dirname(path) if not os.path.islink(path) else folder
-        raise ValueError(f"cannot write {path}: no folder {shown or folder}")
+        raise ValueError(f"cannot write {path}: no folder {folder}")
     if not os.access(folder, os.W_OK):
         raise ValueError(f"cannot write {path}: the folder is not writable")
-    return Target("replace", path, real), info
+    return Target("replace", path, file), info
+
+
+def _link_followed(path: str) -> str:
+    """``path`` with its last part's symbolic links followed, each link's target
+    joined to the link's folder as text: never normalised, so that the system
+    resolves every ``..`` where it stands (after a missing folder, or a linked
+    one), as it does for a shell's ``>``.
+
+    >>> _link_followed("r/nosuch/../a.yaml")
+    'r/nosuch/../a.yaml'
+    """
+    for _ in range(_MAX_LINKS):
+        if not os.path.islink(path):
+            break
+        path = os.path.join(os.path.dirname(path), os.readlink(path))
+    return path
+
+
+def _folder(path: str) -> str:
+    """The folder ``path`` names its file in, as given (``.`` for a bare name).
+
+    >>> _folder("r/nosuch/../a.yaml"), _folder("a.yaml")
+    ('r/nosuch/..', '.')
+    """
+    return os.path.dirname(path) or os.curdir
 
 
 def _not_an_input(shown: str, info: os.stat_result, inputs: Iterable) -> None:
@@ -154,10 +183,20 @@ def _descriptor(path: str) -> int | None:
     >>> _descriptor("/dev/stdout"), _descriptor("/dev/fd/3"), _descriptor("/dev/shm/out.jsonl")
     (1, 3, None)
     """
-    match = _DESCRIPTOR.fullmatch(os.path.abspath(path))
-    if match is None:
+    absolute = os.path.abspath(path)
+    match = _DESCRIPTOR.fullmatch(absolute)
+    if match is None or not _same_folder(path, absolute):
         return None
     return ("stdin", "stdout", "stderr").index(match[1]) if match[1] else int(match[2])
+
+
+def _same_folder(path: str, normalised: str) -> bool:
+    """Whether the system finds ``path`` in the folder of its ``normalised`` text
+    (not so for ``/dev/nosuch/../stdout``, whose folder is missing)."""
+    try:
+        return os.path.samestat(os.stat(_folder(path)), os.stat(_folder(normalised)))
+    except OSError:
+        return False
 
 
 def _descriptor_stat(fd: int) -> os.stat_result | None:
@@ -255,7 +294,7 @@ def _errors_named(path: str):
 
 @contextmanager
 def _replacing(path: str) -> Iterator[IO[bytes]]:
-    folder = os.path.dirname(path)
+    folder = _folder(path)  # as given: the folder the system finds the path in
     prefix = owned_prefix(TEMP_STEM)
     remove_orphans(folder, TEMP_STEM)  # what runs killed by SIGKILL left
     try:

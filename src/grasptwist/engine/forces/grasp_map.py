@@ -46,6 +46,8 @@ __all__ = [
     "nonfinite_result",
     "checked_grip",
     "GRIP_NUMBERS",
+    "wrench_scales",
+    "WRENCH_SCALED_BEYOND",
     "grasp_map",
     "manipulating_reference",
     "squeeze_directions",
@@ -250,6 +252,23 @@ GRIP_NUMBERS = (
 )
 
 
+#: A grip row as the compiled kernel fills it (:func:`~grasptwist.engine.forces.kernel.grip_rows`): the
+#: :class:`~grasptwist.engine.forces.grip.Grip` fields in this order, of these widths.
+GRIP_COLUMNS = (
+    ("force", 9),
+    ("manipulating", 9),
+    ("squeeze", 3),
+    ("normal_force", 3),
+    ("tangential_force", 3),
+    ("friction_used", 3),
+    ("total_normal_force", 1),
+    ("conditioning", 1),
+    ("dual", 6),
+    ("gap", 1),
+    ("certificate", 6),
+)
+
+
 def checked_grip(g):
     """A grip whose ok rows are finite: ``nonfinite-result`` (and NaN numbers) where they are not.
 
@@ -308,7 +327,8 @@ def manipulating_reference(points, wrench) -> np.ndarray:
 
     ``(..., 3, 3), (..., 6) -> (..., 3, 3)``.
 
-    >>> (manipulating_reference([[1, 0, 0], [-0.5, 0.75**0.5, 0], [-0.5, -(0.75**0.5), 0]], [0, 0, 3, 0, 0, 0]).round(6) + 0.0).tolist()
+    >>> f = manipulating_reference([[1, 0, 0], [-0.5, 0.75**0.5, 0], [-0.5, -(0.75**0.5), 0]], [0, 0, 3, 0, 0, 0])
+    >>> (f.round(6) + 0.0).tolist()  # + 0.0: no -0 (LAPACK's sign of a zero differs between CPUs)
     [[0.0, 0.0, 1.0], [0.0, 0.0, 1.0], [0.0, 0.0, 1.0]]
     """
     w = np.asarray(wrench, dtype=float)
@@ -487,6 +507,26 @@ class ManipulatingForces(NamedTuple):
     culprit: np.ndarray
 
 
+#: Wrenches whose largest entry lies outside these bounds are solved scaled to about 1 by a
+#: power of two (exact): the solver squares forces, which overflow from about 1e154 where
+#: the grip itself (linear in the wrench) is still a double.
+WRENCH_SCALED_BEYOND = (1e-100, 1e100)
+
+
+def wrench_scales(w) -> np.ndarray:
+    """Per row of ``w (n, 6)``, the power of two to divide it by before the solve (1 for most).
+
+    >>> wrench_scales(np.array([[0, 0, 9.81, 0, 0, 0], [0, 0, 1e300, 0, 0, 0]])).tolist()[0]
+    1.0
+    >>> bool(1 <= 1e300 / wrench_scales(np.array([[0, 0, 1e300, 0, 0, 0]]))[0] < 2)
+    True
+    """
+    low, high = WRENCH_SCALED_BEYOND
+    largest = np.abs(w).max(axis=-1)
+    extreme = np.isfinite(largest) & (largest > 0) & ((largest > high) | (largest < low))
+    return np.where(extreme, np.exp2(np.floor(np.log2(np.where(extreme, largest, 1.0)))), 1.0)
+
+
 def manipulating_forces(points, wrench, *, tol=DEGENERACY_TOL) -> ManipulatingForces:
     r"""The minimum-norm finger forces that exert ``wrench``: ``f = G^+ w`` (Yoshikawa-Nagai).
 
@@ -520,7 +560,9 @@ def manipulating_forces(points, wrench, *, tol=DEGENERACY_TOL) -> ManipulatingFo
     shape = np.broadcast_shapes(p.shape[:-2], w.shape[:-1])
     p, w = np.broadcast_to(p, shape + (3, 3)), np.broadcast_to(w, shape + (6,))
     geo = geometry(p, tol)
-    f = _manipulating(geo, w)
+    k = wrench_scales(w)  # G^+ is linear: a wrench beyond 1e100 is solved scaled
+    with np.errstate(over="ignore", invalid="ignore"):
+        f = _manipulating(geo, w / k[..., None]) * k[..., None, None]
     status, culprit = geo.status.copy(), geo.culprit.copy()
     line = np.flatnonzero(status.reshape(-1) == ForceStatus.COLLINEAR_CONTACTS)
     if line.size:  # rank 5: G^+ w still makes w when w has no moment about the contacts' line

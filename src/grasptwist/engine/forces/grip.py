@@ -24,7 +24,7 @@ Where no grip exists, phase I's multipliers give ``y`` with ``y . w > 0`` and
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import partial
 
 import numpy as np
@@ -32,8 +32,10 @@ import numpy as np
 from ..checks import check_normals, check_points
 from ..degeneracy import DEGENERACY_TOL
 from ..screws import cross, dot, norm
-from . import closure, one, socp
+from . import closure, compiled, one, socp
 from .grasp_map import (
+    GRIP_COLUMNS,
+    WRENCH_SCALED_BEYOND,
     ForceStatus,
     _manipulating,
     check_friction,
@@ -45,6 +47,7 @@ from .grasp_map import (
     contact_matrices,
     geometry,
     tangent_bases,
+    wrench_scales,
 )
 
 __all__ = ["Grip", "grip", "prepare_grip", "PreparedGrip", "load_words"]
@@ -268,9 +271,81 @@ def grip(points, normals, wrench, friction, *, safety=1.0, tol=DEGENERACY_TOL) -
     p, n, w = (np.broadcast_to(a, shape + a.shape[-t:]) for a, t in ((p, 2), (n, 2), (w, 1)))
     mu = np.broadcast_to(mu if mu.ndim else mu[None], shape + (3,))
     size = int(np.prod(shape))
-    flat = [a.reshape((size,) + a.shape[len(shape) :]) for a in (p, n, mu)]
-    out = _Prepared(*flat, s_f, tol).solve(w.reshape(size, 6))
-    return checked_grip(Grip(safety=s_f, **{k: v.reshape(shape + v.shape[1:]) for k, v in out.items()}))
+    flat = [a.reshape((size,) + a.shape[len(shape) :]) for a in (p, n, mu, w)]
+    return _grip_of(flat, s_f, tol, shape)
+
+
+#: The grip's fields that scale with the wrench (the grip is positively homogeneous in it:
+#: ``grip(k w) = k grip(w)`` for ``k > 0``); the others (``friction_used``, ``dual``,
+#: ``certificate``, ``conditioning``) do not change.
+LINEAR_FIELDS = ("force", "manipulating", "squeeze", "normal_force", "tangential_force", "total_normal_force", "gap")
+
+
+def _grip_of(rows, s_f, tol, shape, prepared=None):
+    """The :class:`Grip` of ``rows = (p, n, mu, w)`` flat over rows, shaped ``shape``.
+
+    Compiled (:mod:`~grasptwist.engine.forces.compiled`) where numba is there: the kernel takes
+    the rows it can, the numpy path (``prepared``, else a :class:`_Prepared` of those rows) the others.
+    A wrench beyond :data:`WRENCH_SCALED_BEYOND` is solved scaled (:func:`wrench_scales`) and its
+    grip scaled back, so that only a grip that is itself beyond a double is ``nonfinite-result``.
+    """
+    k = wrench_scales(rows[3])
+    if (k != 1).any():
+        g = _grip_of((*rows[:3], rows[3] / k[:, None]), s_f, tol, shape, prepared)
+        k = k.reshape(shape)
+        with np.errstate(over="ignore", invalid="ignore"):
+            scaled = {
+                f: getattr(g, f) * k.reshape(k.shape + (1,) * (getattr(g, f).ndim - k.ndim)) for f in LINEAR_FIELDS
+            }
+        return checked_grip(replace(g, **scaled))
+    fast = compiled.kernel()
+    if fast is None:
+        out = (prepared or _Prepared(*rows[:3], s_f, tol)).solve(rows[3])
+        return checked_grip(Grip(safety=s_f, **{k: v.reshape(shape + v.shape[1:]) for k, v in out.items()}))
+    p, n, mu, w = (np.ascontiguousarray(a, dtype=float) for a in rows)
+    limit = np.ascontiguousarray(np.broadcast_to(mu / s_f, (len(p), 3)))
+    return _compiled_grip(fast, (p, n, limit, w), s_f, tol, shape, lambda rest: (p[rest], n[rest], mu[rest]))
+
+
+def _compiled_grip(fast, rows, s_f, tol, shape, others):
+    """The :class:`Grip` of :func:`kernel.grip_rows` on ``rows = (p, n, limit, w)`` (C-contiguous floats).
+
+    The rows it leaves go to the numpy path, on the grasps ``others(rest) = (p, n, mu)``.  Every
+    field is a view of one array the kernel filled.
+    """
+    size = len(rows[0])
+    numbers = np.empty((size, fast.WIDTH))
+    codes = np.empty((size, 3), np.int8)
+    fast.grip_rows(*rows, tol, numbers, codes)
+    out, at = {}, 0
+    for name, width in GRIP_COLUMNS:
+        out[name] = numbers[:, at : at + width]
+        at += width
+    out["status"], out["culprit"] = codes[:, :1], codes[:, 1:2]
+    rest = np.flatnonzero(codes[:, 2] == 0) if size > 1 or not codes[0, 2] else ()
+    if len(rest):
+        more = _Prepared(*others(rest), s_f, tol).solve(rows[3][rest])
+        for name, value in more.items():
+            out[name][rest] = value.reshape(len(rest), -1)
+    g = Grip(safety=s_f, **{k: v.reshape(shape + _TAILS[v.shape[1]]) for k, v in out.items()})
+    return checked_grip(g) if len(rest) else g
+
+
+_TAILS = {1: (), 3: (3,), 6: (6,), 9: (3, 3)}
+
+
+def _views():
+    """``(name, index, shape or None)`` of one row's fields in :func:`kernel.grip_rows`' numbers
+    (``[at, ...]``: a 0-d view of one number, the cheapest there is)."""
+    out, at = [], 0
+    for name, width in GRIP_COLUMNS:
+        index = (at, Ellipsis) if width == 1 else slice(at, at + width)
+        out.append((name, index, (3, 3) if width == 9 else None))
+        at += width
+    return tuple(out)
+
+
+_VIEWS = _views()
 
 
 class PreparedGrip:
@@ -286,6 +361,9 @@ class PreparedGrip:
     def __init__(self, points, normals, friction, safety, tol):
         self.points, self.normals, self.friction, self.safety = points, normals, friction, safety
         self._prepared = _Prepared(points[None], normals[None], friction[None], safety, tol)
+        self._rows = (points[None], normals[None], friction[None])
+        self._limit = np.ascontiguousarray(friction[None] / safety)
+        self._tol = float(tol)
 
     def grip(self, wrench) -> Grip:
         """The same :class:`Grip` as ``grip(points, normals, wrench, friction, safety=safety)``.
@@ -294,18 +372,35 @@ class PreparedGrip:
         """
         w = check_wrench(wrench)
         rows = w.reshape(-1, 6)
-        prepared = self._prepared if len(rows) == 1 else self._prepared.repeat(len(rows))
-        out = prepared.solve(rows)
-        shape = w.shape[:-1]
-        return checked_grip(Grip(safety=self.safety, **{k: v.reshape(shape + v.shape[1:]) for k, v in out.items()}))
+        k = len(rows)
+        fast = compiled.kernel()
+        low, high = WRENCH_SCALED_BEYOND
+        largest = float(np.abs(rows).max())  # a wrench to scale first goes the general way
+        if fast is not None and w.ndim == 1 and (largest == 0 or low <= largest <= high):  # a control loop's call
+            numbers = np.empty((1, fast.WIDTH))
+            codes = np.empty((1, 3), np.int8)
+            fast.grip_rows(self._rows[0], self._rows[1], self._limit, rows, self._tol, numbers, codes)  # w: a copy
+            if codes[0, 2]:
+                flat, codes = numbers[0], codes[0]
+                fields = {name: flat[at] if tail is None else flat[at].reshape(tail) for name, at, tail in _VIEWS}
+                fields.update(status=codes[0, ...], culprit=codes[1, ...], safety=self.safety)
+                g = object.__new__(Grip)  # the frozen dataclass's __init__ was a tenth of the call
+                g.__dict__.update(fields)
+                return g
+        prepared = self._prepared if k == 1 else self._prepared.repeat(k)
+        grasp = (self._rows if k == 1 else tuple(np.repeat(a, k, axis=0) for a in self._rows)) + (rows,)
+        return _grip_of(grasp, self.safety, self._prepared.tol, w.shape[:-1], prepared)
 
 
 def prepare_grip(points, normals, friction, *, safety=1.0, tol=DEGENERACY_TOL) -> PreparedGrip:
     """One grasp's part of :func:`~grasptwist.forces.grip` done once, for a control loop whose wrench changes.
 
-    ``points, normals (3, 3)``, ``friction`` scalar or ``(3,)``.  The geometry, the cones'
-    frames, the squeezes' map and an internal force inside every cone do not depend on the
-    wrench; ``.grip(wrench)`` does the rest and gives what :func:`~grasptwist.forces.grip` gives.
+    ``points, normals (3, 3)``, ``friction`` scalar or ``(3,)``.  The checks, and on the numpy
+    path the geometry, the cones' frames, the squeezes' map and an internal force inside every
+    cone, do not depend on the wrench; ``.grip(wrench)`` does the rest and gives what
+    :func:`~grasptwist.forces.grip` gives.  Compiled (numba), one wrench is one row of the kernel, whose
+    wrench-free part is a small share of its time; the prepared form saves the checks and
+    the conversions around it.
 
     >>> p = [[1, 0, 0], [-0.5, 0.75**0.5, 0], [-0.5, -(0.75**0.5), 0]]
     >>> hand = prepare_grip(p, -np.array(p), 0.5, safety=2)
@@ -318,7 +413,7 @@ def prepare_grip(points, normals, friction, *, safety=1.0, tol=DEGENERACY_TOL) -
     mu = np.broadcast_to(check_friction(friction), (3,)) if np.ndim(friction) <= 1 else None
     if mu is None:
         raise ValueError(f"prepare_grip takes one grasp: friction a scalar or (3,), got {np.shape(friction)}")
-    return PreparedGrip(p, n, mu.astype(float), check_safety(safety), tol)
+    return PreparedGrip(np.ascontiguousarray(p), np.ascontiguousarray(n), mu.astype(float), check_safety(safety), tol)
 
 
 class _Prepared:
@@ -422,7 +517,9 @@ class _Prepared:
                 status[r[fail]], culprit[r[fail]] = ForceStatus.CANNOT_HOLD, blame[fail]
                 certificate[r[fail]] = y[fail]
                 # on the edge of what the fingers can exert (y . w = 0): the contacts y forbids carry nothing
-                edge = np.flatnonzero(fail & ~(np.einsum("ni,ni->n", y, w[r]) > _EDGE_OF_HOLD * norm(y) * norm(w[r])))
+                with np.errstate(over="ignore"):  # a huge wrench: its row is nonfinite-result, not a warning
+                    held = np.einsum("ni,ni->n", y, w[r]) > _EDGE_OF_HOLD * norm(y) * norm(w[r])
+                edge = np.flatnonzero(fail & ~held)
                 for i in edge:
                     found = _on_the_edge(frame[i], m[i], fm[r[i]] / scale[r[i]], z[i])
                     if found is None:

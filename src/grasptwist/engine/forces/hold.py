@@ -9,7 +9,9 @@ The object moves, gravity does not.  At the pose ``(R, x)`` the centre of mass i
 and the grip changes along the path.  :func:`grip_along` solves it at given times;
 :func:`cannot_hold` finds the stretches of the path where no grip exists, between the
 samples, to ``1e-10`` of the shortest segment's duration, as
-:func:`grasptwist.engine.path.degeneracies` finds degenerate stretches.
+:func:`grasptwist.engine.path.degeneracies` finds degenerate stretches; :func:`hold_verdicts`
+adds the stretches where the grip fails for another reason (an overflowing pose, degenerate
+contacts), where whether the weight is held cannot be judged.
 """
 
 from __future__ import annotations
@@ -20,12 +22,12 @@ import numpy as np
 
 from .. import se3
 from ..degeneracy import DEGENERACY_TOL
-from ..path import Poses, check_segments, integrate
+from ..path import Poses, check_segments, integrate, overflowing, pose_overflowed
 from ..screws import cross
 from .grasp_map import ForceStatus
 from .grip import Grip, grip
 
-__all__ = ["HoldStretch", "hold_wrench", "grip_along", "cannot_hold", "PRECISION"]
+__all__ = ["HoldStretch", "Unjudged", "hold_wrench", "grip_along", "cannot_hold", "hold_verdicts", "PRECISION"]
 
 #: Stretch ends are located to this fraction of the shortest segment's duration.
 PRECISION = 1e-10
@@ -46,6 +48,24 @@ class HoldStretch(NamedTuple):
     t_start: float
     t_end: float
     culprit: int
+
+
+class Unjudged(NamedTuple):
+    """A stretch of a path where the grip fails for a reason of its own, so that
+    whether the weight is held cannot be judged there.
+
+    Attributes
+    ----------
+    t_start, t_end : float
+        Where the failure starts and ends, located as :class:`HoldStretch`'s ends are.
+    status : int
+        The grip's :class:`~grasptwist.engine.forces.grasp_map.ForceStatus` just after
+        ``t_start`` (``nonfinite-pose`` where the pose overflows).
+    """
+
+    t_start: float
+    t_end: float
+    status: int
 
 
 def hold_wrench(mass, center_of_mass, gravity, rotation=None, position=None) -> np.ndarray:
@@ -105,7 +125,8 @@ def grip_along(
     Returns
     -------
     (Poses, Grip)
-        The poses at ``times`` and the grip of the moved grasp there, ``(T, ...)``.
+        The poses at ``times`` and the grip of the moved grasp there, ``(T, ...)``
+        (``nonfinite-pose`` where the pose overflows double precision).
 
     Examples
     --------
@@ -125,7 +146,9 @@ def grip_along(
     moved = se3.transform(poses.rotation[..., None, :, :], poses.position[..., None, :], p)
     turned = np.einsum("...ij,kj->...ki", poses.rotation, n)
     wrench = hold_wrench(mass, center_of_mass, gravity, poses.rotation, poses.position)
-    return poses, grip(moved, turned, wrench, friction, safety=safety, tol=tol)
+    held = grip(moved, turned, wrench, friction, safety=safety, tol=tol)
+    lost = overflowing(poses, np.concatenate((p, n)), np.concatenate((moved, turned), axis=-2))
+    return poses, pose_overflowed(held, lost)
 
 
 def cannot_hold(
@@ -148,8 +171,8 @@ def cannot_hold(
     its first (last) node and the held node before (after) it, every end at once, to
     ``1e-10`` (``PRECISION``) of the shortest segment's duration.  A stretch shorter than the
     sampling, between two held nodes, is not seen.  A grasp the grip cannot solve at
-    all (degenerate contacts, ``status`` other than ``cannot-hold``) has no stretches:
-    the path's degeneracies report it.
+    all (degenerate contacts, ``status`` other than ``cannot-hold``) has no stretches: a
+    path's summary lists those as ``hold_unjudged``, and its degeneracies say why.
 
     Parameters
     ----------
@@ -175,38 +198,95 @@ def cannot_hold(
     >>> round(s.t_start, 9), round(2 * np.pi - s.t_end, 9), round(float(np.arctan(0.5)), 9)
     (0.463647609, 0.463647609, 0.463647609)
     """
-    durations = np.array([s.duration for s in check_segments(segments)])
-    ends = np.concatenate(([0.0], np.cumsum(durations)))
-    extra = np.empty(0) if times is None else np.asarray(times, dtype=float).ravel()
-    nodes = np.unique(np.concatenate((ends, extra)))
+    weight = (points, normals, friction, mass, center_of_mass, gravity, segments)
+    return _Verdicts(weight, times, safety, tol).cannot_hold()
 
-    def status(t):
-        return grip_along(
-            points, normals, friction, mass, center_of_mass, gravity, segments, t, safety=safety, tol=tol
-        )[1]
 
-    at = status(nodes)
-    fails = at.status == ForceStatus.CANNOT_HOLD
-    if not fails.any():
-        return ()
-    where = np.flatnonzero(fails)
-    runs = np.split(where, np.flatnonzero(np.diff(where) > 1) + 1)
-    first, last = np.array([r[0] for r in runs]), np.array([r[-1] for r in runs])
-    # Bracket each inner end between a held node and a failing one; `fails` is False at lo, True at hi
-    # for a start, the reverse for an end (flip).
-    opens, closes = first[first > 0], last[last < len(nodes) - 1]
-    lo = np.concatenate((nodes[opens - 1], nodes[closes]))
-    hi = np.concatenate((nodes[opens], nodes[closes + 1]))
-    flip = np.arange(lo.size) >= opens.size
-    eps = PRECISION * durations.min()
-    for _ in range(int(np.max(np.ceil(np.log2(np.maximum((hi - lo) / eps, 1))), initial=0))):
-        mid = 0.5 * (lo + hi)
-        up = (status(mid).status == ForceStatus.CANNOT_HOLD) != flip
-        lo, hi = np.where(up, lo, mid), np.where(up, mid, hi)
-    starts = dict(zip(opens.tolist(), hi[: opens.size].tolist()))
-    stops = dict(zip(closes.tolist(), lo[opens.size :].tolist()))
-    t_start = np.array([starts.get(i, 0.0) for i in first.tolist()])
-    t_end = np.array([stops.get(k, float(ends[-1])) for k in last.tolist()])
-    # the reason a little inside (at the located start the grip is within round-off of existing)
-    culprit = status(t_start + 1e-6 * (t_end - t_start)).culprit
-    return tuple(HoldStretch(float(a), float(b), int(c)) for a, b, c in zip(t_start, t_end, culprit))
+def hold_verdicts(
+    points, normals, friction, mass, center_of_mass, gravity, segments, times=None, *, safety=1.0, tol=DEGENERACY_TOL
+) -> tuple[tuple[HoldStretch, ...], tuple[Unjudged, ...]]:
+    """Where the weight is not held along a path, and where that cannot be judged.
+
+    The stretches of :func:`cannot_hold`, and beside them, located the same way, the
+    stretches where the grip fails for another reason (a status other than ``ok`` and
+    ``cannot-hold``: the pose overflows, the moved contacts are degenerate), each with the
+    status it has just inside.  A path is held all along only where both are empty.
+
+    Parameters
+    ----------
+    points, normals, friction, mass, center_of_mass, gravity, segments, times, safety, tol
+        As for :func:`cannot_hold`.
+
+    Returns
+    -------
+    (tuple of HoldStretch, tuple of Unjudged)
+        Each ordered by ``t_start``.
+
+    Examples
+    --------
+    A tray spun at ``1e300`` rad/s turns through more than the float range at once (its
+    pose overflows, from ``1e-10`` of the path's duration on): it is nowhere known to fall,
+    and nowhere known to be held.
+
+    >>> from grasptwist.path import Segment
+    >>> p = [[1, 0, 0], [-0.5, 0.75**0.5, 0], [-0.5, -(0.75**0.5), 0]]
+    >>> spin = [Segment(1.0, twist=[0, 0, 1e300, 0, 0, 0])]
+    >>> with np.errstate(over="ignore", invalid="ignore"):  # the overflow is the point
+    ...     falls, (u,) = hold_verdicts(p, [[0, 0, 1]] * 3, 0.5, 1.0, [0, 0, 0], [0, 0, -9.81], spin, [0, 0.5, 1])
+    >>> falls, ForceStatus(u.status).code, round(u.t_start, 9), u.t_end
+    ((), 'nonfinite-pose', 0.0, 1.0)
+    """
+    verdicts = _Verdicts((points, normals, friction, mass, center_of_mass, gravity, segments), times, safety, tol)
+    return verdicts.cannot_hold(), verdicts.unjudged()
+
+
+class _Verdicts:
+    """The grip's status along one path: at its nodes (the samples and the segments'
+    ends) once, and the runs of a kind of status located between them."""
+
+    def __init__(self, weight, times, safety, tol):
+        self.weight, self.safety, self.tol = weight, safety, tol
+        durations = np.array([s.duration for s in check_segments(weight[-1])])
+        self.ends = np.concatenate(([0.0], np.cumsum(durations)))
+        self.eps = PRECISION * durations.min()
+        extra = np.empty(0) if times is None else np.asarray(times, dtype=float).ravel()
+        self.nodes = np.unique(np.concatenate((self.ends, extra)))
+        self.at = self.status(self.nodes).status
+
+    def status(self, t) -> Grip:
+        return grip_along(*self.weight, t, safety=self.safety, tol=self.tol)[1]
+
+    def cannot_hold(self) -> tuple[HoldStretch, ...]:
+        t_start, t_end = self._runs(lambda s: s == ForceStatus.CANNOT_HOLD)
+        # the reason a little inside (at the located start the grip is within round-off of existing)
+        culprit = self.status(t_start + 1e-6 * (t_end - t_start)).culprit if t_start.size else ()
+        return tuple(HoldStretch(float(a), float(b), int(c)) for a, b, c in zip(t_start, t_end, culprit))
+
+    def unjudged(self) -> tuple[Unjudged, ...]:
+        t_start, t_end = self._runs(lambda s: (s != ForceStatus.OK) & (s != ForceStatus.CANNOT_HOLD))
+        status = self.status(t_start + 1e-6 * (t_end - t_start)).status if t_start.size else ()
+        return tuple(Unjudged(float(a), float(b), int(s)) for a, b, s in zip(t_start, t_end, status))
+
+    def _runs(self, failing) -> tuple[np.ndarray, np.ndarray]:
+        """``(t_start, t_end)`` of every run of nodes whose status is ``failing``, each inner
+        end bisected between a node that is and one that is not, every end at once."""
+        nodes, fails = self.nodes, failing(self.at)
+        if not fails.any():
+            return np.empty(0), np.empty(0)
+        where = np.flatnonzero(fails)
+        runs = np.split(where, np.flatnonzero(np.diff(where) > 1) + 1)
+        first, last = np.array([r[0] for r in runs]), np.array([r[-1] for r in runs])
+        # `fails` is False at lo, True at hi for a start, the reverse for an end (flip).
+        opens, closes = first[first > 0], last[last < len(nodes) - 1]
+        lo = np.concatenate((nodes[opens - 1], nodes[closes]))
+        hi = np.concatenate((nodes[opens], nodes[closes + 1]))
+        flip = np.arange(lo.size) >= opens.size
+        for _ in range(int(np.max(np.ceil(np.log2(np.maximum((hi - lo) / self.eps, 1))), initial=0))):
+            mid = 0.5 * (lo + hi)
+            up = failing(self.status(mid).status) != flip
+            lo, hi = np.where(up, lo, mid), np.where(up, mid, hi)
+        starts = dict(zip(opens.tolist(), hi[: opens.size].tolist()))
+        stops = dict(zip(closes.tolist(), lo[opens.size :].tolist()))
+        t_start = np.array([starts.get(i, 0.0) for i in first.tolist()])
+        t_end = np.array([stops.get(k, float(self.ends[-1])) for k in last.tolist()])
+        return t_start, t_end

@@ -17,18 +17,55 @@ import math
 
 from .socp import _EDGE, _ITERATIONS, _RESIDUAL, GAP, START_MARGIN
 
-__all__ = ["phase_one", "minimise", "newton_matrices", "solve"]
+__all__ = ["phase_one", "minimise", "newton_matrices", "solve", "edge", "scaling", "w_inv", "w_mul"]
+
+
+def edge(x0, x1, x2, d0, d1, d2):
+    """The largest ``alpha`` with ``x + alpha d`` in the cone (``inf``: none), as :func:`socp._edge`.
+
+    Plain floats in and out: :mod:`~grasptwist.engine.forces.kernel` compiles this same function.
+    """
+    s = math.sqrt(x0 * x0 - x1 * x1 - x2 * x2)
+    x0, x1, x2 = x0 / s, x1 / s, x2 / s
+    d0, d1, d2 = d0 / s, d1 / s, d2 / s
+    rho0 = x0 * d0 - x1 * d1 - x2 * d2
+    f = (rho0 + d0) / (x0 + 1)
+    e1, e2 = d1 - f * x1, d2 - f * x2
+    t = math.sqrt(e1 * e1 + e2 * e2) - rho0
+    return 1 / t if t > 0 else math.inf
 
 
 def _edge(x, d):
-    """The largest ``alpha`` with ``x + alpha d`` in the cone (``inf``: none), as :func:`socp._edge`."""
-    s = math.sqrt(x[0] * x[0] - x[1] * x[1] - x[2] * x[2])
-    x0, x1, x2 = x[0] / s, x[1] / s, x[2] / s
-    d0, d1, d2 = d[0] / s, d[1] / s, d[2] / s
-    rho0 = x0 * d0 - x1 * d1 - x2 * d2
-    f = (rho0 + d0) / (x0 + 1)
-    t = math.hypot(d1 - f * x1, d2 - f * x2) - rho0
-    return 1 / t if t > 0 else math.inf
+    return edge(x[0], x[1], x[2], d[0], d[1], d[2])
+
+
+def scaling(y0, y1, y2, z0, z1, z2):
+    """Nesterov-Todd scaling of one cone (``W z = W^-1 y = lambda``, ``W = beta (2 v v^T - J)``):
+    ``(w0, w1, w2, v0, v1, v2, beta, lambda0, lambda1, lambda2)`` (``w`` the scaling point).
+
+    Plain floats, compiled as it is by :mod:`~grasptwist.engine.forces.kernel`.
+    """
+    ys = math.sqrt(y0 * y0 - y1 * y1 - y2 * y2)
+    zs = math.sqrt(z0 * z0 - z1 * z1 - z2 * z2)
+    twice = 2 * math.sqrt((1 + (y0 * z0 + y1 * z1 + y2 * z2) / (ys * zs)) / 2)
+    w0, w1, w2 = (y0 / ys + z0 / zs) / twice, (y1 / ys - z1 / zs) / twice, (y2 / ys - z2 / zs) / twice
+    r = math.sqrt(2 * (w0 + 1))
+    v0, v1, v2 = (w0 + 1) / r, w1 / r, w2 / r
+    beta = math.sqrt(ys / zs)
+    vz = 2 * (v0 * z0 + v1 * z1 + v2 * z2)
+    return w0, w1, w2, v0, v1, v2, beta, beta * (v0 * vz - z0), beta * (v1 * vz + z1), beta * (v2 * vz + z2)
+
+
+def w_inv(v0, v1, v2, beta, u0, u1, u2):
+    """``W^-1 u`` (plain floats; compiled as it is by :mod:`~grasptwist.engine.forces.kernel`)."""
+    t = 2 * (v0 * u0 - v1 * u1 - v2 * u2)
+    return (t * v0 - u0) / beta, (u1 - t * v1) / beta, (u2 - t * v2) / beta
+
+
+def w_mul(v0, v1, v2, beta, u0, u1, u2):
+    """``W u`` (plain floats; compiled as it is by :mod:`~grasptwist.engine.forces.kernel`)."""
+    t = 2 * (v0 * u0 + v1 * u1 + v2 * u2)
+    return beta * (t * v0 - u0), beta * (t * v1 + u1), beta * (t * v2 + u2)
 
 
 def newton_matrices(A):
@@ -109,15 +146,11 @@ def _transposed(AT, u, first):
 
 
 def _w_inv(v, beta, u):
-    v0, v1, v2 = v
-    t = 2 * (v0 * u[0] - v1 * u[1] - v2 * u[2])
-    return ((t * v0 - u[0]) / beta, (u[1] - t * v1) / beta, (u[2] - t * v2) / beta)
+    return w_inv(v[0], v[1], v[2], beta, u[0], u[1], u[2])
 
 
 def _w_mul(v, beta, u):
-    v0, v1, v2 = v
-    t = 2 * (v0 * u[0] + v1 * u[1] + v2 * u[2])
-    return (beta * (t * v0 - u[0]), beta * (t * v1 + u[1]), beta * (t * v2 + u[2]))
+    return w_mul(v[0], v[1], v[2], beta, u[0], u[1], u[2])
 
 
 def _step(AT, b, c, x, z, P, leave):
@@ -126,16 +159,9 @@ def _step(AT, b, c, x, z, P, leave):
     res = _transposed(AT, z, c)
     y = _times(AT, b, x)
     V, B, L, G = [], [], [], []
-    for (y0, y1, y2), (z0, z1, z2), cols in zip(y, z, AT):
-        ys = math.sqrt(y0 * y0 - y1 * y1 - y2 * y2)
-        zs = math.sqrt(z0 * z0 - z1 * z1 - z2 * z2)
-        twice = 2 * math.sqrt((1 + (y0 * z0 + y1 * z1 + y2 * z2) / (ys * zs)) / 2)
-        w0, w1, w2 = (y0 / ys + z0 / zs) / twice, (y1 / ys - z1 / zs) / twice, (y2 / ys - z2 / zs) / twice
-        r = math.sqrt(2 * (w0 + 1))
-        v0, v1, v2 = (w0 + 1) / r, w1 / r, w2 / r
-        beta = math.sqrt(ys / zs)
-        vz = 2 * (v0 * z0 + v1 * z1 + v2 * z2)
-        L.append((beta * (v0 * vz - z0), beta * (v1 * vz + z1), beta * (v2 * vz + z2)))
+    for ym, zm, cols in zip(y, z, AT):
+        w0, w1, w2, v0, v1, v2, beta, l0, l1, l2 = scaling(*ym, *zm)
+        L.append((l0, l1, l2))
         G.append([a0 * w0 - a1 * w1 - a2 * w2 for a0, a1, a2 in cols])
         V.append((v0, v1, v2))
         B.append(1 / (beta * beta))
