@@ -46,7 +46,7 @@ def compare(label, contents, repeats, per_file):
     )
 
 
-# Hostile files the loader must refuse at once (tests/test_grasp_file.py checks what it says).
+# Hostile files the loader must refuse at once (tests/io/test_grasp_file.py checks what it says).
 HOSTILE = {
     "billion laughs": 'a: &a ["lol","lol","lol","lol","lol","lol","lol","lol","lol"]\n'
     + "".join(f"{b}: &{b} [*{a},*{a},*{a},*{a},*{a},*{a},*{a},*{a},*{a}]\n" for a, b in zip("abcdefgh", "bcdefghi")),

@@ -4,7 +4,7 @@ import os
 
 # The grip's numpy path in every test and subprocess: numba's kernel (the `fast` extra) costs
 # some 16 s of compiling per process on a fresh clone, so the tests that hold it to the numpy
-# path (tests/test_forces.py, `compiled`) are `slow` and switch it on themselves.
+# path (tests/engine/test_forces.py, `compiled`) are `slow` and switch it on themselves.
 os.environ.setdefault("GRASPTWIST_NUMBA", "0")
 
 import numpy as np  # noqa: E402

@@ -13,7 +13,8 @@ from pathlib import Path
 
 from markdown_it import MarkdownIt
 
-ROOT = Path(__file__).resolve().parents[1]
+from places import ROOT
+
 #: What a ``console`` block's commands see: a terminal 100 columns wide, without colour.
 CONSOLE_ENV = {"COLUMNS": "100", "NO_COLOR": "1", "FORCE_COLOR": None, "LINES": None}
 #: The lines a console command may not hold: a shell would treat them, the test runs no shell.

@@ -1,6 +1,6 @@
 """Sphinx configuration of grasptwist's API reference (``docs/api/``), built from the docstrings.
 
-Build: ``python -m sphinx -W -b html docs/api /tmp/api`` (tests/test_api.py does, offline).
+Build: ``python -m sphinx -W -b html docs/api /tmp/api`` (tests/api/test_api.py does, offline).
 Sphinx with numpydoc, the numpy docstring standard's own renderer, as numpy, scipy,
 scikit-image and pytransform3d do; the alabaster theme ships with Sphinx.
 """

@@ -14,7 +14,7 @@ cluster's ``distributed.Client``.
 
 Dask, distributed, pandas and pyarrow are the extra ``grasptwist[dask]``
 (imported when these functions run, not with this module).  For example
-(tests/test_dask.py runs such code on a cluster)::
+(tests/run/test_dask.py runs such code on a cluster)::
 
     points = da.from_array(np.array([[[1, 0, 0], [-0.5, 0.866, 0], [-0.5, -0.866, 0]]] * 4), chunks=(2, 3, 3))
     r = resolve_array(points, -points, da.zeros((4, 3)) + [0, 0, 1], da.zeros((4, 6)) + [0, 0, 0, 0, 0, 1])

@@ -10,7 +10,7 @@ family's rows: its records, its table and the formats it offers.  The
 pipeline (:mod:`grasptwist.run.pipeline`), the output formats
 (:mod:`grasptwist.output.formats`) and the command line read a job's
 command and family here and never compare a command's name; a test
-(``tests/test_layers.py``) holds that.
+(``tests/api/test_layers.py``) holds that.
 
 What a family adds to another's records is a :class:`Contribution`:
 ``check`` shows, beside each method's verdict, the least friction that
@@ -181,7 +181,7 @@ class Command:
 
 # Each family's compute, records and columns load with its first run, through the
 # small functions below: a JSON resolve never imports the force engine, follow's
-# paths or the hand's kinematics (tests/test_layers.py, bench/startup.py).
+# paths or the hand's kinematics (tests/api/test_layers.py, bench/startup.py).
 
 # -- twist rows ---------------------------------------------------------------
 

@@ -8,7 +8,7 @@ method of :mod:`~grasptwist.engine.forces.socp` step for step (Mehrotra's predic
 with Nesterov-Todd scaling, 0.99 of the way to the cones' edge, the same stopping rules, phase
 I, dual polish and culprits; its scalar pieces are :mod:`~grasptwist.engine.forces.one`'s
 functions, compiled), then the dual or the certificate and the figures.  The numpy path stays
-the reference: ``tests/test_forces.py`` holds the two to the same verdicts and totals to
+the reference: ``tests/engine/test_forces.py`` holds the two to the same verdicts and totals to
 ``1e-9``.  A row of the method is ``A[m, k, j]`` (cone ``m``, component ``k``, unknown ``j``),
 ``b[m, k]``, ``c[j]``; ``d`` unknowns, ``K`` cones.  numpy's error model: a division by zero
 is ``inf`` or NaN, which ends a row's iterations as a non-finite step does in numpy.

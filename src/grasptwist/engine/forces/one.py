@@ -4,7 +4,7 @@ For one grasp numpy's cost per call (a microsecond or more, on arrays of three n
 is all there is: an iteration of the batched method makes some 300 numpy calls.  This is
 the same method, step for step (Mehrotra's predictor-corrector with Nesterov-Todd
 scaling, 0.99 of the way to the cones' edge, the same stopping rules), on lists of
-floats: a few hundred multiplications an iteration.  ``tests/test_forces.py`` holds it to
+floats: a few hundred multiplications an iteration.  ``tests/engine/test_forces.py`` holds it to
 the batched solver on random rows (the verdicts, and the optimum to ``1e-9``).
 
 A row is ``A[m][k][j]`` (cone ``m``, component ``k``, unknown ``j``), ``b[m][k]``,

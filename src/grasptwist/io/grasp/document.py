@@ -6,7 +6,7 @@ its keys into fields of the :class:`~grasptwist.model.Grasp`.  A new part
 of the format is a new module with a ``SECTION`` (as ``forces.py`` did, issue
 19), imported and added to :data:`SECTIONS` below; its keys then join
 :data:`GRASP_KEYS`, the fast path hands them to it, and the JSON Schema must
-list them (tests/test_grasp_schema.py checks both agree).
+list them (tests/io/test_grasp_schema.py checks both agree).
 """
 
 from __future__ import annotations

@@ -30,7 +30,7 @@ __all__ = ["Bail", "Parts", "fast_document"]
 # its recorded events with ``compose`` and checks it with ``read_document``, which
 # give every error and its position.  So the fast path returns a grasp only
 # where the general one returns the same grasp, bit for bit
-# (tests/test_grasp_file_speed_paths.py compares the two).
+# (tests/io/test_grasp_file_speed_paths.py compares the two).
 
 
 class Bail(Exception):

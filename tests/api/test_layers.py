@@ -1,0 +1,285 @@
+"""Imports go one way, down the layers of ARCHITECTURE.md, and never in a circle.
+
+An ast walk over src/grasptwist: every ``import`` and ``from ... import``,
+at module level or inside a function (a deferred import may keep start-up
+fast or an optional dependency optional; it never hides a circle).
+"""
+
+import ast
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+from places import ROOT
+
+SRC = ROOT / "src"
+PACKAGE = SRC / "grasptwist"
+
+#: Lowest first.  A module may import its own group and any group of a lower layer;
+#: groups of one layer are independent of each other.
+LAYERS = [
+    ["grasptwist.model", "grasptwist.extras", "grasptwist._version"],  # data types, no math
+    ["grasptwist.engine"],  # the math on arrays
+    ["grasptwist.io"],  # files in
+    ["grasptwist.results"],  # the registry of result kinds and their fields
+    ["grasptwist.output", "grasptwist.plot"],  # records and tables out; pictures
+    ["grasptwist.run"],  # batches, workers, streams, the -o target: engine over inputs into outputs
+    ["grasptwist.cli"],  # the command line
+    # the public facades and entry points: nothing inside the package imports them
+    [
+        "grasptwist",
+        "grasptwist.screws",
+        "grasptwist.hand",
+        "grasptwist.forces",
+        "grasptwist.path",
+        "grasptwist.pictures",
+        "grasptwist.dask",
+        "grasptwist.__main__",
+    ],
+]
+
+#: Beyond the layers: pictures are drawn from the engine's geometry only; reading
+#: files and writing records is the command line's (issue 22).
+FORBIDDEN = {"grasptwist.plot": ("grasptwist.io", "grasptwist.output", "grasptwist.results", "grasptwist.run")}
+
+#: Facades only re-export.
+FACADES = ("grasptwist.screws", "grasptwist.hand", "grasptwist.forces", "grasptwist.path", "grasptwist.pictures")
+
+
+def module_name(path: Path) -> str:
+    parts = path.relative_to(SRC).with_suffix("").parts
+    return ".".join(parts[:-1] if parts[-1] == "__init__" else parts)
+
+
+MODULES = {module_name(p): p for p in sorted(PACKAGE.rglob("*.py"))}
+
+
+def imports(name: str) -> set[str]:
+    """The package's modules ``name`` imports anywhere in its code."""
+    path = MODULES[name]
+    package = name if path.name == "__init__.py" else name.rpartition(".")[0]
+    found = set()
+    for node in ast.walk(ast.parse(path.read_text(), str(path))):
+        if isinstance(node, ast.Import):
+            found.update(a.name for a in node.names)
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = package.split(".")[: len(package.split(".")) - node.level + 1]
+                target = ".".join(base + ([node.module] if node.module else []))
+            else:
+                target = node.module
+            # `from pkg import module` imports the module; `from module import name`, the module
+            found.update(f"{target}.{a.name}" if f"{target}.{a.name}" in MODULES else target for a in node.names)
+    return {m for m in found if m in MODULES and m != name}
+
+
+GRAPH = {name: imports(name) for name in MODULES}
+
+
+def group(name: str) -> tuple[int, str]:
+    """The layer and group of a module: its longest matching group."""
+    matches = [
+        (len(g), k, g)
+        for k, layer in enumerate(LAYERS)
+        for g in layer
+        if name == g or (name.startswith(g + ".") and g != "grasptwist")  # the package's own __init__: itself only
+    ]
+    assert matches, f"{name} is in no layer: add it to LAYERS"
+    _, k, g = max(matches)
+    return k, g
+
+
+def test_the_walk_sees_deferred_and_relative_imports():
+    # a deferred import inside a function, a relative `from . import module`, an absolute one
+    assert "grasptwist.run.signals" in imports("grasptwist.__main__")
+    assert "grasptwist.cli" in imports("grasptwist.__main__")
+    assert "grasptwist.engine.kernels" in imports("grasptwist.engine.decompose")
+    assert "grasptwist.output.parquet_writer" in imports("grasptwist.output.formats")
+    assert group("grasptwist.engine.hands") == (1, "grasptwist.engine")
+    assert group("grasptwist.hand") == (7, "grasptwist.hand")
+
+
+@pytest.mark.parametrize("name", sorted(MODULES))
+def test_imports_go_down_the_layers(name):
+    layer, own = group(name)
+    upward = []
+    for target in sorted(GRAPH[name]):
+        their_layer, theirs = group(target)
+        if theirs == own:
+            continue
+        if their_layer >= layer or theirs in FORBIDDEN.get(own, ()):
+            upward.append(f"{target} ({theirs}, layer {their_layer})")
+    assert not upward, f"{name} ({own}, layer {layer}) imports {', '.join(upward)}"
+
+
+def test_no_import_circles():
+    circles = []
+    state = {}  # name -> 1 on the current path, 2 done
+
+    def visit(name, path):
+        state[name] = 1
+        for target in sorted(GRAPH[name]):
+            if state.get(target) == 1:
+                circles.append(" -> ".join(path[path.index(target) :] + [target]))
+            elif target not in state:
+                visit(target, path + [target])
+        state[name] = 2
+
+    for name in sorted(MODULES):
+        if name not in state:
+            visit(name, [name])
+    assert not circles, "import circles:\n" + "\n".join(circles)
+
+
+def test_the_loader_only_reads():
+    # a hand is put on its contacts (inverse kinematics) by the run layer, not while parsing (issue 28)
+    solving = {"grasptwist.engine.ik", "grasptwist.engine.tracking"}
+    assert not {
+        name: GRAPH[name] & solving for name in GRAPH if name.startswith("grasptwist.io") and GRAPH[name] & solving
+    }
+
+
+@pytest.mark.parametrize("name", FACADES)
+def test_facades_only_re_export(name):
+    tree = ast.parse(MODULES[name].read_text())
+    for node in tree.body:
+        docstring = isinstance(node, ast.Expr) and isinstance(node.value, ast.Constant)
+        all_ = isinstance(node, ast.Assign) and [t.id for t in node.targets if isinstance(t, ast.Name)] == ["__all__"]
+        assert docstring or all_ or isinstance(node, ast.ImportFrom), f"{name}:{node.lineno}: not a re-export"
+
+
+@pytest.mark.parametrize(
+    "name", [n for n, p in MODULES.items() if p.name != "__init__.py" and not p.name.startswith("_")]
+)
+def test_every_module_says_what_is_public(name):
+    # the public API is grasptwist's _EXPORTS; each module marks its own public names
+    tree = ast.parse(MODULES[name].read_text())
+    assert any(
+        isinstance(node, ast.Assign) and any(isinstance(t, ast.Name) and t.id == "__all__" for t in node.targets)
+        for node in tree.body
+    ), f"{name} has no __all__"
+
+
+#: Where commands and their families are named: the registry (issue 28).
+REGISTRY = "grasptwist.run.families"
+
+
+def _command_names() -> set[str]:
+    """The registry's command names, read from its source (no import: this file only reads)."""
+    tree = ast.parse(MODULES[REGISTRY].read_text())
+    names = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Call) and getattr(node.func, "id", None) == "Command":
+            first = node.args[0] if node.args else next((k.value for k in node.keywords if k.arg == "name"), None)
+            if isinstance(first, ast.Constant) and isinstance(first.value, str):
+                names.add(first.value)
+    return names
+
+
+COMMAND_NAMES = _command_names()
+
+
+def branches_on_a_name(tree: ast.AST) -> list[tuple[int, str]]:
+    """``(line, text)`` of each comparison with a command's name (``kind == "forces"``,
+    ``job.kind != "resolve"``, ``kind in ("basis", "check")``) and each mapping keyed by commands
+    (``{"resolve": TableWriter, "basis": ...}``; one such key is a name that is also a function's)."""
+
+    def named(node) -> bool:
+        if isinstance(node, ast.Constant):
+            return node.value in COMMAND_NAMES
+        if isinstance(node, ast.Tuple | ast.List | ast.Set):
+            return any(named(e) for e in node.elts)
+        return False
+
+    found = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Compare) and any(named(c) for c in (node.left, *node.comparators)):
+            found.append((node.lineno, ast.unparse(node)))
+        elif isinstance(node, ast.Dict) and sum(k is not None and named(k) for k in node.keys) > 1:
+            found.append((node.lineno, ast.unparse(node)[:60]))
+    return found
+
+
+def test_the_walk_finds_branches_on_a_command_name():
+    assert {"resolve", "basis", "check", "follow", "forces"} <= COMMAND_NAMES
+    code = (
+        'if job.kind == "forces": pass\nx = kind != "resolve"\ny = k in ("basis", "x")\nw = {"check": 1, "basis": 2}\n'
+    )
+    assert [line for line, _ in branches_on_a_name(ast.parse(code))] == [1, 2, 3, 4]
+    assert not branches_on_a_name(ast.parse('f.kind == "fingers"\nCOMMANDS["forces"].formats\n{"resolve": ".api"}'))
+
+
+@pytest.mark.parametrize("name", sorted(n for n in MODULES if n != REGISTRY and group(n)[0] < len(LAYERS) - 1))
+def test_no_layer_branches_on_a_command_name(name):
+    # the public modules (the last group) name API functions, some called like a command (gt.resolve)
+    # every layer loops over the registry (run/families.py); looking a command up there is fine;
+    found = branches_on_a_name(ast.parse(MODULES[name].read_text()))
+    assert not found, f"{name} branches on a command's name: " + "; ".join(f"line {n}: {t}" for n, t in found)
+
+
+# --------------------------------------------------------------------------
+# Issue 26.4: start-up pays for what the command and format in hand use (bench/startup.py times it)
+
+#: Modules a one-file JSON ``resolve`` never needs: the force side, the hand's kinematics and
+#: inverse kinematics, URDF reading, tables (rich) and pictures.
+NOT_FOR_JSON_RESOLVE = (
+    "grasptwist.engine.forces",
+    "grasptwist.run.forces",
+    "grasptwist.output.force_records",
+    "grasptwist.engine.ik",
+    "grasptwist.engine.kinematics",
+    "grasptwist.engine.hands",
+    "grasptwist.io.urdf",
+    "grasptwist.output.table",
+    "grasptwist.output.follow_table",
+    "grasptwist.plot",
+    "rich",
+    "matplotlib",
+    "scipy",
+)
+
+#: Runs ``grasptwist ARGS`` as the script does, one command line after another in one
+#: process, printing after each the modules loaded so far (JSON, on stderr).
+_IMPORTED = """
+import json, sys
+from grasptwist.__main__ import main
+for args in json.loads(sys.argv[1]):
+    sys.argv = ["grasptwist", *args]
+    try:
+        main()
+    except SystemExit:
+        pass
+    sys.stderr.write("\\nMODULES " + json.dumps(sorted(sys.modules)) + "\\n")
+"""
+
+
+def _loaded(*command_lines) -> list[set[str]]:
+    root = ROOT
+    proc = subprocess.run(
+        [sys.executable, "-c", _IMPORTED, json.dumps(command_lines)],
+        capture_output=True, text=True, cwd=root, timeout=60, env={**os.environ, "NO_COLOR": "1"},
+    )  # fmt: skip
+    found = [set(json.loads(line[8:])) for line in proc.stderr.splitlines() if line.startswith("MODULES ")]
+    assert len(found) == len(command_lines), proc.stderr
+    return found
+
+
+def _among(modules: set[str], names) -> list[str]:
+    return sorted(m for m in modules for n in names if m == n or m.startswith(n + "."))
+
+
+def test_a_json_resolve_of_one_file_imports_no_force_hand_table_or_plot_module():
+    json_run, forces_run, table_run = _loaded(
+        ["resolve", "grasps/polyhedron.yaml", "--format", "json"],
+        ["forces", "grasps/sphere.yaml", "--format", "json"],
+        ["resolve", "grasps/three-finger-hand.yaml"],
+    )
+    assert "grasptwist.engine.decompose" in json_run and "orjson" in json_run  # it did run
+    assert _among(json_run, NOT_FOR_JSON_RESOLVE) == []
+    # the names are right: the commands that need these modules load them
+    assert {"grasptwist.engine.forces.grip", "grasptwist.run.forces"} <= forces_run
+    assert {"grasptwist.output.table", "rich", "grasptwist.engine.kinematics"} <= table_run

@@ -1,0 +1,455 @@
+"""``grasptwist forces`` and check's closure (issue 19 phase 2): records, columns, data sets, errors."""
+
+import csv
+import io
+import json
+import math
+import shutil
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import grasptwist as gt
+from grasptwist.engine.forces.grasp_map import grasp_map, squeeze_forces
+from grasptwist.io.grasp import read_grasps
+from grasptwist.output.columns import FORCE_CSV_COLUMNS
+from hostile import jsonl, run
+from places import ROOT
+
+SPHERE = str(ROOT / "grasps/sphere.yaml")
+POLYHEDRON = str(ROOT / "grasps/polyhedron.yaml")
+P = np.array([[1, 0, 0], [-0.5, 0.75**0.5, 0], [-0.5, -(0.75**0.5), 0]])
+
+
+def records(*args):
+    r, _ = run("forces", *args, "-f", "jsonl")
+    return r, jsonl(r.stdout)
+
+
+def by(recs, grasp, wrench=None):
+    (rec,) = [r for r in recs if r.get("grasp") == grasp and (r["wrench"] or {}).get("name") == wrench]
+    return rec
+
+
+def test_the_bundled_ball_is_held_with_m_g_over_mu_as_the_engine_says():
+    r, recs = records(SPHERE)
+    assert r.exit_code == 0, r.stderr
+    hold = by(recs, "sphere-equator", "hold")
+    assert hold["wrench"] == {"name": "hold", "wrench": [0.0, 0.0, 9.81, 0.0, 0.0, 0.0]}
+    assert hold["friction"] == [0.5, 0.5, 0.5] and hold["units"] == "m" and hold["ok"]
+    grip = hold["grip"]
+    # m g / mu = 19.62 N, by hand: each finger carries m g / 3 by friction at |f_t| = mu f_n
+    assert grip["total_normal_force"] == pytest.approx(19.62, rel=1e-6)
+    assert grip["normal_force"] == pytest.approx([6.54] * 3, rel=1e-5)
+    assert grip["safety"] == 1.0
+    g = read_grasps(SPHERE)[1]
+    engine = gt.grip(g.points, g.normals, g.wrenches[-1].wrench, g.friction)
+    np.testing.assert_allclose(grip["force"], engine.force, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(grip["squeeze"], engine.squeeze, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(hold["manipulating"]["force"], [[0, 0, 3.27]] * 3, atol=1e-12)
+    f = np.array(grip["force"])
+    # the grip exerts the wrench, within every cone, and is manipulating + squeezes
+    np.testing.assert_allclose(grasp_map(g.points) @ f.reshape(9), [0, 0, 9.81, 0, 0, 0], atol=1e-9)
+    assert all(u <= 0.5 + 1e-9 for u in grip["friction_used"])
+    split = np.array(hold["manipulating"]["force"]) + squeeze_forces(g.points, np.array(grip["squeeze"]))
+    np.testing.assert_allclose(split, f, atol=1e-12)
+    assert hold["closure"] == {
+        "force_closure": True,
+        "closure_friction": pytest.approx(0, abs=1e-9),
+        "epsilon": None,
+        "safety": 1.0,
+    }
+    turn = by(recs, "sphere-equator", "turn-z")
+    # 0.01 N m about the vertical: |f_t| = 0.01 / (3 r) at each finger, f_n = |f_t| / mu
+    assert turn["grip"]["total_normal_force"] == pytest.approx(0.01 / (0.035 * 0.5), rel=1e-5)
+
+
+def test_a_grasp_without_wrench_gets_one_record_with_its_closure():
+    r, recs = records(POLYHEDRON)
+    (rec,) = recs
+    assert rec["wrench"] is None and rec["manipulating"] is None and rec["grip"] is None
+    assert rec["friction"] is None and rec["ok"] and r.exit_code == 0
+    # Example 2: tan(phi) with sin(phi) = 1/sqrt(3)
+    assert rec["closure"]["closure_friction"] == pytest.approx(1 / math.sqrt(2), abs=1e-6)
+    assert rec["closure"]["force_closure"] is None and rec["closure"]["epsilon"] is None
+
+
+def test_command_line_wrench_friction_safety_and_quality():
+    r, recs = records(
+        POLYHEDRON, "--wrench", "0,0,1,0,0,0", "--wrench", "1,0,0,0,0,0", "--at", "0,0,1",
+        "--wrench-name", "up", "--wrench-name", "push", "--friction", "0.8", "--safety", "1.1", "--quality",
+    )  # fmt: skip
+    assert r.exit_code == 0, r.stderr
+    up, push = recs
+    assert up["wrench"]["name"] == "up" and up["friction"] == [0.8] * 3
+    # moment about the origin of (1, 0, 0) at (0, 0, 1): (0, 0, 1) x (1, 0, 0) = (0, 1, 0)
+    assert push["wrench"]["wrench"] == [1.0, 0.0, 0.0, 0.0, 1.0, 0.0]
+    g = read_grasps(POLYHEDRON)[0]
+    engine = gt.grip(g.points, g.normals, [1, 0, 0, 0, 1, 0], 0.8, safety=1.1)
+    assert push["grip"]["total_normal_force"] == pytest.approx(float(engine.total_normal_force), rel=1e-12)
+    assert push["grip"]["safety"] == 1.1
+    assert max(push["grip"]["friction_used"]) <= 0.8 / 1.1 + 1e-9
+    c = gt.forces.force_closure(g.points, g.normals, 0.8 / 1.1, quality=True)  # judged with mu / safety
+    assert up["closure"]["force_closure"] is True and up["closure"]["safety"] == 1.1
+    assert up["closure"]["epsilon"] == pytest.approx(float(c.epsilon), rel=1e-9) and up["closure"]["epsilon"] > 0
+
+
+def test_cannot_hold_is_a_failed_record_with_its_reason(tmp_path):
+    tray = tmp_path / "tray.yaml"
+    tray.write_text(
+        "friction: 0.5\nwrenches: [{name: pull, force: [0, 0, -1]}]\ncontacts:\n"
+        + "".join(f"  - {{point: {p.tolist()}, normal: [0, 0, 1]}}\n" for p in P)
+    )
+    r, recs = records(tray)
+    (rec,) = recs
+    assert r.exit_code == 1 and not rec["ok"]
+    assert rec["grip"]["error"]["code"] == "cannot-hold"
+    assert "needs a finger to pull" in rec["grip"]["error"]["message"]
+    assert f"{tray}: grasp 'tray', wrench 'pull': error: grip: cannot-hold: " in r.stderr
+    # the proof: y . w > 0, and no finger pushing up (f_z >= 0, in its cone) has y . G f > 0
+    y = np.array(rec["grip"]["error"]["certificate"])
+    assert y @ [0, 0, -1, 0, 0, 0] > 0 and np.abs(y[3:]).max() < 1e-9 and y[2] < 0
+    assert "; it cannot resist a force along (0, 0, 1) with a moment (0, 0, 0) about the origin" in r.stderr
+
+
+def test_a_held_record_carries_its_dual_and_gap():
+    _, recs = records(SPHERE)
+    grip = by(recs, "sphere-equator", "hold")["grip"]
+    # one more newton of lift costs 1 / mu = 2 N of grip: the dual is d total / d w
+    assert grip["dual"][:3] == pytest.approx([0, 0, 2], abs=1e-6) and abs(grip["gap"]) < 1e-8
+
+
+def test_collinear_contacts_hold_a_push_along_a_normal_at_its_contact(tmp_path):
+    """Issue 26, item 2.6: three contacts on a line; the third pushes up at its own point alone."""
+    line = tmp_path / "line.yaml"
+    line.write_text(
+        "friction: 0.5\ncontacts:\n  - {point: [-0.05, 0, 0], normal: [1, 0, 0]}\n"
+        "  - {point: [0.05, 0, 0], normal: [-1, 0, 0]}\n  - {point: [0, 0, 0], normal: [0, 0, 1]}\n"
+    )
+    r, recs = records(line, "--wrench", "0,0,1,0,0,0", "--at", "0,0,0")
+    (rec,) = recs
+    assert r.exit_code == 0 and rec["ok"], r.stderr
+    assert rec["grip"]["total_normal_force"] == pytest.approx(1.0, rel=1e-8)
+    r, recs = records(line, "--wrench", "0,0,0,1,0,0")  # a moment about the line itself
+    assert r.exit_code == 1 and recs[0]["grip"]["error"]["code"] == "collinear-contacts"
+    y = np.array(recs[0]["grip"]["error"]["certificate"])
+    assert y[3] > 0 and np.abs(y @ grasp_map(np.array([[-0.05, 0, 0], [0.05, 0, 0], [0, 0, 0]]))).max() < 1e-9
+
+
+def test_a_wrench_without_friction_has_no_grip_and_says_so():
+    r, recs = records(POLYHEDRON, "--wrench", "0,0,1,0,0,0")
+    (rec,) = recs
+    assert rec["grip"] is None and rec["manipulating"]["force"] and rec["ok"]
+    assert rec["warnings"] == [
+        "grip skipped: the grasp has no friction (give 'friction:' in the file or --friction MU)"
+    ]
+
+
+def test_a_folder_with_one_bad_file_reports_it_and_the_rest(tmp_path):
+    shutil.copy(SPHERE, tmp_path / "a.yaml")
+    shutil.copy(ROOT / "tests/invalid_grasps/zero-mass.yaml", tmp_path / "b.yaml")
+    r, recs = records(tmp_path)
+    assert r.exit_code == 1
+    assert [rec.get("grasp") for rec in recs] == ["sphere-tripod", "sphere-equator", "sphere-equator", None]
+    assert recs[-1]["error"]["code"] == "invalid-mass" and (recs[-1]["error"]["line"], recs[-1]["error"]["column"]) == (
+        4,
+        7,
+    )
+    assert f"{tmp_path / 'b.yaml'}:4:7: error: invalid-mass: mass: must be > 0, got 0.0" in r.stderr
+
+
+def test_json_lines_from_standard_input():
+    line = json.dumps(
+        {"name": "ball", "friction": 0.5, "contacts": [{"point": p.tolist(), "normal": (-p).tolist()} for p in P]}
+    )
+    r, _ = run("forces", "-", "--wrench", "0,0,9.81,0,0,0", "-f", "jsonl", input=line + "\n")
+    (rec,) = jsonl(r.stdout)
+    assert rec["grip"]["total_normal_force"] == pytest.approx(19.62, rel=1e-9)
+
+
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["--wrench", "0,0,1,0,0"], "needs 6 finite comma-separated numbers"),
+        (["--wrench-name", "a"], "got 1 names for 0 wrenches"),
+        (["--at", "0,0,1"], "applies to --wrench"),
+        (["--friction", "-1"], "--friction"),
+        (["--safety", "0.5"], "--safety"),
+        (["--cone-edges", "2"], "--cone-edges"),
+    ],
+)
+def test_bad_options_are_usage_errors(args, message):
+    r, _ = run("forces", POLYHEDRON, *args)
+    assert r.exit_code == 2 and r.stdout == "" and message in r.stderr
+
+
+def test_csv_columns_and_values():
+    r, _ = run("forces", SPHERE, ROOT / "tests/invalid_grasps/zero-mass.yaml", "-f", "csv")
+    rows = list(csv.DictReader(io.StringIO(r.stdout)))
+    head = r.stdout.splitlines()[0].split(",")
+    assert head == FORCE_CSV_COLUMNS
+    assert head[:5] == ["file", "grasp", "wrench", "ok", "error"]
+    for stem in ("fm1_x", "fm3_z", "f1_x", "f3_z", "squeeze1", "squeeze3", "fn1", "fn3", "ft1", "ft3",
+                 "friction_used1", "friction_used3", "total_normal_force", "grip_error", "force_closure",
+                 "closure_friction", "epsilon", "f_x", "m_z", "mu1", "mu3"):  # fmt: skip
+        assert stem in head
+    tripod, turn, hold, bad = rows
+    assert (tripod["wrench"], tripod["fm1_x"], tripod["total_normal_force"], tripod["mu1"]) == ("", "", "", "")
+    assert float(tripod["closure_friction"]) == pytest.approx(0.4663, abs=1e-4) and tripod["force_closure"] == ""
+    assert hold["wrench"] == "hold" and float(hold["f_z"]) == 9.81 and hold["mu2"] == "0.5"
+    assert float(hold["total_normal_force"]) == pytest.approx(19.62, rel=1e-6)
+    assert float(hold["fm1_z"]) == pytest.approx(3.27) and float(hold["fn3"]) == pytest.approx(6.54, rel=1e-5)
+    assert (hold["ok"], hold["grip_error"], hold["force_closure"], hold["epsilon"]) == ("true", "", "true", "")
+    assert bad["ok"] == "false" and bad["error"].startswith("invalid-mass: ")
+
+
+def test_npz_and_parquet_data_sets_in_and_out(tmp_path):
+    pytest.importorskip("pyarrow")
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    from grasptwist.io.parquet import grasp_table
+
+    grasps = np.stack([P, 2 * P])
+    np.savez(tmp_path / "in.npz", points=grasps, normals=-grasps, wrench=[0, 0, 9.81, 0, 0, 0], friction=[0.5, 0.25])
+    t = grasp_table(grasps, -grasps)
+    for name, values in zip(
+        ("f_x", "f_y", "f_z", "m_x", "m_y", "m_z"), np.array([[0, 0, 9.81, 0, 0, 0], [0, 0, 1, 0, 0, 0]]).T
+    ):
+        t = t.append_column(name, pa.array(values.astype(float)))
+    for k, mu in enumerate(([0.5, 0.1], [0.5, 0.1], [0.5, 0.2]), 1):
+        t = t.append_column(f"mu{k}", pa.array(mu))
+    pq.write_table(t, tmp_path / "in.parquet")
+    r, _ = run("forces", tmp_path / "in.npz", tmp_path / "in.parquet", "-f", "npz", "-o", tmp_path / "out.npz")
+    assert r.exit_code == 0, r.stderr
+    z = np.load(tmp_path / "out.npz")
+    np.testing.assert_allclose(z["total_normal_force"][:2], [19.62, 39.24], rtol=1e-6)
+    assert (
+        z["wrench"].shape == (4, 6) and z["force"].shape == (4, 3, 3) and z["friction"][3].tolist() == [0.1, 0.1, 0.2]
+    )
+    assert z["grip_status"].tolist()[:2] == [0, 0] and list(z["status_legend"][[0, 20]]) == ["ok", "cannot-hold"]
+    engine = gt.grip(P, -P, [0, 0, 1, 0, 0, 0], [0.1, 0.1, 0.2])
+    assert z["total_normal_force"][3] == pytest.approx(float(engine.total_normal_force), rel=1e-12)
+    r, _ = run("forces", tmp_path / "in.npz", "-f", "parquet", "-o", tmp_path / "out.parquet")
+    out = pq.read_table(tmp_path / "out.parquet")
+    statuses = ["manipulating_status", "grip_status"]
+    assert [c for c in out.column_names if c not in statuses] == FORCE_CSV_COLUMNS
+    assert [c for c in out.column_names if c in statuses] == statuses
+    assert out.column("fn1").to_pylist() == pytest.approx([6.54, 13.08], rel=1e-5)
+    assert out.column("epsilon").to_pylist() == [None, None]
+
+
+def test_a_table_labels_every_number_with_its_units():
+    r, _ = run("forces", SPHERE, "--digits", "2")
+    text = r.stdout
+    for label in (
+        "manipulating force (N)",
+        "grip force (N)",
+        "normal (N)",
+        "tangential (N)",
+        "friction used",
+        "of mu/s",
+    ):
+        assert label in text
+    assert "wrench hold = force (0.00, 0.00, 9.81) N; moment (0.00, 0.00, 0.00) N m" in text
+    assert "total normal force 19.62 N (safety 1)" in text and "100%" in text
+    assert "closure: force closure - (no friction); closure friction 0.47" in text
+
+
+def test_check_reports_closure_friction_beside_the_methods():
+    r, _ = run("check", POLYHEDRON, SPHERE, "-f", "jsonl")
+    poly, tripod, equator = jsonl(r.stdout)
+    assert poly["closure_friction"] == pytest.approx(1 / math.sqrt(2), abs=1e-9)  # Example 2
+    assert "force_closure" not in poly and "force_closure" not in tripod
+    assert equator["force_closure"] is True and equator["closure_friction"] == pytest.approx(0, abs=1e-9)
+    table, _ = run("check", POLYHEDRON)
+    head, *rows = [line for line in table.stdout.splitlines() if line.strip() and "─" not in line]
+    assert "closure mu" in head and "0.707" in rows[0]
+
+
+# --- units, antipodal pairs, safety, huge friction, overflow, bad options and data sets (issues 26, 27)
+
+MM = """name: mm
+units: mm
+friction: 0.5
+mass: 1
+center_of_mass: [5, 0, 100]
+contacts:
+  - {point: [35, 0, 0], normal: [-1, 0, 0]}
+  - {point: [-17.5, 30.31, 0], normal: [0.5, -0.866, 0]}
+  - {point: [-17.5, -30.31, 0], normal: [0.5, 0.866, 0]}
+"""
+ANTIPODAL = """name: antipodal
+friction: 0.6
+contacts:
+  - {point: [0.03, 0, 0], normal: [-1, 0, 0]}
+  - {point: [-0.03, 0, 0], normal: [1, 0, 0]}
+  - {point: [0, 0.03, 0.01], normal: [0, -1, 0]}
+wrenches: [{name: up, force: [0, 0, 1]}]
+"""
+
+
+def test_moments_carry_the_files_length_unit_and_gravity_is_in_metres_per_second_squared(tmp_path):
+    (tmp_path / "mm.yaml").write_text(MM)
+    (tmp_path / "bare.yaml").write_text(MM.replace("units: mm\n", ""))
+    r, recs = records(tmp_path / "mm.yaml")
+    (rec,) = recs
+    # 1 kg: 9.81 N whatever the length unit (gravity is not converted); the moment -c x m g in N mm
+    assert rec["units"] == "mm" and rec["wrench"]["wrench"] == pytest.approx([0, 0, 9.81, 0, -49.05, 0], abs=1e-12)
+    table, _ = run("forces", tmp_path / "mm.yaml", "--digits", "2")
+    assert "wrench hold = force (0.00, 0.00, 9.81) N; moment (0.00, -49.05, 0.00) N mm" in table.stdout
+    table, _ = run("forces", tmp_path / "bare.yaml", "--digits", "2")
+    assert "moment (0.00, -49.05, 0.00) N length" in table.stdout
+
+
+def test_an_antipodal_pair_beside_a_good_file_gives_both_their_records_with_epsilon(tmp_path):
+    (tmp_path / "a.yaml").write_text(ANTIPODAL)
+    shutil.copy(SPHERE, tmp_path / "b.yaml")
+    r, recs = records(tmp_path, "--quality")
+    assert r.exit_code == 0, r.stderr
+    assert [rec["grasp"] for rec in recs] == ["antipodal", "sphere-tripod", "sphere-equator", "sphere-equator"]
+    anti = recs[0]
+    assert anti["ok"] and anti["closure"]["force_closure"] is True and anti["closure"]["epsilon"] > 0.05
+    f = np.array(anti["grip"]["force"])
+    np.testing.assert_allclose(grasp_map(np.array([c["point"] for c in anti["contacts"]])) @ f.reshape(9),
+                               [0, 0, 1, 0, 0, 0], atol=1e-9)  # fmt: skip
+
+
+def test_antipodal_and_coincident_contacts_through_forces_and_check(tmp_path):
+    (tmp_path / "a.yaml").write_text(ANTIPODAL)
+    r, _ = run("check", tmp_path / "a.yaml", "-f", "jsonl")
+    (rec,) = jsonl(r.stdout)
+    # the contacts' plane has the normal (0, 1, -3) / sqrt(10): the third normal leaves it at
+    # sin(phi) = 1 / sqrt(10), so the least friction is tan(phi) = 1/3 (the pair squeezes within it)
+    assert rec["force_closure"] is True and rec["closure_friction"] == pytest.approx(1 / 3, abs=1e-9)
+    (tmp_path / "same.yaml").write_text(ANTIPODAL.replace("[-0.03, 0, 0]", "[0.03, 0, 0]"))
+    r, (rec,) = records(tmp_path / "same.yaml", "--quality")
+    assert r.exit_code == 1 and "internal error" not in r.stderr
+    assert rec["grip"]["error"]["code"] == rec["manipulating"]["error"]["code"] == "coincident-contacts"
+    assert rec["closure"] == {"force_closure": False, "closure_friction": None, "epsilon": 0.0, "safety": 1.0}
+
+
+def test_closure_is_judged_with_the_friction_the_safety_factor_leaves():
+    # the tripod closes above mu = 0.4663: with mu 0.6 it does, with 0.6 / 2 it does not
+    for safety, closes in (("1", True), ("2", False)):
+        r, (rec, *_) = records(SPHERE, "--friction", "0.6", "--safety", safety)
+        assert rec["closure"]["force_closure"] is closes and rec["closure"]["safety"] == float(safety)
+        assert rec["closure"]["closure_friction"] == pytest.approx(0.4663, abs=1e-4)
+    table, _ = run("forces", SPHERE, "--friction", "0.6", "--safety", "2", "--digits", "2")
+    assert "closure (with mu/2): force closure no; closure friction 0.47" in table.stdout
+
+
+def test_huge_and_infinite_friction_close_a_grasp_whose_closure_friction_is_finite(tmp_path):
+    for mu in ("1e200", "inf"):
+        r, (rec, *_) = records(SPHERE, "--friction", mu)
+        assert r.exit_code == 0 and rec["closure"]["force_closure"] is True, mu
+    (tmp_path / "f.yaml").write_text(Path(SPHERE).read_text().split("---")[0] + "friction: 1e200\n")
+    r, (rec,) = records(tmp_path / "f.yaml")
+    assert rec["friction"] == [1e200] * 3 and rec["closure"]["force_closure"] is True
+
+
+def test_an_infinite_friction_is_null_in_a_record_and_inf_in_a_table(tmp_path, monkeypatch):
+    monkeypatch.delenv("COLUMNS", raising=False)  # not a terminal: the table in one part, rows whole
+    r, recs = records(SPHERE, "--friction", "inf")
+    assert r.exit_code == 0 and [rec["friction"] for rec in recs] == [[None] * 3] * 3  # no infinity in JSON
+    hold = by(recs, "sphere-equator", "hold")
+    assert hold["ok"] and hold["grip"]["total_normal_force"] < 1e-9  # no limit: the weight hangs on friction alone
+    flat, _ = run("forces", SPHERE, "--friction", "inf", "-f", "csv")
+    assert [[row[f"mu{i}"] for i in (1, 2, 3)] for row in csv.DictReader(io.StringIO(flat.stdout))] == [["inf"] * 3] * 3
+    table, _ = run("forces", SPHERE, "--friction", "inf", "--digits", "2")
+    assert table.exit_code == 0 and "internal error" not in table.stderr, table.stderr
+    rows = [
+        line.split() for line in table.stdout.splitlines() if line.split()[:1] in (["thumb"], ["index"], ["middle"])
+    ]
+    assert len(rows) == 9 and all(row[1] == "inf" for row in rows)  # mu, for the closure-only record too
+    assert [row[-1] for row in rows[3:]] == ["0%"] * 6  # no share of an unlimited friction is used
+    (tmp_path / "f.yaml").write_text(Path(SPHERE).read_text().split("---")[0] + "friction: .inf\n")
+    r, (rec,) = records(tmp_path / "f.yaml")  # a file's numbers are finite: no limit is --friction inf
+    assert r.exit_code == 1 and rec["error"]["code"] == "non-finite" and rec["error"]["line"] == 45  # the line added
+    assert rec["error"]["message"] == "friction: expected a finite number, got .inf"
+
+
+def _numbers(x):
+    if isinstance(x, dict):
+        return [n for v in x.values() for n in _numbers(v)]
+    if isinstance(x, list):
+        return [n for v in x for n in _numbers(v)]
+    return [x]
+
+
+def test_an_overflowing_result_is_a_nonfinite_result_record_never_ok_with_nulls(tmp_path):
+    # a moment of 1.7e308 N m on fingers 3 cm from the centre: forces near 2e309 N, beyond a double
+    r, recs = records(SPHERE, "--friction", "0.5", "--wrench", "0,0,0,0,0,1.7e308", "--wrench", "0,0,0,0,0,0")
+    assert r.exit_code == 1
+    big, still = recs[:2]
+    assert not big["ok"] and big["grip"]["error"]["code"] == big["manipulating"]["error"]["code"] == "nonfinite-result"
+    assert still["ok"] and still["grip"]["friction_used"] == [0.0] * 3  # no force uses no friction
+    (tmp_path / "heavy.yaml").write_text(
+        ANTIPODAL.replace("wrenches: [{name: up, force: [0, 0, 1]}]", "mass: 1.5e307\ncenter_of_mass: [0, 0, 0]")
+    )
+    r, (heavy,) = records(tmp_path / "heavy.yaml")
+    assert r.exit_code == 1 and heavy["grip"]["error"]["code"] == "nonfinite-result" and not heavy["ok"]
+    assert "nonfinite-result: the result overflows double precision" in r.stderr
+    # 1e300 kg: a grip of some 1e301 N is still a double, and an ok record of finite numbers
+    (tmp_path / "heavy.yaml").write_text((tmp_path / "heavy.yaml").read_text().replace("1.5e307", "1e300"))
+    r, (heavy,) = records(tmp_path / "heavy.yaml")
+    assert r.exit_code == 0 and heavy["ok"] and 1e300 < heavy["grip"]["total_normal_force"] < 1e303
+    _, recs = records(SPHERE, "--friction", "0.5", "--wrench", "1e300,0,0,0,0,0", "--wrench", "0,0,9.81,0,0,0")
+    for rec in recs:  # an ok record holds only finite numbers
+        assert not rec["ok"] or None not in _numbers({k: rec[k] for k in ("manipulating", "grip", "wrench")})
+
+
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["--friction", "nan"], "Invalid value for '--friction': must be a number >= 0 (inf: no limit), got nan"),
+        (["--safety", "nan"], "Invalid value for '--safety': safety must be a finite number >= 1, got nan"),
+        (["--safety", "inf"], "Invalid value for '--safety': safety must be a finite number >= 1, got inf"),
+        (["--quality", "--cone-edges", "1000000000"], "cone_edges must be an integer from 3 to 64, got 1000000000"),
+    ],
+)
+def test_absurd_option_values_are_usage_errors(args, message):
+    r, _ = run("forces", SPHERE, *args)
+    assert r.exit_code == 2 and r.stdout == "" and message in " ".join(r.stderr.split())
+
+
+def test_one_friction_for_every_row_of_an_npz(tmp_path):
+    grasps = np.stack([P, 2 * P])
+    np.savez(
+        tmp_path / "in.npz", points=grasps, normals=-grasps, wrench=[0, 0, 9.81, 0, 0, 0], friction=np.float64(0.5)
+    )
+    r, recs = records(tmp_path / "in.npz")
+    assert r.exit_code == 0, r.stderr
+    assert [rec["friction"] for rec in recs] == [[0.5] * 3] * 2
+    assert [rec["grip"]["total_normal_force"] for rec in recs] == pytest.approx([19.62] * 2, rel=1e-6)
+
+
+def test_a_negative_friction_in_a_data_set_is_one_error_record_and_the_other_inputs_keep_theirs(tmp_path):
+    grasps = np.stack([P, 2 * P])
+    np.savez(tmp_path / "neg.npz", points=grasps, normals=-grasps, friction=[0.5, -1.0])
+    r, recs = records(tmp_path / "neg.npz", SPHERE)
+    assert r.exit_code == 1
+    (bad,) = [rec for rec in recs if rec["file"] == str(tmp_path / "neg.npz")]
+    assert bad["error"]["code"] == "bad-dataset" and bad["error"]["message"].startswith(
+        "friction: row 1: -1.0 must be >= 0"
+    )
+    assert [rec["grasp"] for rec in recs if rec["file"] == SPHERE] == [
+        "sphere-tripod",
+        "sphere-equator",
+        "sphere-equator",
+    ]
+
+
+def test_a_negative_mu_in_a_parquet_data_set_is_one_error_record(tmp_path):
+    pytest.importorskip("pyarrow")
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    from grasptwist.io.parquet import grasp_table
+
+    grasps = np.stack([P, 2 * P])
+    pq.write_table(grasp_table(grasps, -grasps).append_column("mu", pa.array([0.5, -2.0])), tmp_path / "neg.parquet")
+    r, recs = records(tmp_path / "neg.parquet", POLYHEDRON)
+    assert r.exit_code == 1 and [rec.get("grasp") for rec in recs] == [None, "polyhedron"]
+    assert recs[0]["error"]["message"].startswith("friction: row 1: -2.0 must be >= 0")

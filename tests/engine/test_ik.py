@@ -1,0 +1,207 @@
+"""Inverse kinematics of a grasp (grasptwist.engine.ik): tips on contacts by forward kinematics,
+within limits, nearest the seed, unreachable contacts with their distance; the contact-off-finger check."""
+
+import numpy as np
+import pytest
+
+from grasptwist.engine.degeneracy import Status
+from grasptwist.engine.ik import IK_TOL, chain_ik, contact_off_finger, hand_ik, home_tips, joint_limits, place_hand
+from grasptwist.engine.kinematics import forward_kinematics
+from grasptwist.io.grasp import load_grasps
+from places import GRASPS, ROOT
+
+
+def tip_points(hand, positions, tips):
+    """Each finger's tip point by forward kinematics: ``(..., 3, 3)``."""
+    return np.stack(
+        [
+            forward_kinematics(f.screws, f.points, tips[i], positions[..., list(f.joint_index)]).tip[..., :3, 3]
+            for i, f in enumerate(hand.fingers)
+        ],
+        axis=-2,
+    )
+
+
+def lengths(hand):
+    return np.array([f.length for f in hand.fingers])
+
+
+@pytest.fixture(scope="module")
+def trifinger():
+    pytest.importorskip("yourdfpy")
+    pytest.importorskip("robot_properties_fingers")
+    return load_grasps(GRASPS / "trifinger-cube.yaml")[0]
+
+
+@pytest.fixture(scope="module")
+def inline():
+    return load_grasps(GRASPS / "three-finger-hand.yaml")[0]
+
+
+def reachable(hand, tips, rng, n, spread):
+    """Contacts the hand reaches: its tips at random joint positions within the limits
+    (within ``spread`` of home where a joint has no limit), and those positions."""
+    q = np.empty((n, len(hand.joint_names)))
+    for f in hand.fingers:
+        lower, upper = joint_limits(f)
+        lo, hi = np.fmax(lower, -spread), np.fmin(upper, spread)
+        q[:, list(f.joint_index)] = rng.uniform(lo, hi, (n, len(lo)))
+    return tip_points(hand, q, tips), q
+
+
+def test_trifinger_tips_land_on_reachable_contacts_within_limits(trifinger):
+    hand, tips = trifinger.hand, home_tips(trifinger.hand)
+    targets, _ = reachable(hand, tips, np.random.default_rng(3), 400, np.pi)
+    r = hand_ik(hand, targets)
+    assert (r.status == Status.OK).all()
+    reached = tip_points(hand, r.positions, tips)
+    error = np.linalg.norm(reached - targets, axis=-1)
+    assert (error <= IK_TOL * lengths(hand)).all()
+    np.testing.assert_allclose(r.tip_error, error, rtol=0, atol=1e-15)
+    for f in hand.fingers:
+        lower, upper = joint_limits(f)
+        q = r.positions[:, list(f.joint_index)]
+        assert np.isfinite(lower).all() and ((q >= lower) & (q <= upper)).all()
+    assert r.within_limits.all()
+
+
+def test_trifinger_file_positions_are_found_again_from_a_nearby_seed(trifinger):
+    """The file's joint positions put each tip sphere's centre at contact - radius * normal:
+    inverse kinematics from a seed 0.1 rad off finds them again, to the iteration's accuracy."""
+    hand = trifinger.hand
+    centres = trifinger.points - 0.01 * trifinger.normals
+    seed = trifinger.joint_positions + 0.1 * np.resize([1, -1, 1], 9)
+    r = hand_ik(hand, centres, seed=seed)
+    assert r.ok
+    np.testing.assert_allclose(r.positions, trifinger.joint_positions, atol=1e-8)
+
+
+def test_inline_hand_reaches_moved_contacts(inline):
+    """The inline fingers' tip points are the file's contacts at home; contacts moved by up to
+    a fifth of the fingers' length are reached to 1e-9 of it, and at home every joint is 0."""
+    hand, tips = inline.hand, home_tips(inline.hand, inline.points)
+    at_home = hand_ik(hand, inline.points, tips=tips)
+    assert at_home.ok and np.abs(at_home.positions).max() == 0.0
+    rng = np.random.default_rng(5)
+    targets, _ = reachable(hand, tips, rng, 300, 0.6)
+    r = hand_ik(hand, targets, tips=tips)
+    assert (r.status == Status.OK).all()
+    error = np.linalg.norm(tip_points(hand, r.positions, tips) - targets, axis=-1)
+    assert (error <= IK_TOL * lengths(hand)).all()
+    assert np.abs(r.positions).max() <= np.pi + 1e-12  # unlimited revolute joints stay within pi of the seed
+
+
+def test_the_solution_nearest_the_seed_is_chosen(inline):
+    """A 3R finger reaches most points two ways (elbow up or down): from a seed near either,
+    the iteration ends at that one, not the other."""
+    hand, tips = inline.hand, home_tips(inline.hand, inline.points)
+    _, q = reachable(hand, tips, np.random.default_rng(8), 50, 0.8)
+    q[:, 2::3] = np.where(np.abs(q[:, 2::3]) < 0.3, 0.5, q[:, 2::3])  # a clearly bent elbow
+    targets = tip_points(hand, q, tips)
+    r = hand_ik(hand, targets, seed=q + 0.05, tips=tips)
+    assert r.ok.all()
+    np.testing.assert_allclose(r.positions, q, atol=1e-7)
+
+
+def test_unreachable_contacts_report_their_distance(inline):
+    """A contact moved away from its finger's base beyond the finger's reach: ``unreachable``,
+    and the tip error is the distance left, at least the excess over the reach."""
+    hand, tips = inline.hand, home_tips(inline.hand, inline.points)
+    far = inline.points.copy()
+    base = hand.fingers[0].points[0]
+    out = (far[0] - base) / np.linalg.norm(far[0] - base)
+    far[0] = base + out * (hand.fingers[0].length + 0.5)
+    r = hand_ik(hand, far, tips=tips)
+    assert r.status.tolist() == [Status.UNREACHABLE, Status.OK, Status.OK]
+    assert not r.ok and int(r.culprit) == 0
+    # the tip stretched straight towards the contact: 0.5 away, and at most that
+    assert 0.5 - 1e-6 <= r.tip_error[0] <= 0.5 + 1e-6
+    reached = tip_points(hand, r.positions, tips)
+    np.testing.assert_allclose(np.linalg.norm(reached[0] - far[0]), r.tip_error[0], rtol=1e-12)
+
+
+def test_a_contact_reachable_only_outside_the_limits_is_outside_limits(trifinger):
+    """Finger 0's tip with its base joint 0.6 rad beyond its upper limit (1.0): reached there,
+    flagged; a tip put by an elbow bent the wrong way (+0.4, limits [-2.7, 0]) is reached within
+    the limits by the other elbow, and is ok."""
+    hand, tips = trifinger.hand, home_tips(trifinger.hand)
+    index = list(hand.fingers[0].joint_index)
+    q = trifinger.joint_positions.copy()
+    q[index] = [1.6, 0.8, -1.2]
+    targets = tip_points(hand, q, tips)
+    r = hand_ik(hand, targets)
+    assert r.status.tolist() == [Status.OUTSIDE_LIMITS, Status.OK, Status.OK]
+    assert r.within_limits.tolist() == [False, True, True]
+    assert r.positions[index[0]] == pytest.approx(1.6, abs=1e-7)  # the base's yaw is the only one that fits
+    error = np.linalg.norm(tip_points(hand, r.positions, tips) - targets, axis=-1)
+    assert (error <= IK_TOL * lengths(hand)).all()
+    q[index] = [0.2, 0.6, 0.4]
+    r = hand_ik(hand, tip_points(hand, q, tips))
+    assert r.ok and r.within_limits.all() and r.positions[index[2]] < 0
+
+
+def test_nonfinite_contacts_are_nonfinite_input(inline):
+    points = inline.points.copy()
+    points[2, 1] = np.nan
+    r = hand_ik(inline.hand, points, tips=home_tips(inline.hand, inline.points))
+    assert r.status.tolist() == [Status.OK, Status.OK, Status.NONFINITE_INPUT]
+
+
+def test_an_inline_finger_without_tip_points_is_refused(inline):
+    with pytest.raises(ValueError, match="has no tip link: give the points"):
+        hand_ik(inline.hand, inline.points)
+
+
+def test_chain_ik_stays_within_limits_and_gives_the_closest_it_can():
+    """A planar 2R arm whose elbow may bend at most 0.5 rad cannot reach a point that needs a
+    right angle: it ends at the limit with the elbow at 0.5, and reports how far it is."""
+    s = [[0, 0, 1.0, 0, 0, 0], [0, 0, 1.0, 0, -1.0, 0]]
+    tip = np.eye(4)
+    tip[0, 3] = 2.0
+    r = chain_ik(s, [[0, 0, 0], [1.0, 0, 0]], tip, [[1.0, 1.0, 0]], [[0.0, 0.0]], [-0.5, -0.5], [0.5, 0.5])
+    assert np.abs(r.positions).max() <= 0.5
+    reached = forward_kinematics(s, [[0, 0, 0], [1.0, 0, 0]], tip, r.positions).tip[0, :3, 3]
+    assert r.error[0] == pytest.approx(np.linalg.norm(reached - [1.0, 1.0, 0]), rel=1e-12)
+    assert r.error[0] > 0.1
+
+
+def test_contact_off_finger_is_the_loaders_check(trifinger):
+    """The grasp file's positions pass; a contact moved 0.9 m away fails, the others do not."""
+    hand = trifinger.hand
+    tips = tip_points(hand, trifinger.joint_positions, home_tips(hand))
+    assert not contact_off_finger(tips, trifinger.points, lengths(hand)).any()
+    far = trifinger.points.copy()
+    far[0, 0] += 0.9
+    assert contact_off_finger(tips, far, lengths(hand)).tolist() == [True, False, False]
+
+
+def test_place_hand_checks_given_positions_and_solves_missing_ones(trifinger, inline):
+    hand = trifinger.hand
+    far = trifinger.points.copy()
+    far[2, 2] += 0.9
+    checked = place_hand(hand, far, trifinger.joint_positions)
+    assert checked.status.tolist() == [Status.OK, Status.OK, Status.CONTACT_OFF_FINGER]
+    assert checked.tip_error[2] > hand.fingers[2].length
+    np.testing.assert_array_equal(checked.positions, trifinger.joint_positions)
+    centres = trifinger.points - 0.01 * trifinger.normals
+    solved = place_hand(hand, centres, seed=trifinger.joint_positions + 0.05)
+    assert solved.ok and solved.tip_error.max() <= IK_TOL * lengths(hand).min()
+    # an inline hand without tip points: as given, unchecked
+    taken = place_hand(inline.hand, far)
+    assert taken.ok and np.isnan(taken.tip_error).all() and not taken.positions.any()
+
+
+def test_the_guide_page_runs_as_printed(monkeypatch):
+    """docs/guide/inverse-kinematics.md's sessions give the outputs shown."""
+    import doctest
+    import re
+
+    monkeypatch.chdir(ROOT)
+    text = (ROOT / "docs" / "guide" / "inverse-kinematics.md").read_text("utf-8")
+    sessions = re.findall(r"^```pycon\n(.*?)^```$", text, flags=re.M | re.S)
+    assert sessions
+    for session in sessions:
+        test = doctest.DocTestParser().get_doctest(session, {}, "inverse-kinematics.md", None, 0)
+        runner = doctest.DocTestRunner(optionflags=doctest.ELLIPSIS)
+        runner.run(test)
+        assert runner.summarize(verbose=False).failed == 0

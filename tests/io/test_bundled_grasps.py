@@ -1,0 +1,172 @@
+"""The grasps bundled in grasps/: they load, match the JSON Schema, and hold the pinned arrays.
+
+The engine tests pin what these grasps resolve to; here we pin what the
+loader hands the engine, so that a change in either file or loader shows.
+"""
+
+import jsonschema
+import numpy as np
+import pytest
+import yaml
+
+from grasptwist.engine.decompose import decompose_off_tangent, decompose_tangent
+from grasptwist.engine.degeneracy import Status
+from grasptwist.io.grasp import grasp_schema, load_grasps
+from places import GRASPS
+
+BUNDLED = sorted(GRASPS.glob("*.yaml"))
+S3 = 0.5773502691896258  # 1/sqrt(3) as written in polyhedron.yaml
+
+
+def unit(*v):
+    v = np.array(v, dtype=float)
+    return v / np.linalg.norm(v)
+
+
+# file -> one dict per document: name, contact names, points, normals (unit), wrist, {twist: screw}
+EXPECTED = {
+    "cylinder.yaml": [
+        dict(
+            name="cylinder",
+            units=None,
+            contacts=("1", "2", "3"),
+            points=[[1, 0, 0], [-0.5, 0.866, 0], [-0.5, -0.866, 0]],
+            normals=[unit(-1, 0, 0), unit(0.5, -0.866, 0), unit(0.5, 0.866, 0)],
+            wrist=[0, 0, 1],
+            twists={
+                "sigma-1": [0, -1, 0, 0, 0, 0.5],
+                "spin-z": [0, 0, 1, 0, 0, 0],
+                "lift-z": [0, 0, 0, 0, 0, 1],
+            },
+        )
+    ],
+    "polyhedron.yaml": [
+        dict(
+            name="polyhedron",
+            units=None,
+            contacts=("1", "2", "3"),
+            points=[[0, 2, 2], [2, 0, 2], [2, 2, 0]],
+            normals=np.eye(3),
+            wrist=[0, 0, 0],
+            twists={"diagonal-spin": [S3, S3, S3, 0, 0, 0]},
+        )
+    ],
+    "sphere.yaml": [
+        dict(
+            name="sphere-tripod",
+            units="m",
+            contacts=("thumb", "index", "middle"),
+            points=[[0.0, 0.031721, -0.014792], [-0.027471, -0.01586, -0.014792], [0.027471, -0.01586, -0.014792]],
+            normals=[
+                unit(0.0, -0.031721, 0.014792),
+                unit(0.027471, 0.01586, 0.014792),
+                unit(-0.027471, 0.01586, 0.014792),
+            ],
+            wrist=[0, 0, 0.11],
+            twists={"roll-x": [1, 0, 0, 0, 0, 0], "spin-z": [0, 0, 1, 0, 0, 0], "lift-z": [0, 0, 0, 0, 0, 0.05]},
+        ),
+        dict(
+            name="sphere-equator",
+            units="m",
+            contacts=("thumb", "index", "middle"),
+            points=[[0.0, 0.035, 0.0], [-0.030311, -0.0175, 0.0], [0.030311, -0.0175, 0.0]],
+            normals=[unit(0, -1, 0), unit(0.866025, 0.5, 0), unit(-0.866025, 0.5, 0)],
+            wrist=[0, 0, 0.11],
+            twists={"roll-x": [1, 0, 0, 0, 0, 0], "lift-z": [0, 0, 0, 0, 0, 0.05]},
+        ),
+    ],
+    "three-finger-hand.yaml": [
+        dict(
+            name="three-finger-hand",
+            units=None,
+            contacts=("1", "2", "3"),
+            points=[[1.0, 0.3, 0.4], [-1.0, -0.2, -0.1], [0.2, -1.0, -0.5]],
+            normals=[[-1, 0, 0], [1, 0, 0], [0, 1, 0]],
+            wrist=[0, 0, 3],
+            twists={"roll-push": [0.4, 0, 0.1, 0, 0.2, 0]},
+        )
+    ],
+    "trifinger-cube.yaml": [
+        dict(
+            name="trifinger-cube",
+            units="m",
+            contacts=("1", "2", "3"),
+            points=[[0.0325, 0.015, 0.045], [0.005, -0.0325, 0.025], [-0.0325, 0.0, 0.015]],
+            normals=[[-1, 0, 0], [0, 1, 0], [1, 0, 0]],
+            wrist=[0, 0, 0.29],
+            twists={"spin": [0, 0, 0.5, 0, 0, 0], "lift-tilt": [0.3, 0, 0, 0, 0.3 * 0.0325, 0.02]},
+        )
+    ],
+    "box-edge.yaml": [
+        dict(
+            name="box-edge",
+            units="m",
+            contacts=("thumb", "index", "middle"),
+            points=[[0.10, 0.0, 0.025], [0.07, 0.1, 0.04], [0.13, 0.1, 0.015]],
+            normals=[[0, 1, 0], [0, -1, 0], [0, -1, 0]],
+            wrist=[0.1, 0.05, 0.15],
+            twists={
+                # v = -omega x at
+                "tip-over-edge": [-1, 0, 0, 0, 0, 0.1],
+                "slide-x": [0, 0, 0, 0.1, 0, 0],
+                "turn-y": [0, 1, 0, -0.025, 0, 0.1],
+            },
+        )
+    ],
+    "handle.yaml": [
+        dict(
+            name="mug-handle",
+            units="m",
+            contacts=("thumb", "index", "middle"),
+            points=[[0.056, 0.0, 0.087], [0.062, 0.0, 0.073], [0.083, 0.0, 0.045]],
+            normals=[[0, 0, -1], [0, 0, 1], [-1, 0, 0]],
+            wrist=[0.14, -0.06, 0.07],
+            twists={"lift-z": [0, 0, 0, 0, 0, 0.1], "pour": [1, 0, 0, 0, 0.06, 0], "turn-z": [0, 0, 1, 0, 0, 0]},
+        )
+    ],
+}
+
+
+def test_every_bundled_file_is_pinned():
+    assert sorted(p.name for p in BUNDLED) == sorted(EXPECTED)
+
+
+@pytest.mark.parametrize("path", BUNDLED, ids=lambda p: p.stem)
+def test_bundled_file_loads_as_pinned(path):
+    grasps = load_grasps(path)
+    expected = EXPECTED[path.name]
+    assert len(grasps) == len(expected)
+    for document, (grasp, want) in enumerate(zip(grasps, expected)):
+        assert (grasp.name, grasp.units, grasp.document, grasp.contact_names) == (
+            want["name"], want["units"], document, want["contacts"],
+        )  # fmt: skip
+        np.testing.assert_array_equal(grasp.points, want["points"])
+        np.testing.assert_allclose(grasp.normals, want["normals"], rtol=0, atol=1e-15)
+        np.testing.assert_array_equal(grasp.wrist, want["wrist"])
+        assert [t.name for t in grasp.twists] == list(want["twists"])
+        for twist in grasp.twists:
+            np.testing.assert_allclose(twist.screw, want["twists"][twist.name], rtol=0, atol=1e-15)
+
+
+@pytest.mark.parametrize("path", BUNDLED, ids=lambda p: p.stem)
+def test_bundled_file_matches_the_json_schema(path):
+    validator = jsonschema.Draft202012Validator(grasp_schema())
+    for document in yaml.safe_load_all(path.read_text("utf-8")):
+        validator.validate(document)
+
+
+@pytest.mark.parametrize("path", BUNDLED, ids=lambda p: p.stem)
+def test_bundled_file_states_its_findings(path):
+    """Each header says what the grasp shows: a "Finding:" naming the engine's status code
+    for exactly the methods the engine finds degenerate, and no finding otherwise."""
+    header = path.read_text("utf-8").split("\nname:")[0]
+    assert header.startswith("# ")
+    found = set()
+    for grasp in load_grasps(path):
+        if grasp.wrist is not None:
+            found.add(Status(int(decompose_off_tangent(grasp.points, grasp.wrist, np.zeros(6)).status)))
+        found.add(Status(int(decompose_tangent(grasp.points, grasp.normals, np.zeros(6)).status)))
+    found.discard(Status.OK)
+    named = {s for s in Status if s != Status.OK and s.code in header}
+    assert named == found
+    assert ("Finding:" in header) == bool(found)

@@ -1,0 +1,85 @@
+"""The HTML views in a real browser: headless Chromium opens the page, a screenshot shows the 3D
+plot drawn (coloured pixels in its plot area, which only WebGL's lines and meshes give: axes,
+text and the dropdown are grey), and no JavaScript error reached the console.
+
+Needs Debian's chromium (`apt-get install chromium`; .ci/run installs it as root) and the test
+extra's websocket-client; skipped, saying so, without them.  One page by default (a Chromium
+start and plotly.js's 5 MB parse: several seconds on a busy machine), the rest with -m slow.
+"""
+
+import tempfile
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from grasptwist.plot.browser import CHROMIUM, capture, chromium
+from places import GRASPS
+
+pytest.importorskip("plotly")
+pytest.importorskip("websocket", reason="the browser tests need websocket-client (the test extra)")
+Image = pytest.importorskip("PIL.Image")
+pytestmark = pytest.mark.skipif(chromium() is None, reason=f"no Chromium at {CHROMIUM}: apt-get install chromium")
+
+
+def coloured_pixels(png, box) -> int:
+    """Pixels of ``box`` ``[x, y, w, h]`` with a colour (channels more than 80 apart), not grey or white."""
+    x, y, w, h = (int(round(v)) for v in box)
+    rgb = np.asarray(Image.open(png).convert("RGB"), dtype=int)[max(y, 0) : y + h, max(x, 0) : x + w]
+    return int(np.sum(rgb.max(axis=2) - rgb.min(axis=2) > 80))
+
+
+def page(tmp_path, grasp, *options):
+    from typer.testing import CliRunner
+
+    from grasptwist.cli import app
+
+    out = tmp_path / f"{grasp}.html"
+    r = CliRunner().invoke(app, ["plot", str(GRASPS / f"{grasp}.yaml"), "-o", str(out), *options])
+    assert r.exit_code == 0, r.output
+    return out
+
+
+def chromium_leftovers():
+    """What a Chromium visit could leave in the temporary folder: its profile, its own files."""
+    tmp = Path(tempfile.gettempdir())
+    return {*tmp.glob("org.chromium.Chromium.*"), *tmp.glob("grasptwist-chromium-*")}
+
+
+def test_a_grasp_page_is_drawn_without_javascript_errors(tmp_path):
+    before = chromium_leftovers()
+    shot = capture(page(tmp_path, "box-edge"), tmp_path / "box-edge.png", size=(1000, 800))
+    assert chromium_leftovers() <= before  # no debris of the visit
+    assert shot.errors == []
+    (box,) = shot.scenes
+    assert box[2] > 500 and box[3] > 400  # the plot area fills most of the window
+    assert coloured_pixels(shot.png, box) > 1000  # the screw axes, velocities, planes
+
+
+@pytest.mark.slow
+def test_a_path_animation_and_a_urdf_hand_are_drawn_too(tmp_path):
+    pytest.importorskip("yourdfpy")
+    pytest.importorskip("robot_properties_fingers")
+    shot = capture(page(tmp_path, "cylinder", "--path", "turn-x"), tmp_path / "c.png", scroll_to=1)
+    assert shot.errors == [] and len(shot.scenes) == 2
+    assert coloured_pixels(shot.png, shot.scenes[1]) > 1000
+    shot = capture(page(tmp_path, "trifinger-cube", "--js-beside"), tmp_path / "t.png")
+    # the hand's grey meshes hide most of the coloured axes; a blank or failed canvas has none
+    assert shot.errors == [] and coloured_pixels(shot.png, shot.scenes[0]) > 100
+
+
+@pytest.mark.slow
+def test_a_javascript_error_is_caught(tmp_path):
+    out = page(tmp_path, "box-edge", "--js-beside")
+    out.write_text(out.read_text("utf-8").replace("</body>", "<script>notAFunction()</script></body>"), "utf-8")
+    shot = capture(out, tmp_path / "e.png")
+    assert any("notAFunction is not defined" in e for e in shot.errors)
+
+
+@pytest.mark.slow
+def test_a_page_with_a_comment_and_script_opening_in_a_name_is_drawn(tmp_path):
+    from test_plot_html import hostile_names_page
+
+    shot = capture(hostile_names_page(tmp_path), tmp_path / "h.png")
+    assert shot.errors == [] and len(shot.scenes) == 1  # 0.3: nothing drew, the page's script was swallowed
+    assert coloured_pixels(shot.png, shot.scenes[0]) > 1000

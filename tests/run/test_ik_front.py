@@ -1,0 +1,196 @@
+"""Inverse kinematics at the front (issue 23): grasp files without joint_positions are solved from
+``hand.seed``, unreachable fingers are located errors, and every output shows the joint positions
+and tip errors the joint rates are at (records, CSV, npz, tables, follow)."""
+
+import csv
+import io
+import json
+import re
+from importlib.util import find_spec
+
+import numpy as np
+import pytest
+import yaml
+from typer.testing import CliRunner
+
+from grasptwist.cli import app
+from grasptwist.engine import hands
+from grasptwist.engine.degeneracy import Status
+from grasptwist.engine.ik import IK_TOL, hand_ik
+from grasptwist.output.follow_table import FollowTable
+from grasptwist.run.placement import read_grasps
+from places import ROOT
+
+TRIFINGER = ROOT / "grasps" / "trifinger-cube.yaml"
+THREE = ROOT / "grasps" / "three-finger-hand.yaml"
+INVALID = ROOT / "tests" / "invalid_grasps"
+urdf = pytest.mark.skipif(
+    find_spec("yourdfpy") is None or find_spec("robot_properties_fingers") is None, reason="needs the TriFinger URDF"
+)
+
+
+def run(*args):
+    return CliRunner().invoke(app, [str(a) for a in args])
+
+
+def jsonl(*args):
+    result = run(*args, "-f", "jsonl")
+    return [json.loads(line) for line in result.stdout.splitlines()]
+
+
+def without_positions(tmp_path, seed=None, **contacts):
+    """The bundled TriFinger grasp without its joint_positions (with ``seed``; contact ``i`` moved)."""
+    doc = yaml.safe_load(TRIFINGER.read_text("utf-8"))
+    file_positions = doc["hand"].pop("joint_positions")
+    if seed is not None:
+        doc["hand"]["seed"] = seed
+    for i, point in contacts.items():
+        doc["contacts"][int(i[1:])]["point"] = point
+    path = tmp_path / "trifinger-ik.yaml"
+    path.write_text(yaml.safe_dump(doc, sort_keys=False), "utf-8")
+    return path, file_positions
+
+
+def tips(hand, q):
+    """Each finger's tip link origin at joint positions ``q`` by forward kinematics, ``(..., 3, 3)``."""
+    return np.stack([s.tip[..., :3, 3] for s in hands.finger_states(hand, q)], axis=-2)
+
+
+@urdf
+def test_a_grasp_without_joint_positions_puts_each_tip_on_its_contact(tmp_path):
+    path, _ = without_positions(tmp_path)
+    (g,) = read_grasps(path)
+    lengths = np.array([f.length for f in g.hand.fingers])
+    distance = np.linalg.norm(tips(g.hand, g.joint_positions) - g.points, axis=-1)
+    assert (distance <= IK_TOL * lengths).all(), distance
+    assert lengths == pytest.approx([0.382036] * 3, abs=1e-6)
+    # the configuration the joint rates are at is in the record, with its tip errors
+    (rec, _) = jsonl("resolve", path)
+    fingers = rec["hand"]["fingers"]
+    assert [q for f in fingers for q in f["joint_positions"]] == g.joint_positions.tolist()
+    assert [f["tip_error"] for f in fingers] == pytest.approx(distance.tolist(), abs=1e-15)
+    assert all(f["within_limits"] for f in fingers) and rec["hand"]["ok"]
+
+
+@urdf
+def test_the_seed_is_where_the_solution_starts(tmp_path):
+    """The elbow-down solution the file's positions hold (each sphere centre one radius inside its
+    contact) from a seed there; the same as the engine's hand_ik from that seed."""
+    path, file_positions = without_positions(tmp_path, seed=None)
+    seed = {k: round(v, 1) for k, v in yaml.safe_load(TRIFINGER.read_text("utf-8"))["hand"]["joint_positions"].items()}
+    seeded, _ = without_positions(tmp_path / "..", seed=seed)
+    (g,) = read_grasps(seeded)
+    want = hand_ik(g.hand, g.points, seed=[seed[name] for name in g.hand.joint_names])
+    np.testing.assert_array_equal(g.joint_positions, want.positions)
+    # the file's positions are 1 cm (the sphere's radius) from the contacts: the solution is near them
+    assert np.abs(g.joint_positions - list(file_positions.values())).max() < 0.1
+
+
+@urdf
+def test_an_unknown_seed_joint_is_located(tmp_path):
+    path, _ = without_positions(tmp_path, seed={"no_such_joint": 0.5})
+    (err,) = read_grasps(path)
+    assert err.code == "unknown-joint"
+    assert err.message.startswith("hand.seed.no_such_joint: not a joint of the hand's fingers")
+
+
+@urdf
+@pytest.mark.parametrize(
+    ("fixture", "code", "match"),
+    [
+        ("hand-unreachable.yaml", "unreachable", r"finger 1 cannot reach its contact: .* no closer than ([0-9.]+) "),
+        ("hand-outside-limits.yaml", "outside-limits", r"finger 1 reaches its contact only with a joint outside"),
+    ],
+)
+def test_a_finger_that_cannot_reach_fails_the_grasp_at_its_tip(fixture, code, match):
+    (err,) = read_grasps(INVALID / fixture)
+    assert (err.code, err.line, err.column) == (code, 13, 24)  # the finger's tip
+    found = re.search(match, err.message.removeprefix("hand.fingers[0].tip: "))
+    assert found, err.message
+    if code == "unreachable":  # the distance is the engine's tip error, 0.9 m out less the finger's reach
+        doc = yaml.safe_load((INVALID / fixture).read_text("utf-8"))
+        (g,) = read_grasps(TRIFINGER)
+        seed = [doc["hand"]["seed"].get(name, 0.0) for name in g.hand.joint_names]
+        points = np.array([c["point"] for c in doc["contacts"]])
+        solved = hand_ik(g.hand, points, seed=seed)
+        assert Status(int(solved.status[0])) == Status.UNREACHABLE
+        assert float(found.group(1)) == pytest.approx(solved.tip_error[0], rel=1e-5)
+        assert 0.7 < solved.tip_error[0] < 0.9
+
+
+@urdf
+def test_the_table_labels_positions_and_tip_errors(tmp_path, monkeypatch):
+    monkeypatch.setenv("COLUMNS", "200")  # one part: narrower, the table splits its columns
+    path, _ = without_positions(tmp_path)
+    (g,) = read_grasps(path)
+    out = run("resolve", path, "--twist", "0,0,0.5,0,0,0").stdout
+    header = next(line for line in out.splitlines() if "position" in line and "tip error" in line)
+    assert header.split()[:5] == ["finger", "in", "hand", "joint", "position"]
+    row = next(line for line in out.splitlines() if "finger_middle_to_lower_joint_120" in line)
+    assert float(row.split()[1]) == pytest.approx(g.joint_positions[5], abs=5e-5)
+
+
+@urdf
+def test_a_data_set_solved_by_ik_carries_its_positions_in_every_format(tmp_path):
+    (g,) = read_grasps(TRIFINGER)
+    rng = np.random.default_rng(7)
+    q = rng.uniform([-0.3, 0.1, -2.5] * 3, [0.9, 1.4, -0.3] * 3, size=(6, 9))
+    points = tips(g.hand, q)
+    data = tmp_path / "rows.npz"
+    np.savez(data, points=points, normals=rng.normal(size=(6, 3, 3)), twist=[0, 0, 0.5, 0, 0, 0])
+    hand_file = tmp_path / "trifinger.yaml"
+    fingers = "".join(f"    - {{name: '{f.name}', tip: {f.tip}}}\n" for f in g.hand.fingers)
+    hand_file.write_text(f"hand:\n  urdf: {g.hand.source}\n  fingers:\n{fingers}", "utf-8")
+    out = tmp_path / "out.npz"
+    assert run("resolve", data, "--hand", hand_file, "-f", "npz", "-o", out).exit_code == 0
+    with np.load(out) as d:
+        solved, tip_error, within = d["joint_positions"], d["tip_error"], d["within_limits"]
+    lengths = np.array([f.length for f in g.hand.fingers])
+    assert solved.shape == (6, 9)
+    assert (np.linalg.norm(tips(g.hand, solved) - points, axis=-1) <= IK_TOL * lengths).all()
+    assert (tip_error <= IK_TOL * lengths).all() and within.all()
+    rows = list(csv.DictReader(io.StringIO(run("resolve", data, "--hand", hand_file, "-f", "csv").stdout)))
+    names = [f"q_{f.name}_{j.name}" for f in g.hand.fingers for j in f.joints]
+    np.testing.assert_array_equal([[float(r[n]) for n in names] for r in rows], solved)
+    recs = jsonl("resolve", data, "--hand", hand_file)
+    np.testing.assert_array_equal(
+        [[q for f in r["hand"]["fingers"] for q in f["joint_positions"]] for r in recs], solved
+    )
+
+
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
+def test_follow_shows_each_samples_positions_and_tip_errors():
+    recs = jsonl("follow", THREE, "--samples", "5")
+    assert len(recs) == 6
+    samples = [r for r in recs if "t" in r]
+    (summary,) = [r for r in recs if "summary" in r]
+    for s in samples:  # the hand's own positions are the sample's (as the path record gives them)
+        assert [f["joint_positions"] for f in s["hand"]["fingers"]] == s["joint_positions"]
+    worst = [max(s["hand"]["fingers"][f]["tip_error"] for s in samples) for f in range(3)]
+    tracked = [f["tip_error"] for f in summary["summary"]["hand"]["fingers"]]
+    # the summary's is the tracker's own error at the samples: the same distance, computed apart
+    assert worst == pytest.approx(tracked, rel=1e-6, abs=1e-15)
+    assert samples[0]["hand"]["fingers"][0]["tip_error"] == 0.0 and max(worst) < 1e-6
+    out = io.BytesIO()  # the table of these records (one path run: a hand's integration costs seconds)
+    writer = FollowTable(out)
+    for rec in recs:
+        writer.write(rec)
+    lines = [line for line in out.getvalue().decode().splitlines() if line.lstrip().startswith("hand  finger")]
+    assert len(lines) == 5
+    last = samples[-1]["hand"]["fingers"][2]
+    want = f"finger 3: q {' '.join(f'{v:.4f}' for v in last['joint_positions'])}, tip error {last['tip_error']:.3g}"
+    assert lines[-1].endswith(want), lines[-1]
+
+
+@urdf
+def test_a_hand_files_seed_is_refused_not_dropped(tmp_path):
+    (g,) = read_grasps(TRIFINGER)
+    hand_file = tmp_path / "trifinger.yaml"
+    fingers = "".join(f"    - {{tip: {f.tip}}}\n" for f in g.hand.fingers)
+    hand_file.write_text(
+        f"hand:\n  urdf: {g.hand.source}\n  seed: {{finger_upper_to_middle_joint_0: 0.5}}\n  fingers:\n{fingers}",
+        "utf-8",
+    )
+    result = run("resolve", TRIFINGER, "--hand", hand_file)
+    assert result.exit_code == 2
+    assert "conflicting-keys" in result.stderr and "hand.seed: only in a grasp file" in " ".join(result.stderr.split())
