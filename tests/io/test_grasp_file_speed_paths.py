@@ -357,6 +357,21 @@ def documents(draw):
     return draw(st.sampled_from(MUTATIONS))(text)
 
 
+#: The parsers of the hand-picked properties below: libyaml's (the loader's own when present) in
+#: the default run, the pure-Python one with ``-m slow`` (over a second each: its events reach the
+#: fast path as libyaml's do, and the default run still reads random streams and every bundled
+#: grasp through both paths with it).
+PARSERS = [
+    pytest.param(
+        p,
+        id=p.__name__,
+        # over a second: docs/reference/development.md, Test time
+        marks=() if p is LOADERS[-1] else pytest.mark.slow,
+    )
+    for p in LOADERS
+]
+
+
 def _examples(cases, **strategies):
     """A property over ``strategies``, run with each parser, with every value of ``cases`` among
     its explicit examples: the hand-picked values are always tried."""
@@ -365,7 +380,7 @@ def _examples(cases, **strategies):
     def decorate(test):
         for case in cases:
             test = example(**{key: case})(test)
-        return pytest.mark.parametrize("parser", LOADERS, ids=lambda p: p.__name__)(given(**strategies)(test))
+        return pytest.mark.parametrize("parser", PARSERS)(given(**strategies)(test))
 
     return decorate
 
