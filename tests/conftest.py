@@ -1,6 +1,20 @@
 """Fixtures shared by the loader's tests."""
 
 import os
+import sys
+import tempfile
+
+# Bytecode. Where PYTHONDONTWRITEBYTECODE is set (no __pycache__ beside the sources), each test
+# worker compiled the package and pytest rewrote every test module anew, and so did each
+# `grasptwist` process a test starts: some 4 s of every worker's collection and 50 ms of each of
+# the default run's subprocesses (docs/reference/development.md, Test time). The run caches them
+# outside the tree instead, in the temporary folder (Python checks each against its source).
+if os.environ.get("PYTHONDONTWRITEBYTECODE") and not os.environ.get("PYTHONPYCACHEPREFIX"):
+    os.environ["PYTHONPYCACHEPREFIX"] = sys.pycache_prefix = os.path.join(
+        tempfile.gettempdir(), f"grasptwist-pycache-{os.getuid()}"
+    )
+    del os.environ["PYTHONDONTWRITEBYTECODE"]  # for the processes the tests start
+    sys.dont_write_bytecode = False
 
 # The grip's numpy path in every test and subprocess: numba's kernel (the `fast` extra) costs
 # some 16 s of compiling per process on a fresh clone, so the tests that hold it to the numpy
