@@ -603,7 +603,17 @@ def test_what_an_npz_member_declares_is_checked_before_it_is_read(tmp_path, memb
 # 7. Names that are not UTF-8
 
 
-@pytest.mark.parametrize("fmt", ["json", "jsonl", "csv", "check", "-o"])
+@pytest.mark.parametrize(
+    "fmt",
+    [
+        # over a second: docs/reference/development.md, Test time (the JSON string's escape, as jsonl's)
+        pytest.param("json", marks=pytest.mark.slow),
+        "jsonl",
+        "csv",
+        "check",
+        "-o",
+    ],
+)
 def test_an_undecodable_file_name_is_escaped_in_every_format(tmp_path, fmt):
     # 0.1: internal error (TypeError: str is not valid UTF-8, or UnicodeEncodeError), no record at all
     folder = tmp_path / "in"

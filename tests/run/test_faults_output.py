@@ -298,7 +298,8 @@ CLOSED = "grasptwist: error: cannot write standard output: it is closed"
         (["resolve", POLY, "-o", "/dev/fd/0"], "< other.txt", EXIT_WRITE, ["grasptwist: error: cannot write /dev/fd/0: it is open for reading only"]),
         # a standard stream closed by the shell, as a closed stdout: exit 3 before any work
         (["resolve", "-", POLY], "<&-", EXIT_WRITE, ["grasptwist: error: cannot read standard input: it is closed"]),
-        (["--version"], ">&-", EXIT_WRITE, [CLOSED]),
+        # over a second: docs/reference/development.md, Test time (as the help's, cli.main's WriteError)
+        pytest.param(["--version"], ">&-", EXIT_WRITE, [CLOSED], marks=pytest.mark.slow),
         ([], ">&-", EXIT_WRITE, [CLOSED]),  # the help that `grasptwist` alone prints
         (["plot", POLY, "-o", "p.html"], ">&-", EXIT_WRITE, [CLOSED]),  # before anything is drawn
     ],
@@ -334,6 +335,7 @@ def test_a_closed_stderr_leaves_an_output_file_its_records_only(tmp_path):
     assert (tmp_path / "out.jsonl").read_text() == invoke("resolve", POLY, "-f", "jsonl").stdout
 
 
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time (as -o /dev/stdout's, above)
 def test_a_closed_stderr_is_no_output(tmp_path):
     """``-o /dev/stderr`` on a closed stderr is refused as closed (exit 3), as ``-o /dev/stdout`` is."""
     done = shell(tmp_path, "2>&-", "resolve", POLY, "-o", "/dev/stderr")
