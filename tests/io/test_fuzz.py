@@ -189,6 +189,9 @@ def test_fuzz(target, check, inputs, strategy, length):
     fuzz(strategy, check, SHORT[target] if length == "short" else LONG)
 
 
+# over a second: docs/reference/development.md, Test time (a check of the fuzz's generator, for
+# the long fuzz that -m slow runs; the default run's short fuzz asserts what the loader does)
+@pytest.mark.slow
 def test_the_generator_makes_valid_grasps_too():
     """The fuzz would prove little if every input were refused at once: unmutated
     documents with plain numbers must load (and some hostile ones must not)."""
