@@ -50,3 +50,17 @@ def grasps(rng, n, scale=1.0, offset=0.0):
     twist = rng.normal(size=(n, 6))
     twist[:, 3:] *= scale
     return points * scale + offset, normals, wrist * scale + offset, twist
+
+
+def in_plane(points, normals, which, tilt):
+    """``normals`` (``(N, 3, 3)``) with normal ``which[k]`` of grasp ``k`` turned into its contacts' plane,
+    plus ``tilt[k]`` (a scalar or ``(N,)``) along that plane's unit normal: a tangent method at or near
+    its ``normal-in-contact-plane`` threshold."""
+    m = np.cross(points[:, 1] - points[:, 0], points[:, 2] - points[:, 0])
+    m /= np.linalg.norm(m, axis=1, keepdims=True)
+    rows = np.arange(len(points))
+    n = normals[rows, which]
+    n = n - np.sum(n * m, axis=1)[:, None] * m
+    out = normals.copy()
+    out[rows, which] = n / np.linalg.norm(n, axis=1, keepdims=True) + np.reshape(tilt, (-1, 1)) * m
+    return out

@@ -12,10 +12,10 @@ import subprocess
 import sys
 
 import pytest
-from test_layers import LAYERS
 
 import grasptwist as gt
 from docs_blocks import ROOT, all_blocks
+from layers import LAYERS
 
 API = ROOT / "docs" / "api"
 

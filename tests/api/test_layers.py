@@ -14,33 +14,11 @@ from pathlib import Path
 
 import pytest
 
+from layers import LAYERS
 from places import ROOT
 
 SRC = ROOT / "src"
 PACKAGE = SRC / "grasptwist"
-
-#: Lowest first.  A module may import its own group and any group of a lower layer;
-#: groups of one layer are independent of each other.
-LAYERS = [
-    ["grasptwist.model", "grasptwist.extras", "grasptwist._version"],  # data types, no math
-    ["grasptwist.engine"],  # the math on arrays
-    ["grasptwist.io"],  # files in
-    ["grasptwist.results"],  # the registry of result kinds and their fields
-    ["grasptwist.output", "grasptwist.plot"],  # records and tables out; pictures
-    ["grasptwist.run"],  # batches, workers, streams, the -o target: engine over inputs into outputs
-    ["grasptwist.cli"],  # the command line
-    # the public facades and entry points: nothing inside the package imports them
-    [
-        "grasptwist",
-        "grasptwist.screws",
-        "grasptwist.hand",
-        "grasptwist.forces",
-        "grasptwist.path",
-        "grasptwist.pictures",
-        "grasptwist.dask",
-        "grasptwist.__main__",
-    ],
-]
 
 #: Beyond the layers: pictures are drawn from the engine's geometry only; reading
 #: files and writing records is the command line's (issue 22).

@@ -7,8 +7,7 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 import grasptwist as gt
-from conftest import in_plane
-from grasp_gen import grasps
+from grasp_gen import grasps, in_plane
 from grasptwist.engine.degeneracy import conditioning_warning
 
 S = gt.Status

@@ -13,8 +13,7 @@ import numpy as np
 import pytest
 
 import grasptwist as gt
-from conftest import in_plane
-from grasp_gen import grasps
+from grasp_gen import grasps, in_plane
 from grasptwist.engine.decompose import CHUNK, SMALL_BATCH
 
 S = gt.Status

@@ -16,7 +16,6 @@ import yaml
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from conftest import CONTACTS, LOADERS
 from grasptwist.engine import screws
 from grasptwist.io.grasp import (
     DEFAULT_MAX_BYTES,
@@ -34,6 +33,7 @@ from grasptwist.io.grasp import (
 from grasptwist.run import placement
 from hostile import jsonl, run
 from hostile import summary as summary_line
+from loaders import CONTACTS, LOADERS
 from places import GRASPS, TESTS
 
 INVALID = TESTS / "invalid_grasps"

@@ -28,8 +28,8 @@ import yaml
 from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
-from conftest import CONTACTS, LOADERS
 from grasptwist.io.grasp import READING, Grasp, GraspFileError, Reading, read_grasps, reader, text
+from loaders import CONTACTS, LOADERS
 from places import TESTS
 
 FILES = sorted(
