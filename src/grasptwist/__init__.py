@@ -52,7 +52,7 @@ _EXPORTS = {
     "Twist": ".model",
     "Wrench": ".model",
     "grasp_table": ".io.parquet",
-    # the grip, where issue 29 names it (a control loop's one call; also in grasptwist.forces)
+    # the grip, a control loop's one call (also in grasptwist.forces, with the rest of the force side)
     "grip": ".engine.forces.grip",
     "Grip": ".engine.forces.grip",
     "prepare_grip": ".engine.forces.grip",

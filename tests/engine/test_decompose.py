@@ -343,3 +343,20 @@ def test_row_picks_a_row_of_a_batch_and_says_so_plainly_on_a_single_result():
     np.testing.assert_allclose(batch.row(1).x, [2 / 3] * 3, atol=1e-4)
     with pytest.raises(ValueError, match="one grasp and one twist"):
         gt.decompose_tangent(EX2, EX2_NORMALS, twists[0]).row(0)
+
+
+def test_components_without_the_bases_is_a_clear_error_and_with_them_sum_to_the_twist():
+    points = np.array([[1, 0, 0], [-0.5, 0.75**0.5, 0], [-0.5, -(0.75**0.5), 0]])
+    normals = -points + [0, 0, 0.3]
+    twist = np.array([0.1, 0.2, 0.3, 0.4, 0.5, 0.6])
+    for amplitudes_only, full in (
+        (
+            gt.decompose_off_tangent(points, [0, 0, 1], twist, bases=False),
+            gt.decompose_off_tangent(points, [0, 0, 1], twist),
+        ),
+        (gt.decompose_tangent(points, normals, twist, bases=False), gt.decompose_tangent(points, normals, twist)),
+    ):
+        with pytest.raises(ValueError, match=r"^components need the basis screws: decompose with bases=True"):
+            amplitudes_only.components()
+        a, b = full.components()
+        np.testing.assert_allclose(a.sum(-2) + b.sum(-2), twist, atol=1e-12)

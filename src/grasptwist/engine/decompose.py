@@ -119,6 +119,12 @@ class _Result:
         """``status == 0`` per row."""
         return self.status == Status.OK
 
+    def _with_bases(self):
+        """``self``, or a ValueError when it was computed with ``bases=False`` (amplitudes only)."""
+        if self.sigma is None:
+            raise ValueError("components need the basis screws: decompose with bases=True (the default)")
+        return self
+
     def row(self, i):
         """Row ``i`` (an index into the leading axis) as a result of the same type.
 
@@ -200,7 +206,9 @@ class OffTangentResult(_Result):
     y: np.ndarray
 
     def components(self):
-        """The component twists ``(x_i Sigma_i, y_i Psi_i)``, each ``(..., 3, 6)``."""
+        """The component twists ``(x_i Sigma_i, y_i Psi_i)``, each ``(..., 3, 6)``: their sums over
+        the component axis (``-2``) add up to the twist.  A ValueError with ``bases=False``."""
+        self._with_bases()
         return self.x[..., None] * self.sigma, self.y[..., None] * self.psi
 
 
@@ -250,7 +258,9 @@ class TangentResult(_Result):
     in_tangent_planes: np.ndarray
 
     def components(self):
-        """The component twists ``(alpha_i Theta_i, beta_i Sigma_i)``, each ``(..., 3, 6)``."""
+        """The component twists ``(alpha_i Theta_i, beta_i Sigma_i)``, each ``(..., 3, 6)``: their sums
+        over the component axis (``-2``) add up to the twist.  A ValueError with ``bases=False``."""
+        self._with_bases()
         return self.alpha[..., None] * self.theta, self.beta[..., None] * self.sigma
 
     def contact_split(self):
