@@ -513,9 +513,12 @@ class ManipulatingForces(NamedTuple):
 WRENCH_SCALED_BEYOND = (1e-100, 1e100)
 
 
-def wrench_scales(w) -> np.ndarray:
-    """Per row of ``w (n, 6)``, the power of two to divide it by before the solve (1 for most).
+def wrench_scales(w) -> np.ndarray | None:
+    """Per row of ``w (..., 6)``, the power of two to divide it by before the solve (1 for most);
+    None when no row needs it (the common case, decided in two reductions: a hot path).
 
+    >>> wrench_scales(np.array([[0, 0, 9.81, 0, 0, 0], [0, 0, 0, 0, 0, 0]])) is None
+    True
     >>> wrench_scales(np.array([[0, 0, 9.81, 0, 0, 0], [0, 0, 1e300, 0, 0, 0]])).tolist()[0]
     1.0
     >>> bool(1 <= 1e300 / wrench_scales(np.array([[0, 0, 1e300, 0, 0, 0]]))[0] < 2)
@@ -523,6 +526,8 @@ def wrench_scales(w) -> np.ndarray:
     """
     low, high = WRENCH_SCALED_BEYOND
     largest = np.abs(w).max(axis=-1)
+    if not (largest > high).any() and not ((largest < low) & (largest > 0)).any():  # NaN: no scale
+        return None
     extreme = np.isfinite(largest) & (largest > 0) & ((largest > high) | (largest < low))
     return np.where(extreme, np.exp2(np.floor(np.log2(np.where(extreme, largest, 1.0)))), 1.0)
 
@@ -561,8 +566,11 @@ def manipulating_forces(points, wrench, *, tol=DEGENERACY_TOL) -> ManipulatingFo
     p, w = np.broadcast_to(p, shape + (3, 3)), np.broadcast_to(w, shape + (6,))
     geo = geometry(p, tol)
     k = wrench_scales(w)  # G^+ is linear: a wrench beyond 1e100 is solved scaled
-    with np.errstate(over="ignore", invalid="ignore"):
-        f = _manipulating(geo, w / k[..., None]) * k[..., None, None]
+    if k is None:
+        f = _manipulating(geo, w)
+    else:
+        with np.errstate(over="ignore", invalid="ignore"):
+            f = _manipulating(geo, w / k[..., None]) * k[..., None, None]
     status, culprit = geo.status.copy(), geo.culprit.copy()
     line = np.flatnonzero(status.reshape(-1) == ForceStatus.COLLINEAR_CONTACTS)
     if line.size:  # rank 5: G^+ w still makes w when w has no moment about the contacts' line

@@ -286,11 +286,11 @@ def _grip_of(rows, s_f, tol, shape, prepared=None):
 
     Compiled (:mod:`~grasptwist.engine.forces.compiled`) where numba is there: the kernel takes
     the rows it can, the numpy path (``prepared``, else a :class:`_Prepared` of those rows) the others.
-    A wrench beyond :data:`WRENCH_SCALED_BEYOND` is solved scaled (:func:`wrench_scales`) and its
+    A wrench beyond ``grasp_map.WRENCH_SCALED_BEYOND`` is solved scaled (``wrench_scales``) and its
     grip scaled back, so that only a grip that is itself beyond a double is ``nonfinite-result``.
     """
     k = wrench_scales(rows[3])
-    if (k != 1).any():
+    if k is not None:
         g = _grip_of((*rows[:3], rows[3] / k[:, None]), s_f, tol, shape, prepared)
         k = k.reshape(shape)
         with np.errstate(over="ignore", invalid="ignore"):
@@ -374,9 +374,11 @@ class PreparedGrip:
         rows = w.reshape(-1, 6)
         k = len(rows)
         fast = compiled.kernel()
+        # a control loop's call; a wrench to scale first (wrench_scales' bounds, tested here on one
+        # number: the array form costs half this call) goes the general way
         low, high = WRENCH_SCALED_BEYOND
-        largest = float(np.abs(rows).max())  # a wrench to scale first goes the general way
-        if fast is not None and w.ndim == 1 and (largest == 0 or low <= largest <= high):  # a control loop's call
+        largest = float(np.abs(rows).max())
+        if fast is not None and w.ndim == 1 and (largest == 0 or low <= largest <= high):
             numbers = np.empty((1, fast.WIDTH))
             codes = np.empty((1, 3), np.int8)
             fast.grip_rows(self._rows[0], self._rows[1], self._limit, rows, self._tol, numbers, codes)  # w: a copy
