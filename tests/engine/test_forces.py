@@ -767,3 +767,10 @@ def test_a_numba_that_cannot_load_the_kernel_leaves_the_numpy_path_with_a_warnin
     with pytest.warns(UserWarning, match=r"^the compiled grip is unavailable \(.*\); the numpy path is used$"):
         g = gt.grip(EQ, -EQ, [0, 0, G, 0, 0, 0], 0.5)
     assert g.total_normal_force == pytest.approx(G / 0.5, rel=1e-9) and compiled.kernel() is None
+
+
+def test_an_infinite_wrench_beside_a_huge_one_keeps_its_status_and_the_huge_one_is_solved():
+    """wrench_scales leaves an infinite row unscaled (once, as the grip recursed on it forever)."""
+    g = gt.grip(EQ, -EQ, [[0, 0, np.inf, 0, 0, 0], [0, 0, G * 1e300, 0, 0, 0]], 0.5)
+    assert g.status.tolist() == [gt.forces.Status.NONFINITE_INPUT, 0]
+    assert g.total_normal_force[1] == pytest.approx(2 * G * 1e300, rel=1e-9)

@@ -517,7 +517,7 @@ def wrench_scales(w) -> np.ndarray | None:
     """Per row of ``w (..., 6)``, the power of two to divide it by before the solve (1 for most);
     None when no row needs it (the common case, decided in two reductions: a hot path).
 
-    >>> wrench_scales(np.array([[0, 0, 9.81, 0, 0, 0], [0, 0, 0, 0, 0, 0]])) is None
+    >>> wrench_scales(np.array([[0, 0, 9.81, 0, 0, 0], [0, 0, 0, 0, 0, 0], [0, 0, np.inf, 0, 0, 0]])) is None
     True
     >>> wrench_scales(np.array([[0, 0, 9.81, 0, 0, 0], [0, 0, 1e300, 0, 0, 0]])).tolist()[0]
     1.0
@@ -526,9 +526,12 @@ def wrench_scales(w) -> np.ndarray | None:
     """
     low, high = WRENCH_SCALED_BEYOND
     largest = np.abs(w).max(axis=-1)
-    if not (largest > high).any() and not ((largest < low) & (largest > 0)).any():  # NaN: no scale
+    big, small = largest > high, (largest < low) & (largest > 0)
+    if not (big.any() or small.any()):  # NaN compares false: no scale
         return None
-    extreme = np.isfinite(largest) & (largest > 0) & ((largest > high) | (largest < low))
+    extreme = np.isfinite(largest) & (big | small)  # an infinite wrench keeps its own status
+    if not extreme.any():
+        return None
     return np.where(extreme, np.exp2(np.floor(np.log2(np.where(extreme, largest, 1.0)))), 1.0)
 
 
