@@ -95,7 +95,7 @@ def primitives(n, loop, repeat):
     for kind, size in PRIMITIVES.items():
         o = check_object(GraspObject(Shape(kind, np.array(size)), np.eye(4)))
         q = near_surface(o, n, rng)
-        ours, s = best(lambda: project_to_surface(o, q), repeat)
+        ours, s = best(lambda o=o, q=q: project_to_surface(o, q), repeat)
         start = time.perf_counter()
         slow = [loop_nearest(kind, size, tuple(p)) for p in q[:loop].tolist()]
         base = (time.perf_counter() - start) * n / loop
