@@ -231,9 +231,10 @@ def volume_of(vertices, faces):
 def assert_closed(faces):
     """Every directed edge once and its reverse once: watertight and consistently oriented."""
     edges = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
-    directed = {tuple(e) for e in edges.tolist()}
+    n = faces.max() + 1
+    directed = np.unique(edges[:, 0] * n + edges[:, 1])
     assert len(directed) == len(edges)
-    assert {(b, a) for a, b in directed} == directed
+    np.testing.assert_array_equal(np.unique(edges[:, 1] * n + edges[:, 0]), directed)
 
 
 @pytest.mark.parametrize(
@@ -255,14 +256,14 @@ def test_tessellation_is_watertight_with_the_closed_form_volume(o, volume):
 
 @pytest.mark.parametrize("o", KINDS[1:], ids=lambda o: o.shape.kind)
 def test_round_tessellations_lie_on_the_surface_and_approach_its_volume(o):
-    coarse, fine = (tessellate(o, segments=k) for k in (16, 128))
+    coarse, fine = (tessellate(o, segments=k) for k in (16, 64))
     for v, f in (coarse, fine):
         assert_closed(f)
         assert abs(project_to_surface(o, v).distance).max() <= 1e-16  # sizes 0.02-0.1: a unit of round-off
     exact = mass_properties(o).volume
     below = [exact - volume_of(*t) for t in (coarse, fine)]
-    assert 0 < below[1] < below[0] / 30  # inscribed, and the error falls as 1 / segments^2 (64 times)
-    assert below[1] < 2e-3 * exact  # about (2 pi / 128)^2 / 6 per direction of the rings
+    assert 0 < below[1] < below[0] / 10  # inscribed, and the error falls as 1 / segments^2 (16 times)
+    assert below[1] < 5e-3 * exact  # about (2 pi / 64)^2 / 6 per direction of the rings
 
 
 def test_the_sphere_tessellation_has_the_promised_rings():
