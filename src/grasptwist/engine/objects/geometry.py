@@ -128,7 +128,7 @@ def project_to_surface(obj: GraspObject, points) -> SurfacePoints:
     >>> box = GraspObject(Shape("box", np.array([2.0, 2.0, 2.0])), pose)
     >>> s = project_to_surface(box, [1.0, 1.5, 0.0])
     >>> s.points.tolist(), s.normals.tolist(), float(s.distance)
-    ([1.0, 1.0, 0.0], [-0.0, -1.0, -0.0], 0.5)
+    ([1.0, 1.0, 0.0], [0.0, -1.0, 0.0], 0.5)
     """
     p = _points(points)
     rotation, translation = obj.pose[:3, :3], obj.pose[:3, 3]
@@ -142,7 +142,7 @@ def project_to_surface(obj: GraspObject, points) -> SurfacePoints:
         c, outward, d = primitives.nearest(shape.kind, shape.size, local, EDGE_TOL * object_size(obj))
     return SurfacePoints(
         (rotate(rotation, c) + translation).reshape(p.shape),
-        rotate(-rotation, outward).reshape(p.shape),
+        (rotate(-rotation, outward) + 0.0).reshape(p.shape),  # + 0.0: zeros without a sign, for records
         d.reshape(p.shape[:-1]),
     )
 
