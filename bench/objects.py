@@ -3,8 +3,8 @@
 ``grasptwist.engine.objects.project_to_surface`` against a same-run baseline:
 
 - primitives: the vectorised closed forms against a per-point Python loop of
-  the same formulas in floats (``--loop`` points, scaled to ``--n``); the two
-  must agree to round-off;
+  the same formulas in floats (``primitives.nearest_one``, ``--loop``
+  points, scaled to ``--n``); the two must agree to round-off;
 - a mesh (a torus of 10^5 triangles made by ``trimesh.creation``; non-convex,
   so the inside/outside sign is tested too): ours (libigl's AABB tree, built
   once and kept with the shape, then our edge and vertex normals and the
@@ -27,7 +27,6 @@ Run: ``python bench/objects.py [--n 1000000] [--mesh-n 100000]``.  Needs the
 """
 
 import argparse
-import math
 import time
 
 import numpy as np
@@ -35,44 +34,10 @@ import trimesh
 
 from grasptwist.engine.objects import SURFACE_TOL, check_object, object_size, project_to_surface, sample_surface
 from grasptwist.engine.objects.mesh import _derived
+from grasptwist.engine.objects.primitives import nearest_one
 from grasptwist.model import GraspObject, Shape
 
 PRIMITIVES = {"box": [0.065, 0.065, 0.065], "sphere": [0.04], "cylinder": [0.03, 0.1], "capsule": [0.02, 0.06]}
-
-
-def loop_nearest(kind, size, q):
-    """One point's nearest point, outward normal and signed distance, in Python floats (the baseline)."""
-    x, y, z = q
-    if kind in ("sphere", "capsule"):
-        half = 0.0 if kind == "sphere" else size[1] / 2
-        az = min(max(z, -half), half)
-        vx, vy, vz = x, y, z - az
-        length = math.sqrt(vx * vx + vy * vy + vz * vz)
-        n = (vx / length, vy / length, vz / length) if length > 0 else (1.0, 0.0, 0.0)
-        r = size[0]
-        return (r * n[0], r * n[1], az + r * n[2]), n, length - r
-    if kind == "box":
-        coords, half = [x, y, z], [s / 2 for s in size]
-    else:  # a cylinder is a rectangle in (rho, z)
-        rho = math.hypot(x, y)
-        coords, half = [rho, z], [size[0], size[1] / 2]
-    sign = [-1.0 if c < 0 else 1.0 for c in coords]
-    gap = [h - abs(c) for h, c in zip(half, coords)]
-    out = [max(-g, 0.0) for g in gap]
-    outside = math.sqrt(sum(o * o for o in out))
-    point = [s * min(abs(c), h) for s, c, h in zip(sign, coords, half)]
-    if outside > 0:
-        normal, distance = [s * o / outside for s, o in zip(sign, out)], outside
-    else:
-        k = gap.index(min(gap))
-        point[k] = sign[k] * half[k]
-        normal = [0.0] * len(coords)
-        normal[k] = sign[k]
-        distance = -gap[k]
-    if kind == "box":
-        return tuple(point), tuple(normal), distance
-    ux, uy = (x / rho, y / rho) if rho > 0 else (1.0, 0.0)
-    return (point[0] * ux, point[0] * uy, point[1]), (normal[0] * ux, normal[0] * uy, normal[1]), distance
 
 
 def best(f, repeat):
@@ -97,7 +62,7 @@ def primitives(n, loop, repeat):
         q = near_surface(o, n, rng)
         ours, s = best(lambda o=o, q=q: project_to_surface(o, q), repeat)
         start = time.perf_counter()
-        slow = [loop_nearest(kind, size, tuple(p)) for p in q[:loop].tolist()]
+        slow = [nearest_one(kind, size, tuple(p)) for p in q[:loop].tolist()]
         base = (time.perf_counter() - start) * n / loop
         points = np.array([p for p, _, _ in slow])
         distance = np.array([d for _, _, d in slow])

@@ -16,6 +16,7 @@ from grasptwist.engine.objects import (
     mass_properties,
     moved,
     object_size,
+    primitives,
     project_to_surface,
     sample_surface,
     tessellate,
@@ -120,6 +121,19 @@ CAPSULE = obj("capsule", 1.0, 2.0)  # radius 1, cap centres at z = +-1
 )
 def test_capsule_closed_forms(point, surface, normal, distance):
     assert_projects(CAPSULE, point, surface, normal, distance)
+
+
+@pytest.mark.parametrize(
+    "kind, size", [("box", (2.0, 4.0, 6.0)), ("sphere", (2.0,)), ("cylinder", (1.0, 4.0)), ("capsule", (1.0, 2.0))]
+)
+def test_the_vectorised_primitives_agree_with_their_per_point_twin(kind, size):
+    q = np.random.default_rng(13).uniform(-5, 5, (300, 3))
+    c, n, d = primitives.nearest(kind, np.array(size), q, 0.0)
+    for i, p in enumerate(q.tolist()):
+        point, normal, distance = primitives.nearest_one(kind, size, p)
+        np.testing.assert_allclose(c[i], point, rtol=0, atol=4e-15)
+        np.testing.assert_allclose(n[i], normal, rtol=0, atol=4e-16)
+        assert d[i] == pytest.approx(distance, rel=0, abs=4e-15)
 
 
 def test_projection_keeps_batch_shape_and_takes_no_points():
@@ -363,3 +377,12 @@ def test_moved_refuses_a_pose_that_is_not_rigid():
 def test_project_refuses_points_of_the_wrong_shape(points, match):
     with pytest.raises(ValueError, match=match):
         project_to_surface(BOX, points)
+
+
+def test_a_point_that_is_not_finite_gets_nan_and_the_others_their_answer():
+    with np.errstate(all="raise"):  # and no warning on the way
+        s = project_to_surface(BOX, [[np.nan, 0, 0], [np.inf, 0, 0], [0, 0, 0]])
+    assert np.isnan(s.points[:2]).all() and np.isnan(s.normals[:2]).all() and np.isnan(s.distance[:2]).all()
+    assert (
+        s.points[2].tolist() == [1.0, 0.0, 0.0] and s.normals[2].tolist() == [-1.0, 0.0, 0.0] and s.distance[2] == -1.0
+    )

@@ -230,6 +230,14 @@ def test_moving_a_mesh_moves_its_projections():
 CUBE_VERTICES, CUBE_FACES = tessellate(primitive("box", 1.0, 1.0, 1.0))
 
 
+def test_a_point_that_is_not_finite_gets_nan_and_the_others_their_answer():
+    s = project_to_surface(mesh_object(CUBE_VERTICES, CUBE_FACES), [[np.nan, 0, 0], [0, -np.inf, 0], [0, 0, 2]])
+    assert np.isnan(s.points[:2]).all() and np.isnan(s.normals[:2]).all() and np.isnan(s.distance[:2]).all()
+    assert (
+        s.points[2].tolist() == [0.0, 0.0, 0.5] and s.normals[2].tolist() == [0.0, 0.0, -1.0] and s.distance[2] == 1.5
+    )
+
+
 def test_a_missing_libigl_is_one_line_naming_the_extra(monkeypatch):
     monkeypatch.setitem(sys.modules, "igl", None)  # import igl now raises ImportError
     mesh = mesh_object(CUBE_VERTICES, CUBE_FACES)

@@ -117,7 +117,8 @@ def project_to_surface(obj: GraspObject, points) -> SurfacePoints:
     -------
     SurfacePoints
         ``points (..., 3)``, ``normals (..., 3)`` (unit, inward),
-        ``distance (...)`` (> 0 outside).
+        ``distance (...)`` (> 0 outside); NaN for a point that is not finite
+        (never an exception, as everywhere in the engine).
 
     Examples
     --------
@@ -134,17 +135,23 @@ def project_to_surface(obj: GraspObject, points) -> SurfacePoints:
     rotation, translation = obj.pose[:3, :3], obj.pose[:3, 3]
     # written out component by component (se3.rotate): a BLAS product of (N, 3) by (3, 3) is
     # several times slower, and its threads fight over a busy machine
-    local = rotate(rotation.T, p - translation).reshape(-1, 3)
-    shape = obj.shape
-    if shape.kind == "mesh":
-        c, outward, d = mesh.nearest(shape, local)
-    else:
-        c, outward, d = primitives.nearest(shape.kind, shape.size, local, EDGE_TOL * object_size(obj))
+    with np.errstate(invalid="ignore", over="ignore"):  # inf * 0 in a point that is not finite
+        local = rotate(rotation.T, p - translation).reshape(-1, 3)
+    finite = np.isfinite(local).all(axis=1)
+    c, outward, d = np.full_like(local, np.nan), np.full_like(local, np.nan), np.full(len(local), np.nan)
+    c[finite], outward[finite], d[finite] = _nearest(obj, local[finite])
     return SurfacePoints(
         (rotate(rotation, c) + translation).reshape(p.shape),
         (rotate(-rotation, outward) + 0.0).reshape(p.shape),  # + 0.0: zeros without a sign, for records
         d.reshape(p.shape[:-1]),
     )
+
+
+def _nearest(obj, local):
+    shape = obj.shape
+    if shape.kind == "mesh":
+        return mesh.nearest(shape, local)
+    return primitives.nearest(shape.kind, shape.size, local, EDGE_TOL * object_size(obj))
 
 
 def _points(points):
