@@ -138,8 +138,11 @@ def project_to_surface(obj: GraspObject, points) -> SurfacePoints:
     with np.errstate(invalid="ignore", over="ignore"):  # inf * 0 in a point that is not finite
         local = rotate(rotation.T, p - translation).reshape(-1, 3)
     finite = np.isfinite(local).all(axis=1)
-    c, outward, d = np.full_like(local, np.nan), np.full_like(local, np.nan), np.full(len(local), np.nan)
-    c[finite], outward[finite], d[finite] = _nearest(obj, local[finite])
+    if finite.all():  # the common case, without the copies
+        c, outward, d = _nearest(obj, local)
+    else:
+        c, outward, d = np.full_like(local, np.nan), np.full_like(local, np.nan), np.full(len(local), np.nan)
+        c[finite], outward[finite], d[finite] = _nearest(obj, local[finite])
     return SurfacePoints(
         (rotate(rotation, c) + translation).reshape(p.shape),
         (rotate(-rotation, outward) + 0.0).reshape(p.shape),  # + 0.0: zeros without a sign, for records
