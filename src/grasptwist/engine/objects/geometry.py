@@ -125,7 +125,8 @@ def project_to_surface(obj: GraspObject, points) -> SurfacePoints:
     A 2 x 2 x 2 box moved 1 along x; a point 0.5 beyond its +y face:
 
     >>> from grasptwist.objects import Shape
-    >>> pose = np.eye(4); pose[0, 3] = 1.0
+    >>> pose = np.eye(4)
+    >>> pose[0, 3] = 1.0
     >>> box = GraspObject(Shape("box", np.array([2.0, 2.0, 2.0])), pose)
     >>> s = project_to_surface(box, [1.0, 1.5, 0.0])
     >>> s.points.tolist(), s.normals.tolist(), float(s.distance)
@@ -178,7 +179,8 @@ def mass_properties(obj: GraspObject) -> MassProperties:
     primitive, the closed mesh's (``mesh.volume_centroid``).
 
     >>> from grasptwist.objects import Shape
-    >>> pose = np.eye(4); pose[:3, 3] = [0, 0, 0.05]
+    >>> pose = np.eye(4)
+    >>> pose[:3, 3] = [0, 0, 0.05]
     >>> m = mass_properties(GraspObject(Shape("box", np.array([0.1, 0.1, 0.1])), pose, density=1000.0))
     >>> round(m.volume, 6), round(m.mass, 6), m.center_of_mass.tolist()
     (0.001, 1.0, [0.0, 0.0, 0.05])
