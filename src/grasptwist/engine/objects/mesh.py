@@ -141,7 +141,7 @@ class _Derived:
         self.edge_normals = _unit(weighted[mine] + weighted[self.other_face])
         self.edge_pseudo = self.face_normals[mine] + self.face_normals[self.other_face]
         self.tol = MESH_EDGE_TOL * diagonal(v)
-        igl = require("igl", "a mesh object's nearest points")
+        igl = require("igl", "a mesh object's nearest points")  # optional (the mesh extra): imported when used
         self.vertices = np.ascontiguousarray(v, dtype=float)
         self.faces = np.ascontiguousarray(f, dtype=np.int64)
         self.tree = igl.AABB()
