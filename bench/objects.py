@@ -107,7 +107,7 @@ def mesh(n, loop, check, repeat):
     m, exact = torus((400, 125))
     shape = Shape("mesh", np.zeros(0), np.asarray(m.vertices, dtype=float), np.asarray(m.faces))
     o = check_object(GraspObject(shape, np.eye(4)))
-    build, _ = best(lambda: _derived(o.shape), 1)
+    build, _ = best(lambda: _derived(o.shape).nearest_faces(np.zeros((1, 3))), 1)  # normals and tree, once
     rng = np.random.default_rng(1)
     near = near_surface(o, n, rng)
     lower, upper = m.bounds
