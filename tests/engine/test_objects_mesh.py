@@ -164,6 +164,33 @@ def test_inside_and_outside_of_a_torus_as_its_closed_form():
     assert np.abs(got - exact).max() < 1e-3
 
 
+def winding_number(vertices, faces, q):
+    """The generalized winding number of each point (Van Oosterom and Strackee's solid angles): 1 inside, 0 outside."""
+    a, b, c = (vertices[faces[:, i]][None] - q[:, None] for i in range(3))
+    la, lb, lc = (np.linalg.norm(x, axis=-1) for x in (a, b, c))
+    det = np.einsum("pfi,pfi->pf", a, np.cross(b, c))
+    dots = (
+        np.einsum("pfi,pfi->pf", a, b) * lc + np.einsum("pfi,pfi->pf", b, c) * la + np.einsum("pfi,pfi->pf", c, a) * lb
+    )
+    return (2 * np.arctan2(det, la * lb * lc + dots)).sum(axis=1) / (4 * np.pi)
+
+
+def test_points_a_hair_from_a_torus_mesh_are_inside_or_outside_as_its_winding_number_says():
+    vertices, faces = torus_mesh(0.05, 0.015, 16, 8)  # concave inside the hole, convex outside
+    mesh = mesh_object(vertices, faces)
+    rng = np.random.default_rng(10)
+    near = np.concatenate(
+        [vertices, 0.5 * (vertices[faces[:, 0]] + vertices[faces[:, 1]]), sample_surface(mesh, 100, rng)[0]]
+    )
+    step = rng.normal(size=near.shape)
+    q = near + step / np.linalg.norm(step, axis=1, keepdims=True) * 10 ** rng.uniform(
+        -7, -4, (len(near), 1)
+    ) * object_size(mesh)
+    inside = winding_number(vertices, faces, q) > 0.5
+    assert 0.3 < inside.mean() < 0.7
+    np.testing.assert_array_equal(project_to_surface(mesh, q).distance < 0, inside)
+
+
 def test_edges_and_vertices_take_the_area_weighted_normal_of_their_faces():
     v, f = SPHERE
     mesh = mesh_object(v, f)
