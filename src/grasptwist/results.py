@@ -339,15 +339,34 @@ def _per_joint(name):
 
 
 def _per_finger(name, fill):
-    """``(N, 3)`` attribute ``name`` of the hand result, ``fill`` where there is none."""
+    """``(N, 3, ...)`` attribute ``name`` of the hand result (per finger: a value or a vector), ``fill``
+    where there is none."""
 
     def get(r, block, hand):
         values = None if r is None else getattr(r, name)
         if values is None:
-            return np.full((len(block), 3), fill)
-        return np.where(block.has_hand[:, None], values, fill)
+            return np.full((len(block), 3, 3) if name in _FINGER_VECTORS else (len(block), 3), fill)
+        has = block.has_hand.reshape((-1,) + (1,) * (np.ndim(values) - 1))
+        return np.where(has, values, fill)
 
     return get
+
+
+#: The hand result's attributes that hold a 3-vector per finger.
+_FINGER_VECTORS = ("tip_center", "tip_contact")
+
+
+def finger_column_names(prefix, axes, hand) -> tuple[str, ...]:
+    """Flat column names of a value (``axes`` empty) or a vector per finger of ``hand``:
+    ``<prefix>_<finger>[_<axis>]``.
+
+    >>> from grasptwist.model import Finger, Hand
+    >>> f = Finger("a", None, (), None, None, None, 1.0, ())
+    >>> h = Hand((f, f, f), (), None, None)
+    >>> finger_column_names("tip_center", "xy", h)[:2], finger_column_names("tip_gap", "", h)[:1]
+    (('tip_center_a_x', 'tip_center_a_y'), ('tip_gap_a',))
+    """
+    return tuple(f"{prefix}_{f.name}" + (f"_{a}" if a else "") for f in hand.fingers for a in (axes or [""]))
 
 
 def joint_column_names(prefix, hand) -> tuple[str, ...]:
@@ -380,6 +399,28 @@ HAND = ResultKind(
             per_hand=True,
         ),
         Column("tip_error", _per_finger("tip_error", np.nan), per_hand=True),
+        # the fingertips' spheres against the contacts (engine/fingertips.py): shown even where the hand failed
+        Column(
+            "tip_center",
+            _per_finger("tip_center", np.nan),
+            partial(finger_column_names, "tip_center", "xyz"),
+            only_where_ok=False,
+            per_hand=True,
+        ),
+        Column(
+            "tip_gap",
+            _per_finger("tip_gap", np.nan),
+            partial(finger_column_names, "tip_gap", ""),
+            only_where_ok=False,
+            per_hand=True,
+        ),
+        Column(
+            "tip_contact",
+            _per_finger("tip_contact", np.nan),
+            partial(finger_column_names, "tip_contact", "xyz"),
+            only_where_ok=False,
+            per_hand=True,
+        ),
         Column("within_limits", _per_finger("within_limits", False), dtype="?", per_hand=True),
         Column("finger_rank", _per_finger("finger_rank", -1), dtype="i8", per_hand=True),
         Column("finger_residual", _per_finger("finger_residual", np.nan), per_hand=True),

@@ -28,6 +28,10 @@ def jsonl(*args):
     return [json.loads(line) for line in run(*args, "-f", "jsonl").stdout.splitlines()]
 
 
+def rec_points(path):
+    return [c["point"] for c in jsonl("resolve", path)[0]["contacts"]]
+
+
 def test_csv_of_a_hand_grasp_has_its_joint_columns():
     result = run("resolve", THREE, "-f", "csv")
     assert result.exit_code == 0
@@ -35,7 +39,13 @@ def test_csv_of_a_hand_grasp_has_its_joint_columns():
     header, (row,) = rows[0], rows[1:]
     joints = [f"qdot_{f}_{f}.{k}" for f in ("east", "west", "south") for k in (1, 2, 3)]
     positions = [name.replace("qdot_", "q_", 1) for name in joints]
-    assert header == CSV_COLUMNS + joints + positions + ["hand_error"]
+    fingers = ("east", "west", "south")
+    centres = [f"tip_center_{f}_{a}" for f in fingers for a in "xyz"]
+    where = [f"tip_gap_{f}" for f in fingers] + [f"tip_contact_{f}_{a}" for f in fingers for a in "xyz"]
+    assert header == CSV_COLUMNS + joints + positions + centres + where + ["hand_error"]
+    # point tips (no tip_radius): each centre is its contact, touching it (gap 0)
+    assert [float(row[header.index(name)]) for name in centres] == [x for c in rec_points(THREE) for x in c]
+    assert [float(row[header.index(f"tip_gap_{f}")]) for f in fingers] == [0.0] * 3
     (rec,) = jsonl("resolve", THREE)
     want = [r for f in rec["hand"]["fingers"] for r in f["joint_rates"]]
     assert [float(row[header.index(name)]) for name in joints] == want
@@ -148,15 +158,17 @@ def test_the_plot_scene_draws_each_finger_joint_axis():
 
 
 def _rows(tmp_path, trifinger, n=30, seed=4):
-    """A TriFinger data set: contacts at the tip links' origins at random joint positions within
-    the limits, and a hand file of the TriFinger."""
+    """A TriFinger data set: contacts one fingertip radius (10 mm) beyond the tip links' origins,
+    along their normals, at random joint positions within the limits, and a hand file of the TriFinger."""
     rng = np.random.default_rng(seed)
     q = rng.uniform([-0.3, 0.1, -2.5] * 3, [0.9, 1.4, -0.3] * 3, size=(n, 9))
-    points = np.stack([s.tip[:, :3, 3] for s in hand.finger_states(trifinger, q)], axis=1)
+    normals = rng.normal(size=(n, 3, 3))
+    normals /= np.linalg.norm(normals, axis=-1, keepdims=True)
+    points = np.stack([s.tip[:, :3, 3] for s in hand.finger_states(trifinger, q)], axis=1) + 0.01 * normals
     hand_file = tmp_path / "trifinger.yaml"
     fingers = "".join(f"    - {{tip: {f.tip}}}\n" for f in trifinger.fingers)
     hand_file.write_text(f"hand:\n  urdf: {trifinger.source}\n  fingers:\n{fingers}", "utf-8")
-    return q, points, rng.normal(size=(n, 3, 3)), hand_file
+    return q, points, normals, hand_file
 
 
 @urdf_only
