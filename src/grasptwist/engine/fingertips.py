@@ -52,7 +52,9 @@ SPHERE_VERTICES = 16
 def tip_radii(hand):
     """Each finger's fingertip radius, ``(3,)`` (0: a point tip).
 
-    >>> from grasptwist.model import Finger, Hand
+    Examples
+    --------
+    >>> from grasptwist.hand import Finger, Hand
     >>> f = Finger("a", None, (), None, None, None, 1.0, (), tip_radius=0.01)
     >>> tip_radii(Hand((f, f, f), (), None, None)).tolist()
     [0.01, 0.01, 0.01]
@@ -78,6 +80,8 @@ def tip_centers(points, normals, radii):
     -------
     (..., 3, 3) array
 
+    Examples
+    --------
     >>> tip_centers([[0.0, 0, 1]] * 3, [[0, 0, 2.0]] * 3, [0.0, 0.5, 1.0])[:, 2].tolist()
     [1.0, 0.5, 0.0]
     """
@@ -110,7 +114,7 @@ def tip_contacts(tip_poses, points, normals, radii) -> TipContacts:
     ----------
     tip_poses : (..., 3, 4, 4) array
         Each finger's tip link pose (for a finger given inline, the frame
-        its tip point is carried by: :func:`~grasptwist.engine.ik.home_tips`).
+        its tip point is carried by: :func:`~grasptwist.hand.home_tips`).
     points, normals : (..., 3, 3) arrays
     radii : (3,) array
 
@@ -118,6 +122,8 @@ def tip_contacts(tip_poses, points, normals, radii) -> TipContacts:
     -------
     TipContacts
 
+    Examples
+    --------
     A tip of radius 1 at height 1 above a floor (normal down, into it),
     turned a quarter turn about x (its ``-y`` now points down): it touches the floor there:
 
@@ -137,7 +143,7 @@ def sphere_radius(vertices):
     """The radius of a mesh that is a sphere, or a cap of one, about the origin; None if it is not.
 
     The vertices nearest the origin, at distance ``r``, must be at least
-    :data:`SPHERE_VERTICES` on that sphere (within :data:`SPHERE_TOL` of ``r``),
+    ``SPHERE_VERTICES`` (16) on that sphere (within ``SPHERE_TOL`` (1e-6) of ``r``, relative),
     spread over at least as many latitudes (a hundredth of ``r`` apart) along
     each of their principal axes: a tessellated sphere or hemisphere, not
     a box's corners or the two rims of a cylinder, which are equidistant too.
@@ -151,6 +157,8 @@ def sphere_radius(vertices):
     -------
     float or None
 
+    Examples
+    --------
     >>> u = np.random.default_rng(0).normal(size=(200, 3)); u[:, 2] = -np.abs(u[:, 2])
     >>> round(sphere_radius(0.01 * u / np.linalg.norm(u, axis=1, keepdims=True)), 12)  # a hemisphere
     0.01

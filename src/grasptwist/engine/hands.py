@@ -93,9 +93,9 @@ def tip_poses(hand, positions, tips):
 
     .. math:: \\mathrm{tip}_f(q) = g_f(q)\\, M_f
 
-    (:func:`~grasptwist.engine.kinematics.forward_kinematics`), ``M_f`` row ``f``
+    (:func:`~grasptwist.hand.forward_kinematics`), ``M_f`` row ``f``
     of ``tips``: the tip link's pose at home, or for a finger given inline the
-    frame its tip point is carried by (:func:`grasptwist.engine.ik.home_tips`).
+    frame its tip point is carried by (:func:`~grasptwist.hand.home_tips`).
 
     Parameters
     ----------
@@ -107,6 +107,8 @@ def tip_poses(hand, positions, tips):
     -------
     (..., 3, 4, 4) array
 
+    Examples
+    --------
     >>> from grasptwist.hand import Finger, Hand, Joint
     >>> f = Finger("1", None, (Joint("x", "prismatic", None, None, None, None),), np.array([[0, 0, 0, 1.0, 0, 0]]), np.zeros((1, 3)), None, 1.0, (0,))
     >>> tip_poses(Hand((f, f, f), ("x",), None, None), [[2.0]], np.eye(4)[None].repeat(3, 0))[0, :, 0, 3].tolist()
@@ -231,7 +233,7 @@ def track(hand, positions, points, segments, times, *, normals=None, steps=16) -
     ``r`` rolls: the contact stays fixed on the object, so the sphere's
     centre (the tip link's origin) tracks ``p(t) - r n(t)``, a point the
     object carries, and the contact moves over the fingertip
-    (:mod:`grasptwist.engine.fingertips`).  A finger given inline has no
+    (:func:`~grasptwist.hand.tip_contacts`).  A finger given inline has no
     tip link: the point it tracks is the one it touches at ``t = 0``.  The
     integration's grid holds the sample times and
     :data:`SEGMENT_INTERVALS` equal intervals of each segment.

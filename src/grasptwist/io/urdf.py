@@ -277,7 +277,7 @@ def load_urdf_hand(urdf, tips, *, names=None, folder=None, max_bytes=DEFAULT_MAX
     ``tip_radius`` is that of the tip link's spherical collision geometry
     about the link's origin: a ``<sphere>`` centred there, or a mesh whose
     vertices nearest it lie on a sphere about it
-    (:func:`grasptwist.engine.fingertips.sphere_radius`, the TriFinger's
+    (:func:`grasptwist.hand.sphere_radius`, the TriFinger's
     fingertips); 0 (a point tip) without one, or when the mesh cannot be
     read (a ``package://`` of no installed Python package, a format trimesh
     does not read): a grasp file's ``tip_radius`` then gives it.

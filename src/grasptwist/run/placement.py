@@ -35,7 +35,7 @@ def place_grasp(grasp: Grasp) -> Grasp | GraspFileError:
     which.  Here the given positions are checked against the contacts (forward kinematics), or
     positions are solved from the seed (inverse kinematics): each tip link's origin, the
     centre of its fingertip's sphere, on ``point - tip_radius * normal``
-    (:func:`grasptwist.engine.fingertips.tip_centers`).
+    (:func:`grasptwist.hand.tip_centers`).
 
     Parameters
     ----------
