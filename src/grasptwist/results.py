@@ -380,6 +380,14 @@ def joint_column_names(prefix, hand) -> tuple[str, ...]:
     return tuple(f"{prefix}_{f.name}_{j.name}" for f in hand.fingers for j in f.joints)
 
 
+def _tip_column(name, axes):
+    """A fingertip's value (``axes`` empty) or vector per finger (engine/fingertips.py): shown even
+    where the hand failed, as the joint positions are."""
+    return Column(
+        name, _per_finger(name, np.nan), partial(finger_column_names, name, axes), only_where_ok=False, per_hand=True
+    )
+
+
 HAND = ResultKind(
     key="hand",
     label="hand",
@@ -399,28 +407,7 @@ HAND = ResultKind(
             per_hand=True,
         ),
         Column("tip_error", _per_finger("tip_error", np.nan), per_hand=True),
-        # the fingertips' spheres against the contacts (engine/fingertips.py): shown even where the hand failed
-        Column(
-            "tip_center",
-            _per_finger("tip_center", np.nan),
-            partial(finger_column_names, "tip_center", "xyz"),
-            only_where_ok=False,
-            per_hand=True,
-        ),
-        Column(
-            "tip_gap",
-            _per_finger("tip_gap", np.nan),
-            partial(finger_column_names, "tip_gap", ""),
-            only_where_ok=False,
-            per_hand=True,
-        ),
-        Column(
-            "tip_contact",
-            _per_finger("tip_contact", np.nan),
-            partial(finger_column_names, "tip_contact", "xyz"),
-            only_where_ok=False,
-            per_hand=True,
-        ),
+        *(_tip_column(name, axes) for name, axes in (("tip_center", "xyz"), ("tip_gap", ""), ("tip_contact", "xyz"))),
         Column("within_limits", _per_finger("within_limits", False), dtype="?", per_hand=True),
         Column("finger_rank", _per_finger("finger_rank", -1), dtype="i8", per_hand=True),
         Column("finger_residual", _per_finger("finger_residual", np.nan), per_hand=True),
