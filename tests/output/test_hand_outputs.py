@@ -13,6 +13,7 @@ import grasptwist as gt
 from grasptwist import hand
 from grasptwist.cli import app
 from grasptwist.output.columns import CSV_COLUMNS
+from grasptwist.output.follow_table import FollowTable
 from places import ROOT
 
 THREE = ROOT / "grasps" / "three-finger-hand.yaml"
@@ -207,3 +208,14 @@ def test_a_data_set_without_joint_positions_is_solved_by_inverse_kinematics(tmp_
         assert b["hand"]["ok"], b["hand"]
         rates = [r for f in b["hand"]["fingers"] for r in f["joint_rates"]]
         assert rates == pytest.approx([r for f in a["hand"]["fingers"] for r in f["joint_rates"]], abs=1e-7)
+
+
+def test_the_follow_table_gives_a_rounded_tips_gap():
+    """Under each sample, a finger with a tip radius shows its gap (a penetration negative); a
+    point tip shows none."""
+    out = io.BytesIO()
+    finger = {"contact": "1", "joint_positions": [0.5], "within_limits": True, "tip_error": 0.0}
+    fingers = [{**finger, "tip_radius": 0.01, "tip_gap": -0.001272}, {**finger, "tip_radius": 0.0, "tip_gap": 0.0}]
+    FollowTable(out)._hand_line({"fingers": fingers})
+    line = out.getvalue().decode()
+    assert "finger 1: q 0.5000, tip error < 1e-12, tip gap -0.00127;" in line and line.count("tip gap") == 1
