@@ -79,11 +79,13 @@ def hemisphere(radius, n=400, seed=1):
         (np.array(np.meshgrid([-1.0, 1], [-1.0, 1], [-1.0, 1])).reshape(3, -1).T, None),
         (np.array([[np.cos(a), np.sin(a), z] for a in range(32) for z in (-1.0, 1.0)]), None),
         (hemisphere(0.01, n=SPHERE_VERTICES - 1), None),  # too few to tell
+        (np.vstack((hemisphere(0.01), [[0.0, 0.0, 0.009]])), None),  # something 10 % inside it
+        (np.vstack((hemisphere(0.01), [[0.0, 0.0, 0.0099]])), 0.01),  # a chord's 1 %: a closed cap's rim
         (hemisphere(0.01) + [0.0, 0.0, 0.001], None),  # a sphere about another point: its cap is not equidistant
         (np.zeros((0, 3)), None),
         (np.full((20, 3), np.nan), None),
     ],
-    ids=["hemisphere", "tip", "float32", "cube", "cylinder", "few", "offset", "empty", "nan"],
+    ids=["hemisphere", "tip", "float32", "cube", "cylinder", "few", "inside", "chord", "offset", "empty", "nan"],
 )
 def test_sphere_radius_of_a_mesh(vertices, want):
     got = sphere_radius(vertices)

@@ -37,16 +37,28 @@ import numpy as np
 
 from .screws import dot, unit
 
-__all__ = ["TipContacts", "tip_radii", "tip_centers", "tip_contacts", "sphere_radius", "SPHERE_TOL", "SPHERE_VERTICES"]
+__all__ = [
+    "TipContacts",
+    "tip_radii",
+    "tip_centers",
+    "tip_contacts",
+    "sphere_radius",
+    "SPHERE_TOL",
+    "SPHERE_VERTICES",
+    "SPHERE_SAG",
+]
 
-#: A mesh's vertex lies on the sphere through its nearest one when their distances from the centre
-#: agree to this, relative (a float32 STL's round-off is some 1e-7).
+#: Two of a mesh's vertices lie on one sphere about a point when their distances from it agree
+#: to this, relative (a float32 STL's round-off is some 1e-7).
 SPHERE_TOL = 1e-6
 
 #: A mesh is a sphere (or a cap of one) about a point when at least this many of its vertices lie
-#: on the sphere through the nearest one, at as many distinct latitudes about each of their
+#: on the sphere through the most of them, at as many distinct latitudes about each of their
 #: principal axes (:func:`sphere_radius`).
 SPHERE_VERTICES = 16
+
+#: ... and none lies farther inside that sphere than this fraction of its radius.
+SPHERE_SAG = 0.05
 
 
 def tip_radii(hand):
@@ -142,11 +154,13 @@ def tip_contacts(tip_poses, points, normals, radii) -> TipContacts:
 def sphere_radius(vertices):
     """The radius of a mesh that is a sphere, or a cap of one, about the origin; None if it is not.
 
-    The vertices nearest the origin, at distance ``r``, must be at least
-    ``SPHERE_VERTICES`` (16) on that sphere (within ``SPHERE_TOL`` (1e-6) of ``r``, relative),
-    spread over at least as many latitudes (a hundredth of ``r`` apart) along
-    each of their principal axes: a tessellated sphere or hemisphere, not
-    a box's corners or the two rims of a cylinder, which are equidistant too.
+    The sphere is the one through the most vertices (within ``SPHERE_TOL``
+    (1e-6) of its radius ``r``, relative); at least ``SPHERE_VERTICES`` (16)
+    must lie on it, spread over at least as many latitudes (a hundredth of
+    ``r`` apart) along each of their principal axes: a tessellated sphere or
+    hemisphere, not a box's corners or the two rims of a cylinder, which are
+    equidistant too.  No vertex may lie more than ``SPHERE_SAG`` (5 %) inside
+    it (a cap closed by a flat face has its rim on chords, a little inside).
 
     Parameters
     ----------
@@ -170,9 +184,11 @@ def sphere_radius(vertices):
     d = np.linalg.norm(v, axis=-1)
     if not v.size or not np.isfinite(d).all() or d.min() <= 0:
         return None
-    r = float(d.min())
+    ordered = np.sort(d)
+    count = np.searchsorted(ordered, ordered * (1 + SPHERE_TOL), side="right") - np.arange(len(d))
+    r = float(ordered[np.argmax(count)])  # the distance most vertices share (the nearest such)
     on = v[np.abs(d - r) <= SPHERE_TOL * r] / r
-    if len(on) < SPHERE_VERTICES:
+    if len(on) < SPHERE_VERTICES or d.min() < (1 - SPHERE_SAG) * r:
         return None
     axes = np.linalg.eigh(np.cov(on.T))[1]
     latitudes = np.round(on @ axes, 2)

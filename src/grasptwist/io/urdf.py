@@ -275,8 +275,8 @@ def load_urdf_hand(urdf, tips, *, names=None, folder=None, max_bytes=DEFAULT_MAX
     ``tips[f]``; fixed joints only carry frames along.  Move the fingers to
     joint positions with :func:`grasptwist.hand.finger_states`.  Its
     ``tip_radius`` is that of the tip link's spherical collision geometry
-    about the link's origin: a ``<sphere>`` centred there, or a mesh whose
-    vertices nearest it lie on a sphere about it
+    about the link's origin: a ``<sphere>`` centred there, or a mesh that is
+    a sphere or a cap of one about it
     (:func:`grasptwist.hand.sphere_radius`, the TriFinger's
     fingertips); 0 (a point tip) without one, or when the mesh cannot be
     read (a ``package://`` of no installed Python package, a format trimesh
@@ -327,17 +327,18 @@ def load_urdf_hand(urdf, tips, *, names=None, folder=None, max_bytes=DEFAULT_MAX
     names = [str(i + 1) for i in range(len(tips))] if names is None else list(names)
     if len(names) != len(tips):
         raise ValueError(f"names: expected {len(tips)} finger names, got {len(names)}")
-    fingers, joint_names = [], {}
+    fingers, joint_names, meshes = [], {}, {}
     for name, tip in zip(names, tips, strict=True):
         path = _path(model, parent_joint, tip, lines, file)
         finger = _finger(name, tip, path, lines, file, joint_names)
-        fingers.append(replace(finger, tip_radius=_tip_radius(model, tip, where, max_bytes)))
+        fingers.append(replace(finger, tip_radius=_tip_radius(model, tip, where, max_bytes, meshes)))
     roots = [link for link in model.link_map if link not in parent_joint]
     return Hand(tuple(fingers), tuple(joint_names), text, roots[0])
 
 
-def _tip_radius(model, tip, urdf, max_bytes):
-    """The radius of link ``tip``'s spherical collision geometry about its origin (0: none)."""
+def _tip_radius(model, tip, urdf, max_bytes, meshes):
+    """The radius of link ``tip``'s spherical collision geometry about its origin (0: none);
+    ``meshes`` keeps each mesh file's vertices read so far (a hand's fingers share their tip's)."""
     from ..engine.fingertips import SPHERE_TOL, sphere_radius
 
     for collision in model.link_map[tip].collisions:
@@ -345,7 +346,9 @@ def _tip_radius(model, tip, urdf, max_bytes):
         sphere, mesh = collision.geometry.sphere, collision.geometry.mesh
         if sphere is not None and float(np.linalg.norm(origin[:3, 3])) <= SPHERE_TOL * sphere.radius:
             return float(sphere.radius)
-        vertices = None if mesh is None else _mesh_vertices(mesh, urdf, max_bytes)
+        if mesh is not None and mesh.filename not in meshes:
+            meshes[mesh.filename] = _mesh_vertices(mesh, urdf, max_bytes)
+        vertices = None if mesh is None else meshes[mesh.filename]
         if vertices is not None:
             scale = np.ones(3) if mesh.scale is None else np.broadcast_to(np.asarray(mesh.scale, dtype=float), 3)
             radius = sphere_radius(vertices * scale @ origin[:3, :3].T + origin[:3, 3])
