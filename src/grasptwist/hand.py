@@ -16,11 +16,13 @@ frame (:class:`Hand`).  The math lives in ``grasptwist.engine.kinematics``,
 
 from __future__ import annotations
 
+from .engine.fingertips import TipContacts, sphere_radius, tip_centers, tip_contacts, tip_radii
 from .engine.hands import (
     SEGMENT_INTERVALS,
     HandTrack,
     finger_states,
     joint_positions,
+    tip_poses,
     track,
     velocity_limits,
 )
@@ -53,6 +55,12 @@ __all__ = [
     "velocity_limits",
     "HandTrack",
     "track",
+    "tip_radii",
+    "tip_centers",
+    "tip_contacts",
+    "TipContacts",
+    "tip_poses",
+    "sphere_radius",
     "SEGMENT_INTERVALS",
     "joint_screw",
     "finger_jacobian",

@@ -401,6 +401,10 @@ class Finger:
         contact farther than this from the tip is a frame mix-up.
     joint_index : tuple of int
         Position of each joint in ``Hand.joint_names``.
+    tip_radius : float
+        Radius of the fingertip's sphere, centred at the tip link's origin (0: a
+        point tip). The tip's centre sits at ``point - tip_radius * normal``
+        (normal into the object), so the sphere touches the object at the contact.
     """
 
     name: str
@@ -411,6 +415,7 @@ class Finger:
     tip_pose: np.ndarray | None
     length: float
     joint_index: tuple[int, ...]
+    tip_radius: float = 0.0
 
 
 @dataclass(frozen=True, eq=False)

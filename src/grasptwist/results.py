@@ -339,15 +339,34 @@ def _per_joint(name):
 
 
 def _per_finger(name, fill):
-    """``(N, 3)`` attribute ``name`` of the hand result, ``fill`` where there is none."""
+    """``(N, 3, ...)`` attribute ``name`` of the hand result (per finger: a value or a vector), ``fill``
+    where there is none."""
 
     def get(r, block, hand):
         values = None if r is None else getattr(r, name)
         if values is None:
-            return np.full((len(block), 3), fill)
-        return np.where(block.has_hand[:, None], values, fill)
+            return np.full((len(block), 3, 3) if name in _FINGER_VECTORS else (len(block), 3), fill)
+        has = block.has_hand.reshape((-1,) + (1,) * (np.ndim(values) - 1))
+        return np.where(has, values, fill)
 
     return get
+
+
+#: The hand result's attributes that hold a 3-vector per finger.
+_FINGER_VECTORS = ("tip_center", "tip_contact")
+
+
+def finger_column_names(prefix, axes, hand) -> tuple[str, ...]:
+    """Flat column names of a value (``axes`` empty) or a vector per finger of ``hand``:
+    ``<prefix>_<finger>[_<axis>]``.
+
+    >>> from grasptwist.model import Finger, Hand
+    >>> f = Finger("a", None, (), None, None, None, 1.0, ())
+    >>> h = Hand((f, f, f), (), None, None)
+    >>> finger_column_names("tip_center", "xy", h)[:2], finger_column_names("tip_gap", "", h)[:1]
+    (('tip_center_a_x', 'tip_center_a_y'), ('tip_gap_a',))
+    """
+    return tuple(f"{prefix}_{f.name}" + (f"_{a}" if a else "") for f in hand.fingers for a in (axes or [""]))
 
 
 def joint_column_names(prefix, hand) -> tuple[str, ...]:
@@ -359,6 +378,14 @@ def joint_column_names(prefix, hand) -> tuple[str, ...]:
     ('q_a_j',)
     """
     return tuple(f"{prefix}_{f.name}_{j.name}" for f in hand.fingers for j in f.joints)
+
+
+def _tip_column(name, axes):
+    """A fingertip's value (``axes`` empty) or vector per finger (engine/fingertips.py): shown even
+    where the hand failed, as the joint positions are."""
+    return Column(
+        name, _per_finger(name, np.nan), partial(finger_column_names, name, axes), only_where_ok=False, per_hand=True
+    )
 
 
 HAND = ResultKind(
@@ -380,6 +407,7 @@ HAND = ResultKind(
             per_hand=True,
         ),
         Column("tip_error", _per_finger("tip_error", np.nan), per_hand=True),
+        *(_tip_column(name, axes) for name, axes in (("tip_center", "xyz"), ("tip_gap", ""), ("tip_contact", "xyz"))),
         Column("within_limits", _per_finger("within_limits", False), dtype="?", per_hand=True),
         Column("finger_rank", _per_finger("finger_rank", -1), dtype="i8", per_hand=True),
         Column("finger_residual", _per_finger("finger_residual", np.nan), per_hand=True),

@@ -16,7 +16,7 @@ import yaml
 from typer.testing import CliRunner
 
 from grasptwist.cli import app
-from grasptwist.io.grasp import grasp_schema
+from grasptwist.io.grasp import grasp_schema, load_grasps
 from grasptwist.run.placement import read_grasps  # the hand placed on its contacts, as every command reads it
 from places import ROOT
 
@@ -137,17 +137,48 @@ def trifinger_text(**changes):
 
 
 @urdf_only
-def test_urdf_form_gives_the_hand_at_its_joint_positions():
-    (g,) = read_grasps(TRIFINGER)
+def test_urdf_form_gives_the_hand_at_its_seed_with_its_tip_radius():
+    """The bundled file gives no joint positions (the run solves them) and no tip radius: the
+    URDF's tip collision mesh (a 10 mm hemisphere about the tip link's origin) gives it."""
+    (g,) = load_grasps(TRIFINGER)  # as read, not yet placed
     assert g.hand.root == "base_link" and g.hand.source.startswith("package://")
     assert [f.tip for f in g.hand.fingers] == ["finger_tip_link_0", "finger_tip_link_120", "finger_tip_link_240"]
-    assert g.joint_positions[0] == 0.181390037
+    assert not g.placement.given and (g.joint_positions == 0).all()
+    assert [f.tip_radius for f in g.hand.fingers] == [0.01] * 3
+
+
+@urdf_only
+def test_a_tip_radius_per_finger_wins_over_the_hands_and_the_urdfs():
+    doc = yaml.safe_load(TRIFINGER.read_text("utf-8"))
+    doc["hand"]["tip_radius"] = 0.005
+    doc["hand"]["fingers"][1]["tip_radius"] = 0
+    (g,) = read_grasps(yaml.safe_dump(doc, sort_keys=False), file=str(TRIFINGER))
+    assert [f.tip_radius for f in g.hand.fingers] == [0.005, 0.0, 0.005]
+
+
+def test_an_inline_hand_takes_a_tip_radius():
+    text = inline(finger(), finger(), finger()).replace("hand:\n", "hand:\n  tip_radius: 0.25\n", 1)
+    (g,) = read_grasps(text, file="g.yaml")
+    assert [f.tip_radius for f in g.hand.fingers] == [0.25] * 3
+
+
+@pytest.mark.parametrize(
+    ("value", "code", "match"),
+    [("-0.01", "invalid-radius", r"^hand.tip_radius: must be 0 or more, got -0.01$"), ("big", "not-a-number", "")],
+)
+def test_a_bad_tip_radius_is_located(value, code, match):
+    text = inline(finger(), finger(), finger()).replace("hand:\n", f"hand:\n  tip_radius: {value}\n", 1)
+    line = text.splitlines().index(f"  tip_radius: {value}") + 1
+    got = one_error(text)
+    assert got[:3] == (code, line, 15), got
+    assert re.search(match, got[3]), got[3]
 
 
 @urdf_only
 def test_contact_off_finger():
     doc = yaml.safe_load(TRIFINGER.read_text("utf-8"))
     doc["contacts"][1]["point"] = [0.5, -0.5, 0.5]  # half a metre away: the hand's frame mistaken
+    doc["hand"]["joint_positions"] = {"finger_base_to_upper_joint_0": 0.0}  # given: checked, not solved
     code, line, column, message = one_error(yaml.safe_dump(doc, sort_keys=False))
     assert code == "contact-off-finger"
     assert message.startswith("hand.fingers[1].tip: contact 2 is ")
@@ -158,7 +189,7 @@ def test_contact_off_finger():
 @urdf_only
 def test_unknown_joint_position_is_located():
     doc = yaml.safe_load(TRIFINGER.read_text("utf-8"))
-    doc["hand"]["joint_positions"]["no_such_joint"] = 1.0
+    doc["hand"]["joint_positions"] = {"no_such_joint": 1.0}
     code, _, _, message = one_error(yaml.safe_dump(doc, sort_keys=False))
     assert code == "unknown-joint"
     assert message.startswith("hand.joint_positions.no_such_joint: not a joint of the hand's fingers")

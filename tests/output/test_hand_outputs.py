@@ -13,6 +13,7 @@ import grasptwist as gt
 from grasptwist import hand
 from grasptwist.cli import app
 from grasptwist.output.columns import CSV_COLUMNS
+from grasptwist.output.follow_table import FollowTable
 from places import ROOT
 
 THREE = ROOT / "grasps" / "three-finger-hand.yaml"
@@ -28,6 +29,10 @@ def jsonl(*args):
     return [json.loads(line) for line in run(*args, "-f", "jsonl").stdout.splitlines()]
 
 
+def rec_points(path):
+    return [c["point"] for c in jsonl("resolve", path)[0]["contacts"]]
+
+
 def test_csv_of_a_hand_grasp_has_its_joint_columns():
     result = run("resolve", THREE, "-f", "csv")
     assert result.exit_code == 0
@@ -35,7 +40,13 @@ def test_csv_of_a_hand_grasp_has_its_joint_columns():
     header, (row,) = rows[0], rows[1:]
     joints = [f"qdot_{f}_{f}.{k}" for f in ("east", "west", "south") for k in (1, 2, 3)]
     positions = [name.replace("qdot_", "q_", 1) for name in joints]
-    assert header == CSV_COLUMNS + joints + positions + ["hand_error"]
+    fingers = ("east", "west", "south")
+    centres = [f"tip_center_{f}_{a}" for f in fingers for a in "xyz"]
+    where = [f"tip_gap_{f}" for f in fingers] + [f"tip_contact_{f}_{a}" for f in fingers for a in "xyz"]
+    assert header == CSV_COLUMNS + joints + positions + centres + where + ["hand_error"]
+    # point tips (no tip_radius): each centre is its contact, touching it (gap 0)
+    assert [float(row[header.index(name)]) for name in centres] == [x for c in rec_points(THREE) for x in c]
+    assert [float(row[header.index(f"tip_gap_{f}")]) for f in fingers] == [0.0] * 3
     (rec,) = jsonl("resolve", THREE)
     want = [r for f in rec["hand"]["fingers"] for r in f["joint_rates"]]
     assert [float(row[header.index(name)]) for name in joints] == want
@@ -148,15 +159,17 @@ def test_the_plot_scene_draws_each_finger_joint_axis():
 
 
 def _rows(tmp_path, trifinger, n=30, seed=4):
-    """A TriFinger data set: contacts at the tip links' origins at random joint positions within
-    the limits, and a hand file of the TriFinger."""
+    """A TriFinger data set: contacts one fingertip radius (10 mm) beyond the tip links' origins,
+    along their normals, at random joint positions within the limits, and a hand file of the TriFinger."""
     rng = np.random.default_rng(seed)
     q = rng.uniform([-0.3, 0.1, -2.5] * 3, [0.9, 1.4, -0.3] * 3, size=(n, 9))
-    points = np.stack([s.tip[:, :3, 3] for s in hand.finger_states(trifinger, q)], axis=1)
+    normals = rng.normal(size=(n, 3, 3))
+    normals /= np.linalg.norm(normals, axis=-1, keepdims=True)
+    points = np.stack([s.tip[:, :3, 3] for s in hand.finger_states(trifinger, q)], axis=1) + 0.01 * normals
     hand_file = tmp_path / "trifinger.yaml"
     fingers = "".join(f"    - {{tip: {f.tip}}}\n" for f in trifinger.fingers)
     hand_file.write_text(f"hand:\n  urdf: {trifinger.source}\n  fingers:\n{fingers}", "utf-8")
-    return q, points, rng.normal(size=(n, 3, 3)), hand_file
+    return q, points, normals, hand_file
 
 
 @urdf_only
@@ -195,3 +208,14 @@ def test_a_data_set_without_joint_positions_is_solved_by_inverse_kinematics(tmp_
         assert b["hand"]["ok"], b["hand"]
         rates = [r for f in b["hand"]["fingers"] for r in f["joint_rates"]]
         assert rates == pytest.approx([r for f in a["hand"]["fingers"] for r in f["joint_rates"]], abs=1e-7)
+
+
+def test_the_follow_table_gives_a_rounded_tips_gap():
+    """Under each sample, a finger with a tip radius shows its gap (a penetration negative); a
+    point tip shows none."""
+    out = io.BytesIO()
+    finger = {"contact": "1", "joint_positions": [0.5], "within_limits": True, "tip_error": 0.0}
+    fingers = [{**finger, "tip_radius": 0.01, "tip_gap": -0.001272}, {**finger, "tip_radius": 0.0, "tip_gap": 0.0}]
+    FollowTable(out)._hand_line({"fingers": fingers})
+    line = out.getvalue().decode()
+    assert "finger 1: q 0.5000, tip error < 1e-12, tip gap -0.00127;" in line and line.count("tip gap") == 1

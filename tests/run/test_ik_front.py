@@ -38,10 +38,25 @@ def jsonl(*args):
     return [json.loads(line) for line in result.stdout.splitlines()]
 
 
+#: The bundled TriFinger grasp's joint positions, as once typed into its file (each fingertip
+#: sphere's centre one radius behind its contact); the run solves them now.
+FILE_POSITIONS = dict(
+    zip(
+        [
+            f"finger_{j}_joint_{f}"
+            for f in (0, 120, 240)
+            for j in ("base_to_upper", "upper_to_middle", "middle_to_lower")
+        ],
+        [0.181390037, 0.5904426439, -1.4828803827, 0.19893411, 0.5545414034, -1.3054491805]
+        + [0.2399650693, 0.5570307797, -1.2184725163],
+    )
+)
+
+
 def without_positions(tmp_path, seed=None, **contacts):
-    """The bundled TriFinger grasp without its joint_positions (with ``seed``; contact ``i`` moved)."""
+    """The bundled TriFinger grasp (with ``seed``; contact ``i`` moved), and the positions once typed."""
     doc = yaml.safe_load(TRIFINGER.read_text("utf-8"))
-    file_positions = doc["hand"].pop("joint_positions")
+    file_positions = FILE_POSITIONS
     if seed is not None:
         doc["hand"]["seed"] = seed
     for i, point in contacts.items():
@@ -58,10 +73,11 @@ def tips(hand, q):
 
 @urdf
 def test_a_grasp_without_joint_positions_puts_each_tip_on_its_contact(tmp_path):
+    """Each tip link's origin, its fingertip sphere's centre, one radius (10 mm) behind its contact."""
     path, _ = without_positions(tmp_path)
     (g,) = read_grasps(path)
     lengths = np.array([f.length for f in g.hand.fingers])
-    distance = np.linalg.norm(tips(g.hand, g.joint_positions) - g.points, axis=-1)
+    distance = np.linalg.norm(tips(g.hand, g.joint_positions) - (g.points - 0.01 * g.normals), axis=-1)
     assert (distance <= IK_TOL * lengths).all(), distance
     assert lengths == pytest.approx([0.382036] * 3, abs=1e-6)
     # the configuration the joint rates are at is in the record, with its tip errors
@@ -77,10 +93,10 @@ def test_the_seed_is_where_the_solution_starts(tmp_path):
     """The elbow-down solution the file's positions hold (each sphere centre one radius inside its
     contact) from a seed there; the same as the engine's hand_ik from that seed."""
     path, file_positions = without_positions(tmp_path, seed=None)
-    seed = {k: round(v, 1) for k, v in yaml.safe_load(TRIFINGER.read_text("utf-8"))["hand"]["joint_positions"].items()}
+    seed = {k: round(v, 1) for k, v in FILE_POSITIONS.items()}
     seeded, _ = without_positions(tmp_path / "..", seed=seed)
     (g,) = read_grasps(seeded)
-    want = hand_ik(g.hand, g.points, seed=[seed[name] for name in g.hand.joint_names])
+    want = hand_ik(g.hand, g.points - 0.01 * g.normals, seed=[seed[name] for name in g.hand.joint_names])
     np.testing.assert_array_equal(g.joint_positions, want.positions)
     # the file's positions are 1 cm (the sphere's radius) from the contacts: the solution is near them
     assert np.abs(g.joint_positions - list(file_positions.values())).max() < 0.1
@@ -112,7 +128,8 @@ def test_a_finger_that_cannot_reach_fails_the_grasp_at_its_tip(fixture, code, ma
         (g,) = read_grasps(TRIFINGER)
         seed = [doc["hand"]["seed"].get(name, 0.0) for name in g.hand.joint_names]
         points = np.array([c["point"] for c in doc["contacts"]])
-        solved = hand_ik(g.hand, points, seed=seed)
+        normals = np.array([c["normal"] for c in doc["contacts"]])
+        solved = hand_ik(g.hand, points - 0.01 * normals, seed=seed)  # the centres, 10 mm behind
         assert Status(int(solved.status[0])) == Status.UNREACHABLE
         assert float(found.group(1)) == pytest.approx(solved.tip_error[0], rel=1e-5)
         assert 0.7 < solved.tip_error[0] < 0.9
@@ -135,9 +152,11 @@ def test_a_data_set_solved_by_ik_carries_its_positions_in_every_format(tmp_path)
     (g,) = read_grasps(TRIFINGER)
     rng = np.random.default_rng(7)
     q = rng.uniform([-0.3, 0.1, -2.5] * 3, [0.9, 1.4, -0.3] * 3, size=(6, 9))
-    points = tips(g.hand, q)
+    normals = rng.normal(size=(6, 3, 3))
+    normals /= np.linalg.norm(normals, axis=-1, keepdims=True)
+    points = tips(g.hand, q) + 0.01 * normals  # the fingertip spheres (radius 10 mm) touch them
     data = tmp_path / "rows.npz"
-    np.savez(data, points=points, normals=rng.normal(size=(6, 3, 3)), twist=[0, 0, 0.5, 0, 0, 0])
+    np.savez(data, points=points, normals=normals, twist=[0, 0, 0.5, 0, 0, 0])
     hand_file = tmp_path / "trifinger.yaml"
     fingers = "".join(f"    - {{name: '{f.name}', tip: {f.tip}}}\n" for f in g.hand.fingers)
     hand_file.write_text(f"hand:\n  urdf: {g.hand.source}\n  fingers:\n{fingers}", "utf-8")
@@ -147,7 +166,7 @@ def test_a_data_set_solved_by_ik_carries_its_positions_in_every_format(tmp_path)
         solved, tip_error, within = d["joint_positions"], d["tip_error"], d["within_limits"]
     lengths = np.array([f.length for f in g.hand.fingers])
     assert solved.shape == (6, 9)
-    assert (np.linalg.norm(tips(g.hand, solved) - points, axis=-1) <= IK_TOL * lengths).all()
+    assert (np.linalg.norm(tips(g.hand, solved) - (points - 0.01 * normals), axis=-1) <= IK_TOL * lengths).all()
     assert (tip_error <= IK_TOL * lengths).all() and within.all()
     rows = list(csv.DictReader(io.StringIO(run("resolve", data, "--hand", hand_file, "-f", "csv").stdout)))
     names = [f"q_{f.name}_{j.name}" for f in g.hand.fingers for j in f.joints]

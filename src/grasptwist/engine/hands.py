@@ -12,6 +12,7 @@ from typing import NamedTuple
 
 import numpy as np
 
+from .fingertips import tip_centers, tip_radii
 from .kinematics import ChainState, forward_kinematics
 from .path import check_segments
 from .tracking import FingerTrack, track_finger
@@ -19,6 +20,7 @@ from .tracking import FingerTrack, track_finger
 __all__ = [
     "joint_positions",
     "finger_states",
+    "tip_poses",
     "velocity_limits",
     "padded",
     "padded_positions",
@@ -84,6 +86,41 @@ def finger_states(hand, positions=None):
     return tuple(
         forward_kinematics(f.screws, f.points, f.tip_pose, positions[..., list(f.joint_index)]) for f in hand.fingers
     )
+
+
+def tip_poses(hand, positions, tips):
+    """Each finger's tip link pose at joint positions, ``(..., 3, 4, 4)``.
+
+    .. math:: \\mathrm{tip}_f(q) = g_f(q)\\, M_f
+
+    (:func:`~grasptwist.hand.forward_kinematics`), ``M_f`` row ``f``
+    of ``tips``: the tip link's pose at home, or for a finger given inline the
+    frame its tip point is carried by (:func:`~grasptwist.hand.home_tips`).
+
+    Parameters
+    ----------
+    hand : Hand
+    positions : (..., n_joints) array
+    tips : (3, 4, 4) array
+
+    Returns
+    -------
+    (..., 3, 4, 4) array
+
+    Examples
+    --------
+    >>> from grasptwist.hand import Finger, Hand, Joint
+    >>> f = Finger("1", None, (Joint("x", "prismatic", None, None, None, None),), np.array([[0, 0, 0, 1.0, 0, 0]]), np.zeros((1, 3)), None, 1.0, (0,))
+    >>> tip_poses(Hand((f, f, f), ("x",), None, None), [[2.0]], np.eye(4)[None].repeat(3, 0))[0, :, 0, 3].tolist()
+    [2.0, 2.0, 2.0]
+    """
+    positions = np.asarray(positions, dtype=float)
+    tips = np.asarray(tips, dtype=float)
+    poses = [
+        forward_kinematics(f.screws, f.points, tips[i], positions[..., list(f.joint_index)]).tip
+        for i, f in enumerate(hand.fingers)
+    ]
+    return np.stack(poses, axis=-3)
 
 
 def velocity_limits(finger):
@@ -187,13 +224,17 @@ def _limits(finger, which):
 SEGMENT_INTERVALS = 4
 
 
-def track(hand, positions, points, segments, times, *, steps=16) -> HandTrack:
+def track(hand, positions, points, segments, times, *, normals=None, steps=16) -> HandTrack:
     """Every finger keeping its tip on its contact while the object follows a path.
 
     Finger ``f`` follows contact ``f`` by :func:`grasptwist.path.track_finger`
     (resolved rates with forward-kinematics feedback), from ``positions``
-    and within its joints' position limits.  A finger given inline has no
-    tip link: the point it touches is the contact itself at ``t = 0``.  The
+    and within its joints' position limits.  A fingertip with a radius
+    ``r`` rolls: the contact stays fixed on the object, so the sphere's
+    centre (the tip link's origin) tracks ``p(t) - r n(t)``, a point the
+    object carries, and the contact moves over the fingertip
+    (:func:`~grasptwist.hand.tip_contacts`).  A finger given inline has no
+    tip link: the point it tracks is the one it touches at ``t = 0``.  The
     integration's grid holds the sample times and
     :data:`SEGMENT_INTERVALS` equal intervals of each segment.
 
@@ -207,6 +248,8 @@ def track(hand, positions, points, segments, times, *, steps=16) -> HandTrack:
     segments : sequence of Segment
     times : (T,) array
         Increasing sample times.
+    normals : (3, 3) array, optional
+        The contacts' normals at ``t = 0``, into the object: needed for fingertips with a radius.
     steps : int
         Runge-Kutta steps per interval of :data:`SEGMENT_INTERVALS`: steps are
         no longer than ``1 / (SEGMENT_INTERVALS * steps)`` of their segment.
@@ -227,7 +270,10 @@ def track(hand, positions, points, segments, times, *, steps=16) -> HandTrack:
     [0.5, 0.0, 0.0]
     """
     q0 = np.zeros(len(hand.joint_names)) if positions is None else np.asarray(positions, dtype=float)
-    points = np.asarray(points, dtype=float)
+    radii = tip_radii(hand)
+    if normals is None and radii.any():
+        raise ValueError("normals: needed for fingertips with a radius (their centres sit at p - r n)")
+    points = tip_centers(points, normals, radii)  # the points the fingers keep on the object
     times = np.asarray(times, dtype=float)
     ends = np.cumsum([0.0] + [s.duration for s in check_segments(segments)])
     extra = np.concatenate([np.linspace(a, b, SEGMENT_INTERVALS + 1)[1:-1] for a, b in zip(ends[:-1], ends[1:])])

@@ -392,6 +392,12 @@ class HandRates:
         None when not told.
     tip_error, within_limits : (..., 3) arrays or None
         Per finger at that configuration, :class:`grasptwist.engine.ik.HandIK`'s.
+    tip_center : (..., 3, 3) array or None
+        Each fingertip sphere's centre, ``p - r n`` (:mod:`grasptwist.engine.fingertips`).
+    tip_gap : (..., 3) array or None
+        Each sphere's gap to its contact's tangent plane at that configuration (< 0: a penetration).
+    tip_contact : (..., 3, 3) array or None
+        Where each sphere faces its contact: a unit vector in its tip link's frame.
     """
 
     rates: np.ndarray
@@ -407,6 +413,9 @@ class HandRates:
     joint_positions: np.ndarray | None = None
     tip_error: np.ndarray | None = None
     within_limits: np.ndarray | None = None
+    tip_center: np.ndarray | None = None
+    tip_gap: np.ndarray | None = None
+    tip_contact: np.ndarray | None = None
 
     @property
     def ok(self) -> np.ndarray:

@@ -41,6 +41,7 @@ import math
 import os
 import re
 import stat
+from dataclasses import replace
 from importlib.util import find_spec
 from pathlib import Path
 
@@ -272,7 +273,14 @@ def load_urdf_hand(urdf, tips, *, names=None, folder=None, max_bytes=DEFAULT_MAX
     The hand's frame (and so the grasp's) is the URDF's root link's frame.
     Finger ``f``'s joints are the movable joints on the path from the root to
     ``tips[f]``; fixed joints only carry frames along.  Move the fingers to
-    joint positions with :func:`grasptwist.hand.finger_states`.
+    joint positions with :func:`grasptwist.hand.finger_states`.  Its
+    ``tip_radius`` is that of the tip link's spherical collision geometry
+    about the link's origin: a ``<sphere>`` centred there, or a mesh that is
+    a sphere or a cap of one about it
+    (:func:`grasptwist.hand.sphere_radius`, the TriFinger's
+    fingertips); 0 (a point tip) without one, or when the mesh cannot be
+    read (a ``package://`` of no installed Python package, a format trimesh
+    does not read): a grasp file's ``tip_radius`` then gives it.
 
     Parameters
     ----------
@@ -303,11 +311,14 @@ def load_urdf_hand(urdf, tips, *, names=None, folder=None, max_bytes=DEFAULT_MAX
     >>> hand.root, len(hand.joint_names), [j.name for j in hand.fingers[0].joints]  # doctest: +NORMALIZE_WHITESPACE
     ('base_link', 9, ['finger_base_to_upper_joint_0', 'finger_upper_to_middle_joint_0',
                       'finger_middle_to_lower_joint_0'])
+    >>> [f.tip_radius for f in hand.fingers]  # from the hemisphere of the tip links' collision mesh
+    [0.01, 0.01, 0.01]
     """
     text = os.fspath(urdf)
     file = text if text.startswith(_PACKAGE) or folder is None else os.path.join(os.fspath(folder), text)
     _library(file)  # before the reference: a package:// one may be missing for the same reason
-    data = _read(resolve_urdf(urdf, folder), max_bytes, file)
+    where = resolve_urdf(urdf, folder)
+    data = _read(where, max_bytes, file)
     root = _parse(data, file)
     _check_joint_elements(root, file)
     model = _model(data, file)
@@ -316,13 +327,52 @@ def load_urdf_hand(urdf, tips, *, names=None, folder=None, max_bytes=DEFAULT_MAX
     names = [str(i + 1) for i in range(len(tips))] if names is None else list(names)
     if len(names) != len(tips):
         raise ValueError(f"names: expected {len(tips)} finger names, got {len(names)}")
-    fingers, joint_names = [], {}
+    fingers, joint_names, meshes = [], {}, {}
     for name, tip in zip(names, tips, strict=True):
         path = _path(model, parent_joint, tip, lines, file)
         finger = _finger(name, tip, path, lines, file, joint_names)
-        fingers.append(finger)
+        fingers.append(replace(finger, tip_radius=_tip_radius(model, tip, where, max_bytes, meshes)))
     roots = [link for link in model.link_map if link not in parent_joint]
     return Hand(tuple(fingers), tuple(joint_names), text, roots[0])
+
+
+def _tip_radius(model, tip, urdf, max_bytes, meshes):
+    """The radius of link ``tip``'s spherical collision geometry about its origin (0: none);
+    ``meshes`` keeps each mesh file's vertices read so far (a hand's fingers share their tip's)."""
+    from ..engine.fingertips import SPHERE_TOL, sphere_radius
+
+    for collision in model.link_map[tip].collisions:
+        origin = np.eye(4) if collision.origin is None else np.asarray(collision.origin, dtype=float)
+        sphere, mesh = collision.geometry.sphere, collision.geometry.mesh
+        if sphere is not None and float(np.linalg.norm(origin[:3, 3])) <= SPHERE_TOL * sphere.radius:
+            return float(sphere.radius)
+        if mesh is not None and mesh.filename not in meshes:
+            meshes[mesh.filename] = _mesh_vertices(mesh, urdf, max_bytes)
+        vertices = None if mesh is None else meshes[mesh.filename]
+        if vertices is not None:
+            scale = np.ones(3) if mesh.scale is None else np.broadcast_to(np.asarray(mesh.scale, dtype=float), 3)
+            radius = sphere_radius(vertices * scale @ origin[:3, :3].T + origin[:3, 3])
+            if radius is not None:  # digits past the sphere's own tolerance are the file's round-off
+                return float(f"{radius:.{-int(np.log10(SPHERE_TOL))}g}")
+    return 0.0
+
+
+def _mesh_vertices(mesh, urdf, max_bytes):
+    """A collision mesh's vertices ``(V, 3)`` in its own frame, None when it cannot be read.
+
+    Resolved as a URDF is (:func:`resolve_urdf`: ``package://`` inside its Python package, a
+    path inside the URDF's folder), at most ``max_bytes``, parsed by trimesh (yourdfpy's own
+    dependency) from the bytes, so that it opens no other file.
+    """
+    import trimesh
+
+    try:
+        path = resolve_urdf(mesh.filename, None if mesh.filename.startswith(_PACKAGE) else urdf.parent)
+        data = _read(path, max_bytes, mesh.filename)
+        loaded = trimesh.load(io.BytesIO(data), file_type=path.suffix.lstrip(".").lower(), force="mesh")
+        return np.asarray(loaded.vertices, dtype=float)
+    except Exception:  # an unreadable mesh only gives no radius: the hand's kinematics do not need it
+        return None
 
 
 def _tree(model, lines, file):

@@ -89,7 +89,8 @@ class FollowTable:
             self._hand_line(rec["hand"])
 
     def _hand_line(self, hand) -> None:
-        """Under a sample, where its fingers are: each one's joint positions and tip error."""
+        """Under a sample, where its fingers are: each one's joint positions and tip error, and for a
+        fingertip with a radius its gap to the surface (< 0: into it)."""
         parts = []
         for f in hand["fingers"]:
             if "joint_positions" not in f:
@@ -97,7 +98,8 @@ class FollowTable:
             error = fmt_figure(f["tip_error"])
             limits = "" if f["within_limits"] else " (outside its limits)"
             q = " ".join(fmt_number(v, self.digits) for v in f["joint_positions"])
-            parts.append(f"finger {escaped(f['contact'])}: q {q}{limits}, tip error {error}")
+            gap = f", tip gap {fmt_figure(f['tip_gap'])}" if f.get("tip_radius") else ""
+            parts.append(f"finger {escaped(f['contact'])}: q {q}{limits}, tip error {error}{gap}")
         if parts:
             self._line(f"{'':>{self.width}}  hand  " + "; ".join(parts))
 

@@ -27,16 +27,29 @@ def _finger_rates(rates, finger):
     return (rates[..., : len(finger.joints)] + 0.0).tolist()
 
 
+def _vector(v):
+    """A 3-vector as a list, or None where it is not finite (no value)."""
+    return (v + 0.0).tolist() if np.isfinite(v).all() else None
+
+
 def _placement(r, i, f, finger) -> dict:
     """Where finger ``f`` of row ``i`` is: its ``joint_positions`` (given, solved or tracked), its
-    ``tip_error`` (null: a finger given inline has no tip link) and ``within_limits``."""
+    ``tip_error`` (null: a finger given inline has no tip link), ``within_limits``, its fingertip's
+    ``tip_radius``, ``tip_center`` and ``tip_gap``, and ``tip_contact``, where its sphere faces the
+    contact in its tip link's frame."""
     if r.joint_positions is None:
         return {}
-    return {
+    out = {
         "joint_positions": _finger_rates(r.joint_positions[i, f], finger),
         "tip_error": _number(r.tip_error[i, f]),
         "within_limits": bool(r.within_limits[i, f]),
     }
+    if r.tip_center is not None:
+        out["tip_radius"] = finger.tip_radius
+        out["tip_center"] = _vector(r.tip_center[i, f])
+        out["tip_gap"] = _number(r.tip_gap[i, f])
+        out["tip_contact"] = _vector(r.tip_contact[i, f])
+    return out
 
 
 def hand_objects(block, order, warnings):

@@ -348,7 +348,7 @@ def _hand_inputs(grasps) -> dict:
 
     # the hand math loads with the first hand: runs without one never pay for it (bench/startup.py)
     from ..engine import hands
-    from ..engine.ik import home_tips, place_hand
+    from ..engine.fingertips import tip_centers, tip_radii
 
     width = max(len(f.joints) for g in grasps if g.hand is not None for f in g.hand.fingers)
     made = {}  # each grasp's fingers once, whatever its number of twists
@@ -356,28 +356,57 @@ def _hand_inputs(grasps) -> dict:
         if g.hand is not None and id(g) not in made:
             states = hands.finger_states(g.hand, g.joint_positions)
             # the loader placed the hand (given and checked, or solved): its tip errors at those positions
-            placed = place_hand(g.hand, g.points, g.joint_positions, tips=home_tips(g.hand, g.points))
-            made[id(g)] = (
-                *hands.padded(g.hand, [s.screws for s in states], width),
-                *hand_placement(g.hand, placed, width),
-            )
-    none = (np.zeros((3, width, 6)), np.full((3, width), np.nan), np.full((3, width), np.nan), np.full(3, np.nan))
-    none += (np.zeros(3, bool),)
-    screws, limits, positions, tip_error, within = (np.stack(a) for a in zip(*(made.get(id(g), none) for g in grasps)))
-    return {
-        "hands": [g.hand for g in grasps],
-        "joint_screws": screws,
-        "joint_limits": limits,
-        "placement": {"joint_positions": positions, "tip_error": tip_error, "within_limits": within},
+            home = tip_centers(g.points, g.normals, tip_radii(g.hand))
+            placement = hand_placement(g.hand, g.points, g.normals, g.joint_positions, home=home, width=width)[1]
+            made[id(g)] = (hands.padded(g.hand, [s.screws for s in states], width), placement)
+    nan3 = np.full(3, np.nan)
+    none = ((np.zeros((3, width, 6)), np.full((3, width), np.nan)), {})
+    rows = [made.get(id(g), none) for g in grasps]
+    screws, limits = (np.stack(a) for a in zip(*(r[0] for r in rows)))
+    empty = {
+        "joint_positions": np.full((3, width), np.nan),
+        "tip_error": nan3,
+        "within_limits": np.zeros(3, bool),
+        "tip_center": np.full((3, 3), np.nan),
+        "tip_gap": nan3,
+        "tip_contact": np.full((3, 3), np.nan),
     }
+    placement = {k: np.stack([r[1].get(k, v) for r in rows]) for k, v in empty.items()}
+    return {"hands": [g.hand for g in grasps], "joint_screws": screws, "joint_limits": limits, "placement": placement}
 
 
-def hand_placement(hand, placed, width=None) -> tuple:
-    """``(joint positions (..., 3, width), tip error (..., 3), within limits (..., 3))`` of a hand
-    placed (:class:`~grasptwist.engine.ik.HandIK`), as a block's ``placement`` holds them."""
+def hand_placement(hand, points, normals, positions=None, *, home=None, width=None) -> tuple:
+    """A hand placed with each fingertip's centre on ``p - r n`` (:mod:`grasptwist.engine.fingertips`),
+    and a block's ``placement`` of it.
+
+    ``positions`` are checked, or else solved for (:func:`~grasptwist.engine.ik.place_hand`);
+    ``home`` ``(3, 3)``: the centres the fingers given inline touch at home (None: those
+    fingers are unchecked).
+
+    Returns
+    -------
+    placed : HandIK
+    placement : dict
+        ``joint_positions (..., 3, width)``, ``tip_error (..., 3)``, ``within_limits (..., 3)``,
+        ``tip_center (..., 3, 3)``, ``tip_gap (..., 3)`` and ``tip_contact (..., 3, 3)``.
+    """
     from ..engine import hands
+    from ..engine.fingertips import tip_centers, tip_contacts, tip_radii
+    from ..engine.ik import home_tips, place_hand
 
-    return hands.padded_positions(hand, placed.positions, width), placed.tip_error, placed.within_limits
+    radii = tip_radii(hand)
+    centers = tip_centers(points, normals, radii)
+    placed = place_hand(hand, centers, positions, tips=None if home is None else home_tips(hand, home))
+    at_home = home_tips(hand, centers if home is None else home)
+    touch = tip_contacts(hands.tip_poses(hand, placed.positions, at_home), points, normals, radii)
+    return placed, {
+        "joint_positions": hands.padded_positions(hand, placed.positions, width),
+        "tip_error": placed.tip_error,
+        "within_limits": placed.within_limits,
+        "tip_center": centers,
+        "tip_gap": touch.gap,
+        "tip_contact": touch.contact,
+    }
 
 
 def selected_twists(grasp: Grasp, names: Sequence[str]) -> Grasp | GraspFileError:
@@ -471,26 +500,24 @@ def check_positions(ds, hand_of_rows) -> None:
         )
 
 
-def _rows_hand(ds, hand_of_rows, start, stop, rows, points):
+def _rows_hand(ds, hand_of_rows, start, stop, rows, points, normals):
     """The hand keywords of :func:`resolve_arrays` for rows ``start:stop`` of a data set, and the
     hand placed on each row's contacts (:func:`~grasptwist.engine.ik.place_hand`: the rows' joint
     positions checked, or solved for when the data set has none)."""
     if hand_of_rows is None:
         return {}, None
     from ..engine import hands
-    from ..engine.ik import place_hand
 
     q = None if ds.joint_positions is None else np.asarray(ds.joint_positions[start:stop], dtype=float)[rows]
-    placed = place_hand(hand_of_rows, points, q)
+    placed, placement = hand_placement(hand_of_rows, points, normals, q)
     states = hands.finger_states(hand_of_rows, placed.positions)
     screws, limits = hands.padded(hand_of_rows, [s.screws for s in states])
     n = len(points)
-    positions, tip_error, within = hand_placement(hand_of_rows, placed)
     return {
         "hands": [hand_of_rows] * n,
         "joint_screws": screws,
         "joint_limits": np.broadcast_to(limits, (n, *limits.shape)),
-        "placement": {"joint_positions": positions, "tip_error": tip_error, "within_limits": within},
+        "placement": placement,
     }, placed
 
 
@@ -531,11 +558,12 @@ def _dataset_block(ds, given, twists, method, start, stop, k, bases, hand_of_row
     # labels stay a numpy string array: a million Python strings cost more than the engine
     label = _labels(ds.names[start:stop][rows]) if ds.names is not None else index.astype(str)
     points = column(ds.points)
-    hand_inputs, placed = _rows_hand(ds, hand_of_rows, start, stop, rows, points)
+    # unit normals exactly as the grasp-file loader makes them
+    normals = direction(np.asarray(ds.normals[start:stop], dtype=float))[rows]
+    hand_inputs, placed = _rows_hand(ds, hand_of_rows, start, stop, rows, points, normals)
     block = resolve_arrays(
         points,
-        # unit normals exactly as the grasp-file loader makes them
-        direction(np.asarray(ds.normals[start:stop], dtype=float))[rows],
+        normals,
         column(ds.wrist),
         np.ascontiguousarray(screw, dtype=float),
         method,

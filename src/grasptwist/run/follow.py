@@ -26,10 +26,10 @@ import numpy as np
 
 from ..engine import hands
 from ..engine.degeneracy import radians_warning
+from ..engine.fingertips import tip_centers, tip_radii
 from ..engine.forces.grip import Grip
 from ..engine.forces.hold import HoldStretch, Unjudged, grip_along, hold_verdicts
 from ..engine.hands import HandTrack
-from ..engine.ik import home_tips, place_hand
 from ..engine.judgements import rotation_over_pi
 from ..engine.path import PathDegeneracies, Poses, degeneracies, follow, pose_overflowed
 from ..io.datasets import DATASET_SUFFIXES
@@ -182,7 +182,9 @@ def _path(job, grasp, p):
         yield GraspFileError("too-many-samples", f"path '{p.name}': {exc}", grasp.file, p.line, None)
         return
     tracked = (
-        None if grasp.hand is None else hands.track(grasp.hand, grasp.joint_positions, grasp.points, p.segments, times)
+        None
+        if grasp.hand is None
+        else hands.track(grasp.hand, grasp.joint_positions, grasp.points, p.segments, times, normals=grasp.normals)
     )
     # the weight, gravity fixed in space: needs a mass to hold and a friction to hold it with
     weight = (
@@ -229,9 +231,9 @@ def _block(grasp, name, f, bases, method, positions=None) -> Block:
     if positions is not None:  # the hand's joint rates at its integrated positions, as resolve's
         states = hands.finger_states(grasp.hand, positions)
         screws, limits = hands.padded(grasp.hand, [s.screws for s in states])
-        # where each finger's tip is against its moving contact (the tracker's error), in the records
-        placed = place_hand(grasp.hand, f.points, positions, tips=home_tips(grasp.hand, grasp.points))
-        placement = dict(zip(("joint_positions", "tip_error", "within_limits"), hand_placement(grasp.hand, placed)))
+        # where each fingertip is against its moving contact (the tracker's error, the gap), in the records
+        home = tip_centers(grasp.points, grasp.normals, tip_radii(grasp.hand))
+        placement = hand_placement(grasp.hand, f.points, f.normals, positions, home=home)[1]
         inputs = {"joint_screws": screws, "joint_limits": limits, "points": f.points, "twist": f.poses.twist}
         inputs["placement"] = placement
         # where the pose overflows, the hand's rates are no result of the path either (as the methods')

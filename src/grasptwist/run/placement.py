@@ -33,7 +33,9 @@ def place_grasp(grasp: Grasp) -> Grasp | GraspFileError:
     The loader only reads (:func:`grasptwist.read_grasps`): a URDF hand comes at the
     ``joint_positions`` its file gives, or at its ``seed``, with ``grasp.placement`` saying
     which.  Here the given positions are checked against the contacts (forward kinematics), or
-    positions are solved from the seed (inverse kinematics).
+    positions are solved from the seed (inverse kinematics): each tip link's origin, the
+    centre of its fingertip's sphere, on ``point - tip_radius * normal``
+    (:func:`grasptwist.hand.tip_centers`).
 
     Parameters
     ----------
@@ -57,10 +59,14 @@ def place_grasp(grasp: Grasp) -> Grasp | GraspFileError:
     p = grasp.placement
     if p is None:
         return grasp
-    from ..engine.ik import place_hand  # inverse kinematics loads with the first URDF hand
+    # inverse kinematics loads with the first URDF hand
+    from ..engine.fingertips import tip_centers, tip_radii
+    from ..engine.ik import place_hand
 
     hand, q = grasp.hand, grasp.joint_positions
-    solved = place_hand(hand, grasp.points, q) if p.given else place_hand(hand, grasp.points, seed=q)
+    # each tip link's origin, the centre of its fingertip's sphere, goes r behind the contact
+    centers = tip_centers(grasp.points, grasp.normals, tip_radii(hand))
+    solved = place_hand(hand, centers, q) if p.given else place_hand(hand, centers, seed=q)
     problems = Problems(MAX_ERRORS)
     for f, finger in enumerate(hand.fingers):
         status = Status(int(solved.status[f]))
@@ -114,7 +120,7 @@ def _placement_message(status, name, finger, distance):
     distance from its tip link's origin."""
     if status == Status.CONTACT_OFF_FINGER:
         return (
-            f"contact {name} is {distance:.6g} from the origin of its finger's tip link {finger.tip!r}, farther "
+            f"contact {name} is {distance:.6g} from the origin of its finger's tip link {finger.tip!r}{_behind(finger)}, farther "
             f"than the finger is long ({finger.length:.6g}): are the contacts in the URDF's root frame?"
         )
     if status == Status.OUTSIDE_LIMITS:
@@ -123,7 +129,12 @@ def _placement_message(status, name, finger, distance):
             "move the contact, or give joint_positions"
         )
     return (
-        f"finger {name} cannot reach its contact: the origin of its tip link {finger.tip!r} comes "
+        f"finger {name} cannot reach its contact: the origin of its tip link {finger.tip!r}{_behind(finger)} comes "
         f"no closer than {distance:.6g} (the finger is {finger.length:.6g} long): "
         "are the contacts in the URDF's root frame?"
     )
+
+
+def _behind(finger):
+    """How far behind the contact the tip's origin goes, for a finger with a fingertip radius."""
+    return f" (to sit {finger.tip_radius:.6g} behind it, the fingertip's radius)" if finger.tip_radius else ""

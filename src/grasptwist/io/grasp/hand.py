@@ -8,7 +8,12 @@ Two forms (README, "Hands and joint rates"), never mixed:
   ``joint_positions`` and ``fingers``, each naming the ``tip`` link that
   touches its contact.  Without ``joint_positions``, they are solved by
   inverse kinematics from ``seed`` (else every joint at 0): each finger's
-  tip link origin on its contact.
+  tip link origin on its contact, ``tip_radius`` behind it.
+
+Either form takes ``tip_radius``, the radius of the fingertip's sphere about
+the tip link's origin (or the point its last link touches), for the hand or
+per finger (the finger's wins); a URDF finger without one gets its tip
+link's spherical collision geometry's (:func:`grasptwist.io.urdf.load_urdf_hand`).
 
 Checked with the loader's shared typed-value checks (:mod:`.values`), so
 problems are located and coded like the rest of the format; a URDF's own problems
@@ -24,6 +29,7 @@ be placed at its ``tip``.
 from __future__ import annotations
 
 import os
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
@@ -58,9 +64,9 @@ __all__ = [
     "inline_hand",
 ]
 
-HAND_KEYS = ("urdf", "joint_positions", "seed", "fingers")
-INLINE_FINGER_KEYS = ("name", "joints")
-URDF_FINGER_KEYS = ("name", "tip")
+HAND_KEYS = ("urdf", "joint_positions", "seed", "tip_radius", "fingers")
+INLINE_FINGER_KEYS = ("name", "joints", "tip_radius")
+URDF_FINGER_KEYS = ("name", "tip", "tip_radius")
 JOINT_KEYS = ("name", "type", "axis", "point", "velocity_limit")
 JOINT_TYPES = ("revolute", "prismatic")
 
@@ -98,6 +104,7 @@ def read_hand(node, points, file, problems):
                 **located(fields["seed"]),
             )
         )
+    radius = _radius(fields, "hand", problems)
     items = read_sequence(fields["fingers"], "hand.fingers", problems) if "fingers" in fields else None
     if items is None:
         return None
@@ -131,17 +138,39 @@ def read_hand(node, points, file, problems):
             )
         read_entry_name(finger, item, "hand.fingers", i, names, problems)
         fingers.append(finger)
+    radii = [_radius(f, f"hand.fingers[{i}]", problems) for i, f in enumerate(fingers)]
     if problems.count:
         return None
     names = list(names)
+    radii = [radius if r is None else r for r in radii]  # the finger's, else the hand's (None: not given)
     if urdf:
-        return _urdf_hand(fields, fingers, names, points is None, file, problems)
-    taken = {}  # joint names, unique over the hand
-    joints = [_joints(f["joints"], f"hand.fingers[{i}]", names[i], taken, problems) for i, f in enumerate(fingers)]
-    if problems.count:
+        read = _urdf_hand(fields, fingers, names, points is None, file, problems)
+    else:
+        taken = {}  # joint names, unique over the hand
+        joints = [_joints(f["joints"], f"hand.fingers[{i}]", names[i], taken, problems) for i, f in enumerate(fingers)]
+        if problems.count:
+            return None
+        hand = inline_hand(names, joints, points)
+        read = hand, np.zeros(len(hand.joint_names)), None
+    if read is None:
         return None
-    hand = inline_hand(names, joints, points)
-    return hand, np.zeros(len(hand.joint_names)), None
+    hand = read[0]
+    given = tuple(f if r is None else replace(f, tip_radius=r) for f, r in zip(hand.fingers, radii))
+    return (replace(hand, fingers=given), *read[1:])
+
+
+def _radius(fields, path, problems):
+    """The ``tip_radius`` of a hand's or finger's fields: a number at least 0, None when not given."""
+    if "tip_radius" not in fields:
+        return None
+    node = fields["tip_radius"]
+    radius = read_number(node, path + ".tip_radius", problems)
+    if radius is not None and radius < 0:
+        problems.add(
+            Reject("invalid-radius", path + ".tip_radius", f"must be 0 or more, got {radius:g}", **located(node))
+        )
+        return None
+    return radius
 
 
 def _joints(node, path, finger, taken, problems):
