@@ -35,20 +35,29 @@ def methods_of(grasp, method: str | None = None) -> tuple[str, ...]:
     return ("off-tangent", "tangent") if default_method(grasp.wrist) == "off-tangent" else ("tangent",)
 
 
-def grasp_scenes(grasp, twist, methods, velocity_scale=None, forces=None) -> list[Scene]:
+def grasp_scenes(grasp, twist, methods, velocity_scale=None, forces=None, extent=None) -> list[Scene]:
     """One scene per method of ``grasp`` and ``twist``, every basis screw and the hand's fingers in each
-    (and with a friction its cones and the grip ``forces`` given).
+    (and with a friction its cones and the grip ``forces`` given), framed on ``extent`` when given.
 
     Without ``velocity_scale`` the scenes are drawn again at the smallest of
     their fitted scales, so that every velocity arrow of a view has one scale.
     """
     scenes = [
-        grasp_scene(grasp, twist, method=m, all_bases=True, links=True, velocity_scale=velocity_scale, forces=forces)
+        grasp_scene(
+            grasp,
+            twist,
+            method=m,
+            all_bases=True,
+            links=True,
+            velocity_scale=velocity_scale,
+            forces=forces,
+            extent=extent,
+        )
         for m in methods
     ]
     shared = velocity_scale_of(scenes) if velocity_scale is None and len(scenes) > 1 else None
     if shared is not None:  # None: no arrow drawn (a zero twist), nothing to share
-        return grasp_scenes(grasp, twist, methods, shared, forces)
+        return grasp_scenes(grasp, twist, methods, shared, forces, extent)
     return scenes
 
 
@@ -74,7 +83,7 @@ def view_title(scenes) -> str:
 
 
 def bounds(scenes) -> tuple[np.ndarray, float]:
-    """Centre and half-width of a cube holding every scene."""
+    """Centre and half-width of a cube holding every scene's (each scene's framed cube)."""
     boxes = [s.bounds() for s in scenes]
     lo = np.min([c - h for c, h in boxes], axis=0)
     hi = np.max([c + h for c, h in boxes], axis=0)
@@ -112,7 +121,8 @@ def twist_figure(grasp, twists=None, *, method: str | None = None, active: int =
         The twist shown first.
     meshes : sequence of (vertices, faces)
         The hand's link meshes (a URDF hand's, as the ``plot`` command reads
-        them), one legend entry shown with every twist.
+        them), one legend entry shown with every twist (cut at the picture's
+        cube, which frames the object and the contacts).
     forces : (3, 3) array or None
         The grip forces drawn with a grasp's friction cones (the engine's, from the caller).
 
@@ -125,8 +135,10 @@ def twist_figure(grasp, twists=None, *, method: str | None = None, active: int =
     """
     methods = methods_of(grasp, method)
     items = list(grasp.twists if twists is None else twists) or [None]
-    views = [grasp_scenes(grasp, t, methods, forces=forces) for t in items]
-    half = bounds([s for v in views for s in v])[1]
+    # one cube for every twist, so that switching twists keeps the picture's frame
+    cube = bounds([s for t in items for s in grasp_scenes(grasp, t, methods, forces=forces)])
+    views = [grasp_scenes(grasp, t, methods, forces=forces, extent=cube) for t in items]
+    half = cube[1]
     data, owner, shown, titles = [], [], [], []
     for k, scenes in enumerate(views):
         for traces in view_traces(scenes, grasp.units, half).values():
@@ -143,7 +155,7 @@ def twist_figure(grasp, twists=None, *, method: str | None = None, active: int =
         shown.append(True)
     layout = {
         "title": {"text": titles[active], "font": {"size": 13}, "x": 0.01, "xanchor": "left"},
-        "scene": scene_layout(views[active][0], grasp.units),
+        "scene": scene_layout(views[active][0], grasp.units, cube),
         "legend": {"groupclick": "togglegroup", "itemsizing": "constant"},
         "margin": {"l": 0, "r": 0, "t": 90, "b": 0},
         "uirevision": "keep",  # switching twists keeps the camera
