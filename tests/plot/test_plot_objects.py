@@ -123,7 +123,7 @@ def test_reach_box_clip_and_edge_arrow_on_numbers():
 def test_a_given_extent_cuts_the_same_picture_to_it():
     picture = plot.grasp_scene(three_finger_hand(), links=True)
     centre, half = picture.bounds()
-    small = framed(replace(picture, extent=None), (centre, 0.5 * half))
+    small = framed(replace(picture, extent=None), extent=(centre, 0.5 * half))
     assert small.bounds() == (centre, 0.5 * half)
     inside = np.abs(np.array([p for s in small.segments for p in (s.start, s.end)]) - centre)
     assert np.all(inside <= 0.5 * half * (1 + 1e-12))
@@ -169,6 +169,11 @@ def test_the_html_figure_holds_the_object_and_tips_and_frames_them():
     ranges = np.array([figure["layout"]["scene"][f"{c}axis"]["range"] for c in "xyz"])
     assert figure["layout"]["scene"]["aspectmode"] == "cube"
     assert np.all(ranges[:, 0] <= vertices.min(axis=0)) and np.all(ranges[:, 1] >= vertices.max(axis=0))
+    # the same object with every twist: one trace, shown by every twist's button
+    figure = plot.twist_figure(sphere_tripod())
+    (slot,) = [n for n, t in enumerate(figure["data"]) if t["name"] == "object"]
+    buttons = figure["layout"]["updatemenus"][0]["buttons"]
+    assert len(buttons) == 3 and all(b["args"][0]["visible"][slot] is True for b in buttons)
 
 
 @pytest.mark.slow  # over a second: docs/reference/development.md, Test time

@@ -9,7 +9,7 @@ import html
 import numpy as np
 
 from .scene import Scene, check_method, default_method, grasp_scene
-from .traces import force_traces, mesh_trace, scene_traces
+from .traces import force_traces, mesh_trace, scene_traces, slot_name
 
 __all__ = [
     "bounds",
@@ -22,6 +22,8 @@ __all__ = [
 ]
 
 _EYE = 1.8  # the camera's distance, in plotly's units of the scene box
+# The same whatever the twist: drawn once, shown with every twist (an object's mesh can be large).
+_EVERY_TWIST = {slot_name("object", None), slot_name("fingertip", None)}
 
 
 def methods_of(grasp, method: str | None = None) -> tuple[str, ...]:
@@ -141,13 +143,15 @@ def twist_figure(grasp, twists=None, *, method: str | None = None, active: int =
     half = cube[1]
     data, owner, shown, titles = [], [], [], []
     for k, scenes in enumerate(views):
-        for traces in view_traces(scenes, grasp.units, half).values():
+        for name, traces in view_traces(scenes, grasp.units, half).items():
+            if name in _EVERY_TWIST and k:
+                continue
             for t in traces:
                 shown.append(t.get("visible", True))  # True, or "legendonly" for the kinds off at first
-                if k != active:
+                if k != active and name not in _EVERY_TWIST:
                     t["visible"] = False
                 data.append(t)
-                owner.append(k)
+                owner.append(None if name in _EVERY_TWIST else k)
         titles.append(view_title(scenes))
     if len(meshes):
         data.append(mesh_trace(meshes, half))

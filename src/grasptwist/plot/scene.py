@@ -248,7 +248,7 @@ class Scene:
         return np.concatenate([np.reshape(p, (-1, 3)) for p in pts] or [np.zeros((0, 3))]).astype(float)
 
     def bounds(self):
-        """Centre ``(3,)`` and half-width of the cube the picture shows: its :attr:`extent`
+        """Centre ``(3,)`` and half-width of the cube the picture shows: its ``extent``
         when framed, else a cube holding every drawn point.
 
         A cube, so that the renderer's axes get equal scales.
@@ -392,7 +392,7 @@ def scene(
     picture = _unframed_scene(
         points, normals, wrist, twist, method, names, grasp_name, twist_name, all_bases, velocity_scale
     )
-    return framed(picture, extent)
+    return framed(picture, extent=extent)
 
 
 def _unframed_scene(points, normals, wrist, twist, method, names, grasp_name, twist_name, all_bases, velocity_scale):
@@ -540,14 +540,14 @@ def edge_arrow(centre, half, target) -> tuple[np.ndarray, np.ndarray, float]:
     return tip - length * d, d, length
 
 
-def framed(picture: Scene, extent=None) -> Scene:
+def framed(picture: Scene, *, extent=None) -> Scene:
     """``picture`` framed on its subject: the contacts, the object and the fingertip spheres.
 
-    Segments are cut to the subject's :func:`reach_box` (or to ``extent``, a given cube
+    Segments are cut to the subject's ``reach_box`` (or to ``extent``, a given cube
     ``(centre, half)``), and dropped when none of them is in it; a marker outside it (a far
     wrist), or a twist axis wholly outside it, becomes an arrow of kind ``"beyond"`` at the
-    edge of the picture pointing to it (:func:`edge_arrow`), labelled with its distance from
-    the picture's centre.  The picture's :attr:`~Scene.extent` is then ``extent``, or the cube
+    edge of the picture pointing to it (``edge_arrow``), labelled with its distance from
+    the picture's centre.  The picture's ``extent`` is then ``extent``, or the cube
     holding everything kept: a far point never shrinks the subject, which spans at least
     ``1 / REACH`` of the picture across.
 
@@ -719,8 +719,8 @@ def grasp_scene(
     forces=None,
     extent=None,
 ) -> Scene:
-    """:func:`scene` for a loaded ``Grasp``, with its object (translucent, :func:`object_mesh`),
-    its hand's fingertip spheres (:func:`fingertips`) and joint axes (and, with ``links``, its
+    """:func:`scene` for a loaded ``Grasp``, with its object (translucent, ``object_mesh``),
+    its hand's fingertip spheres (``fingertips``) and joint axes (and, with ``links``, its
     fingers' chains from joint to joint to tip), and with a ``friction`` its friction cones and
     the grip ``forces (3, 3)`` given; framed on the contacts, object and fingertips (:func:`framed`).
 
@@ -754,7 +754,7 @@ def grasp_scene(
         chains = finger_links(grasp.hand, grasp.joint_positions, grasp.points, grasp.contact_names) if links else ()
         tips = fingertips(grasp.hand, grasp.points, grasp.normals, grasp.contact_names)
         picture = replace(picture, segments=picture.segments + joints + chains, spheres=tips)
-    return framed(picture, extent)
+    return framed(picture, extent=extent)
 
 
 def object_mesh(obj) -> Mesh:
