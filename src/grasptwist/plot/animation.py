@@ -21,7 +21,7 @@ from dataclasses import replace
 import numpy as np
 
 from ..engine.objects import moved
-from .figures import bounds, grasp_scenes, methods_of, scene_layout, velocity_scale_of, view_title
+from .figures import framed_together, grasp_scenes, methods_of, scene_layout, velocity_scale_of, view_title
 from .traces import force_traces, scene_traces
 
 __all__ = ["DEFAULT_SAMPLES", "degenerate_marks", "hold_marks", "path_figure", "path_figures"]
@@ -69,10 +69,14 @@ def path_figure(grasp, chunks, summary, *, method=None) -> dict:
         for k in range(len(times))
     ]
     forces = _frame_forces(chunks, len(times))
-    fitted = [grasp_scenes(g, t, methods, forces=f) for g, t, f in zip(moved, twists, forces)]
+    fitted = [grasp_scenes(g, t, methods, forces=f, extent=False) for g, t, f in zip(moved, twists, forces)]
     scale = min((s for s in map(velocity_scale_of, fitted) if s is not None), default=None)
-    cube = bounds([s for v in fitted for s in v])  # every sample's frame: one for the whole path
-    frames_scenes = [grasp_scenes(g, t, methods, scale, f, cube) for g, t, f in zip(moved, twists, forces)]
+    frames_scenes = (
+        [grasp_scenes(g, t, methods, scale, f, extent=False) for g, t, f in zip(moved, twists, forces)]
+        if scale
+        else fitted
+    )
+    frames_scenes, cube = framed_together(frames_scenes)  # one cube for the whole path
     per_frame = []
     for scenes in frames_scenes:
         traces = scene_traces(scenes[0], grasp.units, own=False, half=cube[1])

@@ -8,11 +8,12 @@ import html
 
 import numpy as np
 
-from .scene import Scene, check_method, default_method, grasp_scene
+from .scene import Scene, check_method, default_method, framed, grasp_scene
 from .traces import force_traces, mesh_trace, scene_traces, slot_name
 
 __all__ = [
     "bounds",
+    "framed_together",
     "grasp_scenes",
     "methods_of",
     "scene_layout",
@@ -39,7 +40,7 @@ def methods_of(grasp, method: str | None = None) -> tuple[str, ...]:
 
 def grasp_scenes(grasp, twist, methods, velocity_scale=None, forces=None, extent=None) -> list[Scene]:
     """One scene per method of ``grasp`` and ``twist``, every basis screw and the hand's fingers in each
-    (and with a friction its cones and the grip ``forces`` given), framed on ``extent`` when given.
+    (and with a friction its cones and the grip ``forces`` given), framed as ``extent`` says (:func:`grasp_scene`).
 
     Without ``velocity_scale`` the scenes are drawn again at the smallest of
     their fitted scales, so that every velocity arrow of a view has one scale.
@@ -76,6 +77,14 @@ def view_traces(scenes, units, half) -> dict[str, list[dict]]:
         out.update(scene_traces(s, units, common=False, half=half))
     out.update(force_traces(scenes[0], units))
     return out
+
+
+def framed_together(views) -> tuple[list[list[Scene]], tuple[np.ndarray, float]]:
+    """Unframed scenes (lists of them) framed on one cube, the smallest holding each one's own
+    frame (:func:`~grasptwist.plot.scene.framed`), so that switching between them, or playing
+    them, keeps the picture still: the framed scenes, in the same lists, and the cube."""
+    cube = bounds([framed(s) for v in views for s in v])
+    return [[framed(s, extent=cube) for s in v] for v in views], cube
 
 
 def view_title(scenes) -> str:
@@ -137,9 +146,7 @@ def twist_figure(grasp, twists=None, *, method: str | None = None, active: int =
     """
     methods = methods_of(grasp, method)
     items = list(grasp.twists if twists is None else twists) or [None]
-    # one cube for every twist, so that switching twists keeps the picture's frame
-    cube = bounds([s for t in items for s in grasp_scenes(grasp, t, methods, forces=forces)])
-    views = [grasp_scenes(grasp, t, methods, forces=forces, extent=cube) for t in items]
+    views, cube = framed_together([grasp_scenes(grasp, t, methods, forces=forces, extent=False) for t in items])
     half = cube[1]
     data, owner, shown, titles = [], [], [], []
     for k, scenes in enumerate(views):

@@ -365,9 +365,10 @@ def scene(
     velocity_scale : float or None
         Drawn length per unit velocity of every velocity arrow; None fits it
         to this scene (several scenes drawn together share the smallest).
-    extent : ((3,) array, float) or None
+    extent : ((3,) array, float), None or False
         The cube to show (several scenes drawn together share one); None
-        frames the contacts (:func:`framed`).
+        frames the contacts (:func:`framed`); False leaves the scene unframed,
+        for a caller that frames several scenes on one cube.
 
     Returns
     -------
@@ -392,7 +393,7 @@ def scene(
     picture = _unframed_scene(
         points, normals, wrist, twist, method, names, grasp_name, twist_name, all_bases, velocity_scale
     )
-    return framed(picture, extent=extent)
+    return picture if extent is False else framed(picture, extent=extent)
 
 
 def _unframed_scene(points, normals, wrist, twist, method, names, grasp_name, twist_name, all_bases, velocity_scale):
@@ -754,7 +755,7 @@ def grasp_scene(
         chains = finger_links(grasp.hand, grasp.joint_positions, grasp.points, grasp.contact_names) if links else ()
         tips = fingertips(grasp.hand, grasp.points, grasp.normals, grasp.contact_names)
         picture = replace(picture, segments=picture.segments + joints + chains, spheres=tips)
-    return framed(picture, extent=extent)
+    return picture if extent is False else framed(picture, extent=extent)
 
 
 def object_mesh(obj) -> Mesh:
