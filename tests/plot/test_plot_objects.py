@@ -67,7 +67,11 @@ def test_fingertip_spheres_touch_the_contacts_from_outside():
         np.testing.assert_allclose(tip.centre, grasp.points[i] - r * unit[i], atol=1e-15)
     vertices, _ = tips[1].triangles()
     assert np.linalg.norm(vertices - tips[1].centre, axis=1) == pytest.approx(0.2, rel=1e-12)
-    assert picture.kinds()[-2:] == ["fingertip", "beyond"]  # the east finger's knuckle is beyond
+    # the west and south fingers start within the picture; the east finger's knuckle, 2 above
+    # its contact, and the wrist 3 up are beyond it: arrows at its edge
+    assert [m.label for m in picture.of_kind("hand-base")] == ["base 2", "base 3"]
+    np.testing.assert_allclose(picture.of_kind("hand-base")[0].position, [-2.0, -0.2, 1.9])
+    assert [a.label.split(" (")[0] for a in picture.of_kind("beyond")] == ["c", "base 1"]
     assert not plot.grasp_scene(three_finger_hand((0, 0, 0))).spheres
 
 
@@ -90,6 +94,17 @@ def test_the_picture_frames_the_ball_and_points_at_the_far_wrist():
         assert np.all(np.abs(picture.points() - centre) <= half * (1 + 1e-12))
     # a wrist 10 away frames the ball as one 0.11 away does (a cube reaching it would be 100 times wider)
     assert near.bounds()[1] == pytest.approx(far.bounds()[1], rel=0.05)
+
+
+def test_far_points_at_one_place_share_an_arrow():
+    # the TriFinger's three fingers start where its wrist is, 0.29 above the table (one 1 mm off)
+    contacts = [plot.Marker(np.array(p), n, "contact") for p, n in (([0.03, 0, 0], "1"), ([-0.03, 0, 0], "2"))]
+    far = [plot.Marker(np.array([0, 0, 0.29]), n, k) for n, k in (("c", "wrist"), ("base 1", "hand-base"))]
+    far += [plot.Marker(np.array([0, 0.001, 0.29]), "base 2", "hand-base")]
+    picture = framed(plot.Scene("t", "tangent", 0, markers=(*contacts, *far)))
+    (arrow,) = picture.of_kind("beyond")
+    assert arrow.label == "c, base 1, base 2 (0.29 away)"
+    np.testing.assert_allclose(arrow.vector, [0, 0, 1])
 
 
 def test_a_near_wrist_stays_a_point_of_the_picture():

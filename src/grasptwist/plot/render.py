@@ -244,6 +244,7 @@ def _check_suffix(suffix: str, formats=FORMATS):
 _STYLE = {
     "contact": {"color": "black", "marker": "o", "s": 40},
     "wrist": {"color": "tab:purple", "marker": "^", "s": 60},
+    "hand-base": {"color": "tab:brown", "marker": "s", "s": 40},
     "normal": {"color": "0.45", "lw": 1.2},
     "tangent-plane": {"color": "tab:cyan", "alpha": 0.25},
     "contact-plane": {"color": "0.6", "alpha": 0.15},

@@ -47,6 +47,7 @@ __all__ = [
     "cube_of",
     "edge_arrow",
     "default_method",
+    "finger_bases",
     "finger_links",
     "fingertips",
     "force_parts",
@@ -80,6 +81,7 @@ _SPHERE_SEGMENTS = 16  # a fingertip sphere's tessellation (the object engine's 
 REACH = 2.0
 _EDGE_ARROW = 0.25  # an arrow to a point beyond the picture: its length, of the picture's half-width
 _EDGE_INSET = 0.02  # its tip this far inside the edge, of the half-width
+_SAME_PLACE = 0.1  # points beyond the picture this close (of its half-width) share one arrow
 
 
 # --- scene data ---------------------------------------------------------------
@@ -260,6 +262,7 @@ class Scene:
 KINDS = {
     "contact": "contact",
     "wrist": "wrist c",
+    "hand-base": "finger base (its first joint)",
     "normal": "surface normal",
     "tangent-plane": "tangent plane",
     "contact-plane": "plane of the contacts",
@@ -546,9 +549,10 @@ def framed(picture: Scene, *, extent=None) -> Scene:
 
     Segments are cut to the subject's ``reach_box`` (or to ``extent``, a given cube
     ``(centre, half)``), and dropped when none of them is in it; a marker outside it (a far
-    wrist), or a twist axis wholly outside it, becomes an arrow of kind ``"beyond"`` at the
-    edge of the picture pointing to it (``edge_arrow``), labelled with its distance from
-    the picture's centre.  The picture's ``extent`` is then ``extent``, or the cube
+    wrist, a finger's base), or a twist axis wholly outside it, becomes an arrow of kind
+    ``"beyond"`` at the edge of the picture pointing to it (``edge_arrow``), labelled with its
+    distance from the picture's centre (points at one place share an arrow and its label).
+    The picture's ``extent`` is then ``extent``, or the cube
     holding everything kept: a far point never shrinks the subject, which spans at least
     ``1 / REACH`` of the picture across.
 
@@ -578,11 +582,24 @@ def framed(picture: Scene, *, extent=None) -> Scene:
     kept = replace(picture, markers=tuple(markers), segments=tuple(segments))
     cube = box if extent is not None else cube_of(kept.points())
     beyond = []
-    for point, label in far:
+    for point, labels in _places(far, _SAME_PLACE * cube[1]):
         origin, d, length = edge_arrow(*cube, point)
         away = float(norm(point - cube[0]))
-        beyond.append(Arrow(origin, d, f"{label} ({away:.3g} away)", "beyond", length))
+        beyond.append(Arrow(origin, d, f"{', '.join(labels)} ({away:.3g} away)", "beyond", length))
     return replace(kept, arrows=kept.arrows + tuple(beyond), extent=cube)
+
+
+def _places(points, tol):
+    """``[(point, label)]`` gathered by place: points within ``tol`` of an earlier one (the
+    TriFinger's three finger bases at its wrist) share its arrow, their labels in order."""
+    places = []
+    for point, label in points:
+        near = next((p for p in places if float(norm(p[0] - point)) <= tol), None)
+        if near is None:
+            places.append((point, [label]))
+        else:
+            near[1].append(label)
+    return places
 
 
 def _velocity_arrows(points, t, r, method, names, size, ok, scale=None):
@@ -754,7 +771,10 @@ def grasp_scene(
         joints = joint_segments(grasp.hand, grasp.joint_positions, _JOINT_HALF * _grasp_size(grasp.points))
         chains = finger_links(grasp.hand, grasp.joint_positions, grasp.points, grasp.contact_names) if links else ()
         tips = fingertips(grasp.hand, grasp.points, grasp.normals, grasp.contact_names)
-        picture = replace(picture, segments=picture.segments + joints + chains, spheres=tips)
+        bases = finger_bases(grasp.hand, grasp.joint_positions, grasp.contact_names)
+        picture = replace(
+            picture, markers=picture.markers + bases, segments=picture.segments + joints + chains, spheres=tips
+        )
     return picture if extent is False else framed(picture, extent=extent)
 
 
@@ -862,6 +882,20 @@ def finger_links(hand, positions, contacts, names=("1", "2", "3")) -> tuple[Line
         stops = list(state.points) + ([] if state.tip is None else [state.tip[:3, 3]]) + [contact]
         out += [LinePiece(a, b, f"finger {name}", "finger-link") for a, b in zip(stops[:-1], stops[1:])]
     return tuple(out)
+
+
+def finger_bases(hand, positions, names=("1", "2", "3")) -> tuple[Marker, ...]:
+    """Where each finger starts (its first joint's point at ``positions``), labelled by its
+    contact's name: the hand's base, pointed at from the picture's edge when it lies beyond.
+
+    >>> from grasptwist.io.grasp import inline_hand
+    >>> h = inline_hand(["a", "b", "c"], [[("j", "revolute", [0, 0, 2], [1, 0, 0], None, 1)]] * 3, None)
+    >>> b = finger_bases(h, None)[0]
+    >>> b.label, b.position.tolist()
+    ('base 1', [1.0, 0.0, 0.0])
+    """
+    states = finger_states(hand, positions)
+    return tuple(Marker(s.points[0], f"base {name}", "hand-base") for name, s in zip(names, states) if len(s.points))
 
 
 def joint_segments(hand, positions, half) -> tuple[LinePiece, ...]:

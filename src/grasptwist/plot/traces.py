@@ -24,6 +24,7 @@ MESH_NAME = "hand (URDF visual meshes)"
 COMMON_KINDS = (
     "contact",
     "wrist",
+    "hand-base",
     "normal",
     "contact-plane",
     "tangent-plane",
@@ -41,6 +42,7 @@ COMMON_KINDS = (
 _STYLE = {
     "contact": ("black", 0, None),
     "wrist": ("#9467bd", 0, None),
+    "hand-base": ("#8c564b", 0, None),
     "normal": ("#737373", 3, None),
     "tangent-plane": ("#17becf", 0, None),
     "contact-plane": ("#999999", 0, None),
@@ -111,7 +113,7 @@ def scene_traces(scene: Scene, units: str | None, *, common=True, own=True, half
         elif kind.endswith("-part") or kind in {"normal", "contact-velocity", "twist-translation", "beyond"}:
             elements = [a for a in elements if _shown(a, half)]
             traces = _arrows(elements, kind, name, units, half)
-        elif kind in {"contact", "wrist"}:
+        elif kind in {"contact", "wrist", "hand-base"}:
             traces = [_markers(elements, kind, name, units)]
         elif kind.endswith("plane"):
             traces = [_patches(elements, kind, name)]
@@ -190,7 +192,8 @@ def _markers(markers, kind, name, units) -> dict:
     trace["hovertext"] = [f"{m.label}: {_fmt(m.position, units)}" for m in markers]
     trace["textposition"] = "top center"
     trace["textfont"] = {"color": colour, "size": 14}
-    trace["marker"] = {"color": colour, "size": 6, "symbol": "diamond" if kind == "wrist" else "circle"}
+    symbol = {"wrist": "diamond", "hand-base": "square"}.get(kind, "circle")
+    trace["marker"] = {"color": colour, "size": 6, "symbol": symbol}
     return trace
 
 
