@@ -2,7 +2,8 @@
 
 A scene (:func:`scene` from arrays, :func:`grasp_scene` from a loaded grasp) is
 what gets drawn, in numbers: markers, line pieces (screw axes), arrows (twists,
-velocities, forces) and patches (tangent planes, cones).  :func:`render` draws
+velocities, forces), patches (tangent planes, cones), the object's mesh and the
+fingertip spheres, framed on the contacts, object and fingertips (:func:`framed`).  :func:`render` draws
 it with matplotlib (the extra ``grasptwist[plot]``); :func:`twist_figure` and
 :func:`grasp_page` make plotly.js figures as plain dicts, :func:`write_page`
 writes them as one HTML page (the extra ``grasptwist[html]``).
@@ -23,7 +24,21 @@ The code is in ``grasptwist.plot`` (internal).
 from .plot.figures import twist_figure
 from .plot.html import MissingPlotly, grasp_page, read_figures, write_page
 from .plot.render import MissingMatplotlib, image_name, plot_grasp, render, render_grasps
-from .plot.scene import KINDS, METHODS, Arrow, LinePiece, Marker, Patch, Scene, grasp_scene, scene
+from .plot.scene import (
+    KINDS,
+    METHODS,
+    REACH,
+    Arrow,
+    LinePiece,
+    Marker,
+    Mesh,
+    Patch,
+    Scene,
+    Sphere,
+    framed,
+    grasp_scene,
+    scene,
+)
 
 __all__ = [
     "scene",
@@ -33,8 +48,12 @@ __all__ = [
     "LinePiece",
     "Arrow",
     "Patch",
+    "Mesh",
+    "Sphere",
+    "framed",
     "KINDS",
     "METHODS",
+    "REACH",
     "render",
     "plot_grasp",
     "render_grasps",

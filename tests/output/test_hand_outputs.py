@@ -148,7 +148,8 @@ def test_the_plot_scene_draws_each_finger_joint_axis():
     from grasptwist.plot.scene import grasp_scene
 
     (g,) = load_grasps(THREE)
-    axes = grasp_scene(g, g.twists[0]).of_kind("joint-axis")
+    # a cube holding the whole hand: framed on the contacts, the knuckles' axes would be cut away
+    axes = grasp_scene(g, g.twists[0], extent=(np.zeros(3), 10.0)).of_kind("joint-axis")
     assert [s.label for s in axes] == list(g.hand.joint_names)
     east_2 = axes[1]  # about y through the knuckle (2, 0.3, 2.4)
     np.testing.assert_allclose((east_2.start + east_2.end) / 2, [2.0, 0.3, 2.4])

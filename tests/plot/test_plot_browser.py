@@ -83,3 +83,20 @@ def test_a_page_with_a_comment_and_script_opening_in_a_name_is_drawn(tmp_path):
     shot = capture(hostile_names_page(tmp_path), tmp_path / "h.png")
     assert shot.errors == [] and len(shot.scenes) == 1  # 0.3: nothing drew, the page's script was swallowed
     assert coloured_pixels(shot.png, shot.scenes[0]) > 1000
+
+
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
+def test_the_object_is_drawn(tmp_path):
+    from test_plot_objects import sphere_tripod
+
+    from grasptwist.plot import grasp_page, write_page
+
+    page = write_page(tmp_path / "ball.html", grasp_page(sphere_tripod()), title="ball", js_beside=True)
+    only = 'Plotly.restyle(figures[0], {visible: figures[0].data.map(t => t.name === "object")})'
+    shot = capture(page, tmp_path / "ball.png", size=(900, 700), before=only)
+    assert shot.errors == []
+    x, y, w, h = (int(round(v)) for v in shot.scenes[0])
+    rgb = np.asarray(Image.open(shot.png).convert("RGB"), dtype=int)[y : y + h, x : x + w]
+    # everything else hidden: the tan ball (red over blue, where the grey axes have neither) fills
+    # some 38,000 pixels; an undrawn mesh none
+    assert np.sum(rgb[..., 0] - rgb[..., 2] > 15) > 10000

@@ -9,7 +9,8 @@ degenerate stretch are marked ``✗`` and the frame's title names the method
 and the reason.  Every frame has the same traces in the same order (an
 element missing from a frame, like the basis axes of a degenerate grasp, is
 an empty trace), and one velocity scale and one cube of axis ranges hold
-for the whole path, so nothing jumps but what moves.
+for the whole path, so nothing jumps but what moves.  The grasp's object
+moves with the contacts: at each sample it is carried by the path's pose there.
 """
 
 from __future__ import annotations
@@ -19,7 +20,8 @@ from dataclasses import replace
 
 import numpy as np
 
-from .figures import bounds, grasp_scenes, methods_of, scene_layout, velocity_scale_of, view_title
+from ..engine.objects import moved
+from .figures import framed_together, grasp_scenes, methods_of, scene_layout, velocity_scale_of, view_title
 from .traces import force_traces, scene_traces
 
 __all__ = ["DEFAULT_SAMPLES", "degenerate_marks", "hold_marks", "path_figure", "path_figures"]
@@ -55,17 +57,26 @@ def path_figure(grasp, chunks, summary, *, method=None) -> dict:
     twists = np.concatenate([c.poses.twist for c in chunks])
     times = np.concatenate([c.poses.time for c in chunks])
     joints = None if grasp.hand is None else np.concatenate([c.joint_positions for c in chunks])
+    objects = _moved_objects(grasp.object, chunks)
     moved = [
-        replace(grasp, points=points[k], normals=normals[k], joint_positions=None if joints is None else joints[k])
+        replace(
+            grasp,
+            points=points[k],
+            normals=normals[k],
+            joint_positions=None if joints is None else joints[k],
+            object=objects[k],
+        )
         for k in range(len(times))
     ]
     forces = _frame_forces(chunks, len(times))
-    fitted = [grasp_scenes(g, t, methods, forces=f) for g, t, f in zip(moved, twists, forces)]
+    fitted = [grasp_scenes(g, t, methods, forces=f, extent=False) for g, t, f in zip(moved, twists, forces)]
     scale = min((s for s in map(velocity_scale_of, fitted) if s is not None), default=None)
     frames_scenes = (
-        [grasp_scenes(g, t, methods, scale, f) for g, t, f in zip(moved, twists, forces)] if scale else fitted
+        [grasp_scenes(g, t, methods, scale, f, extent=False) for g, t, f in zip(moved, twists, forces)]
+        if scale
+        else fitted
     )
-    cube = bounds([s for v in frames_scenes for s in v])
+    frames_scenes, cube = framed_together(frames_scenes)  # one cube for the whole path
     per_frame = []
     for scenes in frames_scenes:
         traces = scene_traces(scenes[0], grasp.units, own=False, half=cube[1])
@@ -168,6 +179,18 @@ def hold_marks(times, stretches) -> list[bool]:
     for c in stretches:
         inside |= (times >= c.t_start) & (times <= c.t_end)
     return inside.tolist()
+
+
+def _moved_objects(obj, chunks) -> list:
+    """The grasp's object at each sample, carried by the path's pose there (None: no object)."""
+    if obj is None:
+        return [None] * sum(len(c) for c in chunks)
+    rotation = np.concatenate([c.poses.rotation for c in chunks])
+    poses = np.zeros((len(rotation), 4, 4))
+    poses[:, :3, :3] = rotation
+    poses[:, :3, 3] = np.concatenate([c.poses.position for c in chunks])
+    poses[:, 3, 3] = 1.0
+    return [moved(obj, pose) for pose in poses]
 
 
 def _frame_forces(chunks, count) -> list:

@@ -8,11 +8,12 @@ import html
 
 import numpy as np
 
-from .scene import Scene, check_method, default_method, grasp_scene
-from .traces import force_traces, mesh_trace, scene_traces
+from .scene import Scene, check_method, default_method, framed, grasp_scene
+from .traces import force_traces, mesh_trace, scene_traces, slot_name
 
 __all__ = [
     "bounds",
+    "framed_together",
     "grasp_scenes",
     "methods_of",
     "scene_layout",
@@ -22,6 +23,8 @@ __all__ = [
 ]
 
 _EYE = 1.8  # the camera's distance, in plotly's units of the scene box
+# The same whatever the twist: drawn once, shown with every twist (an object's mesh can be large).
+_EVERY_TWIST = {slot_name("object", None), slot_name("fingertip", None)}
 
 
 def methods_of(grasp, method: str | None = None) -> tuple[str, ...]:
@@ -35,20 +38,29 @@ def methods_of(grasp, method: str | None = None) -> tuple[str, ...]:
     return ("off-tangent", "tangent") if default_method(grasp.wrist) == "off-tangent" else ("tangent",)
 
 
-def grasp_scenes(grasp, twist, methods, velocity_scale=None, forces=None) -> list[Scene]:
+def grasp_scenes(grasp, twist, methods, velocity_scale=None, forces=None, extent=None) -> list[Scene]:
     """One scene per method of ``grasp`` and ``twist``, every basis screw and the hand's fingers in each
-    (and with a friction its cones and the grip ``forces`` given).
+    (and with a friction its cones and the grip ``forces`` given), framed as ``extent`` says (:func:`grasp_scene`).
 
     Without ``velocity_scale`` the scenes are drawn again at the smallest of
     their fitted scales, so that every velocity arrow of a view has one scale.
     """
     scenes = [
-        grasp_scene(grasp, twist, method=m, all_bases=True, links=True, velocity_scale=velocity_scale, forces=forces)
+        grasp_scene(
+            grasp,
+            twist,
+            method=m,
+            all_bases=True,
+            links=True,
+            velocity_scale=velocity_scale,
+            forces=forces,
+            extent=extent,
+        )
         for m in methods
     ]
     shared = velocity_scale_of(scenes) if velocity_scale is None and len(scenes) > 1 else None
     if shared is not None:  # None: no arrow drawn (a zero twist), nothing to share
-        return grasp_scenes(grasp, twist, methods, shared, forces)
+        return grasp_scenes(grasp, twist, methods, shared, forces, extent)
     return scenes
 
 
@@ -67,6 +79,14 @@ def view_traces(scenes, units, half) -> dict[str, list[dict]]:
     return out
 
 
+def framed_together(views) -> tuple[list[list[Scene]], tuple[np.ndarray, float]]:
+    """Unframed scenes (lists of them) framed on one cube, the smallest holding each one's own
+    frame (:func:`~grasptwist.plot.scene.framed`), so that switching between them, or playing
+    them, keeps the picture still: the framed scenes, in the same lists, and the cube."""
+    cube = bounds([framed(s) for v in views for s in v])
+    return [[framed(s, extent=cube) for s in v] for v in views], cube
+
+
 def view_title(scenes) -> str:
     """The first scene's title line, then each method's line(s), as plotly's ``<br>``-separated text."""
     lines = scenes[0].title.split("\n")[:1] + [line for s in scenes for line in s.title.split("\n")[1:]]
@@ -74,7 +94,7 @@ def view_title(scenes) -> str:
 
 
 def bounds(scenes) -> tuple[np.ndarray, float]:
-    """Centre and half-width of a cube holding every scene."""
+    """Centre and half-width of a cube holding every scene's (each scene's framed cube)."""
     boxes = [s.bounds() for s in scenes]
     lo = np.min([c - h for c, h in boxes], axis=0)
     hi = np.max([c + h for c, h in boxes], axis=0)
@@ -112,7 +132,8 @@ def twist_figure(grasp, twists=None, *, method: str | None = None, active: int =
         The twist shown first.
     meshes : sequence of (vertices, faces)
         The hand's link meshes (a URDF hand's, as the ``plot`` command reads
-        them), one legend entry shown with every twist.
+        them), one legend entry shown with every twist (cut at the picture's
+        cube, which frames the object and the contacts).
     forces : (3, 3) array or None
         The grip forces drawn with a grasp's friction cones (the engine's, from the caller).
 
@@ -125,17 +146,19 @@ def twist_figure(grasp, twists=None, *, method: str | None = None, active: int =
     """
     methods = methods_of(grasp, method)
     items = list(grasp.twists if twists is None else twists) or [None]
-    views = [grasp_scenes(grasp, t, methods, forces=forces) for t in items]
-    half = bounds([s for v in views for s in v])[1]
+    views, cube = framed_together([grasp_scenes(grasp, t, methods, forces=forces, extent=False) for t in items])
+    half = cube[1]
     data, owner, shown, titles = [], [], [], []
     for k, scenes in enumerate(views):
-        for traces in view_traces(scenes, grasp.units, half).values():
+        for name, traces in view_traces(scenes, grasp.units, half).items():
+            if name in _EVERY_TWIST and k:
+                continue
             for t in traces:
                 shown.append(t.get("visible", True))  # True, or "legendonly" for the kinds off at first
-                if k != active:
+                if k != active and name not in _EVERY_TWIST:
                     t["visible"] = False
                 data.append(t)
-                owner.append(k)
+                owner.append(None if name in _EVERY_TWIST else k)
         titles.append(view_title(scenes))
     if len(meshes):
         data.append(mesh_trace(meshes, half))
@@ -143,7 +166,7 @@ def twist_figure(grasp, twists=None, *, method: str | None = None, active: int =
         shown.append(True)
     layout = {
         "title": {"text": titles[active], "font": {"size": 13}, "x": 0.01, "xanchor": "left"},
-        "scene": scene_layout(views[active][0], grasp.units),
+        "scene": scene_layout(views[active][0], grasp.units, cube),
         "legend": {"groupclick": "togglegroup", "itemsizing": "constant"},
         "margin": {"l": 0, "r": 0, "t": 90, "b": 0},
         "uirevision": "keep",  # switching twists keeps the camera

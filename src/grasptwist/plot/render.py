@@ -244,6 +244,7 @@ def _check_suffix(suffix: str, formats=FORMATS):
 _STYLE = {
     "contact": {"color": "black", "marker": "o", "s": 40},
     "wrist": {"color": "tab:purple", "marker": "^", "s": 60},
+    "hand-base": {"color": "tab:brown", "marker": "s", "s": 40},
     "normal": {"color": "0.45", "lw": 1.2},
     "tangent-plane": {"color": "tab:cyan", "alpha": 0.25},
     "contact-plane": {"color": "0.6", "alpha": 0.15},
@@ -259,6 +260,9 @@ _STYLE = {
     "joint-axis": {"color": "tab:brown", "lw": 2.0, "ls": "-"},
     "friction-cone": {"color": "tab:olive", "alpha": 0.18},
     "grip-force": {"color": "tab:pink", "lw": 2.6},
+    "object": {"color": "tan", "alpha": 0.3},
+    "fingertip": {"color": "tab:brown", "alpha": 0.45},
+    "beyond": {"color": "tab:purple", "lw": 2.0},
 }
 
 
@@ -320,6 +324,12 @@ def _draw(ax, scene: Scene, view, head: float):
     """Put every element of ``scene`` on one 3D axes seen along ``view``; arrow heads about ``head`` long."""
     from mpl_toolkits.mplot3d.art3d import Poly3DCollection
 
+    for solid in scene.meshes + scene.spheres:  # shaded, so that a translucent body still shows its form
+        st = _STYLE[solid.kind]
+        vertices, faces = solid.triangles()
+        ax.add_collection3d(
+            Poly3DCollection(vertices[faces], facecolors=st["color"], alpha=st["alpha"], edgecolor="none", shade=True)
+        )
     for p in scene.patches:
         st = _STYLE[p.kind]
         # a cone's patch is a fan from its apex (scene.force_parts), a plane's one polygon
@@ -337,6 +347,8 @@ def _draw(ax, scene: Scene, view, head: float):
         st = _STYLE[a.kind]
         for line in _arrow_lines(a.origin, a.scale * a.vector, view, head):
             ax.plot(*line.T, color=st["color"], lw=st["lw"], solid_capstyle="round")
+        if a.kind == "beyond":  # what it points to, and how far
+            ax.text(*a.origin, a.label + " ", color=st["color"], fontsize=8, ha="right")
     for m in scene.markers:
         st = _STYLE[m.kind]
         ax.scatter(*m.position, color=st["color"], marker=st["marker"], s=st["s"], depthshade=False)

@@ -10,6 +10,11 @@ it comes from the engine (:mod:`grasptwist.engine.decompose`,
 Velocity arrows keep their true vectors; the scene also gives the one length
 per unit velocity (``Arrow.scale``) that draws them all at a common scale
 fitted to the grasp, so their lengths compare with each other.
+
+A scene is framed on its subject, the contacts, the object and the fingertips
+(:func:`framed`): what lies farther than :data:`REACH` times the subject's size
+is cut at the edge (segments) or becomes an arrow at the edge pointing to it
+(a far wrist), so that a far point never shrinks the grasp into a corner.
 """
 
 from __future__ import annotations
@@ -21,24 +26,37 @@ import numpy as np
 from ..engine.decompose import contact_velocities, decompose_off_tangent, decompose_tangent
 from ..engine.degeneracy import NOISE_FLOOR, Status, conditioning_warning, status_message
 from ..engine.hands import finger_states
+from ..engine.objects import tessellate
 from ..engine.screws import J, K, axis_point, cross, dot, field_at, norm, pitch, rigid_motion, unit
+from ..model import GraspObject, Shape
 
 __all__ = [
     "KINDS",
     "METHODS",
+    "REACH",
     "Arrow",
     "FORCE_KINDS",
     "Marker",
+    "Mesh",
     "Patch",
     "Scene",
     "LinePiece",
+    "Sphere",
     "check_method",
+    "clip_segment",
+    "cube_of",
+    "edge_arrow",
     "default_method",
+    "finger_bases",
     "finger_links",
+    "fingertips",
     "force_parts",
+    "framed",
     "grasp_scene",
     "joint_segments",
     "legend_text",
+    "object_mesh",
+    "reach_box",
     "scene",
 ]
 
@@ -55,6 +73,15 @@ _JOINT_HALF = 0.12  # half-length of a finger joint's axis segment
 _CONE_HEIGHT = 0.3  # a friction cone's height along its normal
 _CONE_SIDES = 24  # a cone's rim is drawn as this polygon
 _FORCE_LEN = 0.45  # the largest grip force's drawn length
+_SPHERE_SEGMENTS = 16  # a fingertip sphere's tessellation (the object engine's segments)
+
+#: What a picture frames: its subject's bounding box (the contacts, the object and the fingertip
+#: spheres) grown to this many times its half-width about its centre (so the subject fills at
+#: least ``1 / REACH`` of the picture across); anything farther is cut at the edge or pointed at.
+REACH = 2.0
+_EDGE_ARROW = 0.25  # an arrow to a point beyond the picture: its length, of the picture's half-width
+_EDGE_INSET = 0.02  # its tip this far inside the edge, of the half-width
+_SAME_PLACE = 0.1  # points beyond the picture this close (of its half-width) share one arrow
 
 
 # --- scene data ---------------------------------------------------------------
@@ -120,6 +147,44 @@ class Patch:
 
 
 @dataclass(frozen=True)
+class Mesh:
+    """A triangle mesh (the object): ``vertices (V, 3)`` and ``faces (F, 3)`` int, rows of vertex indices."""
+
+    vertices: np.ndarray
+    faces: np.ndarray
+    label: str
+    kind: str
+
+    def triangles(self) -> tuple[np.ndarray, np.ndarray]:
+        """``(vertices, faces)``, as drawn."""
+        return self.vertices, self.faces
+
+    def corners(self) -> np.ndarray:
+        """The points its bounding box holds, ``(V, 3)``."""
+        return self.vertices
+
+
+@dataclass(frozen=True)
+class Sphere:
+    """A sphere (a fingertip) of ``radius`` centred at ``centre (3,)``."""
+
+    centre: np.ndarray
+    radius: float
+    label: str
+    kind: str
+
+    def triangles(self, segments: int = _SPHERE_SEGMENTS) -> tuple[np.ndarray, np.ndarray]:
+        """``(vertices, faces)``: the object engine's tessellation of a sphere, as drawn."""
+        pose = np.eye(4)
+        pose[:3, 3] = self.centre
+        return tessellate(GraspObject(Shape("sphere", np.array([self.radius])), pose), segments=segments)
+
+    def corners(self) -> np.ndarray:
+        """The two opposite corners of its bounding box, ``(2, 3)``."""
+        return self.centre + np.array([[-1.0], [1.0]]) * self.radius
+
+
+@dataclass(frozen=True)
 class Scene:
     """Everything a picture of one grasp and twist shows, as plain data.
 
@@ -138,6 +203,10 @@ class Scene:
     views : tuple of (str, (3,) array)
         Named unit directions from the scene towards the camera: an oblique
         view, then one looking down the normal of the contacts' plane.
+    meshes, spheres : tuple
+        The object (a :class:`Mesh`, in the grasp's frame) and the fingertips (:class:`Sphere`).
+    extent : ((3,) array, float) or None
+        The cube the picture shows, centre and half-width (:func:`framed`); None: not framed.
     """
 
     title: str
@@ -148,10 +217,17 @@ class Scene:
     arrows: tuple[Arrow, ...] = ()
     patches: tuple[Patch, ...] = ()
     views: tuple[tuple[str, np.ndarray], ...] = field(default=())
+    meshes: tuple[Mesh, ...] = ()
+    spheres: tuple[Sphere, ...] = ()
+    extent: tuple[np.ndarray, float] | None = None
+
+    def elements(self) -> tuple:
+        """Every element, in drawing order."""
+        return self.meshes + self.spheres + self.markers + self.segments + self.arrows + self.patches
 
     def of_kind(self, kind: str) -> list:
         """Every element of the given kind, in drawing order."""
-        return [e for e in self.markers + self.segments + self.arrows + self.patches if e.kind == kind]
+        return [e for e in self.elements() if e.kind == kind]
 
     def drawn_arrows(self) -> list[Arrow]:
         """The arrows long enough to see (a zero amplitude gives a zero part)."""
@@ -160,28 +236,33 @@ class Scene:
 
     def kinds(self) -> list[str]:
         """The kinds drawn, in :data:`KINDS` order (the legend's order)."""
-        present = {e.kind for e in self.markers + self.segments + self.patches + tuple(self.drawn_arrows())}
+        present = {e.kind for e in self.elements() if not isinstance(e, Arrow)}
+        present |= {a.kind for a in self.drawn_arrows()}
         return [k for k in KINDS if k in present]
 
+    def points(self) -> np.ndarray:
+        """Every drawn point ``(n, 3)``: markers, ends of segments and arrows, corners of patches,
+        mesh vertices and the corners of the spheres' boxes."""
+        pts = [m.position[None] for m in self.markers]
+        pts += [np.array([s.start, s.end]) for s in self.segments]
+        pts += [np.array([a.origin, a.tip]) for a in self.arrows]
+        pts += [p.corners for p in self.patches] + [m.corners() for m in self.meshes + self.spheres]
+        return np.concatenate([np.reshape(p, (-1, 3)) for p in pts] or [np.zeros((0, 3))]).astype(float)
+
     def bounds(self):
-        """Centre ``(3,)`` and half-width of a cube holding every drawn point.
+        """Centre ``(3,)`` and half-width of the cube the picture shows: its ``extent``
+        when framed, else a cube holding every drawn point.
 
         A cube, so that the renderer's axes get equal scales.
         """
-        pts = [m.position for m in self.markers]
-        pts += [p for s in self.segments for p in (s.start, s.end)]
-        pts += [p for a in self.arrows for p in (a.origin, a.tip)]
-        pts += [c for p in self.patches for c in p.corners]
-        pts = np.array(pts, dtype=float).reshape(-1, 3)
-        lo, hi = pts.min(axis=0), pts.max(axis=0)
-        half = 0.5 * float(np.max(hi - lo))
-        return (lo + hi) / 2, (half if half > 0 else 1.0)
+        return self.extent if self.extent is not None else cube_of(self.points())
 
 
 #: Every element kind and its legend text, in legend order.
 KINDS = {
     "contact": "contact",
     "wrist": "wrist c",
+    "hand-base": "finger base (its first joint)",
     "normal": "surface normal",
     "tangent-plane": "tangent plane",
     "contact-plane": "plane of the contacts",
@@ -198,6 +279,9 @@ KINDS = {
     "finger-link": "finger (joint to joint to tip)",
     "friction-cone": "friction cone (half-angle atan μ_i)",
     "grip-force": "grip force f_i",
+    "object": "object",
+    "fingertip": "fingertip sphere",
+    "beyond": "beyond the picture (arrow towards it)",
 }
 
 #: The force side's kinds (issue 19): drawn when the grasp has a friction.
@@ -259,6 +343,7 @@ def scene(
     twist_name: str | None = None,
     all_bases: bool = False,
     velocity_scale: float | None = None,
+    extent=None,
 ) -> Scene:
     """The picture of one grasp and twist, as plain data (no matplotlib).
 
@@ -283,6 +368,10 @@ def scene(
     velocity_scale : float or None
         Drawn length per unit velocity of every velocity arrow; None fits it
         to this scene (several scenes drawn together share the smallest).
+    extent : ((3,) array, float), None or False
+        The cube to show (several scenes drawn together share one); None
+        frames the contacts (:func:`framed`); False leaves the scene unframed,
+        for a caller that frames several scenes on one cube.
 
     Returns
     -------
@@ -297,13 +386,21 @@ def scene(
         ``y_j Psi_j(p_i)`` (``j != i``); tangent ``alpha_j Theta_j(p_i)``
         (``j != i``) and ``beta_i Sigma_i(p_i)``.  A grasp degenerate for the
         method keeps its contacts and velocities, loses its basis axes and
-        parts, and says why in the title.
+        parts, and says why in the title.  Framed by :func:`framed`.
 
     Raises
     ------
     ValueError
         Unknown method, or the off-tangent method without a wrist.
     """
+    picture = _unframed_scene(
+        points, normals, wrist, twist, method, names, grasp_name, twist_name, all_bases, velocity_scale
+    )
+    return picture if extent is False else framed(picture, extent=extent)
+
+
+def _unframed_scene(points, normals, wrist, twist, method, names, grasp_name, twist_name, all_bases, velocity_scale):
+    """:func:`scene`'s elements, every one where it is (not yet framed)."""
     method = check_method(method, wrist)
     points = np.asarray(points, dtype=float)
     normals = np.asarray(normals, dtype=float)
@@ -369,6 +466,140 @@ def scene(
         patches=tuple(p for p in patches if _finite(p.corners)),
         views=_views(points, wrist),
     )
+
+
+# --- framing -------------------------------------------------------------------
+
+
+def cube_of(points) -> tuple[np.ndarray, float]:
+    """Centre ``(3,)`` and half-width of the cube centred on the bounding box of ``points (n, 3)``
+    that holds them (half-width 1 for a single point).
+
+    >>> centre, half = cube_of([[0, 0, 0], [2, 1, 0]])
+    >>> centre.tolist(), half
+    ([1.0, 0.5, 0.0], 1.0)
+    """
+    pts = np.asarray(points, dtype=float).reshape(-1, 3)
+    lo, hi = pts.min(axis=0), pts.max(axis=0)
+    half = 0.5 * float(np.max(hi - lo))
+    return (lo + hi) / 2, (half if half > 0 else 1.0)
+
+
+def reach_box(subject, reach: float = REACH) -> tuple[np.ndarray, float]:
+    r"""The cube a picture may show around its subject's points ``(n, 3)``: centred on their
+    bounding box, ``reach`` times its half-width :math:`h`,
+
+    .. math:: [c - \text{reach}\, h,\; c + \text{reach}\, h]^3,
+
+    so the subject spans at least ``1 / reach`` of it across.
+
+    >>> centre, half = reach_box([[0, 0, 0], [0.06, 0.02, 0]])
+    >>> centre.tolist(), round(half, 12)
+    ([0.03, 0.01, 0.0], 0.06)
+    """
+    centre, half = cube_of(subject)
+    return centre, reach * half
+
+
+def clip_segment(start, end, centre, half):
+    r"""The piece of the segment from ``start`` to ``end`` (each ``(3,)``) inside the cube of
+    ``centre (3,)`` and half-width ``half``, as ``(start, end)``; None when none of it is.
+
+    The points :math:`a + t (b - a)`, :math:`0 \le t \le 1`, inside every slab
+    :math:`|x_k - c_k| \le h` (Liang and Barsky's clipping).
+
+    >>> [p.tolist() for p in clip_segment([0, 0, 0], [4, 0, 0], np.zeros(3), 1.0)]
+    [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]]
+    >>> clip_segment([2, 2, 0], [4, 0, 0], np.zeros(3), 1.0) is None
+    True
+    """
+    a, b = np.asarray(start, dtype=float), np.asarray(end, dtype=float)
+    d = b - a
+    lo, hi = centre - half, centre + half
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t_lo, t_hi = (lo - a) / d, (hi - a) / d
+    inside = (a >= lo) & (a <= hi)  # where d_k = 0 the segment is in the slab or never
+    enter = np.where(d == 0, np.where(inside, -np.inf, np.inf), np.minimum(t_lo, t_hi))
+    leave = np.where(d == 0, np.where(inside, np.inf, -np.inf), np.maximum(t_lo, t_hi))
+    t0, t1 = max(0.0, float(enter.max())), min(1.0, float(leave.min()))
+    if t0 > t1 or (t0 == t1 and np.any(d)):
+        return None
+    return a + t0 * d, a + t1 * d
+
+
+def edge_arrow(centre, half, target) -> tuple[np.ndarray, np.ndarray, float]:
+    r"""An arrow inside the cube of ``centre (3,)`` and half-width ``half`` pointing from its
+    centre towards ``target (3,)``, its tip at the cube's edge: ``(origin, direction, length)``.
+
+    The ray :math:`c + t d` leaves the cube at :math:`t_e = h / \max_k |d_k|`; the tip sits
+    :data:`_EDGE_INSET` of :math:`h` before it, the arrow is :data:`_EDGE_ARROW` of :math:`h` long.
+
+    >>> origin, d, length = edge_arrow(np.zeros(3), 1.0, [0, 0, 25.0])
+    >>> (origin + length * d).tolist(), d.tolist(), length
+    ([0.0, 0.0, 0.98], [0.0, 0.0, 1.0], 0.25)
+    """
+    d = unit(np.asarray(target, dtype=float) - centre)
+    tip = centre + (half / float(np.max(np.abs(d))) - _EDGE_INSET * half) * d
+    length = _EDGE_ARROW * half
+    return tip - length * d, d, length
+
+
+def framed(picture: Scene, *, extent=None) -> Scene:
+    """``picture`` framed on its subject: the contacts, the object and the fingertip spheres.
+
+    Segments are cut to the subject's ``reach_box`` (or to ``extent``, a given cube
+    ``(centre, half)``), and dropped when none of them is in it; a marker outside it (a far
+    wrist, a finger's base), or a twist axis wholly outside it, becomes an arrow of kind
+    ``"beyond"`` at the edge of the picture pointing to it (``edge_arrow``), labelled with its
+    distance from the picture's centre (points at one place share an arrow and its label).
+    The picture's ``extent`` is then ``extent``, or the cube
+    holding everything kept: a far point never shrinks the subject, which spans at least
+    ``1 / REACH`` of the picture across.
+
+    >>> contacts = [Marker(np.array([x, 0.0, 0.0]), str(x), "contact") for x in (0, 1)]
+    >>> picture = framed(Scene("t", "tangent", 0, markers=(*contacts, Marker(np.array([0.5, 0, 9]), "c", "wrist"))))
+    >>> [(a.label, a.tip.tolist()) for a in picture.arrows], picture.bounds()[1]
+    ([('c (9 away)', [0.5, 0.0, 0.49])], 0.5)
+    """
+    if extent is None:
+        subject = [m.position[None] for m in picture.of_kind("contact")]
+        subject += [m.corners() for m in picture.meshes + picture.spheres]
+        box = reach_box(np.concatenate(subject))
+    else:
+        box = (np.asarray(extent[0], dtype=float), float(extent[1]))
+    far, markers, segments = [], [], []
+    for m in picture.markers:
+        if m.kind == "contact" or np.all(np.abs(m.position - box[0]) <= box[1]):
+            markers.append(m)
+        else:
+            far.append((m.position, m.label))
+    for s in picture.segments:
+        piece = clip_segment(s.start, s.end, *box)
+        if piece is not None:
+            segments.append(replace(s, start=piece[0], end=piece[1]))
+        elif s.kind == "twist-axis":
+            far.append(((s.start + s.end) / 2, s.label))
+    kept = replace(picture, markers=tuple(markers), segments=tuple(segments))
+    cube = box if extent is not None else cube_of(kept.points())
+    beyond = []
+    for point, labels in _places(far, _SAME_PLACE * cube[1]):
+        origin, d, length = edge_arrow(*cube, point)
+        away = float(norm(point - cube[0]))
+        beyond.append(Arrow(origin, d, f"{', '.join(labels)} ({away:.3g} away)", "beyond", length))
+    return replace(kept, arrows=kept.arrows + tuple(beyond), extent=cube)
+
+
+def _places(points, tol):
+    """``[(point, label)]`` gathered by place: points within ``tol`` of an earlier one (the
+    TriFinger's three finger bases at its wrist) share its arrow, their labels in order."""
+    places = []
+    for point, label in points:
+        near = next((p for p in places if float(norm(p[0] - point)) <= tol), None)
+        if near is None:
+            places.append((point, [label]))
+        else:
+            near[1].append(label)
+    return places
 
 
 def _velocity_arrows(points, t, r, method, names, size, ok, scale=None):
@@ -504,39 +735,80 @@ def grasp_scene(
     links=False,
     velocity_scale=None,
     forces=None,
+    extent=None,
 ) -> Scene:
-    """:func:`scene` for a loaded ``Grasp``, with its hand's joint axes (and, with
-    ``links``, its fingers' chains from joint to joint to tip), and with a ``friction``
-    its friction cones and the grip ``forces (3, 3)`` given.
+    """:func:`scene` for a loaded ``Grasp``, with its object (translucent, ``object_mesh``),
+    its hand's fingertip spheres (``fingertips``) and joint axes (and, with ``links``, its
+    fingers' chains from joint to joint to tip), and with a ``friction`` its friction cones and
+    the grip ``forces (3, 3)`` given; framed on the contacts, object and fingertips (:func:`framed`).
 
     ``twist`` is a ``Twist`` (its ``name`` and ``screw`` are used), a ``(6,)``
     array (named ``twist_name``), or None for the grasp and its basis only.
-    ``all_bases`` and ``velocity_scale`` are :func:`scene`'s.
+    ``all_bases``, ``velocity_scale`` and ``extent`` are :func:`scene`'s.
     """
     if twist is not None and hasattr(twist, "screw"):
         twist_name = twist_name or twist.name
         twist = twist.screw
-    picture = scene(
+    picture = _unframed_scene(
         grasp.points,
         grasp.normals,
         grasp.wrist,
         twist,
-        method=method,
-        names=grasp.contact_names,
-        grasp_name=grasp.name,
-        twist_name=twist_name,
-        all_bases=all_bases,
-        velocity_scale=velocity_scale,
+        method,
+        grasp.contact_names,
+        grasp.name,
+        twist_name,
+        all_bases,
+        velocity_scale,
     )
     friction = getattr(grasp, "friction", None)
     if friction is not None:
         cones, arrows = force_parts(grasp.points, grasp.normals, friction, forces, grasp.contact_names)
         picture = replace(picture, patches=picture.patches + cones, arrows=picture.arrows + arrows)
-    if grasp.hand is None:
-        return picture
-    joints = joint_segments(grasp.hand, grasp.joint_positions, _JOINT_HALF * _grasp_size(grasp.points))
-    chains = finger_links(grasp.hand, grasp.joint_positions, grasp.points, grasp.contact_names) if links else ()
-    return replace(picture, segments=picture.segments + joints + chains)
+    if getattr(grasp, "object", None) is not None:
+        picture = replace(picture, meshes=(object_mesh(grasp.object),))
+    if grasp.hand is not None:
+        joints = joint_segments(grasp.hand, grasp.joint_positions, _JOINT_HALF * _grasp_size(grasp.points))
+        chains = finger_links(grasp.hand, grasp.joint_positions, grasp.points, grasp.contact_names) if links else ()
+        tips = fingertips(grasp.hand, grasp.points, grasp.normals, grasp.contact_names)
+        bases = finger_bases(grasp.hand, grasp.joint_positions, grasp.contact_names)
+        picture = replace(
+            picture, markers=picture.markers + bases, segments=picture.segments + joints + chains, spheres=tips
+        )
+    return picture if extent is False else framed(picture, extent=extent)
+
+
+def object_mesh(obj) -> Mesh:
+    """The object as drawn: the object engine's triangles of it in the grasp's frame
+    (``engine.objects.tessellate``, the geometry every other use of it sees).
+
+    >>> box = object_mesh(GraspObject(Shape("box", np.array([1.0, 2.0, 3.0])), np.eye(4)))
+    >>> box.faces.shape, box.vertices.max(axis=0).tolist(), box.label
+    ((12, 3), [0.5, 1.0, 1.5], 'box')
+    """
+    vertices, faces = tessellate(obj)
+    return Mesh(vertices, faces, obj.shape.kind, "object")
+
+
+def fingertips(hand, points, normals, names=("1", "2", "3")) -> tuple[Sphere, ...]:
+    r"""Each finger's fingertip sphere of radius ``tip_radius`` (those with a radius > 0): centred
+    at :math:`p_i - r_i n_i` (the unit normal into the object), touching it at the contact.
+
+    >>> from grasptwist.io.grasp import inline_hand
+    >>> h = inline_hand(["a", "b", "c"], [[("j", "revolute", [0, 0, 2], [1, 0, 0], None, 1)]] * 3, None)
+    >>> h = replace(h, fingers=tuple(replace(f, tip_radius=0.5) for f in h.fingers))
+    >>> tip = fingertips(h, 3 * np.eye(3), -2 * np.eye(3))[0]
+    >>> tip.centre.tolist(), tip.radius, tip.label
+    ([3.5, 0.0, 0.0], 0.5, 'tip 1')
+    """
+    n = unit(np.asarray(normals, dtype=float))
+    return tuple(
+        Sphere(
+            np.asarray(points[i], dtype=float) - f.tip_radius * n[i], float(f.tip_radius), f"tip {name}", "fingertip"
+        )
+        for i, (f, name) in enumerate(zip(hand.fingers, names))
+        if f.tip_radius > 0
+    )
 
 
 def force_parts(points, normals, friction, forces=None, names=("1", "2", "3")):
@@ -610,6 +882,20 @@ def finger_links(hand, positions, contacts, names=("1", "2", "3")) -> tuple[Line
         stops = list(state.points) + ([] if state.tip is None else [state.tip[:3, 3]]) + [contact]
         out += [LinePiece(a, b, f"finger {name}", "finger-link") for a, b in zip(stops[:-1], stops[1:])]
     return tuple(out)
+
+
+def finger_bases(hand, positions, names=("1", "2", "3")) -> tuple[Marker, ...]:
+    """Where each finger starts (its first joint's point at ``positions``), labelled by its
+    contact's name: the hand's base, pointed at from the picture's edge when it lies beyond.
+
+    >>> from grasptwist.io.grasp import inline_hand
+    >>> h = inline_hand(["a", "b", "c"], [[("j", "revolute", [0, 0, 2], [1, 0, 0], None, 1)]] * 3, None)
+    >>> b = finger_bases(h, None)[0]
+    >>> b.label, b.position.tolist()
+    ('base 1', [1.0, 0.0, 0.0])
+    """
+    states = finger_states(hand, positions)
+    return tuple(Marker(s.points[0], f"base {name}", "hand-base") for name, s in zip(names, states) if len(s.points))
 
 
 def joint_segments(hand, positions, half) -> tuple[LinePiece, ...]:

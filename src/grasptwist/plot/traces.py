@@ -24,6 +24,7 @@ MESH_NAME = "hand (URDF visual meshes)"
 COMMON_KINDS = (
     "contact",
     "wrist",
+    "hand-base",
     "normal",
     "contact-plane",
     "tangent-plane",
@@ -32,12 +33,16 @@ COMMON_KINDS = (
     "contact-velocity",
     "finger-link",
     "joint-axis",
+    "object",
+    "fingertip",
+    "beyond",
 )
 
 # kind -> plotly colour, line width, dash; matplotlib's tab10 colours, as the static pictures
 _STYLE = {
     "contact": ("black", 0, None),
     "wrist": ("#9467bd", 0, None),
+    "hand-base": ("#8c564b", 0, None),
     "normal": ("#737373", 3, None),
     "tangent-plane": ("#17becf", 0, None),
     "contact-plane": ("#999999", 0, None),
@@ -54,9 +59,12 @@ _STYLE = {
     "finger-link": ("#c7a17a", 10, None),
     "friction-cone": ("#bcbd22", 0, None),
     "grip-force": ("#e377c2", 6, None),
+    "object": ("#d2b48c", 0, None),
+    "fingertip": ("#8c564b", 0, None),
+    "beyond": ("#9467bd", 6, None),
 }
 _DASHED_METHOD = {"tangent": "dot"}  # the tangent method's Sigma axes are the off-tangent's lines: tell them apart
-_OPACITY = {"tangent-plane": 0.35, "contact-plane": 0.2, "friction-cone": 0.25}
+_OPACITY = {"tangent-plane": 0.35, "contact-plane": 0.2, "friction-cone": 0.25, "object": 0.35, "fingertip": 0.5}
 _HEAD = 0.07  # arrow-head length, of the scene's half-width
 _HIDDEN = ("sigma-part", "psi-part", "theta-part", "tangent-plane")  # off at first: toggled in the legend
 
@@ -100,10 +108,12 @@ def scene_traces(scene: Scene, units: str | None, *, common=True, own=True, half
             continue
         name = slot_name(kind, scene.method)
         elements = scene.of_kind(kind)
-        if kind.endswith("-part") or kind in {"normal", "contact-velocity", "twist-translation"}:
+        if kind in {"object", "fingertip"}:
+            traces = [mesh_trace([e.triangles() for e in elements], half, name, _STYLE[kind][0], _OPACITY[kind])]
+        elif kind.endswith("-part") or kind in {"normal", "contact-velocity", "twist-translation", "beyond"}:
             elements = [a for a in elements if _shown(a, half)]
             traces = _arrows(elements, kind, name, units, half)
-        elif kind in {"contact", "wrist"}:
+        elif kind in {"contact", "wrist", "hand-base"}:
             traces = [_markers(elements, kind, name, units)]
         elif kind.endswith("plane"):
             traces = [_patches(elements, kind, name)]
@@ -143,8 +153,9 @@ def force_traces(scene: Scene, units: str | None) -> dict[str, list[dict]]:
     return out
 
 
-def mesh_trace(meshes, half) -> dict:
-    """Triangle meshes ``[(vertices (n, 3), faces (m, 3))]`` as one ``mesh3d`` trace, shaded.
+def mesh_trace(meshes, half, name=MESH_NAME, color="#b0b0b0", opacity=0.5) -> dict:
+    """Triangle meshes ``[(vertices (n, 3), faces (m, 3))]`` as one ``mesh3d`` trace, shaded:
+    by default a hand's link meshes; a scene's object and fingertips are named by their kind.
 
     Coordinates are rounded to a millionth of ``half`` (the drawing's
     half-width): invisible, and it halves the page's share of them.
@@ -153,10 +164,10 @@ def mesh_trace(meshes, half) -> dict:
     vertices = np.round(np.concatenate([v for v, _ in meshes]), decimals)
     offsets = np.cumsum([0] + [len(v) for v, _ in meshes[:-1]])
     faces = np.concatenate([f + o for (_, f), o in zip(meshes, offsets)])
-    trace = {"type": "mesh3d", "name": MESH_NAME, "showlegend": True, "legendgroup": MESH_NAME}
+    trace = {"type": "mesh3d", "name": name, "showlegend": True, "legendgroup": name}
     trace.update({c: vertices[:, n].tolist() for n, c in enumerate("xyz")})
     trace.update({c: faces[:, n].tolist() for n, c in enumerate("ijk")})
-    trace.update(color="#b0b0b0", opacity=0.5, hoverinfo="name", flatshading=True)
+    trace.update(color=color, opacity=opacity, hoverinfo="name", flatshading=True)
     return trace
 
 
@@ -181,7 +192,8 @@ def _markers(markers, kind, name, units) -> dict:
     trace["hovertext"] = [f"{m.label}: {_fmt(m.position, units)}" for m in markers]
     trace["textposition"] = "top center"
     trace["textfont"] = {"color": colour, "size": 14}
-    trace["marker"] = {"color": colour, "size": 6, "symbol": "diamond" if kind == "wrist" else "circle"}
+    symbol = {"wrist": "diamond", "hand-base": "square"}.get(kind, "circle")
+    trace["marker"] = {"color": colour, "size": 6, "symbol": symbol}
     return trace
 
 
@@ -216,9 +228,13 @@ def _arrows(arrows, kind, name, units, half) -> list[dict]:
         text = f"{a.label}<br>{what} {_fmt(a.vector)}"
         points += [a.origin, a.tip, None]
         hover += [text, text, None]
-    shafts = _base(kind, name, "lines")
+    shafts = _base(kind, name, "lines+text" if kind == "beyond" else "lines")
     shafts.update(_xyz(points))
     shafts["hovertext"] = hover
+    if kind == "beyond":  # what it points to, and how far, at its tail
+        shafts["text"] = [t for a in arrows for t in (a.label, "", None)]
+        shafts["textposition"] = "bottom center"
+        shafts["textfont"] = {"color": colour}
     shafts["line"] = {"color": colour, "width": width}
     tips = np.array([a.tip for a in arrows])
     drawn = np.array([a.scale * a.vector for a in arrows])
