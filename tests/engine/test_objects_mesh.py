@@ -8,6 +8,8 @@ import sys
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 pytest.importorskip("igl")
 
@@ -182,6 +184,21 @@ def test_points_a_hair_from_a_torus_mesh_are_inside_or_outside_as_its_winding_nu
     inside = winding_number(vertices, faces, q) > 0.5
     assert 0.3 < inside.mean() < 0.7
     np.testing.assert_array_equal(project_to_surface(mesh, q).distance < 0, inside)
+
+
+TORUS = mesh_object(*torus_mesh(0.05, 0.015, 16, 8))
+coordinate = st.floats(-0.08, 0.08, allow_nan=False)
+
+
+@settings(max_examples=20, deadline=None)
+@given(point=st.tuples(coordinate, coordinate, coordinate))
+def test_a_mesh_point_is_its_distance_away_on_the_surface(point):
+    s = project_to_surface(TORUS, point)
+    assert np.linalg.norm(np.asarray(point) - s.points) == pytest.approx(abs(s.distance), rel=0, abs=1e-16)
+    np.testing.assert_allclose(np.linalg.norm(s.normals), 1.0, rtol=0, atol=1e-15)
+    again = project_to_surface(TORUS, s.points)
+    assert abs(again.distance) <= 1e-16  # sizes about 0.1: round-off
+    np.testing.assert_allclose(again.points, s.points, rtol=0, atol=1e-16)
 
 
 def test_edges_and_vertices_take_the_area_weighted_normal_of_their_faces():
