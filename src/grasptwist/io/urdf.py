@@ -59,8 +59,8 @@ _MOVABLE = {"revolute": "revolute", "continuous": "revolute", "prismatic": "pris
 _UNSUPPORTED = {"floating", "planar"}
 
 
-def resolve_urdf(reference, folder=None):
-    """The file a URDF reference names, refused if it leaves its package or folder.
+def resolve_urdf(reference, folder=None, *, allow_outside=False):
+    """The file a URDF (or mesh) reference names, refused if it leaves its package or folder.
 
     Parameters
     ----------
@@ -69,6 +69,9 @@ def resolve_urdf(reference, folder=None):
     folder : str or os.PathLike, optional
         The referring file's folder: a path is taken relative to it and must
         stay inside it.  None: a path is used as given (the caller chose it).
+    allow_outside : bool
+        Take a relative path wherever it leads (``--allow-outside``: the
+        user vouches for the files the grasp files name).
 
     Returns
     -------
@@ -91,6 +94,8 @@ def resolve_urdf(reference, folder=None):
         raise InputError("unsupported-url", f"only package:// URLs and file paths are read, got {text!r}", text)
     if folder is None:
         return Path(text).resolve()
+    if allow_outside:
+        return (Path(folder) / text).resolve()
     return _inside(Path(folder).resolve(), text, text)
 
 
@@ -267,7 +272,7 @@ def _model(data, file):
         raise InputError("invalid-urdf", f"yourdfpy cannot read it: {type(exc).__name__}: {exc}", file) from None
 
 
-def load_urdf_hand(urdf, tips, *, names=None, folder=None, max_bytes=DEFAULT_MAX_BYTES):
+def load_urdf_hand(urdf, tips, *, names=None, folder=None, max_bytes=DEFAULT_MAX_BYTES, allow_outside=False):
     """A hand from a URDF: one finger per tip link, its joints at home (all 0).
 
     The hand's frame (and so the grasp's) is the URDF's root link's frame.
@@ -291,9 +296,11 @@ def load_urdf_hand(urdf, tips, *, names=None, folder=None, max_bytes=DEFAULT_MAX
     names : sequence of str, optional
         Finger names; default ``"1"``, ``"2"``, ...
     folder : str or os.PathLike, optional
-        The referring grasp file's folder; a path must stay inside it.
+        The referring grasp file's folder; a path must stay inside it, unless ``allow_outside``.
     max_bytes : int
         Size cap of the URDF (default 1 MiB, as for grasp files).
+    allow_outside : bool
+        Take a relative path wherever it leads (``--allow-outside``).
 
     Returns
     -------
@@ -317,7 +324,7 @@ def load_urdf_hand(urdf, tips, *, names=None, folder=None, max_bytes=DEFAULT_MAX
     text = os.fspath(urdf)
     file = text if text.startswith(_PACKAGE) or folder is None else os.path.join(os.fspath(folder), text)
     _library(file)  # before the reference: a package:// one may be missing for the same reason
-    where = resolve_urdf(urdf, folder)
+    where = resolve_urdf(urdf, folder, allow_outside=allow_outside)
     data = _read(where, max_bytes, file)
     root = _parse(data, file)
     _check_joint_elements(root, file)

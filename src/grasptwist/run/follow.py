@@ -129,7 +129,7 @@ def follow_inputs(job, inputs: Iterable) -> Iterator[GraspFileError | Samples | 
         elif item.endswith(DATASET_SUFFIXES):
             yield GraspFileError("read-error", "follow reads grasp files, not data sets", item)
         else:
-            for entry in read(item, job.max_bytes):
+            for entry in read(item, job.max_bytes, job.reading):
                 yield from follow_grasp(job.options, entry) if isinstance(entry, Grasp) else (entry,)
 
 
@@ -257,6 +257,8 @@ def _block(grasp, name, f, bases, method, positions=None) -> Block:
         center_of_mass=None
         if grasp.center_of_mass is None
         else f.poses.rotation @ grasp.center_of_mass + f.poses.position,
+        # the contacts move with the object: each keeps its distance from the surface
+        surface_distance=None if grasp.surface_distance is None else np.broadcast_to(grasp.surface_distance, (n, 3)),
     )
     return with_reasons(block)  # a method asked for by name that cannot run fails, as in resolve
 

@@ -1,0 +1,256 @@
+"""An object's triangle mesh (STL, OBJ or PLY), read as untrusted input.
+
+A grasp file's ``object: {mesh: path}`` names it; trimesh (the optional
+extra ``grasptwist[mesh]``) parses STL and PLY, an OBJ's ``v`` and ``f``
+lines are read here (the format this project writes, without trimesh's
+second of import), and the checks are numpy's.  Around it, as for a URDF
+(:mod:`grasptwist.io.urdf`, whose path rule this shares):
+
+* the reference: a path relative to the grasp file's folder, refused when it
+  resolves (symbolic links followed) outside that folder (``path-outside``)
+  unless the caller allows it (``--allow-outside``); ``package://PKG/path``
+  inside an installed Python package;
+* the bytes: at most ``max_bytes`` (the loader's ``--max-bytes``) of a regular
+  file are read before anything is parsed, and a PLY header declaring more
+  than ``max_triangles`` faces is refused unparsed, so memory stays bounded
+  by the cap;
+* the geometry: at most ``max_triangles`` triangles (:data:`~grasptwist.io.limits.MAX_TRIANGLES`),
+  finite vertices, every face index a vertex, and a closed surface: each
+  edge shared by exactly two triangles, wound the same way (a volume, a
+  centre of mass and an inside need one).  A mesh wound inwards is turned
+  outwards.
+
+Every refusal is a :class:`~grasptwist.model.InputError` with a code:
+
+=======================  ==========================================================
+``read-error``           missing or unreadable file, not a regular file
+``too-large``            more than ``max_bytes``
+``path-outside``         the path resolves outside the grasp file's folder
+``unsupported-url``      a URL scheme other than ``package://``
+``package-not-found``    ``package://PKG``: no installed Python package ``PKG``
+``unsupported-mesh``     a file name not ending in ``.stl``, ``.obj`` or ``.ply``
+``invalid-mesh``         not readable as its format (bad face indices, truncated)
+``empty-mesh``           no triangles
+``too-many-triangles``   more than ``max_triangles``
+``non-finite``           a vertex coordinate that is NaN or infinite
+``not-watertight``       an open, non-manifold or inconsistently wound surface
+``mesh-unavailable``     trimesh is not installed (an STL or PLY)
+=======================  ==========================================================
+"""
+
+from __future__ import annotations
+
+import os
+import re
+from pathlib import Path
+
+import numpy as np
+
+from ..model import InputError
+from .limits import DEFAULT_MAX_BYTES, MAX_TRIANGLES
+from .urdf import _read, resolve_urdf
+
+__all__ = ["MESH_SUFFIXES", "read_mesh", "check_mesh"]
+
+#: The formats read, by file suffix (in any letter case).
+MESH_SUFFIXES = (".stl", ".obj", ".ply")
+
+_PLY_FACES = re.compile(rb"^element\s+face\s+(\d+)\s*$", re.MULTILINE)
+
+
+def read_mesh(
+    reference,
+    folder=None,
+    *,
+    max_bytes=DEFAULT_MAX_BYTES,
+    max_triangles=MAX_TRIANGLES,
+    allow_outside=False,
+):
+    """The vertices and outward-wound triangles of a mesh file.
+
+    Parameters
+    ----------
+    reference : str
+        The file as the grasp file names it: a path relative to ``folder``,
+        or ``package://PKG/path``.
+    folder : str or os.PathLike, optional
+        The grasp file's folder, which the path must stay inside.  None: the
+        path is used as given.
+    max_bytes : int
+        Size cap, checked before parsing.
+    max_triangles : int
+        Most triangles.
+    allow_outside : bool
+        Take a relative path wherever it leads.
+
+    Returns
+    -------
+    vertices : numpy.ndarray
+        ``(V, 3)`` float, every one used by a face.
+    faces : numpy.ndarray
+        ``(F, 3)`` int vertex indices, counter-clockwise seen from outside.
+
+    Raises
+    ------
+    InputError
+        One of the codes in the module's table, its message one line.
+
+    Examples
+    --------
+    >>> read_mesh("box.step", ".")
+    Traceback (most recent call last):
+    grasptwist.model.GraspFileError: box.step: expected a mesh file ending in .stl, .obj or .ply
+    """
+    text = os.fspath(reference)
+    suffix = Path(text).suffix.lower()
+    if suffix not in MESH_SUFFIXES:
+        raise InputError(
+            "unsupported-mesh", f"expected a mesh file ending in {', '.join(MESH_SUFFIXES[:-1])} or .ply", text
+        )
+    data = _read(resolve_urdf(text, folder, allow_outside=allow_outside), max_bytes, text)
+    if suffix == ".ply":
+        _check_ply_header(data, max_triangles, text)
+    try:
+        vertices, faces = _obj(data) if suffix == ".obj" else _parsed(data, suffix, text)
+    except (ValueError, IndexError):
+        raise InputError("invalid-mesh", f"not a readable {suffix[1:].upper()} file", text) from None
+    return check_mesh(vertices, faces, max_triangles, text)
+
+
+def _obj(data):
+    """``(vertices, faces)`` of a Wavefront OBJ's ``v`` and ``f`` lines (polygons as fans of
+    triangles; ``a/b/c`` takes ``a``; negative indices count back from the vertices so far),
+    read here: it is the format this project writes (``grasps/meshes/make_bottle.py``), and trimesh
+    costs a second to import.  Other lines (normals, texture coordinates, groups, materials)
+    are passed over.  Raises ValueError on what does not read."""
+    vertices, faces = [], []
+    for line in data.decode("utf-8", "strict").splitlines():
+        words = line.split()
+        if not words or words[0] not in ("v", "f"):
+            continue
+        if words[0] == "v":
+            vertices.append([float(w) for w in words[1:4]])
+            continue
+        corners = [int(w.partition("/")[0]) for w in words[1:]]
+        if len(corners) < 3 or 0 in corners:
+            raise ValueError("a face needs three vertices, numbered from 1")
+        corners = [c - 1 if c > 0 else len(vertices) + c for c in corners]
+        faces += [(corners[0], corners[k], corners[k + 1]) for k in range(1, len(corners) - 1)]
+    return np.array(vertices, dtype=float).reshape(-1, 3), np.array(faces, dtype=np.int64).reshape(-1, 3)
+
+
+def _parsed(data, suffix, file):
+    """``(vertices, faces)`` of an STL or PLY file, parsed by trimesh."""
+    trimesh = _library(file)
+    try:
+        mesh = trimesh.load(
+            trimesh.util.wrap_as_stream(data), file_type=suffix[1:], force="mesh", process=False, skip_materials=True
+        )
+        return np.asarray(mesh.vertices, dtype=float), np.asarray(mesh.faces, dtype=np.int64).reshape(-1, 3)
+    except Exception:  # a parser's failure on hostile bytes has no one type; what it says varies by version
+        raise ValueError(f"not a readable {suffix[1:].upper()} file") from None
+
+
+def check_mesh(vertices, faces, max_triangles, file):
+    """``(vertices, faces)`` of a parsed mesh once it is a closed surface within the limits:
+    equal vertices merged (an STL repeats each per triangle), unused ones dropped, wound outwards.
+
+    A closed, consistently wound surface has each directed edge ``(a, b)`` of its triangles once,
+    and its reverse ``(b, a)`` once: an open edge has no reverse, a non-manifold one (three or more
+    triangles) or a triangle wound the other way repeats one.  Outwards: the signed volume
+
+    .. math::
+
+        V = \\frac{1}{6} \\sum_f \\mathbf v_{f,0} \\cdot (\\mathbf v_{f,1} \\times \\mathbf v_{f,2}) > 0.
+
+    Parameters
+    ----------
+    vertices : (V, 3) float array
+    faces : (F, 3) int array
+    max_triangles : int
+    file : str
+        The mesh file, as the grasp file names it (for the errors).
+
+    Returns
+    -------
+    vertices : (V', 3) float array, read-only
+    faces : (F, 3) int array, read-only
+
+    Raises
+    ------
+    InputError
+        ``empty-mesh``, ``too-many-triangles``, ``invalid-mesh``, ``non-finite`` or ``not-watertight``.
+
+    >>> tetra = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.0]])
+    >>> faces = np.array([[0, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2]])  # wound inwards
+    >>> vertices, outwards = check_mesh(tetra, faces, 10, "t.obj")
+    >>> a, b, c = vertices[outwards].transpose(1, 0, 2)
+    >>> float(np.einsum("ij,ij->", a, np.cross(b, c)) / 6)  # the tetrahedron's volume, now positive
+    0.16666666666666666
+    >>> check_mesh(tetra, faces[:3], 10, "t.obj")
+    Traceback (most recent call last):
+    grasptwist.model.GraspFileError: t.obj: not a closed surface (every edge shared by exactly two triangles, wound the same way)
+    """
+    if not len(faces):
+        raise InputError("empty-mesh", "no triangles in the mesh", file)
+    if len(faces) > max_triangles:
+        raise InputError("too-many-triangles", f"{len(faces)} triangles, more than the limit of {max_triangles}", file)
+    if faces.min() < 0 or faces.max() >= len(vertices):
+        raise InputError("invalid-mesh", "a face names a vertex the file does not have", file)
+    if not np.isfinite(vertices).all():
+        raise InputError("non-finite", "a vertex coordinate is NaN or infinite", file)
+    vertices, merged = np.unique(vertices, axis=0, return_inverse=True)
+    faces = merged.reshape(-1)[faces]
+    used, faces = np.unique(faces, return_inverse=True)
+    vertices, faces = vertices[used], faces.reshape(-1, 3)
+    if not _closed(faces):
+        raise InputError(
+            "not-watertight",
+            "not a closed surface (every edge shared by exactly two triangles, wound the same way)",
+            file,
+        )
+    a, b, c = vertices[faces].transpose(1, 0, 2)
+    if np.einsum("ij,ij->", a, np.cross(b, c)) < 0:
+        faces = faces[:, ::-1]
+    faces = np.ascontiguousarray(faces)
+    for array in (vertices, faces):
+        array.setflags(write=False)
+    return vertices, faces
+
+
+def _closed(faces):
+    """Whether each directed edge of the triangles is there once and so is its reverse."""
+    edges = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
+    if (edges[:, 0] == edges[:, 1]).any():  # a triangle with a repeated corner
+        return False
+    n = int(faces.max()) + 1
+    keys, counts = np.unique(edges[:, 0] * n + edges[:, 1], return_counts=True)
+    reverse = np.sort(edges[:, 1] * n + edges[:, 0])
+    return bool((counts == 1).all() and np.array_equal(keys, reverse))
+
+
+def _check_ply_header(data, max_triangles, file):
+    """Refuse a PLY whose header declares more faces than ``max_triangles`` before trimesh
+    allocates arrays of that length."""
+    end = data.find(b"end_header")
+    header = data[: end if end >= 0 else 4096]
+    declared = _PLY_FACES.search(header)
+    if declared and int(declared.group(1)) > max_triangles:
+        raise InputError(
+            "too-many-triangles",
+            f"the header declares {int(declared.group(1))} faces, more than the limit of {max_triangles}",
+            file,
+        )
+
+
+def _library(file):
+    """trimesh, or the error that says which extra to install."""
+    try:
+        import trimesh
+    except ImportError:
+        raise InputError(
+            "mesh-unavailable",
+            "reading a mesh needs trimesh: pip install trimesh (from a clone of grasptwist: pip install -e '.[mesh]')",
+            file,
+        ) from None
+    return trimesh
