@@ -1,0 +1,150 @@
+"""Fingers through the object: which links of a placed hand go into it, and how deep.
+
+With a URDF hand and an object, every finger link's collision geometry
+(:func:`~grasptwist.io.urdf_meshes.link_geometry`) is checked against the
+object (:func:`~grasptwist.engine.collision.penetration_depths`) at the
+grasp (:mod:`.placement`) and at every path sample (:mod:`.follow`); a link
+deeper than :func:`~grasptwist.engine.collision.collision_tolerance` (0.1 %
+of the object's size) is a :class:`Collision`, a warning ``finger-collides``
+in its record and one line on stderr.  The fingertip's sphere (the tip
+link's vertices within ``tip_radius`` plus that tolerance of its origin) is
+the contact itself and left out.  No math here.
+"""
+
+from __future__ import annotations
+
+from typing import NamedTuple
+
+import numpy as np
+
+from ..engine.collision import clusters, collision_tolerance, link_poses, penetration_depths, tip_sphere
+from ..io.limits import DEFAULT_MAX_BYTES
+from ..io.urdf_meshes import grasp_folder, link_geometry
+from ..model import Grasp
+from ..output.names import escaped
+
+__all__ = ["CODE", "Collision", "collision_warning", "finger_collisions", "finger_collisions_along"]
+
+#: The warning's code.
+CODE = "finger-collides"
+
+
+class Collision(NamedTuple):
+    """A finger link inside the object.
+
+    Attributes
+    ----------
+    finger : str
+        The finger's name: its contact's (as every message names fingers).
+    link : str
+        The link's name in the URDF.
+    depth : float
+        How deep its deepest vertex is inside the object (grasp units), above the tolerance.
+    """
+
+    finger: str
+    link: str
+    depth: float
+
+
+def collision_warning(c: Collision) -> str:
+    """The warning, one line, for records and stderr.
+
+    >>> collision_warning(Collision("1", "finger_middle_link_0", 0.0042))
+    "finger-collides: finger 1's link 'finger_middle_link_0' is 0.0042 inside the object"
+    """
+    return f"{CODE}: finger {escaped(c.finger)}'s link {escaped(c.link)!r} is {c.depth:.3g} inside the object"
+
+
+#: Link geometry of the last hands checked: a folder's grasps name the same URDF (each its own Hand).
+_LOADED: dict = {}
+
+
+def _geometry(hand, folder, max_bytes):
+    """The hand's finger links and their vertices in clusters, loaded once per hand."""
+    key = (hand.source, folder, max_bytes, tuple(tuple(j.name for j in f.joints) for f in hand.fingers))
+    if key not in _LOADED:
+        if len(_LOADED) >= 8:  # bounded: a run over many hands keeps the last few
+            del _LOADED[next(iter(_LOADED))]
+        geometry = link_geometry(hand, folder=folder, max_bytes=max_bytes)
+        _LOADED[key] = geometry, clusters([g.vertices for g in geometry])
+    return _LOADED[key]
+
+
+def _checked(grasp, max_bytes):
+    """The links and their clusters with the fingertip spheres left out, or None when there is
+    nothing to check."""
+    if grasp.object is None or grasp.hand is None or grasp.hand.source is None:
+        return None
+    geometry, parts = _geometry(grasp.hand, grasp_folder(grasp), max_bytes)
+    tol = collision_tolerance(grasp.object)
+    fingers = [grasp.hand.fingers[g.finger] for g in geometry]
+    on_tip = np.array([g.link == f.tip for g, f in zip(geometry, fingers)], dtype=bool)[parts.link]
+    center = np.array([f.tip_pose[:3, 3] for f in fingers]).reshape(-1, 3)[parts.link]
+    radius = np.array([f.tip_radius for f in fingers], dtype=float)[parts.link]
+    sphere = tip_sphere(parts.vertices, center[:, None], radius[:, None], tol) & on_tip[:, None]
+    return geometry, parts._replace(keep=~sphere), tol
+
+
+def finger_collisions_along(grasp: Grasp, joint_positions, frames=None, *, max_bytes=DEFAULT_MAX_BYTES):
+    """Per configuration, the links of ``grasp``'s hand inside its object.
+
+    Parameters
+    ----------
+    grasp : Grasp
+        With a URDF hand and an object (else no collisions).
+    joint_positions : (N, n_joints) array
+    frames : (N, 4, 4) array, optional
+        The object's motion at each configuration (a path's poses); None: where the grasp has it.
+    max_bytes : int
+        Size cap of the URDF.
+
+    Returns
+    -------
+    list of tuple of Collision
+        One tuple per configuration, deepest first.
+
+    Raises
+    ------
+    InputError
+        The URDF's or a mesh's (:func:`~grasptwist.io.urdf_meshes.link_geometry`).
+    """
+    q = np.asarray(joint_positions, dtype=float)
+    checked = _checked(grasp, max_bytes)
+    if checked is None:
+        return [()] * len(q)
+    geometry, parts, tol = checked
+    depth = penetration_depths(grasp.object, parts, link_poses(grasp.hand, geometry, q, frames), len(geometry))
+    names = grasp.contact_names
+    out = []
+    for row in depth:
+        hits = np.flatnonzero(row > tol)
+        hits = hits[np.argsort(-row[hits], kind="stable")]
+        out.append(tuple(Collision(names[geometry[l].finger], geometry[l].link, float(row[l])) for l in hits))
+    return out
+
+
+def finger_collisions(grasp: Grasp, joint_positions) -> tuple[Collision, ...]:
+    """The links of ``grasp``'s hand inside its object at ``joint_positions``, deepest first.
+
+    Parameters
+    ----------
+    grasp : Grasp
+        With a URDF hand and an object (else none); the object where the grasp has it.
+    joint_positions : (n_joints,) array
+        In ``grasp.hand.joint_names`` order.
+
+    Returns
+    -------
+    tuple of Collision
+        Each link deeper than :func:`~grasptwist.engine.collision.collision_tolerance`, naming its
+        finger, link and depth; the fingertip spheres touching their contacts are no collision.
+
+    Examples
+    --------
+    >>> import grasptwist as gt
+    >>> (g,) = gt.read_grasps("grasps/trifinger-cube.yaml")
+    >>> finger_collisions(g, g.joint_positions)
+    ()
+    """
+    return finger_collisions_along(grasp, np.asarray(joint_positions, dtype=float)[None])[0]
