@@ -60,30 +60,26 @@ def collision_warning(c: Collision) -> str:
 _LOADED: dict = {}
 
 
-def _geometry(hand, folder, max_bytes):
-    """The hand's finger links and their vertices in clusters, loaded once per hand."""
-    key = (hand.source, folder, max_bytes, tuple(tuple(j.name for j in f.joints) for f in hand.fingers))
-    if key not in _LOADED:
+def _checked(grasp, max_bytes):
+    """The finger links and their vertices in clusters, fingertip spheres left out, and the tolerance;
+    None when there is nothing to check.  Loaded and cut once per hand, tip radii and tolerance."""
+    hand = grasp.hand
+    if grasp.object is None or hand is None or hand.source is None:
+        return None
+    folder = grasp_folder(grasp)
+    tol = collision_tolerance(grasp.object)
+    key = (hand.source, folder, max_bytes, tuple((tuple(j.name for j in f.joints), f.tip_radius) for f in hand.fingers))
+    if (key, tol) not in _LOADED:
         if len(_LOADED) >= 8:  # bounded: a run over many hands keeps the last few
             del _LOADED[next(iter(_LOADED))]
         geometry = link_geometry(hand, folder=folder, max_bytes=max_bytes)
-        _LOADED[key] = geometry, clusters([g.vertices for g in geometry])
-    return _LOADED[key]
-
-
-def _checked(grasp, max_bytes):
-    """The links and their clusters with the fingertip spheres left out, or None when there is
-    nothing to check."""
-    if grasp.object is None or grasp.hand is None or grasp.hand.source is None:
-        return None
-    geometry, parts = _geometry(grasp.hand, grasp_folder(grasp), max_bytes)
-    tol = collision_tolerance(grasp.object)
-    fingers = [grasp.hand.fingers[g.finger] for g in geometry]
-    on_tip = np.array([g.link == f.tip for g, f in zip(geometry, fingers)], dtype=bool)[parts.link]
-    center = np.array([f.tip_pose[:3, 3] for f in fingers]).reshape(-1, 3)[parts.link]
-    radius = np.array([f.tip_radius for f in fingers], dtype=float)[parts.link]
-    sphere = tip_sphere(parts.vertices, center[:, None], radius[:, None], tol) & on_tip[:, None]
-    return geometry, parts._replace(keep=~sphere), tol
+        kept = []
+        for g in geometry:
+            f = hand.fingers[g.finger]
+            on_sphere = tip_sphere(g.vertices, f.tip_pose[:3, 3], f.tip_radius, tol) & (g.link == f.tip)
+            kept.append(g.vertices[~on_sphere])
+        _LOADED[key, tol] = geometry, clusters(kept), tol
+    return _LOADED[key, tol]
 
 
 def finger_collisions_along(grasp: Grasp, joint_positions, frames=None, *, max_bytes=DEFAULT_MAX_BYTES):
