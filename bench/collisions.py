@@ -69,13 +69,13 @@ def naive(grasp, geometry, poses):
     """Every vertex of every link (tip spheres left out) through the object's signed distance, one by one."""
     depth = np.zeros(poses.shape[:2])
     for k in range(len(poses)):
-        for l, g in enumerate(geometry):
+        for i, g in enumerate(geometry):
             finger = grasp.hand.fingers[g.finger]
             v = g.vertices
             if g.link == finger.tip:
                 v = v[np.linalg.norm(v - finger.tip_pose[:3, 3], axis=1) > TIP_RADIUS + 1e-3 * EDGE * 3**0.5]
-            v = v @ poses[k, l, :3, :3].T + poses[k, l, :3, 3]
-            depth[k, l] = max(0.0, -gt.objects.project_to_surface(grasp.object, v).distance.min())
+            v = v @ poses[k, i, :3, :3].T + poses[k, i, :3, 3]
+            depth[k, i] = max(0.0, -gt.objects.project_to_surface(grasp.object, v).distance.min())
     return depth
 
 
@@ -85,8 +85,8 @@ def manager_rebuilt(mesh, geometry, poses):
     hits = np.zeros(len(poses), dtype=bool)
     for k in range(len(poses)):
         manager = trimesh.collision.CollisionManager()
-        for l, link in enumerate(links):
-            manager.add_object(str(l), link, transform=poses[k, l])
+        for i, link in enumerate(links):
+            manager.add_object(str(i), link, transform=poses[k, i])
         hits[k] = manager.in_collision_single(mesh, transform=OBJECT_POSE)
     return hits
 
@@ -106,8 +106,8 @@ def fcl_kept(mesh, geometry, poses):
     links = [fcl.CollisionObject(bvh(g.vertices, g.faces)) for g in geometry]
     request, hits = fcl.CollisionRequest(), np.zeros(len(poses), dtype=bool)
     for k in range(len(poses)):
-        for l, link in enumerate(links):
-            link.setTransform(fcl.Transform(poses[k, l, :3, :3], poses[k, l, :3, 3]))
+        for i, link in enumerate(links):
+            link.setTransform(fcl.Transform(poses[k, i, :3, :3], poses[k, i, :3, 3]))
             if fcl.collide(link, target, request, fcl.CollisionResult()):
                 hits[k] = True
     return hits

@@ -46,8 +46,8 @@ from typing import NamedTuple
 import numpy as np
 
 from .kinematics import forward_kinematics
-from .se3 import inverse
 from .objects import object_size, project_to_surface
+from .se3 import inverse
 
 __all__ = [
     "CLUSTER",
@@ -213,13 +213,13 @@ def link_poses(hand, geometry, positions, frames=None):
     q = np.asarray(positions, dtype=float)
     out = np.empty(q.shape[:-1] + (len(geometry), 4, 4))
     out[...] = np.eye(4)
-    for l, g in enumerate(geometry):
+    for i, g in enumerate(geometry):
         if g.joints == 0:
             continue
         finger = hand.fingers[g.finger]
         joints = list(finger.joint_index[: g.joints])
         state = forward_kinematics(finger.screws[: g.joints], finger.points[: g.joints], np.eye(4), q[..., joints])
-        out[..., l, :, :] = state.tip
+        out[..., i, :, :] = state.tip
     if frames is not None:
         frames = np.asarray(frames, dtype=float)
         rotation, translation = inverse(frames[..., :3, :3], frames[..., :3, 3])
@@ -271,7 +271,7 @@ def penetration_depths(obj, parts: LinkClusters, poses, n_links: int | None = No
     rotation = back @ poses[..., :3, :3]  # (N, L, 3, 3)
     translation = _apply(back, poses[..., :3, 3]) + shift
     box = _box(obj.shape)
-    found = [_near(parts, l, rotation[:, l], translation[:, l], box) for l in np.unique(parts.link)]
+    found = [_near(parts, i, rotation[:, i], translation[:, i], box) for i in np.unique(parts.link)]
     rows = np.concatenate([f[0] for f in found])
     if len(rows) == 0:
         return depth

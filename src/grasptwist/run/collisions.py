@@ -116,7 +116,7 @@ def finger_collisions_along(grasp: Grasp, joint_positions, frames=None, *, max_b
     for row in depth:
         hits = np.flatnonzero(row > tol)
         hits = hits[np.argsort(-row[hits], kind="stable")]
-        out.append(tuple(Collision(names[geometry[l].finger], geometry[l].link, float(row[l])) for l in hits))
+        out.append(tuple(Collision(names[geometry[i].finger], geometry[i].link, float(row[i])) for i in hits))
     return out
 
 
