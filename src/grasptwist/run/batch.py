@@ -91,6 +91,7 @@ class Block:
     center_of_mass: np.ndarray | None = (
         None  # (n, 3) the grasps' centre of mass, NaN rows where none; None: no row has one
     )
+    grasp_warnings: list | None = None  # per row its grasp's warnings (Grasp.warnings); None: no row has one
     # field values computed so far, by (kind key, Field); a block cut from another keeps its rows of them
     values: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
@@ -177,6 +178,7 @@ _ROW_FIELDS = (
     "hands",
     "friction",
     "center_of_mass",
+    "grasp_warnings",
 )
 
 
@@ -338,7 +340,14 @@ def _stack(jobs, method) -> Block:
         friction = np.stack([nan if g.friction is None else g.friction for g in grasps])
     if any(g.center_of_mass is not None for g in grasps):
         center = np.stack([nan if g.center_of_mass is None else g.center_of_mass for g in grasps])
-    return replace(block, contact_names=[g.contact_names for g in grasps], friction=friction, center_of_mass=center)
+    said = [g.warnings for g in grasps] if any(g.warnings for g in grasps) else None
+    return replace(
+        block,
+        contact_names=[g.contact_names for g in grasps],
+        friction=friction,
+        center_of_mass=center,
+        grasp_warnings=said,
+    )
 
 
 def _hand_inputs(grasps) -> dict:

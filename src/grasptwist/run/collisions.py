@@ -13,6 +13,7 @@ the contact itself and left out.  No math here.
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import NamedTuple
 
 import numpy as np
@@ -20,10 +21,18 @@ import numpy as np
 from ..engine.collision import clusters, collision_tolerance, link_poses, penetration_depths, tip_sphere
 from ..io.limits import DEFAULT_MAX_BYTES
 from ..io.urdf_meshes import grasp_folder, link_geometry
-from ..model import Grasp
+from ..model import Grasp, GraspFileError, InputError
 from ..output.names import escaped
 
-__all__ = ["CODE", "Collision", "collision_warning", "finger_collisions", "finger_collisions_along"]
+__all__ = [
+    "CODE",
+    "Collision",
+    "collision_warning",
+    "finger_collisions",
+    "finger_collisions_along",
+    "with_collisions",
+    "PathCollisions",
+]
 
 #: The warning's code.
 CODE = "finger-collides"
@@ -144,3 +153,62 @@ def finger_collisions(grasp: Grasp, joint_positions) -> tuple[Collision, ...]:
     ()
     """
     return finger_collisions_along(grasp, np.asarray(joint_positions, dtype=float)[None])[0]
+
+
+def with_collisions(grasp: Grasp) -> Grasp | GraspFileError:
+    """A placed grasp with a ``finger-collides`` warning per link inside its object (none without an
+    object), or the error of its hand's meshes (read from its URDF for the check).
+
+    Examples
+    --------
+    >>> import grasptwist as gt
+    >>> (g,) = gt.read_grasps("grasps/trifinger-cube.yaml")
+    >>> with_collisions(g).warnings
+    ()
+    """
+    try:
+        found = finger_collisions(grasp, grasp.joint_positions)
+    except InputError as exc:
+        return GraspFileError(exc.code, f"hand: {exc.message}", grasp.file, grasp.line, None, grasp.document)
+    if not found:
+        return grasp
+    return replace(grasp, warnings=grasp.warnings + tuple(collision_warning(c) for c in found))
+
+
+class PathCollisions:
+    """The collisions along one path of a grasp, chunk by chunk of its samples: each sample's
+    records get their warnings, the path's summary one line per link that went into the object."""
+
+    def __init__(self, grasp: Grasp):
+        self.grasp = grasp
+        self.seen = {}  # (finger, link) -> [deepest, samples, first time]
+
+    def block(self, block, positions, poses):
+        """``block`` (the samples at ``positions`` and object ``poses``) with each sample's warnings."""
+        if positions is None or self.grasp.object is None:
+            return block
+        frames = np.zeros((len(poses.time), 4, 4))
+        frames[:, :3, :3], frames[:, :3, 3], frames[:, 3, 3] = poses.rotation, poses.position, 1.0
+        found = finger_collisions_along(self.grasp, positions, frames)
+        for time, hits in zip(poses.time.tolist(), found):
+            for c in hits:
+                seen = self.seen.setdefault((c.finger, c.link), [0.0, 0, time])
+                seen[0], seen[1] = max(seen[0], c.depth), seen[1] + 1
+        if not any(found):
+            return block
+        return replace(block, grasp_warnings=[tuple(map(collision_warning, hits)) for hits in found])
+
+    def warnings(self, samples: int) -> tuple[str, ...]:
+        """The summary's lines, one per link that went into the object, deepest first.
+
+        >>> along = PathCollisions(None)
+        >>> along.seen[("1", "finger_lower_link_0")] = [0.0042, 3, 0.5]
+        >>> along.warnings(21)
+        ("finger-collides: finger 1's link 'finger_lower_link_0' goes up to 0.0042 inside the object at 3 of 21 samples, from t = 0.5",)
+        """
+        ranked = sorted(self.seen.items(), key=lambda item: -item[1][0])
+        return tuple(
+            f"{CODE}: finger {escaped(finger)}'s link {escaped(link)!r} goes up to {depth:.3g} inside the object "
+            f"at {count} of {samples} samples, from t = {first:.6g}"
+            for (finger, link), (depth, count, first) in ranked
+        )
