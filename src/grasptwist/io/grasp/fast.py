@@ -10,6 +10,7 @@ import yaml
 from ...engine import screws
 from ...model import Grasp, Twist
 from .compose import PLAIN_WORDS, compose, resolve_plain
+from .contacts import NO_NORMAL
 from .document import SECTIONS
 from .problems import Problems, StreamStop
 from .values import NOT_IN_A_NAME, readonly
@@ -52,11 +53,12 @@ _INF = math.inf
 _ZERO = (0.0, 0.0, 0.0)
 
 
-def fast_document(get, keep, file):
+def fast_document(get, keep, file, reading, max_bytes):
     """A plain valid document's ``Parts``, from the events after its start.
 
     ``get()`` gives the next event; each one read is passed to ``keep``.
-    ``file`` is the grasp file's name (a URDF hand is found from its folder).
+    ``file`` is the grasp file's name (a URDF hand or a mesh is found from its
+    folder, read as ``reading`` and ``max_bytes`` say).
     """
     event = get()
     keep(event)
@@ -84,15 +86,15 @@ def fast_document(get, keep, file):
             composed[key] = _value(get, keep)
         else:
             raise Bail
-    if contacts is None:
-        raise Bail
+    if contacts is None or ("object" not in composed and any(n is NO_NORMAL for n in contacts[2])):
+        raise Bail  # a contact without its normal needs an object
     event = get()
     keep(event)
     if type(event) is not yaml.DocumentEndEvent:
         raise Bail
     parts = Parts(name, units, wrist, contacts, twists)
     if composed:
-        parts.sections = _sections(composed, parts, file)
+        parts.sections = _sections(composed, parts, {"file": file, "reading": reading, "max_bytes": max_bytes})
     return parts
 
 
@@ -119,14 +121,15 @@ def _value(get, keep):
     return node
 
 
-def _sections(composed, parts, file):
-    """The Grasp fields of the composed sections, read by their modules (after the contacts)."""
+def _sections(composed, parts, found):
+    """The Grasp fields of the composed sections, read by their modules (after the contacts);
+    ``found`` holds the file's name and how the files it names are read."""
     contact_names, points, normals = parts.contacts
-    found = {"file": file, "contact_names": contact_names, "points": readonly(points), "normals": readonly(normals)}
+    found.update(contact_names=contact_names, points=readonly(points), normals=readonly(normals))
     fields = {}
     problems = Problems(0)
     for section in _COMPOSED_SECTIONS:
-        if not composed.keys().isdisjoint(section.keys):
+        if not composed.keys().isdisjoint((*section.keys, *section.reads_also)):
             read = section.read(composed, found, problems) or {}
             found.update(read)
             fields.update(read)
@@ -224,7 +227,7 @@ def _fast_contacts(get, keep):
                 name = _fast_name(get, keep)
             else:
                 raise Bail
-        if point is None or normal is None or not any(normal):
+        if point is None or (normal is not None and not any(normal)):
             raise Bail
         if name is None:
             name = str(len(names) + 1)
@@ -232,7 +235,7 @@ def _fast_contacts(get, keep):
             raise Bail
         names.append(name)
         points.append(point)
-        normals.append(screws.direction3(*normal))
+        normals.append(NO_NORMAL if normal is None else screws.direction3(*normal))
     if len(names) != 3:
         raise Bail
     return tuple(names), points, normals
@@ -296,16 +299,15 @@ class Parts:
 
     def grasp(self, *, file, document, name, line):
         contact_names, points, normals = self.contacts
+        contacts = {"points": readonly(points), "normals": readonly(normals)}
         return Grasp(
             name=name,
             units=self.units,
             file=file,
             document=document,
             contact_names=contact_names,
-            points=readonly(points),
-            normals=readonly(normals),
             wrist=None if self.wrist is None else readonly(self.wrist),
             twists=tuple(Twist(twist, readonly(screw), twist_line) for twist, screw, twist_line in self.twists),
             line=line,
-            **self.sections,
+            **(contacts | self.sections),  # an object puts the points on its surface
         )
