@@ -65,30 +65,41 @@ def collision_warning(c: Collision) -> str:
     return f"{CODE}: finger {escaped(c.finger)}'s link {escaped(c.link)!r} is {c.depth:.3g} inside the object"
 
 
-#: Link geometry of the last hands checked: a folder's grasps name the same URDF (each its own Hand).
-_LOADED: dict = {}
+#: The last hands' link geometry, and their clusters by tip radii and tolerance: a folder's grasps name
+#: the same URDF (each its own Hand), a path's samples the same grasp.  Bounded: a few of each.
+_GEOMETRY: dict = {}
+_CLUSTERS: dict = {}
+
+
+def _kept(cache, key, make):
+    if key not in cache:
+        if len(cache) >= 8:
+            del cache[next(iter(cache))]
+        cache[key] = make()
+    return cache[key]
 
 
 def _checked(grasp, max_bytes):
-    """The finger links and their vertices in clusters, fingertip spheres left out, and the tolerance;
-    None when there is nothing to check.  Loaded and cut once per hand, tip radii and tolerance."""
+    """The finger links, their vertices in clusters with the fingertip spheres left out, and the
+    tolerance; None when there is nothing to check."""
     hand = grasp.hand
     if grasp.object is None or hand is None or hand.source is None:
         return None
     folder = grasp_folder(grasp)
+    key = (hand.source, folder, max_bytes, tuple(tuple(j.name for j in f.joints) for f in hand.fingers))
+    geometry = _kept(_GEOMETRY, key, lambda: link_geometry(hand, folder=folder, max_bytes=max_bytes))
     tol = collision_tolerance(grasp.object)
-    key = (hand.source, folder, max_bytes, tuple((tuple(j.name for j in f.joints), f.tip_radius) for f in hand.fingers))
-    if (key, tol) not in _LOADED:
-        if len(_LOADED) >= 8:  # bounded: a run over many hands keeps the last few
-            del _LOADED[next(iter(_LOADED))]
-        geometry = link_geometry(hand, folder=folder, max_bytes=max_bytes)
+
+    def cut():
         kept = []
         for g in geometry:
             f = hand.fingers[g.finger]
             on_sphere = tip_sphere(g.vertices, f.tip_pose[:3, 3], f.tip_radius, tol) & (g.link == f.tip)
             kept.append(g.vertices[~on_sphere])
-        _LOADED[key, tol] = geometry, clusters(kept), tol
-    return _LOADED[key, tol]
+        return clusters(kept)
+
+    parts = _kept(_CLUSTERS, (key, tuple(f.tip_radius for f in hand.fingers), tol), cut)
+    return geometry, parts, tol
 
 
 def finger_collisions_along(grasp: Grasp, joint_positions, frames=None, *, max_bytes=DEFAULT_MAX_BYTES):
@@ -183,10 +194,11 @@ class PathCollisions:
         self.grasp = grasp
         self.seen = {}  # (finger, link) -> [deepest, samples, first time]
 
-    def block(self, block, positions, poses):
-        """``block`` (the samples at ``positions`` and object ``poses``) with each sample's warnings."""
+    def at(self, positions, poses) -> list | None:
+        """Each sample's warnings at joint ``positions`` and object ``poses``
+        (:class:`~grasptwist.engine.path.Poses`), None when none has any (the block's ``grasp_warnings``)."""
         if positions is None or self.grasp.object is None:
-            return block
+            return None
         frames = np.zeros((len(poses.time), 4, 4))
         frames[:, :3, :3], frames[:, :3, 3], frames[:, 3, 3] = poses.rotation, poses.position, 1.0
         found = finger_collisions_along(self.grasp, positions, frames)
@@ -194,9 +206,7 @@ class PathCollisions:
             for c in hits:
                 seen = self.seen.setdefault((c.finger, c.link), [0.0, 0, time])
                 seen[0], seen[1] = max(seen[0], c.depth), seen[1] + 1
-        if not any(found):
-            return block
-        return replace(block, grasp_warnings=[tuple(map(collision_warning, hits)) for hits in found])
+        return [tuple(map(collision_warning, hits)) for hits in found] if any(found) else None
 
     def warnings(self, samples: int) -> tuple[str, ...]:
         """The summary's lines, one per link that went into the object, deepest first.

@@ -104,7 +104,7 @@ class Summary:
     cannot_hold: tuple[HoldStretch, ...] | None = None  # where no grip holds its weight, with mass and friction
     unjudged: tuple[Unjudged, ...] | None = None  # where the grip fails otherwise: held or not is unknown there
     tip_error: np.ndarray | None = None  # (3,) with a hand: each finger's largest tip error at the samples
-    warnings: tuple[str, ...] = ()  # about the path as given: rotation vectors over pi
+    warnings: tuple[str, ...] = ()  # rotation vectors over pi (the path as given); links through the object
 
 
 def sample_times(duration: float, samples: int | None = None, dt: float | None = None) -> np.ndarray:
@@ -205,7 +205,7 @@ def _path(job, grasp, p):
             method=job.method,
             bases=job.bases,
         )
-        block = collided.block(_block(grasp, p.name, f, job.bases, job.method, q), q, f.poses)
+        block = replace(_block(grasp, p.name, f, job.bases, job.method, q), grasp_warnings=collided.at(q, f.poses))
         if tracked is not None:
             seen = block.results["hand"].tip_error.max(axis=0)
             largest = seen if largest is None else np.maximum(largest, seen)
