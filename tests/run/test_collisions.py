@@ -155,3 +155,36 @@ def test_a_urdf_without_collision_geometry_falls_back_to_its_visual_geometry(tmp
         # the box's centre at home: 25 mm down the a3 frame, which is the tip's less its 10 mm, 50 mm offset
         a3_frame = toy.fingers[0].tip_pose @ np.array([[1, 0, 0, -0.01], [0, 1, 0, 0], [0, 0, 1, 0.05], [0, 0, 0, 1.0]])
         assert a.vertices.mean(axis=0) == pytest.approx(a3_frame[:3, :3] @ [0, 0, -0.025] + a3_frame[:3, 3], abs=1e-15)
+
+
+def test_a_hand_mesh_that_cannot_be_read_fails_its_grasp_located(grasp, monkeypatch):
+    from grasptwist.model import GraspFileError, InputError
+    from grasptwist.run import collisions
+
+    def unreadable(hand, folder=None, max_bytes=None):
+        raise InputError("read-error", "mesh 'prox-sim.stl': cannot read: no such file", hand.source)
+
+    monkeypatch.setattr(collisions, "link_geometry", unreadable)
+    monkeypatch.setattr(collisions, "_GEOMETRY", {})
+    error = collisions.with_collisions(grasp)
+    assert isinstance(error, GraspFileError)
+    assert (error.code, error.file, error.line) == ("read-error", grasp.file, grasp.line)
+    assert error.message == "hand: mesh 'prox-sim.stl': cannot read: no such file"
+    assert collisions.with_collisions(replace(grasp, object=None)) is not None  # nothing to read: no error
+
+
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
+def test_follow_names_the_links_through_the_object_per_sample_and_in_its_summary(tmp_path):
+    doc = yaml.safe_load(TRIFINGER.read_text("utf-8"))
+    doc["object"] = {"box": [EDGE, EDGE, 0.3], "pose": {"position": [0, 0, 0.15]}}
+    path = tmp_path / "column.yaml"
+    path.write_text(yaml.safe_dump(doc, sort_keys=False), "utf-8")
+    result = run("follow", path, "--twist", "0,0,0.5,0,0,0", "--duration", "1", "--samples", "3", "-f", "jsonl")
+    *samples, summary = [json.loads(line) for line in result.stdout.splitlines()]
+    assert [s["t"] for s in samples] == [0.0, 0.5, 1.0]
+    first = [w for w in samples[0]["warnings"] if w.startswith("finger-collides")]
+    assert "finger-collides: finger 2's link 'finger_upper_link_120' is 0.0148 inside the object" in first
+    said = [w for w in summary["warnings"] if w.startswith("finger-collides")]
+    assert said[0].endswith("at 3 of 3 samples, from t = 0")
+    stderr = [line.split(": warning: ", 1)[1] for line in result.stderr.splitlines() if "finger-collides" in line]
+    assert stderr == said  # samples are counted, not told: the summary's lines

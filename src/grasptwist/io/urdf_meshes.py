@@ -21,6 +21,7 @@ import io
 import lzma
 import os
 import stat
+import warnings
 import zipfile
 import zlib
 from pathlib import Path
@@ -240,14 +241,16 @@ def _loaded(hand, folder, max_bytes, *, collision):
 
     asked = []  # the mesh files handed to the library, the one it is reading last
     try:
-        return yourdfpy.URDF.load(
-            io.BytesIO(data),
-            build_scene_graph=not collision,
-            load_meshes=not collision,
-            build_collision_scene_graph=collision,
-            load_collision_meshes=collision,
-            filename_handler=mesh_file,
-        )
+        with warnings.catch_warnings():  # yourdfpy's own call of a trimesh method trimesh deprecates
+            warnings.filterwarnings("ignore", r".*Scene\.dump", DeprecationWarning)
+            return yourdfpy.URDF.load(
+                io.BytesIO(data),
+                build_scene_graph=not collision,
+                load_meshes=not collision,
+                build_collision_scene_graph=collision,
+                load_collision_meshes=collision,
+                filename_handler=mesh_file,
+            )
     except InputError:
         raise
     except Exception as exc:  # noqa: BLE001 - a malformed mesh: each format's parser raises its own kinds

@@ -153,8 +153,14 @@ def finger_collisions(grasp: Grasp, joint_positions) -> tuple[Collision, ...]:
     Returns
     -------
     tuple of Collision
-        Each link deeper than :func:`~grasptwist.engine.collision.collision_tolerance`, naming its
-        finger, link and depth; the fingertip spheres touching their contacts are no collision.
+        Each link deeper than :data:`~grasptwist.hand.COLLISION_TOL` times the object's size, naming its
+        finger, link and depth; the fingertip spheres touching their contacts are no collision
+        (docs/guide/hands.md, "Fingers through the object").
+
+    Raises
+    ------
+    InputError
+        The URDF's or a mesh's, as :func:`~grasptwist.hand.place_grasp` reports them.
 
     Examples
     --------
