@@ -16,6 +16,7 @@ from grasptwist.cli import app
 from grasptwist.engine.collision import collision_tolerance
 from grasptwist.engine.path import Poses
 from grasptwist.model import GraspObject, Shape
+from hand_grasps import trifinger_cube
 from places import ROOT, TESTS
 
 pytestmark = pytest.mark.skipif(
@@ -32,12 +33,25 @@ def box(size, position):
     return GraspObject(Shape("box", np.asarray(size, dtype=float)), pose)
 
 
+def trifinger_file(folder, **changes):
+    """The bundled TriFinger grasp at the joint positions of ``hand_grasps`` (each tip sphere's centre
+    one radius behind its contact, whatever the bundled file solves for), with ``changes``."""
+    doc = yaml.safe_load(TRIFINGER.read_text("utf-8"))
+    doc["hand"].pop("seed", None)
+    doc["hand"]["joint_positions"] = trifinger_cube()["joint_positions"]
+    doc["twists"] = doc["twists"][:1]
+    doc.update(changes)
+    path = folder / "trifinger.yaml"
+    path.write_text(yaml.safe_dump(doc, sort_keys=False), "utf-8")
+    return path
+
+
 @pytest.fixture(scope="module")
-def grasp():
-    """The bundled TriFinger grasp on its cube, placed, its fingertips 10 mm spheres."""
+def grasp(tmp_path_factory):
+    """The TriFinger grasp on its cube, placed, its fingertips 10 mm spheres."""
     from grasptwist.run.placement import read_grasps
 
-    (g,) = read_grasps(TRIFINGER)
+    (g,) = read_grasps(trifinger_file(tmp_path_factory.mktemp("trifinger")))
     hand = replace(g.hand, fingers=tuple(replace(f, tip_radius=0.01) for f in g.hand.fingers))
     return replace(g, hand=hand, object=box([EDGE] * 3, [0, 0, EDGE / 2]))
 
@@ -121,11 +135,7 @@ def run(*args):
 
 def test_a_column_through_the_fingers_is_a_warning_in_the_records_and_on_stderr(tmp_path):
     # the cube's faces continued 30 cm up: the contacts stay on them, the upper and middle links cross them
-    doc = yaml.safe_load(TRIFINGER.read_text("utf-8"))
-    doc["object"] = {"box": [EDGE, EDGE, 0.3], "pose": {"position": [0, 0, 0.15]}}
-    doc["twists"] = doc["twists"][:1]
-    path = tmp_path / "column.yaml"
-    path.write_text(yaml.safe_dump(doc, sort_keys=False), "utf-8")
+    path = trifinger_file(tmp_path, object={"box": [EDGE, EDGE, 0.3], "pose": {"position": [0, 0, 0.15]}})
     result = run("resolve", path, "-f", "jsonl")
     (rec,) = [json.loads(line) for line in result.stdout.splitlines()]
     said = [w for w in rec["warnings"] if w.startswith("finger-collides")]
@@ -175,10 +185,7 @@ def test_a_hand_mesh_that_cannot_be_read_fails_its_grasp_located(grasp, monkeypa
 
 @pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_follow_names_the_links_through_the_object_per_sample_and_in_its_summary(tmp_path):
-    doc = yaml.safe_load(TRIFINGER.read_text("utf-8"))
-    doc["object"] = {"box": [EDGE, EDGE, 0.3], "pose": {"position": [0, 0, 0.15]}}
-    path = tmp_path / "column.yaml"
-    path.write_text(yaml.safe_dump(doc, sort_keys=False), "utf-8")
+    path = trifinger_file(tmp_path, object={"box": [EDGE, EDGE, 0.3], "pose": {"position": [0, 0, 0.15]}})
     result = run("follow", path, "--twist", "0,0,0.5,0,0,0", "--duration", "1", "--samples", "3", "-f", "jsonl")
     *samples, summary = [json.loads(line) for line in result.stdout.splitlines()]
     assert [s["t"] for s in samples] == [0.0, 0.5, 1.0]

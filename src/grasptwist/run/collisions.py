@@ -165,8 +165,8 @@ def finger_collisions(grasp: Grasp, joint_positions) -> tuple[Collision, ...]:
     Examples
     --------
     >>> import grasptwist as gt
-    >>> (g,) = gt.read_grasps("grasps/trifinger-cube.yaml")
-    >>> finger_collisions(g, g.joint_positions)
+    >>> g = gt.hand.place_grasp(gt.read_grasps("grasps/trifinger-cube.yaml")[0])
+    >>> finger_collisions(g, g.joint_positions)  # the fingertips touch the cube, nothing else does
     ()
     """
     return finger_collisions_along(grasp, np.asarray(joint_positions, dtype=float)[None])[0]
@@ -179,8 +179,8 @@ def with_collisions(grasp: Grasp) -> Grasp | GraspFileError:
     Examples
     --------
     >>> import grasptwist as gt
-    >>> (g,) = gt.read_grasps("grasps/trifinger-cube.yaml")
-    >>> with_collisions(g).warnings
+    >>> g = gt.hand.place_grasp(gt.read_grasps("grasps/trifinger-cube.yaml")[0])  # checked there
+    >>> g.warnings
     ()
     """
     try:
