@@ -45,9 +45,8 @@ from typing import NamedTuple
 
 import numpy as np
 
-from .kinematics import forward_kinematics
+from . import se3
 from .objects import object_size, project_to_surface
-from .se3 import inverse
 
 __all__ = [
     "CLUSTER",
@@ -213,16 +212,18 @@ def link_poses(hand, geometry, positions, frames=None):
     q = np.asarray(positions, dtype=float)
     out = np.empty(q.shape[:-1] + (len(geometry), 4, 4))
     out[...] = np.eye(4)
-    for i, g in enumerate(geometry):
-        if g.joints == 0:
-            continue
-        finger = hand.fingers[g.finger]
-        joints = list(finger.joint_index[: g.joints])
-        state = forward_kinematics(finger.screws[: g.joints], finger.points[: g.joints], np.eye(4), q[..., joints])
-        out[..., i, :, :] = state.tip
+    for f, finger in enumerate(hand.fingers):
+        mine = [(i, g.joints) for i, g in enumerate(geometry) if g.finger == f and g.joints]
+        # g_j = g_(j-1) e^([S_j] q_j), one exponential per joint shared by the finger's links
+        rotation, translation = np.eye(3), np.zeros(3)
+        for j in range(max((joints for _, joints in mine), default=0)):
+            r, t = se3.exp(finger.screws[j], q[..., finger.joint_index[j]])
+            rotation, translation = rotation @ r, (rotation @ t[..., None])[..., 0] + translation
+            for i in (i for i, joints in mine if joints == j + 1):
+                out[..., i, :3, :3], out[..., i, :3, 3] = rotation, translation
     if frames is not None:
         frames = np.asarray(frames, dtype=float)
-        rotation, translation = inverse(frames[..., :3, :3], frames[..., :3, 3])
+        rotation, translation = se3.inverse(frames[..., :3, :3], frames[..., :3, 3])
         back = np.zeros(frames.shape)
         back[..., :3, :3], back[..., :3, 3], back[..., 3, 3] = rotation, translation, 1.0
         out = back[..., None, :, :] @ out
@@ -267,7 +268,7 @@ def penetration_depths(obj, parts: LinkClusters, poses, n_links: int | None = No
     if len(parts.link) == 0 or n == 0:
         return depth
     # in the object's own frame, where its bounding box is axis-aligned
-    back, shift = inverse(obj.pose[:3, :3], obj.pose[:3, 3])
+    back, shift = se3.inverse(obj.pose[:3, :3], obj.pose[:3, 3])
     rotation = back @ poses[..., :3, :3]  # (N, L, 3, 3)
     translation = _apply(back, poses[..., :3, 3]) + shift
     box = _box(obj.shape)
