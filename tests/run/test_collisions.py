@@ -144,9 +144,9 @@ def test_a_column_through_the_fingers_is_a_warning_in_the_records_and_on_stderr(
     lines = [line for line in result.stderr.splitlines() if "finger-collides" in line]
     assert lines[0] == f"{path}: grasp 'trifinger-cube', twist 'spin': warning: {said[0]}"
     assert len(lines) == len(said)
-    forces = run("forces", path, "--friction", "0.5", "-f", "jsonl")  # the force records carry them too
-    (rec,) = [json.loads(line) for line in forces.stdout.splitlines()]
-    assert [w for w in rec["warnings"] if w.startswith("finger-collides")] == said
+    for command in (("forces", "--friction", "0.5"), ("check",)):  # their records carry them too
+        (rec,) = [json.loads(line) for line in run(*command, path, "-f", "jsonl").stdout.splitlines()]
+        assert [w for w in rec["warnings"] if w.startswith("finger-collides")] == said
 
 
 def test_a_urdf_without_collision_geometry_falls_back_to_its_visual_geometry(tmp_path):
