@@ -16,6 +16,7 @@ frame (:class:`Hand`).  The math lives in ``grasptwist.engine.kinematics``,
 
 from __future__ import annotations
 
+from .engine.collision import COLLISION_TOL
 from .engine.fingertips import TipContacts, sphere_radius, tip_centers, tip_contacts, tip_radii
 from .engine.hands import (
     SEGMENT_INTERVALS,
@@ -43,6 +44,7 @@ from .engine.kinematics import (
 )
 from .io.urdf import load_urdf_hand
 from .model import Finger, Hand, HandPlacement, Joint
+from .run.collisions import Collision, finger_collisions
 from .run.placement import place_grasp
 
 __all__ = [
@@ -81,4 +83,7 @@ __all__ = [
     "FOLLOW_TOL",
     "OFF_TANGENT_FIXED",
     "TANGENT_FIXED",
+    "finger_collisions",
+    "Collision",
+    "COLLISION_TOL",
 ]

@@ -131,6 +131,9 @@ class Grasp:
     surface_distance : numpy.ndarray or None
         ``(3,)`` each given point's signed distance from the object's surface
         (> 0 outside) before it was put on it; None without an object.
+    warnings : tuple of str
+        Found when its hand was placed (``finger-collides``: a finger link inside the object),
+        carried into each of its records.
     """
 
     name: str
@@ -154,6 +157,7 @@ class Grasp:
     placement: HandPlacement | None = None
     object: GraspObject | None = None
     surface_distance: np.ndarray | None = None
+    warnings: tuple[str, ...] = ()
 
 
 @dataclass(frozen=True, eq=False)

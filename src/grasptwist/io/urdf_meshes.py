@@ -21,17 +21,19 @@ import io
 import lzma
 import os
 import stat
+import warnings
 import zipfile
 import zlib
 from pathlib import Path
 
 import numpy as np
 
+from ..engine.collision import LinkGeometry
 from ..model import InputError
 from .limits import DEFAULT_MAX_BYTES
 from .urdf import _library, _parse, _read, resolve_urdf
 
-__all__ = ["MAX_MESH_BYTES", "decoded_size", "grasp_folder", "hand_meshes"]
+__all__ = ["MAX_MESH_BYTES", "decoded_size", "grasp_folder", "hand_meshes", "link_geometry"]
 
 #: Most bytes a mesh file may hold, or decode to when it is an archive or compressed.
 MAX_MESH_BYTES = 64 << 20
@@ -106,6 +108,105 @@ def hand_meshes(hand, positions=None, *, folder=None, max_bytes=DEFAULT_MAX_BYTE
     """
     if hand.source is None:
         return []
+    model = _loaded(hand, folder, max_bytes, collision=False)
+    if positions is not None:
+        moved = dict(zip(hand.joint_names, map(float, positions)))
+        model.update_cfg({j: moved.get(j, 0.0) for j in model.actuated_joint_names})
+    return [(np.asarray(m.vertices, dtype=float), np.asarray(m.faces)) for m in model.scene.dump(concatenate=False)]
+
+
+def link_geometry(hand, *, folder=None, max_bytes=DEFAULT_MAX_BYTES) -> tuple[LinkGeometry, ...]:
+    """Every finger link's collision geometry from ``hand``'s URDF, at home in the hand's root frame.
+
+    A link is a finger's when the movable joints above it are the first ones of that finger (a link
+    above every finger's first joint, the palm, moves with none and is no finger's).  Its geometry
+    is its ``<collision>`` elements (meshes, boxes, spheres, cylinders, with their origins and
+    scales); a URDF with no ``<collision>`` at all falls back to its ``<visual>`` ones.  Only one
+    of the two is read: a URDF that has collision geometry keeps its visual-only links (the
+    TriFinger's ``*_visuals_*`` decorations) out of the check.
+
+    Parameters
+    ----------
+    hand : Hand
+        Read from a URDF (``hand.source``); inline joints have no geometry.
+    folder : str or os.PathLike, optional
+        The referring grasp file's folder, for a URDF given by path.
+    max_bytes : int
+        Size cap of the URDF.
+
+    Returns
+    -------
+    tuple of LinkGeometry
+        Finger by finger, base to tip; empty for a hand without a URDF.
+
+    Raises
+    ------
+    InputError
+        As :func:`hand_meshes`.
+
+    Examples
+    --------
+    >>> import grasptwist as gt
+    >>> (g,) = gt.read_grasps("grasps/trifinger-cube.yaml")
+    >>> [(l.finger, l.link, l.joints) for l in link_geometry(g.hand)][:4]
+    [(0, 'finger_upper_link_0', 1), (0, 'finger_middle_link_0', 2), (0, 'finger_lower_link_0', 3), (0, 'finger_tip_link_0', 3)]
+    """
+    if hand.source is None:
+        return ()
+    model = _loaded(hand, folder, max_bytes, collision=True)
+    scene = model.collision_scene
+    if not scene.graph.nodes_geometry:
+        model = _loaded(hand, folder, max_bytes, collision=False)
+        scene = model.scene
+    model.update_cfg({j: 0.0 for j in model.actuated_joint_names})
+    owners = _finger_links(hand, model)
+    meshes = {}  # link -> [(vertices, faces)], in the root frame at home
+    for node in scene.graph.nodes_geometry:
+        link = scene.graph.transforms.parents.get(node)
+        if link not in owners:
+            continue
+        pose, name = scene.graph[node]
+        mesh = scene.geometry[name]
+        v = np.asarray(mesh.vertices, dtype=float) @ pose[:3, :3].T + pose[:3, 3]
+        meshes.setdefault(link, []).append((v, np.asarray(mesh.faces, dtype=int)))
+    out = []
+    for link, (finger, joints) in owners.items():
+        if link not in meshes:
+            continue
+        parts = meshes[link]
+        offsets = np.cumsum([0] + [len(v) for v, _ in parts[:-1]])
+        vertices = np.concatenate([v for v, _ in parts])
+        faces = np.concatenate([f + o for (_, f), o in zip(parts, offsets)])
+        out.append(LinkGeometry(finger, link, joints, vertices, faces))
+    return tuple(sorted(out, key=lambda g: (g.finger, g.joints)))
+
+
+def _finger_links(hand, model) -> dict:
+    """Each link moved by some finger's first joints: ``{link: (finger, joints)}`` (the first finger
+    whose joints they are, when fingers share joints)."""
+    parent = {j.child: j for j in model.robot.joints}
+    prefixes = {}
+    for f, finger in enumerate(hand.fingers):
+        names = tuple(j.name for j in finger.joints)
+        for k in range(1, len(names) + 1):
+            prefixes.setdefault(names[:k], (f, k))
+    owners = {}
+    for link in model.link_map:
+        above, at = [], link
+        while at in parent:
+            joint = parent[at]
+            if joint.type != "fixed":
+                above.append(joint.name)
+            at = joint.parent
+        owner = prefixes.get(tuple(reversed(above)))
+        if owner is not None:
+            owners[link] = owner
+    return owners
+
+
+def _loaded(hand, folder, max_bytes, *, collision):
+    """``hand``'s URDF read by yourdfpy with its visual (or collision) meshes loaded, every mesh file
+    resolved and size-checked first (see the module's docstring)."""
     urdf = resolve_urdf(hand.source, folder)
     data = _read(urdf, max_bytes, hand.source)
     _parse(data, hand.source)  # refuses a DTD, as the joints' reading did
@@ -140,23 +241,21 @@ def hand_meshes(hand, positions=None, *, folder=None, max_bytes=DEFAULT_MAX_BYTE
 
     asked = []  # the mesh files handed to the library, the one it is reading last
     try:
-        model = yourdfpy.URDF.load(
-            io.BytesIO(data),
-            build_scene_graph=True,
-            load_meshes=True,
-            build_collision_scene_graph=False,
-            load_collision_meshes=False,
-            filename_handler=mesh_file,
-        )
+        with warnings.catch_warnings():  # yourdfpy's own call of a trimesh method trimesh deprecates
+            warnings.filterwarnings("ignore", r".*Scene\.dump", DeprecationWarning)
+            return yourdfpy.URDF.load(
+                io.BytesIO(data),
+                build_scene_graph=not collision,
+                load_meshes=not collision,
+                build_collision_scene_graph=collision,
+                load_collision_meshes=collision,
+                filename_handler=mesh_file,
+            )
     except InputError:
         raise
     except Exception as exc:  # noqa: BLE001 - a malformed mesh: each format's parser raises its own kinds
         what = f"mesh {asked[-1]!r}" if asked else "its meshes"
         raise InputError("read-error", f"{what}: cannot read: {type(exc).__name__}: {exc}", hand.source) from None
-    if positions is not None:
-        moved = dict(zip(hand.joint_names, map(float, positions)))
-        model.update_cfg({j: moved.get(j, 0.0) for j in model.actuated_joint_names})
-    return [(np.asarray(m.vertices, dtype=float), np.asarray(m.faces)) for m in model.scene.dump(concatenate=False)]
 
 
 def grasp_folder(grasp) -> Path | None:

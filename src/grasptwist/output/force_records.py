@@ -73,6 +73,7 @@ def force_records(block) -> list[dict]:
         warnings = [outward_warning(block, i)] if outward[i] else []
         if disagrees[i]:
             warnings.append(disagrees_warning(block, i))
+        warnings += block.grasp_warnings[i] if block.grasp_warnings is not None else ()
         rec = {
             "file": escaped(block.file[i], controls=False),
             "grasp": escaped(block.grasp[i], controls=False),

@@ -61,6 +61,8 @@ def records(block, order: str = "omega-v") -> list[dict]:
         warnings[i].append(outward_warning(block, i))
     for i in np.flatnonzero(block.disagrees().any(axis=-1)):
         warnings[i].append(disagrees_warning(block, i))
+    for i, said in enumerate(block.grasp_warnings or ()):
+        warnings[i] += said
     objects = [(k.key, _kind_rows(block, k, order, warnings)) for k in block.kinds() if k.record is None]
     written = [(k.key, _written(k)(block, order, warnings)) for k in block.kinds() if k.record is not None]
     ok = (~block.failed_rows()).tolist()
@@ -210,6 +212,8 @@ def _kind_rows(block, kind, order, warnings):
 def talking_rows(block) -> np.ndarray:
     """Rows whose record has something for stderr: a failed or skipped kind, or a warning."""
     talk = block.outward().any(axis=-1) | block.disagrees().any(axis=-1)
+    if block.grasp_warnings is not None:
+        talk |= np.array([bool(said) for said in block.grasp_warnings])
     for kind in block.kinds():
         ok = block.value(kind.key, STATUS) == Status.OK
         applies = block.applies(kind.key)
@@ -256,6 +260,7 @@ def _row_objects(block, i, fields_of, order, warnings, with_failure=()):
         warnings.append(outward_warning(block, i))
     if block.disagrees()[i].any():
         warnings.append(disagrees_warning(block, i))
+    warnings += block.grasp_warnings[i] if block.grasp_warnings is not None else ()
     for kind in block.kinds():
         key = kind.key
         if kind.record is not None:  # a resolve-only kind (a hand's joint rates)

@@ -96,6 +96,7 @@ class Block:
     # (degrees), NaN rows without an object; None: no row has one (see surface_columns)
     surface_distance: np.ndarray | None = None
     normal_angle: np.ndarray | None = None
+    grasp_warnings: list | None = None  # per row its grasp's warnings (Grasp.warnings); None: no row has one
     # field values computed so far, by (kind key, Field); a block cut from another keeps its rows of them
     values: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
@@ -192,6 +193,7 @@ _ROW_FIELDS = (
     "center_of_mass",
     "surface_distance",
     "normal_angle",
+    "grasp_warnings",
 )
 
 
@@ -354,6 +356,7 @@ def _stack(jobs, method) -> Block:
     if any(g.center_of_mass is not None for g in grasps):
         center = np.stack([nan if g.center_of_mass is None else g.center_of_mass for g in grasps])
     distance, angle = surface_columns(grasps)
+    said = [g.warnings for g in grasps] if any(g.warnings for g in grasps) else None
     return replace(
         block,
         contact_names=[g.contact_names for g in grasps],
@@ -361,6 +364,7 @@ def _stack(jobs, method) -> Block:
         center_of_mass=center,
         surface_distance=distance,
         normal_angle=angle,
+        grasp_warnings=said,
     )
 
 

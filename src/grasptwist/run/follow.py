@@ -39,6 +39,7 @@ from ..output.formats import FORMATS
 from ..output.records import diagnostics, error_record
 from ..results import BY_KEY, selected
 from .batch import Block, hand_placement, with_reasons
+from .collisions import PathCollisions
 from .options import FollowOptions
 from .outputs import Output
 from .placement import read
@@ -103,7 +104,7 @@ class Summary:
     cannot_hold: tuple[HoldStretch, ...] | None = None  # where no grip holds its weight, with mass and friction
     unjudged: tuple[Unjudged, ...] | None = None  # where the grip fails otherwise: held or not is unknown there
     tip_error: np.ndarray | None = None  # (3,) with a hand: each finger's largest tip error at the samples
-    warnings: tuple[str, ...] = ()  # about the path as given: rotation vectors over pi
+    warnings: tuple[str, ...] = ()  # rotation vectors over pi (the path as given); links through the object
 
 
 def sample_times(duration: float, samples: int | None = None, dt: float | None = None) -> np.ndarray:
@@ -193,6 +194,7 @@ def _path(job, grasp, p):
         else (grasp.points, grasp.normals, grasp.friction, grasp.mass, grasp.center_of_mass, grasp.gravity, p.segments)
     )
     largest = None  # each finger's largest tip error at the samples, as their records give it
+    collided = PathCollisions(grasp)
     for start in range(0, len(times), CHUNK):
         q = None if tracked is None else tracked.positions[start : start + CHUNK]
         grip = None if weight is None else grip_along(*weight, times[start : start + CHUNK])[1]
@@ -205,16 +207,15 @@ def _path(job, grasp, p):
             method=job.method,
             bases=job.bases,
         )
-        block = _block(grasp, p.name, f, job.bases, job.method, q)
+        block = replace(_block(grasp, p.name, f, job.bases, job.method, q), grasp_warnings=collided.at(q, f.poses))
         if tracked is not None:
             seen = block.results["hand"].tip_error.max(axis=0)
             largest = seen if largest is None else np.maximum(largest, seen)
         yield Samples(p.name, block, f.poses, q, grip)
     found = degeneracies(grasp.points, grasp.normals, grasp.wrist, p.segments, times)
     stretches, unjudged = (None, None) if weight is None else hold_verdicts(*weight, times)
-    yield Summary(
-        grasp.file, grasp, p.name, len(times), found, labels, tracked, stretches, unjudged, largest, _radians(p)
-    )
+    said = _radians(p) + collided.warnings(len(times))
+    yield Summary(grasp.file, grasp, p.name, len(times), found, labels, tracked, stretches, unjudged, largest, said)
 
 
 def _radians(path) -> tuple[str, ...]:

@@ -173,6 +173,7 @@ class ForceBlock:
     center_of_mass: np.ndarray | None = None  # (n, 3), NaN rows where none; None: no row has one
     surface_distance: np.ndarray | None = None  # (n, 3), as resolve's Block (run/batch.py's surface_columns)
     normal_angle: np.ndarray | None = None
+    grasp_warnings: list | None = None  # per row its grasp's warnings (Grasp.warnings), as resolve's Block
 
     def __len__(self) -> int:
         return len(self.grasp)
@@ -278,7 +279,8 @@ def _stack(rows, options) -> ForceBlock:
         contact_names=[g.contact_names for g in grasps],
     )
     distance, angle = surface_columns(grasps)
-    return replace(block, surface_distance=distance, normal_angle=angle)
+    said = [g.warnings for g in grasps] if any(g.warnings for g in grasps) else None
+    return replace(block, surface_distance=distance, normal_angle=angle, grasp_warnings=said)
 
 
 def force_dataset_blocks(

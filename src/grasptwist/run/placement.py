@@ -78,7 +78,9 @@ def place_grasp(grasp: Grasp) -> Grasp | GraspFileError:
     if problems.count:
         errors = [reject.error(grasp.file, grasp.document) for reject in problems.first()[0]]
         return GraspFileError(*errors[0].args[:6], errors)  # one per document, as the reader gives them
-    return replace(grasp, joint_positions=readonly(solved.positions), placement=None)
+    from .collisions import with_collisions  # as the inverse kinematics: with the first URDF hand
+
+    return with_collisions(replace(grasp, joint_positions=readonly(solved.positions), placement=None))
 
 
 def placed(items: Iterable) -> list:

@@ -1,0 +1,331 @@
+r"""Fingers against the object: how deep each finger link's geometry goes into it.
+
+A link's geometry is the vertices of its mesh (a URDF's collision geometry),
+held in the hand's root frame at home (every joint at 0).  A link moves with
+the first ``j`` joints of its finger, the product of exponentials of
+:func:`~grasptwist.engine.kinematics.forward_kinematics`:
+
+.. math::
+
+    v(q) = g_j(q)\, v_0, \qquad g_j(q) = e^{[S_1] q_1} \cdots e^{[S_j] q_j} .
+
+Its penetration depth is the deepest of its vertices inside the object,
+
+.. math::
+
+    d = \max\Bigl(0,\ \max_{v} -\phi\bigl(v(q)\bigr)\Bigr),
+
+with :math:`\phi` the object's signed distance (> 0 outside,
+:func:`~grasptwist.engine.objects.project_to_surface`): exact for the
+vertices, so exact for a link whose deepest point is a vertex (a flat face
+or a corner pushed into the object).  An object's edge or corner poking into
+a face of a link between its vertices is seen only as deep as the nearest
+vertices go: the depth is a lower bound, as close as the link's mesh is fine
+(the TriFinger's collision meshes have vertices every few millimetres).
+
+Speed comes from never asking the object about far vertices (the checks are
+conservative, so nothing is missed): each link's vertices are cut into
+compact *clusters* of at most :data:`CLUSTER` vertices, each in a ball of
+centre :math:`c` and radius :math:`\rho`; a cluster whose ball misses the
+object's bounding ball, or whose centre is farther than :math:`\rho` from
+the object (:math:`\phi(c) > \rho`: the signed distance is 1-Lipschitz), has
+no vertex inside it.
+
+The fingertip's own contact is no collision: :func:`tip_sphere` says which
+vertices of a finger's tip link lie on its fingertip sphere (within
+``tip_radius`` plus :data:`COLLISION_TOL` times the object's size of the tip
+link's origin, the sphere's centre); they are left out.  The rest of the tip
+link (a stem holding the sphere) still counts.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from typing import NamedTuple
+
+import numpy as np
+
+from . import se3
+from .objects import object_size, project_to_surface
+
+__all__ = [
+    "CLUSTER",
+    "COLLISION_TOL",
+    "LinkGeometry",
+    "LinkClusters",
+    "clusters",
+    "collision_tolerance",
+    "link_poses",
+    "penetration_depths",
+    "tip_sphere",
+]
+
+#: Depths at most this, times the object's size (its bounding box's diagonal), are no collision:
+#: round-off and tessellation (a 65 mm cube: 0.11 mm).  It also pads the fingertip's sphere.
+COLLISION_TOL = 1e-3
+
+#: Most vertices of one cluster (:func:`clusters`): small enough that a cluster near the
+#: object asks about few far vertices, large enough that far clusters are few (measured with
+#: ``bench/collisions.py``: 32 beats 16 and 64 by 1.5 to 2.5 times).
+CLUSTER = 32
+
+
+class LinkGeometry(NamedTuple):
+    """One finger link's collision geometry.
+
+    Attributes
+    ----------
+    finger : int
+        The finger's index in ``hand.fingers``.
+    link : str
+        The link's name in its URDF.
+    joints : int
+        How many of the finger's movable joints (base first) move it.
+    vertices : numpy.ndarray
+        ``(V, 3)`` in the hand's root frame at home (every joint at 0).
+    faces : numpy.ndarray
+        ``(F, 3)`` int, triangles of ``vertices`` (pictures, the library baseline of ``bench/``).
+    """
+
+    finger: int
+    link: str
+    joints: int
+    vertices: np.ndarray
+    faces: np.ndarray
+
+
+class LinkClusters(NamedTuple):
+    """Links' vertices cut into compact clusters (:func:`clusters`), padded to one width.
+
+    Attributes
+    ----------
+    link : numpy.ndarray
+        ``(C,)`` int, the link each cluster belongs to.
+    center, radius : numpy.ndarray
+        ``(C, 3)``, ``(C,)``: each cluster's ball at home.
+    vertices : numpy.ndarray
+        ``(C, CLUSTER, 3)``: a cluster's vertices, padded by repeating its first.
+    """
+
+    link: np.ndarray
+    center: np.ndarray
+    radius: np.ndarray
+    vertices: np.ndarray
+
+
+def tip_sphere(vertices, center, radius, tol):
+    r"""Which vertices lie on a fingertip sphere: within ``radius + tol`` of its centre.
+
+    .. math::
+
+        |v - c| \le r + \varepsilon
+
+    Parameters
+    ----------
+    vertices : (..., 3) array
+    center : (..., 3) array
+        The tip link's origin (the sphere's centre).
+    radius : float or (...) array
+        ``Finger.tip_radius`` (0: a point tip, only the centre is on it).
+    tol : float
+
+    Returns
+    -------
+    (...) bool array
+
+    >>> tip_sphere([[0, 0, 0.01], [0, 0, 0.02]], [0, 0, 0], 0.01, 1e-4).tolist()
+    [True, False]
+    """
+    v = np.asarray(vertices, dtype=float)
+    return np.linalg.norm(v - np.asarray(center, dtype=float), axis=-1) <= np.asarray(radius) + tol
+
+
+def clusters(vertices, size: int = CLUSTER) -> LinkClusters:
+    """Each link's vertices cut into clusters of at most ``size``, halving along the longest side.
+
+    Parameters
+    ----------
+    vertices : sequence of (V_l, 3) arrays
+        One per link (a link without vertices gets no cluster).
+    size : int
+
+    Returns
+    -------
+    LinkClusters
+
+    >>> c = clusters([np.arange(30.0).reshape(10, 3)], size=4)
+    >>> c.link.tolist(), c.vertices.shape, bool((c.radius > 0).all())
+    ([0, 0, 0, 0], (4, 4, 3), True)
+    """
+    links, groups = [], []
+    for index, v in enumerate(vertices):
+        stack = [np.asarray(v, dtype=float).reshape(-1, 3)]
+        while stack:
+            part = stack.pop()
+            if len(part) == 0:
+                continue
+            if len(part) <= size:
+                links.append(index)
+                groups.append(part)
+                continue
+            axis = np.argmax(np.ptp(part, axis=0))
+            order = np.argsort(part[:, axis], kind="stable")
+            half = len(part) // 2
+            stack += [part[order[:half]], part[order[half:]]]
+    padded = np.array([np.concatenate([g, np.repeat(g[:1], size - len(g), axis=0)]) for g in groups]).reshape(
+        -1, size, 3
+    )
+    center = 0.5 * (padded.min(axis=1) + padded.max(axis=1))
+    radius = np.linalg.norm(padded - center[:, None], axis=-1).max(axis=1) if len(groups) else np.zeros(0)
+    return LinkClusters(np.array(links, dtype=int), center, radius, padded)
+
+
+def link_poses(hand, geometry, positions, frames=None):
+    r"""Each link's motion from home, :math:`g_j(q)`, at joint ``positions``, seen from a moving object.
+
+    With the object moved by :math:`P` (a path's pose), the link is where
+    :math:`P^{-1} g_j(q)` puts it against the object where the grasp has it.
+
+    Parameters
+    ----------
+    hand : Hand
+    geometry : sequence of LinkGeometry
+    positions : (N, n_joints) array
+        In ``hand.joint_names`` order.
+    frames : (N, 4, 4) array, optional
+        The object's motion :math:`P` at each configuration; None: the identity.
+
+    Returns
+    -------
+    (N, L, 4, 4) array
+        Link ``l``'s vertices are ``R v + t`` of its pose.
+
+    Examples
+    --------
+    >>> from grasptwist.model import Finger
+    >>> hand = type("H", (), {"fingers": [Finger("1", None, (), np.array([[0, 0, 1.0, 0, 0, 0]]),
+    ...     np.zeros((1, 3)), None, 1.0, (0,))]})
+    >>> link = LinkGeometry(0, "a", 1, np.zeros((1, 3)), np.zeros((0, 3), int))
+    >>> link_poses(hand, [link], [[np.pi / 2]])[0, 0, :2, :2].round(12).tolist()
+    [[0.0, -1.0], [1.0, 0.0]]
+    """
+    q = np.asarray(positions, dtype=float)
+    out = np.empty(q.shape[:-1] + (len(geometry), 4, 4))
+    out[...] = np.eye(4)
+    for f, finger in enumerate(hand.fingers):
+        mine = [(i, g.joints) for i, g in enumerate(geometry) if g.finger == f and g.joints]
+        # g_j = g_(j-1) e^([S_j] q_j), one exponential per joint shared by the finger's links
+        rotation, translation = np.eye(3), np.zeros(3)
+        for j in range(max((joints for _, joints in mine), default=0)):
+            r, t = se3.exp(finger.screws[j], q[..., finger.joint_index[j]])
+            rotation, translation = rotation @ r, (rotation @ t[..., None])[..., 0] + translation
+            for i in (i for i, joints in mine if joints == j + 1):
+                out[..., i, :3, :3], out[..., i, :3, 3] = rotation, translation
+    if frames is not None:
+        frames = np.asarray(frames, dtype=float)
+        rotation, translation = se3.inverse(frames[..., :3, :3], frames[..., :3, 3])
+        back = np.zeros(frames.shape)
+        back[..., :3, :3], back[..., :3, 3], back[..., 3, 3] = rotation, translation, 1.0
+        out = back[..., None, :, :] @ out
+    return out
+
+
+def collision_tolerance(obj) -> float:
+    """The depth below which a link touching ``obj`` is no collision: :data:`COLLISION_TOL` times its size."""
+    return COLLISION_TOL * object_size(obj)
+
+
+def penetration_depths(obj, parts: LinkClusters, poses, n_links: int | None = None):
+    r"""Per link, how deep its vertices go into the object (0 when apart).
+
+    Parameters
+    ----------
+    obj : GraspObject
+        In the grasp frame (the hand's root frame).
+    parts : LinkClusters
+        The links' vertices at home (:func:`clusters`).
+    poses : (N, L, 4, 4) array
+        Each link's pose from home (:func:`link_poses`).
+    n_links : int, optional
+        ``L`` (default: from ``poses``).
+
+    Returns
+    -------
+    (N, L) array
+        :math:`\max(0, \max_v -\phi(v))` over each link's vertices.
+
+    Examples
+    --------
+    >>> from grasptwist.model import GraspObject, Shape
+    >>> box = GraspObject(Shape("box", np.array([2.0, 2.0, 2.0])), np.eye(4))
+    >>> parts = clusters([[[0.0, 0.0, 0.75], [0.0, 0.0, 3.0]], [[5.0, 0.0, 0.0]]])
+    >>> penetration_depths(box, parts, np.broadcast_to(np.eye(4), (1, 2, 4, 4))).tolist()
+    [[0.25, 0.0]]
+    """
+    poses = np.asarray(poses, dtype=float)
+    n, links = poses.shape[0], poses.shape[1] if n_links is None else n_links
+    depth = np.zeros((n, links))
+    if len(parts.link) == 0 or n == 0:
+        return depth
+    # in the object's own frame, where its bounding box is axis-aligned
+    back, shift = se3.inverse(obj.pose[:3, :3], obj.pose[:3, 3])
+    rotation = back @ poses[..., :3, :3]  # (N, L, 3, 3)
+    translation = _apply(back, poses[..., :3, 3]) + shift
+    box = _box(obj.shape)
+    found = [_near(parts, i, rotation[:, i], translation[:, i], box) for i in np.unique(parts.link)]
+    rows = np.concatenate([f[0] for f in found])
+    if len(rows) == 0:
+        return depth
+    cols, center = np.concatenate([f[1] for f in found]), np.concatenate([f[2] for f in found])
+    here = replace(obj, pose=np.eye(4))
+    phi = project_to_surface(here, center).distance
+    radius, link = parts.radius[cols], parts.link[cols]
+    # branch and bound: every vertex of a cluster is at least -phi - r deep and at most -phi + r
+    # (the signed distance is 1-Lipschitz), so only a cluster that may hold the deepest vertex is opened
+    bound = np.zeros((n, links))
+    np.maximum.at(bound, (rows, link), -phi - radius)
+    open_ = -phi + radius >= bound[rows, link]
+    rows, cols, link = rows[open_], cols[open_], link[open_]
+    r, t = rotation[rows, link], translation[rows, link]
+    v = np.einsum("kij,kmj->kmi", r, parts.vertices[cols]) + t[:, None]
+    deepest = -project_to_surface(here, v).distance.min(axis=1)
+    np.maximum.at(depth, (rows, link), deepest)
+    return depth
+
+
+def _near(parts, link, rotation, translation, box):
+    """The (configuration, cluster) pairs of one link whose balls reach the object's bounding box,
+    and the clusters' centres there: first the link's ball (holding its clusters'), then theirs."""
+    (mine,) = np.nonzero(parts.link == link)
+    center, radius = parts.center[mine], parts.radius[mine]
+    middle = 0.5 * (center.min(axis=0) + center.max(axis=0))
+    reach = np.max(np.linalg.norm(center - middle, axis=-1) + radius)
+    (rows,) = np.nonzero(_outside(_apply(rotation, middle) + translation, box) <= reach)
+    moved = np.einsum("nij,cj->nci", rotation[rows], center) + translation[rows, None]
+    hit, which = np.nonzero(_outside(moved, box) <= radius)
+    return rows[hit], mine[which], moved[hit, which]
+
+
+def _outside(points, box):
+    """How far points are outside an axis-aligned box ``(low, high)`` (0 inside)."""
+    low, high = box
+    return np.linalg.norm(np.maximum(np.maximum(low - points, points - high), 0.0), axis=-1)
+
+
+def _apply(r, x):
+    """``R x`` over batches."""
+    return (r @ x[..., None])[..., 0]
+
+
+def _box(shape):
+    """The corners ``(3,), (3,)`` of the shape's bounding box in its own frame."""
+    if shape.kind == "mesh":
+        return shape.vertices.min(axis=0), shape.vertices.max(axis=0)
+    s = np.asarray(shape.size, dtype=float)
+    half = {
+        "box": lambda: s / 2,
+        "sphere": lambda: np.full(3, s[0]),
+        "cylinder": lambda: np.array([s[0], s[0], s[1] / 2]),
+        "capsule": lambda: np.array([s[0], s[0], s[1] / 2 + s[0]]),
+    }[shape.kind]()
+    return -half, half
