@@ -33,7 +33,8 @@ def sphere_tripod(wrist=None):
 def three_finger_hand(radii=(0.1, 0.0, 0.2)):
     grasp = load_grasps(GRASPS / "three-finger-hand.yaml")[0]
     fingers = tuple(replace(f, tip_radius=r) for f, r in zip(grasp.hand.fingers, radii))
-    return replace(grasp, hand=replace(grasp.hand, fingers=fingers))
+    # without its box: the framing below is the contacts' and the tips' alone
+    return replace(grasp, object=None, hand=replace(grasp.hand, fingers=fingers))
 
 
 def fill(picture, subject_half):
