@@ -19,6 +19,7 @@ LAYERS = [
         "grasptwist.forces",
         "grasptwist.path",
         "grasptwist.pictures",
+        "grasptwist.objects",
         "grasptwist.dask",
         "grasptwist.__main__",
     ],

@@ -4,7 +4,8 @@ The core: the twist decompositions (pure numpy, batched over leading axes),
 their statuses, and grasp files.  One public module per topic holds the rest:
 :mod:`grasptwist.screws` (screw algebra), :mod:`grasptwist.hand` (hands, joint
 rates, inverse kinematics), :mod:`grasptwist.forces`, :mod:`grasptwist.path`,
-:mod:`grasptwist.pictures` and :mod:`grasptwist.dask`.  Every other module is
+:mod:`grasptwist.pictures`, :mod:`grasptwist.objects` (the object held) and
+:mod:`grasptwist.dask`.  Every other module is
 internal (``docs/api/index.rst`` says which).
 
 >>> import grasptwist as gt
@@ -63,11 +64,12 @@ _EXPORTS = {
     "forces": ".forces",
     "path": ".path",
     "pictures": ".pictures",
+    "objects": ".objects",
     "dask": ".dask",
 }
 
 #: Names above that are modules themselves.
-_MODULES = {"screws", "hand", "forces", "path", "pictures", "dask"}
+_MODULES = {"screws", "hand", "forces", "path", "pictures", "objects", "dask"}
 
 #: 0.3's names that moved to a topic module: old name -> (topic, name there).
 #: They still work, with a DeprecationWarning naming their new place.

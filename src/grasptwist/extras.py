@@ -1,4 +1,4 @@
-"""Optional dependencies (the extras ``parquet`` and ``dask``): imported only when used.
+"""Optional dependencies (the extras ``parquet``, ``dask``, ``mesh``, ...): imported only when used.
 
 A missing one is a :class:`MissingExtra` whose message is the one line to
 show: what needs it and how to install it.
@@ -18,6 +18,8 @@ EXTRAS = {
     "dask": ("'dask[dataframe]' distributed", "dask"),
     "distributed": ("'dask[dataframe]' distributed", "dask"),
     "scipy": ("scipy", "quality"),
+    "igl": ("libigl", "mesh"),
+    "trimesh": ("trimesh", "mesh"),
 }
 
 

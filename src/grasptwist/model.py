@@ -1,4 +1,4 @@
-"""The data types every layer shares: grasps, twists and input errors.
+"""The data types every layer shares: grasps, twists, objects and input errors.
 
 No parsing and no math here: the loaders in :mod:`grasptwist.io` build these,
 the runner in :mod:`grasptwist.run` feeds them to the engine, and the
@@ -15,6 +15,8 @@ __all__ = [
     "Twist",
     "Wrench",
     "Grasp",
+    "Shape",
+    "GraspObject",
     "Segment",
     "ObjectPath",
     "InputError",
@@ -124,6 +126,11 @@ class Grasp:
         A URDF hand not yet placed on the contacts, as the file gives it (the
         loader only reads: :func:`grasptwist.hand.place_grasp` checks or
         solves the joint positions); None once placed, or for an inline hand.
+    object : GraspObject or None
+        The object the fingers hold, None when the file gives none.
+    surface_distance : numpy.ndarray or None
+        ``(3,)`` each given point's signed distance from the object's surface
+        (> 0 outside) before it was put on it; None without an object.
     """
 
     name: str
@@ -145,6 +152,67 @@ class Grasp:
     center_of_mass: np.ndarray | None = None
     gravity: np.ndarray | None = None
     placement: HandPlacement | None = None
+    object: GraspObject | None = None
+    surface_distance: np.ndarray | None = None
+
+
+@dataclass(frozen=True, eq=False)
+class Shape:
+    """An object's shape in its own frame: a primitive centred at its origin, or a triangle mesh.
+
+    Checked by :func:`grasptwist.objects.check_shape`; the geometry is in
+    ``grasptwist.engine.objects``.
+
+    Attributes
+    ----------
+    kind : str
+        ``"box"``, ``"sphere"``, ``"cylinder"``, ``"capsule"`` or ``"mesh"``.
+    size : numpy.ndarray
+        A box's ``(3,)`` edge lengths ``a, b, c`` along x, y, z; a sphere's
+        ``(1,)`` radius; a cylinder's ``(2,)`` radius and height (axis z); a
+        capsule's ``(2,)`` radius and height, the distance between its two
+        caps' centres (axis z: trimesh's convention); ``(0,)`` for a mesh.
+    vertices : numpy.ndarray or None
+        A mesh's ``(V, 3)`` float vertices, scale already applied; None for a primitive.
+    faces : numpy.ndarray or None
+        A mesh's ``(F, 3)`` int vertex indices of each triangle, counter-clockwise
+        seen from outside; None for a primitive.
+    source : str or None
+        A mesh's file as the grasp file names it; None for a primitive.
+    """
+
+    kind: str
+    size: np.ndarray
+    vertices: np.ndarray | None = None
+    faces: np.ndarray | None = None
+    source: str | None = None
+
+
+@dataclass(frozen=True, eq=False)
+class GraspObject:
+    """The object a grasp holds: its shape, where it is, and what it weighs.
+
+    Attributes
+    ----------
+    shape : Shape
+        In the object's own frame.
+    pose : numpy.ndarray
+        ``(4, 4)`` homogeneous rigid transform from the object's frame to the
+        grasp's frame (the identity when the file gives no ``pose``).
+    mass : float or None
+        Its mass (kg), given or from ``density`` times its volume; None when
+        neither is given.
+    density : float or None
+        Its density (kg per cubed length unit) as given; None when not given.
+    line : int or None
+        1-based line where the ``object`` key starts in the file.
+    """
+
+    shape: Shape
+    pose: np.ndarray
+    mass: float | None = None
+    density: float | None = None
+    line: int | None = None
 
 
 @dataclass(frozen=True)

@@ -34,7 +34,7 @@ def public_names():
 
 
 def test_the_core_has_a_module_per_topic():
-    assert sorted(TOPICS) == ["dask", "forces", "hand", "path", "pictures", "screws"]
+    assert sorted(TOPICS) == ["dask", "forces", "hand", "objects", "path", "pictures", "screws"]
     assert sorted(TOPICS) == sorted(n for n in gt.__all__ if inspect.ismodule(getattr(gt, n)))
     for topic, name in TOPICS.items():
         assert getattr(gt, topic) is module(name)

@@ -25,7 +25,14 @@ PACKAGE = SRC / "grasptwist"
 FORBIDDEN = {"grasptwist.plot": ("grasptwist.io", "grasptwist.output", "grasptwist.results", "grasptwist.run")}
 
 #: Facades only re-export.
-FACADES = ("grasptwist.screws", "grasptwist.hand", "grasptwist.forces", "grasptwist.path", "grasptwist.pictures")
+FACADES = (
+    "grasptwist.screws",
+    "grasptwist.hand",
+    "grasptwist.forces",
+    "grasptwist.path",
+    "grasptwist.pictures",
+    "grasptwist.objects",
+)
 
 
 def module_name(path: Path) -> str:

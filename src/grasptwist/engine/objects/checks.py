@@ -1,0 +1,167 @@
+"""Validators of an object (its shape, pose, mass and density), done once where it enters.
+
+Each ``check_*`` returns what it checked, arrays as read-only float (faces
+int) arrays, and raises ``ValueError`` with one line naming the field and what
+is wrong.  The grasp-file loader turns that line into a located error; the
+geometry functions trust an object these accepted.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import replace
+
+import numpy as np
+
+from ...model import GraspObject, Shape
+from .primitives import PRIMITIVES
+
+__all__ = ["KINDS", "RIGID_TOL", "check_shape", "check_pose", "check_object"]
+
+#: The shapes an object may have.
+KINDS = (*PRIMITIVES, "mesh")
+
+#: A pose's rotation block must be orthonormal to this (as a path's pose targets).
+RIGID_TOL = 1e-9
+
+_SIZE_NAMES = {
+    "box": ("a", "b", "c"),
+    "sphere": ("radius",),
+    "cylinder": ("radius", "height"),
+    "capsule": ("radius", "height"),
+}
+
+
+def _real(a, name, dtype=float):
+    try:
+        a = np.array(a, dtype=dtype)
+    except (TypeError, ValueError, OverflowError):
+        raise ValueError(f"{name} must hold real numbers") from None
+    return a
+
+
+def _frozen(a):
+    a.setflags(write=False)
+    return a
+
+
+def check_shape(shape: Shape) -> Shape:
+    """The shape with its arrays as read-only floats (ints for faces), else ValueError saying what is wrong.
+
+    Every size of a primitive must be finite and > 0 (a capsule of height 0 is
+    a sphere: say so).  A mesh needs ``(V, 3)`` finite vertices and ``(F, 3)``
+    faces indexing them, closed and consistently oriented (each edge in
+    exactly two faces, once in each direction), enclosing a positive volume
+    (faces counter-clockwise seen from outside).
+
+    >>> check_shape(Shape("sphere", [0.03])).size.tolist()
+    [0.03]
+    >>> check_shape(Shape("cylinder", [0.03, -1]))
+    Traceback (most recent call last):
+    ValueError: cylinder height must be a finite number > 0, got -1.0
+    """
+    if not isinstance(shape, Shape):
+        raise ValueError(f"shape must be a Shape, got {type(shape).__name__}")
+    if shape.kind not in KINDS:
+        raise ValueError(f"shape kind must be one of {', '.join(KINDS)}, got {shape.kind!r}")
+    size = _real(shape.size, f"{shape.kind} size").reshape(-1) if shape.kind != "mesh" else np.zeros(0)
+    if shape.kind == "mesh":
+        vertices, faces = _check_mesh(shape.vertices, shape.faces)
+        return replace(shape, size=_frozen(size), vertices=vertices, faces=faces)
+    names = _SIZE_NAMES[shape.kind]
+    if size.shape != (len(names),):
+        raise ValueError(f"{shape.kind} size must hold {len(names)} number(s) ({', '.join(names)}), got {size.size}")
+    for name, value in zip(names, size.tolist()):
+        if not (math.isfinite(value) and value > 0):
+            raise ValueError(f"{shape.kind} {name} must be a finite number > 0, got {value!r}")
+    return replace(shape, size=_frozen(size))
+
+
+def _check_mesh(vertices, faces):
+    if vertices is None or faces is None:
+        raise ValueError("mesh needs vertices and faces")
+    v = _real(vertices, "mesh vertices")
+    if v.ndim != 2 or v.shape[1] != 3 or len(v) < 4:
+        raise ValueError(f"mesh vertices must have shape (V, 3) with V >= 4, got {v.shape}")
+    if not np.isfinite(v).all():
+        row = int(np.flatnonzero(~np.isfinite(v).all(axis=1))[0])
+        raise ValueError(f"mesh vertex {row} is not finite: {v[row].tolist()}")
+    f = _real(faces, "mesh faces", dtype=np.float64)
+    if f.ndim != 2 or f.shape[1] != 3 or len(f) < 4:
+        raise ValueError(f"mesh faces must have shape (F, 3) with F >= 4, got {f.shape}")
+    if not (np.isfinite(f).all() and (f == np.round(f)).all() and f.min() >= 0 and f.max() < len(v)):
+        raise ValueError(f"mesh faces must be whole vertex indices from 0 to {len(v) - 1}")
+    f = f.astype(np.int64)
+    _check_closed(f)
+    if _signed_volume(v, f) <= 0:
+        raise ValueError("mesh encloses no positive volume: its faces must be counter-clockwise seen from outside")
+    return _frozen(v), _frozen(f)
+
+
+def _check_closed(faces):
+    """Each directed edge once, and its reverse once: a closed, consistently oriented surface."""
+    edges = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
+    if (edges[:, 0] == edges[:, 1]).any():
+        raise ValueError("mesh has a face with a repeated vertex")
+    n = int(faces.max()) + 1
+    directed = edges[:, 0] * n + edges[:, 1]
+    unique, counts = np.unique(directed, return_counts=True)
+    if (counts > 1).any():
+        raise ValueError(
+            f"mesh is not consistently oriented or not manifold: {int((counts > 1).sum())} edge(s) run the same way in two faces"
+        )
+    reverse = edges[:, 1] * n + edges[:, 0]
+    missing = ~np.isin(reverse, unique)
+    if missing.any():
+        raise ValueError(f"mesh is not closed: {int(missing.sum())} edge(s) belong to one face only")
+
+
+def _signed_volume(vertices, faces):
+    a, b, c = vertices[faces[:, 0]], vertices[faces[:, 1]], vertices[faces[:, 2]]
+    return float(np.einsum("ij,ij->", a, np.cross(b, c))) / 6.0
+
+
+def check_pose(pose) -> np.ndarray:
+    """The ``(4, 4)`` rigid pose as a read-only float array, else ValueError saying what is wrong.
+
+    Its rotation block must be orthonormal to ``RIGID_TOL`` (1e-9) with
+    determinant +1, its last row ``(0, 0, 0, 1)``.
+
+    >>> check_pose(np.diag([1.0, 1, -1, 1]))
+    Traceback (most recent call last):
+    ValueError: pose must be rigid: its rotation block is not a rotation (orthonormal, determinant +1)
+    """
+    p = _real(pose, "pose")
+    if p.shape != (4, 4):
+        raise ValueError(f"pose must have shape (4, 4), got {p.shape}")
+    if not np.isfinite(p).all():
+        raise ValueError("pose must be finite")
+    if not (p[3] == (0.0, 0.0, 0.0, 1.0)).all():
+        raise ValueError(f"pose must be rigid: its last row must be (0, 0, 0, 1), got {tuple(p[3].tolist())}")
+    r = p[:3, :3]
+    if not (np.abs(r.T @ r - np.eye(3)).max() <= RIGID_TOL and np.linalg.det(r) > 0):
+        raise ValueError("pose must be rigid: its rotation block is not a rotation (orthonormal, determinant +1)")
+    return _frozen(p)
+
+
+def check_object(obj: GraspObject) -> GraspObject:
+    """The object with its shape and pose checked, else ValueError saying what is wrong.
+
+    ``mass`` and ``density``, when given, must be finite and > 0.
+
+    >>> check_object(GraspObject(Shape("box", [1, 1, 1]), np.eye(4), mass=0.0))
+    Traceback (most recent call last):
+    ValueError: object mass must be a finite number > 0, got 0.0
+    """
+    if not isinstance(obj, GraspObject):
+        raise ValueError(f"object must be a GraspObject, got {type(obj).__name__}")
+    for name in ("mass", "density"):
+        value = getattr(obj, name)
+        if value is not None:
+            try:
+                good = math.isfinite(value) and value > 0
+            except TypeError:
+                good = False
+            if not good:
+                raise ValueError(f"object {name} must be a finite number > 0, got {value!r}")
+    return replace(obj, shape=check_shape(obj.shape), pose=check_pose(obj.pose))

@@ -1,0 +1,248 @@
+r"""An object's geometry in the grasp frame: nearest surface points, mass properties, samples, triangles.
+
+Each function takes a :class:`~grasptwist.model.GraspObject` checked by
+:func:`~grasptwist.objects.check_object` and works in the grasp frame: points go into
+the object's frame through its pose :math:`T = (R, t)`, :math:`q = R^T (p - t)`,
+are answered there by ``primitives`` (exact) or ``mesh``, and come
+back as :math:`R c + t` (points) and :math:`R n` (normals).  Normals point
+into the object, as a grasp's do; distances are signed, > 0 outside, so that
+every point ``p`` satisfies
+
+.. math::
+
+    c = p + d\, n
+
+with ``c`` its nearest surface point, ``d`` its signed distance and ``n``
+the unit inward normal there.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+from typing import NamedTuple
+
+import numpy as np
+
+from ...model import GraspObject
+from . import mesh, primitives
+from .checks import check_pose
+from .tolerances import EDGE_TOL
+
+__all__ = [
+    "SurfacePoints",
+    "MassProperties",
+    "project_to_surface",
+    "mass_properties",
+    "sample_surface",
+    "tessellate",
+    "object_size",
+    "moved",
+]
+
+
+class SurfacePoints(NamedTuple):
+    """Points put on an object's surface (:func:`project_to_surface`).
+
+    Attributes
+    ----------
+    points : numpy.ndarray
+        ``(..., 3)`` the nearest surface point of each given point.
+    normals : numpy.ndarray
+        ``(..., 3)`` the unit inward normal there.
+    distance : numpy.ndarray
+        ``(...)`` each given point's signed distance from the surface: > 0
+        outside, < 0 inside.
+    """
+
+    points: np.ndarray
+    normals: np.ndarray
+    distance: np.ndarray
+
+
+class MassProperties(NamedTuple):
+    """An object's volume, mass and centre of mass (:func:`mass_properties`).
+
+    Attributes
+    ----------
+    volume : float
+        In cubed length units.
+    mass : float or None
+        The given mass, else ``density * volume``; None when neither is given.
+    center_of_mass : numpy.ndarray
+        ``(3,)`` in the grasp frame (the centroid of the solid: uniform density).
+    """
+
+    volume: float
+    mass: float | None
+    center_of_mass: np.ndarray
+
+
+def object_size(obj: GraspObject) -> float:
+    """The diagonal of the object's bounding box in its own frame: the scale of every tolerance.
+
+    In its own frame so that it does not change as the object moves.
+
+    >>> from grasptwist.objects import Shape
+    >>> object_size(GraspObject(Shape("box", np.array([0.03, 0.04, 0.12])), np.eye(4)))
+    0.13
+    """
+    shape = obj.shape
+    if shape.kind == "mesh":
+        return mesh.diagonal(shape.vertices)
+    return primitives.diagonal(shape.kind, shape.size)
+
+
+def project_to_surface(obj: GraspObject, points) -> SurfacePoints:
+    r"""Each point's nearest point on the object's surface, the inward normal there and its signed distance.
+
+    Exact for the primitives (``grasptwist.engine.objects.primitives`` says which answer a point
+    without a unique nearest point gets); for a mesh, the nearest point of its
+    triangles with that face's normal, or within
+    :data:`~grasptwist.objects.MESH_EDGE_TOL` of an edge or vertex the area-weighted
+    normal of the faces there (``grasptwist.engine.objects.mesh``).
+
+    .. math::
+
+        c = p + d\, n, \qquad |d| = \min_{s \in \partial O} |p - s|
+
+    Parameters
+    ----------
+    obj : GraspObject
+        Checked by :func:`~grasptwist.objects.check_object`.
+    points : array-like, shape (..., 3)
+        Points in the grasp frame.
+
+    Returns
+    -------
+    SurfacePoints
+        ``points (..., 3)``, ``normals (..., 3)`` (unit, inward),
+        ``distance (...)`` (> 0 outside).
+
+    Examples
+    --------
+    A 2 x 2 x 2 box moved 1 along x; a point 0.5 beyond its +y face:
+
+    >>> from grasptwist.objects import Shape
+    >>> pose = np.eye(4); pose[0, 3] = 1.0
+    >>> box = GraspObject(Shape("box", np.array([2.0, 2.0, 2.0])), pose)
+    >>> s = project_to_surface(box, [1.0, 1.5, 0.0])
+    >>> s.points.tolist(), s.normals.tolist(), float(s.distance)
+    ([1.0, 1.0, 0.0], [-0.0, -1.0, -0.0], 0.5)
+    """
+    p = _points(points)
+    rotation, translation = obj.pose[:3, :3], obj.pose[:3, 3]
+    local = ((p - translation) @ rotation).reshape(-1, 3)  # rows R^T (p - t)
+    shape = obj.shape
+    if shape.kind == "mesh":
+        c, outward, d = mesh.nearest(shape, local)
+    else:
+        c, outward, d = primitives.nearest(shape.kind, shape.size, local, EDGE_TOL * object_size(obj))
+    return SurfacePoints(
+        (c @ rotation.T + translation).reshape(p.shape),
+        -(outward @ rotation.T).reshape(p.shape),
+        d.reshape(p.shape[:-1]),
+    )
+
+
+def _points(points):
+    try:
+        p = np.asarray(points, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError("points must be real numbers of shape (..., 3)") from None
+    if p.shape[-1:] != (3,):
+        raise ValueError(f"points must have shape (..., 3), got {p.shape}")
+    return p
+
+
+def mass_properties(obj: GraspObject) -> MassProperties:
+    r"""The object's volume, its mass (given, or from its density) and its centre of mass in the grasp frame.
+
+    .. math::
+
+        m = \rho V, \qquad c = R\, c_O + t
+
+    with :math:`c_O` the centroid in the object's frame: its origin for a
+    primitive, the closed mesh's (``mesh.volume_centroid``).
+
+    >>> from grasptwist.objects import Shape
+    >>> pose = np.eye(4); pose[:3, 3] = [0, 0, 0.05]
+    >>> m = mass_properties(GraspObject(Shape("box", np.array([0.1, 0.1, 0.1])), pose, density=1000.0))
+    >>> round(m.volume, 6), round(m.mass, 6), m.center_of_mass.tolist()
+    (0.001, 1.0, [0.0, 0.0, 0.05])
+    """
+    shape = obj.shape
+    if shape.kind == "mesh":
+        volume, centroid = mesh.volume_centroid(shape)
+    else:
+        volume, centroid = primitives.volume(shape.kind, shape.size), np.zeros(3)
+    mass = obj.mass if obj.mass is not None else (None if obj.density is None else obj.density * volume)
+    return MassProperties(volume, mass, obj.pose[:3, :3] @ centroid + obj.pose[:3, 3])
+
+
+def sample_surface(obj: GraspObject, n: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    """``n`` points uniformly distributed over the object's surface (by area), with the inward normals there.
+
+    The same generator state gives the same points (``primitives.sample`` and
+    ``mesh.sample`` in ``grasptwist.engine.objects`` say how they are drawn).
+
+    Returns
+    -------
+    points, normals : numpy.ndarray
+        Shape ``(n, 3)`` each, in the grasp frame; the normals unit and inward.
+
+    Examples
+    --------
+    >>> from grasptwist.objects import Shape
+    >>> ball = GraspObject(Shape("sphere", np.array([1.0])), np.eye(4))
+    >>> p, n = sample_surface(ball, 3, np.random.default_rng(1))
+    >>> np.allclose(p, -n)
+    True
+    """
+    shape = obj.shape
+    if shape.kind == "mesh":
+        points, outward = mesh.sample(shape, n, rng)
+    else:
+        points, outward = primitives.sample(shape.kind, shape.size, n, rng)
+    rotation, translation = obj.pose[:3, :3], obj.pose[:3, 3]
+    return points @ rotation.T + translation, -(outward @ rotation.T)
+
+
+def tessellate(obj: GraspObject, *, segments: int = 32) -> tuple[np.ndarray, np.ndarray]:
+    """A closed triangle mesh of the object in the grasp frame, for pictures and collisions.
+
+    A mesh is itself; a primitive's round parts get ``segments`` vertices per
+    ring (``grasptwist.engine.objects.primitives.triangles``), on its exact surface.
+
+    Returns
+    -------
+    vertices : numpy.ndarray
+        ``(V, 3)`` in the grasp frame.
+    faces : numpy.ndarray
+        ``(F, 3)`` int, counter-clockwise seen from outside.
+
+    Examples
+    --------
+    >>> from grasptwist.objects import Shape
+    >>> v, f = tessellate(GraspObject(Shape("box", np.ones(3)), np.eye(4)))
+    >>> v.shape, f.shape
+    ((8, 3), (12, 3))
+    """
+    shape = obj.shape
+    if shape.kind == "mesh":
+        vertices, faces = shape.vertices, shape.faces.copy()
+    else:
+        vertices, faces = primitives.triangles(shape.kind, shape.size, segments)
+    return vertices @ obj.pose[:3, :3].T + obj.pose[:3, 3], faces
+
+
+def moved(obj: GraspObject, pose) -> GraspObject:
+    """The object carried by the rigid motion ``pose`` (``(4, 4)``, in the grasp frame): its pose becomes ``pose @ obj.pose``.
+
+    >>> from grasptwist.objects import Shape
+    >>> step = np.eye(4); step[2, 3] = 1.0
+    >>> moved(GraspObject(Shape("sphere", np.ones(1)), np.eye(4)), step).pose[:3, 3].tolist()
+    [0.0, 0.0, 1.0]
+    """
+    new = check_pose(pose) @ obj.pose
+    new.setflags(write=False)
+    return replace(obj, pose=new)
