@@ -4,6 +4,7 @@ from .diagnostics import Warnings
 from .exits import run_command
 from .options import (
     ALL,
+    AllowOutside,
     Debug,
     Digits,
     Json,
@@ -16,8 +17,10 @@ from .options import (
     Quiet,
     RecordFormat,
     RecordFormatOption,
+    SurfaceTol,
     WarningsOption,
     Workers,
+    reading_option,
 )
 from .records import OutputSettings, write_records
 
@@ -33,6 +36,8 @@ def basis(
     digits: Digits = 4,
     order: OrderOption = Order.omega_v,
     max_bytes: MaxBytes = None,
+    surface_tol: SurfaceTol = None,
+    allow_outside: AllowOutside = False,
     workers: Workers = 0,
     quiet: Quiet = False,
     warnings: WarningsOption = Warnings.summary,
@@ -53,6 +58,7 @@ def basis(
         command=COMMANDS["basis"],
         fmt="json" if json_ else fmt.value,
         max_bytes=max_bytes,
+        reading=reading_option(surface_tol, allow_outside),
         order=order.value,
         options=TwistOptions(method=method.value),
     )

@@ -4,6 +4,7 @@ from .diagnostics import Warnings
 from .exits import run_command
 from .options import (
     ALL,
+    AllowOutside,
     Debug,
     Json,
     MaxBytes,
@@ -13,8 +14,10 @@ from .options import (
     Quiet,
     RecordFormat,
     RecordFormatOption,
+    SurfaceTol,
     WarningsOption,
     Workers,
+    reading_option,
 )
 from .records import OutputSettings, write_records
 
@@ -28,6 +31,8 @@ def check(
     json_: Json = False,
     output: Output = None,
     max_bytes: MaxBytes = None,
+    surface_tol: SurfaceTol = None,
+    allow_outside: AllowOutside = False,
     workers: Workers = 0,
     quiet: Quiet = False,
     warnings: WarningsOption = Warnings.summary,
@@ -48,6 +53,7 @@ def check(
         command=COMMANDS["check"],
         fmt="json" if json_ else fmt.value,
         max_bytes=max_bytes,
+        reading=reading_option(surface_tol, allow_outside),
         options=TwistOptions(method=method.value),
     )
     run_command(debug, lambda: write_records(job, paths, OutputSettings(output, quiet, warnings, workers)))

@@ -8,6 +8,7 @@ from .diagnostics import Warnings
 from .exits import run_command
 from .options import (
     ALL,
+    AllowOutside,
     Debug,
     Digits,
     FollowFormat,
@@ -19,8 +20,10 @@ from .options import (
     OrderOption,
     Output,
     Quiet,
+    SurfaceTol,
     hand_option,
     not_binary_to_a_terminal,
+    reading_option,
     segments_option,
 )
 from .records import OutputSettings, write_records
@@ -70,6 +73,8 @@ def follow(
     digits: Digits = 4,
     order: OrderOption = Order.omega_v,
     max_bytes: MaxBytes = None,
+    surface_tol: SurfaceTol = None,
+    allow_outside: AllowOutside = False,
     quiet: Quiet = False,
     debug: Debug = False,
 ) -> None:
@@ -103,6 +108,7 @@ def follow(
         command=COMMANDS["follow"],
         fmt=fmt.value,
         max_bytes=max_bytes,
+        reading=reading_option(surface_tol, allow_outside),
         order=order.value,
         hand=hand_option(None, paths, fmt.value),
         options=FollowOptions(method=method.value, path=path, segments=segments, samples=samples, dt=dt),

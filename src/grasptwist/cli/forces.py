@@ -7,6 +7,7 @@ import typer
 from .diagnostics import Warnings
 from .exits import run_command
 from .options import (
+    AllowOutside,
     Debug,
     Digits,
     ForcesFormat,
@@ -15,9 +16,11 @@ from .options import (
     Output,
     Paths,
     Quiet,
+    SurfaceTol,
     WarningsOption,
     Workers,
     not_binary_to_a_terminal,
+    reading_option,
     wrenches_option,
 )
 from .records import OutputSettings, write_records
@@ -114,6 +117,8 @@ def forces(
     output: Output = None,
     digits: Digits = 4,
     max_bytes: MaxBytes = None,
+    surface_tol: SurfaceTol = None,
+    allow_outside: AllowOutside = False,
     workers: Workers = 0,
     quiet: Quiet = False,
     warnings: WarningsOption = Warnings.summary,
@@ -145,6 +150,7 @@ def forces(
         command=COMMANDS["forces"],
         fmt=fmt.value,
         max_bytes=max_bytes,
+        reading=reading_option(surface_tol, allow_outside),
         options=ForceOptions(
             wrenches=None if wrenches is None else tuple(wrenches),
             friction=friction,

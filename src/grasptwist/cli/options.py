@@ -36,6 +36,9 @@ __all__ = [
     "Digits",
     "OrderOption",
     "MaxBytes",
+    "SurfaceTol",
+    "AllowOutside",
+    "reading_option",
     "Quiet",
     "WarningsOption",
     "Debug",
@@ -126,6 +129,52 @@ MaxBytes = Annotated[
         help="Refuse grasp files larger than this many bytes (default 1 MiB; 1e8 is 100 MB).",
     ),
 ]
+
+
+def surface_tol(text: str) -> float:
+    """A surface tolerance: a finite number >= 0, relative to the object's size.
+
+    >>> surface_tol("1e-3")
+    0.001
+    """
+    try:
+        value = float(text)
+    except ValueError:
+        value = -1.0
+    if not 0 <= value < float("inf"):
+        raise typer.BadParameter(f"expected a finite number >= 0 (a fraction of the object's size), got {text!r}")
+    return value
+
+
+SurfaceTol = Annotated[
+    float | None,
+    typer.Option(
+        "--surface-tol",
+        parser=surface_tol,
+        metavar="FRACTION",
+        help="How far a contact may lie from its object's surface, as a fraction of the object's size "
+        "(its bounding box's diagonal; default 0.01).",
+    ),
+]
+AllowOutside = Annotated[
+    bool,
+    typer.Option(
+        "--allow-outside",
+        help="Read meshes and URDFs that a grasp file names outside its own folder (default: refused, path-outside).",
+    ),
+]
+
+
+def reading_option(surface_tol: float | None, allow_outside: bool):
+    """How grasp files are read under ``--surface-tol`` and ``--allow-outside``: the loader's
+    :class:`~grasptwist.io.grasp.Reading`."""
+    from dataclasses import replace
+
+    from ..io.grasp import READING
+
+    return replace(READING, surface_tol=surface_tol, allow_outside=allow_outside)
+
+
 Quiet = Annotated[bool, typer.Option("-q", "--quiet", help="No warnings or summary on stderr (errors still).")]
 WarningsOption = Annotated[
     Warnings,

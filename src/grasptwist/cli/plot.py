@@ -8,7 +8,7 @@ import typer
 
 from .diagnostics import Diagnostics, to_stderr
 from .exits import EXIT_FAILED, EXIT_OK, checked_output, run_command
-from .options import Debug, MaxBytes, PlotMethod, Select, twists_option
+from .options import AllowOutside, Debug, MaxBytes, PlotMethod, Select, SurfaceTol, reading_option, twists_option
 
 __all__ = ["plot", "draw_pictures"]
 
@@ -56,6 +56,8 @@ def plot(
         ),
     ] = None,
     max_bytes: MaxBytes = None,
+    surface_tol: SurfaceTol = None,
+    allow_outside: AllowOutside = False,
     debug: Debug = False,
 ) -> None:
     """Draw a grasp, its basis screw axes and the finger-tip velocities (needs matplotlib: from a clone,
@@ -87,13 +89,16 @@ def plot(
         raise typer.BadParameter(f"a picture draws one twist: give one (got {len(select)})", param_hint="--select")
     chosen = select[0] if select else None
     views = {"js_beside": js_beside, "path_name": path_name}
+    reading = reading_option(surface_tol, allow_outside)
     run_command(
         debug,
-        lambda: draw_pictures(path, output, twists, chosen, method.value if method else None, max_bytes, views),
+        lambda: draw_pictures(
+            path, output, twists, chosen, method.value if method else None, max_bytes, views, reading
+        ),
     )
 
 
-def draw_pictures(path, output, twists, twist_name, method, max_bytes, views) -> int:
+def draw_pictures(path, output, twists, twist_name, method, max_bytes, views, reading) -> int:
     """The body of ``plot``: the command line's checks, then the run's reading
     (:func:`grasptwist.run.pictures.read_grasps`) and drawing (:func:`grasptwist.run.pictures.draw`);
     notes on stderr, the pictures' names on stdout; the exit status."""
@@ -125,7 +130,7 @@ def draw_pictures(path, output, twists, twist_name, method, max_bytes, views) ->
     try:
         (pictures.require_plotly if html else pictures.require_matplotlib)()  # before anything is read
         grasps = []
-        for item in read_grasps(inputs, twists, max_bytes):
+        for item in read_grasps(inputs, twists, max_bytes, reading):
             if isinstance(item, pictures.Note):
                 note(item.line, item.error)
             else:

@@ -8,6 +8,7 @@ from .diagnostics import Warnings
 from .exits import run_command
 from .options import (
     ALL,
+    AllowOutside,
     Debug,
     Digits,
     ExtraPoint,
@@ -21,10 +22,12 @@ from .options import (
     Quiet,
     ResolveFormat,
     Select,
+    SurfaceTol,
     WarningsOption,
     Workers,
     hand_option,
     not_binary_to_a_terminal,
+    reading_option,
     twists_option,
 )
 from .records import OutputSettings, write_records
@@ -93,6 +96,8 @@ def resolve(
         ),
     ] = None,
     max_bytes: MaxBytes = None,
+    surface_tol: SurfaceTol = None,
+    allow_outside: AllowOutside = False,
     workers: Workers = 0,
     quiet: Quiet = False,
     warnings: WarningsOption = Warnings.summary,
@@ -136,6 +141,7 @@ def resolve(
         command=COMMANDS["resolve"],
         fmt=fmt.value,
         max_bytes=max_bytes,
+        reading=reading_option(surface_tol, allow_outside),
         order=order.value,
         extra_point=extra_point.value,
         hand=hand_option(hand, paths, fmt.value),

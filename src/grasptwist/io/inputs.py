@@ -21,7 +21,7 @@ import os
 from collections.abc import Iterable, Iterator
 
 from ..model import Grasp, GraspFileError
-from .grasp import one_per_document, read_grasps
+from .grasp import READING, Reading, one_per_document, read_grasps
 from .limits import DEFAULT_MAX_BYTES, NOT_REGULAR
 
 __all__ = ["GRASP_SUFFIXES", "STDIN", "expand", "is_grasp_file", "read"]
@@ -122,11 +122,11 @@ def _is_file(entry: os.DirEntry) -> bool:
         return False
 
 
-def read(path: str, max_bytes: int | None = None) -> list[Grasp | GraspFileError]:
+def read(path: str, max_bytes: int | None = None, reading: Reading = READING) -> list[Grasp | GraspFileError]:
     """The grasps (or errors: one per failed document, every problem in its ``problems``)
-    of one file; ``-`` reads standard input."""
+    of one file; ``-`` reads standard input; ``reading`` as for :func:`~grasptwist.io.grasp.read_grasps`."""
     cap = DEFAULT_MAX_BYTES if max_bytes is None else max_bytes
-    return one_per_document(read_grasps(path, max_bytes=cap))
+    return one_per_document(read_grasps(path, max_bytes=cap, reading=reading))
 
 
 def _io_error(path: str, why: str) -> GraspFileError:

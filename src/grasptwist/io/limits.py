@@ -5,10 +5,15 @@ loader's ``hand:`` section calls; the ``.npz`` and Parquet readers) need not
 import another for its constants.
 """
 
-__all__ = ["DEFAULT_MAX_BYTES", "INFLATION_FLOOR", "MAX_INFLATION", "NOT_REGULAR", "check_inflation"]
+__all__ = ["DEFAULT_MAX_BYTES", "INFLATION_FLOOR", "MAX_INFLATION", "MAX_TRIANGLES", "NOT_REGULAR", "check_inflation"]
 
 DEFAULT_MAX_BYTES = 1 << 20
 """Default size cap in bytes; larger files are rejected before parsing."""
+
+MAX_TRIANGLES = 200_000
+"""Most triangles of an object's mesh (:mod:`grasptwist.io.mesh_file`): a grasp needs a few
+thousand, ``bench/`` projects onto 10^5; a file within the size cap that holds more (an OBJ's
+long polygons, a PLY's compact faces) is refused."""
 
 #: Why a path that is not a regular file (or folder) is not read.
 NOT_REGULAR = "not a regular file (a pipe, socket or device)"

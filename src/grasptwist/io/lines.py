@@ -22,7 +22,7 @@ import stat
 from collections.abc import Iterator
 
 from ..model import Grasp, GraspFileError, Twist
-from .grasp import one_per_document, read_grasps, read_line, read_twist_line
+from .grasp import READING, Reading, one_per_document, read_grasps, read_line, read_twist_line
 from .grasp.text import standard_input
 from .inputs import STDIN
 from .limits import DEFAULT_MAX_BYTES, NOT_REGULAR
@@ -126,12 +126,17 @@ def _opened(path: str):
 
 
 def grasp_batches(
-    path: str, max_bytes: int | None = None, per_batch: int = 64
+    path: str, max_bytes: int | None = None, per_batch: int = 64, reading: Reading = READING
 ) -> Iterator[list[Grasp | GraspFileError]]:
     """The grasps (and errors) of a JSON Lines file, or of standard input
     (``-``: JSON Lines or a YAML grasp file, as its first character says),
-    in lists: one per line when the lines may come one by one."""
-    return _stream(path, max_bytes, per_batch, read_line, sniff=path == STDIN)
+    in lists: one per line when the lines may come one by one; ``reading``
+    as for :func:`~grasptwist.io.grasp.read_grasps`."""
+
+    def read(data, **where):
+        return read_line(data, reading=reading, **where)
+
+    return _stream(path, max_bytes, per_batch, read, sniff=path == STDIN, reading=reading)
 
 
 def twist_batches(
@@ -144,10 +149,10 @@ def twist_batches(
         entry = read_twist_line(data, **where)
         return entry if isinstance(entry, list) else [entry]
 
-    return _stream(path, max_bytes, per_batch, read, sniff=False)
+    return _stream(path, max_bytes, per_batch, read, sniff=False, reading=READING)
 
 
-def _stream(path, max_bytes, per_batch, read, sniff):
+def _stream(path, max_bytes, per_batch, read, sniff, reading):
     """``read(line, file=, line=, max_bytes=)`` of each line of ``path``, in batches
     (see :func:`numbered_batches`); with ``sniff``, a stream that is not JSON
     Lines is read whole as a YAML grasp file."""
@@ -164,7 +169,9 @@ def _stream(path, max_bytes, per_batch, read, sniff):
             json_lines, head = _sniff(handle, cap)
             if not json_lines:
                 yield one_per_document(
-                    read_grasps(head + handle.read(max(0, cap + 1 - len(head))), file=file, max_bytes=cap)
+                    read_grasps(
+                        head + handle.read(max(0, cap + 1 - len(head))), file=file, max_bytes=cap, reading=reading
+                    )
                 )
                 return
         for batch in numbered_batches(handle, cap, per_batch, head):

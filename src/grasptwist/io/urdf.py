@@ -58,8 +58,8 @@ _MOVABLE = {"revolute": "revolute", "continuous": "revolute", "prismatic": "pris
 _UNSUPPORTED = {"floating", "planar"}
 
 
-def resolve_urdf(reference, folder=None):
-    """The file a URDF reference names, refused if it leaves its package or folder.
+def resolve_urdf(reference, folder=None, *, allow_outside=False):
+    """The file a URDF (or mesh) reference names, refused if it leaves its package or folder.
 
     Parameters
     ----------
@@ -68,6 +68,9 @@ def resolve_urdf(reference, folder=None):
     folder : str or os.PathLike, optional
         The referring file's folder: a path is taken relative to it and must
         stay inside it.  None: a path is used as given (the caller chose it).
+    allow_outside : bool
+        Take a relative path wherever it leads (``--allow-outside``: the
+        user vouches for the files the grasp files name).
 
     Returns
     -------
@@ -90,6 +93,8 @@ def resolve_urdf(reference, folder=None):
         raise InputError("unsupported-url", f"only package:// URLs and file paths are read, got {text!r}", text)
     if folder is None:
         return Path(text).resolve()
+    if allow_outside:
+        return (Path(folder) / text).resolve()
     return _inside(Path(folder).resolve(), text, text)
 
 

@@ -205,7 +205,7 @@ def _twists_beside(job, paths, tuning):
     o = job.options
     if o.twists_from is None:
         return None
-    return twist_stream(paths, o.twists_from, o.method, job.max_bytes, tuning.files_per_group)
+    return twist_stream(paths, o.twists_from, o.method, job.max_bytes, tuning.files_per_group, job.reading)
 
 
 def _twist_columns():

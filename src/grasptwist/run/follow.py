@@ -129,7 +129,7 @@ def follow_inputs(job, inputs: Iterable) -> Iterator[GraspFileError | Samples | 
         elif item.endswith(DATASET_SUFFIXES):
             yield GraspFileError("read-error", "follow reads grasp files, not data sets", item)
         else:
-            for entry in read(item, job.max_bytes):
+            for entry in read(item, job.max_bytes, job.reading):
                 yield from follow_grasp(job.options, entry) if isinstance(entry, Grasp) else (entry,)
 
 

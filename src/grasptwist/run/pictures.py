@@ -14,6 +14,7 @@ from dataclasses import replace
 
 from .. import plot as pictures
 from ..engine.forces.grip import grip
+from ..io.grasp import READING, Reading
 from ..io.urdf_meshes import grasp_folder, hand_meshes
 from ..model import Grasp, InputError
 from ..output.records import diagnostics, error_record
@@ -25,11 +26,11 @@ from .placement import read
 __all__ = ["draw", "read_grasps", "page_extras", "grip_forces"]
 
 
-def read_grasps(inputs, twists, max_bytes: int | None) -> Iterator[Grasp | pictures.Note]:
+def read_grasps(inputs, twists, max_bytes: int | None, reading: Reading = READING) -> Iterator[Grasp | pictures.Note]:
     """The grasps of ``inputs`` (files, and the errors of listing a folder), read as every command
     reads them, with ``twists`` (the command line's) in place of their own; an input's errors as notes."""
     for item in inputs:
-        for entry in read(item, max_bytes) if isinstance(item, str) else [item]:
+        for entry in read(item, max_bytes, reading) if isinstance(item, str) else [item]:
             if isinstance(entry, InputError):
                 yield from (pictures.Note(line) for line in diagnostics(error_record(entry))[0])
             else:

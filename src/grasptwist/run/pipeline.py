@@ -25,6 +25,7 @@ from functools import partial
 from typing import Any
 
 from ..io.datasets import DATASET_SUFFIXES, open_dataset
+from ..io.grasp import READING, Reading
 from ..io.lines import grasp_batches
 from ..model import GraspFileError, Hand
 from ..output.formats import FORMATS
@@ -63,6 +64,7 @@ class Job:
     command: Command = field(default_factory=lambda: COMMANDS["resolve"])
     fmt: str = "jsonl"
     max_bytes: int | None = None
+    reading: Reading = READING  # --surface-tol, --allow-outside: how grasp files and the files they name are read
     order: str = "omega-v"
     extra_point: str = "wrist"
     hand: Hand | None = None  # --hand: the hand of a data set's rows, whose joints CSV and npz columns name
@@ -151,7 +153,7 @@ def _alone(job: Job, path: str, workers: int, tuning: Tuning) -> Iterator[Output
 def _stream_batches(job: Job, path: str, tuning: Tuning):
     """The blocks and errors of the grasps of the stream ``path``, a batch of lines at a time
     (each batch's records are written as soon as it is read)."""
-    for batch in grasp_batches(path, job.max_bytes, tuning.files_per_group):
+    for batch in grasp_batches(path, job.max_bytes, tuning.files_per_group, job.reading):
         yield list(job.family.rows(placed(batch), job))
 
 
@@ -259,7 +261,7 @@ def _read(job: Job, paths: Sequence) -> list:
     """The grasps and errors of a group of files (and errors found listing folders), in order."""
     items = []
     for p in paths:
-        items.extend(read(p, job.max_bytes) if isinstance(p, str) else [p])
+        items.extend(read(p, job.max_bytes, job.reading) if isinstance(p, str) else [p])
     return items
 
 

@@ -20,6 +20,7 @@ from dataclasses import replace
 from ..engine.degeneracy import Status
 from ..io import grasp as loader
 from ..io import inputs
+from ..io.grasp import READING, Reading
 from ..io.grasp.problems import MAX_ERRORS, Problems, Reject
 from ..io.grasp.values import readonly
 from ..model import Grasp, GraspFileError, Hand
@@ -79,9 +80,9 @@ def placed(items: Iterable) -> list:
     return [place_grasp(item) if isinstance(item, Grasp) else item for item in items]
 
 
-def read(path, max_bytes: int | None = None) -> list:
+def read(path, max_bytes: int | None = None, reading: Reading = READING) -> list:
     """The grasps and errors of one input (:func:`grasptwist.io.inputs.read`), hands placed."""
-    return placed(inputs.read(path, max_bytes))
+    return placed(inputs.read(path, max_bytes, reading))
 
 
 def run_hand(path: str | None, paths: list[str], per_hand: bool) -> Hand | None:

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 from collections.abc import Iterator, Sequence
 
+from ..io.grasp import READING, Reading
 from ..io.inputs import STDIN
 from ..io.lines import grasp_batches, is_json_lines, twist_batches
 from ..model import Grasp, GraspFileError, Twist
@@ -31,14 +32,14 @@ def is_stream(path) -> bool:
 
 
 def twist_stream(
-    paths: Sequence, twists_from: str, method: str, max_bytes: int | None, per_batch: int
+    paths: Sequence, twists_from: str, method: str, max_bytes: int | None, per_batch: int, reading: Reading = READING
 ) -> Iterator[list]:
     """The grasps of ``paths`` resolved with each twist of the stream
     ``twists_from`` in turn: first the errors of the grasps' files, then for
     each twist line its rows (one per grasp, in order) or its errors."""
     grasps, errors = [], []
     for p in paths:
-        for item in _items(p, max_bytes, per_batch):
+        for item in _items(p, max_bytes, per_batch, reading):
             (grasps if isinstance(item, Grasp) else errors).append(item)
     yield errors
     for batch in twist_batches(twists_from, max_bytes, per_batch):
@@ -64,10 +65,10 @@ def _twist_major(grasps, twists, method):
     return [x for t in twists for x in resolve(grasps, [t], method)]
 
 
-def _items(path, max_bytes, per_batch):
+def _items(path, max_bytes, per_batch, reading):
     """The grasps and errors of one input (a file, a stream or an error found listing folders)."""
     if not isinstance(path, str):
         return [path]
     if is_stream(path):
-        return [item for batch in grasp_batches(path, max_bytes, per_batch) for item in placed(batch)]
-    return read(path, max_bytes)
+        return [item for batch in grasp_batches(path, max_bytes, per_batch, reading) for item in placed(batch)]
+    return read(path, max_bytes, reading)

@@ -15,13 +15,19 @@ __all__ = ["CONTACT_KEYS", "SECTION", "read_contacts"]
 
 CONTACT_KEYS = ("name", "point", "normal", "friction")
 
+# A contact on an object that gives no normal, until the surface's is taken.
+_NO_NORMAL = (math.nan, math.nan, math.nan)
+
 # What contacts look like, for the message when they are not a list.
 _CONTACTS_SHAPE = "a list of 3 contacts like [{point: [x, y, z], normal: [x, y, z]}, ...]"
 
 
-def read_contacts(node, problems):
+def read_contacts(node, problems, on_object=False):
     """Names, points, unit normals and own frictions (None, or NaN where a
-    contact gives none) of the three contacts (None after a problem)."""
+    contact gives none) of the three contacts (None after a problem).
+
+    ``on_object``: the grasp gives an object, so a contact may leave out its
+    normal (a row of NaN here; :mod:`.objects` takes the surface's)."""
     items = read_sequence(node, "contacts", problems, _CONTACTS_SHAPE, _contacts_hint)
     if items is None:
         return None
@@ -32,7 +38,7 @@ def read_contacts(node, problems):
     names, points, normals, friction = {}, [], [], []
     for i, item in enumerate(items):
         path = f"contacts[{i}]"
-        fields = read_mapping(item, path, CONTACT_KEYS, ("point", "normal"), problems)
+        fields = read_mapping(item, path, CONTACT_KEYS, ("point",) if on_object else ("point", "normal"), problems)
         if fields is None:
             continue
         read_entry_name(fields, item, "contacts", i, names, problems)
@@ -47,7 +53,8 @@ def read_contacts(node, problems):
         friction.append(math.nan if node is None else read_friction(node, path + ".friction", problems))
     if problems.count:
         return None
-    normals = [screws.direction3(*n) for n in normals]  # of any finite size: no over- or underflow
+    # of any finite size: no over- or underflow
+    normals = [_NO_NORMAL if n is None else screws.direction3(*n) for n in normals]
     # The grasp's own ``friction`` fills the NaNs (forces.py).
     own = None if all(math.isnan(mu) for mu in friction) else readonly(friction)
     return tuple(names), readonly(np.array(points)), readonly(normals), own
@@ -64,7 +71,7 @@ def _contacts_hint(node):
 
 
 def _read(fields, found, problems):
-    contacts = read_contacts(fields["contacts"], problems) if "contacts" in fields else None
+    contacts = read_contacts(fields["contacts"], problems, "object" in fields) if "contacts" in fields else None
     if contacts is None:
         return None
     names, points, normals, friction = contacts

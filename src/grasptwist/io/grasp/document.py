@@ -15,6 +15,7 @@ from ...model import Grasp
 from .contacts import SECTION as CONTACTS
 from .forces import SECTION as FORCES
 from .hand import SECTION as HAND
+from .objects import SECTION as OBJECT
 from .paths import SECTION as PATHS
 from .problems import Reject, located
 from .twists import SECTION as TWISTS
@@ -23,9 +24,10 @@ from .values import read_mapping, read_name, read_vector, readonly
 __all__ = ["SECTIONS", "GRASP_KEYS", "read_document", "grasp_schema"]
 
 #: The sections of a grasp document, in the order they are read (a later one
-#: sees the fields of the earlier ones: the hand needs the contacts, the
-#: forces the contacts' own frictions).
-SECTIONS = (CONTACTS, TWISTS, PATHS, HAND, FORCES)
+#: sees the fields of the earlier ones: the object puts the contacts on its
+#: surface, the hand needs the contacts there, the forces the contacts' own
+#: frictions and the object's weight).
+SECTIONS = (CONTACTS, OBJECT, TWISTS, PATHS, HAND, FORCES)
 
 #: The top-level keys, in the order the values are checked.
 GRASP_KEYS = ("name", "units", "wrist", *(key for section in SECTIONS for key in section.keys))
@@ -33,8 +35,9 @@ GRASP_KEYS = ("name", "units", "wrist", *(key for section in SECTIONS for key in
 _REQUIRED = tuple(key for section in SECTIONS for key in section.required)
 
 
-def read_document(root, problems, *, file, document, name, line):
-    """Check one document's node tree: its Grasp, or None when ``problems`` has any."""
+def read_document(root, problems, *, file, document, name, line, reading, max_bytes):
+    """Check one document's node tree: its Grasp, or None when ``problems`` has any
+    (``reading`` and ``max_bytes``: how the files it names are read)."""
     if root.kind == "scalar" and root.value is None:
         problems.add(Reject("empty-document", "", "empty document", **located(root)))
         return None
@@ -45,12 +48,13 @@ def read_document(root, problems, *, file, document, name, line):
         name = read_name(fields["name"], "name", problems)
     units = read_name(fields["units"], "units", problems) if "units" in fields else None
     wrist = read_vector(fields["wrist"], 3, "wrist", problems) if "wrist" in fields else None
-    found = {"file": file}
+    found = {"file": file, "reading": reading, "max_bytes": max_bytes}
     for section in SECTIONS:
         found.update(section.read(fields, found, problems) or {})
     if problems.count:
         return None
-    del found["file"]
+    for key in ("file", "reading", "max_bytes"):
+        del found[key]
     return Grasp(
         name=name,
         units=units,

@@ -52,11 +52,12 @@ _INF = math.inf
 _ZERO = (0.0, 0.0, 0.0)
 
 
-def fast_document(get, keep, file):
+def fast_document(get, keep, file, reading, max_bytes):
     """A plain valid document's ``Parts``, from the events after its start.
 
     ``get()`` gives the next event; each one read is passed to ``keep``.
-    ``file`` is the grasp file's name (a URDF hand is found from its folder).
+    ``file`` is the grasp file's name (a URDF hand or a mesh is found from its
+    folder, read as ``reading`` and ``max_bytes`` say).
     """
     event = get()
     keep(event)
@@ -92,7 +93,7 @@ def fast_document(get, keep, file):
         raise Bail
     parts = Parts(name, units, wrist, contacts, twists)
     if composed:
-        parts.sections = _sections(composed, parts, file)
+        parts.sections = _sections(composed, parts, {"file": file, "reading": reading, "max_bytes": max_bytes})
     return parts
 
 
@@ -119,14 +120,15 @@ def _value(get, keep):
     return node
 
 
-def _sections(composed, parts, file):
-    """The Grasp fields of the composed sections, read by their modules (after the contacts)."""
+def _sections(composed, parts, found):
+    """The Grasp fields of the composed sections, read by their modules (after the contacts);
+    ``found`` holds the file's name and how the files it names are read."""
     contact_names, points, normals = parts.contacts
-    found = {"file": file, "contact_names": contact_names, "points": readonly(points), "normals": readonly(normals)}
+    found.update(contact_names=contact_names, points=readonly(points), normals=readonly(normals))
     fields = {}
     problems = Problems(0)
     for section in _COMPOSED_SECTIONS:
-        if not composed.keys().isdisjoint(section.keys):
+        if not composed.keys().isdisjoint((*section.keys, *section.reads_also)):
             read = section.read(composed, found, problems) or {}
             found.update(read)
             fields.update(read)
@@ -296,16 +298,15 @@ class Parts:
 
     def grasp(self, *, file, document, name, line):
         contact_names, points, normals = self.contacts
+        contacts = {"points": readonly(points), "normals": readonly(normals)}
         return Grasp(
             name=name,
             units=self.units,
             file=file,
             document=document,
             contact_names=contact_names,
-            points=readonly(points),
-            normals=readonly(normals),
             wrist=None if self.wrist is None else readonly(self.wrist),
             twists=tuple(Twist(twist, readonly(screw), twist_line) for twist, screw, twist_line in self.twists),
             line=line,
-            **self.sections,
+            **(contacts | self.sections),  # an object puts the points on its surface
         )

@@ -4,6 +4,10 @@ A wrench is ``(force; moment about the origin)``, the resultant the fingers
 must exert on the object (docs/guide/forces.md).  ``mass`` adds the wrench
 named ``hold`` that balances the weight: gravity pulls with ``m g`` at the
 centre of mass ``c``, so the fingers must exert ``(-m g; -c x m g)``.
+An ``object`` with a ``mass`` or ``density`` gives both ``m`` and ``c`` (its
+centre of mass, in the grasp's frame): the top-level ``mass`` and
+``center_of_mass`` are then an error (``conflicting-keys``: one weight,
+given once), ``gravity`` still applies.
 A contact's own ``friction`` (read by :mod:`.contacts` with
 :func:`read_friction`) overrides the grasp's.
 """
@@ -80,8 +84,11 @@ def read_wrenches(node, problems):
     return [(name, w, item.line) for name, w, item in zip(names, wrench, items)]
 
 
-def _read_hold(fields, problems):
-    """``(mass, center_of_mass, gravity, hold wrench)`` from the weight's keys, or None."""
+def _read_hold(fields, obj, problems):
+    """``(mass, center_of_mass, gravity, hold wrench)`` from the weight's keys or the object
+    ``obj`` (None, or a :class:`~grasptwist.model.GraspObject` whose ``mass`` may be None), or None."""
+    if obj is not None and obj.mass is not None:
+        return _object_hold(fields, obj, problems)
     given = [key for key in ("mass", "center_of_mass", "gravity") if key in fields]
     if not given:
         return None
@@ -105,6 +112,33 @@ def _read_hold(fields, problems):
     gravity = read_vector(fields["gravity"], 3, "gravity", problems) if "gravity" in fields else list(GRAVITY)
     if mass is None or center is None or gravity is None:
         return None
+    return _hold(mass, center, gravity, fields["mass"], "mass", problems)
+
+
+def _object_hold(fields, obj, problems):
+    """The weight of an object that gives its mass: the top-level ``mass`` and ``center_of_mass``
+    would be a second one."""
+    for key in ("mass", "center_of_mass"):
+        if key in fields:
+            problems.add(
+                Reject(
+                    "conflicting-keys",
+                    key,
+                    "the object's mass (or density) already gives the weight and its centre (give it once)",
+                    **located(fields[key]),
+                )
+            )
+    gravity = read_vector(fields["gravity"], 3, "gravity", problems) if "gravity" in fields else list(GRAVITY)
+    if gravity is None or problems.count:
+        return None
+    from ...engine.objects import mass_properties
+
+    center = mass_properties(obj).center_of_mass
+    return _hold(obj.mass, list(center), gravity, fields["object"], "object", problems)
+
+
+def _hold(mass, center, gravity, node, path, problems):
+    """``(mass, center, gravity, hold wrench)``, or None when the wrench overflows (``path``, at ``node``)."""
     with np.errstate(over="ignore", invalid="ignore"):
         weight = mass * np.array(gravity)
         hold = 0.0 - np.concatenate([weight, screws.cross(np.array(center), weight)])  # no -0.0
@@ -112,9 +146,9 @@ def _read_hold(fields, problems):
         problems.add(
             Reject(
                 "non-finite",
-                "mass",
+                path,
                 "the weight or its moment about the origin overflows (mass x gravity, center_of_mass x weight)",
-                **located(fields["mass"]),
+                **located(node),
             )
         )
         return None
@@ -142,7 +176,7 @@ def _read(fields, found, problems):
     elif mu is not None:
         out["friction"] = readonly([mu, mu, mu])
     wrenches = read_wrenches(fields["wrenches"], problems) if "wrenches" in fields else []
-    hold = _read_hold(fields, problems)
+    hold = _read_hold(fields, found.get("object"), problems)
     if wrenches is None or problems.count:
         return None
     if hold is not None:
@@ -160,7 +194,7 @@ def _read(fields, found, problems):
                     )
                 )
                 return None
-        line = fields["mass"].line
+        line = (fields["mass"] if "mass" in fields else fields["object"]).line
         wrenches.append((HOLD, w, line))
         out.update(mass=mass, center_of_mass=readonly(center), gravity=readonly(gravity))
     if wrenches:
@@ -168,4 +202,4 @@ def _read(fields, found, problems):
     return out
 
 
-SECTION = Section(FORCE_KEYS, _read)
+SECTION = Section(FORCE_KEYS, _read, reads_also=("object",))

@@ -24,13 +24,14 @@ _INF = math.inf
 _ZERO = (0.0, 0.0, 0.0)
 
 
-def read_line(data, *, file, line, max_bytes=DEFAULT_MAX_BYTES):
+def read_line(data, *, file, line, max_bytes=DEFAULT_MAX_BYTES, reading=READING):
     """The grasp of one line of a JSON Lines stream, or its errors, placed at ``line``.
 
     The line is one grasp document (JSON is YAML), checked as in a grasp
     file; positions count from the stream's start, an unnamed grasp is
     ``stem#line`` and ``document`` is ``line - 1``.  ``max_bytes`` caps the
-    line, not the stream.
+    line, not the stream (and each file a line names); ``reading`` as for
+    :func:`~grasptwist.io.grasp.read_grasps`.
 
     >>> for error in read_line(b'{"contacts": []}', file="in.jsonl", line=7):
     ...     print(error)
@@ -40,7 +41,10 @@ def read_line(data, *, file, line, max_bytes=DEFAULT_MAX_BYTES):
         text = _line_text(data, max_bytes)
     except Reject as reject:
         return [_on_line(reject.error(file, None), line)]
-    return [_on_line(entry, line) for entry in read_text(text, file, READING, name=f"{stem_name(file)}#{line}")]
+    return [
+        _on_line(entry, line)
+        for entry in read_text(text, file, reading, name=f"{stem_name(file)}#{line}", max_bytes=max_bytes)
+    ]
 
 
 def read_twist_line(data, *, file, line, max_bytes=DEFAULT_MAX_BYTES):

@@ -10,7 +10,7 @@ from .problems import Reject, join, located
 from .twists import twist_parts
 from .values import Section, describe, read_entry_name, read_mapping, read_number, read_sequence, read_vector
 
-__all__ = ["PATH_KEYS", "SEGMENT_KEYS", "POSE_KEYS", "SECTION", "read_paths"]
+__all__ = ["PATH_KEYS", "SEGMENT_KEYS", "POSE_KEYS", "SECTION", "read_paths", "read_pose"]
 
 PATH_KEYS = ("name", "frame", "segments")
 SEGMENT_KEYS = ("duration", "screw", "angular", "linear", "at", "pose")
@@ -85,7 +85,7 @@ def _segment(item, path, frame, problems):
         _conflicts(
             fields, path, ("screw", "angular", "linear", "at"), "'pose' (give a twist or a pose target)", problems
         )
-        pose = _pose(fields["pose"], path + ".pose", problems)
+        pose = read_pose(fields["pose"], path + ".pose", problems)
         return None if pose is None else Segment(duration, position=pose[0], rotation=pose[1], **pose[2])
     if not {"screw", "angular", "linear"} & set(fields):
         problems.add(
@@ -126,8 +126,8 @@ def _conflicts(fields, path, others, what, problems):
             )
 
 
-def _pose(node, path, problems):
-    """``(position, rotation matrix, given)`` of a pose target: position default zero, rotation a
+def read_pose(node, path, problems):
+    """``(position, rotation matrix, given)`` of a pose (a path's target, an object's place): position default zero, rotation a
     quaternion ``(w, x, y, z)`` or a rotation vector, default none; ``given`` the rotation vector
     as written and where (the :class:`~grasptwist.model.Segment` keywords), if one was."""
     from ...engine import se3

@@ -16,7 +16,7 @@ from pathlib import Path
 import yaml
 
 from ...model import GraspFileError
-from ..limits import DEFAULT_MAX_BYTES
+from ..limits import DEFAULT_MAX_BYTES, MAX_TRIANGLES
 from .compose import PARSER, compose, syntax_error
 from .document import read_document
 from .fast import Bail, Parts, fast_document
@@ -31,6 +31,7 @@ __all__ = [
     "load_grasps",
     "one_per_document",
     "read_text",
+    "check_surface_tol",
     "stem_name",
 ]
 
@@ -60,19 +61,33 @@ class Reading:
     fast : bool
         Try the fast path on each document first (False: every document
         through the general composer, which must give the same entries).
+    surface_tol : float or None
+        How far a contact may be from its object's surface, relative to the
+        object's size (``--surface-tol``); None:
+        :data:`grasptwist.engine.objects.SURFACE_TOL`.
+    allow_outside : bool
+        Read a mesh (or URDF) that a relative path names outside the grasp
+        file's folder (``--allow-outside``).
+    max_triangles : int
+        Most triangles of an object's mesh (see :data:`~grasptwist.io.limits.MAX_TRIANGLES`).
     """
 
     parser: type = PARSER
     max_documents: int = MAX_DOCUMENTS
     max_errors: int = MAX_ERRORS
     fast: bool = True
+    surface_tol: float | None = None
+    allow_outside: bool = False
+    max_triangles: int = MAX_TRIANGLES
 
 
 #: The command line's way of reading.
 READING = Reading()
 
 
-def read_grasps(source, *, file=None, max_bytes=DEFAULT_MAX_BYTES, reading=READING):
+def read_grasps(
+    source, *, file=None, max_bytes=DEFAULT_MAX_BYTES, reading=READING, surface_tol=None, allow_outside=None
+):
     """Read every grasp of a grasp file, keeping errors as values.
 
     Parameters
@@ -88,6 +103,13 @@ def read_grasps(source, *, file=None, max_bytes=DEFAULT_MAX_BYTES, reading=READI
         Size cap; a larger input fails with ``too-large`` before parsing.
     reading : Reading
         The parser and per-file limits (default: the command line's).
+    surface_tol : float, optional
+        How far a contact may be from its object's surface, relative to the
+        object's size (default :data:`grasptwist.engine.objects.SURFACE_TOL`):
+        ``reading.surface_tol``, as the command line's ``--surface-tol``.
+    allow_outside : bool, optional
+        Read meshes and URDFs that relative paths name outside the file's
+        folder (``reading.allow_outside``, ``--allow-outside``).
 
     Returns
     -------
@@ -109,6 +131,7 @@ def read_grasps(source, *, file=None, max_bytes=DEFAULT_MAX_BYTES, reading=READI
     g.yaml:2:13: contacts[0].point: expected 3 numbers, got 2
     g.yaml:2:36: contacts[0].normal[2]: expected a number, got the string '0'
     """
+    reading = _with(reading, surface_tol, allow_outside)
     is_content = isinstance(source, (bytes, bytearray, memoryview)) or (isinstance(source, str) and file is not None)
     if file is None:
         file = "<string>" if is_content else "<stdin>" if source == "-" else os.fspath(source)
@@ -116,11 +139,13 @@ def read_grasps(source, *, file=None, max_bytes=DEFAULT_MAX_BYTES, reading=READI
         text = file_text(source, is_content, max_bytes)
     except Reject as reject:
         return [reject.error(file, None)]
-    return read_text(text, file, reading)
+    return read_text(text, file, reading, max_bytes=max_bytes)
 
 
-def load_grasps(source, *, file=None, max_bytes=DEFAULT_MAX_BYTES, reading=READING):
-    """Like :func:`read_grasps`, but raise its first :class:`GraspFileError`.
+def load_grasps(
+    source, *, file=None, max_bytes=DEFAULT_MAX_BYTES, reading=READING, surface_tol=None, allow_outside=None
+):
+    """Like :func:`read_grasps` (the same keywords), but raise its first :class:`GraspFileError`.
 
     Returns
     -------
@@ -138,11 +163,39 @@ def load_grasps(source, *, file=None, max_bytes=DEFAULT_MAX_BYTES, reading=READI
     Traceback (most recent call last):
     grasptwist.model.GraspFileError: g.yaml:1:11: contacts: expected exactly 3 contacts, got 0
     """
-    entries = read_grasps(source, file=file, max_bytes=max_bytes, reading=reading)
+    entries = read_grasps(
+        source, file=file, max_bytes=max_bytes, reading=reading, surface_tol=surface_tol, allow_outside=allow_outside
+    )
     for entry in entries:
         if isinstance(entry, GraspFileError):
             raise entry
     return entries
+
+
+def _with(reading, surface_tol, allow_outside):
+    """``reading`` with the tolerance and path rule given as keywords (None: its own)."""
+    given = {"surface_tol": surface_tol, "allow_outside": allow_outside}
+    given = {key: value for key, value in given.items() if value is not None}
+    if "surface_tol" in given:
+        check_surface_tol(given["surface_tol"])
+    return replace(reading, **given) if given else reading
+
+
+def check_surface_tol(value):
+    """A surface tolerance: a finite number >= 0 (relative to the object's size).
+
+    Raises
+    ------
+    ValueError
+        Saying what it got.
+
+    >>> check_surface_tol(-1)
+    Traceback (most recent call last):
+    ...
+    ValueError: surface_tol must be a finite number >= 0 (relative to the object's size), got -1
+    """
+    if not (isinstance(value, (int, float)) and 0 <= value < float("inf")):
+        raise ValueError(f"surface_tol must be a finite number >= 0 (relative to the object's size), got {value!r}")
 
 
 def one_per_document(entries):
@@ -177,10 +230,11 @@ def one_per_document(entries):
 # Stream -> grasps.
 
 
-def read_text(text, file, reading, name=None):
+def read_text(text, file, reading, name=None, max_bytes=DEFAULT_MAX_BYTES):
     """Parse ``text`` and turn each document into a Grasp or its errors, as it is read
-    (an unnamed grasp called ``name`` if given)."""
-    entries = _Entries(file, reading.max_errors, name)
+    (an unnamed grasp called ``name`` if given; the files it names, such as meshes,
+    read within ``max_bytes``)."""
+    entries = _Entries(file, reading, name, max_bytes)
     stop = None
     parser = reading.parser(text)
     get_event = parser.get_event
@@ -202,7 +256,7 @@ def read_text(text, file, reading, name=None):
             try:
                 if not reading.fast:
                     raise Bail
-                root = fast_document(get_event, events.append, file)
+                root = fast_document(get_event, events.append, file, reading, max_bytes)
             except Bail:
                 # The general composer, from the document's first event.
                 problems = Problems(reading.max_errors - entries.reported)
@@ -225,9 +279,11 @@ class _Entries:
     document's grasp is named ``stem`` until a second document shows up.
     """
 
-    def __init__(self, file, max_errors, name=None):
+    def __init__(self, file, reading, name=None, max_bytes=DEFAULT_MAX_BYTES):
         self.file = file
-        self.max_errors = max_errors
+        self.reading = reading
+        self.max_bytes = max_bytes
+        self.max_errors = reading.max_errors
         self.name = name  # the default name, if not the file's stem
         self.entries = []
         self.documents = 0
@@ -249,7 +305,14 @@ class _Entries:
             grasp = root.grasp(file=self.file, document=document, name=name, line=line)
         else:
             grasp = read_document(
-                root, problems, file=self.file, document=document, name=self._default_name(document), line=line
+                root,
+                problems,
+                file=self.file,
+                document=document,
+                name=self._default_name(document),
+                line=line,
+                reading=self.reading,
+                max_bytes=self.max_bytes,
             )
             if grasp is None:
                 first, covered = problems.first()

@@ -51,11 +51,15 @@ class Section:
         problem.
     required : tuple of str
         Those of ``keys`` every document must have.
+    reads_also : tuple of str
+        Other sections' keys that give it something to read when none of its
+        own is there (the forces: an object's weight).
     """
 
     keys: tuple
     read: Callable
     required: tuple = ()
+    reads_also: tuple = ()
 
 
 def read_entry_name(fields, item, collection, index, taken, problems):

@@ -1,0 +1,249 @@
+"""The ``object`` section: the shape the fingers hold, and the contacts put on its surface.
+
+One shape, a primitive centred at the object's origin or a mesh file::
+
+    object:
+      box: [0.065, 0.065, 0.065]        # edge lengths along x, y, z
+      # or  sphere: 0.03                # radius
+      # or  cylinder: {radius: 0.03, height: 0.1}      # axis z
+      # or  capsule: {radius: 0.03, height: 0.1}       # height: between the caps' centres
+      # or  mesh: meshes/bottle.stl     # STL, OBJ or PLY beside the grasp file
+      #     scale: 0.001                # a mesh's units to the grasp's (a number, or 3)
+      pose: {position: [0, 0, 0.1], rotation: [1, 0, 0, 0]}   # as a path's pose target
+      density: 700                      # or mass: 0.2 (not both)
+
+With an object a contact may leave out its ``normal``: its point is then
+put on the surface (the nearest point) and its normal is the inward normal
+there.  A contact that gives its normal stays as written (the user's point
+and direction), checked against the surface.  A point farther from the surface than the tolerance
+(``Reading.surface_tol`` times the object's size; ``--surface-tol``) is
+``contact-off-surface``; a given normal pointing out of the object is
+``outward-normal``.  The geometry is :mod:`grasptwist.engine.objects`'; a
+mesh is read by :mod:`grasptwist.io.mesh_file`.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ...model import GraspObject, InputError, Shape
+from .paths import read_pose
+from .problems import Reject, join, located
+from .values import Section, read_mapping, read_name, read_number, read_vector, readonly
+
+__all__ = ["OBJECT_KEYS", "SHAPE_KEYS", "SIZE_KEYS", "SECTION", "read_object", "on_surface"]
+
+#: The shapes, one of which an object gives.
+SHAPE_KEYS = ("box", "sphere", "cylinder", "capsule", "mesh")
+OBJECT_KEYS = (*SHAPE_KEYS, "scale", "pose", "density", "mass")
+#: The keys of a cylinder's or capsule's size.
+SIZE_KEYS = ("radius", "height")
+
+
+def read_object(node, file, reading, max_bytes, problems):
+    """The :class:`~grasptwist.model.GraspObject` of an ``object`` node (None after a problem);
+    a mesh is read from ``file``'s folder within ``max_bytes`` and ``reading``'s limits."""
+    fields = read_mapping(node, "object", OBJECT_KEYS, (), problems)
+    if fields is None:
+        return None
+    shapes = [key for key in SHAPE_KEYS if key in fields]
+    if not shapes:
+        problems.add(Reject("missing-key", "object", f"needs one shape: {', '.join(SHAPE_KEYS)}", **located(node)))
+    for key in shapes[1:]:
+        problems.add(
+            Reject(
+                "conflicting-keys",
+                f"object.{key}",
+                f"cannot be combined with '{shapes[0]}' (an object has one shape)",
+                **located(fields[key]),
+            )
+        )
+    if "scale" in fields and "mesh" not in fields:
+        problems.add(Reject("conflicting-keys", "object.scale", "only with 'mesh'", **located(fields["scale"])))
+    if "density" in fields and "mass" in fields:
+        problems.add(
+            Reject(
+                "conflicting-keys",
+                "object.mass",
+                "cannot be combined with 'density' (give the mass, or the density it follows from)",
+                **located(fields["mass"]),
+            )
+        )
+    density, mass = (
+        _positive(fields[key], f"object.{key}", problems) if key in fields else None for key in ("density", "mass")
+    )
+    pose = np.eye(4)
+    if "pose" in fields:
+        read = read_pose(fields["pose"], "object.pose", problems)
+        if read is not None:
+            pose[:3, 3], pose[:3, :3] = read[0], read[1]
+    shape = _shape(shapes[0], fields, file, reading, max_bytes, problems) if shapes else None
+    if shape is None or problems.count:
+        return None
+    pose.setflags(write=False)
+    obj = GraspObject(shape, pose, mass=mass, density=density, line=node.line)
+    if density is None:
+        return obj
+    from ...engine.objects import mass_properties
+
+    return GraspObject(shape, pose, mass=float(mass_properties(obj).mass), density=density, line=node.line)
+
+
+def _shape(kind, fields, file, reading, max_bytes, problems):
+    """The :class:`~grasptwist.model.Shape` of the ``kind`` key (None after a problem)."""
+    node, path = fields[kind], f"object.{kind}"
+    if kind == "mesh":
+        return _mesh(node, fields.get("scale"), file, reading, max_bytes, problems)
+    if kind == "box":
+        size = read_vector(node, 3, path, problems)
+        sizes = (
+            None if size is None else [(v, f"{path}[{i}]", item) for i, (v, item) in enumerate(zip(size, node.value))]
+        )
+    elif kind == "sphere":
+        radius = read_number(node, path, problems)
+        sizes = None if radius is None else [(radius, path, node)]
+    else:
+        parts = read_mapping(node, path, SIZE_KEYS, SIZE_KEYS, problems)
+        if parts is None or len(parts) < 2:
+            return None
+        sizes = [(read_number(parts[key], join(path, key), problems), join(path, key), parts[key]) for key in SIZE_KEYS]
+        if any(value is None for value, _, _ in sizes):
+            return None
+    if sizes is None:
+        return None
+    for value, where, item in sizes:
+        if not value > 0:
+            problems.add(Reject("invalid-size", where, f"must be > 0, got {value!r}", **located(item)))
+            return None
+    return Shape(kind, readonly([value for value, _, _ in sizes]))
+
+
+def _mesh(node, scale_node, file, reading, max_bytes, problems):
+    """A mesh shape: its file read (:func:`grasptwist.io.mesh_file.read_mesh`), scaled."""
+    reference = read_name(node, "object.mesh", problems)
+    scale = _scale(scale_node, problems) if scale_node is not None else 1.0
+    if reference is None or scale is None or problems.count:
+        return None
+    # trimesh and the mesh reader load with the first mesh (a grasp file with a primitive never pays)
+    from pathlib import Path
+
+    from ..mesh_file import read_mesh
+
+    folder = Path(file).parent if not file.startswith("<") else Path.cwd()
+    try:
+        vertices, faces = read_mesh(
+            reference,
+            folder,
+            max_bytes=max_bytes,
+            max_triangles=reading.max_triangles,
+            allow_outside=reading.allow_outside,
+        )
+    except InputError as err:
+        problems.add(Reject(err.code, "object.mesh", str(err), **located(node)))
+        return None
+    return Shape("mesh", readonly(np.zeros(0)), readonly(vertices * scale), faces, reference)
+
+
+def _scale(node, problems):
+    """A mesh's ``scale``: one number > 0, or three (per axis)."""
+    if node.kind == "sequence":
+        values = read_vector(node, 3, "object.scale", problems)
+        items = node.value
+    else:
+        values = read_number(node, "object.scale", problems)
+        values, items = (None, None) if values is None else ([values], [node])
+    if values is None:
+        return None
+    for i, (value, item) in enumerate(zip(values, items)):
+        if not value > 0:
+            where = "object.scale" if node.kind != "sequence" else f"object.scale[{i}]"
+            problems.add(Reject("invalid-scale", where, f"must be > 0, got {value!r}", **located(item)))
+            return None
+    return np.array(values)
+
+
+def _positive(node, path, problems):
+    """A number > 0 (a mass, a density)."""
+    value = read_number(node, path, problems)
+    if value is not None and not value > 0:
+        code = "invalid-mass" if path.endswith("mass") else "invalid-density"
+        problems.add(Reject(code, path, f"must be > 0, got {value!r}", **located(node)))
+        return None
+    return value
+
+
+def on_surface(obj, points, normals, tolerance):
+    """The contacts put on ``obj``'s surface: ``(points, normals, distance, problems)``.
+
+    Parameters
+    ----------
+    obj : GraspObject
+    points : (3, 3) array
+        The points as given.
+    normals : (3, 3) array
+        The given unit normals, a row of NaN where a contact gives none.
+    tolerance : float
+        The farthest a point may be from the surface, relative to the object's size.
+
+    Returns
+    -------
+    points : (3, 3) array
+        Each given point where the contact gives its normal, else the nearest surface point.
+    normals : (3, 3) array
+        Each given normal, or the inward surface normal where none is given.
+    distance : (3,) array
+        Each given point's signed distance from the surface (> 0 outside).
+    problems : list of (code, contact, message)
+        ``contact-off-surface`` (farther than the tolerance) and ``outward-normal`` (a given
+        normal pointing out of the object), per contact.
+    """
+    from ...engine.objects import object_size, project_to_surface
+
+    surface = project_to_surface(obj, points)
+    limit = tolerance * object_size(obj)
+    given = ~np.isnan(normals).any(axis=1)
+    problems = []
+    for i in range(len(points)):
+        if abs(surface.distance[i]) > limit:
+            problems.append(
+                (
+                    "contact-off-surface",
+                    i,
+                    f"{abs(surface.distance[i]):.3g} from the object's surface "
+                    f"({'outside' if surface.distance[i] > 0 else 'inside'}; the tolerance is {limit:.3g})",
+                )
+            )
+        elif given[i] and np.dot(normals[i], surface.normals[i]) < 0:
+            problems.append(("outward-normal", i, "the normal points out of the object (normals point into it)"))
+    points = np.where(given[:, None], points, surface.points)
+    return points, np.where(given[:, None], normals, surface.normals), surface.distance, problems
+
+
+def _read(fields, found, problems):
+    if "object" not in fields:
+        return {}
+    obj = read_object(fields["object"], found["file"], found["reading"], found["max_bytes"], problems)
+    points = found.get("points")
+    if obj is None or points is None:
+        return None
+    from ...engine.objects import SURFACE_TOL
+
+    tolerance = SURFACE_TOL if found["reading"].surface_tol is None else found["reading"].surface_tol
+    points, normals, distance, off = on_surface(obj, points, found["normals"], tolerance)
+    contacts = fields.get("contacts")
+    for code, i, message in off:
+        item = contacts.value[i] if contacts is not None and contacts.kind == "sequence" else fields["object"]
+        key = "normal" if code == "outward-normal" else "point"
+        where = item.value.get(key, (None, item))[1] if item.kind == "mapping" else item
+        problems.add(Reject(code, f"contacts[{i}].{key}", message, **located(where)))
+    if off:
+        return None
+    return {
+        "object": obj,
+        "points": readonly(points),
+        "normals": readonly(normals),
+        "surface_distance": readonly(distance),
+    }
+
+
+SECTION = Section(("object",), _read)

@@ -1,0 +1,124 @@
+"""io/mesh_file.py: a mesh read within its limits, every refusal one coded error."""
+
+import sys
+
+import numpy as np
+import pytest
+from places import GRASPS
+
+from grasptwist.io.limits import MAX_TRIANGLES
+from grasptwist.io.mesh_file import read_mesh
+from grasptwist.model import InputError
+
+trimesh = pytest.importorskip("trimesh")
+
+# The tetrahedron (0, 0, 0), e_x, e_y, e_z, wound counter-clockwise seen from outside.
+TETRA_V = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
+TETRA_F = ["f 1 3 2", "f 1 2 4", "f 1 4 3", "f 2 3 4"]
+
+
+def obj(tmp_path, text, name="m.obj"):
+    (tmp_path / name).write_text(text)
+    return name
+
+
+def tetra(faces=TETRA_F, vertices=TETRA_V):
+    return vertices + "\n".join(faces) + "\n"
+
+
+def test_a_closed_mesh_is_read_with_its_volume_outwards(tmp_path):
+    vertices, faces = read_mesh(obj(tmp_path, tetra()), tmp_path)
+    assert vertices.shape == (4, 3) and faces.shape == (4, 3)
+    assert trimesh.Trimesh(vertices, faces).volume == pytest.approx(1 / 6)
+    assert not vertices.flags.writeable and not faces.flags.writeable
+
+
+def test_a_mesh_wound_inwards_is_turned_outwards(tmp_path):
+    inward = [f"f {a} {c} {b}" for _, a, b, c in (f.split() for f in TETRA_F)]
+    vertices, faces = read_mesh(obj(tmp_path, tetra(inward)), tmp_path)
+    assert trimesh.Trimesh(vertices, faces).volume == pytest.approx(1 / 6)
+
+
+def test_an_stl_repeats_its_vertices_and_is_merged(tmp_path):
+    trimesh.creation.box((1, 2, 3)).export(tmp_path / "box.stl")
+    vertices, faces = read_mesh("box.stl", tmp_path)
+    assert (len(vertices), len(faces)) == (8, 12)
+    assert np.ptp(vertices, axis=0).tolist() == [1, 2, 3]
+
+
+def test_the_bundled_bottle():
+    vertices, faces = read_mesh("meshes/bottle.obj", GRASPS)
+    assert len(faces) == 1152
+    assert trimesh.Trimesh(vertices, faces).volume == pytest.approx(6.938e-4, rel=1e-3)
+
+
+@pytest.mark.parametrize(
+    ("text", "name", "code", "match"),
+    [
+        (tetra(), "m.step", "unsupported-mesh", r"^m.step: expected a mesh file ending in \.stl, \.obj or \.ply$"),
+        ("", "m.obj", "empty-mesh", "no triangles in the mesh$"),
+        ("solid x\nendsolid x\n", "m.stl", "empty-mesh", "no triangles"),
+        (tetra(["f 1 2 9"]), "m.obj", "invalid-mesh", "^m.obj: not a readable OBJ file$"),
+        (tetra(vertices="v nan 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"), "m.obj", "non-finite", "NaN or infinite$"),
+        (tetra(TETRA_F[:3]), "m.obj", "not-watertight", r"not a closed surface \(every edge shared by exactly two"),
+        (tetra([*TETRA_F[:3], "f 2 4 3"]), "m.obj", "not-watertight", "wound the same way"),
+        # two tetrahedra sharing an edge: four triangles meet there (non-manifold)
+        (
+            tetra([*TETRA_F, "f 1 2 5", "f 1 5 6", "f 2 6 5", "f 1 6 2"], TETRA_V + "v 0.5 -1 -1\nv 0.5 -1 1\n"),
+            "m.obj",
+            "not-watertight",
+            "closed surface",
+        ),
+        (
+            "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nelement face 9999999\nend_header\n",
+            "m.ply",
+            "too-many-triangles",
+            f"the header declares 9999999 faces, more than the limit of {MAX_TRIANGLES}$",
+        ),
+    ],
+    ids=["suffix", "empty", "empty-stl", "bad-index", "nan", "open", "winding", "non-manifold", "ply-header"],
+)
+def test_each_refusal_is_one_coded_error(tmp_path, text, name, code, match):
+    (tmp_path / name).write_text(text)
+    with pytest.raises(InputError, match=match) as caught:
+        read_mesh(name, tmp_path)
+    assert caught.value.code == code and caught.value.file == name
+
+
+def test_a_missing_file_is_a_read_error(tmp_path):
+    with pytest.raises(InputError, match="^none.obj: cannot read: ") as caught:
+        read_mesh("none.obj", tmp_path)
+    assert caught.value.code == "read-error"
+
+
+def test_the_size_cap_is_checked_before_parsing(tmp_path, monkeypatch):
+    name = obj(tmp_path, tetra())
+    monkeypatch.setattr(trimesh, "load", lambda *a, **k: pytest.fail("parsed"))
+    with pytest.raises(InputError, match="larger than the size limit of 20 bytes$") as caught:
+        read_mesh(name, tmp_path, max_bytes=20)
+    assert caught.value.code == "too-large"
+
+
+def test_the_triangle_limit(tmp_path):
+    name = obj(tmp_path, tetra())
+    assert len(read_mesh(name, tmp_path, max_triangles=4)[1]) == 4
+    with pytest.raises(InputError, match="4 triangles, more than the limit of 3$") as caught:
+        read_mesh(name, tmp_path, max_triangles=3)
+    assert caught.value.code == "too-many-triangles"
+
+
+def test_a_path_outside_the_folder_is_refused_unless_allowed(tmp_path):
+    inner = tmp_path / "grasps"
+    inner.mkdir()
+    obj(tmp_path, tetra())
+    with pytest.raises(InputError, match=r"^\.\./m\.obj: '\.\./m\.obj' resolves outside ") as caught:
+        read_mesh("../m.obj", inner)
+    assert caught.value.code == "path-outside"
+    assert len(read_mesh("../m.obj", inner, allow_outside=True)[1]) == 4
+
+
+def test_without_trimesh_the_error_says_which_extra(tmp_path, monkeypatch):
+    monkeypatch.setitem(sys.modules, "trimesh", None)
+    with pytest.raises(InputError, match=r"needs trimesh: pip install trimesh .*'\.\[mesh\]'") as caught:
+        read_mesh(obj(tmp_path, tetra()), tmp_path)
+    assert caught.value.code == "mesh-unavailable"
