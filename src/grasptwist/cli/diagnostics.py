@@ -97,6 +97,8 @@ class Diagnostics:
         if not self.quiet:
             for line in out.warnings:
                 self.warn(line)
+            for line in out.notes:
+                to_stderr(line)
         if self.hint and self.records > TABLE_HINT_AT:
             to_stderr(self.hint)
             self.hint = None

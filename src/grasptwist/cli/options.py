@@ -67,6 +67,7 @@ ResolveFormat = _choices("Format", COMMANDS["resolve"].formats)
 RecordFormat = _choices("RecordFormat", COMMANDS["basis"].formats)
 FollowFormat = _choices("FollowFormat", COMMANDS["follow"].formats)
 ForcesFormat = _choices("ForcesFormat", COMMANDS["forces"].formats)
+SynthesizeFormat = _choices("SynthesizeFormat", COMMANDS["synthesize"].formats)
 #: ``plot --method``: the bases that can be drawn.
 PlotMethod = _choices("PlotMethod", [k.label for k in KINDS if k.method])
 #: The default of ``--method``: every method.

@@ -23,6 +23,7 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 from dataclasses import dataclass
+from functools import partial
 from typing import NamedTuple
 
 import numpy as np
@@ -31,6 +32,8 @@ from ..degeneracy import DEGENERACY_TOL
 from ..forces.closure import force_closure
 from ..forces.grasp_map import check_friction, check_safety, check_wrench
 from ..forces.grip import Grip, grip
+from ..forces.hold import hold_wrench
+from ..objects import mass_properties, object_size, project_to_surface, sample_surface
 from .candidates import candidate_triples, tangent_steps, triple_distance
 from .scores import CONSTRAINTS, METHODS, check_min_conditioning, check_objective, conditionings, score_triples
 
@@ -39,6 +42,9 @@ __all__ = [
     "Failure",
     "Synthesis",
     "search",
+    "synthesize",
+    "surface_of",
+    "GRAVITY",
     "verified",
     "check_budget",
     "CHUNK",
@@ -46,6 +52,9 @@ __all__ = [
     "REFINE_SHARE",
     "GAP_TOL",
 ]
+
+#: Gravity when none is given: 9.81 down the z axis (as grasp files').
+GRAVITY = (0.0, 0.0, -9.81)
 
 #: Candidates scored together (the grip's batches stay in cache; the budget is checked after each).
 CHUNK = 2048
@@ -455,3 +464,51 @@ def _failure(archive, mu, min_conditioning, tol) -> Failure:
             mu,
         )
     return Failure(name, "no candidate's grip holds every wrench within the friction cones", np.nan, np.nan)
+
+
+def surface_of(obj) -> Surface:
+    """The :class:`Surface` of a :class:`~grasptwist.model.GraspObject` (``grasptwist.engine.objects``)."""
+    return Surface(partial(sample_surface, obj), partial(project_to_surface, obj), object_size(obj))
+
+
+def synthesize(obj, friction, *, wrenches=(), hold=True, gravity=GRAVITY, **options) -> Synthesis:
+    r"""Grasps of an object: :func:`search` over its surface for its weight and ``wrenches``.
+
+    Parameters
+    ----------
+    obj : GraspObject
+        With a ``mass`` or ``density`` when ``hold`` (the weight ``m g`` at its centre of mass).
+    friction : float
+        ``mu`` at every contact.
+    wrenches : sequence of (6,) arrays
+        More wrenches every grasp must exert, ``(force; moment about the origin)``.
+    hold : bool
+        Hold the object's weight: the wrench ``(-m g; -c x m g)`` comes first.
+    gravity : (3,) array
+    **options
+        :func:`search`'s keyword options (``count``, ``safety``, ``objective``, ``seed``,
+        ``candidates``, ``seconds``, ...).
+
+    Returns
+    -------
+    Synthesis
+
+    Examples
+    --------
+    A 65 mm cube of 100 g, ``mu = 0.8``:
+
+    >>> from grasptwist.model import GraspObject, Shape
+    >>> cube = GraspObject(Shape("box", np.full(3, 0.065)), np.eye(4), mass=0.1)
+    >>> s = synthesize(cube, 0.8, count=2, candidates=4000)
+    >>> s.points.shape, bool((s.closure_friction < 0.8).all())
+    ((2, 3, 3), True)
+    """
+    listed = [np.asarray(w, float).reshape(6) for w in wrenches]
+    if hold:
+        props = mass_properties(obj)
+        if props.mass is None:
+            raise ValueError("hold=True needs the object's mass (or density): its weight is the wrench to hold")
+        listed.insert(0, hold_wrench(props.mass, props.center_of_mass, np.asarray(gravity, float)))
+    if not listed:
+        raise ValueError("nothing to hold: give the object a mass (hold=True) or wrenches")
+    return search(surface_of(obj), np.array(listed), friction, **options)
