@@ -149,7 +149,8 @@ def grasp_documents(found, folder: str) -> str:
     """The grasps found as grasp-file documents (YAML, ``---`` between them), read back by every command.
 
     Each keeps the input's object, units, wrist and friction, its wrenches by name (the weight as
-    ``mass`` and ``center_of_mass`` when one of them is ``hold``), and gives the contacts found.
+    the object's mass, or ``mass`` and ``center_of_mass``, when one of them is ``hold``), and gives
+    the contacts found.
     """
     s = found.synthesis
     docs = []
@@ -172,9 +173,9 @@ def grasp_documents(found, folder: str) -> str:
         ]
         if found.hold is not None:
             mass, center, gravity = found.hold
-            doc.update(
-                mass=float(mass), center_of_mass=np.asarray(center).tolist(), gravity=np.asarray(gravity).tolist()
-            )
+            if found.object.mass is None and found.object.density is None:  # else the object's weight is the hold
+                doc.update(mass=float(mass), center_of_mass=np.asarray(center).tolist())
+            doc["gravity"] = np.asarray(gravity).tolist()
         if wrenches:
             doc["wrenches"] = wrenches
         docs.append(yaml.safe_dump(doc, sort_keys=False, default_flow_style=None))

