@@ -3,8 +3,8 @@ independently (an independent conic solver, the grasp map, the surface), and rea
 
 import numpy as np
 import pytest
-from conic import closure_margin, least_grip
 
+from conic import closure_margin, least_grip
 from grasptwist.engine.forces.grasp_map import grasp_map
 from grasptwist.engine.objects import project_to_surface
 from grasptwist.engine.synthesis.candidates import antipodality, candidate_triples, triple_distance
@@ -14,7 +14,7 @@ from grasptwist.engine.synthesis.scores import (
     check_objective,
     score_triples,
 )
-from grasptwist.engine.synthesis.search import check_budget, search, surface_of, synthesize, verified
+from grasptwist.engine.synthesis.search import check_budget, surface_of, synthesize, verified
 from grasptwist.model import GraspObject, Shape
 
 G = 9.81
