@@ -204,10 +204,11 @@ class _Budget:
 
 
 class _Archive:
-    """The best feasible candidates so far (at most ``size``), and the furthest any got."""
+    """The best feasible candidates so far (at most ``size``, each ``spacing`` or more from the better
+    ones, so that refinement and selection start from distinct grasps), and the furthest any got."""
 
-    def __init__(self, size):
-        self.size = size
+    def __init__(self, size, spacing):
+        self.size, self.spacing = size, spacing
         self.points = np.empty((0, 3, 3))
         self.normals = np.empty((0, 3, 3))
         self.objective = np.empty(0)
@@ -220,7 +221,8 @@ class _Archive:
         self.points = np.concatenate((self.points, p[ok]))
         self.normals = np.concatenate((self.normals, n[ok]))
         self.objective = np.concatenate((self.objective, s.objective[ok]))
-        keep = np.argsort(self.objective, kind="stable")[: self.size]
+        order = np.argsort(self.objective, kind="stable")[: 8 * self.size]
+        keep = order[_spread(self.points[order], self.size, self.spacing)]
         self.points, self.normals, self.objective = self.points[keep], self.normals[keep], self.objective[keep]
         reached = np.where(s.failed == -1, len(CONSTRAINTS), s.failed)
         self.furthest = max(self.furthest, int(reached.max(initial=0)))
@@ -322,7 +324,7 @@ def search(
     started = time.perf_counter()
     rng = np.random.default_rng(seed)
     budget = _Budget(budget_size, seconds, progress)
-    archive = _Archive(max(ELITES, 4 * count))
+    archive = _Archive(max(ELITES, 4 * count), spacing)
     chunk = CHUNK if objective == "total_normal_force" else CHUNK // 8  # closure friction, epsilon: slower rows
 
     def score(p, n):
@@ -348,7 +350,7 @@ def search(
             archive.add(p, n, score(p, n))
             budget.spent(k)
         _refine(surface, archive, score, budget, rng)
-    picked = _distinct(archive, count, spacing)
+    picked = _spread(archive.points, count, spacing)
     points, normals = archive.points[picked], archive.normals[picked]
     out = _results(surface, points, normals, w, mu, safety, wrist, methods, quality or objective == "epsilon", tol)
     failure = None if len(out["points"]) else _failure(archive, mu / safety, min_conditioning, tol)
@@ -391,13 +393,14 @@ def _refine(surface, archive, score, budget, rng):
         step = np.where(better, step, step / 2)
 
 
-def _distinct(archive, count, spacing):
-    """Indices of the best archived grasps, in order, each ``spacing`` or more from those picked before."""
+def _spread(points, count, spacing):
+    """Indices of up to ``count`` of the grasps ``points (N, 3, 3)``, in order, each ``spacing`` or more
+    from those picked before it (:func:`~.candidates.triple_distance`)."""
     picked = []
-    for i in range(len(archive.objective)):
+    for i in range(len(points)):
         if len(picked) == count:
             break
-        if not picked or triple_distance(archive.points[i], archive.points[picked]).min() >= spacing:
+        if not picked or triple_distance(points[i], points[picked]).min() >= spacing:
             picked.append(i)
     return np.array(picked, int)
 
