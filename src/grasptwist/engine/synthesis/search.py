@@ -137,7 +137,7 @@ class Synthesis:
     epsilon : (K,) or None
         Ferrari-Canny's epsilon at ``mu / safety`` (asked for, or the objective).
     conditioning : (K, 2)
-        Of each decomposition (:data:`~.scores.METHODS`; NaN where not asked or without a wrist).
+        Of the off-tangent and the tangent decomposition (NaN where not asked, or without a wrist).
     grips : tuple of tuple of Grip
         The verified grip of each grasp and wrench (one row each).
     candidates : int
@@ -145,7 +145,8 @@ class Synthesis:
     seconds : float
     seed : int
     failure : Failure or None
-        Why nothing was found (``K = 0``).
+        Why nothing was found (``K = 0``): ``constraint`` (the tightest: ``degenerate``,
+        ``conditioning``, ``force_closure`` or ``grip``), ``message``, ``best`` and ``needed``.
     """
 
     points: np.ndarray
@@ -488,7 +489,12 @@ def surface_of(obj) -> Surface:
 
 
 def synthesize(obj, friction, *, wrenches=(), hold=True, gravity=GRAVITY, **options) -> Synthesis:
-    r"""Grasps of an object: :func:`search` over its surface for its weight and ``wrenches``.
+    r"""Grasps of an object: its surface searched for grasps that hold its weight and ``wrenches``.
+
+    The search (``grasptwist.engine.synthesis.search.search``; the guide's synthesis page) scores
+    candidate triples in batches against the constraints (degeneracy and conditioning of the
+    decompositions, force closure at ``friction / safety``, a grip for every wrench), refines the
+    best on the surface and verifies each grasp it returns by the exact grip and its certificate.
 
     Parameters
     ----------
@@ -502,8 +508,10 @@ def synthesize(obj, friction, *, wrenches=(), hold=True, gravity=GRAVITY, **opti
         Hold the object's weight: the wrench ``(-m g; -c x m g)`` comes first.
     gravity : (3,) array
     **options
-        :func:`search`'s keyword options (``count``, ``safety``, ``objective``, ``seed``,
-        ``candidates``, ``seconds``, ...).
+        The search's keyword options: ``count`` (grasps wanted, 1), ``safety`` (1), ``objective``
+        (``total_normal_force``, ``closure_friction`` or ``epsilon``), ``wrist`` (None),
+        ``methods``, ``min_conditioning`` (0), ``min_spacing`` (None: 5% of the object's size),
+        ``quality`` (False), ``seed`` (0), ``candidates`` (20000), ``seconds`` (None), ``progress``.
 
     Returns
     -------
@@ -513,7 +521,7 @@ def synthesize(obj, friction, *, wrenches=(), hold=True, gravity=GRAVITY, **opti
     --------
     A 65 mm cube of 100 g, ``mu = 0.8``:
 
-    >>> from grasptwist.model import GraspObject, Shape
+    >>> from grasptwist.objects import GraspObject, Shape
     >>> cube = GraspObject(Shape("box", np.full(3, 0.065)), np.eye(4), mass=0.1)
     >>> s = synthesize(cube, 0.8, count=2, candidates=4000)
     >>> s.points.shape, bool((s.closure_friction < 0.8).all())
