@@ -90,3 +90,34 @@ def test_a_file_without_object_or_friction_is_an_error_of_its_own(tmp_path):
 def test_bad_options_are_usage_errors(args, message):
     r, _ = run("synthesize", SPHERE, *args)
     assert r.exit_code == 2 and message in r.stderr
+
+
+@pytest.mark.slow  # over a second (pyarrow's import): docs/reference/development.md, Test time
+def test_parquet_has_the_csv_columns(tmp_path):
+    pq = pytest.importorskip("pyarrow.parquet")
+    r, _ = run(
+        "synthesize", SPHERE, "--friction", "0.5", "--mass", "1", *FAST, "-f", "parquet", "-o", tmp_path / "g.parquet"
+    )
+    assert r.exit_code == 0, r.stderr
+    table = pq.read_table(tmp_path / "g.parquet")
+    assert table.num_rows == 4 and table.column("rank").to_pylist() == [1, 2, 1, 2]
+    assert table.column("epsilon").null_count == 4  # not asked for
+
+
+def test_follow_reads_the_grasp_file_back(tmp_path):
+    found = tmp_path / "found.yaml"
+    r, _ = run("synthesize", SPHERE, "--friction", "0.5", "--mass", "1", *FAST, "-o", found, "-q")
+    assert r.exit_code == 0, r.stderr
+    follow, _ = run("follow", found, "--twist", "0,0,1,0,0,0", "--duration", "1", "--samples", "2", "-f", "jsonl")
+    # two samples and a summary (its first_warning null: none) per grasp
+    assert follow.exit_code == 0 and len(follow.stdout.splitlines()) == 4 * 3, follow.stderr
+
+
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
+def test_plot_draws_a_grasp_found(tmp_path):
+    pytest.importorskip("matplotlib")
+    found = tmp_path / "found.yaml"
+    run("synthesize", SPHERE, "--friction", "0.5", "--mass", "1", *FAST, "-o", found, "-q")
+    r, _ = run("plot", found, "-o", tmp_path / "g.png")
+    assert r.exit_code == 0, r.stderr
+    assert (tmp_path / "g.png").stat().st_size > 1000
