@@ -311,7 +311,7 @@ def search(
     >>> def project(q):
     ...     r = np.linalg.norm(q, axis=-1, keepdims=True)
     ...     return q / r, -q / r, r[..., 0] - 1
-    >>> s = search(Surface(sample, project, 2 * 3**0.5), [[0, 0, 1.0, 0, 0, 0]], 0.5, candidates=3000)
+    >>> s = search(Surface(sample, project, 2 * 3**0.5), [[0, 0, 1.0, 0, 0, 0]], 0.5, candidates=1000)
     >>> bool(0.894 < s.total_normal_force[0, 0] < 1.0), s.failure
     (True, None)
     """
@@ -523,7 +523,7 @@ def synthesize(obj, friction, *, wrenches=(), hold=True, gravity=GRAVITY, **opti
 
     >>> from grasptwist.objects import GraspObject, Shape
     >>> cube = GraspObject(Shape("box", np.full(3, 0.065)), np.eye(4), mass=0.1)
-    >>> s = synthesize(cube, 0.8, count=2, candidates=4000)
+    >>> s = synthesize(cube, 0.8, count=2, candidates=1000)
     >>> s.points.shape, bool((s.closure_friction < 0.8).all())
     ((2, 3, 3), True)
     """
