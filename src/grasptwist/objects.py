@@ -5,7 +5,7 @@
 >>> cube = GraspObject(Shape("box", np.array([0.065, 0.065, 0.065])), np.eye(4))
 >>> s = project_to_surface(cube, [0.04, 0.01, 0.0])
 >>> s.points.round(4).tolist(), s.normals.tolist(), round(float(s.distance), 4)
-([0.0325, 0.01, 0.0], [-1.0, -0.0, -0.0], 0.0075)
+([0.0325, 0.01, 0.0], [-1.0, 0.0, 0.0], 0.0075)
 
 Normals point into the object, distances are > 0 outside.  The math is in
 ``grasptwist.engine.objects``.

@@ -16,6 +16,7 @@ from grasptwist.engine.objects import (
     mass_properties,
     moved,
     object_size,
+    primitives,
     project_to_surface,
     sample_surface,
     tessellate,
@@ -122,6 +123,18 @@ def test_capsule_closed_forms(point, surface, normal, distance):
     assert_projects(CAPSULE, point, surface, normal, distance)
 
 
+@pytest.mark.parametrize(
+    "kind, size", [("box", (2.0, 4.0, 6.0)), ("sphere", (2.0,)), ("cylinder", (1.0, 4.0)), ("capsule", (1.0, 2.0))]
+)
+def test_the_vectorised_primitives_agree_with_their_per_point_twin(kind, size):
+    q = np.random.default_rng(13).uniform(-5, 5, (300, 3))
+    c, n, d = primitives.nearest(kind, np.array(size), q, 0.0)
+    point, normal, distance = (np.array(a) for a in zip(*(primitives.nearest_one(kind, size, p) for p in q.tolist())))
+    np.testing.assert_allclose(c, point, rtol=0, atol=4e-15)
+    np.testing.assert_allclose(n, normal, rtol=0, atol=4e-16)
+    np.testing.assert_allclose(d, distance, rtol=0, atol=4e-15)
+
+
 def test_projection_keeps_batch_shape_and_takes_no_points():
     s = project_to_surface(BOX, np.zeros((2, 5, 3)))
     assert s.points.shape == (2, 5, 3) and s.normals.shape == (2, 5, 3) and s.distance.shape == (2, 5)
@@ -146,7 +159,7 @@ def test_projecting_the_moved_object_moves_the_projections(o):
 coordinate = st.floats(-0.2, 0.2, allow_nan=False)
 
 
-@settings(max_examples=30, deadline=None)
+@settings(max_examples=20, deadline=None)
 @given(
     kind=st.sampled_from(range(len(KINDS))),
     point=st.tuples(coordinate, coordinate, coordinate),
@@ -231,9 +244,10 @@ def volume_of(vertices, faces):
 def assert_closed(faces):
     """Every directed edge once and its reverse once: watertight and consistently oriented."""
     edges = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
-    directed = {tuple(e) for e in edges.tolist()}
+    n = faces.max() + 1
+    directed = np.unique(edges[:, 0] * n + edges[:, 1])
     assert len(directed) == len(edges)
-    assert {(b, a) for a, b in directed} == directed
+    np.testing.assert_array_equal(np.unique(edges[:, 1] * n + edges[:, 0]), directed)
 
 
 @pytest.mark.parametrize(
@@ -255,14 +269,14 @@ def test_tessellation_is_watertight_with_the_closed_form_volume(o, volume):
 
 @pytest.mark.parametrize("o", KINDS[1:], ids=lambda o: o.shape.kind)
 def test_round_tessellations_lie_on_the_surface_and_approach_its_volume(o):
-    coarse, fine = (tessellate(o, segments=k) for k in (16, 128))
+    coarse, fine = (tessellate(o, segments=k) for k in (16, 64))
     for v, f in (coarse, fine):
         assert_closed(f)
         assert abs(project_to_surface(o, v).distance).max() <= 1e-16  # sizes 0.02-0.1: a unit of round-off
     exact = mass_properties(o).volume
     below = [exact - volume_of(*t) for t in (coarse, fine)]
-    assert 0 < below[1] < below[0] / 30  # inscribed, and the error falls as 1 / segments^2 (64 times)
-    assert below[1] < 2e-3 * exact  # about (2 pi / 128)^2 / 6 per direction of the rings
+    assert 0 < below[1] < below[0] / 10  # inscribed, and the error falls as 1 / segments^2 (16 times)
+    assert below[1] < 5e-3 * exact  # about (2 pi / 64)^2 / 6 per direction of the rings
 
 
 def test_the_sphere_tessellation_has_the_promised_rings():
@@ -362,3 +376,12 @@ def test_moved_refuses_a_pose_that_is_not_rigid():
 def test_project_refuses_points_of_the_wrong_shape(points, match):
     with pytest.raises(ValueError, match=match):
         project_to_surface(BOX, points)
+
+
+def test_a_point_that_is_not_finite_gets_nan_and_the_others_their_answer():
+    with np.errstate(all="raise"):  # and no warning on the way
+        s = project_to_surface(BOX, [[np.nan, 0, 0], [np.inf, 0, 0], [0, 0, 0]])
+    assert np.isnan(s.points[:2]).all() and np.isnan(s.normals[:2]).all() and np.isnan(s.distance[:2]).all()
+    assert (
+        s.points[2].tolist() == [1.0, 0.0, 0.0] and s.normals[2].tolist() == [-1.0, 0.0, 0.0] and s.distance[2] == -1.0
+    )

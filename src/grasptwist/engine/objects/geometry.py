@@ -24,6 +24,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ...model import GraspObject
+from ..se3 import rotate
 from . import mesh, primitives
 from .checks import check_pose
 from .tolerances import EDGE_TOL
@@ -116,32 +117,45 @@ def project_to_surface(obj: GraspObject, points) -> SurfacePoints:
     -------
     SurfacePoints
         ``points (..., 3)``, ``normals (..., 3)`` (unit, inward),
-        ``distance (...)`` (> 0 outside).
+        ``distance (...)`` (> 0 outside); NaN for a point that is not finite
+        (never an exception, as everywhere in the engine).
 
     Examples
     --------
     A 2 x 2 x 2 box moved 1 along x; a point 0.5 beyond its +y face:
 
     >>> from grasptwist.objects import Shape
-    >>> pose = np.eye(4); pose[0, 3] = 1.0
+    >>> pose = np.eye(4)
+    >>> pose[0, 3] = 1.0
     >>> box = GraspObject(Shape("box", np.array([2.0, 2.0, 2.0])), pose)
     >>> s = project_to_surface(box, [1.0, 1.5, 0.0])
     >>> s.points.tolist(), s.normals.tolist(), float(s.distance)
-    ([1.0, 1.0, 0.0], [-0.0, -1.0, -0.0], 0.5)
+    ([1.0, 1.0, 0.0], [0.0, -1.0, 0.0], 0.5)
     """
     p = _points(points)
     rotation, translation = obj.pose[:3, :3], obj.pose[:3, 3]
-    local = ((p - translation) @ rotation).reshape(-1, 3)  # rows R^T (p - t)
-    shape = obj.shape
-    if shape.kind == "mesh":
-        c, outward, d = mesh.nearest(shape, local)
+    # written out component by component (se3.rotate): a BLAS product of (N, 3) by (3, 3) is
+    # several times slower, and its threads fight over a busy machine
+    with np.errstate(invalid="ignore", over="ignore"):  # inf * 0 in a point that is not finite
+        local = rotate(rotation.T, p - translation).reshape(-1, 3)
+    finite = np.isfinite(local).all(axis=1)
+    if finite.all():  # the common case, without the copies
+        c, outward, d = _nearest(obj, local)
     else:
-        c, outward, d = primitives.nearest(shape.kind, shape.size, local, EDGE_TOL * object_size(obj))
+        c, outward, d = np.full_like(local, np.nan), np.full_like(local, np.nan), np.full(len(local), np.nan)
+        c[finite], outward[finite], d[finite] = _nearest(obj, local[finite])
     return SurfacePoints(
-        (c @ rotation.T + translation).reshape(p.shape),
-        -(outward @ rotation.T).reshape(p.shape),
+        (rotate(rotation, c) + translation).reshape(p.shape),
+        (rotate(-rotation, outward) + 0.0).reshape(p.shape),  # + 0.0: zeros without a sign, for records
         d.reshape(p.shape[:-1]),
     )
+
+
+def _nearest(obj, local):
+    shape = obj.shape
+    if shape.kind == "mesh":
+        return mesh.nearest(shape, local)
+    return primitives.nearest(shape.kind, shape.size, local, EDGE_TOL * object_size(obj))
 
 
 def _points(points):
@@ -165,7 +179,8 @@ def mass_properties(obj: GraspObject) -> MassProperties:
     primitive, the closed mesh's (``mesh.volume_centroid``).
 
     >>> from grasptwist.objects import Shape
-    >>> pose = np.eye(4); pose[:3, 3] = [0, 0, 0.05]
+    >>> pose = np.eye(4)
+    >>> pose[:3, 3] = [0, 0, 0.05]
     >>> m = mass_properties(GraspObject(Shape("box", np.array([0.1, 0.1, 0.1])), pose, density=1000.0))
     >>> round(m.volume, 6), round(m.mass, 6), m.center_of_mass.tolist()
     (0.001, 1.0, [0.0, 0.0, 0.05])
@@ -204,7 +219,7 @@ def sample_surface(obj: GraspObject, n: int, rng: np.random.Generator) -> tuple[
     else:
         points, outward = primitives.sample(shape.kind, shape.size, n, rng)
     rotation, translation = obj.pose[:3, :3], obj.pose[:3, 3]
-    return points @ rotation.T + translation, -(outward @ rotation.T)
+    return rotate(rotation, points) + translation, rotate(-rotation, outward)
 
 
 def tessellate(obj: GraspObject, *, segments: int = 32) -> tuple[np.ndarray, np.ndarray]:
@@ -232,7 +247,7 @@ def tessellate(obj: GraspObject, *, segments: int = 32) -> tuple[np.ndarray, np.
         vertices, faces = shape.vertices, shape.faces.copy()
     else:
         vertices, faces = primitives.triangles(shape.kind, shape.size, segments)
-    return vertices @ obj.pose[:3, :3].T + obj.pose[:3, 3], faces
+    return rotate(obj.pose[:3, :3], vertices) + obj.pose[:3, 3], faces
 
 
 def moved(obj: GraspObject, pose) -> GraspObject:

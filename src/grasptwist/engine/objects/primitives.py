@@ -44,6 +44,7 @@ import numpy as np
 __all__ = [
     "PRIMITIVES",
     "nearest",
+    "nearest_one",
     "volume",
     "diagonal",
     "sample",
@@ -159,6 +160,49 @@ def nearest(kind, size, q, tol):
     [[0.5774, 0.5774, 0.5774], [0.7071, 0.7071, 0.0], [1.0, 0.0, 0.0]]
     """
     return _NEAREST[kind](np.asarray(size, dtype=float), q, tol)
+
+
+def nearest_one(kind, size, q):
+    """One point's nearest point, outward normal and signed distance in Python floats: :func:`nearest`'s readable twin.
+
+    The same formulas, one point at a time, without the edge tolerance (a
+    point exactly on an edge takes one face's normal here); the tests and
+    ``bench/objects.py`` hold the vectorised :func:`nearest` to it.
+
+    >>> nearest_one("cylinder", [1.0, 2.0], (0.0, 3.0, 0.5))
+    ((0.0, 1.0, 0.5), (0.0, 1.0, 0.0), 2.0)
+    """
+    x, y, z = q
+    if kind in ("sphere", "capsule"):
+        half = 0.0 if kind == "sphere" else size[1] / 2
+        az = min(max(z, -half), half)
+        vx, vy, vz = x, y, z - az
+        length = math.sqrt(vx * vx + vy * vy + vz * vz)
+        n = (vx / length, vy / length, vz / length) if length > 0 else (1.0, 0.0, 0.0)
+        r = size[0]
+        return (r * n[0], r * n[1], az + r * n[2]), n, length - r
+    if kind == "box":
+        coords, half = [x, y, z], [s / 2 for s in size]
+    else:  # a cylinder is a rectangle in (rho, z)
+        rho = math.hypot(x, y)
+        coords, half = [rho, z], [size[0], size[1] / 2]
+    sign = [-1.0 if c < 0 else 1.0 for c in coords]
+    gap = [h - abs(c) for h, c in zip(half, coords)]
+    out = [max(-g, 0.0) for g in gap]
+    outside = math.sqrt(sum(o * o for o in out))
+    point = [s * min(abs(c), h) for s, c, h in zip(sign, coords, half)]
+    if outside > 0:
+        normal, distance = [s * o / outside for s, o in zip(sign, out)], outside
+    else:
+        k = gap.index(min(gap))
+        point[k] = sign[k] * half[k]
+        normal = [0.0] * len(coords)
+        normal[k] = sign[k]
+        distance = -gap[k]
+    if kind == "box":
+        return tuple(point), tuple(normal), distance
+    ux, uy = (x / rho, y / rho) if rho > 0 else (1.0, 0.0)
+    return (point[0] * ux, point[0] * uy, point[1]), (normal[0] * ux, normal[0] * uy, normal[1]), distance
 
 
 def volume(kind, size) -> float:
