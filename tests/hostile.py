@@ -20,6 +20,7 @@ NULLABLE = {"units", "wrist", "off_tangent", "tip", "velocity_limit_ratio"}  # t
 # forces records: a grasp without a wrench or a friction, closure without one, epsilon without --quality
 NULLABLE |= {"wrench", "friction", "manipulating", "grip", "force_closure", "closure_friction", "epsilon"}
 NULLABLE |= {"squeeze"}  # a grip on collinear contacts, whose internal forces are not three squeezes
+NULLABLE |= {"surface_distance"}  # a contact of a grasp without an object
 
 
 def run(*args, input=None):

@@ -433,7 +433,7 @@ def test_every_bundled_grasp_takes_the_fast_path(monkeypatch, loader):
 
     monkeypatch.setattr(reader, "read_document", fail)
     bundled = sorted((TESTS.parent / "grasps").rglob("*.yaml"))
-    assert len(bundled) == 7
+    assert len(bundled) == 8
     for path in bundled:
         for entry in read_grasps(path, reading=loader):
             assert isinstance(entry, Grasp), str(entry)

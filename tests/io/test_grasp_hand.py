@@ -148,6 +148,7 @@ def test_urdf_form_gives_the_hand_at_its_joint_positions():
 def test_contact_off_finger():
     doc = yaml.safe_load(TRIFINGER.read_text("utf-8"))
     doc["contacts"][1]["point"] = [0.5, -0.5, 0.5]  # half a metre away: the hand's frame mistaken
+    del doc["object"]  # which would call it contact-off-surface first
     code, line, column, message = one_error(yaml.safe_dump(doc, sort_keys=False))
     assert code == "contact-off-finger"
     assert message.startswith("hand.fingers[1].tip: contact 2 is ")
@@ -192,6 +193,21 @@ def test_urdf_errors_are_reported_at_the_urdf_key(tmp_path, reference, tips, cod
     assert got[:3] == (code, 6, 9), got
     assert got[3].startswith("hand.urdf: ")
     assert re.search(match, got[3]), got[3]
+
+
+@urdf_only
+def test_a_urdf_outside_the_folder_is_read_with_allow_outside(tmp_path):
+    """--allow-outside (Reading.allow_outside) lifts the folder rule for a URDF as for a mesh."""
+    inner = tmp_path / "grasps"
+    inner.mkdir()
+    shutil.copy(CORPUS / "hand.urdf", tmp_path / "hand.urdf")
+    fingers = "".join("    - {tip: a_tip}\n" for _ in range(3))
+    path = inner / "g.yaml"
+    path.write_text(CONTACTS + f"hand:\n  urdf: ../hand.urdf\n  fingers:\n{fingers}", "utf-8")
+    assert errors_of(path)[:3] == ("path-outside", 6, 9)
+    result = CliRunner().invoke(app, ["resolve", str(path), "--allow-outside", "-f", "jsonl"])
+    # read now: its one-link fingers cannot reach these contacts, which the run says after reading it
+    assert json.loads(result.stdout)["error"]["code"] == "unreachable" and "path-outside" not in result.stderr
 
 
 def errors_of(path):

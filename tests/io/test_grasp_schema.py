@@ -38,6 +38,10 @@ NOT_IN_THE_SCHEMA = {
     "contact-off-finger": "a contact farther from its URDF tip link than the finger is long",
     "unreachable": "a contact no joint positions of its URDF finger reach (inverse kinematics)",
     "outside-limits": "a contact its URDF finger reaches only outside its joint limits (inverse kinematics)",
+    # the object's geometry, and its mesh, another file
+    "contact-off-surface": "a contact farther from the object's surface than the tolerance",
+    "outward-normal": "a given normal pointing out of the object",
+    "path-outside": "a mesh path that leaves the grasp file's folder",
 }
 
 NOT_DATA = object()
@@ -137,5 +141,5 @@ def test_the_schema_names_the_loaders_keys_in_its_order():
 
 def test_what_the_schema_cannot_state_is_in_its_description():
     description = grasp_schema()["description"]
-    for words in ("unique contact and twist names", "finite numbers"):
+    for words in ("unique contact and twist names", "finite numbers", "within the surface tolerance"):
         assert words in description

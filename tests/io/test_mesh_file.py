@@ -4,11 +4,11 @@ import sys
 
 import numpy as np
 import pytest
-from places import GRASPS
 
 from grasptwist.io.limits import MAX_TRIANGLES
 from grasptwist.io.mesh_file import read_mesh
 from grasptwist.model import InputError
+from places import GRASPS
 
 trimesh = pytest.importorskip("trimesh")
 

@@ -27,6 +27,7 @@ __all__ = [
     "conditioning_warning",
     "skipped_warning",
     "outward_normals_warning",
+    "normal_disagrees_warning",
     "radians_warning",
 ]
 
@@ -216,6 +217,38 @@ def outward_normals_warning(outward, names=("1", "2", "3"), center=False) -> str
         f"outward-normals: the normals at contacts {', '.join(which[:-1])} and {which[-1]} point away from {away}, "
         "but normals point into the object: flip them, unless the fingers push outward from inside a hollow"
     )
+
+
+def normal_disagrees_warning(disagrees, angles, names=("1", "2", "3"), limit=10.0) -> str | None:
+    """The warning for given normals more than ``limit`` degrees from the object's surface normal,
+    naming each contact and its angle (to a tenth of a degree); None when none is.  It starts with its code.
+
+    >>> normal_disagrees_warning([False, True, False], [0.0, 14.04, 2.0], limit=10)[:83]
+    "normal-disagrees: the normal given at contact 2 is 14.0 degrees from the object's s"
+    >>> normal_disagrees_warning([True, False, True], [12.3, 0.0, 45.6], ("a", "b", "c"))[:83]
+    'normal-disagrees: the normals given at contacts a and c are 12.3 and 45.6 degrees f'
+    >>> normal_disagrees_warning([False] * 3, [0.0] * 3) is None
+    True
+    """
+    which = [(name, f"{angle:.1f}") for name, angle, off in zip(names, angles, disagrees) if off]
+    if not which:
+        return None
+    if len(which) == 1:
+        ((name, angle),) = which
+        return (
+            f"normal-disagrees: the normal given at contact {name} is {angle} degrees from the object's surface "
+            f"normal there (more than {limit:g}): check the normal, or leave it out to take the surface's"
+        )
+    names, angles = (_and([w[k] for w in which]) for k in (0, 1))
+    return (
+        f"normal-disagrees: the normals given at contacts {names} are {angles} degrees from the object's surface "
+        f"normals there (more than {limit:g}): check them, or leave them out to take the surface's"
+    )
+
+
+def _and(words):
+    """``a, b and c``."""
+    return f"{', '.join(words[:-1])} and {words[-1]}"
 
 
 def radians_warning(rotvec, line=None, column=None) -> str:

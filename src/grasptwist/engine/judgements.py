@@ -37,6 +37,7 @@ __all__ = [
     "tangent_moves",
     "about_wrist",
     "outward_contacts",
+    "normal_angles",
     "rotation_over_pi",
 ]
 
@@ -184,6 +185,32 @@ def about_wrist(x, y, tol=IN_PLANE_TOL):
     """
     moves = off_tangent_moves(x, y, tol)
     return ~moves[..., :3, :].any(axis=(-2, -1)) & moves[..., 3:, :].any(axis=(-2, -1))
+
+
+def normal_angles(normals, surface_normals):
+    """The angle between each given normal and the object's surface normal there, in degrees.
+
+    .. math::
+
+        \theta_i = \\operatorname{atan2}(\\lVert \\hat n_i \times \\hat s_i \rVert, \\hat n_i \\cdot \\hat s_i)
+
+    (accurate near 0 and 180 degrees, where the arccosine of the dot product is not).
+
+    Parameters
+    ----------
+    normals, surface_normals : (..., 3) arrays
+        Unit vectors: a contact's normal as given and the surface's inward one at its point.
+
+    Returns
+    -------
+    (...) array
+        Degrees in ``[0, 180]``; NaN where an input is.
+
+    >>> normal_angles([[1.0, 0, 0], [0, 1, 0]], [[1.0, 0, 0], [0, 0, 1]]).tolist()
+    [0.0, 90.0]
+    """
+    n, s = np.asarray(normals, dtype=float), np.asarray(surface_normals, dtype=float)
+    return np.degrees(np.arctan2(np.linalg.norm(np.cross(n, s), axis=-1), dot(n, s)))
 
 
 def outward_contacts(points, normals, center=None, tol=IN_PLANE_TOL):

@@ -105,10 +105,10 @@ def read_mesh(
         raise InputError(
             "unsupported-mesh", f"expected a mesh file ending in {', '.join(MESH_SUFFIXES[:-1])} or .ply", text
         )
-    trimesh = _library(text)
     data = _read(resolve_urdf(text, folder, allow_outside=allow_outside), max_bytes, text)
     if suffix == ".ply":
         _check_ply_header(data, max_triangles, text)
+    trimesh = _library(text)  # after the checks that need no parser: a refused file costs no import (1 s)
     try:
         mesh = trimesh.load(
             trimesh.util.wrap_as_stream(data), file_type=suffix[1:], force="mesh", process=False, skip_materials=True

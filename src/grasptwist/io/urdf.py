@@ -271,7 +271,7 @@ def _model(data, file):
         raise InputError("invalid-urdf", f"yourdfpy cannot read it: {type(exc).__name__}: {exc}", file) from None
 
 
-def load_urdf_hand(urdf, tips, *, names=None, folder=None, max_bytes=DEFAULT_MAX_BYTES):
+def load_urdf_hand(urdf, tips, *, names=None, folder=None, max_bytes=DEFAULT_MAX_BYTES, allow_outside=False):
     """A hand from a URDF: one finger per tip link, its joints at home (all 0).
 
     The hand's frame (and so the grasp's) is the URDF's root link's frame.
@@ -288,9 +288,11 @@ def load_urdf_hand(urdf, tips, *, names=None, folder=None, max_bytes=DEFAULT_MAX
     names : sequence of str, optional
         Finger names; default ``"1"``, ``"2"``, ...
     folder : str or os.PathLike, optional
-        The referring grasp file's folder; a path must stay inside it.
+        The referring grasp file's folder; a path must stay inside it, unless ``allow_outside``.
     max_bytes : int
         Size cap of the URDF (default 1 MiB, as for grasp files).
+    allow_outside : bool
+        Take a relative path wherever it leads (``--allow-outside``).
 
     Returns
     -------
@@ -312,7 +314,7 @@ def load_urdf_hand(urdf, tips, *, names=None, folder=None, max_bytes=DEFAULT_MAX
     text = os.fspath(urdf)
     file = text if text.startswith(_PACKAGE) or folder is None else os.path.join(os.fspath(folder), text)
     _library(file)  # before the reference: a package:// one may be missing for the same reason
-    data = _read(resolve_urdf(urdf, folder), max_bytes, file)
+    data = _read(resolve_urdf(urdf, folder, allow_outside=allow_outside), max_bytes, file)
     root = _parse(data, file)
     _check_joint_elements(root, file)
     model = _model(data, file)

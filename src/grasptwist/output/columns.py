@@ -116,14 +116,27 @@ BLOCK_COLUMNS = (
         tuple(f"v{i}_{a}" for i in range(1, 4) for a in "xyz"),
         only_where_ok=False,
     ),
+    SURFACE_DISTANCE := Column(
+        "surface_distance",
+        _block(lambda b: surface_distance(b)),
+        ("surface_distance1", "surface_distance2", "surface_distance3"),
+        only_where_ok=False,
+    ),
 )
 
 #: Columns that hold screws, written in the order asked for.
 _SCREWS = {"twist"}
 
-#: Columns with NaN rows where there is no value (a grasp without a wrist):
+#: Columns with NaN rows where there is no value (a grasp without a wrist, or without an object):
 #: npz keeps the NaN, flat columns are empty there.
-_OPTIONAL = {"wrist"}
+_OPTIONAL = {"wrist", "surface_distance"}
+
+
+def surface_distance(block) -> np.ndarray:
+    """``(N, 3)`` each contact's distance from its grasp's object, NaN rows without one."""
+    if block.surface_distance is None:
+        return np.full((len(block), 3), np.nan)
+    return block.surface_distance
 
 
 def _status(key: str, block) -> np.ndarray:
@@ -301,6 +314,7 @@ FORCE_COLUMNS = (
     (Column("error", _block(lambda b: np.full(len(b), "")), ("error",), dtype="U", array=False), None),
     (Column("wrench", _block(lambda b: b.wrench), ("f_x", "f_y", "f_z", "m_x", "m_y", "m_z")), lambda b: b.has_wrench),
     (Column("friction", _block(lambda b: b.friction), ("mu1", "mu2", "mu3")), lambda b: b.has_friction),
+    (SURFACE_DISTANCE, lambda b: ~np.isnan(surface_distance(b)).any(axis=-1)),
     (Column("manipulating", _r("manipulating"), _xyz("fm")), _manipulated),
     (Column("force", _r("force"), _xyz("f")), _gripped),
     (Column("squeeze", _r("squeeze"), ("squeeze1", "squeeze2", "squeeze3")), _gripped),

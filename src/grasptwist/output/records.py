@@ -19,6 +19,7 @@ from ..engine.degeneracy import (
     CONDITION_WARNING,
     Status,
     conditioning_warning,
+    normal_disagrees_warning,
     outward_normals_warning,
     skipped_warning,
     status_message,
@@ -33,6 +34,8 @@ __all__ = [
     "ORDERS",
     "records",
     "outward_warning",
+    "disagrees_warning",
+    "surface_distances",
     "basis_record",
     "check_record",
     "error_record",
@@ -56,6 +59,8 @@ def records(block, order: str = "omega-v") -> list[dict]:
     warnings = [[] for _ in range(len(block))]
     for i in np.flatnonzero(block.outward().any(axis=-1)):
         warnings[i].append(outward_warning(block, i))
+    for i in np.flatnonzero(block.disagrees().any(axis=-1)):
+        warnings[i].append(disagrees_warning(block, i))
     objects = [(k.key, _kind_rows(block, k, order, warnings)) for k in block.kinds() if k.record is None]
     written = [(k.key, _written(k)(block, order, warnings)) for k in block.kinds() if k.record is not None]
     ok = (~block.failed_rows()).tolist()
@@ -69,19 +74,20 @@ def records(block, order: str = "omega-v") -> list[dict]:
         _contact_names(block),
         _rows(block.points),
         _rows(block.normals),
+        surface_distances(block),
         _wrists(block),
         _rows(block.velocity),
     )
-    for i, (file, grasp, units, twist_name, screw, names, p, q, c, v) in enumerate(rows):
+    for i, (file, grasp, units, twist_name, screw, names, p, q, d, c, v) in enumerate(rows):
         rec = {
             "file": file,
             "grasp": grasp,
             "units": units,
             "twist": {"name": twist_name, "screw": screw},
             "contacts": [
-                {"name": names[0], "point": p[0], "normal": q[0]},
-                {"name": names[1], "point": p[1], "normal": q[1]},
-                {"name": names[2], "point": p[2], "normal": q[2]},
+                {"name": names[0], "point": p[0], "normal": q[0], "surface_distance": d[0]},
+                {"name": names[1], "point": p[1], "normal": q[1], "surface_distance": d[1]},
+                {"name": names[2], "point": p[2], "normal": q[2], "surface_distance": d[2]},
             ],
             "wrist": c,
             "contact_velocity": v,
@@ -108,6 +114,22 @@ def outward_warning(block, i: int) -> str | None:
     does too."""
     center = block.center_of_mass is not None and not np.isnan(block.center_of_mass[i]).any()
     return outward_normals_warning(block.outward()[i].tolist(), escaped_each(block.contact_names[i]), center)
+
+
+def disagrees_warning(block, i: int) -> str | None:
+    """Row ``i``'s warning naming the contacts whose given normals are far from the object's surface
+    normal (:meth:`~grasptwist.run.batch.Block.disagrees`), or None; a force block does too."""
+    from ..engine.objects import NORMAL_DISAGREE_DEG  # with the first grasp that has an object
+
+    names = escaped_each(block.contact_names[i])
+    return normal_disagrees_warning(block.disagrees()[i], block.normal_angle[i], names, NORMAL_DISAGREE_DEG)
+
+
+def surface_distances(block) -> list:
+    """Each row's three ``surface_distance`` values, None where the grasp has no object."""
+    if block.surface_distance is None:
+        return [(None, None, None)] * len(block)
+    return [[None if d != d else d for d in row] for row in (block.surface_distance + 0.0).tolist()]
 
 
 def _contact_names(block) -> list:
@@ -187,7 +209,7 @@ def _kind_rows(block, kind, order, warnings):
 
 def talking_rows(block) -> np.ndarray:
     """Rows whose record has something for stderr: a failed or skipped kind, or a warning."""
-    talk = block.outward().any(axis=-1)
+    talk = block.outward().any(axis=-1) | block.disagrees().any(axis=-1)
     for kind in block.kinds():
         ok = block.value(kind.key, STATUS) == Status.OK
         applies = block.applies(kind.key)
@@ -208,12 +230,18 @@ def _methods_ok(rec):
 
 def _grasp_fields(block, i: int) -> dict:
     names = escaped_each(block.contact_names[i])
+    distance = surface_distances(block.take([i]))[0]
     return {
         "file": escaped(block.file[i], controls=False),
         "grasp": escaped(block.grasp[i], controls=False),
         "units": block.units[i],
         "contacts": [
-            {"name": names[c], "point": block.points[i, c].tolist(), "normal": block.normals[i, c].tolist()}
+            {
+                "name": names[c],
+                "point": block.points[i, c].tolist(),
+                "normal": block.normals[i, c].tolist(),
+                "surface_distance": distance[c],
+            }
             for c in range(3)
         ],
         "wrist": block.wrist[i].tolist() if np.isfinite(block.wrist[i]).all() else None,
@@ -226,6 +254,8 @@ def _row_objects(block, i, fields_of, order, warnings, with_failure=()):
     out = {}
     if block.outward()[i].any():
         warnings.append(outward_warning(block, i))
+    if block.disagrees()[i].any():
+        warnings.append(disagrees_warning(block, i))
     for kind in block.kinds():
         key = kind.key
         if kind.record is not None:  # a resolve-only kind (a hand's joint rates)

@@ -22,6 +22,7 @@ from ..engine.forces.grip import grip
 from ..engine.judgements import outward_contacts
 from ..engine.screws import direction
 from ..model import Grasp, GraspFileError
+from .batch import disagreeing, surface_columns
 from .options import ForceOptions
 
 __all__ = [
@@ -170,6 +171,8 @@ class ForceBlock:
     friction: np.ndarray  # (n, 3), NaN rows where there is none
     result: ForceResult
     center_of_mass: np.ndarray | None = None  # (n, 3), NaN rows where none; None: no row has one
+    surface_distance: np.ndarray | None = None  # (n, 3), as resolve's Block (run/batch.py's surface_columns)
+    normal_angle: np.ndarray | None = None
 
     def __len__(self) -> int:
         return len(self.grasp)
@@ -198,6 +201,10 @@ class ForceBlock:
         """Per row and contact ``(n, 3)``: does its normal point out of the object
         (:func:`~grasptwist.engine.judgements.outward_contacts`, as for resolve's blocks)?"""
         return outward_contacts(self.points, self.normals, self.center_of_mass)
+
+    def disagrees(self) -> np.ndarray:
+        """Per row and contact ``(n, 3)``: a given normal far from the surface's (as resolve's blocks)."""
+        return disagreeing(self.normal_angle, len(self))
 
     def failed_rows(self) -> np.ndarray:
         """Rows whose manipulating forces or grip failed."""
@@ -255,7 +262,7 @@ def _stack(rows, options) -> ForceBlock:
         mu = np.full((len(rows), 3), float(options.friction))
     else:
         mu = np.stack([nan3 if g.friction is None else g.friction for g in grasps])
-    return force_arrays(
+    block = force_arrays(
         np.stack([g.points for g in grasps]),
         np.stack([g.normals for g in grasps]),
         np.stack([nan6 if w is None else w.wrench for _, w in rows]),
@@ -270,6 +277,8 @@ def _stack(rows, options) -> ForceBlock:
         units=[g.units for g in grasps],
         contact_names=[g.contact_names for g in grasps],
     )
+    distance, angle = surface_columns(grasps)
+    return replace(block, surface_distance=distance, normal_angle=angle)
 
 
 def force_dataset_blocks(

@@ -11,12 +11,12 @@ from .forces import read_friction
 from .problems import Reject, located
 from .values import Section, read_entry_name, read_mapping, read_sequence, read_vector, readonly, shorten
 
-__all__ = ["CONTACT_KEYS", "SECTION", "read_contacts"]
+__all__ = ["CONTACT_KEYS", "NO_NORMAL", "SECTION", "read_contacts"]
 
 CONTACT_KEYS = ("name", "point", "normal", "friction")
 
-# A contact on an object that gives no normal, until the surface's is taken.
-_NO_NORMAL = (math.nan, math.nan, math.nan)
+#: The normal of a contact on an object that gives none, until the surface's is taken.
+NO_NORMAL = (math.nan, math.nan, math.nan)
 
 # What contacts look like, for the message when they are not a list.
 _CONTACTS_SHAPE = "a list of 3 contacts like [{point: [x, y, z], normal: [x, y, z]}, ...]"
@@ -54,7 +54,7 @@ def read_contacts(node, problems, on_object=False):
     if problems.count:
         return None
     # of any finite size: no over- or underflow
-    normals = [_NO_NORMAL if n is None else screws.direction3(*n) for n in normals]
+    normals = [NO_NORMAL if n is None else screws.direction3(*n) for n in normals]
     # The grasp's own ``friction`` fills the NaNs (forces.py).
     own = None if all(math.isnan(mu) for mu in friction) else readonly(friction)
     return tuple(names), readonly(np.array(points)), readonly(normals), own

@@ -10,6 +10,7 @@ import yaml
 from ...engine import screws
 from ...model import Grasp, Twist
 from .compose import PLAIN_WORDS, compose, resolve_plain
+from .contacts import NO_NORMAL
 from .document import SECTIONS
 from .problems import Problems, StreamStop
 from .values import NOT_IN_A_NAME, readonly
@@ -85,8 +86,8 @@ def fast_document(get, keep, file, reading, max_bytes):
             composed[key] = _value(get, keep)
         else:
             raise Bail
-    if contacts is None:
-        raise Bail
+    if contacts is None or ("object" not in composed and any(n is NO_NORMAL for n in contacts[2])):
+        raise Bail  # a contact without its normal needs an object
     event = get()
     keep(event)
     if type(event) is not yaml.DocumentEndEvent:
@@ -226,7 +227,7 @@ def _fast_contacts(get, keep):
                 name = _fast_name(get, keep)
             else:
                 raise Bail
-        if point is None or normal is None or not any(normal):
+        if point is None or (normal is not None and not any(normal)):
             raise Bail
         if name is None:
             name = str(len(names) + 1)
@@ -234,7 +235,7 @@ def _fast_contacts(get, keep):
             raise Bail
         names.append(name)
         points.append(point)
-        normals.append(screws.direction3(*normal))
+        normals.append(NO_NORMAL if normal is None else screws.direction3(*normal))
     if len(names) != 3:
         raise Bail
     return tuple(names), points, normals

@@ -65,12 +65,12 @@ JOINT_KEYS = ("name", "type", "axis", "point", "velocity_limit")
 JOINT_TYPES = ("revolute", "prismatic")
 
 
-def read_hand(node, points, file, problems):
+def read_hand(node, points, file, problems, allow_outside=False):
     """``(Hand, joint positions, placement)`` of a ``hand`` node, or None after a problem.
 
     ``points`` are the contacts (None: a hand file, whose rows bring their own);
     ``file`` is the grasp file, whose folder a relative ``urdf`` path stays
-    inside.  A URDF hand of a grasp file comes with its
+    inside unless ``allow_outside``.  A URDF hand of a grasp file comes with its
     :class:`~grasptwist.model.HandPlacement` (the positions are then the ones
     given, or the seed), to be put on its contacts by the run layer; else the
     placement is None.
@@ -135,7 +135,7 @@ def read_hand(node, points, file, problems):
         return None
     names = list(names)
     if urdf:
-        return _urdf_hand(fields, fingers, names, points is None, file, problems)
+        return _urdf_hand(fields, fingers, names, points is None, file, problems, allow_outside)
     taken = {}  # joint names, unique over the hand
     joints = [_joints(f["joints"], f"hand.fingers[{i}]", names[i], taken, problems) for i, f in enumerate(fingers)]
     if problems.count:
@@ -265,7 +265,7 @@ def inline_hand(names, fingers, points):
     return Hand(tuple(out), tuple(joint_names), None, None)
 
 
-def _urdf_hand(fields, fingers, names, hand_file, file, problems):
+def _urdf_hand(fields, fingers, names, hand_file, file, problems, allow_outside=False):
     """The URDF form: load the hand, with its ``joint_positions`` (checked on the contacts later)
     or ``seed`` (solved from later) and where each finger's tip stands in the file; in a hand file
     (``hand_file``), at its joint positions."""
@@ -283,7 +283,7 @@ def _urdf_hand(fields, fingers, names, hand_file, file, problems):
         return None
     folder = Path(file).parent if not file.startswith("<") else Path.cwd()
     try:
-        hand = load_urdf_hand(reference, tips, names=names, folder=folder)
+        hand = load_urdf_hand(reference, tips, names=names, folder=folder, allow_outside=allow_outside)
     except InputError as err:
         problems.add(Reject(err.code, "hand.urdf", str(err), **located(node)))
         return None
@@ -383,7 +383,7 @@ def load_hand_file(path, *, max_bytes=DEFAULT_MAX_BYTES):
 def _read(fields, found, problems):
     if "hand" not in fields:
         return {}
-    hand = read_hand(fields["hand"], found.get("points"), found["file"], problems)
+    hand = read_hand(fields["hand"], found.get("points"), found["file"], problems, found["reading"].allow_outside)
     if hand is None:
         return None
     return {"hand": hand[0], "joint_positions": readonly(hand[1]), "placement": hand[2]}

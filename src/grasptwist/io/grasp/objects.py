@@ -46,7 +46,7 @@ def read_object(node, file, reading, max_bytes, problems):
     fields = read_mapping(node, "object", OBJECT_KEYS, (), problems)
     if fields is None:
         return None
-    shapes = [key for key in SHAPE_KEYS if key in fields]
+    shapes = [key for key in fields if key in SHAPE_KEYS]  # in the file's order: the first is kept
     if not shapes:
         problems.add(Reject("missing-key", "object", f"needs one shape: {', '.join(SHAPE_KEYS)}", **located(node)))
     for key in shapes[1:]:
