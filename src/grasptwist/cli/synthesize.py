@@ -7,19 +7,23 @@ import typer
 
 from .diagnostics import Warnings
 from .exits import run_command
-from .forces import _friction, _safety
 from .options import (
     ALL,
     AllowOutside,
+    At,
     Debug,
     Digits,
+    Friction,
     Json,
     MaxBytes,
     Method,
     Output,
     Quiet,
+    Safety,
     SurfaceTol,
     SynthesizeFormat,
+    WrenchName,
+    WrenchOption,
     not_binary_to_a_terminal,
     reading_option,
     wrenches_option,
@@ -77,40 +81,17 @@ def synthesize(
         ),
     ],
     count: Annotated[int, typer.Option("-n", "--count", min=1, max=10_000, help="Grasps wanted per object.")] = 5,
-    friction: Annotated[
-        float | None,
-        typer.Option(
-            "--friction", metavar="MU", min=0, callback=_friction, help="Friction coefficient (replaces the files')."
-        ),
-    ] = None,
+    friction: Friction = None,
     mass: Annotated[
         float | None,
         typer.Option(
             "--mass", metavar="KG", callback=_checked(_mass), help="The object's mass: its weight is the wrench 'hold'."
         ),
     ] = None,
-    wrench: Annotated[
-        list[str] | None,
-        typer.Option(
-            "--wrench",
-            metavar="F,F,F,M,M,M",
-            help="A wrench every grasp must also exert (force; moment about --at); repeatable; replaces the files'.",
-        ),
-    ] = None,
-    wrench_name: Annotated[
-        list[str] | None,
-        typer.Option("--wrench-name", metavar="NAME", help="Name of each --wrench, paired in order."),
-    ] = None,
-    at: Annotated[
-        str | None,
-        typer.Option("--at", metavar="X,Y,Z", help="Point the --wrench moments are about (default: the origin)."),
-    ] = None,
-    safety: Annotated[
-        float,
-        typer.Option(
-            "--safety", metavar="S", callback=_safety, help="Safety factor >= 1: forces and closure use mu / S."
-        ),
-    ] = 1.0,
+    wrench: WrenchOption = None,
+    wrench_name: WrenchName = None,
+    at: At = None,
+    safety: Safety = 1.0,
     objective: Annotated[
         Objective, typer.Option("--objective", help="What the search minimises (epsilon: maximises).")
     ] = Objective.total_normal_force,
