@@ -120,3 +120,22 @@ def test_plot_draws_a_grasp_found(tmp_path):
     r, _ = run("plot", found, "-o", tmp_path / "g.png")
     assert r.exit_code == 0, r.stderr
     assert (tmp_path / "g.png").stat().st_size > 1000
+
+
+@pytest.mark.slow  # over a second (trimesh's and libigl's imports): docs/reference/development.md, Test time
+def test_a_mesh_file_with_the_command_line_s_friction_and_mass(tmp_path):
+    trimesh = pytest.importorskip("trimesh")
+    pytest.importorskip("igl")
+    trimesh.creation.icosphere(subdivisions=1, radius=0.04).export(tmp_path / "ball.stl")
+    found = tmp_path / "found.yaml"
+    r, _ = run(
+        "synthesize", tmp_path / "ball.stl", "--friction", "0.5", "--mass", "0.2", *FAST, "-o", found, "-f", "jsonl"
+    )
+    assert r.exit_code == 0, r.stderr
+    (rec, *_) = jsonl(r.stdout)
+    assert rec["grasp"] == "ball" and rec["scores"]["closure_friction"] < 0.5
+    assert rec["scores"]["total_normal_force"]["hold"] >= 0.2 * 9.81 / np.sqrt(1.25) * (1 - 1e-9)
+    (first, *_) = read_grasps(found)  # the mesh named beside the new file
+    assert first.object.shape.kind == "mesh" and first.mass == pytest.approx(0.2)
+    r, _ = run("synthesize", tmp_path / "ball.stl", *FAST)
+    assert r.exit_code == 1 and "no-friction" in r.stderr
