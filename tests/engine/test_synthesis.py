@@ -235,3 +235,16 @@ def test_a_ball_held_against_its_weight_reaches_the_least_total_and_its_latitude
     latitude = np.arcsin(s.points[0, carrying, 2] / 0.05)
     np.testing.assert_allclose(latitude, -np.arctan(1 / mu), atol=np.radians(2))
     _independent_checks(obj, s, [[0, 0, 0.1 * G, 0, 0, 0]], mu)
+
+
+def test_further_constraints_are_kept_and_one_nothing_passes_is_named():
+    above = 0.0325 - 0.065 / 2 + 0.01  # a table under the cube: every contact 10 mm above its bottom
+
+    def off_the_table(points, normals):
+        return (points[..., 2] > above).all(axis=-1)
+
+    s = synthesize(box(), 0.8, count=2, candidates=800, constraints=[off_the_table])
+    assert s.failure is None and (s.points[..., 2] > above).all()
+    assert s.total_normal_force[0, 0] > 0.1 * G * 1.05  # no finger under the cube: friction lifts it
+    none = synthesize(box(), 0.8, candidates=300, constraints=[lambda p, n: np.zeros(len(p), bool)])
+    assert none.failure.constraint == "constraints"

@@ -9,7 +9,9 @@ before it):
    the off-tangent one when a wrist is given);
 2. it is force closure at the friction the grip may use, ``mu / safety`` (the planar
    reduction's one test, :func:`~grasptwist.engine.forces.closure.internal_inside`);
-3. a grip exists for every wrench (the batched least grip,
+3. it passes every further constraint given (``constraints``: functions of the contacts and
+   normals, a hand's reach or a table, each ``(n, 3, 3), (n, 3, 3) -> (n,) bool``);
+4. a grip exists for every wrench (the batched least grip,
    :func:`~grasptwist.engine.forces.grip.grip`), and for each its least total normal force
 
 .. math:: \min \sum_i f_i \cdot n_i \quad \text{s.t.} \quad G f = w, \;
@@ -47,7 +49,7 @@ __all__ = [
 OBJECTIVES = ("total_normal_force", "closure_friction", "epsilon")
 
 #: The constraints in the order they are tested; a row's ``failed`` indexes this (-1: feasible).
-CONSTRAINTS = ("degenerate", "conditioning", "force_closure", "grip")
+CONSTRAINTS = ("degenerate", "conditioning", "force_closure", "constraints", "grip")
 
 #: The decompositions whose conditioning a grasp must keep above ``min_conditioning``.
 METHODS = ("off_tangent", "tangent")
@@ -132,6 +134,7 @@ def score_triples(
     wrist=None,
     methods=METHODS,
     min_conditioning=0.0,
+    constraints=(),
     tol=DEGENERACY_TOL,
 ) -> Scores:
     """Score ``N`` candidate triples against every constraint and the objective (module docstring).
@@ -144,7 +147,7 @@ def score_triples(
         The wrenches every grasp must exert (``W >= 1``).
     friction : float
         ``mu``, the same at every contact.
-    safety, objective, wrist, methods, min_conditioning, tol
+    safety, objective, wrist, methods, min_conditioning, constraints, tol
         As :func:`~grasptwist.engine.synthesis.search.search`.
 
     Returns
@@ -181,6 +184,10 @@ def score_triples(
     mu = np.full((live.size, 3), friction / safety)
     inside = internal_inside(p[live], n[live], type(geo)(*(a[live] for a in geo)), mu)
     live = live[~np.isnan(inside).any(axis=1)]
+    failed[live] = CONSTRAINTS.index("constraints")
+    for constraint in constraints:  # a hand's reach, a table, ...: after the cheap tests, before the grip
+        if live.size:
+            live = live[np.asarray(constraint(p[live], n[live]), bool)]
     failed[live] = CONSTRAINTS.index("grip")
     held = np.ones(live.size, bool)
     for k, wrench in enumerate(w if live.size else ()):  # the grip of no rows fails (an empty batch)

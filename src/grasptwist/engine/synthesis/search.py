@@ -146,7 +146,8 @@ class Synthesis:
     seed : int
     failure : Failure or None
         Why nothing was found (``K = 0``): ``constraint`` (the tightest: ``degenerate``,
-        ``conditioning``, ``force_closure`` or ``grip``), ``message``, ``best`` and ``needed``.
+        ``conditioning``, ``force_closure``, ``constraints`` or ``grip``), ``message``, ``best``
+        and ``needed``.
     """
 
     points: np.ndarray
@@ -248,6 +249,7 @@ def search(
     methods=METHODS,
     min_conditioning=0.0,
     min_spacing=None,
+    constraints=(),
     quality=False,
     seed=0,
     candidates=20000,
@@ -283,6 +285,9 @@ def search(
     min_spacing : float or None
         Returned grasps are at least this far apart (:func:`~.candidates.triple_distance`);
         None: :data:`MIN_SPACING` times the object's size.
+    constraints : sequence of callables
+        Further constraints (a hand's reach, a table), each ``(points (n, 3, 3), normals (n, 3, 3))
+        -> (n,) bool``, tested after closure and before the grip.
     quality : bool
         Compute ``epsilon`` for the returned grasps (scipy) even when it is not the objective.
     seed : int
@@ -339,6 +344,7 @@ def search(
             wrist=wrist,
             methods=methods,
             min_conditioning=min_conditioning,
+            constraints=constraints,
             tol=tol,
         )
 
@@ -480,6 +486,8 @@ def _failure(archive, mu, min_conditioning, tol) -> Failure:
             best,
             mu,
         )
+    if name == "constraints":
+        return Failure(name, "no force-closure candidate passed the further constraints", np.nan, np.nan)
     return Failure(name, "no candidate's grip holds every wrench within the friction cones", np.nan, np.nan)
 
 
