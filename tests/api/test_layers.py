@@ -24,15 +24,8 @@ PACKAGE = SRC / "grasptwist"
 #: files and writing records is the command line's (issue 22).
 FORBIDDEN = {"grasptwist.plot": ("grasptwist.io", "grasptwist.output", "grasptwist.results", "grasptwist.run")}
 
-#: Facades only re-export.
-FACADES = (
-    "grasptwist.screws",
-    "grasptwist.hand",
-    "grasptwist.forces",
-    "grasptwist.path",
-    "grasptwist.pictures",
-    "grasptwist.objects",
-)
+#: Facades only re-export: the public modules but the core, ``dask`` (which holds its own code) and the script.
+FACADES = tuple(m for m in LAYERS[-1] if m not in ("grasptwist", "grasptwist.dask", "grasptwist.__main__"))
 
 
 def module_name(path: Path) -> str:

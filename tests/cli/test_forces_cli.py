@@ -366,7 +366,7 @@ def test_an_infinite_friction_is_null_in_a_record_and_inf_in_a_table(tmp_path, m
     assert [row[-1] for row in rows[3:]] == ["0%"] * 6  # no share of an unlimited friction is used
     (tmp_path / "f.yaml").write_text(Path(SPHERE).read_text().split("---")[0] + "friction: .inf\n")
     r, (rec,) = records(tmp_path / "f.yaml")  # a file's numbers are finite: no limit is --friction inf
-    assert r.exit_code == 1 and rec["error"]["code"] == "non-finite" and rec["error"]["line"] == 45  # the line added
+    assert r.exit_code == 1 and rec["error"]["code"] == "non-finite" and rec["error"]["line"] == 47  # the line added
     assert rec["error"]["message"] == "friction: expected a finite number, got .inf"
 
 

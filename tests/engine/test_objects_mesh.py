@@ -243,6 +243,8 @@ def test_a_missing_libigl_is_one_line_naming_the_extra(monkeypatch):
     mesh = mesh_object(CUBE_VERTICES, CUBE_FACES)
     with pytest.raises(MissingExtra, match=r"needs igl: pip install libigl .*pip install -e '\.\[mesh\]'"):
         project_to_surface(mesh, [0.0, 0.0, 2.0])
+    assert mass_properties(mesh).volume == pytest.approx(1.0, rel=1e-15)  # what needs no libigl works without it
+    assert sample_surface(mesh, 3, np.random.default_rng(0))[0].shape == (3, 3)
 
 
 @pytest.mark.parametrize(

@@ -249,7 +249,6 @@ def tetra_file(tmp_path, scale="1", mesh="tetra.obj", folder="."):
 
 
 def test_a_mesh_is_read_beside_the_grasp_file_and_scaled(tmp_path):
-    pytest.importorskip("trimesh")
     (g,) = load_grasps(tetra_file(tmp_path, scale="[2, 2, 2]"))
     assert g.object.shape.kind == "mesh" and g.object.shape.source == "tetra.obj"
     assert g.object.shape.vertices.max() == 2 and len(g.object.shape.faces) == 4
@@ -270,7 +269,6 @@ def test_a_scale_must_be_positive(tmp_path, scale, expected):
 
 
 def test_a_mesh_error_is_located_at_the_mesh_key_naming_the_file(tmp_path):
-    pytest.importorskip("trimesh")
     path = tetra_file(tmp_path, mesh="none.stl")
     ((e,),) = [read_grasps(path)]
     assert (e.code, e.line, e.column) == ("read-error", 2, 9)
@@ -278,7 +276,6 @@ def test_a_mesh_error_is_located_at_the_mesh_key_naming_the_file(tmp_path):
 
 
 def test_a_mesh_outside_the_folder_needs_allow_outside(tmp_path):
-    pytest.importorskip("trimesh")
     path = tetra_file(tmp_path, mesh="../tetra.obj", folder="inner")
     ((e,),) = [read_grasps(path)]
     assert (e.code, e.line, e.column) == ("path-outside", 2, 9)
@@ -286,7 +283,6 @@ def test_a_mesh_outside_the_folder_needs_allow_outside(tmp_path):
 
 
 def test_the_size_cap_reaches_the_mesh(tmp_path):
-    pytest.importorskip("trimesh")
     path = tetra_file(tmp_path)
     (tmp_path / "tetra.obj").write_text("#" * 300 + "\n" + TETRA)  # larger than the grasp file
     ((e,),) = [read_grasps(path, max_bytes=300)]
@@ -298,7 +294,6 @@ def test_the_size_cap_reaches_the_mesh(tmp_path):
 
 
 def test_the_triangle_limit_reaches_the_mesh(tmp_path):
-    pytest.importorskip("trimesh")
     ((e,),) = [read_grasps(tetra_file(tmp_path), reading=Reading(max_triangles=3))]
     assert (e.code, e.line) == ("too-many-triangles", 2)
 
@@ -308,7 +303,6 @@ def test_the_triangle_limit_reaches_the_mesh(tmp_path):
 
 
 def test_a_folder_with_a_bad_mesh_still_runs_the_rest(tmp_path):
-    pytest.importorskip("trimesh")
     tetra_file(tmp_path, folder="a")  # a/g.yaml names a/tetra.obj: missing
     (tmp_path / "b.yaml").write_text(CUBE_GRASP.format(object=CUBE) + "twists: [{angular: [0, 0, 1]}]\n")
     result = CliRunner().invoke(app, ["resolve", str(tmp_path), "-f", "jsonl", "--method", "tangent"])
@@ -322,7 +316,6 @@ def test_a_folder_with_a_bad_mesh_still_runs_the_rest(tmp_path):
 
 
 def test_surface_tol_and_allow_outside_on_the_command_line(tmp_path):
-    pytest.importorskip("trimesh")
     path = tetra_file(tmp_path, mesh="../tetra.obj", folder="inner")
     path.write_text(path.read_text().replace("-0.01", "-0.05") + "twists: [{angular: [0, 0, 1]}]\n")
     run = lambda *args: CliRunner().invoke(app, ["check", str(path), *args])  # noqa: E731

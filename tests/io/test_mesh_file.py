@@ -1,16 +1,32 @@
 """io/mesh_file.py: a mesh read within its limits, every refusal one coded error."""
 
 import sys
+from importlib.util import find_spec
 
 import numpy as np
 import pytest
 
 from grasptwist.io.limits import MAX_TRIANGLES
-from grasptwist.io.mesh_file import read_mesh
+from grasptwist.io.mesh_file import check_mesh, read_mesh
 from grasptwist.model import InputError
 from places import GRASPS
 
-trimesh = pytest.importorskip("trimesh")
+
+@pytest.fixture
+def trimesh():
+    """trimesh, for the STL and PLY it parses: its import takes a second, so these tests are slow."""
+    return pytest.importorskip("trimesh")
+
+
+# STL and PLY go through trimesh, whose import takes a second: over a second, docs/reference/development.md, Test time
+TRIMESH = [pytest.mark.slow, pytest.mark.skipif(find_spec("trimesh") is None, reason="the mesh extra")]
+
+
+def volume(vertices, faces):
+    """The signed volume of a closed triangle mesh (> 0 wound outwards)."""
+    a, b, c = vertices[faces].transpose(1, 0, 2)
+    return float(np.einsum("ij,ij->", a, np.cross(b, c)) / 6)
+
 
 # The tetrahedron (0, 0, 0), e_x, e_y, e_z, wound counter-clockwise seen from outside.
 TETRA_V = "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"
@@ -29,17 +45,18 @@ def tetra(faces=TETRA_F, vertices=TETRA_V):
 def test_a_closed_mesh_is_read_with_its_volume_outwards(tmp_path):
     vertices, faces = read_mesh(obj(tmp_path, tetra()), tmp_path)
     assert vertices.shape == (4, 3) and faces.shape == (4, 3)
-    assert trimesh.Trimesh(vertices, faces).volume == pytest.approx(1 / 6)
+    assert volume(vertices, faces) == pytest.approx(1 / 6)
     assert not vertices.flags.writeable and not faces.flags.writeable
 
 
 def test_a_mesh_wound_inwards_is_turned_outwards(tmp_path):
     inward = [f"f {a} {c} {b}" for _, a, b, c in (f.split() for f in TETRA_F)]
     vertices, faces = read_mesh(obj(tmp_path, tetra(inward)), tmp_path)
-    assert trimesh.Trimesh(vertices, faces).volume == pytest.approx(1 / 6)
+    assert volume(vertices, faces) == pytest.approx(1 / 6)
 
 
-def test_an_stl_repeats_its_vertices_and_is_merged(tmp_path):
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
+def test_an_stl_repeats_its_vertices_and_is_merged(tmp_path, trimesh):
     trimesh.creation.box((1, 2, 3)).export(tmp_path / "box.stl")
     vertices, faces = read_mesh("box.stl", tmp_path)
     assert (len(vertices), len(faces)) == (8, 12)
@@ -49,7 +66,7 @@ def test_an_stl_repeats_its_vertices_and_is_merged(tmp_path):
 def test_the_bundled_bottle():
     vertices, faces = read_mesh("meshes/bottle.obj", GRASPS)
     assert len(faces) == 1152
-    assert trimesh.Trimesh(vertices, faces).volume == pytest.approx(6.938e-4, rel=1e-3)
+    assert volume(vertices, faces) == pytest.approx(6.938e-4, rel=1e-3)
 
 
 @pytest.mark.parametrize(
@@ -57,8 +74,11 @@ def test_the_bundled_bottle():
     [
         (tetra(), "m.step", "unsupported-mesh", r"^m.step: expected a mesh file ending in \.stl, \.obj or \.ply$"),
         ("", "m.obj", "empty-mesh", "no triangles in the mesh$"),
-        ("solid x\nendsolid x\n", "m.stl", "empty-mesh", "no triangles"),
-        (tetra(["f 1 2 9"]), "m.obj", "invalid-mesh", "^m.obj: not a readable OBJ file$"),
+        pytest.param("solid x\nendsolid x\n", "m.stl", "empty-mesh", "no triangles", marks=TRIMESH),
+        (tetra(["f 1 2 9"]), "m.obj", "invalid-mesh", "^m.obj: a face names a vertex the file does not have$"),
+        (tetra(["f 1 2 x"]), "m.obj", "invalid-mesh", "^m.obj: not a readable OBJ file$"),
+        (tetra(["f 1 2"]), "m.obj", "invalid-mesh", "^m.obj: not a readable OBJ file$"),
+        pytest.param(b"solid x\n\xff\xfe garbage", "m.stl", "empty-mesh", "no triangles", marks=TRIMESH),
         (tetra(vertices="v nan 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"), "m.obj", "non-finite", "NaN or infinite$"),
         (tetra(TETRA_F[:3]), "m.obj", "not-watertight", r"not a closed surface \(every edge shared by exactly two"),
         (tetra([*TETRA_F[:3], "f 2 4 3"]), "m.obj", "not-watertight", "wound the same way"),
@@ -76,10 +96,23 @@ def test_the_bundled_bottle():
             f"the header declares 9999999 faces, more than the limit of {MAX_TRIANGLES}$",
         ),
     ],
-    ids=["suffix", "empty", "empty-stl", "bad-index", "nan", "open", "winding", "non-manifold", "ply-header"],
+    ids=[
+        "suffix",
+        "empty",
+        "empty-stl",
+        "bad-index",
+        "bad-word",
+        "two-corners",
+        "junk-stl",
+        "nan",
+        "open",
+        "winding",
+        "non-manifold",
+        "ply-header",
+    ],
 )
 def test_each_refusal_is_one_coded_error(tmp_path, text, name, code, match):
-    (tmp_path / name).write_text(text)
+    (tmp_path / name).write_bytes(text if isinstance(text, bytes) else text.encode())
     with pytest.raises(InputError, match=match) as caught:
         read_mesh(name, tmp_path)
     assert caught.value.code == code and caught.value.file == name
@@ -92,8 +125,10 @@ def test_a_missing_file_is_a_read_error(tmp_path):
 
 
 def test_the_size_cap_is_checked_before_parsing(tmp_path, monkeypatch):
+    from grasptwist.io import mesh_file
+
     name = obj(tmp_path, tetra())
-    monkeypatch.setattr(trimesh, "load", lambda *a, **k: pytest.fail("parsed"))
+    monkeypatch.setattr(mesh_file, "_obj", lambda *a, **k: pytest.fail("parsed"))
     with pytest.raises(InputError, match="larger than the size limit of 20 bytes$") as caught:
         read_mesh(name, tmp_path, max_bytes=20)
     assert caught.value.code == "too-large"
@@ -117,8 +152,30 @@ def test_a_path_outside_the_folder_is_refused_unless_allowed(tmp_path):
     assert len(read_mesh("../m.obj", inner, allow_outside=True)[1]) == 4
 
 
-def test_without_trimesh_the_error_says_which_extra(tmp_path, monkeypatch):
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
+def test_without_trimesh_an_stl_says_which_extra_and_an_obj_is_read(tmp_path, monkeypatch, trimesh):
+    trimesh.creation.box((1, 2, 3)).export(tmp_path / "box.stl")
     monkeypatch.setitem(sys.modules, "trimesh", None)
     with pytest.raises(InputError, match=r"needs trimesh: pip install trimesh .*'\.\[mesh\]'") as caught:
-        read_mesh(obj(tmp_path, tetra()), tmp_path)
+        read_mesh("box.stl", tmp_path)
     assert caught.value.code == "mesh-unavailable"
+    assert len(read_mesh(obj(tmp_path, tetra()), tmp_path)[1]) == 4
+
+
+def test_an_obj_reads_polygons_negative_indices_and_skips_the_rest(tmp_path):
+    """A square pyramid: its base a quad, its sides by negative indices, with normals and a group."""
+    text = "o pyramid\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0.5 0.5 1\nvn 0 0 -1\ng sides\n"
+    text += "f 1//1 4//1 3//1 2//1\nf -5 -4 -1\nf -4 -3 -1\nf 3/1/1 4/1/1 5/1/1\nf 4 1 5\n"
+    vertices, faces = read_mesh(obj(tmp_path, text), tmp_path)
+    assert (len(vertices), len(faces)) == (5, 6)
+    assert volume(vertices, faces) == pytest.approx(1 / 3)
+
+
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
+def test_the_obj_reader_and_trimesh_agree_on_the_bottle(trimesh):
+    """Our OBJ lines and trimesh's parse of the same file: the same closed mesh."""
+    ours = read_mesh("meshes/bottle.obj", GRASPS)
+    mesh = trimesh.load(GRASPS / "meshes" / "bottle.obj", process=False, force="mesh")
+    theirs = check_mesh(np.asarray(mesh.vertices), np.asarray(mesh.faces), MAX_TRIANGLES, "bottle.obj")
+    for a, b in zip(ours, theirs):
+        np.testing.assert_array_equal(a, b)

@@ -192,7 +192,7 @@ def normal_angles(normals, surface_normals):
 
     .. math::
 
-        \theta_i = \\operatorname{atan2}(\\lVert \\hat n_i \times \\hat s_i \rVert, \\hat n_i \\cdot \\hat s_i)
+        \\theta_i = \\operatorname{atan2}(\\lVert \\hat n_i \\times \\hat s_i \\rVert, \\hat n_i \\cdot \\hat s_i)
 
     (accurate near 0 and 180 degrees, where the arccosine of the dot product is not).
 

@@ -124,7 +124,7 @@ def _is_file(entry: os.DirEntry) -> bool:
 
 def read(path: str, max_bytes: int | None = None, reading: Reading = READING) -> list[Grasp | GraspFileError]:
     """The grasps (or errors: one per failed document, every problem in its ``problems``)
-    of one file; ``-`` reads standard input; ``reading`` as for :func:`~grasptwist.io.grasp.read_grasps`."""
+    of one file; ``-`` reads standard input; ``reading`` as for :func:`~grasptwist.read_grasps`."""
     cap = DEFAULT_MAX_BYTES if max_bytes is None else max_bytes
     return one_per_document(read_grasps(path, max_bytes=cap, reading=reading))
 

@@ -131,7 +131,7 @@ def grasp_batches(
     """The grasps (and errors) of a JSON Lines file, or of standard input
     (``-``: JSON Lines or a YAML grasp file, as its first character says),
     in lists: one per line when the lines may come one by one; ``reading``
-    as for :func:`~grasptwist.io.grasp.read_grasps`."""
+    as for :func:`~grasptwist.read_grasps`."""
 
     def read(data, **where):
         return read_line(data, reading=reading, **where)

@@ -1,7 +1,9 @@
 """An object's triangle mesh (STL, OBJ or PLY), read as untrusted input.
 
 A grasp file's ``object: {mesh: path}`` names it; trimesh (the optional
-extra ``grasptwist[mesh]``) parses it.  Around it, as for a URDF
+extra ``grasptwist[mesh]``) parses STL and PLY, an OBJ's ``v`` and ``f``
+lines are read here (the format this project writes, without trimesh's
+second of import), and the checks are numpy's.  Around it, as for a URDF
 (:mod:`grasptwist.io.urdf`, whose path rule this shares):
 
 * the reference: a path relative to the grasp file's folder, refused when it
@@ -32,7 +34,7 @@ Every refusal is a :class:`~grasptwist.model.InputError` with a code:
 ``too-many-triangles``   more than ``max_triangles``
 ``non-finite``           a vertex coordinate that is NaN or infinite
 ``not-watertight``       an open, non-manifold or inconsistently wound surface
-``mesh-unavailable``     trimesh is not installed
+``mesh-unavailable``     trimesh is not installed (an STL or PLY)
 =======================  ==========================================================
 """
 
@@ -108,21 +110,87 @@ def read_mesh(
     data = _read(resolve_urdf(text, folder, allow_outside=allow_outside), max_bytes, text)
     if suffix == ".ply":
         _check_ply_header(data, max_triangles, text)
-    trimesh = _library(text)  # after the checks that need no parser: a refused file costs no import (1 s)
+    try:
+        vertices, faces = _obj(data) if suffix == ".obj" else _parsed(data, suffix, text)
+    except (ValueError, IndexError):
+        raise InputError("invalid-mesh", f"not a readable {suffix[1:].upper()} file", text) from None
+    return check_mesh(vertices, faces, max_triangles, text)
+
+
+def _obj(data):
+    """``(vertices, faces)`` of a Wavefront OBJ's ``v`` and ``f`` lines (polygons as fans of
+    triangles; ``a/b/c`` takes ``a``; negative indices count back from the vertices so far),
+    read here: it is the format this project writes (``grasps/meshes/make_bottle.py``), and trimesh
+    costs a second to import.  Other lines (normals, texture coordinates, groups, materials)
+    are passed over.  Raises ValueError on what does not read."""
+    vertices, faces = [], []
+    for line in data.decode("utf-8", "strict").splitlines():
+        words = line.split()
+        if not words or words[0] not in ("v", "f"):
+            continue
+        if words[0] == "v":
+            vertices.append([float(w) for w in words[1:4]])
+            continue
+        corners = [int(w.partition("/")[0]) for w in words[1:]]
+        if len(corners) < 3 or 0 in corners:
+            raise ValueError("a face needs three vertices, numbered from 1")
+        corners = [c - 1 if c > 0 else len(vertices) + c for c in corners]
+        faces += [(corners[0], corners[k], corners[k + 1]) for k in range(1, len(corners) - 1)]
+    return np.array(vertices, dtype=float).reshape(-1, 3), np.array(faces, dtype=np.int64).reshape(-1, 3)
+
+
+def _parsed(data, suffix, file):
+    """``(vertices, faces)`` of an STL or PLY file, parsed by trimesh."""
+    trimesh = _library(file)
     try:
         mesh = trimesh.load(
             trimesh.util.wrap_as_stream(data), file_type=suffix[1:], force="mesh", process=False, skip_materials=True
         )
-        vertices = np.asarray(mesh.vertices, dtype=float)
-        faces = np.asarray(mesh.faces, dtype=np.int64).reshape(-1, 3)
+        return np.asarray(mesh.vertices, dtype=float), np.asarray(mesh.faces, dtype=np.int64).reshape(-1, 3)
     except Exception:  # a parser's failure on hostile bytes has no one type; what it says varies by version
-        raise InputError("invalid-mesh", f"not a readable {suffix[1:].upper()} file", text) from None
-    return check_mesh(trimesh, vertices, faces, max_triangles, text)
+        raise ValueError(f"not a readable {suffix[1:].upper()} file") from None
 
 
-def check_mesh(trimesh, vertices, faces, max_triangles, file):
-    """``(vertices, faces)`` of a parsed mesh once it is a closed surface within the limits,
-    its duplicate vertices merged and wound outwards (see :func:`read_mesh`)."""
+def check_mesh(vertices, faces, max_triangles, file):
+    """``(vertices, faces)`` of a parsed mesh once it is a closed surface within the limits:
+    equal vertices merged (an STL repeats each per triangle), unused ones dropped, wound outwards.
+
+    A closed, consistently wound surface has each directed edge ``(a, b)`` of its triangles once,
+    and its reverse ``(b, a)`` once: an open edge has no reverse, a non-manifold one (three or more
+    triangles) or a triangle wound the other way repeats one.  Outwards: the signed volume
+
+    .. math::
+
+        V = \\frac{1}{6} \\sum_f \\mathbf v_{f,0} \\cdot (\\mathbf v_{f,1} \\times \\mathbf v_{f,2}) > 0.
+
+    Parameters
+    ----------
+    vertices : (V, 3) float array
+    faces : (F, 3) int array
+    max_triangles : int
+    file : str
+        The mesh file, as the grasp file names it (for the errors).
+
+    Returns
+    -------
+    vertices : (V', 3) float array, read-only
+    faces : (F, 3) int array, read-only
+
+    Raises
+    ------
+    InputError
+        ``empty-mesh``, ``too-many-triangles``, ``invalid-mesh``, ``non-finite`` or ``not-watertight``.
+
+    >>> tetra = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.0]])
+    >>> faces = np.array([[0, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2]])  # wound inwards
+    >>> vertices, outwards = check_mesh(tetra, faces, 10, "t.obj")
+    >>> a, b, c = vertices[outwards].transpose(1, 0, 2)
+    >>> float(np.einsum("ij,ij->", a, np.cross(b, c)) / 6)  # the tetrahedron's volume, now positive
+    0.16666666666666666
+    >>> check_mesh(tetra, faces[:3], 10, "t.obj")
+    Traceback (most recent call last):
+    grasptwist.model.GraspFileError: t.obj: not a closed surface (every edge shared by exactly two triangles, wound the same way)
+    """
     if not len(faces):
         raise InputError("empty-mesh", "no triangles in the mesh", file)
     if len(faces) > max_triangles:
@@ -131,21 +199,34 @@ def check_mesh(trimesh, vertices, faces, max_triangles, file):
         raise InputError("invalid-mesh", "a face names a vertex the file does not have", file)
     if not np.isfinite(vertices).all():
         raise InputError("non-finite", "a vertex coordinate is NaN or infinite", file)
-    mesh = trimesh.Trimesh(vertices, faces, process=False)
-    mesh.merge_vertices()  # an STL repeats each vertex per triangle: edges are shared only once merged
-    mesh.remove_unreferenced_vertices()
-    if not (mesh.is_watertight and mesh.is_winding_consistent):
+    vertices, merged = np.unique(vertices, axis=0, return_inverse=True)
+    faces = merged.reshape(-1)[faces]
+    used, faces = np.unique(faces, return_inverse=True)
+    vertices, faces = vertices[used], faces.reshape(-1, 3)
+    if not _closed(faces):
         raise InputError(
             "not-watertight",
             "not a closed surface (every edge shared by exactly two triangles, wound the same way)",
             file,
         )
-    if mesh.volume < 0:
-        mesh.invert()
-    vertices, faces = np.array(mesh.vertices, dtype=float), np.array(mesh.faces, dtype=np.int64)
-    for a in (vertices, faces):
-        a.setflags(write=False)
+    a, b, c = vertices[faces].transpose(1, 0, 2)
+    if np.einsum("ij,ij->", a, np.cross(b, c)) < 0:
+        faces = faces[:, ::-1]
+    faces = np.ascontiguousarray(faces)
+    for array in (vertices, faces):
+        array.setflags(write=False)
     return vertices, faces
+
+
+def _closed(faces):
+    """Whether each directed edge of the triangles is there once and so is its reverse."""
+    edges = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
+    if (edges[:, 0] == edges[:, 1]).any():  # a triangle with a repeated corner
+        return False
+    n = int(faces.max()) + 1
+    keys, counts = np.unique(edges[:, 0] * n + edges[:, 1], return_counts=True)
+    reverse = np.sort(edges[:, 1] * n + edges[:, 0])
+    return bool((counts == 1).all() and np.array_equal(keys, reverse))
 
 
 def _check_ply_header(data, max_triangles, file):

@@ -141,7 +141,7 @@ class Block:
 
     def disagrees(self) -> np.ndarray:
         """Per row and contact ``(n, 3)``: is its given normal more than
-        :data:`~grasptwist.engine.objects.NORMAL_DISAGREE_DEG` from its object's surface normal?"""
+        :data:`~grasptwist.objects.NORMAL_DISAGREE_DEG` from its object's surface normal?"""
         got = self.values.get(DISAGREES)
         if got is None:
             got = self.values[DISAGREES] = disagreeing(self.normal_angle, len(self))
@@ -388,7 +388,7 @@ def surface_columns(grasps) -> tuple:
 
 def disagreeing(angle, n) -> np.ndarray:
     """``(n, 3)``: the angles (None: no row has an object) beyond
-    :data:`~grasptwist.engine.objects.NORMAL_DISAGREE_DEG`."""
+    :data:`~grasptwist.objects.NORMAL_DISAGREE_DEG`."""
     if angle is None:
         return np.zeros((n, 3), bool)
     from ..engine.objects import NORMAL_DISAGREE_DEG

@@ -255,6 +255,8 @@ def _block(grasp, name, f, bases, method, positions=None) -> Block:
         center_of_mass=None
         if grasp.center_of_mass is None
         else f.poses.rotation @ grasp.center_of_mass + f.poses.position,
+        # the contacts move with the object: each keeps its distance from the surface
+        surface_distance=None if grasp.surface_distance is None else np.broadcast_to(grasp.surface_distance, (n, 3)),
     )
     return with_reasons(block)  # a method asked for by name that cannot run fails, as in resolve
 

@@ -136,16 +136,23 @@ class _Derived:
         pair = np.empty_like(order)
         pair[order[0::2]] = order[1::2]
         pair[order[1::2]] = order[0::2]
-        self.other_face = (pair // 3).reshape(-1, 3)
+        other = (pair // 3).reshape(-1, 3)
         mine = np.repeat(np.arange(len(f)), 3).reshape(-1, 3)
-        self.edge_normals = _unit(weighted[mine] + weighted[self.other_face])
-        self.edge_pseudo = self.face_normals[mine] + self.face_normals[self.other_face]
+        self.edge_normals = _unit(weighted[mine] + weighted[other])
+        self.edge_pseudo = self.face_normals[mine] + self.face_normals[other]
         self.tol = MESH_EDGE_TOL * diagonal(v)
-        igl = require("igl", "a mesh object's nearest points")
         self.vertices = np.ascontiguousarray(v, dtype=float)
         self.faces = np.ascontiguousarray(f, dtype=np.int64)
-        self.tree = igl.AABB()
-        self.tree.init(self.vertices, self.faces)
+        self._tree = None
+
+    def nearest_faces(self, q):
+        """libigl's answer for the points ``q (N, 3)``: the nearest face of each and the nearest point on it."""
+        if self._tree is None:  # the first query builds the tree: sampling and volumes need no libigl
+            igl = require("igl", "a mesh object's nearest points")  # optional (the mesh extra): imported when used
+            self._tree = igl.AABB()
+            self._tree.init(self.vertices, self.faces)
+        _, face, c = self._tree.squared_distance(self.vertices, self.faces, np.ascontiguousarray(q, dtype=float))
+        return face, c
 
 
 def _angle(u, v):
@@ -198,7 +205,7 @@ def nearest(shape: Shape, q: np.ndarray):
     d = _derived(shape)
     if len(q) == 0:
         return np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0)
-    _, face, c = d.tree.squared_distance(d.vertices, d.faces, np.ascontiguousarray(q, dtype=float))
+    face, c = d.nearest_faces(q)
     lam = _barycentric(shape, face, c)
     near_edge = lam * d.heights[face] <= d.tol  # (N, 3): on the edge opposite vertex i
     count = near_edge.sum(axis=1)

@@ -32,7 +32,7 @@ the faces that meet there; a point as far from two faces inside a box or a
 cylinder goes to the first (x before y before z; a cylinder's side before
 its caps; the positive face before the negative); a point on the axis of a
 cylinder or capsule, or at a sphere's centre, goes to the ``+x`` side.  No
-input gives NaN.
+finite input gives NaN.
 """
 
 from __future__ import annotations

@@ -31,7 +31,7 @@ def read_line(data, *, file, line, max_bytes=DEFAULT_MAX_BYTES, reading=READING)
     file; positions count from the stream's start, an unnamed grasp is
     ``stem#line`` and ``document`` is ``line - 1``.  ``max_bytes`` caps the
     line, not the stream (and each file a line names); ``reading`` as for
-    :func:`~grasptwist.io.grasp.read_grasps`.
+    :func:`~grasptwist.read_grasps`.
 
     >>> for error in read_line(b'{"contacts": []}', file="in.jsonl", line=7):
     ...     print(error)

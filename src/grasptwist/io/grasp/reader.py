@@ -64,7 +64,7 @@ class Reading:
     surface_tol : float or None
         How far a contact may be from its object's surface, relative to the
         object's size (``--surface-tol``); None:
-        :data:`grasptwist.engine.objects.SURFACE_TOL`.
+        :data:`grasptwist.objects.SURFACE_TOL`.
     allow_outside : bool
         Read a mesh (or URDF) that a relative path names outside the grasp
         file's folder (``--allow-outside``).
@@ -105,7 +105,7 @@ def read_grasps(
         The parser and per-file limits (default: the command line's).
     surface_tol : float, optional
         How far a contact may be from its object's surface, relative to the
-        object's size (default :data:`grasptwist.engine.objects.SURFACE_TOL`):
+        object's size (default :data:`grasptwist.objects.SURFACE_TOL`):
         ``reading.surface_tol``, as the command line's ``--surface-tol``.
     allow_outside : bool, optional
         Read meshes and URDFs that relative paths name outside the file's
