@@ -107,6 +107,9 @@ class Family:
     tells_progress : bool
         A progress bar and the table hint count its records (``follow`` tells
         a path by its summary instead).
+    long_inputs : bool
+        Each input is long work (``synthesize``'s searches): a progress bar even for one
+        input, advanced by the work its outputs report.
     """
 
     name: str
@@ -118,6 +121,7 @@ class Family:
     beside: Callable[..., Any] = lambda job, paths, tuning: None
     outputs: Callable[..., Iterator] | None = None
     tells_progress: bool = True
+    long_inputs: bool = False
 
 
 @dataclass(frozen=True)
@@ -316,6 +320,7 @@ SYNTHESIS = Family(
     options=SynthesisOptions,
     columns=_synthesis_columns,
     outputs=_synthesis_outputs,
+    long_inputs=True,
 )
 
 #: Every family.

@@ -13,13 +13,14 @@ from __future__ import annotations
 import os
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, replace
+from typing import NamedTuple
 
 import numpy as np
 
 from ..engine.forces.hold import hold_wrench
 from ..engine.objects import mass_properties
 from ..engine.synthesis.scores import METHODS
-from ..engine.synthesis.search import GRAVITY, Synthesis, search, surface_of
+from ..engine.synthesis.search import GRAVITY, Synthesis, search_steps, surface_of
 from ..io.grasp.forces import HOLD
 from ..io.mesh_file import MESH_SUFFIXES, read_mesh
 from ..model import Grasp, GraspFileError, GraspObject, InputError, Shape
@@ -31,7 +32,15 @@ from .outputs import Output
 from .placement import read
 from .target import opened
 
-__all__ = ["Found", "synthesize_inputs", "synthesize_outputs", "NO_OBJECT", "NOTHING_TO_HOLD", "NO_FRICTION"]
+__all__ = [
+    "Found",
+    "Progress",
+    "synthesize_inputs",
+    "synthesize_outputs",
+    "NO_OBJECT",
+    "NOTHING_TO_HOLD",
+    "NO_FRICTION",
+]
 
 #: Error codes of an input the search cannot start from.
 NO_OBJECT, NOTHING_TO_HOLD, NO_FRICTION = "no-object", "nothing-to-hold", "no-friction"
@@ -109,12 +118,21 @@ def _mesh_grasp(path: str, job) -> Grasp | GraspFileError:
     return Grasp(name, None, path, 0, _CONTACT_NAMES, p, p, None, (), 1, object=obj)
 
 
-def synthesize_inputs(job, inputs: Iterable, progress=None) -> Iterator[GraspFileError | Found]:
-    """Every object of ``inputs`` (paths or the errors of ``expand``) searched, in order."""
+class Progress(NamedTuple):
+    """Work for a progress bar: ``extra`` units found (a search's budget), ``done`` units done."""
+
+    extra: int
+    done: int
+
+
+def synthesize_inputs(job, inputs: Iterable) -> Iterator[GraspFileError | Found | Progress]:
+    """Every object of ``inputs`` (paths or the errors of ``expand``) searched, in order, with the
+    progress of each search (its candidates) and of each input (one unit)."""
     o = job.options
     for item in inputs:
         if isinstance(item, GraspFileError):
             yield item
+            yield Progress(0, 1)
             continue
         entries = (
             [_mesh_grasp(item, job)] if item.lower().endswith(MESH_SUFFIXES) else read(item, job.max_bytes, job.reading)
@@ -125,7 +143,8 @@ def synthesize_inputs(job, inputs: Iterable, progress=None) -> Iterator[GraspFil
                 yield task
                 continue
             obj, friction, names, wrenches, hold = task
-            found = search(
+            yield Progress(o.candidates, 0)
+            for step in search_steps(
                 surface_of(obj),
                 wrenches,
                 friction,
@@ -140,8 +159,10 @@ def synthesize_inputs(job, inputs: Iterable, progress=None) -> Iterator[GraspFil
                 seed=o.seed,
                 candidates=o.candidates,
                 seconds=o.seconds,
-                progress=progress,
-            )
+            ):
+                if isinstance(step, int):
+                    yield Progress(0, step)
+            yield Progress(0, o.candidates - step.candidates)  # the budget left unspent
             yield Found(
                 entry.file,
                 entry.name,
@@ -153,9 +174,10 @@ def synthesize_inputs(job, inputs: Iterable, progress=None) -> Iterator[GraspFil
                 names,
                 wrenches,
                 hold,
-                found,
+                step,
                 entry.contact_names,
             )
+        yield Progress(0, 1)
 
 
 def synthesize_outputs(job, inputs: Iterable, w, workers: int = 1, tuning=None) -> Iterator[Output]:
@@ -165,17 +187,19 @@ def synthesize_outputs(job, inputs: Iterable, w, workers: int = 1, tuning=None) 
     inputs = list(inputs)
     documents = []
     for item in synthesize_inputs(job, inputs):
+        if isinstance(item, Progress):
+            yield Output(extra_work=item.extra, done=item.done)
+            continue
         if isinstance(item, GraspFileError):
             rec = error_record(item)
             out = Output(encoded=[_encode(job, rec, error=True)], records=1)
             out.errors.extend(diagnostics(rec)[0])
             out.count(rec)
-            out.done = 1
             yield out
             continue
         if not len(item):
             rec = sr.failure_record(item)
-            out = Output(encoded=[_encode(job, rec, error=True)], records=1, done=1, notes=[_summary(item)])
+            out = Output(encoded=[_encode(job, rec, error=True)], records=1, notes=[_summary(item)])
             out.errors.extend(diagnostics(rec)[0])
             out.count(rec)
             yield out
@@ -190,7 +214,7 @@ def synthesize_outputs(job, inputs: Iterable, w, workers: int = 1, tuning=None) 
             encoded = _csv(item)
         else:
             encoded = [_encode(job, rec) for rec in recs]
-        yield Output(encoded=encoded, records=len(recs), done=1, notes=[_summary(item)])
+        yield Output(encoded=encoded, records=len(recs), notes=[_summary(item)])
     if job.options.grasp_file is not None and documents:
         with opened(job.options.grasp_file, [p for p in inputs if isinstance(p, str)]) as out:
             out.write("---\n".join(documents).encode())

@@ -23,7 +23,7 @@ of candidates (no time limit reached) two runs return the same grasps bit for bi
 from __future__ import annotations
 
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
 from functools import partial
 from typing import NamedTuple
@@ -44,6 +44,7 @@ __all__ = [
     "Failure",
     "Synthesis",
     "search",
+    "search_steps",
     "synthesize",
     "surface_of",
     "GRAVITY",
@@ -185,12 +186,11 @@ def check_budget(candidates, seconds) -> tuple[int, float | None]:
 
 
 class _Budget:
-    """Candidates and time left; ``progress(n)`` is told of every chunk scored."""
+    """Candidates and time left."""
 
-    def __init__(self, candidates, seconds, progress):
+    def __init__(self, candidates, seconds):
         self.left, self.used = candidates, 0
         self.deadline = None if seconds is None else time.perf_counter() + seconds
-        self.progress = progress
 
     def take(self, n) -> int:
         """Up to ``n`` candidates, 0 when the budget is spent."""
@@ -201,8 +201,6 @@ class _Budget:
     def spent(self, n):
         self.left -= n
         self.used += n
-        if self.progress is not None:
-            self.progress(n)
 
 
 class _Archive:
@@ -254,7 +252,6 @@ def search(
     seed=0,
     candidates=20000,
     seconds=None,
-    progress=None,
     tol=DEGENERACY_TOL,
 ) -> Synthesis:
     r"""Search ``surface`` for ``count`` three-finger grasps that exert ``wrenches`` with the least grip.
@@ -296,12 +293,14 @@ def search(
         Candidates scored at most (sampling and refinement together).
     seconds : float or None
         Time allowed, checked after each chunk of :data:`CHUNK` candidates.
-    progress : callable or None
-        Called with the number of candidates of each chunk scored.
 
     Returns
     -------
     Synthesis
+
+    See Also
+    --------
+    search_steps : the same search, telling its progress.
 
     Examples
     --------
@@ -320,6 +319,48 @@ def search(
     >>> bool(0.894 < s.total_normal_force[0, 0] < 1.0), s.failure
     (True, None)
     """
+    *_, found = search_steps(
+        surface,
+        wrenches,
+        friction,
+        count=count,
+        safety=safety,
+        objective=objective,
+        wrist=wrist,
+        methods=methods,
+        min_conditioning=min_conditioning,
+        min_spacing=min_spacing,
+        constraints=constraints,
+        quality=quality,
+        seed=seed,
+        candidates=candidates,
+        seconds=seconds,
+        tol=tol,
+    )
+    return found
+
+
+def search_steps(
+    surface: Surface,
+    wrenches,
+    friction,
+    *,
+    count=1,
+    safety=1.0,
+    objective="total_normal_force",
+    wrist=None,
+    methods=METHODS,
+    min_conditioning=0.0,
+    min_spacing=None,
+    constraints=(),
+    quality=False,
+    seed=0,
+    candidates=20000,
+    seconds=None,
+    tol=DEGENERACY_TOL,
+) -> Iterator:
+    """:func:`search`, one step at a time: yields the candidates of each chunk scored (ints), then the
+    :class:`Synthesis` (a progress bar's way through a long search)."""
     w = check_wrench(wrenches).reshape(-1, 6)
     mu = float(check_friction(friction))
     safety = check_safety(safety)
@@ -329,7 +370,7 @@ def search(
     spacing = MIN_SPACING * surface.size if min_spacing is None else float(min_spacing)
     started = time.perf_counter()
     rng = np.random.default_rng(seed)
-    budget = _Budget(budget_size, seconds, progress)
+    budget = _Budget(budget_size, seconds)
     archive = _Archive(max(ELITES, 4 * count), spacing)
     chunk = CHUNK if objective == "total_normal_force" else CHUNK // 8  # closure friction, epsilon: slower rows
 
@@ -356,12 +397,13 @@ def search(
             p, n = pool_p[t], pool_n[t]
             archive.add(p, n, score(p, n))
             budget.spent(k)
-        _refine(surface, archive, score, budget, rng)
+            yield k
+        yield from _refine(surface, archive, score, budget, rng)
     picked = _spread(archive.points, count, spacing)
     points, normals = archive.points[picked], archive.normals[picked]
     out = _results(surface, points, normals, w, mu, safety, wrist, methods, quality or objective == "epsilon", tol)
     failure = None if len(out["points"]) else _failure(archive, mu / safety, min_conditioning, tol)
-    return Synthesis(
+    yield Synthesis(
         **out,
         candidates=budget.used,
         seconds=time.perf_counter() - started,
@@ -371,7 +413,8 @@ def search(
 
 
 def _refine(surface, archive, score, budget, rng):
-    """Hill-climb the archive's best on the surface (module docstring, 2.) while the budget lasts."""
+    """Hill-climb the archive's best on the surface (module docstring, 2.) while the budget lasts;
+    yields the candidates of each round."""
     elites = min(ELITES, len(archive.objective))
     if not elites:
         return
@@ -392,6 +435,7 @@ def _refine(surface, archive, score, budget, rng):
             archive.add(q[defined], m[defined], s)
             value[defined] = s.objective
         budget.spent(k)
+        yield k
         value = value.reshape(elites, children)
         child = np.argmin(value, axis=1)
         better = value[np.arange(elites), child] < best
@@ -519,7 +563,7 @@ def synthesize(obj, friction, *, wrenches=(), hold=True, gravity=GRAVITY, **opti
         The search's keyword options: ``count`` (grasps wanted, 1), ``safety`` (1), ``objective``
         (``total_normal_force``, ``closure_friction`` or ``epsilon``), ``wrist`` (None),
         ``methods``, ``min_conditioning`` (0), ``min_spacing`` (None: 5% of the object's size),
-        ``quality`` (False), ``seed`` (0), ``candidates`` (20000), ``seconds`` (None), ``progress``.
+        ``quality`` (False), ``seed`` (0), ``candidates`` (20000), ``seconds`` (None).
 
     Returns
     -------
