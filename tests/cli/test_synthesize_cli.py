@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from grasptwist.io.grasp import read_grasps
-from hostile import jsonl, run
+from hostile import jsonl, on_a_terminal, run
 from places import GRASPS
 
 SPHERE = GRASPS / "sphere.yaml"  # two balls: 'sphere-tripod' has no friction or mass, 'sphere-equator' both
@@ -143,28 +143,7 @@ def test_a_mesh_file_with_the_command_line_s_friction_and_mass(tmp_path):
 
 @pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_a_progress_bar_on_a_terminal_for_one_object(tmp_path):
-    import os
-    import pty
-    import subprocess
-    import sys
-    from pathlib import Path
-
-    exe = Path(sys.executable).parent / "grasptwist"
-    cmd = [str(exe)] if exe.exists() else [sys.executable, "-m", "grasptwist"]
-    args = ["synthesize", str(SPHERE), "--friction", "0.5", "--mass", "1", "--candidates", "30000", "-n", "1"]
-    main, child = pty.openpty()
-    proc = subprocess.Popen(cmd + args + ["-o", str(tmp_path / "r.jsonl"), "-f", "jsonl"], stderr=child)
-    os.close(child)
-    seen = b""
-    while True:  # read as it comes: a bar redrawn for seconds fills a terminal's buffer
-        try:
-            chunk = os.read(main, 65536)
-        except OSError:
-            break
-        if not chunk:
-            break
-        seen += chunk
-    os.close(main)
-    proc.wait(timeout=120)
-    assert proc.returncode == 0 and b"grasptwist synthesize" in seen and b"candidates scored in" in seen
+    args = ["synthesize", SPHERE, "--friction", "0.5", "--mass", "1", "--candidates", "30000", "-n", "1"]
+    code, seen = on_a_terminal([*args, "-o", tmp_path / "r.jsonl", "-f", "jsonl"])
+    assert code == 0 and b"grasptwist synthesize" in seen and b"candidates scored in" in seen
     assert len((tmp_path / "r.jsonl").read_text().splitlines()) == 2

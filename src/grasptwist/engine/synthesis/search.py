@@ -235,25 +235,7 @@ class _Archive:
             self.near_normals = np.concatenate((self.near_normals, n[at]))[:_CLOSEST]
 
 
-def search(
-    surface: Surface,
-    wrenches,
-    friction,
-    *,
-    count=1,
-    safety=1.0,
-    objective="total_normal_force",
-    wrist=None,
-    methods=METHODS,
-    min_conditioning=0.0,
-    min_spacing=None,
-    constraints=(),
-    quality=False,
-    seed=0,
-    candidates=20000,
-    seconds=None,
-    tol=DEGENERACY_TOL,
-) -> Synthesis:
+def search(surface: Surface, wrenches, friction, **options) -> Synthesis:
     r"""Search ``surface`` for ``count`` three-finger grasps that exert ``wrenches`` with the least grip.
 
     Parameters
@@ -265,34 +247,38 @@ def search(
     friction : float
         ``mu`` at every contact; the forces keep within ``mu / safety``, and closure is
         required at ``mu / safety``.
-    count : int
+    **options
+        Keyword-only:
+    count : int, default 1
         The grasps wanted (fewer when fewer distinct feasible ones are found).
-    safety : float
+    safety : float, default 1
         ``>= 1``.
-    objective : str
+    objective : str, default ``total_normal_force``
         ``total_normal_force`` (the largest over the wrenches of the least total normal force),
         ``closure_friction`` (the least common friction of closure), or ``epsilon``
         (Ferrari-Canny's, maximised); less is better for the first two.
-    wrist : (3,) array or None
+    wrist : (3,) array or None, default None
         With a wrist the off-tangent decomposition's conditioning counts too.
-    methods : tuple of str
+    methods : tuple of str, default both
         Decompositions that must stay non-degenerate (:data:`~.scores.METHODS`).
-    min_conditioning : float
+    min_conditioning : float, default 0
         Their conditioning must be at least this (0 to 1).
-    min_spacing : float or None
+    min_spacing : float or None, default None
         Returned grasps are at least this far apart (:func:`~.candidates.triple_distance`);
         None: :data:`MIN_SPACING` times the object's size.
-    constraints : sequence of callables
+    constraints : sequence of callables, default none
         Further constraints (a hand's reach, a table), each ``(points (n, 3, 3), normals (n, 3, 3))
         -> (n,) bool``, tested after closure and before the grip.
-    quality : bool
+    quality : bool, default False
         Compute ``epsilon`` for the returned grasps (scipy) even when it is not the objective.
-    seed : int
+    seed : int, default 0
         Seeds the random numbers.
-    candidates : int
+    candidates : int, default 20000
         Candidates scored at most (sampling and refinement together).
-    seconds : float or None
+    seconds : float or None, default None
         Time allowed, checked after each chunk of :data:`CHUNK` candidates.
+    tol : float, default ``DEGENERACY_TOL``
+        The degeneracy tolerance of the contacts (``DEGENERACY_TOL``).
 
     Returns
     -------
@@ -319,24 +305,7 @@ def search(
     >>> bool(0.894 < s.total_normal_force[0, 0] < 1.0), s.failure
     (True, None)
     """
-    *_, found = search_steps(
-        surface,
-        wrenches,
-        friction,
-        count=count,
-        safety=safety,
-        objective=objective,
-        wrist=wrist,
-        methods=methods,
-        min_conditioning=min_conditioning,
-        min_spacing=min_spacing,
-        constraints=constraints,
-        quality=quality,
-        seed=seed,
-        candidates=candidates,
-        seconds=seconds,
-        tol=tol,
-    )
+    *_, found = search_steps(surface, wrenches, friction, **options)
     return found
 
 
