@@ -91,6 +91,13 @@ def test_bad_options_are_usage_errors(args, message):
     assert r.exit_code == 2 and message in r.stderr
 
 
+def test_a_grasp_file_that_cannot_be_written_is_refused_before_any_search(tmp_path):
+    r, _ = run("synthesize", SPHERE, "-o", tmp_path / "missing" / "found.yaml")
+    assert r.exit_code == 2 and "no folder" in r.stderr and "candidates scored" not in r.stderr
+    r, _ = run("synthesize", SPHERE, "-o", SPHERE)
+    assert r.exit_code == 2 and "it is the input" in r.stderr
+
+
 @pytest.mark.slow  # over a second (pyarrow's import): docs/reference/development.md, Test time
 def test_parquet_has_the_csv_columns(tmp_path):
     pq = pytest.importorskip("pyarrow.parquet")

@@ -6,7 +6,7 @@ from typing import Annotated
 import typer
 
 from .diagnostics import Warnings
-from .exits import run_command
+from .exits import checked_output, run_command
 from .options import (
     ALL,
     AllowOutside,
@@ -160,6 +160,10 @@ def synthesize(
     wrenches = wrenches_option(wrench, at, wrench_name)
     grasp_file = output if output is not None and output.lower().endswith(GRASP_FILE_SUFFIXES) else None
     records_to = None if grasp_file is not None else output
+    if grasp_file is not None:  # written at the end of the run: refused before any work, as a records file is
+        from ..io.inputs import expand
+
+        checked_output(grasp_file, [p for p in expand(paths) if isinstance(p, str)])
     fmt = SynthesizeFormat.json if json_ else fmt
     not_binary_to_a_terminal(fmt.value, records_to)
     job = Job(
