@@ -12,6 +12,14 @@ def rotation(rng, n=None):
     return q[0] if n is None else q
 
 
+def rigid_pose(rng):
+    """A random ``(4, 4)`` rigid pose: a random rotation, a shift in ``[-1, 1)^3``."""
+    p = np.eye(4)
+    p[:3, :3] = rotation(rng)
+    p[:3, 3] = rng.uniform(-1, 1, 3)
+    return p
+
+
 def grasps(rng, n, scale=1.0, offset=0.0):
     """``n`` random grasps well away from every degenerate condition.
 

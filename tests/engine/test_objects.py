@@ -8,7 +8,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from grasp_gen import rotation
+from grasp_gen import rigid_pose
 from grasptwist.engine.objects import (
     check_object,
     check_pose,
@@ -31,13 +31,6 @@ def obj(kind, *size, pose=None, **kw):
     return check_object(
         GraspObject(Shape(kind, np.array(size, dtype=float)), np.eye(4) if pose is None else pose, **kw)
     )
-
-
-def pose_of(rng):
-    p = np.eye(4)
-    p[:3, :3] = rotation(rng)
-    p[:3, 3] = rng.uniform(-1, 1, 3)
-    return p
 
 
 def assert_projects(o, point, surface, normal, distance):
@@ -148,7 +141,7 @@ KINDS = [obj("box", 0.03, 0.05, 0.08), obj("sphere", 0.04), obj("cylinder", 0.03
 def test_projecting_the_moved_object_moves_the_projections(o):
     rng = np.random.default_rng(3)
     q = rng.uniform(-0.1, 0.1, (200, 3))
-    pose = pose_of(rng)
+    pose = rigid_pose(rng)
     here = project_to_surface(o, q)
     there = project_to_surface(moved(o, pose), q @ pose[:3, :3].T + pose[:3, 3])
     np.testing.assert_allclose(there.points, here.points @ pose[:3, :3].T + pose[:3, 3], rtol=0, atol=1e-15)
@@ -166,7 +159,7 @@ coordinate = st.floats(-0.2, 0.2, allow_nan=False)
     seed=st.integers(0, 2**32 - 1),
 )
 def test_the_surface_point_is_on_the_surface_along_the_normal(kind, point, seed):
-    o = moved(KINDS[kind], pose_of(np.random.default_rng(seed)))
+    o = moved(KINDS[kind], rigid_pose(np.random.default_rng(seed)))
     s = project_to_surface(o, point)
     np.testing.assert_allclose(np.linalg.norm(s.normals), 1.0, rtol=0, atol=1e-15)
     # coordinates up to 1.4 (the pose's shift): a few units of 2.2e-16 each
@@ -187,7 +180,7 @@ def test_the_surface_point_is_on_the_surface_along_the_normal(kind, point, seed)
     ids=lambda x: getattr(getattr(x, "shape", None), "kind", ""),
 )
 def test_mass_properties_closed_forms(o, volume):
-    pose = pose_of(np.random.default_rng(4))
+    pose = rigid_pose(np.random.default_rng(4))
     m = mass_properties(check_object(GraspObject(o.shape, pose, density=500.0)))
     assert m.volume == pytest.approx(volume, rel=1e-15)
     assert m.mass == pytest.approx(500.0 * volume, rel=1e-15)
@@ -201,12 +194,12 @@ def test_object_size_is_the_bounding_box_diagonal():
     assert object_size(obj("sphere", 1.0)) == pytest.approx(2 * math.sqrt(3), rel=1e-15)
     assert object_size(obj("cylinder", 1.0, 1.0)) == pytest.approx(3.0, rel=1e-15)  # 2, 2, 1
     assert object_size(obj("capsule", 1.0, 2.0)) == pytest.approx(math.sqrt(24), rel=1e-15)  # 2, 2, 4
-    assert object_size(moved(obj("box", 3.0, 4.0, 12.0), pose_of(np.random.default_rng(0)))) == 13.0
+    assert object_size(moved(obj("box", 3.0, 4.0, 12.0), rigid_pose(np.random.default_rng(0)))) == 13.0
 
 
 def test_box_samples_fall_on_its_faces_in_proportion_to_their_areas():
     o = obj("box", 1.0, 2.0, 3.0)  # face areas 6, 3, 2 (x, y, z): 6/11, 3/11, 2/11 of the samples
-    pose = pose_of(np.random.default_rng(5))
+    pose = rigid_pose(np.random.default_rng(5))
     n = 20000
     p, normals = sample_surface(moved(o, pose), n, np.random.default_rng(6))
     local, inward = (p - pose[:3, 3]) @ pose[:3, :3], normals @ pose[:3, :3]
@@ -219,7 +212,7 @@ def test_box_samples_fall_on_its_faces_in_proportion_to_their_areas():
 
 @pytest.mark.parametrize("o", KINDS, ids=lambda o: o.shape.kind)
 def test_samples_lie_on_the_surface_with_its_normal_and_are_reproducible(o):
-    o = moved(o, pose_of(np.random.default_rng(7)))
+    o = moved(o, rigid_pose(np.random.default_rng(7)))
     p, n = sample_surface(o, 500, np.random.default_rng(8))
     s = project_to_surface(o, p)
     np.testing.assert_allclose(s.distance, 0.0, rtol=0, atol=1e-15)
@@ -260,7 +253,7 @@ def assert_closed(faces):
     ids=["box", "cylinder"],
 )
 def test_tessellation_is_watertight_with_the_closed_form_volume(o, volume):
-    pose = pose_of(np.random.default_rng(10))
+    pose = rigid_pose(np.random.default_rng(10))
     v, f = tessellate(moved(o, pose), segments=16)
     assert_closed(f)
     assert volume_of(v, f) == pytest.approx(volume, rel=1e-13)
@@ -335,7 +328,7 @@ def test_check_pose_refuses(pose, match):
 
 
 def test_check_pose_takes_a_rotation_to_round_off():
-    p = pose_of(np.random.default_rng(11))
+    p = rigid_pose(np.random.default_rng(11))
     assert not check_pose(p).flags.writeable
 
 

@@ -8,10 +8,12 @@ import sys
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 
 pytest.importorskip("igl")
 
-from grasp_gen import rotation  # noqa: E402
+from grasp_gen import rigid_pose  # noqa: E402
 from grasptwist.engine.objects import (  # noqa: E402
     MESH_EDGE_TOL,
     check_object,
@@ -34,13 +36,6 @@ def mesh_object(vertices, faces, pose=None, **kw):
 
 def primitive(kind, *size, pose=None):
     return check_object(GraspObject(Shape(kind, np.array(size, dtype=float)), np.eye(4) if pose is None else pose))
-
-
-def pose_of(rng):
-    p = np.eye(4)
-    p[:3, :3] = rotation(rng)
-    p[:3, 3] = rng.uniform(-1, 1, 3)
-    return p
 
 
 def angle(a, b):
@@ -71,7 +66,7 @@ SPHERE = tessellate(primitive("sphere", RADIUS), segments=32)  # 16 bands of lat
 
 
 def sphere_against_mesh(vertices, faces, rng):
-    pose = pose_of(rng)
+    pose = rigid_pose(rng)
     mesh = mesh_object(vertices, faces, pose)
     sphere = primitive("sphere", RADIUS, pose=pose)
     q = pose[:3, 3] + rng.uniform(-0.08, 0.08, (2000, 3))
@@ -111,7 +106,7 @@ def test_mesh_mass_properties_agree_with_trimesh():
     m = trimesh.creation.torus(0.05, 0.015, major_sections=24, minor_sections=12)
     m.apply_translation([0.3, -0.2, 0.1])
     m = trimesh.util.concatenate([m, trimesh.creation.box([0.02, 0.03, 0.04])])  # two bodies, one off-centre
-    pose = pose_of(np.random.default_rng(1))
+    pose = rigid_pose(np.random.default_rng(1))
     props = mass_properties(mesh_object(m.vertices, m.faces, pose, density=800.0))
     assert props.volume == pytest.approx(m.volume, rel=1e-12)
     assert props.mass == pytest.approx(800.0 * m.volume, rel=1e-12)
@@ -119,7 +114,7 @@ def test_mesh_mass_properties_agree_with_trimesh():
 
 
 def test_mesh_mass_properties_closed_forms():
-    pose = pose_of(np.random.default_rng(1))
+    pose = rigid_pose(np.random.default_rng(1))
     box = tessellate(primitive("box", 0.02, 0.03, 0.04))
     torus = torus_mesh(0.05, 0.015, 24, 12)
     # two bodies: the box (volume 2.4e-5) at the origin, the torus shifted by (0.3, -0.2, 0.1)
@@ -138,7 +133,7 @@ def test_mesh_mass_properties_closed_forms():
 
 
 def test_a_box_mesh_answers_as_the_box_off_its_edges():
-    box = primitive("box", 0.02, 0.04, 0.06, pose=pose_of(np.random.default_rng(2)))
+    box = primitive("box", 0.02, 0.04, 0.06, pose=rigid_pose(np.random.default_rng(2)))
     mesh = mesh_object(*tessellate(box))
     rng = np.random.default_rng(3)
     q = rng.uniform(-1.5, 1.5, (3000, 3)) * np.array([0.01, 0.02, 0.03])
@@ -162,6 +157,48 @@ def test_inside_and_outside_of_a_torus_as_its_closed_form():
     assert clear.sum() > 3000
     np.testing.assert_array_equal(np.sign(got[clear]), np.sign(exact[clear]))
     assert np.abs(got - exact).max() < 1e-3
+
+
+def winding_number(vertices, faces, q):
+    """The generalized winding number of each point (Van Oosterom and Strackee's solid angles): 1 inside, 0 outside."""
+    a, b, c = (vertices[faces[:, i]][None] - q[:, None] for i in range(3))
+    la, lb, lc = (np.linalg.norm(x, axis=-1) for x in (a, b, c))
+    det = np.einsum("pfi,pfi->pf", a, np.cross(b, c))
+    dots = (
+        np.einsum("pfi,pfi->pf", a, b) * lc + np.einsum("pfi,pfi->pf", b, c) * la + np.einsum("pfi,pfi->pf", c, a) * lb
+    )
+    return (2 * np.arctan2(det, la * lb * lc + dots)).sum(axis=1) / (4 * np.pi)
+
+
+def test_points_a_hair_from_a_torus_mesh_are_inside_or_outside_as_its_winding_number_says():
+    vertices, faces = torus_mesh(0.05, 0.015, 16, 8)  # concave inside the hole, convex outside
+    mesh = mesh_object(vertices, faces)
+    rng = np.random.default_rng(10)
+    near = np.concatenate(
+        [vertices, 0.5 * (vertices[faces[:, 0]] + vertices[faces[:, 1]]), sample_surface(mesh, 100, rng)[0]]
+    )
+    step = rng.normal(size=near.shape)
+    q = near + step / np.linalg.norm(step, axis=1, keepdims=True) * 10 ** rng.uniform(
+        -7, -4, (len(near), 1)
+    ) * object_size(mesh)
+    inside = winding_number(vertices, faces, q) > 0.5
+    assert 0.3 < inside.mean() < 0.7
+    np.testing.assert_array_equal(project_to_surface(mesh, q).distance < 0, inside)
+
+
+TORUS = mesh_object(*torus_mesh(0.05, 0.015, 16, 8))
+coordinate = st.floats(-0.08, 0.08, allow_nan=False)
+
+
+@settings(max_examples=20, deadline=None)
+@given(point=st.tuples(coordinate, coordinate, coordinate))
+def test_a_mesh_point_is_its_distance_away_on_the_surface(point):
+    s = project_to_surface(TORUS, point)
+    assert np.linalg.norm(np.asarray(point) - s.points) == pytest.approx(abs(s.distance), rel=0, abs=1e-16)
+    np.testing.assert_allclose(np.linalg.norm(s.normals), 1.0, rtol=0, atol=1e-15)
+    again = project_to_surface(TORUS, s.points)
+    assert abs(again.distance) <= 1e-16  # sizes about 0.1: round-off
+    np.testing.assert_allclose(again.points, s.points, rtol=0, atol=1e-16)
 
 
 def test_edges_and_vertices_take_the_area_weighted_normal_of_their_faces():
@@ -193,7 +230,7 @@ def test_edges_and_vertices_take_the_area_weighted_normal_of_their_faces():
 
 
 def test_mesh_samples_lie_on_their_faces_and_are_reproducible():
-    mesh = mesh_object(*torus_mesh(0.05, 0.015, 16, 8), pose_of(np.random.default_rng(5)))
+    mesh = mesh_object(*torus_mesh(0.05, 0.015, 16, 8), rigid_pose(np.random.default_rng(5)))
     p, n = sample_surface(mesh, 400, np.random.default_rng(6))
     s = project_to_surface(mesh, p)
     assert np.abs(s.distance).max() < 1e-15  # coordinates about 1: round-off
@@ -210,7 +247,7 @@ def test_mesh_samples_spread_by_area():
 
 
 def test_a_mesh_tessellates_as_itself_in_the_grasp_frame():
-    pose = pose_of(np.random.default_rng(8))
+    pose = rigid_pose(np.random.default_rng(8))
     v, f = tessellate(mesh_object(*SPHERE, pose))
     np.testing.assert_allclose(v, SPHERE[0] @ pose[:3, :3].T + pose[:3, 3], rtol=0, atol=1e-15)
     np.testing.assert_array_equal(f, SPHERE[1])
@@ -219,7 +256,7 @@ def test_a_mesh_tessellates_as_itself_in_the_grasp_frame():
 def test_moving_a_mesh_moves_its_projections():
     mesh = mesh_object(*torus_mesh(0.05, 0.015, 16, 8))
     rng = np.random.default_rng(9)
-    q, pose = rng.uniform(-0.07, 0.07, (300, 3)), pose_of(rng)
+    q, pose = rng.uniform(-0.07, 0.07, (300, 3)), rigid_pose(rng)
     here = project_to_surface(mesh, q)
     there = project_to_surface(moved(mesh, pose), q @ pose[:3, :3].T + pose[:3, 3])
     np.testing.assert_allclose(there.points, here.points @ pose[:3, :3].T + pose[:3, 3], rtol=0, atol=1e-14)

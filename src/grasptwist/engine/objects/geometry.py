@@ -6,14 +6,17 @@ the object's frame through its pose :math:`T = (R, t)`, :math:`q = R^T (p - t)`,
 are answered there by ``primitives`` (exact) or ``mesh``, and come
 back as :math:`R c + t` (points) and :math:`R n` (normals).  Normals point
 into the object, as a grasp's do; distances are signed, > 0 outside, so that
-every point ``p`` satisfies
+a point ``p`` satisfies
 
 .. math::
 
     c = p + d\, n
 
 with ``c`` its nearest surface point, ``d`` its signed distance and ``n``
-the unit inward normal there.
+the unit inward normal there: every point for a primitive; for a mesh,
+those whose nearest point is inside a face (at an edge or vertex ``n`` is
+the normal of the faces there, not the direction from ``p``, and only
+:math:`|c - p| = |d|` holds).
 """
 
 from __future__ import annotations
@@ -104,7 +107,9 @@ def project_to_surface(obj: GraspObject, points) -> SurfacePoints:
 
     .. math::
 
-        c = p + d\, n, \qquad |d| = \min_{s \in \partial O} |p - s|
+        |d| = \min_{s \in \partial O} |p - s| = |c - p|, \qquad c = p + d\, n
+
+    (the second for a mesh only inside a face).
 
     Parameters
     ----------
