@@ -244,3 +244,14 @@ def test_the_bottle_script_makes_the_committed_mesh(tmp_path):
     np.testing.assert_array_equal(made[1], committed[1])
     np.testing.assert_allclose(made[0], committed[0], rtol=0, atol=1e-6)
     assert committed[1].shape == (1152, 3) and committed[0].shape == (578, 3)
+
+
+def test_the_bottles_density_gives_its_weight():
+    """1000 kg/m^3 over the mesh's 693.8 cm^3 is 0.6938 kg, held at its centre of mass on the axis
+    (the volume and centre as test_mesh_file.py's signed volume and trimesh give them)."""
+    (g,) = load_grasps(GRASPS / "bottle.yaml")
+    assert g.object.density == 1000 and g.object.mass == pytest.approx(0.69382, rel=1e-4)
+    (hold,) = g.wrenches
+    np.testing.assert_allclose(hold.wrench[:3], [0, 0, g.object.mass * 9.81], rtol=1e-12)
+    np.testing.assert_allclose(hold.wrench[3:], 0, atol=1e-15)  # the centre is on the vertical axis
+    np.testing.assert_allclose(g.center_of_mass, [0, 0, 0.09183], atol=1e-5)

@@ -3,6 +3,8 @@ the surface, and every mistake a located error; a mesh file through io/mesh_file
 
 import numpy as np
 import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
 from typer.testing import CliRunner
 
 from grasptwist.cli import app
@@ -155,6 +157,14 @@ def test_a_surface_tolerance_must_be_a_number_at_least_zero():
             ("unknown-key", 3, 10, "object.pose.place: unknown key (expected one of: position, rotation, rotvec)"),
         ),
         ("  [1, 2]", ("not-a-mapping", 2, 3, "object: expected a mapping, got a list")),
+        (
+            "  box: [1e308, 1e308, 1e308]",
+            ("non-finite", 2, 3, "object: its size overflows double precision: rescale it"),
+        ),
+        (
+            "  sphere: 1e103\n  density: 10",
+            ("non-finite", 3, 12, "object.density: the mass (density x volume) overflows double precision"),
+        ),
     ],
     ids=lambda v: v if isinstance(v, str) and not v.startswith(" ") else None,
 )
@@ -330,3 +340,33 @@ def test_surface_tol_and_allow_outside_on_the_command_line(tmp_path):
 def test_a_grasp_file_error_is_a_grasp_file_error():
     with pytest.raises(GraspFileError, match=r"^g\.yaml:2:11: object\.sphere: must be > 0, got -1\.0$"):
         grasp("  sphere: -1")
+
+
+# --------------------------------------------------------------------------
+# Anything under `object`: a grasp or located errors, never an exception.
+
+_VALUES = st.one_of(
+    st.sampled_from([0, -1, 1, 0.5, 1e308, -1e-308, ".nan", "x", None, True, "m.obj", "../m.stl", "m.ply"]),
+    st.lists(st.sampled_from([0, 1, -2, 0.1, "a"]), max_size=4),
+    st.dictionaries(
+        st.sampled_from(["radius", "height", "position", "rotation", "rotvec", "r"]), st.integers(-2, 2), max_size=3
+    ),
+)
+_OBJECTS = st.dictionaries(
+    st.sampled_from(["box", "sphere", "cylinder", "capsule", "mesh", "scale", "pose", "density", "mass", "colour"]),
+    _VALUES,
+    max_size=4,
+)
+
+
+@settings(max_examples=25, deadline=None, database=None)
+@given(obj=_OBJECTS)
+def test_any_object_gives_a_grasp_or_located_errors(obj):
+    import json
+
+    text = CUBE_GRASP.format(object="  " + json.dumps(obj).replace('".nan"', ".nan"))
+    for entry in read_grasps(text, file="g.yaml"):
+        if isinstance(entry, GraspFileError):
+            assert entry.line is not None and entry.column is not None, entry
+        else:
+            assert entry.object is not None and np.isfinite(entry.points).all()

@@ -24,6 +24,8 @@ mesh is read by :mod:`grasptwist.io.mesh_file`.
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 from ...model import GraspObject, InputError, Shape
@@ -82,11 +84,30 @@ def read_object(node, file, reading, max_bytes, problems):
         return None
     pose.setflags(write=False)
     obj = GraspObject(shape, pose, mass=mass, density=density, line=node.line)
+    from ...engine.objects import mass_properties, object_size
+
+    if not np.isfinite(object_size(obj)):
+        problems.add(Reject("non-finite", "object", "its size overflows double precision: rescale it", **located(node)))
+        return None
     if density is None:
         return obj
-    from ...engine.objects import mass_properties
-
-    return GraspObject(shape, pose, mass=float(mass_properties(obj).mass), density=density, line=node.line)
+    try:
+        with np.errstate(over="ignore", invalid="ignore"):
+            weighed = float(mass_properties(obj).mass)
+    except OverflowError:  # a volume beyond a double, in Python floats
+        weighed = math.inf
+    if not np.isfinite(weighed):
+        where = fields["density"]
+        problems.add(
+            Reject(
+                "non-finite",
+                "object.density",
+                "the mass (density x volume) overflows double precision",
+                **located(where),
+            )
+        )
+        return None
+    return GraspObject(shape, pose, mass=weighed, density=density, line=node.line)
 
 
 def _shape(kind, fields, file, reading, max_bytes, problems):
