@@ -152,3 +152,26 @@ def summary(records: list[dict]) -> str:
         if isinstance(r.get(key), dict) and "error" in r[key]
     )
     return summary_line(len(records), len(degenerate), sum("error" in r for r in records), codes)
+
+
+def on_a_terminal(args, timeout=120):
+    """``grasptwist ARGS`` with stderr on a pseudo-terminal: (exit status, what the terminal got).
+
+    The terminal is read as the command writes (a progress bar redrawn for long enough would
+    fill its buffer and stop the command)."""
+    import pty
+
+    main, child = pty.openpty()
+    proc = subprocess.Popen(entry_point() + [str(a) for a in args], stderr=child)
+    os.close(child)
+    seen = b""
+    while True:
+        try:
+            chunk = os.read(main, 65536)
+        except OSError:  # the command closed its end
+            break
+        if not chunk:
+            break
+        seen += chunk
+    os.close(main)
+    return proc.wait(timeout=timeout), seen

@@ -58,6 +58,9 @@ _EXPORTS = {
     "Grip": ".engine.forces.grip",
     "prepare_grip": ".engine.forces.grip",
     "PreparedGrip": ".engine.forces.grip",
+    # finding grasps on an object's surface
+    "synthesize": ".engine.synthesis.search",
+    "Synthesis": ".engine.synthesis.search",
     # the topics
     "screws": ".screws",
     "hand": ".hand",

@@ -19,7 +19,7 @@ from grasptwist.cli import app
 from grasptwist.io.grasp import grasp_schema
 from grasptwist.output.columns import CSV_COLUMNS
 from grasptwist.output.writers import JsonArray
-from hostile import run_installed
+from hostile import on_a_terminal, run_installed
 
 # Example 2's polyhedron, with a wrist off the contacts' plane x + y + z = 4
 POLY = """\
@@ -325,25 +325,9 @@ def test_two_workers_write_exactly_what_one_writes(files):
 
 @pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_a_progress_bar_on_a_terminal(files):
-    import pty
-
-    exe = Path(sys.executable).parent / "grasptwist"
-    cmd = [str(exe)] if exe.exists() else [sys.executable, "-m", "grasptwist"]
     out = files / "out.jsonl"
-    main, child = pty.openpty()
-    proc = subprocess.run(cmd + ["resolve", str(files), "-f", "jsonl", "-o", str(out)], stderr=child, timeout=60)
-    os.close(child)
-    seen = b""
-    while True:
-        try:
-            chunk = os.read(main, 65536)
-        except OSError:
-            break
-        if not chunk:
-            break
-        seen += chunk
-    os.close(main)
-    assert proc.returncode == 1 and b"grasptwist resolve" in seen and b"3 records: 1 with a degenerate method" in seen
+    code, seen = on_a_terminal(["resolve", files, "-f", "jsonl", "-o", out], timeout=60)
+    assert code == 1 and b"grasptwist resolve" in seen and b"3 records: 1 with a degenerate method" in seen
     assert len(out.read_text().splitlines()) == 3
 
 

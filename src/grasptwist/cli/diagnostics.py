@@ -97,6 +97,8 @@ class Diagnostics:
         if not self.quiet:
             for line in out.warnings:
                 self.warn(line)
+            for line in out.notes:
+                to_stderr(line)
         if self.hint and self.records > TABLE_HINT_AT:
             to_stderr(self.hint)
             self.hint = None
@@ -203,17 +205,17 @@ def table_hint(formats) -> str:
 
 
 @contextmanager
-def progress_bar(inputs: list, command: str, out, shown: bool = True):
+def progress_bar(inputs: list, command: str, out, shown: bool = True, long_inputs: bool = False):
     """A rich progress bar on stderr, named after ``command``, when it is a
-    terminal and there is more than one input or a data set (whose records
-    are counted as they come); not when the output ``out`` goes to a
+    terminal and there is more than one input, a data set (whose records
+    are counted as they come) or ``long_inputs`` (each input long work); not when the output ``out`` goes to a
     terminal too, where it shows the progress itself (and a bar would be
     drawn between its lines), nor when not ``shown`` (a command whose
     outputs do not count the inputs done).  Yields the function that
     advances it by a pipeline Output."""
     from ..io.datasets import DATASET_SUFFIXES
 
-    big = len(inputs) > 1 or any(isinstance(p, str) and p.endswith(DATASET_SUFFIXES) for p in inputs)
+    big = long_inputs or len(inputs) > 1 or any(isinstance(p, str) and p.endswith(DATASET_SUFFIXES) for p in inputs)
     if not shown or not big or not _stderr_is_terminal() or out.isatty():
         yield lambda output: None
         return

@@ -8,17 +8,22 @@ from .diagnostics import Warnings
 from .exits import run_command
 from .options import (
     AllowOutside,
+    At,
     Debug,
     Digits,
     ForcesFormat,
+    Friction,
     Json,
     MaxBytes,
     Output,
     Paths,
     Quiet,
+    Safety,
     SurfaceTol,
     WarningsOption,
     Workers,
+    WrenchName,
+    WrenchOption,
     not_binary_to_a_terminal,
     reading_option,
     wrenches_option,
@@ -26,22 +31,6 @@ from .options import (
 from .records import OutputSettings, write_records
 
 __all__ = ["forces"]
-
-
-def _friction(value: float | None) -> float | None:
-    """NaN is no coefficient: refused as a negative one is (``inf``, no limit, is one)."""
-    if value is not None and value != value:
-        raise typer.BadParameter("must be a number >= 0 (inf: no limit), got nan")
-    return value
-
-
-def _safety(value: float) -> float:
-    from ..engine.forces.grasp_map import check_safety  # the force engine loads only when forces runs
-
-    try:
-        return check_safety(value)
-    except ValueError as err:
-        raise typer.BadParameter(str(err)) from None
 
 
 def _cone_edges(value: int) -> int:
@@ -55,46 +44,11 @@ def _cone_edges(value: int) -> int:
 
 def forces(
     paths: Paths,
-    wrench: Annotated[
-        list[str] | None,
-        typer.Option(
-            "--wrench",
-            metavar="F,F,F,M,M,M",
-            help="Wrench the fingers exert on the object (force; moment about --at); repeatable; "
-            "replaces the files' wrenches.",
-        ),
-    ] = None,
-    wrench_name: Annotated[
-        list[str] | None,
-        typer.Option(
-            "--wrench-name",
-            metavar="NAME",
-            help="Name of each --wrench in the records, paired in order (default: the wrench as written).",
-        ),
-    ] = None,
-    at: Annotated[
-        str | None,
-        typer.Option("--at", metavar="X,Y,Z", help="Point the --wrench moments are about (default: the origin)."),
-    ] = None,
-    friction: Annotated[
-        float | None,
-        typer.Option(
-            "--friction",
-            metavar="MU",
-            min=0,
-            callback=_friction,
-            help="Friction coefficient of every contact (replaces the files'; inf: no limit).",
-        ),
-    ] = None,
-    safety: Annotated[
-        float,
-        typer.Option(
-            "--safety",
-            metavar="S",
-            callback=_safety,
-            help="Safety factor >= 1: forces keep within mu / S, closure is judged with it.",
-        ),
-    ] = 1.0,
+    wrench: WrenchOption = None,
+    wrench_name: WrenchName = None,
+    at: At = None,
+    friction: Friction = None,
+    safety: Safety = 1.0,
     quality: Annotated[
         bool, typer.Option("--quality", help="Also Ferrari-Canny's epsilon (needs scipy: grasptwist[quality]).")
     ] = False,

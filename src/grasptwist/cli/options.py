@@ -67,6 +67,7 @@ ResolveFormat = _choices("Format", COMMANDS["resolve"].formats)
 RecordFormat = _choices("RecordFormat", COMMANDS["basis"].formats)
 FollowFormat = _choices("FollowFormat", COMMANDS["follow"].formats)
 ForcesFormat = _choices("ForcesFormat", COMMANDS["forces"].formats)
+SynthesizeFormat = _choices("SynthesizeFormat", COMMANDS["synthesize"].formats)
 #: ``plot --method``: the bases that can be drawn.
 PlotMethod = _choices("PlotMethod", [k.label for k in KINDS if k.method])
 #: The default of ``--method``: every method.
@@ -186,6 +187,65 @@ WarningsOption = Annotated[
 ]
 Debug = Annotated[bool, typer.Option("--debug", help="Show the Python traceback of an internal error.")]
 Json = Annotated[bool, typer.Option("--json", help="Same as --format json.")]
+
+
+def _friction(value: float | None) -> float | None:
+    """NaN is no coefficient: refused as a negative one is (``inf``, no limit, is one)."""
+    if value is not None and value != value:
+        raise typer.BadParameter("must be a number >= 0 (inf: no limit), got nan")
+    return value
+
+
+def _safety(value: float) -> float:
+    from ..engine.forces.grasp_map import check_safety  # the force engine loads only when a force command runs
+
+    try:
+        return check_safety(value)
+    except ValueError as err:
+        raise typer.BadParameter(str(err)) from None
+
+
+# the force commands' options (forces, synthesize)
+WrenchOption = Annotated[
+    list[str] | None,
+    typer.Option(
+        "--wrench",
+        metavar="F,F,F,M,M,M",
+        help="Wrench the fingers exert on the object (force; moment about --at); repeatable; "
+        "replaces the files' wrenches.",
+    ),
+]
+WrenchName = Annotated[
+    list[str] | None,
+    typer.Option(
+        "--wrench-name",
+        metavar="NAME",
+        help="Name of each --wrench in the records, paired in order (default: the wrench as written).",
+    ),
+]
+At = Annotated[
+    str | None,
+    typer.Option("--at", metavar="X,Y,Z", help="Point the --wrench moments are about (default: the origin)."),
+]
+Friction = Annotated[
+    float | None,
+    typer.Option(
+        "--friction",
+        metavar="MU",
+        min=0,
+        callback=_friction,
+        help="Friction coefficient of every contact (replaces the files'; inf: no limit).",
+    ),
+]
+Safety = Annotated[
+    float,
+    typer.Option(
+        "--safety",
+        metavar="S",
+        callback=_safety,
+        help="Safety factor >= 1: forces keep within mu / S, closure is judged with it.",
+    ),
+]
 Workers = Annotated[
     int,
     typer.Option(

@@ -42,7 +42,7 @@ def write_records(job, paths: list[str], settings: OutputSettings) -> int:
     fmt = FORMATS[job.fmt]
     with (
         output_target(settings.output, [*inputs, *settings.reads]) as out,
-        progress_bar(inputs, job.command.name, out, counted) as advance,
+        progress_bar(inputs, job.command.name, out, counted, job.family.long_inputs) as advance,
     ):
         w = fmt.open(out, job, **settings.table_options)
         # block writers (npz) take results in the run; the others get records encoded where they were made

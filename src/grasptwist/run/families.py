@@ -57,10 +57,21 @@ from ..output.formats import FORMATS
 from ..output.json_rows import encode_records
 from ..output.records import basis_record, check_record, dumps, records, talking_rows
 from .batch import ZERO_TWIST, dataset_blocks, resolve
-from .options import FollowOptions, ForceOptions, TwistOptions
+from .options import FollowOptions, ForceOptions, SynthesisOptions, TwistOptions
 from .stream import twist_stream
 
-__all__ = ["Family", "Contribution", "Command", "FAMILIES", "COMMANDS", "TWIST", "WRENCH", "PATH", "CLOSURE"]
+__all__ = [
+    "Family",
+    "Contribution",
+    "Command",
+    "FAMILIES",
+    "COMMANDS",
+    "TWIST",
+    "WRENCH",
+    "PATH",
+    "SYNTHESIS",
+    "CLOSURE",
+]
 
 
 @dataclass(frozen=True)
@@ -96,6 +107,9 @@ class Family:
     tells_progress : bool
         A progress bar and the table hint count its records (``follow`` tells
         a path by its summary instead).
+    long_inputs : bool
+        Each input is long work (``synthesize``'s searches): a progress bar even for one
+        input, advanced by the work its outputs report.
     """
 
     name: str
@@ -107,6 +121,7 @@ class Family:
     beside: Callable[..., Any] = lambda job, paths, tuning: None
     outputs: Callable[..., Iterator] | None = None
     tells_progress: bool = True
+    long_inputs: bool = False
 
 
 @dataclass(frozen=True)
@@ -285,8 +300,31 @@ PATH = Family(
     tells_progress=False,
 )
 
+# -- grasps synthesised ---------------------------------------------------------
+
+
+def _synthesis_outputs(job, inputs, w, workers, tuning):
+    from .synthesize import synthesize_outputs  # the search, with the first synthesize
+
+    return synthesize_outputs(job, inputs, w, workers, tuning)
+
+
+def _synthesis_columns():
+    from ..output.synthesis_records import SYNTHESIS_COLUMNS
+
+    return SYNTHESIS_COLUMNS
+
+
+SYNTHESIS = Family(
+    name="synthesis",
+    options=SynthesisOptions,
+    columns=_synthesis_columns,
+    outputs=_synthesis_outputs,
+    long_inputs=True,
+)
+
 #: Every family.
-FAMILIES: tuple[Family, ...] = (TWIST, WRENCH, PATH)
+FAMILIES: tuple[Family, ...] = (TWIST, WRENCH, PATH, SYNTHESIS)
 
 # -- commands -----------------------------------------------------------------
 
@@ -317,6 +355,12 @@ def _sample_records(samples, job):
     from ..output.follow_records import sample_records
 
     return sample_records(samples, job.order)
+
+
+def _synthesis_records(found, job):
+    from ..output.synthesis_records import synthesis_records
+
+    return synthesis_records(found)
 
 
 def _force_records(block, job):
@@ -353,5 +397,12 @@ COMMANDS: dict[str, Command] = {
         ),
         Command("follow", PATH, (*_RECORDS, "csv", "npz"), _sample_records, "follow_table.FollowTable"),
         Command("forces", WRENCH, _ROWS, _force_records, "table.ForceTableWriter"),
+        Command(
+            "synthesize",
+            SYNTHESIS,
+            (*_RECORDS, "csv", "parquet"),
+            _synthesis_records,
+            "synthesis_records.SynthesisTable",
+        ),
     )
 }

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 from ..model import Twist, Wrench
 
-__all__ = ["TwistOptions", "ForceOptions", "FollowOptions"]
+__all__ = ["TwistOptions", "ForceOptions", "FollowOptions", "SynthesisOptions"]
 
 
 def _count(given) -> int:
@@ -87,3 +87,30 @@ class FollowOptions:
     samples: int | None = None
     dt: float | None = None
     bases: bool = True
+
+
+@dataclass(frozen=True)
+class SynthesisOptions:
+    """The synthesis family's options: what ``grasptwist synthesize`` searches for, and how long.
+
+    ``friction`` (``--friction``), ``mass`` (``--mass``: the object's weight, at its centre of
+    mass, is the wrench ``hold``) and ``wrenches`` (``--wrench``) replace a grasp file's;
+    ``count`` (``-n``) grasps are wanted, at least ``min_spacing`` apart; ``candidates`` and
+    ``seconds`` bound the search; ``grasp_file`` (``-o FILE.yaml``) receives the grasps found.
+    The rest go to :func:`grasptwist.engine.synthesis.search.search`.
+    """
+
+    count: int = 5
+    friction: float | None = None
+    mass: float | None = None
+    wrenches: tuple[Wrench, ...] | None = None
+    safety: float = 1.0
+    objective: str = "total_normal_force"
+    method: str = "both"
+    min_conditioning: float = 1e-3
+    min_spacing: float | None = None
+    quality: bool = False
+    seed: int = 0
+    candidates: int = 20000
+    seconds: float | None = 60.0
+    grasp_file: str | None = None

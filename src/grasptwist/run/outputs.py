@@ -22,6 +22,7 @@ class Output:
     errors: list[str] = field(default_factory=list)  # always printed
     row_errors: list[str] = field(default_factory=list)  # of a data set's or stream's rows: printed like warnings
     warnings: list[str] = field(default_factory=list)
+    notes: list[str] = field(default_factory=list)  # what a run says of itself (synthesize's search): not with -q
     records: int = 0
     failed: int = 0  # records not ok: inputs that failed, and grasps (or rows) with a degenerate method
     inputs_failed: int = 0  # of ``failed``: inputs (files, documents, lines of a stream) that could not be read

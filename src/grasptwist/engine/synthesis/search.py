@@ -1,0 +1,559 @@
+r"""The search: candidate triples scored in chunks, the best refined on the surface, each returned grasp verified.
+
+1. **Sampling.**  Chunks of candidates (:func:`~.candidates.candidate_triples` over fresh
+   area-weighted samples of the surface) are scored by :func:`~.scores.score_triples`;
+   an archive keeps the best feasible ones.
+2. **Refinement.**  The archive's best grasps are perturbed in their tangent planes,
+   put back on the surface and re-scored (a contact put on an edge or corner, where
+   the normal is not defined, is not); an improvement replaces its parent, a round
+   without one halves that grasp's step.
+   Without a feasible grasp to refine, the budget goes on sampling.
+3. **Selection.**  The best grasps in order, each at least ``min_spacing`` from those
+   before it (:func:`~.candidates.triple_distance`).
+4. **Verification.**  Each is solved again, one row at a time, by the exact grip
+   (:func:`~grasptwist.engine.forces.grip.grip`), whose certificate (``dual`` with a zero
+   ``gap``, ``n_i - G_i^T dual`` in every dual cone) proves the total optimal; one that
+   fails is not returned.
+
+The budget holds: the search stops after ``candidates`` scored rows or ``seconds``,
+whichever comes first, checked after every chunk.  With the same ``seed`` and a budget
+of candidates (no time limit reached) two runs return the same grasps bit for bit.
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable, Iterator
+from dataclasses import dataclass
+from functools import partial
+from typing import NamedTuple
+
+import numpy as np
+
+from ..degeneracy import DEGENERACY_TOL
+from ..forces.closure import force_closure
+from ..forces.grasp_map import check_friction, check_safety, check_wrench
+from ..forces.grip import Grip, grip
+from ..forces.hold import hold_wrench
+from ..objects import mass_properties, object_size, project_to_surface, sample_surface
+from .candidates import candidate_triples, tangent_steps, triple_distance
+from .scores import CONSTRAINTS, METHODS, check_min_conditioning, check_objective, conditionings, score_triples
+
+__all__ = [
+    "Surface",
+    "Failure",
+    "Synthesis",
+    "search",
+    "search_steps",
+    "synthesize",
+    "surface_of",
+    "GRAVITY",
+    "verified",
+    "check_budget",
+    "CHUNK",
+    "MIN_SPACING",
+    "REFINE_SHARE",
+    "GAP_TOL",
+]
+
+#: Gravity when none is given: 9.81 down the z axis (as grasp files').
+GRAVITY = (0.0, 0.0, -9.81)
+
+#: Candidates scored together (the grip's batches stay in cache; the budget is checked after each).
+CHUNK = 2048
+
+#: The default ``min_spacing``, relative to the object's size.
+MIN_SPACING = 0.05
+
+#: The share of the candidate budget spent refining the best grasps found by sampling.
+REFINE_SHARE = 0.3
+
+#: Grasps refined at once, and perturbations of each per round.
+ELITES, CHILDREN = 16, 16
+
+#: A verified grip's duality gap must be within this of its total (relative).
+GAP_TOL = 1e-6
+
+#: Normals closer than this (cosine) are the same: a contact whose normal turns when put on the
+#: surface again sits on an edge, where the surface has no one normal.
+_SAME_NORMAL = 1 - 1e-9
+
+#: Candidates whose closure friction is computed to say how close a failed search came.
+_CLOSEST = 256
+
+
+class Surface(NamedTuple):
+    """An object's surface as the search needs it (in the grasp frame).
+
+    Attributes
+    ----------
+    sample : callable
+        ``sample(n, rng) -> (points (n, 3), normals (n, 3))``: area-weighted points and unit
+        inward normals, reproducible for a ``numpy.random.Generator``.
+    project : callable
+        ``project(points (..., 3)) -> (points, normals, distance)``: the nearest surface
+        points, their unit inward normals and the signed distance.
+    size : float
+        The object's size (the diagonal of its bounding box): the scale of steps and spacing.
+    """
+
+    sample: Callable
+    project: Callable
+    size: float
+
+
+class Failure(NamedTuple):
+    """Why a search found no feasible grasp.
+
+    Attributes
+    ----------
+    constraint : str
+        The tightest constraint (:data:`~.scores.CONSTRAINTS`): the furthest any candidate got.
+    message : str
+        In words, with how close the best candidate came.
+    best, needed : float
+        That constraint's best value among the candidates and the value it needed
+        (NaN where it has no number: the grip).
+    """
+
+    constraint: str
+    message: str
+    best: float
+    needed: float
+
+
+@dataclass(frozen=True, eq=False)
+class Synthesis:
+    """The grasps a search returns, best first, and what the search did.
+
+    Attributes
+    ----------
+    points, normals : (K, 3, 3)
+        Each grasp's contacts and unit inward normals.
+    surface_distance : (K, 3)
+        Each contact's distance from the surface (round-off: they are put on it).
+    total_normal_force : (K, W)
+        Each wrench's least total normal force, from the verified grip.
+    closure_friction : (K,)
+    epsilon : (K,) or None
+        Ferrari-Canny's epsilon at ``mu / safety`` (asked for, or the objective).
+    conditioning : (K, 2)
+        Of the off-tangent and the tangent decomposition (NaN where not asked, or without a wrist).
+    grips : tuple of tuple of Grip
+        The verified grip of each grasp and wrench (one row each).
+    candidates : int
+        Candidates scored.
+    seconds : float
+    seed : int
+    failure : Failure or None
+        Why nothing was found (``K = 0``): ``constraint`` (the tightest: ``degenerate``,
+        ``conditioning``, ``force_closure``, ``constraints`` or ``grip``), ``message``, ``best``
+        and ``needed``.
+    """
+
+    points: np.ndarray
+    normals: np.ndarray
+    surface_distance: np.ndarray
+    total_normal_force: np.ndarray
+    closure_friction: np.ndarray
+    epsilon: np.ndarray | None
+    conditioning: np.ndarray
+    grips: tuple
+    candidates: int
+    seconds: float
+    seed: int
+    failure: Failure | None
+
+
+def check_budget(candidates, seconds) -> tuple[int, float | None]:
+    """A search's budget: ``candidates`` a positive integer, ``seconds`` None or a positive number.
+
+    >>> check_budget(1000, None)
+    (1000, None)
+    >>> check_budget(0, 1.0)
+    Traceback (most recent call last):
+    ValueError: candidates must be a positive integer, got 0
+    >>> check_budget(10, float("inf"))
+    Traceback (most recent call last):
+    ValueError: seconds must be a positive finite number or None, got inf
+    """
+    if not (isinstance(candidates, (int, np.integer)) and not isinstance(candidates, bool) and candidates > 0):
+        raise ValueError(f"candidates must be a positive integer, got {candidates!r}")
+    number = isinstance(seconds, (int, float, np.integer, np.floating)) and not isinstance(seconds, bool)
+    if seconds is not None and not (number and 0 < seconds < np.inf):
+        raise ValueError(f"seconds must be a positive finite number or None, got {seconds!r}")
+    return int(candidates), None if seconds is None else float(seconds)
+
+
+class _Budget:
+    """Candidates and time left."""
+
+    def __init__(self, candidates, seconds):
+        self.left, self.used = candidates, 0
+        self.deadline = None if seconds is None else time.perf_counter() + seconds
+
+    def take(self, n) -> int:
+        """Up to ``n`` candidates, 0 when the budget is spent."""
+        if self.deadline is not None and time.perf_counter() >= self.deadline:
+            return 0
+        return max(0, min(n, self.left))
+
+    def spent(self, n):
+        self.left -= n
+        self.used += n
+
+
+class _Archive:
+    """The best feasible candidates so far (at most ``size``, each ``spacing`` or more from the better
+    ones, so that refinement and selection start from distinct grasps), and the furthest any got."""
+
+    def __init__(self, size, spacing):
+        self.size, self.spacing = size, spacing
+        self.points = np.empty((0, 3, 3))
+        self.normals = np.empty((0, 3, 3))
+        self.objective = np.empty(0)
+        self.furthest = 0
+        self.near_points, self.near_normals = np.empty((0, 3, 3)), np.empty((0, 3, 3))
+        self.best_conditioning = 0.0
+
+    def add(self, p, n, s):
+        ok = s.failed == -1
+        self.points = np.concatenate((self.points, p[ok]))
+        self.normals = np.concatenate((self.normals, n[ok]))
+        self.objective = np.concatenate((self.objective, s.objective[ok]))
+        order = np.argsort(self.objective, kind="stable")[: 8 * self.size]
+        keep = order[_spread(self.points[order], self.size, self.spacing)]
+        self.points, self.normals, self.objective = self.points[keep], self.normals[keep], self.objective[keep]
+        reached = np.where(s.failed == -1, len(CONSTRAINTS), s.failed)
+        self.furthest = max(self.furthest, int(reached.max(initial=0)))
+        worst = np.fmin(s.conditioning[:, 0], s.conditioning[:, 1])  # the asked methods' smaller
+        self.best_conditioning = max(self.best_conditioning, float(np.nanmax(worst, initial=0.0)))
+        closure = CONSTRAINTS.index("force_closure")
+        at = reached >= closure
+        if at.any() and len(self.near_points) < _CLOSEST:
+            self.near_points = np.concatenate((self.near_points, p[at]))[:_CLOSEST]
+            self.near_normals = np.concatenate((self.near_normals, n[at]))[:_CLOSEST]
+
+
+def search(surface: Surface, wrenches, friction, **options) -> Synthesis:
+    r"""Search ``surface`` for ``count`` three-finger grasps that exert ``wrenches`` with the least grip.
+
+    Parameters
+    ----------
+    surface : Surface
+    wrenches : (W, 6) array
+        Wrenches the fingers must exert, ``(force; moment about the origin)`` (to hold a weight:
+        :func:`~grasptwist.engine.forces.hold.hold_wrench`).
+    friction : float
+        ``mu`` at every contact; the forces keep within ``mu / safety``, and closure is
+        required at ``mu / safety``.
+    **options
+        Keyword-only:
+    count : int, default 1
+        The grasps wanted (fewer when fewer distinct feasible ones are found).
+    safety : float, default 1
+        ``>= 1``.
+    objective : str, default ``total_normal_force``
+        ``total_normal_force`` (the largest over the wrenches of the least total normal force),
+        ``closure_friction`` (the least common friction of closure), or ``epsilon``
+        (Ferrari-Canny's, maximised); less is better for the first two.
+    wrist : (3,) array or None, default None
+        With a wrist the off-tangent decomposition's conditioning counts too.
+    methods : tuple of str, default both
+        Decompositions that must stay non-degenerate (:data:`~.scores.METHODS`).
+    min_conditioning : float, default 0
+        Their conditioning must be at least this (0 to 1).
+    min_spacing : float or None, default None
+        Returned grasps are at least this far apart (:func:`~.candidates.triple_distance`);
+        None: :data:`MIN_SPACING` times the object's size.
+    constraints : sequence of callables, default none
+        Further constraints (a hand's reach, a table), each ``(points (n, 3, 3), normals (n, 3, 3))
+        -> (n,) bool``, tested after closure and before the grip.
+    quality : bool, default False
+        Compute ``epsilon`` for the returned grasps (scipy) even when it is not the objective.
+    seed : int, default 0
+        Seeds the random numbers.
+    candidates : int, default 20000
+        Candidates scored at most (sampling and refinement together).
+    seconds : float or None, default None
+        Time allowed, checked after each chunk of :data:`CHUNK` candidates.
+    tol : float, default ``DEGENERACY_TOL``
+        The degeneracy tolerance of the contacts (``DEGENERACY_TOL``).
+
+    Returns
+    -------
+    Synthesis
+
+    See Also
+    --------
+    search_steps : the same search, telling its progress.
+
+    Examples
+    --------
+    A unit ball (inward normals ``-p``) held against 1 N of weight with ``mu = 0.5``: no grasp
+    needs less than ``1 / sqrt(1 + mu^2) = 0.894`` (a contact lifts at most ``sqrt(1 + mu^2)``
+    per newton of normal force), far below the equator's ``1 / mu = 2``:
+
+    >>> def sample(n, rng):
+    ...     p = rng.normal(size=(n, 3))
+    ...     p /= np.linalg.norm(p, axis=1, keepdims=True)
+    ...     return p, -p
+    >>> def project(q):
+    ...     r = np.linalg.norm(q, axis=-1, keepdims=True)
+    ...     return q / r, -q / r, r[..., 0] - 1
+    >>> s = search(Surface(sample, project, 2 * 3**0.5), [[0, 0, 1.0, 0, 0, 0]], 0.5, candidates=1000)
+    >>> bool(0.894 < s.total_normal_force[0, 0] < 1.0), s.failure
+    (True, None)
+    """
+    *_, found = search_steps(surface, wrenches, friction, **options)
+    return found
+
+
+def search_steps(
+    surface: Surface,
+    wrenches,
+    friction,
+    *,
+    count=1,
+    safety=1.0,
+    objective="total_normal_force",
+    wrist=None,
+    methods=METHODS,
+    min_conditioning=0.0,
+    min_spacing=None,
+    constraints=(),
+    quality=False,
+    seed=0,
+    candidates=20000,
+    seconds=None,
+    tol=DEGENERACY_TOL,
+) -> Iterator:
+    """:func:`search`, one step at a time: yields the candidates of each chunk scored (ints), then the
+    :class:`Synthesis` (a progress bar's way through a long search)."""
+    w = check_wrench(wrenches).reshape(-1, 6)
+    mu = float(check_friction(friction))
+    safety = check_safety(safety)
+    objective = check_objective(objective)
+    min_conditioning = check_min_conditioning(min_conditioning)
+    budget_size, seconds = check_budget(candidates, seconds)
+    spacing = MIN_SPACING * surface.size if min_spacing is None else float(min_spacing)
+    started = time.perf_counter()
+    rng = np.random.default_rng(seed)
+    budget = _Budget(budget_size, seconds)
+    archive = _Archive(max(ELITES, 4 * count), spacing)
+    chunk = CHUNK if objective == "total_normal_force" else CHUNK // 8  # closure friction, epsilon: slower rows
+
+    def score(p, n):
+        return score_triples(
+            p,
+            n,
+            w,
+            mu,
+            safety=safety,
+            objective=objective,
+            wrist=wrist,
+            methods=methods,
+            min_conditioning=min_conditioning,
+            constraints=constraints,
+            tol=tol,
+        )
+
+    # sampling, then refining; with nothing to refine, sampling all the way
+    for until in (budget_size - int(REFINE_SHARE * budget_size), budget_size):
+        while (k := budget.take(min(chunk, until - budget.used))) > 0:
+            pool_p, pool_n = surface.sample(k, rng)
+            t = candidate_triples(pool_p, pool_n, k, rng)
+            p, n = pool_p[t], pool_n[t]
+            archive.add(p, n, score(p, n))
+            budget.spent(k)
+            yield k
+        yield from _refine(surface, archive, score, budget, rng)
+    picked = _spread(archive.points, count, spacing)
+    points, normals = archive.points[picked], archive.normals[picked]
+    out = _results(surface, points, normals, w, mu, safety, wrist, methods, quality or objective == "epsilon", tol)
+    failure = None if len(out["points"]) else _failure(archive, mu / safety, min_conditioning, tol)
+    yield Synthesis(
+        **out,
+        candidates=budget.used,
+        seconds=time.perf_counter() - started,
+        seed=seed,
+        failure=failure,
+    )
+
+
+def _refine(surface, archive, score, budget, rng):
+    """Hill-climb the archive's best on the surface (module docstring, 2.) while the budget lasts;
+    yields the candidates of each round."""
+    elites = min(ELITES, len(archive.objective))
+    if not elites:
+        return
+    p, n, best = archive.points[:elites].copy(), archive.normals[:elites].copy(), archive.objective[:elites].copy()
+    step = np.full(elites, 0.05 * surface.size)
+    while (children := budget.take(elites * CHILDREN) // elites) > 0:  # the last round may be smaller
+        k = elites * children
+        parent = np.repeat(np.arange(elites), children)
+        moved = rng.random((k, 3)) < 2 / 3
+        moved[np.arange(k), rng.integers(0, 3, k)] = True  # at least one contact moves
+        q = p[parent] + tangent_steps(n[parent], step[parent, None] * moved, rng)
+        q, m, _ = surface.project(q)
+        # a point put on an edge or corner has no one normal: projected again, its normal may turn
+        defined = (np.einsum("nix,nix->ni", surface.project(q)[1], m) > _SAME_NORMAL).all(axis=1)
+        value = np.full(k, np.inf)
+        if defined.any():
+            s = score(q[defined], m[defined])
+            archive.add(q[defined], m[defined], s)
+            value[defined] = s.objective
+        budget.spent(k)
+        yield k
+        value = value.reshape(elites, children)
+        child = np.argmin(value, axis=1)
+        better = value[np.arange(elites), child] < best
+        rows = np.arange(elites)[better] * children + child[better]
+        p[better], n[better], best[better] = q[rows], m[rows], value[better, child[better]]
+        step = np.where(better, step, step / 2)
+
+
+def _spread(points, count, spacing):
+    """Indices of up to ``count`` of the grasps ``points (N, 3, 3)``, in order, each ``spacing`` or more
+    from those picked before it (:func:`~.candidates.triple_distance`)."""
+    picked = []
+    for i in range(len(points)):
+        if len(picked) == count:
+            break
+        if not picked or triple_distance(points[i], points[picked]).min() >= spacing:
+            picked.append(i)
+    return np.array(picked, int)
+
+
+def verified(points, normals, wrench, friction, safety, tol=DEGENERACY_TOL) -> Grip | None:
+    r"""The exact grip of one grasp and wrench when its certificate proves it optimal, else None.
+
+    One row through :func:`~grasptwist.engine.forces.grip.grip`; its ``dual`` must close the gap
+    (``|total - w . dual| <= GAP_TOL max(total, 1)``) and be dual feasible:
+    ``n_i - G_i^T dual`` (``G_i^T dual = dual_F + dual_M x p_i``) in each dual cone
+    ``(mu / s) |z_t| <= z_n``, to :data:`GAP_TOL`.
+
+    >>> p = np.array([[1.0, 0, 0], [-0.5, 0.75**0.5, -0.2], [-0.5, -(0.75**0.5), -0.2]])
+    >>> g = verified(p, -p / np.linalg.norm(p, axis=1, keepdims=True), [0, 0, 1.0, 0, 0, 0], 0.5, 1.0)
+    >>> g is not None and bool(g.ok)
+    True
+    """
+    g = grip(points, normals, wrench, friction, safety=safety, tol=tol)
+    if not g.ok:
+        return None
+    total = float(g.total_normal_force)
+    if not abs(float(g.gap)) <= GAP_TOL * max(total, 1.0):
+        return None
+    n = np.asarray(normals, float)
+    n = n / np.linalg.norm(n, axis=-1, keepdims=True)
+    z = n - (g.dual[:3] + np.cross(g.dual[3:], np.asarray(points, float)))
+    zn = np.sum(z * n, axis=-1)
+    zt = np.linalg.norm(z - zn[:, None] * n, axis=-1)
+    return g if ((friction / safety) * zt - zn <= GAP_TOL).all() else None
+
+
+def _results(surface, points, normals, w, mu, safety, wrist, methods, quality, tol):
+    """The returned grasps' fields of :class:`Synthesis`, each grasp verified (the others dropped)."""
+    grips, keep = [], []
+    for i in range(len(points)):
+        found = tuple(verified(points[i], normals[i], wrench, mu, safety, tol) for wrench in w)
+        if all(g is not None for g in found):
+            grips.append(found)
+            keep.append(i)
+    p, n = points[keep], normals[keep]
+    closure = force_closure(p, n, mu / safety, quality=quality, tol=tol) if len(p) else None
+    return {
+        "points": p,
+        "normals": n,
+        "surface_distance": np.abs(surface.project(p)[2]) if len(p) else np.empty((0, 3)),
+        "total_normal_force": np.array([[float(g.total_normal_force) for g in row] for row in grips]).reshape(
+            len(p), len(w)
+        ),
+        "closure_friction": closure.closure_friction if closure else np.empty(0),
+        "epsilon": (closure.epsilon if closure else np.empty(0)) if quality else None,
+        "conditioning": conditionings(p, n, wrist, methods, tol) if len(p) else np.empty((0, 2)),
+        "grips": tuple(grips),
+    }
+
+
+def _failure(archive, mu, min_conditioning, tol) -> Failure:
+    """Why no candidate was feasible: the furthest constraint any reached, and how close the best came."""
+    name = CONSTRAINTS[min(archive.furthest, len(CONSTRAINTS) - 1)]
+    if name == "degenerate":
+        return Failure(name, "every candidate's contacts were degenerate (coincident or collinear)", 0.0, tol)
+    if name == "conditioning":
+        best = archive.best_conditioning
+        return Failure(
+            name,
+            f"no candidate's conditioning reached {min_conditioning:g} (the best: {best:.3g})",
+            best,
+            min_conditioning,
+        )
+    if name == "force_closure":
+        needed = force_closure(archive.near_points, archive.near_normals, tol=tol).closure_friction
+        best = float(np.nanmin(needed, initial=np.inf))
+        words = "no friction" if not np.isfinite(best) else f"friction {best:.3g}"
+        return Failure(
+            name,
+            f"no candidate is force closure at friction {mu:g} (friction / safety); the best needs {words}",
+            best,
+            mu,
+        )
+    if name == "constraints":
+        return Failure(name, "no force-closure candidate passed the further constraints", np.nan, np.nan)
+    return Failure(name, "no candidate's grip holds every wrench within the friction cones", np.nan, np.nan)
+
+
+def surface_of(obj) -> Surface:
+    """The :class:`Surface` of a :class:`~grasptwist.model.GraspObject` (``grasptwist.engine.objects``)."""
+    return Surface(partial(sample_surface, obj), partial(project_to_surface, obj), object_size(obj))
+
+
+def synthesize(obj, friction, *, wrenches=(), hold=True, gravity=GRAVITY, **options) -> Synthesis:
+    r"""Grasps of an object: its surface searched for grasps that hold its weight and ``wrenches``.
+
+    The search (``grasptwist.engine.synthesis.search.search``; the guide's synthesis page) scores
+    candidate triples in batches against the constraints (degeneracy and conditioning of the
+    decompositions, force closure at ``friction / safety``, a grip for every wrench), refines the
+    best on the surface and verifies each grasp it returns by the exact grip and its certificate.
+
+    Parameters
+    ----------
+    obj : GraspObject
+        With a ``mass`` or ``density`` when ``hold`` (the weight ``m g`` at its centre of mass).
+    friction : float
+        ``mu`` at every contact.
+    wrenches : sequence of (6,) arrays
+        More wrenches every grasp must exert, ``(force; moment about the origin)``.
+    hold : bool
+        Hold the object's weight: the wrench ``(-m g; -c x m g)`` comes first.
+    gravity : (3,) array
+    **options
+        The search's keyword options: ``count`` (grasps wanted, 1), ``safety`` (1), ``objective``
+        (``total_normal_force``, ``closure_friction`` or ``epsilon``), ``wrist`` (None),
+        ``methods``, ``min_conditioning`` (0), ``min_spacing`` (None: 5% of the object's size),
+        ``quality`` (False), ``seed`` (0), ``candidates`` (20000), ``seconds`` (None).
+
+    Returns
+    -------
+    Synthesis
+
+    Examples
+    --------
+    A 65 mm cube of 100 g, ``mu = 0.8``:
+
+    >>> from grasptwist.objects import GraspObject, Shape
+    >>> cube = GraspObject(Shape("box", np.full(3, 0.065)), np.eye(4), mass=0.1)
+    >>> s = synthesize(cube, 0.8, count=2, candidates=1000)
+    >>> s.points.shape, bool((s.closure_friction < 0.8).all())
+    ((2, 3, 3), True)
+    """
+    listed = [np.asarray(w, float).reshape(6) for w in wrenches]
+    if hold:
+        props = mass_properties(obj)
+        if props.mass is None:
+            raise ValueError("hold=True needs the object's mass (or density): its weight is the wrench to hold")
+        listed.insert(0, hold_wrench(props.mass, props.center_of_mass, np.asarray(gravity, float)))
+    if not listed:
+        raise ValueError("nothing to hold: give the object a mass (hold=True) or wrenches")
+    return search(surface_of(obj), np.array(listed), friction, **options)

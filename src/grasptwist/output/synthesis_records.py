@@ -1,0 +1,309 @@
+"""The records of ``grasptwist synthesize``, their columns, their table and the grasp file they make.
+
+A search's result (:class:`grasptwist.run.synthesize.Found`: its file, grasp name, wrench
+names, contact names and the engine's :class:`~grasptwist.engine.synthesis.search.Synthesis`)
+gives one record per grasp, best first::
+
+    {"file", "grasp", "rank", "ok": true,
+     "contacts": [{"name", "point", "normal", "surface_distance"}, x3],
+     "scores": {"total_normal_force": {wrench name: N}, "closure_friction",
+                "epsilon" (or null), "conditioning": {"off_tangent", "tangent"} (null: not asked)},
+     "search": {"candidates", "seconds", "seed"}, "warnings": []}
+
+A search that finds nothing gives one error record (``no-grasp``) naming the tightest
+constraint and how close the best candidate came.  The flat columns (CSV, Parquet)
+give the largest total over the wrenches as ``total_normal_force``.  Nothing is computed
+here: the records say what the search found.
+"""
+
+from __future__ import annotations
+
+import os
+from enum import IntEnum
+from typing import IO
+
+import numpy as np
+import yaml
+
+from .columns import ColumnSet
+from .csv_rows import lines
+from .names import escaped
+from .numbers import fmt_number
+
+__all__ = [
+    "NO_GRASP",
+    "synthesis_records",
+    "failure_record",
+    "grasp_documents",
+    "SYNTHESIS_COLUMNS",
+    "SynthesisTable",
+]
+
+#: The error code of a search that found no feasible grasp.
+NO_GRASP = "no-grasp"
+
+_METHODS = ("off_tangent", "tangent")
+
+
+def _float(v):
+    return None if v is None or not np.isfinite(v) else float(v)
+
+
+def synthesis_records(found) -> list[dict]:
+    """One record per grasp found, best first (module docstring)."""
+    s = found.synthesis
+    search = {"candidates": int(s.candidates), "seconds": float(s.seconds), "seed": int(s.seed)}
+    out = []
+    for k in range(len(s.points)):
+        contacts = [
+            {
+                "name": found.contact_names[i],
+                "point": s.points[k, i].tolist(),
+                "normal": s.normals[k, i].tolist(),
+                "surface_distance": float(s.surface_distance[k, i]),
+            }
+            for i in range(3)
+        ]
+        scores = {
+            "total_normal_force": {name: float(v) for name, v in zip(found.wrench_names, s.total_normal_force[k])},
+            "closure_friction": _float(s.closure_friction[k]),
+            "epsilon": None if s.epsilon is None else _float(s.epsilon[k]),
+            "conditioning": {m: _float(c) for m, c in zip(_METHODS, s.conditioning[k])},
+        }
+        out.append(
+            {
+                "file": escaped(found.file, controls=False),
+                "grasp": escaped(found.name, controls=False),
+                "rank": k + 1,
+                "ok": True,
+                "contacts": contacts,
+                "scores": scores,
+                "search": search,
+                "warnings": [],
+            }
+        )
+    return out
+
+
+def failure_record(found) -> dict:
+    """The one record of a search that found nothing: why, as an error (exit 1)."""
+    f, s = found.synthesis.failure, found.synthesis
+    error = {
+        "code": NO_GRASP,
+        "message": f"grasp '{found.name}': no feasible grasp in {s.candidates} candidates: {f.message}",
+        "line": found.line,
+        "column": None,
+        "constraint": f.constraint,
+        "best": _float(f.best),
+        "needed": _float(f.needed),
+    }
+    return {
+        "file": escaped(found.file, controls=False),
+        "grasp": escaped(found.name, controls=False),
+        "ok": False,
+        "error": error,
+        "errors": [error],
+        "search": {"candidates": int(s.candidates), "seconds": float(s.seconds), "seed": int(s.seed)},
+    }
+
+
+def _object_node(obj, folder):
+    """The ``object`` section of a grasp file for ``obj`` (a mesh's path relative to ``folder``)."""
+    shape = obj.shape
+    if shape.kind == "mesh":
+        node = {"mesh": os.path.relpath(os.path.abspath(shape.source), folder)}
+    elif shape.kind == "box":
+        node = {"box": shape.size.tolist()}
+    elif shape.kind == "sphere":
+        node = {"sphere": float(shape.size[0])}
+    else:
+        node = {shape.kind: {"radius": float(shape.size[0]), "height": float(shape.size[1])}}
+    rotation, position = obj.pose[:3, :3], obj.pose[:3, 3]
+    if not np.array_equal(obj.pose, np.eye(4)):
+        node["pose"] = {"position": position.tolist(), "rotation": _quaternion(rotation)}
+    if obj.mass is not None:
+        node["mass"] = float(obj.mass)
+    elif obj.density is not None:
+        node["density"] = float(obj.density)
+    return node
+
+
+def _quaternion(r):
+    """``(w, x, y, z)`` of a rotation matrix (Shepperd's method: the largest of four first)."""
+    t = np.trace(r)
+    q = np.array([1 + t, 1 + 2 * r[0, 0] - t, 1 + 2 * r[1, 1] - t, 1 + 2 * r[2, 2] - t])
+    i = int(np.argmax(q))
+    s = np.sqrt(q[i])
+    if i == 0:
+        v = [s, (r[2, 1] - r[1, 2]) / s, (r[0, 2] - r[2, 0]) / s, (r[1, 0] - r[0, 1]) / s]
+    elif i == 1:
+        v = [(r[2, 1] - r[1, 2]) / s, s, (r[0, 1] + r[1, 0]) / s, (r[0, 2] + r[2, 0]) / s]
+    elif i == 2:
+        v = [(r[0, 2] - r[2, 0]) / s, (r[0, 1] + r[1, 0]) / s, s, (r[1, 2] + r[2, 1]) / s]
+    else:
+        v = [(r[1, 0] - r[0, 1]) / s, (r[0, 2] + r[2, 0]) / s, (r[1, 2] + r[2, 1]) / s, s]
+    return (np.array(v) / 2).tolist()
+
+
+def grasp_documents(found, folder: str) -> str:
+    """The grasps found as grasp-file documents (YAML, ``---`` between them), read back by every command.
+
+    Each keeps the input's object, units, wrist and friction, its wrenches by name (the weight as
+    the object's mass, or ``mass`` and ``center_of_mass``, when one of them is ``hold``), and gives
+    the contacts found.
+    """
+    s = found.synthesis
+    docs = []
+    for k in range(len(s.points)):
+        doc = {"name": f"{found.name}-{k + 1}"}
+        if found.units is not None:
+            doc["units"] = found.units
+        if found.wrist is not None:
+            doc["wrist"] = np.asarray(found.wrist).tolist()
+        doc["object"] = _object_node(found.object, folder)
+        doc["contacts"] = [
+            {"name": found.contact_names[i], "point": s.points[k, i].tolist(), "normal": s.normals[k, i].tolist()}
+            for i in range(3)
+        ]
+        doc["friction"] = float(found.friction)
+        wrenches = [
+            {"name": name, "wrench": np.asarray(w).tolist()}
+            for name, w in zip(found.wrench_names, found.wrenches)
+            if name != found.hold_name
+        ]
+        if found.hold is not None:
+            mass, center, gravity = found.hold
+            if found.object.mass is None and found.object.density is None:  # else the object's weight is the hold
+                doc.update(mass=float(mass), center_of_mass=np.asarray(center).tolist())
+            doc["gravity"] = np.asarray(gravity).tolist()
+        if wrenches:
+            doc["wrenches"] = wrenches
+        docs.append(yaml.safe_dump(doc, sort_keys=False, default_flow_style=None))
+    return "---\n".join(docs)
+
+
+# -- columns ------------------------------------------------------------------------
+
+_XYZ = ("x", "y", "z")
+_OWN = ("file", "grasp", "rank", "ok", "error")
+_NUMBERS = (
+    *(f"p{i}_{a}" for i in (1, 2, 3) for a in _XYZ),
+    *(f"n{i}_{a}" for i in (1, 2, 3) for a in _XYZ),
+    *(f"surface_distance_{i}" for i in (1, 2, 3)),
+    "total_normal_force",
+    "closure_friction",
+    "epsilon",
+    "conditioning_off_tangent",
+    "conditioning_tangent",
+    "candidates",
+    "seconds",
+    "seed",
+)
+_HEADER = ",".join((*_OWN, *_NUMBERS)).encode() + b"\n"
+
+
+def _header(hand=None) -> bytes:
+    return _HEADER
+
+
+def _typed(hand=None) -> dict:
+    types = {"file": "U", "grasp": "U", "rank": "int64", "ok": "?", "error": "U"}
+    types.update({name: "float64" for name in _NUMBERS})
+    types.update(candidates="int64", seed="int64")
+    return types
+
+
+def _flat(found, order="omega-v", hand=None, typed=False) -> dict:
+    s, k = found.synthesis, len(found)
+    nan = np.full(k, np.nan)
+    columns = {
+        "file": np.array([found.file] * k, dtype=object),
+        "grasp": np.array([found.name] * k, dtype=object),
+        "rank": np.arange(1, k + 1),
+        "ok": np.ones(k, bool),
+        "error": np.ma.masked_all(k, dtype=object),
+    }
+    columns.update({f"p{i + 1}_{a}": s.points[:, i, j] for i in range(3) for j, a in enumerate(_XYZ)})
+    columns.update({f"n{i + 1}_{a}": s.normals[:, i, j] for i in range(3) for j, a in enumerate(_XYZ)})
+    columns.update({f"surface_distance_{i + 1}": s.surface_distance[:, i] for i in range(3)})
+    columns["total_normal_force"] = s.total_normal_force.max(axis=1, initial=-np.inf) if k else nan
+    columns["closure_friction"] = s.closure_friction
+    columns["epsilon"] = nan if s.epsilon is None else s.epsilon
+    columns["conditioning_off_tangent"] = s.conditioning[:, 0]
+    columns["conditioning_tangent"] = s.conditioning[:, 1]
+    columns["candidates"] = np.full(k, s.candidates)
+    columns["seconds"] = np.full(k, s.seconds)
+    columns["seed"] = np.full(k, s.seed)
+    for name, a in columns.items():
+        if a.dtype.kind == "f":
+            columns[name] = np.ma.masked_invalid(a)
+    return columns
+
+
+def _arrays(found, order="omega-v", hand=None) -> dict:
+    return {name: np.ma.getdata(a) for name, a in _flat(found).items()}
+
+
+def _error_row(rec: dict, hand=None) -> bytes:
+    err = rec["error"]
+    row = [rec["file"], rec.get("grasp", ""), "", "false", f"{err['code']}: {err['message']}"]
+    return lines({str(j): np.array([v], dtype=object) for j, v in enumerate(row + [""] * len(_NUMBERS))})[0]
+
+
+class _Statuses(IntEnum):
+    OK = 0
+
+
+#: The synthesis family's columns (CSV and Parquet; no npz).
+SYNTHESIS_COLUMNS = ColumnSet(
+    header=_header,
+    flat=_flat,
+    arrays=_arrays,
+    error_row=_error_row,
+    statuses=_Statuses,
+    typed_header=_typed,
+)
+
+
+# -- table ----------------------------------------------------------------------------
+
+
+class SynthesisTable:
+    """The grasps found as a plain table (``write(record)``, ``close()``): per object its grasps, best
+    first, each with its scores and contacts."""
+
+    def __init__(self, out: IO[bytes], digits: int = 4, **_):
+        self.out = out
+        self.digits = digits
+        self.current = None
+
+    def _line(self, text: str = "") -> None:
+        self.out.write(text.encode() + b"\n")
+
+    def _number(self, v) -> str:
+        return fmt_number(v, self.digits)
+
+    def write(self, rec: dict) -> None:
+        if "error" in rec:  # its line is on stderr; tables carry results only
+            return
+        here = (rec["file"], rec["grasp"])
+        if here != self.current:
+            if self.current is not None:
+                self._line()
+            self._line(f"{escaped(rec['file'])}: grasp '{escaped(rec['grasp'])}'")
+            self.current = here
+        scores = rec["scores"]
+        totals = ", ".join(f"{escaped(n)} {self._number(v)}" for n, v in scores["total_normal_force"].items())
+        cond = ", ".join(f"{m} {self._number(c)}" for m, c in scores["conditioning"].items() if c is not None)
+        extra = "" if scores["epsilon"] is None else f"  epsilon {self._number(scores['epsilon'])}"
+        self._line(
+            f"  #{rec['rank']}  total normal force: {totals}  closure mu {self._number(scores['closure_friction'])}"
+            f"{extra}  conditioning: {cond}"
+        )
+        for c in rec["contacts"]:
+            point = ", ".join(self._number(v) for v in c["point"])
+            normal = ", ".join(self._number(v) for v in c["normal"])
+            self._line(f"    {escaped(c['name'])}: point ({point})  normal ({normal})")
+
+    def close(self) -> None:
+        pass

@@ -1,0 +1,242 @@
+"""Synthesize grasps: objects in, the grasps found (or why none) out, one record set per object.
+
+Each input is a grasp file whose documents name an ``object`` (the file's contacts are not
+used: the search finds its own), or a mesh file (STL, OBJ, PLY) with the command line's
+friction and mass.  The command line's ``--friction``, ``--mass`` and ``--wrench`` replace
+the file's.  The search is :func:`grasptwist.engine.synthesis.search.search`; with ``-o
+FILE.yaml`` the grasps found are also written as a grasp file (atomically, at the end).
+No math here: only reading, routing and labelling.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Iterable, Iterator
+from dataclasses import dataclass, replace
+from typing import NamedTuple
+
+import numpy as np
+
+from ..engine.forces.hold import hold_wrench
+from ..engine.objects import mass_properties
+from ..engine.synthesis.scores import METHODS
+from ..engine.synthesis.search import GRAVITY, Synthesis, search_steps, surface_of
+from ..io.grasp.forces import HOLD
+from ..io.mesh_file import MESH_SUFFIXES, read_mesh
+from ..model import Grasp, GraspFileError, GraspObject, InputError, Shape
+from ..output import synthesis_records as sr
+from ..output.formats import FORMATS
+from ..output.records import diagnostics, dumps, error_record
+from .options import SynthesisOptions
+from .outputs import Output
+from .placement import read
+from .target import opened
+
+__all__ = [
+    "Found",
+    "Progress",
+    "synthesize_inputs",
+    "synthesize_outputs",
+    "NO_OBJECT",
+    "NOTHING_TO_HOLD",
+    "NO_FRICTION",
+]
+
+#: Error codes of an input the search cannot start from.
+NO_OBJECT, NOTHING_TO_HOLD, NO_FRICTION = "no-object", "nothing-to-hold", "no-friction"
+
+_CONTACT_NAMES = ("1", "2", "3")
+
+
+@dataclass(frozen=True, eq=False)
+class Found:
+    """One object's search: what it was asked and what it found (its grasps are its rows)."""
+
+    file: str
+    name: str
+    line: int | None
+    units: str | None
+    wrist: np.ndarray | None
+    object: GraspObject
+    friction: float
+    wrench_names: tuple[str, ...]
+    wrenches: np.ndarray
+    hold: tuple | None  # (mass, centre of mass, gravity) of the wrench named hold, written as top-level keys
+    synthesis: Synthesis
+    contact_names: tuple[str, str, str] = _CONTACT_NAMES
+    hold_name: str = HOLD
+
+    def __len__(self) -> int:
+        return len(self.synthesis.points)
+
+
+def _problem(file, code, message, line=None) -> GraspFileError:
+    return GraspFileError(code, message, file, line, None)
+
+
+def _task(options: SynthesisOptions, grasp: Grasp):
+    """What one grasp document asks: ``(object, friction, names, wrenches, hold)``, or its error."""
+    if grasp.object is None:
+        return _problem(grasp.file, NO_OBJECT, f"grasp '{grasp.name}' has no object to search", grasp.line)
+    obj = grasp.object if options.mass is None else replace(grasp.object, mass=options.mass, density=None)
+    if options.friction is not None:
+        friction = options.friction
+    elif grasp.friction is not None:
+        friction = float(np.min(grasp.friction))  # the contacts found are none of the file's: the least
+    else:
+        return _problem(grasp.file, NO_FRICTION, f"grasp '{grasp.name}' has no friction: give --friction", grasp.line)
+    named = [] if options.wrenches is not None else [(w.name, w.wrench) for w in grasp.wrenches if w.name != HOLD]
+    named += [(w.name, w.wrench) for w in options.wrenches or ()]
+    hold = None
+    if options.mass is not None or (grasp.mass is not None and options.wrenches is None):
+        props = mass_properties(obj)
+        mass = props.mass if props.mass is not None else grasp.mass
+        center = props.center_of_mass if grasp.object.mass is not None or options.mass else grasp.center_of_mass
+        gravity = np.asarray(GRAVITY if grasp.gravity is None else grasp.gravity, float)
+        hold = (mass, center, gravity)
+        named.insert(0, (HOLD, hold_wrench(mass, center, gravity)))
+    if not named:
+        return _problem(
+            grasp.file,
+            NOTHING_TO_HOLD,
+            f"grasp '{grasp.name}' has nothing to hold: give the object a mass (--mass) or --wrench",
+            grasp.line,
+        )
+    return obj, friction, tuple(n for n, _ in named), np.array([w for _, w in named]), hold
+
+
+def _mesh_grasp(path: str, job) -> Grasp | GraspFileError:
+    """A mesh file as a grasp document with only its object (the command line gives the rest)."""
+    try:
+        vertices, faces = read_mesh(path, None, max_bytes=job.max_bytes or 64 * 2**20)
+    except InputError as exc:
+        return exc
+    shape = Shape("mesh", np.zeros(0), vertices=vertices, faces=faces, source=path)
+    obj = GraspObject(shape, np.eye(4))
+    name = os.path.splitext(os.path.basename(path))[0]
+    p = np.zeros((3, 3))
+    return Grasp(name, None, path, 0, _CONTACT_NAMES, p, p, None, (), 1, object=obj)
+
+
+class Progress(NamedTuple):
+    """Work for a progress bar: ``extra`` units found (a search's budget), ``done`` units done."""
+
+    extra: int
+    done: int
+
+
+def synthesize_inputs(job, inputs: Iterable) -> Iterator[GraspFileError | Found | Progress]:
+    """Every object of ``inputs`` (paths or the errors of ``expand``) searched, in order, with the
+    progress of each search (its candidates) and of each input (one unit)."""
+    o = job.options
+    for item in inputs:
+        if isinstance(item, GraspFileError):
+            yield item
+            yield Progress(0, 1)
+            continue
+        entries = (
+            [_mesh_grasp(item, job)] if item.lower().endswith(MESH_SUFFIXES) else read(item, job.max_bytes, job.reading)
+        )
+        for entry in entries:
+            task = _task(o, entry) if isinstance(entry, Grasp) else entry
+            if isinstance(task, GraspFileError):
+                yield task
+                continue
+            obj, friction, names, wrenches, hold = task
+            yield Progress(o.candidates, 0)
+            for step in search_steps(
+                surface_of(obj),
+                wrenches,
+                friction,
+                count=o.count,
+                safety=o.safety,
+                objective=o.objective,
+                wrist=entry.wrist,
+                methods=METHODS if o.method == "both" else (o.method.replace("-", "_"),),
+                min_conditioning=o.min_conditioning,
+                min_spacing=o.min_spacing,
+                quality=o.quality,
+                seed=o.seed,
+                candidates=o.candidates,
+                seconds=o.seconds,
+            ):
+                if isinstance(step, int):
+                    yield Progress(0, step)
+            yield Progress(0, o.candidates - step.candidates)  # the budget left unspent
+            yield Found(
+                entry.file,
+                entry.name,
+                entry.line,
+                entry.units,
+                entry.wrist,
+                obj,
+                friction,
+                names,
+                wrenches,
+                hold,
+                step,
+                entry.contact_names,
+            )
+        yield Progress(0, 1)
+
+
+def synthesize_outputs(job, inputs: Iterable, w, workers: int = 1, tuning=None) -> Iterator[Output]:
+    """The :class:`~grasptwist.run.outputs.Output` of each object searched (one process: a search is
+    vectorised already); the grasp file of ``-o FILE.yaml`` is written once every search is done."""
+    fmt = FORMATS[job.fmt]
+    inputs = list(inputs)
+    documents = []
+    for item in synthesize_inputs(job, inputs):
+        if isinstance(item, Progress):
+            yield Output(extra_work=item.extra, done=item.done)
+            continue
+        if isinstance(item, GraspFileError):
+            rec = error_record(item)
+            out = Output(encoded=[_encode(job, rec, error=True)], records=1)
+            out.errors.extend(diagnostics(rec)[0])
+            out.count(rec)
+            yield out
+            continue
+        if not len(item):
+            rec = sr.failure_record(item)
+            out = Output(encoded=[_encode(job, rec, error=True)], records=1, notes=[_summary(item)])
+            out.errors.extend(diagnostics(rec)[0])
+            out.count(rec)
+            yield out
+            continue
+        recs = sr.synthesis_records(item)
+        if job.options.grasp_file is not None:
+            documents.append(sr.grasp_documents(item, os.path.dirname(os.path.abspath(job.options.grasp_file))))
+        if fmt.takes_blocks:
+            w.write(item)
+            encoded = []
+        elif job.fmt == "csv":
+            encoded = _csv(item)
+        else:
+            encoded = [_encode(job, rec) for rec in recs]
+        yield Output(encoded=encoded, records=len(recs), notes=[_summary(item)])
+    if job.options.grasp_file is not None and documents:
+        with opened(job.options.grasp_file, [p for p in inputs if isinstance(p, str)]) as out:
+            out.write("---\n".join(documents).encode())
+
+
+def _summary(found) -> str:
+    s = found.synthesis
+    return (
+        f"{found.file}: grasp '{found.name}': {len(found)} grasps from {s.candidates} candidates scored "
+        f"in {s.seconds:.2f} s ({s.candidates / max(s.seconds, 1e-9):.3g} per second)"
+    )
+
+
+def _csv(found) -> list[bytes]:
+    from ..output.csv_rows import lines
+
+    return lines(sr.SYNTHESIS_COLUMNS.flat(found))
+
+
+def _encode(job, rec, error=False):
+    if job.fmt == "table":
+        return rec
+    if job.fmt == "csv" and error:
+        return sr.SYNTHESIS_COLUMNS.error_row(rec)
+    return dumps(rec)

@@ -1,0 +1,250 @@
+"""Grasp synthesis against theory (docs/guide/synthesis.md): what the search returns holds, is verified
+independently (an independent conic solver, the grasp map, the surface), and reaches the analytic optimum."""
+
+import numpy as np
+import pytest
+
+from conic import closure_margin, least_grip
+from grasptwist.engine.forces.grasp_map import grasp_map
+from grasptwist.engine.objects import project_to_surface
+from grasptwist.engine.synthesis.candidates import antipodality, candidate_triples, triple_distance
+from grasptwist.engine.synthesis.scores import (
+    CONSTRAINTS,
+    check_min_conditioning,
+    check_objective,
+    score_triples,
+)
+from grasptwist.engine.synthesis.search import check_budget, surface_of, synthesize, verified
+from grasptwist.model import GraspObject, Shape
+
+G = 9.81
+
+
+def ball(radius=0.05, mass=0.1):
+    return GraspObject(Shape("sphere", np.array([radius])), np.eye(4), mass=mass)
+
+
+def box(size=(0.065, 0.065, 0.065), mass=0.1):
+    pose = np.eye(4)
+    pose[:3, 3] = [0.1, -0.05, 0.0325]  # anywhere: the search works in the grasp frame
+    return GraspObject(Shape("box", np.array(size)), pose, mass=mass)
+
+
+# -- validators -----------------------------------------------------------------------
+
+
+def test_check_objective_refuses_an_unknown_one():
+    assert check_objective("closure_friction") == "closure_friction"
+    with pytest.raises(ValueError, match="objective must be one of total_normal_force"):
+        check_objective("speed")
+
+
+@pytest.mark.parametrize("bad", [-0.1, 1.5, float("nan"), True, "0.1"])
+def test_check_min_conditioning_refuses_what_is_not_from_0_to_1(bad):
+    with pytest.raises(ValueError, match="min_conditioning must be a number from 0 to 1"):
+        check_min_conditioning(bad)
+
+
+def test_check_budget_refuses_no_candidates_and_endless_time():
+    assert check_budget(5, 2) == (5, 2.0)
+    with pytest.raises(ValueError, match="candidates must be a positive integer"):
+        check_budget(0, None)
+    with pytest.raises(ValueError, match="candidates must be a positive integer"):
+        check_budget(2.5, None)
+    for bad in (0, -1, float("inf"), float("nan")):
+        with pytest.raises(ValueError, match="seconds must be a positive finite number or None"):
+            check_budget(5, bad)
+
+
+def test_synthesize_needs_something_to_hold():
+    with pytest.raises(ValueError, match="needs the object's mass"):
+        synthesize(ball(mass=None), 0.5)
+    with pytest.raises(ValueError, match="nothing to hold"):
+        synthesize(ball(), 0.5, hold=False)
+
+
+# -- candidates -------------------------------------------------------------------------
+
+
+def test_triple_distance_ignores_the_fingers_order_and_is_the_largest_contact_move():
+    rng = np.random.default_rng(3)
+    a = rng.normal(size=(3, 3))
+    assert triple_distance(a, a[[2, 0, 1]]) == 0.0
+    b = a.copy()
+    b[1] += [0.0, 0.3, 0.4]
+    assert triple_distance(a, b) == pytest.approx(0.5)
+
+
+def test_antipodal_pairs_score_one_and_pushing_away_scores_below_zero():
+    p, n = np.array([0.0, 0, 0]), np.array([1.0, 0, 0])
+    assert antipodality(p, n, np.array([2.0, 0, 0]), -n) == 1.0
+    assert antipodality(p, -n, np.array([2.0, 0, 0]), n) == -1.0
+
+
+def test_candidates_are_reproducible_and_half_start_with_a_good_pair():
+    points, normals = surface_of(ball()).sample(500, np.random.default_rng(0))
+    a = candidate_triples(points, normals, 400, np.random.default_rng(1))
+    b = candidate_triples(points, normals, 400, np.random.default_rng(1))
+    assert np.array_equal(a, b)
+    score = antipodality(points[a[:, 0]], normals[a[:, 0]], points[a[:, 1]], normals[a[:, 1]])
+    assert np.median(score[:200]) > 0.95 > np.median(score[200:])  # the biased half: the best of 8 partners
+
+
+# -- scores ------------------------------------------------------------------------------
+
+
+def _latitude_triples(phi, radius=1.0):
+    """Three contacts 120 degrees apart at latitude ``-phi`` of a ball, normals inward."""
+    lon = np.array([0.0, 2 * np.pi / 3, 4 * np.pi / 3])
+    p = radius * np.stack(
+        [
+            np.cos(phi)[:, None] * np.cos(lon),
+            np.cos(phi)[:, None] * np.sin(lon),
+            -np.sin(phi)[:, None] * np.ones(3),
+        ],
+        axis=-1,
+    )
+    return p, -p / radius
+
+
+@pytest.mark.parametrize("mu", [0.3, 0.5, 1.0])
+def test_three_contacts_at_one_latitude_need_the_analytic_least_total_just_inside_closure(mu):
+    # EXTENSIONS.md, Finding grasps: at latitude -phi a finger lifts f_n (sin phi + mu cos phi); closure
+    # needs tan phi < mu, so the least total over such triples tends to m g sqrt(1 + mu^2) / (2 mu) there
+    theta = np.arctan(mu)
+    phi = theta * np.array([0.0, 0.5, 0.99, 0.999999, 1.01, 1.2])
+    p, n = _latitude_triples(phi)
+    s = score_triples(p, n, [[0, 0, G, 0, 0, 0]], mu, methods=("off_tangent",))
+    equator = G / mu
+    expected = G / (3 * (np.sin(phi) + mu * np.cos(phi))) * 3
+    ok = phi < theta
+    assert (s.failed[ok] == -1).all()
+    assert (s.failed[~ok] == CONSTRAINTS.index("force_closure")).all()
+    np.testing.assert_allclose(s.objective[ok], expected[ok], rtol=1e-9)
+    assert s.objective[0] == pytest.approx(equator, rel=1e-9)
+    assert s.objective[3] == pytest.approx(G * np.sqrt(1 + mu**2) / (2 * mu), rel=1e-6)
+
+
+def test_a_degenerate_decomposition_and_a_low_conditioning_fail_their_constraints():
+    p, n = _latitude_triples(np.array([0.0, 0.01, 0.3]))
+    s = score_triples(p, n, [[0, 0, G, 0, 0, 0]], 0.5, min_conditioning=0.05)
+    # at the equator the normals lie in the contacts' plane: the tangent method is degenerate
+    names = [CONSTRAINTS[k] if k >= 0 else "feasible" for k in s.failed]
+    assert names == ["degenerate", "conditioning", "feasible"]
+    assert s.conditioning[1, 1] < 0.05 <= s.conditioning[2, 1]
+    assert np.isnan(s.conditioning[:, 0]).all()  # no wrist: no off-tangent method
+
+
+def test_verified_refuses_a_grasp_without_a_grip():
+    p, n = _latitude_triples(np.array([0.3]))
+    assert verified(p[0], n[0], [0, 0, G, 0, 0, 0], 0.1, 1.0) is not None
+    # every cone of mu = 0.1 points up (the normals rise 17 degrees): nothing pulls the ball down
+    assert verified(p[0], n[0], [0, 0, -G, 0, 0, 0], 0.1, 1.0) is None
+
+
+# -- the search ----------------------------------------------------------------------------
+
+
+def _independent_checks(obj, s, wrenches, mu):
+    """What a returned grasp must pass, checked without the engine's grip."""
+    size = 0.065 * np.sqrt(3)
+    on = project_to_surface(obj, s.points)
+    np.testing.assert_allclose(on.distance, 0, atol=1e-12 * size)
+    np.testing.assert_allclose(on.normals, s.normals, atol=1e-9)
+    for k in range(len(s.points)):
+        assert closure_margin(s.points[k], s.normals[k], mu) > 1e-9  # force closure at mu
+        for j, w in enumerate(wrenches):
+            g = s.grips[k][j]
+            f = g.force
+            np.testing.assert_allclose(grasp_map(s.points[k]) @ f.reshape(9), w, atol=1e-9 * np.abs(w).max())
+            fn = np.einsum("ij,ij->i", f, s.normals[k])
+            ft = np.linalg.norm(f - fn[:, None] * s.normals[k], axis=1)
+            assert (ft <= mu * fn + 1e-9 * fn.sum()).all()
+            total, _ = least_grip(s.points[k], s.normals[k], w, mu)
+            assert s.total_normal_force[k, j] == pytest.approx(total, rel=1e-6)
+
+
+def test_every_grasp_returned_on_a_box_is_force_closure_and_passes_independent_checks():
+    obj = box()
+    turn = np.array([0, 0, 0, 0, 0, 0.002])  # a twist about the vertical too: the third finger's job
+    s = synthesize(obj, 0.8, wrenches=[turn], count=3, candidates=1500, min_conditioning=1e-3)
+    assert s.failure is None and len(s.points) == 3
+    assert (s.closure_friction < 0.8).all()
+    assert (s.conditioning[:, 1] >= 1e-3).all()
+    weight = np.array([0, 0, 0.1 * G, *np.cross(obj.pose[:3, 3], [0, 0, 0.1 * G])])
+    _independent_checks(obj, s, [weight, turn], 0.8)
+    # distinct, best first
+    assert (np.diff(s.total_normal_force.max(axis=1)) >= 0).all()
+    assert triple_distance(s.points[0], s.points[1]) >= 0.05 * 0.065 * np.sqrt(3)
+
+
+def test_a_seed_makes_a_search_reproducible_bit_for_bit():
+    a = synthesize(box(), 0.8, count=2, candidates=500, seed=7)
+    b = synthesize(box(), 0.8, count=2, candidates=500, seed=7)
+    c = synthesize(box(), 0.8, count=2, candidates=500, seed=8)
+    assert np.array_equal(a.points, b.points) and np.array_equal(a.total_normal_force, b.total_normal_force)
+    assert not np.array_equal(a.points, c.points)
+    assert a.candidates == b.candidates <= 500
+
+
+def test_a_ball_without_friction_has_no_grasp_and_says_how_close_it_came():
+    s = synthesize(ball(), 0.0, candidates=2000, seconds=5.0)
+    assert len(s.points) == 0 and s.candidates <= 2000
+    assert s.failure.constraint == "force_closure"
+    assert s.failure.needed == 0.0 and 0 < s.failure.best < 0.1
+    assert "no candidate is force closure at friction 0" in s.failure.message
+
+
+def test_a_needle_is_too_thin_for_well_conditioned_grasps():
+    needle = GraspObject(Shape("cylinder", np.array([1e-5, 0.1])), np.eye(4), mass=0.001)
+    s = synthesize(needle, 0.5, candidates=2000, min_conditioning=1e-3)
+    assert len(s.points) == 0 and s.failure.constraint == "conditioning"
+    assert s.failure.best < 1e-3 == s.failure.needed
+
+
+def test_the_time_budget_holds():
+    s = synthesize(box(), 0.8, candidates=10**9, seconds=0.05)
+    assert s.seconds < 2.0  # checked after every chunk (a chunk is milliseconds): generous on a busy machine
+    assert 0 < s.candidates < 10**9
+
+
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
+def test_other_objectives_rank_by_their_own_figure():
+    s = synthesize(box(), 0.8, count=3, candidates=1200, objective="closure_friction")
+    assert (np.diff(s.closure_friction) >= 0).all()
+    pytest.importorskip("scipy")
+    e = synthesize(box(), 0.8, count=2, candidates=600, objective="epsilon")
+    assert (e.epsilon > 0).all() and e.epsilon[0] >= e.epsilon[1]
+
+
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
+@pytest.mark.parametrize("mu", [0.3, 0.5])
+def test_a_ball_held_against_its_weight_reaches_the_least_total_and_its_latitude(mu):
+    # no finger lifts more than sqrt(1 + mu^2) per newton of normal force: m g / sqrt(1 + mu^2) is a lower
+    # bound, reached with closure by two fingers at latitude -atan(1 / mu) whose forces are vertical and a
+    # third that closes the grasp carrying nothing (far below the equator's m g / mu, and below the
+    # m g sqrt(1 + mu^2) / (2 mu) of three fingers at one latitude)
+    obj = ball(radius=0.05, mass=0.1)
+    s = synthesize(obj, mu, count=1, candidates=60000)
+    least = 0.1 * G / np.sqrt(1 + mu**2)
+    total = s.total_normal_force[0, 0]
+    assert least * (1 - 1e-9) <= total <= least * 1.005
+    assert total < 0.1 * G * np.sqrt(1 + mu**2) / (2 * mu) * 0.99
+    fn = s.grips[0][0].normal_force
+    carrying = fn > 0.05 * fn.sum()
+    latitude = np.arcsin(s.points[0, carrying, 2] / 0.05)
+    np.testing.assert_allclose(latitude, -np.arctan(1 / mu), atol=np.radians(2))
+    _independent_checks(obj, s, [[0, 0, 0.1 * G, 0, 0, 0]], mu)
+
+
+def test_further_constraints_are_kept_and_one_nothing_passes_is_named():
+    above = 0.0325 - 0.065 / 2 + 0.01  # a table under the cube: every contact 10 mm above its bottom
+
+    def off_the_table(points, normals):
+        return (points[..., 2] > above).all(axis=-1)
+
+    s = synthesize(box(), 0.8, count=2, candidates=800, constraints=[off_the_table])
+    assert s.failure is None and (s.points[..., 2] > above).all()
+    assert s.total_normal_force[0, 0] > 0.1 * G * 1.05  # no finger under the cube: friction lifts it
+    none = synthesize(box(), 0.8, candidates=300, constraints=[lambda p, n: np.zeros(len(p), bool)])
+    assert none.failure.constraint == "constraints"
