@@ -29,7 +29,11 @@ from .socp import _EDGE, _ITERATIONS, _RESIDUAL, GAP, START_MARGIN
 
 __all__ = ["grip_rows", "WIDTH"]
 
-_JIT = {"cache": True, "error_model": "numpy", "fastmath": {"arcp", "contract"}}
+# no reference counting (numba's runtime) in the arithmetic: its atomic increments and decrements
+# on every array passed or sliced were a third of a row's time; the workspaces are allocated by
+# the two functions that need the runtime (_ALLOC)
+_JIT = {"cache": True, "error_model": "numpy", "fastmath": {"arcp", "contract"}, "_nrt": False}
+_ALLOC = {"cache": True}
 
 
 # the scalar pieces are one.py's functions, compiled: the two paths share them line for line
@@ -191,7 +195,7 @@ def _iterate(A, b, c, x, z, P, phase_one, d, K, ws):
 _D, _K = 5, 4
 
 
-@njit(**_JIT)
+@njit(**_ALLOC)
 def _workspace():
     """The arrays :func:`_iterate` works in, allocated once per call of :func:`solve` (numba's
     allocations, not the arithmetic, were most of a row's time)."""
@@ -224,7 +228,7 @@ def _newton_matrices(A, d, K, P):
                 P[m, i, j] = A[m, 0, i] * A[m, 0, j] - A[m, 1, i] * A[m, 1, j] - A[m, 2, i] * A[m, 2, j]
 
 
-@njit(**_JIT)
+@njit(**_ALLOC)
 def _row_workspace():
     """The arrays of one row's phases (``wide``, ``bw``, ``cw``, ``xw``, ``zw``, ``P``, ``c``, ``x``, ``h``, ``dz``)."""
     return (
@@ -419,17 +423,17 @@ def _omega(q, mv, t, x0, x1, x2, out):
 
 
 @njit(**_JIT)
-def _internal_inside(p, unit, mv, e, limit, out):
+def _internal_inside(p, unit, mv, e, limit, out, rows):
     """``closure.internal_inside`` for one row: a unit squeeze strictly inside every cone into ``out (3)``,
     or NaN.  The planar reduction (``closure._Plane``), the sectors of half-angle ``atan(limit_i)``
-    (``closure._own_rows``) and the extreme rays of their cone of squeezes (``closure.closure_test``)."""
+    (``closure._own_rows``) and the extreme rays of their cone of squeezes (``closure.closure_test``);
+    ``rows (6, 3)``: a workspace."""
     ml = math.sqrt(mv[0] ** 2 + mv[1] ** 2 + mv[2] ** 2)
     n0, n1, n2 = mv[0] / ml, mv[1] / ml, mv[2] / ml
     x0, x1, x2 = p[1, 0] - p[0, 0], p[1, 1] - p[0, 1], p[1, 2] - p[0, 2]
     xl = math.sqrt(x0 * x0 + x1 * x1 + x2 * x2)
     x0, x1, x2 = x0 / xl, x1 / xl, x2 / xl
     y0, y1, y2 = _cross(n0, n1, n2, x0, x1, x2)
-    rows = np.empty((6, 3))
     good = True
     for i in range(3):
         un = unit[i, 0] * n0 + unit[i, 1] * n1 + unit[i, 2] * n2
@@ -488,7 +492,7 @@ def _internal_inside(p, unit, mv, e, limit, out):
     out[0], out[1], out[2] = (s0, s1, s2) if good else (math.nan, math.nan, math.nan)
 
 
-@njit(**_JIT)
+@njit(**_ALLOC)
 def grip_rows(p, n, limit, w, tol, out, codes):
     """The whole grip of the rows numpy's :class:`grip._Prepared` solves by cones (three distinct,
     non-collinear contacts, friction at each).
@@ -498,13 +502,36 @@ def grip_rows(p, n, limit, w, tol, out, codes):
     non-finite number (input, or an overflow on the way), a wrench on the edge of what the fingers
     exert.  ``limit (n, 3)`` is ``mu / safety``.
     """
-    ws, rw = _workspace(), _row_workspace()
-    q, mv, g = np.empty((3, 3)), np.empty(3), np.empty(3)
-    unit, e, fm = np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 3))
-    frame, M = np.empty((3, 3, 3)), np.zeros((3, 3, 3))
-    A, b = np.empty((3, 3, 3)), np.empty((3, 3))
-    s, z = np.empty(3), np.empty((3, 3))
-    d, lam, inside = np.empty((3, 3)), np.empty(6), np.empty(3)
+    _grip_rows(p, n, limit, w, tol, out, codes, _workspace(), _row_workspace(), _grip_workspace())
+
+
+@njit(**_ALLOC)
+def _grip_workspace():
+    """The arrays of one row's geometry, cones and answer (``M`` zero off its squeezes' entries)."""
+    return (
+        np.empty((3, 3)),
+        np.empty(3),
+        np.empty(3),
+        np.empty((3, 3)),
+        np.empty((3, 3)),
+        np.empty((3, 3)),
+        np.empty((3, 3, 3)),
+        np.zeros((3, 3, 3)),
+        np.empty((3, 3, 3)),
+        np.empty((3, 3)),
+        np.empty(3),
+        np.empty((3, 3)),
+        np.empty((3, 3)),
+        np.empty(6),
+        np.empty(3),
+        np.empty((6, 3)),
+    )
+
+
+@njit(**_JIT)
+def _grip_rows(p, n, limit, w, tol, out, codes, ws, rw, gw):
+    """:func:`grip_rows` in the workspaces ``ws``, ``rw`` and ``gw`` (:func:`_grip_workspace`)."""
+    q, mv, g, unit, e, fm, frame, M, A, b, s, z, d, lam, inside, corners = gw
     for r in range(p.shape[0]):
         o = out[r]
         codes[r, 0], codes[r, 1], codes[r, 2] = 0, -1, 0
@@ -606,7 +633,7 @@ def grip_rows(p, n, limit, w, tol, out, codes):
             for i in range(3):
                 for k in range(3):
                     z[i, k] = 0.0
-            _internal_inside(p[r], unit, mv, e, limit[r], inside)
+            _internal_inside(p[r], unit, mv, e, limit[r], inside, corners)
             fail, blame = _solve_row(A, b, inside, s, z, ws, rw)
             # the multipliers as forces' duals; the dual twist through n_i - u_i, phase I's y through -u_i
             for i in range(3):
