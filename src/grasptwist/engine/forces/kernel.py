@@ -40,7 +40,7 @@ _ALLOC = {"cache": True}
 _edge, _scaling, _w_inv, _w_mul = (njit(**_JIT)(f) for f in (one.edge, one.scaling, one.w_inv, one.w_mul))
 
 
-@njit(**_JIT)
+@njit(**_JIT, inline="always")
 def _spd_solve(H, g, d, out):
     """``H^-1 g`` by elimination without pivoting (``H`` symmetric positive definite, overwritten)."""
     for k in range(d):
@@ -56,7 +56,7 @@ def _spd_solve(H, g, d, out):
         out[i] = v / H[i, i]
 
 
-@njit(**_JIT)
+@njit(**_JIT, inline="always")
 def _apply(A, x, d, K, out):
     """``out_m = A_m x`` for the ``K`` cones."""
     for m in range(K):
@@ -67,7 +67,7 @@ def _apply(A, x, d, K, out):
             out[m, k] = t
 
 
-@njit(**_JIT)
+@njit(**_JIT, inline="always")
 def _direction(A, L, V, beta, rhs, res, H, d, K, U, WU, g, Hw, dx, dy, dz):
     """``lambda o (W dz + W^-1 dy) = rhs``, ``dy = A dx``, ``sum_m A_m^T dz_m = res``: into ``dx, dy, dz``."""
     for m in range(K):
