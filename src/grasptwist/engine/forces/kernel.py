@@ -115,6 +115,7 @@ def _iterate(A, b, c, x, z, P, phase_one, d, K, ws):
             for j in range(d):
                 G[m, j] = A[m, 0, j] * w0 - A[m, 1, j] * w1 - A[m, 2, j] * w2
             V[m, 0], V[m, 1], V[m, 2] = v0, v1, v2
+            beta[m] = bt
             scale[m] = 1 / (bt * bt)
         top = -math.inf
         for i in range(d):
@@ -127,8 +128,6 @@ def _iterate(A, b, c, x, z, P, phase_one, d, K, ws):
             top = max(top, H[i, i])
         for i in range(d):
             H[i, i] += 1e-14 * top
-        for m in range(K):
-            beta[m] = 1 / math.sqrt(scale[m])
         mu = 0.0
         for m in range(K):
             l0, l1, l2 = L[m, 0], L[m, 1], L[m, 2]
