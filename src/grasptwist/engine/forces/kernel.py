@@ -96,7 +96,7 @@ def _direction(A, L, V, beta, rhs, res, H, d, K, U, WU, g, Hw, dx, dy, dz):
 def _iterate(A, b, c, x, z, P, phase_one, d, K, ws):
     """``socp._iterate`` for one row (``phase_one``: its leaving rule, else phase II's); ``x``, ``z`` in place;
     ``ws``: :func:`_workspace` (indexed below ``d`` and ``K`` only)."""
-    res, y, L, V, G, beta, scale, H, Hw, U, WU, rhs, square, g, dx, dy, dz = ws
+    res, y, L, V, G, beta, scale, H, Hw, U, WU, rhs, square, g, dx, dy, dz, ys, zs = ws
     for it in range(_ITERATIONS):
         for j in range(d):
             t = c[j]
@@ -109,7 +109,7 @@ def _iterate(A, b, c, x, z, P, phase_one, d, K, ws):
                 for j in range(d):
                     t += A[m, k, j] * x[j]
                 y[m, k] = t
-            w0, w1, w2, v0, v1, v2, bt, L[m, 0], L[m, 1], L[m, 2] = _scaling(
+            w0, w1, w2, v0, v1, v2, bt, L[m, 0], L[m, 1], L[m, 2], ys[m], zs[m] = _scaling(
                 y[m, 0], y[m, 1], y[m, 2], z[m, 0], z[m, 1], z[m, 2]
             )
             for j in range(d):
@@ -138,8 +138,8 @@ def _iterate(A, b, c, x, z, P, phase_one, d, K, ws):
         _direction(A, L, V, beta, rhs, res, H, d, K, U, WU, g, Hw, dx, dy, dz)
         step = 1.0
         for m in range(K):
-            step = min(step, _edge(y[m, 0], y[m, 1], y[m, 2], dy[m, 0], dy[m, 1], dy[m, 2]))
-            step = min(step, _edge(z[m, 0], z[m, 1], z[m, 2], dz[m, 0], dz[m, 1], dz[m, 2]))
+            step = min(step, _edge(y[m, 0], y[m, 1], y[m, 2], dy[m, 0], dy[m, 1], dy[m, 2], ys[m]))
+            step = min(step, _edge(z[m, 0], z[m, 1], z[m, 2], dz[m, 0], dz[m, 1], dz[m, 2], zs[m]))
         mu_aff = 0.0
         for m in range(K):
             for k in range(3):
@@ -154,8 +154,8 @@ def _iterate(A, b, c, x, z, P, phase_one, d, K, ws):
         _direction(A, L, V, beta, rhs, res, H, d, K, U, WU, g, Hw, dx, dy, dz)
         edge = math.inf
         for m in range(K):
-            edge = min(edge, _edge(y[m, 0], y[m, 1], y[m, 2], dy[m, 0], dy[m, 1], dy[m, 2]))
-            edge = min(edge, _edge(z[m, 0], z[m, 1], z[m, 2], dz[m, 0], dz[m, 1], dz[m, 2]))
+            edge = min(edge, _edge(y[m, 0], y[m, 1], y[m, 2], dy[m, 0], dy[m, 1], dy[m, 2], ys[m]))
+            edge = min(edge, _edge(z[m, 0], z[m, 1], z[m, 2], dz[m, 0], dz[m, 1], dz[m, 2], zs[m]))
         step = min(1.0, _EDGE * edge)
         finite = math.isfinite(step)
         for j in range(d):
@@ -220,6 +220,8 @@ def _workspace():
         np.empty(_D),
         np.empty((_K, 3)),
         np.empty((_K, 3)),
+        np.empty(_K),
+        np.empty(_K),
     )
 
 
