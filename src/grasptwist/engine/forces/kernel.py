@@ -37,7 +37,7 @@ _ALLOC = {"cache": True}
 
 
 # the scalar pieces are one.py's functions, compiled: the two paths share them line for line
-_edge, _scaling, _w_inv, _w_mul = (njit(**_JIT)(f) for f in (one.edge, one.scaling, one.w_inv, one.w_mul))
+_approach, _scaling, _w_inv, _w_mul = (njit(**_JIT)(f) for f in (one.approach, one.scaling, one.w_inv, one.w_mul))
 
 
 @njit(**_JIT, inline="always")
@@ -92,6 +92,21 @@ def _direction(A, L, V, beta, rhs, res, H, d, K, U, WU, g, Hw, dx, dy, dz):
         )
 
 
+@njit(**_JIT, inline="always")
+def _edge(y, z, dy, dz, ys, zs, K):
+    """The largest step along ``(dy, dz)`` that keeps every ``y_m`` and ``z_m`` in its cone (``inf``: none):
+    ``1 / max t`` of :func:`one.approach`'s rates (a NaN rate is no limit, as in ``socp._edge``)."""
+    top = 0.0
+    for m in range(K):
+        t = _approach(y[m, 0], y[m, 1], y[m, 2], dy[m, 0], dy[m, 1], dy[m, 2], ys[m])
+        if t > top:
+            top = t
+        t = _approach(z[m, 0], z[m, 1], z[m, 2], dz[m, 0], dz[m, 1], dz[m, 2], zs[m])
+        if t > top:
+            top = t
+    return 1 / top if top > 0 else math.inf
+
+
 @njit(**_JIT)
 def _iterate(A, b, c, x, z, P, phase_one, d, K, ws):
     """``socp._iterate`` for one row (``phase_one``: its leaving rule, else phase II's); ``x``, ``z`` in place;
@@ -136,10 +151,7 @@ def _iterate(A, b, c, x, z, P, phase_one, d, K, ws):
             mu += y[m, 0] * z[m, 0] + y[m, 1] * z[m, 1] + y[m, 2] * z[m, 2]
         mu /= K
         _direction(A, L, V, beta, rhs, res, H, d, K, U, WU, g, Hw, dx, dy, dz)
-        step = 1.0
-        for m in range(K):
-            step = min(step, _edge(y[m, 0], y[m, 1], y[m, 2], dy[m, 0], dy[m, 1], dy[m, 2], ys[m]))
-            step = min(step, _edge(z[m, 0], z[m, 1], z[m, 2], dz[m, 0], dz[m, 1], dz[m, 2], zs[m]))
+        step = min(1.0, _edge(y, z, dy, dz, ys, zs, K))
         mu_aff = 0.0
         for m in range(K):
             for k in range(3):
@@ -152,11 +164,7 @@ def _iterate(A, b, c, x, z, P, phase_one, d, K, ws):
             rhs[m, 1] = -square[m, 1] - (p0 * q1 + q0 * p1)
             rhs[m, 2] = -square[m, 2] - (p0 * q2 + q0 * p2)
         _direction(A, L, V, beta, rhs, res, H, d, K, U, WU, g, Hw, dx, dy, dz)
-        edge = math.inf
-        for m in range(K):
-            edge = min(edge, _edge(y[m, 0], y[m, 1], y[m, 2], dy[m, 0], dy[m, 1], dy[m, 2], ys[m]))
-            edge = min(edge, _edge(z[m, 0], z[m, 1], z[m, 2], dz[m, 0], dz[m, 1], dz[m, 2], zs[m]))
-        step = min(1.0, _EDGE * edge)
+        step = min(1.0, _EDGE * _edge(y, z, dy, dz, ys, zs, K))
         finite = math.isfinite(step)
         for j in range(d):
             finite = finite and math.isfinite(dx[j])
