@@ -30,7 +30,7 @@ from .socp import _EDGE, _ITERATIONS, _RESIDUAL, GAP, START_MARGIN
 __all__ = ["grip_rows", "WIDTH"]
 
 # no reference counting (numba's runtime) in the arithmetic: its atomic increments and decrements
-# on every array passed or sliced were a third of a row's time; the workspaces are allocated by
+# on every array passed or sliced were a fifth of a row's time; the workspaces are allocated by
 # the two functions that need the runtime (_ALLOC)
 _JIT = {"cache": True, "error_model": "numpy", "fastmath": {"arcp", "contract"}, "_nrt": False}
 _ALLOC = {"cache": True}
