@@ -29,14 +29,18 @@ from .socp import _EDGE, _ITERATIONS, _RESIDUAL, GAP, START_MARGIN
 
 __all__ = ["grip_rows", "WIDTH"]
 
-_JIT = {"cache": True, "error_model": "numpy", "fastmath": {"arcp", "contract"}}
+# no reference counting (numba's runtime) in the arithmetic: its atomic increments and decrements
+# on every array passed or sliced were a fifth of a row's time; the workspaces are allocated by
+# the two functions that need the runtime (_ALLOC)
+_JIT = {"cache": True, "error_model": "numpy", "fastmath": {"arcp", "contract"}, "_nrt": False}
+_ALLOC = {"cache": True}
 
 
 # the scalar pieces are one.py's functions, compiled: the two paths share them line for line
-_edge, _scaling, _w_inv, _w_mul = (njit(**_JIT)(f) for f in (one.edge, one.scaling, one.w_inv, one.w_mul))
+_approach, _scaling, _w_inv, _w_mul = (njit(**_JIT)(f) for f in (one.approach, one.scaling, one.w_inv, one.w_mul))
 
 
-@njit(**_JIT)
+@njit(**_JIT, inline="always")
 def _spd_solve(H, g, d, out):
     """``H^-1 g`` by elimination without pivoting (``H`` symmetric positive definite, overwritten)."""
     for k in range(d):
@@ -52,7 +56,7 @@ def _spd_solve(H, g, d, out):
         out[i] = v / H[i, i]
 
 
-@njit(**_JIT)
+@njit(**_JIT, inline="always")
 def _apply(A, x, d, K, out):
     """``out_m = A_m x`` for the ``K`` cones."""
     for m in range(K):
@@ -63,7 +67,7 @@ def _apply(A, x, d, K, out):
             out[m, k] = t
 
 
-@njit(**_JIT)
+@njit(**_JIT, inline="always")
 def _direction(A, L, V, beta, rhs, res, H, d, K, U, WU, g, Hw, dx, dy, dz):
     """``lambda o (W dz + W^-1 dy) = rhs``, ``dy = A dx``, ``sum_m A_m^T dz_m = res``: into ``dx, dy, dz``."""
     for m in range(K):
@@ -88,11 +92,26 @@ def _direction(A, L, V, beta, rhs, res, H, d, K, U, WU, g, Hw, dx, dy, dz):
         )
 
 
+@njit(**_JIT, inline="always")
+def _edge(y, z, dy, dz, ys, zs, K):
+    """The largest step along ``(dy, dz)`` that keeps every ``y_m`` and ``z_m`` in its cone (``inf``: none):
+    ``1 / max t`` of :func:`one.approach`'s rates (a NaN rate is no limit, as in ``socp._edge``)."""
+    top = 0.0
+    for m in range(K):
+        t = _approach(y[m, 0], y[m, 1], y[m, 2], dy[m, 0], dy[m, 1], dy[m, 2], ys[m])
+        if t > top:
+            top = t
+        t = _approach(z[m, 0], z[m, 1], z[m, 2], dz[m, 0], dz[m, 1], dz[m, 2], zs[m])
+        if t > top:
+            top = t
+    return 1 / top if top > 0 else math.inf
+
+
 @njit(**_JIT)
 def _iterate(A, b, c, x, z, P, phase_one, d, K, ws):
     """``socp._iterate`` for one row (``phase_one``: its leaving rule, else phase II's); ``x``, ``z`` in place;
     ``ws``: :func:`_workspace` (indexed below ``d`` and ``K`` only)."""
-    res, y, L, V, G, beta, scale, H, Hw, U, WU, rhs, square, g, dx, dy, dz = ws
+    res, y, L, V, G, beta, scale, H, Hw, U, WU, rhs, square, g, dx, dy, dz, ys, zs = ws
     for it in range(_ITERATIONS):
         for j in range(d):
             t = c[j]
@@ -105,12 +124,13 @@ def _iterate(A, b, c, x, z, P, phase_one, d, K, ws):
                 for j in range(d):
                     t += A[m, k, j] * x[j]
                 y[m, k] = t
-            w0, w1, w2, v0, v1, v2, bt, L[m, 0], L[m, 1], L[m, 2] = _scaling(
+            w0, w1, w2, v0, v1, v2, bt, L[m, 0], L[m, 1], L[m, 2], ys[m], zs[m] = _scaling(
                 y[m, 0], y[m, 1], y[m, 2], z[m, 0], z[m, 1], z[m, 2]
             )
             for j in range(d):
                 G[m, j] = A[m, 0, j] * w0 - A[m, 1, j] * w1 - A[m, 2, j] * w2
             V[m, 0], V[m, 1], V[m, 2] = v0, v1, v2
+            beta[m] = bt
             scale[m] = 1 / (bt * bt)
         top = -math.inf
         for i in range(d):
@@ -123,8 +143,6 @@ def _iterate(A, b, c, x, z, P, phase_one, d, K, ws):
             top = max(top, H[i, i])
         for i in range(d):
             H[i, i] += 1e-14 * top
-        for m in range(K):
-            beta[m] = 1 / math.sqrt(scale[m])
         mu = 0.0
         for m in range(K):
             l0, l1, l2 = L[m, 0], L[m, 1], L[m, 2]
@@ -133,10 +151,7 @@ def _iterate(A, b, c, x, z, P, phase_one, d, K, ws):
             mu += y[m, 0] * z[m, 0] + y[m, 1] * z[m, 1] + y[m, 2] * z[m, 2]
         mu /= K
         _direction(A, L, V, beta, rhs, res, H, d, K, U, WU, g, Hw, dx, dy, dz)
-        step = 1.0
-        for m in range(K):
-            step = min(step, _edge(y[m, 0], y[m, 1], y[m, 2], dy[m, 0], dy[m, 1], dy[m, 2]))
-            step = min(step, _edge(z[m, 0], z[m, 1], z[m, 2], dz[m, 0], dz[m, 1], dz[m, 2]))
+        step = min(1.0, _edge(y, z, dy, dz, ys, zs, K))
         mu_aff = 0.0
         for m in range(K):
             for k in range(3):
@@ -149,11 +164,7 @@ def _iterate(A, b, c, x, z, P, phase_one, d, K, ws):
             rhs[m, 1] = -square[m, 1] - (p0 * q1 + q0 * p1)
             rhs[m, 2] = -square[m, 2] - (p0 * q2 + q0 * p2)
         _direction(A, L, V, beta, rhs, res, H, d, K, U, WU, g, Hw, dx, dy, dz)
-        edge = math.inf
-        for m in range(K):
-            edge = min(edge, _edge(y[m, 0], y[m, 1], y[m, 2], dy[m, 0], dy[m, 1], dy[m, 2]))
-            edge = min(edge, _edge(z[m, 0], z[m, 1], z[m, 2], dz[m, 0], dz[m, 1], dz[m, 2]))
-        step = min(1.0, _EDGE * edge)
+        step = min(1.0, _EDGE * _edge(y, z, dy, dz, ys, zs, K))
         finite = math.isfinite(step)
         for j in range(d):
             finite = finite and math.isfinite(dx[j])
@@ -190,8 +201,12 @@ def _iterate(A, b, c, x, z, P, phase_one, d, K, ws):
 #: The most unknowns and cones a row has: phase I of collinear contacts' four internal forces.
 _D, _K = 5, 4
 
+# The kernel's rows: three squeezes, three cones (phase I: one more of each).  Passed to _iterate as
+# constants, so that numba compiles it for these sizes (its loops unrolled): 7.6 -> 6.4 us a grasp.
+_SQUEEZES, _CONES = 3, 3
 
-@njit(**_JIT)
+
+@njit(**_ALLOC)
 def _workspace():
     """The arrays :func:`_iterate` works in, allocated once per call of :func:`solve` (numba's
     allocations, not the arithmetic, were most of a row's time)."""
@@ -213,6 +228,8 @@ def _workspace():
         np.empty(_D),
         np.empty((_K, 3)),
         np.empty((_K, 3)),
+        np.empty(_K),
+        np.empty(_K),
     )
 
 
@@ -224,7 +241,7 @@ def _newton_matrices(A, d, K, P):
                 P[m, i, j] = A[m, 0, i] * A[m, 0, j] - A[m, 1, i] * A[m, 1, j] - A[m, 2, i] * A[m, 2, j]
 
 
-@njit(**_JIT)
+@njit(**_ALLOC)
 def _row_workspace():
     """The arrays of one row's phases (``wide``, ``bw``, ``cw``, ``xw``, ``zw``, ``P``, ``c``, ``x``, ``h``, ``dz``)."""
     return (
@@ -263,8 +280,8 @@ def _phase_one(A, b, rays, ws, rw):
         c[j] = 0.0
     x[d] = max(over + 1, 0.0)
     c[d] = 1.0
-    _newton_matrices(wide, d + 1, K + 1, P)
-    _iterate(wide, bw, c, x, z, P, True, d + 1, K + 1, ws)
+    _newton_matrices(wide, _SQUEEZES + 1, _CONES + 1, P)
+    _iterate(wide, bw, c, x, z, P, True, _SQUEEZES + 1, _CONES + 1, ws)
     return x[d]
 
 
@@ -368,8 +385,8 @@ def _solve_row(A, b, inside, s, z, ws, rw):
     for m in range(K):
         z[m, 0], z[m, 1], z[m, 2] = 1.0, 0.0, 0.0
     P = rw[5]
-    _newton_matrices(A, d, K, P)
-    _iterate(A, b, c, x, z, P, False, d, K, ws)
+    _newton_matrices(A, _SQUEEZES, _CONES, P)
+    _iterate(A, b, c, x, z, P, False, _SQUEEZES, _CONES, ws)
     _dual_polish(A, b, c, x, z, rw)
     for j in range(d):
         s[j] = x[j]
@@ -419,31 +436,35 @@ def _omega(q, mv, t, x0, x1, x2, out):
 
 
 @njit(**_JIT)
-def _internal_inside(p, unit, mv, e, limit, out):
+def _internal_inside(p, unit, mv, e, limit, out, rows):
     """``closure.internal_inside`` for one row: a unit squeeze strictly inside every cone into ``out (3)``,
     or NaN.  The planar reduction (``closure._Plane``), the sectors of half-angle ``atan(limit_i)``
-    (``closure._own_rows``) and the extreme rays of their cone of squeezes (``closure.closure_test``)."""
+    (``closure._own_rows``) and the extreme rays of their cone of squeezes (``closure.closure_test``);
+    ``rows (6, 3)``: a workspace."""
     ml = math.sqrt(mv[0] ** 2 + mv[1] ** 2 + mv[2] ** 2)
     n0, n1, n2 = mv[0] / ml, mv[1] / ml, mv[2] / ml
     x0, x1, x2 = p[1, 0] - p[0, 0], p[1, 1] - p[0, 1], p[1, 2] - p[0, 2]
     xl = math.sqrt(x0 * x0 + x1 * x1 + x2 * x2)
     x0, x1, x2 = x0 / xl, x1 / xl, x2 / xl
     y0, y1, y2 = _cross(n0, n1, n2, x0, x1, x2)
-    rows = np.empty((6, 3))
     good = True
     for i in range(3):
         un = unit[i, 0] * n0 + unit[i, 1] * n1 + unit[i, 2] * n2
         sin = abs(un)
         cos = math.sqrt(max(1 - sin * sin, 0.0))
-        phi = math.asin(min(sin, 1.0))
         p0, p1, p2 = unit[i, 0] - un * n0, unit[i, 1] - un * n1, unit[i, 2] - un * n2
         a, c = p0 * x0 + p1 * x1 + p2 * x2, p0 * y0 + p1 * y1 + p2 * y2
         h = math.sqrt(a * a + c * c)
         m0, m1 = a / h, c / h
-        theta = math.atan(limit[i])
-        good = good and theta > phi and cos > 0
-        sin_beta = math.sqrt(max(math.sin(theta - phi) * math.sin(theta + phi), 0.0)) / cos
-        cos_beta = min(math.cos(theta) / cos, 1.0)
+        # theta = atan(limit), phi = asin(sin) without the angles (five libm calls a contact were a
+        # tenth of a row's set-up): sin(theta - phi) sin(theta + phi) = (sin t - sin p)(sin t + sin p)
+        radius = math.hypot(1.0, limit[i])  # no overflow for a huge limit
+        cos_theta = 1 / radius
+        sin_theta = 1.0 if math.isinf(limit[i]) else limit[i] / radius
+        sin_phi = min(sin, 1.0)
+        good = good and sin_theta > sin_phi and cos > 0
+        sin_beta = math.sqrt(max((sin_theta - sin_phi) * (sin_theta + sin_phi), 0.0)) / cos
+        cos_beta = min(cos_theta / cos, 1.0)
         for edge in range(2):
             sign = -1.0 if edge == 0 else 1.0
             v0 = sin_beta * m0 + sign * cos_beta * -m1
@@ -488,7 +509,7 @@ def _internal_inside(p, unit, mv, e, limit, out):
     out[0], out[1], out[2] = (s0, s1, s2) if good else (math.nan, math.nan, math.nan)
 
 
-@njit(**_JIT)
+@njit(**_ALLOC)
 def grip_rows(p, n, limit, w, tol, out, codes):
     """The whole grip of the rows numpy's :class:`grip._Prepared` solves by cones (three distinct,
     non-collinear contacts, friction at each).
@@ -498,13 +519,36 @@ def grip_rows(p, n, limit, w, tol, out, codes):
     non-finite number (input, or an overflow on the way), a wrench on the edge of what the fingers
     exert.  ``limit (n, 3)`` is ``mu / safety``.
     """
-    ws, rw = _workspace(), _row_workspace()
-    q, mv, g = np.empty((3, 3)), np.empty(3), np.empty(3)
-    unit, e, fm = np.empty((3, 3)), np.empty((3, 3)), np.empty((3, 3))
-    frame, M = np.empty((3, 3, 3)), np.zeros((3, 3, 3))
-    A, b = np.empty((3, 3, 3)), np.empty((3, 3))
-    s, z = np.empty(3), np.empty((3, 3))
-    d, lam, inside = np.empty((3, 3)), np.empty(6), np.empty(3)
+    _grip_rows(p, n, limit, w, tol, out, codes, _workspace(), _row_workspace(), _grip_workspace())
+
+
+@njit(**_ALLOC)
+def _grip_workspace():
+    """The arrays of one row's geometry, cones and answer (``M`` zero off its squeezes' entries)."""
+    return (
+        np.empty((3, 3)),
+        np.empty(3),
+        np.empty(3),
+        np.empty((3, 3)),
+        np.empty((3, 3)),
+        np.empty((3, 3)),
+        np.empty((3, 3, 3)),
+        np.zeros((3, 3, 3)),
+        np.empty((3, 3, 3)),
+        np.empty((3, 3)),
+        np.empty(3),
+        np.empty((3, 3)),
+        np.empty((3, 3)),
+        np.empty(6),
+        np.empty(3),
+        np.empty((6, 3)),
+    )
+
+
+@njit(**_JIT)
+def _grip_rows(p, n, limit, w, tol, out, codes, ws, rw, gw):
+    """:func:`grip_rows` in the workspaces ``ws``, ``rw`` and ``gw`` (:func:`_grip_workspace`)."""
+    q, mv, g, unit, e, fm, frame, M, A, b, s, z, d, lam, inside, corners = gw
     for r in range(p.shape[0]):
         o = out[r]
         codes[r, 0], codes[r, 1], codes[r, 2] = 0, -1, 0
@@ -606,7 +650,7 @@ def grip_rows(p, n, limit, w, tol, out, codes):
             for i in range(3):
                 for k in range(3):
                     z[i, k] = 0.0
-            _internal_inside(p[r], unit, mv, e, limit[r], inside)
+            _internal_inside(p[r], unit, mv, e, limit[r], inside, corners)
             fail, blame = _solve_row(A, b, inside, s, z, ws, rw)
             # the multipliers as forces' duals; the dual twist through n_i - u_i, phase I's y through -u_i
             for i in range(3):

@@ -17,31 +17,34 @@ import math
 
 from .socp import _EDGE, _ITERATIONS, _RESIDUAL, GAP, START_MARGIN
 
-__all__ = ["phase_one", "minimise", "newton_matrices", "solve", "edge", "scaling", "w_inv", "w_mul"]
+__all__ = ["phase_one", "minimise", "newton_matrices", "solve", "approach", "scaling", "w_inv", "w_mul"]
 
 
-def edge(x0, x1, x2, d0, d1, d2):
-    """The largest ``alpha`` with ``x + alpha d`` in the cone (``inf``: none), as :func:`socp._edge`.
+def approach(x0, x1, x2, d0, d1, d2, s):
+    """How fast ``x + alpha d`` nears the cone's edge: ``t`` with the largest ``alpha`` in the cone
+    ``1 / t`` where ``t > 0`` (none otherwise), as :func:`socp._edge`; ``s = sqrt(x0^2 - x1^2 - x2^2)``,
+    which :func:`scaling` has computed already.  A step's length is ``1 / max t`` over its cones: one
+    division, not one a cone.
 
     Plain floats in and out: :mod:`~grasptwist.engine.forces.kernel` compiles this same function.
     """
-    s = math.sqrt(x0 * x0 - x1 * x1 - x2 * x2)
     x0, x1, x2 = x0 / s, x1 / s, x2 / s
     d0, d1, d2 = d0 / s, d1 / s, d2 / s
     rho0 = x0 * d0 - x1 * d1 - x2 * d2
     f = (rho0 + d0) / (x0 + 1)
     e1, e2 = d1 - f * x1, d2 - f * x2
-    t = math.sqrt(e1 * e1 + e2 * e2) - rho0
-    return 1 / t if t > 0 else math.inf
+    return math.sqrt(e1 * e1 + e2 * e2) - rho0
 
 
 def _edge(x, d):
-    return edge(x[0], x[1], x[2], d[0], d[1], d[2])
+    t = approach(x[0], x[1], x[2], d[0], d[1], d[2], math.sqrt(x[0] * x[0] - x[1] * x[1] - x[2] * x[2]))
+    return 1 / t if t > 0 else math.inf
 
 
 def scaling(y0, y1, y2, z0, z1, z2):
     """Nesterov-Todd scaling of one cone (``W z = W^-1 y = lambda``, ``W = beta (2 v v^T - J)``):
-    ``(w0, w1, w2, v0, v1, v2, beta, lambda0, lambda1, lambda2)`` (``w`` the scaling point).
+    ``(w0, w1, w2, v0, v1, v2, beta, lambda0, lambda1, lambda2, ys, zs)`` (``w`` the scaling point,
+    ``ys = sqrt(y^T J y)`` and ``zs`` the cones' own norms of ``y`` and ``z``, for :func:`approach`).
 
     Plain floats, compiled as it is by :mod:`~grasptwist.engine.forces.kernel`.
     """
@@ -53,7 +56,7 @@ def scaling(y0, y1, y2, z0, z1, z2):
     v0, v1, v2 = (w0 + 1) / r, w1 / r, w2 / r
     beta = math.sqrt(ys / zs)
     vz = 2 * (v0 * z0 + v1 * z1 + v2 * z2)
-    return w0, w1, w2, v0, v1, v2, beta, beta * (v0 * vz - z0), beta * (v1 * vz + z1), beta * (v2 * vz + z2)
+    return w0, w1, w2, v0, v1, v2, beta, beta * (v0 * vz - z0), beta * (v1 * vz + z1), beta * (v2 * vz + z2), ys, zs
 
 
 def w_inv(v0, v1, v2, beta, u0, u1, u2):
@@ -160,7 +163,7 @@ def _step(AT, b, c, x, z, P, leave):
     y = _times(AT, b, x)
     V, B, L, G = [], [], [], []
     for ym, zm, cols in zip(y, z, AT):
-        w0, w1, w2, v0, v1, v2, beta, l0, l1, l2 = scaling(*ym, *zm)
+        w0, w1, w2, v0, v1, v2, beta, l0, l1, l2, _, _ = scaling(*ym, *zm)
         L.append((l0, l1, l2))
         G.append([a0 * w0 - a1 * w1 - a2 * w2 for a0, a1, a2 in cols])
         V.append((v0, v1, v2))

@@ -120,11 +120,12 @@ def _iterate(A, b, c, x, z, leave):
     P = [[_jdot(A[:, i], A[:, j]) for j in range(d)] for i in range(d)]
     rows = np.arange(x.shape[1])
     K = A.shape[2]
+    # the rows still iterating, gathered only when some leave (none do for the first 7 or so steps)
+    a, bb, cc, xx, zz = A, b, c, x[:, rows], z[..., rows]
     for _ in range(_ITERATIONS):
         if not rows.size:
             break
-        a, bb, xx, zz = A[..., rows], b[..., rows], x[:, rows], z[..., rows]
-        res = c[:, rows] - np.stack([_dot(a[:, j], zz).sum(axis=0) for j in range(d)])
+        res = cc - np.stack([_dot(a[:, j], zz).sum(axis=0) for j in range(d)])
         y = bb + _apply(a, xx)
         # Nesterov-Todd scaling: W z = W^-1 y = lambda, W = beta (2 v v^T - J), w the scaling point
         ys, zs = np.sqrt(_jdot(y, y)), np.sqrt(_jdot(zz, zz))
@@ -147,7 +148,7 @@ def _iterate(A, b, c, x, z, leave):
         H = [[None] * d for _ in range(d)]
         for i in range(d):
             for j in range(i + 1):
-                H[i][j] = H[j][i] = ((2 * g[i] * g[j] - P[i][j][:, rows]) * scale).sum(axis=0)
+                H[i][j] = H[j][i] = ((2 * g[i] * g[j] - P[i][j]) * scale).sum(axis=0)
         ridge = 1e-14 * np.max([H[i][i] for i in range(d)], axis=0)  # directions that move no cone
         for i in range(d):
             H[i][i] = H[i][i] + ridge
@@ -180,9 +181,12 @@ def _iterate(A, b, c, x, z, leave):
         zz = zz + step * np.where(good, dz, 0.0)
         x[:, rows], z[..., rows] = xx, zz
         gap = _dot(y + step * dy, zz).sum(axis=0)
-        obj = (c[:, rows] * xx).sum(axis=0)
+        obj = (cc * xx).sum(axis=0)
         feasible = (np.abs(res) * (1 - step)).max(axis=0) <= _RESIDUAL
-        rows = rows[good & ~leave(xx, gap <= GAP * (1 + np.abs(obj)), np.where(feasible, obj - gap, -np.inf))]
+        stay = good & ~leave(xx, gap <= GAP * (1 + np.abs(obj)), np.where(feasible, obj - gap, -np.inf))
+        if not stay.all():
+            rows, a, bb, cc, xx, zz = rows[stay], a[..., stay], bb[..., stay], cc[:, stay], xx[:, stay], zz[..., stay]
+            P = [[p[:, stay] for p in row] for row in P]
     return x
 
 
