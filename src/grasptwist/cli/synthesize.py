@@ -23,6 +23,7 @@ from .options import (
     SurfaceTol,
     SynthesizeFormat,
     WrenchName,
+    hand_option,
     WrenchOption,
     not_binary_to_a_terminal,
     reading_option,
@@ -114,6 +115,24 @@ def synthesize(
             help="Grasps returned are at least this far apart (default: 5% of the object's size).",
         ),
     ] = None,
+    hand: Annotated[
+        str | None,
+        typer.Option(
+            "--hand",
+            metavar="FILE",
+            help="A hand that must reach every grasp (a YAML file holding just hand:, a URDF one); "
+            "default: the grasp file's hand.",
+        ),
+    ] = None,
+    tip_radius: Annotated[
+        float | None,
+        typer.Option(
+            "--tip-radius",
+            metavar="R",
+            min=0,
+            help="Every fingertip's radius (default: the hand's tip_radius, or its URDF's tip spheres).",
+        ),
+    ] = None,
     quality: Annotated[bool, typer.Option("--quality", help="Also Ferrari-Canny's epsilon (needs scipy).")] = False,
     seed: Annotated[int, typer.Option("--seed", min=0, help="Seed of the random numbers (reproducible runs).")] = 0,
     candidates: Annotated[
@@ -141,8 +160,10 @@ def synthesize(
     Candidates are scored in batches (force closure at mu / S, both decompositions
     well conditioned, the least total normal force for every wrench), the best
     refined on the surface, and each grasp returned is verified by the exact grip.
-    With -o FILE.yaml the grasps are written as a grasp file every command reads
-    (the records go to stdout). Exit 1 when an object has no feasible grasp.
+    With a hand (the file's, or --hand) every grasp is reached within the joint limits,
+    fingertips on the surface and no finger link in the object; the records give the
+    joint positions. With -o FILE.yaml the grasps are written as a grasp file every
+    command reads (the records go to stdout). Exit 1 when an object has no feasible grasp.
     Examples:
 
     \b
@@ -169,6 +190,7 @@ def synthesize(
     job = Job(
         command=COMMANDS["synthesize"],
         fmt=fmt.value,
+        hand=None if hand is None else hand_option(hand, [], fmt.value),
         max_bytes=max_bytes,
         reading=reading_option(surface_tol, allow_outside),
         options=SynthesisOptions(
@@ -186,7 +208,9 @@ def synthesize(
             candidates=candidates,
             seconds=seconds,
             grasp_file=grasp_file,
+            tip_radius=tip_radius,
+            hand_file=hand,
         ),
     )
-    settings = OutputSettings(records_to, quiet, Warnings.summary, 1, {"digits": digits})
+    settings = OutputSettings(records_to, quiet, Warnings.summary, 1, {"digits": digits}, reads=(hand,))
     run_command(debug, lambda: write_records(job, paths, settings))

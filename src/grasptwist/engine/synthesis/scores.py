@@ -12,7 +12,12 @@ before it):
 3. it passes every further constraint given (``constraints``: functions of the contacts and
    normals, a hand's reach or a table, each ``(n, 3, 3), (n, 3, 3) -> (n,) bool``);
 4. a grip exists for every wrench (the batched least grip,
-   :func:`~grasptwist.engine.forces.grip.grip`), and for each its least total normal force
+   :func:`~grasptwist.engine.forces.grip.grip`);
+5. with a hand (``hand``), some assignment of its fingers to the contacts has the fingertips
+   on the surface, reaches every contact within the joint limits and keeps every finger link
+   out of the object (:mod:`~grasptwist.engine.synthesis.reach`: the most expensive test, last).
+
+For each wrench the least total normal force
 
 .. math:: \min \sum_i f_i \cdot n_i \quad \text{s.t.} \quad G f = w, \;
           |f_i - (f_i \cdot n_i) n_i| \le \frac{\mu}{s} f_i \cdot n_i
@@ -34,6 +39,7 @@ from ..degeneracy import DEGENERACY_TOL
 from ..forces.closure import force_closure, internal_inside
 from ..forces.grasp_map import geometry
 from ..forces.grip import grip
+from .reach import HAND_CONSTRAINTS, reach
 
 __all__ = [
     "OBJECTIVES",
@@ -49,7 +55,7 @@ __all__ = [
 OBJECTIVES = ("total_normal_force", "closure_friction", "epsilon")
 
 #: The constraints in the order they are tested; a row's ``failed`` indexes this (-1: feasible).
-CONSTRAINTS = ("degenerate", "conditioning", "force_closure", "constraints", "grip")
+CONSTRAINTS = ("degenerate", "conditioning", "force_closure", "constraints", "grip", *HAND_CONSTRAINTS)
 
 #: The decompositions whose conditioning a grasp must keep above ``min_conditioning``.
 METHODS = ("off_tangent", "tangent")
@@ -68,12 +74,22 @@ class Scores(NamedTuple):
         Of the off-tangent (NaN without a wrist) and the tangent decomposition (:data:`METHODS`).
     failed : (N,) int8
         The first constraint (:data:`CONSTRAINTS`) the row fails, or -1.
+    order : (N, 3) int or None
+        With a hand: finger ``f`` touches contact ``order[:, f]``.
+    joint_positions : (N, n_joints) or None
+        With a hand: where it reaches the feasible rows (NaN elsewhere).
+    miss : (N,) or None
+        With a hand: how close a row that fails one of its constraints came
+        (:class:`~grasptwist.engine.synthesis.reach.Reached`).
     """
 
     objective: np.ndarray
     total_normal_force: np.ndarray
     conditioning: np.ndarray
     failed: np.ndarray
+    order: np.ndarray | None = None
+    joint_positions: np.ndarray | None = None
+    miss: np.ndarray | None = None
 
 
 def check_objective(objective) -> str:
@@ -135,6 +151,7 @@ def score_triples(
     methods=METHODS,
     min_conditioning=0.0,
     constraints=(),
+    hand=None,
     tol=DEGENERACY_TOL,
 ) -> Scores:
     """Score ``N`` candidate triples against every constraint and the objective (module docstring).
@@ -147,7 +164,7 @@ def score_triples(
         The wrenches every grasp must exert (``W >= 1``).
     friction : float
         ``mu``, the same at every contact.
-    safety, objective, wrist, methods, min_conditioning, constraints, tol
+    safety, objective, wrist, methods, min_conditioning, constraints, hand, tol
         As :func:`~grasptwist.engine.synthesis.search.search`.
 
     Returns
@@ -196,8 +213,19 @@ def score_triples(
         held &= g.ok
     live = live[held]
     failed[live] = -1
+    hand_fields = {}
+    if hand is not None:
+        order = np.tile(np.arange(3), (rows, 1))
+        positions = np.full((rows, len(hand.hand.joint_names)), np.nan)
+        miss = np.full(rows, np.nan)
+        if live.size:
+            r = reach(hand, p[live], n[live])
+            failed[live] = np.where(r.failed == -1, -1, CONSTRAINTS.index("grip") + 1 + r.failed)
+            order[live], positions[live], miss[live] = r.order, r.positions, r.miss
+            live = live[r.failed == -1]
+        hand_fields = {"order": order, "joint_positions": positions, "miss": miss}
     objective_value[live] = objective_values(p[live], n[live], total[live], friction / safety, objective, tol)
-    return Scores(objective_value, total, cond, failed)
+    return Scores(objective_value, total, cond, failed, **hand_fields)
 
 
 def objective_values(points, normals, total, mu, objective, tol=DEGENERACY_TOL):
