@@ -22,9 +22,10 @@ from .options import (
     Safety,
     SurfaceTol,
     SynthesizeFormat,
+    Workers,
     WrenchName,
-    hand_option,
     WrenchOption,
+    hand_option,
     not_binary_to_a_terminal,
     reading_option,
     wrenches_option,
@@ -152,6 +153,7 @@ def synthesize(
     max_bytes: MaxBytes = None,
     surface_tol: SurfaceTol = None,
     allow_outside: AllowOutside = False,
+    workers: Workers = 1,
     quiet: Quiet = False,
     debug: Debug = False,
 ) -> None:
@@ -169,6 +171,7 @@ def synthesize(
     \b
         grasptwist synthesize grasps/sphere.yaml -n 3
         grasptwist synthesize grasps/trifinger-cube.yaml --friction 0.8 --mass 0.1 -o found.yaml
+        grasptwist synthesize objects/ -j 2 -f jsonl      # a folder: one object a process
     """
     from ..run.families import COMMANDS
     from ..run.options import SynthesisOptions
@@ -212,5 +215,5 @@ def synthesize(
             hand_file=hand,
         ),
     )
-    settings = OutputSettings(records_to, quiet, Warnings.summary, 1, {"digits": digits}, reads=(hand,))
+    settings = OutputSettings(records_to, quiet, Warnings.summary, workers, {"digits": digits}, reads=(hand,))
     run_command(debug, lambda: write_records(job, paths, settings))

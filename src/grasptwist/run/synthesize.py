@@ -36,6 +36,7 @@ from ..output.formats import FORMATS
 from ..output.records import diagnostics, dumps, error_record
 from .options import SynthesisOptions
 from .outputs import Output
+from .pool import Pool, pool_size
 from .target import opened
 
 __all__ = [
@@ -43,6 +44,8 @@ __all__ = [
     "Progress",
     "synthesize_inputs",
     "synthesize_outputs",
+    "searched",
+    "input_records",
     "NO_OBJECT",
     "NOTHING_TO_HOLD",
     "NO_FRICTION",
@@ -250,13 +253,38 @@ def synthesize_inputs(job, inputs: Iterable) -> Iterator[GraspFileError | Found 
         yield Progress(0, 1)
 
 
+def searched(job, inputs: list, workers: int = 1) -> Iterator[GraspFileError | Found | Progress]:
+    """:func:`synthesize_inputs`, each input on one of ``workers`` forked processes
+    (:class:`~grasptwist.run.pool.Pool`) when there are several: the same items in the same order
+    (a search depends on its seed alone), each input's as its search ends."""
+    if pool_size(workers, len(inputs)) <= 1:
+        yield from synthesize_inputs(job, inputs)
+        return
+    with Pool(lambda i: list(synthesize_inputs(job, inputs[i : i + 1])), workers, in_flight=1) as pool:
+        for items in pool.results(len(inputs)):
+            yield from items
+
+
+def input_records(job, path: str) -> list[dict]:
+    """The JSON records of one input, as ``grasptwist synthesize PATH -f json`` gives them
+    (``grasptwist.dask``'s unit of work)."""
+    out = []
+    for item in synthesize_inputs(job, [path]):
+        if isinstance(item, GraspFileError):
+            out.append(error_record(item))
+        elif isinstance(item, Found):
+            out.extend(sr.synthesis_records(item) if len(item) else [sr.failure_record(item)])
+    return out
+
+
 def synthesize_outputs(job, inputs: Iterable, w, workers: int = 1, tuning=None) -> Iterator[Output]:
-    """The :class:`~grasptwist.run.outputs.Output` of each object searched (one process: a search is
-    vectorised already); the grasp file of ``-o FILE.yaml`` is written once every search is done."""
+    """The :class:`~grasptwist.run.outputs.Output` of each object searched (one object a process:
+    a search is vectorised already); the grasp file of ``-o FILE.yaml`` is written once every
+    search is done."""
     fmt = FORMATS[job.fmt]
     inputs = list(inputs)
     documents = []
-    for item in synthesize_inputs(job, inputs):
+    for item in searched(job, inputs, workers):
         if isinstance(item, Progress):
             yield Output(extra_work=item.extra, done=item.done)
             continue

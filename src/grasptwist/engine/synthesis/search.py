@@ -220,7 +220,7 @@ class _Archive:
     """The best feasible candidates so far (at most ``size``, each ``spacing`` or more from the better
     ones, so that refinement and selection start from distinct grasps), and the furthest any got."""
 
-    def __init__(self, size, spacing):
+    def __init__(self, size, spacing, joints=None):
         self.size, self.spacing = size, spacing
         self.points = np.empty((0, 3, 3))
         self.normals = np.empty((0, 3, 3))
@@ -228,15 +228,14 @@ class _Archive:
         self.furthest = 0
         self.near_points, self.near_normals = np.empty((0, 3, 3)), np.empty((0, 3, 3))
         self.best_conditioning = 0.0
-        self.positions = None  # with a hand: (N, n_joints)
+        self.positions = None if joints is None else np.empty((0, joints))  # with a hand: (N, n_joints)
         self.best_miss = {}  # a hand's constraint -> the closest a row failing it came
 
     def add(self, p, n, s):
         ok = s.failed == -1
         if s.order is not None:  # contact f is finger f's
             p, n = (np.take_along_axis(a, s.order[..., None], axis=1) for a in (p, n))
-            got = s.joint_positions[ok]
-            self.positions = got if self.positions is None else np.concatenate((self.positions, got))
+            self.positions = np.concatenate((self.positions, s.joint_positions[ok]))
             for k in np.unique(s.failed[s.failed > CONSTRAINTS.index("grip")]):
                 best = float(np.nanmin(s.miss[s.failed == k], initial=np.inf))
                 self.best_miss[CONSTRAINTS[k]] = min(self.best_miss.get(CONSTRAINTS[k], np.inf), best)
@@ -370,7 +369,7 @@ def search_steps(
     started = time.perf_counter()
     rng = np.random.default_rng(seed)
     budget = _Budget(budget_size, seconds)
-    archive = _Archive(max(ELITES, 4 * count), spacing)
+    archive = _Archive(max(ELITES, 4 * count), spacing, None if hand is None else len(hand.hand.joint_names))
     chunk = CHUNK if objective == "total_normal_force" else CHUNK // 8  # closure friction, epsilon: slower rows
 
     def score(p, n):
@@ -401,7 +400,7 @@ def search_steps(
         yield from _refine(surface, archive, score, budget, rng)
     picked = _spread(archive.points, count, spacing)
     points, normals = archive.points[picked], archive.normals[picked]
-    positions = None if hand is None else archive.positions[picked].reshape(len(picked), -1)
+    positions = None if hand is None else archive.positions[picked]
     quality = quality or objective == "epsilon"
     out = _results(surface, points, normals, w, mu, safety, wrist, methods, quality, tol, hand, positions)
     failure = None if len(out["points"]) else _failure(archive, mu / safety, min_conditioning, tol)
