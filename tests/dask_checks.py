@@ -131,7 +131,7 @@ def array_equals_the_engine():
 
 
 def synthesis_on_a_cluster(tmp_path):
-    """synthesize_bag over three objects (one with no grasp) on two worker processes, against the command line."""
+    """synthesize_bag over three objects on two worker processes, against the command line."""
     import json
     import shutil
 

@@ -73,7 +73,8 @@ class Scores(NamedTuple):
     conditioning : (N, 2)
         Of the off-tangent (NaN without a wrist) and the tangent decomposition (:data:`METHODS`).
     failed : (N,) int8
-        The first constraint (:data:`CONSTRAINTS`) the row fails, or -1.
+        The first constraint (:data:`CONSTRAINTS`) the row fails, -1 where it passes them all,
+        ``len(CONSTRAINTS)`` where it was not tested further (``bound``).
     order : (N, 3) int or None
         With a hand: finger ``f`` touches contact ``order[:, f]``.
     joint_positions : (N, n_joints) or None
@@ -152,6 +153,7 @@ def score_triples(
     min_conditioning=0.0,
     constraints=(),
     hand=None,
+    bound=np.inf,
     tol=DEGENERACY_TOL,
 ) -> Scores:
     """Score ``N`` candidate triples against every constraint and the objective (module docstring).
@@ -166,6 +168,10 @@ def score_triples(
         ``mu``, the same at every contact.
     safety, objective, wrist, methods, min_conditioning, constraints, hand, tol
         As :func:`~grasptwist.engine.synthesis.search.search`.
+    bound : float
+        With a hand: rows whose objective is at least this are not put to the hand's test
+        (a search's archive would not keep them); their ``failed`` is ``len(CONSTRAINTS)``,
+        their objective ``inf``.
 
     Returns
     -------
@@ -213,19 +219,22 @@ def score_triples(
         held &= g.ok
     live = live[held]
     failed[live] = -1
-    hand_fields = {}
-    if hand is not None:
-        order = np.tile(np.arange(3), (rows, 1))
-        positions = np.full((rows, len(hand.hand.joint_names)), np.nan)
-        miss = np.full(rows, np.nan)
-        if live.size:
-            r = reach(hand, p[live], n[live])
-            failed[live] = np.where(r.failed == -1, -1, CONSTRAINTS.index("grip") + 1 + r.failed)
-            order[live], positions[live], miss[live] = r.order, r.positions, r.miss
-            live = live[r.failed == -1]
-        hand_fields = {"order": order, "joint_positions": positions, "miss": miss}
     objective_value[live] = objective_values(p[live], n[live], total[live], friction / safety, objective, tol)
-    return Scores(objective_value, total, cond, failed, **hand_fields)
+    if hand is None:
+        return Scores(objective_value, total, cond, failed)
+    # rows no better than ``bound`` are never kept: the hand, the costliest test, is spared them
+    spared = live[objective_value[live] >= bound]
+    failed[spared], objective_value[spared] = len(CONSTRAINTS), np.inf
+    live = live[objective_value[live] < bound]
+    order = np.tile(np.arange(3), (rows, 1))
+    positions = np.full((rows, len(hand.hand.joint_names)), np.nan)
+    miss = np.full(rows, np.nan)
+    if live.size:
+        r = reach(hand, p[live], n[live])
+        failed[live] = np.where(r.failed == -1, -1, CONSTRAINTS.index("grip") + 1 + r.failed)
+        order[live], positions[live], miss[live] = r.order, r.positions, r.miss
+        objective_value[live[r.failed != -1]] = np.inf
+    return Scores(objective_value, total, cond, failed, order, positions, miss)
 
 
 def objective_values(points, normals, total, mu, objective, tol=DEGENERACY_TOL):

@@ -231,12 +231,18 @@ class _Archive:
         self.positions = None if joints is None else np.empty((0, joints))  # with a hand: (N, n_joints)
         self.best_miss = {}  # a hand's constraint -> the closest a row failing it came
 
+    @property
+    def bound(self) -> float:
+        """An objective no better than this is never kept: the worst kept once the archive is full."""
+        return float(self.objective[-1]) if len(self.objective) >= self.size else np.inf
+
     def add(self, p, n, s):
         ok = s.failed == -1
         if s.order is not None:  # contact f is finger f's
             p, n = (np.take_along_axis(a, s.order[..., None], axis=1) for a in (p, n))
             self.positions = np.concatenate((self.positions, s.joint_positions[ok]))
-            for k in np.unique(s.failed[s.failed > CONSTRAINTS.index("grip")]):
+            tested = (s.failed > CONSTRAINTS.index("grip")) & (s.failed < len(CONSTRAINTS))
+            for k in np.unique(s.failed[tested]):
                 best = float(np.nanmin(s.miss[s.failed == k], initial=np.inf))
                 self.best_miss[CONSTRAINTS[k]] = min(self.best_miss.get(CONSTRAINTS[k], np.inf), best)
         self.points = np.concatenate((self.points, p[ok]))
@@ -370,9 +376,10 @@ def search_steps(
     rng = np.random.default_rng(seed)
     budget = _Budget(budget_size, seconds)
     archive = _Archive(max(ELITES, 4 * count), spacing, None if hand is None else len(hand.hand.joint_names))
-    chunk = CHUNK if objective == "total_normal_force" else CHUNK // 8  # closure friction, epsilon: slower rows
+    # closure friction, epsilon: slower rows; a hand: the archive fills (and spares rows the hand's test) sooner
+    chunk = CHUNK if objective == "total_normal_force" and hand is None else CHUNK // 8
 
-    def score(p, n):
+    def score(p, n, bound=None):
         return score_triples(
             p,
             n,
@@ -385,6 +392,7 @@ def search_steps(
             min_conditioning=min_conditioning,
             constraints=constraints,
             hand=hand,
+            bound=archive.bound if bound is None else bound,
             tol=tol,
         )
 
@@ -432,7 +440,8 @@ def _refine(surface, archive, score, budget, rng):
         defined = (np.einsum("nix,nix->ni", surface.project(q)[1], m) > _SAME_NORMAL).all(axis=1)
         value = np.full(k, np.inf)
         if defined.any():
-            s = score(q[defined], m[defined])
+            # a child better than its parent is never spared the hand's test, kept or not
+            s = score(q[defined], m[defined], max(archive.bound, float(best.max())))
             archive.add(q[defined], m[defined], s)
             value[defined] = s.objective
         budget.spent(k)
