@@ -150,13 +150,6 @@ def deepest_link(grasp: Grasp, *, max_bytes=DEFAULT_MAX_BYTES):
     ------
     InputError
         The URDF's or a mesh's, read here once.
-
-    Examples
-    --------
-    >>> import grasptwist as gt
-    >>> g = gt.hand.place_grasp(gt.read_grasps("grasps/trifinger-cube.yaml")[0])
-    >>> deepest_link(g)(g.joint_positions[None]).tolist()  # the fingertip spheres are the contacts
-    [0.0]
     """
     checked = _checked(grasp, max_bytes)
     if checked is None:

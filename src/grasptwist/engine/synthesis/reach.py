@@ -139,7 +139,7 @@ def reach(hand_reach: HandReach, points, normals) -> Reached:
     >>> def finger(i):
     ...     tip = np.eye(4); tip[:3, 3] = base[i]
     ...     j = (Joint(f"z{i}", "prismatic", None, -2.0, 2.0, None),)
-    ...     return Finger(str(i), None, j, np.array([[0, 0, 0, 0, 0, 1.0]]), base[i : i + 1], tip, 2.0, (i,))
+    ...     return Finger(str(i), None, j, np.array([[0, 0, 0, 0, 0, 1.0]]), base[i : i + 1] - [0, 0, 1], tip, 1.0, (i,))
     >>> hand = Hand(tuple(finger(i) for i in range(3)), ("z0", "z1", "z2"), None, None)
     >>> far = lambda q: (q, -q, np.full(q.shape[:-1], 10.0))  # nothing near: every sphere is clear
     >>> r = reach(HandReach(hand, np.array([f.tip_pose for f in hand.fingers]), np.zeros(3), far, 1e-6),

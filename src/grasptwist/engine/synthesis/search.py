@@ -571,8 +571,8 @@ def _failure(archive, mu, min_conditioning, tol) -> Failure:
         best = archive.best_miss.get(name, np.inf)
         return Failure(
             name,
-            f"the hand reaches no candidate's contacts within its joint limits: the closest a fingertip came "
-            f"is {best:.3g} from where it must be",
+            f"the hand reaches no candidate's contacts within its joint limits: the best candidate leaves a "
+            f"fingertip {best:.3g} from where it must be",
             best,
             0.0,
         )
