@@ -204,8 +204,7 @@ def synthesize_bag(objects, *, hand: str | None = None, **options):
     hand : str, optional
         As ``--hand``: a YAML file holding just ``hand:`` that must reach every grasp.
     **options
-        As the command line's, by their names in
-        :class:`~grasptwist.run.options.SynthesisOptions`: ``count`` (5), ``friction``,
+        As the command line's, by their names in ``grasptwist.run.options.SynthesisOptions``: ``count`` (5), ``friction``,
         ``mass``, ``safety``, ``objective``, ``method``, ``min_conditioning`` (0.001),
         ``min_spacing``, ``quality``, ``seed`` (0), ``candidates`` (20000), ``seconds`` (60),
         ``tip_radius``.

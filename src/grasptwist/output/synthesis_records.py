@@ -346,6 +346,9 @@ class SynthesisTable:
             point = ", ".join(self._number(v) for v in c["point"])
             normal = ", ".join(self._number(v) for v in c["normal"])
             self._line(f"    {escaped(c['name'])}: point ({point})  normal ({normal})")
+        if rec.get("joint_positions"):
+            joints = ", ".join(f"{escaped(n)} {self._number(q)}" for n, q in rec["joint_positions"].items())
+            self._line(f"    joints: {joints}")
 
     def close(self) -> None:
         pass

@@ -615,7 +615,19 @@ def hand_reach(obj, hand, *, tips=None, tip_radius=None, collide=None) -> HandRe
     return check_hand_reach(reach)
 
 
-def synthesize(obj, friction, *, wrenches=(), hold=True, gravity=GRAVITY, hand=None, **options) -> Synthesis:
+def synthesize(
+    obj,
+    friction,
+    *,
+    wrenches=(),
+    hold=True,
+    gravity=GRAVITY,
+    hand=None,
+    tips=None,
+    tip_radius=None,
+    collide=None,
+    **options,
+) -> Synthesis:
     r"""Grasps of an object: its surface searched for grasps that hold its weight and ``wrenches``.
 
     The search (``grasptwist.engine.synthesis.search.search``; the guide's synthesis page) scores
@@ -634,10 +646,16 @@ def synthesize(obj, friction, *, wrenches=(), hold=True, gravity=GRAVITY, hand=N
     hold : bool
         Hold the object's weight: the wrench ``(-m g; -c x m g)`` comes first.
     gravity : (3,) array
-    hand : Hand or HandReach, optional
+    hand : Hand, optional
         A hand that must reach every grasp: fingertips on the surface, every contact within
-        the joint limits, no finger link in the object (:func:`hand_reach`: a Hand is taken
-        with its fingers' tip links and radii, links not checked against the object).
+        the joint limits, no finger link in the object; the grasps then list contact ``f`` for
+        finger ``f`` (the fingers are assigned to the contacts in every order), and
+        ``joint_positions`` and ``reach_error`` say where the hand holds each.
+    tips, tip_radius, collide
+        As ``grasptwist.engine.synthesis.search.hand_reach``: each finger's tip link pose at home (needed for a finger
+        given inline), every fingertip's radius (default each finger's ``tip_radius``), and
+        the depth of the deepest link at joint positions (default: links not checked; the
+        command line checks a URDF's meshes).
     **options
         The search's keyword options: ``count`` (grasps wanted, 1), ``safety`` (1), ``objective``
         (``total_normal_force``, ``closure_friction`` or ``epsilon``), ``wrist`` (None),
@@ -667,5 +685,5 @@ def synthesize(obj, friction, *, wrenches=(), hold=True, gravity=GRAVITY, hand=N
     if not listed:
         raise ValueError("nothing to hold: give the object a mass (hold=True) or wrenches")
     if hand is not None and not isinstance(hand, HandReach):
-        hand = hand_reach(obj, hand)
+        hand = hand_reach(obj, hand, tips=tips, tip_radius=tip_radius, collide=collide)
     return search(surface_of(obj), np.array(listed), friction, hand=hand, **options)
