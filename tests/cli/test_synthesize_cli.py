@@ -84,6 +84,8 @@ def test_a_file_without_object_or_friction_is_an_error_of_its_own(tmp_path):
         (("--min-conditioning", "2"), "min_conditioning must be a number from 0 to 1"),
         (("--mass", "-1"), "must be a finite number > 0"),
         (("--objective", "speed"), "speed"),
+        (("--tip-radius", "-0.1"), "-0.1"),
+        (("--hand", "missing-hand.yaml"), "--hand"),
     ],
 )
 def test_bad_options_are_usage_errors(args, message):
@@ -280,3 +282,19 @@ def test_a_cube_out_of_the_trifinger_s_reach_is_exit_1_with_the_reason(tmp_path)
     assert r.exit_code == 1
     (rec,) = jsonl(r.stdout)
     assert rec["error"]["constraint"] == "reach" and rec["error"]["best"] > 0.1
+
+
+def test_the_table_gives_a_hand_s_joint_positions():
+    from grasptwist.output.synthesis_records import SynthesisTable
+
+    out = io.BytesIO()
+    rec = {
+        "file": "f.yaml",
+        "grasp": "g",
+        "rank": 1,
+        "contacts": [{"name": "1", "point": [0, 0, 0], "normal": [1, 0, 0]}],
+        "scores": {"total_normal_force": {"hold": 1.0}, "closure_friction": 0.1, "epsilon": None, "conditioning": {}},
+        "joint_positions": {"a.1": 0.5, "a.2": -0.25},
+    }
+    SynthesisTable(out).write(rec)
+    assert out.getvalue().decode().splitlines()[-1] == "    joints: a.1 0.5000, a.2 -0.2500"

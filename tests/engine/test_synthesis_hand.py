@@ -8,7 +8,7 @@ import pytest
 
 from grasptwist.engine.ik import IK_TOL, joint_limits
 from grasptwist.engine.kinematics import forward_kinematics
-from grasptwist.engine.synthesis.reach import HandReach, check_hand_reach
+from grasptwist.engine.synthesis.reach import HAND_CONSTRAINTS, HandReach, check_hand_reach, reach
 from grasptwist.engine.synthesis.search import hand_reach, synthesize
 from grasptwist.io.grasp import read_grasps
 from grasptwist.model import Finger, GraspObject, Hand, Joint, Shape
@@ -71,3 +71,15 @@ def test_a_hand_whose_fingers_share_a_joint_is_refused():
     shared = Hand((f, f, f), INLINE.hand.joint_names[:3], None, None)
     with pytest.raises(ValueError, match="three fingers that share no joint"):
         check_hand_reach(HandReach(shared, np.zeros((3, 4, 4)), np.zeros(3), None, 0.0))
+
+
+def test_links_in_the_object_and_fingertips_in_it_are_named_with_how_close_they_came():
+    home = tips_of(INLINE, 0.0)
+    always_in = hand_reach(CUBE, INLINE.hand, tips=home, collide=lambda q: np.full(len(q), 0.25))
+    s = synthesize(CUBE, 0.8, hand=always_in, count=1, candidates=250)
+    assert s.failure.constraint == "collision" and s.failure.best == 0.25
+    assert "puts a finger link into the object (the shallowest 0.25 deep)" in s.failure.message
+    # a surface whose every point is a crease: no sphere of radius 0.1 touches it at one point alone
+    crease = HandReach(INLINE.hand, home, np.full(3, 0.1), lambda c: (c, c, np.zeros(c.shape[:-1])), 1e-6)
+    r = reach(crease, INLINE.points[None], INLINE.normals[None])
+    assert r.failed.tolist() == [HAND_CONSTRAINTS.index("fingertips")] and np.isnan(r.positions).all()
