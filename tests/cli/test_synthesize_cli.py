@@ -215,7 +215,22 @@ def test_a_folder_on_two_workers_gives_the_records_of_one(tmp_path):
         (tmp_path / name).write_bytes((GRASPS / name).read_bytes())
     got = []
     for j in ("1", "2"):
-        r, _ = run("synthesize", tmp_path, "--friction", "0.6", "--mass", "1", *FAST, "-f", "jsonl", "-j", j)
+        r, _ = run(
+            "synthesize",
+            tmp_path,
+            "--friction",
+            "0.6",
+            "--mass",
+            "1",
+            "--candidates",
+            "60",
+            "-n",
+            "2",
+            "-f",
+            "jsonl",
+            "-j",
+            j,
+        )
         assert r.exit_code == 0, r.stderr
         got.append([{**x, "search": {**x["search"], "seconds": None}} for x in jsonl(r.stdout)])
     assert got[0] == got[1] and len(got[0]) == 6

@@ -29,7 +29,7 @@ def test_every_grasp_puts_each_tip_centre_one_radius_out_by_forward_kinematics()
     r = 0.1
     hand = replace(INLINE.hand, fingers=tuple(replace(f, tip_radius=r) for f in INLINE.hand.fingers))
     reach = hand_reach(CUBE, hand, tips=tips_of(INLINE, r))
-    s = synthesize(CUBE, 0.8, hand=reach, count=2, candidates=250)
+    s = synthesize(CUBE, 0.8, hand=reach, count=2, candidates=150)
     assert s.failure is None and len(s.points) == 2 and s.joint_positions.shape == (2, 9)
     for k in range(2):
         for f, finger in enumerate(hand.fingers):
@@ -76,7 +76,7 @@ def test_a_hand_whose_fingers_share_a_joint_is_refused():
 def test_links_in_the_object_and_fingertips_in_it_are_named_with_how_close_they_came():
     home = tips_of(INLINE, 0.0)
     always_in = hand_reach(CUBE, INLINE.hand, tips=home, collide=lambda q: np.full(len(q), 0.25))
-    s = synthesize(CUBE, 0.8, hand=always_in, count=1, candidates=250)
+    s = synthesize(CUBE, 0.8, hand=always_in, count=1, candidates=100)
     assert s.failure.constraint == "collision" and s.failure.best == 0.25
     assert "puts a finger link into the object (the shallowest 0.25 deep)" in s.failure.message
     # a surface whose every point is a crease: no sphere of radius 0.1 touches it at one point alone
