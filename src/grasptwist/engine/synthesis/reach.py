@@ -21,8 +21,10 @@ finger and then as a whole:
    :mod:`grasptwist.run.collisions` builds it from the hand's meshes).
 
 The nine (finger, contact) pairs of a candidate are solved once each, batched over
-every candidate, and the six assignments are read off them; the assignments are
-checked for collisions in a fixed order, the first clear one kept.  Fingers must not
+every candidate, and the six assignments are read off them; the assignments that reach
+are checked for collisions nearest first (the least total distance from each finger's first
+joint to its target: a finger reaching around the object to a far contact is the one whose
+links go through it), the first clear one kept.  Fingers must not
 share joints (each finger's inverse kinematics is its own).
 """
 
@@ -183,10 +185,17 @@ def reach(hand_reach: HandReach, points, normals) -> Reached:
     order = np.tile(np.arange(3), (rows, 1))
     positions = np.full((rows, len(hr.hand.joint_names)), np.nan)
     depth = np.full(rows, np.inf)
-    for k in range(len(_ORDERS)):  # the assignments in order: the first clear of the object is kept
-        todo = np.flatnonzero(reached[:, k] & (failed != -1))
+    # the assignments tried nearest first (the fingers' first joints to their targets, in all): a finger
+    # that reaches around the object to a far contact is the one whose links go through it
+    base = np.array([f.points[0] for f in fingers])  # (3, 3)
+    spread = np.linalg.norm(centre - base, axis=-1)[pick].sum(axis=-1)  # (N, 6)
+    ranked = np.argsort(np.where(reached, spread, np.inf), axis=1, kind="stable")
+    for rank in range(len(_ORDERS)):  # the first assignment clear of the object is kept
+        k = ranked[:, rank]
+        todo = np.flatnonzero(reached[np.arange(rows), k] & (failed != -1))
         if not todo.size:
             continue
+        k = k[todo]
         trial = np.empty((todo.size, len(hr.hand.joint_names)))
         for f, finger in enumerate(fingers):
             trial[:, list(finger.joint_index)] = q[todo, _SHIFTS[k, f], f, : len(finger.joints)]
@@ -195,7 +204,7 @@ def reach(hand_reach: HandReach, points, normals) -> Reached:
         ok = deep <= hr.tolerance
         failed[todo[~ok]] = HAND_CONSTRAINTS.index("collision")
         won = todo[ok]
-        failed[won], order[won], positions[won] = -1, _ORDERS[k], trial[ok]
+        failed[won], order[won], positions[won] = -1, _ORDERS[k[ok]], trial[ok]
     miss = np.where(failed == HAND_CONSTRAINTS.index("collision"), depth, miss)
     return Reached(failed, order, positions, np.where(failed == -1, np.nan, miss))
 
