@@ -130,6 +130,50 @@ def array_equals_the_engine():
     print(f"{len(got)} rows in {r.numblocks[0]} chunks equal the engine")
 
 
+def synthesis_on_a_cluster(tmp_path):
+    """synthesize_bag over three objects on two worker processes, against the command line."""
+    import json
+    import shutil
+
+    from grasptwist.dask import synthesize_bag
+    from places import GRASPS
+
+    tmp_path.mkdir(exist_ok=True)
+    for name in ("sphere.yaml", "box-edge.yaml", "cylinder.yaml"):
+        shutil.copy(GRASPS / name, tmp_path / name)
+    paths = sorted(str(p) for p in tmp_path.glob("*.yaml"))
+    options = {"count": 2, "candidates": 1500, "mass": 0.2, "friction": 0.3}
+    cli = CliRunner().invoke(
+        app,
+        [
+            "synthesize",
+            *paths,
+            "-n",
+            "2",
+            "--candidates",
+            "1500",
+            "--mass",
+            "0.2",
+            "--friction",
+            "0.3",
+            "-f",
+            "jsonl",
+            "-q",
+        ],
+    )
+    theirs = [json.loads(line) for line in cli.stdout.splitlines()]
+    with (
+        distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=":0") as cluster,
+        distributed.Client(cluster) as client,
+    ):
+        assert len(client.scheduler_info()["workers"]) == 2
+        ours = synthesize_bag(paths, **options).compute()
+    for rec in ours + theirs:
+        rec["search"].pop("seconds")
+    assert ours == theirs and len(ours) >= 3
+    print(f"{len(ours)} records equal, {sum(not r['ok'] for r in ours)} objects without a grasp")
+
+
 def readme_block(folder):
     """The docs' Dask example as printed (the python block marked ``runner=dask``), run in ``folder``
     on 3 shards of 3,000 grasps in ``shards/``."""

@@ -21,6 +21,7 @@ NULLABLE = {"units", "wrist", "off_tangent", "tip", "velocity_limit_ratio"}  # t
 NULLABLE |= {"wrench", "friction", "manipulating", "grip", "force_closure", "closure_friction", "epsilon"}
 NULLABLE |= {"squeeze"}  # a grip on collinear contacts, whose internal forces are not three squeezes
 NULLABLE |= {"surface_distance"}  # a contact of a grasp without an object
+NULLABLE |= {"joint_positions", "reach_error"}  # a grasp synthesized without a hand
 
 
 def run(*args, input=None):

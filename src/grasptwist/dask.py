@@ -8,7 +8,9 @@ the same reader, blocks and columns as ``grasptwist resolve data.parquet -f
 parquet``, so the values are the command line's, bit for bit.
 :func:`resolve_array` maps dask arrays of points, normals, wrists and
 twists chunked by rows (``map_blocks``) to a dask array of records whose
-fields are the npz arrays.  Neither computes anything until asked: run
+fields are the npz arrays.  :func:`synthesize_bag` maps a Dask bag of
+objects (grasp files with an ``object``, mesh files) to a bag of the
+records ``grasptwist synthesize -f json`` gives, one object a task.  None computes anything until asked: run
 them on any Dask scheduler, e.g. a ``distributed.LocalCluster`` or a
 cluster's ``distributed.Client``.
 
@@ -32,7 +34,7 @@ from .model import Twist
 from .output.columns import arrays
 from .output.formats import FORMATS
 
-__all__ = ["resolve_dataframe", "to_parquet", "resolve_array", "result_dtype"]
+__all__ = ["resolve_dataframe", "to_parquet", "resolve_array", "result_dtype", "synthesize_bag"]
 
 _WHAT = "grasptwist.dask"
 #: npz groups that are labels, not numbers: not fields of resolve_array's records.
@@ -170,3 +172,50 @@ def resolve_array(points, normals, wrist, twist, *, method="both", order="omega-
     return stacked.rechunk({1: -1}).map_blocks(
         _resolve_rows, wrist is not None, method, order, dtype, dtype=dtype, drop_axis=1
     )
+
+
+def _synthesized(path: str, options: dict, hand_file: str | None) -> list[dict]:
+    """One object's records, as ``grasptwist synthesize PATH -f json`` gives them."""
+    from .io.grasp import load_hand_file
+    from .run.families import COMMANDS
+    from .run.options import SynthesisOptions
+    from .run.pipeline import Job
+    from .run.synthesize import input_records
+
+    hand = None if hand_file is None else load_hand_file(hand_file)[0]
+    job = Job(
+        command=COMMANDS["synthesize"],
+        fmt="json",
+        hand=hand,
+        options=SynthesisOptions(**options, hand_file=hand_file),
+    )
+    return input_records(job, path)
+
+
+def synthesize_bag(objects, *, hand: str | None = None, **options):
+    """Synthesize grasps for every object of a data set, lazily: a Dask bag of records, one object a task.
+
+    Parameters
+    ----------
+    objects : dask.bag.Bag or sequence of str
+        Paths of grasp files with an ``object`` (each document searched) or of mesh files
+        (STL, OBJ, PLY: give ``friction`` and ``mass``); a sequence becomes a bag of one
+        path a partition.
+    hand : str, optional
+        As ``--hand``: a YAML file holding just ``hand:`` that must reach every grasp.
+    **options
+        As the command line's, by their names in ``grasptwist.run.options.SynthesisOptions``: ``count`` (5), ``friction``,
+        ``mass``, ``safety``, ``objective``, ``method``, ``min_conditioning`` (0.001),
+        ``min_spacing``, ``quality``, ``seed`` (0), ``candidates`` (20000), ``seconds`` (60),
+        ``tip_radius``.
+
+    Returns
+    -------
+    dask.bag.Bag of dict
+        The JSON records of ``grasptwist synthesize -f json`` (a grasp each, or an object's
+        error: ``no-grasp`` with its reason), in the objects' order; ``.compute()`` them,
+        or write them with ``.map(json.dumps).to_textfiles(...)``.
+    """
+    db = require("dask.bag", _WHAT)
+    bag = objects if isinstance(objects, db.Bag) else db.from_sequence(list(objects), npartitions=len(objects) or 1)
+    return bag.map(_synthesized, options, hand).flatten()

@@ -84,6 +84,8 @@ def test_a_file_without_object_or_friction_is_an_error_of_its_own(tmp_path):
         (("--min-conditioning", "2"), "min_conditioning must be a number from 0 to 1"),
         (("--mass", "-1"), "must be a finite number > 0"),
         (("--objective", "speed"), "speed"),
+        (("--tip-radius", "-0.1"), "-0.1"),
+        (("--hand", "missing-hand.yaml"), "--hand"),
     ],
 )
 def test_bad_options_are_usage_errors(args, message):
@@ -154,3 +156,160 @@ def test_a_progress_bar_on_a_terminal_for_one_object(tmp_path):
     code, seen = on_a_terminal([*args, "-o", tmp_path / "r.jsonl", "-f", "jsonl"])
     assert code == 0 and b"grasptwist synthesize" in seen and b"candidates scored in" in seen
     assert len((tmp_path / "r.jsonl").read_text().splitlines()) == 2
+
+
+HAND = GRASPS / "three-finger-hand.yaml"  # an inline hand of three 3R fingers around a cube, no mass
+STIFF = """name: stiff
+object: {box: [2, 2, 2], mass: 1}
+friction: 0.8
+contacts:
+  - {point: [1.0, 0.3, 0.4], normal: [-1, 0, 0]}
+  - {point: [-1.0, -0.2, -0.1], normal: [1, 0, 0]}
+  - {point: [0.2, -1.0, -0.5], normal: [0, 1, 0]}
+hand:  # each finger slides along its contact's normal: it reaches a line, never a face
+  fingers:
+    - joints: [{type: prismatic, axis: [-1, 0, 0]}]
+    - joints: [{type: prismatic, axis: [1, 0, 0]}]
+    - joints: [{type: prismatic, axis: [0, 1, 0]}]
+"""
+
+
+def test_a_hand_s_joint_positions_are_in_the_records_and_the_grasp_file_read_back(tmp_path):
+    found = tmp_path / "found.yaml"
+    args = ("--mass", "1", "--friction", "0.8", "--tip-radius", "0.1", *FAST, "-o", found, "-f", "jsonl")
+    r, _ = run("synthesize", HAND, *args)
+    assert r.exit_code == 0, r.stderr
+    rec = jsonl(r.stdout)[0]
+    grasp = read_grasps(found)[0]
+    assert (
+        list(rec["joint_positions"])
+        == list(grasp.hand.joint_names)
+        == [f"{f}.{j}" for f in ("east", "west", "south") for j in (1, 2, 3)]
+    )
+    assert len(rec["reach_error"]) == 3 and max(rec["reach_error"]) < 1e-9
+    # the file's inline joints are given at the found joint positions, its tips one radius out of the contacts
+    assert [f.tip_radius for f in grasp.hand.fingers] == [0.1] * 3
+    np.testing.assert_allclose(grasp.points, [c["point"] for c in rec["contacts"]], rtol=1e-15)
+    back, _ = run("resolve", found, "--twist", "0,0,1,0,0,0", "-f", "jsonl")
+    assert back.exit_code == 0, back.stderr
+    assert [f["name"] for f in jsonl(back.stdout)[0]["hand"]["fingers"]] == ["east", "west", "south"]
+
+
+def test_a_hand_that_reaches_nothing_is_one_no_grasp_record_naming_the_reach(tmp_path):
+    (tmp_path / "stiff.yaml").write_text(STIFF)
+    r, _ = run("synthesize", tmp_path / "stiff.yaml", *FAST, "-f", "jsonl")
+    assert r.exit_code == 1
+    (rec,) = jsonl(r.stdout)
+    assert rec["error"]["code"] == "no-grasp" and rec["error"]["constraint"] == "reach" and rec["error"]["best"] > 0
+    assert "the hand reaches no candidate's contacts within its joint limits" in r.stderr
+
+
+def test_an_inline_hand_from_hand_has_no_tip_points(tmp_path):
+    (tmp_path / "hand.yaml").write_text("hand:\n" + HAND.read_text().split("\nhand:\n")[1].split("\npaths:")[0] + "\n")
+    r, _ = run("synthesize", SPHERE, "--friction", "0.5", "--mass", "1", "--hand", tmp_path / "hand.yaml", *FAST)
+    assert r.exit_code == 1 and "no-tip-points: an inline hand has no tip points" in r.stderr
+
+
+def test_a_folder_on_two_workers_gives_the_records_of_one(tmp_path):
+    for name in ("sphere.yaml", "box-edge.yaml"):
+        (tmp_path / name).write_bytes((GRASPS / name).read_bytes())
+    got = []
+    for j in ("1", "2"):
+        r, _ = run(
+            "synthesize",
+            tmp_path,
+            "--friction",
+            "0.6",
+            "--mass",
+            "1",
+            "--candidates",
+            "60",
+            "-n",
+            "2",
+            "-f",
+            "jsonl",
+            "-j",
+            j,
+        )
+        assert r.exit_code == 0, r.stderr
+        got.append([{**x, "search": {**x["search"], "seconds": None}} for x in jsonl(r.stdout)])
+    assert got[0] == got[1] and len(got[0]) == 6
+
+
+TRIFINGER = GRASPS / "trifinger-cube.yaml"
+
+
+def _trifinger_available():
+    import importlib.util
+
+    return all(importlib.util.find_spec(m) is not None for m in ("yourdfpy", "robot_properties_fingers"))
+
+
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
+@pytest.mark.skipif(not _trifinger_available(), reason="needs the urdf extra and robot-properties-fingers")
+def test_trifinger_grasps_on_the_cube_are_reached_within_limits_without_collision(tmp_path):
+    from grasptwist.engine.ik import IK_TOL, joint_limits
+    from grasptwist.hand import finger_collisions, forward_kinematics
+
+    found = tmp_path / "found.yaml"
+    args = ("--friction", "0.8", "--mass", "0.1", "-n", "4", "--candidates", "1500", "-f", "jsonl", "-o", found)
+    r, _ = run("synthesize", TRIFINGER, *args)
+    assert r.exit_code == 0, r.stderr
+    recs = jsonl(r.stdout)
+    grasps = read_grasps(found)
+    assert len(recs) == len(grasps) == 4
+    for rec, g in zip(recs, grasps):
+        q = np.array(list(rec["joint_positions"].values()))
+        np.testing.assert_array_equal(q, g.joint_positions)  # the file carries them, as given
+        for f, finger in enumerate(g.hand.fingers):
+            qf = q[list(finger.joint_index)]
+            tip = forward_kinematics(finger.screws, finger.points, finger.tip_pose, qf).tip[:3, 3]
+            centre = g.points[f] - 0.01 * g.normals[f]  # the TriFinger's fingertip spheres: 10 mm
+            assert np.linalg.norm(tip - centre) <= IK_TOL * finger.length
+            lower, upper = joint_limits(finger)
+            assert ((qf >= lower) & (qf <= upper)).all()
+        assert finger_collisions(g, q) == ()
+        assert rec["scores"]["closure_friction"] < 0.8 and rec["scores"]["total_normal_force"]["hold"] >= 0.981
+    for command in (
+        ("resolve", "--twist", "0,0,0.5,0,0,0"),
+        ("follow", "--twist", "0,0,0.5,0,0,0", "--duration", "0.2"),
+    ):
+        back, _ = run(command[0], found, *command[1:], "-f", "jsonl")
+        assert back.exit_code == 0, back.stderr
+        assert "finger-collides" not in back.stdout and '"ok":false' not in back.stdout
+
+
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
+@pytest.mark.skipif(not _trifinger_available(), reason="needs the urdf extra and robot-properties-fingers")
+def test_a_cube_out_of_the_trifinger_s_reach_is_exit_1_with_the_reason(tmp_path):
+    far = TRIFINGER.read_text().replace("pose: {position: [0, 0, 0.0325]}", "pose: {position: [0.6, 0, 0.0325]}")
+    far = re.sub(
+        r"contacts:\n(  - .*\n)+",
+        "contacts:\n"
+        + "".join(
+            f"  - {{point: [{0.6 + x}, {y}, 0.03], normal: [{-np.sign(x)}, {-np.sign(y)}, 0]}}\n"
+            for x, y in ((0.0325, 0.0), (-0.0325, 0.0), (0.0, 0.0325))
+        ),
+        far,
+    )
+    (tmp_path / "far.yaml").write_text(far)
+    r, _ = run("synthesize", tmp_path / "far.yaml", "--friction", "0.8", "--mass", "0.1", *FAST, "-f", "jsonl")
+    assert r.exit_code == 1
+    (rec,) = jsonl(r.stdout)
+    assert rec["error"]["constraint"] == "reach" and rec["error"]["best"] > 0.1
+
+
+def test_the_table_gives_a_hand_s_joint_positions():
+    from grasptwist.output.synthesis_records import SynthesisTable
+
+    out = io.BytesIO()
+    rec = {
+        "file": "f.yaml",
+        "grasp": "g",
+        "rank": 1,
+        "contacts": [{"name": "1", "point": [0, 0, 0], "normal": [1, 0, 0]}],
+        "scores": {"total_normal_force": {"hold": 1.0}, "closure_friction": 0.1, "epsilon": None, "conditioning": {}},
+        "joint_positions": {"a.1": 0.5, "a.2": -0.25},
+    }
+    SynthesisTable(out).write(rec)
+    assert out.getvalue().decode().splitlines()[-1] == "    joints: a.1 0.5000, a.2 -0.2500"

@@ -41,3 +41,9 @@ def test_a_few_hundred_thousand_rows_of_sharded_parquet_on_a_two_worker_cluster(
     # LocalCluster(n_workers=2, processes=True), as the issue asks
     lines = check("on_a_cluster", tmp_path, 300_000)
     assert lines[0] == "2 workers" and lines[1].startswith("300000 rows equal")
+
+
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
+def test_synthesize_bag_gives_the_command_line_s_records_on_a_two_worker_cluster(tmp_path):
+    lines = check("synthesis_on_a_cluster", tmp_path)
+    assert lines[-1].endswith("objects without a grasp") and int(lines[-1].split()[0]) >= 3

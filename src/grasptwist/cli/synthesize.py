@@ -22,8 +22,10 @@ from .options import (
     Safety,
     SurfaceTol,
     SynthesizeFormat,
+    Workers,
     WrenchName,
     WrenchOption,
+    hand_option,
     not_binary_to_a_terminal,
     reading_option,
     wrenches_option,
@@ -114,6 +116,24 @@ def synthesize(
             help="Grasps returned are at least this far apart (default: 5% of the object's size).",
         ),
     ] = None,
+    hand: Annotated[
+        str | None,
+        typer.Option(
+            "--hand",
+            metavar="FILE",
+            help="A hand that must reach every grasp (a YAML file holding just hand:, a URDF one); "
+            "default: the grasp file's hand.",
+        ),
+    ] = None,
+    tip_radius: Annotated[
+        float | None,
+        typer.Option(
+            "--tip-radius",
+            metavar="R",
+            min=0,
+            help="Every fingertip's radius (default: the hand's tip_radius, or its URDF's tip spheres).",
+        ),
+    ] = None,
     quality: Annotated[bool, typer.Option("--quality", help="Also Ferrari-Canny's epsilon (needs scipy).")] = False,
     seed: Annotated[int, typer.Option("--seed", min=0, help="Seed of the random numbers (reproducible runs).")] = 0,
     candidates: Annotated[
@@ -133,6 +153,7 @@ def synthesize(
     max_bytes: MaxBytes = None,
     surface_tol: SurfaceTol = None,
     allow_outside: AllowOutside = False,
+    workers: Workers = 1,
     quiet: Quiet = False,
     debug: Debug = False,
 ) -> None:
@@ -141,13 +162,16 @@ def synthesize(
     Candidates are scored in batches (force closure at mu / S, both decompositions
     well conditioned, the least total normal force for every wrench), the best
     refined on the surface, and each grasp returned is verified by the exact grip.
-    With -o FILE.yaml the grasps are written as a grasp file every command reads
-    (the records go to stdout). Exit 1 when an object has no feasible grasp.
+    With a hand (the file's, or --hand) every grasp is reached within the joint limits,
+    fingertips on the surface and no finger link in the object; the records give the
+    joint positions. With -o FILE.yaml the grasps are written as a grasp file every
+    command reads (the records go to stdout). Exit 1 when an object has no feasible grasp.
     Examples:
 
     \b
         grasptwist synthesize grasps/sphere.yaml -n 3
         grasptwist synthesize grasps/trifinger-cube.yaml --friction 0.8 --mass 0.1 -o found.yaml
+        grasptwist synthesize objects/ -j 2 -f jsonl      # a folder: one object a process
     """
     from ..run.families import COMMANDS
     from ..run.options import SynthesisOptions
@@ -169,6 +193,7 @@ def synthesize(
     job = Job(
         command=COMMANDS["synthesize"],
         fmt=fmt.value,
+        hand=None if hand is None else hand_option(hand, [], fmt.value),
         max_bytes=max_bytes,
         reading=reading_option(surface_tol, allow_outside),
         options=SynthesisOptions(
@@ -186,7 +211,9 @@ def synthesize(
             candidates=candidates,
             seconds=seconds,
             grasp_file=grasp_file,
+            tip_radius=tip_radius,
+            hand_file=hand,
         ),
     )
-    settings = OutputSettings(records_to, quiet, Warnings.summary, 1, {"digits": digits})
+    settings = OutputSettings(records_to, quiet, Warnings.summary, workers, {"digits": digits}, reads=(hand,))
     run_command(debug, lambda: write_records(job, paths, settings))

@@ -52,6 +52,7 @@ __all__ = [
     "chain_ik",
     "HandIK",
     "hand_ik",
+    "finger_ik",
     "joint_limits",
     "home_tips",
     "contact_off_finger",
@@ -313,27 +314,62 @@ def hand_ik(hand, points, *, seed=None, tips=None, iterations=IK_ITERATIONS) -> 
         lower, upper = joint_limits(finger)
         target = points[..., f, :].reshape(-1, 3)
         start = np.clip(seed[..., index].reshape(-1, len(index)), lower, upper)
-        solved = _finger(chain, target, start, lower, upper, finger, iterations)
-        q, err, inside, code = solved
+        q, err, inside, code = _finger(chain, target, start, lower, upper, finger, iterations)
         positions[..., index] = q.reshape(lead + (len(index),))
         tip_error[..., f], within[..., f], status[..., f] = (a.reshape(lead) for a in (err, inside, code))
     return HandIK(positions, tip_error, within, status)
 
 
-def _finger(chain, target, start, lower, upper, finger, iterations):
+def finger_ik(finger, tip, targets, *, seeds=IK_SEEDS, classify=True, iterations=IK_ITERATIONS):
+    """One finger's inverse kinematics over rows of targets, from home (:func:`hand_ik`'s for one finger).
+
+    Parameters
+    ----------
+    finger : Finger
+    tip : (4, 4) array
+        Its tip link's pose at home (:func:`home_tips`).
+    targets : (B, 3) array
+    seeds : int
+        Spread seeds (:func:`spread_seeds`) tried by rows that miss from home; fewer is faster.
+    classify : bool
+        Tell ``outside-limits`` from ``unreachable`` (a second solve without limits); a search
+        that only needs to know whether the finger reaches leaves it out.
+    iterations : int
+
+    Returns
+    -------
+    (positions (B, n), tip error (B,), within limits (B,), status (B,) int8)
+
+    >>> from grasptwist.hand import Finger, Joint
+    >>> s = np.array([[0, 0, 1.0, 0, 0, 0], [0, 0, 1.0, 0, -1.0, 0]])
+    >>> j = (Joint("a", "revolute", None, None, None, None), Joint("b", "revolute", None, None, None, None))
+    >>> tip = np.eye(4); tip[0, 3] = 2.0
+    >>> f = Finger("1", "tip", j, s, np.array([[0, 0, 0], [1.0, 0, 0]]), tip, 2.0, (0, 1))
+    >>> [Status(int(c)).code for c in finger_ik(f, tip, [[1.0, 1, 0], [3.0, 0, 0]], classify=False)[3]]
+    ['ok', 'unreachable']
+    """
+    targets = np.asarray(targets, dtype=float).reshape(-1, 3)
+    lower, upper = joint_limits(finger)
+    start = np.clip(np.zeros((len(targets), len(finger.joints))), lower, upper)
+    chain = (finger.screws, finger.points, np.asarray(tip, dtype=float))
+    return _finger(chain, targets, start, lower, upper, finger, iterations, seeds, classify)
+
+
+def _finger(chain, target, start, lower, upper, finger, iterations, seeds=IK_SEEDS, classify=True):
     """One finger over flat rows: positions, tip error, within limits, status (per row)."""
     length = _length(chain)
     tol = IK_TOL * length
     finite = np.isfinite(target).all(axis=-1)
     target = np.where(finite[:, None], target, 0.0)
     unlimited = np.array([j.type != "prismatic" for j in finger.joints]) & ~np.isfinite(lower) & ~np.isfinite(upper)
-    spread = spread_seeds(finger)
+    spread = spread_seeds(finger)[:seeds]
     best = chain_ik(*chain, target, start, lower, upper, iterations=iterations)
     q, err = best.positions, np.where(finite, best.error, 0.0)
     _restart(chain, target, start, spread, lower, upper, tol, iterations, q, err)
     status = np.where(err <= tol, Status.OK, Status.UNREACHABLE)
     missed = np.flatnonzero(err > tol)
-    if missed.size and (np.isfinite(lower).any() or np.isfinite(upper).any()):  # reachable outside the limits?
+    limited = np.isfinite(lower).any() or np.isfinite(upper).any()
+    if classify and missed.size and limited:  # reachable outside the limits?
         free = chain_ik(*chain, target[missed], start[missed], iterations=iterations)
         fq, fe = free.positions, free.error
         _restart(chain, target[missed], start[missed], spread, None, None, tol, iterations, fq, fe)

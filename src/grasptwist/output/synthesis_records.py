@@ -8,7 +8,13 @@ gives one record per grasp, best first::
      "contacts": [{"name", "point", "normal", "surface_distance"}, x3],
      "scores": {"total_normal_force": {wrench name: N}, "closure_friction",
                 "epsilon" (or null), "conditioning": {"off_tangent", "tangent"} (null: not asked)},
+     "joint_positions": {joint name: position} (null without a hand),
+     "reach_error": [3] (null without a hand),
      "search": {"candidates", "seconds", "seed"}, "warnings": []}
+
+With a hand, finger ``f`` touches contact ``f``; ``reach_error`` is each finger's distance, by
+forward kinematics at ``joint_positions``, from its tip link's origin to its fingertip's
+centre ``point - tip_radius * normal``.
 
 A search that finds nothing gives one error record (``no-grasp``) naming the tightest
 constraint and how close the best candidate came.  The flat columns (CSV, Parquet)
@@ -78,11 +84,19 @@ def synthesis_records(found) -> list[dict]:
                 "ok": True,
                 "contacts": contacts,
                 "scores": scores,
+                "joint_positions": _joint_positions(found, k),
+                "reach_error": None if s.reach_error is None else s.reach_error[k].tolist(),
                 "search": search,
                 "warnings": [],
             }
         )
     return out
+
+
+def _joint_positions(found, k):
+    if found.hand is None:
+        return None
+    return {name: float(q) for name, q in zip(found.hand.joint_names, found.synthesis.joint_positions[k])}
 
 
 def failure_record(found) -> dict:
@@ -145,6 +159,32 @@ def _quaternion(r):
     return (np.array(v) / 2).tolist()
 
 
+def _hand_node(found, k, folder):
+    """The ``hand`` section of grasp ``k``: a URDF at its joint positions (the reference relative to
+    ``folder``), or inline joints moved to them (inline joints are given at the configuration)."""
+    hand, q = found.hand, found.synthesis.joint_positions[k]
+    if hand.source is not None:
+        urdf = hand.source
+        if not urdf.startswith("package://") and not os.path.isabs(urdf):
+            urdf = os.path.relpath(os.path.join(os.path.dirname(os.path.abspath(found.hand_file)), urdf), folder)
+        return {
+            "urdf": urdf,
+            "joint_positions": {name: float(v) for name, v in zip(hand.joint_names, q)},
+            "fingers": [{"name": f.name, "tip": f.tip, "tip_radius": float(f.tip_radius)} for f in hand.fingers],
+        }
+    fingers = []
+    for f, (screws, points) in zip(hand.fingers, found.joints_at[k]):
+        joints = []
+        for joint, screw, point in zip(f.joints, screws, points):
+            axis = screw[:3] if joint.type == "revolute" else screw[3:]
+            node = {"name": joint.name, "type": joint.type, "axis": axis.tolist(), "point": point.tolist()}
+            if joint.velocity_limit is not None:
+                node["velocity_limit"] = float(joint.velocity_limit)
+            joints.append(node)
+        fingers.append({"name": f.name, "tip_radius": float(f.tip_radius), "joints": joints})
+    return {"fingers": fingers}
+
+
 def grasp_documents(found, folder: str) -> str:
     """The grasps found as grasp-file documents (YAML, ``---`` between them), read back by every command.
 
@@ -178,6 +218,8 @@ def grasp_documents(found, folder: str) -> str:
             doc["gravity"] = np.asarray(gravity).tolist()
         if wrenches:
             doc["wrenches"] = wrenches
+        if found.hand is not None:
+            doc["hand"] = _hand_node(found, k, folder)
         docs.append(yaml.safe_dump(doc, sort_keys=False, default_flow_style=None))
     return "---\n".join(docs)
 
@@ -304,6 +346,9 @@ class SynthesisTable:
             point = ", ".join(self._number(v) for v in c["point"])
             normal = ", ".join(self._number(v) for v in c["normal"])
             self._line(f"    {escaped(c['name'])}: point ({point})  normal ({normal})")
+        if rec.get("joint_positions"):
+            joints = ", ".join(f"{escaped(n)} {self._number(q)}" for n, q in rec["joint_positions"].items())
+            self._line(f"    joints: {joints}")
 
     def close(self) -> None:
         pass

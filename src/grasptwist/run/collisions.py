@@ -30,6 +30,7 @@ __all__ = [
     "collision_warning",
     "finger_collisions",
     "finger_collisions_along",
+    "deepest_link",
     "with_collisions",
     "PathCollisions",
 ]
@@ -138,6 +139,28 @@ def finger_collisions_along(grasp: Grasp, joint_positions, frames=None, *, max_b
         hits = hits[np.argsort(-row[hits], kind="stable")]
         out.append(tuple(Collision(names[geometry[i].finger], geometry[i].link, float(row[i])) for i in hits))
     return out
+
+
+def deepest_link(grasp: Grasp, *, max_bytes=DEFAULT_MAX_BYTES):
+    """How deep the deepest finger link of ``grasp``'s hand goes into its object, as a function of
+    joint positions ``(N, n_joints) -> (N,)`` (the synthesis search's collision constraint); None
+    without a URDF hand or an object.
+
+    Raises
+    ------
+    InputError
+        The URDF's or a mesh's, read here once.
+    """
+    checked = _checked(grasp, max_bytes)
+    if checked is None:
+        return None
+    geometry, parts, _ = checked
+
+    def deepest(positions):
+        poses = link_poses(grasp.hand, geometry, np.asarray(positions, dtype=float))
+        return penetration_depths(grasp.object, parts, poses, len(geometry)).max(axis=1, initial=0.0)
+
+    return deepest
 
 
 def finger_collisions(grasp: Grasp, joint_positions) -> tuple[Collision, ...]:

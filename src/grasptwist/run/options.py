@@ -96,7 +96,9 @@ class SynthesisOptions:
     ``friction`` (``--friction``), ``mass`` (``--mass``: the object's weight, at its centre of
     mass, is the wrench ``hold``) and ``wrenches`` (``--wrench``) replace a grasp file's;
     ``count`` (``-n``) grasps are wanted, at least ``min_spacing`` apart; ``candidates`` and
-    ``seconds`` bound the search; ``grasp_file`` (``-o FILE.yaml``) receives the grasps found.
+    ``seconds`` bound the search; ``grasp_file`` (``-o FILE.yaml``) receives the grasps found;
+    ``tip_radius`` (``--tip-radius``) replaces every fingertip's radius of the hand (the file's, or
+    the job's ``hand``: ``--hand``, read from ``hand_file``).
     The rest go to :func:`grasptwist.engine.synthesis.search.search`.
     """
 
@@ -114,3 +116,5 @@ class SynthesisOptions:
     candidates: int = 20000
     seconds: float | None = 60.0
     grasp_file: str | None = None
+    tip_radius: float | None = None
+    hand_file: str | None = None

@@ -1,8 +1,11 @@
 """Synthesize grasps: objects in, the grasps found (or why none) out, one record set per object.
 
 Each input is a grasp file whose documents name an ``object`` (the file's contacts are not
-used: the search finds its own), or a mesh file (STL, OBJ, PLY) with the command line's
-friction and mass.  The command line's ``--friction``, ``--mass`` and ``--wrench`` replace
+searched from: the search finds its own), or a mesh file (STL, OBJ, PLY) with the command
+line's friction and mass.  A hand (the file's ``hand``, or the job's: ``--hand``) must reach
+every grasp: its fingertips (``--tip-radius``, else each finger's ``tip_radius``) on the
+surface, its joints within their limits, its links (a URDF's meshes) out of the object; a
+hand given inline has its tips where the file's contacts are (its joints are given there).  The command line's ``--friction``, ``--mass`` and ``--wrench`` replace
 the file's.  The search is :func:`grasptwist.engine.synthesis.search.search`; with ``-o
 FILE.yaml`` the grasps found are also written as a grasp file (atomically, at the end).
 No math here: only reading, routing and labelling.
@@ -17,19 +20,23 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ..engine.fingertips import tip_centers, tip_radii
 from ..engine.forces.hold import hold_wrench
+from ..engine.ik import home_tips
 from ..engine.objects import mass_properties
 from ..engine.synthesis.scores import METHODS
-from ..engine.synthesis.search import GRAVITY, Synthesis, search_steps, surface_of
+from ..engine.synthesis.search import GRAVITY, Synthesis, hand_reach, search_steps, surface_of
 from ..io.grasp.forces import HOLD
+from ..io.inputs import read as read_unplaced
+from ..io.limits import DEFAULT_MAX_BYTES
 from ..io.mesh_file import MESH_SUFFIXES, read_mesh
-from ..model import Grasp, GraspFileError, GraspObject, InputError, Shape
+from ..model import Grasp, GraspFileError, GraspObject, Hand, InputError, Shape
 from ..output import synthesis_records as sr
 from ..output.formats import FORMATS
 from ..output.records import diagnostics, dumps, error_record
 from .options import SynthesisOptions
 from .outputs import Output
-from .placement import read
+from .pool import Pool, pool_size
 from .target import opened
 
 __all__ = [
@@ -37,13 +44,21 @@ __all__ = [
     "Progress",
     "synthesize_inputs",
     "synthesize_outputs",
+    "searched",
+    "input_records",
     "NO_OBJECT",
     "NOTHING_TO_HOLD",
     "NO_FRICTION",
+    "NO_TIP_POINTS",
+    "UNSEARCHABLE_HAND",
 ]
 
 #: Error codes of an input the search cannot start from.
 NO_OBJECT, NOTHING_TO_HOLD, NO_FRICTION = "no-object", "nothing-to-hold", "no-friction"
+
+#: An inline hand without the contacts its tips touch (``--hand`` with a mesh); a hand whose
+#: fingers share joints (the search solves each finger on its own).
+NO_TIP_POINTS, UNSEARCHABLE_HAND = "no-tip-points", "unsearchable-hand"
 
 _CONTACT_NAMES = ("1", "2", "3")
 
@@ -65,6 +80,9 @@ class Found:
     synthesis: Synthesis
     contact_names: tuple[str, str, str] = _CONTACT_NAMES
     hold_name: str = HOLD
+    hand: Hand | None = None  # with a hand: its fingers in contact order, at the synthesis' joint positions
+    hand_file: str | None = None  # the file the hand's URDF reference is relative to
+    joints_at: tuple | None = None  # an inline hand's joints at each grasp: per finger (screws (n, 6), points (n, 3))
 
     def __len__(self) -> int:
         return len(self.synthesis.points)
@@ -105,6 +123,52 @@ def _task(options: SynthesisOptions, grasp: Grasp):
     return obj, friction, tuple(n for n, _ in named), np.array([w for _, w in named]), hold
 
 
+def _hand(job, grasp: Grasp, obj: GraspObject):
+    """The hand that must reach the grasps of ``grasp`` (``(HandReach, Hand, its file)``), None
+    without one, or the error of the document."""
+    hand = job.hand if job.hand is not None else grasp.hand
+    if hand is None:
+        return None
+    radius = job.options.tip_radius
+    if radius is not None:
+        hand = replace(hand, fingers=tuple(replace(f, tip_radius=radius) for f in hand.fingers))
+    # an inline finger's tip point is where the file's contact is (its joints are given at that configuration)
+    tips = None
+    if any(f.tip_pose is None for f in hand.fingers):
+        if job.hand is not None or grasp.file.lower().endswith(MESH_SUFFIXES):
+            return _problem(
+                grasp.file,
+                NO_TIP_POINTS,
+                "an inline hand has no tip points without the contacts its fingers touch: put it in a grasp file",
+                grasp.line,
+            )
+        tips = home_tips(hand, tip_centers(grasp.points, grasp.normals, tip_radii(hand)))
+    from .collisions import deepest_link  # the finger links' meshes: with the first URDF hand
+
+    # a URDF's meshes are found from the file that names it: the grasp file, or --hand's
+    named_by = grasp.file if job.hand is None else job.options.hand_file
+    try:
+        held = replace(grasp, hand=hand, object=obj, file=named_by)
+        collide = deepest_link(held, max_bytes=job.max_bytes or DEFAULT_MAX_BYTES)
+        return hand_reach(obj, hand, tips=tips, collide=collide), hand
+    except InputError as exc:
+        return GraspFileError(exc.code, f"hand: {exc.message}", grasp.file, grasp.line, None, grasp.document)
+    except ValueError as exc:
+        return _problem(grasp.file, UNSEARCHABLE_HAND, str(exc), grasp.line)
+
+
+def _inline_joints(hand, synthesis):
+    """An inline hand's joints moved to each grasp's joint positions (its file gives them there)."""
+    if hand is None or hand.source is not None:
+        return None
+    from ..engine.kinematics import forward_kinematics
+
+    return tuple(
+        tuple(forward_kinematics(f.screws, f.points, None, q[list(f.joint_index)])[:2] for f in hand.fingers)
+        for q in synthesis.joint_positions
+    )
+
+
 def _mesh_grasp(path: str, job) -> Grasp | GraspFileError:
     """A mesh file as a grasp document with only its object (the command line gives the rest)."""
     try:
@@ -134,15 +198,20 @@ def synthesize_inputs(job, inputs: Iterable) -> Iterator[GraspFileError | Found 
             yield item
             yield Progress(0, 1)
             continue
-        entries = (
-            [_mesh_grasp(item, job)] if item.lower().endswith(MESH_SUFFIXES) else read(item, job.max_bytes, job.reading)
-        )
+        # a hand is placed on the contacts found, not on the file's: the grasps are read unplaced
+        mesh = item.lower().endswith(MESH_SUFFIXES)
+        entries = [_mesh_grasp(item, job)] if mesh else read_unplaced(item, job.max_bytes, job.reading)
         for entry in entries:
             task = _task(o, entry) if isinstance(entry, Grasp) else entry
             if isinstance(task, GraspFileError):
                 yield task
                 continue
             obj, friction, names, wrenches, hold = task
+            hand = _hand(job, entry, obj)
+            if isinstance(hand, GraspFileError):
+                yield hand
+                continue
+            reach, hand = hand if hand is not None else (None, None)
             yield Progress(o.candidates, 0)
             for step in search_steps(
                 surface_of(obj),
@@ -155,6 +224,7 @@ def synthesize_inputs(job, inputs: Iterable) -> Iterator[GraspFileError | Found 
                 methods=METHODS if o.method == "both" else (o.method.replace("-", "_"),),
                 min_conditioning=o.min_conditioning,
                 min_spacing=o.min_spacing,
+                hand=reach,
                 quality=o.quality,
                 seed=o.seed,
                 candidates=o.candidates,
@@ -176,17 +246,45 @@ def synthesize_inputs(job, inputs: Iterable) -> Iterator[GraspFileError | Found 
                 hold,
                 step,
                 entry.contact_names,
+                hand=hand,
+                hand_file=None if hand is None else (o.hand_file if job.hand is not None else entry.file),
+                joints_at=_inline_joints(hand, step),
             )
         yield Progress(0, 1)
 
 
+def searched(job, inputs: list, workers: int = 1) -> Iterator[GraspFileError | Found | Progress]:
+    """:func:`synthesize_inputs`, each input on one of ``workers`` forked processes
+    (:class:`~grasptwist.run.pool.Pool`) when there are several: the same items in the same order
+    (a search depends on its seed alone), each input's as its search ends."""
+    if pool_size(workers, len(inputs)) <= 1:
+        yield from synthesize_inputs(job, inputs)
+        return
+    with Pool(lambda i: list(synthesize_inputs(job, inputs[i : i + 1])), workers, in_flight=1) as pool:
+        for items in pool.results(len(inputs)):
+            yield from items
+
+
+def input_records(job, path: str) -> list[dict]:
+    """The JSON records of one input, as ``grasptwist synthesize PATH -f json`` gives them
+    (``grasptwist.dask``'s unit of work)."""
+    out = []
+    for item in synthesize_inputs(job, [path]):
+        if isinstance(item, GraspFileError):
+            out.append(error_record(item))
+        elif isinstance(item, Found):
+            out.extend(sr.synthesis_records(item) if len(item) else [sr.failure_record(item)])
+    return out
+
+
 def synthesize_outputs(job, inputs: Iterable, w, workers: int = 1, tuning=None) -> Iterator[Output]:
-    """The :class:`~grasptwist.run.outputs.Output` of each object searched (one process: a search is
-    vectorised already); the grasp file of ``-o FILE.yaml`` is written once every search is done."""
+    """The :class:`~grasptwist.run.outputs.Output` of each object searched (one object a process:
+    a search is vectorised already); the grasp file of ``-o FILE.yaml`` is written once every
+    search is done."""
     fmt = FORMATS[job.fmt]
     inputs = list(inputs)
     documents = []
-    for item in synthesize_inputs(job, inputs):
+    for item in searched(job, inputs, workers):
         if isinstance(item, Progress):
             yield Output(extra_work=item.extra, done=item.done)
             continue

@@ -12,7 +12,12 @@ before it):
 3. it passes every further constraint given (``constraints``: functions of the contacts and
    normals, a hand's reach or a table, each ``(n, 3, 3), (n, 3, 3) -> (n,) bool``);
 4. a grip exists for every wrench (the batched least grip,
-   :func:`~grasptwist.engine.forces.grip.grip`), and for each its least total normal force
+   :func:`~grasptwist.engine.forces.grip.grip`);
+5. with a hand (``hand``), some assignment of its fingers to the contacts has the fingertips
+   on the surface, reaches every contact within the joint limits and keeps every finger link
+   out of the object (:mod:`~grasptwist.engine.synthesis.reach`: the most expensive test, last).
+
+For each wrench the least total normal force
 
 .. math:: \min \sum_i f_i \cdot n_i \quad \text{s.t.} \quad G f = w, \;
           |f_i - (f_i \cdot n_i) n_i| \le \frac{\mu}{s} f_i \cdot n_i
@@ -34,6 +39,7 @@ from ..degeneracy import DEGENERACY_TOL
 from ..forces.closure import force_closure, internal_inside
 from ..forces.grasp_map import geometry
 from ..forces.grip import grip
+from .reach import HAND_CONSTRAINTS, reach
 
 __all__ = [
     "OBJECTIVES",
@@ -49,7 +55,7 @@ __all__ = [
 OBJECTIVES = ("total_normal_force", "closure_friction", "epsilon")
 
 #: The constraints in the order they are tested; a row's ``failed`` indexes this (-1: feasible).
-CONSTRAINTS = ("degenerate", "conditioning", "force_closure", "constraints", "grip")
+CONSTRAINTS = ("degenerate", "conditioning", "force_closure", "constraints", "grip", *HAND_CONSTRAINTS)
 
 #: The decompositions whose conditioning a grasp must keep above ``min_conditioning``.
 METHODS = ("off_tangent", "tangent")
@@ -67,13 +73,24 @@ class Scores(NamedTuple):
     conditioning : (N, 2)
         Of the off-tangent (NaN without a wrist) and the tangent decomposition (:data:`METHODS`).
     failed : (N,) int8
-        The first constraint (:data:`CONSTRAINTS`) the row fails, or -1.
+        The first constraint (:data:`CONSTRAINTS`) the row fails, -1 where it passes them all,
+        ``len(CONSTRAINTS)`` where it was not tested further (``bound``).
+    order : (N, 3) int or None
+        With a hand: finger ``f`` touches contact ``order[:, f]``.
+    joint_positions : (N, n_joints) or None
+        With a hand: where it reaches the feasible rows (NaN elsewhere).
+    miss : (N,) or None
+        With a hand: how close a row that fails one of its constraints came
+        (:class:`~grasptwist.engine.synthesis.reach.Reached`).
     """
 
     objective: np.ndarray
     total_normal_force: np.ndarray
     conditioning: np.ndarray
     failed: np.ndarray
+    order: np.ndarray | None = None
+    joint_positions: np.ndarray | None = None
+    miss: np.ndarray | None = None
 
 
 def check_objective(objective) -> str:
@@ -135,6 +152,8 @@ def score_triples(
     methods=METHODS,
     min_conditioning=0.0,
     constraints=(),
+    hand=None,
+    bound=np.inf,
     tol=DEGENERACY_TOL,
 ) -> Scores:
     """Score ``N`` candidate triples against every constraint and the objective (module docstring).
@@ -147,8 +166,12 @@ def score_triples(
         The wrenches every grasp must exert (``W >= 1``).
     friction : float
         ``mu``, the same at every contact.
-    safety, objective, wrist, methods, min_conditioning, constraints, tol
+    safety, objective, wrist, methods, min_conditioning, constraints, hand, tol
         As :func:`~grasptwist.engine.synthesis.search.search`.
+    bound : float
+        With a hand: rows whose objective is at least this are not put to the hand's test
+        (a search's archive would not keep them); their ``failed`` is ``len(CONSTRAINTS)``,
+        their objective ``inf``.
 
     Returns
     -------
@@ -197,7 +220,21 @@ def score_triples(
     live = live[held]
     failed[live] = -1
     objective_value[live] = objective_values(p[live], n[live], total[live], friction / safety, objective, tol)
-    return Scores(objective_value, total, cond, failed)
+    if hand is None:
+        return Scores(objective_value, total, cond, failed)
+    # rows no better than ``bound`` are never kept: the hand, the costliest test, is spared them
+    spared = live[objective_value[live] >= bound]
+    failed[spared], objective_value[spared] = len(CONSTRAINTS), np.inf
+    live = live[objective_value[live] < bound]
+    order = np.tile(np.arange(3), (rows, 1))
+    positions = np.full((rows, len(hand.hand.joint_names)), np.nan)
+    miss = np.full(rows, np.nan)
+    if live.size:
+        r = reach(hand, p[live], n[live])
+        failed[live] = np.where(r.failed == -1, -1, CONSTRAINTS.index("grip") + 1 + r.failed)
+        order[live], positions[live], miss[live] = r.order, r.positions, r.miss
+        objective_value[live[r.failed != -1]] = np.inf
+    return Scores(objective_value, total, cond, failed, order, positions, miss)
 
 
 def objective_values(points, normals, total, mu, objective, tol=DEGENERACY_TOL):

@@ -30,13 +30,17 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ..collision import collision_tolerance
 from ..degeneracy import DEGENERACY_TOL
+from ..fingertips import tip_radii
 from ..forces.closure import force_closure
 from ..forces.grasp_map import check_friction, check_safety, check_wrench
 from ..forces.grip import Grip, grip
 from ..forces.hold import hold_wrench
+from ..ik import home_tips, joint_limits
 from ..objects import mass_properties, object_size, project_to_surface, sample_surface
 from .candidates import candidate_triples, tangent_steps, triple_distance
+from .reach import HandReach, check_hand_reach, reach_tolerance, tip_errors
 from .scores import CONSTRAINTS, METHODS, check_min_conditioning, check_objective, conditionings, score_triples
 
 __all__ = [
@@ -47,6 +51,7 @@ __all__ = [
     "search_steps",
     "synthesize",
     "surface_of",
+    "hand_reach",
     "GRAVITY",
     "verified",
     "check_budget",
@@ -141,6 +146,12 @@ class Synthesis:
         Of the off-tangent and the tangent decomposition (NaN where not asked, or without a wrist).
     grips : tuple of tuple of Grip
         The verified grip of each grasp and wrench (one row each).
+    joint_positions : (K, n_joints) or None
+        With a hand: where it holds each grasp, finger ``f`` on contact ``f``.
+    reach_error : (K, 3) or None
+        With a hand: each finger's distance from its tip point, by forward kinematics at
+        ``joint_positions``, to its fingertip's centre ``p - r n`` (within the inverse
+        kinematics' tolerance).
     candidates : int
         Candidates scored.
     seconds : float
@@ -163,6 +174,8 @@ class Synthesis:
     seconds: float
     seed: int
     failure: Failure | None
+    joint_positions: np.ndarray | None = None
+    reach_error: np.ndarray | None = None
 
 
 def check_budget(candidates, seconds) -> tuple[int, float | None]:
@@ -207,7 +220,7 @@ class _Archive:
     """The best feasible candidates so far (at most ``size``, each ``spacing`` or more from the better
     ones, so that refinement and selection start from distinct grasps), and the furthest any got."""
 
-    def __init__(self, size, spacing):
+    def __init__(self, size, spacing, joints=None):
         self.size, self.spacing = size, spacing
         self.points = np.empty((0, 3, 3))
         self.normals = np.empty((0, 3, 3))
@@ -215,15 +228,31 @@ class _Archive:
         self.furthest = 0
         self.near_points, self.near_normals = np.empty((0, 3, 3)), np.empty((0, 3, 3))
         self.best_conditioning = 0.0
+        self.positions = None if joints is None else np.empty((0, joints))  # with a hand: (N, n_joints)
+        self.best_miss = {}  # a hand's constraint -> the closest a row failing it came
+
+    @property
+    def bound(self) -> float:
+        """An objective no better than this is never kept: the worst kept once the archive is full."""
+        return float(self.objective[-1]) if len(self.objective) >= self.size else np.inf
 
     def add(self, p, n, s):
         ok = s.failed == -1
+        if s.order is not None:  # contact f is finger f's
+            p, n = (np.take_along_axis(a, s.order[..., None], axis=1) for a in (p, n))
+            self.positions = np.concatenate((self.positions, s.joint_positions[ok]))
+            tested = (s.failed > CONSTRAINTS.index("grip")) & (s.failed < len(CONSTRAINTS))
+            for k in np.unique(s.failed[tested]):
+                best = float(np.nanmin(s.miss[s.failed == k], initial=np.inf))
+                self.best_miss[CONSTRAINTS[k]] = min(self.best_miss.get(CONSTRAINTS[k], np.inf), best)
         self.points = np.concatenate((self.points, p[ok]))
         self.normals = np.concatenate((self.normals, n[ok]))
         self.objective = np.concatenate((self.objective, s.objective[ok]))
         order = np.argsort(self.objective, kind="stable")[: 8 * self.size]
         keep = order[_spread(self.points[order], self.size, self.spacing)]
         self.points, self.normals, self.objective = self.points[keep], self.normals[keep], self.objective[keep]
+        if self.positions is not None:
+            self.positions = self.positions[keep]
         reached = np.where(s.failed == -1, len(CONSTRAINTS), s.failed)
         self.furthest = max(self.furthest, int(reached.max(initial=0)))
         worst = np.fmin(s.conditioning[:, 0], s.conditioning[:, 1])  # the asked methods' smaller
@@ -267,8 +296,12 @@ def search(surface: Surface, wrenches, friction, **options) -> Synthesis:
         Returned grasps are at least this far apart (:func:`~.candidates.triple_distance`);
         None: :data:`MIN_SPACING` times the object's size.
     constraints : sequence of callables, default none
-        Further constraints (a hand's reach, a table), each ``(points (n, 3, 3), normals (n, 3, 3))
+        Further constraints (a table, a region), each ``(points (n, 3, 3), normals (n, 3, 3))
         -> (n,) bool``, tested after closure and before the grip.
+    hand : HandReach or None, default None
+        A hand that must reach each grasp (:mod:`~.reach`: fingertips on the surface, every
+        contact within the joint limits, no finger link in the object), tested after the grip;
+        the grasps returned then list contact ``f`` for finger ``f``, with the joint positions.
     quality : bool, default False
         Compute ``epsilon`` for the returned grasps (scipy) even when it is not the objective.
     seed : int, default 0
@@ -322,6 +355,7 @@ def search_steps(
     min_conditioning=0.0,
     min_spacing=None,
     constraints=(),
+    hand=None,
     quality=False,
     seed=0,
     candidates=20000,
@@ -337,13 +371,15 @@ def search_steps(
     min_conditioning = check_min_conditioning(min_conditioning)
     budget_size, seconds = check_budget(candidates, seconds)
     spacing = MIN_SPACING * surface.size if min_spacing is None else float(min_spacing)
+    hand = None if hand is None else check_hand_reach(hand)
     started = time.perf_counter()
     rng = np.random.default_rng(seed)
     budget = _Budget(budget_size, seconds)
-    archive = _Archive(max(ELITES, 4 * count), spacing)
-    chunk = CHUNK if objective == "total_normal_force" else CHUNK // 8  # closure friction, epsilon: slower rows
+    archive = _Archive(max(ELITES, 4 * count), spacing, None if hand is None else len(hand.hand.joint_names))
+    # closure friction, epsilon: slower rows; a hand: the archive fills (and spares rows the hand's test) sooner
+    chunk = CHUNK if objective == "total_normal_force" and hand is None else CHUNK // 8
 
-    def score(p, n):
+    def score(p, n, bound=None):
         return score_triples(
             p,
             n,
@@ -355,6 +391,8 @@ def search_steps(
             methods=methods,
             min_conditioning=min_conditioning,
             constraints=constraints,
+            hand=hand,
+            bound=archive.bound if bound is None else bound,
             tol=tol,
         )
 
@@ -370,7 +408,9 @@ def search_steps(
         yield from _refine(surface, archive, score, budget, rng)
     picked = _spread(archive.points, count, spacing)
     points, normals = archive.points[picked], archive.normals[picked]
-    out = _results(surface, points, normals, w, mu, safety, wrist, methods, quality or objective == "epsilon", tol)
+    positions = None if hand is None else archive.positions[picked]
+    quality = quality or objective == "epsilon"
+    out = _results(surface, points, normals, w, mu, safety, wrist, methods, quality, tol, hand, positions)
     failure = None if len(out["points"]) else _failure(archive, mu / safety, min_conditioning, tol)
     yield Synthesis(
         **out,
@@ -400,7 +440,8 @@ def _refine(surface, archive, score, budget, rng):
         defined = (np.einsum("nix,nix->ni", surface.project(q)[1], m) > _SAME_NORMAL).all(axis=1)
         value = np.full(k, np.inf)
         if defined.any():
-            s = score(q[defined], m[defined])
+            # a child better than its parent is never spared the hand's test, kept or not
+            s = score(q[defined], m[defined], max(archive.bound, float(best.max())))
             archive.add(q[defined], m[defined], s)
             value[defined] = s.objective
         budget.spent(k)
@@ -452,14 +493,21 @@ def verified(points, normals, wrench, friction, safety, tol=DEGENERACY_TOL) -> G
     return g if ((friction / safety) * zt - zn <= GAP_TOL).all() else None
 
 
-def _results(surface, points, normals, w, mu, safety, wrist, methods, quality, tol):
-    """The returned grasps' fields of :class:`Synthesis`, each grasp verified (the others dropped)."""
+def _results(surface, points, normals, w, mu, safety, wrist, methods, quality, tol, hand=None, positions=None):
+    """The returned grasps' fields of :class:`Synthesis`, each grasp verified (the others dropped): the
+    exact grip, and with a hand its tips by forward kinematics, its limits and its links clear."""
     grips, keep = [], []
     for i in range(len(points)):
         found = tuple(verified(points[i], normals[i], wrench, mu, safety, tol) for wrench in w)
         if all(g is not None for g in found):
             grips.append(found)
             keep.append(i)
+    hand_fields = {}
+    if hand is not None:
+        error = tip_errors(hand, points[keep], normals[keep], positions[keep])
+        good = _held(hand, error, positions[keep])
+        grips, keep = [g for g, k in zip(grips, good) if k], [i for i, k in zip(keep, good) if k]
+        hand_fields = {"joint_positions": positions[keep], "reach_error": error[good]}
     p, n = points[keep], normals[keep]
     closure = force_closure(p, n, mu / safety, quality=quality, tol=tol) if len(p) else None
     return {
@@ -473,7 +521,21 @@ def _results(surface, points, normals, w, mu, safety, wrist, methods, quality, t
         "epsilon": (closure.epsilon if closure else np.empty(0)) if quality else None,
         "conditioning": conditionings(p, n, wrist, methods, tol) if len(p) else np.empty((0, 2)),
         "grips": tuple(grips),
+        **hand_fields,
     }
+
+
+def _held(hand, error, positions):
+    """Which placed hands are verified: every tip on its target (:func:`~.reach.reach_tolerance`), every
+    joint within its limits, no link in the object (``(K, 3)``, ``(K, n_joints)`` -> ``(K,)``)."""
+    good = (error <= reach_tolerance(hand)).all(axis=1)
+    for finger in hand.hand.fingers:
+        lower, upper = joint_limits(finger)
+        q = positions[:, list(finger.joint_index)]
+        good &= ((q >= lower) & (q <= upper)).all(axis=1)
+    if hand.collide is not None and len(positions):
+        good &= np.asarray(hand.collide(positions), float) <= hand.tolerance
+    return good
 
 
 def _failure(archive, mu, min_conditioning, tol) -> Failure:
@@ -501,6 +563,27 @@ def _failure(archive, mu, min_conditioning, tol) -> Failure:
         )
     if name == "constraints":
         return Failure(name, "no force-closure candidate passed the further constraints", np.nan, np.nan)
+    if name == "fingertips":
+        return Failure(
+            name, "on every candidate some fingertip sphere would go into the object (concave there)", np.nan, np.nan
+        )
+    if name == "reach":
+        best = archive.best_miss.get(name, np.inf)
+        return Failure(
+            name,
+            f"the hand reaches no candidate's contacts within its joint limits: the best candidate leaves a "
+            f"fingertip {best:.3g} from where it must be",
+            best,
+            0.0,
+        )
+    if name == "collision":
+        best = archive.best_miss.get(name, np.inf)
+        return Failure(
+            name,
+            f"every grasp the hand reaches puts a finger link into the object (the shallowest {best:.3g} deep)",
+            best,
+            np.nan,
+        )
     return Failure(name, "no candidate's grip holds every wrench within the friction cones", np.nan, np.nan)
 
 
@@ -509,7 +592,42 @@ def surface_of(obj) -> Surface:
     return Surface(partial(sample_surface, obj), partial(project_to_surface, obj), object_size(obj))
 
 
-def synthesize(obj, friction, *, wrenches=(), hold=True, gravity=GRAVITY, **options) -> Synthesis:
+def hand_reach(obj, hand, *, tips=None, tip_radius=None, collide=None) -> HandReach:
+    """A hand as the search takes it (:class:`~.reach.HandReach`) against ``obj``.
+
+    Parameters
+    ----------
+    obj : GraspObject
+    hand : Hand
+        Three fingers that share no joint, in the grasp frame.
+    tips : (3, 4, 4) array, optional
+        Each finger's tip link pose at home; default its tip link's (a finger given inline has
+        none: give where its tip point is at home, :func:`~grasptwist.engine.ik.home_tips`).
+    tip_radius : float, optional
+        Every fingertip's radius; default each finger's ``tip_radius``.
+    collide : callable, optional
+        ``collide(positions (N, n_joints)) -> (N,)`` the deepest any finger link goes into the
+        object (the command line's, from a URDF's meshes); None: links not checked.
+    """
+    radii = tip_radii(hand) if tip_radius is None else np.full(3, float(tip_radius))
+    tips = home_tips(hand) if tips is None else np.asarray(tips, float)
+    reach = HandReach(hand, tips, radii, partial(project_to_surface, obj), collision_tolerance(obj), collide)
+    return check_hand_reach(reach)
+
+
+def synthesize(
+    obj,
+    friction,
+    *,
+    wrenches=(),
+    hold=True,
+    gravity=GRAVITY,
+    hand=None,
+    tips=None,
+    tip_radius=None,
+    collide=None,
+    **options,
+) -> Synthesis:
     r"""Grasps of an object: its surface searched for grasps that hold its weight and ``wrenches``.
 
     The search (``grasptwist.engine.synthesis.search.search``; the guide's synthesis page) scores
@@ -528,6 +646,16 @@ def synthesize(obj, friction, *, wrenches=(), hold=True, gravity=GRAVITY, **opti
     hold : bool
         Hold the object's weight: the wrench ``(-m g; -c x m g)`` comes first.
     gravity : (3,) array
+    hand : Hand, optional
+        A hand that must reach every grasp: fingertips on the surface, every contact within
+        the joint limits, no finger link in the object; the grasps then list contact ``f`` for
+        finger ``f`` (the fingers are assigned to the contacts in every order), and
+        ``joint_positions`` and ``reach_error`` say where the hand holds each.
+    tips, tip_radius, collide
+        As ``grasptwist.engine.synthesis.search.hand_reach``: each finger's tip link pose at home (needed for a finger
+        given inline), every fingertip's radius (default each finger's ``tip_radius``), and
+        the depth of the deepest link at joint positions (default: links not checked; the
+        command line checks a URDF's meshes).
     **options
         The search's keyword options: ``count`` (grasps wanted, 1), ``safety`` (1), ``objective``
         (``total_normal_force``, ``closure_friction`` or ``epsilon``), ``wrist`` (None),
@@ -556,4 +684,6 @@ def synthesize(obj, friction, *, wrenches=(), hold=True, gravity=GRAVITY, **opti
         listed.insert(0, hold_wrench(props.mass, props.center_of_mass, np.asarray(gravity, float)))
     if not listed:
         raise ValueError("nothing to hold: give the object a mass (hold=True) or wrenches")
-    return search(surface_of(obj), np.array(listed), friction, **options)
+    if hand is not None and not isinstance(hand, HandReach):
+        hand = hand_reach(obj, hand, tips=tips, tip_radius=tip_radius, collide=collide)
+    return search(surface_of(obj), np.array(listed), friction, hand=hand, **options)

@@ -1,0 +1,232 @@
+r"""A hand's reach as constraints of the search: fingertips on the surface, joints within limits, no collision.
+
+A candidate ``(p, n)`` is reachable by a hand when some assignment of its fingers to
+the contacts (the TriFinger code's way: every permutation tried) passes, finger by
+finger and then as a whole:
+
+1. **fingertips** (``fingertips``): finger ``f``'s sphere of radius ``r_f``, centred at
+
+   .. math:: c = p - r_f \hat n
+
+   (one radius out of the object along its inward normal), stays outside the object:
+   the signed distance of ``c`` is at least ``r_f - tol`` (``tol`` the collision
+   tolerance, :data:`~grasptwist.engine.collision.COLLISION_TOL` times the object's
+   size), so the sphere touches the surface at ``p`` and goes in nowhere else;
+2. **reach** (``reach``): joint positions within the limits put the finger's tip point
+   (its tip link's origin, the sphere's centre) on ``c``, to the inverse kinematics'
+   tolerance (:func:`~grasptwist.engine.ik.finger_ik`); a centre farther from the
+   finger's first joint than the finger is long is out of reach without solving;
+3. **collision** (``collision``): at those positions no finger link goes deeper into
+   the object than ``tol`` (a function of the joint positions the caller gives, as
+   :mod:`grasptwist.run.collisions` builds it from the hand's meshes).
+
+The nine (finger, contact) pairs of a candidate are solved once each, batched over
+every candidate, and the six assignments are read off them; the assignments that reach
+are checked for collisions nearest first (the least total distance from each finger's first
+joint to its target: a finger reaching around the object to a far contact is the one whose
+links go through it), the first clear one kept.  Fingers must not
+share joints (each finger's inverse kinematics is its own).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from itertools import permutations
+from typing import NamedTuple
+
+import numpy as np
+
+from ..degeneracy import Status
+from ..ik import IK_TOL, finger_ik
+from ..kinematics import forward_kinematics
+
+__all__ = [
+    "HAND_CONSTRAINTS",
+    "IK_RESTARTS",
+    "HandReach",
+    "Reached",
+    "check_hand_reach",
+    "reach",
+    "reach_tolerance",
+    "tip_errors",
+]
+
+#: The hand's constraints in the order they are tested (after the grip: the inverse kinematics
+#: is the search's most expensive test, so it runs on the fewest rows).
+HAND_CONSTRAINTS = ("fingertips", "reach", "collision")
+
+#: Spread seeds a (finger, contact) pair that misses from home starts again from: a search has
+#: many candidates, so a pair the first seeds miss is given up rather than chased.
+IK_RESTARTS = 2
+
+#: Finger f's contact in each assignment, and the shift ``(contact - f) mod 3`` it reads.
+_ORDERS = np.array(list(permutations(range(3))))
+_SHIFTS = (_ORDERS - np.arange(3)) % 3
+
+
+class HandReach(NamedTuple):
+    """A hand as the search needs it (in the grasp frame).
+
+    Attributes
+    ----------
+    hand : Hand
+    tips : (3, 4, 4) array
+        Each finger's tip link pose at home (:func:`~grasptwist.engine.ik.home_tips`).
+    radii : (3,) array
+        Each finger's fingertip radius.
+    project : callable
+        The object's ``project(points (..., 3)) -> (points, normals, distance)``.
+    tolerance : float
+        Depths (of a link, or of a fingertip sphere) at most this are no collision.
+    collide : callable or None
+        ``collide(positions (N, n_joints)) -> (N,)`` the deepest any link goes into the
+        object; None: no link geometry to check.
+    """
+
+    hand: object
+    tips: np.ndarray
+    radii: np.ndarray
+    project: Callable
+    tolerance: float
+    collide: Callable | None = None
+
+
+class Reached(NamedTuple):
+    """The hand on ``N`` candidates.
+
+    Attributes
+    ----------
+    failed : (N,) int8
+        The first of :data:`HAND_CONSTRAINTS` no assignment passes, -1 where one passes all.
+    order : (N, 3) int
+        Finger ``f`` touches contact ``order[:, f]`` (identity where none passes).
+    positions : (N, n_joints)
+        Joint positions of the assignment kept (NaN where none).
+    miss : (N,)
+        How close a failing row came: for ``reach``, its best assignment's largest distance
+        from a tip point to its target; for ``collision``, its shallowest deepest link; NaN else.
+    """
+
+    failed: np.ndarray
+    order: np.ndarray
+    positions: np.ndarray
+    miss: np.ndarray
+
+
+def check_hand_reach(hand_reach: HandReach) -> HandReach:
+    """A :class:`HandReach` whose fingers are three and share no joint.
+
+    >>> from grasptwist.hand import Finger, Hand
+    >>> f = Finger("a", None, (), None, None, None, 1.0, (0,))
+    >>> check_hand_reach(HandReach(Hand((f, f, f), ("j",), None, None), None, None, None, 0.0))
+    Traceback (most recent call last):
+    ValueError: a hand searched over must have three fingers that share no joint
+    """
+    index = [i for f in hand_reach.hand.fingers for i in f.joint_index]
+    if len(hand_reach.hand.fingers) != 3 or len(set(index)) != len(index):
+        raise ValueError("a hand searched over must have three fingers that share no joint")
+    return hand_reach
+
+
+def reach(hand_reach: HandReach, points, normals) -> Reached:
+    """Put the hand on each candidate (module docstring): ``(N, 3, 3)`` contacts and unit inward normals.
+
+    Examples
+    --------
+    Three one-joint fingers, each a prismatic joint along z through its contact; each reaches
+    only its own contact's vertical line, so the second candidate's assignment swaps fingers 1 and 2:
+
+    >>> from grasptwist.hand import Finger, Hand, Joint
+    >>> base = np.array([[1.0, 0, 0], [0, 1.0, 0], [-1.0, 0, 0]])
+    >>> def finger(i):
+    ...     tip = np.eye(4); tip[:3, 3] = base[i]
+    ...     j = (Joint(f"z{i}", "prismatic", None, -2.0, 2.0, None),)
+    ...     return Finger(str(i), None, j, np.array([[0, 0, 0, 0, 0, 1.0]]), base[i : i + 1] - [0, 0, 1], tip, 1.0, (i,))
+    >>> hand = Hand(tuple(finger(i) for i in range(3)), ("z0", "z1", "z2"), None, None)
+    >>> far = lambda q: (q, -q, np.full(q.shape[:-1], 10.0))  # nothing near: every sphere is clear
+    >>> r = reach(HandReach(hand, np.array([f.tip_pose for f in hand.fingers]), np.zeros(3), far, 1e-6),
+    ...           [base + [0, 0, 0.5], base[[0, 2, 1]] + [0, 0, -1.0]], -base[None].repeat(2, 0))
+    >>> r.failed.tolist(), r.order.tolist(), r.positions.round(12).tolist()
+    ([-1, -1], [[0, 1, 2], [0, 2, 1]], [[0.5, 0.5, 0.5], [-1.0, -1.0, -1.0]])
+    """
+    hr = hand_reach
+    p, n = np.asarray(points, float), np.asarray(normals, float)
+    rows = len(p)
+    fingers = hr.hand.fingers
+    radii = np.asarray(hr.radii, float)
+    # pair (row, shift s, finger f): finger f on contact (f + s) mod 3, its sphere's centre one radius out
+    contact = (np.arange(3)[None, :] + np.arange(3)[:, None]) % 3  # (s, f)
+    centre = p[:, contact] - radii[None, None, :, None] * n[:, contact]
+    clear = hr.project(centre)[2] >= radii - hr.tolerance  # (N, 3, 3)
+    error = np.full((rows, 3, 3), np.inf)
+    q = np.full((rows, 3, 3, max(len(f.joints) for f in fingers)), np.nan)
+    for f, finger in enumerate(fingers):
+        # a revolute chain reaches no farther from its first joint than it is long: no solve needed
+        revolute = all(j.type == "revolute" for j in finger.joints)
+        gap = np.linalg.norm(centre[:, :, f] - finger.points[0], axis=-1) - finger.length if revolute else -1.0
+        gap = np.broadcast_to(gap, (rows, 3))
+        error[:, :, f] = np.where(clear[:, :, f], np.maximum(gap, 0.0), np.inf)
+        todo = np.flatnonzero((clear[:, :, f] & (gap <= 0)).reshape(-1))
+        if todo.size:
+            got, err, _, status = finger_ik(
+                finger, hr.tips[f], centre[:, :, f].reshape(-1, 3)[todo], seeds=IK_RESTARTS, classify=False
+            )
+            flat_q, flat_e = q[:, :, f].reshape(-1, q.shape[-1]), error[:, :, f].reshape(-1)
+            flat_q[todo, : len(finger.joints)] = got
+            flat_e[todo] = np.where(status == Status.OK, 0.0, err)
+            q[:, :, f], error[:, :, f] = flat_q.reshape(rows, 3, -1), flat_e.reshape(rows, 3)
+    pick = (slice(None), _SHIFTS[:, :], np.arange(3)[None, :])  # (N, 6 assignments, 3 fingers)
+    touches = clear[pick].all(axis=-1)
+    worst = error[pick].max(axis=-1)  # (N, 6): 0 where every finger reaches
+    reached = worst == 0.0
+    failed = np.full(rows, HAND_CONSTRAINTS.index("fingertips"), np.int8)
+    failed[touches.any(axis=1)] = HAND_CONSTRAINTS.index("reach")
+    miss = np.where(touches.any(axis=1), worst.min(axis=1, initial=np.inf), np.nan)
+    order = np.tile(np.arange(3), (rows, 1))
+    positions = np.full((rows, len(hr.hand.joint_names)), np.nan)
+    depth = np.full(rows, np.inf)
+    # the assignments tried nearest first (the fingers' first joints to their targets, in all): a finger
+    # that reaches around the object to a far contact is the one whose links go through it
+    base = np.array([f.points[0] for f in fingers])  # (3, 3)
+    spread = np.linalg.norm(centre - base, axis=-1)[pick].sum(axis=-1)  # (N, 6)
+    ranked = np.argsort(np.where(reached, spread, np.inf), axis=1, kind="stable")
+    for rank in range(len(_ORDERS)):  # the first assignment clear of the object is kept
+        k = ranked[:, rank]
+        todo = np.flatnonzero(reached[np.arange(rows), k] & (failed != -1))
+        if not todo.size:
+            continue
+        k = k[todo]
+        trial = np.empty((todo.size, len(hr.hand.joint_names)))
+        for f, finger in enumerate(fingers):
+            trial[:, list(finger.joint_index)] = q[todo, _SHIFTS[k, f], f, : len(finger.joints)]
+        deep = np.zeros(todo.size) if hr.collide is None else np.asarray(hr.collide(trial), float)
+        depth[todo] = np.minimum(depth[todo], deep)
+        ok = deep <= hr.tolerance
+        failed[todo[~ok]] = HAND_CONSTRAINTS.index("collision")
+        won = todo[ok]
+        failed[won], order[won], positions[won] = -1, _ORDERS[k[ok]], trial[ok]
+    miss = np.where(failed == HAND_CONSTRAINTS.index("collision"), depth, miss)
+    return Reached(failed, order, positions, np.where(failed == -1, np.nan, miss))
+
+
+def tip_errors(hand_reach: HandReach, points, normals, positions):
+    """Each finger's distance from its tip point, by forward kinematics at ``positions``, to ``p - r n``.
+
+    ``(K, 3, 3)`` contacts (row ``f`` finger ``f``'s), normals, ``(K, n_joints)`` -> ``(K, 3)``: the
+    check, independent of the inverse kinematics, of the grasps a search returns.
+    """
+    p, n = np.asarray(points, float), np.asarray(normals, float)
+    centre = p - np.asarray(hand_reach.radii, float)[:, None] * n
+    out = np.empty(p.shape[:-1])
+    for f, finger in enumerate(hand_reach.hand.fingers):
+        q = np.asarray(positions, float)[:, list(finger.joint_index)]
+        tip = forward_kinematics(finger.screws, finger.points, hand_reach.tips[f], q).tip[..., :3, 3]
+        out[:, f] = np.linalg.norm(tip - centre[:, f], axis=-1)
+    return out
+
+
+def reach_tolerance(hand_reach: HandReach):
+    """How far each finger's tip point may be from its target: :data:`~grasptwist.engine.ik.IK_TOL`
+    times the finger's length, ``(3,)`` (the inverse kinematics' own test).
+    """
+    return IK_TOL * np.array([f.length for f in hand_reach.hand.fingers])
