@@ -18,7 +18,9 @@ there.  A contact that gives its normal stays as written (the user's point
 and direction), checked against the surface.  A point farther from the surface than the tolerance
 (``Reading.surface_tol`` times the object's size; ``--surface-tol``) is
 ``contact-off-surface``; a given normal pointing out of the object is
-``outward-normal``.  The geometry is :mod:`grasptwist.engine.objects`'; a
+``outward-normal``.  Two warnings are found here too, where their places are known, and
+carried in ``Grasp.warnings``: a given normal far from the surface's (``normal-disagrees``)
+and a pose's rotation vector over pi (``rotation-over-pi``, as a path's).  The geometry is :mod:`grasptwist.engine.objects`'; a
 mesh is read by :mod:`grasptwist.io.mesh_file`.
 """
 
