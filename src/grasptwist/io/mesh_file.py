@@ -275,7 +275,9 @@ def _too_many(declared, max_triangles, file):
     allocates arrays of that length."""
     if declared is not None and declared > max_triangles:
         raise InputError(
-            "too-many-triangles", f"the file declares {declared} faces, more than the limit of {max_triangles} triangles", file
+            "too-many-triangles",
+            f"the file declares {declared} faces, more than the limit of {max_triangles} triangles",
+            file,
         )
 
 
