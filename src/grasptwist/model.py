@@ -132,7 +132,9 @@ class Grasp:
         ``(3,)`` each given point's signed distance from the object's surface
         (> 0 outside) before it was put on it; None without an object.
     warnings : tuple of str
-        Found when its hand was placed (``finger-collides``: a finger link inside the object),
+        Found when it was read (``rotation-over-pi``: its object's pose turned by a rotation
+        vector over pi; ``normal-disagrees``: a given normal far from the object's surface normal),
+        then when its hand was placed (``finger-collides``: a finger link inside the object),
         carried into each of its records.
     """
 

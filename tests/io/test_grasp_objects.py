@@ -190,6 +190,52 @@ def test_a_pose_moves_the_object_and_its_surface():
     np.testing.assert_allclose(g.surface_distance, 0, atol=1e-15)
     np.testing.assert_allclose(g.normals, [[-1, 0, 0], [1, 0, 0], [0, 1, 0]], atol=1e-15)
 
+    assert g.warnings == ()  # a quarter turn in radians: no warning
+
+
+@pytest.mark.parametrize(
+    ("pose", "warned"),
+    [
+        ("{rotvec: [0, 0, 90]}", "rotation of 90 (rotvec [0, 0, 90], line 3, column 18) is over pi: "),
+        (
+            "{position: [0, 0, 0], rotvec: [0, 0, 45]}",
+            "rotation of 45 (rotvec [0, 0, 45], line 3, column 39) is over pi: ",
+        ),
+        ("{rotvec: [0, 0, 3.141592653589793]}", None),  # a half turn is not over pi
+        ("{rotation: [0, 0, 0, 1]}", None),  # a quaternion says its own turn
+    ],
+)
+def test_an_objects_pose_over_pi_is_the_paths_located_warning(pose, warned):
+    """Degrees typed as radians: 90 turns the sphere 116.6 degrees, 45 turns it 58.3, as a path's
+    pose target would (issue 30's user got no word); a sphere keeps every contact on it."""
+    obj = f"  sphere: 1.5\n  pose: {pose}"
+    text = CUBE_GRASP.format(object=obj).replace("[-1, -0.4, 0.1]", "[-1.5, 0, 0]")
+    (g,) = load_grasps(
+        text.replace("[1, 0.2, 0.3]", "[1.5, 0, 0]").replace("[0.1, -1, 0.5]", "[0, -1.5, 0]"), file="g.yaml"
+    )
+    said = [w for w in g.warnings if w.startswith("rotation-over-pi")]
+    if warned is None:
+        assert said == []
+    else:
+        (w,) = said
+        turn = {"90": 116.6, "45": 58.3}[warned.split()[2]]
+        assert w == f"rotation-over-pi: {warned}rotations are in radians (this one is a turn of {turn} degrees)"
+
+
+def test_each_disagreeing_normal_is_its_own_warning_located_at_the_normal():
+    text = CUBE_GRASP.format(object=CUBE).replace(
+        "{point: [1, 0.2, 0.3]}", "{point: [1, 0.2, 0.3], normal: [-1, 0, 0.5]}"
+    )
+    text = text.replace("normal: [1, 0, 0]", "normal: [1, 0.25, 0]")
+    (g,) = load_grasps(text, file="g.yaml")
+    assert g.warnings == (
+        "normal-disagrees: contacts[0].normal (line 4, column 36) is 26.6 degrees from the object's surface normal "
+        "there (more than 10): check it, or leave it out to take the surface's",
+        "normal-disagrees: contacts[1].normal (line 5, column 38) is 14.0 degrees from the object's surface normal "
+        "there (more than 10): check it, or leave it out to take the surface's",
+    )
+    assert grasp().warnings == ()  # normals taken from the surface, or given on it
+
 
 # --------------------------------------------------------------------------
 # The weight: an object's mass or density gives the hold wrench.

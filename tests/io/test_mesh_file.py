@@ -79,6 +79,9 @@ def test_the_bundled_bottle():
         (tetra(["f 1 2 x"]), "m.obj", "invalid-mesh", "^m.obj: not a readable OBJ file$"),
         (tetra(["f 1 2"]), "m.obj", "invalid-mesh", "^m.obj: not a readable OBJ file$"),
         pytest.param(b"solid x\n\xff\xfe garbage", "m.stl", "empty-mesh", "no triangles", marks=TRIMESH),
+        # a text file named .stl (issue 30's user): no STL of either kind, refused unparsed
+        (b"not a mesh", "m.stl", "invalid-mesh", r"^m.stl: not a readable STL file \(neither a binary STL "),
+        (bytes(80) + (3).to_bytes(4, "little") + bytes(149), "m.stl", "invalid-mesh", "not a readable STL"),
         (tetra(vertices="v nan 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\n"), "m.obj", "non-finite", "NaN or infinite$"),
         (tetra(TETRA_F[:3]), "m.obj", "not-watertight", r"not a closed surface \(every edge shared by exactly two"),
         (tetra([*TETRA_F[:3], "f 2 4 3"]), "m.obj", "not-watertight", "wound the same way"),
@@ -93,7 +96,7 @@ def test_the_bundled_bottle():
             "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nelement face 9999999\nend_header\n",
             "m.ply",
             "too-many-triangles",
-            f"the header declares 9999999 faces, more than the limit of {MAX_TRIANGLES}$",
+            f"^m.ply: the file declares 9999999 faces, more than the limit of {MAX_TRIANGLES} triangles$",
         ),
     ],
     ids=[
@@ -104,6 +107,8 @@ def test_the_bundled_bottle():
         "bad-word",
         "two-corners",
         "junk-stl",
+        "text-stl",
+        "truncated-stl",
         "nan",
         "open",
         "winding",
@@ -134,11 +139,45 @@ def test_the_size_cap_is_checked_before_parsing(tmp_path, monkeypatch):
     assert caught.value.code == "too-large"
 
 
-def test_the_triangle_limit(tmp_path):
+def test_the_triangle_limit(tmp_path, monkeypatch):
+    from grasptwist.io import mesh_file
+
     name = obj(tmp_path, tetra())
     assert len(read_mesh(name, tmp_path, max_triangles=4)[1]) == 4
-    with pytest.raises(InputError, match="4 triangles, more than the limit of 3$") as caught:
+    # the four f lines say it before the file is parsed
+    monkeypatch.setattr(mesh_file, "_obj", lambda *a, **k: pytest.fail("parsed"))
+    with pytest.raises(
+        InputError, match="^m.obj: the file declares 4 faces, more than the limit of 3 triangles$"
+    ) as caught:
         read_mesh(name, tmp_path, max_triangles=3)
+    assert caught.value.code == "too-many-triangles"
+    monkeypatch.undo()
+    # two quadrilaterals and two triangles: 4 faces, 6 triangles, counted once parsed
+    quads = tetra(["f 1 3 2", "f 1 2 4", "f 1 4 3 3", "f 2 3 4 4"])
+    with pytest.raises(InputError, match="^m.obj: 6 triangles, more than the limit of 5$"):
+        read_mesh(obj(tmp_path, quads), tmp_path, max_triangles=5)
+
+
+@pytest.mark.parametrize(
+    ("data", "declared"),
+    [
+        (b"Solid box\n" + b"facet normal 0 0 1\n outer loop\n endloop\nendfacet\n" * 5 + b"endsolid\n", 5),
+        (b"solid" + bytes(75) + (5).to_bytes(4, "little") + bytes(250), 5),  # binary, though its header says solid
+        (bytes(80) + (200_000).to_bytes(4, "little") + bytes(10_000_000), 200_000),
+    ],
+    ids=["ascii", "binary-solid", "binary-10MB"],
+)
+def test_an_stl_over_the_limit_is_refused_before_trimesh_parses_it(tmp_path, monkeypatch, data, declared):
+    """A binary STL's header gives its count (a 100 MB one once took trimesh 2.7 s and 420 MB to refuse),
+    an ASCII one its endfacet words."""
+    from grasptwist.io import mesh_file
+
+    (tmp_path / "m.stl").write_bytes(data)
+    monkeypatch.setattr(mesh_file, "_parsed", lambda *a, **k: pytest.fail("parsed"))
+    with pytest.raises(
+        InputError, match=f"^m.stl: the file declares {declared} faces, more than the limit of 4 "
+    ) as caught:
+        read_mesh("m.stl", tmp_path, max_triangles=4, max_bytes=len(data))
     assert caught.value.code == "too-many-triangles"
 
 

@@ -30,9 +30,10 @@ contacts:
   - {point: [0.2, -1.0, -0.5], normal: [0, 1, 0]}
 twists: [{angular: [0, 0, 1]}]
 """
+# located where the file gives that normal, named as the file's errors name a contact (issue 30's user)
 WARNING = (
-    "normal-disagrees: the normal given at contact 2 is 14.0 degrees from the object's surface normal there "
-    "(more than 10): check the normal, or leave it out to take the surface's"
+    "normal-disagrees: contacts[1].normal (line 5, column 38) is 14.0 degrees from the object's surface normal "
+    "there (more than 10): check it, or leave it out to take the surface's"
 )
 
 
@@ -101,3 +102,18 @@ def test_records_by_template_write_the_same_distances(files):
         else:
             np.testing.assert_allclose(distances, [0.02, 0, 0], atol=1e-15)
             assert r["warnings"] == ([WARNING] if r["grasp"] == "cube" else [])
+
+
+def test_a_paths_summary_carries_the_grasps_warnings_as_read(files):
+    """The object's pose and normals are the grasp's, not a sample's: follow's summary says them once."""
+    text = GRASP.replace(
+        "object: {box: [2, 2, 2]}", "object: {box: [2, 2, 2], pose: {rotvec: [0, 0, 6.283185307179586]}}"
+    )
+    (files / "cube.yaml").write_text(text + "paths: [{segments: [{duration: 1, angular: [0, 0, 1]}]}]\n")
+    result = run("follow", files / "cube.yaml", "--samples", 2, "--method", "tangent", "-f", "jsonl")
+    summary = json.loads(result.stdout.splitlines()[-1])
+    assert summary["warnings"] == [
+        "rotation-over-pi: rotation of 6.28319 (rotvec [0, 0, 6.28319], line 2, column 41) is over pi: "
+        "rotations are in radians (this one is a turn of 0.0 degrees)",  # 2 pi: a whole turn
+        WARNING,
+    ]

@@ -203,3 +203,70 @@ def test_a_png_of_the_object_and_tips_is_written(tmp_path):
         rgb = np.asarray(png.convert("RGB"), dtype=int)
     # matplotlib's "tan" object, shaded and translucent: pixels with red well over blue
     assert np.sum((rgb[..., 0] - rgb[..., 2] > 40) & (rgb[..., 0] > 150)) > 500
+
+
+def _layout(fig):
+    """The drawn figure's text boxes (display pixels) by what they are: the legend, each panel's
+    title, and per panel and axis its axis name and the tick labels within its limits."""
+    renderer = fig.canvas.get_renderer()
+    fig.draw_without_rendering()
+    out = {"legend": [fig.legends[0].get_window_extent(renderer)]}
+    for k, ax in enumerate(fig.axes):
+        out[f"title {k}"] = [ax.title.get_window_extent(renderer)]
+        for name, axis in zip("xyz", (ax.xaxis, ax.yaxis, ax.zaxis)):
+            lo, hi = sorted(getattr(ax, f"get_{name}lim")())
+            labels = zip(axis.get_ticklabels(), axis.get_majorticklocs())
+            out[f"{name} ticks {k}"] = [
+                t.get_window_extent(renderer) for t, v in labels if t.get_text() and lo <= v <= hi
+            ]
+            if axis.label.get_text():
+                out[f"{name} name {k}"] = [axis.label.get_window_extent(renderer)]
+    return out
+
+
+def _overprinted(layout):
+    """Pairs of boxes that overlap: the legend or a title with anything, an axis's tick labels
+    with each other or with its name (tick labels of two axes meeting at a corner of the
+    cube are matplotlib's 3D layout, not counted)."""
+    found = set()
+    keys = list(layout)
+    for i, a in enumerate(keys):
+        for b in keys[i:]:
+            same_axis = a.split()[0] == b.split()[0] and a.split()[-1] == b.split()[-1]
+            if not ({"legend", "title"} & {a.split()[0], b.split()[0]} or same_axis):
+                continue
+            for m, x in enumerate(layout[a]):
+                for n, y in enumerate(layout[b]):
+                    if (a != b or n > m) and x.overlaps(y):
+                        found.add((a, b))
+    return found
+
+
+def test_the_pngs_axes_have_few_ticks_and_its_legend_one_object():
+    """Without drawing (fast): at most TICKS + 1 ticks on each axis within its limits (the bottle's
+    x ticks ran together), one legend entry per kind, the object's among them."""
+    pytest.importorskip("matplotlib")
+    from grasptwist.plot.render import TICKS, figure
+    from grasptwist.plot.scene import grasp_scene
+
+    (g,) = load_grasps(GRASPS / "box-edge.yaml")
+    fig = figure(grasp_scene(g, g.twists[0]))
+    for ax in fig.axes:
+        for name, axis in zip("xyz", (ax.xaxis, ax.yaxis, ax.zaxis)):
+            lo, hi = sorted(getattr(ax, f"get_{name}lim")())
+            assert 2 <= sum(lo <= v <= hi for v in axis.get_majorticklocs()) <= TICKS + 1
+    legend = [t.get_text() for t in fig.legends[0].get_texts()]
+    assert legend.count("object") == 1 and len(set(legend)) == len(legend) == 12
+
+
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
+@pytest.mark.parametrize("name", ["box-edge.yaml", "bottle.yaml", "handle.yaml", "trifinger-cube.yaml"])
+def test_the_pngs_text_does_not_overprint(name):
+    """Issue 30's user: down the contact-plane normal the bottle's x tick labels ran together and
+    the y name sat on the panel's title; with a box the legend was printed over tick labels."""
+    pytest.importorskip("matplotlib")
+    from grasptwist.plot.render import figure
+    from grasptwist.plot.scene import grasp_scene
+
+    (g,) = load_grasps(GRASPS / name)
+    assert _overprinted(_layout(figure(grasp_scene(g, g.twists[0])))) == set()

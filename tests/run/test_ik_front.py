@@ -89,6 +89,28 @@ def test_a_grasp_without_joint_positions_puts_each_tip_on_its_contact(tmp_path):
 
 
 @urdf
+def test_the_tip_error_is_measured_to_the_spheres_centre_not_the_contact(tmp_path):
+    """Given joint positions a little off: each finger's tip_error is its tip link origin's distance
+    from ``p - r n`` (what the docs say), not from the contact ``p``."""
+    doc = yaml.safe_load(TRIFINGER.read_text("utf-8"))
+    moved = dict(
+        FILE_POSITIONS, finger_upper_to_middle_joint_120=FILE_POSITIONS["finger_upper_to_middle_joint_120"] + 0.05
+    )
+    doc["hand"]["joint_positions"] = moved
+    path = tmp_path / "trifinger-given.yaml"
+    path.write_text(yaml.safe_dump(doc, sort_keys=False), "utf-8")
+    (g,) = read_grasps(path)
+    at = tips(g.hand, g.joint_positions)
+    to_target = np.linalg.norm(at - (g.points - 0.01 * g.normals), axis=-1)
+    to_contact = np.linalg.norm(at - g.points, axis=-1)
+    (rec, _) = jsonl("resolve", path)
+    errors = [f["tip_error"] for f in rec["hand"]["fingers"]]
+    assert errors == pytest.approx(to_target.tolist(), rel=1e-9, abs=1e-12)
+    assert errors[0] < 1e-8 and errors[2] < 1e-8 and 0.005 < errors[1] < 0.05  # the moved finger only
+    assert to_contact[0] == pytest.approx(0.01, abs=1e-8)  # the contact is one radius away
+
+
+@urdf
 def test_the_seed_is_where_the_solution_starts(tmp_path):
     """The elbow-down solution the file's positions hold (each sphere centre one radius inside its
     contact) from a seed there; the same as the engine's hand_ik from that seed."""

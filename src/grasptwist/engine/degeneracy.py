@@ -219,36 +219,28 @@ def outward_normals_warning(outward, names=("1", "2", "3"), center=False) -> str
     )
 
 
-def normal_disagrees_warning(disagrees, angles, names=("1", "2", "3"), limit=10.0) -> str | None:
-    """The warning for given normals more than ``limit`` degrees from the object's surface normal,
-    naming each contact and its angle (to a tenth of a degree); None when none is.  It starts with its code.
+def normal_disagrees_warning(contact: int, angle, line=None, column=None, limit=10.0) -> str:
+    """The warning for contact ``contact``'s given normal (0-based, named by its place in the file,
+    ``contacts[i].normal``, as the file's errors name it), ``angle`` degrees (to a tenth) from the
+    object's surface normal, more than ``limit``, with where it is written.  It starts with its code.
 
-    >>> normal_disagrees_warning([False, True, False], [0.0, 14.04, 2.0], limit=10)[:83]
-    "normal-disagrees: the normal given at contact 2 is 14.0 degrees from the object's s"
-    >>> normal_disagrees_warning([True, False, True], [12.3, 0.0, 45.6], ("a", "b", "c"))[:83]
-    'normal-disagrees: the normals given at contacts a and c are 12.3 and 45.6 degrees f'
-    >>> normal_disagrees_warning([False] * 3, [0.0] * 3) is None
-    True
+    >>> normal_disagrees_warning(1, 14.04, 6, 41, limit=10)[:90]
+    "normal-disagrees: contacts[1].normal (line 6, column 41) is 14.0 degrees from the object's"
     """
-    which = [(name, f"{angle:.1f}") for name, angle, off in zip(names, angles, disagrees) if off]
-    if not which:
-        return None
-    if len(which) == 1:
-        ((name, angle),) = which
-        return (
-            f"normal-disagrees: the normal given at contact {name} is {angle} degrees from the object's surface "
-            f"normal there (more than {limit:g}): check the normal, or leave it out to take the surface's"
-        )
-    names, angles = (_and([w[k] for w in which]) for k in (0, 1))
+    where = _place(line, column)
     return (
-        f"normal-disagrees: the normals given at contacts {names} are {angles} degrees from the object's surface "
-        f"normals there (more than {limit:g}): check them, or leave them out to take the surface's"
+        f"normal-disagrees: contacts[{contact}].normal{where and f' ({where})'} is {float(angle):.1f} degrees from "
+        f"the object's surface normal there (more than {limit:g}): check it, or leave it out to take the surface's"
     )
 
 
-def _and(words):
-    """``a, b and c``."""
-    return f"{', '.join(words[:-1])} and {words[-1]}"
+def _place(line, column) -> str:
+    """Where a value is written, ``line 6, column 41``, as a warning in a record says it.
+
+    >>> _place(6, 41), _place(6, None)
+    ('line 6, column 41', 'line 6')
+    """
+    return ", ".join(f"{name} {n}" for name, n in (("line", line), ("column", column)) if n is not None)
 
 
 def radians_warning(rotvec, line=None, column=None) -> str:
@@ -261,8 +253,8 @@ def radians_warning(rotvec, line=None, column=None) -> str:
     r = np.asarray(rotvec, dtype=float)
     angle = float(np.sqrt(r @ r))
     turn = np.degrees(abs((angle + np.pi) % (2 * np.pi) - np.pi))  # the rotation's own angle, in [0, 180]
-    where = "".join(f", {name} {n}" for name, n in (("line", line), ("column", column)) if n is not None)
+    where = _place(line, column)
     return (
-        f"rotation-over-pi: rotation of {angle:g} (rotvec [{', '.join(f'{x:g}' for x in r)}]{where}) is over pi: "
+        f"rotation-over-pi: rotation of {angle:g} (rotvec [{', '.join(f'{x:g}' for x in r)}]{where and ', ' + where}) is over pi: "
         f"rotations are in radians (this one is a turn of {turn:.1f} degrees)"
     )

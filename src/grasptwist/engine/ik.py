@@ -197,8 +197,9 @@ class HandIK:
     positions : (..., n_joints)
         In ``hand.joint_names`` order.
     tip_error : (..., 3)
-        Per finger, the distance from its tip point to its contact at
-        ``positions`` (for an ``unreachable`` finger, the smallest distance found).
+        Per finger, the distance from its tip point to its target at
+        ``positions``: the point given for it (a contact, or with a fingertip radius the
+        sphere's centre ``p - r n``); for an ``unreachable`` finger, the smallest distance found.
     within_limits : (..., 3) bool
         Per finger, whether its joints at ``positions`` are within their limits.
     status : (..., 3) int8
@@ -439,7 +440,7 @@ def place_hand(hand, points, positions=None, *, seed=None, tips=None) -> HandIK:
 
     With ``positions``, each finger's tip is checked against its contact
     (``contact-off-finger`` when a contact is farther from its tip than the
-    finger is long; the tip error the distance from the tip to the contact); without, they are solved by
+    finger is long; the tip error the distance from the tip to the point given); without, they are solved by
     :func:`hand_ik` from ``seed``.  A finger given inline has no tip point
     unless ``tips`` gives one: it is unchecked (tip error NaN), and a hand
     with such a finger is not solved but taken as given (every joint at 0,

@@ -11,9 +11,12 @@ second of import), and the checks are numpy's.  Around it, as for a URDF
   unless the caller allows it (``--allow-outside``); ``package://PKG/path``
   inside an installed Python package;
 * the bytes: at most ``max_bytes`` (the loader's ``--max-bytes``) of a regular
-  file are read before anything is parsed, and a PLY header declaring more
-  than ``max_triangles`` faces is refused unparsed, so memory stays bounded
-  by the cap;
+  file are read before anything is parsed, and a file whose format says it
+  holds more than ``max_triangles`` triangles is refused unparsed (a binary
+  STL's count, an ASCII STL's ``endfacet`` words, a PLY header's faces, an
+  OBJ's ``f`` lines), so memory stays bounded by the cap; bytes that are no
+  STL (neither a binary STL of its count's length nor text starting with
+  ``solid``) are ``invalid-mesh`` unparsed;
 * the geometry: at most ``max_triangles`` triangles (:data:`~grasptwist.io.limits.MAX_TRIANGLES`),
   finite vertices, every face index a vertex, and a closed surface: each
   edge shared by exactly two triangles, wound the same way (a volume, a
@@ -56,6 +59,9 @@ __all__ = ["MESH_SUFFIXES", "read_mesh", "check_mesh"]
 MESH_SUFFIXES = (".stl", ".obj", ".ply")
 
 _PLY_FACES = re.compile(rb"^element\s+face\s+(\d+)\s*$", re.MULTILINE)
+_ASCII_STL = re.compile(rb"\s*solid", re.IGNORECASE)
+#: A binary STL: an 80-byte header, a little-endian uint32 count, then 50 bytes per triangle.
+_STL_HEADER, _STL_TRIANGLE = 84, 50
 
 
 def read_mesh(
@@ -108,8 +114,7 @@ def read_mesh(
             "unsupported-mesh", f"expected a mesh file ending in {', '.join(MESH_SUFFIXES[:-1])} or .ply", text
         )
     data = _read(resolve_urdf(text, folder, allow_outside=allow_outside), max_bytes, text)
-    if suffix == ".ply":
-        _check_ply_header(data, max_triangles, text)
+    _too_many(_declared_triangles(data, suffix, text), max_triangles, text)
     try:
         vertices, faces = _obj(data) if suffix == ".obj" else _parsed(data, suffix, text)
     except (ValueError, IndexError):
@@ -229,16 +234,49 @@ def _closed(faces):
     return bool((counts == 1).all() and np.array_equal(keys, reverse))
 
 
-def _check_ply_header(data, max_triangles, file):
-    """Refuse a PLY whose header declares more faces than ``max_triangles`` before trimesh
+def _declared_triangles(data, suffix, file):
+    r"""How many triangles (or faces: a polygon is a fan of them) the file says it holds, found
+    without parsing it; None where the format does not say.
+
+    A binary STL gives its count in its header, and is exactly that long; an ASCII STL starts with
+    ``solid`` and closes each triangle with ``endfacet``; a PLY's header declares its faces; an
+    OBJ has an ``f`` line per face.  Bytes that are neither kind of STL are ``invalid-mesh``.
+
+    >>> import struct
+    >>> _declared_triangles(bytes(80) + struct.pack("<I", 2) + bytes(100), ".stl", "a.stl")
+    2
+    >>> _declared_triangles(b"v 0 0 0\nf 1 2 3\r\nf 1 3 4\n", ".obj", "a.obj")
+    2
+    >>> _declared_triangles(b"not a mesh", ".stl", "junk.stl")
+    Traceback (most recent call last):
+    grasptwist.model.GraspFileError: junk.stl: not a readable STL file (neither a binary STL of the length its count gives nor text starting with 'solid')
+    """
+    if suffix == ".stl":
+        if len(data) >= _STL_HEADER:
+            count = int.from_bytes(data[80:84], "little")
+            if len(data) == _STL_HEADER + _STL_TRIANGLE * count:
+                return count
+        if _ASCII_STL.match(data[:1024]):
+            return data.count(b"endfacet")
+        raise InputError(
+            "invalid-mesh",
+            "not a readable STL file (neither a binary STL of the length its count gives nor text starting with 'solid')",
+            file,
+        )
+    if suffix == ".ply":
+        end = data.find(b"end_header")
+        declared = _PLY_FACES.search(data[: end if end >= 0 else 4096])
+        return int(declared.group(1)) if declared else None
+    return sum(data.count(line) for line in (b"\nf ", b"\nf\t")) + data.startswith((b"f ", b"f\t"))
+
+
+def _too_many(declared, max_triangles, file):
+    """Refuse a file that says it holds more than ``max_triangles`` triangles, before a parser
     allocates arrays of that length."""
-    end = data.find(b"end_header")
-    header = data[: end if end >= 0 else 4096]
-    declared = _PLY_FACES.search(header)
-    if declared and int(declared.group(1)) > max_triangles:
+    if declared is not None and declared > max_triangles:
         raise InputError(
             "too-many-triangles",
-            f"the header declares {int(declared.group(1))} faces, more than the limit of {max_triangles}",
+            f"the file declares {declared} faces, more than the limit of {max_triangles} triangles",
             file,
         )
 

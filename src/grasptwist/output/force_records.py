@@ -15,7 +15,7 @@ from ..engine.forces.grip import load_words
 from .columns import ColumnSet, force_arrays, force_columns, force_typed_header
 from .csv_rows import FORCE_HEADER, force_error_row
 from .names import escaped, escaped_each
-from .records import disagrees_warning, outward_warning, surface_distances
+from .records import outward_warning, surface_distances
 
 __all__ = ["WRENCH_COLUMNS", "force_records", "GRIP_FIELDS", "CLOSURE_FIELDS", "NO_FRICTION_WARNING"]
 
@@ -65,14 +65,11 @@ def force_records(block) -> list[dict]:
     closure_friction, epsilon = r.closure_friction.tolist(), r.epsilon.tolist()
     force_closure = r.force_closure.tolist()
     outward = block.outward().any(axis=-1).tolist()
-    disagrees = block.disagrees().any(axis=-1).tolist()
     distance = surface_distances(block)
     out = []
     for i in range(len(block)):
         names = escaped_each(block.contact_names[i])
         warnings = [outward_warning(block, i)] if outward[i] else []
-        if disagrees[i]:
-            warnings.append(disagrees_warning(block, i))
         warnings += block.grasp_warnings[i] if block.grasp_warnings is not None else ()
         rec = {
             "file": escaped(block.file[i], controls=False),

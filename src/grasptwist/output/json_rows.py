@@ -127,7 +127,6 @@ def _marker_block(block, row: int):
     one.values.update({c: marked[c] for c in cols if c[0] is not None})
     one.values.update({c: block.value(*c)[[row]] for c in _coded(block)})  # known already: no need to judge again
     block.outward()  # the block's own verdicts (owner None) are judged on its real numbers, not on markers
-    block.disagrees()
     one.values.update({c: v[[row]] for c, v in block.values.items() if c[0] is None})
     return one
 

@@ -19,7 +19,6 @@ from ..engine.degeneracy import (
     CONDITION_WARNING,
     Status,
     conditioning_warning,
-    normal_disagrees_warning,
     outward_normals_warning,
     skipped_warning,
     status_message,
@@ -34,7 +33,6 @@ __all__ = [
     "ORDERS",
     "records",
     "outward_warning",
-    "disagrees_warning",
     "surface_distances",
     "basis_record",
     "check_record",
@@ -59,8 +57,6 @@ def records(block, order: str = "omega-v") -> list[dict]:
     warnings = [[] for _ in range(len(block))]
     for i in np.flatnonzero(block.outward().any(axis=-1)):
         warnings[i].append(outward_warning(block, i))
-    for i in np.flatnonzero(block.disagrees().any(axis=-1)):
-        warnings[i].append(disagrees_warning(block, i))
     for i, said in enumerate(block.grasp_warnings or ()):
         warnings[i] += said
     objects = [(k.key, _kind_rows(block, k, order, warnings)) for k in block.kinds() if k.record is None]
@@ -116,15 +112,6 @@ def outward_warning(block, i: int) -> str | None:
     does too."""
     center = block.center_of_mass is not None and not np.isnan(block.center_of_mass[i]).any()
     return outward_normals_warning(block.outward()[i].tolist(), escaped_each(block.contact_names[i]), center)
-
-
-def disagrees_warning(block, i: int) -> str | None:
-    """Row ``i``'s warning naming the contacts whose given normals are far from the object's surface
-    normal (:meth:`~grasptwist.run.batch.Block.disagrees`), or None; a force block does too."""
-    from ..engine.objects import NORMAL_DISAGREE_DEG  # with the first grasp that has an object
-
-    names = escaped_each(block.contact_names[i])
-    return normal_disagrees_warning(block.disagrees()[i], block.normal_angle[i], names, NORMAL_DISAGREE_DEG)
 
 
 def surface_distances(block) -> list:
@@ -211,7 +198,7 @@ def _kind_rows(block, kind, order, warnings):
 
 def talking_rows(block) -> np.ndarray:
     """Rows whose record has something for stderr: a failed or skipped kind, or a warning."""
-    talk = block.outward().any(axis=-1) | block.disagrees().any(axis=-1)
+    talk = block.outward().any(axis=-1)
     if block.grasp_warnings is not None:
         talk |= np.array([bool(said) for said in block.grasp_warnings])
     for kind in block.kinds():
@@ -258,8 +245,6 @@ def _row_objects(block, i, fields_of, order, warnings, with_failure=()):
     out = {}
     if block.outward()[i].any():
         warnings.append(outward_warning(block, i))
-    if block.disagrees()[i].any():
-        warnings.append(disagrees_warning(block, i))
     warnings += block.grasp_warnings[i] if block.grasp_warnings is not None else ()
     for kind in block.kinds():
         key = kind.key

@@ -697,7 +697,7 @@ class HandTable:
 
         ratio = m["velocity_limit_ratio"]
         title = "hand: joint rates" + ("" if ratio is None else f"   velocity-limit ratio {fmt_figure(ratio)}")
-        # where the hand is (its joint positions given or solved, each tip's distance to its contact)
+        # where the hand is (its joint positions given or solved, each tip's distance to its target p - r n)
         placed = "joint_positions" in m["fingers"][0]
         where = ("position",) if placed else ()
         tip = ("tip error",) if placed else ()

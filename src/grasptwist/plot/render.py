@@ -30,6 +30,7 @@ __all__ = [
     "Note",
     "TwistNotFound",
     "chosen_twist",
+    "figure",
     "image_name",
     "image_paths",
     "opened_for_writing",
@@ -240,6 +241,9 @@ def _check_suffix(suffix: str, formats=FORMATS):
 
 # --- drawing (matplotlib, imported here only) ----------------------------------
 
+#: Most columns of the legend under the views, and most ticks along each axis.
+LEGEND_COLUMNS, TICKS = 7, 5
+
 # kind -> matplotlib style
 _STYLE = {
     "contact": {"color": "black", "marker": "o", "s": 40},
@@ -293,6 +297,18 @@ def render(scene: Scene, path, *, size=(1400, 700), dpi=100, opener=None) -> Pat
     """
     path = Path(path)
     _check_suffix(path.suffix)
+    fig = figure(scene, size=size, dpi=dpi)
+    with (opener or opened_for_writing)(path) as f:
+        fig.savefig(f, dpi=dpi, format=path.suffix[1:].lower())
+    return path
+
+
+def figure(scene: Scene, *, size=(1400, 700), dpi=100):
+    """The matplotlib ``Figure`` :func:`render` saves: the two views, the title, the legend.
+
+    Its tick labels, axis names, titles and legend do not overlap (``tests/plot``'s
+    layout test draws it and compares their boxes).
+    """
     require_matplotlib()
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
@@ -306,18 +322,19 @@ def render(scene: Scene, path, *, size=(1400, 700), dpi=100, opener=None) -> Pat
         for setter, c in zip((ax.set_xlim, ax.set_ylim, ax.set_zlim), centre):
             setter(c - half, c + half)
         ax.set_proj_type("ortho")  # lengths compare across the picture
-        ax.set_box_aspect((1, 1, 1), zoom=1.05)
+        # a little smaller than the panel: a view from above puts tick labels around the cube's
+        # edges, and they must stay off the title above and the legend below
+        ax.set_box_aspect((1, 1, 1), zoom=0.95)
         _label_axes(ax, direction)
         elev, azim = _elev_azim(direction)
         ax.view_init(elev=elev, azim=azim)
         ax.set_title(view_name, fontsize=9)
     fig.suptitle(scene.title, fontsize=10)
     handles = [_legend_handle(k, scene.method) for k in scene.kinds()]
-    fig.legend(handles=handles, loc="lower center", ncol=min(len(handles), 7), fontsize=8, frameon=False)
-    fig.subplots_adjust(left=0.0, right=1.0, top=0.9, bottom=0.1, wspace=0.0)
-    with (opener or opened_for_writing)(path) as f:
-        fig.savefig(f, dpi=dpi, format=path.suffix[1:].lower())
-    return path
+    rows = -(-len(handles) // LEGEND_COLUMNS)  # as few rows as the columns allow, the columns then balanced
+    fig.legend(handles=handles, loc="lower center", ncol=-(-len(handles) // rows), fontsize=8, frameon=False)
+    fig.subplots_adjust(left=0.0, right=1.0, top=0.9, bottom=0.04 + 0.03 * rows, wspace=0.0)
+    return fig
 
 
 def _draw(ax, scene: Scene, view, head: float):
@@ -375,8 +392,12 @@ def _arrow_lines(origin, vector, view, head):
 
 
 def _label_axes(ax, direction):
-    """Name the x, y, z axes, except one seen end-on, whose ticks would pile up."""
+    """Name the x, y, z axes, except one seen end-on, whose ticks would pile up; at most
+    :data:`TICKS` ticks on each, so that their labels (``-0.025``) do not run together."""
+    from matplotlib.ticker import MaxNLocator
+
     for e, (name, axis) in enumerate(zip("xyz", (ax.xaxis, ax.yaxis, ax.zaxis))):
+        axis.set_major_locator(MaxNLocator(TICKS, steps=[1, 2, 2.5, 5, 10]))
         if abs(float(unit(direction)[e])) > 0.95:
             axis.set_ticklabels([])
         else:

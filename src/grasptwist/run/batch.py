@@ -55,7 +55,6 @@ ZERO_TWIST = Twist(name="0", screw=np.zeros(6), line=None)
 
 #: Key of :meth:`Block.outward`'s verdicts among a block's computed values.
 OUTWARD = (None, "outward_contacts")
-DISAGREES = (None, "normals_disagree")
 
 #: Rows per engine call on a data set: bounded memory, long vectors.
 ROWS_PER_BLOCK = 65536
@@ -92,10 +91,8 @@ class Block:
     center_of_mass: np.ndarray | None = (
         None  # (n, 3) the grasps' centre of mass, NaN rows where none; None: no row has one
     )
-    # (n, 3) each contact's distance from the grasp's object and its normal's angle from the surface's
-    # (degrees), NaN rows without an object; None: no row has one (see surface_columns)
+    # (n, 3) each contact's distance from the grasp's object, NaN rows without an object; None: no row has one
     surface_distance: np.ndarray | None = None
-    normal_angle: np.ndarray | None = None
     grasp_warnings: list | None = None  # per row its grasp's warnings (Grasp.warnings); None: no row has one
     # field values computed so far, by (kind key, Field); a block cut from another keeps its rows of them
     values: dict = field(default_factory=dict, init=False, repr=False, compare=False)
@@ -138,14 +135,6 @@ class Block:
         got = self.values.get(OUTWARD)
         if got is None:
             got = self.values[OUTWARD] = outward_contacts(self.points, self.normals, self.center_of_mass)
-        return got
-
-    def disagrees(self) -> np.ndarray:
-        """Per row and contact ``(n, 3)``: is its given normal more than
-        :data:`~grasptwist.objects.NORMAL_DISAGREE_DEG` from its object's surface normal?"""
-        got = self.values.get(DISAGREES)
-        if got is None:
-            got = self.values[DISAGREES] = disagreeing(self.normal_angle, len(self))
         return got
 
     def failed_rows(self) -> np.ndarray:
@@ -192,7 +181,6 @@ _ROW_FIELDS = (
     "friction",
     "center_of_mass",
     "surface_distance",
-    "normal_angle",
     "grasp_warnings",
 )
 
@@ -355,50 +343,23 @@ def _stack(jobs, method) -> Block:
         friction = np.stack([nan if g.friction is None else g.friction for g in grasps])
     if any(g.center_of_mass is not None for g in grasps):
         center = np.stack([nan if g.center_of_mass is None else g.center_of_mass for g in grasps])
-    distance, angle = surface_columns(grasps)
     said = [g.warnings for g in grasps] if any(g.warnings for g in grasps) else None
     return replace(
         block,
         contact_names=[g.contact_names for g in grasps],
         friction=friction,
         center_of_mass=center,
-        surface_distance=distance,
-        normal_angle=angle,
+        surface_distance=surface_distances(grasps),
         grasp_warnings=said,
     )
 
 
-def surface_columns(grasps) -> tuple:
-    """``(surface_distance, normal_angle)`` of rows of ``grasps``, each ``(n, 3)`` with NaN rows for
-    grasps without an object, or ``(None, None)`` when none has one: each contact's distance from the
-    surface as read, and the angle in degrees between its normal and the surface's there
-    (:func:`~grasptwist.engine.judgements.normal_angles`; 0 where the surface gave it)."""
+def surface_distances(grasps) -> np.ndarray | None:
+    """``(n, 3)`` each contact's distance from its grasp's object as read (``Grasp.surface_distance``),
+    NaN rows for grasps without one; None when none has one."""
     if all(g.object is None for g in grasps):
-        return None, None
-    # the objects' geometry loads with the first grasp that has one
-    from ..engine.judgements import normal_angles
-    from ..engine.objects import project_to_surface
-
-    distance, angle = np.full((2, len(grasps), 3), np.nan)
-    known = {}  # a grasp's rows (one per twist) share its judgement
-    for k, g in enumerate(grasps):
-        if g.object is None:
-            continue
-        if id(g) not in known:
-            known[id(g)] = normal_angles(g.normals, project_to_surface(g.object, g.points).normals)
-        distance[k], angle[k] = g.surface_distance, known[id(g)]
-    return distance, angle
-
-
-def disagreeing(angle, n) -> np.ndarray:
-    """``(n, 3)``: the angles (None: no row has an object) beyond
-    :data:`~grasptwist.objects.NORMAL_DISAGREE_DEG`."""
-    if angle is None:
-        return np.zeros((n, 3), bool)
-    from ..engine.objects import NORMAL_DISAGREE_DEG
-
-    with np.errstate(invalid="ignore"):
-        return angle > NORMAL_DISAGREE_DEG
+        return None
+    return np.stack([np.full(3, np.nan) if g.surface_distance is None else g.surface_distance for g in grasps])
 
 
 def _hand_inputs(grasps) -> dict:

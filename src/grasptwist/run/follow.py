@@ -39,7 +39,7 @@ from ..output.formats import FORMATS
 from ..output.records import diagnostics, error_record
 from ..results import BY_KEY, selected
 from .batch import Block, hand_placement, with_reasons
-from .collisions import PathCollisions
+from .collisions import CODE, PathCollisions
 from .options import FollowOptions
 from .outputs import Output
 from .placement import read
@@ -104,7 +104,9 @@ class Summary:
     cannot_hold: tuple[HoldStretch, ...] | None = None  # where no grip holds its weight, with mass and friction
     unjudged: tuple[Unjudged, ...] | None = None  # where the grip fails otherwise: held or not is unknown there
     tip_error: np.ndarray | None = None  # (3,) with a hand: each finger's largest tip error at the samples
-    warnings: tuple[str, ...] = ()  # rotation vectors over pi (the path as given); links through the object
+    # the grasp's as read (its object's pose, its normals); rotation vectors over pi (the path as given);
+    # links through the object
+    warnings: tuple[str, ...] = ()
 
 
 def sample_times(duration: float, samples: int | None = None, dt: float | None = None) -> np.ndarray:
@@ -214,7 +216,10 @@ def _path(job, grasp, p):
         yield Samples(p.name, block, f.poses, q, grip)
     found = degeneracies(grasp.points, grasp.normals, grasp.wrist, p.segments, times)
     stretches, unjudged = (None, None) if weight is None else hold_verdicts(*weight, times)
-    said = _radians(p) + collided.warnings(len(times))
+    # the grasp's own warnings as read (its object's pose, its normals), not its collisions at rest:
+    # the samples' own (t = 0 among them) say those
+    read_warnings = tuple(w for w in grasp.warnings if not w.startswith(f"{CODE}:"))
+    said = read_warnings + _radians(p) + collided.warnings(len(times))
     yield Summary(grasp.file, grasp, p.name, len(times), found, labels, tracked, stretches, unjudged, largest, said)
 
 

@@ -22,7 +22,7 @@ from ..engine.forces.grip import grip
 from ..engine.judgements import outward_contacts
 from ..engine.screws import direction
 from ..model import Grasp, GraspFileError
-from .batch import disagreeing, surface_columns
+from .batch import surface_distances
 from .options import ForceOptions
 
 __all__ = [
@@ -171,8 +171,7 @@ class ForceBlock:
     friction: np.ndarray  # (n, 3), NaN rows where there is none
     result: ForceResult
     center_of_mass: np.ndarray | None = None  # (n, 3), NaN rows where none; None: no row has one
-    surface_distance: np.ndarray | None = None  # (n, 3), as resolve's Block (run/batch.py's surface_columns)
-    normal_angle: np.ndarray | None = None
+    surface_distance: np.ndarray | None = None  # (n, 3), as resolve's Block (run/batch.py's surface_distances)
     grasp_warnings: list | None = None  # per row its grasp's warnings (Grasp.warnings), as resolve's Block
 
     def __len__(self) -> int:
@@ -202,10 +201,6 @@ class ForceBlock:
         """Per row and contact ``(n, 3)``: does its normal point out of the object
         (:func:`~grasptwist.engine.judgements.outward_contacts`, as for resolve's blocks)?"""
         return outward_contacts(self.points, self.normals, self.center_of_mass)
-
-    def disagrees(self) -> np.ndarray:
-        """Per row and contact ``(n, 3)``: a given normal far from the surface's (as resolve's blocks)."""
-        return disagreeing(self.normal_angle, len(self))
 
     def failed_rows(self) -> np.ndarray:
         """Rows whose manipulating forces or grip failed."""
@@ -278,9 +273,8 @@ def _stack(rows, options) -> ForceBlock:
         units=[g.units for g in grasps],
         contact_names=[g.contact_names for g in grasps],
     )
-    distance, angle = surface_columns(grasps)
     said = [g.warnings for g in grasps] if any(g.warnings for g in grasps) else None
-    return replace(block, surface_distance=distance, normal_angle=angle, grasp_warnings=said)
+    return replace(block, surface_distance=surface_distances(grasps), grasp_warnings=said)
 
 
 def force_dataset_blocks(

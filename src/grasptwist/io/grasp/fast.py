@@ -133,7 +133,7 @@ def _sections(composed, parts, found):
             read = section.read(composed, found, problems) or {}
             found.update(read)
             fields.update(read)
-    if problems.count:
+    if problems.count or fields.get("warnings"):  # a warning names a contact's place: the general path has it
         raise Bail
     return fields
 

@@ -18,7 +18,9 @@ there.  A contact that gives its normal stays as written (the user's point
 and direction), checked against the surface.  A point farther from the surface than the tolerance
 (``Reading.surface_tol`` times the object's size; ``--surface-tol``) is
 ``contact-off-surface``; a given normal pointing out of the object is
-``outward-normal``.  The geometry is :mod:`grasptwist.engine.objects`'; a
+``outward-normal``.  Two warnings are found here too, where their places are known, and
+carried in ``Grasp.warnings``: a given normal far from the surface's (``normal-disagrees``)
+and a pose's rotation vector over pi (``rotation-over-pi``, as a path's).  The geometry is :mod:`grasptwist.engine.objects`'; a
 mesh is read by :mod:`grasptwist.io.mesh_file`.
 """
 
@@ -42,9 +44,10 @@ OBJECT_KEYS = (*SHAPE_KEYS, "scale", "pose", "density", "mass")
 SIZE_KEYS = ("radius", "height")
 
 
-def read_object(node, file, reading, max_bytes, problems):
+def read_object(node, file, reading, max_bytes, problems, warnings):
     """The :class:`~grasptwist.model.GraspObject` of an ``object`` node (None after a problem);
-    a mesh is read from ``file``'s folder within ``max_bytes`` and ``reading``'s limits."""
+    a mesh is read from ``file``'s folder within ``max_bytes`` and ``reading``'s limits.  A pose's
+    rotation vector over pi adds its ``rotation-over-pi`` warning to ``warnings``, as a path's."""
     fields = read_mapping(node, "object", OBJECT_KEYS, (), problems)
     if fields is None:
         return None
@@ -79,6 +82,7 @@ def read_object(node, file, reading, max_bytes, problems):
         read = read_pose(fields["pose"], "object.pose", problems)
         if read is not None:
             pose[:3, 3], pose[:3, :3] = read[0], read[1]
+            warnings += _radians(read[2])
     shape = _shape(shapes[0], fields, file, reading, max_bytes, problems) if shapes else None
     if shape is None or problems.count:
         return None
@@ -108,6 +112,16 @@ def read_object(node, file, reading, max_bytes, problems):
         )
         return None
     return GraspObject(shape, pose, mass=weighed, density=density, line=node.line)
+
+
+def _radians(given) -> list:
+    """The warning of a pose's rotation vector over pi (``given``: :func:`~.paths.read_pose`'s), if it is."""
+    if "rotvec" not in given:
+        return []
+    from ...engine.degeneracy import radians_warning
+    from ...engine.judgements import rotation_over_pi
+
+    return [radians_warning(**given)] if rotation_over_pi(given["rotvec"]) else []
 
 
 def _shape(kind, fields, file, reading, max_bytes, problems):
@@ -194,7 +208,7 @@ def _positive(node, path, problems):
 
 
 def on_surface(obj, points, normals, tolerance):
-    """The contacts put on ``obj``'s surface: ``(points, normals, distance, problems)``.
+    """The contacts put on ``obj``'s surface: ``(points, normals, distance, problems, disagree)``.
 
     Parameters
     ----------
@@ -217,8 +231,12 @@ def on_surface(obj, points, normals, tolerance):
     problems : list of (code, contact, message)
         ``contact-off-surface`` (farther than the tolerance) and ``outward-normal`` (a given
         normal pointing out of the object), per contact.
+    disagree : list of (contact, angle)
+        The given normals more than :data:`~grasptwist.objects.NORMAL_DISAGREE_DEG` from the
+        surface's (``normal-disagrees``), with their angles in degrees.
     """
-    from ...engine.objects import object_size, project_to_surface
+    from ...engine.judgements import normal_angles
+    from ...engine.objects import NORMAL_DISAGREE_DEG, object_size, project_to_surface
 
     surface = project_to_surface(obj, points)
     limit = tolerance * object_size(obj)
@@ -236,35 +254,50 @@ def on_surface(obj, points, normals, tolerance):
             )
         elif given[i] and np.dot(normals[i], surface.normals[i]) < 0:
             problems.append(("outward-normal", i, "the normal points out of the object (normals point into it)"))
+    angles = normal_angles(np.where(given[:, None], normals, surface.normals), surface.normals)
+    disagree = [(i, float(angles[i])) for i in range(len(points)) if angles[i] > NORMAL_DISAGREE_DEG]
     points = np.where(given[:, None], points, surface.points)
-    return points, np.where(given[:, None], normals, surface.normals), surface.distance, problems
+    return points, np.where(given[:, None], normals, surface.normals), surface.distance, problems, disagree
 
 
 def _read(fields, found, problems):
     if "object" not in fields:
         return {}
-    obj = read_object(fields["object"], found["file"], found["reading"], found["max_bytes"], problems)
+    said = []
+    obj = read_object(fields["object"], found["file"], found["reading"], found["max_bytes"], problems, said)
     points = found.get("points")
     if obj is None or points is None:
         return None
-    from ...engine.objects import SURFACE_TOL
+    from ...engine.degeneracy import normal_disagrees_warning
+    from ...engine.objects import NORMAL_DISAGREE_DEG, SURFACE_TOL
 
     tolerance = SURFACE_TOL if found["reading"].surface_tol is None else found["reading"].surface_tol
-    points, normals, distance, off = on_surface(obj, points, found["normals"], tolerance)
-    contacts = fields.get("contacts")
+    points, normals, distance, off, disagree = on_surface(obj, points, found["normals"], tolerance)
     for code, i, message in off:
-        item = contacts.value[i] if contacts is not None and contacts.kind == "sequence" else fields["object"]
         key = "normal" if code == "outward-normal" else "point"
-        where = item.value.get(key, (None, item))[1] if item.kind == "mapping" else item
-        problems.add(Reject(code, f"contacts[{i}].{key}", message, **located(where)))
+        problems.add(Reject(code, f"contacts[{i}].{key}", message, **located(_contact_node(fields, i, key))))
     if off:
         return None
+    for i, angle in disagree:
+        where = located(_contact_node(fields, i, "normal"))
+        said.append(normal_disagrees_warning(i, angle, where["line"], where["column"], NORMAL_DISAGREE_DEG))
     return {
         "object": obj,
         "points": readonly(points),
         "normals": readonly(normals),
         "surface_distance": readonly(distance),
+        "warnings": tuple(said),
     }
+
+
+def _contact_node(fields, i, key):
+    """Where contact ``i``'s ``key`` is written: its node, else the contact's, else the object's
+    (the fast reader composes no contacts: it reads again when a contact must be located)."""
+    contacts = fields.get("contacts")
+    if contacts is None or contacts.kind != "sequence":
+        return fields["object"]
+    item = contacts.value[i]
+    return item.value.get(key, (None, item))[1] if item.kind == "mapping" else item
 
 
 SECTION = Section(("object",), _read)
