@@ -21,6 +21,11 @@ if os.environ.get("PYTHONDONTWRITEBYTECODE") and not os.environ.get("PYTHONPYCAC
 # path (tests/engine/test_forces.py, `compiled`) are `slow` and switch it on themselves.
 os.environ.setdefault("GRASPTWIST_NUMBA", "0")
 
+# One OpenBLAS thread in every test and subprocess, set before numpy loads: the grip's matrices are
+# 6 by 6 or so, and OpenBLAS starting (and spinning) a thread per core cost each `grasptwist`
+# process the tests start 0.1 s of CPU more than its whole import (docs/reference/development.md, Test time).
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
 import pytest  # noqa: E402
 
 from grasptwist.io.grasp import Reading  # noqa: E402
