@@ -55,7 +55,8 @@ def test_each_python_block_runs(block, tmp_path, monkeypatch):
     exec(compile(block.text, block.where, "exec"), {"__name__": "__docs__"})
 
 
-@pytest.mark.parametrize("page", [p for p in pages() if any(b.lang == "pycon" for b in blocks(p))], ids=name)
+# the pages in page order, from the blocks already read (reading the pages again cost each test worker 0.1 s)
+@pytest.mark.parametrize("page", list(dict.fromkeys(b.page for b in BLOCKS if b.lang == "pycon")), ids=name)
 def test_the_python_sessions_print_what_the_page_shows(page, tmp_path, monkeypatch):
     monkeypatch.chdir(scratch(tmp_path, page))
     runner = doctest.DocTestRunner(optionflags=doctest.ELLIPSIS)
