@@ -28,7 +28,6 @@ os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 
 import pytest  # noqa: E402
 
-from grasptwist.io.grasp import Reading  # noqa: E402
 from loaders import LOADERS  # noqa: E402
 
 # a script run in processes of its own (see its docstring), not a module for --doctest-modules to import
@@ -38,4 +37,7 @@ collect_ignore = ["dask_checks.py"]
 @pytest.fixture(params=LOADERS, ids=lambda loader: loader.__name__)
 def loader(request):
     """Run the test once with each available YAML parser: the ``reading=`` to pass."""
+    # imported here: xdist's controlling process loads this file too, and runs no test
+    from grasptwist.io.grasp import Reading
+
     return Reading(parser=request.param)
