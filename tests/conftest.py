@@ -21,9 +21,13 @@ if os.environ.get("PYTHONDONTWRITEBYTECODE") and not os.environ.get("PYTHONPYCAC
 # path (tests/engine/test_forces.py, `compiled`) are `slow` and switch it on themselves.
 os.environ.setdefault("GRASPTWIST_NUMBA", "0")
 
+# One OpenBLAS thread in every test and subprocess, set before numpy loads: the grip's matrices are
+# 6 by 6 or so, and OpenBLAS starting (and spinning) a thread per core cost each `grasptwist`
+# process the tests start 0.1 s of CPU more than its whole import (docs/reference/development.md, Test time).
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
 import pytest  # noqa: E402
 
-from grasptwist.io.grasp import Reading  # noqa: E402
 from loaders import LOADERS  # noqa: E402
 
 # a script run in processes of its own (see its docstring), not a module for --doctest-modules to import
@@ -33,4 +37,7 @@ collect_ignore = ["dask_checks.py"]
 @pytest.fixture(params=LOADERS, ids=lambda loader: loader.__name__)
 def loader(request):
     """Run the test once with each available YAML parser: the ``reading=`` to pass."""
+    # imported here: xdist's controlling process loads this file too, and runs no test
+    from grasptwist.io.grasp import Reading
+
     return Reading(parser=request.param)

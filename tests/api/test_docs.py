@@ -11,9 +11,10 @@ from pathlib import Path
 
 import pytest
 from markdown_it import MarkdownIt
+from typer.testing import CliRunner
 
 from docs_blocks import ROOT, all_blocks, blocks, commands, mismatch, name, pages, run, scratch
-from hostile import run_installed
+from grasptwist.cli import app
 
 BLOCKS = all_blocks()
 
@@ -55,7 +56,8 @@ def test_each_python_block_runs(block, tmp_path, monkeypatch):
     exec(compile(block.text, block.where, "exec"), {"__name__": "__docs__"})
 
 
-@pytest.mark.parametrize("page", [p for p in pages() if any(b.lang == "pycon" for b in blocks(p))], ids=name)
+# the pages in page order, from the blocks already read (reading the pages again cost each test worker 0.1 s)
+@pytest.mark.parametrize("page", list(dict.fromkeys(b.page for b in BLOCKS if b.lang == "pycon")), ids=name)
 def test_the_python_sessions_print_what_the_page_shows(page, tmp_path, monkeypatch):
     monkeypatch.chdir(scratch(tmp_path, page))
     runner = doctest.DocTestRunner(optionflags=doctest.ELLIPSIS)
@@ -126,13 +128,15 @@ def test_relative_links_lead_to_a_file_and_a_heading_that_are_there():
     assert broken == []
 
 
-def test_the_output_contract_example_is_a_record_of_a_bundled_grasp():
+def test_the_output_contract_example_is_a_record_of_a_bundled_grasp(monkeypatch):
     page = ROOT / "docs" / "reference" / "output-contract.md"
     (example,) = [b.text for b in blocks(page) if b.lang == "text" and b.text.startswith('{"file": "grasps/')]
     names = dict(re.findall(r'"(file|grasp|units)": "([^"]+)"', example))
     twist = re.search(r'"twist": \{"name": "([^"]+)"', example).group(1)
-    p, _ = run_installed("resolve", names["file"], "-f", "jsonl", cwd=ROOT)
-    recs = {r["twist"]["name"]: r for r in map(json.loads, p.stdout.splitlines())}
+    monkeypatch.chdir(ROOT)  # the example's file name is relative to the repository
+    done = CliRunner().invoke(app, ["resolve", names["file"], "-f", "jsonl"])
+    assert done.exit_code == 0, done.stderr
+    recs = {r["twist"]["name"]: r for r in map(json.loads, done.stdout.splitlines())}
     rec = recs[twist]
     assert (rec["file"], rec["grasp"], rec["units"]) == (names["file"], names["grasp"], names["units"])
     assert list(rec) == top_level_keys(example), example

@@ -6,6 +6,7 @@ fast or an optional dependency optional; it never hides a circle).
 """
 
 import ast
+import functools
 import json
 import os
 import subprocess
@@ -55,7 +56,11 @@ def imports(name: str) -> set[str]:
     return {m for m in found if m in MODULES and m != name}
 
 
-GRAPH = {name: imports(name) for name in MODULES}
+@functools.cache
+def graph() -> dict[str, set[str]]:
+    """Each module's imports of the package's modules, parsed when a test first asks: at
+    collection, every test worker would pay its 0.4 s (docs/reference/development.md, Test time)."""
+    return {name: imports(name) for name in MODULES}
 
 
 def group(name: str) -> tuple[int, str]:
@@ -85,7 +90,7 @@ def test_the_walk_sees_deferred_and_relative_imports():
 def test_imports_go_down_the_layers(name):
     layer, own = group(name)
     upward = []
-    for target in sorted(GRAPH[name]):
+    for target in sorted(graph()[name]):
         their_layer, theirs = group(target)
         if theirs == own:
             continue
@@ -100,7 +105,7 @@ def test_no_import_circles():
 
     def visit(name, path):
         state[name] = 1
-        for target in sorted(GRAPH[name]):
+        for target in sorted(graph()[name]):
             if state.get(target) == 1:
                 circles.append(" -> ".join(path[path.index(target) :] + [target]))
             elif target not in state:
@@ -117,7 +122,9 @@ def test_the_loader_only_reads():
     # a hand is put on its contacts (inverse kinematics) by the run layer, not while parsing (issue 28)
     solving = {"grasptwist.engine.ik", "grasptwist.engine.tracking"}
     assert not {
-        name: GRAPH[name] & solving for name in GRAPH if name.startswith("grasptwist.io") and GRAPH[name] & solving
+        name: imported & solving
+        for name, imported in graph().items()
+        if name.startswith("grasptwist.io") and imported & solving
     }
 
 

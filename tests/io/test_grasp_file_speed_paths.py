@@ -410,7 +410,7 @@ def test_a_document_of_any_shape_reads_the_same_both_ways(doc, parser):
     both_paths(doc.encode("utf-8", "surrogatepass"), Reading(parser=parser))
 
 
-@settings(max_examples=50, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@_SETTINGS  # 25 streams in the default run: the many below are -m slow's
 @given(st.lists(documents(), min_size=1, max_size=3), st.sampled_from(LOADERS))
 def test_streams_of_documents_read_the_same_both_ways(docs, parser):
     both_paths("---\n".join(docs), Reading(parser=parser), file="dir/random.yaml")

@@ -462,14 +462,18 @@ def test_a_page_whose_checksum_fails_is_one_error_record(tmp_path, files):
 
 @pytest.mark.parametrize(
     ("columns", "said"),
+    # made in the test: an Arrow array loads pandas (0.4 s), which collecting the tests need not
     [
-        ({"p1_x": pa.array(2**53 + np.arange(50, dtype=np.int64))}, "column p1_x: an integer beyond 2^53 in rows 0-49"),
-        ({"c_z": pa.array(np.ones(50))}, None),  # the wrist's other columns missing: a known error
+        (
+            lambda: {"p1_x": pa.array(2**53 + np.arange(50, dtype=np.int64))},
+            "column p1_x: an integer beyond 2^53 in rows 0-49",
+        ),
+        (lambda: {"c_z": pa.array(np.ones(50))}, None),  # the wrist's other columns missing: a known error
     ],
     ids=["beyond-2^53", "missing"],
 )
 def test_values_a_float_cannot_hold_are_one_error_record(tmp_path, files, columns, said):
-    pq.write_table(small_table(**columns), tmp_path / "odd.parquet")
+    pq.write_table(small_table(**columns()), tmp_path / "odd.parquet")
     line = resolved_beside_a_good_file(tmp_path, tmp_path / "odd.parquet", files)
     assert line.startswith(said or "missing column(s) c_x, c_y (the wrist)")
 

@@ -561,13 +561,13 @@ def test_a_damaged_npz_member_is_a_read_error_where_it_is_found(tmp_path, rows):
     end = info.header_offset + info.compress_size  # the member's last bytes: its checksum fails at its end
     data[end - 100 : end - 50] = bytes(50)
     (tmp_path / "set.npz").write_bytes(data)
-    proc, _ = run_installed("resolve", tmp_path / "set.npz", POLY, *TWIST, "-f", "jsonl", "-j", "1")
-    assert_no_crash(proc.stderr)
-    assert proc.returncode == 1
-    [line] = [x for x in proc.stderr.splitlines() if "read-error" in x]
+    r = invoke("resolve", tmp_path / "set.npz", POLY, *TWIST, "-f", "jsonl", "-j", "1")
+    assert_no_crash(r.stderr)  # the commands' catch-all says so in process too
+    assert r.exit_code == 1
+    [line] = [x for x in r.stderr.splitlines() if "read-error" in x]
     assert line.startswith(f"{tmp_path / 'set.npz'}: error: read-error: points.npy: ")
     assert line.endswith("(damaged, or changed while being read)")
-    assert jsonl(proc.stdout)[-1]["file"] == str(POLY)  # the next input is still resolved
+    assert jsonl(r.stdout)[-1]["file"] == str(POLY)  # the next input is still resolved
 
 
 @pytest.mark.parametrize(
@@ -636,9 +636,9 @@ def test_bytes_names_in_an_npz_are_decoded_and_the_other_inputs_kept(tmp_path):
     path = tmp_path / "names.npz"
     arrays = np.random.default_rng(7).normal(size=(2, 3, 3, 3))
     np.savez(path, points=arrays[0], normals=arrays[1], names=np.array([b"ok", b"\xff", b"caf\xc3\xa9"]))
-    proc, _ = run_installed("resolve", path, POLY, *TWIST, "-f", "jsonl")
-    assert_no_crash(proc.stderr)
-    assert [r["grasp"] for r in jsonl(proc.stdout)] == ["ok", "\\xff", "caf\u00e9", "polyhedron"]
+    r = invoke("resolve", path, POLY, *TWIST, "-f", "jsonl")
+    assert_no_crash(r.stderr)
+    assert [rec["grasp"] for rec in jsonl(r.stdout)] == ["ok", "\\xff", "caf\u00e9", "polyhedron"]
 
 
 # --------------------------------------------------------------------------
