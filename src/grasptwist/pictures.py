@@ -3,7 +3,8 @@
 A scene (:func:`scene` from arrays, :func:`grasp_scene` from a loaded grasp) is
 what gets drawn, in numbers: markers, line pieces (screw axes), arrows (twists,
 velocities, forces), patches (tangent planes, cones), the object's mesh and the
-fingertip spheres, framed on the contacts, object and fingertips (:func:`framed`).  :func:`render` draws
+fingertip spheres, framed on the contacts, object and fingertips (:func:`framed`);
+:func:`grasps_scene` draws several grasps of one object together.  :func:`render` draws
 it with matplotlib (the extra ``grasptwist[plot]``); :func:`twist_figure` and
 :func:`grasp_page` make plotly.js figures as plain dicts, :func:`write_page`
 writes them as one HTML page (the extra ``grasptwist[html]``).
@@ -21,10 +22,11 @@ off-tangent: x = (0, 0, 0)   y = (-0.471, -0.471, -0.471)
 The code is in ``grasptwist.plot`` (internal).
 """
 
-from .plot.figures import twist_figure
+from .plot.figures import grasps_figure, twist_figure
 from .plot.html import MissingPlotly, grasp_page, read_figures, write_page
 from .plot.render import MissingMatplotlib, image_name, plot_grasp, render, render_grasps
 from .plot.scene import (
+    GRASP_COLOURS,
     KINDS,
     METHODS,
     REACH,
@@ -37,12 +39,14 @@ from .plot.scene import (
     Sphere,
     framed,
     grasp_scene,
+    grasps_scene,
     scene,
 )
 
 __all__ = [
     "scene",
     "grasp_scene",
+    "grasps_scene",
     "Scene",
     "Marker",
     "LinePiece",
@@ -54,11 +58,13 @@ __all__ = [
     "KINDS",
     "METHODS",
     "REACH",
+    "GRASP_COLOURS",
     "render",
     "plot_grasp",
     "render_grasps",
     "image_name",
     "twist_figure",
+    "grasps_figure",
     "grasp_page",
     "write_page",
     "read_figures",

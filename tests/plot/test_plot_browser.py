@@ -100,3 +100,27 @@ def test_the_object_is_drawn(tmp_path):
     # everything else hidden: the tan ball (red over blue, where the grey axes have neither) fills
     # some 38,000 pixels; an undrawn mesh none
     assert np.sum(rgb[..., 0] - rgb[..., 2] > 15) > 10000
+
+
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
+def test_several_grasps_of_one_object_are_drawn_each_in_its_colour(tmp_path):
+    from test_plot_several import found_text
+    from typer.testing import CliRunner
+
+    from grasptwist.cli import app
+    from grasptwist.plot.scene import GRASP_COLOURS
+
+    found = tmp_path / "found.yaml"
+    found.write_text(found_text())
+    out = tmp_path / "found.html"
+    r = CliRunner().invoke(app, ["plot", str(found), "-o", str(out), "--js-beside"])
+    assert r.exit_code == 0, r.output
+    # the object hidden, so that the contacts behind it keep their colours
+    hide = 'Plotly.restyle(figures[0], {visible: figures[0].data.map(t => t.name !== "object")})'
+    shot = capture(out, tmp_path / "found.png", size=(1000, 800), before=hide)
+    assert shot.errors == [] and len(shot.scenes) == 1
+    x, y, w, h = (int(round(v)) for v in shot.scenes[0])
+    rgb = np.asarray(Image.open(shot.png).convert("RGB"), dtype=int)[y : y + h, x : x + w]
+    for colour in GRASP_COLOURS[:3]:  # each grasp's dots, arrows and labels in its own colour
+        want = np.array([int(colour[i : i + 2], 16) for i in (1, 3, 5)])
+        assert np.sum(np.abs(rgb - want).max(axis=2) < 12) > 30, colour

@@ -1,6 +1,7 @@
 """Pictures of a grasp and a twist: the scene as data (:mod:`.scene`), drawn by matplotlib
 (:mod:`.render`) or as an interactive HTML page (:mod:`.html`, :mod:`.traces`, :mod:`.animation`)."""
 
+from .figures import grasps_figure
 from .html import HTML, MissingPlotly, grasp_page, html_loaded, read_figures, require_plotly, twist_figure, write_page
 from .render import (
     FORMATS,
@@ -27,6 +28,7 @@ from .scene import (
     check_method,
     default_method,
     grasp_scene,
+    grasps_scene,
     legend_text,
     scene,
 )
@@ -50,6 +52,8 @@ __all__ = [
     "default_method",
     "grasp_page",
     "grasp_scene",
+    "grasps_figure",
+    "grasps_scene",
     "html_loaded",
     "image_name",
     "image_paths",

@@ -8,13 +8,14 @@ import html
 
 import numpy as np
 
-from .scene import Scene, check_method, default_method, framed, grasp_scene
-from .traces import force_traces, mesh_trace, scene_traces, slot_name
+from .scene import Scene, check_method, default_method, framed, grasp_scene, grasps_scene
+from .traces import force_traces, group_traces, mesh_trace, scene_traces, slot_name
 
 __all__ = [
     "bounds",
     "framed_together",
     "grasp_scenes",
+    "grasps_figure",
     "methods_of",
     "scene_layout",
     "twist_figure",
@@ -118,6 +119,33 @@ def scene_layout(scene: Scene, units: str | None, cube=None) -> dict:
     return axes | {"aspectmode": "data" if cube is None else "cube", "camera": camera}
 
 
+def grasps_figure(grasps) -> dict:
+    """The figure of several grasps of one object (``grasps_scene``): the object, and each grasp's
+    contacts and normals as one legend entry in its colour (``GRASP_COLOURS``), on the picture's cube.
+
+    Returns
+    -------
+    dict
+        A plotly.js figure ``{"data", "layout"}``.
+    """
+    picture = grasps_scene(grasps)
+    units = grasps[0].units
+    cube = picture.bounds()
+    traces = scene_traces(picture, units, half=cube[1]) | group_traces(picture, units, cube[1])
+    layout = _layout(view_title([picture]), picture, units, cube)
+    return {"data": [t for group in traces.values() for t in group], "layout": layout}
+
+
+def _layout(title: str, scene: Scene, units: str | None, cube) -> dict:
+    """A figure's layout: its title, the 3D scene on ``cube`` (:func:`scene_layout`), its legend."""
+    return {
+        "title": {"text": title, "font": {"size": 13}, "x": 0.01, "xanchor": "left"},
+        "scene": scene_layout(scene, units, cube),
+        "legend": {"groupclick": "togglegroup", "itemsizing": "constant"},
+        "margin": {"l": 0, "r": 0, "t": 90, "b": 0},
+    }
+
+
 def twist_figure(grasp, twists=None, *, method: str | None = None, active: int = 0, meshes=(), forces=None) -> dict:
     """The figure of a grasp and its twists: a dropdown switches between twists.
 
@@ -164,13 +192,8 @@ def twist_figure(grasp, twists=None, *, method: str | None = None, active: int =
         data.append(mesh_trace(meshes, half))
         owner.append(None)
         shown.append(True)
-    layout = {
-        "title": {"text": titles[active], "font": {"size": 13}, "x": 0.01, "xanchor": "left"},
-        "scene": scene_layout(views[active][0], grasp.units, cube),
-        "legend": {"groupclick": "togglegroup", "itemsizing": "constant"},
-        "margin": {"l": 0, "r": 0, "t": 90, "b": 0},
-        "uirevision": "keep",  # switching twists keeps the camera
-    }
+    # switching twists keeps the camera
+    layout = _layout(titles[active], views[active][0], grasp.units, cube) | {"uirevision": "keep"}
     if len(items) > 1:
         buttons = []
         for k, t in enumerate(items):

@@ -22,7 +22,7 @@ from pathlib import Path
 import numpy as np
 
 from ..engine.screws import cross, norm, unit
-from .scene import Scene, check_method, grasp_scene, legend_text
+from .scene import GRASP_COLOURS, Scene, check_method, grasp_scene, legend_text
 
 __all__ = [
     "FORMATS",
@@ -330,7 +330,7 @@ def figure(scene: Scene, *, size=(1400, 700), dpi=100):
         ax.view_init(elev=elev, azim=azim)
         ax.set_title(view_name, fontsize=9)
     fig.suptitle(scene.title, fontsize=10)
-    handles = [_legend_handle(k, scene.method) for k in scene.kinds()]
+    handles = [_legend_handle(k, scene.method) for k in scene.kinds()] + _group_handles(scene)
     rows = -(-len(handles) // LEGEND_COLUMNS)  # as few rows as the columns allow, the columns then balanced
     fig.legend(handles=handles, loc="lower center", ncol=-(-len(handles) // rows), fontsize=8, frameon=False)
     fig.subplots_adjust(left=0.0, right=1.0, top=0.9, bottom=0.04 + 0.03 * rows, wspace=0.0)
@@ -363,13 +363,30 @@ def _draw(ax, scene: Scene, view, head: float):
     for a in scene.drawn_arrows():
         st = _STYLE[a.kind]
         for line in _arrow_lines(a.origin, a.scale * a.vector, view, head):
-            ax.plot(*line.T, color=st["color"], lw=st["lw"], solid_capstyle="round")
+            ax.plot(*line.T, color=_colour(a), lw=st["lw"], solid_capstyle="round")
         if a.kind == "beyond":  # what it points to, and how far
             ax.text(*a.origin, a.label + " ", color=st["color"], fontsize=8, ha="right")
     for m in scene.markers:
         st = _STYLE[m.kind]
-        ax.scatter(*m.position, color=st["color"], marker=st["marker"], s=st["s"], depthshade=False)
-        ax.text(*m.position, "  " + m.label, color=st["color"], fontsize=9, fontweight="bold")
+        ax.scatter(*m.position, color=_colour(m), marker=st["marker"], s=st["s"], depthshade=False)
+        ax.text(*m.position, "  " + m.label, color=_colour(m), fontsize=9, fontweight="bold")
+
+
+def _colour(element) -> str:
+    """A marker's or arrow's colour: its grasp's in a picture of several, else its kind's."""
+    if element.group is None:
+        return _STYLE[element.kind]["color"]
+    return GRASP_COLOURS[element.group % len(GRASP_COLOURS)]
+
+
+def _group_handles(scene: Scene) -> list:
+    """The legend's entry of each grasp of a picture of several: its contacts' dot and normals' line."""
+    from matplotlib.lines import Line2D
+
+    return [
+        Line2D([], [], color=GRASP_COLOURS[k % len(GRASP_COLOURS)], marker="o", lw=1.2, label=text)
+        for k, text in enumerate(scene.groups)
+    ]
 
 
 def _arrow_lines(origin, vector, view, head):

@@ -52,7 +52,9 @@ __all__ = [
     "fingertips",
     "force_parts",
     "framed",
+    "GRASP_COLOURS",
     "grasp_scene",
+    "grasps_scene",
     "joint_segments",
     "legend_text",
     "object_mesh",
@@ -89,11 +91,13 @@ _SAME_PLACE = 0.1  # points beyond the picture this close (of its half-width) sh
 
 @dataclass(frozen=True)
 class Marker:
-    """A labelled point, ``position (3,)``."""
+    """A labelled point, ``position (3,)``; ``group``: the index of its grasp in a picture of
+    several (:func:`grasps_scene`), else None."""
 
     position: np.ndarray
     label: str
     kind: str
+    group: int | None = None
 
 
 @dataclass(frozen=True)
@@ -123,6 +127,7 @@ class Arrow:
 
     For velocities ``vector`` is the true velocity and ``scale`` the scene's
     drawing length per unit velocity; for normals ``scale`` is their drawn length.
+    ``group``: the index of its grasp in a picture of several, else None.
     """
 
     origin: np.ndarray
@@ -130,6 +135,7 @@ class Arrow:
     label: str
     kind: str
     scale: float = 1.0
+    group: int | None = None
 
     @property
     def tip(self) -> np.ndarray:
@@ -194,7 +200,7 @@ class Scene:
         Grasp name, twist, method and amplitudes (or the status message), one
         item a line.
     method : str
-        ``"off-tangent"`` or ``"tangent"``.
+        ``"off-tangent"`` or ``"tangent"``; ``""`` for a picture of several grasps (no basis).
     status : int
         The engine's :class:`~grasptwist.engine.degeneracy.Status` for this grasp
         and method; when not 0 the scene has no basis axes or components.
@@ -207,6 +213,9 @@ class Scene:
         The object (a :class:`Mesh`, in the grasp's frame) and the fingertips (:class:`Sphere`).
     extent : ((3,) array, float) or None
         The cube the picture shows, centre and half-width (:func:`framed`); None: not framed.
+    groups : tuple of str
+        A picture of several grasps (:func:`grasps_scene`): each grasp's legend text; the
+        elements of grasp ``k`` have ``group`` ``k``.  Empty for one grasp.
     """
 
     title: str
@@ -220,6 +229,7 @@ class Scene:
     meshes: tuple[Mesh, ...] = ()
     spheres: tuple[Sphere, ...] = ()
     extent: tuple[np.ndarray, float] | None = None
+    groups: tuple[str, ...] = ()
 
     def elements(self) -> tuple:
         """Every element, in drawing order."""
@@ -235,10 +245,15 @@ class Scene:
         return [a for a in self.arrows if float(norm(a.scale * a.vector)) > tiny]
 
     def kinds(self) -> list[str]:
-        """The kinds drawn, in :data:`KINDS` order (the legend's order)."""
-        present = {e.kind for e in self.elements() if not isinstance(e, Arrow)}
-        present |= {a.kind for a in self.drawn_arrows()}
+        """The kinds drawn, in :data:`KINDS` order (the legend's order), but for those of a grasp
+        of a picture of several (the legend names the grasps instead: ``groups``)."""
+        drawn = [e for e in self.elements() if not isinstance(e, Arrow)] + self.drawn_arrows()
+        present = {e.kind for e in drawn if getattr(e, "group", None) is None}
         return [k for k in KINDS if k in present]
+
+    def of_group(self, group: int) -> list:
+        """Every element of the grasp ``group`` of a picture of several, in drawing order."""
+        return [e for e in self.elements() if getattr(e, "group", None) == group]
 
     def points(self) -> np.ndarray:
         """Every drawn point ``(n, 3)``: markers, ends of segments and arrows, corners of patches,
@@ -286,6 +301,10 @@ KINDS = {
 
 #: The force side's kinds (issue 19): drawn when the grasp has a friction.
 FORCE_KINDS = ("friction-cone", "grip-force")
+
+#: The colour of each grasp of a picture of several (:func:`grasps_scene`), by its index, in
+#: turn: matplotlib's tab10 without its grey, brown and the tan of the object, for both drawings.
+GRASP_COLOURS = ("#1f77b4", "#d62728", "#2ca02c", "#ff7f0e", "#9467bd", "#e377c2", "#17becf", "#bcbd22")
 
 
 def legend_text(kind: str, method: str) -> str:
@@ -776,6 +795,54 @@ def grasp_scene(
             picture, markers=picture.markers + bases, segments=picture.segments + joints + chains, spheres=tips
         )
     return picture if extent is False else framed(picture, extent=extent)
+
+
+def grasps_scene(grasps) -> Scene:
+    """One picture of several grasps of one object (the grasp file ``synthesize -o`` writes): the
+    first grasp's object once (the object engine's triangles, as :func:`grasp_scene` draws it) and
+    each grasp's contacts and surface normals.
+
+    Grasp ``k``'s elements have ``group`` ``k`` (drawn in ``GRASP_COLOURS[k]``), its contacts are
+    labelled ``k + 1`` and their name, and the legend names it (``groups``, ``"k + 1: name"``); no
+    basis, twist or forces, which a picture of one grasp shows.  Seen from the first grasp's views
+    (:func:`scene`'s) and framed on the contacts and the object (:func:`framed`).
+
+    >>> from types import SimpleNamespace as G
+    >>> ball = GraspObject(Shape("sphere", np.array([1.0])), np.eye(4))
+    >>> p = np.array([[1.0, 0, 0], [-0.5, 0.866, 0], [-0.5, -0.866, 0]])
+    >>> two = [G(name=n, contact_names=("a", "b", "c"), points=q, normals=-q, wrist=None, object=ball)
+    ...        for n, q in (("one", p), ("two", p[:, [0, 2, 1]]))]
+    >>> s = grasps_scene(two)
+    >>> len(s.meshes), [m.label for m in s.of_kind("contact")][3:], s.groups, s.title
+    (1, ['2 a', '2 b', '2 c'], ('1: one', '2: two'), '2 grasps of one sphere: one to two')
+    """
+    markers, arrows, groups = [], [], []
+    for k, grasp in enumerate(grasps):
+        points = np.asarray(grasp.points, dtype=float)
+        normals = unit(np.asarray(grasp.normals, dtype=float))
+        length = _NORMAL_LEN * _grasp_size(points)
+        rank = str(k + 1)
+        for i, name in enumerate(grasp.contact_names):
+            markers.append(Marker(points[i], f"{rank} {name}", "contact", k))
+            arrows.append(Arrow(points[i], normals[i], f"{rank} n{_sub(name)}", "normal", length, k))
+        groups.append(f"{rank}: {grasp.name}")
+    first, last = grasps[0], grasps[-1]
+    obj = getattr(first, "object", None)
+    picture = Scene(
+        title=f"{len(grasps)} grasps of one {obj.shape.kind if obj is not None else 'object'}: "
+        f"{first.name} to {last.name}",
+        method="",
+        status=int(Status.OK),
+        markers=tuple(markers),
+        arrows=tuple(arrows),
+        views=tuple(
+            (f"{name} of 1" if n else name, d)
+            for n, (name, d) in enumerate(_views(np.asarray(first.points, dtype=float), first.wrist))
+        ),
+        meshes=(object_mesh(obj),) if obj is not None else (),
+        groups=tuple(groups),
+    )
+    return framed(picture)
 
 
 def object_mesh(obj) -> Mesh:

@@ -13,9 +13,9 @@ from __future__ import annotations
 import numpy as np
 
 from ..engine.screws import norm
-from .scene import FORCE_KINDS, Scene, legend_text
+from .scene import FORCE_KINDS, GRASP_COLOURS, Arrow, Marker, Scene, legend_text
 
-__all__ = ["COMMON_KINDS", "MESH_NAME", "force_traces", "mesh_trace", "scene_traces", "slot_name"]
+__all__ = ["COMMON_KINDS", "MESH_NAME", "force_traces", "group_traces", "mesh_trace", "scene_traces", "slot_name"]
 
 #: The legend entry of a hand's link meshes.
 MESH_NAME = "hand (URDF visual meshes)"
@@ -153,6 +153,25 @@ def force_traces(scene: Scene, units: str | None) -> dict[str, list[dict]]:
     return out
 
 
+def group_traces(scene: Scene, units: str | None, half: float) -> dict[str, list[dict]]:
+    """Each grasp of a picture of several (``scene.groups``) as one legend entry in its colour
+    (``GRASP_COLOURS``): its contacts, labelled, and its surface normals, drawn as
+    :func:`scene_traces` draws the contacts and normals of one grasp."""
+    out = {}
+    for k, name in enumerate(scene.groups):
+        colour = GRASP_COLOURS[k % len(GRASP_COLOURS)]
+        elements = scene.of_group(k)
+        markers = [e for e in elements if isinstance(e, Marker)]
+        arrows = [e for e in elements if isinstance(e, Arrow) and _shown(e, half)]
+        traces = [_markers(markers, "contact", name, units, colour)]
+        traces += _arrows(arrows, "normal", name, units, half, colour)
+        traces[0]["showlegend"] = True
+        for t in traces:
+            t["legendgroup"] = name
+        out[name] = traces
+    return out
+
+
 def mesh_trace(meshes, half, name=MESH_NAME, color="#b0b0b0", opacity=0.5) -> dict:
     """Triangle meshes ``[(vertices (n, 3), faces (m, 3))]`` as one ``mesh3d`` trace, shaded:
     by default a hand's link meshes; a scene's object and fingertips are named by their kind.
@@ -184,8 +203,8 @@ def _base(kind, name, mode) -> dict:
     return {"type": "scatter3d", "mode": mode, "name": name, "hoverinfo": "text", "showlegend": False}
 
 
-def _markers(markers, kind, name, units) -> dict:
-    colour = _STYLE[kind][0]
+def _markers(markers, kind, name, units, colour=None) -> dict:
+    colour = colour or _STYLE[kind][0]
     trace = _base(kind, name, "markers+text")
     trace.update(_xyz([m.position for m in markers]))
     trace["text"] = [m.label for m in markers]
@@ -217,11 +236,13 @@ def _segments(segments, kind, name, units, method) -> dict:
     return trace
 
 
-def _arrows(arrows, kind, name, units, half) -> list[dict]:
-    """Shafts as one line trace, heads as one cone trace (both in the legend group)."""
+def _arrows(arrows, kind, name, units, half, colour=None) -> list[dict]:
+    """Shafts as one line trace, heads as one cone trace (both in the legend group); ``colour``
+    instead of the kind's."""
     if not arrows:
         return []
-    colour, width, _ = _STYLE[kind]
+    own, width, _ = _STYLE[kind]
+    colour = colour or own
     points, hover = [], []
     for a in arrows:
         what = "direction" if kind == "normal" else "vector"

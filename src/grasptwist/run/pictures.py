@@ -9,8 +9,11 @@ come back as :class:`~grasptwist.plot.Note` lines, in order.
 
 from __future__ import annotations
 
+import os
 from collections.abc import Iterator
 from dataclasses import replace
+
+import numpy as np
 
 from .. import plot as pictures
 from ..engine.forces.grip import grip
@@ -23,7 +26,7 @@ from .follow import Samples, Summary, follow_grasp
 from .options import FollowOptions
 from .placement import read
 
-__all__ = ["draw", "read_grasps", "page_extras", "grip_forces"]
+__all__ = ["draw", "drawn_together", "read_grasps", "page_extras", "grip_forces", "same_object"]
 
 
 def read_grasps(inputs, twists, max_bytes: int | None, reading: Reading = READING) -> Iterator[Grasp | pictures.Note]:
@@ -74,16 +77,50 @@ def grip_forces(grasp):
     return g.force if bool(g.ok) else None
 
 
+def same_object(a, b) -> bool:
+    """Whether two objects are one: the same shape (kind, sizes, a mesh's vertices and faces)
+    at the same pose, number for number (as the documents ``synthesize -o`` writes hold it)."""
+    x, y = a.shape, b.shape
+    pairs = ((x.size, y.size), (x.vertices, y.vertices), (x.faces, y.faces), (a.pose, b.pose))
+    return x.kind == y.kind and all(
+        (u is None) == (v is None) and (u is None or np.array_equal(u, v)) for u, v in pairs
+    )
+
+
+def drawn_together(path, grasps, asked: bool) -> bool:
+    """Whether the grasps read from ``path`` make one picture (:func:`grasptwist.plot.grasps_scene`):
+    a file (not a folder) of several grasps of one object (:func:`same_object`), as ``synthesize -o``
+    writes them, none with a twist or a path to draw, and none asked for (``asked``: a twist, a
+    method or a path on the command line).  Otherwise each grasp is a picture of its own, of a
+    file its first."""
+    if asked or os.path.isdir(path) or len(grasps) < 2 or grasps[0].object is None:
+        return False
+    first = grasps[0].object
+    return all(not g.twists and not g.paths and g.object is not None and same_object(g.object, first) for g in grasps)
+
+
 def draw(path, output, grasps, twist_name, method, html: bool, views, opener) -> Iterator[pictures.Note | str]:
     """Draw ``grasps`` (of ``path``) into ``output`` (``html``: interactive pages, with ``views``'
     ``js_beside`` and ``path_name``), each file written by ``opener``: the notes of what could not
-    be drawn, and the name of each picture written, in order, as they are drawn.
+    be drawn, and the name of each picture written, in order, as they are drawn.  Several grasps
+    of one object (:func:`drawn_together`) make one picture of them all.
 
     Raises
     ------
     TwistNotFound, ValueError
         ``twist_name`` is not a twist of the file; an unknown method or suffix.
     """
+    asked = twist_name is not None or method is not None or views["path_name"] is not None
+    if drawn_together(path, grasps, asked):
+        if html:
+            figure = pictures.grasps_figure(grasps)
+            heading = f"{grasps[0].name} to {grasps[-1].name}"
+            yield pictures.write_page(
+                output, [(heading, figure)], title=f"grasptwist: {heading}", js_beside=views["js_beside"], opener=opener
+            )
+        else:
+            yield pictures.render(pictures.grasps_scene(grasps), output, opener=opener)
+        return
     if html:
         yield from pictures.html_loaded(
             path,
