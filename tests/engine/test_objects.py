@@ -13,6 +13,7 @@ from grasptwist.engine.objects import (
     check_object,
     check_pose,
     check_shape,
+    check_size,
     mass_properties,
     moved,
     object_size,
@@ -293,6 +294,37 @@ def test_the_sphere_tessellation_has_the_promised_rings():
 def test_check_shape_refuses(shape, match):
     with pytest.raises(ValueError, match=match):
         check_shape(shape)
+
+
+def test_a_scalar_radius_is_a_sphere_everywhere():
+    """A sphere's one size as a number alone, in a Shape built by hand and never checked."""
+    ball = GraspObject(Shape("sphere", 0.035), np.eye(4), mass=1.0)  # 0.5.0: TypeError in mass_properties
+    assert check_size("sphere", 0.035).tolist() == check_shape(ball.shape).size.tolist() == [0.035]
+    assert mass_properties(ball).volume == pytest.approx(4 / 3 * math.pi * 0.035**3, rel=1e-12)
+    assert float(project_to_surface(ball, [0.0, 0.0, 0.05]).distance) == pytest.approx(0.015, rel=1e-12)
+    assert tessellate(ball, segments=8)[0].shape == (26, 3) and object_size(ball) == pytest.approx(0.07 * math.sqrt(3))
+
+
+@pytest.mark.parametrize(
+    "use", [mass_properties, object_size, tessellate, lambda o: project_to_surface(o, [0.0, 0.0, 1.0])]
+)
+@pytest.mark.parametrize(
+    "shape, match",
+    [
+        (Shape("cylinder", 0.035), r"^cylinder size must hold 2 number\(s\) \(radius, height\), got 1$"),
+        (Shape("box", [0.1, 0.1]), r"^box size must hold 3 number\(s\) \(a, b, c\), got 2$"),
+        (Shape("sphere", "big"), "^sphere size must hold real numbers$"),
+        (Shape("sphere", -1.0), r"^sphere radius must be a finite number > 0, got -1.0$"),
+    ],
+)
+def test_a_hand_built_shape_with_a_wrong_size_is_one_line_naming_the_field(use, shape, match):
+    with pytest.raises(ValueError, match=match):
+        use(GraspObject(shape, np.eye(4)))
+
+
+def test_sample_surface_checks_the_size_too():
+    with pytest.raises(ValueError, match=r"^capsule size must hold 2 number\(s\)"):
+        sample_surface(GraspObject(Shape("capsule", 0.01), np.eye(4)), 3, np.random.default_rng(0))
 
 
 def test_check_shape_returns_read_only_floats():

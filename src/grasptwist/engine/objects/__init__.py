@@ -5,13 +5,13 @@
   ``moved``), re-exported here;
 - ``primitives``: box, sphere, cylinder and capsule in their own frame, exactly (numpy only);
 - ``mesh``: a closed triangle mesh in its own frame (nearest points through libigl, the ``mesh`` extra);
-- ``checks``: the validators ``check_shape``, ``check_pose``, ``check_object``;
+- ``checks``: the validators ``check_shape``, ``check_size``, ``check_pose``, ``check_object``;
 - ``tolerances``: ``SURFACE_TOL``, ``NORMAL_DISAGREE_DEG``, ``EDGE_TOL``, ``MESH_EDGE_TOL``.
 
 Conventions: normals point into the object, distances are > 0 outside (docs/guide/objects.md).
 """
 
-from .checks import KINDS, check_object, check_pose, check_shape
+from .checks import KINDS, check_object, check_pose, check_shape, check_size
 from .geometry import (
     MassProperties,
     SurfacePoints,
@@ -35,6 +35,7 @@ __all__ = [
     "object_size",
     "moved",
     "check_shape",
+    "check_size",
     "check_pose",
     "check_object",
     "SURFACE_TOL",

@@ -16,7 +16,7 @@ import numpy as np
 from ...model import GraspObject, Shape
 from .primitives import PRIMITIVES
 
-__all__ = ["KINDS", "RIGID_TOL", "check_shape", "check_pose", "check_object"]
+__all__ = ["KINDS", "RIGID_TOL", "check_shape", "check_size", "check_pose", "check_object"]
 
 #: The shapes an object may have.
 KINDS = (*PRIMITIVES, "mesh")
@@ -64,17 +64,34 @@ def check_shape(shape: Shape) -> Shape:
         raise ValueError(f"shape must be a Shape, got {type(shape).__name__}")
     if shape.kind not in KINDS:
         raise ValueError(f"shape kind must be one of {', '.join(KINDS)}, got {shape.kind!r}")
-    size = _real(shape.size, f"{shape.kind} size").reshape(-1) if shape.kind != "mesh" else np.zeros(0)
     if shape.kind == "mesh":
         vertices, faces = _check_mesh(shape.vertices, shape.faces)
-        return replace(shape, size=_frozen(size), vertices=vertices, faces=faces)
-    names = _SIZE_NAMES[shape.kind]
+        return replace(shape, size=_frozen(np.zeros(0)), vertices=vertices, faces=faces)
+    return replace(shape, size=check_size(shape.kind, shape.size))
+
+
+def check_size(kind: str, size) -> np.ndarray:
+    """A primitive's sizes as a read-only float ``(n,)`` array, else ValueError naming the field.
+
+    A box has 3 (``a, b, c``), a sphere 1 (``radius``: a number alone will do), a cylinder and a
+    capsule 2 (``radius, height``), each finite and > 0.  Cheap (a few microseconds): the
+    geometry functions call it where they read a primitive's sizes, so that a ``Shape`` built by
+    hand is refused in one line rather than deep inside them.
+
+    >>> check_size("sphere", 0.035).tolist()
+    [0.035]
+    >>> check_size("box", 0.035)
+    Traceback (most recent call last):
+    ValueError: box size must hold 3 number(s) (a, b, c), got 1
+    """
+    names = _SIZE_NAMES[kind]
+    size = _real(size, f"{kind} size").reshape(-1)
     if size.shape != (len(names),):
-        raise ValueError(f"{shape.kind} size must hold {len(names)} number(s) ({', '.join(names)}), got {size.size}")
+        raise ValueError(f"{kind} size must hold {len(names)} number(s) ({', '.join(names)}), got {size.size}")
     for name, value in zip(names, size.tolist()):
         if not (math.isfinite(value) and value > 0):
-            raise ValueError(f"{shape.kind} {name} must be a finite number > 0, got {value!r}")
-    return replace(shape, size=_frozen(size))
+            raise ValueError(f"{kind} {name} must be a finite number > 0, got {value!r}")
+    return _frozen(size)
 
 
 def _check_mesh(vertices, faces):

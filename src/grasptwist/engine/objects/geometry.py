@@ -1,7 +1,8 @@
 r"""An object's geometry in the grasp frame: nearest surface points, mass properties, samples, triangles.
 
 Each function takes a :class:`~grasptwist.model.GraspObject` checked by
-:func:`~grasptwist.objects.check_object` and works in the grasp frame: points go into
+:func:`~grasptwist.objects.check_object` (a primitive's sizes it checks itself, cheaply:
+``check_size``, so that a ``Shape("sphere", 0.035)`` built by hand works) and works in the grasp frame: points go into
 the object's frame through its pose :math:`T = (R, t)`, :math:`q = R^T (p - t)`,
 are answered there by ``primitives`` (exact) or ``mesh``, and come
 back as :math:`R c + t` (points) and :math:`R n` (normals).  Normals point
@@ -29,7 +30,7 @@ import numpy as np
 from ...model import GraspObject
 from ..se3 import rotate
 from . import mesh, primitives
-from .checks import check_pose
+from .checks import check_pose, check_size
 from .tolerances import EDGE_TOL
 
 __all__ = [
@@ -93,7 +94,7 @@ def object_size(obj: GraspObject) -> float:
     shape = obj.shape
     if shape.kind == "mesh":
         return mesh.diagonal(shape.vertices)
-    return primitives.diagonal(shape.kind, shape.size)
+    return primitives.diagonal(shape.kind, check_size(shape.kind, shape.size))
 
 
 def project_to_surface(obj: GraspObject, points) -> SurfacePoints:
@@ -160,7 +161,7 @@ def _nearest(obj, local):
     shape = obj.shape
     if shape.kind == "mesh":
         return mesh.nearest(shape, local)
-    return primitives.nearest(shape.kind, shape.size, local, EDGE_TOL * object_size(obj))
+    return primitives.nearest(shape.kind, check_size(shape.kind, shape.size), local, EDGE_TOL * object_size(obj))
 
 
 def _points(points):
@@ -194,7 +195,7 @@ def mass_properties(obj: GraspObject) -> MassProperties:
     if shape.kind == "mesh":
         volume, centroid = mesh.volume_centroid(shape)
     else:
-        volume, centroid = primitives.volume(shape.kind, shape.size), np.zeros(3)
+        volume, centroid = primitives.volume(shape.kind, check_size(shape.kind, shape.size)), np.zeros(3)
     mass = obj.mass if obj.mass is not None else (None if obj.density is None else obj.density * volume)
     return MassProperties(volume, mass, obj.pose[:3, :3] @ centroid + obj.pose[:3, 3])
 
@@ -222,7 +223,7 @@ def sample_surface(obj: GraspObject, n: int, rng: np.random.Generator) -> tuple[
     if shape.kind == "mesh":
         points, outward = mesh.sample(shape, n, rng)
     else:
-        points, outward = primitives.sample(shape.kind, shape.size, n, rng)
+        points, outward = primitives.sample(shape.kind, check_size(shape.kind, shape.size), n, rng)
     rotation, translation = obj.pose[:3, :3], obj.pose[:3, 3]
     return rotate(rotation, points) + translation, rotate(-rotation, outward)
 
@@ -251,7 +252,7 @@ def tessellate(obj: GraspObject, *, segments: int = 32) -> tuple[np.ndarray, np.
     if shape.kind == "mesh":
         vertices, faces = shape.vertices, shape.faces.copy()
     else:
-        vertices, faces = primitives.triangles(shape.kind, shape.size, segments)
+        vertices, faces = primitives.triangles(shape.kind, check_size(shape.kind, shape.size), segments)
     return rotate(obj.pose[:3, :3], vertices) + obj.pose[:3, 3], faces
 
 
