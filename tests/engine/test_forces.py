@@ -762,6 +762,7 @@ def test_the_compiled_grip_answers_each_row_as_alone(compiled_path):
 
     out, codes = rows(np.arange(2500))
     assert 0.2 < (codes[:, 0] == 0).mean() < 0.95 and codes[:, 2].all()  # held and cannot-hold, none to numpy
+    assert rows(np.arange(0))[0].shape == (0, kernel.WIDTH)  # no rows: no chunk
     order = np.random.default_rng(5).permutation(2500)
     again, codes_again = rows(order)
     assert (again == out[order]).all() and (codes_again == codes[order]).all()

@@ -348,7 +348,7 @@ def _iterate(A, b, c, x, z, order, phase_one, d, K, width):
 
 
 @njit(**_JIT)
-def _in_lanes(A, b, c, x, z, order, phase_one, d, K, ws):
+def _in_lanes(A, b, c, x, z, order, phase_one, d, K):
     """:func:`_iterate` on the rows ``order``: in :data:`_LANES` lanes where they fill them, else one at a time
     (the lanes' loops compiled for a constant width: a row alone pays no vector code's set-up)."""
     d, K = literally(d), literally(K)
@@ -772,7 +772,7 @@ def grip_rows(p, n, limit, w, tol, out, codes):
     exert.  ``limit (n, 3)`` is ``mu / safety``.
     """
     rows = min(p.shape[0], _CHUNK)
-    _grip_rows(p, n, limit, w, tol, out, codes, _lanes(min(rows, _LANES)), _chunk(rows), _grip_workspace())
+    _grip_rows(p, n, limit, w, tol, out, codes, _chunk(rows), _grip_workspace())
 
 
 @njit(**_ALLOC)
@@ -802,15 +802,15 @@ def _grip_workspace():
 
 
 @njit(**_JIT)
-def _grip_rows(p, n, limit, w, tol, out, codes, lanes, chunk, gw):
+def _grip_rows(p, n, limit, w, tol, out, codes, chunk, gw):
     """:func:`grip_rows` a chunk of rows at a time, in passes: set-up, phase I (then phase I on the rays,
     for a culprit), phase II, finish; the phases' rows in step (:func:`_iterate`)."""
     (q, mv, g, unit, fm, frame), (M, A, b, c, x, z), (wide, bw, cw, xw, zw, inside), sizes, lists = chunk
     t, size2, scale = sizes[:, 0], sizes[:, 1], sizes[:, 2]
     stage, blame, one, two, again = lists
     e, corners, d, lam, (omega, h, res, delta, dz) = gw
-    for first in range(0, p.shape[0], stage.size):
-        rows = min(stage.size, p.shape[0] - first)
+    for first in range(0, p.shape[0], _CHUNK):  # no rows: no chunk
+        rows = min(_CHUNK, p.shape[0] - first)
         ones, twos, agains = 0, 0, 0
         for i in range(rows):
             r = first + i
@@ -848,7 +848,7 @@ def _grip_rows(p, n, limit, w, tol, out, codes, lanes, chunk, gw):
                     _phase_one_problem(A[i], b[i], False, wide[i], bw[i], cw[i], xw[i], zw[i])
                     one[ones] = i
                     ones += 1
-        _in_lanes(wide, bw, cw, xw, zw, one[:ones], True, _D, _K, lanes)
+        _in_lanes(wide, bw, cw, xw, zw, one[:ones], True, _D, _K)
         for k in range(ones):
             i = one[k]
             for j in range(3):
@@ -868,14 +868,14 @@ def _grip_rows(p, n, limit, w, tol, out, codes, lanes, chunk, gw):
                 agains += 1
             for j in range(3):
                 x[i, j] = math.nan
-        _in_lanes(wide, bw, cw, xw, zw, again[:agains], True, _D, _K, lanes)
+        _in_lanes(wide, bw, cw, xw, zw, again[:agains], True, _D, _K)
         for k in range(agains):
             if not xw[again[k], 3] < 0:
                 blame[again[k]] = -1
         for k in range(twos):
             for m in range(3):
                 z[two[k], m, 0], z[two[k], m, 1], z[two[k], m, 2] = 1.0, 0.0, 0.0
-        _in_lanes(A, b, c, x, z, two[:twos], False, _SQUEEZES, _CONES, lanes)
+        _in_lanes(A, b, c, x, z, two[:twos], False, _SQUEEZES, _CONES)
         for i in range(rows):
             if stage[i] == _SKIP:
                 continue
