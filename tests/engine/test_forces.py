@@ -745,6 +745,33 @@ def test_the_compiled_grip_follows_the_numpy_path(compiled_path):
     assert fast.total_normal_force == pytest.approx(float(alone.total_normal_force), rel=1e-9)
 
 
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time (numba's compile)
+def test_the_compiled_grip_answers_each_row_as_alone(compiled_path):
+    """The kernel solves rows in step, 32 lanes and 2048 rows a chunk (engine/forces/kernel.py): a row's answer,
+    to the last bit, is the same in any order, whatever its neighbours' iterations; alone (one lane, compiled
+    apart) it has the same verdict and total to round-off."""
+    from grasptwist.engine.forces import kernel
+
+    p, n, w, mu = grasps(2500, 23)  # two chunks, both phases full of lanes
+    limit = np.ascontiguousarray(np.broadcast_to(mu / 1.5, (2500, 3)))
+
+    def rows(index):
+        out, codes = np.empty((len(index), kernel.WIDTH)), np.empty((len(index), 3), np.int8)
+        kernel.grip_rows(p[index], n[index], limit[index], w[index], 1e-9, out, codes)
+        return np.nan_to_num(out, nan=7.0), codes
+
+    out, codes = rows(np.arange(2500))
+    assert 0.2 < (codes[:, 0] == 0).mean() < 0.95 and codes[:, 2].all()  # held and cannot-hold, none to numpy
+    assert rows(np.arange(0))[0].shape == (0, kernel.WIDTH)  # no rows: no chunk
+    order = np.random.default_rng(5).permutation(2500)
+    again, codes_again = rows(order)
+    assert (again == out[order]).all() and (codes_again == codes[order]).all()
+    for i in (0, 1, 2, 1000, 2499):
+        alone, code = rows(np.array([i]))
+        assert (code[0] == codes[i]).all()
+        assert alone[0, kernel._TOTAL] == pytest.approx(out[i, kernel._TOTAL], rel=1e-12, abs=0)
+
+
 def test_importing_grasptwist_imports_no_numba():
     """The compiled kernel is loaded on the first grip, never at import (the CLI's start-up stays short)."""
     code = "import sys, grasptwist, grasptwist.cli; assert 'numba' not in sys.modules, 'numba imported'"

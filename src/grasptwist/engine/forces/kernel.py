@@ -1,5 +1,5 @@
-r"""The grip compiled by numba, a whole row at a time (imported only through
-:mod:`~grasptwist.engine.forces.compiled`, which loads it at the first grip).
+r"""The grip compiled by numba (imported only through :mod:`~grasptwist.engine.forces.compiled`,
+which loads it at the first grip).
 
 :func:`grip_rows` does for each row what the numpy path does for the rows it solves by cones:
 the geometry and ``G^+ w`` (:mod:`~grasptwist.engine.forces.grasp_map`), the cones and a start
@@ -12,6 +12,12 @@ the reference: ``tests/engine/test_forces.py`` holds the two to the same verdict
 ``1e-9``.  A row of the method is ``A[m, k, j]`` (cone ``m``, component ``k``, unknown ``j``),
 ``b[m, k]``, ``c[j]``; ``d`` unknowns, ``K`` cones.  numpy's error model: a division by zero
 is ``inf`` or NaN, which ends a row's iterations as a non-finite step does in numpy.
+
+It goes through a chunk of rows in passes: set-up (each row), phase I and phase II (the rows
+that need them in step, :data:`_LANES` at a time, :func:`_iterate`), finish (each row).  A row
+keeps its own iterations and stopping, and its answer is the same to the last bit in any order or
+company; alone (fewer rows than lanes: :func:`_iterate` compiled for one lane) to round-off
+(``test_the_compiled_grip_answers_each_row_as_alone``).
 """
 
 from __future__ import annotations
@@ -20,7 +26,7 @@ import math
 from itertools import accumulate
 
 import numpy as np
-from numba import njit
+from numba import literally, njit
 
 from . import one
 from .closure import _PAIRS, _STRICT
@@ -31,7 +37,7 @@ __all__ = ["grip_rows", "WIDTH"]
 
 # no reference counting (numba's runtime) in the arithmetic: its atomic increments and decrements
 # on every array passed or sliced were a fifth of a row's time; the workspaces are allocated by
-# the two functions that need the runtime (_ALLOC)
+# the functions that need the runtime (_ALLOC; _iterate, whose own arrays are passed to nothing)
 _JIT = {"cache": True, "error_model": "numpy", "fastmath": {"arcp", "contract"}, "_nrt": False}
 _ALLOC = {"cache": True}
 
@@ -40,230 +46,324 @@ _ALLOC = {"cache": True}
 _approach, _scaling, _w_inv, _w_mul = (njit(**_JIT)(f) for f in (one.approach, one.scaling, one.w_inv, one.w_mul))
 
 
-@njit(**_JIT, inline="always")
-def _spd_solve(H, g, d, out):
-    """``H^-1 g`` by elimination without pivoting (``H`` symmetric positive definite, overwritten)."""
-    for k in range(d):
-        for i in range(k + 1, d):
-            f = H[i, k] / H[k, k]
-            for j in range(k + 1, d):
-                H[i, j] -= f * H[k, j]
-            g[i] -= f * g[k]
-    for i in range(d - 1, -1, -1):
-        v = g[i]
-        for j in range(i + 1, d):
-            v -= H[i, j] * out[j]
-        out[i] = v / H[i, i]
+#: Rows the interior-point method takes in step, each in a lane (the last axis of its workspace): the
+#: divisions and roots of independent rows overlap and vectorise, where one row's wait on each other.
+_LANES = 32
 
+#: The most unknowns and cones a row has: phase I's three squeezes and a margin, four cones.
+_D, _K = 4, 4
 
-@njit(**_JIT, inline="always")
-def _apply(A, x, d, K, out):
-    """``out_m = A_m x`` for the ``K`` cones."""
-    for m in range(K):
-        for k in range(3):
-            t = 0.0
-            for j in range(d):
-                t += A[m, k, j] * x[j]
-            out[m, k] = t
-
-
-@njit(**_JIT, inline="always")
-def _direction(A, L, V, beta, rhs, res, H, d, K, U, WU, g, Hw, dx, dy, dz):
-    """``lambda o (W dz + W^-1 dy) = rhs``, ``dy = A dx``, ``sum_m A_m^T dz_m = res``: into ``dx, dy, dz``."""
-    for m in range(K):
-        l0, l1, l2 = L[m, 0], L[m, 1], L[m, 2]
-        r0, r1, r2 = rhs[m, 0], rhs[m, 1], rhs[m, 2]
-        u0 = (l0 * r0 - l1 * r1 - l2 * r2) / (l0 * l0 - l1 * l1 - l2 * l2)
-        U[m, 0], U[m, 1], U[m, 2] = u0, (r1 - u0 * l1) / l0, (r2 - u0 * l2) / l0
-        WU[m, 0], WU[m, 1], WU[m, 2] = _w_inv(V[m, 0], V[m, 1], V[m, 2], beta[m], U[m, 0], U[m, 1], U[m, 2])
-    for j in range(d):
-        t = res[j]
-        for m in range(K):
-            t -= A[m, 0, j] * WU[m, 0] + A[m, 1, j] * WU[m, 1] + A[m, 2, j] * WU[m, 2]
-        g[j] = -t
-        for i in range(d):
-            Hw[j, i] = H[j, i]
-    _spd_solve(Hw, g, d, dx)
-    _apply(A, dx, d, K, dy)
-    for m in range(K):
-        q0, q1, q2 = _w_inv(V[m, 0], V[m, 1], V[m, 2], beta[m], dy[m, 0], dy[m, 1], dy[m, 2])
-        dz[m, 0], dz[m, 1], dz[m, 2] = _w_inv(
-            V[m, 0], V[m, 1], V[m, 2], beta[m], U[m, 0] - q0, U[m, 1] - q1, U[m, 2] - q2
-        )
-
-
-@njit(**_JIT, inline="always")
-def _edge(y, z, dy, dz, ys, zs, K):
-    """The largest step along ``(dy, dz)`` that keeps every ``y_m`` and ``z_m`` in its cone (``inf``: none):
-    ``1 / max t`` of :func:`one.approach`'s rates (a NaN rate is no limit, as in ``socp._edge``)."""
-    top = 0.0
-    for m in range(K):
-        t = _approach(y[m, 0], y[m, 1], y[m, 2], dy[m, 0], dy[m, 1], dy[m, 2], ys[m])
-        if t > top:
-            top = t
-        t = _approach(z[m, 0], z[m, 1], z[m, 2], dz[m, 0], dz[m, 1], dz[m, 2], zs[m])
-        if t > top:
-            top = t
-    return 1 / top if top > 0 else math.inf
-
-
-@njit(**_JIT)
-def _iterate(A, b, c, x, z, P, phase_one, d, K, ws):
-    """``socp._iterate`` for one row (``phase_one``: its leaving rule, else phase II's); ``x``, ``z`` in place;
-    ``ws``: :func:`_workspace` (indexed below ``d`` and ``K`` only)."""
-    res, y, L, V, G, beta, scale, H, Hw, U, WU, rhs, square, g, dx, dy, dz, ys, zs = ws
-    for it in range(_ITERATIONS):
-        for j in range(d):
-            t = c[j]
-            for m in range(K):
-                t -= A[m, 0, j] * z[m, 0] + A[m, 1, j] * z[m, 1] + A[m, 2, j] * z[m, 2]
-            res[j] = t
-        for m in range(K):
-            for k in range(3):
-                t = b[m, k]
-                for j in range(d):
-                    t += A[m, k, j] * x[j]
-                y[m, k] = t
-            w0, w1, w2, v0, v1, v2, bt, L[m, 0], L[m, 1], L[m, 2], ys[m], zs[m] = _scaling(
-                y[m, 0], y[m, 1], y[m, 2], z[m, 0], z[m, 1], z[m, 2]
-            )
-            for j in range(d):
-                G[m, j] = A[m, 0, j] * w0 - A[m, 1, j] * w1 - A[m, 2, j] * w2
-            V[m, 0], V[m, 1], V[m, 2] = v0, v1, v2
-            beta[m] = bt
-            scale[m] = 1 / (bt * bt)
-        top = -math.inf
-        for i in range(d):
-            for j in range(i + 1):
-                h = 0.0
-                for m in range(K):
-                    h += (2 * G[m, i] * G[m, j] - P[m, i, j]) * scale[m]
-                H[i, j] = h
-                H[j, i] = h
-            top = max(top, H[i, i])
-        for i in range(d):
-            H[i, i] += 1e-14 * top
-        mu = 0.0
-        for m in range(K):
-            l0, l1, l2 = L[m, 0], L[m, 1], L[m, 2]
-            square[m, 0], square[m, 1], square[m, 2] = l0 * l0 + l1 * l1 + l2 * l2, 2 * l0 * l1, 2 * l0 * l2
-            rhs[m, 0], rhs[m, 1], rhs[m, 2] = -square[m, 0], -square[m, 1], -square[m, 2]
-            mu += y[m, 0] * z[m, 0] + y[m, 1] * z[m, 1] + y[m, 2] * z[m, 2]
-        mu /= K
-        _direction(A, L, V, beta, rhs, res, H, d, K, U, WU, g, Hw, dx, dy, dz)
-        step = min(1.0, _edge(y, z, dy, dz, ys, zs, K))
-        mu_aff = 0.0
-        for m in range(K):
-            for k in range(3):
-                mu_aff += (y[m, k] + step * dy[m, k]) * (z[m, k] + step * dz[m, k])
-        sigma = min(max(mu_aff / K / mu, 0.0), 1.0) ** 3
-        for m in range(K):
-            p0, p1, p2 = _w_inv(V[m, 0], V[m, 1], V[m, 2], beta[m], dy[m, 0], dy[m, 1], dy[m, 2])
-            q0, q1, q2 = _w_mul(V[m, 0], V[m, 1], V[m, 2], beta[m], dz[m, 0], dz[m, 1], dz[m, 2])
-            rhs[m, 0] = -square[m, 0] - (p0 * q0 + p1 * q1 + p2 * q2) + sigma * mu
-            rhs[m, 1] = -square[m, 1] - (p0 * q1 + q0 * p1)
-            rhs[m, 2] = -square[m, 2] - (p0 * q2 + q0 * p2)
-        _direction(A, L, V, beta, rhs, res, H, d, K, U, WU, g, Hw, dx, dy, dz)
-        step = min(1.0, _EDGE * _edge(y, z, dy, dz, ys, zs, K))
-        finite = math.isfinite(step)
-        for j in range(d):
-            finite = finite and math.isfinite(dx[j])
-        for m in range(K):
-            for k in range(3):
-                finite = finite and math.isfinite(dz[m, k])
-        if not finite:  # round-off at the cones' edge: the row stops where it is, still inside
-            return it
-        for j in range(d):
-            x[j] += step * dx[j]
-        gap = 0.0
-        for m in range(K):
-            for k in range(3):
-                z[m, k] += step * dz[m, k]
-                gap += (y[m, k] + step * dy[m, k]) * z[m, k]
-        obj = 0.0
-        big = 0.0
-        for j in range(d):
-            obj += c[j] * x[j]
-            big = max(big, abs(res[j]))
-        dual = obj - gap if big * (1 - step) <= _RESIDUAL else -math.inf
-        closed = gap <= GAP * (1 + abs(obj))
-        if phase_one:
-            size = 1.0
-            for j in range(d):
-                size += abs(x[j])
-            if x[d - 1] <= -START_MARGIN or dual > _RESIDUAL * size or (closed and dual > -math.inf):
-                return it + 1
-        elif closed and dual > -math.inf:
-            return it + 1
-    return _ITERATIONS
-
-
-#: The most unknowns and cones a row has: phase I of collinear contacts' four internal forces.
-_D, _K = 5, 4
-
-# The kernel's rows: three squeezes, three cones (phase I: one more of each).  Passed to _iterate as
-# constants, so that numba compiles it for these sizes (its loops unrolled): 7.6 -> 6.4 us a grasp.
+# The kernel's rows: three squeezes, three cones (phase I: one more of each).  _iterate is compiled for
+# these sizes and its width as constants (numba's literally; its loops over them unrolled).
 _SQUEEZES, _CONES = 3, 3
 
 
-@njit(**_ALLOC)
-def _workspace():
-    """The arrays :func:`_iterate` works in, allocated once per call of :func:`solve` (numba's
-    allocations, not the arithmetic, were most of a row's time)."""
-    return (
-        np.empty(_D),
-        np.empty((_K, 3)),
-        np.empty((_K, 3)),
-        np.empty((_K, 3)),
-        np.empty((_K, _D)),
-        np.empty(_K),
-        np.empty(_K),
-        np.empty((_D, _D)),
-        np.empty((_D, _D)),
-        np.empty((_K, 3)),
-        np.empty((_K, 3)),
-        np.empty((_K, 3)),
-        np.empty((_K, 3)),
-        np.empty(_D),
-        np.empty(_D),
-        np.empty((_K, 3)),
-        np.empty((_K, 3)),
-        np.empty(_K),
-        np.empty(_K),
-    )
+@njit(**_JIT, inline="always")
+def _spd_solve(H, g, d, width, out):
+    """``H^-1 g`` by elimination without pivoting in every lane (``H (d, d, lanes)`` symmetric positive
+    definite and ``g (d, lanes)`` overwritten; ``out (d, lanes)``)."""
+    for k in range(d):
+        for i in range(k + 1, d):
+            for ln in range(width):
+                f = H[i, k, ln] / H[k, k, ln]
+                for j in range(k + 1, d):
+                    H[i, j, ln] -= f * H[k, j, ln]
+                g[i, ln] -= f * g[k, ln]
+    for i in range(d - 1, -1, -1):
+        for ln in range(width):
+            v = g[i, ln]
+            for j in range(i + 1, d):
+                v -= H[i, j, ln] * out[j, ln]
+            out[i, ln] = v / H[i, i, ln]
 
 
-@njit(**_JIT)
-def _newton_matrices(A, d, K, P):
+@njit(**_JIT, inline="always")
+def _direction(A, L, V, beta, rhs, res, H, d, K, width, U, WU, g, Hw, dx, dy, dz):
+    """``lambda o (W dz + W^-1 dy) = rhs``, ``dy = A dx``, ``sum_m A_m^T dz_m = res`` in every lane: into ``dx, dy, dz``."""
     for m in range(K):
+        for ln in range(width):
+            l0, l1, l2 = L[m, 0, ln], L[m, 1, ln], L[m, 2, ln]
+            r0, r1, r2 = rhs[m, 0, ln], rhs[m, 1, ln], rhs[m, 2, ln]
+            u0 = (l0 * r0 - l1 * r1 - l2 * r2) / (l0 * l0 - l1 * l1 - l2 * l2)
+            u1, u2 = (r1 - u0 * l1) / l0, (r2 - u0 * l2) / l0
+            U[m, 0, ln], U[m, 1, ln], U[m, 2, ln] = u0, u1, u2
+            WU[m, 0, ln], WU[m, 1, ln], WU[m, 2, ln] = _w_inv(
+                V[m, 0, ln], V[m, 1, ln], V[m, 2, ln], beta[m, ln], u0, u1, u2
+            )
+    for j in range(d):
+        for ln in range(width):
+            t = res[j, ln]
+            for m in range(K):
+                t -= A[m, 0, j, ln] * WU[m, 0, ln] + A[m, 1, j, ln] * WU[m, 1, ln] + A[m, 2, j, ln] * WU[m, 2, ln]
+            g[j, ln] = -t
         for i in range(d):
-            for j in range(d):
-                P[m, i, j] = A[m, 0, i] * A[m, 0, j] - A[m, 1, i] * A[m, 1, j] - A[m, 2, i] * A[m, 2, j]
+            for ln in range(width):
+                Hw[j, i, ln] = H[j, i, ln]
+    _spd_solve(Hw, g, d, width, dx)
+    for m in range(K):
+        for k in range(3):
+            for ln in range(width):
+                t = 0.0
+                for j in range(d):
+                    t += A[m, k, j, ln] * dx[j, ln]
+                dy[m, k, ln] = t
+        for ln in range(width):
+            v0, v1, v2, bt = V[m, 0, ln], V[m, 1, ln], V[m, 2, ln], beta[m, ln]
+            q0, q1, q2 = _w_inv(v0, v1, v2, bt, dy[m, 0, ln], dy[m, 1, ln], dy[m, 2, ln])
+            dz[m, 0, ln], dz[m, 1, ln], dz[m, 2, ln] = _w_inv(
+                v0, v1, v2, bt, U[m, 0, ln] - q0, U[m, 1, ln] - q1, U[m, 2, ln] - q2
+            )
 
 
-@njit(**_ALLOC)
-def _row_workspace():
-    """The arrays of one row's phases (``wide``, ``bw``, ``cw``, ``xw``, ``zw``, ``P``, ``c``, ``x``, ``h``, ``dz``)."""
+@njit(**_JIT, inline="always")
+def _edge(y, z, dy, dz, ys, zs, K, width, out):
+    """The largest step along ``(dy, dz)`` that keeps every ``y_m`` and ``z_m`` in its cone (``inf``: none), in
+    every lane: ``1 / max t`` of :func:`one.approach`'s rates (a NaN rate is no limit, as in ``socp._edge``)."""
+    for ln in range(width):
+        top = 0.0
+        for m in range(K):
+            t = _approach(y[m, 0, ln], y[m, 1, ln], y[m, 2, ln], dy[m, 0, ln], dy[m, 1, ln], dy[m, 2, ln], ys[m, ln])
+            top = t if t > top else top
+            t = _approach(z[m, 0, ln], z[m, 1, ln], z[m, 2, ln], dz[m, 0, ln], dz[m, 1, ln], dz[m, 2, ln], zs[m, ln])
+            top = t if t > top else top
+        out[ln] = 1 / top if top > 0 else math.inf
+
+
+@njit(**_ALLOC, inline="always")
+def _lanes(lanes):
+    """The arrays :func:`_iterate` works in, ``lanes`` rows at once (the last axis), indexed below ``d`` and
+    ``K`` only: eight allocations, the arrays of a shape views of one."""
+    wide, unknowns, cones = np.empty((11, _K, 3, lanes)), np.empty((5, _D, lanes)), np.empty((4, _K, lanes))
+    square, pair, counts = np.empty((2, _D, _D, lanes)), np.empty((2, lanes)), np.empty((2, lanes), np.int64)
     return (
-        np.empty((_K, 3, _D)),
-        np.empty((_K, 3)),
-        np.empty(_D),
-        np.empty(_D),
-        np.empty((_K, 3)),
-        np.empty((_K, _D, _D)),
-        np.empty(_D),
-        np.empty(_D),
-        np.empty((_D, _D)),
-        np.empty((_K, 3)),
+        np.empty((_K, 3, _D, lanes)),
+        wide[0],
+        unknowns[0],
+        unknowns[1],
+        wide[1],
+        np.empty((_K, _D, _D, lanes)),
+        counts[0],
+        counts[1],
+        unknowns[2],
+        wide[2],
+        wide[3],
+        wide[4],
+        np.empty((_K, _D, lanes)),
+        cones[0],
+        cones[1],
+        square[0],
+        square[1],
+        wide[5],
+        wide[6],
+        wide[7],
+        wide[8],
+        unknowns[3],
+        unknowns[4],
+        wide[9],
+        wide[10],
+        cones[2],
+        cones[3],
+        pair[0],
+        pair[1],
     )
 
 
+@njit(**(_JIT | {"_nrt": True}))
+def _iterate(A, b, c, x, z, order, phase_one, d, K, width):
+    """``socp._iterate`` (``phase_one``: its leaving rule, else phase II's) on the rows ``order`` of
+    ``A (R, K, 3, d)``, ``b (R, K, 3)``, ``c (R, d)``; their ``x (R, d)``, ``z (R, K, 3)`` in place.
+
+    The rows go through :func:`_lanes`' arrays in step, a row a lane; a lane whose row has finished (by
+    its own count and rules, exactly as alone) takes the next.  Nothing mixes lanes, so a row's answer
+    is the same in any company; an empty lane's numbers are never read.  Its arrays are its own
+    (:func:`_lanes`): their shapes constants, the lanes' loops vectorise (passed in: 2.2 us a row of
+    phase II, against 1.4).
+    """
+    (
+        a,
+        bl,
+        cl,
+        xl,
+        zl,
+        P,
+        row,
+        it,
+        res,
+        y,
+        L,
+        V,
+        G,
+        beta,
+        scale,
+        H,
+        Hw,
+        U,
+        WU,
+        rhs,
+        square,
+        g,
+        dx,
+        dy,
+        dz,
+        ys,
+        zs,
+        mu,
+        step,
+    ) = _lanes(width)
+    for ln in range(width):
+        row[ln] = -1
+    taken = 0
+    while True:
+        busy = 0
+        for ln in range(width):
+            if row[ln] < 0 and taken < order.size:
+                r = order[taken]
+                taken += 1
+                row[ln], it[ln] = r, 0
+                for m in range(K):
+                    for k in range(3):
+                        bl[m, k, ln], zl[m, k, ln] = b[r, m, k], z[r, m, k]
+                        for j in range(d):
+                            a[m, k, j, ln] = A[r, m, k, j]
+                    for i in range(d):
+                        for j in range(d):
+                            P[m, i, j, ln] = (
+                                A[r, m, 0, i] * A[r, m, 0, j]
+                                - A[r, m, 1, i] * A[r, m, 1, j]
+                                - A[r, m, 2, i] * A[r, m, 2, j]
+                            )
+                for j in range(d):
+                    cl[j, ln], xl[j, ln] = c[r, j], x[r, j]
+            busy += row[ln] >= 0
+        if busy == 0:
+            return
+        for j in range(d):
+            for ln in range(width):
+                t = cl[j, ln]
+                for m in range(K):
+                    t -= a[m, 0, j, ln] * zl[m, 0, ln] + a[m, 1, j, ln] * zl[m, 1, ln] + a[m, 2, j, ln] * zl[m, 2, ln]
+                res[j, ln] = t
+        for m in range(K):
+            for k in range(3):
+                for ln in range(width):
+                    t = bl[m, k, ln]
+                    for j in range(d):
+                        t += a[m, k, j, ln] * xl[j, ln]
+                    y[m, k, ln] = t
+            for ln in range(width):
+                w0, w1, w2, v0, v1, v2, bt, L[m, 0, ln], L[m, 1, ln], L[m, 2, ln], ys[m, ln], zs[m, ln] = _scaling(
+                    y[m, 0, ln], y[m, 1, ln], y[m, 2, ln], zl[m, 0, ln], zl[m, 1, ln], zl[m, 2, ln]
+                )
+                for j in range(d):
+                    G[m, j, ln] = a[m, 0, j, ln] * w0 - a[m, 1, j, ln] * w1 - a[m, 2, j, ln] * w2
+                V[m, 0, ln], V[m, 1, ln], V[m, 2, ln] = v0, v1, v2
+                beta[m, ln] = bt
+                scale[m, ln] = 1 / (bt * bt)
+        for ln in range(width):
+            top = -math.inf
+            for i in range(d):
+                for j in range(i + 1):
+                    h = 0.0
+                    for m in range(K):
+                        h += (2 * G[m, i, ln] * G[m, j, ln] - P[m, i, j, ln]) * scale[m, ln]
+                    H[i, j, ln] = h
+                    H[j, i, ln] = h
+                top = max(top, H[i, i, ln])
+            for i in range(d):
+                H[i, i, ln] += 1e-14 * top
+            s = 0.0
+            for m in range(K):
+                l0, l1, l2 = L[m, 0, ln], L[m, 1, ln], L[m, 2, ln]
+                square[m, 0, ln], square[m, 1, ln], square[m, 2, ln] = (
+                    l0 * l0 + l1 * l1 + l2 * l2,
+                    2 * l0 * l1,
+                    2 * l0 * l2,
+                )
+                rhs[m, 0, ln], rhs[m, 1, ln], rhs[m, 2, ln] = -square[m, 0, ln], -square[m, 1, ln], -square[m, 2, ln]
+                s += y[m, 0, ln] * zl[m, 0, ln] + y[m, 1, ln] * zl[m, 1, ln] + y[m, 2, ln] * zl[m, 2, ln]
+            mu[ln] = s / K
+        for corrector in range(2):  # Mehrotra: the predictor, then the corrector through the same code
+            _direction(a, L, V, beta, rhs, res, H, d, K, width, U, WU, g, Hw, dx, dy, dz)
+            _edge(y, zl, dy, dz, ys, zs, K, width, step)
+            if corrector:
+                break
+            for ln in range(width):
+                st = min(1.0, step[ln])
+                s = 0.0
+                for m in range(K):
+                    for k in range(3):
+                        s += (y[m, k, ln] + st * dy[m, k, ln]) * (zl[m, k, ln] + st * dz[m, k, ln])
+                sigma = min(max(s / K / mu[ln], 0.0), 1.0) ** 3
+                for m in range(K):
+                    v0, v1, v2, bt = V[m, 0, ln], V[m, 1, ln], V[m, 2, ln], beta[m, ln]
+                    p0, p1, p2 = _w_inv(v0, v1, v2, bt, dy[m, 0, ln], dy[m, 1, ln], dy[m, 2, ln])
+                    q0, q1, q2 = _w_mul(v0, v1, v2, bt, dz[m, 0, ln], dz[m, 1, ln], dz[m, 2, ln])
+                    rhs[m, 0, ln] = -square[m, 0, ln] - (p0 * q0 + p1 * q1 + p2 * q2) + sigma * mu[ln]
+                    rhs[m, 1, ln] = -square[m, 1, ln] - (p0 * q1 + q0 * p1)
+                    rhs[m, 2, ln] = -square[m, 2, ln] - (p0 * q2 + q0 * p2)
+        for ln in range(width):
+            if row[ln] < 0:
+                continue
+            st = min(1.0, _EDGE * step[ln])
+            finite = math.isfinite(st)
+            for j in range(d):
+                finite = finite and math.isfinite(dx[j, ln])
+            for m in range(K):
+                for k in range(3):
+                    finite = finite and math.isfinite(dz[m, k, ln])
+            done = not finite
+            if finite:
+                for j in range(d):
+                    xl[j, ln] += st * dx[j, ln]
+                gap = 0.0
+                for m in range(K):
+                    for k in range(3):
+                        zl[m, k, ln] += st * dz[m, k, ln]
+                        gap += (y[m, k, ln] + st * dy[m, k, ln]) * zl[m, k, ln]
+                obj = 0.0
+                big = 0.0
+                for j in range(d):
+                    obj += cl[j, ln] * xl[j, ln]
+                    big = max(big, abs(res[j, ln]))
+                dual = obj - gap if big * (1 - st) <= _RESIDUAL else -math.inf
+                closed = gap <= GAP * (1 + abs(obj))
+                it[ln] += 1
+                if phase_one:
+                    size = 1.0
+                    for j in range(d):
+                        size += abs(xl[j, ln])
+                    if xl[d - 1, ln] <= -START_MARGIN or dual > _RESIDUAL * size or (closed and dual > -math.inf):
+                        done = True
+                elif closed and dual > -math.inf:
+                    done = True
+                done = done or it[ln] >= _ITERATIONS
+            if done:
+                r = row[ln]
+                for j in range(d):
+                    x[r, j] = xl[j, ln]
+                for m in range(K):
+                    for k in range(3):
+                        z[r, m, k] = zl[m, k, ln]
+                row[ln] = -1
+
+
 @njit(**_JIT)
-def _phase_one(A, b, rays, ws, rw):
-    """``socp.phase_one`` for one row into ``rw``'s ``xw`` (``x`` and ``r`` last) and ``zw``; ``rays``: the cones
-    with no friction limit (``b``'s tangential components taken as 0)."""
+def _in_lanes(A, b, c, x, z, order, phase_one, d, K):
+    """:func:`_iterate` on the rows ``order``: in :data:`_LANES` lanes where they fill them, else one at a time
+    (the lanes' loops compiled for a constant width: a row alone pays no vector code's set-up)."""
+    d, K = literally(d), literally(K)
+    if order.size < _LANES:
+        _iterate(A, b, c, x, z, order, phase_one, d, K, 1)
+    else:
+        _iterate(A, b, c, x, z, order, phase_one, d, K, _LANES)
+
+
+@njit(**_JIT)
+def _phase_one_problem(A, b, rays, wide, bw, c, x, z):
+    """``socp.phase_one``'s problem for one row into ``wide (K + 1, 3, d + 1)``, ``bw``, ``c``, and its start
+    ``x`` (the margin ``r`` last), ``z``; ``rays``: the cones with no friction limit (``b``'s tangential
+    components taken as 0)."""
     K, d = A.shape[0], A.shape[2]
-    wide, bw, c, x, z, P = rw[0], rw[1], rw[2], rw[3], rw[4], rw[5]
     over = -math.inf
     for m in range(K + 1):
         for k in range(3):
@@ -280,25 +380,76 @@ def _phase_one(A, b, rays, ws, rw):
         c[j] = 0.0
     x[d] = max(over + 1, 0.0)
     c[d] = 1.0
-    _newton_matrices(wide, _SQUEEZES + 1, _CONES + 1, P)
-    _iterate(wide, bw, c, x, z, P, True, _SQUEEZES + 1, _CONES + 1, ws)
-    return x[d]
 
 
 @njit(**_JIT)
-def _dual_polish(A, b, c, x, z, rw):
-    """``grip._dual_polish`` for one row (``z`` in place)."""
+def _start(A, b, inside, c, x):
+    """``grip._solve``'s objective ``c`` (the normal forces' sum) and, where the contacts are in force
+    closure (``inside`` finite), its start ``x``: ``inside`` scaled to clear every cone by ``START_MARGIN``;
+    whether there is one (else phase I finds it)."""
     K, d = A.shape[0], A.shape[2]
-    res, omega, h, dz, delta = rw[2], rw[1][:, 0], rw[8], rw[9], rw[3]
     for j in range(d):
-        res[j] = c[j]
+        c[j] = 0.0
+        for m in range(K):
+            c[j] += A[m, 0, j]
+    for j in range(d):
+        if math.isnan(inside[j]):
+            return False
+    reach = -math.inf
+    for m in range(K):
+        y0, y1, y2 = 0.0, 0.0, 0.0
+        for j in range(d):
+            y0 += A[m, 0, j] * inside[j]
+            y1 += A[m, 1, j] * inside[j]
+            y2 += A[m, 2, j] * inside[j]
+        depth = y0 - math.sqrt(y1 * y1 + y2 * y2)
+        reach = max(reach, (START_MARGIN + abs(b[m, 0]) + math.sqrt(b[m, 1] ** 2 + b[m, 2] ** 2)) / depth)
+    for j in range(d):
+        x[j] = reach * inside[j]
+    return True
+
+
+@njit(**_JIT)
+def _culprit(A, b, x):
+    """``grip._solve``'s culprit of a row phase I found infeasible (``x``: its end): the cone it leaves
+    furthest; and whether the row may be infeasible with unlimited friction too (pulling), possible
+    unless the squeezes reach every normal force."""
+    K, d = A.shape[0], A.shape[2]
+    worst, blame = -math.inf, 0
+    for m in range(K):
+        y0, y1, y2 = b[m, 0], b[m, 1], b[m, 2]
+        for j in range(d):
+            y0 += A[m, 0, j] * x[j]
+            y1 += A[m, 1, j] * x[j]
+            y2 += A[m, 2, j] * x[j]
+        over = math.sqrt(y1 * y1 + y2 * y2) - y0
+        if over > worst or (math.isnan(over) and not math.isnan(worst)):  # argmax: NaN wins, as numpy's
+            worst, blame = over, m
+    det = (
+        A[0, 0, 0] * (A[1, 0, 1] * A[2, 0, 2] - A[1, 0, 2] * A[2, 0, 1])
+        - A[0, 0, 1] * (A[1, 0, 0] * A[2, 0, 2] - A[1, 0, 2] * A[2, 0, 0])
+        + A[0, 0, 2] * (A[1, 0, 0] * A[2, 0, 1] - A[1, 0, 1] * A[2, 0, 0])
+    )
+    scale = 1.0
+    for m in range(3):
+        scale *= math.sqrt(A[m, 0, 0] ** 2 + A[m, 0, 1] ** 2 + A[m, 0, 2] ** 2)
+    return blame, not abs(det) > 1e-9 * scale
+
+
+@njit(**_JIT)
+def _dual_polish(A, b, c, x, z, omega, h, res, delta, dz):
+    """``grip._dual_polish`` for one row (``z`` in place; ``h (d, d, 1)``, ``res``, ``delta (d, 1)``: one lane
+    of :func:`_spd_solve`)."""
+    K, d = A.shape[0], A.shape[2]
+    for j in range(d):
+        res[j, 0] = c[j]
     for m in range(K):
         ny, nz = 0.0, 0.0
         for k in range(3):
             t = b[m, k]
             for j in range(d):
                 t += A[m, k, j] * x[j]
-                res[j] -= A[m, k, j] * z[m, k]
+                res[j, 0] -= A[m, k, j] * z[m, k]
             ny += t * t
             nz += z[m, k] * z[m, k]
         omega[m] = math.sqrt(nz) / max(math.sqrt(ny), 1e-300)
@@ -308,13 +459,15 @@ def _dual_polish(A, b, c, x, z, rw):
             for m in range(K):
                 for k in range(3):
                     t += omega[m] * A[m, k, i] * A[m, k, j]
-            h[i, j] = t
-        h[i, i] += 1e-300
-    _spd_solve(h, res, d, delta)
-    _apply(A, delta, d, K, dz)
+            h[i, j, 0] = t
+        h[i, i, 0] += 1e-300
+    _spd_solve(h, res, d, 1, delta)
     for m in range(K):
         for k in range(3):
-            dz[m, k] *= omega[m]
+            t = 0.0
+            for j in range(d):
+                t += A[m, k, j] * delta[j, 0]
+            dz[m, k] = t * omega[m]
             if not math.isfinite(dz[m, k]):
                 return
     for m in range(K):
@@ -322,82 +475,18 @@ def _dual_polish(A, b, c, x, z, rw):
             z[m, k] += dz[m, k]
 
 
-@njit(**_JIT)
-def _solve_row(A, b, inside, s, z, ws, rw):
-    """``grip._solve`` for one row: ``s``, ``z`` filled (NaN ``s`` where it fails); returns ``(fail, blame)``."""
-    K, d = A.shape[0], A.shape[2]
-    c, x = rw[6], rw[7]
-    for j in range(d):
-        c[j] = 0.0
-        for m in range(K):
-            c[j] += A[m, 0, j]
-    closing = True
-    for j in range(d):
-        closing = closing and not math.isnan(inside[j])
-    r = -1.0
-    if closing:
-        reach = -math.inf
-        for m in range(K):
-            y0, y1, y2 = 0.0, 0.0, 0.0
-            for j in range(d):
-                y0 += A[m, 0, j] * inside[j]
-                y1 += A[m, 1, j] * inside[j]
-                y2 += A[m, 2, j] * inside[j]
-            depth = y0 - math.sqrt(y1 * y1 + y2 * y2)
-            reach = max(reach, (START_MARGIN + abs(b[m, 0]) + math.sqrt(b[m, 1] ** 2 + b[m, 2] ** 2)) / depth)
-        for j in range(d):
-            x[j] = reach * inside[j]
-    else:
-        r = _phase_one(A, b, False, ws, rw)
-        for j in range(d):
-            x[j] = rw[3][j]
-        for m in range(K):
-            for k in range(3):
-                z[m, k] = rw[4][m, k]
-    if not r < 0:
-        worst, blame = -math.inf, 0
-        for m in range(K):
-            y0, y1, y2 = b[m, 0], b[m, 1], b[m, 2]
-            for j in range(d):
-                y0 += A[m, 0, j] * x[j]
-                y1 += A[m, 1, j] * x[j]
-                y2 += A[m, 2, j] * x[j]
-            over = math.sqrt(y1 * y1 + y2 * y2) - y0
-            if over > worst or (math.isnan(over) and not math.isnan(worst)):  # argmax: NaN wins, as numpy's
-                worst, blame = over, m
-        # pulling: infeasible with unlimited friction too, possible unless the squeezes reach every normal force
-        maybe = True
-        if d == 3:
-            det = (
-                A[0, 0, 0] * (A[1, 0, 1] * A[2, 0, 2] - A[1, 0, 2] * A[2, 0, 1])
-                - A[0, 0, 1] * (A[1, 0, 0] * A[2, 0, 2] - A[1, 0, 2] * A[2, 0, 0])
-                + A[0, 0, 2] * (A[1, 0, 0] * A[2, 0, 1] - A[1, 0, 1] * A[2, 0, 0])
-            )
-            scale = 1.0
-            for m in range(3):
-                scale *= math.sqrt(A[m, 0, 0] ** 2 + A[m, 0, 1] ** 2 + A[m, 0, 2] ** 2)
-            maybe = not abs(det) > 1e-9 * scale
-        if maybe and not _phase_one(A, b, True, ws, rw) < 0:
-            blame = -1
-        for j in range(d):
-            s[j] = math.nan
-        return True, blame
-    for m in range(K):
-        z[m, 0], z[m, 1], z[m, 2] = 1.0, 0.0, 0.0
-    P = rw[5]
-    _newton_matrices(A, _SQUEEZES, _CONES, P)
-    _iterate(A, b, c, x, z, P, False, _SQUEEZES, _CONES, ws)
-    _dual_polish(A, b, c, x, z, rw)
-    for j in range(d):
-        s[j] = x[j]
-    return False, -1
-
-
 # where each of grasp_map.GRIP_COLUMNS starts, and the row's width
 _F, _FM, _S, _FN, _FT, _USED, _TOTAL, _COND, _DUAL, _GAP, _CERT, WIDTH = accumulate(
     (w for _, w in GRIP_COLUMNS), initial=0
 )
 _JJ, _KK = (1, 2, 0), (2, 0, 1)  # screws.J, screws.K: side i joins contacts J[i] and K[i]
+
+#: A row's stage between the passes: left to numpy; no wrench (no force); phase I to find a start; phase
+#: II from a start; cannot hold (phase I found none).
+_SKIP, _NONE, _OPEN, _HOLD, _FAIL = range(5)
+
+#: Rows set up at a time: the passes keep some 2 kB a row between them.
+_CHUNK = 2048
 
 
 @njit(**_JIT)
@@ -509,6 +598,169 @@ def _internal_inside(p, unit, mv, e, limit, out, rows):
     out[0], out[1], out[2] = (s0, s1, s2) if good else (math.nan, math.nan, math.nan)
 
 
+@njit(**_JIT)
+def _set_up(r, p, n, limit, w, tol, o, codes, q, mv, g, unit, e, fm, frame, M, A, b, inside, corners, lam):
+    """Row ``r``'s set-up pass: its geometry, ``G^+ w``, cones and a squeeze inside them into the arrays
+    given (``o``: its row of ``out``); ``(stage, t, size2, scale)``, the stage one of :data:`_SKIP`,
+    :data:`_NONE`, :data:`_OPEN`."""
+    codes[r, 0], codes[r, 1], codes[r, 2] = 0, -1, 0
+    plain = True
+    for i in range(3):
+        for k in range(3):
+            plain = plain and math.isfinite(p[r, i, k]) and math.isfinite(n[r, i, k])
+        plain = plain and limit[r, i] > 0  # NaN and 0 (frictionless, mixed) to numpy
+    for k in range(6):
+        plain = plain and math.isfinite(w[r, k])
+    if not plain:
+        return _SKIP, 0.0, 0.0, 0.0
+    # geometry (grasp_map.geometry): centroid, spread, conditioning; degenerate rows to numpy
+    for k in range(3):
+        g[k] = (p[r, 0, k] + p[r, 1, k] + p[r, 2, k]) / 3
+    t, size2 = 0.0, 0.0
+    for i in range(3):
+        q2 = 0.0
+        for k in range(3):
+            q[i, k] = p[r, i, k] - g[k]
+            q2 += q[i, k] * q[i, k]
+        t += q2
+        size2 = max(size2, q2)
+    mv[0], mv[1], mv[2] = _cross(
+        p[r, 1, 0] - p[r, 0, 0],
+        p[r, 1, 1] - p[r, 0, 1],
+        p[r, 1, 2] - p[r, 0, 2],
+        p[r, 2, 0] - p[r, 0, 0],
+        p[r, 2, 1] - p[r, 0, 1],
+        p[r, 2, 2] - p[r, 0, 2],
+    )
+    mm = mv[0] * mv[0] + mv[1] * mv[1] + mv[2] * mv[2]
+    det = mm / 3
+    small = 2 * det / (t + math.sqrt(max(t * t - 4 * det, 0.0)))
+    conditioning = math.sqrt(2 * small / t)
+    plain = t > 0 and conditioning > tol
+    for i in range(3):
+        a, c = _JJ[i], _KK[i]
+        e0, e1, e2 = p[r, c, 0] - p[r, a, 0], p[r, c, 1] - p[r, a, 1], p[r, c, 2] - p[r, a, 2]
+        side = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
+        plain = plain and side > tol * math.sqrt(t)
+        e[i, 0], e[i, 1], e[i, 2] = e0 / side, e1 / side, e2 / side
+        length = math.sqrt(n[r, i, 0] ** 2 + n[r, i, 1] ** 2 + n[r, i, 2] ** 2)
+        plain = plain and length > 0
+        for k in range(3):
+            unit[i, k] = n[r, i, k] / length
+    if not plain:
+        return _SKIP, 0.0, 0.0, 0.0
+    # G^+ w (grasp_map._manipulating): the twist (omega; F/3) about the centroid
+    F0, F1, F2 = w[r, 0], w[r, 1], w[r, 2]
+    c0, c1, c2 = _cross(g[0], g[1], g[2], F0, F1, F2)
+    _omega(q, mv, t, w[r, 3] - c0, w[r, 4] - c1, w[r, 5] - c2, lam)
+    scale = 0.0
+    for i in range(3):
+        c0, c1, c2 = _cross(lam[3], lam[4], lam[5], q[i, 0], q[i, 1], q[i, 2])
+        fm[i, 0], fm[i, 1], fm[i, 2] = F0 / 3 + c0, F1 / 3 + c1, F2 / 3 + c2
+        for k in range(3):
+            o[_FM + 3 * i + k] = fm[i, k]
+            scale = max(scale, abs(fm[i, k]))
+            plain = plain and math.isfinite(fm[i, k])
+    if not plain:  # overflow: nonfinite-result, said by the numpy path
+        return _SKIP, 0.0, 0.0, 0.0
+    o[_COND] = conditioning
+    for k in range(6):
+        o[_CERT + k] = math.nan
+    if scale == 0:  # no wrench: no force at all is the least
+        for k in range(6):
+            o[_DUAL + k] = 0.0
+        return _NONE, t, size2, scale
+    # the cones (grasp_map.tangent_bases, grip._cones) and the squeezes' map (contact_matrices)
+    for i in range(3):
+        kappa = 0.0 if math.isinf(limit[r, i]) else 1 / limit[r, i]
+        u0, u1, u2 = unit[i, 0], unit[i, 1], unit[i, 2]
+        b0, b1, b2 = _cross(u0, u1, u2, 1.0, 0.0, 0.0) if abs(u0) < 0.9 else _cross(u0, u1, u2, 0.0, 1.0, 0.0)
+        bl = math.sqrt(b0 * b0 + b1 * b1 + b2 * b2)
+        b0, b1, b2 = b0 / bl, b1 / bl, b2 / bl
+        t0, t1, t2 = _cross(u0, u1, u2, b0, b1, b2)
+        frame[i, 0, 0], frame[i, 0, 1], frame[i, 0, 2] = u0, u1, u2
+        frame[i, 1, 0], frame[i, 1, 1], frame[i, 1, 2] = kappa * b0, kappa * b1, kappa * b2
+        frame[i, 2, 0], frame[i, 2, 1], frame[i, 2, 2] = kappa * t0, kappa * t1, kappa * t2
+        for k in range(3):
+            M[i, k, _KK[i]] = e[_KK[i], k]
+            M[i, k, _JJ[i]] = -e[_JJ[i], k]
+            M[i, k, i] = 0.0
+    for i in range(3):
+        for k in range(3):
+            b[i, k] = (
+                frame[i, k, 0] * (fm[i, 0] / scale)
+                + frame[i, k, 1] * (fm[i, 1] / scale)
+                + frame[i, k, 2] * (fm[i, 2] / scale)
+            )
+            for j in range(3):
+                A[i, k, j] = frame[i, k, 0] * M[i, 0, j] + frame[i, k, 1] * M[i, 1, j] + frame[i, k, 2] * M[i, 2, j]
+    _internal_inside(p[r], unit, mv, e, limit[r], inside, corners)
+    return _OPEN, t, size2, scale
+
+
+@njit(**_JIT)
+def _finish(r, w, o, codes, fail, blame, q, mv, t, g, size2, unit, fm, frame, M, scale, s, z, d, lam):
+    """Row ``r``'s last pass: the dual or the certificate (``z``: the multipliers of phase II or of a
+    failed phase I), the forces of the squeezes ``s`` and their figures into ``o`` (its row of ``out``)."""
+    if scale:
+        # the multipliers as forces' duals; the dual twist through n_i - u_i, phase I's y through -u_i
+        for i in range(3):
+            for k in range(3):
+                d[i, k] = frame[i, 0, k] * z[i, 0] + frame[i, 1, k] * z[i, 1] + frame[i, 2, k] * z[i, 2]
+        if fail:
+            _twist(q, mv, t, g, d, lam, -1.0)
+            yw, yy, ww = 0.0, 0.0, 0.0
+            for k in range(6):
+                yw += lam[k] * w[r, k]
+                yy += lam[k] * lam[k]
+                ww += w[r, k] * w[r, k]
+            if not yw > 1e-8 * math.sqrt(yy) * math.sqrt(ww):  # grip._EDGE_OF_HOLD: facial reduction in numpy
+                return
+            length = math.sqrt(
+                lam[0] ** 2 + lam[1] ** 2 + lam[2] ** 2 + size2 * (lam[3] ** 2 + lam[4] ** 2 + lam[5] ** 2)
+            )
+            for k in range(6):
+                o[_CERT + k] = lam[k] / length
+                o[_DUAL + k] = math.nan
+        else:
+            for i in range(3):
+                for k in range(3):
+                    d[i, k] = unit[i, k] - d[i, k]
+            _twist(q, mv, t, g, d, lam, 1.0)
+            for k in range(6):
+                o[_DUAL + k] = lam[k]
+    codes[r, 0], codes[r, 1] = (20, blame) if fail else (0, -1)
+    # the forces and their figures (grip._Prepared.solve, grasp_map.checked_grip)
+    top, total, finite = 0.0, 0.0, True
+    for i in range(3):
+        for k in range(3):
+            f = fm[i, k] + scale * (M[i, k, 0] * s[0] + M[i, k, 1] * s[1] + M[i, k, 2] * s[2]) if scale else 0.0
+            o[_F + 3 * i + k] = math.nan if fail else f
+            top = max(top, abs(f))
+        o[_S + i] = math.nan if fail else scale * s[i]
+    for i in range(3):
+        fn = 0.0
+        for k in range(3):
+            fn += o[_F + 3 * i + k] * unit[i, k]
+        ft2 = 0.0
+        for k in range(3):
+            tk = o[_F + 3 * i + k] - fn * unit[i, k]
+            ft2 += tk * tk
+        ft = math.sqrt(ft2)
+        o[_FN + i], o[_FT + i] = fn, ft
+        o[_USED + i] = 0.0 if not fail and ft <= 1e-12 * top else ft / fn
+        total += fn
+        finite = finite and math.isfinite(fn) and math.isfinite(ft) and math.isfinite(o[_USED + i])
+    o[_TOTAL] = total
+    finite = finite and math.isfinite(total)
+    gap = total
+    for k in range(6):
+        gap -= w[r, k] * o[_DUAL + k]
+        finite = finite and math.isfinite(o[_DUAL + k])
+    o[_GAP] = gap
+    codes[r, 2] = 1 if fail or (finite and math.isfinite(gap)) else 0
+
+
 @njit(**_ALLOC)
 def grip_rows(p, n, limit, w, tol, out, codes):
     """The whole grip of the rows numpy's :class:`grip._Prepared` solves by cones (three distinct,
@@ -519,192 +771,136 @@ def grip_rows(p, n, limit, w, tol, out, codes):
     non-finite number (input, or an overflow on the way), a wrench on the edge of what the fingers
     exert.  ``limit (n, 3)`` is ``mu / safety``.
     """
-    _grip_rows(p, n, limit, w, tol, out, codes, _workspace(), _row_workspace(), _grip_workspace())
+    rows = min(p.shape[0], _CHUNK)
+    _grip_rows(p, n, limit, w, tol, out, codes, _chunk(rows), _grip_workspace())
+
+
+@njit(**_ALLOC)
+def _chunk(rows):
+    """What the passes keep of each of ``rows`` rows: geometry, ``G^+ w``, cones (``M`` zero off its
+    squeezes' entries), both phases' problems and answers, stage, culprit, and the rows of each phase."""
+    f, i = np.empty, np.int64
+    return (
+        (f((rows, 3, 3)), f((rows, 3)), f((rows, 3)), f((rows, 3, 3)), f((rows, 3, 3)), f((rows, 3, 3, 3))),
+        (np.zeros((rows, 3, 3, 3)), f((rows, 3, 3, 3)), f((rows, 3, 3)), f((rows, 3)), f((rows, 3)), f((rows, 3, 3))),
+        (f((rows, _K, 3, _D)), f((rows, _K, 3)), f((rows, _D)), f((rows, _D)), f((rows, _K, 3)), f((rows, 3))),
+        f((rows, 3)),
+        (np.empty(rows, i), np.empty(rows, i), np.empty(rows, i), np.empty(rows, i), np.empty(rows, i)),
+    )
 
 
 @njit(**_ALLOC)
 def _grip_workspace():
-    """The arrays of one row's geometry, cones and answer (``M`` zero off its squeezes' entries)."""
+    """One row's scratch arrays: ``e``, ``corners``, ``d``, ``lam``, and :func:`_dual_polish`'s."""
     return (
         np.empty((3, 3)),
-        np.empty(3),
-        np.empty(3),
-        np.empty((3, 3)),
-        np.empty((3, 3)),
-        np.empty((3, 3)),
-        np.empty((3, 3, 3)),
-        np.zeros((3, 3, 3)),
-        np.empty((3, 3, 3)),
-        np.empty((3, 3)),
-        np.empty(3),
-        np.empty((3, 3)),
+        np.empty((6, 3)),
         np.empty((3, 3)),
         np.empty(6),
-        np.empty(3),
-        np.empty((6, 3)),
+        (np.empty(3), np.empty((3, 3, 1)), np.empty((3, 1)), np.empty((3, 1)), np.empty((3, 3))),
     )
 
 
 @njit(**_JIT)
-def _grip_rows(p, n, limit, w, tol, out, codes, ws, rw, gw):
-    """:func:`grip_rows` in the workspaces ``ws``, ``rw`` and ``gw`` (:func:`_grip_workspace`)."""
-    q, mv, g, unit, e, fm, frame, M, A, b, s, z, d, lam, inside, corners = gw
-    for r in range(p.shape[0]):
-        o = out[r]
-        codes[r, 0], codes[r, 1], codes[r, 2] = 0, -1, 0
-        plain = True
-        for i in range(3):
-            for k in range(3):
-                plain = plain and math.isfinite(p[r, i, k]) and math.isfinite(n[r, i, k])
-            plain = plain and limit[r, i] > 0  # NaN and 0 (frictionless, mixed) to numpy
-        for k in range(6):
-            plain = plain and math.isfinite(w[r, k])
-        if not plain:
-            continue
-        # geometry (grasp_map.geometry): centroid, spread, conditioning; degenerate rows to numpy
-        for k in range(3):
-            g[k] = (p[r, 0, k] + p[r, 1, k] + p[r, 2, k]) / 3
-        t, size2 = 0.0, 0.0
-        for i in range(3):
-            q2 = 0.0
-            for k in range(3):
-                q[i, k] = p[r, i, k] - g[k]
-                q2 += q[i, k] * q[i, k]
-            t += q2
-            size2 = max(size2, q2)
-        mv[0], mv[1], mv[2] = _cross(
-            p[r, 1, 0] - p[r, 0, 0],
-            p[r, 1, 1] - p[r, 0, 1],
-            p[r, 1, 2] - p[r, 0, 2],
-            p[r, 2, 0] - p[r, 0, 0],
-            p[r, 2, 1] - p[r, 0, 1],
-            p[r, 2, 2] - p[r, 0, 2],
-        )
-        mm = mv[0] * mv[0] + mv[1] * mv[1] + mv[2] * mv[2]
-        det = mm / 3
-        small = 2 * det / (t + math.sqrt(max(t * t - 4 * det, 0.0)))
-        conditioning = math.sqrt(2 * small / t)
-        plain = t > 0 and conditioning > tol
-        for i in range(3):
-            a, c = _JJ[i], _KK[i]
-            e0, e1, e2 = p[r, c, 0] - p[r, a, 0], p[r, c, 1] - p[r, a, 1], p[r, c, 2] - p[r, a, 2]
-            side = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
-            plain = plain and side > tol * math.sqrt(t)
-            e[i, 0], e[i, 1], e[i, 2] = e0 / side, e1 / side, e2 / side
-            length = math.sqrt(n[r, i, 0] ** 2 + n[r, i, 1] ** 2 + n[r, i, 2] ** 2)
-            plain = plain and length > 0
-            for k in range(3):
-                unit[i, k] = n[r, i, k] / length
-        if not plain:
-            continue
-        # G^+ w (grasp_map._manipulating): the twist (omega; F/3) about the centroid
-        F0, F1, F2 = w[r, 0], w[r, 1], w[r, 2]
-        c0, c1, c2 = _cross(g[0], g[1], g[2], F0, F1, F2)
-        _omega(q, mv, t, w[r, 3] - c0, w[r, 4] - c1, w[r, 5] - c2, lam)
-        scale = 0.0
-        for i in range(3):
-            c0, c1, c2 = _cross(lam[3], lam[4], lam[5], q[i, 0], q[i, 1], q[i, 2])
-            fm[i, 0], fm[i, 1], fm[i, 2] = F0 / 3 + c0, F1 / 3 + c1, F2 / 3 + c2
-            for k in range(3):
-                o[_FM + 3 * i + k] = fm[i, k]
-                scale = max(scale, abs(fm[i, k]))
-                plain = plain and math.isfinite(fm[i, k])
-        if not plain:  # overflow: nonfinite-result, said by the numpy path
-            continue
-        o[_COND] = conditioning
-        for k in range(6):
-            o[_CERT + k] = math.nan
-        fail, blame = False, -1
-        if scale == 0:  # no wrench: no force at all is the least
-            for k in range(3):
-                s[k] = 0.0
-            for k in range(6):
-                o[_DUAL + k] = 0.0
-        else:
-            # the cones (grasp_map.tangent_bases, grip._cones) and the squeezes' map (contact_matrices)
-            for i in range(3):
-                kappa = 0.0 if math.isinf(limit[r, i]) else 1 / limit[r, i]
-                u0, u1, u2 = unit[i, 0], unit[i, 1], unit[i, 2]
-                b0, b1, b2 = _cross(u0, u1, u2, 1.0, 0.0, 0.0) if abs(u0) < 0.9 else _cross(u0, u1, u2, 0.0, 1.0, 0.0)
-                bl = math.sqrt(b0 * b0 + b1 * b1 + b2 * b2)
-                b0, b1, b2 = b0 / bl, b1 / bl, b2 / bl
-                t0, t1, t2 = _cross(u0, u1, u2, b0, b1, b2)
-                frame[i, 0, 0], frame[i, 0, 1], frame[i, 0, 2] = u0, u1, u2
-                frame[i, 1, 0], frame[i, 1, 1], frame[i, 1, 2] = kappa * b0, kappa * b1, kappa * b2
-                frame[i, 2, 0], frame[i, 2, 1], frame[i, 2, 2] = kappa * t0, kappa * t1, kappa * t2
-                for k in range(3):
-                    M[i, k, _KK[i]] = e[_KK[i], k]
-                    M[i, k, _JJ[i]] = -e[_JJ[i], k]
-                    M[i, k, i] = 0.0
-            for i in range(3):
-                for k in range(3):
-                    b[i, k] = (
-                        frame[i, k, 0] * (fm[i, 0] / scale)
-                        + frame[i, k, 1] * (fm[i, 1] / scale)
-                        + frame[i, k, 2] * (fm[i, 2] / scale)
-                    )
-                    for j in range(3):
-                        A[i, k, j] = (
-                            frame[i, k, 0] * M[i, 0, j] + frame[i, k, 1] * M[i, 1, j] + frame[i, k, 2] * M[i, 2, j]
-                        )
-            for i in range(3):
-                for k in range(3):
-                    z[i, k] = 0.0
-            _internal_inside(p[r], unit, mv, e, limit[r], inside, corners)
-            fail, blame = _solve_row(A, b, inside, s, z, ws, rw)
-            # the multipliers as forces' duals; the dual twist through n_i - u_i, phase I's y through -u_i
-            for i in range(3):
-                for k in range(3):
-                    d[i, k] = frame[i, 0, k] * z[i, 0] + frame[i, 1, k] * z[i, 1] + frame[i, 2, k] * z[i, 2]
-            if fail:
-                _twist(q, mv, t, g, d, lam, -1.0)
-                yw, yy, ww = 0.0, 0.0, 0.0
-                for k in range(6):
-                    yw += lam[k] * w[r, k]
-                    yy += lam[k] * lam[k]
-                    ww += w[r, k] * w[r, k]
-                if not yw > 1e-8 * math.sqrt(yy) * math.sqrt(ww):  # grip._EDGE_OF_HOLD: facial reduction in numpy
-                    continue
-                length = math.sqrt(
-                    lam[0] ** 2 + lam[1] ** 2 + lam[2] ** 2 + size2 * (lam[3] ** 2 + lam[4] ** 2 + lam[5] ** 2)
-                )
-                for k in range(6):
-                    o[_CERT + k] = lam[k] / length
-                    o[_DUAL + k] = math.nan
-            else:
-                for i in range(3):
-                    for k in range(3):
-                        d[i, k] = unit[i, k] - d[i, k]
-                _twist(q, mv, t, g, d, lam, 1.0)
-                for k in range(6):
-                    o[_DUAL + k] = lam[k]
-        codes[r, 0], codes[r, 1] = (20, blame) if fail else (0, -1)
-        # the forces and their figures (grip._Prepared.solve, grasp_map.checked_grip)
-        top, total, finite = 0.0, 0.0, True
-        for i in range(3):
-            for k in range(3):
-                f = fm[i, k] + scale * (M[i, k, 0] * s[0] + M[i, k, 1] * s[1] + M[i, k, 2] * s[2]) if scale else 0.0
-                o[_F + 3 * i + k] = math.nan if fail else f
-                top = max(top, abs(f))
-            o[_S + i] = math.nan if fail else scale * s[i]
-        for i in range(3):
-            fn = 0.0
-            for k in range(3):
-                fn += o[_F + 3 * i + k] * unit[i, k]
-            ft2 = 0.0
-            for k in range(3):
-                tk = o[_F + 3 * i + k] - fn * unit[i, k]
-                ft2 += tk * tk
-            ft = math.sqrt(ft2)
-            o[_FN + i], o[_FT + i] = fn, ft
-            o[_USED + i] = 0.0 if not fail and ft <= 1e-12 * top else ft / fn
-            total += fn
-            finite = finite and math.isfinite(fn) and math.isfinite(ft) and math.isfinite(o[_USED + i])
-        o[_TOTAL] = total
-        finite = finite and math.isfinite(total)
-        gap = total
-        for k in range(6):
-            gap -= w[r, k] * o[_DUAL + k]
-            finite = finite and math.isfinite(o[_DUAL + k])
-        o[_GAP] = gap
-        codes[r, 2] = 1 if fail or (finite and math.isfinite(gap)) else 0
+def _grip_rows(p, n, limit, w, tol, out, codes, chunk, gw):
+    """:func:`grip_rows` a chunk of rows at a time, in passes: set-up, phase I (then phase I on the rays,
+    for a culprit), phase II, finish; the phases' rows in step (:func:`_iterate`)."""
+    (q, mv, g, unit, fm, frame), (M, A, b, c, x, z), (wide, bw, cw, xw, zw, inside), sizes, lists = chunk
+    t, size2, scale = sizes[:, 0], sizes[:, 1], sizes[:, 2]
+    stage, blame, one, two, again = lists
+    e, corners, d, lam, (omega, h, res, delta, dz) = gw
+    for first in range(0, p.shape[0], _CHUNK):  # no rows: no chunk
+        rows = min(_CHUNK, p.shape[0] - first)
+        ones, twos, agains = 0, 0, 0
+        for i in range(rows):
+            r = first + i
+            stage[i], t[i], size2[i], scale[i] = _set_up(
+                r,
+                p,
+                n,
+                limit,
+                w,
+                tol,
+                out[r],
+                codes,
+                q[i],
+                mv[i],
+                g[i],
+                unit[i],
+                e,
+                fm[i],
+                frame[i],
+                M[i],
+                A[i],
+                b[i],
+                inside[i],
+                corners,
+                lam,
+            )
+            blame[i] = -1
+            if stage[i] == _NONE:
+                x[i, 0], x[i, 1], x[i, 2] = 0.0, 0.0, 0.0
+            elif stage[i] == _OPEN:
+                if _start(A[i], b[i], inside[i], c[i], x[i]):
+                    stage[i], two[twos] = _HOLD, i
+                    twos += 1
+                else:
+                    _phase_one_problem(A[i], b[i], False, wide[i], bw[i], cw[i], xw[i], zw[i])
+                    one[ones] = i
+                    ones += 1
+        _in_lanes(wide, bw, cw, xw, zw, one[:ones], True, _D, _K)
+        for k in range(ones):
+            i = one[k]
+            for j in range(3):
+                x[i, j] = xw[i, j]
+            if xw[i, 3] < 0:
+                stage[i], two[twos] = _HOLD, i
+                twos += 1
+                continue
+            stage[i] = _FAIL
+            for m in range(3):
+                for j in range(3):
+                    z[i, m, j] = zw[i, m, j]
+            blame[i], maybe = _culprit(A[i], b[i], x[i])
+            if maybe:
+                _phase_one_problem(A[i], b[i], True, wide[i], bw[i], cw[i], xw[i], zw[i])
+                again[agains] = i
+                agains += 1
+            for j in range(3):
+                x[i, j] = math.nan
+        _in_lanes(wide, bw, cw, xw, zw, again[:agains], True, _D, _K)
+        for k in range(agains):
+            if not xw[again[k], 3] < 0:
+                blame[again[k]] = -1
+        for k in range(twos):
+            for m in range(3):
+                z[two[k], m, 0], z[two[k], m, 1], z[two[k], m, 2] = 1.0, 0.0, 0.0
+        _in_lanes(A, b, c, x, z, two[:twos], False, _SQUEEZES, _CONES)
+        for i in range(rows):
+            if stage[i] == _SKIP:
+                continue
+            if stage[i] == _HOLD:
+                _dual_polish(A[i], b[i], c[i], x[i], z[i], omega, h, res, delta, dz)
+            r = first + i
+            _finish(
+                r,
+                w,
+                out[r],
+                codes,
+                stage[i] == _FAIL,
+                blame[i],
+                q[i],
+                mv[i],
+                t[i],
+                g[i],
+                size2[i],
+                unit[i],
+                fm[i],
+                frame[i],
+                M[i],
+                scale[i],
+                x[i],
+                z[i],
+                d,
+                lam,
+            )
