@@ -801,3 +801,10 @@ def test_an_infinite_wrench_beside_a_huge_one_keeps_its_status_and_the_huge_one_
     g = gt.grip(EQ, -EQ, [[0, 0, np.inf, 0, 0, 0], [0, 0, G * 1e300, 0, 0, 0]], 0.5)
     assert g.status.tolist() == [gt.forces.Status.NONFINITE_INPUT, 0]
     assert g.total_normal_force[1] == pytest.approx(2 * G * 1e300, rel=1e-9)
+
+
+@pytest.mark.parametrize("batch", [(0,), (2, 0)])
+def test_an_empty_batch_grips_to_empty_fields(batch):
+    g = grip(np.zeros(batch + (3, 3)), np.zeros(batch + (3, 3)), np.zeros(batch + (6,)), 0.5)
+    assert g.status.shape == g.total_normal_force.shape == batch
+    assert g.force.shape == batch + (3, 3) and g.dual.shape == batch + (6,)

@@ -289,6 +289,8 @@ def _grip_of(rows, s_f, tol, shape, prepared=None):
     A wrench beyond ``grasp_map.WRENCH_SCALED_BEYOND`` is solved scaled (``wrench_scales``) and its
     grip scaled back, so that only a grip that is itself beyond a double is ``nonfinite-result``.
     """
+    if not len(rows[0]):  # both paths index a first row
+        return _no_rows(s_f, shape)
     k = wrench_scales(rows[3])
     if k is not None:
         g = _grip_of((*rows[:3], rows[3] / k[:, None]), s_f, tol, shape, prepared)
@@ -332,6 +334,12 @@ def _compiled_grip(fast, rows, s_f, tol, shape, others):
 
 
 _TAILS = {1: (), 3: (3,), 6: (6,), 9: (3, 3)}
+
+
+def _no_rows(s_f, shape):
+    """The :class:`Grip` of an empty batch: every field with ``shape`` and its own trailing shape."""
+    fields = {name: np.empty(shape + _TAILS[width]) for name, width in GRIP_COLUMNS}
+    return Grip(safety=s_f, status=np.empty(shape, np.int8), culprit=np.empty(shape, np.int8), **fields)
 
 
 def _views():
