@@ -313,3 +313,35 @@ def test_the_table_gives_a_hand_s_joint_positions():
     }
     SynthesisTable(out).write(rec)
     assert out.getvalue().decode().splitlines()[-1] == "    joints: a.1 0.5000, a.2 -0.2500"
+
+
+OCTAHEDRON = (
+    "v 0.05 0 0\nv -0.05 0 0\nv 0 0.05 0\nv 0 -0.05 0\nv 0 0 0.05\nv 0 0 -0.05\n"
+    "f 1 3 5\nf 3 2 5\nf 2 4 5\nf 4 1 5\nf 3 1 6\nf 2 3 6\nf 4 2 6\nf 1 4 6\n"
+)
+
+
+def test_a_folder_s_mesh_files_are_searched_beside_its_grasp_files(tmp_path):
+    (tmp_path / "bad.yaml").write_text("contacts: [\n")
+    (tmp_path / "oct.obj").write_text(OCTAHEDRON)
+    (tmp_path / "notes.txt").write_text("not an object")
+    r, _ = run(
+        "synthesize",
+        tmp_path,
+        "--friction",
+        "0.6",
+        "--mass",
+        "0.2",
+        "--candidates",
+        "60",
+        "-n",
+        "1",
+        "-j",
+        "2",
+        "-f",
+        "jsonl",
+    )
+    assert r.exit_code == 1  # bad.yaml's error
+    recs = jsonl(r.stdout)
+    assert [(x["file"].rsplit("/", 1)[1], x["ok"]) for x in recs] == [("bad.yaml", False), ("oct.obj", True)]
+    assert recs[1]["grasp"] == "oct" and "no-grasp-files" not in r.stderr

@@ -185,9 +185,9 @@ def synthesize(
     grasp_file = output if output is not None and output.lower().endswith(GRASP_FILE_SUFFIXES) else None
     records_to = None if grasp_file is not None else output
     if grasp_file is not None:  # written at the end of the run: refused before any work, as a records file is
-        from ..io.inputs import expand
+        from ..io.inputs import OBJECT_SUFFIXES, expand
 
-        checked_output(grasp_file, [p for p in expand(paths) if isinstance(p, str)])
+        checked_output(grasp_file, [p for p in expand(paths, OBJECT_SUFFIXES) if isinstance(p, str)])
     fmt = SynthesizeFormat.json if json_ else fmt
     not_binary_to_a_terminal(fmt.value, records_to)
     job = Job(
