@@ -345,3 +345,12 @@ def test_a_folder_s_mesh_files_are_searched_beside_its_grasp_files(tmp_path):
     recs = jsonl(r.stdout)
     assert [(x["file"].rsplit("/", 1)[1], x["ok"]) for x in recs] == [("bad.yaml", False), ("oct.obj", True)]
     assert recs[1]["grasp"] == "oct" and "no-grasp-files" not in r.stderr
+
+
+def test_wrench_adds_to_the_object_s_weight_never_replaces_it():
+    r, _ = run("synthesize", SPHERE, "--friction", "0.5", "--wrench", "0,0,0,0,0,0.02", *FAST, "-f", "jsonl")
+    recs = jsonl(r.stdout)
+    assert set(recs[0]["scores"]["total_normal_force"]) == {"0,0,0,0,0,0.02"}  # the tripod ball has no mass
+    totals = recs[2]["scores"]["total_normal_force"]
+    assert set(totals) == {"hold", "0,0,0,0,0,0.02"}  # the file's turn-z replaced, its 1 kg still held
+    assert totals["hold"] >= 9.81 / np.sqrt(1 + 0.5**2) * (1 - 1e-9)  # no grip holds 1 kg with less

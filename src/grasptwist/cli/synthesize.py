@@ -164,7 +164,8 @@ def synthesize(
     refined on the surface, and each grasp returned is verified by the exact grip.
     With a hand (the file's, or --hand) every grasp is reached within the joint limits,
     fingertips on the surface and no finger link in the object; the records give the
-    joint positions. With -o FILE.yaml the grasps are written as a grasp file every
+    joint positions. The object's weight ('hold', from its mass or --mass) is always
+    held; --wrench adds wrenches beside it. With -o FILE.yaml the grasps are written as a grasp file every
     command reads (the records go to stdout). Exit 1 when an object has no feasible grasp.
     Examples:
 

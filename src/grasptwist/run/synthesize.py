@@ -5,8 +5,9 @@ searched from: the search finds its own), or a mesh file (STL, OBJ, PLY) with th
 line's friction and mass.  A hand (the file's ``hand``, or the job's: ``--hand``) must reach
 every grasp: its fingertips (``--tip-radius``, else each finger's ``tip_radius``) on the
 surface, its joints within their limits, its links (a URDF's meshes) out of the object; a
-hand given inline has its tips where the file's contacts are (its joints are given there).  The command line's ``--friction``, ``--mass`` and ``--wrench`` replace
-the file's.  The search is :func:`grasptwist.engine.synthesis.search.search`; with ``-o
+hand given inline has its tips where the file's contacts are (its joints are given there).  The command
+line's ``--friction`` and ``--mass`` replace the file's; ``--wrench`` replaces its other wrenches, beside
+the weight (``hold``), which is held whenever there is a mass.  The search is :func:`grasptwist.engine.synthesis.search.search`; with ``-o
 FILE.yaml`` the grasps found are also written as a grasp file (atomically, at the end).
 No math here: only reading, routing and labelling.
 """
@@ -103,10 +104,11 @@ def _task(options: SynthesisOptions, grasp: Grasp):
         friction = float(np.min(grasp.friction))  # the contacts found are none of the file's: the least
     else:
         return _problem(grasp.file, NO_FRICTION, f"grasp '{grasp.name}' has no friction: give --friction", grasp.line)
+    # --wrench replaces the file's other wrenches; the weight is always held (beside them)
     named = [] if options.wrenches is not None else [(w.name, w.wrench) for w in grasp.wrenches if w.name != HOLD]
     named += [(w.name, w.wrench) for w in options.wrenches or ()]
     hold = None
-    if options.mass is not None or (grasp.mass is not None and options.wrenches is None):
+    if options.mass is not None or grasp.mass is not None:
         props = mass_properties(obj)
         mass = props.mass if props.mass is not None else grasp.mass
         center = props.center_of_mass if grasp.object.mass is not None or options.mass else grasp.center_of_mass
