@@ -354,3 +354,23 @@ def test_wrench_adds_to_the_object_s_weight_never_replaces_it():
     totals = recs[2]["scores"]["total_normal_force"]
     assert set(totals) == {"hold", "0,0,0,0,0,0.02"}  # the file's turn-z replaced, its 1 kg still held
     assert totals["hold"] >= 9.81 / np.sqrt(1 + 0.5**2) * (1 - 1e-9)  # no grip holds 1 kg with less
+
+
+def test_the_grasp_file_keeps_the_input_s_twists_and_paths(tmp_path):
+    source = GRASPS / "polyhedron.yaml"  # a body-frame path with a pose target, a twist about the diagonal
+    found = tmp_path / "found.yaml"
+    r, _ = run("synthesize", source, "--friction", "0.8", "--mass", "1", "-n", "1", "--candidates", "120", "-o", found)
+    assert r.exit_code == 0, r.stderr
+    (given,), (written,) = read_grasps(source), read_grasps(found)
+    assert [t.name for t in written.twists] == [t.name for t in given.twists]
+    np.testing.assert_array_equal([t.screw for t in written.twists], [t.screw for t in given.twists])
+    assert [p.name for p in written.paths] == [p.name for p in given.paths]
+    for a, b in zip(written.paths[0].segments, given.paths[0].segments):
+        assert (a.duration, a.frame) == (b.duration, b.frame)
+        for key in ("twist", "position"):
+            if getattr(b, key) is not None:
+                np.testing.assert_array_equal(getattr(a, key), getattr(b, key))
+        if b.rotation is not None:
+            np.testing.assert_allclose(a.rotation, b.rotation, atol=1e-15)
+    resolved, _ = run("resolve", found, "-f", "jsonl")  # its own twists: no --twist needed
+    assert resolved.exit_code == 0 and [x["twist"]["name"] for x in jsonl(resolved.stdout)] == ["diagonal-spin"]

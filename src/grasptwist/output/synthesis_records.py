@@ -185,12 +185,32 @@ def _hand_node(found, k, folder):
     return {"fingers": fingers}
 
 
+def _path_node(path) -> dict:
+    """An object path as a grasp file writes it: each segment a screw, or a pose target (its rotation as given)."""
+    segments = []
+    for seg in path.segments:
+        node = {"duration": float(seg.duration)}
+        if seg.twist is not None:
+            node["screw"] = np.asarray(seg.twist).tolist()
+        else:
+            pose = {"position": np.asarray(seg.position).tolist()}
+            if seg.rotvec is not None:
+                pose["rotvec"] = np.asarray(seg.rotvec).tolist()  # as written: its size is judged on reading
+            else:
+                pose["rotation"] = _quaternion(np.asarray(seg.rotation))
+            node["pose"] = pose
+        segments.append(node)
+    frames = {seg.frame for seg in path.segments if seg.twist is not None}
+    return {"name": path.name, **({"frame": "body"} if frames == {"body"} else {}), "segments": segments}
+
+
 def grasp_documents(found, folder: str) -> str:
     """The grasps found as grasp-file documents (YAML, ``---`` between them), read back by every command.
 
     Each keeps the input's object, units, wrist and friction, its wrenches by name (the weight as
-    the object's mass, or ``mass`` and ``center_of_mass``, when one of them is ``hold``), and gives
-    the contacts found.
+    the object's mass, or ``mass`` and ``center_of_mass``, when one of them is ``hold``), its twists
+    and paths (in the grasp frame, as the contacts: valid for any contacts), and gives the contacts
+    found.
     """
     s = found.synthesis
     docs = []
@@ -205,6 +225,10 @@ def grasp_documents(found, folder: str) -> str:
             {"name": found.contact_names[i], "point": s.points[k, i].tolist(), "normal": s.normals[k, i].tolist()}
             for i in range(3)
         ]
+        if found.twists:
+            doc["twists"] = [{"name": t.name, "screw": np.asarray(t.screw).tolist()} for t in found.twists]
+        if found.paths:
+            doc["paths"] = [_path_node(path) for path in found.paths]
         doc["friction"] = float(found.friction)
         wrenches = [
             {"name": name, "wrench": np.asarray(w).tolist()}

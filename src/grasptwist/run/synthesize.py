@@ -84,6 +84,8 @@ class Found:
     hand: Hand | None = None  # with a hand: its fingers in contact order, at the synthesis' joint positions
     hand_file: str | None = None  # the file the hand's URDF reference is relative to
     joints_at: tuple | None = None  # an inline hand's joints at each grasp: per finger (screws (n, 6), points (n, 3))
+    twists: tuple = ()  # the input's twists and paths, written with each grasp found (-o FILE.yaml)
+    paths: tuple = ()
 
     def __len__(self) -> int:
         return len(self.synthesis.points)
@@ -251,6 +253,8 @@ def synthesize_inputs(job, inputs: Iterable) -> Iterator[GraspFileError | Found 
                 hand=hand,
                 hand_file=None if hand is None else (o.hand_file if job.hand is not None else entry.file),
                 joints_at=_inline_joints(hand, step),
+                twists=entry.twists,
+                paths=entry.paths,
             )
         yield Progress(0, 1)
 
