@@ -374,3 +374,19 @@ def test_the_grasp_file_keeps_the_input_s_twists_and_paths(tmp_path):
             np.testing.assert_allclose(a.rotation, b.rotation, atol=1e-15)
     resolved, _ = run("resolve", found, "-f", "jsonl")  # its own twists: no --twist needed
     assert resolved.exit_code == 0 and [x["twist"]["name"] for x in jsonl(resolved.stdout)] == ["diagonal-spin"]
+
+
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
+def test_csv_with_a_hand_has_its_reach_errors_and_joint_positions():
+    args = ("--mass", "1", "--friction", "0.8", "--tip-radius", "0.1", *FAST)
+    r, _ = run("synthesize", HAND, *args, "-f", "csv")
+    assert r.exit_code == 0, r.stderr
+    rows = list(csv.DictReader(io.StringIO(r.stdout)))
+    joints = [f"q_{f}_{f}.{j}" for f in ("east", "west", "south") for j in (1, 2, 3)]  # as resolve's CSV names them
+    assert list(rows[0])[-12:] == ["reach_error_1", "reach_error_2", "reach_error_3", *joints]
+    recs = jsonl(run("synthesize", HAND, *args, "-f", "jsonl")[0].stdout)
+    for row, rec in zip(rows, recs, strict=True):
+        assert [float(row[n]) for n in joints] == pytest.approx(list(rec["joint_positions"].values()), rel=1e-15)
+        assert max(float(row[f"reach_error_{i}"]) for i in (1, 2, 3)) < 1e-9
+    plain, _ = run("synthesize", SPHERE, "--friction", "0.5", "--mass", "1", *FAST, "-f", "csv")
+    assert "reach_error_1" not in plain.stdout.splitlines()[0]  # no hand, no hand columns

@@ -194,7 +194,8 @@ def synthesize(
     job = Job(
         command=COMMANDS["synthesize"],
         fmt=fmt.value,
-        hand=None if hand is None else hand_option(hand, [], fmt.value),
+        # --hand's, else one grasp file's first hand: it names the joint columns of CSV and Parquet
+        hand=hand_option(hand, paths, fmt.value),
         max_bytes=max_bytes,
         reading=reading_option(surface_tol, allow_outside),
         options=SynthesisOptions(

@@ -31,6 +31,7 @@ from typing import IO
 import numpy as np
 import yaml
 
+from ..results import joint_column_names
 from .columns import ColumnSet
 from .csv_rows import lines
 from .names import escaped
@@ -266,17 +267,34 @@ _NUMBERS = (
     "seed",
 )
 _HEADER = ",".join((*_OWN, *_NUMBERS)).encode() + b"\n"
+_REACH = tuple(f"reach_error_{i}" for i in (1, 2, 3))
+
+
+def _hand_columns(hand) -> tuple[str, ...]:
+    """The columns a run's hand adds: each finger's reach error, then its joints' positions ``q_<finger>_<joint>``."""
+    return () if hand is None else (*_REACH, *joint_column_names("q", hand))
 
 
 def _header(hand=None) -> bytes:
-    return _HEADER
+    return _HEADER if hand is None else ",".join((*_OWN, *_NUMBERS, *_hand_columns(hand))).encode() + b"\n"
 
 
 def _typed(hand=None) -> dict:
     types = {"file": "U", "grasp": "U", "rank": "int64", "ok": "?", "error": "U"}
-    types.update({name: "float64" for name in _NUMBERS})
+    types.update({name: "float64" for name in (*_NUMBERS, *_hand_columns(hand))})
     types.update(candidates="int64", seed="int64")
     return types
+
+
+def _joint_values(found, hand) -> dict:
+    """The hand's columns of ``found``'s grasps: NaN where its hand is not the run's (another file's)."""
+    s, k = found.synthesis, len(found)
+    names = joint_column_names("q", hand)
+    same = found.hand is not None and joint_column_names("q", found.hand) == names
+    out = {name: s.reach_error[:, i] if same else np.full(k, np.nan) for i, name in enumerate(_REACH)}
+    joints = [j for f in found.hand.fingers for j in f.joint_index] if same else [None] * len(names)
+    out.update({n: s.joint_positions[:, j] if same else np.full(k, np.nan) for n, j in zip(names, joints)})
+    return out
 
 
 def _flat(found, order="omega-v", hand=None, typed=False) -> dict:
@@ -300,6 +318,8 @@ def _flat(found, order="omega-v", hand=None, typed=False) -> dict:
     columns["candidates"] = np.full(k, s.candidates)
     columns["seconds"] = np.full(k, s.seconds)
     columns["seed"] = np.full(k, s.seed)
+    if hand is not None:
+        columns.update(_joint_values(found, hand))
     for name, a in columns.items():
         if a.dtype.kind == "f":
             columns[name] = np.ma.masked_invalid(a)
@@ -307,13 +327,14 @@ def _flat(found, order="omega-v", hand=None, typed=False) -> dict:
 
 
 def _arrays(found, order="omega-v", hand=None) -> dict:
-    return {name: np.ma.getdata(a) for name, a in _flat(found).items()}
+    return {name: np.ma.getdata(a) for name, a in _flat(found, hand=hand).items()}
 
 
 def _error_row(rec: dict, hand=None) -> bytes:
     err = rec["error"]
     row = [rec["file"], rec.get("grasp", ""), "", "false", f"{err['code']}: {err['message']}"]
-    return lines({str(j): np.array([v], dtype=object) for j, v in enumerate(row + [""] * len(_NUMBERS))})[0]
+    pad = [""] * (len(_NUMBERS) + len(_hand_columns(hand)))
+    return lines({str(j): np.array([v], dtype=object) for j, v in enumerate(row + pad)})[0]
 
 
 class _Statuses(IntEnum):

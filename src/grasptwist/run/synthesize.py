@@ -130,7 +130,8 @@ def _task(options: SynthesisOptions, grasp: Grasp):
 def _hand(job, grasp: Grasp, obj: GraspObject):
     """The hand that must reach the grasps of ``grasp`` (``(HandReach, Hand, its file)``), None
     without one, or the error of the document."""
-    hand = job.hand if job.hand is not None else grasp.hand
+    given = job.options.hand_file is not None  # --hand; else job.hand only names the columns (the file's)
+    hand = job.hand if given else grasp.hand
     if hand is None:
         return None
     radius = job.options.tip_radius
@@ -139,7 +140,7 @@ def _hand(job, grasp: Grasp, obj: GraspObject):
     # an inline finger's tip point is where the file's contact is (its joints are given at that configuration)
     tips = None
     if any(f.tip_pose is None for f in hand.fingers):
-        if job.hand is not None or grasp.file.lower().endswith(MESH_SUFFIXES):
+        if given or grasp.file.lower().endswith(MESH_SUFFIXES):
             return _problem(
                 grasp.file,
                 NO_TIP_POINTS,
@@ -150,7 +151,7 @@ def _hand(job, grasp: Grasp, obj: GraspObject):
     from .collisions import deepest_link  # the finger links' meshes: with the first URDF hand
 
     # a URDF's meshes are found from the file that names it: the grasp file, or --hand's
-    named_by = grasp.file if job.hand is None else job.options.hand_file
+    named_by = job.options.hand_file if given else grasp.file
     try:
         held = replace(grasp, hand=hand, object=obj, file=named_by)
         collide = deepest_link(held, max_bytes=job.max_bytes or DEFAULT_MAX_BYTES)
@@ -251,7 +252,7 @@ def synthesize_inputs(job, inputs: Iterable) -> Iterator[GraspFileError | Found 
                 step,
                 entry.contact_names,
                 hand=hand,
-                hand_file=None if hand is None else (o.hand_file if job.hand is not None else entry.file),
+                hand_file=None if hand is None else (o.hand_file or entry.file),
                 joints_at=_inline_joints(hand, step),
                 twists=entry.twists,
                 paths=entry.paths,
@@ -315,7 +316,7 @@ def synthesize_outputs(job, inputs: Iterable, w, workers: int = 1, tuning=None) 
             w.write(item)
             encoded = []
         elif job.fmt == "csv":
-            encoded = _csv(item)
+            encoded = _csv(job, item)
         else:
             encoded = [_encode(job, rec) for rec in recs]
         yield Output(encoded=encoded, records=len(recs), notes=[_summary(item)])
@@ -332,15 +333,15 @@ def _summary(found) -> str:
     )
 
 
-def _csv(found) -> list[bytes]:
+def _csv(job, found) -> list[bytes]:
     from ..output.csv_rows import lines
 
-    return lines(sr.SYNTHESIS_COLUMNS.flat(found))
+    return lines(sr.SYNTHESIS_COLUMNS.flat(found, hand=job.hand))
 
 
 def _encode(job, rec, error=False):
     if job.fmt == "table":
         return rec
     if job.fmt == "csv" and error:
-        return sr.SYNTHESIS_COLUMNS.error_row(rec)
+        return sr.SYNTHESIS_COLUMNS.error_row(rec, job.hand)
     return dumps(rec)
