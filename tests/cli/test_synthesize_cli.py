@@ -390,3 +390,15 @@ def test_csv_with_a_hand_has_its_reach_errors_and_joint_positions():
         assert max(float(row[f"reach_error_{i}"]) for i in (1, 2, 3)) < 1e-9
     plain, _ = run("synthesize", SPHERE, "--friction", "0.5", "--mass", "1", *FAST, "-f", "csv")
     assert "reach_error_1" not in plain.stdout.splitlines()[0]  # no hand, no hand columns
+
+
+def test_the_off_tangent_method_without_a_wrist_is_said_once_per_object(tmp_path):
+    (tmp_path / "oct.obj").write_text(OCTAHEDRON)
+    args = ("--friction", "0.6", "--mass", "0.2", "--candidates", "60", "-n", "2", "--method", "off-tangent")
+    r, _ = run("synthesize", tmp_path / "oct.obj", SPHERE, *args)
+    assert r.exit_code == 0, r.stderr
+    said = "grasp 'oct': warning: off-tangent conditioning not checked without a wrist"
+    assert r.stderr.count(said) == 1 and r.stderr.count("not checked without a wrist") == 1  # the balls have one
+    table = r.stdout.split("grasp 'sphere-tripod'")
+    assert "#2  total normal force" in table[0] and "conditioning" not in table[0]  # nothing to print
+    assert "conditioning: off_tangent" in table[1]

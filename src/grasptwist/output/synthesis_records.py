@@ -383,9 +383,10 @@ class SynthesisTable:
         totals = ", ".join(f"{escaped(n)} {self._number(v)}" for n, v in scores["total_normal_force"].items())
         cond = ", ".join(f"{m} {self._number(c)}" for m, c in scores["conditioning"].items() if c is not None)
         extra = "" if scores["epsilon"] is None else f"  epsilon {self._number(scores['epsilon'])}"
+        extra += f"  conditioning: {cond}" if cond else ""  # none: the off-tangent method alone, no wrist
         self._line(
             f"  #{rec['rank']}  total normal force: {totals}  closure mu {self._number(scores['closure_friction'])}"
-            f"{extra}  conditioning: {cond}"
+            f"{extra}"
         )
         for c in rec["contacts"]:
             point = ", ".join(self._number(v) for v in c["point"])

@@ -34,6 +34,7 @@ from ..io.mesh_file import MESH_SUFFIXES, read_mesh
 from ..model import Grasp, GraspFileError, GraspObject, Hand, InputError, Shape
 from ..output import synthesis_records as sr
 from ..output.formats import FORMATS
+from ..output.names import escaped
 from ..output.records import diagnostics, dumps, error_record
 from .options import SynthesisOptions
 from .outputs import Output
@@ -302,9 +303,10 @@ def synthesize_outputs(job, inputs: Iterable, w, workers: int = 1, tuning=None) 
             out.count(rec)
             yield out
             continue
+        warnings = _unchecked(job, item)
         if not len(item):
             rec = sr.failure_record(item)
-            out = Output(encoded=[_encode(job, rec, error=True)], records=1, notes=[_summary(item)])
+            out = Output(encoded=[_encode(job, rec, error=True)], records=1, notes=[_summary(item)], warnings=warnings)
             out.errors.extend(diagnostics(rec)[0])
             out.count(rec)
             yield out
@@ -319,10 +321,21 @@ def synthesize_outputs(job, inputs: Iterable, w, workers: int = 1, tuning=None) 
             encoded = _csv(job, item)
         else:
             encoded = [_encode(job, rec) for rec in recs]
-        yield Output(encoded=encoded, records=len(recs), notes=[_summary(item)])
+        yield Output(encoded=encoded, records=len(recs), notes=[_summary(item)], warnings=warnings)
     if job.options.grasp_file is not None and documents:
         with opened(job.options.grasp_file, [p for p in inputs if isinstance(p, str)]) as out:
             out.write("---\n".join(documents).encode())
+
+
+def _unchecked(job, found) -> list[str]:
+    """The warning of an object searched without a wrist when the off-tangent method was asked: its
+    conditioning cannot be checked (the search keeps to the tangent method's), once per object."""
+    if found.wrist is not None or job.options.method not in ("off-tangent", "both"):
+        return []
+    return [
+        f"{escaped(found.file)}: grasp '{escaped(found.name)}': warning: off-tangent conditioning not "
+        "checked without a wrist (a grasp file's 'wrist')"
+    ]
 
 
 def _summary(found) -> str:
