@@ -80,7 +80,7 @@ def test_a_file_without_object_or_friction_is_an_error_of_its_own(tmp_path):
 @pytest.mark.parametrize(
     ("args", "message"),
     [
-        (("--seconds", "0"), "seconds must be a positive finite number"),
+        (("--seconds", "0"), "'--seconds': must be a finite number > 0, got 0"),
         (("--min-conditioning", "2"), "min_conditioning must be a number from 0 to 1"),
         (("--mass", "-1"), "must be a finite number > 0"),
         (("--objective", "speed"), "speed"),
@@ -90,7 +90,7 @@ def test_a_file_without_object_or_friction_is_an_error_of_its_own(tmp_path):
 )
 def test_bad_options_are_usage_errors(args, message):
     r, _ = run("synthesize", SPHERE, *args)
-    assert r.exit_code == 2 and message in r.stderr
+    assert r.exit_code == 2 and message in r.stderr and "None" not in r.stderr
 
 
 def test_a_grasp_file_that_cannot_be_written_is_refused_before_any_search(tmp_path):
@@ -402,3 +402,14 @@ def test_the_off_tangent_method_without_a_wrist_is_said_once_per_object(tmp_path
     table = r.stdout.split("grasp 'sphere-tripod'")
     assert "#2  total normal force" in table[0] and "conditioning" not in table[0]  # nothing to print
     assert "conditioning: off_tangent" in table[1]
+
+
+def test_the_summary_says_how_many_of_the_grasps_wanted_and_tip_radius_without_a_hand_warns(tmp_path):
+    (tmp_path / "oct.obj").write_text(OCTAHEDRON)
+    args = ("--friction", "0.6", "--mass", "0.2", "--candidates", "60", "--method", "tangent")
+    r, _ = run("synthesize", tmp_path / "oct.obj", *args, "-n", "50", "--min-spacing", "0.2", "--tip-radius", "0.01")
+    assert r.exit_code == 0, r.stderr
+    assert "grasp 'oct': 1 of 50 grasps wanted (min spacing 0.2) from 60 candidates scored" in r.stderr
+    assert r.stderr.count("warning: --tip-radius ignored: no hand") == 1
+    one, _ = run("synthesize", tmp_path / "oct.obj", *args, "-n", "1")
+    assert "grasp 'oct': 1 grasp from 60 candidates" in one.stderr and "wanted" not in one.stderr

@@ -62,16 +62,11 @@ def _min_conditioning(value):
     return check_min_conditioning(value)
 
 
-def _mass(value):
+def _positive(value):
+    """--mass, --seconds: the engine's checks (check_budget's seconds), in the command line's words."""
     if not 0 < value < float("inf"):
-        raise ValueError(f"must be a finite number > 0, got {value}")
+        raise ValueError(f"must be a finite number > 0, got {value:g}")
     return value
-
-
-def _seconds(value):
-    from ..engine.synthesis.search import check_budget
-
-    return check_budget(1, value)[1]
 
 
 def synthesize(
@@ -87,7 +82,10 @@ def synthesize(
     mass: Annotated[
         float | None,
         typer.Option(
-            "--mass", metavar="KG", callback=_checked(_mass), help="The object's mass: its weight is the wrench 'hold'."
+            "--mass",
+            metavar="KG",
+            callback=_checked(_positive),
+            help="The object's mass: its weight is the wrench 'hold'.",
         ),
     ] = None,
     wrench: WrenchOption = None,
@@ -131,7 +129,8 @@ def synthesize(
             "--tip-radius",
             metavar="R",
             min=0,
-            help="Every fingertip's radius (default: the hand's tip_radius, or its URDF's tip spheres).",
+            help="Every fingertip's radius (default: the hand's tip_radius, or its URDF's tip spheres); "
+            "an object without a hand warns that it is ignored.",
         ),
     ] = None,
     quality: Annotated[bool, typer.Option("--quality", help="Also Ferrari-Canny's epsilon (needs scipy).")] = False,
@@ -141,7 +140,7 @@ def synthesize(
     ] = 20000,
     seconds: Annotated[
         float,
-        typer.Option("--seconds", metavar="S", callback=_checked(_seconds), help="Time allowed per object."),
+        typer.Option("--seconds", metavar="S", callback=_checked(_positive), help="Time allowed per object."),
     ] = 60.0,
     fmt: Annotated[
         SynthesizeFormat,

@@ -306,7 +306,9 @@ def synthesize_outputs(job, inputs: Iterable, w, workers: int = 1, tuning=None) 
         warnings = _unchecked(job, item)
         if not len(item):
             rec = sr.failure_record(item)
-            out = Output(encoded=[_encode(job, rec, error=True)], records=1, notes=[_summary(item)], warnings=warnings)
+            out = Output(
+                encoded=[_encode(job, rec, error=True)], records=1, notes=[_summary(job, item)], warnings=warnings
+            )
             out.errors.extend(diagnostics(rec)[0])
             out.count(rec)
             yield out
@@ -321,27 +323,33 @@ def synthesize_outputs(job, inputs: Iterable, w, workers: int = 1, tuning=None) 
             encoded = _csv(job, item)
         else:
             encoded = [_encode(job, rec) for rec in recs]
-        yield Output(encoded=encoded, records=len(recs), notes=[_summary(item)], warnings=warnings)
+        yield Output(encoded=encoded, records=len(recs), notes=[_summary(job, item)], warnings=warnings)
     if job.options.grasp_file is not None and documents:
         with opened(job.options.grasp_file, [p for p in inputs if isinstance(p, str)]) as out:
             out.write("---\n".join(documents).encode())
 
 
 def _unchecked(job, found) -> list[str]:
-    """The warning of an object searched without a wrist when the off-tangent method was asked: its
-    conditioning cannot be checked (the search keeps to the tangent method's), once per object."""
-    if found.wrist is not None or job.options.method not in ("off-tangent", "both"):
-        return []
-    return [
-        f"{escaped(found.file)}: grasp '{escaped(found.name)}': warning: off-tangent conditioning not "
-        "checked without a wrist (a grasp file's 'wrist')"
-    ]
+    """Warnings of an object, once each: an option that does not apply to it.  The off-tangent
+    method asked without a wrist (its conditioning cannot be checked: the tangent method's alone
+    is), ``--tip-radius`` without a hand (no fingertip to size: the contacts are points)."""
+    where = f"{escaped(found.file)}: grasp '{escaped(found.name)}': warning:"
+    said = []
+    if found.wrist is None and job.options.method in ("off-tangent", "both"):
+        said.append(f"{where} off-tangent conditioning not checked without a wrist (a grasp file's 'wrist')")
+    if job.options.tip_radius is not None and found.hand is None:
+        said.append(f"{where} --tip-radius ignored: no hand (give --hand, or a grasp file's 'hand')")
+    return said
 
 
-def _summary(found) -> str:
-    s = found.synthesis
+def _summary(job, found) -> str:
+    s, o = found.synthesis, job.options
+    found_count = f"{len(found)} grasp" if len(found) == 1 else f"{len(found)} grasps"
+    if 0 < len(found) < o.count:  # fewer distinct feasible grasps than wanted: the spacing may be why
+        spacing = "default" if o.min_spacing is None else f"{o.min_spacing:g}"
+        found_count = f"{len(found)} of {o.count} grasps wanted (min spacing {spacing})"
     return (
-        f"{found.file}: grasp '{found.name}': {len(found)} grasps from {s.candidates} candidates scored "
+        f"{found.file}: grasp '{found.name}': {found_count} from {s.candidates} candidates scored "
         f"in {s.seconds:.2f} s ({s.candidates / max(s.seconds, 1e-9):.3g} per second)"
     )
 
