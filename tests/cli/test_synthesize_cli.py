@@ -413,3 +413,18 @@ def test_the_summary_says_how_many_of_the_grasps_wanted_and_tip_radius_without_a
     assert r.stderr.count("warning: --tip-radius ignored: no hand") == 1
     one, _ = run("synthesize", tmp_path / "oct.obj", *args, "-n", "1")
     assert "grasp 'oct': 1 grasp from 60 candidates" in one.stderr and "wanted" not in one.stderr
+
+
+def test_a_grasp_file_needs_no_contacts_for_synthesize_only(tmp_path):
+    bare = tmp_path / "bare.yaml"
+    bare.write_text(
+        "name: ball\nobject:\n  sphere: 0.04\n  mass: 0.2\nfriction: 0.6\n---\nname: nothing\nfriction: 0.6\n"
+    )
+    r, _ = run("synthesize", bare, "--candidates", "60", "-n", "1", "-f", "jsonl")
+    recs = jsonl(r.stdout)
+    assert [(x.get("grasp"), x["ok"]) for x in recs] == [("ball", True), (None, False)]
+    assert [c["name"] for c in recs[0]["contacts"]] == ["1", "2", "3"]
+    assert recs[0]["scores"]["total_normal_force"]["hold"] >= 0.2 * 9.81 / np.sqrt(1 + 0.6**2) * (1 - 1e-9)
+    assert (recs[1]["error"]["code"], recs[1]["error"]["line"]) == ("no-object", 6) and r.exit_code == 1
+    resolved, _ = run("resolve", bare, "--twist", "0,0,1,0,0,0")  # the other commands still need contacts
+    assert resolved.exit_code == 1 and "bare.yaml:1:1: error: missing-key: contacts" in resolved.stderr

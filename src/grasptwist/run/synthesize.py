@@ -31,7 +31,7 @@ from ..io.grasp.forces import HOLD
 from ..io.inputs import read as read_unplaced
 from ..io.limits import DEFAULT_MAX_BYTES
 from ..io.mesh_file import MESH_SUFFIXES, read_mesh
-from ..model import Grasp, GraspFileError, GraspObject, Hand, InputError, Shape
+from ..model import CONTACT_NAMES, Grasp, GraspFileError, GraspObject, Hand, InputError, Shape
 from ..output import synthesis_records as sr
 from ..output.formats import FORMATS
 from ..output.names import escaped
@@ -62,8 +62,6 @@ NO_OBJECT, NOTHING_TO_HOLD, NO_FRICTION = "no-object", "nothing-to-hold", "no-fr
 #: fingers share joints (the search solves each finger on its own).
 NO_TIP_POINTS, UNSEARCHABLE_HAND = "no-tip-points", "unsearchable-hand"
 
-_CONTACT_NAMES = ("1", "2", "3")
-
 
 @dataclass(frozen=True, eq=False)
 class Found:
@@ -80,7 +78,7 @@ class Found:
     wrenches: np.ndarray
     hold: tuple | None  # (mass, centre of mass, gravity) of the wrench named hold, written as top-level keys
     synthesis: Synthesis
-    contact_names: tuple[str, str, str] = _CONTACT_NAMES
+    contact_names: tuple[str, str, str] = CONTACT_NAMES
     hold_name: str = HOLD
     hand: Hand | None = None  # with a hand: its fingers in contact order, at the synthesis' joint positions
     hand_file: str | None = None  # the file the hand's URDF reference is relative to
@@ -141,7 +139,7 @@ def _hand(job, grasp: Grasp, obj: GraspObject):
     # an inline finger's tip point is where the file's contact is (its joints are given at that configuration)
     tips = None
     if any(f.tip_pose is None for f in hand.fingers):
-        if given or grasp.file.lower().endswith(MESH_SUFFIXES):
+        if given or np.isnan(grasp.points).any():  # --hand, a mesh, a document without contacts
             return _problem(
                 grasp.file,
                 NO_TIP_POINTS,
@@ -184,8 +182,8 @@ def _mesh_grasp(path: str, job) -> Grasp | GraspFileError:
     shape = Shape("mesh", np.zeros(0), vertices=vertices, faces=faces, source=path)
     obj = GraspObject(shape, np.eye(4))
     name = os.path.splitext(os.path.basename(path))[0]
-    p = np.zeros((3, 3))
-    return Grasp(name, None, path, 0, _CONTACT_NAMES, p, p, None, (), 1, object=obj)
+    p = np.full((3, 3), np.nan)  # no contacts: as a document read without them
+    return Grasp(name, None, path, 0, CONTACT_NAMES, p, p, None, (), 1, object=obj)
 
 
 class Progress(NamedTuple):
@@ -206,7 +204,9 @@ def synthesize_inputs(job, inputs: Iterable) -> Iterator[GraspFileError | Found 
             continue
         # a hand is placed on the contacts found, not on the file's: the grasps are read unplaced
         mesh = item.lower().endswith(MESH_SUFFIXES)
-        entries = [_mesh_grasp(item, job)] if mesh else read_unplaced(item, job.max_bytes, job.reading)
+        # the contacts are found: a document need not give them (an object and the weight suffice)
+        reading = replace(job.reading, contacts=False)
+        entries = [_mesh_grasp(item, job)] if mesh else read_unplaced(item, job.max_bytes, reading)
         for entry in entries:
             task = _task(o, entry) if isinstance(entry, Grasp) else entry
             if isinstance(task, GraspFileError):
