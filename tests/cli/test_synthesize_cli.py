@@ -325,22 +325,8 @@ def test_a_folder_s_mesh_files_are_searched_beside_its_grasp_files(tmp_path):
     (tmp_path / "bad.yaml").write_text("contacts: [\n")
     (tmp_path / "oct.obj").write_text(OCTAHEDRON)
     (tmp_path / "notes.txt").write_text("not an object")
-    r, _ = run(
-        "synthesize",
-        tmp_path,
-        "--friction",
-        "0.6",
-        "--mass",
-        "0.2",
-        "--candidates",
-        "60",
-        "-n",
-        "1",
-        "-j",
-        "2",
-        "-f",
-        "jsonl",
-    )
+    args = ("--friction", "0.6", "--mass", "0.2", "--candidates", "60", "-n", "1", "-j", "2", "-f", "jsonl")
+    r, _ = run("synthesize", tmp_path, *args)
     assert r.exit_code == 1  # bad.yaml's error
     recs = jsonl(r.stdout)
     assert [(x["file"].rsplit("/", 1)[1], x["ok"]) for x in recs] == [("bad.yaml", False), ("oct.obj", True)]
