@@ -166,7 +166,7 @@ class Synthesis:
     failure : Failure or None
         Why nothing was found (``K = 0``): ``constraint`` (the tightest: ``degenerate``,
         ``conditioning``, ``force_closure``, ``constraints``, ``grip``, with a hand ``fingertips``,
-        ``reach`` or ``collision``; or ``budget``, ``verification``: :class:`Failure`), ``message``,
+        ``reach`` or ``collision``; or ``budget``, ``verification``: ``Failure``), ``message``,
         ``best`` and ``needed``.
     """
 
