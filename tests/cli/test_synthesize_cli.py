@@ -80,7 +80,7 @@ def test_a_file_without_object_or_friction_is_an_error_of_its_own(tmp_path):
 @pytest.mark.parametrize(
     ("args", "message"),
     [
-        (("--seconds", "0"), "seconds must be a positive finite number"),
+        (("--seconds", "0"), "'--seconds': must be a finite number > 0, got 0"),
         (("--min-conditioning", "2"), "min_conditioning must be a number from 0 to 1"),
         (("--mass", "-1"), "must be a finite number > 0"),
         (("--objective", "speed"), "speed"),
@@ -90,7 +90,7 @@ def test_a_file_without_object_or_friction_is_an_error_of_its_own(tmp_path):
 )
 def test_bad_options_are_usage_errors(args, message):
     r, _ = run("synthesize", SPHERE, *args)
-    assert r.exit_code == 2 and message in r.stderr
+    assert r.exit_code == 2 and message in r.stderr and "None" not in r.stderr
 
 
 def test_a_grasp_file_that_cannot_be_written_is_refused_before_any_search(tmp_path):
@@ -313,3 +313,104 @@ def test_the_table_gives_a_hand_s_joint_positions():
     }
     SynthesisTable(out).write(rec)
     assert out.getvalue().decode().splitlines()[-1] == "    joints: a.1 0.5000, a.2 -0.2500"
+
+
+OCTAHEDRON = (
+    "v 0.05 0 0\nv -0.05 0 0\nv 0 0.05 0\nv 0 -0.05 0\nv 0 0 0.05\nv 0 0 -0.05\n"
+    "f 1 3 5\nf 3 2 5\nf 2 4 5\nf 4 1 5\nf 3 1 6\nf 2 3 6\nf 4 2 6\nf 1 4 6\n"
+)
+
+
+def test_a_folder_s_mesh_files_are_searched_beside_its_grasp_files(tmp_path):
+    (tmp_path / "bad.yaml").write_text("contacts: [\n")
+    (tmp_path / "oct.obj").write_text(OCTAHEDRON)
+    (tmp_path / "notes.txt").write_text("not an object")
+    args = ("--friction", "0.6", "--mass", "0.2", "--candidates", "60", "-n", "1", "-j", "2", "-f", "jsonl")
+    r, _ = run("synthesize", tmp_path, *args)
+    assert r.exit_code == 1  # bad.yaml's error
+    recs = jsonl(r.stdout)
+    assert [(x["file"].rsplit("/", 1)[1], x["ok"]) for x in recs] == [("bad.yaml", False), ("oct.obj", True)]
+    assert recs[1]["grasp"] == "oct" and "no-grasp-files" not in r.stderr
+
+
+def test_wrench_adds_to_the_object_s_weight_never_replaces_it():
+    r, _ = run("synthesize", SPHERE, "--friction", "0.5", "--wrench", "0,0,0,0,0,0.02", *FAST, "-f", "jsonl")
+    recs = jsonl(r.stdout)
+    assert set(recs[0]["scores"]["total_normal_force"]) == {"0,0,0,0,0,0.02"}  # the tripod ball has no mass
+    totals = recs[2]["scores"]["total_normal_force"]
+    assert set(totals) == {"hold", "0,0,0,0,0,0.02"}  # the file's turn-z replaced, its 1 kg still held
+    assert totals["hold"] >= 9.81 / np.sqrt(1 + 0.5**2) * (1 - 1e-9)  # no grip holds 1 kg with less
+
+
+def test_the_grasp_file_keeps_the_input_s_twists_and_paths(tmp_path):
+    source = GRASPS / "polyhedron.yaml"  # a body-frame path with a pose target, a twist about the diagonal
+    found = tmp_path / "found.yaml"
+    r, _ = run("synthesize", source, "--friction", "0.8", "--mass", "1", "-n", "1", "--candidates", "120", "-o", found)
+    assert r.exit_code == 0, r.stderr
+    (given,), (written,) = read_grasps(source), read_grasps(found)
+    assert [t.name for t in written.twists] == [t.name for t in given.twists]
+    np.testing.assert_array_equal([t.screw for t in written.twists], [t.screw for t in given.twists])
+    assert [p.name for p in written.paths] == [p.name for p in given.paths]
+    for a, b in zip(written.paths[0].segments, given.paths[0].segments):
+        assert (a.duration, a.frame) == (b.duration, b.frame)
+        for key in ("twist", "position"):
+            if getattr(b, key) is not None:
+                np.testing.assert_array_equal(getattr(a, key), getattr(b, key))
+        if b.rotation is not None:
+            np.testing.assert_allclose(a.rotation, b.rotation, atol=1e-15)
+    resolved, _ = run("resolve", found, "-f", "jsonl")  # its own twists: no --twist needed
+    assert resolved.exit_code == 0 and [x["twist"]["name"] for x in jsonl(resolved.stdout)] == ["diagonal-spin"]
+
+
+@pytest.mark.slow  # over a second: docs/reference/development.md, Test time
+def test_csv_with_a_hand_has_its_reach_errors_and_joint_positions():
+    args = ("--mass", "1", "--friction", "0.8", "--tip-radius", "0.1", *FAST)
+    r, _ = run("synthesize", HAND, *args, "-f", "csv")
+    assert r.exit_code == 0, r.stderr
+    rows = list(csv.DictReader(io.StringIO(r.stdout)))
+    joints = [f"q_{f}_{f}.{j}" for f in ("east", "west", "south") for j in (1, 2, 3)]  # as resolve's CSV names them
+    assert list(rows[0])[-12:] == ["reach_error_1", "reach_error_2", "reach_error_3", *joints]
+    recs = jsonl(run("synthesize", HAND, *args, "-f", "jsonl")[0].stdout)
+    for row, rec in zip(rows, recs, strict=True):
+        assert [float(row[n]) for n in joints] == pytest.approx(list(rec["joint_positions"].values()), rel=1e-15)
+        assert max(float(row[f"reach_error_{i}"]) for i in (1, 2, 3)) < 1e-9
+    plain, _ = run("synthesize", SPHERE, "--friction", "0.5", "--mass", "1", *FAST, "-f", "csv")
+    assert "reach_error_1" not in plain.stdout.splitlines()[0]  # no hand, no hand columns
+
+
+def test_the_off_tangent_method_without_a_wrist_is_said_once_per_object(tmp_path):
+    (tmp_path / "oct.obj").write_text(OCTAHEDRON)
+    args = ("--friction", "0.6", "--mass", "0.2", "--candidates", "60", "-n", "2", "--method", "off-tangent")
+    r, _ = run("synthesize", tmp_path / "oct.obj", SPHERE, *args)
+    assert r.exit_code == 0, r.stderr
+    said = "grasp 'oct': warning: off-tangent conditioning not checked without a wrist"
+    assert r.stderr.count(said) == 1 and r.stderr.count("not checked without a wrist") == 1  # the balls have one
+    table = r.stdout.split("grasp 'sphere-tripod'")
+    assert "#2  total normal force" in table[0] and "conditioning" not in table[0]  # nothing to print
+    assert "conditioning: off_tangent" in table[1]
+
+
+def test_the_summary_says_how_many_of_the_grasps_wanted_and_tip_radius_without_a_hand_warns(tmp_path):
+    (tmp_path / "oct.obj").write_text(OCTAHEDRON)
+    args = ("--friction", "0.6", "--mass", "0.2", "--candidates", "60", "--method", "tangent")
+    r, _ = run("synthesize", tmp_path / "oct.obj", *args, "-n", "50", "--min-spacing", "0.2", "--tip-radius", "0.01")
+    assert r.exit_code == 0, r.stderr
+    assert "grasp 'oct': 1 of 50 grasps wanted (min spacing 0.2) from 60 candidates scored" in r.stderr
+    assert r.stderr.count("warning: --tip-radius ignored: no hand") == 1
+    one, _ = run("synthesize", tmp_path / "oct.obj", *args, "-n", "1")
+    assert "grasp 'oct': 1 grasp from 60 candidates" in one.stderr and "wanted" not in one.stderr
+
+
+def test_a_grasp_file_needs_no_contacts_for_synthesize_only(tmp_path):
+    bare = tmp_path / "bare.yaml"
+    bare.write_text(
+        "name: ball\nobject:\n  sphere: 0.04\n  mass: 0.2\nfriction: 0.6\n---\nname: nothing\nfriction: 0.6\n"
+    )
+    r, _ = run("synthesize", bare, "--candidates", "60", "-n", "1", "-f", "jsonl")
+    recs = jsonl(r.stdout)
+    assert [(x.get("grasp"), x["ok"]) for x in recs] == [("ball", True), (None, False)]
+    assert [c["name"] for c in recs[0]["contacts"]] == ["1", "2", "3"]
+    assert recs[0]["scores"]["total_normal_force"]["hold"] >= 0.2 * 9.81 / np.sqrt(1 + 0.6**2) * (1 - 1e-9)
+    assert (recs[1]["error"]["code"], recs[1]["error"]["line"]) == ("no-object", 6) and r.exit_code == 1
+    resolved, _ = run("resolve", bare, "--twist", "0,0,1,0,0,0")  # the other commands still need contacts
+    assert resolved.exit_code == 1 and "bare.yaml:1:1: error: missing-key: contacts" in resolved.stderr

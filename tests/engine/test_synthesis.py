@@ -248,3 +248,28 @@ def test_further_constraints_are_kept_and_one_nothing_passes_is_named():
     assert s.total_normal_force[0, 0] > 0.1 * G * 1.05  # no finger under the cube: friction lifts it
     none = synthesize(box(), 0.8, candidates=300, constraints=[lambda p, n: np.zeros(len(p), bool)])
     assert none.failure.constraint == "constraints"
+
+
+def test_infinite_friction_finds_grasps_held_by_tangential_forces_alone():
+    # with no limit the cone is the half-space f . n >= 0: friction holds the weight, no squeeze needed
+    s = synthesize(ball(), np.inf, count=2, candidates=200)
+    assert s.failure is None and len(s.points) == 2
+    assert (s.total_normal_force < 1e-6 * 0.1 * G).all()
+    assert np.isfinite(s.closure_friction).all() and (s.closure_friction < 1).all()
+
+
+@pytest.mark.parametrize("budget", [1, 3])
+def test_a_budget_too_small_to_judge_is_the_reason_not_degeneracy(budget):
+    s = synthesize(ball(), 0.6, candidates=budget)
+    assert len(s.points) == 0 and s.failure.constraint == "budget"
+    assert s.failure.best == budget and s.failure.needed == 100
+    assert f"{budget} scored {'is' if budget == 1 else 'are'} too few to judge" in s.failure.message
+
+
+def test_candidates_that_pass_every_test_unverified_are_not_said_to_fail_a_hand_s(monkeypatch):
+    from grasptwist.engine.synthesis import search as search_module
+
+    monkeypatch.setattr(search_module, "verified", lambda *a, **k: None)  # no certificate proves anything
+    s = synthesize(ball(), 0.6, candidates=200)
+    assert len(s.points) == 0 and s.failure.constraint == "verification"
+    assert "collision" not in s.failure.message and "finger" not in s.failure.message

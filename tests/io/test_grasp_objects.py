@@ -338,6 +338,16 @@ def test_a_mesh_outside_the_folder_needs_allow_outside(tmp_path):
     assert load_grasps(path, allow_outside=True)[0].object.shape.kind == "mesh"
 
 
+def test_an_object_not_read_gives_no_follow_on_weight_errors(tmp_path):
+    # synthesize -o writes the weight as the object's mass beside a top-level gravity
+    path = tetra_file(tmp_path, mesh="../tetra.obj", folder="inner")
+    path.write_text(path.read_text() + "gravity: [0, 0, -9.81]\n")
+    ((e,),) = [read_grasps(path)]
+    assert [p.code for p in e.problems] == ["path-outside"] and e.line == 2
+    path.write_text(path.read_text().replace("../tetra.obj", "../tetra.obj\n  mass: 0.1"))
+    assert load_grasps(path, allow_outside=True)[0].mass == pytest.approx(0.1)
+
+
 def test_the_size_cap_reaches_the_mesh(tmp_path):
     path = tetra_file(tmp_path)
     (tmp_path / "tetra.obj").write_text("#" * 300 + "\n" + TETRA)  # larger than the grasp file

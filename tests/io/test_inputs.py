@@ -131,3 +131,16 @@ def test_an_undecodable_file_name_costs_no_good_record(tmp_path):
 
 def test_stdin_is_read_once():
     assert listed(["-", "-"]) == ["-", ("-", "read-error", "cannot read: standard input can be read only once")]
+
+
+def test_a_family_s_suffixes_list_mesh_files_in_folders(tmp_path):
+    from grasptwist.io.inputs import OBJECT_SUFFIXES
+
+    for name in ("a.yaml", "b.STL", "c.obj", "d.ply", "e.txt"):
+        (tmp_path / name).write_text("")
+    names = [os.path.basename(p) for p in expand([str(tmp_path)], OBJECT_SUFFIXES)]
+    assert names == ["a.yaml", "b.STL", "c.obj", "d.ply"]
+    assert [os.path.basename(p) for p in expand([str(tmp_path)])] == ["a.yaml"]
+    (tmp_path / "empty").mkdir()
+    (empty,) = expand([str(tmp_path / "empty")], OBJECT_SUFFIXES)
+    assert empty.code == "no-grasp-files" and ".stl, .obj or .ply" in empty.message

@@ -38,7 +38,7 @@ def write_records(job, paths: list[str], settings: OutputSettings) -> int:
     counted = job.family.tells_progress
     hint = table_hint(job.command.formats) if job.fmt == "table" and counted else None
     stderr = Diagnostics(settings.quiet, settings.warnings, hint=hint)
-    inputs = list(expand(paths))
+    inputs = list(expand(paths, job.family.suffixes))
     fmt = FORMATS[job.fmt]
     with (
         output_target(settings.output, [*inputs, *settings.reads]) as out,

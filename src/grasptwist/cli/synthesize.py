@@ -62,16 +62,11 @@ def _min_conditioning(value):
     return check_min_conditioning(value)
 
 
-def _mass(value):
+def _positive(value):
+    """--mass, --seconds: the engine's checks (check_budget's seconds), in the command line's words."""
     if not 0 < value < float("inf"):
-        raise ValueError(f"must be a finite number > 0, got {value}")
+        raise ValueError(f"must be a finite number > 0, got {value:g}")
     return value
-
-
-def _seconds(value):
-    from ..engine.synthesis.search import check_budget
-
-    return check_budget(1, value)[1]
 
 
 def synthesize(
@@ -87,7 +82,10 @@ def synthesize(
     mass: Annotated[
         float | None,
         typer.Option(
-            "--mass", metavar="KG", callback=_checked(_mass), help="The object's mass: its weight is the wrench 'hold'."
+            "--mass",
+            metavar="KG",
+            callback=_checked(_positive),
+            help="The object's mass: its weight is the wrench 'hold'.",
         ),
     ] = None,
     wrench: WrenchOption = None,
@@ -131,7 +129,8 @@ def synthesize(
             "--tip-radius",
             metavar="R",
             min=0,
-            help="Every fingertip's radius (default: the hand's tip_radius, or its URDF's tip spheres).",
+            help="Every fingertip's radius (default: the hand's tip_radius, or its URDF's tip spheres); "
+            "an object without a hand warns that it is ignored.",
         ),
     ] = None,
     quality: Annotated[bool, typer.Option("--quality", help="Also Ferrari-Canny's epsilon (needs scipy).")] = False,
@@ -141,7 +140,7 @@ def synthesize(
     ] = 20000,
     seconds: Annotated[
         float,
-        typer.Option("--seconds", metavar="S", callback=_checked(_seconds), help="Time allowed per object."),
+        typer.Option("--seconds", metavar="S", callback=_checked(_positive), help="Time allowed per object."),
     ] = 60.0,
     fmt: Annotated[
         SynthesizeFormat,
@@ -164,7 +163,8 @@ def synthesize(
     refined on the surface, and each grasp returned is verified by the exact grip.
     With a hand (the file's, or --hand) every grasp is reached within the joint limits,
     fingertips on the surface and no finger link in the object; the records give the
-    joint positions. With -o FILE.yaml the grasps are written as a grasp file every
+    joint positions. The object's weight ('hold', from its mass or --mass) is always
+    held; --wrench adds wrenches beside it. With -o FILE.yaml the grasps are written as a grasp file every
     command reads (the records go to stdout). Exit 1 when an object has no feasible grasp.
     Examples:
 
@@ -185,15 +185,16 @@ def synthesize(
     grasp_file = output if output is not None and output.lower().endswith(GRASP_FILE_SUFFIXES) else None
     records_to = None if grasp_file is not None else output
     if grasp_file is not None:  # written at the end of the run: refused before any work, as a records file is
-        from ..io.inputs import expand
+        from ..io.inputs import OBJECT_SUFFIXES, expand
 
-        checked_output(grasp_file, [p for p in expand(paths) if isinstance(p, str)])
+        checked_output(grasp_file, [p for p in expand(paths, OBJECT_SUFFIXES) if isinstance(p, str)])
     fmt = SynthesizeFormat.json if json_ else fmt
     not_binary_to_a_terminal(fmt.value, records_to)
     job = Job(
         command=COMMANDS["synthesize"],
         fmt=fmt.value,
-        hand=None if hand is None else hand_option(hand, [], fmt.value),
+        # --hand's, else one grasp file's first hand: it names the joint columns of CSV and Parquet
+        hand=hand_option(hand, paths, fmt.value),
         max_bytes=max_bytes,
         reading=reading_option(surface_tol, allow_outside),
         options=SynthesisOptions(

@@ -1,7 +1,8 @@
 """Which files a command reads: paths, folders and stdin, in a stable order.
 
 A folder is searched at any depth for grasp files: names ending in ``.yaml``,
-``.yml`` or ``.json`` (JSON is YAML), in any letter case.  Its files come
+``.yml`` or ``.json`` (JSON is YAML), in any letter case, or in the suffixes a
+command's family reads (``synthesize`` also takes mesh files: :data:`OBJECT_SUFFIXES`).  Its files come
 sorted by their path relative to it.  The walk keeps its own stack instead
 of recursing, so no depth of folders can exhaust Python's recursion limit.
 Symbolic links are followed, but a folder reached twice (a link cycle, or two
@@ -23,24 +24,29 @@ from collections.abc import Iterable, Iterator
 from ..model import Grasp, GraspFileError
 from .grasp import READING, Reading, one_per_document, read_grasps
 from .limits import DEFAULT_MAX_BYTES, NOT_REGULAR
+from .mesh_file import MESH_SUFFIXES
 
-__all__ = ["GRASP_SUFFIXES", "STDIN", "expand", "is_grasp_file", "read"]
+__all__ = ["GRASP_SUFFIXES", "OBJECT_SUFFIXES", "STDIN", "expand", "is_grasp_file", "read"]
 
 GRASP_SUFFIXES = (".yaml", ".yml", ".json")
+#: The files a folder gives a command that reads objects (``synthesize``): grasp and mesh files.
+OBJECT_SUFFIXES = (*GRASP_SUFFIXES, *MESH_SUFFIXES)
 STDIN = "-"
 
 
-def is_grasp_file(name: str) -> bool:
-    """Whether a folder's entry ``name`` is read as a grasp file (its suffix, in any case).
+def is_grasp_file(name: str, suffixes: tuple[str, ...] = GRASP_SUFFIXES) -> bool:
+    """Whether a folder's entry ``name`` is read (its suffix among ``suffixes``, in any case).
 
-    >>> [is_grasp_file(n) for n in ("box.yaml", "BOX.YML", "hand.json", "notes.txt", "yaml")]
-    [True, True, True, False, False]
+    >>> [is_grasp_file(n) for n in ("box.yaml", "BOX.YML", "hand.json", "notes.txt", "yaml", "can.STL")]
+    [True, True, True, False, False, False]
+    >>> is_grasp_file("can.STL", OBJECT_SUFFIXES)
+    True
     """
-    return name.lower().endswith(GRASP_SUFFIXES)
+    return name.lower().endswith(suffixes)
 
 
-def expand(paths: Iterable[str]) -> Iterator[str | GraspFileError]:
-    """Every grasp file named by ``paths``, folders expanded, in order."""
+def expand(paths: Iterable[str], suffixes: tuple[str, ...] = GRASP_SUFFIXES) -> Iterator[str | GraspFileError]:
+    """Every file named by ``paths``, folders expanded (their files ending in ``suffixes``), in order."""
     stdin_seen = False
     for path in paths:
         if path == STDIN and stdin_seen:
@@ -49,7 +55,7 @@ def expand(paths: Iterable[str]) -> Iterator[str | GraspFileError]:
             stdin_seen |= path == STDIN
             yield path
         elif os.path.isdir(path):
-            yield from _walk(path)
+            yield from _walk(path, suffixes)
         else:
             yield _io_error(path, _not_a_file(path))
 
@@ -66,8 +72,8 @@ def _not_a_file(path: str) -> str:
     return NOT_REGULAR
 
 
-def _walk(top: str) -> Iterator[str | GraspFileError]:
-    """The grasp files under the folder ``top``, depth first in name order.
+def _walk(top: str, suffixes: tuple[str, ...]) -> Iterator[str | GraspFileError]:
+    """The files ending in ``suffixes`` under the folder ``top``, depth first in name order.
 
     Visiting each folder's entries in name order, a subfolder's files at its
     name's place, gives the files sorted by their path's components.
@@ -95,15 +101,15 @@ def _walk(top: str) -> Iterator[str | GraspFileError]:
         for entry in reversed(entries):
             if _is_dir(entry):
                 pending.append((True, entry.path))
-            elif is_grasp_file(entry.name):
+            elif is_grasp_file(entry.name, suffixes):
                 pending.append(
                     (False, entry.path if _is_file(entry) else _io_error(entry.path, _not_a_file(entry.path)))
                 )
     if empty:
-        suffixes = ", ".join(GRASP_SUFFIXES[:-1]) + " or " + GRASP_SUFFIXES[-1]
+        names = ", ".join(suffixes[:-1]) + " or " + suffixes[-1]
         yield GraspFileError(
             "no-grasp-files",
-            f"no grasp files in this folder or below it (looked for names ending in {suffixes}, in any letter case)",
+            f"no grasp files in this folder or below it (looked for names ending in {names}, in any letter case)",
             top,
         )
 

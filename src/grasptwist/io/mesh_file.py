@@ -51,7 +51,6 @@ import numpy as np
 
 from ..model import InputError
 from .limits import DEFAULT_MAX_BYTES, MAX_TRIANGLES
-from .urdf import _read, resolve_urdf
 
 __all__ = ["MESH_SUFFIXES", "read_mesh", "check_mesh"]
 
@@ -113,6 +112,8 @@ def read_mesh(
         raise InputError(
             "unsupported-mesh", f"expected a mesh file ending in {', '.join(MESH_SUFFIXES[:-1])} or .ply", text
         )
+    from .urdf import _read, resolve_urdf  # here: listing a folder (MESH_SUFFIXES) imports no URDF reader
+
     data = _read(resolve_urdf(text, folder, allow_outside=allow_outside), max_bytes, text)
     _too_many(_declared_triangles(data, suffix, text), max_triangles, text)
     try:

@@ -31,6 +31,7 @@ from typing import IO
 import numpy as np
 import yaml
 
+from ..results import joint_column_names
 from .columns import ColumnSet
 from .csv_rows import lines
 from .names import escaped
@@ -185,12 +186,32 @@ def _hand_node(found, k, folder):
     return {"fingers": fingers}
 
 
+def _path_node(path) -> dict:
+    """An object path as a grasp file writes it: each segment a screw, or a pose target (its rotation as given)."""
+    segments = []
+    for seg in path.segments:
+        node = {"duration": float(seg.duration)}
+        if seg.twist is not None:
+            node["screw"] = np.asarray(seg.twist).tolist()
+        else:
+            pose = {"position": np.asarray(seg.position).tolist()}
+            if seg.rotvec is not None:
+                pose["rotvec"] = np.asarray(seg.rotvec).tolist()  # as written: its size is judged on reading
+            else:
+                pose["rotation"] = _quaternion(np.asarray(seg.rotation))
+            node["pose"] = pose
+        segments.append(node)
+    frames = {seg.frame for seg in path.segments if seg.twist is not None}
+    return {"name": path.name, **({"frame": "body"} if frames == {"body"} else {}), "segments": segments}
+
+
 def grasp_documents(found, folder: str) -> str:
     """The grasps found as grasp-file documents (YAML, ``---`` between them), read back by every command.
 
     Each keeps the input's object, units, wrist and friction, its wrenches by name (the weight as
-    the object's mass, or ``mass`` and ``center_of_mass``, when one of them is ``hold``), and gives
-    the contacts found.
+    the object's mass, or ``mass`` and ``center_of_mass``, when one of them is ``hold``), its twists
+    and paths (in the grasp frame, as the contacts: valid for any contacts), and gives the contacts
+    found.
     """
     s = found.synthesis
     docs = []
@@ -205,6 +226,10 @@ def grasp_documents(found, folder: str) -> str:
             {"name": found.contact_names[i], "point": s.points[k, i].tolist(), "normal": s.normals[k, i].tolist()}
             for i in range(3)
         ]
+        if found.twists:
+            doc["twists"] = [{"name": t.name, "screw": np.asarray(t.screw).tolist()} for t in found.twists]
+        if found.paths:
+            doc["paths"] = [_path_node(path) for path in found.paths]
         doc["friction"] = float(found.friction)
         wrenches = [
             {"name": name, "wrench": np.asarray(w).tolist()}
@@ -242,17 +267,34 @@ _NUMBERS = (
     "seed",
 )
 _HEADER = ",".join((*_OWN, *_NUMBERS)).encode() + b"\n"
+_REACH = tuple(f"reach_error_{i}" for i in (1, 2, 3))
+
+
+def _hand_columns(hand) -> tuple[str, ...]:
+    """The columns a run's hand adds: each finger's reach error, then its joints' positions ``q_<finger>_<joint>``."""
+    return () if hand is None else (*_REACH, *joint_column_names("q", hand))
 
 
 def _header(hand=None) -> bytes:
-    return _HEADER
+    return _HEADER if hand is None else ",".join((*_OWN, *_NUMBERS, *_hand_columns(hand))).encode() + b"\n"
 
 
 def _typed(hand=None) -> dict:
     types = {"file": "U", "grasp": "U", "rank": "int64", "ok": "?", "error": "U"}
-    types.update({name: "float64" for name in _NUMBERS})
+    types.update({name: "float64" for name in (*_NUMBERS, *_hand_columns(hand))})
     types.update(candidates="int64", seed="int64")
     return types
+
+
+def _joint_values(found, hand) -> dict:
+    """The hand's columns of ``found``'s grasps: NaN where its hand is not the run's (another file's)."""
+    s, k = found.synthesis, len(found)
+    names = joint_column_names("q", hand)
+    same = found.hand is not None and joint_column_names("q", found.hand) == names
+    out = {name: s.reach_error[:, i] if same else np.full(k, np.nan) for i, name in enumerate(_REACH)}
+    joints = [j for f in found.hand.fingers for j in f.joint_index] if same else [None] * len(names)
+    out.update({n: s.joint_positions[:, j] if same else np.full(k, np.nan) for n, j in zip(names, joints)})
+    return out
 
 
 def _flat(found, order="omega-v", hand=None, typed=False) -> dict:
@@ -276,6 +318,8 @@ def _flat(found, order="omega-v", hand=None, typed=False) -> dict:
     columns["candidates"] = np.full(k, s.candidates)
     columns["seconds"] = np.full(k, s.seconds)
     columns["seed"] = np.full(k, s.seed)
+    if hand is not None:
+        columns.update(_joint_values(found, hand))
     for name, a in columns.items():
         if a.dtype.kind == "f":
             columns[name] = np.ma.masked_invalid(a)
@@ -283,13 +327,14 @@ def _flat(found, order="omega-v", hand=None, typed=False) -> dict:
 
 
 def _arrays(found, order="omega-v", hand=None) -> dict:
-    return {name: np.ma.getdata(a) for name, a in _flat(found).items()}
+    return {name: np.ma.getdata(a) for name, a in _flat(found, hand=hand).items()}
 
 
 def _error_row(rec: dict, hand=None) -> bytes:
     err = rec["error"]
     row = [rec["file"], rec.get("grasp", ""), "", "false", f"{err['code']}: {err['message']}"]
-    return lines({str(j): np.array([v], dtype=object) for j, v in enumerate(row + [""] * len(_NUMBERS))})[0]
+    pad = [""] * (len(_NUMBERS) + len(_hand_columns(hand)))
+    return lines({str(j): np.array([v], dtype=object) for j, v in enumerate(row + pad)})[0]
 
 
 class _Statuses(IntEnum):
@@ -338,9 +383,10 @@ class SynthesisTable:
         totals = ", ".join(f"{escaped(n)} {self._number(v)}" for n, v in scores["total_normal_force"].items())
         cond = ", ".join(f"{m} {self._number(c)}" for m, c in scores["conditioning"].items() if c is not None)
         extra = "" if scores["epsilon"] is None else f"  epsilon {self._number(scores['epsilon'])}"
+        extra += f"  conditioning: {cond}" if cond else ""  # none: the off-tangent method alone, no wrist
         self._line(
             f"  #{rec['rank']}  total normal force: {totals}  closure mu {self._number(scores['closure_friction'])}"
-            f"{extra}  conditioning: {cond}"
+            f"{extra}"
         )
         for c in rec["contacts"]:
             point = ", ".join(self._number(v) for v in c["point"])

@@ -53,6 +53,7 @@ from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field
 from typing import Any
 
+from ..io.inputs import GRASP_SUFFIXES, OBJECT_SUFFIXES
 from ..output.formats import FORMATS
 from ..output.json_rows import encode_records
 from ..output.records import basis_record, check_record, dumps, records, talking_rows
@@ -110,6 +111,9 @@ class Family:
     long_inputs : bool
         Each input is long work (``synthesize``'s searches): a progress bar even for one
         input, advanced by the work its outputs report.
+    suffixes : tuple of str
+        The files a folder gives its commands (:func:`~grasptwist.io.inputs.expand`): grasp
+        files, and mesh files for ``synthesize``.
     """
 
     name: str
@@ -122,6 +126,7 @@ class Family:
     outputs: Callable[..., Iterator] | None = None
     tells_progress: bool = True
     long_inputs: bool = False
+    suffixes: tuple[str, ...] = GRASP_SUFFIXES
 
 
 @dataclass(frozen=True)
@@ -321,6 +326,7 @@ SYNTHESIS = Family(
     columns=_synthesis_columns,
     outputs=_synthesis_outputs,
     long_inputs=True,
+    suffixes=OBJECT_SUFFIXES,
 )
 
 #: Every family.

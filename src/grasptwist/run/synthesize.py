@@ -5,8 +5,9 @@ searched from: the search finds its own), or a mesh file (STL, OBJ, PLY) with th
 line's friction and mass.  A hand (the file's ``hand``, or the job's: ``--hand``) must reach
 every grasp: its fingertips (``--tip-radius``, else each finger's ``tip_radius``) on the
 surface, its joints within their limits, its links (a URDF's meshes) out of the object; a
-hand given inline has its tips where the file's contacts are (its joints are given there).  The command line's ``--friction``, ``--mass`` and ``--wrench`` replace
-the file's.  The search is :func:`grasptwist.engine.synthesis.search.search`; with ``-o
+hand given inline has its tips where the file's contacts are (its joints are given there).  The command
+line's ``--friction`` and ``--mass`` replace the file's; ``--wrench`` replaces its other wrenches, beside
+the weight (``hold``), which is held whenever there is a mass.  The search is :func:`grasptwist.engine.synthesis.search.search`; with ``-o
 FILE.yaml`` the grasps found are also written as a grasp file (atomically, at the end).
 No math here: only reading, routing and labelling.
 """
@@ -30,9 +31,10 @@ from ..io.grasp.forces import HOLD
 from ..io.inputs import read as read_unplaced
 from ..io.limits import DEFAULT_MAX_BYTES
 from ..io.mesh_file import MESH_SUFFIXES, read_mesh
-from ..model import Grasp, GraspFileError, GraspObject, Hand, InputError, Shape
+from ..model import CONTACT_NAMES, Grasp, GraspFileError, GraspObject, Hand, InputError, Shape
 from ..output import synthesis_records as sr
 from ..output.formats import FORMATS
+from ..output.names import escaped
 from ..output.records import diagnostics, dumps, error_record
 from .options import SynthesisOptions
 from .outputs import Output
@@ -60,8 +62,6 @@ NO_OBJECT, NOTHING_TO_HOLD, NO_FRICTION = "no-object", "nothing-to-hold", "no-fr
 #: fingers share joints (the search solves each finger on its own).
 NO_TIP_POINTS, UNSEARCHABLE_HAND = "no-tip-points", "unsearchable-hand"
 
-_CONTACT_NAMES = ("1", "2", "3")
-
 
 @dataclass(frozen=True, eq=False)
 class Found:
@@ -78,11 +78,13 @@ class Found:
     wrenches: np.ndarray
     hold: tuple | None  # (mass, centre of mass, gravity) of the wrench named hold, written as top-level keys
     synthesis: Synthesis
-    contact_names: tuple[str, str, str] = _CONTACT_NAMES
+    contact_names: tuple[str, str, str] = CONTACT_NAMES
     hold_name: str = HOLD
     hand: Hand | None = None  # with a hand: its fingers in contact order, at the synthesis' joint positions
     hand_file: str | None = None  # the file the hand's URDF reference is relative to
     joints_at: tuple | None = None  # an inline hand's joints at each grasp: per finger (screws (n, 6), points (n, 3))
+    twists: tuple = ()  # the input's twists and paths, written with each grasp found (-o FILE.yaml)
+    paths: tuple = ()
 
     def __len__(self) -> int:
         return len(self.synthesis.points)
@@ -103,10 +105,11 @@ def _task(options: SynthesisOptions, grasp: Grasp):
         friction = float(np.min(grasp.friction))  # the contacts found are none of the file's: the least
     else:
         return _problem(grasp.file, NO_FRICTION, f"grasp '{grasp.name}' has no friction: give --friction", grasp.line)
+    # --wrench replaces the file's other wrenches; the weight is always held (beside them)
     named = [] if options.wrenches is not None else [(w.name, w.wrench) for w in grasp.wrenches if w.name != HOLD]
     named += [(w.name, w.wrench) for w in options.wrenches or ()]
     hold = None
-    if options.mass is not None or (grasp.mass is not None and options.wrenches is None):
+    if options.mass is not None or grasp.mass is not None:
         props = mass_properties(obj)
         mass = props.mass if props.mass is not None else grasp.mass
         center = props.center_of_mass if grasp.object.mass is not None or options.mass else grasp.center_of_mass
@@ -126,7 +129,8 @@ def _task(options: SynthesisOptions, grasp: Grasp):
 def _hand(job, grasp: Grasp, obj: GraspObject):
     """The hand that must reach the grasps of ``grasp`` (``(HandReach, Hand, its file)``), None
     without one, or the error of the document."""
-    hand = job.hand if job.hand is not None else grasp.hand
+    given = job.options.hand_file is not None  # --hand; else job.hand only names the columns (the file's)
+    hand = job.hand if given else grasp.hand
     if hand is None:
         return None
     radius = job.options.tip_radius
@@ -135,7 +139,7 @@ def _hand(job, grasp: Grasp, obj: GraspObject):
     # an inline finger's tip point is where the file's contact is (its joints are given at that configuration)
     tips = None
     if any(f.tip_pose is None for f in hand.fingers):
-        if job.hand is not None or grasp.file.lower().endswith(MESH_SUFFIXES):
+        if given or np.isnan(grasp.points).any():  # --hand, a mesh, a document without contacts
             return _problem(
                 grasp.file,
                 NO_TIP_POINTS,
@@ -146,7 +150,7 @@ def _hand(job, grasp: Grasp, obj: GraspObject):
     from .collisions import deepest_link  # the finger links' meshes: with the first URDF hand
 
     # a URDF's meshes are found from the file that names it: the grasp file, or --hand's
-    named_by = grasp.file if job.hand is None else job.options.hand_file
+    named_by = job.options.hand_file if given else grasp.file
     try:
         held = replace(grasp, hand=hand, object=obj, file=named_by)
         collide = deepest_link(held, max_bytes=job.max_bytes or DEFAULT_MAX_BYTES)
@@ -178,8 +182,8 @@ def _mesh_grasp(path: str, job) -> Grasp | GraspFileError:
     shape = Shape("mesh", np.zeros(0), vertices=vertices, faces=faces, source=path)
     obj = GraspObject(shape, np.eye(4))
     name = os.path.splitext(os.path.basename(path))[0]
-    p = np.zeros((3, 3))
-    return Grasp(name, None, path, 0, _CONTACT_NAMES, p, p, None, (), 1, object=obj)
+    p = np.full((3, 3), np.nan)  # no contacts: as a document read without them
+    return Grasp(name, None, path, 0, CONTACT_NAMES, p, p, None, (), 1, object=obj)
 
 
 class Progress(NamedTuple):
@@ -200,7 +204,9 @@ def synthesize_inputs(job, inputs: Iterable) -> Iterator[GraspFileError | Found 
             continue
         # a hand is placed on the contacts found, not on the file's: the grasps are read unplaced
         mesh = item.lower().endswith(MESH_SUFFIXES)
-        entries = [_mesh_grasp(item, job)] if mesh else read_unplaced(item, job.max_bytes, job.reading)
+        # the contacts are found: a document need not give them (an object and the weight suffice)
+        reading = replace(job.reading, contacts=False)
+        entries = [_mesh_grasp(item, job)] if mesh else read_unplaced(item, job.max_bytes, reading)
         for entry in entries:
             task = _task(o, entry) if isinstance(entry, Grasp) else entry
             if isinstance(task, GraspFileError):
@@ -247,8 +253,10 @@ def synthesize_inputs(job, inputs: Iterable) -> Iterator[GraspFileError | Found 
                 step,
                 entry.contact_names,
                 hand=hand,
-                hand_file=None if hand is None else (o.hand_file if job.hand is not None else entry.file),
+                hand_file=None if hand is None else (o.hand_file or entry.file),
                 joints_at=_inline_joints(hand, step),
+                twists=entry.twists,
+                paths=entry.paths,
             )
         yield Progress(0, 1)
 
@@ -295,9 +303,12 @@ def synthesize_outputs(job, inputs: Iterable, w, workers: int = 1, tuning=None) 
             out.count(rec)
             yield out
             continue
+        warnings = _unchecked(job, item)
         if not len(item):
             rec = sr.failure_record(item)
-            out = Output(encoded=[_encode(job, rec, error=True)], records=1, notes=[_summary(item)])
+            out = Output(
+                encoded=[_encode(job, rec, error=True)], records=1, notes=[_summary(job, item)], warnings=warnings
+            )
             out.errors.extend(diagnostics(rec)[0])
             out.count(rec)
             yield out
@@ -309,32 +320,49 @@ def synthesize_outputs(job, inputs: Iterable, w, workers: int = 1, tuning=None) 
             w.write(item)
             encoded = []
         elif job.fmt == "csv":
-            encoded = _csv(item)
+            encoded = _csv(job, item)
         else:
             encoded = [_encode(job, rec) for rec in recs]
-        yield Output(encoded=encoded, records=len(recs), notes=[_summary(item)])
+        yield Output(encoded=encoded, records=len(recs), notes=[_summary(job, item)], warnings=warnings)
     if job.options.grasp_file is not None and documents:
         with opened(job.options.grasp_file, [p for p in inputs if isinstance(p, str)]) as out:
             out.write("---\n".join(documents).encode())
 
 
-def _summary(found) -> str:
-    s = found.synthesis
+def _unchecked(job, found) -> list[str]:
+    """Warnings of an object, once each: an option that does not apply to it.  The off-tangent
+    method asked without a wrist (its conditioning cannot be checked: the tangent method's alone
+    is), ``--tip-radius`` without a hand (no fingertip to size: the contacts are points)."""
+    where = f"{escaped(found.file)}: grasp '{escaped(found.name)}': warning:"
+    said = []
+    if found.wrist is None and job.options.method in ("off-tangent", "both"):
+        said.append(f"{where} off-tangent conditioning not checked without a wrist (a grasp file's 'wrist')")
+    if job.options.tip_radius is not None and found.hand is None:
+        said.append(f"{where} --tip-radius ignored: no hand (give --hand, or a grasp file's 'hand')")
+    return said
+
+
+def _summary(job, found) -> str:
+    s, o = found.synthesis, job.options
+    found_count = f"{len(found)} grasp" if len(found) == 1 else f"{len(found)} grasps"
+    if 0 < len(found) < o.count:  # fewer distinct feasible grasps than wanted: the spacing may be why
+        spacing = "default" if o.min_spacing is None else f"{o.min_spacing:g}"
+        found_count = f"{len(found)} of {o.count} grasps wanted (min spacing {spacing})"
     return (
-        f"{found.file}: grasp '{found.name}': {len(found)} grasps from {s.candidates} candidates scored "
+        f"{found.file}: grasp '{found.name}': {found_count} from {s.candidates} candidates scored "
         f"in {s.seconds:.2f} s ({s.candidates / max(s.seconds, 1e-9):.3g} per second)"
     )
 
 
-def _csv(found) -> list[bytes]:
+def _csv(job, found) -> list[bytes]:
     from ..output.csv_rows import lines
 
-    return lines(sr.SYNTHESIS_COLUMNS.flat(found))
+    return lines(sr.SYNTHESIS_COLUMNS.flat(found, hand=job.hand))
 
 
 def _encode(job, rec, error=False):
     if job.fmt == "table":
         return rec
     if job.fmt == "csv" and error:
-        return sr.SYNTHESIS_COLUMNS.error_row(rec)
+        return sr.SYNTHESIS_COLUMNS.error_row(rec, job.hand)
     return dumps(rec)

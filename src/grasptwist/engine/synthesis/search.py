@@ -59,6 +59,7 @@ __all__ = [
     "MIN_SPACING",
     "REFINE_SHARE",
     "GAP_TOL",
+    "FEW_CANDIDATES",
 ]
 
 #: Gravity when none is given: 9.81 down the z axis (as grasp files').
@@ -85,6 +86,10 @@ _SAME_NORMAL = 1 - 1e-9
 
 #: Candidates whose closure friction is computed to say how close a failed search came.
 _CLOSEST = 256
+
+#: Fewer candidates than this, every one degenerate, say nothing of the object: the budget is the reason
+#: (a chunk of ``k`` candidates draws its contacts from ``k`` surface points, all alike when ``k < 3``).
+FEW_CANDIDATES = 100
 
 
 class Surface(NamedTuple):
@@ -113,7 +118,9 @@ class Failure(NamedTuple):
     Attributes
     ----------
     constraint : str
-        The tightest constraint (:data:`~.scores.CONSTRAINTS`): the furthest any candidate got.
+        The tightest constraint (:data:`~.scores.CONSTRAINTS`): the furthest any candidate got;
+        ``budget`` when fewer than :data:`FEW_CANDIDATES` were scored, all degenerate (``best``:
+        how many); ``verification`` when candidates passed every test but none was verified.
     message : str
         In words, with how close the best candidate came.
     best, needed : float
@@ -158,8 +165,9 @@ class Synthesis:
     seed : int
     failure : Failure or None
         Why nothing was found (``K = 0``): ``constraint`` (the tightest: ``degenerate``,
-        ``conditioning``, ``force_closure``, ``constraints`` or ``grip``), ``message``, ``best``
-        and ``needed``.
+        ``conditioning``, ``force_closure``, ``constraints``, ``grip``, with a hand ``fingertips``,
+        ``reach`` or ``collision``; or ``budget``, ``verification``: ``Failure``), ``message``,
+        ``best`` and ``needed``.
     """
 
     points: np.ndarray
@@ -411,7 +419,7 @@ def search_steps(
     positions = None if hand is None else archive.positions[picked]
     quality = quality or objective == "epsilon"
     out = _results(surface, points, normals, w, mu, safety, wrist, methods, quality, tol, hand, positions)
-    failure = None if len(out["points"]) else _failure(archive, mu / safety, min_conditioning, tol)
+    failure = None if len(out["points"]) else _failure(archive, budget.used, mu / safety, min_conditioning, tol)
     yield Synthesis(
         **out,
         candidates=budget.used,
@@ -472,11 +480,15 @@ def verified(points, normals, wrench, friction, safety, tol=DEGENERACY_TOL) -> G
     One row through :func:`~grasptwist.engine.forces.grip.grip`; its ``dual`` must close the gap
     (``|total - w . dual| <= GAP_TOL max(total, 1)``) and be dual feasible:
     ``n_i - G_i^T dual`` (``G_i^T dual = dual_F + dual_M x p_i``) in each dual cone
-    ``(mu / s) |z_t| <= z_n``, to :data:`GAP_TOL`.
+    ``(mu / s) |z_t| <= z_n``, to :data:`GAP_TOL`; with ``mu = inf`` (the half-space
+    ``f . n >= 0``, no limit) the dual cone is the ray along ``n``: ``|z_t| = 0 <= z_n``.
 
     >>> p = np.array([[1.0, 0, 0], [-0.5, 0.75**0.5, -0.2], [-0.5, -(0.75**0.5), -0.2]])
     >>> g = verified(p, -p / np.linalg.norm(p, axis=1, keepdims=True), [0, 0, 1.0, 0, 0, 0], 0.5, 1.0)
     >>> g is not None and bool(g.ok)
+    True
+    >>> g = verified(p, -p / np.linalg.norm(p, axis=1, keepdims=True), [0, 0, 1.0, 0, 0, 0], np.inf, 1.0)
+    >>> g is not None and bool(g.total_normal_force < 1e-6)  # tangential forces alone hold it
     True
     """
     g = grip(points, normals, wrench, friction, safety=safety, tol=tol)
@@ -490,7 +502,10 @@ def verified(points, normals, wrench, friction, safety, tol=DEGENERACY_TOL) -> G
     z = n - (g.dual[:3] + np.cross(g.dual[3:], np.asarray(points, float)))
     zn = np.sum(z * n, axis=-1)
     zt = np.linalg.norm(z - zn[:, None] * n, axis=-1)
-    return g if ((friction / safety) * zt - zn <= GAP_TOL).all() else None
+    limit = friction / safety
+    # no limit: (mu / s) |z_t| is inf * 0 on the ray, so ask for the ray itself
+    inside = (zt <= GAP_TOL) & (zn >= -GAP_TOL) if np.isinf(limit) else limit * zt - zn <= GAP_TOL
+    return g if inside.all() else None
 
 
 def _results(surface, points, normals, w, mu, safety, wrist, methods, quality, tol, hand=None, positions=None):
@@ -538,9 +553,26 @@ def _held(hand, error, positions):
     return good
 
 
-def _failure(archive, mu, min_conditioning, tol) -> Failure:
-    """Why no candidate was feasible: the furthest constraint any reached, and how close the best came."""
-    name = CONSTRAINTS[min(archive.furthest, len(CONSTRAINTS) - 1)]
+def _failure(archive, scored, mu, min_conditioning, tol) -> Failure:
+    """Why no candidate was feasible: the furthest constraint any reached, and how close the best came
+    (a hand's constraints are reached only with a hand: after the grip a row without one is feasible)."""
+    if archive.furthest == 0 and scored < FEW_CANDIDATES:
+        return Failure(
+            "budget",
+            f"{scored} scored {'is' if scored == 1 else 'are'} too few to judge the object, none with three "
+            f"distinct contacts off one line (allow {FEW_CANDIDATES} candidates or more)",
+            float(scored),
+            float(FEW_CANDIDATES),
+        )
+    if archive.furthest >= len(CONSTRAINTS):  # feasible, or spared as no better than the grasps kept
+        return Failure(
+            "verification",
+            "candidates passed every test, but the exact grip's certificate (or the hand's forward "
+            "kinematics) verified none",
+            np.nan,
+            np.nan,
+        )
+    name = CONSTRAINTS[archive.furthest]
     if name == "degenerate":
         return Failure(name, "every candidate's contacts were degenerate (coincident or collinear)", 0.0, tol)
     if name == "conditioning":

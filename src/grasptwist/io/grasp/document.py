@@ -11,7 +11,9 @@ list them (tests/io/test_grasp_schema.py checks both agree).
 
 from __future__ import annotations
 
-from ...model import Grasp
+import numpy as np
+
+from ...model import CONTACT_NAMES, Grasp
 from .contacts import SECTION as CONTACTS
 from .forces import SECTION as FORCES
 from .hand import SECTION as HAND
@@ -34,6 +36,9 @@ GRASP_KEYS = ("name", "units", "wrist", *(key for section in SECTIONS for key in
 
 _REQUIRED = tuple(key for section in SECTIONS for key in section.required)
 
+#: The points and normals of a document read without contacts (``Reading(contacts=False)``).
+_NO_CONTACTS = readonly(np.full((3, 3), np.nan))
+
 
 def read_document(root, problems, *, file, document, name, line, reading, max_bytes):
     """Check one document's node tree: its Grasp, or None when ``problems`` has any
@@ -41,7 +46,8 @@ def read_document(root, problems, *, file, document, name, line, reading, max_by
     if root.kind == "scalar" and root.value is None:
         problems.add(Reject("empty-document", "", "empty document", **located(root)))
         return None
-    fields = read_mapping(root, "", GRASP_KEYS, _REQUIRED, problems)
+    required = _REQUIRED if reading.contacts else tuple(k for k in _REQUIRED if k != "contacts")
+    fields = read_mapping(root, "", GRASP_KEYS, required, problems)
     if fields is None:
         return None
     if "name" in fields:
@@ -55,6 +61,8 @@ def read_document(root, problems, *, file, document, name, line, reading, max_by
         return None
     for key in ("file", "reading", "max_bytes"):
         del found[key]
+    if "points" not in found:  # contacts not required of this reading: to be found (NaN)
+        found.update(contact_names=CONTACT_NAMES, points=_NO_CONTACTS, normals=_NO_CONTACTS)
     return Grasp(
         name=name,
         units=units,

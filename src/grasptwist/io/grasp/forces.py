@@ -89,6 +89,8 @@ def _read_hold(fields, obj, problems):
     ``obj`` (None, or a :class:`~grasptwist.model.GraspObject` whose ``mass`` may be None), or None."""
     if obj is not None and obj.mass is not None:
         return _object_hold(fields, obj, problems)
+    if obj is None and "object" in fields:  # not read (its error is said): its mass may be the one asked for
+        return None
     given = [key for key in ("mass", "center_of_mass", "gravity") if key in fields]
     if not given:
         return None

@@ -266,6 +266,8 @@ def _read(fields, found, problems):
     said = []
     obj = read_object(fields["object"], found["file"], found["reading"], found["max_bytes"], problems, said)
     points = found.get("points")
+    if obj is not None and points is None and not found["reading"].contacts:  # synthesize finds them
+        return {"object": obj, "warnings": tuple(said)}
     if obj is None or points is None:
         return None
     from ...engine.degeneracy import normal_disagrees_warning

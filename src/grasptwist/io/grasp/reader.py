@@ -70,6 +70,9 @@ class Reading:
         file's folder (``--allow-outside``).
     max_triangles : int
         Most triangles of an object's mesh (see :data:`~grasptwist.io.limits.MAX_TRIANGLES`).
+    contacts : bool
+        Documents must give ``contacts`` (False: ``synthesize``'s, which finds its own; a document
+        without them has NaN points and normals, contacts named ``1``, ``2``, ``3``).
     """
 
     parser: type = PARSER
@@ -79,6 +82,7 @@ class Reading:
     surface_tol: float | None = None
     allow_outside: bool = False
     max_triangles: int = MAX_TRIANGLES
+    contacts: bool = True
 
 
 #: The command line's way of reading.
