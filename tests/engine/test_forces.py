@@ -805,6 +805,6 @@ def test_an_infinite_wrench_beside_a_huge_one_keeps_its_status_and_the_huge_one_
 
 @pytest.mark.parametrize("batch", [(0,), (2, 0)])
 def test_an_empty_batch_grips_to_empty_fields(batch):
-    g = grip(np.zeros(batch + (3, 3)), np.zeros(batch + (3, 3)), np.zeros(batch + (6,)), 0.5)
+    g = gt.grip(np.zeros(batch + (3, 3)), np.zeros(batch + (3, 3)), np.zeros(batch + (6,)), 0.5)
     assert g.status.shape == g.total_normal_force.shape == batch
     assert g.force.shape == batch + (3, 3) and g.dual.shape == batch + (6,)
