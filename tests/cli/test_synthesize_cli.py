@@ -369,13 +369,13 @@ def test_csv_with_a_hand_has_its_reach_errors_and_joint_positions():
     assert r.exit_code == 0, r.stderr
     rows = list(csv.DictReader(io.StringIO(r.stdout)))
     joints = [f"q_{f}_{f}.{j}" for f in ("east", "west", "south") for j in (1, 2, 3)]  # as resolve's CSV names them
-    assert list(rows[0])[-12:] == ["reach_error_1", "reach_error_2", "reach_error_3", *joints]
+    assert list(rows[0])[-12:] == ["reach_error1", "reach_error2", "reach_error3", *joints]
     recs = jsonl(run("synthesize", HAND, *args, "-f", "jsonl")[0].stdout)
     for row, rec in zip(rows, recs, strict=True):
         assert [float(row[n]) for n in joints] == pytest.approx(list(rec["joint_positions"].values()), rel=1e-15)
-        assert max(float(row[f"reach_error_{i}"]) for i in (1, 2, 3)) < 1e-9
+        assert max(float(row[f"reach_error{i}"]) for i in (1, 2, 3)) < 1e-9
     plain, _ = run("synthesize", SPHERE, "--friction", "0.5", "--mass", "1", *FAST, "-f", "csv")
-    assert "reach_error_1" not in plain.stdout.splitlines()[0]  # no hand, no hand columns
+    assert "reach_error1" not in plain.stdout.splitlines()[0]  # no hand, no hand columns
 
 
 def test_the_off_tangent_method_without_a_wrist_is_said_once_per_object(tmp_path):

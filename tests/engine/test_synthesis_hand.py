@@ -39,6 +39,7 @@ def test_every_grasp_puts_each_tip_centre_one_radius_out_by_forward_kinematics()
             tip = forward_kinematics(finger.screws, finger.points, home, q).tip[:3, 3]
             centre = s.points[k, f] - r * s.normals[k, f]
             assert np.linalg.norm(tip - centre) <= IK_TOL * finger.length
+            np.testing.assert_allclose(s.tip_center[k, f], centre, rtol=0, atol=1e-15)
             lower, upper = joint_limits(finger)
             assert ((q >= lower) & (q <= upper)).all()
     # each sphere touches the cube only at its contact: its centre is r outside the face

@@ -68,6 +68,7 @@ def synthesis_records(found) -> list[dict]:
                 "point": s.points[k, i].tolist(),
                 "normal": s.normals[k, i].tolist(),
                 "surface_distance": float(s.surface_distance[k, i]),
+                **({} if s.tip_center is None else {"tip_center": s.tip_center[k, i].tolist()}),
             }
             for i in range(3)
         ]
@@ -256,7 +257,7 @@ _OWN = ("file", "grasp", "rank", "ok", "error")
 _NUMBERS = (
     *(f"p{i}_{a}" for i in (1, 2, 3) for a in _XYZ),
     *(f"n{i}_{a}" for i in (1, 2, 3) for a in _XYZ),
-    *(f"surface_distance_{i}" for i in (1, 2, 3)),
+    *(f"surface_distance{i}" for i in (1, 2, 3)),
     "total_normal_force",
     "closure_friction",
     "epsilon",
@@ -267,7 +268,7 @@ _NUMBERS = (
     "seed",
 )
 _HEADER = ",".join((*_OWN, *_NUMBERS)).encode() + b"\n"
-_REACH = tuple(f"reach_error_{i}" for i in (1, 2, 3))
+_REACH = tuple(f"reach_error{i}" for i in (1, 2, 3))
 
 
 def _hand_columns(hand) -> tuple[str, ...]:
@@ -309,7 +310,7 @@ def _flat(found, order="omega-v", hand=None, typed=False) -> dict:
     }
     columns.update({f"p{i + 1}_{a}": s.points[:, i, j] for i in range(3) for j, a in enumerate(_XYZ)})
     columns.update({f"n{i + 1}_{a}": s.normals[:, i, j] for i in range(3) for j, a in enumerate(_XYZ)})
-    columns.update({f"surface_distance_{i + 1}": s.surface_distance[:, i] for i in range(3)})
+    columns.update({f"surface_distance{i + 1}": s.surface_distance[:, i] for i in range(3)})
     columns["total_normal_force"] = s.total_normal_force.max(axis=1, initial=-np.inf) if k else nan
     columns["closure_friction"] = s.closure_friction
     columns["epsilon"] = nan if s.epsilon is None else s.epsilon

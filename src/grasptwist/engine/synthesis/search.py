@@ -32,7 +32,7 @@ import numpy as np
 
 from ..collision import collision_tolerance
 from ..degeneracy import DEGENERACY_TOL
-from ..fingertips import tip_radii
+from ..fingertips import tip_centers, tip_radii
 from ..forces.closure import force_closure
 from ..forces.grasp_map import check_friction, check_safety, check_wrench
 from ..forces.grip import Grip, grip
@@ -159,6 +159,8 @@ class Synthesis:
         With a hand: each finger's distance from its tip point, by forward kinematics at
         ``joint_positions``, to its fingertip's centre ``p - r n`` (within the inverse
         kinematics' tolerance).
+    tip_center : (K, 3, 3) or None
+        With a hand: each fingertip sphere's centre ``p - r n`` (finger ``f`` on contact ``f``).
     candidates : int
         Candidates scored.
     seconds : float
@@ -184,6 +186,7 @@ class Synthesis:
     failure: Failure | None
     joint_positions: np.ndarray | None = None
     reach_error: np.ndarray | None = None
+    tip_center: np.ndarray | None = None
 
 
 def check_budget(candidates, seconds) -> tuple[int, float | None]:
@@ -522,13 +525,17 @@ def _results(surface, points, normals, w, mu, safety, wrist, methods, quality, t
         error = tip_errors(hand, points[keep], normals[keep], positions[keep])
         good = _held(hand, error, positions[keep])
         grips, keep = [g for g, k in zip(grips, good) if k], [i for i, k in zip(keep, good) if k]
-        hand_fields = {"joint_positions": positions[keep], "reach_error": error[good]}
+        hand_fields = {
+            "joint_positions": positions[keep],
+            "reach_error": error[good],
+            "tip_center": tip_centers(points[keep], normals[keep], hand.radii),
+        }
     p, n = points[keep], normals[keep]
     closure = force_closure(p, n, mu / safety, quality=quality, tol=tol) if len(p) else None
     return {
         "points": p,
         "normals": n,
-        "surface_distance": np.abs(surface.project(p)[2]) if len(p) else np.empty((0, 3)),
+        "surface_distance": surface.project(p)[2] if len(p) else np.empty((0, 3)),
         "total_normal_force": np.array([[float(g.total_normal_force) for g in row] for row in grips]).reshape(
             len(p), len(w)
         ),
