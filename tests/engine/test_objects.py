@@ -272,6 +272,19 @@ def test_round_tessellations_lie_on_the_surface_and_approach_its_volume(o):
     assert below[1] < 5e-3 * exact  # about (2 pi / 64)^2 / 6 per direction of the rings
 
 
+@pytest.mark.parametrize(
+    "shape, match",
+    [
+        (Shape("box", np.full(3, 1e100)), r"^box size \(the diagonal of its bounding box\) is 1.73e\+100, outside"),
+        (Shape("sphere", [1e-80]), r"^sphere size \(the diagonal of its bounding box\) is 3.46e-80, outside"),
+        (Shape("box", np.full(3, 1e200)), "^box size overflows double precision: rescale it"),
+    ],
+)
+def test_check_shape_refuses_a_size_beyond_double_precision_areas(shape, match):
+    with pytest.raises(ValueError, match=match):
+        check_shape(shape)
+
+
 def test_the_sphere_tessellation_has_the_promised_rings():
     v, f = tessellate(obj("sphere", 1.0), segments=8)  # 4 bands: 3 rings of 8 and 2 poles
     assert v.shape == (26, 3) and f.shape == (48, 3)

@@ -89,9 +89,14 @@ def read_object(node, file, reading, max_bytes, problems, warnings):
     pose.setflags(write=False)
     obj = GraspObject(shape, pose, mass=mass, density=density, line=node.line)
     from ...engine.objects import mass_properties, object_size
+    from ...engine.objects.checks import check_size
 
-    if not np.isfinite(object_size(obj)):
-        problems.add(Reject("non-finite", "object", "its size overflows double precision: rescale it", **located(node)))
+    size = object_size(obj)
+    try:  # the engine's rule, for a primitive and a scaled mesh alike
+        check_size(size)
+    except ValueError as err:
+        code = "non-finite" if not np.isfinite(size) else "invalid-size"
+        problems.add(Reject(code, "object", str(err), **located(node)))
         return None
     if density is None:
         return obj
