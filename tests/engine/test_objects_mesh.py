@@ -345,3 +345,17 @@ def test_check_shape_keeps_a_mesh_read_only():
     s = check_shape(Shape("mesh", np.zeros(0), CUBE_VERTICES.tolist(), CUBE_FACES.tolist(), source="cube.stl"))
     assert s.vertices.dtype == np.float64 and s.faces.dtype == np.int64 and s.source == "cube.stl"
     assert not (s.vertices.flags.writeable or s.faces.flags.writeable)
+
+
+def test_on_edge_is_true_within_the_mesh_edge_tolerance_of_an_edge_or_vertex():
+    mesh = mesh_object(CUBE_VERTICES, CUBE_FACES)  # the unit cube, faces halved by a diagonal
+    tol = MESH_EDGE_TOL * object_size(mesh)
+    q = [
+        [1.0, 1.0, 0.1],  # outside the edge x = y = 0.5
+        [1.0, 1.0, 1.0],  # outside a corner
+        [0.6, 0.3, -0.1],  # over the +x face, off its diagonal
+        [0.6, 0.0, 0.0],  # over the middle of the +x face: its diagonal, an edge between coplanar faces
+        [0.6, 0.5 - 2 * tol, 0.1],  # over the +x face, twice the tolerance from its edge
+        [0.6, 0.5 - 0.5 * tol, 0.1],  # half the tolerance from it
+    ]
+    assert project_to_surface(mesh, q).on_edge.tolist() == [True, True, False, True, False, True]
