@@ -75,8 +75,8 @@ def check_shape(shape: Shape) -> Shape:
     faces indexing them, closed and consistently oriented (each edge in
     exactly two faces, once in each direction), enclosing a positive volume
     (faces counter-clockwise seen from outside), no face degenerate
-    (:func:`degenerate_faces`); every shape's size must be within
-    :data:`SIZE_RANGE` (:func:`check_size`).
+    (``degenerate_faces``); every shape's size must be within
+    ``SIZE_RANGE`` (``check_size``, in ``grasptwist.engine.objects.checks``).
 
     >>> check_shape(Shape("sphere", [0.03])).size.tolist()
     [0.03]
