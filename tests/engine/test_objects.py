@@ -122,7 +122,7 @@ def test_capsule_closed_forms(point, surface, normal, distance):
 )
 def test_the_vectorised_primitives_agree_with_their_per_point_twin(kind, size):
     q = np.random.default_rng(13).uniform(-5, 5, (300, 3))
-    c, n, d = primitives.nearest(kind, np.array(size), q, 0.0)
+    c, n, d, _ = primitives.nearest(kind, np.array(size), q, 0.0)
     point, normal, distance = (np.array(a) for a in zip(*(primitives.nearest_one(kind, size, p) for p in q.tolist())))
     np.testing.assert_allclose(c, point, rtol=0, atol=4e-15)
     np.testing.assert_allclose(n, normal, rtol=0, atol=4e-16)
@@ -273,6 +273,19 @@ def test_round_tessellations_lie_on_the_surface_and_approach_its_volume(o):
     assert below[1] < 5e-3 * exact  # about (2 pi / 64)^2 / 6 per direction of the rings
 
 
+@pytest.mark.parametrize(
+    "shape, match",
+    [
+        (Shape("box", np.full(3, 1e100)), r"^box size \(the diagonal of its bounding box\) is 1.73e\+100, outside"),
+        (Shape("sphere", [1e-80]), r"^sphere size \(the diagonal of its bounding box\) is 3.46e-80, outside"),
+        (Shape("box", np.full(3, 1e200)), "^box size overflows double precision: rescale it"),
+    ],
+)
+def test_check_shape_refuses_a_size_beyond_double_precision_areas(shape, match):
+    with pytest.raises(ValueError, match=match):
+        check_shape(shape)
+
+
 def test_the_sphere_tessellation_has_the_promised_rings():
     v, f = tessellate(obj("sphere", 1.0), segments=8)  # 4 bands: 3 rings of 8 and 2 poles
     assert v.shape == (26, 3) and f.shape == (48, 3)
@@ -410,3 +423,15 @@ def test_a_point_that_is_not_finite_gets_nan_and_the_others_their_answer():
     assert (
         s.points[2].tolist() == [1.0, 0.0, 0.0] and s.normals[2].tolist() == [-1.0, 0.0, 0.0] and s.distance[2] == -1.0
     )
+
+
+def test_on_edge_is_true_on_edges_corners_and_rims_only():
+    box, cylinder, sphere = obj("box", 2.0, 2.0, 2.0), obj("cylinder", 1.0, 2.0), obj("capsule", 1.0, 2.0)
+    # outside an edge, outside a corner, inside a face, a hair inside an edge (2e-9 of the size off it)
+    q = [[2.0, 2.0, 0.0], [3.0, 3.0, 3.0], [0.5, 0.2, 0.1], [1.0, 1.0 - 4e-9, 0.0]]
+    assert project_to_surface(box, q).on_edge.tolist() == [True, True, False, False]
+    # outside the top rim, over the top's middle, beside the side
+    q = [[2.0, 0.0, 2.0], [0.3, 0.0, 2.0], [2.0, 0.0, 0.0]]
+    assert project_to_surface(cylinder, q).on_edge.tolist() == [True, False, False]
+    assert not project_to_surface(sphere, [[2.0, 0.0, 1.0], [0.0, 0.0, 3.0]]).on_edge.any()
+    assert project_to_surface(box, [[np.nan, 0, 0], [2.0, 2.0, 2.0]]).on_edge.tolist() == [False, True]

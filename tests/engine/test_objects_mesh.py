@@ -309,7 +309,53 @@ def test_check_shape_refuses_a_bad_mesh(vertices, faces, match):
         check_shape(Shape("mesh", np.zeros(0), vertices, faces))
 
 
+def split_cube():
+    """The unit cube with its edge 0-3 split at its midpoint 8 by the zero-area face (3, 8, 0)."""
+    v = np.vstack([CUBE_VERTICES, 0.5 * (CUBE_VERTICES[0] + CUBE_VERTICES[3])])
+    f = CUBE_FACES.tolist()
+    f.remove([0, 3, 2])
+    return v, np.array([*f, [0, 8, 2], [8, 3, 2], [3, 8, 0]])
+
+
+def test_check_shape_refuses_a_degenerate_face():
+    # paired with the cube's edge 0-3 it would give that edge one face's normal, not the bisector
+    with pytest.raises(ValueError, match=r"^mesh face 13 is degenerate: its area is within AREA_TOL of 0"):
+        check_shape(Shape("mesh", np.zeros(0), *split_cube()))
+
+
+@pytest.mark.parametrize("scale", [1e76, 1e100, 1e-76, 1e-160])
+def test_check_shape_refuses_a_mesh_whose_size_is_beyond_double_precision_areas(scale):
+    with pytest.raises(
+        ValueError, match=r"^mesh size \(the diagonal of its bounding box\) is .*, outside 1e-75 to 1e\+75"
+    ):
+        check_shape(Shape("mesh", np.zeros(0), CUBE_VERTICES * scale, CUBE_FACES))
+
+
+@pytest.mark.parametrize("scale", [1e74, 1e-74])
+def test_a_mesh_at_the_ends_of_the_size_range_samples_and_projects(scale):
+    mesh = mesh_object(CUBE_VERTICES * scale, CUBE_FACES)
+    p, n = sample_surface(mesh, 50, np.random.default_rng(0))
+    assert np.isfinite(p).all() and np.isfinite(n).all()
+    s = project_to_surface(mesh, [[0.5 * scale, 0.1 * scale, 0.2 * scale], [2 * scale, 0, 0]])
+    np.testing.assert_allclose(s.distance / scale, [0.0, 1.5], rtol=0, atol=1e-15)
+    np.testing.assert_allclose(s.normals, [[-1, 0, 0], [-1, 0, 0]], rtol=0, atol=1e-15)
+
+
 def test_check_shape_keeps_a_mesh_read_only():
     s = check_shape(Shape("mesh", np.zeros(0), CUBE_VERTICES.tolist(), CUBE_FACES.tolist(), source="cube.stl"))
     assert s.vertices.dtype == np.float64 and s.faces.dtype == np.int64 and s.source == "cube.stl"
     assert not (s.vertices.flags.writeable or s.faces.flags.writeable)
+
+
+def test_on_edge_is_true_within_the_mesh_edge_tolerance_of_an_edge_or_vertex():
+    mesh = mesh_object(CUBE_VERTICES, CUBE_FACES)  # the unit cube, faces halved by a diagonal
+    tol = MESH_EDGE_TOL * object_size(mesh)
+    q = [
+        [1.0, 1.0, 0.1],  # outside the edge x = y = 0.5
+        [1.0, 1.0, 1.0],  # outside a corner
+        [0.6, 0.3, -0.1],  # over the +x face, off its diagonal
+        [0.6, 0.0, 0.0],  # over the middle of the +x face: its diagonal, an edge between coplanar faces
+        [0.6, 0.5 - 2 * tol, 0.1],  # over the +x face, twice the tolerance from its edge
+        [0.6, 0.5 - 0.5 * tol, 0.1],  # half the tolerance from it
+    ]
+    assert project_to_surface(mesh, q).on_edge.tolist() == [True, True, False, True, False, True]

@@ -162,7 +162,17 @@ def test_a_surface_tolerance_must_be_a_number_at_least_zero():
             ("non-finite", 2, 3, "object: its size overflows double precision: rescale it"),
         ),
         (
-            "  sphere: 1e103\n  density: 10",
+            "  box: [1e-80, 1e-80, 1e-80]",
+            (
+                "invalid-size",
+                2,
+                3,
+                "object: its size (the diagonal of its bounding box) is 1.73e-80, outside 1e-75 to 1e+75 "
+                "where its areas and volume are double-precision numbers: rescale it",
+            ),
+        ),
+        (
+            "  sphere: 1e74\n  density: 1e100",
             ("non-finite", 3, 12, "object.density: the mass (density x volume) overflows double precision"),
         ),
     ],

@@ -123,6 +123,27 @@ def test_each_refusal_is_one_coded_error(tmp_path, text, name, code, match):
     assert caught.value.code == code and caught.value.file == name
 
 
+CUBE_V = "".join(f"v {x} {y} {z}\n" for z in (-1, 1) for y in (-1, 1) for x in (-1, 1))
+CUBE_F = ["f 1 3 4 2", "f 5 6 8 7", "f 1 2 6 5", "f 3 7 8 4", "f 1 5 7 3", "f 2 4 8 6"]
+
+
+@pytest.mark.parametrize("scale", ["1e100", "1e-160"])
+def test_a_mesh_beyond_double_precision_areas_is_refused(tmp_path, scale):
+    (tmp_path / "m.obj").write_text(tetra(CUBE_F, CUBE_V.replace("1", scale)))
+    with pytest.raises(InputError, match=r"^m.obj: the mesh's size .* is .*, outside 1e-75 to 1e\+75") as caught:
+        read_mesh("m.obj", tmp_path)
+    assert caught.value.code == "invalid-size"
+
+
+def test_a_degenerate_triangle_is_refused_with_its_index(tmp_path):
+    # the cube's edge 1-3 split at its middle 9 by the zero-area triangle (3, 9, 1)
+    faces = ["f 1 9 4 2", "f 9 3 4", "f 3 9 1", *CUBE_F[1:]]
+    (tmp_path / "m.obj").write_text(tetra(faces, CUBE_V + "v -1 0 -1\n"))
+    with pytest.raises(InputError, match=r"^m.obj: triangle 3 \(counted from 0\) is degenerate") as caught:
+        read_mesh("m.obj", tmp_path)
+    assert caught.value.code == "invalid-mesh"
+
+
 def test_a_missing_file_is_a_read_error(tmp_path):
     with pytest.raises(InputError, match="^none.obj: cannot read: ") as caught:
         read_mesh("none.obj", tmp_path)

@@ -27,9 +27,9 @@ Speed comes from never asking the object about far vertices (the checks are
 conservative, so nothing is missed): each link's vertices are cut into
 compact *clusters* of at most :data:`CLUSTER` vertices, each in a ball of
 centre :math:`c` and radius :math:`\rho`; a cluster whose ball misses the
-object's bounding ball, or whose centre is farther than :math:`\rho` from
-the object (:math:`\phi(c) > \rho`: the signed distance is 1-Lipschitz), has
-no vertex inside it.
+object's bounding box (axis-aligned in the object's own frame), or whose
+centre is farther than :math:`\rho` from the object (:math:`\phi(c) > \rho`:
+the signed distance is 1-Lipschitz), has no vertex inside it.
 
 The fingertip's own contact is no collision: :func:`tip_sphere` says which
 vertices of a finger's tip link lie on its fingertip sphere (within

@@ -20,8 +20,9 @@ second of import), and the checks are numpy's.  Around it, as for a URDF
 * the geometry: at most ``max_triangles`` triangles (:data:`~grasptwist.io.limits.MAX_TRIANGLES`),
   finite vertices, every face index a vertex, and a closed surface: each
   edge shared by exactly two triangles, wound the same way (a volume, a
-  centre of mass and an inside need one).  A mesh wound inwards is turned
-  outwards.
+  centre of mass and an inside need one), no degenerate (zero-area)
+  triangle, and a size within ``SIZE_RANGE`` (:mod:`grasptwist.engine.objects.checks`).
+  A mesh wound inwards is turned outwards.
 
 Every refusal is a :class:`~grasptwist.model.InputError` with a code:
 
@@ -32,11 +33,12 @@ Every refusal is a :class:`~grasptwist.model.InputError` with a code:
 ``unsupported-url``      a URL scheme other than ``package://``
 ``package-not-found``    ``package://PKG``: no installed Python package ``PKG``
 ``unsupported-mesh``     a file name not ending in ``.stl``, ``.obj`` or ``.ply``
-``invalid-mesh``         not readable as its format (bad face indices, truncated)
+``invalid-mesh``         not readable as its format (bad face indices, truncated), a degenerate triangle
 ``empty-mesh``           no triangles
 ``too-many-triangles``   more than ``max_triangles``
 ``non-finite``           a vertex coordinate that is NaN or infinite
 ``not-watertight``       an open, non-manifold or inconsistently wound surface
+``invalid-size``         a size (bounding box diagonal) outside ``SIZE_RANGE``, 1e-75 to 1e75
 ``mesh-unavailable``     trimesh is not installed (an STL or PLY)
 =======================  ==========================================================
 """
@@ -215,6 +217,7 @@ def check_mesh(vertices, faces, max_triangles, file):
             "not a closed surface (every edge shared by exactly two triangles, wound the same way)",
             file,
         )
+    _check_geometry(vertices, faces, file)
     a, b, c = vertices[faces].transpose(1, 0, 2)
     if np.einsum("ij,ij->", a, np.cross(b, c)) < 0:
         faces = faces[:, ::-1]
@@ -222,6 +225,26 @@ def check_mesh(vertices, faces, max_triangles, file):
     for array in (vertices, faces):
         array.setflags(write=False)
     return vertices, faces
+
+
+def _check_geometry(vertices, faces, file):
+    """Refuse a mesh whose own size is outside :data:`~grasptwist.engine.objects.checks.SIZE_RANGE`
+    (its volume is computed here, before any ``scale``) or with a degenerate triangle (no normal:
+    :func:`~grasptwist.engine.objects.checks.degenerate_faces`), as the engine's ``check_shape`` does."""
+    from ..engine.objects.checks import AREA_TOL, check_extent, degenerate_faces
+
+    try:
+        check_extent(np.linalg.norm(vertices.max(axis=0) - vertices.min(axis=0)), "the mesh's")
+    except ValueError as err:
+        raise InputError("invalid-size", str(err), file) from None
+    flat = degenerate_faces(vertices, faces)
+    if len(flat):
+        raise InputError(
+            "invalid-mesh",
+            f"triangle {int(flat[0])} (counted from 0) is degenerate: its area is at most {AREA_TOL:g} "
+            f"of the squared size (corners on a line){f', and {len(flat) - 1} more' if len(flat) > 1 else ''}",
+            file,
+        )
 
 
 def _closed(faces):

@@ -14,15 +14,38 @@ from dataclasses import replace
 import numpy as np
 
 from ...model import GraspObject, Shape
-from .primitives import PRIMITIVES
+from .primitives import PRIMITIVES, diagonal
 
-__all__ = ["KINDS", "RIGID_TOL", "check_shape", "check_size", "check_pose", "check_object"]
+__all__ = [
+    "KINDS",
+    "RIGID_TOL",
+    "SIZE_RANGE",
+    "AREA_TOL",
+    "check_shape",
+    "check_pose",
+    "check_object",
+    "check_size",
+    "check_extent",
+    "degenerate_faces",
+]
 
 #: The shapes an object may have.
 KINDS = (*PRIMITIVES, "mesh")
 
 #: A pose's rotation block must be orthonormal to this (as a path's pose targets).
 RIGID_TOL = 1e-9
+
+#: An object's size (the diagonal of its bounding box, after any scale) must lie in this range.
+#: The geometry multiplies up to four lengths (a mesh's barycentric coordinates; areas two,
+#: volumes three): within 1e-75 to 1e75 every such product stays a normal double (1e-300 to
+#: 1e300); beyond it areas overflow or vanish (sampling by area, a contact's distance from a
+#: face), as a 1e100 cube's did.
+SIZE_RANGE = (1e-75, 1e75)
+
+#: A mesh face whose area is at most ``AREA_TOL`` times the squared size is degenerate (its
+#: corners on one line, to round-off: about 1e-16 of the squared size) and has no normal; the
+#: thinnest faces trimesh makes (a uv sphere's, a capsule's) are some 2e-5 of it.
+AREA_TOL = 1e-12
 
 _SIZE_NAMES = {
     "box": ("a", "b", "c"),
@@ -52,7 +75,9 @@ def check_shape(shape: Shape) -> Shape:
     a sphere: say so).  A mesh needs ``(V, 3)`` finite vertices and ``(F, 3)``
     faces indexing them, closed and consistently oriented (each edge in
     exactly two faces, once in each direction), enclosing a positive volume
-    (faces counter-clockwise seen from outside).
+    (faces counter-clockwise seen from outside), no face degenerate
+    (``degenerate_faces``); every shape's size must be within
+    ``SIZE_RANGE`` (``check_extent``, in ``grasptwist.engine.objects.checks``).
 
     >>> check_shape(Shape("sphere", [0.03])).size.tolist()
     [0.03]
@@ -91,7 +116,51 @@ def check_size(kind: str, size) -> np.ndarray:
     for name, value in zip(names, size.tolist()):
         if not (math.isfinite(value) and value > 0):
             raise ValueError(f"{kind} {name} must be a finite number > 0, got {value!r}")
+    check_extent(diagonal(kind, size), kind)
     return _frozen(size)
+
+
+def check_extent(size: float, what: str = "its") -> float:
+    """The object's size (its bounding box's diagonal) when it is within :data:`SIZE_RANGE`, else ValueError
+    saying ``what`` size is wrong.
+
+    >>> check_extent(0.1)
+    0.1
+    >>> check_extent(1e100)
+    Traceback (most recent call last):
+    ValueError: its size (the diagonal of its bounding box) is 1e+100, outside 1e-75 to 1e+75 where its areas and volume are double-precision numbers: rescale it
+    """
+    size = float(size)
+    if not math.isfinite(size):
+        raise ValueError(f"{what} size overflows double precision: rescale it")
+    low, high = SIZE_RANGE
+    if not low <= size <= high:
+        raise ValueError(
+            f"{what} size (the diagonal of its bounding box) is {size:.3g}, outside {low:.0e} to {high:.0e} "
+            "where its areas and volume are double-precision numbers: rescale it"
+        )
+    return size
+
+
+def degenerate_faces(vertices, faces) -> np.ndarray:
+    r"""The indices of the faces whose area is at most :data:`AREA_TOL` times the squared size ``s``.
+
+    .. math::
+
+        A_f = \tfrac12 |(b - a) \times (c - a)| \le \text{AREA\_TOL}\, s^2
+
+    ``vertices (V, 3)`` float, ``faces (F, 3)`` int; returns ``(k,)`` int, ascending.
+
+    >>> v = np.array([[0.0, 0, 0], [1, 0, 0], [2, 0, 0], [0, 1, 0]])
+    >>> degenerate_faces(v, np.array([[0, 1, 3], [0, 1, 2]])).tolist()
+    [1]
+    """
+    v = np.asarray(vertices, dtype=float)
+    f = np.asarray(faces)
+    a, b, c = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
+    size = float(np.linalg.norm(v.max(axis=0) - v.min(axis=0)))
+    area = 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1)
+    return np.flatnonzero(area <= AREA_TOL * size * size)
 
 
 def _check_mesh(vertices, faces):
@@ -109,7 +178,13 @@ def _check_mesh(vertices, faces):
     if not (np.isfinite(f).all() and (f == np.round(f)).all() and f.min() >= 0 and f.max() < len(v)):
         raise ValueError(f"mesh faces must be whole vertex indices from 0 to {len(v) - 1}")
     f = f.astype(np.int64)
+    check_extent(np.linalg.norm(v.max(axis=0) - v.min(axis=0)), "mesh")
     _check_closed(f)
+    flat = degenerate_faces(v, f)
+    if len(flat):
+        raise ValueError(
+            f"mesh face {int(flat[0])} is degenerate: its area is within AREA_TOL of 0 (corners on a line)"
+        )
     if _signed_volume(v, f) <= 0:
         raise ValueError("mesh encloses no positive volume: its faces must be counter-clockwise seen from outside")
     return _frozen(v), _frozen(f)

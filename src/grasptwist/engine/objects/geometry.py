@@ -57,11 +57,17 @@ class SurfacePoints(NamedTuple):
     distance : numpy.ndarray
         ``(...)`` each given point's signed distance from the surface: > 0
         outside, < 0 inside.
+    on_edge : numpy.ndarray
+        ``(...)`` bool: the nearest point is on an edge or corner, where the surface has no one
+        normal and ``normals`` holds the faces' average: within ``EDGE_TOL`` of the size of a
+        box's edge or corner or a cylinder's rim, within ``MESH_EDGE_TOL`` of a mesh's edge or
+        vertex (one between coplanar faces too); never on a sphere or capsule.
     """
 
     points: np.ndarray
     normals: np.ndarray
     distance: np.ndarray
+    on_edge: np.ndarray
 
 
 class MassProperties(NamedTuple):
@@ -123,8 +129,9 @@ def project_to_surface(obj: GraspObject, points) -> SurfacePoints:
     -------
     SurfacePoints
         ``points (..., 3)``, ``normals (..., 3)`` (unit, inward),
-        ``distance (...)`` (> 0 outside); NaN for a point that is not finite
-        (never an exception, as everywhere in the engine).
+        ``distance (...)`` (> 0 outside), ``on_edge (...)`` (the nearest point is on an
+        edge, corner, rim or mesh vertex: its normal is an average); NaN (``on_edge``
+        False) for a point that is not finite (never an exception, as everywhere in the engine).
 
     Examples
     --------
@@ -135,8 +142,8 @@ def project_to_surface(obj: GraspObject, points) -> SurfacePoints:
     >>> pose[0, 3] = 1.0
     >>> box = GraspObject(Shape("box", np.array([2.0, 2.0, 2.0])), pose)
     >>> s = project_to_surface(box, [1.0, 1.5, 0.0])
-    >>> s.points.tolist(), s.normals.tolist(), float(s.distance)
-    ([1.0, 1.0, 0.0], [0.0, -1.0, 0.0], 0.5)
+    >>> s.points.tolist(), s.normals.tolist(), float(s.distance), bool(s.on_edge)
+    ([1.0, 1.0, 0.0], [0.0, -1.0, 0.0], 0.5, False)
     """
     p = _points(points)
     rotation, translation = obj.pose[:3, :3], obj.pose[:3, 3]
@@ -146,14 +153,16 @@ def project_to_surface(obj: GraspObject, points) -> SurfacePoints:
         local = rotate(rotation.T, p - translation).reshape(-1, 3)
     finite = np.isfinite(local).all(axis=1)
     if finite.all():  # the common case, without the copies
-        c, outward, d = _nearest(obj, local)
+        c, outward, d, edge = _nearest(obj, local)
     else:
         c, outward, d = np.full_like(local, np.nan), np.full_like(local, np.nan), np.full(len(local), np.nan)
-        c[finite], outward[finite], d[finite] = _nearest(obj, local[finite])
+        edge = np.zeros(len(local), dtype=bool)
+        c[finite], outward[finite], d[finite], edge[finite] = _nearest(obj, local[finite])
     return SurfacePoints(
         (rotate(rotation, c) + translation).reshape(p.shape),
         (rotate(-rotation, outward) + 0.0).reshape(p.shape),  # + 0.0: zeros without a sign, for records
         d.reshape(p.shape[:-1]),
+        edge.reshape(p.shape[:-1]),
     )
 
 

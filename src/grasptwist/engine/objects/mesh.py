@@ -185,7 +185,7 @@ def _derived(shape: Shape) -> _Derived:
 
 
 def nearest(shape: Shape, q: np.ndarray):
-    """Nearest surface point, outward unit normal and signed distance (> 0 outside) of each point ``q (N, 3)``.
+    """Nearest surface point, outward unit normal, signed distance (> 0 outside) and edge flag of each point ``q (N, 3)``.
 
     Returns
     -------
@@ -193,18 +193,21 @@ def nearest(shape: Shape, q: np.ndarray):
         Shape ``(N, 3)`` each.
     distance : numpy.ndarray
         Shape ``(N,)``.
+    on_edge : numpy.ndarray
+        Shape ``(N,)`` bool: the nearest point is within ``MESH_EDGE_TOL`` of the size of an edge
+        or vertex (one between coplanar faces too), where the normal is the faces' average.
 
     >>> from grasptwist.engine.objects.primitives import triangles
     >>> v, f = triangles("box", [2.0, 2.0, 2.0], 0)
-    >>> c, n, d = nearest(Shape("mesh", np.zeros(0), v, f), np.array([[0.0, 0, 3], [2, 2, 2], [0.2, 0, 0]]))
+    >>> c, n, d, on_edge = nearest(Shape("mesh", np.zeros(0), v, f), np.array([[0.0, 0, 3], [2, 2, 2], [0.5, 0.2, 0]]))
     >>> c.round(12).tolist(), d.round(4).tolist()
-    ([[0.0, 0.0, 1.0], [1.0, 1.0, 1.0], [1.0, 0.0, 0.0]], [2.0, 1.7321, -0.8])
-    >>> n.round(4).tolist()
-    [[0.0, 0.0, 1.0], [0.5774, 0.5774, 0.5774], [1.0, 0.0, 0.0]]
+    ([[0.0, 0.0, 1.0], [1.0, 1.0, 1.0], [1.0, 0.2, 0.0]], [2.0, 1.7321, -0.5])
+    >>> n.round(4).tolist(), on_edge.tolist()
+    ([[0.0, 0.0, 1.0], [0.5774, 0.5774, 0.5774], [1.0, 0.0, 0.0]], [True, True, False])
     """
     d = _derived(shape)
     if len(q) == 0:
-        return np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0)
+        return np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0), np.zeros(0, dtype=bool)
     face, c = d.nearest_faces(q)
     lam = _barycentric(shape, face, c)
     near_edge = lam * d.heights[face] <= d.tol  # (N, 3): on the edge opposite vertex i
@@ -225,7 +228,7 @@ def nearest(shape: Shape, q: np.ndarray):
     away = q - c
     distance = np.linalg.norm(away, axis=1)
     inside = np.einsum("ij,ij->i", away, pseudo) < 0
-    return c, normal, np.where(inside, -distance, distance)
+    return c, normal, np.where(inside, -distance, distance), count >= 1
 
 
 def _barycentric(shape, face, c):

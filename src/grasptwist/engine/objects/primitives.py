@@ -62,7 +62,8 @@ def _norm(v):
 
 
 def _nearest_on_box(q, half, tol):
-    """Nearest point, outward unit normal and signed distance of ``q (N, k)`` to the box ``|q_i| <= half_i``."""
+    """Nearest point, outward unit normal, signed distance and whether the point is on an edge or corner
+    (within ``tol`` of two faces) of ``q (N, k)`` to the box ``|q_i| <= half_i``."""
     sign = np.where(q < 0, -1.0, 1.0)
     gap = half - np.abs(q)  # > 0: inside along that axis
     out = np.maximum(-gap, 0.0)
@@ -78,7 +79,8 @@ def _nearest_on_box(q, half, tol):
     on = (np.abs(distance) <= tol)[:, None]
     normal = np.where(on, sign * (gap <= tol), normal)
     normal /= _norm(normal)[:, None]
-    return point, normal, distance
+    edge = ((half - np.abs(point)) <= tol).sum(axis=-1) >= 2  # the nearest point on two faces or more
+    return point, normal, distance, edge
 
 
 def _radial(q):
@@ -96,8 +98,8 @@ def _box(size, q, tol):
 def _cylinder(size, q, tol):
     rho, u = _radial(q)
     half = np.array([size[0], 0.5 * size[1]])
-    point, normal, distance = _nearest_on_box(np.stack([rho, q[:, 2]], axis=-1), half, tol)
-    return _lift(point, u), _lift(normal, u), distance
+    point, normal, distance, rim = _nearest_on_box(np.stack([rho, q[:, 2]], axis=-1), half, tol)
+    return _lift(point, u), _lift(normal, u), distance, rim
 
 
 def _lift(rz, u):
@@ -121,14 +123,14 @@ def _round(radius, half, q):
     length = _norm(v)
     with np.errstate(invalid="ignore", divide="ignore"):
         normal = np.where((length > 0)[:, None], v / length[:, None], _X)
-    return axis + radius * normal, normal, length - radius
+    return axis + radius * normal, normal, length - radius, np.zeros(len(q), dtype=bool)  # smooth: no edge
 
 
 _NEAREST = {"box": _box, "sphere": _sphere, "cylinder": _cylinder, "capsule": _capsule}
 
 
 def nearest(kind, size, q, tol):
-    """Nearest surface point, outward unit normal and signed distance (> 0 outside) of each point.
+    """Nearest surface point, outward unit normal, signed distance (> 0 outside) and edge flag of each point.
 
     Parameters
     ----------
@@ -148,16 +150,19 @@ def nearest(kind, size, q, tol):
         Shape ``(N, 3)`` each.
     distance : numpy.ndarray
         Shape ``(N,)``, > 0 outside.
+    on_edge : numpy.ndarray
+        Shape ``(N,)`` bool: the nearest point is within ``tol`` of a box's edge or corner or
+        of a cylinder's rim (never on a sphere or capsule, which are smooth).
 
     Examples
     --------
     A unit cube's corner region, an edge and a face's inside:
 
-    >>> c, n, d = nearest("box", np.ones(3), np.array([[1.0, 1, 1], [0.5, 0.5, 0], [0.25, 0, 0]]), 1e-12)
+    >>> c, n, d, on_edge = nearest("box", np.ones(3), np.array([[1.0, 1, 1], [0.5, 0.5, 0], [0.25, 0, 0]]), 1e-12)
     >>> c.tolist(), d.round(4).tolist()
     ([[0.5, 0.5, 0.5], [0.5, 0.5, 0.0], [0.5, 0.0, 0.0]], [0.866, 0.0, -0.25])
-    >>> n.round(4).tolist()
-    [[0.5774, 0.5774, 0.5774], [0.7071, 0.7071, 0.0], [1.0, 0.0, 0.0]]
+    >>> n.round(4).tolist(), on_edge.tolist()
+    ([[0.5774, 0.5774, 0.5774], [0.7071, 0.7071, 0.0], [1.0, 0.0, 0.0]], [True, True, False])
     """
     return _NEAREST[kind](np.asarray(size, dtype=float), q, tol)
 

@@ -80,10 +80,6 @@ ELITES, CHILDREN = 16, 16
 #: A verified grip's duality gap must be within this of its total (relative).
 GAP_TOL = 1e-6
 
-#: Normals closer than this (cosine) are the same: a contact whose normal turns when put on the
-#: surface again sits on an edge, where the surface has no one normal.
-_SAME_NORMAL = 1 - 1e-9
-
 #: Candidates whose closure friction is computed to say how close a failed search came.
 _CLOSEST = 256
 
@@ -101,8 +97,9 @@ class Surface(NamedTuple):
         ``sample(n, rng) -> (points (n, 3), normals (n, 3))``: area-weighted points and unit
         inward normals, reproducible for a ``numpy.random.Generator``.
     project : callable
-        ``project(points (..., 3)) -> (points, normals, distance)``: the nearest surface
-        points, their unit inward normals and the signed distance.
+        ``project(points (..., 3)) -> (points, normals, distance, on_edge)``: the nearest surface
+        points, their unit inward normals, the signed distance and whether each is on an edge or
+        corner (where the surface has no one normal).
     size : float
         The object's size (the diagonal of its bounding box): the scale of steps and spacing.
     """
@@ -344,7 +341,7 @@ def search(surface: Surface, wrenches, friction, **options) -> Synthesis:
     ...     return p, -p
     >>> def project(q):
     ...     r = np.linalg.norm(q, axis=-1, keepdims=True)
-    ...     return q / r, -q / r, r[..., 0] - 1
+    ...     return q / r, -q / r, r[..., 0] - 1, np.zeros(q.shape[:-1], dtype=bool)
     >>> s = search(Surface(sample, project, 2 * 3**0.5), [[0, 0, 1.0, 0, 0, 0]], 0.5, candidates=1000)
     >>> bool(0.894 < s.total_normal_force[0, 0] < 1.0), s.failure
     (True, None)
@@ -446,9 +443,9 @@ def _refine(surface, archive, score, budget, rng):
         moved = rng.random((k, 3)) < 2 / 3
         moved[np.arange(k), rng.integers(0, 3, k)] = True  # at least one contact moves
         q = p[parent] + tangent_steps(n[parent], step[parent, None] * moved, rng)
-        q, m, _ = surface.project(q)
-        # a point put on an edge or corner has no one normal: projected again, its normal may turn
-        defined = (np.einsum("nix,nix->ni", surface.project(q)[1], m) > _SAME_NORMAL).all(axis=1)
+        q, m, _, on_edge = surface.project(q)
+        # a point put on an edge or corner has no one normal (a mesh's there is an average: kept, it games the grip)
+        defined = ~on_edge.any(axis=1)
         value = np.full(k, np.inf)
         if defined.any():
             # a child better than its parent is never spared the hand's test, kept or not

@@ -88,10 +88,19 @@ def read_object(node, file, reading, max_bytes, problems, warnings):
         return None
     pose.setflags(write=False)
     obj = GraspObject(shape, pose, mass=mass, density=density, line=node.line)
-    from ...engine.objects import mass_properties, object_size
+    from ...engine.objects import mass_properties
+    from ...engine.objects.checks import check_extent
+    from ...engine.objects.mesh import diagonal as mesh_diagonal
+    from ...engine.objects.primitives import diagonal
 
-    if not np.isfinite(object_size(obj)):
-        problems.add(Reject("non-finite", "object", "its size overflows double precision: rescale it", **located(node)))
+    # the extent unchecked (object_size would refuse it), then the engine's rule for all kinds
+    with np.errstate(over="ignore", invalid="ignore"):
+        size = mesh_diagonal(shape.vertices) if shape.kind == "mesh" else diagonal(shape.kind, shape.size)
+    try:
+        check_extent(size)
+    except ValueError as err:
+        code = "non-finite" if not np.isfinite(size) else "invalid-size"
+        problems.add(Reject(code, "object", str(err), **located(node)))
         return None
     if density is None:
         return obj
