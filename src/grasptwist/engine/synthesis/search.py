@@ -80,9 +80,6 @@ ELITES, CHILDREN = 16, 16
 #: A verified grip's duality gap must be within this of its total (relative).
 GAP_TOL = 1e-6
 
-#: Candidates whose closure friction is computed to say how close a failed search came.
-_CLOSEST = 256
-
 #: Fewer candidates than this, every one degenerate, say nothing of the object: the budget is the reason
 #: (a chunk of ``k`` candidates draws its contacts from ``k`` surface points, all alike when ``k < 3``).
 FEW_CANDIDATES = 100
@@ -228,13 +225,13 @@ class _Archive:
     """The best feasible candidates so far (at most ``size``, each ``spacing`` or more from the better
     ones, so that refinement and selection start from distinct grasps), and the furthest any got."""
 
-    def __init__(self, size, spacing, joints=None):
-        self.size, self.spacing = size, spacing
+    def __init__(self, size, spacing, joints=None, tol=DEGENERACY_TOL):
+        self.size, self.spacing, self.tol = size, spacing, tol
         self.points = np.empty((0, 3, 3))
         self.normals = np.empty((0, 3, 3))
         self.objective = np.empty(0)
         self.furthest = 0
-        self.near_points, self.near_normals = np.empty((0, 3, 3)), np.empty((0, 3, 3))
+        self.closest = np.inf  # the least closure friction of a row that failed closure, over every chunk
         self.best_conditioning = 0.0
         self.positions = None if joints is None else np.empty((0, joints))  # with a hand: (N, n_joints)
         self.best_miss = {}  # a hand's constraint -> the closest a row failing it came
@@ -266,10 +263,11 @@ class _Archive:
         worst = np.fmin(s.conditioning[:, 0], s.conditioning[:, 1])  # the asked methods' smaller
         self.best_conditioning = max(self.best_conditioning, float(np.nanmax(worst, initial=0.0)))
         closure = CONSTRAINTS.index("force_closure")
-        at = reached >= closure
-        if at.any() and len(self.near_points) < _CLOSEST:
-            self.near_points = np.concatenate((self.near_points, p[at]))[:_CLOSEST]
-            self.near_normals = np.concatenate((self.near_normals, n[at]))[:_CLOSEST]
+        at = reached == closure
+        # only while closure is the furthest constraint is it what a failed search reports
+        if at.any() and self.furthest == closure:
+            needed = force_closure(p[at], n[at], tol=self.tol).closure_friction
+            self.closest = min(self.closest, float(np.nanmin(needed, initial=np.inf)))
 
 
 def search(surface: Surface, wrenches, friction, **options) -> Synthesis:
@@ -383,7 +381,8 @@ def search_steps(
     started = time.perf_counter()
     rng = np.random.default_rng(seed)
     budget = _Budget(budget_size, seconds)
-    archive = _Archive(max(ELITES, 4 * count), spacing, None if hand is None else len(hand.hand.joint_names))
+    joints = None if hand is None else len(hand.hand.joint_names)
+    archive = _Archive(max(ELITES, 4 * count), spacing, joints, tol)
     # closure friction, epsilon: slower rows; a hand: the archive fills (and spares rows the hand's test) sooner
     chunk = CHUNK if objective == "total_normal_force" and hand is None else CHUNK // 8
 
@@ -588,8 +587,7 @@ def _failure(archive, scored, mu, min_conditioning, tol) -> Failure:
             min_conditioning,
         )
     if name == "force_closure":
-        needed = force_closure(archive.near_points, archive.near_normals, tol=tol).closure_friction
-        best = float(np.nanmin(needed, initial=np.inf))
+        best = archive.closest
         words = "no friction" if not np.isfinite(best) else f"friction {best:.3g}"
         return Failure(
             name,
