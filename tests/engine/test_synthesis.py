@@ -231,6 +231,58 @@ def test_the_time_budget_holds():
     assert 0 < s.candidates < 10**9
 
 
+class _FakeClock:
+    """The search's clock, moved by hand: no wall-clock assertion."""
+
+    def __init__(self):
+        self.now = 0.0
+
+    def __call__(self):
+        return self.now
+
+
+def test_verification_stops_at_the_deadline_and_counts_the_grasps_left(monkeypatch):
+    from grasptwist.engine.synthesis import search as search_module
+
+    clock, real = _FakeClock(), search_module.verified
+
+    def one_second_each(*args, **kwargs):
+        clock.now += 1.0
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(search_module, "_clock", clock)
+    monkeypatch.setattr(search_module, "verified", one_second_each)
+    # the search (no verification) takes no time on this clock: its candidates end it
+    s = synthesize(ball(), 0.8, count=8, candidates=600, seconds=5.0, min_spacing=0.0)
+    assert s.candidates == 600 and s.seconds == 5.0  # the budget, exactly
+    assert len(s.points) == 5 and s.unverified == 3 and len(s.grips) == 5 and s.failure is None
+    s = synthesize(ball(), 0.8, count=8, candidates=600, min_spacing=0.0)  # no time limit: all verified
+    assert len(s.points) == 8 and s.unverified == 0
+
+
+@pytest.mark.parametrize("chunk_seconds, returned", [(0.3, 2), (0.35, 0)])
+def test_a_search_stops_at_its_share_of_the_time_and_verifies_before_the_deadline(monkeypatch, chunk_seconds, returned):
+    from grasptwist.engine.synthesis import search as search_module
+
+    clock, real = _FakeClock(), search_module.score_triples
+
+    def slow(*args, **kwargs):
+        clock.now += chunk_seconds
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(search_module, "_clock", clock)
+    monkeypatch.setattr(search_module, "score_triples", slow)
+    s = synthesize(ball(), 0.8, count=2, candidates=10**6, seconds=1.0)
+    # the search stops after the chunk that passes 0.8 s (1 - VERIFY_SHARE): the third
+    assert search_module.VERIFY_SHARE == 0.2 and s.candidates == 3 * 2048
+    assert s.seconds == pytest.approx(3 * chunk_seconds)
+    assert len(s.points) == returned and s.unverified == 2 - returned
+    if returned:  # 0.9 s: verified in the time left
+        assert s.failure is None
+    else:  # 1.05 s: none verified, and the failure says why
+        assert s.failure.constraint == "verification" and "time ran out" in s.failure.message
+
+
 @pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 def test_other_objectives_rank_by_their_own_figure():
     s = synthesize(box(), 0.8, count=3, candidates=1200, objective="closure_friction")

@@ -348,9 +348,10 @@ def _summary(job, found) -> str:
     if 0 < len(found) < o.count:  # fewer distinct feasible grasps than wanted: the spacing may be why
         spacing = "default" if o.min_spacing is None else f"{o.min_spacing:g}"
         found_count = f"{len(found)} of {o.count} grasps wanted (min spacing {spacing})"
+    late = f"; {s.unverified} found but not verified before --seconds ran out" if s.unverified else ""
     return (
         f"{found.file}: grasp '{found.name}': {found_count} from {s.candidates} candidates scored "
-        f"in {s.seconds:.2f} s ({s.candidates / max(s.seconds, 1e-9):.3g} per second)"
+        f"in {s.seconds:.2f} s ({s.candidates / max(s.seconds, 1e-9):.3g} per second){late}"
     )
 
 

@@ -15,9 +15,12 @@ r"""The search: candidate triples scored in chunks, the best refined on the surf
    ``gap``, ``n_i - G_i^T dual`` in every dual cone) proves the total optimal; one that
    fails is not returned.
 
-The budget holds: the search stops after ``candidates`` scored rows or ``seconds``,
-whichever comes first, checked after every chunk.  With the same ``seed`` and a budget
-of candidates (no time limit reached) two runs return the same grasps bit for bit.
+The budget holds: the search stops after ``candidates`` scored rows or ``(1 - VERIFY_SHARE)
+seconds``, whichever comes first, checked after every chunk; the rest of ``seconds`` is
+selection's and verification's, which stops at the deadline (checked before each grasp): the
+grasps verified by then are returned, the others counted as ``unverified``.  With the same
+``seed`` and a budget of candidates (no time limit reached) two runs return the same grasps bit
+for bit.
 """
 
 from __future__ import annotations
@@ -60,6 +63,7 @@ __all__ = [
     "REFINE_SHARE",
     "GAP_TOL",
     "FEW_CANDIDATES",
+    "VERIFY_SHARE",
 ]
 
 #: Gravity when none is given: 9.81 down the z axis (as grasp files').
@@ -76,6 +80,12 @@ REFINE_SHARE = 0.3
 
 #: Grasps refined at once, and perturbations of each per round.
 ELITES, CHILDREN = 16, 16
+
+#: The share of ``seconds`` kept for selecting and verifying the grasps found (the search stops before it).
+VERIFY_SHARE = 0.2
+
+#: The clock of the time budget (a module attribute: tests replace it).
+_clock = time.perf_counter
 
 #: A verified grip's duality gap must be within this of its total (relative).
 GAP_TOL = 1e-6
@@ -155,6 +165,8 @@ class Synthesis:
         kinematics' tolerance).
     tip_center : (K, 3, 3) or None
         With a hand: each fingertip sphere's centre ``p - r n`` (finger ``f`` on contact ``f``).
+    unverified : int
+        Grasps selected but not verified, so not returned: ``seconds`` ran out before their turn.
     candidates : int
         Candidates scored.
     seconds : float
@@ -181,6 +193,7 @@ class Synthesis:
     joint_positions: np.ndarray | None = None
     reach_error: np.ndarray | None = None
     tip_center: np.ndarray | None = None
+    unverified: int = 0
 
 
 def check_budget(candidates, seconds) -> tuple[int, float | None]:
@@ -204,15 +217,15 @@ def check_budget(candidates, seconds) -> tuple[int, float | None]:
 
 
 class _Budget:
-    """Candidates and time left."""
+    """Candidates and time left (``deadline`` on :data:`_clock`, or None)."""
 
-    def __init__(self, candidates, seconds):
+    def __init__(self, candidates, deadline):
         self.left, self.used = candidates, 0
-        self.deadline = None if seconds is None else time.perf_counter() + seconds
+        self.deadline = deadline
 
     def take(self, n) -> int:
         """Up to ``n`` candidates, 0 when the budget is spent."""
-        if self.deadline is not None and time.perf_counter() >= self.deadline:
+        if self.deadline is not None and _clock() >= self.deadline:
             return 0
         return max(0, min(n, self.left))
 
@@ -315,7 +328,8 @@ def search(surface: Surface, wrenches, friction, **options) -> Synthesis:
     candidates : int, default 20000
         Candidates scored at most (sampling and refinement together).
     seconds : float or None, default None
-        Time allowed, checked after each chunk of :data:`CHUNK` candidates.
+        Time allowed: the search stops after the chunk of :data:`CHUNK` candidates that passes
+        ``(1 - VERIFY_SHARE) seconds``, verification before the first grasp after ``seconds``.
     tol : float, default ``DEGENERACY_TOL``
         The degeneracy tolerance of the contacts (``DEGENERACY_TOL``).
 
@@ -378,9 +392,10 @@ def search_steps(
     budget_size, seconds = check_budget(candidates, seconds)
     spacing = MIN_SPACING * surface.size if min_spacing is None else float(min_spacing)
     hand = None if hand is None else check_hand_reach(hand)
-    started = time.perf_counter()
+    started = _clock()
+    deadline = None if seconds is None else started + seconds
     rng = np.random.default_rng(seed)
-    budget = _Budget(budget_size, seconds)
+    budget = _Budget(budget_size, None if seconds is None else started + (1 - VERIFY_SHARE) * seconds)
     joints = None if hand is None else len(hand.hand.joint_names)
     archive = _Archive(max(ELITES, 4 * count), spacing, joints, tol)
     # closure friction, epsilon: slower rows; a hand: the archive fills (and spares rows the hand's test) sooner
@@ -417,12 +432,21 @@ def search_steps(
     points, normals = archive.points[picked], archive.normals[picked]
     positions = None if hand is None else archive.positions[picked]
     quality = quality or objective == "epsilon"
-    out = _results(surface, points, normals, w, mu, safety, wrist, methods, quality, tol, hand, positions)
-    failure = None if len(out["points"]) else _failure(archive, budget.used, mu / safety, min_conditioning, tol)
+    out = _results(surface, points, normals, w, mu, safety, wrist, methods, quality, tol, hand, positions, deadline)
+    failure = None
+    if not len(out["points"]) and out["unverified"]:
+        failure = Failure(
+            "verification",
+            f"the time ran out before a grasp found was verified ({out['unverified']} not verified: allow more seconds)",
+            np.nan,
+            np.nan,
+        )
+    elif not len(out["points"]):
+        failure = _failure(archive, budget.used, mu / safety, min_conditioning, tol)
     yield Synthesis(
         **out,
         candidates=budget.used,
-        seconds=time.perf_counter() - started,
+        seconds=_clock() - started,
         seed=seed,
         failure=failure,
     )
@@ -464,6 +488,8 @@ def _refine(surface, archive, score, budget, rng):
 def _spread(points, count, spacing):
     """Indices of up to ``count`` of the grasps ``points (N, 3, 3)``, in order, each ``spacing`` or more
     from those picked before it (:func:`~.candidates.triple_distance`)."""
+    if spacing <= 0:  # every distance is at least 0: the first ``count`` (spared a quadratic loop)
+        return np.arange(min(count, len(points)))
     picked = []
     for i in range(len(points)):
         if len(picked) == count:
@@ -507,11 +533,17 @@ def verified(points, normals, wrench, friction, safety, tol=DEGENERACY_TOL) -> G
     return g if inside.all() else None
 
 
-def _results(surface, points, normals, w, mu, safety, wrist, methods, quality, tol, hand=None, positions=None):
+def _results(
+    surface, points, normals, w, mu, safety, wrist, methods, quality, tol, hand=None, positions=None, deadline=None
+):
     """The returned grasps' fields of :class:`Synthesis`, each grasp verified (the others dropped): the
-    exact grip, and with a hand its tips by forward kinematics, its limits and its links clear."""
-    grips, keep = [], []
+    exact grip, and with a hand its tips by forward kinematics, its limits and its links clear; those
+    whose turn comes after ``deadline`` (on :data:`_clock`) are not verified, only counted."""
+    grips, keep, unverified = [], [], 0
     for i in range(len(points)):
+        if deadline is not None and _clock() >= deadline:
+            unverified = len(points) - i
+            break
         found = tuple(verified(points[i], normals[i], wrench, mu, safety, tol) for wrench in w)
         if all(g is not None for g in found):
             grips.append(found)
@@ -539,6 +571,7 @@ def _results(surface, points, normals, w, mu, safety, wrist, methods, quality, t
         "epsilon": (closure.epsilon if closure else np.empty(0)) if quality else None,
         "conditioning": conditionings(p, n, wrist, methods, tol) if len(p) else np.empty((0, 2)),
         "grips": tuple(grips),
+        "unverified": unverified,
         **hand_fields,
     }
 
