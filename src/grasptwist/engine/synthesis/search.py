@@ -39,9 +39,9 @@ from ..fingertips import tip_centers, tip_radii
 from ..forces.closure import force_closure
 from ..forces.grasp_map import check_friction, check_safety, check_wrench
 from ..forces.grip import Grip, grip
-from ..forces.hold import hold_wrench
+from ..forces.hold import object_weight
 from ..ik import home_tips, joint_limits
-from ..objects import mass_properties, object_size, project_to_surface, sample_surface
+from ..objects import object_size, project_to_surface, sample_surface
 from .candidates import candidate_triples, tangent_steps, triple_distance
 from .reach import HandReach, check_hand_reach, reach_tolerance, tip_errors
 from .scores import CONSTRAINTS, METHODS, check_min_conditioning, check_objective, conditionings, score_triples
@@ -745,10 +745,10 @@ def synthesize(
     """
     listed = [np.asarray(w, float).reshape(6) for w in wrenches]
     if hold:
-        props = mass_properties(obj)
-        if props.mass is None:
+        weight = object_weight(obj, gravity)
+        if weight is None:
             raise ValueError("hold=True needs the object's mass (or density): its weight is the wrench to hold")
-        listed.insert(0, hold_wrench(props.mass, props.center_of_mass, np.asarray(gravity, float)))
+        listed.insert(0, weight.wrench)
     if not listed:
         raise ValueError("nothing to hold: give the object a mass (hold=True) or wrenches")
     if hand is not None and not isinstance(hand, HandReach):
