@@ -260,7 +260,7 @@ def test_verification_stops_at_the_deadline_and_counts_the_grasps_left(monkeypat
     assert len(s.points) == 8 and s.unverified == 0
 
 
-@pytest.mark.parametrize("chunk_seconds, returned", [(0.3, 2), (0.35, 0)])
+@pytest.mark.parametrize("chunk_seconds, returned", [(0.85, 2), (1.05, 0)])
 def test_a_search_stops_at_its_share_of_the_time_and_verifies_before_the_deadline(monkeypatch, chunk_seconds, returned):
     from grasptwist.engine.synthesis import search as search_module
 
@@ -273,11 +273,10 @@ def test_a_search_stops_at_its_share_of_the_time_and_verifies_before_the_deadlin
     monkeypatch.setattr(search_module, "_clock", clock)
     monkeypatch.setattr(search_module, "score_triples", slow)
     s = synthesize(ball(), 0.8, count=2, candidates=10**6, seconds=1.0)
-    # the search stops after the chunk that passes 0.8 s (1 - VERIFY_SHARE): the third
-    assert search_module.VERIFY_SHARE == 0.2 and s.candidates == 3 * 2048
-    assert s.seconds == pytest.approx(3 * chunk_seconds)
+    # the search stops after the chunk that passes 0.8 s (1 - VERIFY_SHARE): the first
+    assert search_module.VERIFY_SHARE == 0.2 and s.candidates == 2048 and s.seconds == chunk_seconds
     assert len(s.points) == returned and s.unverified == 2 - returned
-    if returned:  # 0.9 s: verified in the time left
+    if returned:  # 0.85 s: verified in the time left
         assert s.failure is None
     else:  # 1.05 s: none verified, and the failure says why
         assert s.failure.constraint == "verification" and "time ran out" in s.failure.message
