@@ -414,3 +414,24 @@ def test_a_grasp_file_needs_no_contacts_for_synthesize_only(tmp_path):
     assert (recs[1]["error"]["code"], recs[1]["error"]["line"]) == ("no-object", 6) and r.exit_code == 1
     resolved, _ = run("resolve", bare, "--twist", "0,0,1,0,0,0")  # the other commands still need contacts
     assert resolved.exit_code == 1 and "bare.yaml:1:1: error: missing-key: contacts" in resolved.stderr
+
+
+def test_grasps_left_unverified_when_the_time_runs_out_are_counted_on_stderr(monkeypatch):
+    from grasptwist.engine.synthesis import search as search_module
+
+    now, real = [0.0], search_module.verified
+
+    def one_second_each(*args, **kwargs):  # a clock moved by hand: no wall-clock assertion
+        now[0] += 1.0
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(search_module, "_clock", lambda: now[0])
+    monkeypatch.setattr(search_module, "verified", one_second_each)
+    # 'sphere-tripod' one wrench: 1 s a grasp, three verified by 3 s; 'sphere-equator' two: 2 s a grasp, the
+    # second verified from 2 s to 4 s (the slack: one grasp's grips), the third left
+    r, _ = run("synthesize", SPHERE, "--friction", "0.5", "--mass", "1", *FAST, "-n", "3", "--seconds", "3")
+    assert r.exit_code == 0, r.stderr
+    tripod, equator = (line for line in r.stderr.splitlines() if "candidates scored" in line)
+    assert "'sphere-tripod': 3 grasps from 120 candidates scored in 3.00 s" in tripod and "verified" not in tripod
+    assert "'sphere-equator': 2 of 3 grasps wanted" in equator and "scored in 4.00 s" in equator
+    assert equator.endswith("; 1 found but not verified before --seconds ran out")

@@ -19,9 +19,9 @@ import numpy as np
 import pytest
 
 from grasptwist.engine.forces.grasp_map import ForceStatus
-from grasptwist.engine.forces.hold import cannot_hold, grip_along, hold_verdicts, hold_wrench
+from grasptwist.engine.forces.hold import cannot_hold, grip_along, hold_verdicts, hold_wrench, object_weight
 from grasptwist.io.grasp import load_grasps
-from grasptwist.model import Segment
+from grasptwist.model import GraspObject, Segment, Shape
 
 TRIANGLE = np.array([[1, 0, 0], [-0.5, 0.75**0.5, 0], [-0.5, -(0.75**0.5), 0]])
 UP = np.array([[0.0, 0, 1]] * 3)
@@ -216,3 +216,15 @@ def test_follow_never_says_the_weight_is_held_where_the_pose_overflows(tmp_path)
     assert table.exit_code == 1 and "held all along" not in table.stdout
     summary_lines = table.stdout.split("summary:")[1].splitlines()
     assert summary_lines[-1] == f"  {line.replace('000000', '0000')}"
+
+
+def test_an_object_s_weight_is_its_mass_or_density_times_volume_at_its_centre():
+    pose = np.eye(4)
+    pose[:3, 3] = [0.0, 0.5, 0.0]
+    box = GraspObject(Shape("box", np.array([0.1, 0.2, 0.5])), pose, density=1000.0)  # 0.01 m^3: 10 kg
+    w = object_weight(box, [0.0, 0.0, -10.0])
+    assert w.mass == pytest.approx(10.0, rel=1e-12)
+    np.testing.assert_allclose(w.center_of_mass, [0.0, 0.5, 0.0], atol=1e-15)
+    # lifted by 100 N along z, whose line is 0.5 m along y: a moment of 0.5 x 100 about x
+    np.testing.assert_allclose(w.wrench, [0, 0, 100.0, 50.0, 0, 0], rtol=1e-12, atol=1e-12)
+    assert object_weight(GraspObject(box.shape, pose), [0.0, 0.0, -10.0]) is None

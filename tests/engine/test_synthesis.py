@@ -195,6 +195,29 @@ def test_a_ball_without_friction_has_no_grasp_and_says_how_close_it_came():
     assert "no candidate is force closure at friction 0" in s.failure.message
 
 
+def test_how_close_a_failed_search_came_is_the_least_over_every_candidate_scored(monkeypatch):
+    """Once only the first 256 candidates were looked at: a cube at friction 0 reported 0.039 after 5,000
+    or 50,000 candidates while some needed 1e-4."""
+    from grasptwist.engine.forces.closure import force_closure
+    from grasptwist.engine.synthesis import search as search_module
+
+    scored = []
+
+    def recording(p, n, *args, **kwargs):
+        s = score_triples(p, n, *args, **kwargs)
+        scored.append((p, n, s.failed))
+        return s
+
+    monkeypatch.setattr(search_module, "score_triples", recording)
+    s = synthesize(box(), 0.0, candidates=2048, seed=3)
+    p, n, failed = (np.concatenate(a) for a in zip(*scored))
+    at = failed == CONSTRAINTS.index("force_closure")
+    assert len(p) == 2048 and at.sum() > 2000
+    needed = force_closure(p[at], n[at]).closure_friction
+    assert s.failure.constraint == "force_closure" and s.failure.best == pytest.approx(np.nanmin(needed), rel=1e-9)
+    assert 0 < s.failure.best < 0.7 * np.nanmin(needed[:256])  # 0.0045: closer than the first 256 (0.0078)
+
+
 def test_a_needle_is_too_thin_for_well_conditioned_grasps():
     needle = GraspObject(Shape("cylinder", np.array([1e-5, 0.1])), np.eye(4), mass=0.001)
     s = synthesize(needle, 0.5, candidates=2000, min_conditioning=1e-3)
@@ -206,6 +229,57 @@ def test_the_time_budget_holds():
     s = synthesize(box(), 0.8, candidates=10**9, seconds=0.05)
     assert s.seconds < 2.0  # checked after every chunk (a chunk is milliseconds): generous on a busy machine
     assert 0 < s.candidates < 10**9
+
+
+class _FakeClock:
+    """The search's clock, moved by hand: no wall-clock assertion."""
+
+    def __init__(self):
+        self.now = 0.0
+
+    def __call__(self):
+        return self.now
+
+
+def test_verification_stops_at_the_deadline_and_counts_the_grasps_left(monkeypatch):
+    from grasptwist.engine.synthesis import search as search_module
+
+    clock, real = _FakeClock(), search_module.verified
+
+    def one_second_each(*args, **kwargs):
+        clock.now += 1.0
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(search_module, "_clock", clock)
+    monkeypatch.setattr(search_module, "verified", one_second_each)
+    # the search (no verification) takes no time on this clock: its candidates end it
+    s = synthesize(ball(), 0.8, count=8, candidates=600, seconds=5.0, min_spacing=0.0)
+    assert s.candidates == 600 and s.seconds == 5.0  # the budget, exactly
+    assert len(s.points) == 5 and s.unverified == 3 and len(s.grips) == 5 and s.failure is None
+    s = synthesize(ball(), 0.8, count=8, candidates=600, min_spacing=0.0)  # no time limit: all verified
+    assert len(s.points) == 8 and s.unverified == 0
+
+
+@pytest.mark.parametrize("chunk_seconds, returned", [(0.85, 2), (1.05, 0)])
+def test_a_search_stops_at_its_share_of_the_time_and_verifies_before_the_deadline(monkeypatch, chunk_seconds, returned):
+    from grasptwist.engine.synthesis import search as search_module
+
+    clock, real = _FakeClock(), search_module.score_triples
+
+    def slow(*args, **kwargs):
+        clock.now += chunk_seconds
+        return real(*args, **kwargs)
+
+    monkeypatch.setattr(search_module, "_clock", clock)
+    monkeypatch.setattr(search_module, "score_triples", slow)
+    s = synthesize(ball(), 0.8, count=2, candidates=10**6, seconds=1.0)
+    # the search stops after the chunk that passes 0.8 s (1 - VERIFY_SHARE): the first
+    assert search_module.VERIFY_SHARE == 0.2 and s.candidates == 2048 and s.seconds == chunk_seconds
+    assert len(s.points) == returned and s.unverified == 2 - returned
+    if returned:  # 0.85 s: verified in the time left
+        assert s.failure is None
+    else:  # 1.05 s: none verified, and the failure says why
+        assert s.failure.constraint == "verification" and "time ran out" in s.failure.message
 
 
 @pytest.mark.slow  # over a second: docs/reference/development.md, Test time

@@ -140,7 +140,12 @@ def synthesize(
     ] = 20000,
     seconds: Annotated[
         float,
-        typer.Option("--seconds", metavar="S", callback=_checked(_positive), help="Time allowed per object."),
+        typer.Option(
+            "--seconds",
+            metavar="S",
+            callback=_checked(_positive),
+            help="Time allowed per object: the search stops at 80% of it, verification at the end (grasps left unverified are not reported).",
+        ),
     ] = 60.0,
     fmt: Annotated[
         SynthesizeFormat,

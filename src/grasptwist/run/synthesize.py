@@ -22,9 +22,8 @@ from typing import NamedTuple
 import numpy as np
 
 from ..engine.fingertips import tip_centers, tip_radii
-from ..engine.forces.hold import hold_wrench
+from ..engine.forces.hold import Weight, hold_wrench, object_weight
 from ..engine.ik import home_tips
-from ..engine.objects import mass_properties
 from ..engine.synthesis.scores import METHODS
 from ..engine.synthesis.search import GRAVITY, Synthesis, hand_reach, search_steps, surface_of
 from ..io.grasp.forces import HOLD
@@ -110,12 +109,13 @@ def _task(options: SynthesisOptions, grasp: Grasp):
     named += [(w.name, w.wrench) for w in options.wrenches or ()]
     hold = None
     if options.mass is not None or grasp.mass is not None:
-        props = mass_properties(obj)
-        mass = props.mass if props.mass is not None else grasp.mass
-        center = props.center_of_mass if grasp.object.mass is not None or options.mass else grasp.center_of_mass
         gravity = np.asarray(GRAVITY if grasp.gravity is None else grasp.gravity, float)
-        hold = (mass, center, gravity)
-        named.insert(0, (HOLD, hold_wrench(mass, center, gravity)))
+        weight = object_weight(obj, gravity)
+        if weight is None:  # a weight apart from the object: the file's top-level mass and center_of_mass
+            mass, center = grasp.mass, grasp.center_of_mass
+            weight = Weight(mass, center, gravity, hold_wrench(mass, center, gravity))
+        hold = (weight.mass, weight.center_of_mass, weight.gravity)
+        named.insert(0, (HOLD, weight.wrench))
     if not named:
         return _problem(
             grasp.file,
@@ -348,9 +348,10 @@ def _summary(job, found) -> str:
     if 0 < len(found) < o.count:  # fewer distinct feasible grasps than wanted: the spacing may be why
         spacing = "default" if o.min_spacing is None else f"{o.min_spacing:g}"
         found_count = f"{len(found)} of {o.count} grasps wanted (min spacing {spacing})"
+    late = f"; {s.unverified} found but not verified before --seconds ran out" if s.unverified else ""
     return (
         f"{found.file}: grasp '{found.name}': {found_count} from {s.candidates} candidates scored "
-        f"in {s.seconds:.2f} s ({s.candidates / max(s.seconds, 1e-9):.3g} per second)"
+        f"in {s.seconds:.2f} s ({s.candidates / max(s.seconds, 1e-9):.3g} per second){late}"
     )
 
 

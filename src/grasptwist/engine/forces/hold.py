@@ -22,12 +22,23 @@ import numpy as np
 
 from .. import se3
 from ..degeneracy import DEGENERACY_TOL
+from ..objects import mass_properties
 from ..path import Poses, check_segments, integrate, overflowing, pose_overflowed
 from ..screws import cross
 from .grasp_map import ForceStatus
 from .grip import Grip, grip
 
-__all__ = ["HoldStretch", "Unjudged", "hold_wrench", "grip_along", "cannot_hold", "hold_verdicts", "PRECISION"]
+__all__ = [
+    "HoldStretch",
+    "Unjudged",
+    "Weight",
+    "hold_wrench",
+    "object_weight",
+    "grip_along",
+    "cannot_hold",
+    "hold_verdicts",
+    "PRECISION",
+]
 
 #: Stretch ends are located to this fraction of the shortest segment's duration.
 PRECISION = 1e-10
@@ -101,6 +112,57 @@ def hold_wrench(mass, center_of_mass, gravity, rotation=None, position=None) -> 
     weight = float(mass) * np.asarray(gravity, dtype=float)
     moment = cross(c, weight)
     return 0.0 - np.concatenate((np.broadcast_to(weight, moment.shape), moment), axis=-1)  # 0.0 -: no -0.0
+
+
+class Weight(NamedTuple):
+    """An object's weight as the fingers hold it (:func:`object_weight`).
+
+    Attributes
+    ----------
+    mass : float
+    center_of_mass, gravity : (3,) arrays
+        In the grasp frame.
+    wrench : (6,) array
+        :func:`hold_wrench` of the three.
+    """
+
+    mass: float
+    center_of_mass: np.ndarray
+    gravity: np.ndarray
+    wrench: np.ndarray
+
+
+def object_weight(obj, gravity) -> Weight | None:
+    r"""The weight of an object (its ``mass``, or ``density`` times its volume, at its centre of mass) and
+    the wrench that holds it, :func:`hold_wrench`; None when the object has neither mass nor density.
+
+    .. math:: w = \left(-m g;\; -c \times m g\right)
+
+    Parameters
+    ----------
+    obj : GraspObject
+    gravity : (3,) array
+
+    Returns
+    -------
+    Weight or None
+
+    Examples
+    --------
+    >>> from grasptwist.objects import GraspObject, Shape
+    >>> pose = np.eye(4)
+    >>> pose[:3, 3] = [1.0, 0, 0]
+    >>> ball = GraspObject(Shape("sphere", np.array([0.05])), pose, mass=1.0)
+    >>> object_weight(ball, [0, 0, -9.81]).wrench.tolist()
+    [0.0, 0.0, 9.81, 0.0, -9.81, 0.0]
+    >>> object_weight(GraspObject(Shape("sphere", np.array([0.05])), pose), [0, 0, -9.81]) is None
+    True
+    """
+    props = mass_properties(obj)
+    if props.mass is None:
+        return None
+    g = np.asarray(gravity, dtype=float)
+    return Weight(float(props.mass), props.center_of_mass, g, hold_wrench(props.mass, props.center_of_mass, g))
 
 
 def grip_along(

@@ -15,9 +15,12 @@ r"""The search: candidate triples scored in chunks, the best refined on the surf
    ``gap``, ``n_i - G_i^T dual`` in every dual cone) proves the total optimal; one that
    fails is not returned.
 
-The budget holds: the search stops after ``candidates`` scored rows or ``seconds``,
-whichever comes first, checked after every chunk.  With the same ``seed`` and a budget
-of candidates (no time limit reached) two runs return the same grasps bit for bit.
+The budget holds: the search stops after ``candidates`` scored rows or ``(1 - VERIFY_SHARE)
+seconds``, whichever comes first, checked after every chunk; the rest of ``seconds`` is
+selection's and verification's, which stops at the deadline (checked before each grasp): the
+grasps verified by then are returned, the others counted as ``unverified``.  With the same
+``seed`` and a budget of candidates (no time limit reached) two runs return the same grasps bit
+for bit.
 """
 
 from __future__ import annotations
@@ -36,9 +39,9 @@ from ..fingertips import tip_centers, tip_radii
 from ..forces.closure import force_closure
 from ..forces.grasp_map import check_friction, check_safety, check_wrench
 from ..forces.grip import Grip, grip
-from ..forces.hold import hold_wrench
+from ..forces.hold import object_weight
 from ..ik import home_tips, joint_limits
-from ..objects import mass_properties, object_size, project_to_surface, sample_surface
+from ..objects import object_size, project_to_surface, sample_surface
 from .candidates import candidate_triples, tangent_steps, triple_distance
 from .reach import HandReach, check_hand_reach, reach_tolerance, tip_errors
 from .scores import CONSTRAINTS, METHODS, check_min_conditioning, check_objective, conditionings, score_triples
@@ -60,6 +63,7 @@ __all__ = [
     "REFINE_SHARE",
     "GAP_TOL",
     "FEW_CANDIDATES",
+    "VERIFY_SHARE",
 ]
 
 #: Gravity when none is given: 9.81 down the z axis (as grasp files').
@@ -77,11 +81,14 @@ REFINE_SHARE = 0.3
 #: Grasps refined at once, and perturbations of each per round.
 ELITES, CHILDREN = 16, 16
 
+#: The share of ``seconds`` kept for selecting and verifying the grasps found (the search stops before it).
+VERIFY_SHARE = 0.2
+
+#: The clock of the time budget (a module attribute: tests replace it).
+_clock = time.perf_counter
+
 #: A verified grip's duality gap must be within this of its total (relative).
 GAP_TOL = 1e-6
-
-#: Candidates whose closure friction is computed to say how close a failed search came.
-_CLOSEST = 256
 
 #: Fewer candidates than this, every one degenerate, say nothing of the object: the budget is the reason
 #: (a chunk of ``k`` candidates draws its contacts from ``k`` surface points, all alike when ``k < 3``).
@@ -158,6 +165,8 @@ class Synthesis:
         kinematics' tolerance).
     tip_center : (K, 3, 3) or None
         With a hand: each fingertip sphere's centre ``p - r n`` (finger ``f`` on contact ``f``).
+    unverified : int
+        Grasps selected but not verified, so not returned: ``seconds`` ran out before their turn.
     candidates : int
         Candidates scored.
     seconds : float
@@ -184,6 +193,7 @@ class Synthesis:
     joint_positions: np.ndarray | None = None
     reach_error: np.ndarray | None = None
     tip_center: np.ndarray | None = None
+    unverified: int = 0
 
 
 def check_budget(candidates, seconds) -> tuple[int, float | None]:
@@ -207,15 +217,15 @@ def check_budget(candidates, seconds) -> tuple[int, float | None]:
 
 
 class _Budget:
-    """Candidates and time left."""
+    """Candidates and time left (``deadline`` on :data:`_clock`, or None)."""
 
-    def __init__(self, candidates, seconds):
+    def __init__(self, candidates, deadline):
         self.left, self.used = candidates, 0
-        self.deadline = None if seconds is None else time.perf_counter() + seconds
+        self.deadline = deadline
 
     def take(self, n) -> int:
         """Up to ``n`` candidates, 0 when the budget is spent."""
-        if self.deadline is not None and time.perf_counter() >= self.deadline:
+        if self.deadline is not None and _clock() >= self.deadline:
             return 0
         return max(0, min(n, self.left))
 
@@ -228,13 +238,13 @@ class _Archive:
     """The best feasible candidates so far (at most ``size``, each ``spacing`` or more from the better
     ones, so that refinement and selection start from distinct grasps), and the furthest any got."""
 
-    def __init__(self, size, spacing, joints=None):
-        self.size, self.spacing = size, spacing
+    def __init__(self, size, spacing, joints=None, tol=DEGENERACY_TOL):
+        self.size, self.spacing, self.tol = size, spacing, tol
         self.points = np.empty((0, 3, 3))
         self.normals = np.empty((0, 3, 3))
         self.objective = np.empty(0)
         self.furthest = 0
-        self.near_points, self.near_normals = np.empty((0, 3, 3)), np.empty((0, 3, 3))
+        self.closest = np.inf  # the least closure friction of a row that failed closure, over every chunk
         self.best_conditioning = 0.0
         self.positions = None if joints is None else np.empty((0, joints))  # with a hand: (N, n_joints)
         self.best_miss = {}  # a hand's constraint -> the closest a row failing it came
@@ -266,10 +276,11 @@ class _Archive:
         worst = np.fmin(s.conditioning[:, 0], s.conditioning[:, 1])  # the asked methods' smaller
         self.best_conditioning = max(self.best_conditioning, float(np.nanmax(worst, initial=0.0)))
         closure = CONSTRAINTS.index("force_closure")
-        at = reached >= closure
-        if at.any() and len(self.near_points) < _CLOSEST:
-            self.near_points = np.concatenate((self.near_points, p[at]))[:_CLOSEST]
-            self.near_normals = np.concatenate((self.near_normals, n[at]))[:_CLOSEST]
+        at = reached == closure
+        # only while closure is the furthest constraint is it what a failed search reports
+        if at.any() and self.furthest == closure:
+            needed = force_closure(p[at], n[at], tol=self.tol).closure_friction
+            self.closest = min(self.closest, float(np.nanmin(needed, initial=np.inf)))
 
 
 def search(surface: Surface, wrenches, friction, **options) -> Synthesis:
@@ -317,7 +328,8 @@ def search(surface: Surface, wrenches, friction, **options) -> Synthesis:
     candidates : int, default 20000
         Candidates scored at most (sampling and refinement together).
     seconds : float or None, default None
-        Time allowed, checked after each chunk of :data:`CHUNK` candidates.
+        Time allowed: the search stops after the chunk of :data:`CHUNK` candidates that passes
+        ``(1 - VERIFY_SHARE) seconds``, verification before the first grasp after ``seconds``.
     tol : float, default ``DEGENERACY_TOL``
         The degeneracy tolerance of the contacts (``DEGENERACY_TOL``).
 
@@ -380,10 +392,12 @@ def search_steps(
     budget_size, seconds = check_budget(candidates, seconds)
     spacing = MIN_SPACING * surface.size if min_spacing is None else float(min_spacing)
     hand = None if hand is None else check_hand_reach(hand)
-    started = time.perf_counter()
+    started = _clock()
+    deadline = None if seconds is None else started + seconds
     rng = np.random.default_rng(seed)
-    budget = _Budget(budget_size, seconds)
-    archive = _Archive(max(ELITES, 4 * count), spacing, None if hand is None else len(hand.hand.joint_names))
+    budget = _Budget(budget_size, None if seconds is None else started + (1 - VERIFY_SHARE) * seconds)
+    joints = None if hand is None else len(hand.hand.joint_names)
+    archive = _Archive(max(ELITES, 4 * count), spacing, joints, tol)
     # closure friction, epsilon: slower rows; a hand: the archive fills (and spares rows the hand's test) sooner
     chunk = CHUNK if objective == "total_normal_force" and hand is None else CHUNK // 8
 
@@ -418,12 +432,21 @@ def search_steps(
     points, normals = archive.points[picked], archive.normals[picked]
     positions = None if hand is None else archive.positions[picked]
     quality = quality or objective == "epsilon"
-    out = _results(surface, points, normals, w, mu, safety, wrist, methods, quality, tol, hand, positions)
-    failure = None if len(out["points"]) else _failure(archive, budget.used, mu / safety, min_conditioning, tol)
+    out = _results(surface, points, normals, w, mu, safety, wrist, methods, quality, tol, hand, positions, deadline)
+    failure = None
+    if not len(out["points"]) and out["unverified"]:
+        failure = Failure(
+            "verification",
+            f"the time ran out before a grasp found was verified ({out['unverified']} not verified: allow more seconds)",
+            np.nan,
+            np.nan,
+        )
+    elif not len(out["points"]):
+        failure = _failure(archive, budget.used, mu / safety, min_conditioning, tol)
     yield Synthesis(
         **out,
         candidates=budget.used,
-        seconds=time.perf_counter() - started,
+        seconds=_clock() - started,
         seed=seed,
         failure=failure,
     )
@@ -465,6 +488,8 @@ def _refine(surface, archive, score, budget, rng):
 def _spread(points, count, spacing):
     """Indices of up to ``count`` of the grasps ``points (N, 3, 3)``, in order, each ``spacing`` or more
     from those picked before it (:func:`~.candidates.triple_distance`)."""
+    if spacing <= 0:  # every distance is at least 0: the first ``count`` (spared a quadratic loop)
+        return np.arange(min(count, len(points)))
     picked = []
     for i in range(len(points)):
         if len(picked) == count:
@@ -508,11 +533,17 @@ def verified(points, normals, wrench, friction, safety, tol=DEGENERACY_TOL) -> G
     return g if inside.all() else None
 
 
-def _results(surface, points, normals, w, mu, safety, wrist, methods, quality, tol, hand=None, positions=None):
+def _results(
+    surface, points, normals, w, mu, safety, wrist, methods, quality, tol, hand=None, positions=None, deadline=None
+):
     """The returned grasps' fields of :class:`Synthesis`, each grasp verified (the others dropped): the
-    exact grip, and with a hand its tips by forward kinematics, its limits and its links clear."""
-    grips, keep = [], []
+    exact grip, and with a hand its tips by forward kinematics, its limits and its links clear; those
+    whose turn comes after ``deadline`` (on :data:`_clock`) are not verified, only counted."""
+    grips, keep, unverified = [], [], 0
     for i in range(len(points)):
+        if deadline is not None and _clock() >= deadline:
+            unverified = len(points) - i
+            break
         found = tuple(verified(points[i], normals[i], wrench, mu, safety, tol) for wrench in w)
         if all(g is not None for g in found):
             grips.append(found)
@@ -540,6 +571,7 @@ def _results(surface, points, normals, w, mu, safety, wrist, methods, quality, t
         "epsilon": (closure.epsilon if closure else np.empty(0)) if quality else None,
         "conditioning": conditionings(p, n, wrist, methods, tol) if len(p) else np.empty((0, 2)),
         "grips": tuple(grips),
+        "unverified": unverified,
         **hand_fields,
     }
 
@@ -588,8 +620,7 @@ def _failure(archive, scored, mu, min_conditioning, tol) -> Failure:
             min_conditioning,
         )
     if name == "force_closure":
-        needed = force_closure(archive.near_points, archive.near_normals, tol=tol).closure_friction
-        best = float(np.nanmin(needed, initial=np.inf))
+        best = archive.closest
         words = "no friction" if not np.isfinite(best) else f"friction {best:.3g}"
         return Failure(
             name,
@@ -714,10 +745,10 @@ def synthesize(
     """
     listed = [np.asarray(w, float).reshape(6) for w in wrenches]
     if hold:
-        props = mass_properties(obj)
-        if props.mass is None:
+        weight = object_weight(obj, gravity)
+        if weight is None:
             raise ValueError("hold=True needs the object's mass (or density): its weight is the wrench to hold")
-        listed.insert(0, hold_wrench(props.mass, props.center_of_mass, np.asarray(gravity, float)))
+        listed.insert(0, weight.wrench)
     if not listed:
         raise ValueError("nothing to hold: give the object a mass (hold=True) or wrenches")
     if hand is not None and not isinstance(hand, HandReach):

@@ -141,9 +141,10 @@ def _object_hold(fields, obj, problems):
 
 def _hold(mass, center, gravity, node, path, problems):
     """``(mass, center, gravity, hold wrench)``, or None when the wrench overflows (``path``, at ``node``)."""
+    from ...engine.forces.hold import hold_wrench
+
     with np.errstate(over="ignore", invalid="ignore"):
-        weight = mass * np.array(gravity)
-        hold = 0.0 - np.concatenate([weight, screws.cross(np.array(center), weight)])  # no -0.0
+        hold = hold_wrench(mass, center, gravity)
     if not np.isfinite(hold).all():
         problems.add(
             Reject(
