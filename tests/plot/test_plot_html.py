@@ -252,11 +252,12 @@ def test_a_comment_and_script_opening_in_a_name_stay_in_the_figures_json(tmp_pat
 def test_a_urdf_hands_meshes_are_posed_at_its_joint_positions_touching_the_contacts():
     pytest.importorskip("yourdfpy")
     pytest.importorskip("robot_properties_fingers")
+    from grasptwist.hand import place_grasp
     from grasptwist.io.urdf_meshes import hand_meshes
     from grasptwist.plot import grasp_page
     from grasptwist.plot.traces import MESH_NAME
 
-    grasp = load_grasps(GRASPS / "trifinger-cube.yaml")[0]
+    grasp = place_grasp(load_grasps(GRASPS / "trifinger-cube.yaml")[0])  # its joint positions solved
     meshes = hand_meshes(grasp.hand, grasp.joint_positions, folder=GRASPS)
     (section,) = grasp_page(grasp, meshes=meshes)  # no paths
     sections = [section]

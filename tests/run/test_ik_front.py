@@ -18,6 +18,7 @@ from grasptwist.engine import hands
 from grasptwist.engine.degeneracy import Status
 from grasptwist.engine.ik import IK_TOL, hand_ik
 from grasptwist.output.follow_table import FollowTable
+from grasptwist.output.numbers import fmt_figure
 from grasptwist.run.placement import read_grasps
 from places import ROOT
 
@@ -219,7 +220,8 @@ def test_follow_shows_each_samples_positions_and_tip_errors():
     lines = [line for line in out.getvalue().decode().splitlines() if line.lstrip().startswith("hand  finger")]
     assert len(lines) == 5
     last = samples[-1]["hand"]["fingers"][2]
-    want = f"finger 3: q {' '.join(f'{v:.4f}' for v in last['joint_positions'])}, tip error {last['tip_error']:.3g}"
+    q = " ".join(f"{v:.4f}" for v in last["joint_positions"])
+    want = f"finger 3: q {q}, tip error {fmt_figure(last['tip_error'])}"  # noise-sized errors print '< 1e-12'
     assert lines[-1].endswith(want), lines[-1]
 
 
