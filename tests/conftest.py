@@ -2,17 +2,15 @@
 
 import os
 import sys
-import tempfile
 
-# Bytecode. Where PYTHONDONTWRITEBYTECODE is set (no __pycache__ beside the sources), each test
-# worker compiled the package and pytest rewrote every test module anew, and so did each
-# `grasptwist` process a test starts: some 4 s of every worker's collection and 50 ms of each of
-# the default run's subprocesses (docs/reference/development.md, Test time). The run caches them
-# outside the tree instead, in the temporary folder (Python checks each against its source).
-if os.environ.get("PYTHONDONTWRITEBYTECODE") and not os.environ.get("PYTHONPYCACHEPREFIX"):
-    os.environ["PYTHONPYCACHEPREFIX"] = sys.pycache_prefix = os.path.join(
-        tempfile.gettempdir(), f"grasptwist-pycache-{os.getuid()}"
-    )
+# Bytecode. Where PYTHONDONTWRITEBYTECODE is set (no __pycache__ written), each test worker
+# compiled the package and pytest rewrote every test module anew, and so did each `grasptwist`
+# process a test starts: some 4 s of every worker's collection and 50 ms of each of the default
+# run's subprocesses (docs/reference/development.md, Test time). The run writes bytecode as
+# Python does by default, in `__pycache__` beside the sources (git ignores it); a cache prefix
+# elsewhere would also hide the bytecode pip compiled for the libraries and have them all
+# compiled again, 13 s of CPU on a fresh clone.
+if os.environ.get("PYTHONDONTWRITEBYTECODE"):
     del os.environ["PYTHONDONTWRITEBYTECODE"]  # for the processes the tests start
     sys.dont_write_bytecode = False
 
