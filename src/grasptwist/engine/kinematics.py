@@ -654,4 +654,5 @@ def chain_length(points, tip):
     7.0
     """
     path = np.concatenate((_checked(points, (None, 3), "points"), _checked(tip, (3,), "tip")[..., None, :]), axis=-2)
-    return norm(np.diff(path, axis=-2)).sum(axis=-1)
+    with np.errstate(over="ignore"):  # hypot: no square overflows below 1e308 (the sum of links may)
+        return np.hypot.reduce(np.diff(path, axis=-2), axis=-1).sum(axis=-1)
