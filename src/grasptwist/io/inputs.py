@@ -23,8 +23,7 @@ from collections.abc import Iterable, Iterator
 
 from ..model import Grasp, GraspFileError
 from .grasp import READING, Reading, one_per_document, read_grasps
-from .limits import DEFAULT_MAX_BYTES, NOT_REGULAR
-from .mesh_file import MESH_SUFFIXES
+from .limits import DEFAULT_MAX_BYTES, MESH_SUFFIXES, NOT_REGULAR
 
 __all__ = ["GRASP_SUFFIXES", "OBJECT_SUFFIXES", "STDIN", "expand", "is_grasp_file", "read"]
 

@@ -1,14 +1,26 @@
 """Limits on untrusted input files, shared by the readers of grasp files, URDFs, meshes and data sets.
 
 Here, not in any one reader, so that each (the URDF reader, which the grasp
-loader's ``hand:`` section calls; the ``.npz`` and Parquet readers) need not
-import another for its constants.
+loader's ``hand:`` section calls; the ``.npz`` and Parquet readers; the folder
+lister, which needs the mesh formats but not the mesh reader) need not import
+another for its constants.
 """
 
-__all__ = ["DEFAULT_MAX_BYTES", "INFLATION_FLOOR", "MAX_INFLATION", "MAX_TRIANGLES", "NOT_REGULAR", "check_inflation"]
+__all__ = [
+    "DEFAULT_MAX_BYTES",
+    "INFLATION_FLOOR",
+    "MAX_INFLATION",
+    "MAX_TRIANGLES",
+    "MESH_SUFFIXES",
+    "NOT_REGULAR",
+    "check_inflation",
+]
 
 DEFAULT_MAX_BYTES = 1 << 20
 """Default size cap in bytes; larger files are rejected before parsing."""
+
+MESH_SUFFIXES = (".stl", ".obj", ".ply")
+"""The mesh formats read (:mod:`grasptwist.io.mesh_file`), by file suffix (in any letter case)."""
 
 MAX_TRIANGLES = 200_000
 """Most triangles of an object's mesh (:mod:`grasptwist.io.mesh_file`): a grasp needs a few

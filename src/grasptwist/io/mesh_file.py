@@ -52,12 +52,9 @@ from pathlib import Path
 import numpy as np
 
 from ..model import InputError
-from .limits import DEFAULT_MAX_BYTES, MAX_TRIANGLES
+from .limits import DEFAULT_MAX_BYTES, MAX_TRIANGLES, MESH_SUFFIXES
 
-__all__ = ["MESH_SUFFIXES", "read_mesh", "check_mesh"]
-
-#: The formats read, by file suffix (in any letter case).
-MESH_SUFFIXES = (".stl", ".obj", ".ply")
+__all__ = ["read_mesh", "check_mesh"]
 
 _PLY_FACES = re.compile(rb"^element\s+face\s+(\d+)\s*$", re.MULTILINE)
 _ASCII_STL = re.compile(rb"\s*solid", re.IGNORECASE)

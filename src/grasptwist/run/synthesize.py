@@ -28,8 +28,8 @@ from ..engine.synthesis.scores import METHODS
 from ..engine.synthesis.search import GRAVITY, Synthesis, hand_reach, search_steps, surface_of
 from ..io.grasp.forces import HOLD
 from ..io.inputs import read as read_unplaced
-from ..io.limits import DEFAULT_MAX_BYTES
-from ..io.mesh_file import MESH_SUFFIXES, read_mesh
+from ..io.limits import DEFAULT_MAX_BYTES, MESH_SUFFIXES
+from ..io.mesh_file import read_mesh
 from ..model import CONTACT_NAMES, Grasp, GraspFileError, GraspObject, Hand, InputError, Shape
 from ..output import synthesis_records as sr
 from ..output.formats import FORMATS
