@@ -415,7 +415,18 @@ def _read(fields, found, problems):
     hand = read_hand(fields["hand"], found.get("points"), found["file"], problems, found["reading"].allow_outside)
     if hand is None:
         return None
-    return {"hand": hand[0], "joint_positions": readonly(hand[1]), "placement": hand[2]}
+    out = {"hand": hand[0], "joint_positions": readonly(hand[1]), "placement": hand[2]}
+    obj = found.get("object")
+    if obj is not None:  # an object a hand 10 times too small or too big: a unit mixed up
+        from ...engine.units import fingers_reach, hand_fit_warning, largest_extent
+
+        said = hand_fit_warning(
+            largest_extent(obj.shape.kind, obj.shape.size, obj.shape.vertices),
+            fingers_reach(hand[0]),
+            found.get("units"),
+        )
+        out["warnings"] = (*found.get("warnings", ()), *([said] if said else []))
+    return out
 
 
 SECTION = Section(("hand",), _read)
