@@ -236,6 +236,7 @@ def _mesh(node, scale_node, file, reading, max_bytes, problems, units=None):
             max_bytes=max_bytes,
             max_triangles=reading.max_triangles,
             allow_outside=reading.allow_outside,
+            output=reading.output,
         )
     except InputError as err:
         problems.add(Reject(err.code, "object.mesh", str(err), **located(where)))
