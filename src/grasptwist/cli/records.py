@@ -35,7 +35,7 @@ def write_records(job, paths: list[str], settings: OutputSettings) -> int:
     import typer
 
     from ..io.inputs import expand
-    from ..io.urdf import OUTPUT_IS_INPUT
+    from ..io.limits import OUTPUT_IS_INPUT
     from ..run.pipeline import outputs
     from ..run.target import replaced_file
 

@@ -50,13 +50,9 @@ import numpy as np
 
 from ..engine.kinematics import chain_from_origins, chain_length
 from ..model import Finger, Hand, InputError, Joint
-from .limits import DEFAULT_MAX_BYTES
+from .limits import DEFAULT_MAX_BYTES, OUTPUT_IS_INPUT
 
-__all__ = ["load_urdf_hand", "resolve_urdf", "OUTPUT_IS_INPUT"]
-
-#: The error of a file a grasp file names (a mesh, a URDF) that is the file ``-o`` replaces: the run
-#: would replace what it reads, so the output is not written.
-OUTPUT_IS_INPUT = "output-is-input"
+__all__ = ["load_urdf_hand", "resolve_urdf"]
 
 _PACKAGE = "package://"
 _URL = re.compile(r"^[A-Za-z][A-Za-z0-9+.-]*://")

@@ -29,9 +29,8 @@ from ..engine.synthesis.search import GRAVITY, Synthesis, hand_reach, search_ste
 from ..engine.units import fingers_reach, hand_fit_warning, largest_extent, mesh_span_warning
 from ..io.grasp.forces import HOLD
 from ..io.inputs import read as read_unplaced
-from ..io.limits import DEFAULT_MAX_BYTES, MESH_SUFFIXES
+from ..io.limits import DEFAULT_MAX_BYTES, MESH_SUFFIXES, OUTPUT_IS_INPUT
 from ..io.mesh_file import read_mesh
-from ..io.urdf import OUTPUT_IS_INPUT
 from ..model import CONTACT_NAMES, Grasp, GraspFileError, GraspObject, Hand, InputError, Shape
 from ..output import synthesis_records as sr
 from ..output.formats import FORMATS

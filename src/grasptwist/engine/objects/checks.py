@@ -1,9 +1,10 @@
 """Validators of an object (its shape, pose, mass and density), done once where it enters.
 
 Each ``check_*`` returns what it checked, arrays as read-only float (faces
-int) arrays, and raises ``ValueError`` with one line naming the field and what
-is wrong.  The grasp-file loader turns that line into a located error; the
-geometry functions trust an object these accepted.
+int) arrays, and raises :class:`ObjectError` (a ``ValueError``) with one line naming the field
+and what is wrong, and the code a grasp file's error gets for it.  :func:`checked` is the one
+gate: every geometry function takes its object through it, and so does the grasp-file loader,
+which turns the line into a located error.
 """
 
 from __future__ import annotations
@@ -101,7 +102,7 @@ def check_shape(shape: Shape) -> Shape:
     [0.03]
     >>> check_shape(Shape("cylinder", [0.03, -1]))
     Traceback (most recent call last):
-    ValueError: cylinder height must be a finite number > 0, got -1.0
+    grasptwist.engine.objects.checks.ObjectError: cylinder height must be a finite number > 0, got -1.0
     """
     if not isinstance(shape, Shape):
         raise ObjectError("invalid-object", f"shape must be a Shape, got {type(shape).__name__}")
@@ -125,7 +126,7 @@ def check_size(kind: str, size) -> np.ndarray:
     [0.035]
     >>> check_size("box", 0.035)
     Traceback (most recent call last):
-    ValueError: box size must hold 3 number(s) (a, b, c), got 1
+    grasptwist.engine.objects.checks.ObjectError: box size must hold 3 number(s) (a, b, c), got 1
     """
     names = _SIZE_NAMES[kind]
     size = _real(size, f"{kind} size").reshape(-1)
@@ -148,7 +149,7 @@ def check_extent(size: float, what: str = "its") -> float:
     0.1
     >>> check_extent(1e100)
     Traceback (most recent call last):
-    ValueError: its size (the diagonal of its bounding box) is 1e+100, outside 1e-75 to 1e+75 where its areas and volume are double-precision numbers: rescale it
+    grasptwist.engine.objects.checks.ObjectError: its size (the diagonal of its bounding box) is 1e+100, outside 1e-75 to 1e+75 where its areas and volume are double-precision numbers: rescale it
     """
     size = float(size)
     if not math.isfinite(size):
@@ -220,17 +221,23 @@ def _check_closed(faces):
     if (edges[:, 0] == edges[:, 1]).any():
         raise ObjectError("not-watertight", "mesh has a face with a repeated vertex")
     n = int(faces.max()) + 1
-    directed = edges[:, 0] * n + edges[:, 1]
-    unique, counts = np.unique(directed, return_counts=True)
-    if (counts > 1).any():
+    # sorted keys, not np.unique and np.isin (hash tables): a 245,760-edge mesh in 0.03 s, not 1.9 s
+    directed = np.sort(edges[:, 0] * n + edges[:, 1])
+    repeated = directed[1:] == directed[:-1]
+    if repeated.any():
+        runs = int(np.count_nonzero(repeated[1:] & ~repeated[:-1]) + repeated[0])  # edges, not their copies
         raise ObjectError(
             "not-watertight",
-            f"mesh is not consistently oriented or not manifold: {int((counts > 1).sum())} edge(s) run the same way in two faces",
+            f"mesh is not consistently oriented or not manifold: {runs} edge(s) run the same way in two faces",
         )
-    reverse = edges[:, 1] * n + edges[:, 0]
-    missing = ~np.isin(reverse, unique)
-    if missing.any():
-        raise ObjectError("not-watertight", f"mesh is not closed: {int(missing.sum())} edge(s) belong to one face only")
+    reverse = np.sort(edges[:, 1] * n + edges[:, 0])
+    if np.array_equal(directed, reverse):  # each directed edge's reverse is there: closed
+        return
+    found = directed[np.minimum(np.searchsorted(directed, reverse), len(directed) - 1)] == reverse
+    if not found.all():
+        raise ObjectError(
+            "not-watertight", f"mesh is not closed: {int((~found).sum())} edge(s) belong to one face only"
+        )
 
 
 def _signed_volume(vertices, faces):
@@ -246,7 +253,7 @@ def check_pose(pose) -> np.ndarray:
 
     >>> check_pose(np.diag([1.0, 1, -1, 1]))
     Traceback (most recent call last):
-    ValueError: pose must be rigid: its rotation block is not a rotation (orthonormal, determinant +1)
+    grasptwist.engine.objects.checks.ObjectError: pose must be rigid: its rotation block is not a rotation (orthonormal, determinant +1)
     """
     p = _real(pose, "pose")
     if p.shape != (4, 4):
@@ -272,7 +279,7 @@ def check_object(obj: GraspObject) -> GraspObject:
 
     >>> check_object(GraspObject(Shape("box", [1, 1, 1]), np.eye(4), mass=0.0))
     Traceback (most recent call last):
-    ValueError: object mass must be a finite number > 0, got 0.0
+    grasptwist.engine.objects.checks.ObjectError: object mass must be a finite number > 0, got 0.0
     """
     if not isinstance(obj, GraspObject):
         raise ObjectError("invalid-object", f"object must be a GraspObject, got {type(obj).__name__}")

@@ -1,8 +1,9 @@
 r"""An object's geometry in the grasp frame: nearest surface points, mass properties, samples, triangles.
 
-Each function takes a :class:`~grasptwist.model.GraspObject` checked by
-:func:`~grasptwist.objects.check_object` (a primitive's sizes it checks itself, cheaply:
-``check_size``, so that a ``Shape("sphere", 0.035)`` built by hand works) and works in the grasp frame: points go into
+Each function takes a :class:`~grasptwist.model.GraspObject` through the one gate,
+:func:`~.checks.checked` (:func:`~grasptwist.objects.check_object` once per object, however it
+was built: an object that is not one raises :class:`~.checks.ObjectError` with the code a grasp
+file's reader gives it) and works in the grasp frame: points go into
 the object's frame through its pose :math:`T = (R, t)`, :math:`q = R^T (p - t)`,
 are answered there by ``primitives`` (exact) or ``mesh``, and come
 back as :math:`R c + t` (points) and :math:`R n` (normals).  Normals point
