@@ -119,3 +119,13 @@ def test_a_mesh_unit_that_is_no_length_is_located(tmp_path):
     assert problems(text, file=str(tmp_path / "g.yaml"))[0][:3] == ("conflicting-keys", 4, 10)
     text = OBJECT_ONLY.format(units="m", object="  mesh: {units: mm}", h=32.5)
     assert problems(text, file=str(tmp_path / "g.yaml"))[0][:2] == ("missing-key", 3)
+
+
+def test_a_file_unit_that_is_no_length_beside_a_mesh_unit_and_a_mass_that_underflows_are_located(tmp_path):
+    cube_obj(tmp_path / "c.obj", 65.0)
+    text = OBJECT_ONLY.format(units="px", object="  mesh: {file: c.obj, units: mm}", h=32.5)
+    ((code, line, column, message),) = problems(text, file=str(tmp_path / "g.yaml"))
+    assert (code, line, column) == ("unknown-units", 3, 30) and "the file's 'px' is none of" in message
+    text = OBJECT_ONLY.format(units="m", object="  box: [1e-20, 1e-20, 1e-20]\n  density: 1e-300", h=5e-21)
+    ((code, line, column, message),) = problems(text)
+    assert (code, line, column) == ("invalid-mass", 4, 12) and "underflows" in message

@@ -113,7 +113,7 @@ def read_object(node, file, reading, max_bytes, problems, warnings, units=None, 
         return None
     pose.setflags(write=False)
     from ...engine.objects import mass_properties
-    from ...engine.objects.checks import ObjectError, checked
+    from ...engine.objects.checks import ObjectError, accept, checked
     from ...engine.units import largest_extent, mesh_span_warning, unit_length
 
     try:
@@ -144,18 +144,18 @@ def read_object(node, file, reading, max_bytes, problems, warnings, units=None, 
             weighed = float(mass_properties(obj).mass) * metres**3
     except OverflowError:  # a volume beyond a double, in Python floats
         weighed = math.inf
-    if not np.isfinite(weighed):
+    if not 0 < weighed < math.inf:
         where = fields["density"]
         problems.add(
             Reject(
-                "non-finite",
+                "non-finite" if weighed else "invalid-mass",
                 "object.density",
-                "the mass (density x volume) overflows double precision",
+                f"the mass (density x volume) {'overflows' if weighed else 'underflows'} double precision",
                 **located(where),
             )
         )
         return None
-    return replace(obj, mass=weighed)
+    return accept(replace(obj, mass=weighed))  # a mass > 0 on an object the gate accepted
 
 
 def _radians(given) -> list:
