@@ -61,8 +61,6 @@ OBJECT_KEYS = (*SHAPE_KEYS, "scale", "pose", "density", "mass")
 SIZE_KEYS = ("radius", "height")
 #: The keys of a mesh given as a mapping: its file, and its own unit or scale.
 MESH_KEYS = ("file", "units", "scale")
-#: The units shown when one is not known.
-LENGTH_UNITS_SHOWN = tuple(LENGTH_UNITS)
 #: The error of a unit whose length is needed but not known (a label such as ``units: px``).
 UNKNOWN_UNITS = "unknown-units"
 
@@ -134,7 +132,7 @@ def read_object(node, file, reading, max_bytes, problems, warnings, units=None, 
                 UNKNOWN_UNITS,
                 "object.density",
                 f"a density is in kg/m^3: weighing the object needs the length of the file's units, "
-                f"and {units!r} is none of {', '.join(LENGTH_UNITS_SHOWN)} (give its mass in kg instead)",
+                f"and {units!r} is none of {', '.join(LENGTH_UNITS)} (give its mass in kg instead)",
                 **located(fields["density"]),
             )
         )
@@ -260,7 +258,7 @@ def _unit_factor(node, units, problems):
                     UNKNOWN_UNITS,
                     "object.mesh.units",
                     f"scaling the mesh into the file's units needs both lengths, and {what} {name!r} is none of "
-                    f"{', '.join(LENGTH_UNITS_SHOWN)}",
+                    f"{', '.join(LENGTH_UNITS)}",
                     **located(node),
                 )
             )
