@@ -185,6 +185,9 @@ class Shape:
         seen from outside; None for a primitive.
     source : str or None
         A mesh's file as the grasp file names it; None for a primitive.
+    scale : numpy.ndarray or None
+        A mesh's ``(1,)`` or ``(3,)`` factor from its file's coordinates to ``vertices`` (its own
+        unit into the grasp file's, times ``scale``), so that a file written back names it; None: 1.
     """
 
     kind: str
@@ -192,6 +195,7 @@ class Shape:
     vertices: np.ndarray | None = None
     faces: np.ndarray | None = None
     source: str | None = None
+    scale: np.ndarray | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -209,7 +213,10 @@ class GraspObject:
         Its mass (kg), given or from ``density`` times its volume; None when
         neither is given.
     density : float or None
-        Its density (kg per cubed length unit) as given; None when not given.
+        Its density as given, in kg/m^3 (a grasp file's object's mass is then its
+        density times its volume in cubic metres, through the file's ``units``); None when
+        not given.  From Python, :func:`~grasptwist.objects.mass_properties` weighs
+        ``density`` times the volume in the shape's own unit: metres, unless ``mass`` is given.
     line : int or None
         1-based line where the ``object`` key starts in the file.
     """

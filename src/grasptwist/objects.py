@@ -11,7 +11,7 @@ Normals point into the object, distances are > 0 outside.  The math is in
 ``grasptwist.engine.objects``.
 """
 
-from .engine.objects.checks import KINDS, check_object, check_pose, check_shape, check_size
+from .engine.objects.checks import KINDS, ObjectError, check_object, check_pose, check_shape, check_size
 from .engine.objects.geometry import (
     MassProperties,
     SurfacePoints,
@@ -40,6 +40,7 @@ __all__ = [
     "check_size",
     "check_pose",
     "check_object",
+    "ObjectError",
     "KINDS",
     "SURFACE_TOL",
     "NORMAL_DISAGREE_DEG",

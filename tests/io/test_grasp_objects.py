@@ -159,7 +159,7 @@ def test_a_surface_tolerance_must_be_a_number_at_least_zero():
         ("  [1, 2]", ("not-a-mapping", 2, 3, "object: expected a mapping, got a list")),
         (
             "  box: [1e308, 1e308, 1e308]",
-            ("non-finite", 2, 3, "object: its size overflows double precision: rescale it"),
+            ("non-finite", 2, 3, "object: box size overflows double precision: rescale it"),
         ),
         (
             "  box: [1e-80, 1e-80, 1e-80]",
@@ -167,7 +167,7 @@ def test_a_surface_tolerance_must_be_a_number_at_least_zero():
                 "invalid-size",
                 2,
                 3,
-                "object: its size (the diagonal of its bounding box) is 1.73e-80, outside 1e-75 to 1e+75 "
+                "object: box size (the diagonal of its bounding box) is 1.73e-80, outside 1e-75 to 1e+75 "
                 "where its areas and volume are double-precision numbers: rescale it",
             ),
         ),

@@ -3,11 +3,11 @@
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 
 from ..output.formats import FORMATS
-from .diagnostics import Diagnostics, Warnings, progress_bar, table_hint
-from .exits import EXIT_FAILED, EXIT_OK, output_target
+from .diagnostics import Diagnostics, Warnings, error_code, progress_bar, table_hint
+from .exits import EXIT_FAILED, EXIT_OK, EXIT_USAGE, failed, output_target
 
 __all__ = ["OutputSettings", "worker_count", "write_records"]
 
@@ -32,14 +32,22 @@ def worker_count(requested: int) -> int:
 
 def write_records(job, paths: list[str], settings: OutputSettings) -> int:
     """Read ``paths``, write the job's records, report on stderr; the exit status."""
+    import typer
+
     from ..io.inputs import expand
+    from ..io.limits import OUTPUT_IS_INPUT
     from ..run.pipeline import outputs
+    from ..run.target import replaced_file
 
     counted = job.family.tells_progress
     hint = table_hint(job.command.formats) if job.fmt == "table" and counted else None
     stderr = Diagnostics(settings.quiet, settings.warnings, hint=hint)
     inputs = list(expand(paths, job.family.suffixes))
     fmt = FORMATS[job.fmt]
+    replaced = replaced_file(settings.output)
+    if replaced is not None:  # a mesh or URDF a grasp file names is read, never replaced
+        job = replace(job, reading=replace(job.reading, output=replaced))
+    reads_output = False
     with (
         output_target(settings.output, [*inputs, *settings.reads]) as out,
         progress_bar(inputs, job.command.name, out, counted, job.family.long_inputs) as advance,
@@ -54,6 +62,11 @@ def write_records(job, paths: list[str], settings: OutputSettings) -> int:
             out.flush()  # a batch streams: each group is out as soon as it is ready
             stderr.take(o)
             advance(o)
+            reads_output = reads_output or any(error_code(line) == OUTPUT_IS_INPUT for line in o.errors)
+        if reads_output:  # leaving the block by an exception keeps the file as it was
+            raise typer.Exit(
+                failed(Exception(f"-o: not written: it is a file the run reads ({OUTPUT_IS_INPUT}, above)"), EXIT_USAGE)
+            )
         w.close()
     stderr.summary()
     return EXIT_FAILED if stderr.failed else EXIT_OK

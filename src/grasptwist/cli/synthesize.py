@@ -62,6 +62,24 @@ def _min_conditioning(value):
     return check_min_conditioning(value)
 
 
+def _units(value):
+    """--units: a length unit the engine knows (its length is what the mesh's size is judged by)."""
+    from ..engine.units import LENGTH_UNITS
+
+    if value not in LENGTH_UNITS:
+        raise ValueError(f"must be a length unit, one of {', '.join(LENGTH_UNITS)}; got {value!r}")
+    return value
+
+
+def _reading(reading, grasp_file):
+    """How grasp files are read: never a mesh or URDF that ``-o FILE.yaml`` would replace."""
+    from dataclasses import replace
+
+    from ..run.target import replaced_file
+
+    return replace(reading, output=replaced_file(grasp_file))
+
+
 def _positive(value):
     """--mass, --seconds: the engine's checks (check_budget's seconds), in the command line's words."""
     if not 0 < value < float("inf"):
@@ -133,6 +151,16 @@ def synthesize(
             "an object without a hand warns that it is ignored.",
         ),
     ] = None,
+    units: Annotated[
+        str | None,
+        typer.Option(
+            "--units",
+            metavar="UNIT",
+            callback=_checked(_units),
+            help="The length unit of mesh files given directly (m, mm, cm, in, ...; default m): the records "
+            "and -o FILE.yaml say it. A grasp file gives its own 'units'.",
+        ),
+    ] = None,
     quality: Annotated[bool, typer.Option("--quality", help="Also Ferrari-Canny's epsilon (needs scipy).")] = False,
     seed: Annotated[int, typer.Option("--seed", min=0, help="Seed of the random numbers (reproducible runs).")] = 0,
     candidates: Annotated[
@@ -201,7 +229,7 @@ def synthesize(
         # --hand's, else one grasp file's first hand: it names the joint columns of CSV and Parquet
         hand=hand_option(hand, paths, fmt.value),
         max_bytes=max_bytes,
-        reading=reading_option(surface_tol, allow_outside),
+        reading=_reading(reading_option(surface_tol, allow_outside), grasp_file),
         options=SynthesisOptions(
             count=count,
             friction=friction,
@@ -219,6 +247,7 @@ def synthesize(
             grasp_file=grasp_file,
             tip_radius=tip_radius,
             hand_file=hand,
+            units=units,
         ),
     )
     settings = OutputSettings(records_to, quiet, Warnings.summary, workers, {"digits": digits}, reads=(hand,))

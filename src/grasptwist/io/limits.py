@@ -13,8 +13,13 @@ __all__ = [
     "MAX_TRIANGLES",
     "MESH_SUFFIXES",
     "NOT_REGULAR",
+    "OUTPUT_IS_INPUT",
     "check_inflation",
 ]
+
+#: The error of a file a grasp file names (a mesh, a URDF) that is the file ``-o`` replaces: the run
+#: would replace what it reads, so the output is not written.
+OUTPUT_IS_INPUT = "output-is-input"
 
 DEFAULT_MAX_BYTES = 1 << 20
 """Default size cap in bytes; larger files are rejected before parsing."""

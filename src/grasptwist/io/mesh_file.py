@@ -69,6 +69,7 @@ def read_mesh(
     max_bytes=DEFAULT_MAX_BYTES,
     max_triangles=MAX_TRIANGLES,
     allow_outside=False,
+    output=None,
 ):
     """The vertices and outward-wound triangles of a mesh file.
 
@@ -86,6 +87,8 @@ def read_mesh(
         Most triangles.
     allow_outside : bool
         Take a relative path wherever it leads.
+    output : (int, int), optional
+        The ``(device, inode)`` of the file ``-o`` replaces: a mesh that is it is ``output-is-input``.
 
     Returns
     -------
@@ -113,7 +116,7 @@ def read_mesh(
         )
     from .urdf import _read, resolve_urdf  # here: listing a folder (MESH_SUFFIXES) imports no URDF reader
 
-    data = _read(resolve_urdf(text, folder, allow_outside=allow_outside), max_bytes, text)
+    data = _read(resolve_urdf(text, folder, allow_outside=allow_outside, output=output), max_bytes, text, output)
     _too_many(_declared_triangles(data, suffix, text), max_triangles, text)
     try:
         vertices, faces = _obj(data) if suffix == ".obj" else _parsed(data, suffix, text)

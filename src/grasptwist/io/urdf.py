@@ -41,6 +41,7 @@ import math
 import os
 import re
 import stat
+from contextlib import suppress
 from dataclasses import replace
 from importlib.util import find_spec
 from pathlib import Path
@@ -49,7 +50,7 @@ import numpy as np
 
 from ..engine.kinematics import chain_from_origins, chain_length
 from ..model import Finger, Hand, InputError, Joint
-from .limits import DEFAULT_MAX_BYTES
+from .limits import DEFAULT_MAX_BYTES, OUTPUT_IS_INPUT
 
 __all__ = ["load_urdf_hand", "resolve_urdf"]
 
@@ -59,7 +60,7 @@ _MOVABLE = {"revolute": "revolute", "continuous": "revolute", "prismatic": "pris
 _UNSUPPORTED = {"floating", "planar"}
 
 
-def resolve_urdf(reference, folder=None, *, allow_outside=False):
+def resolve_urdf(reference, folder=None, *, allow_outside=False, output=None):
     """The file a URDF (or mesh) reference names, refused if it leaves its package or folder.
 
     Parameters
@@ -72,6 +73,10 @@ def resolve_urdf(reference, folder=None, *, allow_outside=False):
     allow_outside : bool
         Take a relative path wherever it leads (``--allow-outside``: the
         user vouches for the files the grasp files name).
+    output : (int, int), optional
+        The ``(device, inode)`` of the file ``-o`` replaces: a path outside the folder that is
+        it is ``output-is-input`` rather than ``path-outside`` (it is refused either way, and
+        the run must not replace it).
 
     Returns
     -------
@@ -96,7 +101,7 @@ def resolve_urdf(reference, folder=None, *, allow_outside=False):
         return Path(text).resolve()
     if allow_outside:
         return (Path(folder) / text).resolve()
-    return _inside(Path(folder).resolve(), text, text)
+    return _inside(Path(folder).resolve(), text, text, output)
 
 
 def _package_folder(package, reference):
@@ -111,20 +116,32 @@ def _package_folder(package, reference):
     return Path(next(iter(spec.submodule_search_locations))).resolve()
 
 
-def _inside(base, relative, reference):
+def _inside(base, relative, reference, output=None):
     path = (base / relative).resolve()
     if not path.is_relative_to(base):
+        with suppress(OSError):
+            info = path.stat()
+            if output is not None and (info.st_dev, info.st_ino) == tuple(output):
+                raise _output_is_input(reference)
         raise InputError("path-outside", f"{reference!r} resolves outside {str(base)!r}", reference)
     return path
 
 
-def _read(path, max_bytes, file):
-    """At most ``max_bytes + 1`` bytes of a regular file (a FIFO or device would block or never end)."""
+def _output_is_input(file):
+    return InputError(OUTPUT_IS_INPUT, "is the file -o writes (the same file): give -o another file name", file)
+
+
+def _read(path, max_bytes, file, output=None):
+    """At most ``max_bytes + 1`` bytes of a regular file (a FIFO or device would block or never end);
+    ``output``, the ``(device, inode)`` of the file ``-o`` replaces, is refused (``output-is-input``)."""
     try:
         fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0) | getattr(os, "O_CLOEXEC", 0))
         try:
-            if not stat.S_ISREG(os.fstat(fd).st_mode):
+            info = os.fstat(fd)
+            if not stat.S_ISREG(info.st_mode):
                 raise InputError("read-error", "cannot read: not a regular file", file)
+            if output is not None and (info.st_dev, info.st_ino) == tuple(output):
+                raise _output_is_input(file)
             with os.fdopen(fd, "rb", closefd=False) as handle:
                 data = handle.read(max_bytes + 1)
         finally:
@@ -272,7 +289,9 @@ def _model(data, file):
         raise InputError("invalid-urdf", f"yourdfpy cannot read it: {type(exc).__name__}: {exc}", file) from None
 
 
-def load_urdf_hand(urdf, tips, *, names=None, folder=None, max_bytes=DEFAULT_MAX_BYTES, allow_outside=False):
+def load_urdf_hand(
+    urdf, tips, *, names=None, folder=None, max_bytes=DEFAULT_MAX_BYTES, allow_outside=False, output=None
+):
     """A hand from a URDF: one finger per tip link, its joints at home (all 0).
 
     The hand's frame (and so the grasp's) is the URDF's root link's frame.
@@ -301,6 +320,8 @@ def load_urdf_hand(urdf, tips, *, names=None, folder=None, max_bytes=DEFAULT_MAX
         Size cap of the URDF (default 1 MiB, as for grasp files).
     allow_outside : bool
         Take a relative path wherever it leads (``--allow-outside``).
+    output : (int, int), optional
+        The ``(device, inode)`` of the file ``-o`` replaces: a URDF that is it is ``output-is-input``.
 
     Returns
     -------
@@ -324,8 +345,8 @@ def load_urdf_hand(urdf, tips, *, names=None, folder=None, max_bytes=DEFAULT_MAX
     text = os.fspath(urdf)
     file = text if text.startswith(_PACKAGE) or folder is None else os.path.join(os.fspath(folder), text)
     _library(file)  # before the reference: a package:// one may be missing for the same reason
-    where = resolve_urdf(urdf, folder, allow_outside=allow_outside)
-    data = _read(where, max_bytes, file)
+    where = resolve_urdf(urdf, folder, allow_outside=allow_outside, output=output)
+    data = _read(where, max_bytes, file, output)
     root = _parse(data, file)
     _check_joint_elements(root, file)
     model = _model(data, file)

@@ -4,13 +4,13 @@ A search's result (:class:`grasptwist.run.synthesize.Found`: its file, grasp nam
 names, contact names and the engine's :class:`~grasptwist.engine.synthesis.search.Synthesis`)
 gives one record per grasp, best first::
 
-    {"file", "grasp", "rank", "ok": true,
+    {"file", "grasp", "units", "rank", "ok": true,
      "contacts": [{"name", "point", "normal", "surface_distance"}, x3],
      "scores": {"total_normal_force": {wrench name: N}, "closure_friction",
                 "epsilon" (or null), "conditioning": {"off_tangent", "tangent"} (null: not asked)},
      "joint_positions": {joint name: position} (null without a hand),
      "reach_error": [3] (null without a hand),
-     "search": {"candidates", "seconds", "seed"}, "warnings": []}
+     "search": {"candidates", "seconds", "seed"}, "warnings": [the object's]}
 
 With a hand, finger ``f`` touches contact ``f``; ``reach_error`` is each finger's distance, by
 forward kinematics at ``joint_positions``, from its tip link's origin to its fingertip's
@@ -82,6 +82,7 @@ def synthesis_records(found) -> list[dict]:
             {
                 "file": escaped(found.file, controls=False),
                 "grasp": escaped(found.name, controls=False),
+                "units": found.units,
                 "rank": k + 1,
                 "ok": True,
                 "contacts": contacts,
@@ -89,7 +90,7 @@ def synthesis_records(found) -> list[dict]:
                 "joint_positions": _joint_positions(found, k),
                 "reach_error": None if s.reach_error is None else s.reach_error[k].tolist(),
                 "search": search,
-                "warnings": [],
+                "warnings": list(found.warnings),
             }
         )
     return out
@@ -123,11 +124,16 @@ def failure_record(found) -> dict:
     }
 
 
-def _object_node(obj, folder):
-    """The ``object`` section of a grasp file for ``obj`` (a mesh's path relative to ``folder``)."""
+def _object_node(obj, folder, file):
+    """The ``object`` section of a grasp file for ``obj``, read from the grasp (or mesh) file
+    ``file``: a mesh's path, which ``file`` names from its own folder, made relative to ``folder``
+    (the new file's), so that the new file reads back from anywhere; with its scale, when not 1."""
     shape = obj.shape
     if shape.kind == "mesh":
-        node = {"mesh": os.path.relpath(os.path.abspath(shape.source), folder)}
+        node = {"mesh": _mesh_path(shape.source, file, folder)}
+        if shape.scale is not None and not (shape.scale == 1).all():
+            scale = shape.scale.tolist()
+            node["scale"] = scale[0] if len(scale) == 1 else scale
     elif shape.kind == "box":
         node = {"box": shape.size.tolist()}
     elif shape.kind == "sphere":
@@ -142,6 +148,18 @@ def _object_node(obj, folder):
     elif obj.density is not None:
         node["density"] = float(obj.density)
     return node
+
+
+def _mesh_path(source, file, folder):
+    """A mesh's reference ``source``, named from the folder of ``file``, as a path from ``folder``
+    (a ``package://`` reference is the same from anywhere).
+
+    >>> _mesh_path("meshes/cube.stl", "objects/cube.yaml", os.path.abspath("out"))
+    '../objects/meshes/cube.stl'
+    """
+    if source.startswith("package://"):
+        return source
+    return os.path.relpath(os.path.join(os.path.dirname(os.path.abspath(file)), source), folder)
 
 
 def _quaternion(r):
@@ -222,7 +240,7 @@ def grasp_documents(found, folder: str) -> str:
             doc["units"] = found.units
         if found.wrist is not None:
             doc["wrist"] = np.asarray(found.wrist).tolist()
-        doc["object"] = _object_node(found.object, folder)
+        doc["object"] = _object_node(found.object, folder, found.file)
         doc["contacts"] = [
             {"name": found.contact_names[i], "point": s.points[k, i].tolist(), "normal": s.normals[k, i].tolist()}
             for i in range(3)

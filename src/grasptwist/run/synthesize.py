@@ -26,9 +26,10 @@ from ..engine.forces.hold import Weight, hold_wrench, object_weight
 from ..engine.ik import home_tips
 from ..engine.synthesis.scores import METHODS
 from ..engine.synthesis.search import GRAVITY, Synthesis, hand_reach, search_steps, surface_of
+from ..engine.units import fingers_reach, hand_fit_warning, largest_extent, mesh_span_warning
 from ..io.grasp.forces import HOLD
 from ..io.inputs import read as read_unplaced
-from ..io.limits import DEFAULT_MAX_BYTES, MESH_SUFFIXES
+from ..io.limits import DEFAULT_MAX_BYTES, MESH_SUFFIXES, OUTPUT_IS_INPUT
 from ..io.mesh_file import read_mesh
 from ..model import CONTACT_NAMES, Grasp, GraspFileError, GraspObject, Hand, InputError, Shape
 from ..output import synthesis_records as sr
@@ -84,6 +85,7 @@ class Found:
     joints_at: tuple | None = None  # an inline hand's joints at each grasp: per finger (screws (n, 6), points (n, 3))
     twists: tuple = ()  # the input's twists and paths, written with each grasp found (-o FILE.yaml)
     paths: tuple = ()
+    warnings: tuple = ()  # of the object: its size against its unit or its hand, its pose's rotation vector
 
     def __len__(self) -> int:
         return len(self.synthesis.points)
@@ -174,16 +176,35 @@ def _inline_joints(hand, synthesis):
 
 
 def _mesh_grasp(path: str, job) -> Grasp | GraspFileError:
-    """A mesh file as a grasp document with only its object (the command line gives the rest)."""
+    """A mesh file as a grasp document with only its object (the command line gives the rest), in
+    ``--units`` (metres without it)."""
     try:
         vertices, faces = read_mesh(path, None, max_bytes=job.max_bytes or 64 * 2**20)
     except InputError as exc:
         return exc
-    shape = Shape("mesh", np.zeros(0), vertices=vertices, faces=faces, source=path)
+    # the path as a grasp file beside the mesh would name it: -o FILE.yaml finds it from the file's folder
+    shape = Shape("mesh", np.zeros(0), vertices=vertices, faces=faces, source=os.path.basename(path))
     obj = GraspObject(shape, np.eye(4))
     name = os.path.splitext(os.path.basename(path))[0]
     p = np.full((3, 3), np.nan)  # no contacts: as a document read without them
-    return Grasp(name, None, path, 0, CONTACT_NAMES, p, p, None, (), 1, object=obj)
+    return Grasp(name, job.options.units or "m", path, 0, CONTACT_NAMES, p, p, None, (), 1, object=obj)
+
+
+#: The warnings of an object that a search's records carry (the others are about the file's contacts).
+OBJECT_WARNINGS = ("rotation-over-pi",)
+
+
+def _object_warnings(entry: Grasp, obj: GraspObject, hand: Hand | None) -> tuple[str, ...]:
+    """The warnings of the object searched: its pose's, and its size against the hand that must
+    reach it (the file's or ``--hand``'s), else against its unit (a mesh)."""
+    said = [w for w in entry.warnings if w.startswith(OBJECT_WARNINGS)]
+    shape = obj.shape
+    extent = largest_extent(shape.kind, shape.size, shape.vertices)
+    if hand is not None:
+        said.append(hand_fit_warning(extent, fingers_reach(hand), entry.units))
+    elif shape.kind == "mesh":
+        said.append(mesh_span_warning(extent, entry.units))
+    return tuple(w for w in said if w)
 
 
 class Progress(NamedTuple):
@@ -218,6 +239,7 @@ def synthesize_inputs(job, inputs: Iterable) -> Iterator[GraspFileError | Found 
                 yield hand
                 continue
             reach, hand = hand if hand is not None else (None, None)
+            said = _object_warnings(entry, obj, hand)
             yield Progress(o.candidates, 0)
             for step in search_steps(
                 surface_of(obj),
@@ -257,6 +279,7 @@ def synthesize_inputs(job, inputs: Iterable) -> Iterator[GraspFileError | Found 
                 joints_at=_inline_joints(hand, step),
                 twists=entry.twists,
                 paths=entry.paths,
+                warnings=said,
             )
         yield Progress(0, 1)
 
@@ -292,11 +315,13 @@ def synthesize_outputs(job, inputs: Iterable, w, workers: int = 1, tuning=None) 
     fmt = FORMATS[job.fmt]
     inputs = list(inputs)
     documents = []
+    reads_output = False  # a grasp file names -o FILE.yaml as its mesh or URDF: it is not written
     for item in searched(job, inputs, workers):
         if isinstance(item, Progress):
             yield Output(extra_work=item.extra, done=item.done)
             continue
         if isinstance(item, GraspFileError):
+            reads_output = reads_output or any(p.code == OUTPUT_IS_INPUT for p in item.problems)
             rec = error_record(item)
             out = Output(encoded=[_encode(job, rec, error=True)], records=1)
             out.errors.extend(diagnostics(rec)[0])
@@ -324,17 +349,18 @@ def synthesize_outputs(job, inputs: Iterable, w, workers: int = 1, tuning=None) 
         else:
             encoded = [_encode(job, rec) for rec in recs]
         yield Output(encoded=encoded, records=len(recs), notes=[_summary(job, item)], warnings=warnings)
-    if job.options.grasp_file is not None and documents:
+    if job.options.grasp_file is not None and documents and not reads_output:
         with opened(job.options.grasp_file, [p for p in inputs if isinstance(p, str)]) as out:
             out.write("---\n".join(documents).encode())
 
 
 def _unchecked(job, found) -> list[str]:
-    """Warnings of an object, once each: an option that does not apply to it.  The off-tangent
+    """Warnings of an object, once each: its own (its size against its unit or its hand), and an
+    option that does not apply to it.  The off-tangent
     method asked without a wrist (its conditioning cannot be checked: the tangent method's alone
     is), ``--tip-radius`` without a hand (no fingertip to size: the contacts are points)."""
     where = f"{escaped(found.file)}: grasp '{escaped(found.name)}': warning:"
-    said = []
+    said = [f"{where} {w}" for w in found.warnings]
     if found.wrist is None and job.options.method in ("off-tangent", "both"):
         said.append(f"{where} off-tangent conditioning not checked without a wrist (a grasp file's 'wrist')")
     if job.options.tip_radius is not None and found.hand is None:

@@ -42,7 +42,7 @@ from typing import IO, NamedTuple
 
 from .scratch import owned_prefix, remove_orphans
 
-__all__ = ["STDOUT", "Target", "WriteError", "check_target", "opened", "guarded"]
+__all__ = ["STDOUT", "Target", "WriteError", "check_target", "replaced_file", "opened", "guarded"]
 
 #: How errors name standard output.
 STDOUT = "standard output"
@@ -110,6 +110,23 @@ def check_target(path: str | None, inputs: Iterable = ()) -> Target:
     if info is not None and stat.S_ISREG(info.st_mode):
         _not_an_input(target.path, info, inputs)
     return target
+
+
+def replaced_file(path: str | None) -> tuple[int, int] | None:
+    """The ``(device, inode)`` of the regular file that writing ``path`` would replace (its links
+    followed), so that the readers refuse it if a grasp file names it (a mesh, a URDF); None for
+    standard output, a descriptor, a pipe or device, and a new file.
+
+    >>> replaced_file(None), replaced_file("-"), replaced_file("no/such/file.jsonl")
+    (None, None, None)
+    """
+    if path is None or path == "-" or _descriptor(path) is not None:
+        return None
+    try:
+        info = os.stat(path)
+    except OSError:
+        return None
+    return (info.st_dev, info.st_ino) if stat.S_ISREG(info.st_mode) else None
 
 
 def _by_type(path: str) -> tuple[Target, os.stat_result | None]:

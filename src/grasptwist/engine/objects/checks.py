@@ -1,14 +1,16 @@
 """Validators of an object (its shape, pose, mass and density), done once where it enters.
 
 Each ``check_*`` returns what it checked, arrays as read-only float (faces
-int) arrays, and raises ``ValueError`` with one line naming the field and what
-is wrong.  The grasp-file loader turns that line into a located error; the
-geometry functions trust an object these accepted.
+int) arrays, and raises :class:`ObjectError` (a ``ValueError``) with one line naming the field
+and what is wrong, and the code a grasp file's error gets for it.  :func:`checked` is the one
+gate: every geometry function takes its object through it, and so does the grasp-file loader,
+which turns the line into a located error.
 """
 
 from __future__ import annotations
 
 import math
+import weakref
 from dataclasses import replace
 
 import numpy as np
@@ -24,6 +26,9 @@ __all__ = [
     "check_shape",
     "check_pose",
     "check_object",
+    "checked",
+    "accept",
+    "ObjectError",
     "check_size",
     "check_extent",
     "degenerate_faces",
@@ -47,6 +52,20 @@ SIZE_RANGE = (1e-75, 1e75)
 #: thinnest faces trimesh makes (a uv sphere's, a capsule's) are some 2e-5 of it.
 AREA_TOL = 1e-12
 
+
+class ObjectError(ValueError):
+    """What is wrong with an object, in one line, with ``code``: the code a grasp file's reader
+    gives the same problem (``invalid-size``, ``invalid-mesh``, ``not-watertight``, ...).
+
+    >>> ObjectError("invalid-size", "sphere radius must be a finite number > 0, got 0.0").code
+    'invalid-size'
+    """
+
+    def __init__(self, code: str, message: str):
+        super().__init__(message)
+        self.code = code
+
+
 _SIZE_NAMES = {
     "box": ("a", "b", "c"),
     "sphere": ("radius",),
@@ -59,7 +78,7 @@ def _real(a, name, dtype=float):
     try:
         a = np.array(a, dtype=dtype)
     except (TypeError, ValueError, OverflowError):
-        raise ValueError(f"{name} must hold real numbers") from None
+        raise ObjectError("not-a-number", f"{name} must hold real numbers") from None
     return a
 
 
@@ -83,12 +102,12 @@ def check_shape(shape: Shape) -> Shape:
     [0.03]
     >>> check_shape(Shape("cylinder", [0.03, -1]))
     Traceback (most recent call last):
-    ValueError: cylinder height must be a finite number > 0, got -1.0
+    grasptwist.engine.objects.checks.ObjectError: cylinder height must be a finite number > 0, got -1.0
     """
     if not isinstance(shape, Shape):
-        raise ValueError(f"shape must be a Shape, got {type(shape).__name__}")
+        raise ObjectError("invalid-object", f"shape must be a Shape, got {type(shape).__name__}")
     if shape.kind not in KINDS:
-        raise ValueError(f"shape kind must be one of {', '.join(KINDS)}, got {shape.kind!r}")
+        raise ObjectError("invalid-object", f"shape kind must be one of {', '.join(KINDS)}, got {shape.kind!r}")
     if shape.kind == "mesh":
         vertices, faces = _check_mesh(shape.vertices, shape.faces)
         return replace(shape, size=_frozen(np.zeros(0)), vertices=vertices, faces=faces)
@@ -107,15 +126,17 @@ def check_size(kind: str, size) -> np.ndarray:
     [0.035]
     >>> check_size("box", 0.035)
     Traceback (most recent call last):
-    ValueError: box size must hold 3 number(s) (a, b, c), got 1
+    grasptwist.engine.objects.checks.ObjectError: box size must hold 3 number(s) (a, b, c), got 1
     """
     names = _SIZE_NAMES[kind]
     size = _real(size, f"{kind} size").reshape(-1)
     if size.shape != (len(names),):
-        raise ValueError(f"{kind} size must hold {len(names)} number(s) ({', '.join(names)}), got {size.size}")
+        raise ObjectError(
+            "invalid-size", f"{kind} size must hold {len(names)} number(s) ({', '.join(names)}), got {size.size}"
+        )
     for name, value in zip(names, size.tolist()):
         if not (math.isfinite(value) and value > 0):
-            raise ValueError(f"{kind} {name} must be a finite number > 0, got {value!r}")
+            raise ObjectError("invalid-size", f"{kind} {name} must be a finite number > 0, got {value!r}")
     check_extent(diagonal(kind, size), kind)
     return _frozen(size)
 
@@ -128,16 +149,17 @@ def check_extent(size: float, what: str = "its") -> float:
     0.1
     >>> check_extent(1e100)
     Traceback (most recent call last):
-    ValueError: its size (the diagonal of its bounding box) is 1e+100, outside 1e-75 to 1e+75 where its areas and volume are double-precision numbers: rescale it
+    grasptwist.engine.objects.checks.ObjectError: its size (the diagonal of its bounding box) is 1e+100, outside 1e-75 to 1e+75 where its areas and volume are double-precision numbers: rescale it
     """
     size = float(size)
     if not math.isfinite(size):
-        raise ValueError(f"{what} size overflows double precision: rescale it")
+        raise ObjectError("non-finite", f"{what} size overflows double precision: rescale it")
     low, high = SIZE_RANGE
     if not low <= size <= high:
-        raise ValueError(
+        raise ObjectError(
+            "invalid-size",
             f"{what} size (the diagonal of its bounding box) is {size:.3g}, outside {low:.0e} to {high:.0e} "
-            "where its areas and volume are double-precision numbers: rescale it"
+            "where its areas and volume are double-precision numbers: rescale it",
         )
     return size
 
@@ -165,28 +187,31 @@ def degenerate_faces(vertices, faces) -> np.ndarray:
 
 def _check_mesh(vertices, faces):
     if vertices is None or faces is None:
-        raise ValueError("mesh needs vertices and faces")
+        raise ObjectError("invalid-mesh", "mesh needs vertices and faces")
     v = _real(vertices, "mesh vertices")
     if v.ndim != 2 or v.shape[1] != 3 or len(v) < 4:
-        raise ValueError(f"mesh vertices must have shape (V, 3) with V >= 4, got {v.shape}")
+        raise ObjectError("invalid-mesh", f"mesh vertices must have shape (V, 3) with V >= 4, got {v.shape}")
     if not np.isfinite(v).all():
         row = int(np.flatnonzero(~np.isfinite(v).all(axis=1))[0])
-        raise ValueError(f"mesh vertex {row} is not finite: {v[row].tolist()}")
+        raise ObjectError("non-finite", f"mesh vertex {row} is not finite: {v[row].tolist()}")
     f = _real(faces, "mesh faces", dtype=np.float64)
     if f.ndim != 2 or f.shape[1] != 3 or len(f) < 4:
-        raise ValueError(f"mesh faces must have shape (F, 3) with F >= 4, got {f.shape}")
+        raise ObjectError("invalid-mesh", f"mesh faces must have shape (F, 3) with F >= 4, got {f.shape}")
     if not (np.isfinite(f).all() and (f == np.round(f)).all() and f.min() >= 0 and f.max() < len(v)):
-        raise ValueError(f"mesh faces must be whole vertex indices from 0 to {len(v) - 1}")
+        raise ObjectError("invalid-mesh", f"mesh faces must be whole vertex indices from 0 to {len(v) - 1}")
     f = f.astype(np.int64)
     check_extent(np.linalg.norm(v.max(axis=0) - v.min(axis=0)), "mesh")
     _check_closed(f)
     flat = degenerate_faces(v, f)
     if len(flat):
-        raise ValueError(
-            f"mesh face {int(flat[0])} is degenerate: its area is within AREA_TOL of 0 (corners on a line)"
+        raise ObjectError(
+            "invalid-mesh",
+            f"mesh face {int(flat[0])} is degenerate: its area is within AREA_TOL of 0 (corners on a line)",
         )
     if _signed_volume(v, f) <= 0:
-        raise ValueError("mesh encloses no positive volume: its faces must be counter-clockwise seen from outside")
+        raise ObjectError(
+            "invalid-mesh", "mesh encloses no positive volume: its faces must be counter-clockwise seen from outside"
+        )
     return _frozen(v), _frozen(f)
 
 
@@ -194,18 +219,25 @@ def _check_closed(faces):
     """Each directed edge once, and its reverse once: a closed, consistently oriented surface."""
     edges = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
     if (edges[:, 0] == edges[:, 1]).any():
-        raise ValueError("mesh has a face with a repeated vertex")
+        raise ObjectError("not-watertight", "mesh has a face with a repeated vertex")
     n = int(faces.max()) + 1
-    directed = edges[:, 0] * n + edges[:, 1]
-    unique, counts = np.unique(directed, return_counts=True)
-    if (counts > 1).any():
-        raise ValueError(
-            f"mesh is not consistently oriented or not manifold: {int((counts > 1).sum())} edge(s) run the same way in two faces"
+    # sorted keys, not np.unique and np.isin (hash tables): a 245,760-edge mesh in 0.03 s, not 1.9 s
+    directed = np.sort(edges[:, 0] * n + edges[:, 1])
+    repeated = directed[1:] == directed[:-1]
+    if repeated.any():
+        runs = int(np.count_nonzero(repeated[1:] & ~repeated[:-1]) + repeated[0])  # edges, not their copies
+        raise ObjectError(
+            "not-watertight",
+            f"mesh is not consistently oriented or not manifold: {runs} edge(s) run the same way in two faces",
         )
-    reverse = edges[:, 1] * n + edges[:, 0]
-    missing = ~np.isin(reverse, unique)
-    if missing.any():
-        raise ValueError(f"mesh is not closed: {int(missing.sum())} edge(s) belong to one face only")
+    reverse = np.sort(edges[:, 1] * n + edges[:, 0])
+    if np.array_equal(directed, reverse):  # each directed edge's reverse is there: closed
+        return
+    found = directed[np.minimum(np.searchsorted(directed, reverse), len(directed) - 1)] == reverse
+    if not found.all():
+        raise ObjectError(
+            "not-watertight", f"mesh is not closed: {int((~found).sum())} edge(s) belong to one face only"
+        )
 
 
 def _signed_volume(vertices, faces):
@@ -221,18 +253,22 @@ def check_pose(pose) -> np.ndarray:
 
     >>> check_pose(np.diag([1.0, 1, -1, 1]))
     Traceback (most recent call last):
-    ValueError: pose must be rigid: its rotation block is not a rotation (orthonormal, determinant +1)
+    grasptwist.engine.objects.checks.ObjectError: pose must be rigid: its rotation block is not a rotation (orthonormal, determinant +1)
     """
     p = _real(pose, "pose")
     if p.shape != (4, 4):
-        raise ValueError(f"pose must have shape (4, 4), got {p.shape}")
+        raise ObjectError("invalid-pose", f"pose must have shape (4, 4), got {p.shape}")
     if not np.isfinite(p).all():
-        raise ValueError("pose must be finite")
+        raise ObjectError("non-finite", "pose must be finite")
     if not (p[3] == (0.0, 0.0, 0.0, 1.0)).all():
-        raise ValueError(f"pose must be rigid: its last row must be (0, 0, 0, 1), got {tuple(p[3].tolist())}")
+        raise ObjectError(
+            "invalid-pose", f"pose must be rigid: its last row must be (0, 0, 0, 1), got {tuple(p[3].tolist())}"
+        )
     r = p[:3, :3]
     if not (np.abs(r.T @ r - np.eye(3)).max() <= RIGID_TOL and np.linalg.det(r) > 0):
-        raise ValueError("pose must be rigid: its rotation block is not a rotation (orthonormal, determinant +1)")
+        raise ObjectError(
+            "invalid-pose", "pose must be rigid: its rotation block is not a rotation (orthonormal, determinant +1)"
+        )
     return _frozen(p)
 
 
@@ -243,10 +279,10 @@ def check_object(obj: GraspObject) -> GraspObject:
 
     >>> check_object(GraspObject(Shape("box", [1, 1, 1]), np.eye(4), mass=0.0))
     Traceback (most recent call last):
-    ValueError: object mass must be a finite number > 0, got 0.0
+    grasptwist.engine.objects.checks.ObjectError: object mass must be a finite number > 0, got 0.0
     """
     if not isinstance(obj, GraspObject):
-        raise ValueError(f"object must be a GraspObject, got {type(obj).__name__}")
+        raise ObjectError("invalid-object", f"object must be a GraspObject, got {type(obj).__name__}")
     for name in ("mass", "density"):
         value = getattr(obj, name)
         if value is not None:
@@ -255,5 +291,43 @@ def check_object(obj: GraspObject) -> GraspObject:
             except TypeError:
                 good = False
             if not good:
-                raise ValueError(f"object {name} must be a finite number > 0, got {value!r}")
+                raise ObjectError(f"invalid-{name}", f"object {name} must be a finite number > 0, got {value!r}")
     return replace(obj, shape=check_shape(obj.shape), pose=check_pose(obj.pose))
+
+
+#: Objects :func:`checked` gave back (accepted, or made by it), and its answer for the others.
+_ACCEPTED: weakref.WeakSet = weakref.WeakSet()
+_CHECKED: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+
+
+def checked(obj: GraspObject) -> GraspObject:
+    """``obj`` checked by :func:`check_object` once: the one gate every geometry function (and so
+    the search, the weight, a hand's reach) takes an object through, however it was built.
+
+    The answer is kept while ``obj`` lives, so a search asking thousands of times checks a mesh
+    once; an object it gave back passes straight through.  Raises :class:`ObjectError`.
+
+    >>> cube = GraspObject(Shape("box", [0.065, 0.065, 0.065]), np.eye(4))
+    >>> checked(cube) is checked(checked(cube))
+    True
+    >>> checked(GraspObject(Shape("box", [0.065, 0.065, 0.065]), np.eye(4), density=-1.0))
+    Traceback (most recent call last):
+    grasptwist.engine.objects.checks.ObjectError: object density must be a finite number > 0, got -1.0
+    """
+    if not isinstance(obj, GraspObject):
+        return check_object(obj)  # which says what it is instead
+    if obj in _ACCEPTED:
+        return obj
+    twin = _CHECKED.get(obj)
+    if twin is None:
+        twin = check_object(obj)
+        _ACCEPTED.add(twin)
+        _CHECKED[obj] = twin
+    return twin
+
+
+def accept(obj: GraspObject) -> GraspObject:
+    """Mark ``obj``, made from an object :func:`checked` accepted by a change that keeps it valid
+    (a pose checked by :func:`check_pose`), as accepted; return it."""
+    _ACCEPTED.add(obj)
+    return obj

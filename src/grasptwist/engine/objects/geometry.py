@@ -1,8 +1,9 @@
 r"""An object's geometry in the grasp frame: nearest surface points, mass properties, samples, triangles.
 
-Each function takes a :class:`~grasptwist.model.GraspObject` checked by
-:func:`~grasptwist.objects.check_object` (a primitive's sizes it checks itself, cheaply:
-``check_size``, so that a ``Shape("sphere", 0.035)`` built by hand works) and works in the grasp frame: points go into
+Each function takes a :class:`~grasptwist.model.GraspObject` through the one gate,
+:func:`~.checks.checked` (:func:`~grasptwist.objects.check_object` once per object, however it
+was built: an object that is not one raises :class:`~.checks.ObjectError` with the code a grasp
+file's reader gives it) and works in the grasp frame: points go into
 the object's frame through its pose :math:`T = (R, t)`, :math:`q = R^T (p - t)`,
 are answered there by ``primitives`` (exact) or ``mesh``, and come
 back as :math:`R c + t` (points) and :math:`R n` (normals).  Normals point
@@ -30,7 +31,7 @@ import numpy as np
 from ...model import GraspObject
 from ..se3 import rotate
 from . import mesh, primitives
-from .checks import check_pose, check_size
+from .checks import accept, check_pose, check_size, checked
 from .tolerances import EDGE_TOL
 
 __all__ = [
@@ -97,7 +98,7 @@ def object_size(obj: GraspObject) -> float:
     >>> object_size(GraspObject(Shape("box", np.array([0.03, 0.04, 0.12])), np.eye(4)))
     0.13
     """
-    shape = obj.shape
+    shape = checked(obj).shape
     if shape.kind == "mesh":
         return mesh.diagonal(shape.vertices)
     return primitives.diagonal(shape.kind, check_size(shape.kind, shape.size))
@@ -145,7 +146,7 @@ def project_to_surface(obj: GraspObject, points) -> SurfacePoints:
     >>> s.points.tolist(), s.normals.tolist(), float(s.distance), bool(s.on_edge)
     ([1.0, 1.0, 0.0], [0.0, -1.0, 0.0], 0.5, False)
     """
-    p = _points(points)
+    p, obj = _points(points), checked(obj)
     rotation, translation = obj.pose[:3, :3], obj.pose[:3, 3]
     # written out component by component (se3.rotate): a BLAS product of (N, 3) by (3, 3) is
     # several times slower, and its threads fight over a busy machine
@@ -200,6 +201,7 @@ def mass_properties(obj: GraspObject) -> MassProperties:
     >>> round(m.volume, 6), round(m.mass, 6), m.center_of_mass.tolist()
     (0.001, 1.0, [0.0, 0.0, 0.05])
     """
+    obj = checked(obj)
     shape = obj.shape
     if shape.kind == "mesh":
         volume, centroid = mesh.volume_centroid(shape)
@@ -228,6 +230,7 @@ def sample_surface(obj: GraspObject, n: int, rng: np.random.Generator) -> tuple[
     >>> np.allclose(p, -n)
     True
     """
+    obj = checked(obj)
     shape = obj.shape
     if shape.kind == "mesh":
         points, outward = mesh.sample(shape, n, rng)
@@ -257,6 +260,7 @@ def tessellate(obj: GraspObject, *, segments: int = 32) -> tuple[np.ndarray, np.
     >>> v.shape, f.shape
     ((8, 3), (12, 3))
     """
+    obj = checked(obj)
     shape = obj.shape
     if shape.kind == "mesh":
         vertices, faces = shape.vertices, shape.faces.copy()
@@ -273,6 +277,7 @@ def moved(obj: GraspObject, pose) -> GraspObject:
     >>> moved(GraspObject(Shape("sphere", np.ones(1)), np.eye(4)), step).pose[:3, 3].tolist()
     [0.0, 0.0, 1.0]
     """
+    obj = checked(obj)
     new = check_pose(pose) @ obj.pose
     new.setflags(write=False)
-    return replace(obj, pose=new)
+    return accept(replace(obj, pose=new))

@@ -54,12 +54,12 @@ def read_document(root, problems, *, file, document, name, line, reading, max_by
         name = read_name(fields["name"], "name", problems)
     units = read_name(fields["units"], "units", problems) if "units" in fields else None
     wrist = read_vector(fields["wrist"], 3, "wrist", problems) if "wrist" in fields else None
-    found = {"file": file, "reading": reading, "max_bytes": max_bytes}
+    found = {"file": file, "reading": reading, "max_bytes": max_bytes, "units": units}
     for section in SECTIONS:
         found.update(section.read(fields, found, problems) or {})
     if problems.count:
         return None
-    for key in ("file", "reading", "max_bytes"):
+    for key in ("file", "reading", "max_bytes", "units"):
         del found[key]
     if "points" not in found:  # contacts not required of this reading: to be found (NaN)
         found.update(contact_names=CONTACT_NAMES, points=_NO_CONTACTS, normals=_NO_CONTACTS)

@@ -94,7 +94,9 @@ def fast_document(get, keep, file, reading, max_bytes):
         raise Bail
     parts = Parts(name, units, wrist, contacts, twists)
     if composed:
-        parts.sections = _sections(composed, parts, {"file": file, "reading": reading, "max_bytes": max_bytes})
+        parts.sections = _sections(
+            composed, parts, {"file": file, "reading": reading, "max_bytes": max_bytes, "units": units}
+        )
     return parts
 
 

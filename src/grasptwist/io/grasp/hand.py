@@ -71,12 +71,13 @@ JOINT_KEYS = ("name", "type", "axis", "point", "velocity_limit")
 JOINT_TYPES = ("revolute", "prismatic")
 
 
-def read_hand(node, points, file, problems, allow_outside=False):
+def read_hand(node, points, file, problems, allow_outside=False, output=None):
     """``(Hand, joint positions, placement)`` of a ``hand`` node, or None after a problem.
 
     ``points`` are the contacts (None: a hand file, whose rows bring their own);
     ``file`` is the grasp file, whose folder a relative ``urdf`` path stays
-    inside unless ``allow_outside``.  A URDF hand of a grasp file comes with its
+    inside unless ``allow_outside`` (and which is not ``output``, the ``(device, inode)`` of the
+    file ``-o`` replaces).  A URDF hand of a grasp file comes with its
     :class:`~grasptwist.model.HandPlacement` (the positions are then the ones
     given, or the seed), to be put on its contacts by the run layer; else the
     placement is None.
@@ -144,7 +145,7 @@ def read_hand(node, points, file, problems, allow_outside=False):
     names = list(names)
     radii = [radius if r is None else r for r in radii]  # the finger's, else the hand's (None: not given)
     if urdf:
-        read = _urdf_hand(fields, fingers, names, points is None, file, problems, allow_outside)
+        read = _urdf_hand(fields, fingers, names, points is None, file, problems, allow_outside, output)
     else:
         taken = {}  # joint names, unique over the hand
         joints = [_joints(f["joints"], f"hand.fingers[{i}]", names[i], taken, problems) for i, f in enumerate(fingers)]
@@ -294,7 +295,7 @@ def inline_hand(names, fingers, points):
     return Hand(tuple(out), tuple(joint_names), None, None)
 
 
-def _urdf_hand(fields, fingers, names, hand_file, file, problems, allow_outside=False):
+def _urdf_hand(fields, fingers, names, hand_file, file, problems, allow_outside=False, output=None):
     """The URDF form: load the hand, with its ``joint_positions`` (checked on the contacts later)
     or ``seed`` (solved from later) and where each finger's tip stands in the file; in a hand file
     (``hand_file``), at its joint positions."""
@@ -312,7 +313,7 @@ def _urdf_hand(fields, fingers, names, hand_file, file, problems, allow_outside=
         return None
     folder = Path(file).parent if not file.startswith("<") else Path.cwd()
     try:
-        hand = load_urdf_hand(reference, tips, names=names, folder=folder, allow_outside=allow_outside)
+        hand = load_urdf_hand(reference, tips, names=names, folder=folder, allow_outside=allow_outside, output=output)
     except InputError as err:
         problems.add(Reject(err.code, "hand.urdf", str(err), **located(node)))
         return None
@@ -412,10 +413,24 @@ def load_hand_file(path, *, max_bytes=DEFAULT_MAX_BYTES):
 def _read(fields, found, problems):
     if "hand" not in fields:
         return {}
-    hand = read_hand(fields["hand"], found.get("points"), found["file"], problems, found["reading"].allow_outside)
+    reading = found["reading"]
+    hand = read_hand(
+        fields["hand"], found.get("points"), found["file"], problems, reading.allow_outside, reading.output
+    )
     if hand is None:
         return None
-    return {"hand": hand[0], "joint_positions": readonly(hand[1]), "placement": hand[2]}
+    out = {"hand": hand[0], "joint_positions": readonly(hand[1]), "placement": hand[2]}
+    obj = found.get("object")
+    if obj is not None:  # an object a hand 10 times too small or too big: a unit mixed up
+        from ...engine.units import fingers_reach, hand_fit_warning, largest_extent
+
+        said = hand_fit_warning(
+            largest_extent(obj.shape.kind, obj.shape.size, obj.shape.vertices),
+            fingers_reach(hand[0]),
+            found.get("units"),
+        )
+        out["warnings"] = (*found.get("warnings", ()), *([said] if said else []))
+    return out
 
 
 SECTION = Section(("hand",), _read)

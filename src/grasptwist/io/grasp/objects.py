@@ -9,8 +9,14 @@ One shape, a primitive centred at the object's origin or a mesh file::
       # or  capsule: {radius: 0.03, height: 0.1}       # height: between the caps' centres
       # or  mesh: meshes/bottle.stl     # STL, OBJ or PLY beside the grasp file
       #     scale: 0.001                # a mesh's units to the grasp's (a number, or 3)
+      # or  mesh: {file: meshes/bottle.stl, units: mm}   # the mesh file's own unit (or scale:)
       pose: {position: [0, 0, 0.1], rotation: [1, 0, 0, 0]}   # as a path's pose target
-      density: 700                      # or mass: 0.2 (not both)
+      density: 700                      # kg/m^3 (or mass: 0.2 kg, not both)
+
+Lengths stay in the grasp file's unit (``units``, metres without it); a ``density`` in kg/m^3
+weighs the volume through that unit's length (:mod:`grasptwist.engine.units`), and a mesh
+with its own ``units`` is scaled into it.  The object is checked by the engine's one gate,
+:func:`~grasptwist.engine.objects.checks.checked`, as an object built in Python is.
 
 With an object a contact may leave out its ``normal``: its point is then
 put on the surface (the nearest point) and its normal is the inward normal
@@ -27,27 +33,44 @@ mesh is read by :mod:`grasptwist.io.mesh_file`.
 from __future__ import annotations
 
 import math
+from dataclasses import replace
 
 import numpy as np
 
+from ...engine.units import LENGTH_UNITS
 from ...model import GraspObject, InputError, Shape
 from .paths import read_pose
 from .problems import Reject, join, located
 from .values import Section, read_mapping, read_name, read_number, read_vector, readonly
 
-__all__ = ["OBJECT_KEYS", "SHAPE_KEYS", "SIZE_KEYS", "SECTION", "read_object", "on_surface"]
+__all__ = [
+    "OBJECT_KEYS",
+    "SHAPE_KEYS",
+    "SIZE_KEYS",
+    "MESH_KEYS",
+    "UNKNOWN_UNITS",
+    "SECTION",
+    "read_object",
+    "on_surface",
+]
 
 #: The shapes, one of which an object gives.
 SHAPE_KEYS = ("box", "sphere", "cylinder", "capsule", "mesh")
 OBJECT_KEYS = (*SHAPE_KEYS, "scale", "pose", "density", "mass")
 #: The keys of a cylinder's or capsule's size.
 SIZE_KEYS = ("radius", "height")
+#: The keys of a mesh given as a mapping: its file, and its own unit or scale.
+MESH_KEYS = ("file", "units", "scale")
+#: The error of a unit whose length is needed but not known (a label such as ``units: px``).
+UNKNOWN_UNITS = "unknown-units"
 
 
-def read_object(node, file, reading, max_bytes, problems, warnings):
+def read_object(node, file, reading, max_bytes, problems, warnings, units=None, hand=False):
     """The :class:`~grasptwist.model.GraspObject` of an ``object`` node (None after a problem);
-    a mesh is read from ``file``'s folder within ``max_bytes`` and ``reading``'s limits.  A pose's
-    rotation vector over pi adds its ``rotation-over-pi`` warning to ``warnings``, as a path's."""
+    a mesh is read from ``file``'s folder within ``max_bytes`` and ``reading``'s limits, in the
+    grasp file's ``units`` (a density weighs the volume through them).  A pose's rotation vector
+    over pi adds its ``rotation-over-pi`` warning to ``warnings``, as a path's; a mesh whose size
+    is unlikely in its unit, without a ``hand`` to compare with, ``mesh-size-unlikely``."""
     fields = read_mapping(node, "object", OBJECT_KEYS, (), problems)
     if fields is None:
         return None
@@ -83,44 +106,54 @@ def read_object(node, file, reading, max_bytes, problems, warnings):
         if read is not None:
             pose[:3, 3], pose[:3, :3] = read[0], read[1]
             warnings += _radians(read[2])
-    shape = _shape(shapes[0], fields, file, reading, max_bytes, problems) if shapes else None
+    shape = _shape(shapes[0], fields, file, reading, max_bytes, problems, units) if shapes else None
     if shape is None or problems.count:
         return None
     pose.setflags(write=False)
-    obj = GraspObject(shape, pose, mass=mass, density=density, line=node.line)
     from ...engine.objects import mass_properties
-    from ...engine.objects.checks import check_extent
-    from ...engine.objects.mesh import diagonal as mesh_diagonal
-    from ...engine.objects.primitives import diagonal
+    from ...engine.objects.checks import ObjectError, accept, checked
+    from ...engine.units import largest_extent, mesh_span_warning, unit_length
 
-    # the extent unchecked (object_size would refuse it), then the engine's rule for all kinds
-    with np.errstate(over="ignore", invalid="ignore"):
-        size = mesh_diagonal(shape.vertices) if shape.kind == "mesh" else diagonal(shape.kind, shape.size)
     try:
-        check_extent(size)
-    except ValueError as err:
-        code = "non-finite" if not np.isfinite(size) else "invalid-size"
-        problems.add(Reject(code, "object", str(err), **located(node)))
+        with np.errstate(over="ignore", invalid="ignore"):  # a size that overflows is the gate's non-finite
+            obj = checked(GraspObject(shape, pose, mass=mass, density=density, line=node.line))
+    except ObjectError as err:
+        problems.add(Reject(err.code, "object", str(err), **located(node)))
         return None
+    if shape.kind == "mesh" and not hand:
+        said = mesh_span_warning(largest_extent("mesh", None, obj.shape.vertices), units)
+        warnings += [said] if said else []
     if density is None:
         return obj
+    metres = unit_length(units)
+    if metres is None:
+        problems.add(
+            Reject(
+                UNKNOWN_UNITS,
+                "object.density",
+                f"a density is in kg/m^3: weighing the object needs the length of the file's units, "
+                f"and {units!r} is none of {', '.join(LENGTH_UNITS)} (give its mass in kg instead)",
+                **located(fields["density"]),
+            )
+        )
+        return None
     try:
         with np.errstate(over="ignore", invalid="ignore"):
-            weighed = float(mass_properties(obj).mass)
+            weighed = float(mass_properties(obj).mass) * metres**3
     except OverflowError:  # a volume beyond a double, in Python floats
         weighed = math.inf
-    if not np.isfinite(weighed):
+    if not 0 < weighed < math.inf:
         where = fields["density"]
         problems.add(
             Reject(
-                "non-finite",
+                "non-finite" if weighed else "invalid-mass",
                 "object.density",
-                "the mass (density x volume) overflows double precision",
+                f"the mass (density x volume) {'overflows' if weighed else 'underflows'} double precision",
                 **located(where),
             )
         )
         return None
-    return GraspObject(shape, pose, mass=weighed, density=density, line=node.line)
+    return accept(replace(obj, mass=weighed))  # a mass > 0 on an object the gate accepted
 
 
 def _radians(given) -> list:
@@ -133,11 +166,11 @@ def _radians(given) -> list:
     return [radians_warning(**given)] if rotation_over_pi(given["rotvec"]) else []
 
 
-def _shape(kind, fields, file, reading, max_bytes, problems):
+def _shape(kind, fields, file, reading, max_bytes, problems, units=None):
     """The :class:`~grasptwist.model.Shape` of the ``kind`` key (None after a problem)."""
     node, path = fields[kind], f"object.{kind}"
     if kind == "mesh":
-        return _mesh(node, fields.get("scale"), file, reading, max_bytes, problems)
+        return _mesh(node, fields.get("scale"), file, reading, max_bytes, problems, units)
     if kind == "box":
         size = read_vector(node, 3, path, problems)
         sizes = (
@@ -162,11 +195,31 @@ def _shape(kind, fields, file, reading, max_bytes, problems):
     return Shape(kind, readonly([value for value, _, _ in sizes]))
 
 
-def _mesh(node, scale_node, file, reading, max_bytes, problems):
-    """A mesh shape: its file read (:func:`grasptwist.io.mesh_file.read_mesh`), scaled."""
-    reference = read_name(node, "object.mesh", problems)
-    scale = _scale(scale_node, problems) if scale_node is not None else 1.0
-    if reference is None or scale is None or problems.count:
+def _mesh(node, scale_node, file, reading, max_bytes, problems, units=None):
+    """A mesh shape: its file read (:func:`grasptwist.io.mesh_file.read_mesh`), scaled by its own
+    unit into the grasp file's (``mesh: {file, units}``) and by ``scale``."""
+    if node.kind == "mapping":
+        parts = read_mapping(node, "object.mesh", MESH_KEYS, ("file",), problems)
+        if parts is None or "file" not in parts:
+            return None
+        if "scale" in parts and scale_node is not None:
+            problems.add(
+                Reject(
+                    "conflicting-keys",
+                    "object.scale",
+                    "cannot be combined with the mesh's own 'scale'",
+                    **located(scale_node),
+                )
+            )
+            return None
+        reference = read_name(parts["file"], "object.mesh.file", problems)
+        scale_node = parts.get("scale", scale_node)
+        factor = _unit_factor(parts["units"], units, problems) if "units" in parts else 1.0
+        where = parts["file"]
+    else:
+        reference, factor, where = read_name(node, "object.mesh", problems), 1.0, node
+    scale = _scale(scale_node, problems) if scale_node is not None else np.ones(1)
+    if reference is None or scale is None or factor is None or problems.count:
         return None
     # trimesh and the mesh reader load with the first mesh (a grasp file with a primitive never pays)
     from pathlib import Path
@@ -181,11 +234,36 @@ def _mesh(node, scale_node, file, reading, max_bytes, problems):
             max_bytes=max_bytes,
             max_triangles=reading.max_triangles,
             allow_outside=reading.allow_outside,
+            output=reading.output,
         )
     except InputError as err:
-        problems.add(Reject(err.code, "object.mesh", str(err), **located(node)))
+        problems.add(Reject(err.code, "object.mesh", str(err), **located(where)))
         return None
-    return Shape("mesh", readonly(np.zeros(0)), readonly(vertices * scale), faces, reference)
+    scale = readonly(scale * factor)
+    return Shape("mesh", readonly(np.zeros(0)), readonly(vertices * scale), faces, reference, scale)
+
+
+def _unit_factor(node, units, problems):
+    """How many of the grasp file's ``units`` one unit of a mesh's own (``node``) is; None after a problem."""
+    from ...engine.units import unit_length
+
+    own = read_name(node, "object.mesh.units", problems)
+    if own is None:
+        return None
+    lengths = unit_length(own), unit_length(units)
+    for length, name, what in zip(lengths, (own, units), ("the mesh's", "the file's")):
+        if length is None:
+            problems.add(
+                Reject(
+                    UNKNOWN_UNITS,
+                    "object.mesh.units",
+                    f"scaling the mesh into the file's units needs both lengths, and {what} {name!r} is none of "
+                    f"{', '.join(LENGTH_UNITS)}",
+                    **located(node),
+                )
+            )
+            return None
+    return lengths[0] / lengths[1]
 
 
 def _scale(node, problems):
@@ -273,7 +351,16 @@ def _read(fields, found, problems):
     if "object" not in fields:
         return {}
     said = []
-    obj = read_object(fields["object"], found["file"], found["reading"], found["max_bytes"], problems, said)
+    obj = read_object(
+        fields["object"],
+        found["file"],
+        found["reading"],
+        found["max_bytes"],
+        problems,
+        said,
+        units=found.get("units"),
+        hand="hand" in fields,
+    )
     points = found.get("points")
     if obj is not None and points is None and not found["reading"].contacts:  # synthesize finds them
         return {"object": obj, "warnings": tuple(said)}

@@ -73,6 +73,9 @@ class Reading:
     contacts : bool
         Documents must give ``contacts`` (False: ``synthesize``'s, which finds its own; a document
         without them has NaN points and normals, contacts named ``1``, ``2``, ``3``).
+    output : (int, int) or None
+        The ``(device, inode)`` of the file the run's ``-o`` replaces: a mesh or URDF that a
+        document names and that is that file is refused (``output-is-input``); None: no such file.
     """
 
     parser: type = PARSER
@@ -83,6 +86,7 @@ class Reading:
     allow_outside: bool = False
     max_triangles: int = MAX_TRIANGLES
     contacts: bool = True
+    output: tuple[int, int] | None = None
 
 
 #: The command line's way of reading.
