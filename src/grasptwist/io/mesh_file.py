@@ -47,16 +47,18 @@ from __future__ import annotations
 
 import os
 import re
+from array import array
 from pathlib import Path
 
 import numpy as np
 
 from ..model import InputError
-from .limits import DEFAULT_MAX_BYTES, MAX_TRIANGLES, MESH_SUFFIXES
+from .limits import MAX_MESH_BYTES, MAX_TRIANGLES, MAX_VERTICES, MESH_SUFFIXES
 
 __all__ = ["read_mesh", "check_mesh"]
 
-_PLY_FACES = re.compile(rb"^element\s+face\s+(\d+)\s*$", re.MULTILINE)
+#: An OBJ's vertex and face lines (others are passed over unsplit), their keyword and the rest.
+_OBJ_LINES = re.compile(rb"^[ \t]*([vf])[ \t]([^\n]*)", re.MULTILINE)
 _ASCII_STL = re.compile(rb"\s*solid", re.IGNORECASE)
 #: A binary STL: an 80-byte header, a little-endian uint32 count, then 50 bytes per triangle.
 _STL_HEADER, _STL_TRIANGLE = 84, 50
@@ -66,7 +68,7 @@ def read_mesh(
     reference,
     folder=None,
     *,
-    max_bytes=DEFAULT_MAX_BYTES,
+    max_bytes=MAX_MESH_BYTES,
     max_triangles=MAX_TRIANGLES,
     allow_outside=False,
 ):
@@ -114,34 +116,96 @@ def read_mesh(
     from .urdf import _read, resolve_urdf  # here: listing a folder (MESH_SUFFIXES) imports no URDF reader
 
     data = _read(resolve_urdf(text, folder, allow_outside=allow_outside), max_bytes, text)
-    _too_many(_declared_triangles(data, suffix, text), max_triangles, text)
+    _too_many(_declared(data, suffix, text), max_triangles, text)
     try:
-        vertices, faces = _obj(data) if suffix == ".obj" else _parsed(data, suffix, text)
+        vertices, faces = _obj(data, max_triangles, text) if suffix == ".obj" else _parsed(data, suffix, text)
     except (ValueError, IndexError):
         raise InputError("invalid-mesh", f"not a readable {suffix[1:].upper()} file", text) from None
     return check_mesh(vertices, faces, max_triangles, text)
 
 
-def _obj(data):
+def _obj(data, max_triangles, file):
     """``(vertices, faces)`` of a Wavefront OBJ's ``v`` and ``f`` lines (polygons as fans of
     triangles; ``a/b/c`` takes ``a``; negative indices count back from the vertices so far),
     read here: it is the format this project writes (``grasps/meshes/make_bottle.py``), and trimesh
     costs a second to import.  Other lines (normals, texture coordinates, groups, materials)
-    are passed over.  Raises ValueError on what does not read."""
-    vertices, faces = [], []
-    for line in data.decode("utf-8", "strict").splitlines():
-        words = line.split()
-        if not words or words[0] not in ("v", "f"):
-            continue
-        if words[0] == "v":
-            vertices.append([float(w) for w in words[1:4]])
-            continue
-        corners = [int(w.partition("/")[0]) for w in words[1:]]
-        if len(corners) < 3 or 0 in corners:
-            raise ValueError("a face needs three vertices, numbered from 1")
-        corners = [c - 1 if c > 0 else len(vertices) + c for c in corners]
-        faces += [(corners[0], corners[k], corners[k + 1]) for k in range(1, len(corners) - 1)]
-    return np.array(vertices, dtype=float).reshape(-1, 3), np.array(faces, dtype=np.int64).reshape(-1, 3)
+    are passed over unsplit.
+
+    Memory stays within the caps whatever the lines: at most :data:`MAX_VERTICES` vertices and
+    ``max_triangles`` triangles are kept, and a face line is split into no more corners than the
+    triangles left allow (a polygon of ``k`` corners is ``k - 2`` of them), so one polygon of
+    millions of corners is refused without making a word of each.
+
+    Raises
+    ------
+    InputError
+        ``invalid-mesh``, ``too-many-vertices`` or ``too-many-triangles``, at the file's line.
+
+    >>> v, f = _obj(b"v 0 0 0\\nv 1 0 0\\nv 0 1 0\\nv 1 1 0\\nf 1 2 4 -2\\n", 10, "a.obj")
+    >>> f.tolist()
+    [[0, 1, 3], [0, 3, 2]]
+    >>> _obj(b"v 0 0 0\\nf 1 2 99999999999999999999999\\n", 10, "a.obj")
+    Traceback (most recent call last):
+    grasptwist.model.GraspFileError: a.obj:2: a face names vertex 99999999999999999999999, which the file does not have
+    """
+    vertices, triangles = array("d"), array("q")
+    for match in _OBJ_LINES.finditer(data):
+        kind, body = match.groups()
+        try:
+            if kind == b"v":
+                _vertex(body, vertices)
+            else:
+                _face(body, len(vertices) // 3, triangles, max_triangles)
+        except _Refused as why:
+            raise InputError(*why.args, file, _line(data, match.start())) from None
+    return np.frombuffer(vertices, dtype=float).reshape(-1, 3), np.frombuffer(triangles, dtype=np.int64).reshape(-1, 3)
+
+
+class _Refused(Exception):
+    """An OBJ line that cannot be read: ``(code, message)``, located by the caller."""
+
+
+def _vertex(body, vertices):
+    """Append a ``v`` line's three coordinates (a fourth, or colours, passed over) to ``vertices``."""
+    if len(vertices) == 3 * MAX_VERTICES:
+        raise _Refused("too-many-vertices", f"more than the limit of {MAX_VERTICES:,} vertices")
+    words = body.split(None, 3)[:3]
+    try:
+        coordinates = [float(w) for w in words]
+    except ValueError:
+        raise _Refused("invalid-mesh", "a vertex's coordinates are not numbers") from None
+    if len(coordinates) < 3:
+        raise _Refused("invalid-mesh", "a vertex needs three coordinates")
+    vertices.extend(coordinates)
+
+
+def _face(body, so_far, triangles, max_triangles):
+    """Append the fan of an ``f`` line's polygon to ``triangles``, its corners split no further than
+    the triangles left allow (``so_far``: the vertices read before it)."""
+    budget = max_triangles - len(triangles) // 3 + 2  # the corners a polygon may have
+    words = body.split(None, budget)
+    if len(words) > budget:
+        raise _Refused(
+            "too-many-triangles",
+            f"a polygon of more than {budget:,} corners takes the mesh past the limit of {max_triangles:,} triangles",
+        )
+    try:
+        corners = [int(w.partition(b"/")[0]) for w in words]
+    except ValueError:
+        raise _Refused("invalid-mesh", "a face's corners are not vertex numbers") from None
+    if len(corners) < 3:
+        raise _Refused("invalid-mesh", "a face needs three corners")
+    for c in corners:  # numbered from 1 (a vertex further on too), or back from the last one so far
+        if not (-so_far <= c <= MAX_VERTICES and c):
+            raise _Refused("invalid-mesh", f"a face names vertex {c}, which the file does not have")
+    first, *rest = [c - 1 if c > 0 else so_far + c for c in corners]
+    for b, c in zip(rest, rest[1:]):
+        triangles.extend((first, b, c))
+
+
+def _line(data, offset):
+    """The 1-based line of ``data`` that byte ``offset`` is on (counted only for an error)."""
+    return data.count(b"\n", 0, offset) + 1
 
 
 def _parsed(data, suffix, file):
@@ -255,51 +319,133 @@ def _closed(faces):
     return bool((counts == 1).all() and np.array_equal(keys, reverse))
 
 
-def _declared_triangles(data, suffix, file):
-    r"""How many triangles (or faces: a polygon is a fan of them) the file says it holds, found
-    without parsing it; None where the format does not say.
+def _declared(data, suffix, file):
+    r"""``(vertices, triangles)``: how many the file says it holds, found without parsing it
+    (a polygon counts as one triangle until it is read).
 
     A binary STL gives its count in its header, and is exactly that long; an ASCII STL starts with
-    ``solid`` and closes each triangle with ``endfacet``; a PLY's header declares its faces; an
-    OBJ has an ``f`` line per face.  Bytes that are neither kind of STL are ``invalid-mesh``.
+    ``solid`` and has per triangle one ``endfacet``, one ``normal`` and three ``vertex`` words (the
+    most any of them gives: trimesh splits the text at each); a PLY's header declares its elements
+    (:func:`_ply_elements`); an OBJ has a ``v`` line per vertex, an ``f`` line per face.  Bytes
+    that are neither kind of STL are ``invalid-mesh``.
 
     >>> import struct
-    >>> _declared_triangles(bytes(80) + struct.pack("<I", 2) + bytes(100), ".stl", "a.stl")
-    2
-    >>> _declared_triangles(b"v 0 0 0\nf 1 2 3\r\nf 1 3 4\n", ".obj", "a.obj")
-    2
-    >>> _declared_triangles(b"not a mesh", ".stl", "junk.stl")
+    >>> _declared(bytes(80) + struct.pack("<I", 2) + bytes(100), ".stl", "a.stl")
+    (6, 2)
+    >>> _declared(b"v 0 0 0\nf 1 2 3\r\nf 1 3 4\n", ".obj", "a.obj")
+    (1, 2)
+    >>> _declared(b"not a mesh", ".stl", "junk.stl")
     Traceback (most recent call last):
     grasptwist.model.GraspFileError: junk.stl: not a readable STL file (neither a binary STL of the length its count gives nor text starting with 'solid')
     """
-    if suffix == ".stl":
-        if len(data) >= _STL_HEADER:
-            count = int.from_bytes(data[80:84], "little")
-            if len(data) == _STL_HEADER + _STL_TRIANGLE * count:
-                return count
-        if _ASCII_STL.match(data[:1024]):
-            return data.count(b"endfacet")
-        raise InputError(
-            "invalid-mesh",
-            "not a readable STL file (neither a binary STL of the length its count gives nor text starting with 'solid')",
-            file,
-        )
     if suffix == ".ply":
-        end = data.find(b"end_header")
-        declared = _PLY_FACES.search(data[: end if end >= 0 else 4096])
-        return int(declared.group(1)) if declared else None
-    return sum(data.count(line) for line in (b"\nf ", b"\nf\t")) + data.startswith((b"f ", b"f\t"))
+        elements = _ply_elements(data, file)
+        return elements.get(b"vertex", 0), elements.get(b"face", 0)
+    if suffix == ".obj":
+        v, f = ((b"\n" + key + b" ", b"\n" + key + b"\t") for key in (b"v", b"f"))
+        return tuple(sum(map(data.count, lines)) + data.startswith(lines[0][1:]) for lines in (v, f))
+    if len(data) >= _STL_HEADER:
+        count = int.from_bytes(data[80:84], "little")
+        if len(data) == _STL_HEADER + _STL_TRIANGLE * count:
+            return 3 * count, count
+    if _ASCII_STL.match(data[:1024]):
+        text = data.lower()
+        count = max(text.count(b"endfacet"), text.count(b"normal"), -(-text.count(b"vertex") // 3))
+        return 3 * count, count
+    raise InputError(
+        "invalid-mesh",
+        "not a readable STL file (neither a binary STL of the length its count gives nor text starting with 'solid')",
+        file,
+    )
 
 
 def _too_many(declared, max_triangles, file):
-    """Refuse a file that says it holds more than ``max_triangles`` triangles, before a parser
-    allocates arrays of that length."""
-    if declared is not None and declared > max_triangles:
+    """Refuse a file that says it holds more than :data:`MAX_VERTICES` vertices or ``max_triangles``
+    triangles, before a parser allocates arrays of that length."""
+    vertices, triangles = declared
+    if vertices > MAX_VERTICES:
+        raise InputError(
+            "too-many-vertices", f"the file declares {vertices:,} vertices, more than the limit of {MAX_VERTICES:,}", file
+        )
+    if triangles > max_triangles:
         raise InputError(
             "too-many-triangles",
-            f"the file declares {declared} faces, more than the limit of {max_triangles} triangles",
+            f"the file declares {triangles:,} faces, more than the limit of {max_triangles:,} triangles",
             file,
         )
+
+
+#: A PLY property's bytes in a binary body, by its type's names.
+_PLY_SIZES = dict.fromkeys((b"char", b"uchar", b"int8", b"uint8"), 1)
+_PLY_SIZES |= dict.fromkeys((b"short", b"ushort", b"int16", b"uint16"), 2)
+_PLY_SIZES |= dict.fromkeys((b"int", b"uint", b"int32", b"uint32", b"float", b"float32"), 4)
+_PLY_SIZES |= dict.fromkeys((b"double", b"float64"), 8)
+_PLY_FORMATS = (b"ascii", b"binary_little_endian", b"binary_big_endian")
+#: Most bytes of a PLY header (a few hundred hold a mesh's).
+_PLY_HEADER = 1 << 16
+
+
+def _ply_elements(data, file):
+    r"""``{name: count}`` of a PLY header's elements, once the body can hold them.
+
+    In ASCII, one line an element: the body's lines (as trimesh splits them) must be as many as
+    the header's elements; in binary, the body must hold at least their fixed-size properties
+    (a list's count, no items).  Either way a count the body cannot hold is named at its line
+    of the header, before a parser allocates for it.
+
+    >>> header = b"ply\nformat ascii 1.0\nelement vertex 2000000000\nproperty float x\nend_header\n"
+    >>> _ply_elements(header + b"0\n1\n", "m.ply")
+    Traceback (most recent call last):
+    grasptwist.model.GraspFileError: m.ply:3: the header declares 2,000,000,000 vertex elements, one a line, but the body holds 2 lines
+    """
+    end = data.find(b"end_header", 0, _PLY_HEADER)
+    if not data.startswith(b"ply") or end < 0:
+        raise InputError("invalid-mesh", f"not a PLY file: no 'ply' ... 'end_header' in its first {_PLY_HEADER:,} bytes", file)
+    body = data.find(b"\n", end) + 1 or len(data)
+    form, elements = None, []  # [name, count, header line, least bytes a row]
+    for number, line in enumerate(data[:end].split(b"\n"), 1):
+        words = line.split()
+        try:
+            if words[:1] == [b"format"]:
+                form = _PLY_FORMATS.index(words[1])
+            elif words[:1] == [b"element"]:
+                elements.append([words[1], int(words[2]), number, 0])
+                if elements[-1][1] < 0:
+                    raise ValueError
+            elif words[:1] == [b"property"]:
+                elements[-1][3] += _PLY_SIZES[words[2] if words[1] == b"list" else words[1]]
+        except (IndexError, ValueError, KeyError):
+            raise InputError("invalid-mesh", f"not a PLY header line: {line[:80]!r}", file, number) from None
+    if form is None:
+        raise InputError("invalid-mesh", "not a PLY file: its header gives no format", file)
+    held = _ply_lines(data[body:], file) if form == 0 else len(data) - body
+    unit = "lines" if form == 0 else "bytes"
+    need = 0
+    for name, count, number, row in elements:
+        need += count if form == 0 else count * row
+        if need > held:
+            what = "one a line" if form == 0 else f"of {row} bytes or more"
+            raise InputError(
+                "invalid-mesh",
+                f"the header declares {count:,} {name.decode(errors='replace')} elements, {what}, "
+                f"but the body holds {held:,} {unit}",
+                file,
+                number,
+            )
+    if form == 0 and need != held:
+        raise InputError("invalid-mesh", f"the body holds {held:,} lines, the header declares {need:,} elements, one a line", file)
+    return {name: count for name, count, _, _ in elements}
+
+
+def _ply_lines(body, file):
+    """The lines of an ASCII PLY body (trailing blank ones aside) as trimesh splits them, after
+    checking that it is ASCII text (else each stray control character would split a line)."""
+    body = body.rstrip()
+    stray = re.search(rb"[^\x20-\x7e\t\r\n]", body)
+    if stray:
+        raise InputError("invalid-mesh", f"byte {body[stray.start()]:#04x} in an ASCII PLY body, which holds text", file)
+    breaks = body.count(b"\n") + body.count(b"\r") - body.count(b"\r\n")
+    return breaks + 1 if body else 0
 
 
 def _library(file):

@@ -93,10 +93,10 @@ def resolve_urdf(reference, folder=None, *, allow_outside=False):
     if _URL.match(text):
         raise InputError("unsupported-url", f"only package:// URLs and file paths are read, got {text!r}", text)
     if folder is None:
-        return Path(text).resolve()
+        return _resolved(Path(text), text)
     if allow_outside:
-        return (Path(folder) / text).resolve()
-    return _inside(Path(folder).resolve(), text, text)
+        return _resolved(Path(folder) / text, text)
+    return _inside(_resolved(Path(folder), text), text, text)
 
 
 def _package_folder(package, reference):
@@ -111,8 +111,16 @@ def _package_folder(package, reference):
     return Path(next(iter(spec.submodule_search_locations))).resolve()
 
 
+def _resolved(path, reference):
+    """``path`` made absolute, its symbolic links followed; a loop of them is a ``read-error``."""
+    try:
+        return path.resolve()
+    except (RuntimeError, OSError):  # Python 3.11-3.12: RuntimeError; 3.13: OSError (ELOOP)
+        raise InputError("read-error", "cannot read: a loop of symbolic links", reference) from None
+
+
 def _inside(base, relative, reference):
-    path = (base / relative).resolve()
+    path = _resolved(base / relative, reference)
     if not path.is_relative_to(base):
         raise InputError("path-outside", f"{reference!r} resolves outside {str(base)!r}", reference)
     return path
