@@ -175,7 +175,9 @@ def test_the_triangle_limit(tmp_path, monkeypatch):
     monkeypatch.undo()
     # two quadrilaterals and two triangles: 4 faces, 6 triangles, counted once parsed
     quads = tetra(["f 1 3 2", "f 1 2 4", "f 1 4 3 3", "f 2 3 4 4"])
-    with pytest.raises(InputError, match="^m.obj:8: a polygon of more than 3 corners takes the mesh past the limit of 5"):
+    with pytest.raises(
+        InputError, match="^m.obj:8: a polygon of more than 3 corners takes the mesh past the limit of 5"
+    ):
         read_mesh(obj(tmp_path, quads), tmp_path, max_triangles=5)
 
 

@@ -47,7 +47,7 @@ from __future__ import annotations
 
 import os
 import re
-from array import array
+from array import array as packed
 from pathlib import Path
 
 import numpy as np
@@ -148,7 +148,7 @@ def _obj(data, max_triangles, file):
     Traceback (most recent call last):
     grasptwist.model.GraspFileError: a.obj:2: a face names vertex 99999999999999999999999, which the file does not have
     """
-    vertices, triangles = array("d"), array("q")
+    vertices, triangles = packed("d"), packed("q")
     for match in _OBJ_LINES.finditer(data):
         kind, body = match.groups()
         try:
@@ -365,7 +365,9 @@ def _too_many(declared, max_triangles, file):
     vertices, triangles = declared
     if vertices > MAX_VERTICES:
         raise InputError(
-            "too-many-vertices", f"the file declares {vertices:,} vertices, more than the limit of {MAX_VERTICES:,}", file
+            "too-many-vertices",
+            f"the file declares {vertices:,} vertices, more than the limit of {MAX_VERTICES:,}",
+            file,
         )
     if triangles > max_triangles:
         raise InputError(
@@ -400,7 +402,9 @@ def _ply_elements(data, file):
     """
     end = data.find(b"end_header", 0, _PLY_HEADER)
     if not data.startswith(b"ply") or end < 0:
-        raise InputError("invalid-mesh", f"not a PLY file: no 'ply' ... 'end_header' in its first {_PLY_HEADER:,} bytes", file)
+        raise InputError(
+            "invalid-mesh", f"not a PLY file: no 'ply' ... 'end_header' in its first {_PLY_HEADER:,} bytes", file
+        )
     body = data.find(b"\n", end) + 1 or len(data)
     form, elements = None, []  # [name, count, header line, least bytes a row]
     for number, line in enumerate(data[:end].split(b"\n"), 1):
@@ -433,7 +437,9 @@ def _ply_elements(data, file):
                 number,
             )
     if form == 0 and need != held:
-        raise InputError("invalid-mesh", f"the body holds {held:,} lines, the header declares {need:,} elements, one a line", file)
+        raise InputError(
+            "invalid-mesh", f"the body holds {held:,} lines, the header declares {need:,} elements, one a line", file
+        )
     return {name: count for name, count, _, _ in elements}
 
 
@@ -443,7 +449,9 @@ def _ply_lines(body, file):
     body = body.rstrip()
     stray = re.search(rb"[^\x20-\x7e\t\r\n]", body)
     if stray:
-        raise InputError("invalid-mesh", f"byte {body[stray.start()]:#04x} in an ASCII PLY body, which holds text", file)
+        raise InputError(
+            "invalid-mesh", f"byte {body[stray.start()]:#04x} in an ASCII PLY body, which holds text", file
+        )
     breaks = body.count(b"\n") + body.count(b"\r") - body.count(b"\r\n")
     return breaks + 1 if body else 0
 

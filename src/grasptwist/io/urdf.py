@@ -49,7 +49,7 @@ import numpy as np
 
 from ..engine.kinematics import chain_from_origins, chain_length
 from ..model import Finger, Hand, InputError, Joint
-from .limits import DEFAULT_MAX_BYTES
+from .limits import MAX_URDF_BYTES
 
 __all__ = ["load_urdf_hand", "resolve_urdf"]
 
@@ -280,7 +280,7 @@ def _model(data, file):
         raise InputError("invalid-urdf", f"yourdfpy cannot read it: {type(exc).__name__}: {exc}", file) from None
 
 
-def load_urdf_hand(urdf, tips, *, names=None, folder=None, max_bytes=DEFAULT_MAX_BYTES, allow_outside=False):
+def load_urdf_hand(urdf, tips, *, names=None, folder=None, max_bytes=MAX_URDF_BYTES, allow_outside=False):
     """A hand from a URDF: one finger per tip link, its joints at home (all 0).
 
     The hand's frame (and so the grasp's) is the URDF's root link's frame.

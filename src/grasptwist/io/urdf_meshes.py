@@ -30,13 +30,10 @@ import numpy as np
 
 from ..engine.collision import LinkGeometry
 from ..model import InputError
-from .limits import DEFAULT_MAX_BYTES
+from .limits import MAX_MESH_BYTES, MAX_URDF_BYTES
 from .urdf import _library, _parse, _read, resolve_urdf
 
-__all__ = ["MAX_MESH_BYTES", "decoded_size", "grasp_folder", "hand_meshes", "link_geometry"]
-
-#: Most bytes a mesh file may hold, or decode to when it is an archive or compressed.
-MAX_MESH_BYTES = 64 << 20
+__all__ = ["decoded_size", "grasp_folder", "hand_meshes", "link_geometry"]
 
 #: Compressed streams by their first bytes, and how to open one.
 _STREAMS = {b"\x1f\x8b": gzip.open, b"BZh": bz2.open, b"\xfd7zXZ\x00": lzma.open}
@@ -81,7 +78,7 @@ def decoded_size(path, cap: int) -> int:
         return size
 
 
-def hand_meshes(hand, positions=None, *, folder=None, max_bytes=DEFAULT_MAX_BYTES) -> list[tuple]:
+def hand_meshes(hand, positions=None, *, folder=None, max_bytes=MAX_URDF_BYTES) -> list[tuple]:
     """Every visual mesh of ``hand``'s URDF at joint ``positions``, in the hand's root frame.
 
     Parameters
@@ -115,7 +112,7 @@ def hand_meshes(hand, positions=None, *, folder=None, max_bytes=DEFAULT_MAX_BYTE
     return [(np.asarray(m.vertices, dtype=float), np.asarray(m.faces)) for m in model.scene.dump(concatenate=False)]
 
 
-def link_geometry(hand, *, folder=None, max_bytes=DEFAULT_MAX_BYTES) -> tuple[LinkGeometry, ...]:
+def link_geometry(hand, *, folder=None, max_bytes=MAX_URDF_BYTES) -> tuple[LinkGeometry, ...]:
     """Every finger link's collision geometry from ``hand``'s URDF, at home in the hand's root frame.
 
     A link is a finger's when the movable joints above it are the first ones of that finger (a link

@@ -28,7 +28,7 @@ from ..engine.synthesis.scores import METHODS
 from ..engine.synthesis.search import GRAVITY, Synthesis, hand_reach, search_steps, surface_of
 from ..io.grasp.forces import HOLD
 from ..io.inputs import read as read_unplaced
-from ..io.limits import DEFAULT_MAX_BYTES, MESH_SUFFIXES
+from ..io.limits import MESH_SUFFIXES
 from ..io.mesh_file import read_mesh
 from ..model import CONTACT_NAMES, Grasp, GraspFileError, GraspObject, Hand, InputError, Shape
 from ..output import synthesis_records as sr
@@ -153,7 +153,7 @@ def _hand(job, grasp: Grasp, obj: GraspObject):
     named_by = job.options.hand_file if given else grasp.file
     try:
         held = replace(grasp, hand=hand, object=obj, file=named_by)
-        collide = deepest_link(held, max_bytes=job.max_bytes or DEFAULT_MAX_BYTES)
+        collide = deepest_link(held)
         return hand_reach(obj, hand, tips=tips, collide=collide), hand
     except InputError as exc:
         return GraspFileError(exc.code, f"hand: {exc.message}", grasp.file, grasp.line, None, grasp.document)
@@ -176,7 +176,8 @@ def _inline_joints(hand, synthesis):
 def _mesh_grasp(path: str, job) -> Grasp | GraspFileError:
     """A mesh file as a grasp document with only its object (the command line gives the rest)."""
     try:
-        vertices, faces = read_mesh(path, None, max_bytes=job.max_bytes or 64 * 2**20)
+        limits = job.reading  # a mesh's caps however it is named (io/limits.py), as a grasp file's mesh gets
+        vertices, faces = read_mesh(path, None, max_bytes=limits.max_mesh_bytes, max_triangles=limits.max_triangles)
     except InputError as exc:
         return exc
     shape = Shape("mesh", np.zeros(0), vertices=vertices, faces=faces, source=path)

@@ -44,9 +44,9 @@ OBJECT_KEYS = (*SHAPE_KEYS, "scale", "pose", "density", "mass")
 SIZE_KEYS = ("radius", "height")
 
 
-def read_object(node, file, reading, max_bytes, problems, warnings):
+def read_object(node, file, reading, problems, warnings):
     """The :class:`~grasptwist.model.GraspObject` of an ``object`` node (None after a problem);
-    a mesh is read from ``file``'s folder within ``max_bytes`` and ``reading``'s limits.  A pose's
+    a mesh is read from ``file``'s folder within ``reading``'s limits.  A pose's
     rotation vector over pi adds its ``rotation-over-pi`` warning to ``warnings``, as a path's."""
     fields = read_mapping(node, "object", OBJECT_KEYS, (), problems)
     if fields is None:
@@ -83,7 +83,7 @@ def read_object(node, file, reading, max_bytes, problems, warnings):
         if read is not None:
             pose[:3, 3], pose[:3, :3] = read[0], read[1]
             warnings += _radians(read[2])
-    shape = _shape(shapes[0], fields, file, reading, max_bytes, problems) if shapes else None
+    shape = _shape(shapes[0], fields, file, reading, problems) if shapes else None
     if shape is None or problems.count:
         return None
     pose.setflags(write=False)
@@ -133,11 +133,11 @@ def _radians(given) -> list:
     return [radians_warning(**given)] if rotation_over_pi(given["rotvec"]) else []
 
 
-def _shape(kind, fields, file, reading, max_bytes, problems):
+def _shape(kind, fields, file, reading, problems):
     """The :class:`~grasptwist.model.Shape` of the ``kind`` key (None after a problem)."""
     node, path = fields[kind], f"object.{kind}"
     if kind == "mesh":
-        return _mesh(node, fields.get("scale"), file, reading, max_bytes, problems)
+        return _mesh(node, fields.get("scale"), file, reading, problems)
     if kind == "box":
         size = read_vector(node, 3, path, problems)
         sizes = (
@@ -162,7 +162,7 @@ def _shape(kind, fields, file, reading, max_bytes, problems):
     return Shape(kind, readonly([value for value, _, _ in sizes]))
 
 
-def _mesh(node, scale_node, file, reading, max_bytes, problems):
+def _mesh(node, scale_node, file, reading, problems):
     """A mesh shape: its file read (:func:`grasptwist.io.mesh_file.read_mesh`), scaled."""
     reference = read_name(node, "object.mesh", problems)
     scale = _scale(scale_node, problems) if scale_node is not None else 1.0
@@ -178,7 +178,7 @@ def _mesh(node, scale_node, file, reading, max_bytes, problems):
         vertices, faces = read_mesh(
             reference,
             folder,
-            max_bytes=max_bytes,
+            max_bytes=reading.max_mesh_bytes,
             max_triangles=reading.max_triangles,
             allow_outside=reading.allow_outside,
         )
@@ -273,7 +273,7 @@ def _read(fields, found, problems):
     if "object" not in fields:
         return {}
     said = []
-    obj = read_object(fields["object"], found["file"], found["reading"], found["max_bytes"], problems, said)
+    obj = read_object(fields["object"], found["file"], found["reading"], problems, said)
     points = found.get("points")
     if obj is not None and points is None and not found["reading"].contacts:  # synthesize finds them
         return {"object": obj, "warnings": tuple(said)}
