@@ -55,7 +55,7 @@ import numpy as np
 from ..model import InputError
 from .limits import MAX_MESH_BYTES, MAX_TRIANGLES, MAX_VERTICES, MESH_SUFFIXES
 
-__all__ = ["read_mesh", "check_mesh"]
+__all__ = ["read_mesh", "check_mesh", "check_counts"]
 
 #: An OBJ's vertex and face lines (others are passed over unsplit), their keyword and the rest.
 _OBJ_LINES = re.compile(rb"^[ \t]*([vf])[ \t]([^\n]*)", re.MULTILINE)
@@ -116,7 +116,7 @@ def read_mesh(
     from .urdf import _read, resolve_urdf  # here: listing a folder (MESH_SUFFIXES) imports no URDF reader
 
     data = _read(resolve_urdf(text, folder, allow_outside=allow_outside), max_bytes, text)
-    _too_many(_declared(data, suffix, text), max_triangles, text)
+    check_counts(data, suffix, text, max_triangles)
     try:
         vertices, faces = _obj(data, max_triangles, text) if suffix == ".obj" else _parsed(data, suffix, text)
     except (ValueError, IndexError):
@@ -359,10 +359,22 @@ def _declared(data, suffix, file):
     )
 
 
-def _too_many(declared, max_triangles, file):
-    """Refuse a file that says it holds more than :data:`MAX_VERTICES` vertices or ``max_triangles``
-    triangles, before a parser allocates arrays of that length."""
-    vertices, triangles = declared
+def check_counts(data, suffix, file, max_triangles=MAX_TRIANGLES):
+    """Refuse the bytes ``data`` of a mesh file (``suffix`` ``.stl``, ``.obj`` or ``.ply``) when
+    they declare more than :data:`~grasptwist.io.limits.MAX_VERTICES` vertices or ``max_triangles``
+    triangles, or (a PLY) more elements than its body holds: before a parser allocates for them.
+
+    Raises
+    ------
+    InputError
+        ``too-many-vertices``, ``too-many-triangles`` or ``invalid-mesh`` (located at the line
+        of a PLY header that declares what the body does not hold).
+
+    >>> check_counts(b"v 0 0 0\\n" * 3 + b"f 1 2 3\\n" * 2, ".obj", "a.obj", max_triangles=1)
+    Traceback (most recent call last):
+    grasptwist.model.GraspFileError: a.obj: the file declares 2 faces, more than the limit of 1 triangles
+    """
+    vertices, triangles = _declared(data, suffix, file)
     if vertices > MAX_VERTICES:
         raise InputError(
             "too-many-vertices",
