@@ -1,22 +1,26 @@
 """An object's triangle mesh (STL, OBJ or PLY), read as untrusted input.
 
-A grasp file's ``object: {mesh: path}`` names it; trimesh (the optional
-extra ``grasptwist[mesh]``) parses STL and PLY, an OBJ's ``v`` and ``f``
-lines are read here (the format this project writes, without trimesh's
-second of import), and the checks are numpy's.  Around it, as for a URDF
+A grasp file's ``object: {mesh: path}`` names it, or ``synthesize``'s command line (a
+path, a folder's file); trimesh (the optional extra ``grasptwist[mesh]``) parses PLY,
+STL and OBJ are read here (without trimesh's second of import, and within the caps
+line by line), and the checks are numpy's.  Around it, as for a URDF
 (:mod:`grasptwist.io.urdf`, whose path rule this shares):
 
 * the reference: a path relative to the grasp file's folder, refused when it
   resolves (symbolic links followed) outside that folder (``path-outside``)
   unless the caller allows it (``--allow-outside``); ``package://PKG/path``
   inside an installed Python package;
-* the bytes: at most ``max_bytes`` (the loader's ``--max-bytes``) of a regular
+* the bytes: at most ``max_bytes`` (:data:`~grasptwist.io.limits.MAX_MESH_BYTES`,
+  ``Reading.max_mesh_bytes``: one cap however the mesh is named) of a regular
   file are read before anything is parsed, and a file whose format says it
-  holds more than ``max_triangles`` triangles is refused unparsed (a binary
-  STL's count, an ASCII STL's ``endfacet`` words, a PLY header's faces, an
-  OBJ's ``f`` lines), so memory stays bounded by the cap; bytes that are no
-  STL (neither a binary STL of its count's length nor text starting with
-  ``solid``) are ``invalid-mesh`` unparsed;
+  holds more than :data:`~grasptwist.io.limits.MAX_VERTICES` vertices or
+  ``max_triangles`` triangles is refused unparsed (a binary STL's count, an
+  ASCII STL's ``endfacet`` words, a PLY header's elements, an OBJ's ``v`` and
+  ``f`` lines; :func:`check_counts`), as is a PLY whose header declares more
+  than its body holds; the STL and OBJ readers stop at the caps whatever
+  the file says, so memory stays within a few times ``max_bytes``; bytes
+  that are no STL (neither a binary STL of its count's length nor text
+  starting with ``solid``) are ``invalid-mesh`` unparsed;
 * the geometry: at most ``max_triangles`` triangles (:data:`~grasptwist.io.limits.MAX_TRIANGLES`),
   finite vertices, every face index a vertex, and a closed surface: each
   edge shared by exactly two triangles, wound the same way (a volume, a
@@ -35,11 +39,12 @@ Every refusal is a :class:`~grasptwist.model.InputError` with a code:
 ``unsupported-mesh``     a file name not ending in ``.stl``, ``.obj`` or ``.ply``
 ``invalid-mesh``         not readable as its format (bad face indices, truncated), a degenerate triangle
 ``empty-mesh``           no triangles
-``too-many-triangles``   more than ``max_triangles``
+``too-many-triangles``   more than ``max_triangles`` (an OBJ polygon counts as its fan's)
+``too-many-vertices``    more than :data:`~grasptwist.io.limits.MAX_VERTICES`
 ``non-finite``           a vertex coordinate that is NaN or infinite
 ``not-watertight``       an open, non-manifold or inconsistently wound surface
 ``invalid-size``         a size (bounding box diagonal) outside ``SIZE_RANGE``, 1e-75 to 1e75
-``mesh-unavailable``     trimesh is not installed (an STL or PLY)
+``mesh-unavailable``     trimesh is not installed (a PLY)
 =======================  ==========================================================
 """
 
@@ -62,6 +67,9 @@ _OBJ_LINES = re.compile(rb"^[ \t]*([vf])[ \t]([^\n]*)", re.MULTILINE)
 _ASCII_STL = re.compile(rb"\s*solid", re.IGNORECASE)
 #: A binary STL: an 80-byte header, a little-endian uint32 count, then 50 bytes per triangle.
 _STL_HEADER, _STL_TRIANGLE = 84, 50
+_STL_RECORD = np.dtype([("normal", "<f4", 3), ("corners", "<f4", (3, 3)), ("attribute", "<u2")])
+#: An ASCII STL's corner: the word ``vertex`` (in any letter case) and three numbers.
+_STL_VERTICES = re.compile(rb"(?i)\bvertex\s+(\S+)\s+(\S+)\s+(\S+)")
 
 
 def read_mesh(
@@ -118,7 +126,7 @@ def read_mesh(
     data = _read(resolve_urdf(text, folder, allow_outside=allow_outside), max_bytes, text)
     check_counts(data, suffix, text, max_triangles)
     try:
-        vertices, faces = _obj(data, max_triangles, text) if suffix == ".obj" else _parsed(data, suffix, text)
+        vertices, faces = _READERS.get(suffix, _parsed)(data, max_triangles, text)
     except (ValueError, IndexError):
         raise InputError("invalid-mesh", f"not a readable {suffix[1:].upper()} file", text) from None
     return check_mesh(vertices, faces, max_triangles, text)
@@ -208,16 +216,55 @@ def _line(data, offset):
     return data.count(b"\n", 0, offset) + 1
 
 
-def _parsed(data, suffix, file):
-    """``(vertices, faces)`` of an STL or PLY file, parsed by trimesh."""
+def _stl(data, max_triangles, file):
+    """``(vertices, faces)`` of an STL, each triangle its own three corners (:func:`check_mesh`
+    merges them): a binary one (its count checked by :func:`_declared`) as numpy's records, an
+    ASCII one by its ``vertex`` words, no more than ``3 * max_triangles`` of them.
+
+    >>> v, f = _stl(b"solid t\\n facet normal 0 0 1\\n  outer loop\\n   vertex 0 0 0\\n   VERTEX 1 0 0\\n"
+    ...             b"   vertex 0 1 0\\n  endloop\\n endfacet\\nendsolid t\\n", 10, "t.stl")
+    >>> v.tolist(), f.tolist()
+    ([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], [[0, 1, 2]])
+    """
+    count = int.from_bytes(data[80:84], "little") if len(data) >= _STL_HEADER else -1
+    if len(data) == _STL_HEADER + _STL_TRIANGLE * count:
+        corners = np.frombuffer(data, _STL_RECORD, count, _STL_HEADER)["corners"].reshape(-1, 3).astype(float)
+    else:
+        corners = packed("d")
+        for match in _STL_VERTICES.finditer(data):
+            if len(corners) == 9 * max_triangles:
+                raise InputError(
+                    "too-many-triangles",
+                    f"more than the limit of {max_triangles:,} triangles",
+                    file,
+                    _line(data, match.start()),
+                )
+            try:
+                corners.extend([float(x) for x in match.groups()])
+            except ValueError:
+                raise InputError(
+                    "invalid-mesh", "a vertex's coordinates are not numbers", file, _line(data, match.start())
+                ) from None
+        if len(corners) % 9:
+            raise InputError("invalid-mesh", f"{len(corners) // 3:,} vertex lines, not three a triangle", file)
+        corners = np.frombuffer(corners, dtype=float).reshape(-1, 3)
+    return corners, np.arange(len(corners)).reshape(-1, 3)
+
+
+def _parsed(data, max_triangles, file):
+    """``(vertices, faces)`` of a PLY file, parsed by trimesh once :func:`check_counts` passed it."""
     trimesh = _library(file)
     try:
         mesh = trimesh.load(
-            trimesh.util.wrap_as_stream(data), file_type=suffix[1:], force="mesh", process=False, skip_materials=True
+            trimesh.util.wrap_as_stream(data), file_type="ply", force="mesh", process=False, skip_materials=True
         )
         return np.asarray(mesh.vertices, dtype=float), np.asarray(mesh.faces, dtype=np.int64).reshape(-1, 3)
     except Exception:  # a parser's failure on hostile bytes has no one type; what it says varies by version
-        raise ValueError(f"not a readable {suffix[1:].upper()} file") from None
+        raise ValueError("not a readable PLY file") from None
+
+
+#: The readers of the formats read here, by suffix; a PLY is trimesh's (:func:`_parsed`).
+_READERS = {".obj": _obj, ".stl": _stl}
 
 
 def check_mesh(vertices, faces, max_triangles, file):
@@ -324,8 +371,7 @@ def _declared(data, suffix, file):
     (a polygon counts as one triangle until it is read).
 
     A binary STL gives its count in its header, and is exactly that long; an ASCII STL starts with
-    ``solid`` and has per triangle one ``endfacet``, one ``normal`` and three ``vertex`` words (the
-    most any of them gives: trimesh splits the text at each); a PLY's header declares its elements
+    ``solid`` and closes each triangle with ``endfacet``; a PLY's header declares its elements
     (:func:`_ply_elements`); an OBJ has a ``v`` line per vertex, an ``f`` line per face.  Bytes
     that are neither kind of STL are ``invalid-mesh``.
 
@@ -349,8 +395,7 @@ def _declared(data, suffix, file):
         if len(data) == _STL_HEADER + _STL_TRIANGLE * count:
             return 3 * count, count
     if _ASCII_STL.match(data[:1024]):
-        text = data.lower()
-        count = max(text.count(b"endfacet"), text.count(b"normal"), -(-text.count(b"vertex") // 3))
+        count = data.count(b"endfacet")
         return 3 * count, count
     raise InputError(
         "invalid-mesh",
