@@ -52,6 +52,7 @@ from __future__ import annotations
 
 import os
 import re
+import warnings
 from array import array as packed
 from pathlib import Path
 
@@ -126,7 +127,7 @@ def read_mesh(
     data = _read(resolve_urdf(text, folder, allow_outside=allow_outside), max_bytes, text)
     check_counts(data, suffix, text, max_triangles)
     try:
-        vertices, faces = _READERS.get(suffix, _parsed)(data, max_triangles, text)
+        vertices, faces = _READERS[suffix](data, max_triangles, text)
     except (ValueError, IndexError):
         raise InputError("invalid-mesh", f"not a readable {suffix[1:].upper()} file", text) from None
     return check_mesh(vertices, faces, max_triangles, text)
@@ -261,10 +262,6 @@ def _parsed(data, max_triangles, file):
         return np.asarray(mesh.vertices, dtype=float), np.asarray(mesh.faces, dtype=np.int64).reshape(-1, 3)
     except Exception:  # a parser's failure on hostile bytes has no one type; what it says varies by version
         raise ValueError("not a readable PLY file") from None
-
-
-#: The readers of the formats read here, by suffix; a PLY is trimesh's (:func:`_parsed`).
-_READERS = {".obj": _obj, ".stl": _stl}
 
 
 def check_mesh(vertices, faces, max_triangles, file):
@@ -444,65 +441,164 @@ _PLY_FORMATS = (b"ascii", b"binary_little_endian", b"binary_big_endian")
 _PLY_HEADER = 1 << 16
 
 
-def _ply_elements(data, file):
-    r"""``{name: count}`` of a PLY header's elements, once the body can hold them.
-
-    In ASCII, one line an element: the body's lines (as trimesh splits them) must be as many as
-    the header's elements; in binary, the body must hold at least their fixed-size properties
-    (a list's count, no items).  Either way a count the body cannot hold is named at its line
-    of the header, before a parser allocates for it.
-
-    >>> header = b"ply\nformat ascii 1.0\nelement vertex 2000000000\nproperty float x\nend_header\n"
-    >>> _ply_elements(header + b"0\n1\n", "m.ply")
-    Traceback (most recent call last):
-    grasptwist.model.GraspFileError: m.ply:3: the header declares 2,000,000,000 vertex elements, one a line, but the body holds 2 lines
-    """
+def _ply_header(data, file):
+    """``(ascii, body, elements)`` of a PLY file: whether it is ASCII, where its body starts, and
+    per element ``(name, count, header line, properties)``, each property ``(name, bytes, list?)``
+    (a list's bytes: its count's)."""
     end = data.find(b"end_header", 0, _PLY_HEADER)
     if not data.startswith(b"ply") or end < 0:
         raise InputError(
             "invalid-mesh", f"not a PLY file: no 'ply' ... 'end_header' in its first {_PLY_HEADER:,} bytes", file
         )
-    body = data.find(b"\n", end) + 1 or len(data)
-    form, elements = None, []  # [name, count, header line, least bytes a row]
+    form, elements = None, []
     for number, line in enumerate(data[:end].split(b"\n"), 1):
         words = line.split()
         try:
             if words[:1] == [b"format"]:
                 form = _PLY_FORMATS.index(words[1])
             elif words[:1] == [b"element"]:
-                elements.append([words[1], int(words[2]), number, 0])
+                elements.append((words[1], int(words[2]), number, []))
                 if elements[-1][1] < 0:
                     raise ValueError
             elif words[:1] == [b"property"]:
-                elements[-1][3] += _PLY_SIZES[words[2] if words[1] == b"list" else words[1]]
+                listed = words[1] == b"list"
+                elements[-1][3].append((words[-1], _PLY_SIZES[words[2] if listed else words[1]], listed))
         except (IndexError, ValueError, KeyError):
             raise InputError("invalid-mesh", f"not a PLY header line: {line[:80]!r}", file, number) from None
     if form is None:
         raise InputError("invalid-mesh", "not a PLY file: its header gives no format", file)
-    held = _ply_lines(data[body:], file) if form == 0 else len(data) - body
-    unit = "lines" if form == 0 else "bytes"
+    return form == 0, data.find(b"\n", end) + 1 or len(data), elements
+
+
+def _ply_elements(data, file):
+    r"""``{name: count}`` of a PLY header's elements, once the body can hold them.
+
+    In ASCII, one line an element: the body's lines must be as many as the header's elements;
+    in binary, the body must hold at least their fixed-size properties (a list's count, no
+    items).  Either way a count the body cannot hold is named at its line of the header, before
+    a parser allocates for it.
+
+    >>> header = b"ply\nformat ascii 1.0\nelement vertex 2000000000\nproperty float x\nend_header\n"
+    >>> _ply_elements(header + b"0\n1\n", "m.ply")
+    Traceback (most recent call last):
+    grasptwist.model.GraspFileError: m.ply:3: the header declares 2,000,000,000 vertex elements, one a line, but the body holds 2 lines
+    """
+    text, body, elements = _ply_header(data, file)
+    held = _ply_lines(data[body:], file) if text else len(data) - body
     need = 0
-    for name, count, number, row in elements:
-        need += count if form == 0 else count * row
+    for name, count, number, properties in elements:
+        row = sum(size for _, size, _ in properties)
+        need += count if text else count * row
         if need > held:
-            what = "one a line" if form == 0 else f"of {row} bytes or more"
+            what = "one a line" if text else f"of {row} bytes or more"
             raise InputError(
                 "invalid-mesh",
                 f"the header declares {count:,} {name.decode(errors='replace')} elements, {what}, "
-                f"but the body holds {held:,} {unit}",
+                f"but the body holds {held:,} {'lines' if text else 'bytes'}",
                 file,
                 number,
             )
-    if form == 0 and need != held:
+    if text and need != held:
         raise InputError(
             "invalid-mesh", f"the body holds {held:,} lines, the header declares {need:,} elements, one a line", file
         )
     return {name: count for name, count, _, _ in elements}
 
 
+def _ply(data, max_triangles, file):
+    """``(vertices, faces)`` of a PLY file (:func:`check_counts` passed it): an ASCII one read here,
+    its numbers parsed at once by numpy (no object a line or a word), a binary one by trimesh.
+
+    >>> v, f = _ply(b"ply\\nformat ascii 1.0\\nelement vertex 4\\nproperty float x\\nproperty float y\\n"
+    ...             b"property float z\\nelement face 1\\nproperty list uchar int vertex_indices\\n"
+    ...             b"end_header\\n0 0 0\\n1 0 0\\n1 1 0\\n0 1 0\\n4 0 1 2 3\\n", 10, "q.ply")
+    >>> f.tolist()
+    [[0, 1, 2], [0, 2, 3]]
+    """
+    text, body, elements = _ply_header(data, file)
+    if not text:
+        return _parsed(data, max_triangles, file)
+    # each row's numbers, two more a list and its corners within the triangle cap: no more are parsed
+    most = max_triangles + sum(n * (len(p) + sum(2 for _, _, listed in p if listed)) for _, n, _, p in elements)
+    words = _words(data, body)
+    if words > most:
+        raise InputError(
+            "invalid-mesh", f"the body holds {words:,} numbers, more than the header's elements can ({most:,})", file
+        )
+    with warnings.catch_warnings():
+        warnings.simplefilter("error", DeprecationWarning)  # numpy's word for a word that is no number
+        try:
+            numbers = np.fromstring(data[body:], sep=" ")
+        except (ValueError, DeprecationWarning):
+            raise InputError("invalid-mesh", "a word of the body is not a number", file) from None
+    at, vertices, triangles = 0, np.zeros((0, 3)), packed("q")
+    for name, count, number, properties in elements:
+        names = [p for p, _, _ in properties]
+        if not any(listed for _, _, listed in properties):  # fixed rows: one slice of the numbers
+            rows = numbers[at : at + count * len(names)]
+            at += count * len(names)
+            if len(rows) < count * len(names):
+                break
+            if name == b"vertex":
+                try:
+                    vertices = rows.reshape(count, -1)[:, [names.index(axis) for axis in (b"x", b"y", b"z")]]
+                except ValueError:
+                    raise InputError("invalid-mesh", "the vertex element has no x, y and z", file, number) from None
+            continue
+        for _ in range(count):  # rows with a list: walked, at most the triangle cap's faces
+            for prop, _, listed in properties:
+                n = int(numbers[at]) if listed and at < len(numbers) and numbers[at] >= 0 else 0
+                corners, at = numbers[at + 1 : at + 1 + n], at + 1 + n if listed else at + 1
+                if name == b"face" and prop in (b"vertex_indices", b"vertex_index"):
+                    try:
+                        _polygon(corners, len(vertices), triangles, max_triangles)
+                    except _Refused as why:
+                        raise InputError(*why.args, file) from None
+    if at != len(numbers):
+        raise InputError(
+            "invalid-mesh", "the body's numbers are not those of the header's elements (a line too long or short)", file
+        )
+    return vertices, np.frombuffer(triangles, dtype=np.int64).reshape(-1, 3)
+
+
+#: The bytes that separate words (Python's ``bytes.split``), as a table of the 256.
+_SPACE = np.isin(np.arange(256), list(b" \t\n\r\x0b\x0c"))
+
+
+def _words(data, start, chunk=1 << 20):
+    """How many words ``data[start:]`` holds, counted a megabyte at a time without making them.
+
+    >>> _words(b"ply 1 2  3 4 ", 3, chunk=3)  # split across chunks of 3 bytes
+    4
+    """
+    count, after_space = 0, True
+    for at in range(start, len(data), chunk):
+        space = _SPACE[np.frombuffer(data, np.uint8, min(chunk, len(data) - at), at)]
+        count += int(np.count_nonzero(~space & np.concatenate(([after_space], space[:-1]))))
+        after_space = bool(space[-1])
+    return count
+
+
+def _polygon(corners, vertices, triangles, max_triangles):
+    """Append the fan of a PLY face's ``corners`` (numbered from 0, of ``vertices``) to ``triangles``."""
+    if len(corners) < 3 or len(corners) - 2 > max_triangles - len(triangles) // 3:
+        raise _Refused(
+            "invalid-mesh" if len(corners) < 3 else "too-many-triangles", f"a face of {len(corners)} corners"
+        )
+    index = corners.astype(np.int64)
+    if not ((index == corners) & (index >= 0) & (index < vertices)).all():
+        raise _Refused("invalid-mesh", "a face names a vertex the file does not have")
+    for b, c in zip(index[1:-1].tolist(), index[2:].tolist()):
+        triangles.extend((int(index[0]), b, c))
+
+
+#: The readers of the formats, by suffix (a binary PLY is trimesh's: :func:`_parsed`).
+_READERS = {".obj": _obj, ".stl": _stl, ".ply": _ply}
+
+
 def _ply_lines(body, file):
-    """The lines of an ASCII PLY body (trailing blank ones aside) as trimesh splits them, after
-    checking that it is ASCII text (else each stray control character would split a line)."""
+    """The lines of an ASCII PLY body (trailing blank ones aside), after checking that it is ASCII
+    text (a stray control character would split a line for some readers and not for others)."""
     body = body.rstrip()
     stray = re.search(rb"[^\x20-\x7e\t\r\n]", body)
     if stray:
