@@ -464,7 +464,9 @@ def _ply_header(data, file):
                 listed = words[1] == b"list"
                 elements[-1][3].append((words[-1], _PLY_SIZES[words[2] if listed else words[1]], listed))
         except (IndexError, ValueError, KeyError):
-            raise InputError("invalid-mesh", f"not a PLY header line: {line[:80]!r}", file, number) from None
+            raise InputError(
+                "invalid-mesh", f"not a PLY header line: {line[:80].decode(errors='replace')!r}", file, number
+            ) from None
     if form is None:
         raise InputError("invalid-mesh", "not a PLY file: its header gives no format", file)
     return form == 0, data.find(b"\n", end) + 1 or len(data), elements
@@ -585,9 +587,9 @@ def _polygon(corners, vertices, triangles, max_triangles):
         raise _Refused(
             "invalid-mesh" if len(corners) < 3 else "too-many-triangles", f"a face of {len(corners)} corners"
         )
-    index = corners.astype(np.int64)
-    if not ((index == corners) & (index >= 0) & (index < vertices)).all():
+    if not ((corners >= 0) & (corners < vertices) & (corners == np.floor(corners))).all():
         raise _Refused("invalid-mesh", "a face names a vertex the file does not have")
+    index = corners.astype(np.int64)
     for b, c in zip(index[1:-1].tolist(), index[2:].tolist()):
         triangles.extend((int(index[0]), b, c))
 

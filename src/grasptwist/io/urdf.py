@@ -36,6 +36,7 @@ Every refusal is a :class:`~grasptwist.model.InputError` with a code:
 
 from __future__ import annotations
 
+import errno
 import io
 import math
 import os
@@ -116,7 +117,8 @@ def _resolved(path, reference):
     try:
         return path.resolve()
     except (RuntimeError, OSError):  # Python 3.11-3.12: RuntimeError; 3.13: OSError (ELOOP)
-        raise InputError("read-error", "cannot read: a loop of symbolic links", reference) from None
+        # the system's words, as a folder's listing and an open() give them
+        raise InputError("read-error", f"cannot read: {os.strerror(errno.ELOOP)}", reference) from None
 
 
 def _inside(base, relative, reference):

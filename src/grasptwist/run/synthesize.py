@@ -179,7 +179,7 @@ def _mesh_grasp(path: str, job) -> Grasp | GraspFileError:
         limits = job.reading  # a mesh's caps however it is named (io/limits.py), as a grasp file's mesh gets
         vertices, faces = read_mesh(path, None, max_bytes=limits.max_mesh_bytes, max_triangles=limits.max_triangles)
     except InputError as exc:
-        return exc
+        return exc.with_traceback(None)  # kept until written: not with the reader's frames (the mesh's bytes)
     shape = Shape("mesh", np.zeros(0), vertices=vertices, faces=faces, source=path)
     obj = GraspObject(shape, np.eye(4))
     name = os.path.splitext(os.path.basename(path))[0]
