@@ -243,3 +243,20 @@ def test_big_hostile_meshes_cost_a_few_times_the_cap_at_most(tmp_path):
     # the mesh cap is 64 MiB, each 60 MB file read whole once: 302 MB here, each alone 58-206 MB
     # (the interpreter's 34 MB with them); 0.5 went past 0.5 GB on the polygon, 2.1 GB on the vertices
     assert peak < 400, f"{peak:.0f} MB"
+
+
+def test_the_docs_table_of_caps_gives_io_limits_own_numbers():
+    import re
+
+    from grasptwist.io import limits
+    from places import ROOT
+
+    page = (ROOT / "docs" / "reference" / "bad-input-and-faults.md").read_text("utf-8")
+    section = page.split("## Caps: one per kind of input")[1].split("\n## ")[0]
+    said = {
+        name: int(number.replace(",", "")) << (20 if mib else 0)
+        for name, number, mib in re.findall(r"`([A-Z_]+)`,? \(?([\d,]+)( MiB)?\)?", section)
+    }
+    caps = {name for name in limits.__all__ if name.isupper()} - {"MESH_SUFFIXES", "NOT_REGULAR"}
+    assert set(said) == caps
+    assert all(getattr(limits, name) == value for name, value in said.items()), said
