@@ -3,8 +3,9 @@
 =================  =============================================  ==========================================
 kind               arrives as                                     cap
 =================  =============================================  ==========================================
-grasp file         a path, a folder's file, standard input;       :data:`DEFAULT_MAX_BYTES` (``--max-bytes``)
-                   a JSON Lines line; a hand file (``--hand``)
+grasp file         a path, a folder's file, standard input;       :data:`DEFAULT_MAX_BYTES` (``--max-bytes``),
+                   a JSON Lines line; a hand file (``--hand``)    :data:`MAX_DOCUMENTS`, :data:`MAX_ERRORS`,
+                                                                  :data:`MAX_DEPTH`
 URDF               a grasp file's ``hand: {urdf: ...}``, a hand   :data:`MAX_URDF_BYTES`
                    file's, for a picture or a collision check
 mesh               an object's ``mesh:``, a path or a folder's    :data:`MAX_MESH_BYTES` (decoded),
@@ -21,6 +22,9 @@ another for its constants, and no reader has a cap of its own.
 __all__ = [
     "DEFAULT_MAX_BYTES",
     "INFLATION_FLOOR",
+    "MAX_DEPTH",
+    "MAX_DOCUMENTS",
+    "MAX_ERRORS",
     "MAX_INFLATION",
     "MAX_MESH_BYTES",
     "MAX_TRIANGLES",
@@ -34,6 +38,21 @@ __all__ = [
 DEFAULT_MAX_BYTES = 1 << 20
 """A grasp file's size cap in bytes by default (``--max-bytes``, ``max_bytes=``); larger ones are
 refused before parsing."""
+
+MAX_DOCUMENTS = 10_000
+"""Most documents read from one grasp file; the rest of a longer file is refused
+with one ``too-many-documents`` entry.  A grasp takes at least about 110
+bytes, so no valid file within the default size cap has this many; a file of
+``---`` lines would otherwise give one entry per 4 bytes."""
+
+MAX_ERRORS = 100
+"""Most problems reported for one grasp file (the first, in file order); one more
+``too-many-errors`` entry says how many were left out."""
+
+MAX_DEPTH = 32
+"""Deepest collection nesting of a grasp file accepted.  A valid grasp needs 4 (document,
+``contacts``, a contact, its ``point``); the margin lets mistyped nested
+values get their specific error instead of ``too-deep``."""
 
 MAX_URDF_BYTES = 1 << 20
 """Most bytes of a URDF (:mod:`grasptwist.io.urdf`), however it is named: the TriFinger's is 30 kB."""

@@ -16,7 +16,7 @@ from pathlib import Path
 import yaml
 
 from ...model import GraspFileError
-from ..limits import DEFAULT_MAX_BYTES, MAX_MESH_BYTES, MAX_TRIANGLES
+from ..limits import DEFAULT_MAX_BYTES, MAX_DOCUMENTS, MAX_MESH_BYTES, MAX_TRIANGLES
 from .compose import PARSER, compose, syntax_error
 from .document import read_document
 from .fast import Bail, Parts, fast_document
@@ -34,12 +34,6 @@ __all__ = [
     "check_surface_tol",
     "stem_name",
 ]
-
-MAX_DOCUMENTS = 10_000
-"""Most documents read from one file; the rest of a longer file is refused
-with one ``too-many-documents`` entry.  A grasp takes at least about 110
-bytes, so no valid file within the default size cap has this many; a file of
-``---`` lines would otherwise give one entry per 4 bytes."""
 
 
 @dataclass(frozen=True)
