@@ -243,3 +243,11 @@ def test_the_obj_reader_and_trimesh_agree_on_the_bottle(trimesh):
     theirs = check_mesh(np.asarray(mesh.vertices), np.asarray(mesh.faces), MAX_TRIANGLES, "bottle.obj")
     for a, b in zip(ours, theirs):
         np.testing.assert_array_equal(a, b)
+
+
+@pytest.mark.parametrize("end", ["\r\n", "\r"])
+def test_an_obj_reads_the_same_whatever_its_line_ends(tmp_path, end):
+    expected = read_mesh(obj(tmp_path, tetra()), tmp_path)
+    (tmp_path / "other.obj").write_bytes(tetra().replace("\n", end).encode())
+    for a, b in zip(read_mesh("other.obj", tmp_path), expected):
+        np.testing.assert_array_equal(a, b)

@@ -64,7 +64,7 @@ from .limits import MAX_MESH_BYTES, MAX_TRIANGLES, MAX_VERTICES, MESH_SUFFIXES
 __all__ = ["read_mesh", "check_mesh", "check_counts"]
 
 #: An OBJ's vertex and face lines (others are passed over unsplit), their keyword and the rest.
-_OBJ_LINES = re.compile(rb"^[ \t]*([vf])[ \t]([^\n]*)", re.MULTILINE)
+_OBJ_LINES = re.compile(rb"^[ \t]*([vf])[ \t]([^\r\n]*)", re.MULTILINE)
 _ASCII_STL = re.compile(rb"\s*solid", re.IGNORECASE)
 #: A binary STL: an 80-byte header, a little-endian uint32 count, then 50 bytes per triangle.
 _STL_HEADER, _STL_TRIANGLE = 84, 50
@@ -157,6 +157,8 @@ def _obj(data, max_triangles, file):
     Traceback (most recent call last):
     grasptwist.model.GraspFileError: a.obj:2: a face names vertex 99999999999999999999999, which the file does not have
     """
+    if data.count(b"\r") > data.count(b"\r\n"):  # lines that end in \r alone (a copy for those files only)
+        data = data.replace(b"\r\n", b"\n").replace(b"\r", b"\n")
     vertices, triangles = packed("d"), packed("q")
     for match in _OBJ_LINES.finditer(data):
         kind, body = match.groups()
