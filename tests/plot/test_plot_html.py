@@ -460,3 +460,21 @@ def test_a_gltf_is_measured_with_its_buffers_and_accessors_before_it_is_read(tmp
     gltf(tmp_path)  # the same glTF, honest
     [(vertices, faces)] = hand_meshes(hand, folder=tmp_path)
     assert vertices.shape == (3, 3) and faces.tolist() == [[0, 1, 2]]  # posed with its link
+
+
+def test_a_urdf_s_mesh_gets_an_object_mesh_s_caps_before_the_library_parses_it(tmp_path, monkeypatch):
+    # issue 36: one polygon of millions of corners went past 0.5 GB; here just past the triangle cap
+    pytest.importorskip("yourdfpy")
+    from grasptwist.io.limits import MAX_TRIANGLES
+    from grasptwist.io.urdf_meshes import hand_meshes
+    from grasptwist.model import InputError
+
+    corners = " ".join(str(1 + k % 4) for k in range(MAX_TRIANGLES + 3))
+    (tmp_path / "p.obj").write_text(f"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf {corners}\n")
+    hand = hand_with_mesh(tmp_path, "p.obj")
+    monkeypatch.setattr("trimesh.load", lambda *a, **k: pytest.fail("the mesh library was given the OBJ"))
+    with pytest.raises(
+        InputError, match=r"^h.urdf: mesh 'p.obj', line 5: a polygon of more than 200,002 corners"
+    ) as caught:
+        hand_meshes(hand, folder=tmp_path)
+    assert caught.value.code == "too-many-triangles"

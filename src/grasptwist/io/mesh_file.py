@@ -61,7 +61,7 @@ import numpy as np
 from ..model import InputError
 from .limits import MAX_MESH_BYTES, MAX_TRIANGLES, MAX_VERTICES, MESH_SUFFIXES
 
-__all__ = ["read_mesh", "check_mesh", "check_counts"]
+__all__ = ["read_mesh", "parse_mesh", "check_mesh", "check_counts"]
 
 #: An OBJ's vertex and face lines (others are passed over unsplit), their keyword and the rest.
 _OBJ_LINES = re.compile(rb"^[ \t]*([vf])[ \t]([^\r\n]*)", re.MULTILINE)
@@ -125,12 +125,29 @@ def read_mesh(
     from .urdf import _read, resolve_urdf  # here: listing a folder (MESH_SUFFIXES) imports no URDF reader
 
     data = _read(resolve_urdf(text, folder, allow_outside=allow_outside), max_bytes, text)
-    check_counts(data, suffix, text, max_triangles)
+    return check_mesh(*parse_mesh(data, suffix, text, max_triangles), max_triangles, text)
+
+
+def parse_mesh(data, suffix, file, max_triangles=MAX_TRIANGLES):
+    """``(vertices, faces)`` as the bytes ``data`` of a mesh file (``suffix`` ``.stl``, ``.obj`` or
+    ``.ply``) give them, unchecked as a surface, once their declared counts pass (:func:`check_counts`):
+    read within the caps whatever the file says.
+
+    Raises
+    ------
+    InputError
+        ``invalid-mesh`` (located at the file's line where there is one), ``too-many-vertices``,
+        ``too-many-triangles`` or ``mesh-unavailable``.
+
+    >>> parse_mesh(b"v 0 0 0\\nf 1 1 0\\n", ".obj", "a.obj")
+    Traceback (most recent call last):
+    grasptwist.model.GraspFileError: a.obj:2: a face names vertex 0, which the file does not have
+    """
+    check_counts(data, suffix, file, max_triangles)
     try:
-        vertices, faces = _READERS[suffix](data, max_triangles, text)
+        return _READERS[suffix](data, max_triangles, file)
     except (ValueError, IndexError):
-        raise InputError("invalid-mesh", f"not a readable {suffix[1:].upper()} file", text) from None
-    return check_mesh(vertices, faces, max_triangles, text)
+        raise InputError("invalid-mesh", f"not a readable {suffix[1:].upper()} file", file) from None
 
 
 def _obj(data, max_triangles, file):

@@ -12,8 +12,9 @@ file that decodes to at most :data:`~grasptwist.io.limits.MAX_MESH_BYTES`
 mesh library inflates it; a glTF with the buffer and image files it names,
 which must stay in its folder, and its accessors' extent, :func:`gltf_bytes`),
 and an STL, OBJ or PLY must declare at most the mesh caps' vertices and
-triangles (:func:`~grasptwist.io.mesh_file.check_counts`), as an object's mesh
-must.  A mesh the library cannot read, whatever it raises, is an
+triangles and read within the caps (:func:`~grasptwist.io.mesh_file.parse_mesh`: a polygon
+of millions of corners, a PLY header that lies), as an object's mesh must, before the library
+parses it again.  A mesh the library cannot read, whatever it raises, is an
 :class:`~grasptwist.model.InputError` naming it.
 """
 
@@ -296,7 +297,7 @@ def _check_mesh_file(name, path):
     """Refuse the mesh file ``name`` (at ``path``) unless it is a regular file within the mesh caps:
     :data:`~grasptwist.io.limits.MAX_MESH_BYTES` held, decoded or read with the files a glTF names,
     and an STL's, OBJ's or PLY's declared vertices and triangles; errors name the file as ``name``."""
-    from .mesh_file import check_counts
+    from .mesh_file import parse_mesh
 
     cap = MAX_MESH_BYTES
     try:
@@ -319,7 +320,7 @@ def _check_mesh_file(name, path):
                 )
                 raise InputError("too-large", f"{what}, more than {cap} bytes", name)
         if suffix in MESH_SUFFIXES:
-            check_counts(_read(path, cap, name), suffix, name, MAX_TRIANGLES)
+            parse_mesh(_read(path, cap, name), suffix, name, MAX_TRIANGLES)
     except (OSError, EOFError, zipfile.BadZipFile, zlib.error, lzma.LZMAError) as exc:
         raise InputError("read-error", f"cannot read: {getattr(exc, 'strerror', None) or exc}", name) from None
     except (ValueError, KeyError, TypeError, AttributeError) as exc:  # JSON that is no glTF's
