@@ -44,7 +44,7 @@ Every refusal is a :class:`~grasptwist.model.InputError` with a code:
 ``non-finite``           a vertex coordinate that is NaN or infinite
 ``not-watertight``       an open, non-manifold or inconsistently wound surface
 ``invalid-size``         a size (bounding box diagonal) outside ``SIZE_RANGE``, 1e-75 to 1e75
-``mesh-unavailable``     trimesh is not installed (a PLY)
+``mesh-unavailable``     trimesh is not installed (a binary PLY)
 =======================  ==========================================================
 """
 
