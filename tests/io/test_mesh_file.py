@@ -251,3 +251,21 @@ def test_an_obj_reads_the_same_whatever_its_line_ends(tmp_path, end):
     (tmp_path / "other.obj").write_bytes(tetra().replace("\n", end).encode())
     for a, b in zip(read_mesh("other.obj", tmp_path), expected):
         np.testing.assert_array_equal(a, b)
+
+
+def test_a_binary_ply_s_polygons_count_as_their_fans_before_trimesh_reads_them(tmp_path, monkeypatch):
+    import struct
+
+    from grasptwist.io import mesh_file
+
+    header = "ply\nformat binary_big_endian 1.0\nelement vertex 6\nproperty double x\nproperty double y\n"
+    header += "property double z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
+    body = struct.pack(">18d", *range(18)) + bytes([6]) + struct.pack(">6i", *range(6))
+    (tmp_path / "m.ply").write_bytes(header.encode() + body)
+    monkeypatch.setattr(mesh_file, "_parsed", lambda *a, **k: pytest.fail("parsed"))
+    with pytest.raises(InputError, match=r"^m.ply:7: the faces hold 4 triangles, more than the limit of 3$") as caught:
+        read_mesh("m.ply", tmp_path, max_triangles=3)
+    assert caught.value.code == "too-many-triangles"
+    (tmp_path / "m.ply").write_bytes(header.encode() + body[:-4])  # the last corner cut off
+    with pytest.raises(InputError, match=r"^m.ply:7: the body ends inside a face row$"):
+        read_mesh("m.ply", tmp_path)

@@ -461,9 +461,9 @@ _PLY_HEADER = 1 << 16
 
 
 def _ply_header(data, file):
-    """``(ascii, body, elements)`` of a PLY file: whether it is ASCII, where its body starts, and
-    per element ``(name, count, header line, properties)``, each property ``(name, bytes, list?)``
-    (a list's bytes: its count's)."""
+    """``(format, body, elements)`` of a PLY file: its format (an index of ``_PLY_FORMATS``), where
+    its body starts, and per element ``(name, count, header line, properties)``, each property
+    ``(name, bytes, list?, item bytes)`` (a list's bytes: its count's)."""
     end = data.find(b"end_header", 0, _PLY_HEADER)
     if not data.startswith(b"ply") or end < 0:
         raise InputError(
@@ -481,14 +481,15 @@ def _ply_header(data, file):
                     raise ValueError
             elif words[:1] == [b"property"]:
                 listed = words[1] == b"list"
-                elements[-1][3].append((words[-1], _PLY_SIZES[words[2] if listed else words[1]], listed))
+                size, item = (_PLY_SIZES[words[2]], _PLY_SIZES[words[3]]) if listed else (_PLY_SIZES[words[1]], 0)
+                elements[-1][3].append((words[-1], size, listed, item))
         except (IndexError, ValueError, KeyError):
             raise InputError(
                 "invalid-mesh", f"not a PLY header line: {line[:80].decode(errors='replace')!r}", file, number
             ) from None
     if form is None:
         raise InputError("invalid-mesh", "not a PLY file: its header gives no format", file)
-    return form == 0, data.find(b"\n", end) + 1 or len(data), elements
+    return form, data.find(b"\n", end) + 1 or len(data), elements
 
 
 def _ply_elements(data, file):
@@ -504,11 +505,12 @@ def _ply_elements(data, file):
     Traceback (most recent call last):
     grasptwist.model.GraspFileError: m.ply:3: the header declares 2,000,000,000 vertex elements, one a line, but the body holds 2 lines
     """
-    text, body, elements = _ply_header(data, file)
+    form, body, elements = _ply_header(data, file)
+    text = form == 0
     held = _ply_lines(data[body:], file) if text else len(data) - body
     need = 0
     for name, count, number, properties in elements:
-        row = sum(size for _, size, _ in properties)
+        row = sum(size for _, size, _, _ in properties)
         need += count if text else count * row
         if need > held:
             what = "one a line" if text else f"of {row} bytes or more"
@@ -536,11 +538,12 @@ def _ply(data, max_triangles, file):
     >>> f.tolist()
     [[0, 1, 2], [0, 2, 3]]
     """
-    text, body, elements = _ply_header(data, file)
-    if not text:
+    form, body, elements = _ply_header(data, file)
+    if form:
+        _binary_fans(data, body, elements, form == 2, max_triangles, file)
         return _parsed(data, max_triangles, file)
     # each row's numbers, two more a list and its corners within the triangle cap: no more are parsed
-    most = max_triangles + sum(n * (len(p) + sum(2 for _, _, listed in p if listed)) for _, n, _, p in elements)
+    most = max_triangles + sum(n * (len(p) + sum(2 for _, _, listed, _ in p if listed)) for _, n, _, p in elements)
     words = _words(data, body)
     if words > most:
         raise InputError(
@@ -554,8 +557,8 @@ def _ply(data, max_triangles, file):
             raise InputError("invalid-mesh", "a word of the body is not a number", file) from None
     at, vertices, triangles = 0, np.zeros((0, 3)), packed("q")
     for name, count, number, properties in elements:
-        names = [p for p, _, _ in properties]
-        if not any(listed for _, _, listed in properties):  # fixed rows: one slice of the numbers
+        names = [p for p, _, _, _ in properties]
+        if not any(listed for _, _, listed, _ in properties):  # fixed rows: one slice of the numbers
             rows = numbers[at : at + count * len(names)]
             at += count * len(names)
             if len(rows) < count * len(names):
@@ -567,7 +570,7 @@ def _ply(data, max_triangles, file):
                     raise InputError("invalid-mesh", "the vertex element has no x, y and z", file, number) from None
             continue
         for _ in range(count):  # rows with a list: walked, at most the triangle cap's faces
-            for prop, _, listed in properties:
+            for prop, _, listed, _ in properties:
                 n = int(numbers[at]) if listed and at < len(numbers) and numbers[at] >= 0 else 0
                 corners, at = numbers[at + 1 : at + 1 + n], at + 1 + n if listed else at + 1
                 if name == b"face" and prop in (b"vertex_indices", b"vertex_index"):
@@ -580,6 +583,36 @@ def _ply(data, max_triangles, file):
             "invalid-mesh", "the body's numbers are not those of the header's elements (a line too long or short)", file
         )
     return vertices, np.frombuffer(triangles, dtype=np.int64).reshape(-1, 3)
+
+
+def _binary_fans(data, at, elements, big, max_triangles, file):
+    """Refuse a binary PLY whose faces' fans hold more than ``max_triangles`` triangles, or whose
+    rows run past its body, walking the rows with a list (at most :data:`MAX_VERTICES` an element)
+    from byte ``at``, before trimesh allocates for them."""
+    order, triangles = "big" if big else "little", 0
+    for name, count, number, properties in elements:
+        if not any(listed for _, _, listed, _ in properties):
+            at += count * sum(size for _, size, _, _ in properties)
+            continue
+        if count > MAX_VERTICES:
+            raise InputError("invalid-mesh", f"{count:,} rows with a list, more than {MAX_VERTICES:,}", file, number)
+        for _ in range(count):
+            for prop, size, listed, item in properties:
+                n = int.from_bytes(data[at : at + size], order) if listed else 0
+                at += size + n * item
+                if name == b"face" and prop in (b"vertex_indices", b"vertex_index"):
+                    triangles += max(n - 2, 0)
+            if at > len(data):
+                raise InputError(
+                    "invalid-mesh", f"the body ends inside a {name.decode(errors='replace')} row", file, number
+                )
+        if triangles > max_triangles:
+            raise InputError(
+                "too-many-triangles",
+                f"the faces hold {triangles:,} triangles, more than the limit of {max_triangles:,}",
+                file,
+                number,
+            )
 
 
 #: The bytes that separate words (Python's ``bytes.split``), as a table of the 256.
