@@ -146,22 +146,22 @@ def test_a_missing_file_is_a_read_error(tmp_path):
 
 
 def test_the_size_cap_is_checked_before_parsing(tmp_path, monkeypatch):
-    from grasptwist.io import mesh_file
+    from grasptwist.io import mesh_formats
 
     name = obj(tmp_path, tetra())
-    monkeypatch.setitem(mesh_file._READERS, ".obj", lambda *a, **k: pytest.fail("parsed"))
+    monkeypatch.setitem(mesh_formats._READERS, ".obj", lambda *a, **k: pytest.fail("parsed"))
     with pytest.raises(InputError, match="larger than the size limit of 20 bytes$") as caught:
         read_mesh(name, tmp_path, max_bytes=20)
     assert caught.value.code == "too-large"
 
 
 def test_the_triangle_limit(tmp_path, monkeypatch):
-    from grasptwist.io import mesh_file
+    from grasptwist.io import mesh_formats
 
     name = obj(tmp_path, tetra())
     assert len(read_mesh(name, tmp_path, max_triangles=4)[1]) == 4
     # the four f lines say it before the file is parsed
-    monkeypatch.setitem(mesh_file._READERS, ".obj", lambda *a, **k: pytest.fail("parsed"))
+    monkeypatch.setitem(mesh_formats._READERS, ".obj", lambda *a, **k: pytest.fail("parsed"))
     with pytest.raises(
         InputError, match="^m.obj: the file declares 4 faces, more than the limit of 3 triangles$"
     ) as caught:
@@ -188,10 +188,10 @@ def test_the_triangle_limit(tmp_path, monkeypatch):
 def test_an_stl_over_the_limit_is_refused_before_it_is_parsed(tmp_path, monkeypatch, data, declared):
     """A binary STL's header gives its count (a 100 MB one once took trimesh 2.7 s and 420 MB to refuse),
     an ASCII one its endfacet words."""
-    from grasptwist.io import mesh_file
+    from grasptwist.io import mesh_formats
 
     (tmp_path / "m.stl").write_bytes(data)
-    monkeypatch.setitem(mesh_file._READERS, ".stl", lambda *a, **k: pytest.fail("parsed"))
+    monkeypatch.setitem(mesh_formats._READERS, ".stl", lambda *a, **k: pytest.fail("parsed"))
     with pytest.raises(
         InputError, match=f"^m.stl: the file declares {declared:,} faces, more than the limit of 4 "
     ) as caught:
@@ -256,13 +256,13 @@ def test_an_obj_reads_the_same_whatever_its_line_ends(tmp_path, end):
 def test_a_binary_ply_s_polygons_count_as_their_fans_before_trimesh_reads_them(tmp_path, monkeypatch):
     import struct
 
-    from grasptwist.io import mesh_file
+    from grasptwist.io import mesh_formats
 
     header = "ply\nformat binary_big_endian 1.0\nelement vertex 6\nproperty double x\nproperty double y\n"
     header += "property double z\nelement face 1\nproperty list uchar int vertex_indices\nend_header\n"
     body = struct.pack(">18d", *range(18)) + bytes([6]) + struct.pack(">6i", *range(6))
     (tmp_path / "m.ply").write_bytes(header.encode() + body)
-    monkeypatch.setattr(mesh_file, "_parsed", lambda *a, **k: pytest.fail("parsed"))
+    monkeypatch.setattr(mesh_formats, "_parsed", lambda *a, **k: pytest.fail("parsed"))
     with pytest.raises(InputError, match=r"^m.ply:7: the faces hold 4 triangles, more than the limit of 3$") as caught:
         read_mesh("m.ply", tmp_path, max_triangles=3)
     assert caught.value.code == "too-many-triangles"

@@ -12,7 +12,7 @@ file that decodes to at most :data:`~grasptwist.io.limits.MAX_MESH_BYTES`
 mesh library inflates it; a glTF with the buffer and image files it names,
 which must stay in its folder, and its accessors' extent, :func:`gltf_bytes`),
 and an STL, OBJ or PLY must declare at most the mesh caps' vertices and
-triangles and read within the caps (:func:`~grasptwist.io.mesh_file.parse_mesh`: a polygon
+triangles and read within the caps (:func:`~grasptwist.io.mesh_formats.parse_mesh`: a polygon
 of millions of corners, a PLY header that lies), as an object's mesh must, before the library
 parses it again.  A mesh the library cannot read, whatever it raises, is an
 :class:`~grasptwist.model.InputError` naming it.
@@ -297,7 +297,7 @@ def _check_mesh_file(name, path):
     """Refuse the mesh file ``name`` (at ``path``) unless it is a regular file within the mesh caps:
     :data:`~grasptwist.io.limits.MAX_MESH_BYTES` held, decoded or read with the files a glTF names,
     and an STL's, OBJ's or PLY's declared vertices and triangles; errors name the file as ``name``."""
-    from .mesh_file import parse_mesh
+    from .mesh_formats import parse_mesh
 
     cap = MAX_MESH_BYTES
     try:
