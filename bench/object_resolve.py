@@ -3,8 +3,8 @@
 Run: ``python bench/object_resolve.py [--runs 11]``.  The bundled bottle
 (``grasps/bottle.yaml``, two twists) five ways, start-up included, each the
 median of alternating runs: its contacts with the normals it resolves to and
-no object; the bottle's bounding box (its contacts put on the box); the bundled OBJ mesh (read by
-grasptwist); the same mesh as a binary STL and a binary PLY (parsed by
+no object; the bottle's bounding box (its contacts put on the box); the bundled OBJ mesh and the
+same mesh as a binary STL (both read by grasptwist); and as a binary PLY (parsed by
 trimesh, the ``mesh`` extra).  Reported, no target: the issue asks how an
 object compares.
 """

@@ -425,15 +425,21 @@ def test_one_friction_for_every_row_of_an_npz(tmp_path):
     assert [rec["grip"]["total_normal_force"] for rec in recs] == pytest.approx([19.62] * 2, rel=1e-6)
 
 
-def test_a_negative_friction_in_a_data_set_is_one_error_record_and_the_other_inputs_keep_theirs(tmp_path):
-    grasps = np.stack([P, 2 * P])
-    np.savez(tmp_path / "neg.npz", points=grasps, normals=-grasps, friction=[0.5, -1.0])
+def test_a_negative_friction_in_a_data_set_is_its_row_s_error_and_the_other_rows_keep_theirs(tmp_path):
+    # issue 36: the rest of the block lost its records (one bad-dataset record for rows 1 to the end)
+    grasps = np.stack([P, 2 * P, 3 * P, 4 * P])
+    np.savez(tmp_path / "neg.npz", points=grasps, normals=-grasps, friction=[0.5, -1.0, 0.5, -2.0])
+    np.savez(tmp_path / "good.npz", points=grasps[[0, 2]], normals=-grasps[[0, 2]], friction=[0.5, 0.5])
     r, recs = records(tmp_path / "neg.npz", SPHERE)
     assert r.exit_code == 1
-    (bad,) = [rec for rec in recs if rec["file"] == str(tmp_path / "neg.npz")]
-    assert bad["error"]["code"] == "bad-dataset" and bad["error"]["message"].startswith(
-        "friction: row 1: -1.0 must be >= 0"
-    )
+    mine = [rec for rec in recs if rec["file"] == str(tmp_path / "neg.npz")]
+    assert [rec.get("grasp") for rec in mine] == ["0", None, "2", None]
+    assert [(rec["error"]["code"], rec["error"]["message"]) for rec in mine if not rec["ok"]] == [
+        ("invalid-friction", "friction: row 1: -1.0 must be >= 0"),
+        ("invalid-friction", "friction: row 3: -2.0 must be >= 0"),
+    ]
+    _, alone = records(tmp_path / "good.npz")
+    assert [rec["closure"] for rec in mine if rec["ok"]] == [rec["closure"] for rec in alone]
     assert [rec["grasp"] for rec in recs if rec["file"] == SPHERE] == [
         "sphere-tripod",
         "sphere-equator",
@@ -451,5 +457,5 @@ def test_a_negative_mu_in_a_parquet_data_set_is_one_error_record(tmp_path):
     grasps = np.stack([P, 2 * P])
     pq.write_table(grasp_table(grasps, -grasps).append_column("mu", pa.array([0.5, -2.0])), tmp_path / "neg.parquet")
     r, recs = records(tmp_path / "neg.parquet", POLYHEDRON)
-    assert r.exit_code == 1 and [rec.get("grasp") for rec in recs] == [None, "polyhedron"]
-    assert recs[0]["error"]["message"].startswith("friction: row 1: -2.0 must be >= 0")
+    assert r.exit_code == 1 and [rec.get("grasp") for rec in recs] == ["0", None, "polyhedron"]
+    assert recs[1]["error"]["message"] == "friction: row 1: -2.0 must be >= 0"

@@ -358,10 +358,13 @@ def test_an_object_not_read_gives_no_follow_on_weight_errors(tmp_path):
     assert load_grasps(path, allow_outside=True)[0].mass == pytest.approx(0.1)
 
 
-def test_the_size_cap_reaches_the_mesh(tmp_path):
+def test_the_mesh_s_own_size_cap_reaches_the_mesh_and_the_grasp_file_s_does_not(tmp_path):
+    # one cap per kind of input (issue 36): a mesh's is MAX_MESH_BYTES however it is named
     path = tetra_file(tmp_path)
     (tmp_path / "tetra.obj").write_text("#" * 300 + "\n" + TETRA)  # larger than the grasp file
-    ((e,),) = [read_grasps(path, max_bytes=300)]
+    ((g,),) = [read_grasps(path, max_bytes=300)]
+    assert g.object.shape.kind == "mesh"
+    ((e,),) = [read_grasps(path, reading=Reading(max_mesh_bytes=300))]
     assert (e.code, e.line, e.message) == (
         "too-large",
         2,

@@ -338,8 +338,8 @@ def test_a_hands_joint_columns_flow_to_parquet(tmp_path):
 
 
 def zigzag_varint(n: int) -> bytes:
-    """``n >= 0`` as Thrift's compact protocol writes an i64: zigzag, then 7 bits a byte."""
-    n, out = 2 * n, bytearray()
+    """``n`` as Thrift's compact protocol writes an i64: zigzag (-1 is 1, 1 is 2), then 7 bits a byte."""
+    n, out = 2 * n if n >= 0 else -2 * n - 1, bytearray()
     while True:
         out.append(n & 0x7F | (0x80 if n >> 7 else 0))
         n >>= 7
@@ -396,8 +396,13 @@ def resolved_beside_a_good_file(tmp_path, bad, files):
         (40, {0, 19}, "row group 0: declares 40 rows, its column p1_x 50"),
         (60, {1}, "row group 0: declares 50 rows, its column p1_x 60"),
         (60, None, "row group 0: declares 60 rows, holds 50"),  # every count agrees: found as it is read
+        # negative counts (issue 36: an internal error, every record of the run lost)
+        (-50, {0}, "the footer declares -50 rows, its row groups 50"),
+        (-50, {19}, "row group 0: declares -50 rows, fewer than none"),
+        (-50, {1}, "row group 0: declares 50 rows, its column p1_x -50"),
+        (-50, None, "row group 0: declares -50 rows, fewer than none"),
     ],
-    ids=["file", "row-group", "both", "both-fewer", "column", "all"],
+    ids=["file", "row-group", "both", "both-fewer", "column", "all", "-file", "-row-group", "-column", "-all"],
 )
 def test_a_footer_whose_row_counts_lie_is_one_error_record(tmp_path, files, new, which, said):
     # 0.3: 50 records, or an internal error that lost every record of the run

@@ -312,9 +312,15 @@ def test_a_malformed_mesh_is_an_input_error_naming_it(tmp_path, name):
     from grasptwist.model import InputError
 
     (tmp_path / name).write_bytes(MALFORMED_MESHES[name])
-    with pytest.raises(InputError, match=rf"^h.urdf: mesh '{re.escape(name)}': cannot read: ") as caught:
+    # a PLY whose header declares more than its body holds is refused before the library parses it (issue 36)
+    said, code = (
+        (", line 3: the header declares 100 vertex", "invalid-mesh")
+        if name == "bad.ply"
+        else (": cannot read: ", "read-error")
+    )
+    with pytest.raises(InputError, match=rf"^h.urdf: mesh '{re.escape(name)}'{said}") as caught:
         hand_meshes(hand_with_mesh(tmp_path, name), folder=tmp_path)
-    assert caught.value.code == "read-error"
+    assert caught.value.code == code
 
 
 def write_zeros(f, mib: int):
@@ -375,7 +381,7 @@ def test_plot_draws_a_page_without_a_malformed_mesh_with_a_warning(tmp_path):
     (tmp_path / "bad.ply").write_bytes(MALFORMED_MESHES["bad.ply"])
     r = run("plot", grasp, "-o", tmp_path / "g.html")
     assert r.exit_code == 0 and "internal error" not in r.output, r.output
-    assert "hand.urdf: warning: no link meshes: mesh 'bad.ply': cannot read: " in r.stderr
+    assert "hand.urdf: warning: no link meshes: mesh 'bad.ply', line 3: the header declares 100 vertex " in r.stderr
     from grasptwist.plot.traces import MESH_NAME
 
     figures = read_figures((tmp_path / "g.html").read_text("utf-8"))
@@ -390,3 +396,85 @@ def test_a_grasp_without_twists_is_drawn(tmp_path):
     r = run("plot", tmp_path / "g.yaml", "-o", tmp_path / "g.html")
     assert r.exit_code == 0, r.output
     assert len(read_figures((tmp_path / "g.html").read_text("utf-8"))) == 1
+
+
+def gltf(folder, buffer="m.bin", count=3, size=None):
+    """A one-triangle glTF naming its buffer ``buffer`` (written beside it, ``size`` bytes: sparse
+    past its 48 bytes of data), its positions accessor declaring ``count`` vertices."""
+    import struct
+
+    doc = {
+        "asset": {"version": "2.0"},
+        "buffers": [{"uri": buffer, "byteLength": 48}],
+        "bufferViews": [{"buffer": 0, "byteLength": 36}, {"buffer": 0, "byteOffset": 36, "byteLength": 12}],
+        "accessors": [
+            {
+                "bufferView": 0,
+                "componentType": 5126,
+                "count": count,
+                "type": "VEC3",
+                "max": [1, 1, 0],
+                "min": [0, 0, 0],
+            },
+            {"bufferView": 1, "componentType": 5125, "count": 3, "type": "SCALAR"},
+        ],
+        "meshes": [{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+        "nodes": [{"mesh": 0}],
+        "scenes": [{"nodes": [0]}],
+        "scene": 0,
+    }
+    (folder / "m.gltf").write_text(json.dumps(doc))
+    if "/" not in buffer:
+        with open(folder / buffer, "wb") as f:
+            f.write(struct.pack("<9f3I", 0, 0, 0, 1, 0, 0, 0, 1, 0, 0, 1, 2))
+            f.truncate(size or 48)
+    return "m.gltf"
+
+
+@pytest.mark.parametrize(
+    ("kind", "said"),
+    [
+        ("sparse-3-gib-buffer", "too-large: mesh 'm.gltf': reads 3,221,225,9"),
+        ("accessor-of-10-9", "too-large: mesh 'm.gltf': declares accessors of 12,000,000,012 bytes"),
+        ("buffer-outside", "path-outside: mesh 'm.gltf': '../m.bin' resolves outside"),
+    ],
+)
+def test_a_gltf_is_measured_with_its_buffers_and_accessors_before_it_is_read(tmp_path, kind, said, monkeypatch):
+    # issue 36: a .gltf naming a sparse 3 GB .bin was read whole (3.2 GB resident)
+    pytest.importorskip("yourdfpy")
+    from grasptwist.io.urdf_meshes import hand_meshes
+    from grasptwist.model import InputError
+
+    args = {
+        "sparse-3-gib-buffer": {"size": 3 << 30},
+        "accessor-of-10-9": {"count": 10**9},
+        "buffer-outside": {"buffer": "../m.bin"},
+    }[kind]
+    name = gltf(tmp_path, **args)
+    hand = hand_with_mesh(tmp_path, name)
+    monkeypatch.setattr("trimesh.load", lambda *a, **k: pytest.fail("the mesh library was given the glTF"))
+    with pytest.raises(InputError) as caught:
+        hand_meshes(hand, folder=tmp_path)
+    assert f"{caught.value.code}: {caught.value.message}".startswith(said), caught.value
+    monkeypatch.undo()
+    gltf(tmp_path)  # the same glTF, honest
+    [(vertices, faces)] = hand_meshes(hand, folder=tmp_path)
+    assert vertices.shape == (3, 3) and faces.tolist() == [[0, 1, 2]]  # posed with its link
+
+
+def test_a_urdf_s_mesh_gets_an_object_mesh_s_caps_before_the_library_parses_it(tmp_path, monkeypatch):
+    # issue 36: one polygon of millions of corners went past 0.5 GB; here just past the triangle cap
+    pytest.importorskip("yourdfpy")
+    from grasptwist.io.limits import MAX_TRIANGLES
+    from grasptwist.io.urdf_meshes import hand_meshes
+    from grasptwist.model import InputError
+
+    corners = " ".join(str(1 + k % 4) for k in range(MAX_TRIANGLES + 3))
+    (tmp_path / "p.obj").write_text(f"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 0 0 1\nf {corners}\n")
+    hand = hand_with_mesh(tmp_path, "p.obj")
+    monkeypatch.setattr("trimesh.load", lambda *a, **k: pytest.fail("the mesh library was given the OBJ"))
+    with pytest.raises(
+        InputError, match=r"^h.urdf: mesh 'p.obj', line 5: a polygon of more than 200,002 corners"
+    ) as caught:
+        hand_meshes(hand, folder=tmp_path)
+    assert caught.value.code == "too-many-triangles"

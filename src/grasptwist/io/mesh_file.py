@@ -1,22 +1,26 @@
 """An object's triangle mesh (STL, OBJ or PLY), read as untrusted input.
 
-A grasp file's ``object: {mesh: path}`` names it; trimesh (the optional
-extra ``grasptwist[mesh]``) parses STL and PLY, an OBJ's ``v`` and ``f``
-lines are read here (the format this project writes, without trimesh's
-second of import), and the checks are numpy's.  Around it, as for a URDF
-(:mod:`grasptwist.io.urdf`, whose path rule this shares):
+A grasp file's ``object: {mesh: path}`` names it, or ``synthesize``'s command line (a
+path, a folder's file); :mod:`grasptwist.io.mesh_formats` turns its bytes into vertices and
+faces (STL, OBJ and ASCII PLY there, without trimesh's second of import; a binary PLY by
+trimesh, the optional extra ``grasptwist[mesh]``), and the checks are numpy's.  Around it, as
+for a URDF (:mod:`grasptwist.io.urdf`, whose path rule this shares):
 
 * the reference: a path relative to the grasp file's folder, refused when it
   resolves (symbolic links followed) outside that folder (``path-outside``)
   unless the caller allows it (``--allow-outside``); ``package://PKG/path``
   inside an installed Python package;
-* the bytes: at most ``max_bytes`` (the loader's ``--max-bytes``) of a regular
+* the bytes: at most ``max_bytes`` (:data:`~grasptwist.io.limits.MAX_MESH_BYTES`,
+  ``Reading.max_mesh_bytes``: one cap however the mesh is named) of a regular
   file are read before anything is parsed, and a file whose format says it
-  holds more than ``max_triangles`` triangles is refused unparsed (a binary
-  STL's count, an ASCII STL's ``endfacet`` words, a PLY header's faces, an
-  OBJ's ``f`` lines), so memory stays bounded by the cap; bytes that are no
-  STL (neither a binary STL of its count's length nor text starting with
-  ``solid``) are ``invalid-mesh`` unparsed;
+  holds more than :data:`~grasptwist.io.limits.MAX_VERTICES` vertices or
+  ``max_triangles`` triangles is refused unparsed (a binary STL's count, an
+  ASCII STL's ``endfacet`` words, a PLY header's elements, an OBJ's ``v`` and
+  ``f`` lines; :func:`~grasptwist.io.mesh_formats.check_counts`), as is a PLY whose header declares more
+  than its body holds; the readers stop at the caps whatever the file
+  says, so memory stays within a few times ``max_bytes``; bytes
+  that are no STL (neither a binary STL of its count's length nor text
+  starting with ``solid``) are ``invalid-mesh`` unparsed;
 * the geometry: at most ``max_triangles`` triangles (:data:`~grasptwist.io.limits.MAX_TRIANGLES`),
   finite vertices, every face index a vertex, and a closed surface: each
   edge shared by exactly two triangles, wound the same way (a volume, a
@@ -35,38 +39,34 @@ Every refusal is a :class:`~grasptwist.model.InputError` with a code:
 ``unsupported-mesh``     a file name not ending in ``.stl``, ``.obj`` or ``.ply``
 ``invalid-mesh``         not readable as its format (bad face indices, truncated), a degenerate triangle
 ``empty-mesh``           no triangles
-``too-many-triangles``   more than ``max_triangles``
+``too-many-triangles``   more than ``max_triangles`` (an OBJ polygon counts as its fan's)
+``too-many-vertices``    more than :data:`~grasptwist.io.limits.MAX_VERTICES`
 ``non-finite``           a vertex coordinate that is NaN or infinite
 ``not-watertight``       an open, non-manifold or inconsistently wound surface
 ``invalid-size``         a size (bounding box diagonal) outside ``SIZE_RANGE``, 1e-75 to 1e75
-``mesh-unavailable``     trimesh is not installed (an STL or PLY)
+``mesh-unavailable``     trimesh is not installed (a binary PLY)
 =======================  ==========================================================
 """
 
 from __future__ import annotations
 
 import os
-import re
 from pathlib import Path
 
 import numpy as np
 
 from ..model import InputError
-from .limits import DEFAULT_MAX_BYTES, MAX_TRIANGLES, MESH_SUFFIXES
+from .limits import MAX_MESH_BYTES, MAX_TRIANGLES, MESH_SUFFIXES
+from .mesh_formats import parse_mesh
 
 __all__ = ["read_mesh", "check_mesh"]
-
-_PLY_FACES = re.compile(rb"^element\s+face\s+(\d+)\s*$", re.MULTILINE)
-_ASCII_STL = re.compile(rb"\s*solid", re.IGNORECASE)
-#: A binary STL: an 80-byte header, a little-endian uint32 count, then 50 bytes per triangle.
-_STL_HEADER, _STL_TRIANGLE = 84, 50
 
 
 def read_mesh(
     reference,
     folder=None,
     *,
-    max_bytes=DEFAULT_MAX_BYTES,
+    max_bytes=MAX_MESH_BYTES,
     max_triangles=MAX_TRIANGLES,
     allow_outside=False,
     output=None,
@@ -117,46 +117,7 @@ def read_mesh(
     from .urdf import _read, resolve_urdf  # here: listing a folder (MESH_SUFFIXES) imports no URDF reader
 
     data = _read(resolve_urdf(text, folder, allow_outside=allow_outside, output=output), max_bytes, text, output)
-    _too_many(_declared_triangles(data, suffix, text), max_triangles, text)
-    try:
-        vertices, faces = _obj(data) if suffix == ".obj" else _parsed(data, suffix, text)
-    except (ValueError, IndexError):
-        raise InputError("invalid-mesh", f"not a readable {suffix[1:].upper()} file", text) from None
-    return check_mesh(vertices, faces, max_triangles, text)
-
-
-def _obj(data):
-    """``(vertices, faces)`` of a Wavefront OBJ's ``v`` and ``f`` lines (polygons as fans of
-    triangles; ``a/b/c`` takes ``a``; negative indices count back from the vertices so far),
-    read here: it is the format this project writes (``grasps/meshes/make_bottle.py``), and trimesh
-    costs a second to import.  Other lines (normals, texture coordinates, groups, materials)
-    are passed over.  Raises ValueError on what does not read."""
-    vertices, faces = [], []
-    for line in data.decode("utf-8", "strict").splitlines():
-        words = line.split()
-        if not words or words[0] not in ("v", "f"):
-            continue
-        if words[0] == "v":
-            vertices.append([float(w) for w in words[1:4]])
-            continue
-        corners = [int(w.partition("/")[0]) for w in words[1:]]
-        if len(corners) < 3 or 0 in corners:
-            raise ValueError("a face needs three vertices, numbered from 1")
-        corners = [c - 1 if c > 0 else len(vertices) + c for c in corners]
-        faces += [(corners[0], corners[k], corners[k + 1]) for k in range(1, len(corners) - 1)]
-    return np.array(vertices, dtype=float).reshape(-1, 3), np.array(faces, dtype=np.int64).reshape(-1, 3)
-
-
-def _parsed(data, suffix, file):
-    """``(vertices, faces)`` of an STL or PLY file, parsed by trimesh."""
-    trimesh = _library(file)
-    try:
-        mesh = trimesh.load(
-            trimesh.util.wrap_as_stream(data), file_type=suffix[1:], force="mesh", process=False, skip_materials=True
-        )
-        return np.asarray(mesh.vertices, dtype=float), np.asarray(mesh.faces, dtype=np.int64).reshape(-1, 3)
-    except Exception:  # a parser's failure on hostile bytes has no one type; what it says varies by version
-        raise ValueError(f"not a readable {suffix[1:].upper()} file") from None
+    return check_mesh(*parse_mesh(data, suffix, text, max_triangles), max_triangles, text)
 
 
 def check_mesh(vertices, faces, max_triangles, file):
@@ -256,63 +217,3 @@ def _closed(faces):
     keys, counts = np.unique(edges[:, 0] * n + edges[:, 1], return_counts=True)
     reverse = np.sort(edges[:, 1] * n + edges[:, 0])
     return bool((counts == 1).all() and np.array_equal(keys, reverse))
-
-
-def _declared_triangles(data, suffix, file):
-    r"""How many triangles (or faces: a polygon is a fan of them) the file says it holds, found
-    without parsing it; None where the format does not say.
-
-    A binary STL gives its count in its header, and is exactly that long; an ASCII STL starts with
-    ``solid`` and closes each triangle with ``endfacet``; a PLY's header declares its faces; an
-    OBJ has an ``f`` line per face.  Bytes that are neither kind of STL are ``invalid-mesh``.
-
-    >>> import struct
-    >>> _declared_triangles(bytes(80) + struct.pack("<I", 2) + bytes(100), ".stl", "a.stl")
-    2
-    >>> _declared_triangles(b"v 0 0 0\nf 1 2 3\r\nf 1 3 4\n", ".obj", "a.obj")
-    2
-    >>> _declared_triangles(b"not a mesh", ".stl", "junk.stl")
-    Traceback (most recent call last):
-    grasptwist.model.GraspFileError: junk.stl: not a readable STL file (neither a binary STL of the length its count gives nor text starting with 'solid')
-    """
-    if suffix == ".stl":
-        if len(data) >= _STL_HEADER:
-            count = int.from_bytes(data[80:84], "little")
-            if len(data) == _STL_HEADER + _STL_TRIANGLE * count:
-                return count
-        if _ASCII_STL.match(data[:1024]):
-            return data.count(b"endfacet")
-        raise InputError(
-            "invalid-mesh",
-            "not a readable STL file (neither a binary STL of the length its count gives nor text starting with 'solid')",
-            file,
-        )
-    if suffix == ".ply":
-        end = data.find(b"end_header")
-        declared = _PLY_FACES.search(data[: end if end >= 0 else 4096])
-        return int(declared.group(1)) if declared else None
-    return sum(data.count(line) for line in (b"\nf ", b"\nf\t")) + data.startswith((b"f ", b"f\t"))
-
-
-def _too_many(declared, max_triangles, file):
-    """Refuse a file that says it holds more than ``max_triangles`` triangles, before a parser
-    allocates arrays of that length."""
-    if declared is not None and declared > max_triangles:
-        raise InputError(
-            "too-many-triangles",
-            f"the file declares {declared} faces, more than the limit of {max_triangles} triangles",
-            file,
-        )
-
-
-def _library(file):
-    """trimesh, or the error that says which extra to install."""
-    try:
-        import trimesh
-    except ImportError:
-        raise InputError(
-            "mesh-unavailable",
-            "reading a mesh needs trimesh: pip install trimesh (from a clone of grasptwist: pip install -e '.[mesh]')",
-            file,
-        ) from None
-    return trimesh

@@ -241,7 +241,11 @@ class _RowGroups:
         except Exception as exc:  # noqa: BLE001 - pyarrow raises several kinds for a file that is not Parquet
             raise _bad(self.path, f"cannot read as Parquet: {exc}") from None
         meta = self.file.metadata
-        self.starts = np.cumsum([0] + [meta.row_group(i).num_rows for i in range(meta.num_row_groups)])
+        counts = [meta.row_group(i).num_rows for i in range(meta.num_row_groups)]
+        negative = next((g for g, n in enumerate(counts) if n < 0), None)
+        if negative is not None:  # a count no file can have: before anything sizes itself by it
+            raise _bad(self.path, f"row group {negative}: declares {counts[negative]:,} rows, fewer than none")
+        self.starts = np.cumsum([0] + counts)
         self.cursor: _Cursor | None = None
 
     def __len__(self) -> int:

@@ -36,6 +36,7 @@ Every refusal is a :class:`~grasptwist.model.InputError` with a code:
 
 from __future__ import annotations
 
+import errno
 import io
 import math
 import os
@@ -50,7 +51,7 @@ import numpy as np
 
 from ..engine.kinematics import chain_from_origins, chain_length
 from ..model import Finger, Hand, InputError, Joint
-from .limits import DEFAULT_MAX_BYTES, OUTPUT_IS_INPUT
+from .limits import MAX_URDF_BYTES, OUTPUT_IS_INPUT
 
 __all__ = ["load_urdf_hand", "resolve_urdf"]
 
@@ -98,10 +99,10 @@ def resolve_urdf(reference, folder=None, *, allow_outside=False, output=None):
     if _URL.match(text):
         raise InputError("unsupported-url", f"only package:// URLs and file paths are read, got {text!r}", text)
     if folder is None:
-        return Path(text).resolve()
+        return _resolved(Path(text), text)
     if allow_outside:
-        return (Path(folder) / text).resolve()
-    return _inside(Path(folder).resolve(), text, text, output)
+        return _resolved(Path(folder) / text, text)
+    return _inside(_resolved(Path(folder), text), text, text, output)
 
 
 def _package_folder(package, reference):
@@ -116,8 +117,17 @@ def _package_folder(package, reference):
     return Path(next(iter(spec.submodule_search_locations))).resolve()
 
 
+def _resolved(path, reference):
+    """``path`` made absolute, its symbolic links followed; a loop of them is a ``read-error``."""
+    try:
+        return path.resolve()
+    except (RuntimeError, OSError):  # Python 3.11-3.12: RuntimeError; 3.13: OSError (ELOOP)
+        # the system's words, as a folder's listing and an open() give them
+        raise InputError("read-error", f"cannot read: {os.strerror(errno.ELOOP)}", reference) from None
+
+
 def _inside(base, relative, reference, output=None):
-    path = (base / relative).resolve()
+    path = _resolved(base / relative, reference)
     if not path.is_relative_to(base):
         with suppress(OSError):
             info = path.stat()
@@ -289,9 +299,7 @@ def _model(data, file):
         raise InputError("invalid-urdf", f"yourdfpy cannot read it: {type(exc).__name__}: {exc}", file) from None
 
 
-def load_urdf_hand(
-    urdf, tips, *, names=None, folder=None, max_bytes=DEFAULT_MAX_BYTES, allow_outside=False, output=None
-):
+def load_urdf_hand(urdf, tips, *, names=None, folder=None, max_bytes=MAX_URDF_BYTES, allow_outside=False, output=None):
     """A hand from a URDF: one finger per tip link, its joints at home (all 0).
 
     The hand's frame (and so the grasp's) is the URDF's root link's frame.

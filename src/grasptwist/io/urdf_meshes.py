@@ -7,9 +7,14 @@ its visual meshes (through trimesh, which yourdfpy brings) and pose them by
 its own forward kinematics of the same joints.  Each mesh file is resolved
 as the URDF itself is (:func:`~grasptwist.io.urdf.resolve_urdf`: inside its
 ``package://`` package, or inside the URDF's folder) and must be a regular
-file that decodes to at most :data:`MAX_MESH_BYTES` (:func:`decoded_size`:
-an archive or compressed stream is measured before the mesh library inflates
-it).  A mesh the library cannot read, whatever it raises, is an
+file that decodes to at most :data:`~grasptwist.io.limits.MAX_MESH_BYTES`
+(:func:`decoded_size`: an archive or compressed stream is measured before the
+mesh library inflates it; a glTF with the buffer and image files it names,
+which must stay in its folder, and its accessors' extent, :func:`gltf_bytes`),
+and an STL, OBJ or PLY must declare at most the mesh caps' vertices and
+triangles and read within the caps (:func:`~grasptwist.io.mesh_formats.parse_mesh`: a polygon
+of millions of corners, a PLY header that lies), as an object's mesh must, before the library
+parses it again.  A mesh the library cannot read, whatever it raises, is an
 :class:`~grasptwist.model.InputError` naming it.
 """
 
@@ -18,6 +23,7 @@ from __future__ import annotations
 import bz2
 import gzip
 import io
+import json
 import lzma
 import os
 import stat
@@ -25,22 +31,23 @@ import warnings
 import zipfile
 import zlib
 from pathlib import Path
+from urllib.parse import unquote
 
 import numpy as np
 
 from ..engine.collision import LinkGeometry
 from ..model import InputError
-from .limits import DEFAULT_MAX_BYTES
+from .limits import MAX_MESH_BYTES, MAX_TRIANGLES, MAX_URDF_BYTES, MESH_SUFFIXES
 from .urdf import _library, _parse, _read, resolve_urdf
 
-__all__ = ["MAX_MESH_BYTES", "decoded_size", "grasp_folder", "hand_meshes", "link_geometry"]
-
-#: Most bytes a mesh file may hold, or decode to when it is an archive or compressed.
-MAX_MESH_BYTES = 64 << 20
+__all__ = ["decoded_size", "gltf_bytes", "grasp_folder", "hand_meshes", "link_geometry"]
 
 #: Compressed streams by their first bytes, and how to open one.
 _STREAMS = {b"\x1f\x8b": gzip.open, b"BZh": bz2.open, b"\xfd7zXZ\x00": lzma.open}
 _CHUNK = 1 << 20
+#: A glTF accessor's bytes a component, by ``componentType``, and its components, by ``type``.
+_COMPONENT_BYTES = {5120: 1, 5121: 1, 5122: 2, 5123: 2, 5125: 4, 5126: 4}
+_COMPONENTS = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4, "MAT2": 4, "MAT3": 9, "MAT4": 16}
 
 
 def decoded_size(path, cap: int) -> int:
@@ -81,7 +88,48 @@ def decoded_size(path, cap: int) -> int:
         return size
 
 
-def hand_meshes(hand, positions=None, *, folder=None, max_bytes=DEFAULT_MAX_BYTES) -> list[tuple]:
+def gltf_bytes(path) -> tuple[int, int]:
+    """``(read, built)``: the bytes a glTF (``.gltf`` text, or ``.glb``) makes a mesh library read,
+    itself and the buffer and image files it names (each resolved as a URDF's mesh is, inside the
+    glTF's folder), and the bytes its accessors declare (``count`` elements of their type, which
+    a library allocates), both found from its JSON before a buffer is opened.
+
+    Raises
+    ------
+    InputError
+        ``path-outside`` (or another of :func:`~grasptwist.io.urdf.resolve_urdf`'s) for a file it names.
+    OSError, ValueError
+        A file that cannot be read, JSON that is not a glTF's.
+
+    >>> import tempfile
+    >>> doc = {"buffers": [{"uri": "data:,"}], "accessors": [{"count": 10**9, "type": "VEC3", "componentType": 5126}]}
+    >>> with tempfile.NamedTemporaryFile("w", suffix=".gltf") as f:
+    ...     f.write(json.dumps(doc)) and None
+    ...     f.flush()
+    ...     gltf_bytes(f.name)[1]
+    12000000000
+    """
+    path = Path(path)
+    with open(path, "rb") as f:
+        head = f.read(20)
+        if head.startswith(b"glTF"):  # a 12-byte header, then the JSON chunk's length and type
+            document = f.read(int.from_bytes(head[12:16], "little"))
+        else:
+            document = head + f.read(MAX_MESH_BYTES)
+        read = os.fstat(f.fileno()).st_size
+    gltf = json.loads(document)
+    for item in [*gltf.get("buffers", []), *gltf.get("images", [])]:
+        uri = item.get("uri")
+        if isinstance(uri, str) and not uri.startswith("data:"):
+            read += os.stat(resolve_urdf(unquote(uri), path.parent)).st_size
+    built = sum(
+        int(a["count"]) * _COMPONENTS[a["type"]] * _COMPONENT_BYTES[a["componentType"]]
+        for a in gltf.get("accessors", [])
+    )
+    return read, built
+
+
+def hand_meshes(hand, positions=None, *, folder=None, max_bytes=MAX_URDF_BYTES) -> list[tuple]:
     """Every visual mesh of ``hand``'s URDF at joint ``positions``, in the hand's root frame.
 
     Parameters
@@ -115,7 +163,7 @@ def hand_meshes(hand, positions=None, *, folder=None, max_bytes=DEFAULT_MAX_BYTE
     return [(np.asarray(m.vertices, dtype=float), np.asarray(m.faces)) for m in model.scene.dump(concatenate=False)]
 
 
-def link_geometry(hand, *, folder=None, max_bytes=DEFAULT_MAX_BYTES) -> tuple[LinkGeometry, ...]:
+def link_geometry(hand, *, folder=None, max_bytes=MAX_URDF_BYTES) -> tuple[LinkGeometry, ...]:
     """Every finger link's collision geometry from ``hand``'s URDF, at home in the hand's root frame.
 
     A link is a finger's when the movable joints above it are the first ones of that finger (a link
@@ -219,23 +267,10 @@ def _loaded(hand, folder, max_bytes, *, collision):
         except InputError as exc:  # the error is the URDF's, about one of its meshes
             raise InputError(exc.code, f"mesh {exc.message}", hand.source) from None
         try:
-            info = os.stat(path)
-        except OSError as exc:
-            raise InputError("read-error", f"mesh {name!r}: cannot read: {exc.strerror}", hand.source) from None
-        if not stat.S_ISREG(info.st_mode):
-            raise InputError("read-error", f"mesh {name!r}: not a regular file", hand.source)
-        if info.st_size > MAX_MESH_BYTES:
-            raise InputError("too-large", f"mesh {name!r}: larger than {MAX_MESH_BYTES} bytes", hand.source)
-        try:
-            size = decoded_size(path, MAX_MESH_BYTES)
-        except (OSError, EOFError, zipfile.BadZipFile, zlib.error, lzma.LZMAError) as exc:
-            raise InputError("read-error", f"mesh {name!r}: cannot read: {exc}", hand.source) from None
-        if size > MAX_MESH_BYTES:
-            raise InputError(
-                "too-large",
-                f"mesh {name!r}: decodes to more than {MAX_MESH_BYTES} bytes ({info.st_size:,} compressed)",
-                hand.source,
-            )
+            _check_mesh_file(name, path)
+        except InputError as exc:
+            where = f", line {exc.line}" if exc.line else ""
+            raise InputError(exc.code, f"mesh {name!r}{where}: {exc.message}", hand.source) from None
         asked.append(name)
         return str(path)
 
@@ -256,6 +291,40 @@ def _loaded(hand, folder, max_bytes, *, collision):
     except Exception as exc:  # noqa: BLE001 - a malformed mesh: each format's parser raises its own kinds
         what = f"mesh {asked[-1]!r}" if asked else "its meshes"
         raise InputError("read-error", f"{what}: cannot read: {type(exc).__name__}: {exc}", hand.source) from None
+
+
+def _check_mesh_file(name, path):
+    """Refuse the mesh file ``name`` (at ``path``) unless it is a regular file within the mesh caps:
+    :data:`~grasptwist.io.limits.MAX_MESH_BYTES` held, decoded or read with the files a glTF names,
+    and an STL's, OBJ's or PLY's declared vertices and triangles; errors name the file as ``name``."""
+    from .mesh_formats import parse_mesh
+
+    cap = MAX_MESH_BYTES
+    try:
+        info = os.stat(path)
+        if not stat.S_ISREG(info.st_mode):
+            raise InputError("read-error", "not a regular file", name)
+        if info.st_size > cap:
+            raise InputError("too-large", f"larger than {cap} bytes", name)
+        size = decoded_size(path, cap)
+        if size > cap:
+            raise InputError("too-large", f"decodes to more than {cap} bytes ({info.st_size:,} compressed)", name)
+        suffix = path.suffix.lower()
+        if suffix in (".gltf", ".glb"):
+            read, built = gltf_bytes(path)
+            if max(read, built) > cap:
+                what = (
+                    f"reads {read:,} bytes with the files it names"
+                    if read > cap
+                    else f"declares accessors of {built:,} bytes"
+                )
+                raise InputError("too-large", f"{what}, more than {cap} bytes", name)
+        if suffix in MESH_SUFFIXES:
+            parse_mesh(_read(path, cap, name), suffix, name, MAX_TRIANGLES)
+    except (OSError, EOFError, zipfile.BadZipFile, zlib.error, lzma.LZMAError) as exc:
+        raise InputError("read-error", f"cannot read: {getattr(exc, 'strerror', None) or exc}", name) from None
+    except (ValueError, KeyError, TypeError, AttributeError) as exc:  # JSON that is no glTF's
+        raise InputError("read-error", f"cannot read: {type(exc).__name__}: {exc}", name) from None
 
 
 def grasp_folder(grasp) -> Path | None:

@@ -19,7 +19,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ..engine.collision import clusters, collision_tolerance, link_poses, penetration_depths, tip_sphere
-from ..io.limits import DEFAULT_MAX_BYTES
+from ..io.limits import MAX_URDF_BYTES
 from ..io.urdf_meshes import grasp_folder, link_geometry
 from ..model import Grasp, GraspFileError, InputError
 from ..output.names import escaped
@@ -103,7 +103,7 @@ def _checked(grasp, max_bytes):
     return geometry, parts, tol
 
 
-def finger_collisions_along(grasp: Grasp, joint_positions, frames=None, *, max_bytes=DEFAULT_MAX_BYTES):
+def finger_collisions_along(grasp: Grasp, joint_positions, frames=None, *, max_bytes=MAX_URDF_BYTES):
     """Per configuration, the links of ``grasp``'s hand inside its object.
 
     Parameters
@@ -141,7 +141,7 @@ def finger_collisions_along(grasp: Grasp, joint_positions, frames=None, *, max_b
     return out
 
 
-def deepest_link(grasp: Grasp, *, max_bytes=DEFAULT_MAX_BYTES):
+def deepest_link(grasp: Grasp, *, max_bytes=MAX_URDF_BYTES):
     """How deep the deepest finger link of ``grasp``'s hand goes into its object, as a function of
     joint positions ``(N, n_joints) -> (N,)`` (the synthesis search's collision constraint); None
     without a URDF hand or an object.

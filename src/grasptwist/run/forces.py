@@ -314,9 +314,13 @@ def force_dataset_blocks(
             mu = np.broadcast_to(own if own.ndim == 0 else own[picked], (n, 3)).copy()
         else:
             mu = np.full((n, 3), np.nan)
-        _check_rows_friction(ds.path, mu, index, end)
+        negative = (mu < 0).any(axis=1)
+        refused = [
+            GraspFileError("invalid-friction", _negative(index[r], mu[r]), ds.path) for r in np.flatnonzero(negative)
+        ]
+        mu[negative] = np.nan  # computed as rows without a friction, then cut out
         labels = ds.names[first:last][picked] if ds.names is not None else index
-        yield force_arrays(
+        block = force_arrays(
             np.asarray(ds.points[first:last], dtype=float)[picked],
             _unit(np.asarray(ds.normals[first:last], dtype=float))[picked],
             wrench,
@@ -328,20 +332,26 @@ def force_dataset_blocks(
             units=[None] * n,
             contact_names=[("1", "2", "3")] * n,
         )
+        yield from _cut(block, negative, refused)
 
 
-def _check_rows_friction(path, mu, index, end):
-    """A negative friction in a data set's rows: its input error (the rows from its block on,
-    to the end of the part being run, get that one error record; other files keep theirs)."""
-    bad = (mu < 0).any(axis=1)
-    if bad.any():
-        row = int(np.argmax(bad))
-        raise GraspFileError(
-            code="bad-dataset",
-            message=f"friction: row {index[row]}: {float(mu[row][mu[row] < 0][0])!r} must be >= 0 "
-            f"(rows {index[0]} to {end - 1} not computed)",
-            file=path,
-        )
+def _negative(row, mu) -> str:
+    """What is wrong with a data set's ``row`` whose friction ``mu`` (3,) has a negative value."""
+    return f"friction: row {row}: {float(mu[mu < 0][0])!r} must be >= 0"
+
+
+def _cut(block, refused_rows, errors):
+    """``block`` without its ``refused_rows``, each run of them replaced by its grasp's error
+    (``errors``, one a refused row: a grasp's rows, one a wrench, share its friction), in order."""
+    start = 0
+    for k, row in enumerate(np.flatnonzero(refused_rows)):
+        if row > start:
+            yield block.part(start, row)
+        if row == 0 or not refused_rows[row - 1] or block.grasp[row] != block.grasp[row - 1]:
+            yield errors[k]
+        start = row + 1
+    if start < len(block):
+        yield block.part(start, len(block)) if start else block
 
 
 def _unit(normals):

@@ -287,6 +287,9 @@ def blocks(job: Job, paths: Sequence, tuning: Tuning = TUNING) -> Iterator[tuple
                 ds = open_dataset(g, job.extra_point)
                 extra_work = len(ds) * job.options.rows_per_grasp() - 1
                 for block in job.family.dataset(ds, job, 0, None, bases):
+                    if isinstance(block, GraspFileError):  # one row's (a negative friction): one unit
+                        yield block, None, True
+                        continue
                     yield block, extra_work, True
                     extra_work = 0
             except GraspFileError as err:
@@ -351,6 +354,11 @@ def _dataset_task(job: Job, ds, rows: tuple[int, int], tuning: Tuning, spool: Sp
     made = job.family.dataset(ds, job, rows[0], rows[1], FORMATS[job.fmt].bases)
     try:
         for block in made:
+            if isinstance(block, GraspFileError):  # one row's (a negative friction), in its place
+                out = Output()
+                _encode_into(job, block, out, at_once)
+                outs.append(_sealed(job, out, spool))
+                continue
             for start in range(0, len(block), at_once):
                 out = Output(rows=True)
                 _encode_into(job, block.part(start, start + at_once), out, at_once)

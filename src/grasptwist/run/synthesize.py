@@ -29,7 +29,7 @@ from ..engine.synthesis.search import GRAVITY, Synthesis, hand_reach, search_ste
 from ..engine.units import fingers_reach, hand_fit_warning, largest_extent, mesh_span_warning
 from ..io.grasp.forces import HOLD
 from ..io.inputs import read as read_unplaced
-from ..io.limits import DEFAULT_MAX_BYTES, MESH_SUFFIXES, OUTPUT_IS_INPUT
+from ..io.limits import MESH_SUFFIXES, OUTPUT_IS_INPUT
 from ..io.mesh_file import read_mesh
 from ..model import CONTACT_NAMES, Grasp, GraspFileError, GraspObject, Hand, InputError, Shape
 from ..output import synthesis_records as sr
@@ -155,7 +155,7 @@ def _hand(job, grasp: Grasp, obj: GraspObject):
     named_by = job.options.hand_file if given else grasp.file
     try:
         held = replace(grasp, hand=hand, object=obj, file=named_by)
-        collide = deepest_link(held, max_bytes=job.max_bytes or DEFAULT_MAX_BYTES)
+        collide = deepest_link(held)
         return hand_reach(obj, hand, tips=tips, collide=collide), hand
     except InputError as exc:
         return GraspFileError(exc.code, f"hand: {exc.message}", grasp.file, grasp.line, None, grasp.document)
@@ -179,9 +179,10 @@ def _mesh_grasp(path: str, job) -> Grasp | GraspFileError:
     """A mesh file as a grasp document with only its object (the command line gives the rest), in
     ``--units`` (metres without it)."""
     try:
-        vertices, faces = read_mesh(path, None, max_bytes=job.max_bytes or 64 * 2**20)
+        limits = job.reading  # a mesh's caps however it is named (io/limits.py), as a grasp file's mesh gets
+        vertices, faces = read_mesh(path, None, max_bytes=limits.max_mesh_bytes, max_triangles=limits.max_triangles)
     except InputError as exc:
-        return exc
+        return exc.with_traceback(None)  # kept until written: not with the reader's frames (the mesh's bytes)
     # the path as a grasp file beside the mesh would name it: -o FILE.yaml finds it from the file's folder
     shape = Shape("mesh", np.zeros(0), vertices=vertices, faces=faces, source=os.path.basename(path))
     obj = GraspObject(shape, np.eye(4))

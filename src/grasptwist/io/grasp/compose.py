@@ -12,6 +12,7 @@ import re
 
 import yaml
 
+from ..limits import MAX_DEPTH
 from .problems import Problems, Reject, StreamStop, join, located, located_mark
 from .values import describe
 
@@ -19,11 +20,6 @@ __all__ = ["PARSER", "MAX_DEPTH", "Node", "CORE", "PLAIN_WORDS", "resolve_plain"
 
 #: The YAML parser read by default: libyaml's ``CSafeLoader`` where PyYAML has it, else the pure ``SafeLoader``.
 PARSER = yaml.CSafeLoader if yaml.__with_libyaml__ else yaml.SafeLoader
-
-MAX_DEPTH = 32
-"""Deepest collection nesting accepted.  A valid grasp needs 4 (document,
-``contacts``, a contact, its ``point``); the margin lets mistyped nested
-values get their specific error instead of ``too-deep``."""
 
 
 class Node:

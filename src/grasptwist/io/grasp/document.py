@@ -40,9 +40,9 @@ _REQUIRED = tuple(key for section in SECTIONS for key in section.required)
 _NO_CONTACTS = readonly(np.full((3, 3), np.nan))
 
 
-def read_document(root, problems, *, file, document, name, line, reading, max_bytes):
+def read_document(root, problems, *, file, document, name, line, reading):
     """Check one document's node tree: its Grasp, or None when ``problems`` has any
-    (``reading`` and ``max_bytes``: how the files it names are read)."""
+    (``reading``: how the files it names are read)."""
     if root.kind == "scalar" and root.value is None:
         problems.add(Reject("empty-document", "", "empty document", **located(root)))
         return None
@@ -54,12 +54,12 @@ def read_document(root, problems, *, file, document, name, line, reading, max_by
         name = read_name(fields["name"], "name", problems)
     units = read_name(fields["units"], "units", problems) if "units" in fields else None
     wrist = read_vector(fields["wrist"], 3, "wrist", problems) if "wrist" in fields else None
-    found = {"file": file, "reading": reading, "max_bytes": max_bytes, "units": units}
+    found = {"file": file, "reading": reading, "units": units}
     for section in SECTIONS:
         found.update(section.read(fields, found, problems) or {})
     if problems.count:
         return None
-    for key in ("file", "reading", "max_bytes", "units"):
+    for key in ("file", "reading", "units"):
         del found[key]
     if "points" not in found:  # contacts not required of this reading: to be found (NaN)
         found.update(contact_names=CONTACT_NAMES, points=_NO_CONTACTS, normals=_NO_CONTACTS)

@@ -53,12 +53,12 @@ _INF = math.inf
 _ZERO = (0.0, 0.0, 0.0)
 
 
-def fast_document(get, keep, file, reading, max_bytes):
+def fast_document(get, keep, file, reading):
     """A plain valid document's ``Parts``, from the events after its start.
 
     ``get()`` gives the next event; each one read is passed to ``keep``.
     ``file`` is the grasp file's name (a URDF hand or a mesh is found from its
-    folder, read as ``reading`` and ``max_bytes`` say).
+    folder, read as ``reading`` says).
     """
     event = get()
     keep(event)
@@ -94,9 +94,7 @@ def fast_document(get, keep, file, reading, max_bytes):
         raise Bail
     parts = Parts(name, units, wrist, contacts, twists)
     if composed:
-        parts.sections = _sections(
-            composed, parts, {"file": file, "reading": reading, "max_bytes": max_bytes, "units": units}
-        )
+        parts.sections = _sections(composed, parts, {"file": file, "reading": reading, "units": units})
     return parts
 
 

@@ -30,7 +30,7 @@ def read_line(data, *, file, line, max_bytes=DEFAULT_MAX_BYTES, reading=READING)
     The line is one grasp document (JSON is YAML), checked as in a grasp
     file; positions count from the stream's start, an unnamed grasp is
     ``stem#line`` and ``document`` is ``line - 1``.  ``max_bytes`` caps the
-    line, not the stream (and each file a line names); ``reading`` as for
+    line, not the stream; ``reading`` as for
     :func:`~grasptwist.read_grasps`.
 
     >>> for error in read_line(b'{"contacts": []}', file="in.jsonl", line=7):
@@ -41,10 +41,7 @@ def read_line(data, *, file, line, max_bytes=DEFAULT_MAX_BYTES, reading=READING)
         text = _line_text(data, max_bytes)
     except Reject as reject:
         return [_on_line(reject.error(file, None), line)]
-    return [
-        _on_line(entry, line)
-        for entry in read_text(text, file, reading, name=f"{stem_name(file)}#{line}", max_bytes=max_bytes)
-    ]
+    return [_on_line(entry, line) for entry in read_text(text, file, reading, name=f"{stem_name(file)}#{line}")]
 
 
 def read_twist_line(data, *, file, line, max_bytes=DEFAULT_MAX_BYTES):

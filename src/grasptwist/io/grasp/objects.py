@@ -65,9 +65,9 @@ MESH_KEYS = ("file", "units", "scale")
 UNKNOWN_UNITS = "unknown-units"
 
 
-def read_object(node, file, reading, max_bytes, problems, warnings, units=None, hand=False):
+def read_object(node, file, reading, problems, warnings, units=None, hand=False):
     """The :class:`~grasptwist.model.GraspObject` of an ``object`` node (None after a problem);
-    a mesh is read from ``file``'s folder within ``max_bytes`` and ``reading``'s limits, in the
+    a mesh is read from ``file``'s folder within ``reading``'s limits, in the
     grasp file's ``units`` (a density weighs the volume through them).  A pose's rotation vector
     over pi adds its ``rotation-over-pi`` warning to ``warnings``, as a path's; a mesh whose size
     is unlikely in its unit, without a ``hand`` to compare with, ``mesh-size-unlikely``."""
@@ -106,7 +106,7 @@ def read_object(node, file, reading, max_bytes, problems, warnings, units=None, 
         if read is not None:
             pose[:3, 3], pose[:3, :3] = read[0], read[1]
             warnings += _radians(read[2])
-    shape = _shape(shapes[0], fields, file, reading, max_bytes, problems, units) if shapes else None
+    shape = _shape(shapes[0], fields, file, reading, problems, units) if shapes else None
     if shape is None or problems.count:
         return None
     pose.setflags(write=False)
@@ -166,11 +166,11 @@ def _radians(given) -> list:
     return [radians_warning(**given)] if rotation_over_pi(given["rotvec"]) else []
 
 
-def _shape(kind, fields, file, reading, max_bytes, problems, units=None):
+def _shape(kind, fields, file, reading, problems, units=None):
     """The :class:`~grasptwist.model.Shape` of the ``kind`` key (None after a problem)."""
     node, path = fields[kind], f"object.{kind}"
     if kind == "mesh":
-        return _mesh(node, fields.get("scale"), file, reading, max_bytes, problems, units)
+        return _mesh(node, fields.get("scale"), file, reading, problems, units)
     if kind == "box":
         size = read_vector(node, 3, path, problems)
         sizes = (
@@ -195,7 +195,7 @@ def _shape(kind, fields, file, reading, max_bytes, problems, units=None):
     return Shape(kind, readonly([value for value, _, _ in sizes]))
 
 
-def _mesh(node, scale_node, file, reading, max_bytes, problems, units=None):
+def _mesh(node, scale_node, file, reading, problems, units=None):
     """A mesh shape: its file read (:func:`grasptwist.io.mesh_file.read_mesh`), scaled by its own
     unit into the grasp file's (``mesh: {file, units}``) and by ``scale``."""
     if node.kind == "mapping":
@@ -231,7 +231,7 @@ def _mesh(node, scale_node, file, reading, max_bytes, problems, units=None):
         vertices, faces = read_mesh(
             reference,
             folder,
-            max_bytes=max_bytes,
+            max_bytes=reading.max_mesh_bytes,
             max_triangles=reading.max_triangles,
             allow_outside=reading.allow_outside,
             output=reading.output,
@@ -355,7 +355,6 @@ def _read(fields, found, problems):
         fields["object"],
         found["file"],
         found["reading"],
-        found["max_bytes"],
         problems,
         said,
         units=found.get("units"),

@@ -10,12 +10,9 @@ from __future__ import annotations
 import re
 
 from ...model import GraspFileError
+from ..limits import MAX_ERRORS
 
 __all__ = ["MAX_ERRORS", "Reject", "StreamStop", "Problems", "located", "located_mark", "join"]
-
-MAX_ERRORS = 100
-"""Most problems reported for one file (the first, in file order); one more
-``too-many-errors`` entry says how many were left out."""
 
 
 class Reject(Exception):

@@ -16,7 +16,7 @@ from pathlib import Path
 import yaml
 
 from ...model import GraspFileError
-from ..limits import DEFAULT_MAX_BYTES, MAX_TRIANGLES
+from ..limits import DEFAULT_MAX_BYTES, MAX_DOCUMENTS, MAX_MESH_BYTES, MAX_TRIANGLES
 from .compose import PARSER, compose, syntax_error
 from .document import read_document
 from .fast import Bail, Parts, fast_document
@@ -34,12 +34,6 @@ __all__ = [
     "check_surface_tol",
     "stem_name",
 ]
-
-MAX_DOCUMENTS = 10_000
-"""Most documents read from one file; the rest of a longer file is refused
-with one ``too-many-documents`` entry.  A grasp takes at least about 110
-bytes, so no valid file within the default size cap has this many; a file of
-``---`` lines would otherwise give one entry per 4 bytes."""
 
 
 @dataclass(frozen=True)
@@ -70,6 +64,9 @@ class Reading:
         file's folder (``--allow-outside``).
     max_triangles : int
         Most triangles of an object's mesh (see :data:`~grasptwist.io.limits.MAX_TRIANGLES`).
+    max_mesh_bytes : int
+        Most bytes of an object's mesh file, however it is named (see
+        :data:`~grasptwist.io.limits.MAX_MESH_BYTES`).
     contacts : bool
         Documents must give ``contacts`` (False: ``synthesize``'s, which finds its own; a document
         without them has NaN points and normals, contacts named ``1``, ``2``, ``3``).
@@ -85,6 +82,7 @@ class Reading:
     surface_tol: float | None = None
     allow_outside: bool = False
     max_triangles: int = MAX_TRIANGLES
+    max_mesh_bytes: int = MAX_MESH_BYTES
     contacts: bool = True
     output: tuple[int, int] | None = None
 
@@ -147,7 +145,7 @@ def read_grasps(
         text = file_text(source, is_content, max_bytes)
     except Reject as reject:
         return [reject.error(file, None)]
-    return read_text(text, file, reading, max_bytes=max_bytes)
+    return read_text(text, file, reading)
 
 
 def load_grasps(
@@ -238,11 +236,11 @@ def one_per_document(entries):
 # Stream -> grasps.
 
 
-def read_text(text, file, reading, name=None, max_bytes=DEFAULT_MAX_BYTES):
+def read_text(text, file, reading, name=None):
     """Parse ``text`` and turn each document into a Grasp or its errors, as it is read
     (an unnamed grasp called ``name`` if given; the files it names, such as meshes,
-    read within ``max_bytes``)."""
-    entries = _Entries(file, reading, name, max_bytes)
+    read within ``reading``'s limits)."""
+    entries = _Entries(file, reading, name)
     stop = None
     parser = reading.parser(text)
     get_event = parser.get_event
@@ -264,7 +262,7 @@ def read_text(text, file, reading, name=None, max_bytes=DEFAULT_MAX_BYTES):
             try:
                 if not reading.fast:
                     raise Bail
-                root = fast_document(get_event, events.append, file, reading, max_bytes)
+                root = fast_document(get_event, events.append, file, reading)
             except Bail:
                 # The general composer, from the document's first event.
                 problems = Problems(reading.max_errors - entries.reported)
@@ -287,10 +285,9 @@ class _Entries:
     document's grasp is named ``stem`` until a second document shows up.
     """
 
-    def __init__(self, file, reading, name=None, max_bytes=DEFAULT_MAX_BYTES):
+    def __init__(self, file, reading, name=None):
         self.file = file
         self.reading = reading
-        self.max_bytes = max_bytes
         self.max_errors = reading.max_errors
         self.name = name  # the default name, if not the file's stem
         self.entries = []
@@ -320,7 +317,6 @@ class _Entries:
                 name=self._default_name(document),
                 line=line,
                 reading=self.reading,
-                max_bytes=self.max_bytes,
             )
             if grasp is None:
                 first, covered = problems.first()
