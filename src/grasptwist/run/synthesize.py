@@ -175,15 +175,20 @@ def _inline_joints(hand, synthesis):
 
 def _mesh_grasp(path: str, job) -> Grasp | GraspFileError:
     """A mesh file as a grasp document with only its object (the command line gives the rest)."""
+    from ..io.grasp.objects import mesh_solid
+
     try:
-        vertices, faces = read_mesh(path, None, max_bytes=job.max_bytes or 64 * 2**20)
+        vertices, faces = read_mesh(path, None, max_bytes=job.max_bytes or 64 * 2**20, warnings=(repaired := []))
     except InputError as exc:
         return exc
     shape = Shape("mesh", np.zeros(0), vertices=vertices, faces=faces, source=path)
+    said = mesh_solid(shape, path, repaired)
+    if isinstance(said, InputError):
+        return said
     obj = GraspObject(shape, np.eye(4))
     name = os.path.splitext(os.path.basename(path))[0]
     p = np.full((3, 3), np.nan)  # no contacts: as a document read without them
-    return Grasp(name, None, path, 0, CONTACT_NAMES, p, p, None, (), 1, object=obj)
+    return Grasp(name, None, path, 0, CONTACT_NAMES, p, p, None, (), 1, object=obj, warnings=tuple(said))
 
 
 class Progress(NamedTuple):
@@ -220,7 +225,7 @@ def synthesize_inputs(job, inputs: Iterable) -> Iterator[GraspFileError | Found 
             reach, hand = hand if hand is not None else (None, None)
             yield Progress(o.candidates, 0)
             for step in search_steps(
-                surface_of(obj),
+                surface_of(obj, o.span_bodies),
                 wrenches,
                 friction,
                 count=o.count,
