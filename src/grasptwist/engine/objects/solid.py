@@ -16,8 +16,9 @@ union).
 The surface a finger may touch is the solid's outer boundary.  A face is tested just off each
 side, at :data:`SIDE_OFFSET` of the mesh's size: with the solid on one side it bounds it (wound
 to face away from the solid), on both sides it is internal (a face of a piece inside another
-piece), on neither it bounds nothing.  A face partly inside another piece is split into
-:math:`4^{`:data:`SPLIT_DEPTH`:math:`}` triangles, each kept or not by its centre.  A connected
+piece), on neither it bounds nothing.  A face partly inside another piece is split in four, and
+again where a part is partly inside, :data:`SPLIT_DEPTH` times, each part kept where it bounds the
+solid (at the last split, by its centre).  A connected
 part of that surface that encloses a negative volume (faces turned inwards, round a void) is a
 cavity, out of reach.  Connected pieces of the mesh that overlap or touch are one body.
 
@@ -50,9 +51,10 @@ __all__ = [
 #: off it: far above round-off (1e-16), far below any wall one would hold (1 mm of a 100 m object).
 SIDE_OFFSET = 1e-5
 
-#: A face partly inside another piece is split this many times in four (64 triangles), each kept
-#: by its centre: the outer surface follows the pieces' intersection to 1/8 of the face's size.
-SPLIT_DEPTH = 3
+#: A face partly inside another piece is split in four, and each part that is partly inside again,
+#: this many times; a part wholly outside is kept, and at the last split a part whose centre is: the
+#: outer surface follows the pieces' intersection to 1/64 of a face's size.
+SPLIT_DEPTH = 6
 
 #: The rays per side of the grid that integrates the solid's mass properties when the mesh is
 #: not one closed surface: the volume is then within about 3e-3 of the exact (overlapping boxes').
@@ -80,7 +82,7 @@ class Solid(NamedTuple):
     open_edges : int
         Edges of the given mesh in one face only.
     largest_hole : float
-        The size (diagonal of the bounding box) of the largest loop of open edges (0 closed).
+        The largest extent along an axis of the largest loop of open edges (0 closed).
     internal : int
         Faces of the given mesh with the solid on both sides, wholly.
     cavities : int
@@ -182,14 +184,14 @@ def _open(faces):
 
 
 def _hole_size(vertices, open_edges):
-    """The bounding-box diagonal of the largest loop of open edges (0 without)."""
+    """The largest extent (along x, y or z) of the largest loop of open edges (0 without): a round hole's diameter."""
     if not len(open_edges):
         return 0.0
     label = components(len(vertices), open_edges)[open_edges[:, 0]]
     sizes = []
     for loop in np.unique(label):
         corners = vertices[np.unique(open_edges[label == loop])]
-        sizes.append(float(np.linalg.norm(corners.max(axis=0) - corners.min(axis=0))))
+        sizes.append(float((corners.max(axis=0) - corners.min(axis=0)).max()))
     return max(sizes)
 
 
@@ -300,21 +302,27 @@ def _classify(v, f, piece, size, lo, hi):
     bound = front != back
     internal = (front & back).all(axis=1)
     loose = (~front & ~back).all(axis=1)
-    whole = bound.all(axis=1) & (back == back[:, :1]).all(axis=1)
-    mixed = ~whole & ~internal & ~loose
+    partners = _crossings(corners, piece, lo, hi)
+    crossed = np.zeros(len(f), dtype=bool)
+    crossed[partners[0]] = True
+    whole = bound.all(axis=1) & (back == back[:, :1]).all(axis=1) & ~crossed
+    mixed = ~whole & ~(internal & ~crossed) & ~(loose & ~crossed)
+    internal, loose = internal & ~crossed, loose & ~crossed
     # faces that bound the solid wholly, wound to face away from it
     kept = np.where(back[whole, 0][:, None], f[whole], f[whole][:, ::-1])
     pieces = [v[kept]]
     owner = [piece[whole]]
-    if mixed.any():
-        small = _split(corners[mixed], SPLIT_DEPTH)
+    small, mine, parent = corners[mixed], piece[mixed], np.flatnonzero(mixed)
+    for level in range(SPLIT_DEPTH):  # the faces another piece crosses, split where it does
+        small, mine, parent = _split(small, 1), np.repeat(mine, 4), np.repeat(parent, 4)
         n = np.cross(small[:, 1] - small[:, 0], small[:, 2] - small[:, 0])
         n /= np.linalg.norm(n, axis=1, keepdims=True)
         fr, bk = _inside(v, f, small.mean(axis=1)[:, None], n[:, None], offset)
-        keep = (fr != bk)[:, 0]
-        small = np.where(bk[:, :1, None], small, small[:, ::-1])[keep]
-        pieces.append(small)
-        owner.append(np.repeat(piece[mixed], 4**SPLIT_DEPTH)[keep])
+        crossed = _crossed(small, parent, corners, partners) if level < SPLIT_DEPTH - 1 else np.zeros(len(small), bool)
+        take = ~crossed & (fr != bk)[:, 0]
+        pieces.append(np.where(bk[take, :1, None], small[take], small[take][:, ::-1]))
+        owner.append(mine[take])
+        small, mine, parent = small[crossed], mine[crossed], parent[crossed]
     # the source: the faces that bound the solid wound outwards, the others as given
     source = f.copy()
     source[whole] = kept
@@ -341,6 +349,62 @@ def _classify(v, f, piece, size, lo, hi):
         source,
         bool(whole.all()),
     )
+
+
+def _segments_cross(p, q, tri):
+    """Whether the segments ``p -> q (N, 3)`` pass through the triangles ``tri (N, 3, 3)``, strictly inside both."""
+    a, b, c = tri[:, 0], tri[:, 1], tri[:, 2]
+    n = np.cross(b - a, c - a)
+    dp = np.einsum("ij,ij->i", p - a, n)
+    dq = np.einsum("ij,ij->i", q - a, n)
+    meets = dp * dq < 0  # strictly: an edge in another face's plane, or ending on it, is the probes' to judge
+    x = p + (dp / np.where(meets, dp - dq, 1.0))[:, None] * (q - p)
+    for u, w in ((a, b), (b, c), (c, a)):
+        meets &= np.einsum("ij,ij->i", np.cross(w - u, x - u), n) > 0
+    return meets
+
+
+def _triangles_cross(t, s):
+    """Whether the triangles ``t (N, 3, 3)`` and ``s (N, 3, 3)`` cross (an edge of one through the other)."""
+    out = np.zeros(len(t), dtype=bool)
+    for i, j in ((0, 1), (1, 2), (2, 0)):
+        out |= _segments_cross(t[:, i], t[:, j], s) | _segments_cross(s[:, i], s[:, j], t)
+    return out
+
+
+def _crossings(corners, piece, lo, hi, chunk=1_000_000):
+    """The pairs of faces of different pieces that cross: ``(2, K)`` int, each pair both ways, sorted by the first."""
+    count = len(lo)
+    flo, fhi = corners.min(axis=1), corners.max(axis=1)
+    found = []
+    for i in range(count):
+        for j in range(i + 1, count):
+            if not ((lo[i] <= hi[j]).all() and (lo[j] <= hi[i]).all()):
+                continue
+            a = np.flatnonzero((piece == i) & (flo <= hi[j]).all(axis=1) & (fhi >= lo[j]).all(axis=1))
+            b = np.flatnonzero((piece == j) & (flo <= hi[i]).all(axis=1) & (fhi >= lo[i]).all(axis=1))
+            for start in range(0, len(a), max(1, chunk // max(len(b), 1))):
+                pa = np.repeat(a[start : start + max(1, chunk // max(len(b), 1))], len(b))
+                pb = np.tile(b, len(pa) // max(len(b), 1))
+                meet = (flo[pa] <= fhi[pb]).all(axis=1) & (flo[pb] <= fhi[pa]).all(axis=1)
+                pa, pb = pa[meet], pb[meet]
+                hit = _triangles_cross(corners[pa], corners[pb])
+                found.append(np.stack([pa[hit], pb[hit]]))
+    pairs = np.concatenate([np.zeros((2, 0), np.int64), *found, *(x[::-1] for x in found)], axis=1)
+    return pairs[:, np.argsort(pairs[0], kind="stable")]
+
+
+def _crossed(small, parent, corners, partners):
+    """Whether each part ``small (K, 3, 3)`` of face ``parent (K,)`` crosses a face that crosses its parent."""
+    first, count = np.unique(partners[0], return_index=True)[1], np.bincount(partners[0], minlength=len(corners))
+    start = np.zeros(len(corners), dtype=np.int64)
+    start[partners[0][first]] = first
+    k = count[parent]
+    row = np.repeat(np.arange(len(small)), k)
+    other = partners[1][np.repeat(start[parent], k) + np.arange(len(row)) - np.repeat(np.cumsum(k) - k, k)]
+    out = np.zeros(len(small), dtype=bool)
+    np.logical_or.at(out, row, _triangles_cross(small[row], corners[other]))
+    return out
 
 
 def _inside(v, f, points, normals, offset):
