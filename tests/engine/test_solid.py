@@ -157,7 +157,7 @@ def test_a_mesh_file_warns_what_it_is():
 
     assert said("two_bodies.obj") == (
         "mesh-bodies: two_bodies.obj: the mesh is 2 bodies, 0.02 apart at the least: "
-        "a synthesized grasp keeps to one (span_bodies to span them)",
+        "a synthesized grasp keeps to one (--span-bodies, span_bodies=True: across them)",
     )
     assert said("overlapping_boxes.obj") == (
         "mesh-internal: overlapping_boxes.obj: 4 faces inside the solid and 0 cavities: out of a finger's reach",

@@ -84,6 +84,7 @@ class Found:
     joints_at: tuple | None = None  # an inline hand's joints at each grasp: per finger (screws (n, 6), points (n, 3))
     twists: tuple = ()  # the input's twists and paths, written with each grasp found (-o FILE.yaml)
     paths: tuple = ()
+    warnings: tuple = ()  # the input's, as read (a mesh's: mesh-repaired, mesh-open, mesh-bodies)
 
     def __len__(self) -> int:
         return len(self.synthesis.points)
@@ -262,6 +263,7 @@ def synthesize_inputs(job, inputs: Iterable) -> Iterator[GraspFileError | Found 
                 joints_at=_inline_joints(hand, step),
                 twists=entry.twists,
                 paths=entry.paths,
+                warnings=entry.warnings,
             )
         yield Progress(0, 1)
 
@@ -335,11 +337,12 @@ def synthesize_outputs(job, inputs: Iterable, w, workers: int = 1, tuning=None) 
 
 
 def _unchecked(job, found) -> list[str]:
-    """Warnings of an object, once each: an option that does not apply to it.  The off-tangent
+    """Warnings of an object, once each: its mesh's as read (``mesh-repaired``, ``mesh-open``,
+    ``mesh-internal``, ``mesh-bodies``), an option that does not apply to it.  The off-tangent
     method asked without a wrist (its conditioning cannot be checked: the tangent method's alone
     is), ``--tip-radius`` without a hand (no fingertip to size: the contacts are points)."""
     where = f"{escaped(found.file)}: grasp '{escaped(found.name)}': warning:"
-    said = []
+    said = [f"{where} {escaped(w)}" for w in found.warnings if w.startswith("mesh-")]
     if found.wrist is None and job.options.method in ("off-tangent", "both"):
         said.append(f"{where} off-tangent conditioning not checked without a wrist (a grasp file's 'wrist')")
     if job.options.tip_radius is not None and found.hand is None:

@@ -575,7 +575,7 @@ def solid_warnings(s: Solid, scale: float = 1.0) -> list:
     >>> from grasptwist.engine.objects.primitives import triangles
     >>> v, f = triangles("box", [1.0, 1.0, 1.0], 0)
     >>> solid_warnings(solid(np.concatenate([v, v + [3, 0, 0]]), np.concatenate([f, f + len(v)])))
-    ['mesh-bodies: the mesh is 2 bodies, 2 apart at the least: a synthesized grasp keeps to one (span_bodies to span them)']
+    ['mesh-bodies: the mesh is 2 bodies, 2 apart at the least: a synthesized grasp keeps to one (--span-bodies, span_bodies=True: across them)']
     """
     said = []
     if s.open_edges:
@@ -591,6 +591,6 @@ def solid_warnings(s: Solid, scale: float = 1.0) -> list:
     if s.bodies > 1:
         said.append(
             f"mesh-bodies: the mesh is {s.bodies} bodies, {s.gap * scale:.3g} apart at the least: "
-            "a synthesized grasp keeps to one (span_bodies to span them)"
+            "a synthesized grasp keeps to one (--span-bodies, span_bodies=True: across them)"
         )
     return said
