@@ -228,13 +228,13 @@ def mass_properties(obj: GraspObject) -> MassProperties:
     return MassProperties(volume, mass, rotation @ centroid + obj.pose[:3, 3], inertia)
 
 
-def sample_surface(obj: GraspObject, n: int, rng: np.random.Generator, body=None) -> tuple[np.ndarray, np.ndarray]:
+def sample_surface(obj: GraspObject, n: int, rng: np.random.Generator, *, body=None) -> tuple[np.ndarray, np.ndarray]:
     """``n`` points uniformly distributed over the object's surface (by area), with the inward normals there.
 
     The same generator state gives the same points (``primitives.sample`` and
     ``mesh.sample`` in ``grasptwist.engine.objects`` say how they are drawn).  A mesh's points
     are on its solid's outer surface (never on a face inside it, nor round a cavity); ``body``
-    (an int, a mesh's only) draws them from that body alone (:func:`bodies`).
+    (an int, a mesh's only) draws them from that body alone (``geometry.body_areas`` lists them).
 
     Returns
     -------
@@ -251,7 +251,7 @@ def sample_surface(obj: GraspObject, n: int, rng: np.random.Generator, body=None
     """
     shape = obj.shape
     if shape.kind == "mesh":
-        points, outward = mesh.sample(shape, n, rng, body)
+        points, outward = mesh.sample(shape, n, rng, body=body)
     else:
         points, outward = primitives.sample(shape.kind, check_size(shape.kind, shape.size), n, rng)
     rotation, translation = obj.pose[:3, :3], obj.pose[:3, 3]

@@ -85,7 +85,7 @@ def mass_moments(shape: Shape) -> tuple[float, np.ndarray, np.ndarray]:
     return volume, centroid, second - volume * np.outer(centroid, centroid)
 
 
-def sample(shape: Shape, n: int, rng: np.random.Generator, body=None) -> tuple[np.ndarray, np.ndarray]:
+def sample(shape: Shape, n: int, rng: np.random.Generator, *, body=None) -> tuple[np.ndarray, np.ndarray]:
     r"""``n`` points uniformly distributed over the solid's outer surface (by area) and the outward normals of their faces.
 
     A face is drawn with probability proportional to its area, then a point

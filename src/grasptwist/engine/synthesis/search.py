@@ -674,7 +674,7 @@ def surface_of(obj, span_bodies=False) -> Surface:
         return Surface(partial(sample_surface, obj), partial(project_to_surface, obj), object_size(obj))
 
     def sample(n, rng):
-        return sample_surface(obj, n, rng, int(rng.choice(len(areas), p=areas / areas.sum())))
+        return sample_surface(obj, n, rng, body=int(rng.choice(len(areas), p=areas / areas.sum())))
 
     return Surface(sample, partial(project_to_surface, obj), object_size(obj), partial(body_of, obj))
 
@@ -746,7 +746,7 @@ def synthesize(
         command line checks a URDF's meshes).
     span_bodies : bool
         Let a grasp's contacts lie on different bodies of the object (a mesh's pieces apart);
-        by default each grasp keeps to one (:func:`surface_of`).
+        by default each grasp keeps to one (``grasptwist.engine.synthesis.search.surface_of``).
     **options
         The search's keyword options: ``count`` (grasps wanted, 1), ``safety`` (1), ``objective``
         (``total_normal_force``, ``closure_friction`` or ``epsilon``), ``wrist`` (None),
