@@ -70,7 +70,8 @@ def mass_moments(shape: Shape) -> tuple[float, np.ndarray, np.ndarray]:
 
     By the divergence theorem when the mesh is one closed surface
     (:func:`~.solid.surface_moments`, needs no libigl), else along rays through the solid
-    (:func:`~.solid.moments`).  A uniform solid of density :math:`\rho` has its inertia
+    (:func:`~.solid.moments`: counting the crossings where each piece is closed, by the winding
+    number where the mesh is open).  A uniform solid of density :math:`\rho` has its inertia
     tensor :math:`\rho\,(\operatorname{tr}(J) I - J)` about :math:`c`.
 
     >>> from grasptwist.engine.objects.primitives import triangles
@@ -80,7 +81,10 @@ def mass_moments(shape: Shape) -> tuple[float, np.ndarray, np.ndarray]:
     (6.0, [1.0, 1.0, 1.0], [0.5, 2.0, 4.5])
     """
     s = _derived(shape).solid
-    volume, first, second = surface_moments(*s.source) if s.closed else moments(s.source, closed=not s.open_edges)
+    if s.closed:
+        volume, first, second = surface_moments(*s.source)
+    else:
+        volume, first, second = moments(s.source, closed=not s.open_edges)
     centroid = first / volume
     return volume, centroid, second - volume * np.outer(centroid, centroid)
 

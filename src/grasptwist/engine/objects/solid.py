@@ -37,6 +37,7 @@ from ...extras import require
 __all__ = [
     "SIDE_OFFSET",
     "SPLIT_DEPTH",
+    "SPLIT_PARTS",
     "MOMENT_RAYS",
     "Solid",
     "solid",
@@ -51,18 +52,19 @@ __all__ = [
 #: off it: far above round-off (1e-16), far below any wall one would hold (1 mm of a 100 m object).
 SIDE_OFFSET = 1e-5
 
-#: A face partly inside another piece is split in four, and each part that is partly inside again,
-#: this many times; a part wholly outside is kept, and at the last split a part whose centre is: the
-#: outer surface follows the pieces' intersection to 1/64 of a face's size.
+#: A face another piece crosses is split in four, and each part that it crosses again, at most
+#: this many times; a part outside is kept, and at the last split a part whose centre is: the outer
+#: surface follows the pieces' intersection to 1/64 of a face's size.
 SPLIT_DEPTH = 6
+
+#: The splitting stops sooner (the parts at that depth kept by their centres) where its next
+#: depth would hold more parts than this or twice the mesh's faces (a mesh of many pieces that
+#: cross along long curves): the time stays a few times the probes' of the faces themselves.
+SPLIT_PARTS = 20_000
 
 #: The rays per side of the grid that integrates the solid's mass properties when the mesh is
 #: not one closed surface: the volume is then within about 3e-3 of the exact (overlapping boxes').
 MOMENT_RAYS = 128
-
-#: Barycentric coordinates of the points where a face's sides are tested: its centre and three
-#: points towards its corners.
-_PROBES = np.array([[1 / 3, 1 / 3, 1 / 3], [2 / 3, 1 / 6, 1 / 6], [1 / 6, 2 / 3, 1 / 6], [1 / 6, 1 / 6, 2 / 3]])
 
 
 class Solid(NamedTuple):
@@ -295,50 +297,53 @@ def _classify(v, f, piece, size, lo, hi):
     """The outer surface of a mesh that is not one closed surface of pieces apart (module docstring)."""
     offset = SIDE_OFFSET * size
     corners = v[f]
-    normals = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
-    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
-    probes = np.einsum("pk,fkj->fpj", _PROBES, corners)  # (F, 4, 3)
-    front, back = _inside(v, f, probes, normals[:, None], offset)
-    bound = front != back
-    internal = (front & back).all(axis=1)
-    loose = (~front & ~back).all(axis=1)
     partners = _crossings(corners, piece, lo, hi)
     crossed = np.zeros(len(f), dtype=bool)
     crossed[partners[0]] = True
-    whole = bound.all(axis=1) & (back == back[:, :1]).all(axis=1) & ~crossed
-    mixed = ~whole & ~(internal & ~crossed) & ~(loose & ~crossed)
-    internal, loose = internal & ~crossed, loose & ~crossed
+    # a face no other piece crosses is wholly on one side of each: its centre tells
+    front, back = _inside(v, f, corners.mean(axis=1)[:, None], _normals(corners)[:, None], offset)
+    front, back = front[:, 0], back[:, 0]
+    whole = (front != back) & ~crossed
+    internal = front & back & ~crossed
+    loose = ~front & ~back & ~crossed
     # faces that bound the solid wholly, wound to face away from it
-    kept = np.where(back[whole, 0][:, None], f[whole], f[whole][:, ::-1])
+    kept = np.where(back[whole][:, None], f[whole], f[whole][:, ::-1])
     pieces = [v[kept]]
     owner = [piece[whole]]
-    small, mine, parent = corners[mixed], piece[mixed], np.flatnonzero(mixed)
+    small, mine, parent = corners[crossed], piece[crossed], np.flatnonzero(crossed)
     for level in range(SPLIT_DEPTH):  # the faces another piece crosses, split where it does
         small, mine, parent = _split(small, 1), np.repeat(mine, 4), np.repeat(parent, 4)
-        n = np.cross(small[:, 1] - small[:, 0], small[:, 2] - small[:, 0])
-        n /= np.linalg.norm(n, axis=1, keepdims=True)
-        fr, bk = _inside(v, f, small.mean(axis=1)[:, None], n[:, None], offset)
-        crossed = _crossed(small, parent, corners, partners) if level < SPLIT_DEPTH - 1 else np.zeros(len(small), bool)
-        take = ~crossed & (fr != bk)[:, 0]
+        fr, bk = _inside(v, f, small.mean(axis=1)[:, None], _normals(small)[:, None], offset)
+        last = level == SPLIT_DEPTH - 1 or 4 * len(small) > max(SPLIT_PARTS, 2 * len(f))
+        again = _crossed(small, parent, corners, partners) if not last else np.zeros(len(small), bool)
+        take = ~again & (fr != bk)[:, 0]
         pieces.append(np.where(bk[take, :1, None], small[take], small[take][:, ::-1]))
         owner.append(mine[take])
-        small, mine, parent = small[crossed], mine[crossed], parent[crossed]
+        small, mine, parent = small[again], mine[again], parent[again]
+        if last:
+            break
     # the source: the faces that bound the solid wound outwards, the others as given
     source = f.copy()
     source[whole] = kept
-    triangles = np.concatenate(pieces)
     owner = np.concatenate(owner)
-    outer_v, index = np.unique(triangles.reshape(-1, 3), axis=0, return_inverse=True)
+    outer_v, index = np.unique(np.concatenate(pieces).reshape(-1, 3), axis=0, return_inverse=True)
     outer_f = index.reshape(-1, 3)
-    # cavities: connected parts of the boundary enclosing a negative volume
+    # cavities: closed parts of the boundary enclosing a negative volume
     part = _face_components(outer_f, len(outer_v)) if len(outer_f) else np.zeros(0, np.int64)
-    parts = int(part.max()) + 1 if len(part) else 0
-    cavity = np.array([_signed_volume(outer_v, outer_f[part == p]) < 0 for p in range(parts)], dtype=bool)
-    reach = ~cavity[part] if parts else np.zeros(0, dtype=bool)
-    body = _bodies(v, f, piece, lo, hi, offset)[owner[reach]]
+    cavity = np.array(
+        [
+            _open(outer_f[part == p])[0] and _signed_volume(outer_v, outer_f[part == p]) < 0
+            for p in range(part.max() + 1)
+        ]
+        if len(part)
+        else [],
+        dtype=bool,
+    )
+    reach = ~cavity[part] if len(part) else np.zeros(0, dtype=bool)
+    joined = np.unique(piece[partners.T], axis=0) if partners.size else np.zeros((0, 2), np.int64)
+    body = _bodies(v, f, piece, lo, hi, offset, joined)[owner[reach]]
     _, body = np.unique(body, return_inverse=True)
-    outer_f = outer_f[reach]
-    used, remap = np.unique(outer_f, return_inverse=True)
+    used, remap = np.unique(outer_f[reach], return_inverse=True)
     return (
         outer_v[used],
         remap.reshape(-1, 3),
@@ -349,6 +354,12 @@ def _classify(v, f, piece, size, lo, hi):
         source,
         bool(whole.all()),
     )
+
+
+def _normals(corners):
+    """The unit normals ``(F, 3)`` of the triangles ``corners (F, 3, 3)``."""
+    n = np.cross(corners[:, 1] - corners[:, 0], corners[:, 2] - corners[:, 0])
+    return n / np.linalg.norm(n, axis=1, keepdims=True)
 
 
 def _segments_cross(p, q, tri):
@@ -416,13 +427,16 @@ def _inside(v, f, points, normals, offset):
     return (w[: len(front)] > 0.5).reshape(shape), (w[len(front) :] > 0.5).reshape(shape)
 
 
-def _bodies(v, f, piece, lo, hi, offset):
-    """Each piece's body: pieces whose boxes meet and that touch (a vertex within ``offset`` of the
-    other's surface) or overlap (a vertex inside the other) are one."""
+def _bodies(v, f, piece, lo, hi, offset, joined):
+    """Each piece's body: pieces that cross (``joined (K, 2)``), or whose boxes meet and that touch (a
+    vertex within ``offset`` of the other's surface) or overlap (a vertex inside the other) are one."""
     count = int(piece.max()) + 1
-    pairs = []
+    pairs = [tuple(p) for p in joined.tolist()]
+    known = set(pairs)
     for i in range(count):
         for j in range(i + 1, count):
+            if (i, j) in known:
+                continue
             if (lo[i] <= hi[j] + offset).all() and (lo[j] <= hi[i] + offset).all() and _meet(v, f, piece, i, j, offset):
                 pairs.append((i, j))
     return components(count, np.array(pairs, dtype=np.int64).reshape(-1, 2))
@@ -458,18 +472,26 @@ def _gap(v, f, body, bodies):
     return least
 
 
+#: Where each line of :func:`moments` passes in its cell, off the centre by these fractions of the
+#: cell's sides (x, y): never through a vertex or an edge laid on the grid's diagonals, and a
+#: shift of the midpoint rule far below its own error.
+_JITTER = np.array([2**0.5, 3**0.5]) * 1e-3
+
+
 def moments(source, rays: int = MOMENT_RAYS, closed: bool = False) -> tuple[float, np.ndarray, np.ndarray]:
     r"""The volume, first moment ``(3,)`` and second moment ``(3, 3)`` of the solid :math:`w > 1/2` of the mesh
     ``source = (vertices, faces)``: :math:`\int dV, \int x\, dV, \int x x^T dV`.
 
-    Integrated along ``rays x rays`` lines parallel to z through the centres of a grid over the
-    bounding box: each line crosses the faces (and the box's bottom and top) at heights :math:`z_k`; between two crossings the
-    winding number is constant, and the stretch is solid when it is above 1/2 at its middle.  Along
-    a line the integrals are exact (:math:`\int_a^b z^k dz`); across the lines, the midpoint rule
-    (with :math:`h^2/12` for the squares of x and y over a cell of side :math:`h`): the error is of the
-    order of the cell's side over the object's (a box's wall between two lines), 3e-3 at 128 rays.
-    ``closed``: every edge of the mesh is in two faces (pieces each closed, overlapping or not), so
-    that outside the first and last crossing a line is out of the solid.
+    Integrated along ``rays x rays`` lines parallel to z through a grid over the bounding box
+    (near the cells' centres): each line crosses the faces (and the box's bottom and top) at
+    heights :math:`z_k`; between two crossings the winding number is constant, and the stretch is
+    solid when it is above 1/2.  ``closed`` (every edge of the mesh in two faces: pieces each
+    closed, overlapping or not): the winding number counts the crossings from below, +1 through a
+    face turned down, -1 through one turned up; else it is evaluated at the stretch's middle.
+    Along a line the integrals are exact (:math:`\int_a^b z^k dz`); across the lines, the midpoint
+    rule (with :math:`h^2/12` for the squares of x and y over a cell of side :math:`h`): the error
+    is of the order of the cell's side over the object's (a box's wall between two lines), 3e-3 at
+    128 rays.
 
     >>> from grasptwist.engine.objects.primitives import triangles
     >>> v, f = triangles("box", [1.0, 2.0, 3.0], 0)
@@ -486,37 +508,45 @@ def moments(source, rays: int = MOMENT_RAYS, closed: bool = False) -> tuple[floa
     upright = np.abs(det) > 0  # a face along z crosses no line in its plane (to round-off)
     a, b, c, det = a[upright], b[upright], c[upright], det[upright]
     tri = np.stack([a, b, c], axis=1)
-    first_cell = np.clip(np.ceil((tri[:, :, :2].min(axis=1) - lo[:2]) / h - 0.5), 0, rays - 1).astype(np.int64)
-    last_cell = np.clip(np.floor((tri[:, :, :2].max(axis=1) - lo[:2]) / h - 0.5), 0, rays - 1).astype(np.int64)
+    shift = 0.5 + _JITTER
+    first_cell = np.clip(np.ceil((tri[:, :, :2].min(axis=1) - lo[:2]) / h - shift), 0, rays - 1).astype(np.int64)
+    last_cell = np.clip(np.floor((tri[:, :, :2].max(axis=1) - lo[:2]) / h - shift), 0, rays - 1).astype(np.int64)
     span = np.maximum(last_cell - first_cell + 1, 0)
     per = span[:, 0] * span[:, 1]
     face = np.repeat(np.arange(len(tri)), per)
     k = np.arange(len(face)) - np.repeat(np.cumsum(per) - per, per)
     ix = first_cell[face, 0] + k % np.maximum(span[face, 0], 1)
     iy = first_cell[face, 1] + k // np.maximum(span[face, 0], 1)
-    x = lo[0] + (ix + 0.5) * h[0]
-    y = lo[1] + (iy + 0.5) * h[1]
+    x = lo[0] + (ix + shift[0]) * h[0]
+    y = lo[1] + (iy + shift[1]) * h[1]
     pa, pb, pc, d = a[face], b[face], c[face], det[face]
     l1 = ((x - pa[:, 0]) * (pc[:, 1] - pa[:, 1]) - (pc[:, 0] - pa[:, 0]) * (y - pa[:, 1])) / d
     l2 = ((pb[:, 0] - pa[:, 0]) * (y - pa[:, 1]) - (x - pa[:, 0]) * (pb[:, 1] - pa[:, 1])) / d
-    tol = 1e-12
-    hit = (l1 >= -tol) & (l2 >= -tol) & (l1 + l2 <= 1 + tol)
+    hit = (l1 >= 0) & (l2 >= 0) & (l1 + l2 <= 1)
     z = (pa[:, 2] + l1 * (pb[:, 2] - pa[:, 2]) + l2 * (pc[:, 2] - pa[:, 2]))[hit]
     ray = (iy * rays + ix)[hit]
+    step = -np.sign(d[hit])  # through a face turned down (its normal's z < 0) going up: into the solid
     if not closed:  # each line also ends at the box's bottom and top: through a hole it crosses one face only
         every = np.arange(rays * rays)
         z = np.concatenate([z, np.full(len(every), lo[2]), np.full(len(every), hi[2])])
         ray = np.concatenate([ray, every, every])
+        step = np.concatenate([step, np.zeros(2 * len(every))])
     order = np.lexsort((z, ray))
-    z, ray = z[order], ray[order]
+    z, ray, step = z[order], ray[order], step[order]
     stretch = np.flatnonzero(ray[1:] == ray[:-1])
     z0, z1, line = z[stretch], z[stretch + 1], ray[stretch]
-    long = z1 > z0
-    z0, z1, line = z0[long], z1[long], line[long]
-    lx = lo[0] + (line % rays + 0.5) * h[0]
+    lx = lo[0] + (line % rays + 0.5) * h[0]  # the cell's centre: its line passes just off it
     ly = lo[1] + (line // rays + 0.5) * h[1]
-    mid = np.stack([lx, ly, 0.5 * (z0 + z1)], axis=1)
-    solidly = winding_number(v, f, mid) > 0.5
+    if closed:
+        count = np.cumsum(step)
+        start = np.flatnonzero(np.r_[True, ray[1:] != ray[:-1]])
+        below = np.repeat(count[start] - step[start], np.diff(np.r_[start, len(ray)]))
+        solidly = (count - below)[stretch] > 0.5
+    else:
+        long = z1 > z0
+        solidly = np.zeros(len(z0), dtype=bool)
+        mid = np.stack([lx[long] + _JITTER[0] * h[0], ly[long] + _JITTER[1] * h[1], 0.5 * (z0 + z1)[long]], axis=1)
+        solidly[long] = winding_number(v, f, mid) > 0.5
     z0, z1, lx, ly = z0[solidly], z1[solidly], lx[solidly], ly[solidly]
     cell = h[0] * h[1]
     m0 = cell * (z1 - z0)
