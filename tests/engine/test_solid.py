@@ -1,6 +1,7 @@
 """The solid a mesh bounds (issue 35): the meshes of tests/meshes/make_meshes.py, each against its exact solid
 and an independent count of winding numbers; closed meshes against trimesh (the divergence theorem)."""
 
+import functools
 import sys
 from pathlib import Path
 
@@ -26,9 +27,15 @@ from grasptwist.model import GraspObject, Shape  # noqa: E402
 from grasptwist.objects import check_object  # noqa: E402
 
 
-def mesh_object(name, **kw):
+@functools.cache
+def checked_shape(name):
+    """The mesh file's shape, checked once for every test (its solid and mass kept with it)."""
     v, f = read_mesh(name, MESHES_DIR)
-    return check_object(GraspObject(Shape("mesh", np.zeros(0), v, f, name), np.eye(4), **kw))
+    return check_object(GraspObject(Shape("mesh", np.zeros(0), v, f, name), np.eye(4))).shape
+
+
+def mesh_object(name, **kw):
+    return GraspObject(checked_shape(name), np.eye(4), **kw)
 
 
 def test_the_meshes_on_disk_are_the_scripts():
@@ -52,7 +59,7 @@ def test_volume_and_centre_agree_with_a_monte_carlo_count_of_winding_numbers(nam
     o = mesh_object(name, density=1.0)
     v, f = o.shape.vertices, o.shape.faces
     lo, hi = v.min(axis=0), v.max(axis=0)
-    q = np.random.default_rng(7).uniform(lo, hi, (40000, 3))
+    q = np.random.default_rng(7).uniform(lo, hi, (20000, 3))  # a volume to some 0.4 %
     inside = winding_number(v, f, q) > 0.5
     volume = inside.mean() * np.prod(hi - lo)
     m = mass_properties(o)
@@ -76,7 +83,7 @@ def test_a_primitives_inertia_is_its_closed_form_and_its_tessellations():
     box = mass_properties(GraspObject(Shape("box", np.array([1.0, 2.0, 3.0])), np.eye(4), mass=6.0))
     np.testing.assert_allclose(box.inertia, trimesh.creation.box((1, 2, 3)).moment_inertia, atol=1e-12)
     for kind, size in (("sphere", [0.5]), ("cylinder", [0.3, 1.0]), ("capsule", [0.3, 1.0])):
-        fine = gt.objects.tessellate(GraspObject(Shape(kind, np.array(size)), np.eye(4)), segments=256)
+        fine = gt.objects.tessellate(GraspObject(Shape(kind, np.array(size)), np.eye(4)), segments=128)
         o = check_object(GraspObject(Shape("mesh", np.zeros(0), *fine), np.eye(4), density=1.0))
         ours = mass_properties(GraspObject(Shape(kind, np.array(size)), np.eye(4), density=1.0))
         np.testing.assert_allclose(ours.inertia, mass_properties(o).inertia, rtol=2e-3, atol=1e-12)
@@ -185,3 +192,15 @@ def test_a_synthesized_grasp_keeps_to_one_body_unless_told():
     s = gt.synthesize(o, 0.8, count=3, candidates=1500)
     bodies = body_of(o, s.points)
     assert len(s.points) and (bodies == bodies[:, :1]).all()
+
+
+def test_span_bodies_draws_from_every_body_and_one_body_from_one():
+    from grasptwist.engine.synthesis.search import surface_of
+
+    o = mesh_object("two_bodies.obj")
+    rng = np.random.default_rng(3)
+    spanning = surface_of(o, span_bodies=True)
+    assert spanning.body is None and set(body_of(o, spanning.sample(200, rng)[0]).tolist()) == {0, 1}
+    one = surface_of(o)
+    for _ in range(5):  # each call's points on one body
+        assert len(set(one.body(one.sample(50, rng)[0]).tolist())) == 1

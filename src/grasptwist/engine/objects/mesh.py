@@ -80,13 +80,14 @@ def mass_moments(shape: Shape) -> tuple[float, np.ndarray, np.ndarray]:
     >>> round(volume, 12), centroid.round(12).tolist(), np.diag(second).round(12).tolist()
     (6.0, [1.0, 1.0, 1.0], [0.5, 2.0, 4.5])
     """
-    s = _derived(shape).solid
-    if s.closed:
-        volume, first, second = surface_moments(*s.source)
-    else:
-        volume, first, second = moments(s.source, closed=not s.open_edges)
-    centroid = first / volume
-    return volume, centroid, second - volume * np.outer(centroid, centroid)
+    d = _derived(shape)
+    if d.moments is None:  # kept with the shape: the rays through an open mesh take a while
+        s = d.solid
+        volume, first, second = surface_moments(*s.source) if s.closed else moments(s.source, closed=not s.open_edges)
+        centroid = first / volume
+        d.moments = volume, centroid, second - volume * np.outer(centroid, centroid)
+    volume, centroid, second = d.moments
+    return volume, centroid.copy(), second.copy()
 
 
 def sample(shape: Shape, n: int, rng: np.random.Generator, *, body=None) -> tuple[np.ndarray, np.ndarray]:
@@ -175,6 +176,7 @@ class _Derived:
         self.vertices = np.ascontiguousarray(v, dtype=float)
         self.faces = np.ascontiguousarray(f, dtype=np.int64)
         self._tree = None
+        self.moments = None  # mass_moments's, when first asked
 
     def nearest_faces(self, q):
         """libigl's answer for the points ``q (N, 3)``: the nearest face of each and the nearest point on it."""

@@ -64,6 +64,8 @@ SPLIT_PARTS = 20_000
 
 #: The rays per side of the grid that integrates the solid's mass properties when the mesh is
 #: not one closed surface: the volume is then within about 3e-3 of the exact (overlapping boxes').
+#: An open mesh, whose winding number is evaluated once a stretch of each ray, takes 3/4 of them
+#: (96: the open cylinder's volume within 1.4e-3 in half the time).
 MOMENT_RAYS = 128
 
 
@@ -478,11 +480,11 @@ def _gap(v, f, body, bodies):
 _JITTER = np.array([2**0.5, 3**0.5]) * 1e-3
 
 
-def moments(source, rays: int = MOMENT_RAYS, closed: bool = False) -> tuple[float, np.ndarray, np.ndarray]:
+def moments(source, rays: int | None = None, closed: bool = False) -> tuple[float, np.ndarray, np.ndarray]:
     r"""The volume, first moment ``(3,)`` and second moment ``(3, 3)`` of the solid :math:`w > 1/2` of the mesh
     ``source = (vertices, faces)``: :math:`\int dV, \int x\, dV, \int x x^T dV`.
 
-    Integrated along ``rays x rays`` lines parallel to z through a grid over the bounding box
+    Integrated along ``rays x rays`` lines (default :data:`MOMENT_RAYS`) parallel to z through a grid over the bounding box
     (near the cells' centres): each line crosses the faces (and the box's bottom and top) at
     heights :math:`z_k`; between two crossings the winding number is constant, and the stretch is
     solid when it is above 1/2.  ``closed`` (every edge of the mesh in two faces: pieces each
@@ -500,6 +502,7 @@ def moments(source, rays: int = MOMENT_RAYS, closed: bool = False) -> tuple[floa
     (6.0, [0.0, 0.0, 0.0], 4.5)
     """
     v, f = (np.asarray(a) for a in source)
+    rays = rays or (MOMENT_RAYS if closed else MOMENT_RAYS * 3 // 4)
     lo, hi = v.min(axis=0), v.max(axis=0)
     h = (hi[:2] - lo[:2]) / rays
     h = np.where(h > 0, h, 1.0)
