@@ -38,6 +38,7 @@ __all__ = [
     "SIDE_OFFSET",
     "SPLIT_DEPTH",
     "SPLIT_PARTS",
+    "GAP_BODIES",
     "MOMENT_RAYS",
     "Solid",
     "solid",
@@ -199,10 +200,15 @@ def _hole_size(vertices, open_edges):
     return max(sizes)
 
 
-def _signed_volume(vertices, faces):
-    a, b, c = (vertices[faces[:, i]] for i in range(3))
-    origin = 0.5 * (vertices.max(axis=0) + vertices.min(axis=0))
-    return float(np.einsum("ij,ij->", a - origin, np.cross(b - origin, c - origin))) / 6.0
+def _volumes(vertices, faces, part, count):
+    """The signed volume each part's faces enclose (tetrahedra to the part's bounding-box centre): ``(count,)``."""
+    corners = vertices[faces]
+    lo = np.full((count, 3), np.inf)
+    hi = np.full((count, 3), -np.inf)
+    np.minimum.at(lo, part, corners.min(axis=1))
+    np.maximum.at(hi, part, corners.max(axis=1))
+    a, b, c = (corners[:, i] - 0.5 * (lo + hi)[part] for i in range(3))
+    return np.bincount(part, weights=np.einsum("ij,ij->i", a, np.cross(b, c)) / 6.0, minlength=count)
 
 
 def _boxes_apart(vertices, faces, piece, count):
@@ -212,8 +218,20 @@ def _boxes_apart(vertices, faces, piece, count):
     for i in range(3):
         np.minimum.at(lo, piece, vertices[faces[:, i]])
         np.maximum.at(hi, piece, vertices[faces[:, i]])
-    meet = (lo[:, None] <= hi[None]).all(axis=2) & (lo[None] <= hi[:, None]).all(axis=2)
-    return int(meet.sum()) == count, lo, hi
+    return not len(_meeting(lo, hi)), lo, hi
+
+
+def _meeting(lo, hi, margin=0.0):
+    """The pairs ``(K, 2)``, ``i < j``, of boxes ``lo, hi (P, 3)`` that meet (within ``margin``): sorted along x and
+    swept, so that pieces many and apart cost no ``P x P`` table."""
+    order = np.argsort(lo[:, 0], kind="stable")
+    pairs = []
+    for k, i in enumerate(order):
+        # the boxes after i in x that start before it ends
+        later = order[k + 1 : k + 1 + int(np.searchsorted(lo[order[k + 1 :], 0], hi[i, 0] + margin, side="right"))]
+        near = later[((lo[later] <= hi[i] + margin) & (lo[i] <= hi[later] + margin)).all(axis=1)]
+        pairs += [(min(i, j), max(i, j)) for j in near.tolist()]
+    return np.array(sorted(pairs), dtype=np.int64).reshape(-1, 2)
 
 
 def _split(corners, depth):
@@ -246,7 +264,7 @@ def solid(vertices, faces) -> Solid:
     piece = _face_components(f, len(v))
     count = int(piece.max()) + 1
     apart, lo, hi = _boxes_apart(v, f, piece, count)
-    if closed and apart and all(_signed_volume(v, f[piece == p]) > 0 for p in range(count)):
+    if closed and apart and (_volumes(v, f, piece, count) > 0).all():
         body = piece
         internal = cavities = loose = 0
         outer_v, outer_f, source_f = v, f, f
@@ -289,9 +307,10 @@ def _oriented(v, f):
         return f
     igl = require("igl", "a mesh's winding")
     turned, patch = igl.bfs_orient(np.ascontiguousarray(f))
-    for p in np.unique(patch):
-        if _signed_volume(v, turned[patch == p]) < 0:
-            turned[patch == p] = turned[patch == p][:, ::-1]
+    _, patch = np.unique(patch, return_inverse=True)
+    patch = patch.reshape(-1)
+    inward = _volumes(v, turned, patch, int(patch.max()) + 1)[patch] < 0
+    turned[inward] = turned[inward][:, ::-1]
     return turned
 
 
@@ -332,15 +351,12 @@ def _classify(v, f, piece, size, lo, hi):
     outer_f = index.reshape(-1, 3)
     # cavities: closed parts of the boundary enclosing a negative volume
     part = _face_components(outer_f, len(outer_v)) if len(outer_f) else np.zeros(0, np.int64)
-    cavity = np.array(
-        [
-            _open(outer_f[part == p])[0] and _signed_volume(outer_v, outer_f[part == p]) < 0
-            for p in range(part.max() + 1)
-        ]
-        if len(part)
-        else [],
-        dtype=bool,
-    )
+    parts = int(part.max()) + 1 if len(part) else 0
+    seams = _open(outer_f)[1] if len(outer_f) else np.zeros((0, 2), np.int64)
+    on_part = np.zeros(len(outer_v), dtype=np.int64)
+    on_part[outer_f.reshape(-1)] = np.repeat(part, 3)
+    cavity = _volumes(outer_v, outer_f, part, parts) < 0 if parts else np.zeros(0, dtype=bool)
+    cavity[on_part[seams.reshape(-1)]] = False  # an open part encloses nothing
     reach = ~cavity[part] if len(part) else np.zeros(0, dtype=bool)
     joined = np.unique(piece[partners.T], axis=0) if partners.size else np.zeros((0, 2), np.int64)
     body = _bodies(v, f, piece, lo, hi, offset, joined)[owner[reach]]
@@ -385,24 +401,25 @@ def _triangles_cross(t, s):
     return out
 
 
-def _crossings(corners, piece, lo, hi, chunk=1_000_000):
-    """The pairs of faces of different pieces that cross: ``(2, K)`` int, each pair both ways, sorted by the first."""
-    count = len(lo)
+def _crossings(corners, piece, lo, hi, chunk=200_000):
+    """The pairs of faces of different pieces that cross: ``(2, K)`` int, each pair both ways, sorted by the first.
+    Tested ``chunk`` pairs at a time (the memory stays some 100 MB)."""
     flo, fhi = corners.min(axis=1), corners.max(axis=1)
+    by_piece = np.argsort(piece, kind="stable")
+    starts = np.searchsorted(piece[by_piece], np.arange(len(lo) + 1))
     found = []
-    for i in range(count):
-        for j in range(i + 1, count):
-            if not ((lo[i] <= hi[j]).all() and (lo[j] <= hi[i]).all()):
-                continue
-            a = np.flatnonzero((piece == i) & (flo <= hi[j]).all(axis=1) & (fhi >= lo[j]).all(axis=1))
-            b = np.flatnonzero((piece == j) & (flo <= hi[i]).all(axis=1) & (fhi >= lo[i]).all(axis=1))
-            for start in range(0, len(a), max(1, chunk // max(len(b), 1))):
-                pa = np.repeat(a[start : start + max(1, chunk // max(len(b), 1))], len(b))
-                pb = np.tile(b, len(pa) // max(len(b), 1))
-                meet = (flo[pa] <= fhi[pb]).all(axis=1) & (flo[pb] <= fhi[pa]).all(axis=1)
-                pa, pb = pa[meet], pb[meet]
-                hit = _triangles_cross(corners[pa], corners[pb])
-                found.append(np.stack([pa[hit], pb[hit]]))
+    for i, j in _meeting(lo, hi).tolist():
+        mine, theirs = by_piece[starts[i] : starts[i + 1]], by_piece[starts[j] : starts[j + 1]]
+        a = mine[((flo[mine] <= hi[j]) & (fhi[mine] >= lo[j])).all(axis=1)]
+        b = theirs[((flo[theirs] <= hi[i]) & (fhi[theirs] >= lo[i])).all(axis=1)]
+        step = max(1, chunk // max(len(b), 1))
+        for start in range(0, len(a), step):
+            pa = np.repeat(a[start : start + step], len(b))
+            pb = np.tile(b, len(pa) // max(len(b), 1))
+            meet = (flo[pa] <= fhi[pb]).all(axis=1) & (flo[pb] <= fhi[pa]).all(axis=1)
+            pa, pb = pa[meet], pb[meet]
+            hit = _triangles_cross(corners[pa], corners[pb])
+            found.append(np.stack([pa[hit], pb[hit]]))
     pairs = np.concatenate([np.zeros((2, 0), np.int64), *found, *(x[::-1] for x in found)], axis=1)
     return pairs[:, np.argsort(pairs[0], kind="stable")]
 
@@ -435,12 +452,9 @@ def _bodies(v, f, piece, lo, hi, offset, joined):
     count = int(piece.max()) + 1
     pairs = [tuple(p) for p in joined.tolist()]
     known = set(pairs)
-    for i in range(count):
-        for j in range(i + 1, count):
-            if (i, j) in known:
-                continue
-            if (lo[i] <= hi[j] + offset).all() and (lo[j] <= hi[i] + offset).all() and _meet(v, f, piece, i, j, offset):
-                pairs.append((i, j))
+    for i, j in _meeting(lo, hi, offset).tolist():
+        if (i, j) not in known and _meet(v, f, piece, i, j, offset):
+            pairs.append((i, j))
     return components(count, np.array(pairs, dtype=np.int64).reshape(-1, 2))
 
 
@@ -463,10 +477,28 @@ def _distance(v, f, points):
     return np.sqrt(d)
 
 
+#: Bodies up to this many get their least gap from their vertices and faces; more, from their boxes.
+GAP_BODIES = 16
+
+
 def _gap(v, f, body, bodies):
-    """The least distance from a vertex of one body to another body's surface (0 with one body)."""
+    """The least distance from a vertex of one body to another body's surface (0 with one body); over
+    :data:`GAP_BODIES` bodies, the least distance between two bodies' bounding boxes (a bound below it)."""
     if bodies < 2:
         return 0.0
+    if bodies > GAP_BODIES:
+        lo = np.full((bodies, 3), np.inf)
+        hi = np.full((bodies, 3), -np.inf)
+        for i in range(3):
+            np.minimum.at(lo, body, v[f[:, i]])
+            np.maximum.at(hi, body, v[f[:, i]])
+        order = np.argsort(lo[:, 0])
+        least = np.inf
+        for k, i in enumerate(order[:-1]):
+            rest = order[k + 1 :]
+            apart = np.maximum(np.maximum(lo[rest] - hi[i], lo[i] - hi[rest]), 0.0)
+            least = min(least, float(np.linalg.norm(apart, axis=1).min()))
+        return least
     least = np.inf
     for b in range(bodies):
         mine = np.unique(f[body == b])
