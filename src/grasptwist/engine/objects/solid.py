@@ -269,7 +269,9 @@ def solid(vertices, faces) -> Solid:
         internal = cavities = loose = 0
         outer_v, outer_f, source_f = v, f, f
     else:
-        outer_v, outer_f, body, internal, cavities, loose, source_f, whole = _classify(v, f, piece, size, lo, hi)
+        outer_v, outer_f, body, internal, cavities, loose, source_f, whole = _classify(
+            v, f, piece, size, lo, hi, closed
+        )
         closed = closed and whole
     bodies = int(body.max()) + 1 if len(body) else 0
     if not len(outer_f):
@@ -314,7 +316,7 @@ def _oriented(v, f):
     return turned
 
 
-def _classify(v, f, piece, size, lo, hi):
+def _classify(v, f, piece, size, lo, hi, closed):
     """The outer surface of a mesh that is not one closed surface of pieces apart (module docstring)."""
     offset = SIDE_OFFSET * size
     corners = v[f]
@@ -322,8 +324,8 @@ def _classify(v, f, piece, size, lo, hi):
     crossed = np.zeros(len(f), dtype=bool)
     crossed[partners[0]] = True
     # a face no other piece crosses is wholly on one side of each: its centre tells
-    front, back = _inside(v, f, corners.mean(axis=1)[:, None], _normals(corners)[:, None], offset)
-    front, back = front[:, 0], back[:, 0]
+    sides = _judge(v, f, piece, lo, hi, offset, closed)
+    front, back = sides(corners.mean(axis=1), _normals(corners), piece)
     whole = (front != back) & ~crossed
     internal = front & back & ~crossed
     loose = ~front & ~back & ~crossed
@@ -334,11 +336,11 @@ def _classify(v, f, piece, size, lo, hi):
     small, mine, parent = corners[crossed], piece[crossed], np.flatnonzero(crossed)
     for level in range(SPLIT_DEPTH):  # the faces another piece crosses, split where it does
         small, mine, parent = _split(small, 1), np.repeat(mine, 4), np.repeat(parent, 4)
-        fr, bk = _inside(v, f, small.mean(axis=1)[:, None], _normals(small)[:, None], offset)
+        fr, bk = sides(small.mean(axis=1), _normals(small), mine)
         last = level == SPLIT_DEPTH - 1 or 4 * len(small) > max(SPLIT_PARTS, 2 * len(f))
         again = _crossed(small, parent, corners, partners) if not last else np.zeros(len(small), bool)
-        take = ~again & (fr != bk)[:, 0]
-        pieces.append(np.where(bk[take, :1, None], small[take], small[take][:, ::-1]))
+        take = ~again & (fr != bk)
+        pieces.append(np.where(bk[take, None, None], small[take], small[take][:, ::-1]))
         owner.append(mine[take])
         small, mine, parent = small[again], mine[again], parent[again]
         if last:
@@ -437,13 +439,43 @@ def _crossed(small, parent, corners, partners):
     return out
 
 
-def _inside(v, f, points, normals, offset):
-    """Whether the solid is just in front of and just behind ``points (F, k, 3)`` (along ``normals (F, 1, 3)``)."""
-    shape = points.shape[:2]
-    front = (points + offset * normals).reshape(-1, 3)
-    back = (points - offset * normals).reshape(-1, 3)
-    w = winding_number(v, f, np.concatenate([front, back]))
-    return (w[: len(front)] > 0.5).reshape(shape), (w[len(front) :] > 0.5).reshape(shape)
+def _judge(v, f, piece, lo, hi, offset, closed):
+    """``sides(points (N, 3), normals (N, 3), own (N,)) -> (front, back)``: whether the solid is just in front of
+    and just behind each point of a face of piece ``own``, ``offset`` along its unit normal.
+
+    Where every piece is closed (``closed``: each edge once each way), the winding number is the
+    pieces' sum, and a piece's own is known off its face: 0 in front and 1 behind (-1 and 0 for a
+    piece wound inwards, a cavity's shell); only the pieces whose boxes hold the point are
+    evaluated, each alone.  Else the whole mesh's at every point.
+    """
+    if not closed:
+
+        def sides(points, normals, own):
+            w = winding_number(v, f, np.concatenate([points + offset * normals, points - offset * normals]))
+            return w[: len(points)] > 0.5, w[len(points) :] > 0.5
+
+        return sides
+    count = len(lo)
+    by_piece = np.argsort(piece, kind="stable")
+    starts = np.searchsorted(piece[by_piece], np.arange(count + 1))
+    front_own = -(_volumes(v, f, piece, count) < 0).astype(float)
+    pairs = _meeting(lo, hi, offset)
+    pairs = np.concatenate([pairs, pairs[:, ::-1]])
+
+    def sides(points, normals, own):
+        q = np.concatenate([points + offset * normals, points - offset * normals])
+        owner = np.concatenate([own, own])
+        w = np.concatenate([front_own[own], front_own[own] + 1.0])
+        order = np.argsort(owner, kind="stable")
+        at = np.searchsorted(owner[order], np.arange(count + 1))
+        for i, j in pairs.tolist():
+            mine = order[at[i] : at[i + 1]]
+            near = mine[((q[mine] >= lo[j] - offset) & (q[mine] <= hi[j] + offset)).all(axis=1)]
+            if len(near):
+                w[near] += winding_number(v, f[by_piece[starts[j] : starts[j + 1]]], q[near])
+        return w[: len(points)] > 0.5, w[len(points) :] > 0.5
+
+    return sides
 
 
 def _bodies(v, f, piece, lo, hi, offset, joined):
