@@ -40,7 +40,7 @@ import numpy as np
 
 from ...extras import require
 from ...model import Shape
-from .solid import _distance, moments, solid, surface_moments, winding_number
+from .solid import _distance, moments, solid, surface_moments, winding_function
 from .tolerances import MESH_EDGE_TOL
 
 __all__ = ["diagonal", "mass_moments", "solid_of", "sample", "body_areas", "body_of", "face_distance", "nearest"]
@@ -177,6 +177,7 @@ class _Derived:
         self.faces = np.ascontiguousarray(f, dtype=np.int64)
         self._tree = None
         self.moments = None  # mass_moments's, when first asked
+        self.winding = winding_function(*s.source)
 
     def nearest_faces(self, q):
         """libigl's answer for the points ``q (N, 3)``: the nearest face of each and the nearest point on it."""
@@ -263,7 +264,7 @@ def nearest(shape: Shape, q: np.ndarray):
     inside = np.einsum("ij,ij->i", away, pseudo) < 0
     seam = d.solid.seam[face]
     if seam.any():  # by the outer surface's open edges: the winding number says
-        inside[seam] = winding_number(*d.solid.source, q[seam]) > 0.5
+        inside[seam] = d.winding(q[seam]) > 0.5
     return c, normal, np.where(inside, -distance, distance), count >= 1
 
 

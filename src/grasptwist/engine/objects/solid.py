@@ -43,6 +43,7 @@ __all__ = [
     "Solid",
     "solid",
     "winding_number",
+    "winding_function",
     "moments",
     "surface_moments",
     "components",
@@ -139,6 +140,42 @@ def winding_number(vertices, faces, points) -> np.ndarray:
     return igl.fast_winding_number(
         np.ascontiguousarray(vertices, dtype=float), np.ascontiguousarray(faces, dtype=np.int64), q
     )
+
+
+def winding_function(vertices, faces):
+    """``w(points (N, 3)) -> (N,)``: the mesh's winding number (:func:`winding_number`), for many calls of a
+    few points each.  Where every piece of the mesh is closed (each edge once each way), the sum of
+    the pieces' whose boxes hold a point (a closed piece's is 0 outside its box), each evaluated alone:
+    libigl's evaluation builds its tree over the faces it is given at each call.
+
+    >>> from grasptwist.engine.objects.primitives import triangles
+    >>> v, f = triangles("box", [2.0, 2.0, 2.0], 0)
+    >>> w = winding_function(np.concatenate([v, v + [1, 0, 0]]), np.concatenate([f, f + len(v)]))
+    >>> (w(np.array([[0.5, 0, 0], [3, 0, 0]])).round(3) + 0.0).tolist()
+    [2.0, 0.0]
+    """
+    v, f = np.asarray(vertices, dtype=float), np.asarray(faces, dtype=np.int64)
+    if not _open(f)[0]:
+        return lambda q: winding_number(v, f, q)
+    piece = _face_components(f, len(v))
+    count = int(piece.max()) + 1
+    corners = v[f]
+    lo = np.full((count, 3), np.inf)
+    hi = np.full((count, 3), -np.inf)
+    np.minimum.at(lo, piece, corners.min(axis=1))
+    np.maximum.at(hi, piece, corners.max(axis=1))
+    by_piece = np.argsort(piece, kind="stable")
+    starts = np.searchsorted(piece[by_piece], np.arange(count + 1))
+
+    def w(q):
+        out = np.zeros(len(q))
+        held = ((q[:, None] >= lo[None]) & (q[:, None] <= hi[None])).all(axis=2)  # (N, pieces)
+        for j in np.flatnonzero(held.any(axis=0)).tolist():
+            near = np.flatnonzero(held[:, j])
+            out[near] += winding_number(v, f[by_piece[starts[j] : starts[j + 1]]], q[near])
+        return out
+
+    return w
 
 
 def components(n, pairs) -> np.ndarray:
