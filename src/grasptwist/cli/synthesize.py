@@ -162,6 +162,12 @@ def synthesize(
         ),
     ] = None,
     quality: Annotated[bool, typer.Option("--quality", help="Also Ferrari-Canny's epsilon (needs scipy).")] = False,
+    span_bodies: Annotated[
+        bool,
+        typer.Option(
+            "--span-bodies", help="Let a grasp's contacts lie on different bodies of a mesh (default: one body)."
+        ),
+    ] = False,
     seed: Annotated[int, typer.Option("--seed", min=0, help="Seed of the random numbers (reproducible runs).")] = 0,
     candidates: Annotated[
         int, typer.Option("--candidates", min=1, max=10**9, help="Candidate triples scored at most, per object.")
@@ -248,6 +254,7 @@ def synthesize(
             tip_radius=tip_radius,
             hand_file=hand,
             units=units,
+            span_bodies=span_bodies,
         ),
     )
     settings = OutputSettings(records_to, quiet, Warnings.summary, workers, {"digits": digits}, reads=(hand,))

@@ -22,10 +22,10 @@ for a URDF (:mod:`grasptwist.io.urdf`, whose path rule this shares):
   that are no STL (neither a binary STL of its count's length nor text
   starting with ``solid``) are ``invalid-mesh`` unparsed;
 * the geometry: at most ``max_triangles`` triangles (:data:`~grasptwist.io.limits.MAX_TRIANGLES`),
-  finite vertices, every face index a vertex, and a closed surface: each
-  edge shared by exactly two triangles, wound the same way (a volume, a
-  centre of mass and an inside need one), no degenerate (zero-area)
-  triangle, and a size within ``SIZE_RANGE`` (:mod:`grasptwist.engine.objects.checks`).
+  finite vertices, every face index a vertex, and a size within ``SIZE_RANGE``
+  (:mod:`grasptwist.engine.objects.checks`).  It is repaired without changing its geometry
+  (equal vertices merged, zero-area triangles dropped: ``mesh-repaired``) and may be open or
+  made of pieces: the solid it bounds is the engine's (:mod:`grasptwist.engine.objects.solid`).
   A mesh wound inwards is turned outwards.
 
 Every refusal is a :class:`~grasptwist.model.InputError` with a code:
@@ -37,12 +37,12 @@ Every refusal is a :class:`~grasptwist.model.InputError` with a code:
 ``unsupported-url``      a URL scheme other than ``package://``
 ``package-not-found``    ``package://PKG``: no installed Python package ``PKG``
 ``unsupported-mesh``     a file name not ending in ``.stl``, ``.obj`` or ``.ply``
-``invalid-mesh``         not readable as its format (bad face indices, truncated), a degenerate triangle
+``invalid-mesh``         not readable as its format (bad face indices, truncated)
 ``empty-mesh``           no triangles
 ``too-many-triangles``   more than ``max_triangles`` (an OBJ polygon counts as its fan's)
 ``too-many-vertices``    more than :data:`~grasptwist.io.limits.MAX_VERTICES`
 ``non-finite``           a vertex coordinate that is NaN or infinite
-``not-watertight``       an open, non-manifold or inconsistently wound surface
+``mesh-not-solid``       every triangle of zero area (the engine's check: no inside anywhere)
 ``invalid-size``         a size (bounding box diagonal) outside ``SIZE_RANGE``, 1e-75 to 1e75
 ``mesh-unavailable``     trimesh is not installed (a binary PLY)
 =======================  ==========================================================
@@ -70,6 +70,7 @@ def read_mesh(
     max_triangles=MAX_TRIANGLES,
     allow_outside=False,
     output=None,
+    warnings=None,
 ):
     """The vertices and outward-wound triangles of a mesh file.
 
@@ -89,6 +90,8 @@ def read_mesh(
         Take a relative path wherever it leads.
     output : (int, int), optional
         The ``(device, inode)`` of the file ``-o`` replaces: a mesh that is it is ``output-is-input``.
+    warnings : list, optional
+        Where the ``mesh-repaired`` warning goes, when the mesh was repaired.
 
     Returns
     -------
@@ -117,16 +120,17 @@ def read_mesh(
     from .urdf import _read, resolve_urdf  # here: listing a folder (MESH_SUFFIXES) imports no URDF reader
 
     data = _read(resolve_urdf(text, folder, allow_outside=allow_outside, output=output), max_bytes, text, output)
-    return check_mesh(*parse_mesh(data, suffix, text, max_triangles), max_triangles, text)
+    return check_mesh(*parse_mesh(data, suffix, text, max_triangles), max_triangles, text, warnings)
 
 
-def check_mesh(vertices, faces, max_triangles, file):
-    """``(vertices, faces)`` of a parsed mesh once it is a closed surface within the limits:
-    equal vertices merged (an STL repeats each per triangle), unused ones dropped, wound outwards.
+def check_mesh(vertices, faces, max_triangles, file, warnings=None):
+    """``(vertices, faces)`` of a parsed mesh within the limits, repaired without changing its geometry
+    (:func:`~grasptwist.engine.objects.checks.repair_mesh`: equal vertices merged, zero-area faces
+    dropped, unused vertices left out) and wound outwards.  Whether it bounds a solid (it may be open
+    or made of pieces) is the engine's to tell (``grasptwist.engine.objects.solid``).
 
-    A closed, consistently wound surface has each directed edge ``(a, b)`` of its triangles once,
-    and its reverse ``(b, a)`` once: an open edge has no reverse, a non-manifold one (three or more
-    triangles) or a triangle wound the other way repeats one.  Outwards: the signed volume
+    A repair adds its ``mesh-repaired`` warning to ``warnings``; an STL repeats each vertex in
+    every triangle, so its merged vertices are not counted.  Outwards: the signed volume
 
     .. math::
 
@@ -139,6 +143,7 @@ def check_mesh(vertices, faces, max_triangles, file):
     max_triangles : int
     file : str
         The mesh file, as the grasp file names it (for the errors).
+    warnings : list, optional
 
     Returns
     -------
@@ -148,7 +153,8 @@ def check_mesh(vertices, faces, max_triangles, file):
     Raises
     ------
     InputError
-        ``empty-mesh``, ``too-many-triangles``, ``invalid-mesh``, ``non-finite`` or ``not-watertight``.
+        ``empty-mesh``, ``too-many-triangles``, ``invalid-mesh``, ``non-finite``, ``invalid-size`` or
+        ``mesh-not-solid`` (every triangle of zero area).
 
     >>> tetra = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.0]])
     >>> faces = np.array([[0, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2]])  # wound inwards
@@ -156,9 +162,10 @@ def check_mesh(vertices, faces, max_triangles, file):
     >>> a, b, c = vertices[outwards].transpose(1, 0, 2)
     >>> float(np.einsum("ij,ij->", a, np.cross(b, c)) / 6)  # the tetrahedron's volume, now positive
     0.16666666666666666
-    >>> check_mesh(tetra, faces[:3], 10, "t.obj")
-    Traceback (most recent call last):
-    grasptwist.model.GraspFileError: t.obj: not a closed surface (every edge shared by exactly two triangles, wound the same way)
+    >>> said = []
+    >>> _ = check_mesh(np.concatenate([tetra, tetra[:1]]), np.concatenate([faces, [[4, 1, 2]]]), 10, "t.obj", said)
+    >>> said
+    ['mesh-repaired: 1 duplicate vertex merged (the geometry is unchanged)']
     """
     if not len(faces):
         raise InputError("empty-mesh", "no triangles in the mesh", file)
@@ -168,52 +175,30 @@ def check_mesh(vertices, faces, max_triangles, file):
         raise InputError("invalid-mesh", "a face names a vertex the file does not have", file)
     if not np.isfinite(vertices).all():
         raise InputError("non-finite", "a vertex coordinate is NaN or infinite", file)
-    vertices, merged = np.unique(vertices, axis=0, return_inverse=True)
-    faces = merged.reshape(-1)[faces]
-    used, faces = np.unique(faces, return_inverse=True)
-    vertices, faces = vertices[used], faces.reshape(-1, 3)
-    if not _closed(faces):
-        raise InputError(
-            "not-watertight",
-            "not a closed surface (every edge shared by exactly two triangles, wound the same way)",
-            file,
-        )
+    from ..engine.objects.checks import repair_mesh
+
     _check_geometry(vertices, faces, file)
+    repaired = repair_mesh(vertices, faces)  # equal vertices merged, zero-area faces dropped
+    if str(file).lower().endswith(".stl"):  # the format repeats each vertex: merging them repairs nothing
+        repaired = repaired._replace(merged=0)
+    if warnings is not None and repaired.warning():
+        warnings.append(repaired.warning())
+    vertices, faces = repaired.vertices, repaired.faces
+    if not len(faces):
+        raise InputError("mesh-not-solid", "every triangle has zero area: the mesh bounds no solid", file)
     a, b, c = vertices[faces].transpose(1, 0, 2)
     if np.einsum("ij,ij->", a, np.cross(b, c)) < 0:
-        faces = faces[:, ::-1]
-    faces = np.ascontiguousarray(faces)
-    for array in (vertices, faces):
-        array.setflags(write=False)
+        faces = np.ascontiguousarray(faces[:, ::-1])
+        faces.setflags(write=False)
     return vertices, faces
 
 
 def _check_geometry(vertices, faces, file):
     """Refuse a mesh whose own size is outside :data:`~grasptwist.engine.objects.checks.SIZE_RANGE`
-    (its volume is computed here, before any ``scale``) or with a degenerate triangle (no normal:
-    :func:`~grasptwist.engine.objects.checks.degenerate_faces`), as the engine's ``check_shape`` does."""
-    from ..engine.objects.checks import AREA_TOL, check_extent, degenerate_faces
+    (checked here, before any ``scale``), as the engine's ``check_shape`` does."""
+    from ..engine.objects.checks import check_extent
 
     try:
         check_extent(np.linalg.norm(vertices.max(axis=0) - vertices.min(axis=0)), "the mesh's")
     except ValueError as err:
         raise InputError("invalid-size", str(err), file) from None
-    flat = degenerate_faces(vertices, faces)
-    if len(flat):
-        raise InputError(
-            "invalid-mesh",
-            f"triangle {int(flat[0])} (counted from 0) is degenerate: its area is at most {AREA_TOL:g} "
-            f"of the squared size (corners on a line){f', and {len(flat) - 1} more' if len(flat) > 1 else ''}",
-            file,
-        )
-
-
-def _closed(faces):
-    """Whether each directed edge of the triangles is there once and so is its reverse."""
-    edges = np.concatenate([faces[:, [0, 1]], faces[:, [1, 2]], faces[:, [2, 0]]])
-    if (edges[:, 0] == edges[:, 1]).any():  # a triangle with a repeated corner
-        return False
-    n = int(faces.max()) + 1
-    keys, counts = np.unique(edges[:, 0] * n + edges[:, 1], return_counts=True)
-    reverse = np.sort(edges[:, 1] * n + edges[:, 0])
-    return bool((counts == 1).all() and np.array_equal(keys, reverse))

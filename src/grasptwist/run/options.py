@@ -99,7 +99,8 @@ class SynthesisOptions:
     ``seconds`` bound the search; ``grasp_file`` (``-o FILE.yaml``) receives the grasps found;
     ``tip_radius`` (``--tip-radius``) replaces every fingertip's radius of the hand (the file's, or
     the job's ``hand``: ``--hand``, read from ``hand_file``); ``units`` (``--units``) is the length
-    unit of the mesh files given directly (a grasp file says its own).
+    unit of the mesh files given directly (a grasp file says its own); ``span_bodies``
+    (``--span-bodies``) lets a grasp's contacts lie on different bodies of a mesh.
     The rest go to :func:`grasptwist.engine.synthesis.search.search`.
     """
 
@@ -120,3 +121,4 @@ class SynthesisOptions:
     tip_radius: float | None = None
     hand_file: str | None = None
     units: str | None = None
+    span_bodies: bool = False

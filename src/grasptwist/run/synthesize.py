@@ -85,7 +85,7 @@ class Found:
     joints_at: tuple | None = None  # an inline hand's joints at each grasp: per finger (screws (n, 6), points (n, 3))
     twists: tuple = ()  # the input's twists and paths, written with each grasp found (-o FILE.yaml)
     paths: tuple = ()
-    warnings: tuple = ()  # of the object: its size against its unit or its hand, its pose's rotation vector
+    warnings: tuple = ()  # of the object: a mesh's as read (mesh-repaired, mesh-open, mesh-bodies), its size, its pose
 
     def __len__(self) -> int:
         return len(self.synthesis.points)
@@ -178,26 +178,40 @@ def _inline_joints(hand, synthesis):
 def _mesh_grasp(path: str, job) -> Grasp | GraspFileError:
     """A mesh file as a grasp document with only its object (the command line gives the rest), in
     ``--units`` (metres without it)."""
+    from ..io.grasp.objects import mesh_solid
+
     try:
         limits = job.reading  # a mesh's caps however it is named (io/limits.py), as a grasp file's mesh gets
-        vertices, faces = read_mesh(path, None, max_bytes=limits.max_mesh_bytes, max_triangles=limits.max_triangles)
+        vertices, faces = read_mesh(
+            path,
+            None,
+            max_bytes=limits.max_mesh_bytes,
+            max_triangles=limits.max_triangles,
+            warnings=(repaired := []),
+        )
     except InputError as exc:
         return exc.with_traceback(None)  # kept until written: not with the reader's frames (the mesh's bytes)
     # the path as a grasp file beside the mesh would name it: -o FILE.yaml finds it from the file's folder
     shape = Shape("mesh", np.zeros(0), vertices=vertices, faces=faces, source=os.path.basename(path))
+    said = mesh_solid(shape, path, repaired)
+    if isinstance(said, InputError):
+        return said
     obj = GraspObject(shape, np.eye(4))
     name = os.path.splitext(os.path.basename(path))[0]
     p = np.full((3, 3), np.nan)  # no contacts: as a document read without them
-    return Grasp(name, job.options.units or "m", path, 0, CONTACT_NAMES, p, p, None, (), 1, object=obj)
+    return Grasp(
+        name, job.options.units or "m", path, 0, CONTACT_NAMES, p, p, None, (), 1, object=obj, warnings=tuple(said)
+    )
 
 
-#: The warnings of an object that a search's records carry (the others are about the file's contacts).
-OBJECT_WARNINGS = ("rotation-over-pi",)
+#: The warnings of an object that a search's records carry (the others are about the file's contacts):
+#: its pose's, and its mesh's as read.
+OBJECT_WARNINGS = ("rotation-over-pi", "mesh-")
 
 
 def _object_warnings(entry: Grasp, obj: GraspObject, hand: Hand | None) -> tuple[str, ...]:
-    """The warnings of the object searched: its pose's, and its size against the hand that must
-    reach it (the file's or ``--hand``'s), else against its unit (a mesh)."""
+    """The warnings of the object searched: its pose's, its mesh's, and its size against the hand
+    that must reach it (the file's or ``--hand``'s), else against its unit (a mesh)."""
     said = [w for w in entry.warnings if w.startswith(OBJECT_WARNINGS)]
     shape = obj.shape
     extent = largest_extent(shape.kind, shape.size, shape.vertices)
@@ -243,7 +257,7 @@ def synthesize_inputs(job, inputs: Iterable) -> Iterator[GraspFileError | Found 
             said = _object_warnings(entry, obj, hand)
             yield Progress(o.candidates, 0)
             for step in search_steps(
-                surface_of(obj),
+                surface_of(obj, o.span_bodies),
                 wrenches,
                 friction,
                 count=o.count,
@@ -356,12 +370,13 @@ def synthesize_outputs(job, inputs: Iterable, w, workers: int = 1, tuning=None) 
 
 
 def _unchecked(job, found) -> list[str]:
-    """Warnings of an object, once each: its own (its size against its unit or its hand), and an
-    option that does not apply to it.  The off-tangent
+    """Warnings of an object, once each: its own (its mesh's as read, ``mesh-repaired``,
+    ``mesh-open``, ``mesh-internal``, ``mesh-bodies``; its size against its unit or its hand), and
+    an option that does not apply to it.  The off-tangent
     method asked without a wrist (its conditioning cannot be checked: the tangent method's alone
     is), ``--tip-radius`` without a hand (no fingertip to size: the contacts are points)."""
     where = f"{escaped(found.file)}: grasp '{escaped(found.name)}': warning:"
-    said = [f"{where} {w}" for w in found.warnings]
+    said = [f"{where} {escaped(w)}" for w in found.warnings]
     if found.wrist is None and job.options.method in ("off-tangent", "both"):
         said.append(f"{where} off-tangent conditioning not checked without a wrist (a grasp file's 'wrist')")
     if job.options.tip_radius is not None and found.hand is None:

@@ -43,6 +43,9 @@ __all__ = [
     "tessellate",
     "object_size",
     "moved",
+    "body_areas",
+    "body_of",
+    "on_hidden_face",
 ]
 
 
@@ -72,7 +75,7 @@ class SurfacePoints(NamedTuple):
 
 
 class MassProperties(NamedTuple):
-    """An object's volume, mass and centre of mass (:func:`mass_properties`).
+    """An object's volume, mass, centre of mass and inertia tensor (:func:`mass_properties`).
 
     Attributes
     ----------
@@ -82,11 +85,15 @@ class MassProperties(NamedTuple):
         The given mass, else ``density * volume``; None when neither is given.
     center_of_mass : numpy.ndarray
         ``(3,)`` in the grasp frame (the centroid of the solid: uniform density).
+    inertia : numpy.ndarray or None
+        ``(3, 3)`` the inertia tensor about the centre of mass, in the grasp frame's axes (mass
+        times squared length units), of the mass spread uniformly over the solid; None without a mass.
     """
 
     volume: float
     mass: float | None
     center_of_mass: np.ndarray
+    inertia: np.ndarray | None = None
 
 
 def object_size(obj: GraspObject) -> float:
@@ -185,37 +192,51 @@ def _points(points):
 
 
 def mass_properties(obj: GraspObject) -> MassProperties:
-    r"""The object's volume, its mass (given, or from its density) and its centre of mass in the grasp frame.
+    r"""The object's volume, its mass (given, or from its density), its centre of mass and inertia tensor in the grasp frame.
 
     .. math::
 
-        m = \rho V, \qquad c = R\, c_O + t
+        m = \rho V, \qquad c = R\, c_O + t, \qquad
+        I = \frac{m}{V} R \left(\operatorname{tr}(J) I_3 - J\right) R^T
 
-    with :math:`c_O` the centroid in the object's frame: its origin for a
-    primitive, the closed mesh's (``mesh.volume_centroid``).
+    with :math:`c_O` the centroid in the object's frame and :math:`J = \int (x - c_O)(x - c_O)^T dV`
+    its second moment of volume: closed forms for a primitive (``primitives.second_moment``,
+    centred on its origin); for a mesh, those of the solid it bounds (``mesh.mass_moments``: by
+    the divergence theorem on a closed surface, along rays through its winding number else).
 
     >>> from grasptwist.objects import Shape
     >>> pose = np.eye(4)
     >>> pose[:3, 3] = [0, 0, 0.05]
     >>> m = mass_properties(GraspObject(Shape("box", np.array([0.1, 0.1, 0.1])), pose, density=1000.0))
-    >>> round(m.volume, 6), round(m.mass, 6), m.center_of_mass.tolist()
-    (0.001, 1.0, [0.0, 0.0, 0.05])
+    >>> round(m.volume, 6), round(m.mass, 6), m.center_of_mass.tolist(), np.diag(m.inertia).round(8).tolist()
+    (0.001, 1.0, [0.0, 0.0, 0.05], [0.00166667, 0.00166667, 0.00166667])
     """
     obj = checked(obj)
     shape = obj.shape
     if shape.kind == "mesh":
-        volume, centroid = mesh.volume_centroid(shape)
+        volume, centroid, second = mesh.mass_moments(shape)
     else:
-        volume, centroid = primitives.volume(shape.kind, check_size(shape.kind, shape.size)), np.zeros(3)
+        size = check_size(shape.kind, shape.size)
+        volume, centroid, second = (
+            primitives.volume(shape.kind, size),
+            np.zeros(3),
+            primitives.second_moment(shape.kind, size),
+        )
     mass = obj.mass if obj.mass is not None else (None if obj.density is None else obj.density * volume)
-    return MassProperties(volume, mass, obj.pose[:3, :3] @ centroid + obj.pose[:3, 3])
+    rotation = obj.pose[:3, :3]
+    inertia = None
+    if mass is not None:
+        inertia = rotation @ ((np.trace(second) * np.eye(3) - second) * (mass / volume)) @ rotation.T
+    return MassProperties(volume, mass, rotation @ centroid + obj.pose[:3, 3], inertia)
 
 
-def sample_surface(obj: GraspObject, n: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+def sample_surface(obj: GraspObject, n: int, rng: np.random.Generator, *, body=None) -> tuple[np.ndarray, np.ndarray]:
     """``n`` points uniformly distributed over the object's surface (by area), with the inward normals there.
 
     The same generator state gives the same points (``primitives.sample`` and
-    ``mesh.sample`` in ``grasptwist.engine.objects`` say how they are drawn).
+    ``mesh.sample`` in ``grasptwist.engine.objects`` say how they are drawn).  A mesh's points
+    are on its solid's outer surface (never on a face inside it, nor round a cavity); ``body``
+    (an int, a mesh's only) draws them from that body alone (``geometry.body_areas`` lists them).
 
     Returns
     -------
@@ -233,11 +254,55 @@ def sample_surface(obj: GraspObject, n: int, rng: np.random.Generator) -> tuple[
     obj = checked(obj)
     shape = obj.shape
     if shape.kind == "mesh":
-        points, outward = mesh.sample(shape, n, rng)
+        points, outward = mesh.sample(shape, n, rng, body=body)
     else:
         points, outward = primitives.sample(shape.kind, check_size(shape.kind, shape.size), n, rng)
     rotation, translation = obj.pose[:3, :3], obj.pose[:3, 3]
     return rotate(rotation, points) + translation, rotate(-rotation, outward)
+
+
+def body_areas(obj: GraspObject) -> np.ndarray:
+    """The area of each body's outer surface (pieces of a mesh that neither overlap nor touch): ``(bodies,)``;
+    a primitive is one body (its area unused: ``[1.0]``).
+
+    >>> from grasptwist.objects import Shape
+    >>> body_areas(GraspObject(Shape("sphere", np.ones(1)), np.eye(4))).tolist()
+    [1.0]
+    """
+    return mesh.body_areas(obj.shape) if obj.shape.kind == "mesh" else np.ones(1)
+
+
+def body_of(obj: GraspObject, points) -> np.ndarray:
+    """The body nearest each point ``(..., 3)`` in the grasp frame: ``(...)`` int (0 for a primitive).
+
+    >>> from grasptwist.objects import Shape
+    >>> body_of(GraspObject(Shape("sphere", np.ones(1)), np.eye(4)), np.zeros((2, 3))).tolist()
+    [0, 0]
+    """
+    p = _points(points)
+    if obj.shape.kind != "mesh":
+        return np.zeros(p.shape[:-1], dtype=np.int64)
+    local = rotate(obj.pose[:3, :3].T, p - obj.pose[:3, 3]).reshape(-1, 3)
+    return mesh.body_of(obj.shape, local).reshape(p.shape[:-1])
+
+
+def on_hidden_face(obj: GraspObject, points, distance, tolerance: float) -> np.ndarray:
+    """Whether each point ``(..., 3)`` lies on a face of the mesh that no finger can reach: within
+    ``tolerance`` (a length) of one of its faces, but deeper than ``tolerance`` inside the solid (its signed
+    ``distance (...)`` from the outer surface, :func:`project_to_surface`'s): a face inside another
+    piece, or round a cavity.  Never for a primitive.
+
+    >>> from grasptwist.objects import Shape
+    >>> on_hidden_face(GraspObject(Shape("sphere", np.ones(1)), np.eye(4)), np.zeros((1, 3)), [-1.0], 0.01).tolist()
+    [False]
+    """
+    p = _points(points)
+    deep = np.asarray(distance, dtype=float) < -tolerance
+    if obj.shape.kind != "mesh" or not deep.any():
+        return np.zeros(p.shape[:-1], dtype=bool)
+    local = rotate(obj.pose[:3, :3].T, p - obj.pose[:3, 3]).reshape(-1, 3)
+    near = mesh.face_distance(obj.shape, local).reshape(p.shape[:-1]) <= tolerance
+    return deep & near
 
 
 def tessellate(obj: GraspObject, *, segments: int = 32) -> tuple[np.ndarray, np.ndarray]:

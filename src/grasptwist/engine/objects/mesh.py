@@ -1,9 +1,12 @@
-r"""A closed triangle mesh in its own frame: nearest points, volume and centroid, sampling.
+r"""A triangle mesh in its own frame: nearest points, mass properties, sampling, on the solid it bounds.
 
 The mesh is a :class:`~grasptwist.model.Shape` of kind ``"mesh"`` accepted by
-:func:`~.checks.check_shape`: closed, faces counter-clockwise seen from
-outside.  What is derived from it once (face normals and areas, the normals
-at edges and vertices, the search tree) is kept while the shape lives.
+:func:`~.checks.check_shape` (repaired: no zero-area face).  Its solid, the points where its
+generalized winding number is above 1/2, and the outer surface that bounds it
+(:mod:`~.solid`) are found once and kept while the shape lives, with what the
+queries derive from them (face normals and areas, the normals at edges and
+vertices, the search tree).  Every query is on the outer surface: a face inside
+another piece, or round a cavity, holds no nearest point and no sample.
 
 Nearest points
 --------------
@@ -23,8 +26,10 @@ meet there,
 
 The sign of the distance (inside or outside) is that of :math:`(q - c)\cdot N`
 with :math:`N` the angle-weighted pseudo-normal of the same face, edge or
-vertex (Baerentzen and Aanaes 2005: exact for a closed mesh, where an
-area-weighted normal is not always).
+vertex (Baerentzen and Aanaes 2005: exact for a closed surface, where an
+area-weighted normal is not always); where the outer surface is open (a hole's
+rim, where a face is split along another piece), the winding number's
+(inside where it is above 1/2).
 """
 
 from __future__ import annotations
@@ -35,9 +40,10 @@ import numpy as np
 
 from ...extras import require
 from ...model import Shape
+from .solid import _distance, moments, solid, surface_moments, winding_function
 from .tolerances import MESH_EDGE_TOL
 
-__all__ = ["diagonal", "volume_centroid", "sample", "nearest"]
+__all__ = ["diagonal", "mass_moments", "solid_of", "sample", "body_areas", "body_of", "face_distance", "nearest"]
 
 
 def diagonal(vertices) -> float:
@@ -49,45 +55,48 @@ def diagonal(vertices) -> float:
     return float(np.linalg.norm(vertices.max(axis=0) - vertices.min(axis=0)))
 
 
-def _corners(shape):
-    v = shape.vertices
-    f = shape.faces
-    return v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
+def solid_of(shape: Shape):
+    """The :class:`~.solid.Solid` of the mesh (its outer surface, bodies, what was found), kept with the shape."""
+    return _derived(shape).solid
 
 
-def volume_centroid(shape: Shape) -> tuple[float, np.ndarray]:
-    r"""The volume a closed mesh encloses and its centroid (a uniform solid's centre of mass).
-
-    Each face and the origin make a tetrahedron of signed volume
-    :math:`V_f = a \cdot (b \times c) / 6` and centroid :math:`(a + b + c) / 4`;
-    summed over the faces of a closed surface, the parts outside cancel:
+def mass_moments(shape: Shape) -> tuple[float, np.ndarray, np.ndarray]:
+    r"""The volume of the mesh's solid, its centroid ``(3,)`` and its second moment about the centroid ``(3, 3)``.
 
     .. math::
 
-        V = \sum_f V_f, \qquad c = \frac{1}{V} \sum_f V_f\, \frac{a_f + b_f + c_f}{4}
+        V = \int_S dV, \qquad c = \frac{1}{V}\int_S x\, dV, \qquad
+        J = \int_S (x - c)(x - c)^T dV
+
+    By the divergence theorem when the mesh is one closed surface
+    (:func:`~.solid.surface_moments`, needs no libigl), else along rays through the solid
+    (:func:`~.solid.moments`: counting the crossings where each piece is closed, by the winding
+    number where the mesh is open).  A uniform solid of density :math:`\rho` has its inertia
+    tensor :math:`\rho\,(\operatorname{tr}(J) I - J)` about :math:`c`.
 
     >>> from grasptwist.engine.objects.primitives import triangles
     >>> v, f = triangles("box", [1.0, 2.0, 3.0], 0)
-    >>> volume, centroid = volume_centroid(Shape("mesh", np.zeros(0), v + 1, f))
-    >>> round(volume, 12), centroid.round(12).tolist()
-    (6.0, [1.0, 1.0, 1.0])
+    >>> volume, centroid, second = mass_moments(Shape("mesh", np.zeros(0), v + 1, f))
+    >>> round(volume, 12), centroid.round(12).tolist(), np.diag(second).round(12).tolist()
+    (6.0, [1.0, 1.0, 1.0], [0.5, 2.0, 4.5])
     """
-    a, b, c = _corners(shape)
-    # about the bounding box's centre: the cancelling tetrahedra stay small
-    origin = 0.5 * (shape.vertices.max(axis=0) + shape.vertices.min(axis=0))
-    a, b, c = a - origin, b - origin, c - origin
-    parts = np.einsum("ij,ij->i", a, np.cross(b, c)) / 6.0
-    volume = float(parts.sum())
-    return volume, (parts @ (a + b + c)) / (4.0 * volume) + origin
+    d = _derived(shape)
+    if d.moments is None:  # kept with the shape: the rays through an open mesh take a while
+        s = d.solid
+        volume, first, second = surface_moments(*s.source) if s.closed else moments(s.source, closed=not s.open_edges)
+        centroid = first / volume
+        d.moments = volume, centroid, second - volume * np.outer(centroid, centroid)
+    volume, centroid, second = d.moments
+    return volume, centroid.copy(), second.copy()
 
 
-def sample(shape: Shape, n: int, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
-    r"""``n`` points uniformly distributed over the mesh (by area) and the outward normals of their faces.
+def sample(shape: Shape, n: int, rng: np.random.Generator, *, body=None) -> tuple[np.ndarray, np.ndarray]:
+    r"""``n`` points uniformly distributed over the solid's outer surface (by area) and the outward normals of their faces.
 
     A face is drawn with probability proportional to its area, then a point
     of it from two uniform numbers :math:`u, v`:
     :math:`(1 - \sqrt u)\, a + \sqrt u (1 - v)\, b + \sqrt u\, v\, c`
-    (uniform over the triangle).
+    (uniform over the triangle).  ``body``: only that body's faces (:attr:`~.solid.Solid.body`).
 
     >>> from grasptwist.engine.objects.primitives import triangles
     >>> v, f = triangles("box", [2.0, 2.0, 2.0], 0)
@@ -96,19 +105,40 @@ def sample(shape: Shape, n: int, rng: np.random.Generator) -> tuple[np.ndarray, 
     (True, True)
     """
     d = _derived(shape)
-    face = rng.choice(len(d.areas), size=n, p=d.areas / d.areas.sum())
+    weight = d.areas if body is None else np.where(d.solid.body == body, d.areas, 0.0)
+    face = rng.choice(len(weight), size=n, p=weight / weight.sum())
     u, v = rng.random((2, n))
     r = np.sqrt(u)[:, None]
-    a, b, c = (x[face] for x in _corners(shape))
+    a, b, c = (x[face] for x in d.corners)
     return (1 - r) * a + r * (1 - v[:, None]) * b + r * v[:, None] * c, d.face_normals[face]
+
+
+def body_areas(shape: Shape) -> np.ndarray:
+    """The area of each body's outer surface: ``(bodies,)``."""
+    d = _derived(shape)
+    return np.bincount(d.solid.body, weights=d.areas, minlength=d.solid.bodies)
+
+
+def body_of(shape: Shape, q: np.ndarray) -> np.ndarray:
+    """The body whose outer surface is nearest each point ``q (N, 3)``: ``(N,)`` int."""
+    d = _derived(shape)
+    if len(q) == 0:
+        return np.zeros(0, dtype=np.int64)
+    return d.solid.body[d.nearest_faces(q)[0]]
+
+
+def face_distance(shape: Shape, q: np.ndarray) -> np.ndarray:
+    """Each point's distance ``(N,)`` to the nearest face of the mesh as given (internal ones and cavities too)."""
+    return _distance(shape.vertices, shape.faces, q) if len(q) else np.zeros(0)
 
 
 class _Derived:
     """What a mesh's queries need, computed once per shape."""
 
     def __init__(self, shape: Shape):
-        v, f = shape.vertices, shape.faces
-        a, b, c = _corners(shape)
+        self.solid = s = solid(shape.vertices, shape.faces)
+        v, f = s.vertices, s.faces
+        self.corners = a, b, c = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
         cross = np.cross(b - a, c - a)
         twice = np.linalg.norm(cross, axis=1)
         self.areas = 0.5 * twice
@@ -126,16 +156,18 @@ class _Derived:
             axis=1,
         )
         self.vertex_pseudo = _accumulate(len(v), f, self.face_normals, angles)
-        # the edge of each face's side i (opposite vertex i), and its partner face
+        # the edge of each face's side i (opposite vertex i) and its partner face: the other face of an edge
+        # in two, the face itself on an open edge (or one in more than two: there the winding number decides)
         n = len(v)
         lo = np.minimum(f[:, [1, 2, 0]], f[:, [2, 0, 1]])
         hi = np.maximum(f[:, [1, 2, 0]], f[:, [2, 0, 1]])
         key = (lo * n + hi).reshape(-1)
         order = np.argsort(key, kind="stable")
-        # closed and manifold: every edge key appears exactly twice, once in each of its faces
-        pair = np.empty_like(order)
-        pair[order[0::2]] = order[1::2]
-        pair[order[1::2]] = order[0::2]
+        _, start, count = np.unique(key[order], return_index=True, return_counts=True)
+        pair = np.arange(len(key))
+        two = start[count == 2]
+        pair[order[two]] = order[two + 1]
+        pair[order[two + 1]] = order[two]
         other = (pair // 3).reshape(-1, 3)
         mine = np.repeat(np.arange(len(f)), 3).reshape(-1, 3)
         self.edge_normals = _unit(weighted[mine] + weighted[other])
@@ -144,6 +176,8 @@ class _Derived:
         self.vertices = np.ascontiguousarray(v, dtype=float)
         self.faces = np.ascontiguousarray(f, dtype=np.int64)
         self._tree = None
+        self.moments = None  # mass_moments's, when first asked
+        self.winding = winding_function(*s.source)
 
     def nearest_faces(self, q):
         """libigl's answer for the points ``q (N, 3)``: the nearest face of each and the nearest point on it."""
@@ -209,7 +243,7 @@ def nearest(shape: Shape, q: np.ndarray):
     if len(q) == 0:
         return np.zeros((0, 3)), np.zeros((0, 3)), np.zeros(0), np.zeros(0, dtype=bool)
     face, c = d.nearest_faces(q)
-    lam = _barycentric(shape, face, c)
+    lam = _barycentric(d, face, c)
     near_edge = lam * d.heights[face] <= d.tol  # (N, 3): on the edge opposite vertex i
     count = near_edge.sum(axis=1)
     normal = d.face_normals[face]
@@ -221,19 +255,22 @@ def nearest(shape: Shape, q: np.ndarray):
     pseudo[edge] = d.edge_pseudo[face[edge], side[edge]]
     # on two edges: the vertex between them (the one whose coordinate is not near 0)
     corner = count >= 2
-    vertex = shape.faces[face, np.argmax(np.where(near_edge, -np.inf, lam), axis=1)]
-    vertex = np.where(count == 3, shape.faces[face, np.argmax(lam, axis=1)], vertex)
+    vertex = d.faces[face, np.argmax(np.where(near_edge, -np.inf, lam), axis=1)]
+    vertex = np.where(count == 3, d.faces[face, np.argmax(lam, axis=1)], vertex)
     normal[corner] = d.vertex_normals[vertex[corner]]
     pseudo[corner] = d.vertex_pseudo[vertex[corner]]
     away = q - c
     distance = np.linalg.norm(away, axis=1)
     inside = np.einsum("ij,ij->i", away, pseudo) < 0
+    seam = d.solid.seam[face]
+    if seam.any():  # by the outer surface's open edges: the winding number says
+        inside[seam] = d.winding(q[seam]) > 0.5
     return c, normal, np.where(inside, -distance, distance), count >= 1
 
 
-def _barycentric(shape, face, c):
-    """Barycentric coordinates ``(N, 3)`` of the points ``c`` in the triangles ``face``."""
-    v, f = shape.vertices, shape.faces[face]
+def _barycentric(d, face, c):
+    """Barycentric coordinates ``(N, 3)`` of the points ``c`` in the outer surface's triangles ``face``."""
+    v, f = d.vertices, d.faces[face]
     a, b, cc = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
     e0, e1, e2 = b - a, cc - a, c - a
     d00 = np.einsum("ij,ij->i", e0, e0)

@@ -43,6 +43,7 @@ import numpy as np
 
 __all__ = [
     "PRIMITIVES",
+    "second_moment",
     "nearest",
     "nearest_one",
     "volume",
@@ -229,6 +230,40 @@ def volume(kind, size) -> float:
         return ball
     tube = math.pi * s[0] ** 2 * s[1]
     return tube if kind == "cylinder" else tube + ball
+
+
+def second_moment(kind, size) -> np.ndarray:
+    r"""The primitive's second moment of volume about its centre, :math:`J = \int x x^T dV` ``(3, 3)`` (diagonal).
+
+    .. math::
+
+        J_\text{box} = \tfrac{V}{12}\operatorname{diag}(a^2, b^2, c^2), \quad
+        J_\text{sphere} = \tfrac{V r^2}{5} I, \quad
+        J_\text{cylinder} = V \operatorname{diag}\left(\tfrac{r^2}{4}, \tfrac{r^2}{4}, \tfrac{h^2}{12}\right)
+
+    and a capsule its cylinder's plus its two half balls' (volume :math:`V_b` together, each's
+    centroid :math:`3r/8` beyond its flat face at :math:`\pm h/2`):
+    :math:`J_{zz} = V_b\,(h^2/4 + 3rh/8 + r^2/5)`, :math:`J_{xx} = J_{yy} = V_b r^2/5`.
+    A uniform body of mass :math:`m` has the inertia tensor
+    :math:`\frac{m}{V}(\operatorname{tr}(J) I - J)` about its centre.
+
+    >>> np.diag(second_moment("box", [1.0, 2.0, 3.0])).tolist()
+    [0.5, 2.0, 4.5]
+    """
+    s = [float(x) for x in size]
+    v = volume(kind, s)
+    if kind == "box":
+        return np.diag([v * x * x / 12.0 for x in s])
+    r = s[0]
+    if kind == "sphere":
+        return np.eye(3) * v * r * r / 5.0
+    tube = math.pi * r * r * s[1]
+    h = s[1]
+    j = tube * np.diag([r * r / 4.0, r * r / 4.0, h * h / 12.0])
+    if kind == "capsule":
+        ball = v - tube
+        j += ball * np.diag([r * r / 5.0, r * r / 5.0, h * h / 4.0 + 3.0 * r * h / 8.0 + r * r / 5.0])
+    return j
 
 
 def diagonal(kind, size) -> float:

@@ -42,6 +42,7 @@ from ..forces.grip import Grip, grip
 from ..forces.hold import object_weight
 from ..ik import home_tips, joint_limits
 from ..objects import object_size, project_to_surface, sample_surface
+from ..objects.geometry import body_areas, body_of
 from .candidates import candidate_triples, tangent_steps, triple_distance
 from .reach import HandReach, check_hand_reach, reach_tolerance, tip_errors
 from .scores import CONSTRAINTS, METHODS, check_min_conditioning, check_objective, conditionings, score_triples
@@ -109,11 +110,16 @@ class Surface(NamedTuple):
         corner (where the surface has no one normal).
     size : float
         The object's size (the diagonal of its bounding box): the scale of steps and spacing.
+    body : callable, optional
+        ``body(points (..., 3)) -> (...)`` int: the body of the object each surface point is on,
+        when a grasp keeps to one (``sample`` then draws each call's points from one body); None:
+        contacts anywhere.
     """
 
     sample: Callable
     project: Callable
     size: float
+    body: Callable | None = None
 
 
 class Failure(NamedTuple):
@@ -469,6 +475,9 @@ def _refine(surface, archive, score, budget, rng):
         q, m, _, on_edge = surface.project(q)
         # a point put on an edge or corner has no one normal (a mesh's there is an average: kept, it games the grip)
         defined = ~on_edge.any(axis=1)
+        if surface.body is not None:  # a child whose contacts moved onto different bodies is dropped
+            b = surface.body(q)
+            defined &= (b == b[:, :1]).all(axis=1)
         value = np.full(k, np.inf)
         if defined.any():
             # a child better than its parent is never spared the hand's test, kept or not
@@ -654,9 +663,20 @@ def _failure(archive, scored, mu, min_conditioning, tol) -> Failure:
     return Failure(name, "no candidate's grip holds every wrench within the friction cones", np.nan, np.nan)
 
 
-def surface_of(obj) -> Surface:
-    """The :class:`Surface` of a :class:`~grasptwist.model.GraspObject` (``grasptwist.engine.objects``)."""
-    return Surface(partial(sample_surface, obj), partial(project_to_surface, obj), object_size(obj))
+def surface_of(obj, span_bodies=False) -> Surface:
+    """The :class:`Surface` of a :class:`~grasptwist.model.GraspObject` (``grasptwist.engine.objects``).
+
+    An object of several bodies (a mesh's pieces apart) keeps each grasp on one body unless
+    ``span_bodies``: each call of ``sample`` draws from one body, chosen by its area.
+    """
+    areas = body_areas(obj)
+    if span_bodies or len(areas) < 2:
+        return Surface(partial(sample_surface, obj), partial(project_to_surface, obj), object_size(obj))
+
+    def sample(n, rng):
+        return sample_surface(obj, n, rng, body=int(rng.choice(len(areas), p=areas / areas.sum())))
+
+    return Surface(sample, partial(project_to_surface, obj), object_size(obj), partial(body_of, obj))
 
 
 def hand_reach(obj, hand, *, tips=None, tip_radius=None, collide=None) -> HandReach:
@@ -693,6 +713,7 @@ def synthesize(
     tips=None,
     tip_radius=None,
     collide=None,
+    span_bodies=False,
     **options,
 ) -> Synthesis:
     r"""Grasps of an object: its surface searched for grasps that hold its weight and ``wrenches``.
@@ -723,6 +744,9 @@ def synthesize(
         given inline), every fingertip's radius (default each finger's ``tip_radius``), and
         the depth of the deepest link at joint positions (default: links not checked; the
         command line checks a URDF's meshes).
+    span_bodies : bool
+        Let a grasp's contacts lie on different bodies of the object (a mesh's pieces apart);
+        by default each grasp keeps to one (``grasptwist.engine.synthesis.search.surface_of``).
     **options
         The search's keyword options: ``count`` (grasps wanted, 1), ``safety`` (1), ``objective``
         (``total_normal_force``, ``closure_friction`` or ``epsilon``), ``wrist`` (None),
@@ -753,4 +777,4 @@ def synthesize(
         raise ValueError("nothing to hold: give the object a mass (hold=True) or wrenches")
     if hand is not None and not isinstance(hand, HandReach):
         hand = hand_reach(obj, hand, tips=tips, tip_radius=tip_radius, collide=collide)
-    return search(surface_of(obj), np.array(listed), friction, hand=hand, **options)
+    return search(surface_of(obj, span_bodies), np.array(listed), friction, hand=hand, **options)

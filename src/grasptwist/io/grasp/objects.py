@@ -52,6 +52,7 @@ __all__ = [
     "SECTION",
     "read_object",
     "on_surface",
+    "mesh_solid",
 ]
 
 #: The shapes, one of which an object gives.
@@ -106,7 +107,7 @@ def read_object(node, file, reading, problems, warnings, units=None, hand=False)
         if read is not None:
             pose[:3, 3], pose[:3, :3] = read[0], read[1]
             warnings += _radians(read[2])
-    shape = _shape(shapes[0], fields, file, reading, problems, units) if shapes else None
+    shape = _shape(shapes[0], fields, file, reading, problems, warnings, units) if shapes else None
     if shape is None or problems.count:
         return None
     pose.setflags(write=False)
@@ -166,11 +167,12 @@ def _radians(given) -> list:
     return [radians_warning(**given)] if rotation_over_pi(given["rotvec"]) else []
 
 
-def _shape(kind, fields, file, reading, problems, units=None):
-    """The :class:`~grasptwist.model.Shape` of the ``kind`` key (None after a problem)."""
+def _shape(kind, fields, file, reading, problems, warnings, units=None):
+    """The :class:`~grasptwist.model.Shape` of the ``kind`` key (None after a problem); a mesh's
+    warnings are added to ``warnings``."""
     node, path = fields[kind], f"object.{kind}"
     if kind == "mesh":
-        return _mesh(node, fields.get("scale"), file, reading, problems, units)
+        return _mesh(node, fields.get("scale"), file, reading, problems, warnings, units)
     if kind == "box":
         size = read_vector(node, 3, path, problems)
         sizes = (
@@ -195,9 +197,10 @@ def _shape(kind, fields, file, reading, problems, units=None):
     return Shape(kind, readonly([value for value, _, _ in sizes]))
 
 
-def _mesh(node, scale_node, file, reading, problems, units=None):
+def _mesh(node, scale_node, file, reading, problems, warnings, units=None):
     """A mesh shape: its file read (:func:`grasptwist.io.mesh_file.read_mesh`), scaled by its own
-    unit into the grasp file's (``mesh: {file, units}``) and by ``scale``."""
+    unit into the grasp file's (``mesh: {file, units}``) and by ``scale``; its
+    repairs and its solid's warnings are added to ``warnings`` (:func:`mesh_solid`)."""
     if node.kind == "mapping":
         parts = read_mapping(node, "object.mesh", MESH_KEYS, ("file",), problems)
         if parts is None or "file" not in parts:
@@ -235,12 +238,19 @@ def _mesh(node, scale_node, file, reading, problems, units=None):
             max_triangles=reading.max_triangles,
             allow_outside=reading.allow_outside,
             output=reading.output,
+            warnings=(repaired := []),
         )
     except InputError as err:
         problems.add(Reject(err.code, "object.mesh", str(err), **located(where)))
         return None
     scale = readonly(scale * factor)
-    return Shape("mesh", readonly(np.zeros(0)), readonly(vertices * scale), faces, reference, scale)
+    shape = Shape("mesh", readonly(np.zeros(0)), readonly(vertices * scale), faces, reference, scale)
+    said = mesh_solid(shape, reference, repaired)
+    if isinstance(said, InputError):
+        problems.add(Reject(said.code, "object.mesh", str(said), **located(where)))
+        return None
+    warnings += said
+    return shape
 
 
 def _unit_factor(node, units, problems):
@@ -264,6 +274,21 @@ def _unit_factor(node, units, problems):
             )
             return None
     return lengths[0] / lengths[1]
+
+
+def mesh_solid(shape, file, repaired=()):
+    """The warnings of a mesh shape read from ``file`` (its reader's ``repaired`` ones, then its solid's:
+    :func:`~grasptwist.engine.objects.solid.solid_warnings`), each naming the file, or the
+    ``mesh-not-solid`` InputError where no inside can be told."""
+    from ...engine.objects.mesh import solid_of
+    from ...engine.objects.solid import solid_warnings
+
+    try:
+        found = solid_of(shape)
+    except ValueError as err:
+        return InputError("mesh-not-solid", f"{err}: repair it (docs/guide/objects.md, Meshes as they come)", file)
+    said = [*repaired, *solid_warnings(found)]
+    return [f"{code}: {file}:{rest}" for code, _, rest in (w.partition(":") for w in said)]
 
 
 def _scale(node, problems):
@@ -316,7 +341,8 @@ def on_surface(obj, points, normals, tolerance):
     distance : (3,) array
         Each given point's signed distance from the surface (> 0 outside).
     problems : list of (code, contact, message)
-        ``contact-off-surface`` (farther than the tolerance) and ``outward-normal`` (a given
+        ``contact-inside-object`` (on a mesh's face inside its solid: a piece's inside another, a
+        cavity's), ``contact-off-surface`` (farther than the tolerance) and ``outward-normal`` (a given
         normal pointing out of the object), per contact.
     disagree : list of (contact, angle)
         The given normals more than :data:`~grasptwist.objects.NORMAL_DISAGREE_DEG` from the
@@ -324,13 +350,24 @@ def on_surface(obj, points, normals, tolerance):
     """
     from ...engine.judgements import normal_angles
     from ...engine.objects import NORMAL_DISAGREE_DEG, object_size, project_to_surface
+    from ...engine.objects.geometry import on_hidden_face
 
     surface = project_to_surface(obj, points)
     limit = tolerance * object_size(obj)
+    hidden = on_hidden_face(obj, points, surface.distance, limit)
     given = ~np.isnan(normals).any(axis=1)
     problems = []
     for i in range(len(points)):
-        if abs(surface.distance[i]) > limit:
+        if hidden[i]:
+            problems.append(
+                (
+                    "contact-inside-object",
+                    i,
+                    f"on a face of the mesh inside its solid (a piece inside another, or a cavity), "
+                    f"{-surface.distance[i]:.3g} deep: no finger reaches it",
+                )
+            )
+        elif abs(surface.distance[i]) > limit:
             problems.append(
                 (
                     "contact-off-surface",
