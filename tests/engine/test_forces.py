@@ -808,3 +808,40 @@ def test_an_empty_batch_grips_to_empty_fields(batch):
     g = gt.grip(np.zeros(batch + (3, 3)), np.zeros(batch + (3, 3)), np.zeros(batch + (6,)), 0.5)
     assert g.status.shape == g.total_normal_force.shape == batch
     assert g.force.shape == batch + (3, 3) and g.dual.shape == batch + (6,)
+    hand = gt.prepare_grip(EQ, -EQ, 0.5)  # and a prepared grasp's (issue 36: it indexed a first row)
+    g = hand.grip(np.zeros(batch + (6,)))
+    assert g.status.shape == g.total_normal_force.shape == batch and g.force.shape == batch + (3, 3)
+
+
+@pytest.mark.parametrize("length", [1e-200, 1e-150, 1e-30, 1.0, 1e30, 1e150, 1e200, 1e300])
+def test_the_grip_and_closure_answer_the_same_for_normals_of_any_finite_length(length, grip_path):
+    """Issue 35: normals of length 1e200 overflowed their squares (unit normals of zero: cannot-hold for a grasp
+    that holds at G / mu); 1e-200 underflowed them (zero-normal).  Scaled by a power of two first, every length
+    gives the same grip (to the rounding of ``length * n``; to the last bit for a power of two)."""
+    w = [0, 0, G, 0, 0, 0]
+    tilted = TRIPOD_N * np.array([[1.0], [3.0], [0.5]])  # lengths differing by contact too
+    with compiled.numpy_path():
+        reference = gt.grip(TRIPOD, tilted, w, 0.7)
+        assert (gt.grip(TRIPOD, 2.0**-700 * tilted, w, 0.7).force == reference.force).all()
+    g = gt.grip(TRIPOD, length * tilted, w, 0.7)
+    assert g.ok and float(g.total_normal_force) == pytest.approx(float(reference.total_normal_force), rel=1e-12)
+    np.testing.assert_allclose(g.force, reference.force, rtol=1e-9, atol=1e-12)
+    hand = gt.prepare_grip(TRIPOD, length * tilted, 0.7)
+    assert float(hand.grip(w).total_normal_force) == pytest.approx(float(reference.total_normal_force), rel=1e-12)
+    c = gt.forces.force_closure(TRIPOD, length * tilted, 0.7)
+    assert bool(c.force_closure) and float(c.closure_friction) == pytest.approx(0.4663, abs=1e-4)
+
+
+def test_nan_normals_are_nonfinite_input_and_a_zero_one_beside_finite_ones_zero_normal(grip_path):
+    """Issue 36: NaN normals read as zero-normal in the grip and force_closure (the twist methods say nonfinite)."""
+    n = np.stack((-EQ, -EQ, -EQ, -EQ))
+    n[0, 1, 2] = np.nan
+    n[1, 2] = np.inf
+    n[2, 0] = 0.0
+    g = gt.grip(EQ, n, [0, 0, G, 0, 0, 0], 0.5)
+    c = gt.forces.force_closure(EQ, n, 0.5)
+    code = gt.forces.Status
+    expected = [code.NONFINITE_INPUT, code.NONFINITE_INPUT, code.ZERO_NORMAL, 0]
+    assert g.status.tolist() == c.status.tolist() == expected
+    assert g.culprit[2] == c.culprit[2] == 0
+    assert int(gt.prepare_grip(EQ, n[0], 0.5).grip([0, 0, G, 0, 0, 0]).status) == code.NONFINITE_INPUT

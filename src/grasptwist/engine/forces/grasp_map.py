@@ -41,6 +41,7 @@ __all__ = [
     "ForceStatus",
     "force_status_message",
     "check_wrench",
+    "unit_normals",
     "check_friction",
     "check_safety",
     "nonfinite_result",
@@ -586,6 +587,29 @@ def manipulating_forces(points, wrench, *, tol=DEGENERACY_TOL) -> ManipulatingFo
     status = nonfinite_result(status, f)
     f[status != 0] = np.nan
     return ManipulatingForces(f, geo.conditioning, status, culprit)
+
+
+def unit_normals(normals):
+    r"""The contacts' unit normals, which contacts' normals are zero, and which rows hold a non-finite normal.
+
+    ``(n, 3, 3) -> unit (n, 3, 3), zero (n, 3), nonfinite (n)``.  Each normal is first
+    scaled by the power of two nearest its largest component (exact), so the squares in its
+    length neither overflow (``1e200``) nor underflow (``1e-200``): ``n / |n|`` to the last bit
+    wherever that does not, and the same direction for any finite non-zero length.  A NaN or
+    infinite normal is non-finite, not zero (``unit`` is NaN there).
+
+    >>> u, zero, bad = unit_normals(np.array([[[3e200, 4e200, 0], [0, 0, 1e-200], [0, 0, 0]]]))
+    >>> u[0].tolist(), zero.tolist(), bad.tolist()
+    ([[0.6, 0.8, 0.0], [0.0, 0.0, 1.0], [nan, nan, nan]], [[False, False, True]], [False])
+    """
+    n = np.asarray(normals, dtype=float)
+    finite = np.isfinite(n).all(axis=-1)
+    big = np.abs(n).max(axis=-1, keepdims=True, initial=0.0)
+    scaled = np.ldexp(n, -np.frexp(np.where(np.isfinite(big), big, 1.0))[1])
+    length = norm(scaled)
+    zero = finite & (length == 0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return scaled / length[..., None], zero, ~finite.all(axis=-1)
 
 
 def tangent_bases(normals):

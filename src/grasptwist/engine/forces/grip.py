@@ -47,6 +47,7 @@ from .grasp_map import (
     contact_matrices,
     geometry,
     tangent_bases,
+    unit_normals,
     wrench_scales,
 )
 
@@ -385,7 +386,7 @@ class PreparedGrip:
         # a control loop's call; a wrench to scale first (wrench_scales' bounds, tested here on one
         # number: the array form costs half this call) goes the general way
         low, high = WRENCH_SCALED_BEYOND
-        largest = float(np.abs(rows).max())
+        largest = float(np.abs(rows).max()) if w.ndim == 1 else 0.0
         if fast is not None and w.ndim == 1 and (largest == 0 or low <= largest <= high):
             numbers = np.empty((1, fast.WIDTH))
             codes = np.empty((1, 3), np.int8)
@@ -435,14 +436,10 @@ class _Prepared:
         status, culprit = geo.status.copy(), geo.culprit.copy()
         line = status == ForceStatus.COLLINEAR_CONTACTS
         status[line] = 0  # solved below when the wrench has no moment about the line
-        with np.errstate(all="ignore"):
-            length = norm(n)
-            self.unit = n / length[..., None]
-        zero = ~(length > 0)
+        self.unit, zero, bad = unit_normals(n)
         hit = (status == 0) & zero.any(axis=1)
         status[hit], culprit[hit] = ForceStatus.ZERO_NORMAL, np.argmax(zero, axis=1)[hit]
-        bad = ~(np.isfinite(n).all(axis=(1, 2)) & ~np.isnan(mu).any(axis=1))
-        status[(status == 0) & bad] = ForceStatus.NONFINITE_INPUT
+        status[(status == 0) & (bad | np.isnan(mu).any(axis=1))] = ForceStatus.NONFINITE_INPUT
         self.frictionless = (mu == 0).all(axis=1)
         status[(status == 0) & (mu == 0).any(axis=1) & ~self.frictionless] = ForceStatus.MIXED_FRICTIONLESS
         status[line & (status == 0) & self.frictionless] = ForceStatus.COLLINEAR_CONTACTS  # not solved there

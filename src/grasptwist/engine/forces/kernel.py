@@ -643,10 +643,15 @@ def _set_up(r, p, n, limit, w, tol, o, codes, q, mv, g, unit, e, fm, frame, M, A
         side = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
         plain = plain and side > tol * math.sqrt(t)
         e[i, 0], e[i, 1], e[i, 2] = e0 / side, e1 / side, e2 / side
-        length = math.sqrt(n[r, i, 0] ** 2 + n[r, i, 1] ** 2 + n[r, i, 2] ** 2)
+        # grasp_map.unit_normals: scaled by a power of two first (exact), so any finite length is a length
+        big = max(abs(n[r, i, 0]), abs(n[r, i, 1]), abs(n[r, i, 2]))
+        power = math.frexp(big)[1]
+        for k in range(3):
+            unit[i, k] = math.ldexp(n[r, i, k], -power)
+        length = math.sqrt(unit[i, 0] ** 2 + unit[i, 1] ** 2 + unit[i, 2] ** 2)
         plain = plain and length > 0
         for k in range(3):
-            unit[i, k] = n[r, i, k] / length
+            unit[i, k] /= length
     if not plain:
         return _SKIP, 0.0, 0.0, 0.0
     # G^+ w (grasp_map._manipulating): the twist (omega; F/3) about the centroid
