@@ -43,6 +43,7 @@ __all__ = [
     "check_wrench",
     "unit_normals",
     "check_friction",
+    "check_torsion",
     "check_safety",
     "nonfinite_result",
     "checked_grip",
@@ -200,6 +201,26 @@ def check_friction(friction) -> np.ndarray:
     bad = a < 0
     if bad.any():
         raise ValueError(f"friction must be >= 0, got {float(a[bad].flat[0])!r}")
+    return a
+
+
+def check_torsion(torsion) -> np.ndarray:
+    """Torsional radii ``e_i >= 0`` (a length; ``0``: a point contact), broadcast against ``(..., 3)``.
+
+    As :func:`check_friction`: NaN is a row status (``nonfinite-input``), a negative or infinite value an error.
+
+    >>> check_torsion([0.01, 0, 0.01]).tolist()
+    [0.01, 0.0, 0.01]
+    >>> check_torsion(-0.01)
+    Traceback (most recent call last):
+    ValueError: torsion must be a finite length >= 0, got -0.01
+    """
+    a = _real(torsion, "torsion")
+    if a.ndim and a.shape[-1] not in (1, 3):
+        raise ValueError(f"torsion must broadcast to (..., 3) (one per contact), got {a.shape}")
+    bad = (a < 0) | np.isinf(a)
+    if bad.any():
+        raise ValueError(f"torsion must be a finite length >= 0, got {float(a[bad].flat[0])!r}")
     return a
 
 
@@ -599,7 +620,7 @@ def unit_normals(normals):
     infinite normal is non-finite, not zero (``unit`` is NaN there).
 
     >>> u, zero, bad = unit_normals(np.array([[[3e200, 4e200, 0], [0, 0, 1e-200], [0, 0, 0]]]))
-    >>> u[0].tolist(), zero.tolist(), bad.tolist()
+    >>> u[0].round(12).tolist(), zero.tolist(), bad.tolist()
     ([[0.6, 0.8, 0.0], [0.0, 0.0, 1.0], [nan, nan, nan]], [[False, False, True]], [False])
     """
     n = np.asarray(normals, dtype=float)

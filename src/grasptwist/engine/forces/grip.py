@@ -32,7 +32,7 @@ import numpy as np
 from ..checks import check_normals, check_points
 from ..degeneracy import DEGENERACY_TOL
 from ..screws import cross, dot, norm
-from . import closure, compiled, one, socp
+from . import closure, compiled, cones, one, socp
 from .grasp_map import (
     GRIP_COLUMNS,
     WRENCH_SCALED_BEYOND,
@@ -40,6 +40,7 @@ from .grasp_map import (
     _manipulating,
     check_friction,
     check_safety,
+    check_torsion,
     check_wrench,
     checked_grip,
     collinear_manipulating,
@@ -102,6 +103,9 @@ class Grip:
         every admissible ``f`` of every contact: a proof that no grip exists (Farkas).
         Scaled to ``|(y_F, L y_M)| = 1``, ``L`` the largest distance from the contacts'
         centroid to a contact (``load_words`` puts it in words).
+    torsion : (..., 3) or None
+        With ``torsion=`` given to :func:`grip`: the torsional moment ``tau_i`` each contact exerts
+        about its normal (0 at a point contact; NaN where ``status != 0``); None otherwise.
     """
 
     force: np.ndarray
@@ -118,6 +122,7 @@ class Grip:
     dual: np.ndarray
     gap: np.ndarray
     certificate: np.ndarray
+    torsion: np.ndarray | None = None
 
     @property
     def ok(self) -> np.ndarray:
@@ -228,7 +233,7 @@ def load_words(certificate, points) -> str:
     return f"cannot resist a force along ({force}) with a moment ({moment}) about the origin"
 
 
-def grip(points, normals, wrench, friction, *, safety=1.0, tol=DEGENERACY_TOL) -> Grip:
+def grip(points, normals, wrench, friction, *, safety=1.0, torsion=None, tol=DEGENERACY_TOL) -> Grip:
     r"""The finger forces that exert ``wrench`` with the least total normal force, inside every cone.
 
     Parameters
@@ -242,6 +247,10 @@ def grip(points, normals, wrench, friction, *, safety=1.0, tol=DEGENERACY_TOL) -
         ``mu_i`` per contact (last axis), ``>= 0``, ``inf`` for no limit.
     safety : float, keyword-only
         ``s >= 1``: the forces keep within ``mu_i / s``.
+    torsion : None, scalar or (..., 3) array, keyword-only
+        Soft-finger contacts: ``e_i`` (a length, ``>= 0``), the torsional radius of contact ``i``, which
+        then also exerts a moment ``tau_i`` about its normal within ``|(f_t, tau / e)| <= (mu / s) f_n``
+        (:mod:`~grasptwist.engine.forces.cones`).  ``0`` (or None) is a point contact.
     tol : float
         Degeneracy tolerance of the contacts (as the twist engine's).
 
@@ -268,12 +277,89 @@ def grip(points, normals, wrench, friction, *, safety=1.0, tol=DEGENERACY_TOL) -
     p, n, w = check_points(points), check_normals(normals), check_wrench(wrench)
     mu = check_friction(friction)
     s_f = check_safety(safety)
+    e = None if torsion is None else check_torsion(torsion)
     shape = np.broadcast_shapes(p.shape[:-2], n.shape[:-2], w.shape[:-1], mu.shape[:-1])
+    if e is not None:
+        shape = np.broadcast_shapes(shape, e.shape[:-1])
     p, n, w = (np.broadcast_to(a, shape + a.shape[-t:]) for a, t in ((p, 2), (n, 2), (w, 1)))
     mu = np.broadcast_to(mu if mu.ndim else mu[None], shape + (3,))
     size = int(np.prod(shape))
     flat = [a.reshape((size,) + a.shape[len(shape) :]) for a in (p, n, mu, w)]
-    return _grip_of(flat, s_f, tol, shape)
+    if e is None:
+        return _grip_of(flat, s_f, tol, shape)
+    e = np.broadcast_to(e if e.ndim else e[None], shape + (3,)).reshape(size, 3)
+    return _with_soft(flat, e, s_f, tol, shape)
+
+
+def _with_soft(rows, e, s_f, tol, shape):
+    """The :class:`Grip` of ``rows`` with torsional radii ``e (n, 3)``: rows with a soft contact (``e > 0``,
+    ``mu > 0``; NaN ``e``: ``nonfinite-input``) over the contacts' cones (:mod:`cones`), the others as
+    point contacts, bit for bit what :func:`grip` gives them without ``torsion``."""
+    mu = rows[2]
+    soft = ((e > 0) & (mu > 0)).any(axis=1) | np.isnan(e).any(axis=1)
+    point = np.flatnonzero(~soft)
+    g = _grip_of([a[point] for a in rows], s_f, tol, (point.size,))
+    fields = {name: getattr(g, name) for name, _ in GRIP_COLUMNS + (("status", 1), ("culprit", 1))}
+    out = {name: np.empty((len(e),) + v.shape[1:], v.dtype) for name, v in fields.items()}
+    for name, v in fields.items():
+        out[name][point] = v
+    out["torsion"] = np.full((len(e), 3), np.nan)
+    out["torsion"][point] = np.where(g.ok[:, None], 0.0, np.nan)
+    rest = np.flatnonzero(soft)
+    if rest.size:
+        for name, v in _soft_rows(*(a[rest] for a in rows), e[rest], s_f, tol).items():
+            out[name][rest] = v
+    return checked_grip(Grip(safety=s_f, **{k: v.reshape(shape + v.shape[1:]) for k, v in out.items()}))
+
+
+def _soft_rows(p, n, mu, w, e, s_f, tol):
+    """The grip's fields for rows with soft contacts, over the contacts' cones (:func:`cones.cone_solve`)."""
+    geo = geometry(p, tol)
+    status, culprit = geo.status.copy(), geo.culprit.copy()
+    status[status == ForceStatus.COLLINEAR_CONTACTS] = 0  # a soft contact's torsion may make what the line cannot
+    unit, zero, bad = unit_normals(n)
+    hit = (status == 0) & zero.any(axis=1)
+    status[hit], culprit[hit] = ForceStatus.ZERO_NORMAL, np.argmax(zero, axis=1)[hit]
+    bad |= np.isnan(mu).any(axis=1) | np.isnan(e).any(axis=1) | ~np.isfinite(w).all(axis=1)
+    status[(status == 0) & bad] = ForceStatus.NONFINITE_INPUT
+    rows = len(p)
+    force, torsion = np.full((rows, 3, 3), np.nan), np.full((rows, 3), np.nan)
+    dual, certificate = np.full((rows, 6), np.nan), np.full((rows, 6), np.nan)
+    todo = np.flatnonzero(status == 0)
+    model = cones.contact_models(mu, e)
+    if todo.size:
+        with np.errstate(all="ignore"):
+            setup = cones.cone_grasp(p[todo], unit[todo], mu[todo] / s_f, e[todo], model[todo])
+            out = cones.cone_solve(setup, w[todo])
+        force[todo], torsion[todo], dual[todo] = out["force"], out["torsion"], out["dual"]
+        certificate[todo] = out["certificate"]
+        status[todo[out["unmade"]]] = ForceStatus.COLLINEAR_CONTACTS
+        status[todo[out["fail"]]] = ForceStatus.CANNOT_HOLD
+        culprit[todo[out["fail"]]] = out["blame"][out["fail"]]
+    ok = status == 0
+    force[~ok], torsion[~ok], dual[~ok] = np.nan, np.nan, np.nan
+    with np.errstate(all="ignore"):
+        fm = _manipulating(geo, w)
+        fn = dot(force, unit)
+        ft = norm(force - fn[..., None] * unit)
+        rubbing = np.where(model == cones.SOFT, np.hypot(ft, torsion / np.where(e > 0, e, 1.0)), ft)
+        total = fn.sum(axis=-1)
+        return {
+            "force": force,
+            "manipulating": fm,
+            "squeeze": np.full((rows, 3), np.nan),
+            "normal_force": fn,
+            "tangential_force": ft,
+            "friction_used": rubbing / fn,
+            "total_normal_force": total,
+            "conditioning": geo.conditioning,
+            "status": status,
+            "culprit": culprit,
+            "dual": dual,
+            "gap": total - np.einsum("ni,ni->n", w, dual),
+            "certificate": _unit(certificate, geo.size),
+            "torsion": torsion,
+        }
 
 
 #: The grip's fields that scale with the wrench (the grip is positively homogeneous in it:
