@@ -2,11 +2,13 @@ r"""A batched primal-dual interior-point method for small second-order cone prog
 
 Each row is the problem
 
-.. math:: \min_x\; c^T x \quad \text{s.t.} \quad y_m = A_m x + b_m \in Q^3 = \{(t, z) : t \ge |z|\},\; m = 1 .. K
+.. math:: \min_x\; c^T x \quad \text{s.t.} \quad y_m = A_m x + b_m \in Q^k = \{(t, z) : t \ge |z|\},\; m = 1 .. K
 
-with ``x`` of 3 or 4 numbers (the grip's squeezes, and phase I's margin), and its dual
-``max -sum_m b_m^T z_m`` s.t. ``sum_m A_m^T z_m = c``, ``z_m in Q^3``; the duality gap is
-``sum_m y_m . z_m``.  A half-space ``a^T x + h >= 0`` is the cone ``(a^T x + h, 0, 0)``.
+with ``x`` of a few numbers (the grip's squeezes, a soft contact's torsions, and phase I's
+margin), and its dual ``max -sum_m b_m^T z_m`` s.t. ``sum_m A_m^T z_m = c``, ``z_m in Q^k``; the
+duality gap is ``sum_m y_m . z_m``.  The cones have ``k`` components (a ray ``k = 1``, ``Q^3``,
+``Q^4``); a smaller cone is padded with components that stay zero, and a half-space
+``a^T x + h >= 0`` is the cone ``(a^T x + h, 0, 0)``.
 
 Both phases start strictly inside the cones, primal and dual; phase II's dual start is
 feasible too (phase I's leaves a residual in the dual equalities, which every step shrinks by
@@ -30,8 +32,8 @@ gone) is above 0 (infeasible: ``cannot-hold``), or its gap has closed (the sign 
 decides).  An infeasible row whose cones share a boundary direction has ``r -> 0`` only
 far along it: it stops at the cap with ``r > 0``.
 
-Every array is components-first: cone vectors ``(3, K, n)`` (component, cone, row), ``A``
-``(3, d, K, n)``, ``x`` ``(d, n)``.
+Every array is components-first: cone vectors ``(k, K, n)`` (component, cone, row), ``A``
+``(k, d, K, n)``, ``x`` ``(d, n)``.
 """
 
 from __future__ import annotations
@@ -133,7 +135,7 @@ def _apply(A, x):
 @np.errstate(divide="ignore", invalid="ignore")
 def _iterate(A, b, c, x, z, leave):
     """Mehrotra steps on the rows of ``(A, b, c)`` from the strictly feasible primal ``x (d, n)`` and the
-    dual ``z (3, K, n)`` inside the cones (in place), until ``leave(x, closed, dual)`` holds for a row or
+    dual ``z (k, K, n)`` inside the cones (in place), until ``leave(x, closed, dual)`` holds for a row or
     the cap.  The dual residual ``c - sum_m A_m^T z_m`` shrinks with every step, by the step's
     length; ``closed`` says the gap is below ``GAP`` of the objective, ``dual`` is the dual objective
     where that residual is below ``_RESIDUAL``, ``-inf`` elsewhere."""
@@ -212,16 +214,16 @@ def _iterate(A, b, c, x, z, leave):
 
 
 def _layout(A, b):
-    """``(n, K, 3, d)``, ``(n, K, 3)`` -> components-first ``(3, d, K, n)``, ``(3, K, n)``."""
+    """``(n, K, k, d)``, ``(n, K, k)`` -> components-first ``(k, d, K, n)``, ``(k, K, n)``."""
     return np.ascontiguousarray(A.transpose(2, 3, 1, 0)), np.ascontiguousarray(b.transpose(2, 1, 0))
 
 
 def phase_one(A, b):
     """A strictly feasible ``x`` per row, the margin ``r`` reached (``r < 0``: feasible) and the dual.
 
-    ``A (n, K, 3, d)``, ``b (n, K, 3)`` -> ``x (n, d)``, ``r (n)``, ``z (n, K, 3)``.  With
+    ``A (n, K, k, d)``, ``b (n, K, k)`` -> ``x (n, d)``, ``r (n)``, ``z (n, K, k)``.  With
     ``r < 0`` every cone holds ``t_m - |z_m| >= -r > 0`` at ``x``.  Where ``r > 0`` the cones'
-    dual ``z_m`` (inside ``Q^3``, ``sum_m A_m^T z_m = 0`` to the residual) has
+    dual ``z_m`` (inside ``Q^k``, ``sum_m A_m^T z_m = 0`` to the residual) has
     ``-sum_m b_m . z_m > 0``: a proof that no ``x`` puts every ``A_m x + b_m`` in its cone
     (Farkas).
     """
@@ -251,9 +253,9 @@ def phase_one(A, b):
 
 
 def minimise(A, b, c, x):
-    """The optimum from the strictly feasible ``x (n, d)``; returns ``x (n, d)`` and the dual ``z (n, 3, 3)``.
+    """The optimum from the strictly feasible ``x (n, d)``; returns ``x (n, d)`` and the dual ``z (n, K, k)``.
 
-    ``A (n, 3, 3, d)``, ``b (n, 3, 3)``, ``c (n, d)`` with ``c = sum_m A_m^T e`` (``e = (1, 0,
+    ``A (n, K, k, d)``, ``b (n, K, k)``, ``c (n, d)`` with ``c = sum_m A_m^T e`` (``e = (1, 0,
     0)``: the objective is the sum of the cones' first components, as the grip's is), so
     ``z_m = e`` is a strictly feasible dual start.  The dual stays feasible
     (``sum_m A_m^T z_m = c`` to round-off); the gap ``sum_m y_m . z_m`` is below ``GAP``
