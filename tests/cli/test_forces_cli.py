@@ -453,3 +453,41 @@ def test_a_negative_mu_in_a_parquet_data_set_is_one_error_record(tmp_path):
     r, recs = records(tmp_path / "neg.parquet", POLYHEDRON)
     assert r.exit_code == 1 and [rec.get("grasp") for rec in recs] == [None, "polyhedron"]
     assert recs[0]["error"]["message"].startswith("friction: row 1: -2.0 must be >= 0")
+
+
+def test_soft_contacts_from_the_command_line_twist_a_rod_point_contacts_cannot(tmp_path):
+    """Issue 39: --contact soft --torsion E; the grip record says its contact model and each torsion."""
+    line = tmp_path / "line.yaml"
+    line.write_text(
+        "friction: 0.5\ncontacts:\n  - {point: [-0.05, 0, 0], normal: [1, 0, 0]}\n"
+        "  - {point: [0.05, 0, 0], normal: [-1, 0, 0]}\n  - {point: [0, 0, 0], normal: [0, 0, 1]}\n"
+    )
+    w = "0,0,1,0.004,0,0"
+    r, (rec,) = records(line, "--wrench", w)
+    assert r.exit_code == 1 and rec["grip"]["error"]["code"] == "collinear-contacts"
+    r, (rec,) = records(line, "--wrench", w, "--contact", "soft", "--torsion", "0.01")
+    # the manipulating forces are the point contacts' split (G^+ w), which the line still lacks
+    assert rec["manipulating"]["error"]["code"] == "collinear-contacts" and "error" not in rec["grip"]
+    points, normals = [[-0.05, 0, 0], [0.05, 0, 0], [0, 0, 0]], [[1, 0, 0], [-1, 0, 0], [0, 0, 1]]
+    engine = gt.grip(points, normals, [0, 0, 1, 0.004, 0, 0], 0.5, torsion=0.01)
+    assert rec["grip"]["contact_model"] == "soft" and rec["grip"]["squeeze"] is None
+    assert rec["grip"]["total_normal_force"] == pytest.approx(float(engine.total_normal_force), rel=1e-12)
+    assert rec["grip"]["torsion"] == pytest.approx([0.002, -0.002, 0], abs=1e-9)
+    _, recs = records(SPHERE)  # point contacts say so, with no torsion
+    grip = by(recs, "sphere-equator", "hold")["grip"]
+    assert grip["contact_model"] == "point" and grip["torsion"] == [0.0, 0.0, 0.0]
+
+
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["--contact", "soft"], "--contact soft needs --torsion E"),
+        (["--torsion", "0.01"], "give --contact soft too"),
+        (["--contact", "soft", "--torsion", "0"], "must be a finite length > 0"),
+        (["--contact", "soft", "--torsion", "nan"], "must be a finite length > 0"),
+        (["--contact", "hard", "--torsion", "0.01"], "--contact"),
+    ],
+)
+def test_soft_contact_options_are_usage_errors_when_half_given(args, message):
+    r, _ = run("forces", SPHERE, *args)
+    assert r.exit_code == 2 and message in r.stderr and not r.stdout

@@ -117,3 +117,14 @@ def test_two_soft_contacts_resist_a_moment_about_their_line_that_point_contacts_
     assert soft.torsion[2] == 0.0
     # a wider twist needs a harder pinch: |tau| <= e mu f_n at each pinching finger
     assert soft.normal_force[0] * 0.01 * 0.5 >= abs(soft.torsion[0]) * (1 - 1e-9)
+
+
+def test_a_prepared_grasp_with_soft_contacts_grips_as_grip_does():
+    w = [[0, 0, 1.0, 0.004, 0, 0], [0, 0, 1.0, -0.002, 0, 0]]
+    hand = gt.prepare_grip(LINE, ACROSS, 0.5, torsion=[0.01, 0.01, 0])
+    with compiled.numpy_path():
+        g = gt.grip(LINE, ACROSS, w, 0.5, torsion=[0.01, 0.01, 0])
+        np.testing.assert_array_equal(hand.grip(w).total_normal_force, g.total_normal_force)
+    assert float(hand.grip(w[0]).total_normal_force) == float(g.total_normal_force[0]) and g.ok.all()
+    with pytest.raises(ValueError, match=r"torsion a scalar or \(3,\)"):
+        gt.prepare_grip(LINE, ACROSS, 0.5, torsion=[[0.01] * 3] * 2)

@@ -62,12 +62,14 @@ class ForceResult:
     dual: np.ndarray  # (N, 6) the grip's certificate of optimality (NaN where it failed)
     gap: np.ndarray  # (N,)
     certificate: np.ndarray  # (N, 6) where no grip exists: the Farkas direction (else NaN)
+    torsion: np.ndarray  # (N, 3) the grip's torsion about each normal (0: point contacts; NaN where it failed)
     closure_friction: np.ndarray
     force_closure: np.ndarray  # (N,) bool
     epsilon: np.ndarray
     closure_status: np.ndarray
     closure_culprit: np.ndarray
     safety: float
+    contact_model: str = "point"  # the grip's contacts: "point", or "soft" (--contact soft --torsion E)
 
 
 def compute_forces(points, normals, wrench, has_wrench, friction, has_friction, options: ForceOptions) -> ForceResult:
@@ -92,6 +94,7 @@ def compute_forces(points, normals, wrench, has_wrench, friction, has_friction, 
         "dual": np.full((n, 6), np.nan),
         "gap": np.full(n, np.nan),
         "certificate": np.full((n, 6), np.nan),
+        "torsion": np.full((n, 3), np.nan),
         "closure_friction": np.full(n, np.nan),
         "force_closure": np.zeros(n, bool),
         "epsilon": np.full(n, np.nan),
@@ -108,9 +111,10 @@ def compute_forces(points, normals, wrench, has_wrench, friction, has_friction, 
         )
     g = np.flatnonzero(has_wrench & has_friction)
     if g.size:
-        r = grip(points[g], normals[g], wrench[g], friction[g], safety=options.safety)
+        r = grip(points[g], normals[g], wrench[g], friction[g], safety=options.safety, torsion=options.torsion)
         for name in (*GRIP_NUMBERS, "certificate"):
             out[name][g] = getattr(r, name)
+        out["torsion"][g] = np.where(r.ok[:, None], 0.0, np.nan) if r.torsion is None else r.torsion
         out["grip_status"][g], out["grip_culprit"][g] = r.status, r.culprit
     # closure and epsilon with the friction the forces may use, as the grip's (issue 31)
     usable = None if friction is None else friction / options.safety
@@ -134,7 +138,8 @@ def compute_forces(points, normals, wrench, has_wrench, friction, has_friction, 
             out["force_closure"][rows] = c.force_closure
         if quality:
             out["epsilon"][rows] = c.epsilon
-    return ForceResult(safety=float(options.safety), **out)
+    model = "point" if options.torsion is None else "soft"
+    return ForceResult(safety=float(options.safety), contact_model=model, **out)
 
 
 def closure_fields(block) -> list[dict]:
@@ -194,7 +199,8 @@ class ForceBlock:
             if f.name != "result" and getattr(self, f.name) is not None
         }
         r = self.result
-        result = replace(r, **{f.name: getattr(r, f.name)[rows] for f in fields(r) if f.name != "safety"})
+        whole = ("safety", "contact_model")
+        result = replace(r, **{f.name: getattr(r, f.name)[rows] for f in fields(r) if f.name not in whole})
         return ForceBlock(**cut, result=result)
 
     def outward(self) -> np.ndarray:

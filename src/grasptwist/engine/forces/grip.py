@@ -104,7 +104,7 @@ class Grip:
         Scaled to ``|(y_F, L y_M)| = 1``, ``L`` the largest distance from the contacts'
         centroid to a contact (``load_words`` puts it in words).
     torsion : (..., 3) or None
-        With ``torsion=`` given to :func:`grip`: the torsional moment ``tau_i`` each contact exerts
+        With ``torsion=`` given to ``grip``: the torsional moment ``tau_i`` each contact exerts
         about its normal (0 at a point contact; NaN where ``status != 0``); None otherwise.
     """
 
@@ -250,7 +250,7 @@ def grip(points, normals, wrench, friction, *, safety=1.0, torsion=None, tol=DEG
     torsion : None, scalar or (..., 3) array, keyword-only
         Soft-finger contacts: ``e_i`` (a length, ``>= 0``), the torsional radius of contact ``i``, which
         then also exerts a moment ``tau_i`` about its normal within ``|(f_t, tau / e)| <= (mu / s) f_n``
-        (:mod:`~grasptwist.engine.forces.cones`).  ``0`` (or None) is a point contact.
+        (the contacts' cones: docs/guide/forces.md).  ``0`` (or None) is a point contact.
     tol : float
         Degeneracy tolerance of the contacts (as the twist engine's).
 
@@ -453,8 +453,9 @@ class PreparedGrip:
     safety : float
     """
 
-    def __init__(self, points, normals, friction, safety, tol):
+    def __init__(self, points, normals, friction, safety, tol, torsion=None):
         self.points, self.normals, self.friction, self.safety = points, normals, friction, safety
+        self.torsion = torsion
         self._prepared = _Prepared(points[None], normals[None], friction[None], safety, tol)
         self._rows = (points[None], normals[None], friction[None])
         self._limit = np.ascontiguousarray(friction[None] / safety)
@@ -466,6 +467,10 @@ class PreparedGrip:
         ``wrench (..., 6)``: any number of wrenches on this grasp.
         """
         w = check_wrench(wrench)
+        if self.torsion is not None:  # soft contacts: the cones' way, set up per call (numpy)
+            return grip(
+                self.points, self.normals, w, self.friction, safety=self.safety, torsion=self.torsion, tol=self._tol
+            )
         rows = w.reshape(-1, 6)
         k = len(rows)
         fast = compiled.kernel()
@@ -489,7 +494,7 @@ class PreparedGrip:
         return _grip_of(grasp, self.safety, self._prepared.tol, w.shape[:-1], prepared)
 
 
-def prepare_grip(points, normals, friction, *, safety=1.0, tol=DEGENERACY_TOL) -> PreparedGrip:
+def prepare_grip(points, normals, friction, *, safety=1.0, torsion=None, tol=DEGENERACY_TOL) -> PreparedGrip:
     """One grasp's part of :func:`~grasptwist.forces.grip` done once, for a control loop whose wrench changes.
 
     ``points, normals (3, 3)``, ``friction`` scalar or ``(3,)``.  The checks, and on the numpy
@@ -497,7 +502,8 @@ def prepare_grip(points, normals, friction, *, safety=1.0, tol=DEGENERACY_TOL) -
     cone, do not depend on the wrench; ``.grip(wrench)`` does the rest and gives what
     :func:`~grasptwist.forces.grip` gives.  Compiled (numba), one wrench is one row of the kernel, whose
     wrench-free part is a small share of its time; the prepared form saves the checks and
-    the conversions around it.
+    the conversions around it.  With ``torsion`` (soft contacts, as :func:`~grasptwist.forces.grip`'s),
+    ``.grip(wrench)`` is that grip, its set-up done per call for now.
 
     >>> p = [[1, 0, 0], [-0.5, 0.75**0.5, 0], [-0.5, -(0.75**0.5), 0]]
     >>> hand = prepare_grip(p, -np.array(p), 0.5, safety=2)
@@ -510,7 +516,13 @@ def prepare_grip(points, normals, friction, *, safety=1.0, tol=DEGENERACY_TOL) -
     mu = np.broadcast_to(check_friction(friction), (3,)) if np.ndim(friction) <= 1 else None
     if mu is None:
         raise ValueError(f"prepare_grip takes one grasp: friction a scalar or (3,), got {np.shape(friction)}")
-    return PreparedGrip(np.ascontiguousarray(p), np.ascontiguousarray(n), mu.astype(float), check_safety(safety), tol)
+    e = None if torsion is None else check_torsion(torsion)
+    if e is not None and np.ndim(e) > 1:
+        raise ValueError(f"prepare_grip takes one grasp: torsion a scalar or (3,), got {np.shape(e)}")
+    e = None if e is None else np.broadcast_to(e, (3,)).astype(float)
+    return PreparedGrip(
+        np.ascontiguousarray(p), np.ascontiguousarray(n), mu.astype(float), check_safety(safety), tol, e
+    )
 
 
 class _Prepared:
