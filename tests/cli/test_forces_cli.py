@@ -491,3 +491,33 @@ def test_soft_contacts_from_the_command_line_twist_a_rod_point_contacts_cannot(t
 def test_soft_contact_options_are_usage_errors_when_half_given(args, message):
     r, _ = run("forces", SPHERE, *args)
     assert r.exit_code == 2 and message in r.stderr and not r.stdout
+
+
+def test_soft_contacts_from_a_grasp_file_and_their_errors_located(tmp_path):
+    """A contact's model: soft with torsion: E (issue 39); half of it, or a bad value, is a located error."""
+    good = tmp_path / "soft.yaml"
+    good.write_text(
+        "friction: 0.5\ncontacts:\n"
+        "  - {point: [-0.05, 0, 0], normal: [1, 0, 0], model: soft, torsion: 0.01}\n"
+        "  - {point: [0.05, 0, 0], normal: [-1, 0, 0], model: soft, torsion: 0.01}\n"
+        "  - {point: [0, 0, 0], normal: [0, 0, 1], model: point}\n"
+        "wrenches:\n  - {name: twist, force: [0, 0, 1], moment: [0.004, 0, 0]}\n"
+    )
+    (grasp,) = read_grasps(good)
+    assert grasp.torsion.tolist() == [0.01, 0.01, 0.0]
+    _, (rec,) = records(good)
+    assert rec["grip"]["contact_model"] == "soft" and rec["grip"]["torsion"] == pytest.approx([0.002, -0.002, 0])
+    cases = {
+        "model: soft": "missing-key: contacts[0].torsion",
+        "torsion: 0.01": "missing-key: contacts[0].model",
+        "model: hard, torsion: 0.01": "invalid-contact-model: contacts[0].model: must be point or soft, got 'hard'",
+        "model: soft, torsion: 0": "invalid-torsion: contacts[0].torsion: must be a length > 0",
+    }
+    for keys, message in cases.items():
+        bad = tmp_path / "bad.yaml"
+        bad.write_text(
+            f"friction: 0.5\ncontacts:\n  - {{point: [-0.05, 0, 0], normal: [1, 0, 0], {keys}}}\n"
+            "  - {point: [0.05, 0, 0], normal: [-1, 0, 0]}\n  - {point: [0, 0, 0], normal: [0, 0, 1]}\n"
+        )
+        r, _ = run("forces", bad)
+        assert r.exit_code == 1 and "bad.yaml:3:" in r.stderr and message in r.stderr, r.stderr

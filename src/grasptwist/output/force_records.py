@@ -103,7 +103,8 @@ def force_records(block) -> list[dict]:
                 rec["grip"]["squeeze"] = None
             rec["grip"]["safety"] = r.safety
             rec["grip"]["dual"], rec["grip"]["gap"] = grip["dual"][i], grip["gap"][i]
-            rec["grip"]["contact_model"], rec["grip"]["torsion"] = r.contact_model, grip["torsion"][i]
+            rec["grip"]["contact_model"] = "point" if r.contact_model is None else str(r.contact_model[i])
+            rec["grip"]["torsion"] = grip["torsion"][i]
         rec["closure"] = {
             "force_closure": force_closure[i] if has_friction[i] else None,
             "closure_friction": _number(closure_friction[i]),
