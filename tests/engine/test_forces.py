@@ -845,3 +845,55 @@ def test_nan_normals_are_nonfinite_input_and_a_zero_one_beside_finite_ones_zero_
     assert g.status.tolist() == c.status.tolist() == expected
     assert g.culprit[2] == c.culprit[2] == 0
     assert int(gt.prepare_grip(EQ, n[0], 0.5).grip([0, 0, G, 0, 0, 0]).status) == code.NONFINITE_INPUT
+
+
+def _kernel_as_python():
+    """engine/forces/kernel.py's own source run by Python and numpy: numba replaced by a stub whose ``njit``
+    returns the function it is given (as ``NUMBA_DISABLE_JIT`` would, without loading numba)."""
+    import importlib.util
+    import types
+
+    import grasptwist.engine.forces as package
+
+    stub = types.ModuleType("numba")
+    stub.njit = lambda *args, **kwargs: args[0] if args and callable(args[0]) else (lambda f: f)
+    stub.literally = lambda value: value
+    saved = sys.modules.get("numba")
+    sys.modules["numba"] = stub
+    try:
+        path = os.path.join(package.__path__[0], "kernel.py")
+        spec = importlib.util.spec_from_file_location("grasptwist.engine.forces._kernel_as_python", path)
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+    finally:
+        if saved is None:
+            del sys.modules["numba"]
+        else:
+            sys.modules["numba"] = saved
+    return module
+
+
+def test_the_compiled_grips_source_follows_the_numpy_path_in_the_default_run():
+    """Issue 39, item 8: the kernel numba compiles (the path every [fast] install takes) held to the numpy path
+    without a compile: its own source, run as Python, on held and cannot-hold rows, a row it leaves to numpy (a
+    NaN wrench) and a row with no wrench; the same verdicts and culprits, totals to 1e-9 (the slow tests compile
+    it; Python's floats raise on 0 / 0 where numba's error model gives NaN, so no degenerate row here)."""
+    kernel = _kernel_as_python()
+    p, n, w, mu = grasps(10, 19)
+    w[0, 2] = np.nan
+    w[1] = 0.0
+    limit = np.ascontiguousarray(np.broadcast_to(mu / 1.3, (10, 3)))
+    out, codes = np.empty((10, kernel.WIDTH)), np.empty((10, 3), np.int8)
+    with np.errstate(all="ignore"):  # numba's error model is numpy's: a 0 / 0 is NaN, quietly
+        kernel.grip_rows(p, n, limit, w, 1e-9, out, codes)
+    with compiled.numpy_path():
+        reference = gt.grip(p, n, w, mu, safety=1.3)
+    plain = codes[:, 2] == 1
+    assert plain.tolist() == [False] + [True] * 9  # the NaN row goes to numpy
+    assert (codes[plain, 0] == reference.status[plain]).all() and (codes[plain, 1] == reference.culprit[plain]).all()
+    assert 2 <= reference.ok[plain].sum() <= 7
+    total = out[:, kernel._TOTAL]
+    np.testing.assert_allclose(total[plain], reference.total_normal_force[plain], rtol=1e-9, atol=0)
+    forces = out[:, kernel._F : kernel._F + 9].reshape(-1, 3, 3)
+    held = plain & reference.ok
+    np.testing.assert_allclose(forces[held], reference.force[held], rtol=1e-6, atol=1e-6)
