@@ -295,6 +295,11 @@ def _with_soft(rows, e, s_f, tol, shape):
     """The :class:`Grip` of ``rows`` with torsional radii ``e (n, 3)``: rows with a soft contact (``e > 0``,
     ``mu > 0``; NaN ``e``: ``nonfinite-input``) over the contacts' cones (:mod:`cones`), the others as
     point contacts, bit for bit what :func:`grip` gives them without ``torsion``."""
+    if not len(e):
+        return replace(_no_rows(s_f, shape), torsion=np.empty(shape + (3,)))
+    k = wrench_scales(rows[3])
+    if k is not None:  # as _grip_of: solved scaled by a power of two, the grip scaled back
+        return _scaled_back(_with_soft((*rows[:3], rows[3] / k[:, None]), e, s_f, tol, shape), k, shape)
     mu = rows[2]
     soft = ((e > 0) & (mu > 0)).any(axis=1) | np.isnan(e).any(axis=1)
     point = np.flatnonzero(~soft)
@@ -380,13 +385,7 @@ def _grip_of(rows, s_f, tol, shape, prepared=None):
         return _no_rows(s_f, shape)
     k = wrench_scales(rows[3])
     if k is not None:
-        g = _grip_of((*rows[:3], rows[3] / k[:, None]), s_f, tol, shape, prepared)
-        k = k.reshape(shape)
-        with np.errstate(over="ignore", invalid="ignore"):
-            scaled = {
-                f: getattr(g, f) * k.reshape(k.shape + (1,) * (getattr(g, f).ndim - k.ndim)) for f in LINEAR_FIELDS
-            }
-        return checked_grip(replace(g, **scaled))
+        return _scaled_back(_grip_of((*rows[:3], rows[3] / k[:, None]), s_f, tol, shape, prepared), k, shape)
     fast = compiled.kernel()
     if fast is None:
         out = (prepared or _Prepared(*rows[:3], s_f, tol)).solve(rows[3])
@@ -394,6 +393,16 @@ def _grip_of(rows, s_f, tol, shape, prepared=None):
     p, n, mu, w = (np.ascontiguousarray(a, dtype=float) for a in rows)
     limit = np.ascontiguousarray(np.broadcast_to(mu / s_f, (len(p), 3)))
     return _compiled_grip(fast, (p, n, limit, w), s_f, tol, shape, lambda rest: (p[rest], n[rest], mu[rest]))
+
+
+def _scaled_back(g, k, shape):
+    """The grip ``g`` of wrenches divided by ``k (n)``, as the grip of the wrenches (:data:`LINEAR_FIELDS`, and
+    the torsions, times ``k``)."""
+    k = k.reshape(shape)
+    names = LINEAR_FIELDS if g.torsion is None else LINEAR_FIELDS + ("torsion",)
+    with np.errstate(over="ignore", invalid="ignore"):
+        scaled = {f: getattr(g, f) * k.reshape(k.shape + (1,) * (getattr(g, f).ndim - k.ndim)) for f in names}
+    return checked_grip(replace(g, **scaled))
 
 
 def _compiled_grip(fast, rows, s_f, tol, shape, others):
