@@ -46,11 +46,10 @@ from ..screws import cross
 from . import socp
 from .grasp_map import tangent_bases
 
-__all__ = ["FRICTIONLESS", "POINT", "SOFT", "MODEL_NAMES", "contact_models", "ConeGrasp", "cone_grasp", "cone_solve"]
+__all__ = ["FRICTIONLESS", "POINT", "SOFT", "contact_models", "ConeGrasp", "cone_grasp", "cone_solve"]
 
-#: The contact models' codes (``contact_models``) and their names in records.
+#: The contact models' codes (``contact_models``).
 FRICTIONLESS, POINT, SOFT = 0, 1, 2
-MODEL_NAMES = ("frictionless", "point", "soft")
 
 _SIZE = 4  # a contact's coordinates, and its cone's rows padded
 
