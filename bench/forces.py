@@ -17,6 +17,10 @@ disturbing moment; safety 1.5.  Baselines are Clarabel through its own Python AP
   on all: the wrench reproduced, the largest friction used over the cone's, and the
   certificates (dual gap, Farkas ``y . w > 0``).
 
+**The edge** (single calls, medians): a 1 kg tray held from below by three fingers (5 cm, normals
+up, mu 0.5) whose centre of mass lies on the line of two of them, so the third carries exactly
+nothing (no grip strictly inside the cones: facial reduction), against the same with 1 mN m more.
+
 The grip's figures come twice where numba is installed (the ``fast`` extra): compiled, then on
 the numpy path (``GRASPTWIST_NUMBA=0``'s), with the two held to each other.  The compiled
 kernel is loaded (or compiled, on a fresh install) before any timing; that first call is printed.
@@ -86,6 +90,19 @@ def single(p, n, w, mu, count):
         print(
             f"single calls, {name} (median of {count}): gt.grip {one:.0f} us, prepared .grip(wrench) {prepared:.0f} us, "
             f"Clarabel direct {clarabel:.0f} us; gt.grip is {clarabel / one:.2f}x Clarabel, prepared {clarabel / prepared:.2f}x"
+        )
+
+
+def edge(count):
+    """The grip's cliff (issue 39): a weight whose grip exists only on the cones' edge, against a clean row."""
+    p = 0.05 * np.array([[1, 0, 0], [-0.5, 0.75**0.5, 0], [-0.5, -(0.75**0.5), 0]])
+    up = np.array([[0, 0, 1.0]] * 3)
+    w = np.concatenate(([0, 0, 9.81], np.cross([-0.025, 0, 0], [0, 0, 9.81])))
+    for name, path in paths():
+        with path():
+            times = [median_us(lambda i, v=v: gt.grip(p, up, v, 0.5), count) for v in (w, w + [0, 0, 0, 0, -1e-3, 0])]
+        print(
+            f"the edge, {name}: a weight held on the cones' edge {times[0]:.0f} us, with 1 mN m about y more (its centre of mass 0.1 mm inside: a clean row) {times[1]:.0f} us"
         )
 
 
@@ -181,6 +198,7 @@ def main():
     if compiled.kernel() is not None:
         print(f"first grip (numba loads its cached kernel, or compiles it on a fresh install): {first:.2f} s (CPU)")
     single(p, n, w, mu, args.single)
+    edge(args.single)
     batched(p, n, w, mu, args.loop, args.closure_loop)
     epsilon(p, n, mu, args.epsilon)
 

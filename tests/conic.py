@@ -83,3 +83,47 @@ def closure_friction(points, normals, hi=1e3, iterations=45):
         mid = 0.5 * (lo + hi)
         lo, hi = (lo, mid) if closure_margin(points, normals, mid) > STRICT else (mid, hi)
     return hi
+
+
+def least_soft_grip(points, normals, wrench, friction, torsion, safety=1.0):
+    """:func:`least_grip` with soft-finger contacts: ``(total, forces (3, 3), torsions (3,))``, ``(None,) * 3``
+    when infeasible, ``(nan, None, None)`` when Clarabel cannot decide (a numerical error).
+
+    Variables ``(f_1, f_2, f_3, tau_1, tau_2, tau_3)``: ``sum_i (f_i; p_i x f_i + tau_i n_i) = w`` and
+    ``(mu_i n_i . f_i, b1 . f_i, b2 . f_i, tau_i / e_i)`` in ``SOC(4)`` (``e_i = 0``: ``SOC(3)`` and ``tau_i = 0``).
+    """
+    n = _unit(normals)
+    mu = np.broadcast_to(np.asarray(friction, float), (3,)) / safety
+    e = np.broadcast_to(np.asarray(torsion, float), (3,))
+    b1, b2 = tangent_bases(n)
+    eq = np.zeros((6, 12))
+    eq[:, :9] = grasp_map(points)
+    for i in range(3):
+        eq[3:, 9 + i] = n[i]
+    rows, cones, fixed = [], [], []
+    for i in range(3):
+        soft = e[i] > 0
+        block = np.zeros((4 if soft else 3, 12))
+        block[:3, 3 * i : 3 * i + 3] = -np.stack((mu[i] * n[i], b1[i], b2[i]))
+        if soft:
+            block[3, 9 + i] = -1 / e[i]
+        else:
+            zero = np.zeros(12)
+            zero[9 + i] = 1.0
+            fixed.append(zero)
+        rows.append(block)
+        cones.append(clarabel.SecondOrderConeT(len(block)))
+    zeros = np.vstack([eq] + fixed)
+    A = sparse.csc_matrix(np.vstack([zeros] + rows))
+    b = np.concatenate((np.asarray(wrench, float), np.zeros(len(fixed)), np.zeros(sum(len(r) for r in rows))))
+    q = np.concatenate((n.reshape(9), np.zeros(3)))
+    solver = clarabel.DefaultSolver(
+        sparse.csc_matrix((12, 12)), q, A, b, [clarabel.ZeroConeT(len(zeros))] + cones, _settings()
+    )
+    sol = solver.solve()
+    if str(sol.status) in ("NumericalError", "InsufficientProgress"):
+        return np.nan, None, None  # undecided (1 of 1000 random grasps: a cone's edge at 258 N)
+    if str(sol.status) not in ("Solved", "AlmostSolved"):
+        return None, None, None
+    x = np.array(sol.x)
+    return float(sol.obj_val), x[:9].reshape(3, 3), x[9:]

@@ -114,6 +114,10 @@ class Grasp:
     friction : numpy.ndarray or None
         ``(3,)`` Coulomb friction coefficient ``mu_i >= 0`` of each contact
         (a contact's own ``friction``, else the grasp's); None when not given.
+    torsion : numpy.ndarray or None
+        ``(3,)`` each contact's torsional radius ``e_i`` (a length): ``> 0`` for a
+        contact given ``model: soft``, 0 for a point contact; None when every
+        contact is a point contact.
     wrenches : tuple of Wrench
         The wrenches the fingers must exert, possibly none; the last is
         ``hold`` when ``mass`` is given.
@@ -152,6 +156,7 @@ class Grasp:
     hand: Hand | None = None
     joint_positions: np.ndarray | None = None
     friction: np.ndarray | None = None
+    torsion: np.ndarray | None = None
     wrenches: tuple[Wrench, ...] = ()
     mass: float | None = None
     center_of_mass: np.ndarray | None = None

@@ -459,3 +459,71 @@ def test_a_negative_mu_in_a_parquet_data_set_is_one_error_record(tmp_path):
     r, recs = records(tmp_path / "neg.parquet", POLYHEDRON)
     assert r.exit_code == 1 and [rec.get("grasp") for rec in recs] == ["0", None, "polyhedron"]
     assert recs[1]["error"]["message"] == "friction: row 1: -2.0 must be >= 0"
+
+
+def test_soft_contacts_from_the_command_line_twist_a_rod_point_contacts_cannot(tmp_path):
+    """Issue 39: --contact soft --torsion E; the grip record says its contact model and each torsion."""
+    line = tmp_path / "line.yaml"
+    line.write_text(
+        "friction: 0.5\ncontacts:\n  - {point: [-0.05, 0, 0], normal: [1, 0, 0]}\n"
+        "  - {point: [0.05, 0, 0], normal: [-1, 0, 0]}\n  - {point: [0, 0, 0], normal: [0, 0, 1]}\n"
+    )
+    w = "0,0,1,0.004,0,0"
+    r, (rec,) = records(line, "--wrench", w)
+    assert r.exit_code == 1 and rec["grip"]["error"]["code"] == "collinear-contacts"
+    r, (rec,) = records(line, "--wrench", w, "--contact", "soft", "--torsion", "0.01")
+    # the manipulating forces are the point contacts' split (G^+ w), which the line still lacks
+    assert rec["manipulating"]["error"]["code"] == "collinear-contacts" and "error" not in rec["grip"]
+    points, normals = [[-0.05, 0, 0], [0.05, 0, 0], [0, 0, 0]], [[1, 0, 0], [-1, 0, 0], [0, 0, 1]]
+    engine = gt.grip(points, normals, [0, 0, 1, 0.004, 0, 0], 0.5, torsion=0.01)
+    assert rec["grip"]["contact_model"] == "soft" and rec["grip"]["squeeze"] is None
+    assert rec["grip"]["total_normal_force"] == pytest.approx(float(engine.total_normal_force), rel=1e-12)
+    assert rec["grip"]["torsion"] == pytest.approx([0.002, -0.002, 0], abs=1e-9)
+    _, recs = records(SPHERE)  # point contacts say so, with no torsion
+    grip = by(recs, "sphere-equator", "hold")["grip"]
+    assert grip["contact_model"] == "point" and grip["torsion"] == [0.0, 0.0, 0.0]
+
+
+@pytest.mark.parametrize(
+    "args, message",
+    [
+        (["--contact", "soft"], "--contact soft needs --torsion E"),
+        (["--torsion", "0.01"], "give --contact soft too"),
+        (["--contact", "soft", "--torsion", "0"], "must be a finite length > 0"),
+        (["--contact", "soft", "--torsion", "nan"], "must be a finite length > 0"),
+        (["--contact", "hard", "--torsion", "0.01"], "--contact"),
+    ],
+)
+def test_soft_contact_options_are_usage_errors_when_half_given(args, message):
+    r, _ = run("forces", SPHERE, *args)
+    assert r.exit_code == 2 and message in r.stderr and not r.stdout
+
+
+def test_soft_contacts_from_a_grasp_file_and_their_errors_located(tmp_path):
+    """A contact's model: soft with torsion: E (issue 39); half of it, or a bad value, is a located error."""
+    good = tmp_path / "soft.yaml"
+    good.write_text(
+        "friction: 0.5\ncontacts:\n"
+        "  - {point: [-0.05, 0, 0], normal: [1, 0, 0], model: soft, torsion: 0.01}\n"
+        "  - {point: [0.05, 0, 0], normal: [-1, 0, 0], model: soft, torsion: 0.01}\n"
+        "  - {point: [0, 0, 0], normal: [0, 0, 1], model: point}\n"
+        "wrenches:\n  - {name: twist, force: [0, 0, 1], moment: [0.004, 0, 0]}\n"
+    )
+    (grasp,) = read_grasps(good)
+    assert grasp.torsion.tolist() == [0.01, 0.01, 0.0]
+    _, (rec,) = records(good)
+    assert rec["grip"]["contact_model"] == "soft" and rec["grip"]["torsion"] == pytest.approx([0.002, -0.002, 0])
+    cases = {
+        "model: soft": "missing-key: contacts[0].torsion",
+        "torsion: 0.01": "missing-key: contacts[0].model",
+        "model: hard, torsion: 0.01": "invalid-contact-model: contacts[0].model: must be point or soft, got 'hard'",
+        "model: soft, torsion: 0": "invalid-torsion: contacts[0].torsion: must be a length > 0",
+    }
+    for keys, message in cases.items():
+        bad = tmp_path / "bad.yaml"
+        bad.write_text(
+            f"friction: 0.5\ncontacts:\n  - {{point: [-0.05, 0, 0], normal: [1, 0, 0], {keys}}}\n"
+            "  - {point: [0.05, 0, 0], normal: [-1, 0, 0]}\n  - {point: [0, 0, 0], normal: [0, 0, 1]}\n"
+        )
+        r, _ = run("forces", bad)
+        assert r.exit_code == 1 and "bad.yaml:3:" in r.stderr and message in r.stderr, r.stderr

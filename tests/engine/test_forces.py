@@ -808,3 +808,92 @@ def test_an_empty_batch_grips_to_empty_fields(batch):
     g = gt.grip(np.zeros(batch + (3, 3)), np.zeros(batch + (3, 3)), np.zeros(batch + (6,)), 0.5)
     assert g.status.shape == g.total_normal_force.shape == batch
     assert g.force.shape == batch + (3, 3) and g.dual.shape == batch + (6,)
+    hand = gt.prepare_grip(EQ, -EQ, 0.5)  # and a prepared grasp's (issue 36: it indexed a first row)
+    g = hand.grip(np.zeros(batch + (6,)))
+    assert g.status.shape == g.total_normal_force.shape == batch and g.force.shape == batch + (3, 3)
+
+
+@pytest.mark.parametrize("length", [1e-200, 1e-150, 1e-30, 1.0, 1e30, 1e150, 1e200, 1e300])
+def test_the_grip_and_closure_answer_the_same_for_normals_of_any_finite_length(length, grip_path):
+    """Issue 35: normals of length 1e200 overflowed their squares (unit normals of zero: cannot-hold for a grasp
+    that holds at G / mu); 1e-200 underflowed them (zero-normal).  Scaled by a power of two first, every length
+    gives the same grip (to the rounding of ``length * n``; to the last bit for a power of two)."""
+    w = [0, 0, G, 0, 0, 0]
+    tilted = TRIPOD_N * np.array([[1.0], [3.0], [0.5]])  # lengths differing by contact too
+    with compiled.numpy_path():
+        reference = gt.grip(TRIPOD, tilted, w, 0.7)
+        assert (gt.grip(TRIPOD, 2.0**-700 * tilted, w, 0.7).force == reference.force).all()
+    g = gt.grip(TRIPOD, length * tilted, w, 0.7)
+    assert g.ok and float(g.total_normal_force) == pytest.approx(float(reference.total_normal_force), rel=1e-12)
+    np.testing.assert_allclose(g.force, reference.force, rtol=1e-9, atol=1e-12)
+    hand = gt.prepare_grip(TRIPOD, length * tilted, 0.7)
+    assert float(hand.grip(w).total_normal_force) == pytest.approx(float(reference.total_normal_force), rel=1e-12)
+    c = gt.forces.force_closure(TRIPOD, length * tilted, 0.7)
+    assert bool(c.force_closure) and float(c.closure_friction) == pytest.approx(0.4663, abs=1e-4)
+
+
+def test_nan_normals_are_nonfinite_input_and_a_zero_one_beside_finite_ones_zero_normal(grip_path):
+    """Issue 36: NaN normals read as zero-normal in the grip and force_closure (the twist methods say nonfinite)."""
+    n = np.stack((-EQ, -EQ, -EQ, -EQ))
+    n[0, 1, 2] = np.nan
+    n[1, 2] = np.inf
+    n[2, 0] = 0.0
+    g = gt.grip(EQ, n, [0, 0, G, 0, 0, 0], 0.5)
+    c = gt.forces.force_closure(EQ, n, 0.5)
+    code = gt.forces.Status
+    expected = [code.NONFINITE_INPUT, code.NONFINITE_INPUT, code.ZERO_NORMAL, 0]
+    assert g.status.tolist() == c.status.tolist() == expected
+    assert g.culprit[2] == c.culprit[2] == 0
+    assert int(gt.prepare_grip(EQ, n[0], 0.5).grip([0, 0, G, 0, 0, 0]).status) == code.NONFINITE_INPUT
+
+
+def _kernel_as_python():
+    """engine/forces/kernel.py's own source run by Python and numpy: numba replaced by a stub whose ``njit``
+    returns the function it is given (as ``NUMBA_DISABLE_JIT`` would, without loading numba)."""
+    import importlib.util
+    import types
+
+    import grasptwist.engine.forces as package
+
+    stub = types.ModuleType("numba")
+    stub.njit = lambda *args, **kwargs: args[0] if args and callable(args[0]) else (lambda f: f)
+    stub.literally = lambda value: value
+    saved = sys.modules.get("numba")
+    sys.modules["numba"] = stub
+    try:
+        path = os.path.join(package.__path__[0], "kernel.py")
+        spec = importlib.util.spec_from_file_location("grasptwist.engine.forces._kernel_as_python", path)
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+    finally:
+        if saved is None:
+            del sys.modules["numba"]
+        else:
+            sys.modules["numba"] = saved
+    return module
+
+
+def test_the_compiled_grips_source_follows_the_numpy_path_in_the_default_run():
+    """Issue 39, item 8: the kernel numba compiles (the path every [fast] install takes) held to the numpy path
+    without a compile: its own source, run as Python, on held and cannot-hold rows, a row it leaves to numpy (a
+    NaN wrench) and a row with no wrench; the same verdicts and culprits, totals to 1e-9 (the slow tests compile
+    it; Python's floats raise on 0 / 0 where numba's error model gives NaN, so no degenerate row here)."""
+    kernel = _kernel_as_python()
+    p, n, w, mu = grasps(10, 19)
+    w[0, 2] = np.nan
+    w[1] = 0.0
+    limit = np.ascontiguousarray(np.broadcast_to(mu / 1.3, (10, 3)))
+    out, codes = np.empty((10, kernel.WIDTH)), np.empty((10, 3), np.int8)
+    with np.errstate(all="ignore"):  # numba's error model is numpy's: a 0 / 0 is NaN, quietly
+        kernel.grip_rows(p, n, limit, w, 1e-9, out, codes)
+    with compiled.numpy_path():
+        reference = gt.grip(p, n, w, mu, safety=1.3)
+    plain = codes[:, 2] == 1
+    assert plain.tolist() == [False] + [True] * 9  # the NaN row goes to numpy
+    assert (codes[plain, 0] == reference.status[plain]).all() and (codes[plain, 1] == reference.culprit[plain]).all()
+    assert 2 <= reference.ok[plain].sum() <= 7
+    total = out[:, kernel._TOTAL]
+    np.testing.assert_allclose(total[plain], reference.total_normal_force[plain], rtol=1e-9, atol=0)
+    forces = out[:, kernel._F : kernel._F + 9].reshape(-1, 3, 3)
+    held = plain & reference.ok
+    np.testing.assert_allclose(forces[held], reference.force[held], rtol=1e-6, atol=1e-6)

@@ -143,3 +143,20 @@ def test_what_the_schema_cannot_state_is_in_its_description():
     description = grasp_schema()["description"]
     for words in ("unique contact and twist names", "finite numbers", "within the surface tolerance"):
         assert words in description
+
+
+def test_the_schema_takes_soft_contacts_as_the_loader_does():
+    """A contact's model: soft needs its torsion, and a torsion needs model: soft (issue 39)."""
+    schema = grasp_schema()
+    rest = [{"point": [0.05, 0, 0], "normal": [-1, 0, 0]}, {"point": [0, 0, 0], "normal": [0, 0, 1]}]
+    soft = {"point": [-0.05, 0, 0], "normal": [1, 0, 0], "model": "soft", "torsion": 0.01}
+    jsonschema.validate({"friction": 0.5, "contacts": [soft, *rest]}, schema)
+    for bad in (
+        {"model": "soft"},
+        {"torsion": 0.01},
+        {"model": "point", "torsion": 0.01},
+        {"model": "soft", "torsion": 0},
+    ):
+        contact = {"point": [-0.05, 0, 0], "normal": [1, 0, 0], **bad}
+        with pytest.raises(jsonschema.ValidationError):
+            jsonschema.validate({"friction": 0.5, "contacts": [contact, *rest]}, schema)

@@ -9,6 +9,8 @@ from .exits import run_command
 from .options import (
     AllowOutside,
     At,
+    Contact,
+    ContactOption,
     Debug,
     Digits,
     ForcesFormat,
@@ -20,10 +22,12 @@ from .options import (
     Quiet,
     Safety,
     SurfaceTol,
+    Torsion,
     WarningsOption,
     Workers,
     WrenchName,
     WrenchOption,
+    contact_torsion,
     not_binary_to_a_terminal,
     reading_option,
     wrenches_option,
@@ -49,6 +53,8 @@ def forces(
     at: At = None,
     friction: Friction = None,
     safety: Safety = 1.0,
+    contact: ContactOption = Contact.point,
+    torsion: Torsion = None,
     quality: Annotated[
         bool, typer.Option("--quality", help="Also Ferrari-Canny's epsilon (needs scipy: grasptwist[quality]).")
     ] = False,
@@ -94,6 +100,7 @@ def forces(
     from ..run.pipeline import Job
 
     wrenches = wrenches_option(wrench, at, wrench_name)
+    torsion = contact_torsion(contact, torsion)
     if quality:
         from ..extras import require
 
@@ -111,6 +118,7 @@ def forces(
             safety=safety,
             quality=quality,
             cone_edges=cone_edges,
+            torsion=torsion,
         ),
     )
     settings = OutputSettings(output, quiet, warnings, workers, {"digits": digits})

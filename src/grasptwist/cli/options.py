@@ -237,6 +237,55 @@ Friction = Annotated[
         help="Friction coefficient of every contact (replaces the files'; inf: no limit).",
     ),
 ]
+
+
+def _torsion(value: float | None) -> float | None:
+    """A torsional radius: a finite length > 0."""
+    if value is not None and not (0 < value < float("inf")):
+        raise typer.BadParameter(f"must be a finite length > 0 (the soft fingers' torsional radius), got {value!r}")
+    return value
+
+
+class Contact(str, Enum):
+    """The contact model of ``--contact``."""
+
+    point = "point"
+    soft = "soft"
+
+
+ContactOption = Annotated[
+    Contact,
+    typer.Option(
+        "--contact",
+        help="Contact model of the grip: point (Coulomb cones) or soft (finger pads that also resist turning "
+        "about the normal, |(f_t, tau / E)| <= mu f_n; needs --torsion).",
+    ),
+]
+Torsion = Annotated[
+    float | None,
+    typer.Option(
+        "--torsion",
+        metavar="E",
+        callback=_torsion,
+        help="Torsional radius of every soft contact (a length, in the grasps' units; with --contact soft).",
+    ),
+]
+
+
+def contact_torsion(contact: Contact, torsion: float | None) -> float | None:
+    """``--contact`` and ``--torsion`` as the grip's torsional radius (None: point contacts); a usage error when
+    one is given without the other."""
+    if contact is Contact.soft and torsion is None:
+        raise typer.BadParameter(
+            "--contact soft needs --torsion E (the torsional radius, a length > 0)", param_hint="'--contact'"
+        )
+    if contact is Contact.point and torsion is not None:
+        raise typer.BadParameter(
+            "--torsion is the soft contacts' radius: give --contact soft too", param_hint="'--torsion'"
+        )
+    return torsion
+
+
 Safety = Annotated[
     float,
     typer.Option(

@@ -60,7 +60,7 @@ def force_records(block) -> list[dict]:
     has_wrench, has_friction = block.has_wrench.tolist(), block.has_friction.tolist()
     points, normals, wrench, friction = (_lists(a) for a in (block.points, block.normals, block.wrench, block.friction))
     manipulating = _lists(r.manipulating)
-    grip = {name: _lists(getattr(r, name)) for name in GRIP_FIELDS + ("dual", "gap")}
+    grip = {name: _lists(getattr(r, name)) for name in GRIP_FIELDS + ("dual", "gap", "torsion")}
     certificate = [None if c[0] != c[0] else c for c in _lists(r.certificate)]
     closure_friction, epsilon = r.closure_friction.tolist(), r.epsilon.tolist()
     force_closure = r.force_closure.tolist()
@@ -103,6 +103,8 @@ def force_records(block) -> list[dict]:
                 rec["grip"]["squeeze"] = None
             rec["grip"]["safety"] = r.safety
             rec["grip"]["dual"], rec["grip"]["gap"] = grip["dual"][i], grip["gap"][i]
+            rec["grip"]["contact_model"] = "point" if r.contact_model is None else str(r.contact_model[i])
+            rec["grip"]["torsion"] = grip["torsion"][i]
         rec["closure"] = {
             "force_closure": force_closure[i] if has_friction[i] else None,
             "closure_friction": _number(closure_friction[i]),

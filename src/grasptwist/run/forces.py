@@ -62,20 +62,27 @@ class ForceResult:
     dual: np.ndarray  # (N, 6) the grip's certificate of optimality (NaN where it failed)
     gap: np.ndarray  # (N,)
     certificate: np.ndarray  # (N, 6) where no grip exists: the Farkas direction (else NaN)
+    torsion: np.ndarray  # (N, 3) the grip's torsion about each normal (0: point contacts; NaN where it failed)
     closure_friction: np.ndarray
     force_closure: np.ndarray  # (N,) bool
     epsilon: np.ndarray
     closure_status: np.ndarray
     closure_culprit: np.ndarray
     safety: float
+    contact_model: np.ndarray | None = None  # (N,) str: "soft" where a contact is soft, else "point"; None: all point
 
 
-def compute_forces(points, normals, wrench, has_wrench, friction, has_friction, options: ForceOptions) -> ForceResult:
+def compute_forces(
+    points, normals, wrench, has_wrench, friction, has_friction, options: ForceOptions, torsion=None
+) -> ForceResult:
     """The engine's force results for ``N`` rows (NaN wrench / friction rows where there is none).
 
     The engine is called once per kind of row (with and without a wrench, a
-    friction), never once per row.
+    friction), never once per row.  ``torsion (N, 3)``: the contacts' torsional radii (grasp
+    files' ``model: soft``); the options' ``torsion`` (``--torsion``) replaces them; None: point contacts.
     """
+    if options.torsion is not None:
+        torsion = np.full((len(points), 3), float(options.torsion))
     n = len(points)
     out = {
         "manipulating": np.full((n, 3, 3), np.nan),
@@ -92,6 +99,7 @@ def compute_forces(points, normals, wrench, has_wrench, friction, has_friction, 
         "dual": np.full((n, 6), np.nan),
         "gap": np.full(n, np.nan),
         "certificate": np.full((n, 6), np.nan),
+        "torsion": np.full((n, 3), np.nan),
         "closure_friction": np.full(n, np.nan),
         "force_closure": np.zeros(n, bool),
         "epsilon": np.full(n, np.nan),
@@ -108,9 +116,11 @@ def compute_forces(points, normals, wrench, has_wrench, friction, has_friction, 
         )
     g = np.flatnonzero(has_wrench & has_friction)
     if g.size:
-        r = grip(points[g], normals[g], wrench[g], friction[g], safety=options.safety)
+        e = None if torsion is None else torsion[g]
+        r = grip(points[g], normals[g], wrench[g], friction[g], safety=options.safety, torsion=e)
         for name in (*GRIP_NUMBERS, "certificate"):
             out[name][g] = getattr(r, name)
+        out["torsion"][g] = np.where(r.ok[:, None], 0.0, np.nan) if r.torsion is None else r.torsion
         out["grip_status"][g], out["grip_culprit"][g] = r.status, r.culprit
     # closure and epsilon with the friction the forces may use, as the grip's (issue 31)
     usable = None if friction is None else friction / options.safety
@@ -134,7 +144,8 @@ def compute_forces(points, normals, wrench, has_wrench, friction, has_friction, 
             out["force_closure"][rows] = c.force_closure
         if quality:
             out["epsilon"][rows] = c.epsilon
-    return ForceResult(safety=float(options.safety), **out)
+    model = None if torsion is None else np.where((torsion > 0).any(axis=1), "soft", "point")
+    return ForceResult(safety=float(options.safety), contact_model=model, **out)
 
 
 def closure_fields(block) -> list[dict]:
@@ -194,7 +205,14 @@ class ForceBlock:
             if f.name != "result" and getattr(self, f.name) is not None
         }
         r = self.result
-        result = replace(r, **{f.name: getattr(r, f.name)[rows] for f in fields(r) if f.name != "safety"})
+        result = replace(
+            r,
+            **{
+                f.name: getattr(r, f.name)[rows]
+                for f in fields(r)
+                if f.name != "safety" and getattr(r, f.name) is not None
+            },
+        )
         return ForceBlock(**cut, result=result)
 
     def outward(self) -> np.ndarray:
@@ -208,14 +226,14 @@ class ForceBlock:
 
 
 def force_arrays(
-    points, normals, wrench, wrench_name, friction, options: ForceOptions, center_of_mass=None, **labels
+    points, normals, wrench, wrench_name, friction, options: ForceOptions, center_of_mass=None, torsion=None, **labels
 ) -> ForceBlock:
     """One block from arrays of rows (``wrench``, ``friction`` and ``center_of_mass`` NaN rows where
     there is none; ``center_of_mass`` None: no row has one)."""
     n = len(points)
     has_friction = ~np.isnan(friction).any(axis=-1)
     has_wrench = np.array([name is not None for name in wrench_name], dtype=bool)
-    result = compute_forces(points, normals, wrench, has_wrench, friction, has_friction, options)
+    result = compute_forces(points, normals, wrench, has_wrench, friction, has_friction, options, torsion)
     return ForceBlock(
         file=labels.get("file", [""] * n),
         grasp=labels.get("grasp", [str(i) for i in range(n)]),
@@ -268,6 +286,9 @@ def _stack(rows, options) -> ForceBlock:
         None
         if all(g.center_of_mass is None for g in grasps)
         else np.stack([nan3 if g.center_of_mass is None else g.center_of_mass for g in grasps]),
+        None
+        if all(g.torsion is None for g in grasps)
+        else np.stack([g.torsion if g.torsion is not None else np.zeros(3) for g in grasps]),
         file=[g.file for g in grasps],
         grasp=[g.name for g in grasps],
         units=[g.units for g in grasps],

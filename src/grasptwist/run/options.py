@@ -47,7 +47,8 @@ class ForceOptions:
 
     ``wrenches`` (``--wrench``) replace each grasp's own, ``friction``
     (``--friction``) its friction; ``safety``, ``quality`` and ``cone_edges``
-    go to the engine.
+    go to the engine; ``torsion`` (``--contact soft --torsion E``), every
+    contact's torsional radius: soft-finger contacts for the grip (None: point contacts).
     """
 
     wrenches: tuple[Wrench, ...] | None = None
@@ -55,6 +56,7 @@ class ForceOptions:
     safety: float = 1.0
     quality: bool = False
     cone_edges: int = 8
+    torsion: float | None = None
 
     def rows_per_grasp(self) -> int:
         """Rows each grasp of a data set gives: one per wrench of the command line, else its own (or none)."""

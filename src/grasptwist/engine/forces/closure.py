@@ -43,7 +43,7 @@ import numpy as np
 from ..checks import check_normals, check_points
 from ..degeneracy import DEGENERACY_TOL
 from ..screws import cross, dot, norm
-from .grasp_map import ForceStatus, check_friction, contact_matrices, geometry, tangent_bases
+from .grasp_map import ForceStatus, check_friction, contact_matrices, geometry, tangent_bases, unit_normals
 
 __all__ = [
     "Closure",
@@ -361,13 +361,10 @@ def force_closure(points, normals, friction=None, *, quality=False, cone_edges=8
 def _closure_rows(p, n, mu, quality, edges, tol):
     geo = geometry(p, tol)
     status, culprit = geo.status.copy(), geo.culprit.copy()
-    with np.errstate(all="ignore"):
-        length = norm(n)
-        unit = n / length[..., None]
-    zero = ~(length > 0)
+    unit, zero, bad = unit_normals(n)
     hit = (status == 0) & zero.any(axis=1)
     status[hit], culprit[hit] = ForceStatus.ZERO_NORMAL, np.argmax(zero, axis=1)[hit]
-    status[(status == 0) & ~np.isfinite(n).all(axis=(1, 2))] = ForceStatus.NONFINITE_INPUT
+    status[(status == 0) & bad] = ForceStatus.NONFINITE_INPUT
     friction = np.full(len(p), np.nan)
     closes = None if mu is None else np.zeros(len(p), bool)
     rows = np.flatnonzero(status == 0)

@@ -41,7 +41,9 @@ __all__ = [
     "ForceStatus",
     "force_status_message",
     "check_wrench",
+    "unit_normals",
     "check_friction",
+    "check_torsion",
     "check_safety",
     "nonfinite_result",
     "checked_grip",
@@ -199,6 +201,26 @@ def check_friction(friction) -> np.ndarray:
     bad = a < 0
     if bad.any():
         raise ValueError(f"friction must be >= 0, got {float(a[bad].flat[0])!r}")
+    return a
+
+
+def check_torsion(torsion) -> np.ndarray:
+    """Torsional radii ``e_i >= 0`` (a length; ``0``: a point contact), broadcast against ``(..., 3)``.
+
+    As :func:`check_friction`: NaN is a row status (``nonfinite-input``), a negative or infinite value an error.
+
+    >>> check_torsion([0.01, 0, 0.01]).tolist()
+    [0.01, 0.0, 0.01]
+    >>> check_torsion(-0.01)
+    Traceback (most recent call last):
+    ValueError: torsion must be a finite length >= 0, got -0.01
+    """
+    a = _real(torsion, "torsion")
+    if a.ndim and a.shape[-1] not in (1, 3):
+        raise ValueError(f"torsion must broadcast to (..., 3) (one per contact), got {a.shape}")
+    bad = (a < 0) | np.isinf(a)
+    if bad.any():
+        raise ValueError(f"torsion must be a finite length >= 0, got {float(a[bad].flat[0])!r}")
     return a
 
 
@@ -586,6 +608,29 @@ def manipulating_forces(points, wrench, *, tol=DEGENERACY_TOL) -> ManipulatingFo
     status = nonfinite_result(status, f)
     f[status != 0] = np.nan
     return ManipulatingForces(f, geo.conditioning, status, culprit)
+
+
+def unit_normals(normals):
+    r"""The contacts' unit normals, which contacts' normals are zero, and which rows hold a non-finite normal.
+
+    ``(n, 3, 3) -> unit (n, 3, 3), zero (n, 3), nonfinite (n)``.  Each normal is first
+    scaled by the power of two nearest its largest component (exact), so the squares in its
+    length neither overflow (``1e200``) nor underflow (``1e-200``): ``n / |n|`` to the last bit
+    wherever that does not, and the same direction for any finite non-zero length.  A NaN or
+    infinite normal is non-finite, not zero (``unit`` is NaN there).
+
+    >>> u, zero, bad = unit_normals(np.array([[[3e200, 4e200, 0], [0, 0, 1e-200], [0, 0, 0]]]))
+    >>> u[0].round(12).tolist(), zero.tolist(), bad.tolist()
+    ([[0.6, 0.8, 0.0], [0.0, 0.0, 1.0], [nan, nan, nan]], [[False, False, True]], [False])
+    """
+    n = np.asarray(normals, dtype=float)
+    finite = np.isfinite(n).all(axis=-1)
+    big = np.abs(n).max(axis=-1, keepdims=True, initial=0.0)
+    scaled = np.ldexp(n, -np.frexp(np.where(np.isfinite(big), big, 1.0))[1])
+    length = norm(scaled)
+    zero = finite & (length == 0)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return scaled / length[..., None], zero, ~finite.all(axis=-1)
 
 
 def tangent_bases(normals):

@@ -32,7 +32,7 @@ import numpy as np
 from ..checks import check_normals, check_points
 from ..degeneracy import DEGENERACY_TOL
 from ..screws import cross, dot, norm
-from . import closure, compiled, one, socp
+from . import closure, compiled, cones, one, socp
 from .grasp_map import (
     GRIP_COLUMNS,
     WRENCH_SCALED_BEYOND,
@@ -40,6 +40,7 @@ from .grasp_map import (
     _manipulating,
     check_friction,
     check_safety,
+    check_torsion,
     check_wrench,
     checked_grip,
     collinear_manipulating,
@@ -47,6 +48,7 @@ from .grasp_map import (
     contact_matrices,
     geometry,
     tangent_bases,
+    unit_normals,
     wrench_scales,
 )
 
@@ -101,6 +103,9 @@ class Grip:
         every admissible ``f`` of every contact: a proof that no grip exists (Farkas).
         Scaled to ``|(y_F, L y_M)| = 1``, ``L`` the largest distance from the contacts'
         centroid to a contact (``load_words`` puts it in words).
+    torsion : (..., 3) or None
+        With ``torsion=`` given to ``grip``: the torsional moment ``tau_i`` each contact exerts
+        about its normal (0 at a point contact; NaN where ``status != 0``); None otherwise.
     """
 
     force: np.ndarray
@@ -117,6 +122,7 @@ class Grip:
     dual: np.ndarray
     gap: np.ndarray
     certificate: np.ndarray
+    torsion: np.ndarray | None = None
 
     @property
     def ok(self) -> np.ndarray:
@@ -227,7 +233,7 @@ def load_words(certificate, points) -> str:
     return f"cannot resist a force along ({force}) with a moment ({moment}) about the origin"
 
 
-def grip(points, normals, wrench, friction, *, safety=1.0, tol=DEGENERACY_TOL) -> Grip:
+def grip(points, normals, wrench, friction, *, safety=1.0, torsion=None, tol=DEGENERACY_TOL) -> Grip:
     r"""The finger forces that exert ``wrench`` with the least total normal force, inside every cone.
 
     Parameters
@@ -241,6 +247,10 @@ def grip(points, normals, wrench, friction, *, safety=1.0, tol=DEGENERACY_TOL) -
         ``mu_i`` per contact (last axis), ``>= 0``, ``inf`` for no limit.
     safety : float, keyword-only
         ``s >= 1``: the forces keep within ``mu_i / s``.
+    torsion : None, scalar or (..., 3) array, keyword-only
+        Soft-finger contacts: ``e_i`` (a length, ``>= 0``), the torsional radius of contact ``i``, which
+        then also exerts a moment ``tau_i`` about its normal within ``|(f_t, tau / e)| <= (mu / s) f_n``
+        (the contacts' cones: docs/guide/forces.md).  ``0`` (or None) is a point contact.
     tol : float
         Degeneracy tolerance of the contacts (as the twist engine's).
 
@@ -267,12 +277,94 @@ def grip(points, normals, wrench, friction, *, safety=1.0, tol=DEGENERACY_TOL) -
     p, n, w = check_points(points), check_normals(normals), check_wrench(wrench)
     mu = check_friction(friction)
     s_f = check_safety(safety)
+    e = None if torsion is None else check_torsion(torsion)
     shape = np.broadcast_shapes(p.shape[:-2], n.shape[:-2], w.shape[:-1], mu.shape[:-1])
+    if e is not None:
+        shape = np.broadcast_shapes(shape, e.shape[:-1])
     p, n, w = (np.broadcast_to(a, shape + a.shape[-t:]) for a, t in ((p, 2), (n, 2), (w, 1)))
     mu = np.broadcast_to(mu if mu.ndim else mu[None], shape + (3,))
     size = int(np.prod(shape))
     flat = [a.reshape((size,) + a.shape[len(shape) :]) for a in (p, n, mu, w)]
-    return _grip_of(flat, s_f, tol, shape)
+    if e is None:
+        return _grip_of(flat, s_f, tol, shape)
+    e = np.broadcast_to(e if e.ndim else e[None], shape + (3,)).reshape(size, 3)
+    return _with_soft(flat, e, s_f, tol, shape)
+
+
+def _with_soft(rows, e, s_f, tol, shape):
+    """The :class:`Grip` of ``rows`` with torsional radii ``e (n, 3)``: rows with a soft contact (``e > 0``,
+    ``mu > 0``; NaN ``e``: ``nonfinite-input``) over the contacts' cones (:mod:`cones`), the others as
+    point contacts, bit for bit what :func:`grip` gives them without ``torsion``."""
+    if not len(e):
+        return replace(_no_rows(s_f, shape), torsion=np.empty(shape + (3,)))
+    k = wrench_scales(rows[3])
+    if k is not None:  # as _grip_of: solved scaled by a power of two, the grip scaled back
+        return _scaled_back(_with_soft((*rows[:3], rows[3] / k[:, None]), e, s_f, tol, shape), k, shape)
+    mu = rows[2]
+    soft = ((e > 0) & (mu > 0)).any(axis=1) | np.isnan(e).any(axis=1)
+    point = np.flatnonzero(~soft)
+    g = _grip_of([a[point] for a in rows], s_f, tol, (point.size,))
+    fields = {name: getattr(g, name) for name, _ in GRIP_COLUMNS + (("status", 1), ("culprit", 1))}
+    out = {name: np.empty((len(e),) + v.shape[1:], v.dtype) for name, v in fields.items()}
+    for name, v in fields.items():
+        out[name][point] = v
+    out["torsion"] = np.full((len(e), 3), np.nan)
+    out["torsion"][point] = np.where(g.ok[:, None], 0.0, np.nan)
+    rest = np.flatnonzero(soft)
+    if rest.size:
+        for name, v in _soft_rows(*(a[rest] for a in rows), e[rest], s_f, tol).items():
+            out[name][rest] = v
+    return checked_grip(Grip(safety=s_f, **{k: v.reshape(shape + v.shape[1:]) for k, v in out.items()}))
+
+
+def _soft_rows(p, n, mu, w, e, s_f, tol):
+    """The grip's fields for rows with soft contacts, over the contacts' cones (:func:`cones.cone_solve`)."""
+    geo = geometry(p, tol)
+    status, culprit = geo.status.copy(), geo.culprit.copy()
+    status[status == ForceStatus.COLLINEAR_CONTACTS] = 0  # a soft contact's torsion may make what the line cannot
+    unit, zero, bad = unit_normals(n)
+    hit = (status == 0) & zero.any(axis=1)
+    status[hit], culprit[hit] = ForceStatus.ZERO_NORMAL, np.argmax(zero, axis=1)[hit]
+    bad |= np.isnan(mu).any(axis=1) | np.isnan(e).any(axis=1) | ~np.isfinite(w).all(axis=1)
+    status[(status == 0) & bad] = ForceStatus.NONFINITE_INPUT
+    rows = len(p)
+    force, torsion = np.full((rows, 3, 3), np.nan), np.full((rows, 3), np.nan)
+    dual, certificate = np.full((rows, 6), np.nan), np.full((rows, 6), np.nan)
+    todo = np.flatnonzero(status == 0)
+    model = cones.contact_models(mu, e)
+    if todo.size:
+        with np.errstate(all="ignore"):
+            setup = cones.cone_grasp(p[todo], unit[todo], mu[todo] / s_f, e[todo], model[todo])
+            out = cones.cone_solve(setup, w[todo])
+        force[todo], torsion[todo], dual[todo] = out["force"], out["torsion"], out["dual"]
+        certificate[todo] = out["certificate"]
+        status[todo[out["unmade"]]] = ForceStatus.COLLINEAR_CONTACTS
+        status[todo[out["fail"]]] = ForceStatus.CANNOT_HOLD
+        culprit[todo[out["fail"]]] = out["blame"][out["fail"]]
+    ok = status == 0
+    force[~ok], torsion[~ok], dual[~ok] = np.nan, np.nan, np.nan
+    with np.errstate(all="ignore"):
+        fm = _manipulating(geo, w)
+        fn = dot(force, unit)
+        ft = norm(force - fn[..., None] * unit)
+        rubbing = np.where(model == cones.SOFT, np.hypot(ft, torsion / np.where(e > 0, e, 1.0)), ft)
+        total = fn.sum(axis=-1)
+        return {
+            "force": force,
+            "manipulating": fm,
+            "squeeze": np.full((rows, 3), np.nan),
+            "normal_force": fn,
+            "tangential_force": ft,
+            "friction_used": rubbing / fn,
+            "total_normal_force": total,
+            "conditioning": geo.conditioning,
+            "status": status,
+            "culprit": culprit,
+            "dual": dual,
+            "gap": total - np.einsum("ni,ni->n", w, dual),
+            "certificate": _unit(certificate, geo.size),
+            "torsion": torsion,
+        }
 
 
 #: The grip's fields that scale with the wrench (the grip is positively homogeneous in it:
@@ -293,13 +385,7 @@ def _grip_of(rows, s_f, tol, shape, prepared=None):
         return _no_rows(s_f, shape)
     k = wrench_scales(rows[3])
     if k is not None:
-        g = _grip_of((*rows[:3], rows[3] / k[:, None]), s_f, tol, shape, prepared)
-        k = k.reshape(shape)
-        with np.errstate(over="ignore", invalid="ignore"):
-            scaled = {
-                f: getattr(g, f) * k.reshape(k.shape + (1,) * (getattr(g, f).ndim - k.ndim)) for f in LINEAR_FIELDS
-            }
-        return checked_grip(replace(g, **scaled))
+        return _scaled_back(_grip_of((*rows[:3], rows[3] / k[:, None]), s_f, tol, shape, prepared), k, shape)
     fast = compiled.kernel()
     if fast is None:
         out = (prepared or _Prepared(*rows[:3], s_f, tol)).solve(rows[3])
@@ -307,6 +393,16 @@ def _grip_of(rows, s_f, tol, shape, prepared=None):
     p, n, mu, w = (np.ascontiguousarray(a, dtype=float) for a in rows)
     limit = np.ascontiguousarray(np.broadcast_to(mu / s_f, (len(p), 3)))
     return _compiled_grip(fast, (p, n, limit, w), s_f, tol, shape, lambda rest: (p[rest], n[rest], mu[rest]))
+
+
+def _scaled_back(g, k, shape):
+    """The grip ``g`` of wrenches divided by ``k (n)``, as the grip of the wrenches (:data:`LINEAR_FIELDS`, and
+    the torsions, times ``k``)."""
+    k = k.reshape(shape)
+    names = LINEAR_FIELDS if g.torsion is None else LINEAR_FIELDS + ("torsion",)
+    with np.errstate(over="ignore", invalid="ignore"):
+        scaled = {f: getattr(g, f) * k.reshape(k.shape + (1,) * (getattr(g, f).ndim - k.ndim)) for f in names}
+    return checked_grip(replace(g, **scaled))
 
 
 def _compiled_grip(fast, rows, s_f, tol, shape, others):
@@ -366,8 +462,9 @@ class PreparedGrip:
     safety : float
     """
 
-    def __init__(self, points, normals, friction, safety, tol):
+    def __init__(self, points, normals, friction, safety, tol, torsion=None):
         self.points, self.normals, self.friction, self.safety = points, normals, friction, safety
+        self.torsion = torsion
         self._prepared = _Prepared(points[None], normals[None], friction[None], safety, tol)
         self._rows = (points[None], normals[None], friction[None])
         self._limit = np.ascontiguousarray(friction[None] / safety)
@@ -379,13 +476,17 @@ class PreparedGrip:
         ``wrench (..., 6)``: any number of wrenches on this grasp.
         """
         w = check_wrench(wrench)
+        if self.torsion is not None:  # soft contacts: the cones' way, set up per call (numpy)
+            return grip(
+                self.points, self.normals, w, self.friction, safety=self.safety, torsion=self.torsion, tol=self._tol
+            )
         rows = w.reshape(-1, 6)
         k = len(rows)
         fast = compiled.kernel()
         # a control loop's call; a wrench to scale first (wrench_scales' bounds, tested here on one
         # number: the array form costs half this call) goes the general way
         low, high = WRENCH_SCALED_BEYOND
-        largest = float(np.abs(rows).max())
+        largest = float(np.abs(rows).max()) if w.ndim == 1 else 0.0
         if fast is not None and w.ndim == 1 and (largest == 0 or low <= largest <= high):
             numbers = np.empty((1, fast.WIDTH))
             codes = np.empty((1, 3), np.int8)
@@ -402,7 +503,7 @@ class PreparedGrip:
         return _grip_of(grasp, self.safety, self._prepared.tol, w.shape[:-1], prepared)
 
 
-def prepare_grip(points, normals, friction, *, safety=1.0, tol=DEGENERACY_TOL) -> PreparedGrip:
+def prepare_grip(points, normals, friction, *, safety=1.0, torsion=None, tol=DEGENERACY_TOL) -> PreparedGrip:
     """One grasp's part of :func:`~grasptwist.forces.grip` done once, for a control loop whose wrench changes.
 
     ``points, normals (3, 3)``, ``friction`` scalar or ``(3,)``.  The checks, and on the numpy
@@ -410,7 +511,8 @@ def prepare_grip(points, normals, friction, *, safety=1.0, tol=DEGENERACY_TOL) -
     cone, do not depend on the wrench; ``.grip(wrench)`` does the rest and gives what
     :func:`~grasptwist.forces.grip` gives.  Compiled (numba), one wrench is one row of the kernel, whose
     wrench-free part is a small share of its time; the prepared form saves the checks and
-    the conversions around it.
+    the conversions around it.  With ``torsion`` (soft contacts, as :func:`~grasptwist.forces.grip`'s),
+    ``.grip(wrench)`` is that grip, its set-up done per call for now.
 
     >>> p = [[1, 0, 0], [-0.5, 0.75**0.5, 0], [-0.5, -(0.75**0.5), 0]]
     >>> hand = prepare_grip(p, -np.array(p), 0.5, safety=2)
@@ -423,7 +525,13 @@ def prepare_grip(points, normals, friction, *, safety=1.0, tol=DEGENERACY_TOL) -
     mu = np.broadcast_to(check_friction(friction), (3,)) if np.ndim(friction) <= 1 else None
     if mu is None:
         raise ValueError(f"prepare_grip takes one grasp: friction a scalar or (3,), got {np.shape(friction)}")
-    return PreparedGrip(np.ascontiguousarray(p), np.ascontiguousarray(n), mu.astype(float), check_safety(safety), tol)
+    e = None if torsion is None else check_torsion(torsion)
+    if e is not None and np.ndim(e) > 1:
+        raise ValueError(f"prepare_grip takes one grasp: torsion a scalar or (3,), got {np.shape(e)}")
+    e = None if e is None else np.broadcast_to(e, (3,)).astype(float)
+    return PreparedGrip(
+        np.ascontiguousarray(p), np.ascontiguousarray(n), mu.astype(float), check_safety(safety), tol, e
+    )
 
 
 class _Prepared:
@@ -435,14 +543,10 @@ class _Prepared:
         status, culprit = geo.status.copy(), geo.culprit.copy()
         line = status == ForceStatus.COLLINEAR_CONTACTS
         status[line] = 0  # solved below when the wrench has no moment about the line
-        with np.errstate(all="ignore"):
-            length = norm(n)
-            self.unit = n / length[..., None]
-        zero = ~(length > 0)
+        self.unit, zero, bad = unit_normals(n)
         hit = (status == 0) & zero.any(axis=1)
         status[hit], culprit[hit] = ForceStatus.ZERO_NORMAL, np.argmax(zero, axis=1)[hit]
-        bad = ~(np.isfinite(n).all(axis=(1, 2)) & ~np.isnan(mu).any(axis=1))
-        status[(status == 0) & bad] = ForceStatus.NONFINITE_INPUT
+        status[(status == 0) & (bad | np.isnan(mu).any(axis=1))] = ForceStatus.NONFINITE_INPUT
         self.frictionless = (mu == 0).all(axis=1)
         status[(status == 0) & (mu == 0).any(axis=1) & ~self.frictionless] = ForceStatus.MIXED_FRICTIONLESS
         status[line & (status == 0) & self.frictionless] = ForceStatus.COLLINEAR_CONTACTS  # not solved there
@@ -646,13 +750,14 @@ def _on_the_edge(frame, m, fm, z):
         if not (b[:, 0] >= np.hypot(b[:, 1], b[:, 2]) - 1e-12 * np.abs(b).max()).all():
             return None
         return s0, multipliers, bare  # one grip only: every kept cone's multiplier 0 closes the gap
-    reduced = A @ free
-    x, r, _ = socp.phase_one(reduced[None], b[None])
-    if not r[0] < 0:
+    # one row: the method in floats (the batched one's numpy calls on one row were 16 ms of a 17 ms grip)
+    reduced, b = (A @ free).tolist(), b.tolist()
+    x, r, _ = one.phase_one(reduced, b)
+    if not r < 0:
         return None
-    t, zk = socp.minimise(reduced[None], b[None], reduced[:, 0, :].sum(axis=0)[None], x)
-    multipliers[kept] = zk[0]
-    return s0 + free @ t[0], multipliers, bare
+    t, zk = one.minimise(reduced, b, np.sum([a[0] for a in reduced], axis=0).tolist(), x, one.newton_matrices(reduced))
+    multipliers[kept] = zk
+    return s0 + free @ np.array(t), multipliers, bare
 
 
 def _edge_dual(frame, p, unit, z, y, bare):
@@ -700,23 +805,6 @@ def _cones(frame, m, fm):
     return A, b, A[:, :, 0, :].sum(axis=1)
 
 
-def _dual_polish(A, b, c, s, z):
-    """``z`` moved to ``sum_m A_m^T z_m = c`` again (the solver keeps it to round-off of its large final steps).
-
-    The correction ``dz_m = omega_m A_m delta`` with ``omega_m = |z_m| / |y_m|`` goes to the cones
-    whose multipliers carry the optimum (``y_m`` on the edge, ``z_m`` large), not to idle ones
-    (``z_m`` near 0), so every ``z_m`` stays in its cone to round-off.
-    """
-    y = np.einsum("nmkd,nd->nmk", A, s) + b
-    res = c - np.einsum("nmkd,nmk->nd", A, z)
-    omega = np.linalg.norm(z, axis=-1) / np.maximum(np.linalg.norm(y, axis=-1), 1e-300)
-    h = np.einsum("nm,nmkd,nmke->nde", omega, A, A)
-    with np.errstate(all="ignore"):
-        delta = np.linalg.solve(h + 1e-300 * np.eye(A.shape[-1]), res[..., None])[..., 0]
-        dz = omega[..., None] * np.einsum("nmkd,nd->nmk", A, delta)
-    return np.where(np.isfinite(dz).all(axis=(1, 2))[:, None, None], z + dz, z)
-
-
 def _solve(frame, m, fm, inside):
     """The grip's internal-force coordinates for rows scaled to order one, the cones' multipliers,
     failing rows and their culprits.
@@ -745,7 +833,7 @@ def _solve(frame, m, fm, inside):
     good = np.flatnonzero(~fail)
     if good.size:
         s[good], z[good] = socp.minimise(A[good], b[good], c[good], x[good])
-        z[good] = _dual_polish(A[good], b[good], c[good], s[good], z[good])
+        z[good] = socp.dual_polish(A[good], b[good], c[good], s[good], z[good])
     blame = np.full(n, -1, np.int8)
     bad = np.flatnonzero(fail)
     if bad.size:

@@ -643,10 +643,20 @@ def _set_up(r, p, n, limit, w, tol, o, codes, q, mv, g, unit, e, fm, frame, M, A
         side = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
         plain = plain and side > tol * math.sqrt(t)
         e[i, 0], e[i, 1], e[i, 2] = e0 / side, e1 / side, e2 / side
-        length = math.sqrt(n[r, i, 0] ** 2 + n[r, i, 1] ** 2 + n[r, i, 2] ** 2)
+        # grasp_map.unit_normals: where the squares may over- or underflow, scaled by a power of two first
+        # (exact, so the same bits as unscaled wherever they do not), so any finite length is a length
+        for k in range(3):
+            unit[i, k] = n[r, i, k]
+        squares = unit[i, 0] ** 2 + unit[i, 1] ** 2 + unit[i, 2] ** 2
+        if not 1e-290 < squares < 1e290:
+            power = math.frexp(max(abs(n[r, i, 0]), abs(n[r, i, 1]), abs(n[r, i, 2])))[1]
+            for k in range(3):
+                unit[i, k] = math.ldexp(n[r, i, k], -power)
+            squares = unit[i, 0] ** 2 + unit[i, 1] ** 2 + unit[i, 2] ** 2
+        length = math.sqrt(squares)
         plain = plain and length > 0
         for k in range(3):
-            unit[i, k] = n[r, i, k] / length
+            unit[i, k] /= length
     if not plain:
         return _SKIP, 0.0, 0.0, 0.0
     # G^+ w (grasp_map._manipulating): the twist (omega; F/3) about the centroid

@@ -231,21 +231,21 @@ def _step(AT, b, c, x, z, P, leave):
 
 
 def phase_one(A, b):
-    """:func:`socp.phase_one` for one row: ``(x, r, z)`` (``z`` of the three cones)."""
+    """:func:`socp.phase_one` for one row: ``(x, r, z)`` (``z`` of the row's cones)."""
     d = len(A[0][0])
     wide = [[row[:] + [1.0 if k == 0 else 0.0] for k, row in enumerate(a)] for a in A]
     wide.append([[0.0] * d + [1.0], [0.0] * (d + 1), [0.0] * (d + 1)])
     bw = [list(bm) for bm in b] + [[1.0, 0.0, 0.0]]
     over = max(math.hypot(bm[1], bm[2]) - bm[0] for bm in b)
     x = [0.0] * d + [max(over + 1, 0.0)]
-    z = [[0.25, 0.0, 0.0] for _ in range(4)]
+    z = [[0.25, 0.0, 0.0] for _ in range(len(A) + 1)]
     c = [0.0] * d + [1.0]
 
     def leave(x, closed, dual):
         return x[d] <= -START_MARGIN or dual > _RESIDUAL * (1 + sum(abs(v) for v in x)) or (closed and dual > -math.inf)
 
     _iterate(wide, bw, c, x, z, newton_matrices(wide), leave)
-    return x[:d], x[d], z[:3]
+    return x[:d], x[d], z[: len(A)]
 
 
 def minimise(A, b, c, x, P):

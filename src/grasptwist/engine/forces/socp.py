@@ -2,11 +2,13 @@ r"""A batched primal-dual interior-point method for small second-order cone prog
 
 Each row is the problem
 
-.. math:: \min_x\; c^T x \quad \text{s.t.} \quad y_m = A_m x + b_m \in Q^3 = \{(t, z) : t \ge |z|\},\; m = 1 .. K
+.. math:: \min_x\; c^T x \quad \text{s.t.} \quad y_m = A_m x + b_m \in Q^k = \{(t, z) : t \ge |z|\},\; m = 1 .. K
 
-with ``x`` of 3 or 4 numbers (the grip's squeezes, and phase I's margin), and its dual
-``max -sum_m b_m^T z_m`` s.t. ``sum_m A_m^T z_m = c``, ``z_m in Q^3``; the duality gap is
-``sum_m y_m . z_m``.  A half-space ``a^T x + h >= 0`` is the cone ``(a^T x + h, 0, 0)``.
+with ``x`` of a few numbers (the grip's squeezes, a soft contact's torsions, and phase I's
+margin), and its dual ``max -sum_m b_m^T z_m`` s.t. ``sum_m A_m^T z_m = c``, ``z_m in Q^k``; the
+duality gap is ``sum_m y_m . z_m``.  The cones have ``k`` components (a ray ``k = 1``, ``Q^3``,
+``Q^4``); a smaller cone is padded with components that stay zero, and a half-space
+``a^T x + h >= 0`` is the cone ``(a^T x + h, 0, 0)``.
 
 Both phases start strictly inside the cones, primal and dual; phase II's dual start is
 feasible too (phase I's leaves a residual in the dual equalities, which every step shrinks by
@@ -30,15 +32,15 @@ gone) is above 0 (infeasible: ``cannot-hold``), or its gap has closed (the sign 
 decides).  An infeasible row whose cones share a boundary direction has ``r -> 0`` only
 far along it: it stops at the cap with ``r > 0``.
 
-Every array is components-first: cone vectors ``(3, K, n)`` (component, cone, row), ``A``
-``(3, d, K, n)``, ``x`` ``(d, n)``.
+Every array is components-first: cone vectors ``(k, K, n)`` (component, cone, row), ``A``
+``(k, d, K, n)``, ``x`` ``(d, n)``.
 """
 
 from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["GAP", "START_MARGIN", "phase_one", "minimise"]
+__all__ = ["GAP", "START_MARGIN", "phase_one", "minimise", "dual_polish"]
 
 #: A row stops once its duality gap is below this times ``1 + |c^T x|``.
 GAP = 1e-10
@@ -49,20 +51,42 @@ START_MARGIN = 0.5
 _RESIDUAL = 1e-9  # a dual residual below this (of the rows' order-one scale) counts as feasible
 _ITERATIONS = 60  # a cap; rows need 10-25
 _EDGE = 0.99  # the fraction of the way to the cones' edge a step goes
-_J = np.array([1.0, -1.0, -1.0])[:, None, None]
 
 
 def _jdot(p, q):
-    """``p^T J q`` per cone: ``(3, K, n)`` -> ``(K, n)``."""
-    return p[0] * q[0] - p[1] * q[1] - p[2] * q[2]
+    """``p^T J q`` per cone (``J = diag(1, -1, .., -1)``): ``(k, K, n)`` -> ``(K, n)``."""
+    out = p[0] * q[0]
+    for i in range(1, len(p)):
+        out = out - p[i] * q[i]
+    return out
 
 
 def _dot(p, q):
-    return p[0] * q[0] + p[1] * q[1] + p[2] * q[2]
+    out = p[0] * q[0]
+    for i in range(1, len(p)):
+        out = out + p[i] * q[i]
+    return out
+
+
+def _norm_z(p):
+    """``|z|`` of each cone's ``(t, z)``: ``(k, ...)`` -> ``(...)`` (0 for a ray, ``k = 1``)."""
+    if len(p) == 1:
+        return np.zeros_like(p[0])
+    out = p[1] ** 2
+    for i in range(2, len(p)):
+        out = out + p[i] ** 2
+    return np.sqrt(out)
+
+
+def _jmul(u):
+    """``J u``."""
+    out = -u
+    out[0] = u[0]
+    return out
 
 
 def _edge(x, d):
-    """The largest ``alpha`` with ``x + alpha d`` in the cone (``inf``: none), ``(3, K, n)`` -> ``(n)``.
+    """The largest ``alpha`` with ``x + alpha d`` in the cone (``inf``: none), ``(k, K, n)`` -> ``(n)``.
 
     ``1 / max(0, -lambda_min)`` with ``lambda_min = rho_0 - |rho_1|`` the smaller eigenvalue of
     ``d`` seen from ``x`` (``P(x^{-1/2}) d`` in the cone's Jordan algebra): with ``xi = x / s``,
@@ -74,7 +98,7 @@ def _edge(x, d):
     xi, delta = x / s, d / s
     rho0 = _jdot(xi, delta)
     f = (rho0 + delta[0]) / (xi[0] + 1)
-    t = np.sqrt((delta[1] - f * xi[1]) ** 2 + (delta[2] - f * xi[2]) ** 2) - rho0
+    t = _norm_z([delta[i] - f * xi[i] for i in range(len(x))]) - rho0
     with np.errstate(divide="ignore"):
         return np.where(t > 0, 1 / t, np.inf).min(axis=0)
 
@@ -101,7 +125,7 @@ def _spd_solve(h, g):
 
 
 def _apply(A, x):
-    """``A x``: ``(3, d, K, n)``, ``(d, n)`` -> ``(3, K, n)``."""
+    """``A x``: ``(k, d, K, n)``, ``(d, n)`` -> ``(k, K, n)``."""
     out = A[:, 0] * x[0]
     for j in range(1, len(x)):
         out += A[:, j] * x[j]
@@ -111,7 +135,7 @@ def _apply(A, x):
 @np.errstate(divide="ignore", invalid="ignore")
 def _iterate(A, b, c, x, z, leave):
     """Mehrotra steps on the rows of ``(A, b, c)`` from the strictly feasible primal ``x (d, n)`` and the
-    dual ``z (3, K, n)`` inside the cones (in place), until ``leave(x, closed, dual)`` holds for a row or
+    dual ``z (k, K, n)`` inside the cones (in place), until ``leave(x, closed, dual)`` holds for a row or
     the cap.  The dual residual ``c - sum_m A_m^T z_m`` shrinks with every step, by the step's
     length; ``closed`` says the gap is below ``GAP`` of the objective, ``dual`` is the dual objective
     where that residual is below ``_RESIDUAL``, ``-inf`` elsewhere."""
@@ -130,17 +154,17 @@ def _iterate(A, b, c, x, z, leave):
         # Nesterov-Todd scaling: W z = W^-1 y = lambda, W = beta (2 v v^T - J), w the scaling point
         ys, zs = np.sqrt(_jdot(y, y)), np.sqrt(_jdot(zz, zz))
         gamma = np.sqrt((1 + _dot(y, zz) / (ys * zs)) / 2)
-        w = (y / ys + _J * zz / zs) / (2 * gamma)
+        w = (y / ys + _jmul(zz) / zs) / (2 * gamma)
         v = w.copy()
         v[0] += 1
         v /= np.sqrt(2 * v[0])
         beta = np.sqrt(ys / zs)
 
         def w_inv(u, v=v, beta=beta):
-            return _J * (2 * v * _jdot(v, u) - u) / beta
+            return _jmul(2 * v * _jdot(v, u) - u) / beta
 
         def w_mul(u, v=v, beta=beta):
-            return beta * (2 * v * _dot(v, u) - _J * u)
+            return beta * (2 * v * _dot(v, u) - _jmul(u))
 
         lam = w_mul(zz)
         g = [_jdot(a[:, j], w) for j in range(d)]
@@ -155,22 +179,21 @@ def _iterate(A, b, c, x, z, leave):
 
         def direction(rhs, lam=lam, a=a, H=H, w_inv=w_inv, res=res):
             # lambda o (W dz + W^-1 dy) = rhs, dy = A dx, sum_m A_m^T dz_m = res
-            l0, l1, l2 = lam
-            u0 = (l0 * rhs[0] - l1 * rhs[1] - l2 * rhs[2]) / _jdot(lam, lam)
-            u = np.stack((u0, (rhs[1] - u0 * l1) / l0, (rhs[2] - u0 * l2) / l0))
+            u0 = _jdot(lam, rhs) / _jdot(lam, lam)
+            u = np.stack([u0] + [(rhs[i] - u0 * lam[i]) / lam[0] for i in range(1, len(lam))])
             wu = w_inv(u)
             dx = _spd_solve(H, [_dot(a[:, j], wu).sum(axis=0) - res[j] for j in range(d)])
             dy = _apply(a, dx)
             return dx, dy, w_inv(u - w_inv(dy))
 
-        square = np.stack((_dot(lam, lam), 2 * lam[0] * lam[1], 2 * lam[0] * lam[2]))
+        square = np.stack([_dot(lam, lam)] + [2 * lam[0] * lam[i] for i in range(1, len(lam))])
         mu = _dot(y, zz).sum(axis=0) / K
         dx, dy, dz = direction(-square)
         step = np.minimum(1.0, np.minimum(_edge(y, dy), _edge(zz, dz)))
         mu_aff = _dot(y + step * dy, zz + step * dz).sum(axis=0) / K
         sigma = np.clip(mu_aff / mu, 0, 1) ** 3
         p, q = w_inv(dy), w_mul(dz)
-        rhs = -square - np.stack((_dot(p, q), p[0] * q[1] + q[0] * p[1], p[0] * q[2] + q[0] * p[2]))
+        rhs = -square - np.stack([_dot(p, q)] + [p[0] * q[i] + q[0] * p[i] for i in range(1, len(p))])
         rhs[0] += sigma * mu
         dx, dy, dz = direction(rhs)
         step = np.minimum(1.0, _EDGE * np.minimum(_edge(y, dy), _edge(zz, dz)))
@@ -191,31 +214,31 @@ def _iterate(A, b, c, x, z, leave):
 
 
 def _layout(A, b):
-    """``(n, K, 3, d)``, ``(n, K, 3)`` -> components-first ``(3, d, K, n)``, ``(3, K, n)``."""
+    """``(n, K, k, d)``, ``(n, K, k)`` -> components-first ``(k, d, K, n)``, ``(k, K, n)``."""
     return np.ascontiguousarray(A.transpose(2, 3, 1, 0)), np.ascontiguousarray(b.transpose(2, 1, 0))
 
 
 def phase_one(A, b):
     """A strictly feasible ``x`` per row, the margin ``r`` reached (``r < 0``: feasible) and the dual.
 
-    ``A (n, K, 3, d)``, ``b (n, K, 3)`` -> ``x (n, d)``, ``r (n)``, ``z (n, K, 3)``.  With
+    ``A (n, K, k, d)``, ``b (n, K, k)`` -> ``x (n, d)``, ``r (n)``, ``z (n, K, k)``.  With
     ``r < 0`` every cone holds ``t_m - |z_m| >= -r > 0`` at ``x``.  Where ``r > 0`` the cones'
-    dual ``z_m`` (inside ``Q^3``, ``sum_m A_m^T z_m = 0`` to the residual) has
+    dual ``z_m`` (inside ``Q^k``, ``sum_m A_m^T z_m = 0`` to the residual) has
     ``-sum_m b_m . z_m > 0``: a proof that no ``x`` puts every ``A_m x + b_m`` in its cone
     (Farkas).
     """
-    n, K, _, d = A.shape
-    wide = np.zeros((n, K + 1, 3, d + 1))
+    n, K, k, d = A.shape
+    wide = np.zeros((n, K + 1, k, d + 1))
     wide[:, :K, :, :d] = A
     wide[:, :K, 0, d] = 1.0  # t_m + r
     wide[:, K, 0, d] = 1.0  # r + 1 >= 0
-    bw = np.zeros((n, K + 1, 3))
+    bw = np.zeros((n, K + 1, k))
     bw[:, :K] = b
     bw[:, K, 0] = 1.0
-    over = np.sqrt(b[..., 1] ** 2 + b[..., 2] ** 2) - b[..., 0]
+    over = _norm_z(np.moveaxis(b, -1, 0)) - b[..., 0]
     x = np.zeros((d + 1, n))
     x[d] = np.maximum(over.max(axis=-1) + 1, 0.0)
-    z = np.zeros((3, K + 1, n))
+    z = np.zeros((k, K + 1, n))
     z[0] = 0.25  # makes the r column of the dual, not yet the squeezes' columns
     c = np.zeros((d + 1, n))
     c[d] = 1.0
@@ -230,9 +253,9 @@ def phase_one(A, b):
 
 
 def minimise(A, b, c, x):
-    """The optimum from the strictly feasible ``x (n, d)``; returns ``x (n, d)`` and the dual ``z (n, 3, 3)``.
+    """The optimum from the strictly feasible ``x (n, d)``; returns ``x (n, d)`` and the dual ``z (n, K, k)``.
 
-    ``A (n, 3, 3, d)``, ``b (n, 3, 3)``, ``c (n, d)`` with ``c = sum_m A_m^T e`` (``e = (1, 0,
+    ``A (n, K, k, d)``, ``b (n, K, k)``, ``c (n, d)`` with ``c = sum_m A_m^T e`` (``e = (1, 0,
     0)``: the objective is the sum of the cones' first components, as the grip's is), so
     ``z_m = e`` is a strictly feasible dual start.  The dual stays feasible
     (``sum_m A_m^T z_m = c`` to round-off); the gap ``sum_m y_m . z_m`` is below ``GAP``
@@ -242,7 +265,7 @@ def minimise(A, b, c, x):
     A, b = _layout(A, b)
     c = np.ascontiguousarray(c.T)
     x = np.ascontiguousarray(x.T)
-    z = np.zeros((3, A.shape[2], n))
+    z = np.zeros((A.shape[0], A.shape[2], n))
     z[0] = 1.0
 
     def leave(x, closed, dual):
@@ -250,3 +273,20 @@ def minimise(A, b, c, x):
 
     x = _iterate(A, b, c, x, z, leave)
     return x.T, z.transpose(2, 1, 0)
+
+
+def dual_polish(A, b, c, s, z):
+    """``z`` moved to ``sum_m A_m^T z_m = c`` again (the solver keeps it to round-off of its large final steps).
+
+    The correction ``dz_m = omega_m A_m delta`` with ``omega_m = |z_m| / |y_m|`` goes to the cones
+    whose multipliers carry the optimum (``y_m`` on the edge, ``z_m`` large), not to idle ones
+    (``z_m`` near 0), so every ``z_m`` stays in its cone to round-off.
+    """
+    y = np.einsum("nmkd,nd->nmk", A, s) + b
+    res = c - np.einsum("nmkd,nmk->nd", A, z)
+    omega = np.linalg.norm(z, axis=-1) / np.maximum(np.linalg.norm(y, axis=-1), 1e-300)
+    h = np.einsum("nm,nmkd,nmke->nde", omega, A, A)
+    with np.errstate(all="ignore"):
+        delta = np.linalg.solve(h + 1e-300 * np.eye(A.shape[-1]), res[..., None])[..., 0]
+        dz = omega[..., None] * np.einsum("nmkd,nd->nmk", A, delta)
+    return np.where(np.isfinite(dz).all(axis=(1, 2))[:, None, None], z + dz, z)

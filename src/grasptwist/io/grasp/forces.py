@@ -51,6 +51,22 @@ def read_friction(node, path, problems):
     return mu
 
 
+def read_torsion(node, path, problems):
+    """A soft contact's torsional radius: a finite length ``> 0``."""
+    e = read_number(node, path, problems)
+    if e is not None and not e > 0:
+        problems.add(
+            Reject(
+                "invalid-torsion",
+                path,
+                f"must be a length > 0 (a soft finger's torsional radius), got {e!r}",
+                **located(node),
+            )
+        )
+        return None
+    return e
+
+
 def read_wrenches(node, problems):
     """The ``wrenches`` entries as ``(name, wrench (6,), line)`` (None after a problem)."""
     items = read_sequence(node, "wrenches", problems)
