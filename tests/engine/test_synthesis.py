@@ -35,7 +35,7 @@ def box(size=(0.065, 0.065, 0.065), mass=0.1):
 
 def test_check_objective_refuses_an_unknown_one():
     assert check_objective("closure_friction") == "closure_friction"
-    with pytest.raises(ValueError, match="objective must be one of total_normal_force"):
+    with pytest.raises(ValueError, match="objective must be one of robust, total_normal_force"):
         check_objective("speed")
 
 

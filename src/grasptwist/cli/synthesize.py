@@ -39,6 +39,7 @@ GRASP_FILE_SUFFIXES = (".yaml", ".yml")
 
 
 class Objective(str, Enum):
+    robust = "robust"
     total_normal_force = "total_normal_force"
     closure_friction = "closure_friction"
     epsilon = "epsilon"
@@ -60,6 +61,18 @@ def _min_conditioning(value):
     from ..engine.synthesis.scores import check_min_conditioning
 
     return check_min_conditioning(value)
+
+
+def _position_error(value):
+    from ..engine.synthesis.robustness import check_position_error
+
+    return check_position_error(value)
+
+
+def _friction_error(value):
+    from ..engine.synthesis.robustness import check_friction_error
+
+    return check_friction_error(value)
 
 
 def _positive(value):
@@ -93,8 +106,36 @@ def synthesize(
     at: At = None,
     safety: Safety = 1.0,
     objective: Annotated[
-        Objective, typer.Option("--objective", help="What the search minimises (epsilon: maximises).")
-    ] = Objective.total_normal_force,
+        Objective,
+        typer.Option(
+            "--objective",
+            help="What ranks the grasps: robust (the most robust first, then the least total normal force), "
+            "or what the search minimises (epsilon: maximises).",
+        ),
+    ] = Objective.robust,
+    position_error: Annotated[
+        float | None,
+        typer.Option(
+            "--position-error",
+            metavar="E",
+            callback=_checked(_position_error),
+            help="How far a perturbation moves each contact at most (robustness; default: half the smallest "
+            "fingertip radius, or 2% of the object's size).",
+        ),
+    ] = None,
+    friction_error: Annotated[
+        float,
+        typer.Option(
+            "--friction-error",
+            metavar="SHARE",
+            callback=_checked(_friction_error),
+            help="The largest share of the friction a perturbation takes away (0 to < 1).",
+        ),
+    ] = 0.2,
+    perturbations: Annotated[
+        int,
+        typer.Option("--perturbations", min=1, max=10**6, help="Perturbations per grasp (robustness)."),
+    ] = 64,
     method: Method = ALL,
     min_conditioning: Annotated[
         float,
@@ -165,7 +206,9 @@ def synthesize(
 
     Candidates are scored in batches (force closure at mu / S, both decompositions
     well conditioned, the least total normal force for every wrench), the best
-    refined on the surface, and each grasp returned is verified by the exact grip.
+    refined on the surface, ranked by robustness (the share of perturbations of the
+    contacts and the friction under which a grip still exists; --objective), and each
+    grasp returned is verified by the exact grip.
     With a hand (the file's, or --hand) every grasp is reached within the joint limits,
     fingertips on the surface and no finger link in the object; the records give the
     joint positions. The object's weight ('hold', from its mass or --mass) is always
@@ -174,7 +217,7 @@ def synthesize(
     Examples:
 
     \b
-        grasptwist synthesize grasps/sphere.yaml -n 3
+        grasptwist synthesize grasps/sphere.yaml -n 3 --friction 0.5 --mass 0.1
         grasptwist synthesize grasps/trifinger-cube.yaml --friction 0.8 --mass 0.1 -o found.yaml
         grasptwist synthesize objects/ -j 2 -f jsonl      # a folder: one object a process
     """
@@ -219,6 +262,9 @@ def synthesize(
             grasp_file=grasp_file,
             tip_radius=tip_radius,
             hand_file=hand,
+            position_error=position_error,
+            friction_error=friction_error,
+            perturbations=perturbations,
         ),
     )
     settings = OutputSettings(records_to, quiet, Warnings.summary, workers, {"digits": digits}, reads=(hand,))

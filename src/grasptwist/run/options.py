@@ -98,7 +98,8 @@ class SynthesisOptions:
     ``count`` (``-n``) grasps are wanted, at least ``min_spacing`` apart; ``candidates`` and
     ``seconds`` bound the search; ``grasp_file`` (``-o FILE.yaml``) receives the grasps found;
     ``tip_radius`` (``--tip-radius``) replaces every fingertip's radius of the hand (the file's, or
-    the job's ``hand``: ``--hand``, read from ``hand_file``).
+    the job's ``hand``: ``--hand``, read from ``hand_file``); ``position_error``, ``friction_error``
+    and ``perturbations`` (``--position-error``, ...) make each grasp's robustness.
     The rest go to :func:`grasptwist.engine.synthesis.search.search`.
     """
 
@@ -107,7 +108,7 @@ class SynthesisOptions:
     mass: float | None = None
     wrenches: tuple[Wrench, ...] | None = None
     safety: float = 1.0
-    objective: str = "total_normal_force"
+    objective: str = "robust"
     method: str = "both"
     min_conditioning: float = 1e-3
     min_spacing: float | None = None
@@ -118,3 +119,6 @@ class SynthesisOptions:
     grasp_file: str | None = None
     tip_radius: float | None = None
     hand_file: str | None = None
+    position_error: float | None = None
+    friction_error: float = 0.2
+    perturbations: int = 64
