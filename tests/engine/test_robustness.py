@@ -46,6 +46,12 @@ def test_the_hold_friction_of_a_tripod_is_tan_phi_and_clarabel_agrees_on_either_
     assert (force_closure(p, n).closure_friction >= h - 1e-9).all()
 
 
+def test_without_a_friction_limit_the_hold_friction_is_bracketed_first():
+    phis = np.radians([20, 60, 80])
+    p, n = map(np.array, zip(*(tripod(phi) for phi in phis)))
+    assert hold_friction(p, n, LIFT, np.inf) == pytest.approx(np.tan(phis), rel=1e-6)
+
+
 def test_the_hold_friction_is_zero_when_a_finger_carries_the_weight_and_nan_when_not_held_at_the_start():
     h = 0.0325
     under = np.array([[[h, 0, 0], [-h, 0, 0], [0, 0, -h]]])  # two squeeze, one under: no friction needed

@@ -340,6 +340,7 @@ def test_infinite_friction_finds_grasps_held_by_tangential_forces_alone():
     assert s.failure is None and len(s.points) == 2
     assert (s.total_normal_force < 1e-6 * 0.1 * G).all()
     assert np.isfinite(s.closure_friction).all() and (s.closure_friction < 1).all()
+    assert (s.hold_friction <= s.closure_friction + 1e-9).all()  # bracketed: no limit to start from
 
 
 @pytest.mark.parametrize("budget", [1, 3])

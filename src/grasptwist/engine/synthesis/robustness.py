@@ -160,7 +160,8 @@ def hold_friction(points, normals, wrenches, upper, *, steps=HOLD_STEPS, tol=DEG
     r"""The least friction at which a grip of every wrench exists (module docstring), by bisection.
 
     ``points, normals (K, 3, 3)``, ``wrenches (W, 6)``, ``upper`` a friction at which to start
-    (every grasp is held there, else its answer is NaN) -> ``(K,)``, to ``upper 2^-steps`` above
+    (every grasp is held there, else its answer is NaN; ``inf``: a bracket is found first,
+    doubling from 1 at most ``steps`` times) -> ``(K,)``, to ``2^-steps`` of the bracket above
     the least (0 where no friction is needed).
 
     Three contacts at latitude ``phi`` above a ball's equator lift its weight when
@@ -180,6 +181,13 @@ def hold_friction(points, normals, wrenches, upper, *, steps=HOLD_STEPS, tol=DEG
     lo = np.zeros(k)
     free = _held(p, n, w, lo, 1.0, tol)
     hi[free] = 0.0
+    if np.isinf(upper):  # no limit (the half-spaces f . n >= 0): a finite bracket first
+        hi[~free] = 1.0
+        for _ in range(steps):
+            out = np.flatnonzero(~free)[~_held(p[~free], n[~free], w, hi[~free], 1.0, tol)]
+            if not out.size:
+                break
+            lo[out], hi[out] = hi[out], 2 * hi[out]
     hi[~free & ~_held(p, n, w, hi, 1.0, tol)] = np.nan
     live = np.flatnonzero(~free & ~np.isnan(hi))
     for _ in range(steps if live.size else 0):
