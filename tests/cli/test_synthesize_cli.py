@@ -53,7 +53,7 @@ def test_the_robustness_options_are_checked_and_change_the_robustness_only(tmp_p
         assert r.exit_code == 2 and option in r.stderr, r.stderr
     box = tmp_path / "box.yaml"
     box.write_text("name: box\nobject:\n  box: [0.065, 0.065, 0.065]\n  mass: 0.1\nfriction: 0.8\n")
-    plain = ("--objective", "total_normal_force", "-f", "csv", "--candidates", "1000", "-n", "3")
+    plain = ("--objective", "total_normal_force", "-f", "csv", "--candidates", "500", "-n", "3")
     rows = []
     for more in ((), ("--position-error", "0.01", "--friction-error", "0.5", "--perturbations", "16")):
         r, _ = run("synthesize", box, *plain, *more)

@@ -183,7 +183,7 @@ class Synthesis:
     tip_center : (K, 3, 3) or None
         With a hand: each fingertip sphere's centre ``p - r n`` (finger ``f`` on contact ``f``).
     hold_friction, edge_distance, robustness : (K,), (K, 3), (K,)
-        Each grasp's margins (:mod:`~.robustness`): the least friction at which every wrench is
+        Each grasp's margins (``grasptwist.engine.synthesis.robustness``): the least friction at which every wrench is
         still held, each contact's distance to the nearest crease, and the share of the
         perturbations under which it is still held.
     unverified : int
