@@ -134,7 +134,7 @@ def synthesize(
     ] = 0.2,
     perturbations: Annotated[
         int,
-        typer.Option("--perturbations", min=1, max=10**6, help="Perturbations per grasp (robustness)."),
+        typer.Option("--perturbations", min=1, max=10_000, help="Perturbations per grasp (robustness)."),
     ] = 64,
     method: Method = ALL,
     min_conditioning: Annotated[
