@@ -183,9 +183,9 @@ class Synthesis:
     tip_center : (K, 3, 3) or None
         With a hand: each fingertip sphere's centre ``p - r n`` (finger ``f`` on contact ``f``).
     hold_friction, edge_distance, robustness : (K,), (K, 3), (K,)
-        Each grasp's margins (``grasptwist.engine.synthesis.robustness``): the least friction at which every wrench is
-        still held, each contact's distance to the nearest crease, and the share of the
-        perturbations under which it is still held.
+        Each grasp's margins (``grasptwist.engine.synthesis.robustness``): the least friction
+        at which every wrench is still held, each contact's distance to the nearest crease, and
+        the share of the perturbations under which it is still held.
     unverified : int
         Grasps selected but not verified, so not returned: ``seconds`` ran out before their turn.
     candidates : int
