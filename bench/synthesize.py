@@ -25,9 +25,17 @@ link meshes) on the same cube where ``grasps/trifinger-cube.yaml`` puts it:
 - **the baseline**, the TriFinger code's way, for ``--hand-baseline`` grasps: up to 40 tries a
   grasp, each three random surface points, closure with a square pyramid (Ferrari-Canny's
   epsilon over 4 cone edges > 0), the six finger assignments through the inverse kinematics one
-  at a time until one reaches, then the collision check.  ``--memory`` also runs the
-search at 10x and 100x fewer candidates and prints the peak resident memory of each (a fresh
-process each): flat in the number of candidates, as the chunks are.
+  at a time until one reaches, then the collision check;
+- **robustness**: the search ranked by robustness (``objective="robust"``, the default: 64
+  perturbations of each finalist, batched) against the same search ranked by the least total
+  normal force (robustness then only on the grasps returned), in CPU seconds;
+- **the command line**: ``grasptwist synthesize grasps/trifinger-cube.yaml -n 20`` in a fresh
+  process (``--hand-candidates``), its wall and CPU seconds (start-up, the URDF and its meshes,
+  numba's cache included).
+
+Every figure with its CPU time beside the wall time (the machine may be shared).  ``--memory``
+also runs the search at 10x and 100x fewer candidates and prints the peak resident memory of each
+(a fresh process each): flat in the number of candidates, as the chunks are.
 """
 
 import argparse
@@ -82,13 +90,35 @@ def trifinger():
     return g, deepest_link(g)
 
 
-def hand_search(grasp, deepest, count, candidates, seed=0):
+def hand_search(grasp, deepest, count, candidates, seed=0, objective="robust"):
+    """The search with the hand: ``(Synthesis, wall seconds, CPU seconds)``."""
     from grasptwist.engine.synthesis.search import hand_reach
 
     reach = hand_reach(grasp.object, grasp.hand, collide=deepest)
+    t, cpu = time.perf_counter(), time.process_time()
+    s = synthesize(
+        grasp.object,
+        MU,
+        hand=reach,
+        count=count,
+        candidates=candidates,
+        seed=seed,
+        min_conditioning=1e-3,
+        objective=objective,
+    )
+    return s, time.perf_counter() - t, time.process_time() - cpu
+
+
+def command_line(count, candidates):
+    """``grasptwist synthesize`` of the TriFinger cube in a fresh process: ``(wall, CPU seconds)``."""
+    args = ["grasps/trifinger-cube.yaml", "--friction", str(MU), "--mass", "0.1", "-n", str(count)]
+    args += ["--candidates", str(candidates), "-f", "jsonl", "-q"]
+    before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t = time.perf_counter()
-    s = synthesize(grasp.object, MU, hand=reach, count=count, candidates=candidates, seed=seed, min_conditioning=1e-3)
-    return s, time.perf_counter() - t
+    subprocess.run([sys.executable, "-m", "grasptwist", "synthesize", *args], capture_output=True, check=True)
+    wall = time.perf_counter() - t
+    after = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return wall, (after.ru_utime + after.ru_stime) - (before.ru_utime + before.ru_stime)
 
 
 def hand_baseline(grasp, wanted, seed=0, tries=40):
@@ -122,12 +152,22 @@ def hand_baseline(grasp, wanted, seed=0, tries=40):
 def hand_bench(args):
     grasp, deepest = trifinger()
     hand_search(grasp, deepest, 2, 300)  # the compiled grip and the link meshes loaded before any timing
-    s, seconds = hand_search(grasp, deepest, args.hand_grasps, args.hand_candidates)
+    s, seconds, cpu = hand_search(grasp, deepest, args.hand_grasps, args.hand_candidates)
     rate = len(s.points) / seconds
     print(
-        f"search with the hand:  {len(s.points)} verified grasps in {seconds:.2f} s: {rate:.1f} a second "
+        f"search with the hand:  {len(s.points)} verified grasps in {seconds:.2f} s ({cpu:.2f} s CPU): "
+        f"{rate:.1f} a second, {len(s.points) / cpu:.1f} a CPU second "
         f"({s.candidates} candidates; largest tip error {np.max(s.reach_error):.1e} m)"
     )
+    _, plain_seconds, plain_cpu = hand_search(
+        grasp, deepest, args.hand_grasps, args.hand_candidates, objective="total_normal_force"
+    )
+    print(
+        f"robustness (64 perturbations of the finalists): {cpu:.2f} s CPU against {plain_cpu:.2f} s ranked by "
+        f"total normal force: {cpu / plain_cpu:.2f}x (wall {seconds / plain_seconds:.2f}x)"
+    )
+    wall, cli_cpu = command_line(args.hand_grasps, args.hand_candidates)
+    print(f"command line:  {args.hand_grasps} grasps in {wall:.2f} s wall, {cli_cpu:.2f} s CPU (a fresh process)")
     found, spent, base_seconds = hand_baseline(grasp, args.hand_baseline)
     base_rate = found / base_seconds
     print(

@@ -25,11 +25,14 @@ def test_records_carry_every_score_and_the_grasp_file_is_read_back_by_every_comm
     ]
     rec = recs[2]
     assert set(rec) >= {"rank", "contacts", "scores", "search"}
-    assert set(rec["contacts"][0]) == {"name", "point", "normal", "surface_distance"}
+    assert set(rec["contacts"][0]) == {"name", "point", "normal", "surface_distance", "edge_distance"}
+    assert rec["contacts"][0]["edge_distance"] is None  # a ball has no crease
     assert rec["contacts"][0]["name"] == "thumb" and rec["contacts"][0]["surface_distance"] < 1e-12
     assert set(rec["scores"]["total_normal_force"]) == {"hold", "turn-z"}  # --mass replaces the file's weight
     assert rec["scores"]["epsilon"] is None and rec["scores"]["closure_friction"] < 0.5
     assert set(rec["scores"]["conditioning"]) == {"off_tangent", "tangent"}
+    assert 0 <= rec["scores"]["hold_friction"] <= rec["scores"]["closure_friction"] + 1e-9  # bisected to 2^-30 mu
+    assert [x["scores"]["robustness"] * 64 % 1 for x in recs] == [0.0] * 4  # a share of 64 perturbations
     assert rec["search"]["seed"] == 0 and 110 < rec["search"]["candidates"] <= 120
     assert "candidates scored in" in r.stderr
     grasps = read_grasps(found)
@@ -42,6 +45,35 @@ def test_records_carry_every_score_and_the_grasp_file_is_read_back_by_every_comm
     assert held[0]["grip"]["total_normal_force"] == pytest.approx(rec["scores"]["total_normal_force"]["hold"])
     resolved, _ = run("resolve", found, "--twist", "0,0,1,0,0,0", "-f", "jsonl")
     assert resolved.exit_code == 0 and len(jsonl(resolved.stdout)) == 4, resolved.stderr
+
+
+def test_the_robustness_options_are_checked_and_change_the_robustness_only(tmp_path):
+    for option, bad in (("--position-error", "-1"), ("--friction-error", "1"), ("--perturbations", "0")):
+        r, _ = run("synthesize", SPHERE, "--friction", "0.5", "--mass", "1", *FAST, option, bad)
+        assert r.exit_code == 2 and option in r.stderr, r.stderr
+    box = tmp_path / "box.yaml"
+    box.write_text("name: box\nobject:\n  box: [0.065, 0.065, 0.065]\n  mass: 0.1\nfriction: 0.8\n")
+    plain = ("--objective", "total_normal_force", "-f", "csv", "--candidates", "500", "-n", "3")
+    rows = []
+    for more in ((), ("--position-error", "0.01", "--friction-error", "0.5", "--perturbations", "16")):
+        r, _ = run("synthesize", box, *plain, *more)
+        assert r.exit_code == 0, r.stderr
+        rows.append(list(csv.DictReader(io.StringIO(r.stdout))))
+    assert [row["p1_x"] for row in rows[0]] == [row["p1_x"] for row in rows[1]]  # the same grasps
+    assert all(float(row["edge_distance1"]) >= 0 and float(row["hold_friction"]) < 0.8 for row in rows[0])
+    assert [float(row["robustness"]) * 16 % 1 for row in rows[1]] == [0.0] * 3
+    assert sum(float(r["robustness"]) for r in rows[1]) < sum(float(r["robustness"]) for r in rows[0])
+
+
+def test_the_synthesis_guide_s_first_example_runs_as_printed(monkeypatch):
+    from docs_blocks import ROOT, blocks, commands
+
+    monkeypatch.chdir(ROOT)
+    first = next(b for b in blocks(ROOT / "docs" / "guide" / "synthesis.md") if b.lang in ("console", "sh"))
+    (command, *_) = commands(first)
+    assert command.args[:2] == ["synthesize", "grasps/sphere.yaml"]
+    r, _ = run(*command.args)
+    assert r.exit_code == 0, r.stderr
 
 
 def test_csv_has_a_row_per_grasp_and_the_table_names_them():
@@ -308,7 +340,14 @@ def test_the_table_gives_a_hand_s_joint_positions():
         "grasp": "g",
         "rank": 1,
         "contacts": [{"name": "1", "point": [0, 0, 0], "normal": [1, 0, 0]}],
-        "scores": {"total_normal_force": {"hold": 1.0}, "closure_friction": 0.1, "epsilon": None, "conditioning": {}},
+        "scores": {
+            "total_normal_force": {"hold": 1.0},
+            "closure_friction": 0.1,
+            "epsilon": None,
+            "conditioning": {},
+            "hold_friction": 0.05,
+            "robustness": 1.0,
+        },
         "joint_positions": {"a.1": 0.5, "a.2": -0.25},
     }
     SynthesisTable(out).write(rec)

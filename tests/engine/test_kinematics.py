@@ -333,3 +333,21 @@ def test_hand_joint_rates_pad_short_fingers_without_changing_them():
     assert r.status == Status.FINGER_CANNOT_FOLLOW and r.culprit == 1  # two joints cannot reach every velocity
     assert r.conditioning == r.finger_conditioning.min() == 0.0
     assert r.velocity_limit_ratio == r.finger_limit_ratio.max()
+
+
+def test_joint_motion_is_the_exponential_of_a_revolute_and_a_prismatic_joint():
+    from grasptwist.engine import se3
+    from grasptwist.engine.kinematics import joint_motion
+
+    rng = np.random.default_rng(7)
+    q = 3 * rng.normal(size=(50,))
+    for _ in range(4):
+        w = rng.normal(size=3)
+        w /= np.linalg.norm(w)
+        for screw in (np.concatenate([w, np.cross(rng.normal(size=3), w)]), np.concatenate([np.zeros(3), w])):
+            r, x = joint_motion(screw, q)
+            r_exp, x_exp = se3.exp(screw, q)
+            np.testing.assert_allclose(r, r_exp, atol=1e-14)
+            np.testing.assert_allclose(x, x_exp, atol=1e-14)
+    pitched = np.array([0, 0, 1.0, 0, 0, 0.5])  # a screw with pitch: the general exponential
+    np.testing.assert_array_equal(joint_motion(pitched, q)[1], se3.exp(pitched, q)[1])

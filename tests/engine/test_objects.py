@@ -435,3 +435,27 @@ def test_on_edge_is_true_on_edges_corners_and_rims_only():
     assert project_to_surface(cylinder, q).on_edge.tolist() == [True, False, False]
     assert not project_to_surface(sphere, [[2.0, 0.0, 1.0], [0.0, 0.0, 3.0]]).on_edge.any()
     assert project_to_surface(box, [[np.nan, 0, 0], [2.0, 2.0, 2.0]]).on_edge.tolist() == [False, True]
+
+
+@pytest.mark.parametrize(
+    "shape",
+    [
+        Shape("box", np.array([0.04, 0.06, 0.1])),
+        Shape("cylinder", np.array([0.03, 0.08])),
+        Shape("sphere", np.array([0.035])),
+        Shape("capsule", np.array([0.02, 0.05])),
+    ],
+    ids=lambda s: s.kind,
+)
+def test_the_signed_distance_alone_is_the_projection_s_bit_for_bit(shape):
+    from grasptwist.engine.objects.geometry import signed_distance
+
+    pose = np.eye(4)
+    pose[:3, :3] = np.linalg.qr(np.random.default_rng(1).normal(size=(3, 3)))[0]
+    pose[:3, 3] = [0.1, -0.2, 0.3]
+    obj = GraspObject(shape, pose)
+    q = pose[:3, 3] + np.random.default_rng(2).normal(scale=0.05, size=(500, 3))
+    q[:3] = [np.nan, 0, 0], [np.inf, 0, 0], pose[:3, 3]  # not finite; the centre (on the axis)
+    expected = project_to_surface(obj, q).distance
+    np.testing.assert_array_equal(signed_distance(obj, q), expected)
+    assert signed_distance(obj, q.reshape(10, 50, 3)).shape == (10, 50)

@@ -35,7 +35,7 @@ def box(size=(0.065, 0.065, 0.065), mass=0.1):
 
 def test_check_objective_refuses_an_unknown_one():
     assert check_objective("closure_friction") == "closure_friction"
-    with pytest.raises(ValueError, match="objective must be one of total_normal_force"):
+    with pytest.raises(ValueError, match="objective must be one of robust, total_normal_force"):
         check_objective("speed")
 
 
@@ -340,6 +340,7 @@ def test_infinite_friction_finds_grasps_held_by_tangential_forces_alone():
     assert s.failure is None and len(s.points) == 2
     assert (s.total_normal_force < 1e-6 * 0.1 * G).all()
     assert np.isfinite(s.closure_friction).all() and (s.closure_friction < 1).all()
+    assert (s.hold_friction <= s.closure_friction + 1e-9).all()  # bracketed: no limit to start from
 
 
 @pytest.mark.parametrize("budget", [1, 3])

@@ -15,7 +15,10 @@ def _found(hand, k=2):
     error = np.full((k, 3), 1e-12)
     z = np.zeros((k, 3, 3))
     s = Synthesis(
-        z, z, np.zeros((k, 3)), np.ones((k, 1)), np.ones(k), None, np.ones((k, 2)), (), 10, 0.1, 0, None, q, error
+        *(z, z, np.zeros((k, 3)), np.ones((k, 1)), np.ones(k), None, np.ones((k, 2)), (), 10, 0.1, 0, None, q, error),
+        hold_friction=np.zeros(k),
+        edge_distance=np.ones((k, 3)),
+        robustness=np.ones(k),
     )
     return g.hand, Found(
         "f.yaml", "g", 1, None, None, g.object, 0.8, ("hold",), np.zeros((1, 6)), None, s, hand=hand and g.hand

@@ -39,6 +39,7 @@ GRASP_FILE_SUFFIXES = (".yaml", ".yml")
 
 
 class Objective(str, Enum):
+    robust = "robust"
     total_normal_force = "total_normal_force"
     closure_friction = "closure_friction"
     epsilon = "epsilon"
@@ -80,6 +81,18 @@ def _reading(reading, grasp_file):
     return replace(reading, output=replaced_file(grasp_file))
 
 
+def _position_error(value):
+    from ..engine.synthesis.robustness import check_position_error
+
+    return check_position_error(value)
+
+
+def _friction_error(value):
+    from ..engine.synthesis.robustness import check_friction_error
+
+    return check_friction_error(value)
+
+
 def _positive(value):
     """--mass, --seconds: the engine's checks (check_budget's seconds), in the command line's words."""
     if not 0 < value < float("inf"):
@@ -111,8 +124,36 @@ def synthesize(
     at: At = None,
     safety: Safety = 1.0,
     objective: Annotated[
-        Objective, typer.Option("--objective", help="What the search minimises (epsilon: maximises).")
-    ] = Objective.total_normal_force,
+        Objective,
+        typer.Option(
+            "--objective",
+            help="What ranks the grasps: robust (the most robust first, then the least total normal force), "
+            "or what the search minimises (epsilon: maximises).",
+        ),
+    ] = Objective.robust,
+    position_error: Annotated[
+        float | None,
+        typer.Option(
+            "--position-error",
+            metavar="E",
+            callback=_checked(_position_error),
+            help="How far a perturbation moves each contact at most (robustness; default: half the smallest "
+            "fingertip radius, or 2% of the object's size).",
+        ),
+    ] = None,
+    friction_error: Annotated[
+        float,
+        typer.Option(
+            "--friction-error",
+            metavar="SHARE",
+            callback=_checked(_friction_error),
+            help="The largest share of the friction a perturbation takes away (0 to < 1).",
+        ),
+    ] = 0.2,
+    perturbations: Annotated[
+        int,
+        typer.Option("--perturbations", min=1, max=10_000, help="Perturbations per grasp (robustness)."),
+    ] = 64,
     method: Method = ALL,
     min_conditioning: Annotated[
         float,
@@ -199,7 +240,9 @@ def synthesize(
 
     Candidates are scored in batches (force closure at mu / S, both decompositions
     well conditioned, the least total normal force for every wrench), the best
-    refined on the surface, and each grasp returned is verified by the exact grip.
+    refined on the surface, ranked by robustness (the share of perturbations of the
+    contacts and the friction under which a grip still exists; --objective), and each
+    grasp returned is verified by the exact grip.
     With a hand (the file's, or --hand) every grasp is reached within the joint limits,
     fingertips on the surface and no finger link in the object; the records give the
     joint positions. The object's weight ('hold', from its mass or --mass) is always
@@ -208,7 +251,7 @@ def synthesize(
     Examples:
 
     \b
-        grasptwist synthesize grasps/sphere.yaml -n 3
+        grasptwist synthesize grasps/sphere.yaml -n 3 --friction 0.5 --mass 0.1
         grasptwist synthesize grasps/trifinger-cube.yaml --friction 0.8 --mass 0.1 -o found.yaml
         grasptwist synthesize objects/ -j 2 -f jsonl      # a folder: one object a process
     """
@@ -255,6 +298,9 @@ def synthesize(
             hand_file=hand,
             units=units,
             span_bodies=span_bodies,
+            position_error=position_error,
+            friction_error=friction_error,
+            perturbations=perturbations,
         ),
     )
     settings = OutputSettings(records_to, quiet, Warnings.summary, workers, {"digits": digits}, reads=(hand,))

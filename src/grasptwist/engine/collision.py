@@ -16,7 +16,7 @@ Its penetration depth is the deepest of its vertices inside the object,
     d = \max\Bigl(0,\ \max_{v} -\phi\bigl(v(q)\bigr)\Bigr),
 
 with :math:`\phi` the object's signed distance (> 0 outside,
-:func:`~grasptwist.engine.objects.project_to_surface`): exact for the
+:func:`~grasptwist.engine.objects.geometry.signed_distance`): exact for the
 vertices, so exact for a link whose deepest point is a vertex (a flat face
 or a corner pushed into the object).  An object's edge or corner poking into
 a face of a link between its vertices is seen only as deep as the nearest
@@ -46,7 +46,7 @@ from typing import NamedTuple
 import numpy as np
 
 from . import se3
-from .objects import object_size, project_to_surface
+from .objects.geometry import object_size, signed_distance
 
 __all__ = [
     "CLUSTER",
@@ -278,7 +278,7 @@ def penetration_depths(obj, parts: LinkClusters, poses, n_links: int | None = No
         return depth
     cols, center = np.concatenate([f[1] for f in found]), np.concatenate([f[2] for f in found])
     here = replace(obj, pose=np.eye(4))
-    phi = project_to_surface(here, center).distance
+    phi = signed_distance(here, center)
     radius, link = parts.radius[cols], parts.link[cols]
     # branch and bound: every vertex of a cluster is at least -phi - r deep and at most -phi + r
     # (the signed distance is 1-Lipschitz), so only a cluster that may hold the deepest vertex is opened
@@ -288,7 +288,7 @@ def penetration_depths(obj, parts: LinkClusters, poses, n_links: int | None = No
     rows, cols, link = rows[open_], cols[open_], link[open_]
     r, t = rotation[rows, link], translation[rows, link]
     v = np.einsum("kij,kmj->kmi", r, parts.vertices[cols]) + t[:, None]
-    deepest = -project_to_surface(here, v).distance.min(axis=1)
+    deepest = -signed_distance(here, v).min(axis=1)
     np.maximum.at(depth, (rows, link), deepest)
     return depth
 

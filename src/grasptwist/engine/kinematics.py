@@ -515,6 +515,38 @@ def _apply(r, x):
     return (r @ x[..., None])[..., 0]
 
 
+#: A home screw is a pure rotation (Rodrigues in :func:`joint_motion`) when ``|omega|`` is 1 and
+#: ``omega . v`` is 0 to this (a URDF's axes are normalised to round-off).
+_UNIT_TOL = 1e-12
+
+
+def joint_motion(screw, q):
+    r"""``exp([S] q)`` of one joint's home screw ``S (6,)`` at positions ``q (...)``: ``(R (..., 3, 3), x (..., 3))``.
+
+    :func:`~grasptwist.engine.se3.exp` in general; for the two kinds of joint, whose screw is
+    the same for the whole batch, the closed forms with the screw's matrices formed once
+    (forward kinematics' inner loop, the inverse kinematics' cost): a revolute joint, the unit
+    line ``(omega; v)`` (``omega . v = 0``), turns about it by Rodrigues' formula,
+
+    .. math:: R = I + \sin q\, [\omega] + (1 - \cos q)\, [\omega]^2, \qquad
+              x = \sin q\, v + (1 - \cos q)\, \omega \times v,
+
+    and a prismatic one ``(0; d)`` moves by ``x = q d`` (``R = I``).
+
+    >>> r, x = joint_motion(np.array([0, 0, 1.0, 0, -1.0, 0]), np.array([np.pi / 2]))
+    >>> (x.round(12) + 0.0).tolist(), (r[0] @ [1.0, 0, 0] + x[0]).round(12).tolist()
+    ([[1.0, -1.0, 0.0]], [1.0, 0.0, 0.0])
+    """
+    w, v = screw[:3], screw[3:]
+    if screw.ndim == 1 and abs(w @ w - 1) <= _UNIT_TOL and abs(w @ v) <= _UNIT_TOL:
+        k = se3.skew(w)
+        s, c = np.sin(q)[..., None], 1 - np.cos(q)[..., None]
+        return np.eye(3) + s[..., None] * k + c[..., None] * (k @ k), s * v + c * cross(w, v)
+    if screw.ndim == 1 and not w.any():
+        return np.broadcast_to(np.eye(3), np.shape(q) + (3, 3)), np.asarray(q, float)[..., None] * v
+    return se3.exp(screw, q)
+
+
 def forward_kinematics(home_screws, home_points, home_tip, positions):
     """Joint screws, joint points and tip pose of a serial chain at joint positions.
 
@@ -571,7 +603,7 @@ def forward_kinematics(home_screws, home_points, home_tip, positions):
             out_screws[..., j, :3] = w
             out_screws[..., j, 3:] = _apply(rotation, s[..., 3:]) + cross(translation, w)
             out_points[..., j, :] = _apply(rotation, a) + translation
-        r, t = se3.exp(s, q[..., j])  # the joint's motion, exp([S_j] q_j)
+        r, t = joint_motion(s, q[..., j])  # the joint's motion, exp([S_j] q_j)
         if rotation is None:
             rotation, translation = r, t
         else:

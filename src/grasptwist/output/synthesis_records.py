@@ -68,6 +68,7 @@ def synthesis_records(found) -> list[dict]:
                 "point": s.points[k, i].tolist(),
                 "normal": s.normals[k, i].tolist(),
                 "surface_distance": float(s.surface_distance[k, i]),
+                "edge_distance": _float(s.edge_distance[k, i]),
                 **({} if s.tip_center is None else {"tip_center": s.tip_center[k, i].tolist()}),
             }
             for i in range(3)
@@ -77,6 +78,8 @@ def synthesis_records(found) -> list[dict]:
             "closure_friction": _float(s.closure_friction[k]),
             "epsilon": None if s.epsilon is None else _float(s.epsilon[k]),
             "conditioning": {m: _float(c) for m, c in zip(_METHODS, s.conditioning[k])},
+            "hold_friction": _float(s.hold_friction[k]),
+            "robustness": float(s.robustness[k]),
         }
         out.append(
             {
@@ -281,6 +284,9 @@ _NUMBERS = (
     "epsilon",
     "conditioning_off_tangent",
     "conditioning_tangent",
+    "hold_friction",
+    "robustness",
+    *(f"edge_distance{i}" for i in (1, 2, 3)),
     "candidates",
     "seconds",
     "seed",
@@ -334,6 +340,9 @@ def _flat(found, order="omega-v", hand=None, typed=False) -> dict:
     columns["epsilon"] = nan if s.epsilon is None else s.epsilon
     columns["conditioning_off_tangent"] = s.conditioning[:, 0]
     columns["conditioning_tangent"] = s.conditioning[:, 1]
+    columns["hold_friction"] = s.hold_friction
+    columns["robustness"] = s.robustness
+    columns.update({f"edge_distance{i + 1}": s.edge_distance[:, i] for i in range(3)})
     columns["candidates"] = np.full(k, s.candidates)
     columns["seconds"] = np.full(k, s.seconds)
     columns["seed"] = np.full(k, s.seed)
@@ -401,7 +410,8 @@ class SynthesisTable:
         scores = rec["scores"]
         totals = ", ".join(f"{escaped(n)} {self._number(v)}" for n, v in scores["total_normal_force"].items())
         cond = ", ".join(f"{m} {self._number(c)}" for m, c in scores["conditioning"].items() if c is not None)
-        extra = "" if scores["epsilon"] is None else f"  epsilon {self._number(scores['epsilon'])}"
+        extra = f"  robustness {self._number(scores['robustness'])}  hold mu {self._number(scores['hold_friction'])}"
+        extra += "" if scores["epsilon"] is None else f"  epsilon {self._number(scores['epsilon'])}"
         extra += f"  conditioning: {cond}" if cond else ""  # none: the off-tangent method alone, no wrist
         self._line(
             f"  #{rec['rank']}  total normal force: {totals}  closure mu {self._number(scores['closure_friction'])}"

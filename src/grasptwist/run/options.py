@@ -102,7 +102,8 @@ class SynthesisOptions:
     ``tip_radius`` (``--tip-radius``) replaces every fingertip's radius of the hand (the file's, or
     the job's ``hand``: ``--hand``, read from ``hand_file``); ``units`` (``--units``) is the length
     unit of the mesh files given directly (a grasp file says its own); ``span_bodies``
-    (``--span-bodies``) lets a grasp's contacts lie on different bodies of a mesh.
+    (``--span-bodies``) lets a grasp's contacts lie on different bodies of a mesh; ``position_error``,
+    ``friction_error`` and ``perturbations`` (``--position-error``, ...) make each grasp's robustness.
     The rest go to :func:`grasptwist.engine.synthesis.search.search`.
     """
 
@@ -111,7 +112,7 @@ class SynthesisOptions:
     mass: float | None = None
     wrenches: tuple[Wrench, ...] | None = None
     safety: float = 1.0
-    objective: str = "total_normal_force"
+    objective: str = "robust"
     method: str = "both"
     min_conditioning: float = 1e-3
     min_spacing: float | None = None
@@ -124,3 +125,6 @@ class SynthesisOptions:
     hand_file: str | None = None
     units: str | None = None
     span_bodies: bool = False
+    position_error: float | None = None
+    friction_error: float = 0.2
+    perturbations: int = 64

@@ -272,6 +272,9 @@ def synthesize_inputs(job, inputs: Iterable) -> Iterator[GraspFileError | Found 
                 seed=o.seed,
                 candidates=o.candidates,
                 seconds=o.seconds,
+                position_error=o.position_error,
+                friction_error=o.friction_error,
+                perturbations=o.perturbations,
             ):
                 if isinstance(step, int):
                     yield Progress(0, step)

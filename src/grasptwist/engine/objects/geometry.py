@@ -38,6 +38,7 @@ __all__ = [
     "SurfacePoints",
     "MassProperties",
     "project_to_surface",
+    "signed_distance",
     "mass_properties",
     "sample_surface",
     "tessellate",
@@ -172,6 +173,26 @@ def project_to_surface(obj: GraspObject, points) -> SurfacePoints:
         d.reshape(p.shape[:-1]),
         edge.reshape(p.shape[:-1]),
     )
+
+
+def signed_distance(obj: GraspObject, points) -> np.ndarray:
+    """``project_to_surface(obj, points).distance``, the same numbers, without the nearest points and
+    normals: ``(..., 3) -> (...)`` (a primitive's alone is cheaper; a mesh's is the projection's).
+
+    >>> from grasptwist.objects import Shape
+    >>> box = GraspObject(Shape("box", np.array([2.0, 2.0, 2.0])), np.eye(4))
+    >>> signed_distance(box, [[1.0, 1.5, 0.0], [0.0, 0.0, 0.5]]).tolist()
+    [0.5, -0.5]
+    """
+    p = _points(points)
+    shape = obj.shape
+    if shape.kind == "mesh":
+        return project_to_surface(obj, p).distance
+    rotation, translation = obj.pose[:3, :3], obj.pose[:3, 3]
+    with np.errstate(invalid="ignore", over="ignore"):  # inf * 0 in a point that is not finite
+        local = rotate(rotation.T, p - translation).reshape(-1, 3)
+        d = primitives.signed_distance(shape.kind, check_size(shape.kind, shape.size), local)
+    return np.where(np.isfinite(local).all(axis=1), d, np.nan).reshape(p.shape[:-1])
 
 
 def _nearest(obj, local):

@@ -170,6 +170,7 @@ class _Derived:
         pair[order[two + 1]] = order[two]
         other = (pair // 3).reshape(-1, 3)
         mine = np.repeat(np.arange(len(f)), 3).reshape(-1, 3)
+        self.partner = other  # (F, 3): the face across each side (creases.py's dihedral angles)
         self.edge_normals = _unit(weighted[mine] + weighted[other])
         self.edge_pseudo = self.face_normals[mine] + self.face_normals[other]
         self.tol = MESH_EDGE_TOL * diagonal(v)

@@ -22,7 +22,7 @@ For each wrench the least total normal force
 .. math:: \min \sum_i f_i \cdot n_i \quad \text{s.t.} \quad G f = w, \;
           |f_i - (f_i \cdot n_i) n_i| \le \frac{\mu}{s} f_i \cdot n_i
 
-is the row's score for that wrench.  The objective ``total_normal_force`` is the
+is the row's score for that wrench.  The objectives ``total_normal_force`` and ``robust`` are the
 largest of them (a grip must hold each wrench); ``closure_friction`` (the least common
 friction of closure) and ``epsilon`` (Ferrari-Canny's, negated so that less is better)
 are computed only on feasible rows.
@@ -51,8 +51,10 @@ __all__ = [
     "score_triples",
 ]
 
-#: The objectives a search may minimise (``epsilon`` is maximised: its score is ``-epsilon``).
-OBJECTIVES = ("total_normal_force", "closure_friction", "epsilon")
+#: The objectives a search may minimise (``epsilon`` is maximised: its score is ``-epsilon``).  ``robust``
+#: scores candidates as ``total_normal_force`` does and ranks the finalists by their robustness
+#: first (:mod:`~grasptwist.engine.synthesis.robustness`, in the search).
+OBJECTIVES = ("robust", "total_normal_force", "closure_friction", "epsilon")
 
 #: The constraints in the order they are tested; a row's ``failed`` indexes this (-1: feasible).
 CONSTRAINTS = ("degenerate", "conditioning", "force_closure", "constraints", "grip", *HAND_CONSTRAINTS)
@@ -100,7 +102,7 @@ def check_objective(objective) -> str:
     'epsilon'
     >>> check_objective("speed")
     Traceback (most recent call last):
-    ValueError: objective must be one of total_normal_force, closure_friction, epsilon, got 'speed'
+    ValueError: objective must be one of robust, total_normal_force, closure_friction, epsilon, got 'speed'
     """
     if objective not in OBJECTIVES:
         raise ValueError(f"objective must be one of {', '.join(OBJECTIVES)}, got {objective!r}")
@@ -239,7 +241,7 @@ def score_triples(
 
 def objective_values(points, normals, total, mu, objective, tol=DEGENERACY_TOL):
     """The objective of feasible rows (less is better): ``(N, 3, 3), (N, 3, 3), (N, W)`` -> ``(N,)``."""
-    if objective == "total_normal_force":
+    if objective in ("robust", "total_normal_force"):
         return total.max(axis=1, initial=-np.inf)
     c = force_closure(points, normals, mu, quality=objective == "epsilon", tol=tol)
     return -c.epsilon if objective == "epsilon" else c.closure_friction

@@ -9,11 +9,13 @@ r"""The search: candidate triples scored in chunks, the best refined on the surf
    without one halves that grasp's step.
    Without a feasible grasp to refine, the budget goes on sampling.
 3. **Selection.**  The best grasps in order, each at least ``min_spacing`` from those
-   before it (:func:`~.candidates.triple_distance`).
+   before it (:func:`~.candidates.triple_distance`).  With the objective ``robust`` (the
+   default) the finalists (the archive) are first ranked by their robustness, most robust first,
+   then by their least total normal force (:mod:`~.robustness`, batched over the finalists).
 4. **Verification.**  Each is solved again, one row at a time, by the exact grip
    (:func:`~grasptwist.engine.forces.grip.grip`), whose certificate (``dual`` with a zero
    ``gap``, ``n_i - G_i^T dual`` in every dual cone) proves the total optimal; one that
-   fails is not returned.
+   fails is not returned.  The grasps returned get their margins (:func:`~.robustness.margins`).
 
 The budget holds: the search stops after ``candidates`` scored rows or ``(1 - VERIFY_SHARE)
 seconds``, whichever comes first, checked after every chunk; the rest of ``seconds`` is
@@ -42,9 +44,20 @@ from ..forces.grip import Grip, grip
 from ..forces.hold import object_weight
 from ..ik import home_tips, joint_limits
 from ..objects import object_size, project_to_surface, sample_surface
+from ..objects.creases import edge_distance
 from ..objects.geometry import body_areas, body_of
 from .candidates import candidate_triples, tangent_steps, triple_distance
 from .reach import HandReach, check_hand_reach, reach_tolerance, tip_errors
+from .robustness import (
+    FRICTION_ERROR,
+    PERTURBATIONS,
+    check_friction_error,
+    check_perturbations,
+    check_position_error,
+    default_position_error,
+    margins,
+    robustness,
+)
 from .scores import CONSTRAINTS, METHODS, check_min_conditioning, check_objective, conditionings, score_triples
 
 __all__ = [
@@ -114,12 +127,16 @@ class Surface(NamedTuple):
         ``body(points (..., 3)) -> (...)`` int: the body of the object each surface point is on,
         when a grasp keeps to one (``sample`` then draws each call's points from one body); None:
         contacts anywhere.
+    edges : callable or None
+        ``edges(points (..., 3)) -> (...)``: each point's distance to the nearest crease
+        (:func:`~grasptwist.engine.objects.creases.edge_distance`); None: a smooth surface.
     """
 
     sample: Callable
     project: Callable
     size: float
     body: Callable | None = None
+    edges: Callable | None = None
 
 
 class Failure(NamedTuple):
@@ -171,6 +188,10 @@ class Synthesis:
         kinematics' tolerance).
     tip_center : (K, 3, 3) or None
         With a hand: each fingertip sphere's centre ``p - r n`` (finger ``f`` on contact ``f``).
+    hold_friction, edge_distance, robustness : (K,), (K, 3), (K,)
+        Each grasp's margins (``grasptwist.engine.synthesis.robustness``): the least friction
+        at which every wrench is still held, each contact's distance to the nearest crease, and
+        the share of the perturbations under which it is still held.
     unverified : int
         Grasps selected but not verified, so not returned: ``seconds`` ran out before their turn.
     candidates : int
@@ -200,6 +221,9 @@ class Synthesis:
     reach_error: np.ndarray | None = None
     tip_center: np.ndarray | None = None
     unverified: int = 0
+    hold_friction: np.ndarray | None = None
+    edge_distance: np.ndarray | None = None
+    robustness: np.ndarray | None = None
 
 
 def check_budget(candidates, seconds) -> tuple[int, float | None]:
@@ -307,10 +331,11 @@ def search(surface: Surface, wrenches, friction, **options) -> Synthesis:
         The grasps wanted (fewer when fewer distinct feasible ones are found).
     safety : float, default 1
         ``>= 1``.
-    objective : str, default ``total_normal_force``
-        ``total_normal_force`` (the largest over the wrenches of the least total normal force),
-        ``closure_friction`` (the least common friction of closure), or ``epsilon``
-        (Ferrari-Canny's, maximised); less is better for the first two.
+    objective : str, default ``robust``
+        ``robust`` (the finalists most robust first, then by ``total_normal_force``: module
+        docstring), ``total_normal_force`` (the largest over the wrenches of the least total
+        normal force), ``closure_friction`` (the least common friction of closure), or
+        ``epsilon`` (Ferrari-Canny's, maximised); less is better for the middle two.
     wrist : (3,) array or None, default None
         With a wrist the off-tangent decomposition's conditioning counts too.
     methods : tuple of str, default both
@@ -338,6 +363,14 @@ def search(surface: Surface, wrenches, friction, **options) -> Synthesis:
         ``(1 - VERIFY_SHARE) seconds``, verification before the first grasp after ``seconds``.
     tol : float, default ``DEGENERACY_TOL``
         The degeneracy tolerance of the contacts (``DEGENERACY_TOL``).
+    position_error : float or None, default None
+        How far each perturbation of the robustness moves a contact at most
+        (:mod:`~.robustness`); None: half the smallest fingertip radius with a hand whose tips
+        have one, else 2% of the object's size.
+    friction_error : float, default 0.2
+        The largest share of ``friction`` a perturbation takes away.
+    perturbations : int, default 64
+        Perturbations per grasp (seeded by ``seed``).
 
     Returns
     -------
@@ -375,7 +408,7 @@ def search_steps(
     *,
     count=1,
     safety=1.0,
-    objective="total_normal_force",
+    objective="robust",
     wrist=None,
     methods=METHODS,
     min_conditioning=0.0,
@@ -387,6 +420,9 @@ def search_steps(
     candidates=20000,
     seconds=None,
     tol=DEGENERACY_TOL,
+    position_error=None,
+    friction_error=FRICTION_ERROR,
+    perturbations=PERTURBATIONS,
 ) -> Iterator:
     """:func:`search`, one step at a time: yields the candidates of each chunk scored (ints), then the
     :class:`Synthesis` (a progress bar's way through a long search)."""
@@ -398,6 +434,15 @@ def search_steps(
     budget_size, seconds = check_budget(candidates, seconds)
     spacing = MIN_SPACING * surface.size if min_spacing is None else float(min_spacing)
     hand = None if hand is None else check_hand_reach(hand)
+    position_error = check_position_error(position_error)
+    if position_error is None:
+        position_error = default_position_error(surface.size, None if hand is None else hand.radii)
+    perturbation = {
+        "position_error": position_error,
+        "friction_error": check_friction_error(friction_error),
+        "perturbations": check_perturbations(perturbations),
+        "seed": seed,
+    }
     started = _clock()
     deadline = None if seconds is None else started + seconds
     rng = np.random.default_rng(seed)
@@ -405,7 +450,7 @@ def search_steps(
     joints = None if hand is None else len(hand.hand.joint_names)
     archive = _Archive(max(ELITES, 4 * count), spacing, joints, tol)
     # closure friction, epsilon: slower rows; a hand: the archive fills (and spares rows the hand's test) sooner
-    chunk = CHUNK if objective == "total_normal_force" and hand is None else CHUNK // 8
+    chunk = CHUNK if objective in ("robust", "total_normal_force") and hand is None else CHUNK // 8
 
     def score(p, n, bound=None):
         return score_triples(
@@ -434,11 +479,16 @@ def search_steps(
             budget.spent(k)
             yield k
         yield from _refine(surface, archive, score, budget, rng)
-    picked = _spread(archive.points, count, spacing)
+    rank = np.arange(len(archive.objective))
+    if objective == "robust" and rank.size:  # the finalists, most robust first, then the least total
+        robust = robustness(surface, archive.points, archive.normals, w, mu, safety=safety, tol=tol, **perturbation)
+        rank = np.lexsort((archive.objective, -robust))
+    picked = rank[_spread(archive.points[rank], count, spacing)]
     points, normals = archive.points[picked], archive.normals[picked]
     positions = None if hand is None else archive.positions[picked]
     quality = quality or objective == "epsilon"
     out = _results(surface, points, normals, w, mu, safety, wrist, methods, quality, tol, hand, positions, deadline)
+    out.update(margins(surface, out["points"], out["normals"], w, mu, safety=safety, tol=tol, **perturbation)._asdict())
     failure = None
     if not len(out["points"]) and out["unverified"]:
         failure = Failure(
@@ -670,13 +720,14 @@ def surface_of(obj, span_bodies=False) -> Surface:
     ``span_bodies``: each call of ``sample`` draws from one body, chosen by its area.
     """
     areas = body_areas(obj)
+    edges = partial(edge_distance, obj)
     if span_bodies or len(areas) < 2:
-        return Surface(partial(sample_surface, obj), partial(project_to_surface, obj), object_size(obj))
+        return Surface(partial(sample_surface, obj), partial(project_to_surface, obj), object_size(obj), edges=edges)
 
     def sample(n, rng):
         return sample_surface(obj, n, rng, body=int(rng.choice(len(areas), p=areas / areas.sum())))
 
-    return Surface(sample, partial(project_to_surface, obj), object_size(obj), partial(body_of, obj))
+    return Surface(sample, partial(project_to_surface, obj), object_size(obj), partial(body_of, obj), edges)
 
 
 def hand_reach(obj, hand, *, tips=None, tip_radius=None, collide=None) -> HandReach:
@@ -749,9 +800,11 @@ def synthesize(
         by default each grasp keeps to one (``grasptwist.engine.synthesis.search.surface_of``).
     **options
         The search's keyword options: ``count`` (grasps wanted, 1), ``safety`` (1), ``objective``
-        (``total_normal_force``, ``closure_friction`` or ``epsilon``), ``wrist`` (None),
+        (``robust``, ``total_normal_force``, ``closure_friction`` or ``epsilon``), ``wrist`` (None),
         ``methods``, ``min_conditioning`` (0), ``min_spacing`` (None: 5% of the object's size),
-        ``quality`` (False), ``seed`` (0), ``candidates`` (20000), ``seconds`` (None).
+        ``quality`` (False), ``seed`` (0), ``candidates`` (20000), ``seconds`` (None),
+        ``position_error`` (None: half a tip radius, or 2% of the object's size),
+        ``friction_error`` (0.2), ``perturbations`` (64).
 
     Returns
     -------
