@@ -119,7 +119,7 @@ def test_a_path_sample_that_pushes_the_cube_into_a_finger_collides_there_only(gr
     assert [bool(w) for w in said] == [False, True, False]
     # the tip mesh's deepest vertex along +x is 0.02 mm inside its 10 mm sphere
     assert said[1][0].startswith("finger-collides: finger 1's link 'finger_tip_link_0' is 0.00298 inside the object")
-    depth, count, first = along.seen["1", "finger_tip_link_0"]
+    depth, count, first = along.seen["finger-collides", "1", "finger_tip_link_0"]
     assert 0.00297 < depth <= 0.003 and (count, first) == (1, 1.0)
     assert along.at(q[:1], Poses(*(a[:1] for a in poses))) is None  # the cube where it is: none
     (line,) = along.warnings(3)

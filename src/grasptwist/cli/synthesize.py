@@ -11,6 +11,7 @@ from .options import (
     ALL,
     AllowOutside,
     At,
+    Clearance,
     Debug,
     Digits,
     Friction,
@@ -22,6 +23,7 @@ from .options import (
     Safety,
     SurfaceTol,
     SynthesizeFormat,
+    Table,
     Workers,
     WrenchName,
     WrenchOption,
@@ -156,6 +158,8 @@ def synthesize(
     digits: Digits = 4,
     max_bytes: MaxBytes = None,
     surface_tol: SurfaceTol = None,
+    table: Table = None,
+    clearance: Clearance = None,
     allow_outside: AllowOutside = False,
     workers: Workers = 1,
     quiet: Quiet = False,
@@ -201,7 +205,7 @@ def synthesize(
         # --hand's, else one grasp file's first hand: it names the joint columns of CSV and Parquet
         hand=hand_option(hand, paths, fmt.value),
         max_bytes=max_bytes,
-        reading=reading_option(surface_tol, allow_outside),
+        reading=reading_option(surface_tol, allow_outside, table, clearance),
         options=SynthesisOptions(
             count=count,
             friction=friction,

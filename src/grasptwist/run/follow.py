@@ -39,7 +39,7 @@ from ..output.formats import FORMATS
 from ..output.records import diagnostics, error_record
 from ..results import BY_KEY, selected
 from .batch import Block, hand_placement, with_reasons
-from .collisions import CODE, PathCollisions
+from .collisions import CODES, PathCollisions
 from .options import FollowOptions
 from .outputs import Output
 from .placement import read
@@ -218,7 +218,7 @@ def _path(job, grasp, p):
     stretches, unjudged = (None, None) if weight is None else hold_verdicts(*weight, times)
     # the grasp's own warnings as read (its object's pose, its normals), not its collisions at rest:
     # the samples' own (t = 0 among them) say those
-    read_warnings = tuple(w for w in grasp.warnings if not w.startswith(f"{CODE}:"))
+    read_warnings = tuple(w for w in grasp.warnings if not w.startswith(tuple(f"{code}:" for code in CODES)))
     said = read_warnings + _radians(p) + collided.warnings(len(times))
     yield Summary(grasp.file, grasp, p.name, len(times), found, labels, tracked, stretches, unjudged, largest, said)
 

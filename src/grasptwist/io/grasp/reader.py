@@ -73,6 +73,11 @@ class Reading:
     contacts : bool
         Documents must give ``contacts`` (False: ``synthesize``'s, which finds its own; a document
         without them has NaN points and normals, contacts named ``1``, ``2``, ``3``).
+    table : float or None
+        A table at this height under every document's object (``--table``), replacing its
+        ``environment``'s; None: the file's.
+    clearance : float or None
+        The fingers' clearance from the environment (``--clearance``), replacing the file's.
     """
 
     parser: type = PARSER
@@ -83,6 +88,8 @@ class Reading:
     allow_outside: bool = False
     max_triangles: int = MAX_TRIANGLES
     contacts: bool = True
+    table: float | None = None
+    clearance: float | None = None
 
 
 #: The command line's way of reading.
