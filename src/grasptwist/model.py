@@ -266,7 +266,7 @@ class Environment:
         The least distance every part of a finger keeps from the table and the boxes (its
         ``clearance``, or ``--clearance``); None: ``grasptwist.engine.environment.CLEARANCE``.
     line : int or None
-        1-based line where the ``environment`` key starts in the file.
+        1-based line where the ``environment``'s mapping starts in the file.
     """
 
     table_height: float | None = None

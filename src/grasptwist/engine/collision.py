@@ -73,7 +73,7 @@ __all__ = [
 COLLISION_TOL = 1e-3
 
 #: How much of a link's extent Qhull may merge its hull's facets by (:func:`convex_planes`): the
-#: TriFinger's hulls keep 80-160 of 200-580 vertices, within 0.5 mm of the exact hull.
+#: TriFinger's hulls keep 80-230 of 200-580 vertices, within 0.5 mm of the exact hull.
 HULL_MERGE = 2e-3
 
 #: Most vertices of a hull's cluster (:class:`LinkHulls`): a TriFinger link's 80-230 hull
@@ -378,9 +378,9 @@ def convex_planes(vertices, merge=HULL_MERGE):
     """The convex hull of points, its facets merged: its vertices ``(H, 3)`` and face planes ``(K, 4)`` (:class:`LinkHulls`).
 
     Qhull (scipy) merges facets whose centrums are within ``merge`` times the points' extent of
-    their neighbours' planes (``C-``): the hull it gives lies inside the exact one by about
-    that much, so depths stay lower bounds.  Flat or straight geometry is joggled (``QJ``) into
-    a thin solid.
+    their neighbours' planes (``C-``): the hull it gives is the exact one to about that much
+    (a point's depth within 2.5 times it, tests/engine/test_environment.py).  Flat or straight
+    geometry is joggled (``QJ``) into a thin solid.
 
     >>> v, planes = convex_planes(np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [0.1, 0.1, 0.1]]))
     >>> len(v), len(planes), float(hull_depth([0.1, 0.1, 0.1], planes).round(12))

@@ -47,7 +47,7 @@ TABLE = -1
 def clearance_of(environment) -> float:
     """The clearance an environment asks of the fingers: its own, else :data:`CLEARANCE`.
 
-    >>> from grasptwist.model import Environment
+    >>> from grasptwist.objects import Environment
     >>> clearance_of(Environment(0.0)), clearance_of(Environment(0.0, clearance=0.005))
     (0.001, 0.005)
     """
@@ -57,7 +57,7 @@ def clearance_of(environment) -> float:
 def has_obstacles(environment) -> bool:
     """Whether there is anything to keep clear of (a table or a box).
 
-    >>> from grasptwist.model import Environment
+    >>> from grasptwist.objects import Environment
     >>> has_obstacles(None), has_obstacles(Environment()), has_obstacles(Environment(0.0))
     (False, False, True)
     """
@@ -68,7 +68,7 @@ def needs_checks(hand, environment) -> bool:
     """Whether a grasp's fingers have anything to be checked against: an environment with a table or
     a box, or a hand whose links (a URDF's) or fingertip spheres could meet each other.
 
-    >>> from grasptwist.model import Environment
+    >>> from grasptwist.objects import Environment
     >>> needs_checks(None, None), needs_checks(None, Environment(0.0))
     (False, True)
     """
@@ -92,6 +92,8 @@ def box_distance(points, size, pose):
     -------
     (...) array
 
+    Examples
+    --------
     >>> box_distance([[0, 0, 2.0], [0.5, 0.5, 0.5], [0, 0, 0.75]], [2.0, 2.0, 2.0], np.eye(4)).tolist()
     [1.0, -0.5, -0.25]
     >>> float(box_distance([2.0, 2.0, 1.0], [2.0, 2.0, 2.0], np.eye(4)))  # from the edge: sqrt(2)
@@ -117,11 +119,11 @@ def environment_distance(points, environment):
     distance : (...) array
         ``inf`` with nothing around.
     nearest : (...) int array
-        :data:`TABLE`, or the index of the box in ``environment.boxes``.
+        -1 for the table, else the index of the box in ``environment.boxes``.
 
     Examples
     --------
-    >>> from grasptwist.model import Environment, Obstacle
+    >>> from grasptwist.objects import Environment, Obstacle
     >>> env = Environment(0.0, (Obstacle(np.ones(3), np.eye(4)),))
     >>> d, k = environment_distance([[0, 0, 0.6], [3.0, 0, 0.25]], env)
     >>> d.round(12).tolist(), k.tolist()
@@ -146,7 +148,7 @@ def sphere_distance(centers, radii, environment):
 
     ``(..., 3)`` centres and ``(...)`` radii (broadcast) -> ``(...)``, ``(...)`` as :func:`environment_distance`.
 
-    >>> from grasptwist.model import Environment
+    >>> from grasptwist.objects import Environment
     >>> d, _ = sphere_distance([[0, 0, 0.0125]], [0.01], Environment(0.0))
     >>> d.round(12).tolist()
     [0.0025]
@@ -194,7 +196,7 @@ def parts_distance(parts, links, poses, centers, radii, environment):
     A link with a vertex 2 mm into the table, a sphere 2.5 mm above it:
 
     >>> from grasptwist.engine.collision import clusters
-    >>> from grasptwist.model import Environment
+    >>> from grasptwist.objects import Environment
     >>> link = clusters([[[0, 0, 0.05], [0, 0, -0.002]]])
     >>> d, k = parts_distance(link, 1, np.eye(4)[None, None], [[[0, 0, 0.0125]]], [0.01], Environment(0.0))
     >>> d.round(12).tolist(), k.tolist()

@@ -363,7 +363,7 @@ def _parts(grasp, max_bytes):
     return hulls, tips, radii, labels
 
 
-def hand_checks_along(grasp: Grasp, joint_positions=None, *, max_bytes=DEFAULT_MAX_BYTES):
+def hand_checks_along(grasp: Grasp, *, joint_positions=None, max_bytes=DEFAULT_MAX_BYTES):
     """Per configuration, the fingers into each other and too near the environment, and the clearance.
 
     Parameters
@@ -418,7 +418,8 @@ def hand_checks_along(grasp: Grasp, joint_positions=None, *, max_bytes=DEFAULT_M
     for i, (d, k) in enumerate(zip(distance, nearest)):
         near = np.flatnonzero(d < room)
         near = near[np.argsort(d[near], kind="stable")]
-        hits[i] = tuple(EnvironmentHit(*labels[j], obstacle_name(int(k[j])), float(d[j]), room) for j in near)
+        found = (EnvironmentHit(*labels[j], obstacle_name(int(k[j])), float(d[j]), room) for j in near)
+        hits[i] = _first(found, lambda h: h[:2])
     return overlaps, hits, distance.min(axis=1)
 
 
@@ -426,7 +427,16 @@ def _overlaps(depth, tol, labels):
     """The pairs of parts deeper than ``tol`` into each other, deepest first."""
     a, b = np.nonzero(np.triu(depth > tol, 1))
     order = np.argsort(-depth[a, b], kind="stable")
-    return tuple(Overlap(*labels[i], *labels[j], float(depth[i, j])) for i, j in zip(a[order], b[order]))
+    found = (Overlap(*labels[i], *labels[j], float(depth[i, j])) for i, j in zip(a[order], b[order]))
+    return _first(found, lambda o: o[:4])
+
+
+def _first(found, key) -> tuple:
+    """The first of each part named alike (a tip link's hull and its fingertip sphere share the tip link's name)."""
+    seen = {}
+    for item in found:
+        seen.setdefault(key(item), item)
+    return tuple(seen.values())
 
 
 def with_collisions(grasp: Grasp) -> Grasp | GraspFileError:
@@ -453,6 +463,7 @@ def with_collisions(grasp: Grasp) -> Grasp | GraspFileError:
         *(overlap_warning(o) for o in overlaps[0]),
         *(environment_warning(h) for h in hits[0]),
     )
+    said = tuple(w for w in said if w not in grasp.warnings)  # a grasp placed twice is warned once
     return replace(grasp, warnings=grasp.warnings + said) if said else grasp
 
 
@@ -474,7 +485,7 @@ class PathCollisions:
         frames[:, :3, :3], frames[:, :3, 3], frames[:, 3, 3] = poses.rotation, poses.position, 1.0
         inside = finger_collisions_along(self.grasp, positions, frames)
         # the hand and the environment stay where they are: the object moves between them
-        overlaps, hits, _ = hand_checks_along(self.grasp, positions)
+        overlaps, hits, _ = hand_checks_along(self.grasp, joint_positions=positions)
         said = []
         for time, a, b, c in zip(poses.time.tolist(), inside, overlaps, hits):
             for hit in a:

@@ -37,15 +37,14 @@ def place_grasp(grasp: Grasp) -> Grasp | GraspFileError:
     which.  Here the given positions are checked against the contacts (forward kinematics), or
     positions are solved from the seed (inverse kinematics): each tip link's origin, the
     centre of its fingertip's sphere, on ``point - tip_radius * normal``
-    (:func:`grasptwist.hand.tip_centers`).
+    (:func:`grasptwist.hand.tip_centers`).  Every grasp's fingers are then checked
+    (:func:`grasptwist.hand.with_collisions`: links in the object, fingers into each other,
+    parts too near its environment: warnings).
 
     Parameters
     ----------
     grasp : Grasp
         As read; one without a pending placement (no hand, an inline hand, placed) is returned as it is.
-
-    Every grasp's fingers are then checked (:func:`grasptwist.hand.with_collisions`: links in the
-    object, fingers into each other, parts too near its environment: warnings).
 
     Returns
     -------
