@@ -157,3 +157,31 @@ def test_gt_synthesize_puts_the_command_lines_checks_on_a_hand(monkeypatch):
     gt.synthesize(g.object, 0.8, hand=g.hand, tips=tips, environment=Environment(-1.0), count=1)
     hand = seen["hand"]
     assert hand.environment.table_height == -1.0 and hand.clearance == 0.001 and hand.hulls is not None
+
+
+@needs_trifinger
+def test_the_trifinger_picture_draws_its_table(placed):
+    from grasptwist.plot.scene import grasp_scene
+
+    (table,) = grasp_scene(placed).of_kind("table")
+    assert table.label == "table z = 0" and (table.corners[:, 2] == 0).all()
+
+
+@needs_trifinger
+@pytest.mark.slow
+def test_twenty_trifinger_grasps_on_its_table_put_no_finger_below_it_nor_into_each_other():
+    # 0.5.0, without the table: 7 of these 20 put a fingertip sphere 6 to 10 mm below the floor,
+    # 10 had two fingers into each other (0.3 to 12.9 mm)
+    args = ["synthesize", str(TRIFINGER), "-n", "20", "--friction", "0.8", "--mass", "0.094", "-f", "jsonl"]
+    result = CliRunner().invoke(app, [*args, "--seconds", "3000"])
+    records = [json.loads(line) for line in result.stdout.splitlines()]
+    assert len(records) == 20 and all(r["ok"] for r in records)
+    assert min(r["clearance"] for r in records) >= 0.001
+    assert min(c["tip_center"][2] for r in records for c in r["contacts"]) >= 0.011  # radius + clearance
+    (g,) = gt.read_grasps(TRIFINGER)
+    for r in records:
+        q = np.array([r["joint_positions"][name] for name in g.hand.joint_names])
+        p = np.array([c["point"] for c in r["contacts"]])
+        n = np.array([c["normal"] for c in r["contacts"]])
+        overlaps, hits, clearance = hand_checks_along(replace(g, points=p, normals=n, joint_positions=q))
+        assert overlaps == [()] and hits == [()] and clearance[0] == pytest.approx(r["clearance"])
