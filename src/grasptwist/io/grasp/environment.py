@@ -97,11 +97,12 @@ def _read(fields, found, problems):
         tolerance = SURFACE_TOL if reading.surface_tol is None else reading.surface_tol
         depth = _below(obj, env.table_height)
         if depth > tolerance * object_size(obj):
-            where = located(fields["environment"]) if "environment" in fields else {"line": obj.line, "column": None}
+            table = fields["environment"].value.get("table") if "environment" in fields else None
+            where = located(table[1]) if table is not None else {"line": obj.line, "column": None}
             problems.add(
                 Reject(
                     OBJECT_BELOW_TABLE,
-                    "environment.table" if "environment" in fields else "object",
+                    "environment.table" if table is not None else "object",
                     f"the object goes {depth:.3g} below the table at z = {env.table_height:g} (beyond the surface "
                     "tolerance): it rests on the table or above it",
                     **where,
