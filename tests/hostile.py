@@ -22,6 +22,7 @@ NULLABLE |= {"wrench", "friction", "manipulating", "grip", "force_closure", "clo
 NULLABLE |= {"squeeze"}  # a grip on collinear contacts, whose internal forces are not three squeezes
 NULLABLE |= {"surface_distance"}  # a contact of a grasp without an object
 NULLABLE |= {"joint_positions", "reach_error"}  # a grasp synthesized without a hand
+NULLABLE |= {"clearance"}  # a grasp synthesized without an environment
 
 
 def run(*args, input=None):
