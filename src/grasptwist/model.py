@@ -143,6 +143,9 @@ class Grasp:
     environment : Environment or None
         The table and obstacles around the object (its ``environment``, or the command line's
         ``--table``); None: nothing around it.
+    clearance : float or None
+        With a table or a box: the least signed distance of any finger part (without a hand, of
+        any contact) from them, found when the grasp was placed; None without.
     """
 
     name: str
@@ -168,6 +171,7 @@ class Grasp:
     surface_distance: np.ndarray | None = None
     warnings: tuple[str, ...] = ()
     environment: Environment | None = None
+    clearance: float | None = None
 
 
 @dataclass(frozen=True, eq=False)

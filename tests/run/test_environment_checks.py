@@ -204,3 +204,15 @@ def test_synthesize_on_a_table_from_the_command_line_reports_each_clearance_and_
     csv = CliRunner().invoke(app, [*args, "-f", "csv"]).stdout.splitlines()
     column = csv[0].split(",").index("clearance")
     assert [float(line.split(",")[column]) for line in csv[1:]] == pytest.approx([r["clearance"] for r in records])
+
+
+@needs_trifinger
+def test_resolve_and_forces_records_carry_the_grasps_clearance_and_none_without_an_environment():
+    (spin, _) = json.loads(CliRunner().invoke(app, ["resolve", str(TRIFINGER), "-f", "json"]).stdout)
+    assert spin["clearance"] == pytest.approx(0.005, abs=1e-9)  # the lowest fingertip sphere's bottom
+    args = ["forces", str(TRIFINGER), "--friction", "0.8", "--wrench", "0,0,1,0,0,0", "-f", "json"]
+    (held,) = json.loads(CliRunner().invoke(app, args).stdout)
+    assert held["clearance"] == spin["clearance"]
+    csv = CliRunner().invoke(app, ["resolve", str(GRASPS / "box-edge.yaml"), "-f", "csv"]).stdout.splitlines()
+    column = csv[0].split(",").index("clearance")
+    assert {line.split(",")[column] for line in csv[1:]} == {""}  # no environment

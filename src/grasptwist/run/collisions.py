@@ -442,7 +442,8 @@ def _first(found, key) -> tuple:
 def with_collisions(grasp: Grasp) -> Grasp | GraspFileError:
     """A placed grasp with a warning per link inside its object (``finger-collides``), per pair of
     fingers into each other (``fingers-collide``) and per part too near its environment
-    (``finger-hits-environment``), or the error of its hand's meshes (read from its URDF for the check).
+    (``finger-hits-environment``), and its ``clearance`` from that environment; or the error of its
+    hand's meshes (read from its URDF for the check).
 
     Examples
     --------
@@ -455,7 +456,7 @@ def with_collisions(grasp: Grasp) -> Grasp | GraspFileError:
         return grasp
     try:
         found = finger_collisions(grasp, grasp.joint_positions) if grasp.hand is not None else ()
-        overlaps, hits, _ = hand_checks_along(grasp)
+        overlaps, hits, clearance = hand_checks_along(grasp)
     except InputError as exc:
         return GraspFileError(exc.code, f"hand: {exc.message}", grasp.file, grasp.line, None, grasp.document)
     said = (
@@ -464,7 +465,10 @@ def with_collisions(grasp: Grasp) -> Grasp | GraspFileError:
         *(environment_warning(h) for h in hits[0]),
     )
     said = tuple(w for w in said if w not in grasp.warnings)  # a grasp placed twice is warned once
-    return replace(grasp, warnings=grasp.warnings + said) if said else grasp
+    least = None if clearance is None else float(clearance[0])
+    if not said and least == grasp.clearance:
+        return grasp
+    return replace(grasp, warnings=grasp.warnings + said, clearance=least)
 
 
 class PathCollisions:
