@@ -480,16 +480,17 @@ class PathCollisions:
         self.grasp = grasp
         self.seen = {}  # (code, names) -> [worst, samples, first time, clearance]
 
-    def at(self, positions, poses) -> list | None:
+    def at(self, positions, poses) -> tuple[list | None, np.ndarray | None]:
         """Each sample's warnings at joint ``positions`` and object ``poses``
-        (:class:`~grasptwist.engine.path.Poses`), None when none has any (the block's ``grasp_warnings``)."""
+        (:class:`~grasptwist.engine.path.Poses`), None when none has any (the block's ``grasp_warnings``),
+        and each sample's clearance from the environment (None without one, or without a hand)."""
         if positions is None or not needs_checks(self.grasp.hand, self.grasp.environment):
-            return None
+            return None, None
         frames = np.zeros((len(poses.time), 4, 4))
         frames[:, :3, :3], frames[:, :3, 3], frames[:, 3, 3] = poses.rotation, poses.position, 1.0
         inside = finger_collisions_along(self.grasp, positions, frames)
         # the hand and the environment stay where they are: the object moves between them
-        overlaps, hits, _ = hand_checks_along(self.grasp, joint_positions=positions)
+        overlaps, hits, clearance = hand_checks_along(self.grasp, joint_positions=positions)
         said = []
         for time, a, b, c in zip(poses.time.tolist(), inside, overlaps, hits):
             for hit in a:
@@ -499,7 +500,7 @@ class PathCollisions:
             for h in c:
                 self._saw((ENVIRONMENT_CODE, h.finger, h.link, h.obstacle, h.clearance), h.distance, time, min)
             said.append((*map(collision_warning, a), *map(overlap_warning, b), *map(environment_warning, c)))
-        return said if any(said) else None
+        return (said if any(said) else None), clearance
 
     def _saw(self, key, value, time, worse):
         seen = self.seen.setdefault(key, [value, 0, time])

@@ -209,7 +209,8 @@ def _path(job, grasp, p):
             method=job.method,
             bases=job.bases,
         )
-        block = replace(_block(grasp, p.name, f, job.bases, job.method, q), grasp_warnings=collided.at(q, f.poses))
+        said, clearance = collided.at(q, f.poses)
+        block = replace(_block(grasp, p.name, f, job.bases, job.method, q), grasp_warnings=said, clearance=clearance)
         if tracked is not None:
             seen = block.results["hand"].tip_error.max(axis=0)
             largest = seen if largest is None else np.maximum(largest, seen)
