@@ -23,6 +23,7 @@ NULLABLE |= {"squeeze"}  # a grip on collinear contacts, whose internal forces a
 NULLABLE |= {"surface_distance"}  # a contact of a grasp without an object
 NULLABLE |= {"joint_positions", "reach_error"}  # a grasp synthesized without a hand
 NULLABLE |= {"edge_distance"}  # a contact on a smooth object (no crease)
+NULLABLE |= {"clearance"}  # a grasp synthesized without an environment
 
 
 def run(*args, input=None):

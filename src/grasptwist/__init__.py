@@ -59,7 +59,7 @@ _EXPORTS = {
     "prepare_grip": ".engine.forces.grip",
     "PreparedGrip": ".engine.forces.grip",
     # finding grasps on an object's surface
-    "synthesize": ".engine.synthesis.search",
+    "synthesize": ".run.grasp_search",
     "Synthesis": ".engine.synthesis.search",
     # the topics
     "screws": ".screws",

@@ -44,7 +44,15 @@ from .engine.kinematics import (
 )
 from .io.urdf import load_urdf_hand
 from .model import Finger, Hand, HandPlacement, Joint
-from .run.collisions import Collision, finger_collisions
+from .run.collisions import (
+    Collision,
+    EnvironmentHit,
+    Overlap,
+    finger_collisions,
+    hand_checks_along,
+    hand_constraints,
+    with_collisions,
+)
 from .run.placement import place_grasp
 
 __all__ = [
@@ -85,5 +93,10 @@ __all__ = [
     "TANGENT_FIXED",
     "finger_collisions",
     "Collision",
+    "hand_checks_along",
+    "Overlap",
+    "EnvironmentHit",
+    "with_collisions",
+    "hand_constraints",
     "COLLISION_TOL",
 ]

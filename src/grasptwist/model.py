@@ -17,6 +17,8 @@ __all__ = [
     "Grasp",
     "Shape",
     "GraspObject",
+    "Obstacle",
+    "Environment",
     "Segment",
     "ObjectPath",
     "InputError",
@@ -138,8 +140,16 @@ class Grasp:
     warnings : tuple of str
         Found when it was read (``rotation-over-pi``: its object's pose turned by a rotation
         vector over pi; ``normal-disagrees``: a given normal far from the object's surface normal),
-        then when its hand was placed (``finger-collides``: a finger link inside the object),
+        then when its hand was placed (``finger-collides``: a finger link inside the object;
+        ``fingers-collide``: two fingers' links overlap; ``finger-hits-environment``: a finger
+        within the clearance of the table or a box),
         carried into each of its records.
+    environment : Environment or None
+        The table and obstacles around the object (its ``environment``, or the command line's
+        ``--table``); None: nothing around it.
+    clearance : float or None
+        With a table or a box: the least signed distance of any finger part (without a hand, of
+        any contact) from them, found when the grasp was placed; None without.
     """
 
     name: str
@@ -165,6 +175,8 @@ class Grasp:
     object: GraspObject | None = None
     surface_distance: np.ndarray | None = None
     warnings: tuple[str, ...] = ()
+    environment: Environment | None = None
+    clearance: float | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -230,6 +242,52 @@ class GraspObject:
     pose: np.ndarray
     mass: float | None = None
     density: float | None = None
+    line: int | None = None
+
+
+@dataclass(frozen=True, eq=False)
+class Obstacle:
+    """A box the fingers must keep clear of, in the grasp frame.
+
+    Attributes
+    ----------
+    size : numpy.ndarray
+        ``(3,)`` edge lengths along the box's own x, y, z (centred at its origin).
+    pose : numpy.ndarray
+        ``(4, 4)`` rigid transform from the box's frame to the grasp's frame.
+    line : int or None
+        1-based line of its entry in the file.
+    """
+
+    size: np.ndarray
+    pose: np.ndarray
+    line: int | None = None
+
+
+@dataclass(frozen=True, eq=False)
+class Environment:
+    """The world around the object: a table under it and boxes beside it (a grasp file's ``environment``).
+
+    The geometry (distances, which finger hits what) is in
+    ``grasptwist.engine.environment``.
+
+    Attributes
+    ----------
+    table_height : float or None
+        The table, a horizontal plane ``z = table_height`` of the grasp frame (gravity along
+        -z) that the object rests on or above; None: no table.
+    boxes : tuple of Obstacle
+        Obstacles.
+    clearance : float or None
+        The least distance every part of a finger keeps from the table and the boxes (its
+        ``clearance``, or ``--clearance``); None: ``grasptwist.engine.environment.CLEARANCE``.
+    line : int or None
+        1-based line where the ``environment``'s mapping starts in the file.
+    """
+
+    table_height: float | None = None
+    boxes: tuple[Obstacle, ...] = ()
+    clearance: float | None = None
     line: int | None = None
 
 

@@ -11,6 +11,7 @@ Normals point into the object, distances are > 0 outside.  The math is in
 ``grasptwist.engine.objects``.
 """
 
+from .engine.environment import CLEARANCE, box_distance, environment_distance
 from .engine.objects.checks import KINDS, ObjectError, check_object, check_pose, check_shape, check_size
 from .engine.objects.geometry import (
     MassProperties,
@@ -23,7 +24,7 @@ from .engine.objects.geometry import (
     tessellate,
 )
 from .engine.objects.tolerances import EDGE_TOL, MESH_EDGE_TOL, NORMAL_DISAGREE_DEG, SURFACE_TOL
-from .model import GraspObject, Shape
+from .model import Environment, GraspObject, Obstacle, Shape
 
 __all__ = [
     "Shape",
@@ -46,4 +47,9 @@ __all__ = [
     "NORMAL_DISAGREE_DEG",
     "EDGE_TOL",
     "MESH_EDGE_TOL",
+    "Environment",
+    "Obstacle",
+    "environment_distance",
+    "box_distance",
+    "CLEARANCE",
 ]

@@ -84,6 +84,7 @@ def test_json_records_match_the_engine(files):
             "contacts",
             "wrist",
             "contact_velocity",
+            "clearance",
             "off_tangent",
             "tangent",
             "warnings",

@@ -138,7 +138,7 @@ def test_the_cylinder_crossing_is_where_the_geometry_puts_it_whatever_the_sampli
 def test_sample_records_have_the_issue_fields_and_resolve_method_fields():
     r = run("follow", CYLINDER, "--samples", 3, "-f", "json")
     *rows, summary = json.loads(r.stdout)
-    assert [list(rec) for rec in rows] == [SAMPLE_KEYS + ["off_tangent", "tangent", "warnings", "ok"]] * 3
+    assert [list(rec) for rec in rows] == [SAMPLE_KEYS + ["off_tangent", "tangent", "clearance", "warnings", "ok"]] * 3
     start, middle, end = rows
     assert [rec["t"] for rec in rows] == [0, math.pi / 2, math.pi]
     np.testing.assert_allclose(middle["pose"]["rotation"], [math.cos(math.pi / 4), math.sin(math.pi / 4), 0, 0])

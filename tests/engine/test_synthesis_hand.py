@@ -78,8 +78,11 @@ def test_links_in_the_object_and_fingertips_in_it_are_named_with_how_close_they_
     home = tips_of(INLINE, 0.0)
     always_in = hand_reach(CUBE, INLINE.hand, tips=home, collide=lambda q: np.full(len(q), 0.25))
     s = synthesize(CUBE, 0.8, hand=always_in, count=1, candidates=100)
-    assert s.failure.constraint == "collision" and s.failure.best == 0.25
-    assert "puts a finger link into the object (the shallowest 0.25 deep)" in s.failure.message
+    # the least violation: 0.25 deep less the tolerance (0.1 % of the cube's diagonal)
+    assert s.failure.constraint == "collision" and s.failure.best == 0.25 - 1e-3 * float(
+        np.sqrt(3) * CUBE.shape.size[0]
+    )
+    assert "puts a finger link into the object or another finger" in s.failure.message
     # a surface whose every point is a crease: no sphere of radius 0.1 touches it at one point alone
     crease = HandReach(INLINE.hand, home, np.full(3, 0.1), lambda c: (c, c, np.zeros(c.shape[:-1])), 1e-6)
     r = reach(crease, INLINE.points[None], INLINE.normals[None])

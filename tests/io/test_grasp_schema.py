@@ -42,6 +42,7 @@ NOT_IN_THE_SCHEMA = {
     "contact-off-surface": "a contact farther from the object's surface than the tolerance",
     "outward-normal": "a given normal pointing out of the object",
     "path-outside": "a mesh path that leaves the grasp file's folder",
+    "object-below-table": "an object whose lowest point is below its environment's table",
 }
 
 NOT_DATA = object()

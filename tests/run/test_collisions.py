@@ -115,13 +115,15 @@ def test_a_path_sample_that_pushes_the_cube_into_a_finger_collides_there_only(gr
     poses = Poses(np.arange(3.0), np.zeros(3, int), np.broadcast_to(np.eye(3), (3, 3, 3)), moved, np.zeros((3, 6)))
     q = np.broadcast_to(grasp.joint_positions, (3, len(grasp.joint_positions)))
     along = PathCollisions(point_tips(grasp))
-    said = along.at(q, poses)
+    said, clearance = along.at(q, poses)
     assert [bool(w) for w in said] == [False, True, False]
+    # the hand held still above the bundled file's table: its tip link's lowest hull vertex 5 mm up
+    assert clearance == pytest.approx([0.005] * 3, abs=5e-4)
     # the tip mesh's deepest vertex along +x is 0.02 mm inside its 10 mm sphere
     assert said[1][0].startswith("finger-collides: finger 1's link 'finger_tip_link_0' is 0.00298 inside the object")
-    depth, count, first = along.seen["1", "finger_tip_link_0"]
+    depth, count, first = along.seen["finger-collides", "1", "finger_tip_link_0"]
     assert 0.00297 < depth <= 0.003 and (count, first) == (1, 1.0)
-    assert along.at(q[:1], Poses(*(a[:1] for a in poses))) is None  # the cube where it is: none
+    assert along.at(q[:1], Poses(*(a[:1] for a in poses)))[0] is None  # the cube where it is: none
     (line,) = along.warnings(3)
     assert line == (
         "finger-collides: finger 1's link 'finger_tip_link_0' goes up to 0.00298 inside the object "

@@ -9,6 +9,7 @@ from .exits import run_command
 from .options import (
     AllowOutside,
     At,
+    Clearance,
     Contact,
     ContactOption,
     Debug,
@@ -22,6 +23,7 @@ from .options import (
     Quiet,
     Safety,
     SurfaceTol,
+    Table,
     Torsion,
     WarningsOption,
     Workers,
@@ -78,6 +80,8 @@ def forces(
     digits: Digits = 4,
     max_bytes: MaxBytes = None,
     surface_tol: SurfaceTol = None,
+    table: Table = None,
+    clearance: Clearance = None,
     allow_outside: AllowOutside = False,
     workers: Workers = 0,
     quiet: Quiet = False,
@@ -111,7 +115,7 @@ def forces(
         command=COMMANDS["forces"],
         fmt=fmt.value,
         max_bytes=max_bytes,
-        reading=reading_option(surface_tol, allow_outside),
+        reading=reading_option(surface_tol, allow_outside, table, clearance),
         options=ForceOptions(
             wrenches=None if wrenches is None else tuple(wrenches),
             friction=friction,

@@ -37,6 +37,8 @@ __all__ = [
     "OrderOption",
     "MaxBytes",
     "SurfaceTol",
+    "Table",
+    "Clearance",
     "AllowOutside",
     "reading_option",
     "Quiet",
@@ -166,14 +168,66 @@ AllowOutside = Annotated[
 ]
 
 
-def reading_option(surface_tol: float | None, allow_outside: bool):
-    """How grasp files are read under ``--surface-tol`` and ``--allow-outside``: the loader's
-    :class:`~grasptwist.io.grasp.Reading`."""
+def reading_option(surface_tol: float | None, allow_outside: bool, table=None, clearance=None):
+    """How grasp files are read under ``--surface-tol``, ``--allow-outside``, ``--table`` and
+    ``--clearance``: the loader's :class:`~grasptwist.io.grasp.Reading`."""
     from dataclasses import replace
 
     from ..io.grasp import READING
 
-    return replace(READING, surface_tol=surface_tol, allow_outside=allow_outside)
+    return replace(READING, surface_tol=surface_tol, allow_outside=allow_outside, table=table, clearance=clearance)
+
+
+def finite(text: str) -> float:
+    """A finite number (a table's height).
+
+    >>> finite("-0.5")
+    -0.5
+    """
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not abs(value) < float("inf"):
+        raise typer.BadParameter(f"expected a finite number, got {text!r}")
+    return value
+
+
+def clearance(text: str) -> float:
+    """A clearance: a finite length >= 0.
+
+    >>> clearance("0.002")
+    0.002
+    """
+    try:
+        value = float(text)
+    except ValueError:
+        value = -1.0
+    if not 0 <= value < float("inf"):
+        raise typer.BadParameter(f"expected a finite length >= 0, got {text!r}")
+    return value
+
+
+Table = Annotated[
+    float | None,
+    typer.Option(
+        "--table",
+        parser=finite,
+        metavar="Z",
+        help="A table at height Z under every object (the plane z = Z of the grasp frame, replacing a file's "
+        "environment table): fingers keep --clearance above it.",
+    ),
+]
+Clearance = Annotated[
+    float | None,
+    typer.Option(
+        "--clearance",
+        parser=clearance,
+        metavar="LENGTH",
+        help="The least distance every finger part keeps from the table and boxes, in the files' units "
+        "(default: a file's environment clearance, else 0.001: 1 mm in metres).",
+    ),
+]
 
 
 Quiet = Annotated[bool, typer.Option("-q", "--quiet", help="No warnings or summary on stderr (errors still).")]

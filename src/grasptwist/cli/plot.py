@@ -8,7 +8,18 @@ import typer
 
 from .diagnostics import Diagnostics, to_stderr
 from .exits import EXIT_FAILED, EXIT_OK, checked_output, run_command
-from .options import AllowOutside, Debug, MaxBytes, PlotMethod, Select, SurfaceTol, reading_option, twists_option
+from .options import (
+    AllowOutside,
+    Clearance,
+    Debug,
+    MaxBytes,
+    PlotMethod,
+    Select,
+    SurfaceTol,
+    Table,
+    reading_option,
+    twists_option,
+)
 
 __all__ = ["plot", "draw_pictures"]
 
@@ -57,6 +68,8 @@ def plot(
     ] = None,
     max_bytes: MaxBytes = None,
     surface_tol: SurfaceTol = None,
+    table: Table = None,
+    clearance: Clearance = None,
     allow_outside: AllowOutside = False,
     debug: Debug = False,
 ) -> None:
@@ -89,7 +102,7 @@ def plot(
         raise typer.BadParameter(f"a picture draws one twist: give one (got {len(select)})", param_hint="--select")
     chosen = select[0] if select else None
     views = {"js_beside": js_beside, "path_name": path_name}
-    reading = reading_option(surface_tol, allow_outside)
+    reading = reading_option(surface_tol, allow_outside, table, clearance)
     run_command(
         debug,
         lambda: draw_pictures(

@@ -11,6 +11,7 @@ from .options import (
     ALL,
     AllowOutside,
     At,
+    Clearance,
     Debug,
     Digits,
     Friction,
@@ -22,6 +23,7 @@ from .options import (
     Safety,
     SurfaceTol,
     SynthesizeFormat,
+    Table,
     Workers,
     WrenchName,
     WrenchOption,
@@ -231,6 +233,8 @@ def synthesize(
     digits: Digits = 4,
     max_bytes: MaxBytes = None,
     surface_tol: SurfaceTol = None,
+    table: Table = None,
+    clearance: Clearance = None,
     allow_outside: AllowOutside = False,
     workers: Workers = 1,
     quiet: Quiet = False,
@@ -278,7 +282,7 @@ def synthesize(
         # --hand's, else one grasp file's first hand: it names the joint columns of CSV and Parquet
         hand=hand_option(hand, paths, fmt.value),
         max_bytes=max_bytes,
-        reading=_reading(reading_option(surface_tol, allow_outside), grasp_file),
+        reading=_reading(reading_option(surface_tol, allow_outside, table, clearance), grasp_file),
         options=SynthesisOptions(
             count=count,
             friction=friction,

@@ -46,6 +46,7 @@ from typing import NamedTuple
 import numpy as np
 
 from . import se3
+from .kinematics import forward_kinematics
 from .objects.geometry import object_size, signed_distance
 
 __all__ = [
@@ -58,11 +59,26 @@ __all__ = [
     "link_poses",
     "penetration_depths",
     "tip_sphere",
+    "HULL_MERGE",
+    "LinkHulls",
+    "convex_planes",
+    "hull_depth",
+    "link_hulls",
+    "tip_centers_at",
+    "finger_overlaps",
 ]
 
 #: Depths at most this, times the object's size (its bounding box's diagonal), are no collision:
 #: round-off and tessellation (a 65 mm cube: 0.11 mm).  It also pads the fingertip's sphere.
 COLLISION_TOL = 1e-3
+
+#: How much of a link's extent Qhull may merge its hull's facets by (:func:`convex_planes`): the
+#: TriFinger's hulls keep 80-230 of 200-580 vertices, within 0.5 mm of the exact hull.
+HULL_MERGE = 2e-3
+
+#: Most vertices of a hull's cluster (:class:`LinkHulls`): a TriFinger link's 80-230 hull
+#: vertices in 8-16 clusters, of which a link near another opens a few.
+HULL_CLUSTER = 16
 
 #: Most vertices of one cluster (:func:`clusters`): small enough that a cluster near the
 #: object asks about few far vertices, large enough that far clusters are few (measured with
@@ -329,3 +345,206 @@ def _box(shape):
         "capsule": lambda: np.array([s[0], s[0], s[1] / 2 + s[0]]),
     }[shape.kind]()
     return -half, half
+
+
+class LinkHulls(NamedTuple):
+    """Finger links as convex hulls (:func:`link_hulls`), padded to one width.
+
+    Attributes
+    ----------
+    links : tuple of LinkGeometry
+        The links (their fingers, joints and names).
+    vertices : numpy.ndarray
+        ``(L, H, 3)`` each hull's vertices at home, padded by repeating its first.
+    planes : numpy.ndarray
+        ``(L, K, 4)`` each hull's faces ``(n, d)``, ``n . x + d <= 0`` inside, ``|n| = 1``, padded
+        by repeating its first.
+    center, radius : numpy.ndarray
+        ``(L, 3)``, ``(L,)``: a ball holding each hull at home.
+    parts : LinkClusters
+        The hulls' vertices in clusters of :data:`HULL_CLUSTER` (:func:`clusters`): a cluster whose
+        ball lies beyond a face plane of another link has no vertex inside it.
+    """
+
+    links: tuple
+    vertices: np.ndarray
+    planes: np.ndarray
+    center: np.ndarray
+    radius: np.ndarray
+    parts: LinkClusters
+
+
+def convex_planes(vertices, merge=HULL_MERGE):
+    """The convex hull of points, its facets merged: its vertices ``(H, 3)`` and face planes ``(K, 4)`` (:class:`LinkHulls`).
+
+    Qhull (scipy) merges facets whose centrums are within ``merge`` times the points' extent of
+    their neighbours' planes (``C-``): the hull it gives is the exact one to about that much
+    (a point's depth within 2.5 times it, tests/engine/test_environment.py).  Flat or straight
+    geometry is joggled (``QJ``) into a thin solid.
+
+    >>> v, planes = convex_planes(np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [0.1, 0.1, 0.1]]))
+    >>> len(v), len(planes), float(hull_depth([0.1, 0.1, 0.1], planes).round(12))
+    (4, 4, 0.1)
+    """
+    from scipy.spatial import ConvexHull, QhullError  # as the closure's epsilon: with the first hull
+
+    v = np.asarray(vertices, dtype=float).reshape(-1, 3)
+    try:
+        hull = ConvexHull(v, qhull_options=f"C-{merge * float(np.ptp(v, axis=0).max()):.6g}")
+    except QhullError:
+        hull = ConvexHull(v, qhull_options="QJ")
+    return v[hull.vertices], np.unique(hull.equations, axis=0)
+
+
+def hull_depth(points, planes):
+    r"""How deep points are inside a convex hull, :math:`\delta(x) = -\max_k (n_k \cdot x + d_k)` (< 0 outside).
+
+    ``(..., 3)`` points, ``(..., K, 4)`` planes (their leading axes broadcast) -> ``(...)``; exact
+    inside, outside a lower bound of the distance.
+
+    >>> cube = np.array([[1, 0, 0, -1], [-1, 0, 0, -1], [0, 1, 0, -1], [0, -1, 0, -1], [0, 0, 1, -1], [0, 0, -1, -1.0]])
+    >>> hull_depth([[0, 0, 0.5], [0, 0, 3.0]], cube).tolist()
+    [0.5, -2.0]
+    """
+    planes = np.asarray(planes, dtype=float)
+    x = np.asarray(points, dtype=float)[..., None, :]
+    return -((x @ planes[..., :3].swapaxes(-1, -2))[..., 0, :] + planes[..., 3]).max(axis=-1)
+
+
+def link_hulls(geometry) -> LinkHulls:
+    """Each finger link's convex hull (:class:`LinkHulls`) from its geometry at home; links without vertices are left out.
+
+    >>> link = LinkGeometry(0, "a", 1, np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.0]]), np.zeros((0, 3), int))
+    >>> h = link_hulls([link])
+    >>> h.vertices.shape, h.planes.shape, h.center.tolist()
+    ((1, 4, 3), (1, 4, 4), [[0.5, 0.5, 0.5]])
+    """
+    links = tuple(g for g in geometry if len(g.vertices))
+    hulls = [convex_planes(g.vertices) for g in links]
+    width = max((len(v) for v, _ in hulls), default=1)
+    faces = max((len(p) for _, p in hulls), default=1)
+    vertices = np.array([np.concatenate([v, np.repeat(v[:1], width - len(v), axis=0)]) for v, _ in hulls])
+    planes = np.array([np.concatenate([p, np.repeat(p[:1], faces - len(p), axis=0)]) for _, p in hulls])
+    vertices, planes = vertices.reshape(-1, width, 3), planes.reshape(-1, faces, 4)
+    center = 0.5 * (vertices.min(axis=1) + vertices.max(axis=1)) if len(links) else np.zeros((0, 3))
+    radius = np.linalg.norm(vertices - center[:, None], axis=-1).max(axis=1) if len(links) else np.zeros(0)
+    return LinkHulls(links, vertices, planes, center, radius, clusters([v for v, _ in hulls], HULL_CLUSTER))
+
+
+def tip_centers_at(hand, tips, positions):
+    """Each finger's tip point (its tip link's origin, its fingertip sphere's centre) at joint positions.
+
+    ``hand`` (``F`` fingers), ``tips (F, 4, 4)`` their tip poses at home, ``positions (N, n_joints)`` ->
+    ``(N, F, 3)``, by :func:`~grasptwist.engine.kinematics.forward_kinematics`.
+    """
+    q = np.asarray(positions, dtype=float)
+    out = np.empty(q.shape[:-1] + (len(hand.fingers), 3))
+    for f, finger in enumerate(hand.fingers):
+        state = forward_kinematics(finger.screws, finger.points, tips[f], q[..., list(finger.joint_index)])
+        out[..., f, :] = state.tip[..., :3, 3]
+    return out
+
+
+def finger_overlaps(hulls: LinkHulls, poses, centers, radii):
+    r"""How deep the parts of different fingers go into each other (module docstring).
+
+    The parts are the links (``L``, :class:`LinkHulls`), then the fingertip spheres (``F``).
+
+    Parameters
+    ----------
+    hulls : LinkHulls
+    poses : (N, L, 4, 4) array
+        Each link's pose from home (:func:`link_poses` of ``hulls.links``).
+    centers : (N, F, 3) array
+        The fingertip spheres' centres (:func:`tip_centers_at`); sphere ``f`` is finger ``f``'s.
+    radii : (F,) array
+        Their radii (0: a point, never in a collision of its own).
+
+    Returns
+    -------
+    (N, L + F, L + F) array
+        Symmetric; 0 for parts of one finger and parts apart.
+
+    Examples
+    --------
+    Two tip spheres of 10 mm whose centres are 15 mm apart overlap by 5 mm:
+
+    >>> d = finger_overlaps(link_hulls([]), np.zeros((1, 0, 4, 4)), [[[0, 0, 0], [0.015, 0, 0]]], [0.01, 0.01])
+    >>> d.round(12).tolist()
+    [[[0.0, 0.005], [0.005, 0.0]]]
+    """
+    poses = np.asarray(poses, dtype=float)
+    c = np.asarray(centers, dtype=float)
+    r = np.asarray(radii, dtype=float)
+    n, links, tips = len(c), len(hulls.links), c.shape[1]
+    parts = links + tips
+    depth = np.zeros((n, parts, parts))
+    finger = np.array([g.finger for g in hulls.links] + list(range(tips)), dtype=int)
+    ball = np.concatenate([_apply(poses[..., :3, :3], hulls.center) + poses[..., :3, 3], c], axis=1)
+    reach = np.concatenate([hulls.radius, r])
+    a, b = np.triu_indices(parts, 1)
+    keep = (finger[a] != finger[b]) & (reach[a] + reach[b] > 0)
+    a, b = a[keep], b[keep]
+    rows, pair = np.nonzero(np.linalg.norm(ball[:, a] - ball[:, b], axis=-1) < (reach[a] + reach[b])[None])
+    a, b = a[pair], b[pair]  # a < b: a link before a sphere
+    found = np.zeros(len(rows))
+    both = b < links
+    found[both] = _hull_overlaps(hulls, poses, rows[both], a[both], b[both])
+    mixed = (a < links) & (b >= links)
+    found[mixed] = _sphere_in_hull(
+        hulls, poses, rows[mixed], a[mixed], c[rows[mixed], b[mixed] - links], r[b[mixed] - links]
+    )
+    two = a >= links
+    gap = np.linalg.norm(c[rows[two], a[two] - links] - c[rows[two], b[two] - links], axis=-1)
+    found[two] = r[a[two] - links] + r[b[two] - links] - gap
+    found = np.maximum(found, 0.0)
+    depth[rows, a, b] = found
+    depth[rows, b, a] = found
+    return depth
+
+
+def _into(poses, rows, a, b):
+    """The rigid motion that takes link ``a``'s home geometry to where link ``b``'s home frame sees it
+    at configuration ``rows``: ``g_b^{-1} g_a``, as ``(R, t)``."""
+    back, shift = se3.inverse(poses[rows, b, :3, :3], poses[rows, b, :3, 3])
+    return back @ poses[rows, a, :3, :3], _apply(back, poses[rows, a, :3, 3]) + shift
+
+
+def _hull_overlaps(hulls, poses, rows, a, b):
+    """The deepest vertex of either of two links inside the other (exact for the vertices); a link, or
+    a cluster of its vertices, whose ball lies beyond a face plane of the other is not opened."""
+    out = np.zeros(len(rows))
+    parts = hulls.parts
+    for one, other in ((a, b), (b, a)):
+        rotation, translation = _into(poses, rows, one, other)
+        centre = _apply(rotation, hulls.center[one]) + translation
+        near = np.flatnonzero(hull_depth(centre, hulls.planes[other]) >= -hulls.radius[one])
+        for start in range(0, len(near), 256):
+            k = near[start : start + 256]
+            # the planes carried to link ``one``'s home frame: n' = R^T n, d' = d + n . t
+            planes = hulls.planes[other[k]]
+            normal = planes[..., :3] @ rotation[k]  # (k, K, 3)
+            offset = planes[..., 3] + np.einsum("kmi,ki->km", planes[..., :3], translation[k])
+            # the clusters of link ``one`` that reach into the other's hull: (pair, cluster)
+            pair, cluster = np.nonzero(parts.link[None, :] == one[k, None])
+            s = np.einsum("ci,cki->ck", parts.center[cluster], normal[pair]) + offset[pair]
+            opened = -s.max(axis=1) >= -parts.radius[cluster]
+            pair, cluster = pair[opened], cluster[opened]
+            depth = parts.vertices[cluster] @ normal[pair].swapaxes(1, 2) + offset[pair, None]  # (m, 16, K)
+            np.maximum.at(out, k[pair], -depth.max(axis=2).min(axis=1))
+    return out
+
+
+def _sphere_in_hull(hulls, poses, rows, link, centers, radii):
+    """How deep fingertip spheres go into links: ``r`` less the centre's distance from the hull,
+    exact inside and over a face, else the nearest vertex's."""
+    back, shift = se3.inverse(poses[rows, link, :3, :3], poses[rows, link, :3, 3])
+    x = _apply(back, centers) + shift  # in the link's home frame
+    planes = hulls.planes[link]
+    s = (x[:, None] @ planes[..., :3].swapaxes(-1, -2))[:, 0] + planes[..., 3]  # (k, K)
+    top = s.argmax(axis=1)
+    out = s[np.arange(len(x)), top]  # the distance where the centre is inside or over a face
+    foot = x - out[:, None] * planes[np.arange(len(x)), top, :3]
+    over_face = (out <= 0) | (hull_depth(foot, planes) >= -1e-9 * (1 + np.abs(out)))
+    nearest = np.linalg.norm(hulls.vertices[link] - x[:, None], axis=-1).min(axis=1)
+    return radii - np.where(over_face, out, nearest)

@@ -37,6 +37,7 @@ __all__ = [
     "arrays",
     "error_texts",
     "FORCE_COLUMNS",
+    "clearance",
     "FORCE_CSV_COLUMNS",
     "force_columns",
     "force_typed_header",
@@ -122,6 +123,7 @@ BLOCK_COLUMNS = (
         ("surface_distance1", "surface_distance2", "surface_distance3"),
         only_where_ok=False,
     ),
+    CLEARANCE := Column("clearance", _block(lambda b: clearance(b)), ("clearance",), only_where_ok=False),
 )
 
 #: Columns that hold screws, written in the order asked for.
@@ -129,7 +131,7 @@ _SCREWS = {"twist"}
 
 #: Columns with NaN rows where there is no value (a grasp without a wrist, or without an object):
 #: npz keeps the NaN, flat columns are empty there.
-_OPTIONAL = {"wrist", "surface_distance"}
+_OPTIONAL = {"wrist", "surface_distance", "clearance"}
 
 
 def surface_distance(block) -> np.ndarray:
@@ -137,6 +139,13 @@ def surface_distance(block) -> np.ndarray:
     if block.surface_distance is None:
         return np.full((len(block), 3), np.nan)
     return block.surface_distance
+
+
+def clearance(block) -> np.ndarray:
+    """``(N,)`` each grasp's clearance from its environment, NaN where it has none."""
+    if block.clearance is None:
+        return np.full(len(block), np.nan)
+    return block.clearance
 
 
 def _status(key: str, block) -> np.ndarray:
@@ -315,6 +324,7 @@ FORCE_COLUMNS = (
     (Column("wrench", _block(lambda b: b.wrench), ("f_x", "f_y", "f_z", "m_x", "m_y", "m_z")), lambda b: b.has_wrench),
     (Column("friction", _block(lambda b: b.friction), ("mu1", "mu2", "mu3")), lambda b: b.has_friction),
     (SURFACE_DISTANCE, lambda b: ~np.isnan(surface_distance(b)).any(axis=-1)),
+    (CLEARANCE, lambda b: ~np.isnan(clearance(b))),
     (Column("manipulating", _r("manipulating"), _xyz("fm")), _manipulated),
     (Column("force", _r("force"), _xyz("f")), _gripped),
     (Column("squeeze", _r("squeeze"), ("squeeze1", "squeeze2", "squeeze3")), _gripped),

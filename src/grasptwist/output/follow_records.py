@@ -99,6 +99,7 @@ def sample_records(samples, order: str = "omega-v") -> list[dict]:
             new["joint_positions"] = _finger_positions(samples.block.hands[i], samples.joint_positions[i])
         if samples.grip is not None:
             new["grip"] = grip_record(samples.grip, i)
+        new["clearance"] = rec["clearance"]
         new["warnings"] = rec["warnings"]
         new["ok"] = rec["ok"]
         out.append(new)

@@ -15,7 +15,7 @@ from ..engine.forces.grip import load_words
 from .columns import ColumnSet, force_arrays, force_columns, force_typed_header
 from .csv_rows import FORCE_HEADER, force_error_row
 from .names import escaped, escaped_each
-from .records import outward_warning, surface_distances
+from .records import clearances, outward_warning, surface_distances
 
 __all__ = ["WRENCH_COLUMNS", "force_records", "GRIP_FIELDS", "CLOSURE_FIELDS", "NO_FRICTION_WARNING"]
 
@@ -66,6 +66,7 @@ def force_records(block) -> list[dict]:
     force_closure = r.force_closure.tolist()
     outward = block.outward().any(axis=-1).tolist()
     distance = surface_distances(block)
+    clearance = clearances(block)
     out = []
     for i in range(len(block)):
         names = escaped_each(block.contact_names[i])
@@ -83,6 +84,7 @@ def force_records(block) -> list[dict]:
                 for c in range(3)
             ],
             "friction": friction[i] if has_friction[i] else None,
+            "clearance": clearance[i],
         }
         if not has_wrench[i]:
             rec["manipulating"] = None

@@ -34,6 +34,7 @@ __all__ = [
     "records",
     "outward_warning",
     "surface_distances",
+    "clearances",
     "basis_record",
     "check_record",
     "error_record",
@@ -75,8 +76,9 @@ def records(block, order: str = "omega-v") -> list[dict]:
         surface_distances(block),
         _wrists(block),
         _rows(block.velocity),
+        clearances(block),
     )
-    for i, (file, grasp, units, twist_name, screw, names, p, q, d, c, v) in enumerate(rows):
+    for i, (file, grasp, units, twist_name, screw, names, p, q, d, c, v, e) in enumerate(rows):
         rec = {
             "file": file,
             "grasp": grasp,
@@ -89,6 +91,7 @@ def records(block, order: str = "omega-v") -> list[dict]:
             ],
             "wrist": c,
             "contact_velocity": v,
+            "clearance": e,
         }
         for key, rows_of_kind in objects:
             rec[key] = rows_of_kind[i]
@@ -112,6 +115,13 @@ def outward_warning(block, i: int) -> str | None:
     does too."""
     center = block.center_of_mass is not None and not np.isnan(block.center_of_mass[i]).any()
     return outward_normals_warning(block.outward()[i].tolist(), escaped_each(block.contact_names[i]), center)
+
+
+def clearances(block) -> list:
+    """Each row's ``clearance`` from its grasp's environment, None where it has none."""
+    if block.clearance is None:
+        return [None] * len(block)
+    return [None if e != e else e for e in (block.clearance + 0.0).tolist()]
 
 
 def surface_distances(block) -> list:

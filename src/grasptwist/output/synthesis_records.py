@@ -10,6 +10,7 @@ gives one record per grasp, best first::
                 "epsilon" (or null), "conditioning": {"off_tangent", "tangent"} (null: not asked)},
      "joint_positions": {joint name: position} (null without a hand),
      "reach_error": [3] (null without a hand),
+     "clearance": least distance of any finger from the environment (null without one),
      "search": {"candidates", "seconds", "seed"}, "warnings": [the object's]}
 
 With a hand, finger ``f`` touches contact ``f``; ``reach_error`` is each finger's distance, by
@@ -92,6 +93,7 @@ def synthesis_records(found) -> list[dict]:
                 "scores": scores,
                 "joint_positions": _joint_positions(found, k),
                 "reach_error": None if s.reach_error is None else s.reach_error[k].tolist(),
+                "clearance": None if found.clearance is None else _float(found.clearance[k]),
                 "search": search,
                 "warnings": list(found.warnings),
             }
@@ -163,6 +165,24 @@ def _mesh_path(source, file, folder):
     if source.startswith("package://"):
         return source
     return os.path.relpath(os.path.join(os.path.dirname(os.path.abspath(file)), source), folder)
+
+
+def _environment_node(env) -> dict:
+    """The ``environment`` section: the table, the boxes, the clearance (as the input gave them)."""
+    node = {}
+    if env.table_height is not None:
+        node["table"] = {"height": float(env.table_height)}
+    if env.boxes:
+        node["boxes"] = [
+            {
+                "size": box.size.tolist(),
+                "pose": {"position": box.pose[:3, 3].tolist(), "rotation": _quaternion(box.pose[:3, :3])},
+            }
+            for box in env.boxes
+        ]
+    if env.clearance is not None:
+        node["clearance"] = float(env.clearance)
+    return node
 
 
 def _quaternion(r):
@@ -267,6 +287,8 @@ def grasp_documents(found, folder: str) -> str:
             doc["wrenches"] = wrenches
         if found.hand is not None:
             doc["hand"] = _hand_node(found, k, folder)
+        if found.environment is not None:
+            doc["environment"] = _environment_node(found.environment)
         docs.append(yaml.safe_dump(doc, sort_keys=False, default_flow_style=None))
     return "---\n".join(docs)
 
@@ -287,6 +309,7 @@ _NUMBERS = (
     "hold_friction",
     "robustness",
     *(f"edge_distance{i}" for i in (1, 2, 3)),
+    "clearance",
     "candidates",
     "seconds",
     "seed",
@@ -343,6 +366,7 @@ def _flat(found, order="omega-v", hand=None, typed=False) -> dict:
     columns["hold_friction"] = s.hold_friction
     columns["robustness"] = s.robustness
     columns.update({f"edge_distance{i + 1}": s.edge_distance[:, i] for i in range(3)})
+    columns["clearance"] = nan if found.clearance is None else np.asarray(found.clearance, float)
     columns["candidates"] = np.full(k, s.candidates)
     columns["seconds"] = np.full(k, s.seconds)
     columns["seed"] = np.full(k, s.seed)

@@ -265,6 +265,7 @@ _STYLE = {
     "friction-cone": {"color": "tab:olive", "alpha": 0.18},
     "grip-force": {"color": "tab:pink", "lw": 2.6},
     "object": {"color": "tan", "alpha": 0.3},
+    "table": {"color": "0.35", "alpha": 0.2},
     "fingertip": {"color": "tab:brown", "alpha": 0.45},
     "beyond": {"color": "tab:purple", "lw": 2.0},
 }

@@ -58,6 +58,7 @@ __all__ = [
     "joint_segments",
     "legend_text",
     "object_mesh",
+    "with_table",
     "reach_box",
     "scene",
 ]
@@ -295,6 +296,7 @@ KINDS = {
     "friction-cone": "friction cone (half-angle atan μ_i)",
     "grip-force": "grip force f_i",
     "object": "object",
+    "table": "table",
     "fingertip": "fingertip sphere",
     "beyond": "beyond the picture (arrow towards it)",
 }
@@ -794,7 +796,30 @@ def grasp_scene(
         picture = replace(
             picture, markers=picture.markers + bases, segments=picture.segments + joints + chains, spheres=tips
         )
-    return picture if extent is False else framed(picture, extent=extent)
+    return picture if extent is False else with_table(framed(picture, extent=extent), grasp)
+
+
+def with_table(picture: Scene, grasp) -> Scene:
+    """A framed ``picture`` with the table of ``grasp``'s environment, a square patch of kind
+    ``"table"`` at its height across the picture (none without a table, or one outside the picture).
+
+    >>> from types import SimpleNamespace as G
+    >>> from grasptwist.model import Environment
+    >>> picture = Scene("t", "tangent", 0, extent=(np.array([0.0, 0, 0.03]), 0.05))
+    >>> (table,) = with_table(picture, G(environment=Environment(0.0))).of_kind("table")
+    >>> table.corners.tolist()
+    [[-0.05, -0.05, 0.0], [0.05, -0.05, 0.0], [0.05, 0.05, 0.0], [-0.05, 0.05, 0.0]]
+    """
+    env = getattr(grasp, "environment", None)
+    if env is None or env.table_height is None or picture.extent is None:
+        return picture
+    centre, half = picture.extent
+    z = float(env.table_height)
+    if abs(z - centre[2]) > half:
+        return picture
+    square = np.array([[-1, -1], [1, -1], [1, 1], [-1, 1]], float) * half + centre[:2]
+    corners = np.column_stack([square, np.full(4, z)])
+    return replace(picture, patches=picture.patches + (Patch(corners, f"table z = {z:g}", "table"),))
 
 
 def grasps_scene(grasps) -> Scene:
@@ -842,7 +867,7 @@ def grasps_scene(grasps) -> Scene:
         meshes=(object_mesh(obj),) if obj is not None else (),
         groups=tuple(groups),
     )
-    return framed(picture)
+    return with_table(framed(picture), first)
 
 
 def object_mesh(obj) -> Mesh:

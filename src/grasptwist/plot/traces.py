@@ -34,6 +34,7 @@ COMMON_KINDS = (
     "finger-link",
     "joint-axis",
     "object",
+    "table",
     "fingertip",
     "beyond",
 )
@@ -60,11 +61,19 @@ _STYLE = {
     "friction-cone": ("#bcbd22", 0, None),
     "grip-force": ("#e377c2", 6, None),
     "object": ("#d2b48c", 0, None),
+    "table": ("#595959", 0, None),
     "fingertip": ("#8c564b", 0, None),
     "beyond": ("#9467bd", 6, None),
 }
 _DASHED_METHOD = {"tangent": "dot"}  # the tangent method's Sigma axes are the off-tangent's lines: tell them apart
-_OPACITY = {"tangent-plane": 0.35, "contact-plane": 0.2, "friction-cone": 0.25, "object": 0.35, "fingertip": 0.5}
+_OPACITY = {
+    "tangent-plane": 0.35,
+    "contact-plane": 0.2,
+    "friction-cone": 0.25,
+    "object": 0.35,
+    "table": 0.2,
+    "fingertip": 0.5,
+}
 _HEAD = 0.07  # arrow-head length, of the scene's half-width
 _HIDDEN = ("sigma-part", "psi-part", "theta-part", "tangent-plane")  # off at first: toggled in the legend
 

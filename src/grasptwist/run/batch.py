@@ -94,6 +94,9 @@ class Block:
     # (n, 3) each contact's distance from the grasp's object, NaN rows without an object; None: no row has one
     surface_distance: np.ndarray | None = None
     grasp_warnings: list | None = None  # per row its grasp's warnings (Grasp.warnings); None: no row has one
+    clearance: np.ndarray | None = (
+        None  # (n,) its grasp's clearance (Grasp.clearance), NaN where none; None: no row has one
+    )
     # field values computed so far, by (kind key, Field); a block cut from another keeps its rows of them
     values: dict = field(default_factory=dict, init=False, repr=False, compare=False)
 
@@ -182,6 +185,7 @@ _ROW_FIELDS = (
     "center_of_mass",
     "surface_distance",
     "grasp_warnings",
+    "clearance",
 )
 
 
@@ -351,7 +355,16 @@ def _stack(jobs, method) -> Block:
         center_of_mass=center,
         surface_distance=surface_distances(grasps),
         grasp_warnings=said,
+        clearance=clearances(grasps),
     )
+
+
+def clearances(grasps) -> np.ndarray | None:
+    """``(n,)`` each grasp's clearance from its environment (``Grasp.clearance``), NaN where it has
+    none; None when none has one."""
+    if all(g.clearance is None for g in grasps):
+        return None
+    return np.array([np.nan if g.clearance is None else g.clearance for g in grasps], dtype=float)
 
 
 def surface_distances(grasps) -> np.ndarray | None:

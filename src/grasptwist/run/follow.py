@@ -39,7 +39,7 @@ from ..output.formats import FORMATS
 from ..output.records import diagnostics, error_record
 from ..results import BY_KEY, selected
 from .batch import Block, hand_placement, with_reasons
-from .collisions import CODE, PathCollisions
+from .collisions import CODES, PathCollisions
 from .options import FollowOptions
 from .outputs import Output
 from .placement import read
@@ -209,7 +209,8 @@ def _path(job, grasp, p):
             method=job.method,
             bases=job.bases,
         )
-        block = replace(_block(grasp, p.name, f, job.bases, job.method, q), grasp_warnings=collided.at(q, f.poses))
+        said, clearance = collided.at(q, f.poses)
+        block = replace(_block(grasp, p.name, f, job.bases, job.method, q), grasp_warnings=said, clearance=clearance)
         if tracked is not None:
             seen = block.results["hand"].tip_error.max(axis=0)
             largest = seen if largest is None else np.maximum(largest, seen)
@@ -218,7 +219,7 @@ def _path(job, grasp, p):
     stretches, unjudged = (None, None) if weight is None else hold_verdicts(*weight, times)
     # the grasp's own warnings as read (its object's pose, its normals), not its collisions at rest:
     # the samples' own (t = 0 among them) say those
-    read_warnings = tuple(w for w in grasp.warnings if not w.startswith(f"{CODE}:"))
+    read_warnings = tuple(w for w in grasp.warnings if not w.startswith(tuple(f"{code}:" for code in CODES)))
     said = read_warnings + _radians(p) + collided.warnings(len(times))
     yield Summary(grasp.file, grasp, p.name, len(times), found, labels, tracked, stretches, unjudged, largest, said)
 

@@ -22,7 +22,7 @@ from ..engine.forces.grip import grip
 from ..engine.judgements import outward_contacts
 from ..engine.screws import direction
 from ..model import Grasp, GraspFileError
-from .batch import surface_distances
+from .batch import clearances, surface_distances
 from .options import ForceOptions
 
 __all__ = [
@@ -184,6 +184,7 @@ class ForceBlock:
     center_of_mass: np.ndarray | None = None  # (n, 3), NaN rows where none; None: no row has one
     surface_distance: np.ndarray | None = None  # (n, 3), as resolve's Block (run/batch.py's surface_distances)
     grasp_warnings: list | None = None  # per row its grasp's warnings (Grasp.warnings), as resolve's Block
+    clearance: np.ndarray | None = None  # (n,), as resolve's Block (run/batch.py's clearances)
 
     def __len__(self) -> int:
         return len(self.grasp)
@@ -295,7 +296,7 @@ def _stack(rows, options) -> ForceBlock:
         contact_names=[g.contact_names for g in grasps],
     )
     said = [g.warnings for g in grasps] if any(g.warnings for g in grasps) else None
-    return replace(block, surface_distance=surface_distances(grasps), grasp_warnings=said)
+    return replace(block, surface_distance=surface_distances(grasps), grasp_warnings=said, clearance=clearances(grasps))
 
 
 def force_dataset_blocks(

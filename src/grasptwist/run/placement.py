@@ -18,6 +18,7 @@ from collections.abc import Iterable
 from dataclasses import replace
 
 from ..engine.degeneracy import Status
+from ..engine.environment import needs_checks
 from ..io import grasp as loader
 from ..io import inputs
 from ..io.grasp import READING, Reading
@@ -36,7 +37,9 @@ def place_grasp(grasp: Grasp) -> Grasp | GraspFileError:
     which.  Here the given positions are checked against the contacts (forward kinematics), or
     positions are solved from the seed (inverse kinematics): each tip link's origin, the
     centre of its fingertip's sphere, on ``point - tip_radius * normal``
-    (:func:`grasptwist.hand.tip_centers`).
+    (:func:`grasptwist.hand.tip_centers`).  Every grasp's fingers are then checked
+    (:func:`grasptwist.hand.with_collisions`: links in the object, fingers into each other,
+    parts too near its environment: warnings).
 
     Parameters
     ----------
@@ -58,8 +61,12 @@ def place_grasp(grasp: Grasp) -> Grasp | GraspFileError:
     True
     """
     p = grasp.placement
-    if p is None:
-        return grasp
+    if p is None:  # placed already, an inline hand or none: its fingers and contacts checked all the same
+        if not needs_checks(grasp.hand, grasp.environment):
+            return grasp
+        from .collisions import with_collisions  # the fingers against each other and the environment
+
+        return with_collisions(grasp)
     # inverse kinematics loads with the first URDF hand
     from ..engine.fingertips import tip_centers, tip_radii
     from ..engine.ik import place_hand

@@ -24,14 +24,15 @@ import numpy as np
 from ..engine.fingertips import tip_centers, tip_radii
 from ..engine.forces.hold import Weight, hold_wrench, object_weight
 from ..engine.ik import home_tips
+from ..engine.synthesis.clearance import environment_search, grasp_clearance
 from ..engine.synthesis.scores import METHODS
-from ..engine.synthesis.search import GRAVITY, Synthesis, hand_reach, search_steps, surface_of
+from ..engine.synthesis.search import GRAVITY, Synthesis, search_steps, surface_of
 from ..engine.units import fingers_reach, hand_fit_warning, largest_extent, mesh_span_warning
 from ..io.grasp.forces import HOLD
 from ..io.inputs import read as read_unplaced
 from ..io.limits import MESH_SUFFIXES, OUTPUT_IS_INPUT
 from ..io.mesh_file import read_mesh
-from ..model import CONTACT_NAMES, Grasp, GraspFileError, GraspObject, Hand, InputError, Shape
+from ..model import CONTACT_NAMES, Environment, Grasp, GraspFileError, GraspObject, Hand, InputError, Shape
 from ..output import synthesis_records as sr
 from ..output.formats import FORMATS
 from ..output.names import escaped
@@ -86,6 +87,8 @@ class Found:
     twists: tuple = ()  # the input's twists and paths, written with each grasp found (-o FILE.yaml)
     paths: tuple = ()
     warnings: tuple = ()  # of the object: a mesh's as read (mesh-repaired, mesh-open, mesh-bodies), its size, its pose
+    environment: Environment | None = None  # the table and boxes the grasps keep clear of
+    clearance: np.ndarray | None = None  # each grasp's least distance of a finger from them (None: no environment)
 
     def __len__(self) -> int:
         return len(self.synthesis.points)
@@ -149,14 +152,20 @@ def _hand(job, grasp: Grasp, obj: GraspObject):
                 grasp.line,
             )
         tips = home_tips(hand, tip_centers(grasp.points, grasp.normals, tip_radii(hand)))
-    from .collisions import deepest_link  # the finger links' meshes: with the first URDF hand
+    from ..io.urdf_meshes import grasp_folder  # the finger links' meshes: with the first URDF hand
+    from .collisions import hand_constraints
 
     # a URDF's meshes are found from the file that names it: the grasp file, or --hand's
-    named_by = job.options.hand_file if given else grasp.file
+    named_by = replace(grasp, file=job.options.hand_file if given else grasp.file)
     try:
-        held = replace(grasp, hand=hand, object=obj, file=named_by)
-        collide = deepest_link(held)
-        return hand_reach(obj, hand, tips=tips, collide=collide), hand
+        reach = hand_constraints(
+            obj,
+            hand,
+            environment=grasp.environment,
+            tips=tips,
+            folder=grasp_folder(named_by),
+        )
+        return reach, hand
     except InputError as exc:
         return GraspFileError(exc.code, f"hand: {exc.message}", grasp.file, grasp.line, None, grasp.document)
     except ValueError as exc:
@@ -199,8 +208,22 @@ def _mesh_grasp(path: str, job) -> Grasp | GraspFileError:
     obj = GraspObject(shape, np.eye(4))
     name = os.path.splitext(os.path.basename(path))[0]
     p = np.full((3, 3), np.nan)  # no contacts: as a document read without them
+    r = job.reading  # --table and --clearance: the world around it
+    env = None if r.table is None and r.clearance is None else Environment(r.table, (), r.clearance)
     return Grasp(
-        name, job.options.units or "m", path, 0, CONTACT_NAMES, p, p, None, (), 1, object=obj, warnings=tuple(said)
+        name,
+        job.options.units or "m",
+        path,
+        0,
+        CONTACT_NAMES,
+        p,
+        p,
+        None,
+        (),
+        1,
+        object=obj,
+        warnings=tuple(said),
+        environment=env,
     )
 
 
@@ -256,8 +279,9 @@ def synthesize_inputs(job, inputs: Iterable) -> Iterator[GraspFileError | Found 
             reach, hand = hand if hand is not None else (None, None)
             said = _object_warnings(entry, obj, hand)
             yield Progress(o.candidates, 0)
+            surface, clear = environment_search(surface_of(obj, o.span_bodies), entry.environment, None, reach)
             for step in search_steps(
-                surface_of(obj, o.span_bodies),
+                surface,
                 wrenches,
                 friction,
                 count=o.count,
@@ -267,6 +291,7 @@ def synthesize_inputs(job, inputs: Iterable) -> Iterator[GraspFileError | Found 
                 methods=METHODS if o.method == "both" else (o.method.replace("-", "_"),),
                 min_conditioning=o.min_conditioning,
                 min_spacing=o.min_spacing,
+                constraints=clear,
                 hand=reach,
                 quality=o.quality,
                 seed=o.seed,
@@ -298,6 +323,8 @@ def synthesize_inputs(job, inputs: Iterable) -> Iterator[GraspFileError | Found 
                 twists=entry.twists,
                 paths=entry.paths,
                 warnings=said,
+                environment=entry.environment,
+                clearance=grasp_clearance(step.points, entry.environment, reach, step.joint_positions),
             )
         yield Progress(0, 1)
 

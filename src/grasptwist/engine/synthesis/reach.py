@@ -18,7 +18,14 @@ finger and then as a whole:
    finger's first joint than the finger is long is out of reach without solving;
 3. **collision** (``collision``): at those positions no finger link goes deeper into
    the object than ``tol`` (a function of the joint positions the caller gives, as
-   :mod:`grasptwist.run.collisions` builds it from the hand's meshes).
+   :mod:`grasptwist.run.collisions` builds it from the hand's meshes), no part of one
+   finger goes deeper than ``tol`` into another finger's (their links' convex hulls and
+   fingertip spheres, :func:`~grasptwist.engine.collision.finger_overlaps`), and every part
+   keeps the ``clearance`` from the environment
+   (:func:`~grasptwist.engine.environment.parts_distance`): :func:`violations`.
+
+With an environment, a fingertip sphere must keep its clearance from it in the first test
+too (``fingertips``), before any inverse kinematics.
 
 The nine (finger, contact) pairs of a candidate are solved once each, batched over
 every candidate, and the six assignments are read off them; the assignments that reach
@@ -36,7 +43,9 @@ from typing import NamedTuple
 
 import numpy as np
 
+from ..collision import LinkHulls, finger_overlaps, link_hulls, link_poses, tip_centers_at
 from ..degeneracy import Status
+from ..environment import has_obstacles, parts_distance, sphere_distance
 from ..ik import IK_TOL, finger_ik
 from ..kinematics import forward_kinematics
 
@@ -46,9 +55,11 @@ __all__ = [
     "HandReach",
     "Reached",
     "check_hand_reach",
+    "hand_clearance",
     "reach",
     "reach_tolerance",
     "tip_errors",
+    "violations",
 ]
 
 #: The hand's constraints in the order they are tested (after the grip: the inverse kinematics
@@ -81,6 +92,12 @@ class HandReach(NamedTuple):
     collide : callable or None
         ``collide(positions (N, n_joints)) -> (N,)`` the deepest any link goes into the
         object; None: no link geometry to check.
+    hulls : LinkHulls or None
+        The finger links' convex hulls (:func:`~grasptwist.engine.collision.link_hulls`), checked
+        against each other and the environment; None: the fingertip spheres alone.
+    environment : Environment or None
+        The table and boxes the fingers keep ``clearance`` from.
+    clearance : float
     """
 
     hand: object
@@ -89,6 +106,9 @@ class HandReach(NamedTuple):
     project: Callable
     tolerance: float
     collide: Callable | None = None
+    hulls: LinkHulls | None = None
+    environment: object = None
+    clearance: float = 0.0
 
 
 class Reached(NamedTuple):
@@ -104,7 +124,7 @@ class Reached(NamedTuple):
         Joint positions of the assignment kept (NaN where none).
     miss : (N,)
         How close a failing row came: for ``reach``, its best assignment's largest distance
-        from a tip point to its target; for ``collision``, its shallowest deepest link; NaN else.
+        from a tip point to its target; for ``collision``, its least :func:`violations`; NaN else.
     """
 
     failed: np.ndarray
@@ -158,6 +178,8 @@ def reach(hand_reach: HandReach, points, normals) -> Reached:
     contact = (np.arange(3)[None, :] + np.arange(3)[:, None]) % 3  # (s, f)
     centre = p[:, contact] - radii[None, None, :, None] * n[:, contact]
     clear = hr.project(centre)[2] >= radii - hr.tolerance  # (N, 3, 3)
+    if has_obstacles(hr.environment):  # and clear of the table and the boxes
+        clear &= sphere_distance(centre, radii, hr.environment)[0] >= hr.clearance
     error = np.full((rows, 3, 3), np.inf)
     q = np.full((rows, 3, 3, max(len(f.joints) for f in fingers)), np.nan)
     for f, finger in enumerate(fingers):
@@ -199,14 +221,68 @@ def reach(hand_reach: HandReach, points, normals) -> Reached:
         trial = np.empty((todo.size, len(hr.hand.joint_names)))
         for f, finger in enumerate(fingers):
             trial[:, list(finger.joint_index)] = q[todo, _SHIFTS[k, f], f, : len(finger.joints)]
-        deep = np.zeros(todo.size) if hr.collide is None else np.asarray(hr.collide(trial), float)
+        deep = violations(hr, trial)
         depth[todo] = np.minimum(depth[todo], deep)
-        ok = deep <= hr.tolerance
+        ok = deep <= 0
         failed[todo[~ok]] = HAND_CONSTRAINTS.index("collision")
         won = todo[ok]
         failed[won], order[won], positions[won] = -1, _ORDERS[k[ok]], trial[ok]
     miss = np.where(failed == HAND_CONSTRAINTS.index("collision"), depth, miss)
     return Reached(failed, order, positions, np.where(failed == -1, np.nan, miss))
+
+
+def violations(hand_reach: HandReach, positions):
+    r"""How far the hand at joint positions breaks its collision tests (> 0: broken, module docstring 3.).
+
+    .. math::
+
+        v = \max\bigl(d_\text{object} - \text{tol},\; d_\text{fingers} - \text{tol},\;
+            c_\min - \phi_E\bigr)
+
+    with :math:`d_\text{object}` the deepest link in the object (``collide``), :math:`d_\text{fingers}`
+    the deepest overlap of two fingers' parts and :math:`\phi_E` the least distance of any part from
+    the environment, tested in that order: a row that breaks one test is not put to the next, and
+    gets the first one's (a lower bound of :math:`v`, > 0 all the same).  ``(N, n_joints)`` -> ``(N,)``.
+    """
+    hr = hand_reach
+    q = np.asarray(positions, float)
+    out = np.full(len(q), -np.inf)
+    if hr.collide is not None and len(q):
+        out = np.asarray(hr.collide(q), float) - hr.tolerance
+    live = np.flatnonzero(out <= 0)
+    if live.size:
+        hulls, poses, centers = _parts_at(hr, q[live])
+        overlap = finger_overlaps(hulls, poses, centers, hr.radii).reshape(live.size, -1)
+        out[live] = np.maximum(out[live], overlap.max(axis=1, initial=0.0) - hr.tolerance)
+        clear = out[live] <= 0
+        if has_obstacles(hr.environment) and clear.any():
+            k = live[clear]
+            distance = _distance(hr, hulls, poses[clear], centers[clear])
+            out[k] = np.maximum(out[k], hr.clearance - distance)
+    return out
+
+
+def hand_clearance(hand_reach: HandReach, positions):
+    """The least signed distance of any part of the hand (links, fingertip spheres) from its environment
+    at joint positions, :func:`~grasptwist.engine.environment.parts_distance`: ``(N, n_joints)`` -> ``(N,)``
+    (``inf`` without one)."""
+    q = np.asarray(positions, float)
+    if not has_obstacles(hand_reach.environment):
+        return np.full(len(q), np.inf)
+    return _distance(hand_reach, *_parts_at(hand_reach, q))
+
+
+def _distance(hand_reach, hulls, poses, centers):
+    """The least distance of any part from the environment, the parts placed (:func:`_parts_at`)."""
+    links = len(hulls.links)
+    env = hand_reach.environment
+    return parts_distance(hulls.parts, links, poses, centers, hand_reach.radii, env)[0].min(axis=1)
+
+
+def _parts_at(hand_reach, q):
+    """The links' hulls, their poses and the fingertip spheres' centres at joint positions ``q``."""
+    hulls = link_hulls(()) if hand_reach.hulls is None else hand_reach.hulls
+    return hulls, link_poses(hand_reach.hand, hulls.links, q), tip_centers_at(hand_reach.hand, hand_reach.tips, q)
 
 
 def tip_errors(hand_reach: HandReach, points, normals, positions):

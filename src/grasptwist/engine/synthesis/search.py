@@ -37,6 +37,7 @@ import numpy as np
 
 from ..collision import collision_tolerance
 from ..degeneracy import DEGENERACY_TOL
+from ..environment import clearance_of
 from ..fingertips import tip_centers, tip_radii
 from ..forces.closure import force_closure
 from ..forces.grasp_map import check_friction, check_safety, check_wrench
@@ -47,7 +48,8 @@ from ..objects import object_size, project_to_surface, sample_surface
 from ..objects.creases import edge_distance
 from ..objects.geometry import body_areas, body_of
 from .candidates import candidate_triples, tangent_steps, triple_distance
-from .reach import HandReach, check_hand_reach, reach_tolerance, tip_errors
+from .clearance import environment_search
+from .reach import HandReach, check_hand_reach, reach_tolerance, tip_errors, violations
 from .robustness import (
     FRICTION_ERROR,
     PERTURBATIONS,
@@ -637,15 +639,13 @@ def _results(
 
 def _held(hand, error, positions):
     """Which placed hands are verified: every tip on its target (:func:`~.reach.reach_tolerance`), every
-    joint within its limits, no link in the object (``(K, 3)``, ``(K, n_joints)`` -> ``(K,)``)."""
+    joint within its limits, no collision (:func:`~.reach.violations`: ``(K, 3)``, ``(K, n_joints)`` -> ``(K,)``)."""
     good = (error <= reach_tolerance(hand)).all(axis=1)
     for finger in hand.hand.fingers:
         lower, upper = joint_limits(finger)
         q = positions[:, list(finger.joint_index)]
         good &= ((q >= lower) & (q <= upper)).all(axis=1)
-    if hand.collide is not None and len(positions):
-        good &= np.asarray(hand.collide(positions), float) <= hand.tolerance
-    return good
+    return good & (violations(hand, positions) <= 0)
 
 
 def _failure(archive, scored, mu, min_conditioning, tol) -> Failure:
@@ -691,7 +691,11 @@ def _failure(archive, scored, mu, min_conditioning, tol) -> Failure:
         return Failure(name, "no force-closure candidate passed the further constraints", np.nan, np.nan)
     if name == "fingertips":
         return Failure(
-            name, "on every candidate some fingertip sphere would go into the object (concave there)", np.nan, np.nan
+            name,
+            "on every candidate some fingertip sphere would go into the object (concave there) or within the "
+            "clearance of the environment",
+            np.nan,
+            np.nan,
         )
     if name == "reach":
         best = archive.best_miss.get(name, np.inf)
@@ -706,7 +710,8 @@ def _failure(archive, scored, mu, min_conditioning, tol) -> Failure:
         best = archive.best_miss.get(name, np.inf)
         return Failure(
             name,
-            f"every grasp the hand reaches puts a finger link into the object (the shallowest {best:.3g} deep)",
+            f"every grasp the hand reaches puts a finger link into the object or another finger, or within the "
+            f"clearance of the environment (the least by {best:.3g})",
             best,
             np.nan,
         )
@@ -730,7 +735,9 @@ def surface_of(obj, span_bodies=False) -> Surface:
     return Surface(sample, partial(project_to_surface, obj), object_size(obj), partial(body_of, obj), edges)
 
 
-def hand_reach(obj, hand, *, tips=None, tip_radius=None, collide=None) -> HandReach:
+def hand_reach(
+    obj, hand, *, tips=None, tip_radius=None, collide=None, hulls=None, environment=None, clearance=None
+) -> HandReach:
     """A hand as the search takes it (:class:`~.reach.HandReach`) against ``obj``.
 
     Parameters
@@ -746,10 +753,19 @@ def hand_reach(obj, hand, *, tips=None, tip_radius=None, collide=None) -> HandRe
     collide : callable, optional
         ``collide(positions (N, n_joints)) -> (N,)`` the deepest any finger link goes into the
         object (the command line's, from a URDF's meshes); None: links not checked.
+    hulls : LinkHulls, optional
+        The finger links' convex hulls (``grasptwist.engine.collision.link_hulls``), kept out of each
+        other and clear of the environment; None: the fingertip spheres alone.
+    environment : Environment, optional
+        The table and boxes every part of the hand keeps ``clearance`` from.
+    clearance : float, optional
+        Default the environment's (``grasptwist.engine.environment.clearance_of``).
     """
     radii = tip_radii(hand) if tip_radius is None else np.full(3, float(tip_radius))
     tips = home_tips(hand) if tips is None else np.asarray(tips, float)
-    reach = HandReach(hand, tips, radii, partial(project_to_surface, obj), collision_tolerance(obj), collide)
+    room = 0.0 if environment is None else (clearance_of(environment) if clearance is None else float(clearance))
+    project = partial(project_to_surface, obj)
+    reach = HandReach(hand, tips, radii, project, collision_tolerance(obj), collide, hulls, environment, room)
     return check_hand_reach(reach)
 
 
@@ -765,6 +781,9 @@ def synthesize(
     tip_radius=None,
     collide=None,
     span_bodies=False,
+    hulls=None,
+    environment=None,
+    clearance=None,
     **options,
 ) -> Synthesis:
     r"""Grasps of an object: its surface searched for grasps that hold its weight and ``wrenches``.
@@ -790,11 +809,18 @@ def synthesize(
         the joint limits, no finger link in the object; the grasps then list contact ``f`` for
         finger ``f`` (the fingers are assigned to the contacts in every order), and
         ``joint_positions`` and ``reach_error`` say where the hand holds each.
-    tips, tip_radius, collide
+    tips, tip_radius, collide, hulls
         As ``grasptwist.engine.synthesis.search.hand_reach``: each finger's tip link pose at home (needed for a finger
-        given inline), every fingertip's radius (default each finger's ``tip_radius``), and
-        the depth of the deepest link at joint positions (default: links not checked; the
-        command line checks a URDF's meshes).
+        given inline), every fingertip's radius (default each finger's ``tip_radius``),
+        the depth of the deepest link at joint positions and the links' convex hulls (default:
+        links not checked, only the fingertip spheres; ``grasptwist.synthesize`` and the command
+        line check a URDF's meshes).
+    environment : Environment, optional
+        A table and boxes (``grasptwist.model.Environment``): every contact's fingertip sphere
+        (a point without a hand) and every part of the hand keep ``clearance`` from them; contacts
+        that cannot are never sampled (``grasptwist.engine.synthesis.clearance``).
+    clearance : float, optional
+        Default the environment's, else ``grasptwist.engine.environment.CLEARANCE``.
     span_bodies : bool
         Let a grasp's contacts lie on different bodies of the object (a mesh's pieces apart);
         by default each grasp keeps to one (``grasptwist.engine.synthesis.search.surface_of``).
@@ -829,5 +855,16 @@ def synthesize(
     if not listed:
         raise ValueError("nothing to hold: give the object a mass (hold=True) or wrenches")
     if hand is not None and not isinstance(hand, HandReach):
-        hand = hand_reach(obj, hand, tips=tips, tip_radius=tip_radius, collide=collide)
-    return search(surface_of(obj, span_bodies), np.array(listed), friction, hand=hand, **options)
+        hand = hand_reach(
+            obj,
+            hand,
+            tips=tips,
+            tip_radius=tip_radius,
+            collide=collide,
+            hulls=hulls,
+            environment=environment,
+            clearance=clearance,
+        )
+    surface, clear = environment_search(surface_of(obj, span_bodies), environment, clearance, hand)
+    options["constraints"] = (*options.get("constraints", ()), *clear)
+    return search(surface, np.array(listed), friction, hand=hand, **options)

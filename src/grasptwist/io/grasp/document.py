@@ -15,6 +15,7 @@ import numpy as np
 
 from ...model import CONTACT_NAMES, Grasp
 from .contacts import SECTION as CONTACTS
+from .environment import SECTION as ENVIRONMENT
 from .forces import SECTION as FORCES
 from .hand import SECTION as HAND
 from .objects import SECTION as OBJECT
@@ -29,7 +30,7 @@ __all__ = ["SECTIONS", "GRASP_KEYS", "read_document", "grasp_schema"]
 #: sees the fields of the earlier ones: the object puts the contacts on its
 #: surface, the hand needs the contacts there, the forces the contacts' own
 #: frictions and the object's weight).
-SECTIONS = (CONTACTS, OBJECT, TWISTS, PATHS, HAND, FORCES)
+SECTIONS = (CONTACTS, OBJECT, TWISTS, PATHS, HAND, FORCES, ENVIRONMENT)
 
 #: The top-level keys, in the order the values are checked.
 GRASP_KEYS = ("name", "units", "wrist", *(key for section in SECTIONS for key in section.keys))

@@ -60,6 +60,8 @@ def fast_document(get, keep, file, reading):
     ``file`` is the grasp file's name (a URDF hand or a mesh is found from its
     folder, read as ``reading`` says).
     """
+    if reading.table is not None or reading.clearance is not None:
+        raise Bail  # the environment's section reads every document then, with or without its key
     event = get()
     keep(event)
     if type(event) is not _MappingStart or event.tag is not None:

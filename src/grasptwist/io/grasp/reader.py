@@ -73,6 +73,11 @@ class Reading:
     output : (int, int) or None
         The ``(device, inode)`` of the file the run's ``-o`` replaces: a mesh or URDF that a
         document names and that is that file is refused (``output-is-input``); None: no such file.
+    table : float or None
+        A table at this height under every document's object (``--table``), replacing its
+        ``environment``'s; None: the file's.
+    clearance : float or None
+        The fingers' clearance from the environment (``--clearance``), replacing the file's.
     """
 
     parser: type = PARSER
@@ -85,6 +90,8 @@ class Reading:
     max_mesh_bytes: int = MAX_MESH_BYTES
     contacts: bool = True
     output: tuple[int, int] | None = None
+    table: float | None = None
+    clearance: float | None = None
 
 
 #: The command line's way of reading.
