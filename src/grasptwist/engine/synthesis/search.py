@@ -42,7 +42,8 @@ from ..forces.grip import Grip, grip
 from ..forces.hold import object_weight
 from ..ik import home_tips, joint_limits
 from ..objects import object_size, project_to_surface, sample_surface
-from .candidates import candidate_triples, tangent_steps, triple_distance
+from .archive import Archive, spread
+from .candidates import candidate_triples, tangent_steps
 from .reach import HandReach, check_hand_reach, reach_tolerance, tip_errors
 from .scores import CONSTRAINTS, METHODS, check_min_conditioning, check_objective, conditionings, score_triples
 
@@ -234,55 +235,6 @@ class _Budget:
         self.used += n
 
 
-class _Archive:
-    """The best feasible candidates so far (at most ``size``, each ``spacing`` or more from the better
-    ones, so that refinement and selection start from distinct grasps), and the furthest any got."""
-
-    def __init__(self, size, spacing, joints=None, tol=DEGENERACY_TOL):
-        self.size, self.spacing, self.tol = size, spacing, tol
-        self.points = np.empty((0, 3, 3))
-        self.normals = np.empty((0, 3, 3))
-        self.objective = np.empty(0)
-        self.furthest = 0
-        self.closest = np.inf  # the least closure friction of a row that failed closure, over every chunk
-        self.best_conditioning = 0.0
-        self.positions = None if joints is None else np.empty((0, joints))  # with a hand: (N, n_joints)
-        self.best_miss = {}  # a hand's constraint -> the closest a row failing it came
-
-    @property
-    def bound(self) -> float:
-        """An objective no better than this is never kept: the worst kept once the archive is full."""
-        return float(self.objective[-1]) if len(self.objective) >= self.size else np.inf
-
-    def add(self, p, n, s):
-        ok = s.failed == -1
-        if s.order is not None:  # contact f is finger f's
-            p, n = (np.take_along_axis(a, s.order[..., None], axis=1) for a in (p, n))
-            self.positions = np.concatenate((self.positions, s.joint_positions[ok]))
-            tested = (s.failed > CONSTRAINTS.index("grip")) & (s.failed < len(CONSTRAINTS))
-            for k in np.unique(s.failed[tested]):
-                best = float(np.nanmin(s.miss[s.failed == k], initial=np.inf))
-                self.best_miss[CONSTRAINTS[k]] = min(self.best_miss.get(CONSTRAINTS[k], np.inf), best)
-        self.points = np.concatenate((self.points, p[ok]))
-        self.normals = np.concatenate((self.normals, n[ok]))
-        self.objective = np.concatenate((self.objective, s.objective[ok]))
-        order = np.argsort(self.objective, kind="stable")[: 8 * self.size]
-        keep = order[_spread(self.points[order], self.size, self.spacing)]
-        self.points, self.normals, self.objective = self.points[keep], self.normals[keep], self.objective[keep]
-        if self.positions is not None:
-            self.positions = self.positions[keep]
-        reached = np.where(s.failed == -1, len(CONSTRAINTS), s.failed)
-        self.furthest = max(self.furthest, int(reached.max(initial=0)))
-        worst = np.fmin(s.conditioning[:, 0], s.conditioning[:, 1])  # the asked methods' smaller
-        self.best_conditioning = max(self.best_conditioning, float(np.nanmax(worst, initial=0.0)))
-        closure = CONSTRAINTS.index("force_closure")
-        at = reached == closure
-        # only while closure is the furthest constraint is it what a failed search reports
-        if at.any() and self.furthest == closure:
-            needed = force_closure(p[at], n[at], tol=self.tol).closure_friction
-            self.closest = min(self.closest, float(np.nanmin(needed, initial=np.inf)))
-
-
 def search(surface: Surface, wrenches, friction, **options) -> Synthesis:
     r"""Search ``surface`` for ``count`` three-finger grasps that exert ``wrenches`` with the least grip.
 
@@ -397,7 +349,7 @@ def search_steps(
     rng = np.random.default_rng(seed)
     budget = _Budget(budget_size, None if seconds is None else started + (1 - VERIFY_SHARE) * seconds)
     joints = None if hand is None else len(hand.hand.joint_names)
-    archive = _Archive(max(ELITES, 4 * count), spacing, joints, tol)
+    archive = Archive(max(ELITES, 4 * count), spacing, joints, tol)
     # closure friction, epsilon: slower rows; a hand: the archive fills (and spares rows the hand's test) sooner
     chunk = CHUNK if objective == "total_normal_force" and hand is None else CHUNK // 8
 
@@ -428,7 +380,7 @@ def search_steps(
             budget.spent(k)
             yield k
         yield from _refine(surface, archive, score, budget, rng)
-    picked = _spread(archive.points, count, spacing)
+    picked = spread(archive.points, count, spacing)
     points, normals = archive.points[picked], archive.normals[picked]
     positions = None if hand is None else archive.positions[picked]
     quality = quality or objective == "epsilon"
@@ -483,20 +435,6 @@ def _refine(surface, archive, score, budget, rng):
         rows = np.arange(elites)[better] * children + child[better]
         p[better], n[better], best[better] = q[rows], m[rows], value[better, child[better]]
         step = np.where(better, step, step / 2)
-
-
-def _spread(points, count, spacing):
-    """Indices of up to ``count`` of the grasps ``points (N, 3, 3)``, in order, each ``spacing`` or more
-    from those picked before it (:func:`~.candidates.triple_distance`)."""
-    if spacing <= 0:  # every distance is at least 0: the first ``count`` (spared a quadratic loop)
-        return np.arange(min(count, len(points)))
-    picked = []
-    for i in range(len(points)):
-        if len(picked) == count:
-            break
-        if not picked or triple_distance(points[i], points[picked]).min() >= spacing:
-            picked.append(i)
-    return np.array(picked, int)
 
 
 def verified(points, normals, wrench, friction, safety, tol=DEGENERACY_TOL) -> Grip | None:
