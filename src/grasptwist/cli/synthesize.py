@@ -44,29 +44,22 @@ class Objective(str, Enum):
     epsilon = "epsilon"
 
 
-def _checked(check):
-    """A typer callback that turns an engine check's ValueError into a usage error."""
+def _checked(name, module="checks"):
+    """A typer callback running the engine's check ``name`` (of ``engine.synthesis.<module>``, imported
+    when the option is given): the library's words, as a usage error naming the option."""
 
     def callback(value):
+        if value is None:
+            return value
+        from importlib import import_module
+
+        check = getattr(import_module(f"grasptwist.engine.synthesis.{module}"), name)
         try:
-            return value if value is None else check(value)
+            return check(value)
         except ValueError as err:
             raise typer.BadParameter(str(err)) from None
 
     return callback
-
-
-def _min_conditioning(value):
-    from ..engine.synthesis.scores import check_min_conditioning
-
-    return check_min_conditioning(value)
-
-
-def _positive(value):
-    """--mass, --seconds: the engine's checks (check_budget's seconds), in the command line's words."""
-    if not 0 < value < float("inf"):
-        raise ValueError(f"must be a finite number > 0, got {value:g}")
-    return value
 
 
 def synthesize(
@@ -77,14 +70,19 @@ def synthesize(
             help="Grasp files with an object (.yaml, .yml, .json), mesh files (.stl, .obj, .ply) or folders.",
         ),
     ],
-    count: Annotated[int, typer.Option("-n", "--count", min=1, max=10_000, help="Grasps wanted per object.")] = 5,
+    count: Annotated[
+        int,
+        typer.Option(
+            "-n", "--count", callback=_checked("check_count"), help="Grasps wanted per object (at most 10000)."
+        ),
+    ] = 5,
     friction: Friction = None,
     mass: Annotated[
         float | None,
         typer.Option(
             "--mass",
             metavar="KG",
-            callback=_checked(_positive),
+            callback=_checked("check_mass"),
             help="The object's mass: its weight is the wrench 'hold'.",
         ),
     ] = None,
@@ -101,7 +99,7 @@ def synthesize(
         typer.Option(
             "--min-conditioning",
             metavar="C",
-            callback=_checked(_min_conditioning),
+            callback=_checked("check_min_conditioning", "scores"),
             help="Each decomposition's conditioning must be at least this (0 to 1).",
         ),
     ] = 1e-3,
@@ -110,7 +108,7 @@ def synthesize(
         typer.Option(
             "--min-spacing",
             metavar="D",
-            min=0,
+            callback=_checked("check_min_spacing"),
             help="Grasps returned are at least this far apart (default: 5% of the object's size).",
         ),
     ] = None,
@@ -128,23 +126,34 @@ def synthesize(
         typer.Option(
             "--tip-radius",
             metavar="R",
-            min=0,
+            callback=_checked("check_tip_radius"),
             help="Every fingertip's radius (default: the hand's tip_radius, or its URDF's tip spheres); "
             "an object without a hand warns that it is ignored.",
         ),
     ] = None,
     quality: Annotated[bool, typer.Option("--quality", help="Also Ferrari-Canny's epsilon (needs scipy).")] = False,
-    seed: Annotated[int, typer.Option("--seed", min=0, help="Seed of the random numbers (reproducible runs).")] = 0,
+    seed: Annotated[
+        int,
+        typer.Option(
+            "--seed",
+            callback=_checked("check_seed"),
+            help="Seed of the random numbers, 0 to 2**63-1 (reproducible runs).",
+        ),
+    ] = 0,
     candidates: Annotated[
-        int, typer.Option("--candidates", min=1, max=10**9, help="Candidate triples scored at most, per object.")
+        int,
+        typer.Option(
+            "--candidates", callback=_checked("check_candidates"), help="Candidate triples scored at most, per object."
+        ),
     ] = 20000,
     seconds: Annotated[
         float,
         typer.Option(
             "--seconds",
             metavar="S",
-            callback=_checked(_positive),
-            help="Time allowed per object: the search stops at 80% of it, verification at the end (grasps left unverified are not reported).",
+            callback=_checked("check_seconds"),
+            help="Time allowed per object, counted after a fresh install's one-time compiling: the search stops "
+            "at 80% of it, verification at the end (grasps left unverified are not reported).",
         ),
     ] = 60.0,
     fmt: Annotated[

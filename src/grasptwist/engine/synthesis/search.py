@@ -15,12 +15,13 @@ r"""The search: candidate triples scored in chunks, the best refined on the surf
    ``gap``, ``n_i - G_i^T dual`` in every dual cone) proves the total optimal; one that
    fails is not returned.
 
-The budget holds: the search stops after ``candidates`` scored rows or ``(1 - VERIFY_SHARE)
-seconds``, whichever comes first, checked after every chunk; the rest of ``seconds`` is
-selection's and verification's, which stops at the deadline (checked before each grasp): the
-grasps verified by then are returned, the others counted as ``unverified``.  With the same
-``seed`` and a budget of candidates (no time limit reached) two runs return the same grasps bit
-for bit.
+The budget (:mod:`~.budget`) holds: the search stops after ``candidates`` scored rows or
+``(1 - VERIFY_SHARE) seconds``, whichever comes first, checked after every chunk; the rest of
+``seconds`` is selection's and verification's, which stops at the deadline (checked before each
+grasp): the grasps verified by then are returned, the others counted as ``unverified``.  The
+clock starts after the one-time warm-up (numba's compiling of the grip on a fresh install), and
+the result says which limit ended it (``stopped_by``).  With the same ``seed`` and a search that
+the candidates ended (``stopped_by == "candidates"``) two runs return the same grasps bit for bit.
 """
 
 from __future__ import annotations
@@ -37,13 +38,15 @@ from ..collision import collision_tolerance
 from ..degeneracy import DEGENERACY_TOL
 from ..fingertips import tip_centers, tip_radii
 from ..forces.closure import force_closure
-from ..forces.grasp_map import check_friction, check_safety, check_wrench
+from ..forces.grasp_map import check_safety
 from ..forces.grip import Grip, grip
 from ..forces.hold import object_weight
 from ..ik import home_tips, joint_limits
 from ..objects import object_size, project_to_surface, sample_surface
 from .archive import Archive, spread
+from .budget import Budget, Spending, check_budget, warm_up
 from .candidates import candidate_triples, tangent_steps
+from .checks import check_count, check_min_spacing, check_search_friction, check_seed, check_tip_radius, check_wrenches
 from .reach import HandReach, check_hand_reach, reach_tolerance, tip_errors
 from .scores import CONSTRAINTS, METHODS, check_min_conditioning, check_objective, conditionings, score_triples
 
@@ -51,6 +54,7 @@ __all__ = [
     "Surface",
     "Failure",
     "Synthesis",
+    "Budget",
     "search",
     "search_steps",
     "synthesize",
@@ -84,9 +88,6 @@ ELITES, CHILDREN = 16, 16
 
 #: The share of ``seconds`` kept for selecting and verifying the grasps found (the search stops before it).
 VERIFY_SHARE = 0.2
-
-#: The clock of the time budget (a module attribute: tests replace it).
-_clock = time.perf_counter
 
 #: A verified grip's duality gap must be within this of its total (relative).
 GAP_TOL = 1e-6
@@ -168,6 +169,10 @@ class Synthesis:
         With a hand: each fingertip sphere's centre ``p - r n`` (finger ``f`` on contact ``f``).
     unverified : int
         Grasps selected but not verified, so not returned: ``seconds`` ran out before their turn.
+    stopped_by : str
+        What ended the search (:data:`~.budget.STOPPED_BY`): ``candidates``, every candidate
+        scored and every grasp selected verified (reproducible bit for bit from ``seed``), or
+        ``seconds``, the time ran out first (the search's share, or verification's).
     candidates : int
         Candidates scored.
     seconds : float
@@ -195,44 +200,7 @@ class Synthesis:
     reach_error: np.ndarray | None = None
     tip_center: np.ndarray | None = None
     unverified: int = 0
-
-
-def check_budget(candidates, seconds) -> tuple[int, float | None]:
-    """A search's budget: ``candidates`` a positive integer, ``seconds`` None or a positive number.
-
-    >>> check_budget(1000, None)
-    (1000, None)
-    >>> check_budget(0, 1.0)
-    Traceback (most recent call last):
-    ValueError: candidates must be a positive integer, got 0
-    >>> check_budget(10, float("inf"))
-    Traceback (most recent call last):
-    ValueError: seconds must be a positive finite number or None, got inf
-    """
-    if not (isinstance(candidates, (int, np.integer)) and not isinstance(candidates, bool) and candidates > 0):
-        raise ValueError(f"candidates must be a positive integer, got {candidates!r}")
-    number = isinstance(seconds, (int, float, np.integer, np.floating)) and not isinstance(seconds, bool)
-    if seconds is not None and not (number and 0 < seconds < np.inf):
-        raise ValueError(f"seconds must be a positive finite number or None, got {seconds!r}")
-    return int(candidates), None if seconds is None else float(seconds)
-
-
-class _Budget:
-    """Candidates and time left (``deadline`` on :data:`_clock`, or None)."""
-
-    def __init__(self, candidates, deadline):
-        self.left, self.used = candidates, 0
-        self.deadline = deadline
-
-    def take(self, n) -> int:
-        """Up to ``n`` candidates, 0 when the budget is spent."""
-        if self.deadline is not None and _clock() >= self.deadline:
-            return 0
-        return max(0, min(n, self.left))
-
-    def spent(self, n):
-        self.left -= n
-        self.used += n
+    stopped_by: str = "candidates"
 
 
 def search(surface: Surface, wrenches, friction, **options) -> Synthesis:
@@ -282,6 +250,9 @@ def search(surface: Surface, wrenches, friction, **options) -> Synthesis:
     seconds : float or None, default None
         Time allowed: the search stops after the chunk of :data:`CHUNK` candidates that passes
         ``(1 - VERIFY_SHARE) seconds``, verification before the first grasp after ``seconds``.
+        The clock starts after :func:`~.budget.warm_up` (a fresh install's compiling).
+    clock : callable, default ``time.perf_counter``
+        What ``seconds`` are read on (:class:`~.budget.Budget`; a test gives a fake one).
     tol : float, default ``DEGENERACY_TOL``
         The degeneracy tolerance of the contacts (``DEGENERACY_TOL``).
 
@@ -332,22 +303,26 @@ def search_steps(
     seed=0,
     candidates=20000,
     seconds=None,
+    clock=time.perf_counter,
     tol=DEGENERACY_TOL,
 ) -> Iterator:
     """:func:`search`, one step at a time: yields the candidates of each chunk scored (ints), then the
     :class:`Synthesis` (a progress bar's way through a long search)."""
-    w = check_wrench(wrenches).reshape(-1, 6)
-    mu = float(check_friction(friction))
+    w = check_wrenches(wrenches)
+    mu = check_search_friction(friction)
+    count = check_count(count)
     safety = check_safety(safety)
     objective = check_objective(objective)
     min_conditioning = check_min_conditioning(min_conditioning)
-    budget_size, seconds = check_budget(candidates, seconds)
-    spacing = MIN_SPACING * surface.size if min_spacing is None else float(min_spacing)
+    seed = check_seed(seed)
+    setting = Budget(candidates, seconds, clock)
+    min_spacing = check_min_spacing(min_spacing)
+    spacing = MIN_SPACING * surface.size if min_spacing is None else min_spacing
     hand = None if hand is None else check_hand_reach(hand)
-    started = _clock()
-    deadline = None if seconds is None else started + seconds
+    warm_up()  # before the clock starts: a first run's compiling is no part of its budget
+    budget = Spending(setting, 1 - VERIFY_SHARE)
+    budget_size = setting.candidates
     rng = np.random.default_rng(seed)
-    budget = _Budget(budget_size, None if seconds is None else started + (1 - VERIFY_SHARE) * seconds)
     joints = None if hand is None else len(hand.hand.joint_names)
     archive = Archive(max(ELITES, 4 * count), spacing, joints, tol)
     # closure friction, epsilon: slower rows; a hand: the archive fills (and spares rows the hand's test) sooner
@@ -384,7 +359,7 @@ def search_steps(
     points, normals = archive.points[picked], archive.normals[picked]
     positions = None if hand is None else archive.positions[picked]
     quality = quality or objective == "epsilon"
-    out = _results(surface, points, normals, w, mu, safety, wrist, methods, quality, tol, hand, positions, deadline)
+    out = _results(surface, points, normals, w, mu, safety, wrist, methods, quality, tol, hand, positions, budget)
     failure = None
     if not len(out["points"]) and out["unverified"]:
         failure = Failure(
@@ -398,9 +373,10 @@ def search_steps(
     yield Synthesis(
         **out,
         candidates=budget.used,
-        seconds=_clock() - started,
+        seconds=budget.seconds(),
         seed=seed,
         failure=failure,
+        stopped_by=budget.stopped_by,
     )
 
 
@@ -472,14 +448,15 @@ def verified(points, normals, wrench, friction, safety, tol=DEGENERACY_TOL) -> G
 
 
 def _results(
-    surface, points, normals, w, mu, safety, wrist, methods, quality, tol, hand=None, positions=None, deadline=None
+    surface, points, normals, w, mu, safety, wrist, methods, quality, tol, hand=None, positions=None, budget=None
 ):
     """The returned grasps' fields of :class:`Synthesis`, each grasp verified (the others dropped): the
     exact grip, and with a hand its tips by forward kinematics, its limits and its links clear; those
-    whose turn comes after ``deadline`` (on :data:`_clock`) are not verified, only counted."""
+    whose turn comes after the ``budget``'s deadline (:meth:`~.budget.Spending.late`) are not verified,
+    only counted."""
     grips, keep, unverified = [], [], 0
     for i in range(len(points)):
-        if deadline is not None and _clock() >= deadline:
+        if budget is not None and budget.late():
             unverified = len(points) - i
             break
         found = tuple(verified(points[i], normals[i], wrench, mu, safety, tol) for wrench in w)
@@ -558,14 +535,9 @@ def _failure(archive, scored, mu, min_conditioning, tol) -> Failure:
             min_conditioning,
         )
     if name == "force_closure":
-        best = archive.closest
-        words = "no friction" if not np.isfinite(best) else f"friction {best:.3g}"
-        return Failure(
-            name,
-            f"no candidate is force closure at friction {mu:g} (friction / safety); the best needs {words}",
-            best,
-            mu,
-        )
+        best = archive.closest  # inf: no candidate is closure at any finite friction (a flat object's)
+        words = f"the best needs friction {best:.3g}" if np.isfinite(best) else "none is at any finite friction"
+        return Failure(name, f"no candidate is force closure at friction {mu:g} (friction / safety); {words}", best, mu)
     if name == "constraints":
         return Failure(name, "no force-closure candidate passed the further constraints", np.nan, np.nan)
     if name == "fingertips":
@@ -576,8 +548,10 @@ def _failure(archive, scored, mu, min_conditioning, tol) -> Failure:
         best = archive.best_miss.get(name, np.inf)
         return Failure(
             name,
-            f"the hand reaches no candidate's contacts within its joint limits: the best candidate leaves a "
-            f"fingertip {best:.3g} from where it must be",
+            "the hand reaches no candidate's contacts within its joint limits"
+            + (
+                f": the best candidate leaves a fingertip {best:.3g} from where it must be" if np.isfinite(best) else ""
+            ),
             best,
             0.0,
         )
@@ -585,7 +559,8 @@ def _failure(archive, scored, mu, min_conditioning, tol) -> Failure:
         best = archive.best_miss.get(name, np.inf)
         return Failure(
             name,
-            f"every grasp the hand reaches puts a finger link into the object (the shallowest {best:.3g} deep)",
+            "every grasp the hand reaches puts a finger link into the object"
+            + (f" (the shallowest {best:.3g} deep)" if np.isfinite(best) else ""),
             best,
             np.nan,
         )
@@ -614,7 +589,8 @@ def hand_reach(obj, hand, *, tips=None, tip_radius=None, collide=None) -> HandRe
         ``collide(positions (N, n_joints)) -> (N,)`` the deepest any finger link goes into the
         object (the command line's, from a URDF's meshes); None: links not checked.
     """
-    radii = tip_radii(hand) if tip_radius is None else np.full(3, float(tip_radius))
+    tip_radius = check_tip_radius(tip_radius)
+    radii = tip_radii(hand) if tip_radius is None else np.full(3, tip_radius)
     tips = home_tips(hand) if tips is None else np.asarray(tips, float)
     reach = HandReach(hand, tips, radii, partial(project_to_surface, obj), collision_tolerance(obj), collide)
     return check_hand_reach(reach)
@@ -681,11 +657,15 @@ def synthesize(
     >>> s.points.shape, bool((s.closure_friction < 0.8).all())
     ((2, 3, 3), True)
     """
-    listed = [np.asarray(w, float).reshape(6) for w in wrenches]
+    tip_radius = check_tip_radius(tip_radius)  # checked with or without a hand, as --tip-radius is
+    listed = list(check_wrenches(wrenches)) if len(wrenches) else []
     if hold:
-        weight = object_weight(obj, gravity)
+        with np.errstate(over="ignore", invalid="ignore"):
+            weight = object_weight(obj, gravity)
         if weight is None:
             raise ValueError("hold=True needs the object's mass (or density): its weight is the wrench to hold")
+        if not np.isfinite(weight.wrench).all():
+            raise ValueError("the object's weight or its moment about the origin overflows (mass x gravity)")
         listed.insert(0, weight.wrench)
     if not listed:
         raise ValueError("nothing to hold: give the object a mass (hold=True) or wrenches")
