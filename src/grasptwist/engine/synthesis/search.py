@@ -43,7 +43,7 @@ from ..forces.grip import Grip, grip
 from ..forces.hold import object_weight
 from ..ik import home_tips, joint_limits
 from ..objects import object_size, project_to_surface, sample_surface
-from .archive import Archive, spread
+from .archive import Archive
 from .budget import Budget, Spending, check_budget, warm_up
 from .candidates import candidate_triples, tangent_steps
 from .checks import check_count, check_min_spacing, check_search_friction, check_seed, check_tip_radius, check_wrenches
@@ -355,9 +355,9 @@ def search_steps(
             budget.spent(k)
             yield k
         yield from _refine(surface, archive, score, budget, rng)
-    picked = spread(archive.points, count, spacing)
-    points, normals = archive.points[picked], archive.normals[picked]
-    positions = None if hand is None else archive.positions[picked]
+    # the archive's grasps are spacing apart already: the best count are the selection
+    points, normals = archive.points[:count], archive.normals[:count]
+    positions = None if hand is None else archive.positions[:count]
     quality = quality or objective == "epsilon"
     out = _results(surface, points, normals, w, mu, safety, wrist, methods, quality, tol, hand, positions, budget)
     failure = None
