@@ -31,6 +31,7 @@ def test_records_carry_every_score_and_the_grasp_file_is_read_back_by_every_comm
     assert rec["scores"]["epsilon"] is None and rec["scores"]["closure_friction"] < 0.5
     assert set(rec["scores"]["conditioning"]) == {"off_tangent", "tangent"}
     assert rec["search"]["seed"] == 0 and 110 < rec["search"]["candidates"] <= 120
+    assert rec["search"]["stopped_by"] == "candidates"  # no time limit reached: reproducible from the seed
     assert "candidates scored in" in r.stderr
     grasps = read_grasps(found)
     assert [g.name for g in grasps] == ["sphere-tripod-1", "sphere-tripod-2", "sphere-equator-1", "sphere-equator-2"]

@@ -237,7 +237,7 @@ def test_the_time_budget_holds(monkeypatch):
     monkeypatch.setattr(search_module, "score_triples", ten_ms_a_chunk)
     s = synthesize(box(), 0.8, candidates=10**9, seconds=0.05, clock=clock)
     # checked after every chunk: it stops after the one that passes its share of the time, 0.04 s
-    assert 0 < s.candidates <= 5 * 2048 and s.seconds <= 0.05 + 0.01 + 1e-12
+    assert 0 < s.candidates <= 5 * 2048 and s.seconds <= 0.05 + 0.01 + 1e-12 and s.stopped_by == "seconds"
 
 
 class _FakeClock:
@@ -264,8 +264,9 @@ def test_verification_stops_at_the_deadline_and_counts_the_grasps_left(monkeypat
     s = synthesize(ball(), 0.8, count=8, candidates=600, seconds=5.0, min_spacing=0.0, clock=clock)
     assert s.candidates == 600 and s.seconds == 5.0  # the budget, exactly
     assert len(s.points) == 5 and s.unverified == 3 and len(s.grips) == 5 and s.failure is None
+    assert s.stopped_by == "seconds"  # every candidate scored, but not every grasp verified
     s = synthesize(ball(), 0.8, count=8, candidates=600, min_spacing=0.0)  # no time limit: all verified
-    assert len(s.points) == 8 and s.unverified == 0
+    assert len(s.points) == 8 and s.unverified == 0 and s.stopped_by == "candidates"
 
 
 @pytest.mark.parametrize("chunk_seconds, returned", [(0.85, 2), (1.05, 0)])
