@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from grasptwist.io.grasp import read_grasps
-from hostile import jsonl, on_a_terminal, run
+from hostile import jsonl, on_a_terminal, run, run_installed
 from places import GRASPS
 
 SPHERE = GRASPS / "sphere.yaml"  # two balls: 'sphere-tripod' has no friction or mass, 'sphere-equator' both
@@ -491,3 +491,35 @@ def test_grasps_left_unverified_when_the_time_runs_out_are_counted_on_stderr(mon
     assert "'sphere-tripod': 3 grasps from 120 candidates scored in 3.00 s" in tripod and "verified" not in tripod
     assert "'sphere-equator': 2 of 3 grasps wanted" in equator and "scored in 4.00 s" in equator
     assert equator.endswith("; 1 found but not verified before --seconds ran out")
+
+
+def test_a_slow_warm_up_is_said_once_on_stderr_and_not_with_quiet(monkeypatch, capsys):
+    import time
+
+    from grasptwist.cli import synthesize as cli_synthesize
+    from grasptwist.engine.synthesis import budget
+
+    cli_synthesize._warmed_up(quiet=False)  # the numpy path's warm-up: a grip, no compile, no word
+    assert capsys.readouterr().err == ""
+    monkeypatch.setattr(cli_synthesize, "COMPILE_NOTICE_AFTER", 0.0)
+    monkeypatch.setattr(budget, "warm_up", lambda: time.sleep(0.3))  # a fresh install's compile, shortened
+    cli_synthesize._warmed_up(quiet=False)
+    said = capsys.readouterr()
+    assert said.err.count("compiling the grip's numba kernels, once per install") == 1 and said.out == ""
+    cli_synthesize._warmed_up(quiet=True)
+    assert capsys.readouterr().err == ""
+
+
+@pytest.mark.slow  # compiles the grip's kernels from nothing: tens of seconds
+def test_a_cold_run_returns_what_a_warm_run_returns(tmp_path):
+    # an empty numba cache: the first run compiles, inside no budget (--seconds 60 would not hold it on a busy machine)
+    pytest.importorskip("numba")
+    env = {"NUMBA_CACHE_DIR": str(tmp_path / "cache"), "GRASPTWIST_NUMBA": "1"}
+    args = ("synthesize", SPHERE, "--friction", "0.5", "--mass", "1", "-n", "3", "--candidates", "2000", "-f", "jsonl")
+    cold, _ = run_installed(*args, "--seconds", "60", env=env, timeout=900)
+    warm, _ = run_installed(*args, "--seconds", "60", env=env, timeout=900)
+    assert cold.returncode == warm.returncode == 0, cold.stderr
+    assert "compiling the grip's numba kernels" in cold.stderr and "compiling" not in warm.stderr
+    for rec in (*jsonl(cold.stdout), *jsonl(warm.stdout)):
+        assert rec["search"].pop("stopped_by") == "candidates" and rec["search"].pop("seconds") > 0
+    assert jsonl(cold.stdout) == jsonl(warm.stdout) and len(jsonl(cold.stdout)) == 6

@@ -269,6 +269,24 @@ def test_verification_stops_at_the_deadline_and_counts_the_grasps_left(monkeypat
     assert len(s.points) == 8 and s.unverified == 0 and s.stopped_by == "candidates"
 
 
+def test_the_clock_starts_after_the_warm_up_so_a_cold_run_returns_what_a_warm_one_does(monkeypatch):
+    from grasptwist.engine.synthesis import search as search_module
+
+    clock, real = _FakeClock(), search_module.warm_up
+
+    def a_fresh_install_s_compile():  # 100 s on the search's clock, beyond its 60 s
+        clock.now += 100.0
+        real()
+
+    warm = synthesize(ball(), 0.8, count=3, candidates=300, seconds=60.0, clock=clock)
+    monkeypatch.setattr(search_module, "warm_up", a_fresh_install_s_compile)
+    cold = synthesize(ball(), 0.8, count=3, candidates=300, seconds=60.0, clock=clock)
+    assert clock.now == 100.0 and cold.seconds == warm.seconds == 0.0  # the search took none of its 60 s
+    assert cold.stopped_by == warm.stopped_by == "candidates" and cold.candidates == 300
+    np.testing.assert_array_equal(cold.points, warm.points)
+    np.testing.assert_array_equal(cold.total_normal_force, warm.total_normal_force)
+
+
 @pytest.mark.parametrize("chunk_seconds, returned", [(0.85, 2), (1.05, 0)])
 def test_a_search_stops_at_its_share_of_the_time_and_verifies_before_the_deadline(monkeypatch, chunk_seconds, returned):
     from grasptwist.engine.synthesis import search as search_module

@@ -1,5 +1,6 @@
 """``grasptwist synthesize``: search an object's surface for three-fingered grasps (issue 31)."""
 
+import sys
 from enum import Enum
 from typing import Annotated
 
@@ -60,6 +61,37 @@ def _checked(name, module="checks"):
             raise typer.BadParameter(str(err)) from None
 
     return callback
+
+
+#: Seconds a warm-up may take before the command line says it is compiling (numba's cache loads sooner).
+COMPILE_NOTICE_AFTER = 1.0
+
+
+def _warmed_up(quiet: bool) -> None:
+    """The grip's kernels compiled, or loaded from numba's cache, before any search's clock starts
+    (:func:`~grasptwist.engine.synthesis.budget.warm_up`; the workers forked later inherit them);
+    a warm-up that outlasts :data:`COMPILE_NOTICE_AFTER` (a fresh install's compile) says so once on
+    stderr."""
+    import threading
+
+    from ..engine.synthesis.budget import warm_up
+
+    def notice():
+        print(
+            "grasptwist: compiling the grip's numba kernels, once per install (about 20 s, longer on a busy "
+            "machine); --seconds counts from when it is done",
+            file=sys.stderr,
+            flush=True,
+        )
+
+    timer = threading.Timer(COMPILE_NOTICE_AFTER, notice)
+    timer.daemon = True
+    if not quiet:
+        timer.start()
+    try:
+        warm_up()
+    finally:
+        timer.cancel()
 
 
 def synthesize(
@@ -231,4 +263,9 @@ def synthesize(
         ),
     )
     settings = OutputSettings(records_to, quiet, Warnings.summary, workers, {"digits": digits}, reads=(hand,))
-    run_command(debug, lambda: write_records(job, paths, settings))
+
+    def search_all() -> int:
+        _warmed_up(quiet)
+        return write_records(job, paths, settings)
+
+    run_command(debug, search_all)
