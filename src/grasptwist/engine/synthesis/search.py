@@ -170,7 +170,7 @@ class Synthesis:
     unverified : int
         Grasps selected but not verified, so not returned: ``seconds`` ran out before their turn.
     stopped_by : str
-        What ended the search (:data:`~.budget.STOPPED_BY`): ``candidates``, every candidate
+        What ended the search (``budget.STOPPED_BY``): ``candidates``, every candidate
         scored and every grasp selected verified (reproducible bit for bit from ``seed``), or
         ``seconds``, the time ran out first (the search's share, or verification's).
     candidates : int
