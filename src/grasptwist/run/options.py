@@ -118,3 +118,11 @@ class SynthesisOptions:
     grasp_file: str | None = None
     tip_radius: float | None = None
     hand_file: str | None = None
+
+    def __post_init__(self):
+        # the options the search never sees as such (they change the object and the hand), checked as
+        # the command line checks them, for every way in (grasptwist.dask passes them as keywords)
+        from ..engine.synthesis.checks import check_mass, check_tip_radius
+
+        check_mass(self.mass)
+        check_tip_radius(self.tip_radius)
