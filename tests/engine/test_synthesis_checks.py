@@ -119,3 +119,21 @@ def test_a_surface_no_finite_friction_closes_is_said_so_not_that_it_needs_no_fri
     s = search(Surface(sample, project, 3.0), [[0, 0, 1.0, 0, 0, 0]], 0.5, candidates=300)
     assert s.failure.constraint == "force_closure" and s.failure.best == np.inf
     assert s.failure.message.endswith("none is at any finite friction") and "needs" not in s.failure.message
+
+
+def test_spending_stops_on_the_time_only_while_candidates_are_left():
+    from grasptwist.engine.synthesis.budget import Spending
+
+    now = [0.0]
+    b = Spending(Budget(100, 10.0, lambda: now[0]), 0.8)
+    assert b.take(60) == 60 and b.stopped_by == "candidates"
+    b.spent(60)
+    assert b.take(60) == 40
+    b.spent(40)
+    now[0] = 9.0  # past the search's 8 s, but every candidate is spent: not the time's doing
+    assert b.take(60) == 0 and b.stopped_by == "candidates" and not b.late()
+    now[0] = 10.0
+    assert b.late() and b.stopped_by == "seconds" and b.seconds() == 10.0
+    early = Spending(Budget(100, 10.0, lambda: now[0]), 0.8)
+    now[0] = 18.0
+    assert early.take(10) == 0 and early.stopped_by == "seconds"

@@ -63,8 +63,9 @@ def _checked(name, module="checks"):
     return callback
 
 
-#: Seconds a warm-up may take before the command line says it is compiling (numba's cache loads sooner).
-COMPILE_NOTICE_AFTER = 1.0
+#: Seconds a warm-up may take before the command line says it is compiling: numba's import and its
+#: cache load in 1-3 s on a busy machine, a compile takes 20 s or more.
+COMPILE_NOTICE_AFTER = 5.0
 
 
 def _warmed_up(quiet: bool) -> None:

@@ -81,11 +81,12 @@ class Spending:
         self.stopped_by = "candidates"
 
     def take(self, n) -> int:
-        """Up to ``n`` candidates, 0 when the budget is spent."""
-        if self.search_deadline is not None and self.clock() >= self.search_deadline:
+        """Up to ``n`` candidates, 0 when the budget is spent (the time only when some are left)."""
+        n = max(0, min(n, self.left))
+        if n and self.search_deadline is not None and self.clock() >= self.search_deadline:
             self.stopped_by = "seconds"
             return 0
-        return max(0, min(n, self.left))
+        return n
 
     def spent(self, n):
         self.left -= n
