@@ -287,6 +287,24 @@ def test_the_clock_starts_after_the_warm_up_so_a_cold_run_returns_what_a_warm_on
     np.testing.assert_array_equal(cold.total_normal_force, warm.total_normal_force)
 
 
+def test_epsilon_is_computed_at_each_grasp_s_turn_within_the_deadline(monkeypatch):
+    pytest.importorskip("scipy")
+    from grasptwist.engine.forces.closure import force_closure
+    from grasptwist.engine.synthesis import search as search_module
+
+    clock = _FakeClock()
+
+    def one_second_an_epsilon(*args, quality=False, **kwargs):  # a convex hull a grasp, slowed down
+        clock.now += 1.0 if quality else 0.0
+        return force_closure(*args, quality=quality, **kwargs)
+
+    monkeypatch.setattr(search_module, "force_closure", one_second_an_epsilon)
+    s = synthesize(ball(), 0.8, count=4, candidates=120, seconds=2.5, quality=True, min_spacing=0.0, clock=clock)
+    # grasps 1-3 take their epsilon at 0, 1 and 2 s; the 4th's turn comes at 3 s, past 2.5 s
+    assert len(s.points) == 3 and s.unverified == 1 and s.stopped_by == "seconds" and s.seconds == 3.0
+    np.testing.assert_allclose(s.epsilon, force_closure(s.points, s.normals, 0.8, quality=True).epsilon, rtol=1e-12)
+
+
 @pytest.mark.parametrize("chunk_seconds, returned", [(0.85, 2), (1.05, 0)])
 def test_a_search_stops_at_its_share_of_the_time_and_verifies_before_the_deadline(monkeypatch, chunk_seconds, returned):
     from grasptwist.engine.synthesis import search as search_module

@@ -453,8 +453,9 @@ def _results(
     """The returned grasps' fields of :class:`Synthesis`, each grasp verified (the others dropped): the
     exact grip, and with a hand its tips by forward kinematics, its limits and its links clear; those
     whose turn comes after the ``budget``'s deadline (:meth:`~.budget.Spending.late`) are not verified,
-    only counted."""
-    grips, keep, unverified = [], [], 0
+    only counted.  Epsilon (``quality``: a convex hull a grasp, milliseconds each) is computed at each
+    grasp's turn, within the deadline."""
+    grips, keep, epsilon, unverified = [], [], [], 0
     for i in range(len(points)):
         if budget is not None and budget.late():
             unverified = len(points) - i
@@ -463,18 +464,21 @@ def _results(
         if all(g is not None for g in found):
             grips.append(found)
             keep.append(i)
+            if quality:
+                epsilon.append(float(force_closure(points[i], normals[i], mu / safety, quality=True, tol=tol).epsilon))
     hand_fields = {}
     if hand is not None:
         error = tip_errors(hand, points[keep], normals[keep], positions[keep])
         good = _held(hand, error, positions[keep])
         grips, keep = [g for g, k in zip(grips, good) if k], [i for i, k in zip(keep, good) if k]
+        epsilon = [e for e, k in zip(epsilon, good) if k]
         hand_fields = {
             "joint_positions": positions[keep],
             "reach_error": error[good],
             "tip_center": tip_centers(points[keep], normals[keep], hand.radii),
         }
     p, n = points[keep], normals[keep]
-    closure = force_closure(p, n, mu / safety, quality=quality, tol=tol) if len(p) else None
+    closure = force_closure(p, n, mu / safety, tol=tol) if len(p) else None
     return {
         "points": p,
         "normals": n,
@@ -483,7 +487,7 @@ def _results(
             len(p), len(w)
         ),
         "closure_friction": closure.closure_friction if closure else np.empty(0),
-        "epsilon": (closure.epsilon if closure else np.empty(0)) if quality else None,
+        "epsilon": np.array(epsilon) if quality else None,
         "conditioning": conditionings(p, n, wrist, methods, tol) if len(p) else np.empty((0, 2)),
         "grips": tuple(grips),
         "unverified": unverified,
