@@ -104,17 +104,32 @@ class Spending:
         return self.clock() - self.started
 
 
-#: A regular grasp of a unit ball: :func:`warm_up`'s grip.
-_BALL = np.array([[1.0, 0, 0], [-0.5, 0.75**0.5, 0], [-0.5, -(0.75**0.5), 0]])
+#: Whether this process has warmed up (:func:`warm_up` runs once).
+_WARM = []
+
+
+def _ball_sample(n, rng):
+    """A unit ball's surface, area-weighted, with inward normals: :func:`warm_up`'s object."""
+    p = rng.normal(size=(n, 3))
+    p /= np.linalg.norm(p, axis=1, keepdims=True)
+    return p, -p
+
+
+def _ball_project(q):
+    r = np.linalg.norm(q, axis=-1, keepdims=True)
+    return q / r, -q / r, r[..., 0] - 1, np.zeros(q.shape[:-1], dtype=bool)
 
 
 def warm_up():
-    """The one-time work of the first search of a process, done before any budget's clock starts:
-    one grip of a fixed grasp, which compiles the grip's numba kernels (or loads them from numba's
-    cache; nothing to do on the numpy path).
+    """The one-time work of a process's first search, done before any budget's clock starts: a small
+    search of a ball, which compiles the grip's numba kernels for the very arrays a search gives them
+    (its batches and its verification's single rows), or loads them from numba's cache; once a process.
 
     >>> warm_up()
     """
-    from ..forces.grip import grip
+    if _WARM:
+        return
+    _WARM.append(True)  # first: the search below warms up too
+    from .search import Surface, search
 
-    grip(_BALL, -_BALL, [0, 0, 1.0, 0, 0, 0], 0.5)
+    search(Surface(_ball_sample, _ball_project, 2 * 3**0.5), [[0, 0, 1.0, 0, 0, 0]], 0.5, candidates=200)
