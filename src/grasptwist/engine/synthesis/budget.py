@@ -123,13 +123,15 @@ def _ball_project(q):
 def warm_up():
     """The one-time work of a process's first search, done before any budget's clock starts: a small
     search of a ball, which compiles the grip's numba kernels for the very arrays a search gives them
-    (its batches and its verification's single rows), or loads them from numba's cache; once a process.
+    (its batches and its verification's single rows), or loads them from numba's cache; once a process,
+    and nothing on the numpy path.
 
     >>> warm_up()
     """
-    if _WARM:
-        return
-    _WARM.append(True)  # first: the search below warms up too
+    from ..forces import compiled
     from .search import Surface, search
 
+    if _WARM or compiled.kernel() is None:  # done, or the numpy path: nothing to compile
+        return
+    _WARM.append(True)  # first: the search below warms up too
     search(Surface(_ball_sample, _ball_project, 2 * 3**0.5), [[0, 0, 1.0, 0, 0, 0]], 0.5, candidates=200)
