@@ -497,12 +497,12 @@ def test_a_slow_warm_up_is_said_once_on_stderr_and_not_with_quiet(monkeypatch, c
     import time
 
     from grasptwist.cli import synthesize as cli_synthesize
-    from grasptwist.engine.synthesis import budget
+    from grasptwist.engine.synthesis import search as search_module
 
     cli_synthesize._warmed_up(quiet=False)  # the numpy path's warm-up: a grip, no compile, no word
     assert capsys.readouterr().err == ""
     monkeypatch.setattr(cli_synthesize, "COMPILE_NOTICE_AFTER", 0.0)
-    monkeypatch.setattr(budget, "warm_up", lambda: time.sleep(0.3))  # a fresh install's compile, shortened
+    monkeypatch.setattr(search_module, "warm_up", lambda: time.sleep(0.3))  # a fresh install's compile, shortened
     cli_synthesize._warmed_up(quiet=False)
     said = capsys.readouterr()
     assert said.err.count("compiling the grip's numba kernels, once per install") == 1 and said.out == ""
@@ -520,6 +520,7 @@ def test_a_cold_run_returns_what_a_warm_run_returns(tmp_path):
     warm, _ = run_installed(*args, "--seconds", "60", env=env, timeout=900)
     assert cold.returncode == warm.returncode == 0, cold.stderr
     assert cold.stderr.count("compiling the grip's numba kernels") == 1  # the warm run's depends on the load
-    for rec in (*jsonl(cold.stdout), *jsonl(warm.stdout)):
+    cold_records, warm_records = jsonl(cold.stdout), jsonl(warm.stdout)
+    for rec in (*cold_records, *warm_records):
         assert rec["search"].pop("stopped_by") == "candidates" and rec["search"].pop("seconds") > 0
-    assert jsonl(cold.stdout) == jsonl(warm.stdout) and len(jsonl(cold.stdout)) == 6
+    assert cold_records == warm_records and len(cold_records) == 6

@@ -70,12 +70,12 @@ COMPILE_NOTICE_AFTER = 10.0
 
 def _warmed_up(quiet: bool) -> None:
     """The grip's kernels compiled, or loaded from numba's cache, before any search's clock starts
-    (:func:`~grasptwist.engine.synthesis.budget.warm_up`; the workers forked later inherit them);
+    (:func:`~grasptwist.engine.synthesis.search.warm_up`; the workers forked later inherit them);
     a warm-up that outlasts :data:`COMPILE_NOTICE_AFTER` (a fresh install's compile) says so once on
     stderr."""
     import threading
 
-    from ..engine.synthesis.budget import warm_up
+    from ..engine.synthesis.search import warm_up
 
     def notice():
         print(

@@ -1,8 +1,8 @@
 """A search's budget, a setting (candidates, seconds and the clock they are read on), and how it is spent.
 
 The clock starts after the one-time work every search needs before its first candidate
-(:func:`warm_up`: numba compiles the grip's kernels on a fresh install, tens of seconds), so that
-work never eats the budget, and a first run returns what every later run returns.  A search says
+(:func:`~.search.warm_up`: numba compiles the grip's kernels on a fresh install, tens of seconds),
+so that work never eats the budget, and a first run returns what every later run returns.  A search says
 which limit ended it (:data:`STOPPED_BY`): ``candidates``, every candidate scored and every grasp
 selected verified (the same ``seed`` gives the same grasps bit for bit), or ``seconds``, the time
 ran out first (the grasps depend on the machine's speed).
@@ -21,11 +21,9 @@ import time
 from collections.abc import Callable
 from dataclasses import dataclass
 
-import numpy as np
-
 from .checks import check_candidates, check_seconds
 
-__all__ = ["Budget", "Spending", "STOPPED_BY", "check_budget", "warm_up"]
+__all__ = ["Budget", "Spending", "STOPPED_BY", "check_budget"]
 
 #: What ended a search: every candidate scored and every grasp verified, or the time.
 STOPPED_BY = ("candidates", "seconds")
@@ -102,36 +100,3 @@ class Spending:
     def seconds(self) -> float:
         """Seconds since the clock started."""
         return self.clock() - self.started
-
-
-#: Whether this process has warmed up (:func:`warm_up` runs once).
-_WARM = []
-
-
-def _ball_sample(n, rng):
-    """A unit ball's surface, area-weighted, with inward normals: :func:`warm_up`'s object."""
-    p = rng.normal(size=(n, 3))
-    p /= np.linalg.norm(p, axis=1, keepdims=True)
-    return p, -p
-
-
-def _ball_project(q):
-    r = np.linalg.norm(q, axis=-1, keepdims=True)
-    return q / r, -q / r, r[..., 0] - 1, np.zeros(q.shape[:-1], dtype=bool)
-
-
-def warm_up():
-    """The one-time work of a process's first search, done before any budget's clock starts: a small
-    search of a ball, which compiles the grip's numba kernels for the very arrays a search gives them
-    (its batches and its verification's single rows), or loads them from numba's cache; once a process,
-    and nothing on the numpy path.
-
-    >>> warm_up()
-    """
-    from ..forces import compiled
-    from .search import Surface, search
-
-    if _WARM or compiled.kernel() is None:  # done, or the numpy path: nothing to compile
-        return
-    _WARM.append(True)  # first: the search below warms up too
-    search(Surface(_ball_sample, _ball_project, 2 * 3**0.5), [[0, 0, 1.0, 0, 0, 0]], 0.5, candidates=200)

@@ -37,6 +37,7 @@ import numpy as np
 from ..collision import collision_tolerance
 from ..degeneracy import DEGENERACY_TOL
 from ..fingertips import tip_centers, tip_radii
+from ..forces import compiled
 from ..forces.closure import force_closure
 from ..forces.grasp_map import check_safety
 from ..forces.grip import Grip, grip
@@ -44,7 +45,7 @@ from ..forces.hold import object_weight
 from ..ik import home_tips, joint_limits
 from ..objects import object_size, project_to_surface, sample_surface
 from .archive import Archive
-from .budget import Budget, Spending, check_budget, warm_up
+from .budget import Budget, Spending, check_budget
 from .candidates import candidate_triples, tangent_steps
 from .checks import check_count, check_min_spacing, check_search_friction, check_seed, check_tip_radius, check_wrenches
 from .reach import HandReach, check_hand_reach, reach_tolerance, tip_errors
@@ -62,6 +63,7 @@ __all__ = [
     "hand_reach",
     "GRAVITY",
     "verified",
+    "warm_up",
     "check_budget",
     "CHUNK",
     "MIN_SPACING",
@@ -676,3 +678,33 @@ def synthesize(
     if hand is not None and not isinstance(hand, HandReach):
         hand = hand_reach(obj, hand, tips=tips, tip_radius=tip_radius, collide=collide)
     return search(surface_of(obj), np.array(listed), friction, hand=hand, **options)
+
+
+#: Whether this process has warmed up (:func:`warm_up` runs once).
+_WARM = []
+
+
+def _ball_sample(n, rng):
+    """A unit ball's surface, area-weighted, with inward normals: :func:`warm_up`'s object."""
+    p = rng.normal(size=(n, 3))
+    p /= np.linalg.norm(p, axis=1, keepdims=True)
+    return p, -p
+
+
+def _ball_project(q):
+    r = np.linalg.norm(q, axis=-1, keepdims=True)
+    return q / r, -q / r, r[..., 0] - 1, np.zeros(q.shape[:-1], dtype=bool)
+
+
+def warm_up():
+    """The one-time work of a process's first search, done before any budget's clock starts: a small
+    search of a ball, which compiles the grip's numba kernels for the very arrays a search gives them
+    (its batches and its verification's single rows), or loads them from numba's cache; once a process,
+    and nothing on the numpy path.
+
+    >>> warm_up()
+    """
+    if _WARM or compiled.kernel() is None:  # done, or the numpy path: nothing to compile
+        return
+    _WARM.append(True)  # first: the search below warms up too
+    search(Surface(_ball_sample, _ball_project, 2 * 3**0.5), [[0, 0, 1.0, 0, 0, 0]], 0.5, candidates=200)
