@@ -47,9 +47,10 @@ def entry_point():
     return [str(exe)] if exe.exists() else [sys.executable, "-m", "grasptwist"]
 
 
-def run_installed(*args, cwd=None, timeout=20):
-    """``grasptwist ARGS`` in a subprocess, colourless; returns (CompletedProcess, seconds)."""
-    env = {**os.environ, "NO_COLOR": "1"}
+def run_installed(*args, cwd=None, timeout=20, env=None):
+    """``grasptwist ARGS`` in a subprocess, colourless (with ``env``'s variables too); returns
+    (CompletedProcess, seconds)."""
+    env = {**os.environ, "NO_COLOR": "1", **(env or {})}
     start = time.monotonic()
     proc = subprocess.run(
         entry_point() + [str(a) for a in args], capture_output=True, text=True, cwd=cwd, env=env, timeout=timeout

@@ -47,12 +47,12 @@ def test_check_min_conditioning_refuses_what_is_not_from_0_to_1(bad):
 
 def test_check_budget_refuses_no_candidates_and_endless_time():
     assert check_budget(5, 2) == (5, 2.0)
-    with pytest.raises(ValueError, match="candidates must be a positive integer"):
+    with pytest.raises(ValueError, match="candidates must be an integer from 1 to 1000000000"):
         check_budget(0, None)
-    with pytest.raises(ValueError, match="candidates must be a positive integer"):
+    with pytest.raises(ValueError, match="candidates must be an integer from 1 to 1000000000"):
         check_budget(2.5, None)
     for bad in (0, -1, float("inf"), float("nan")):
-        with pytest.raises(ValueError, match="seconds must be a positive finite number or None"):
+        with pytest.raises(ValueError, match="seconds must be a finite number > 0"):
             check_budget(5, bad)
 
 
@@ -234,15 +234,14 @@ def test_the_time_budget_holds(monkeypatch):
         clock.now += 0.01
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(search_module, "_clock", clock)
     monkeypatch.setattr(search_module, "score_triples", ten_ms_a_chunk)
-    s = synthesize(box(), 0.8, candidates=10**9, seconds=0.05)
+    s = synthesize(box(), 0.8, candidates=10**9, seconds=0.05, clock=clock)
     # checked after every chunk: it stops after the one that passes its share of the time, 0.04 s
-    assert 0 < s.candidates <= 5 * 2048 and s.seconds <= 0.05 + 0.01 + 1e-12
+    assert 0 < s.candidates <= 5 * 2048 and s.seconds <= 0.05 + 0.01 + 1e-12 and s.stopped_by == "seconds"
 
 
 class _FakeClock:
-    """The search's clock, moved by hand: no wall-clock assertion."""
+    """A search's clock (its ``clock`` option), moved by hand: no wall-clock assertion."""
 
     def __init__(self):
         self.now = 0.0
@@ -260,14 +259,50 @@ def test_verification_stops_at_the_deadline_and_counts_the_grasps_left(monkeypat
         clock.now += 1.0
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(search_module, "_clock", clock)
     monkeypatch.setattr(search_module, "verified", one_second_each)
     # the search (no verification) takes no time on this clock: its candidates end it
-    s = synthesize(ball(), 0.8, count=8, candidates=600, seconds=5.0, min_spacing=0.0)
+    s = synthesize(ball(), 0.8, count=8, candidates=600, seconds=5.0, min_spacing=0.0, clock=clock)
     assert s.candidates == 600 and s.seconds == 5.0  # the budget, exactly
     assert len(s.points) == 5 and s.unverified == 3 and len(s.grips) == 5 and s.failure is None
+    assert s.stopped_by == "seconds"  # every candidate scored, but not every grasp verified
     s = synthesize(ball(), 0.8, count=8, candidates=600, min_spacing=0.0)  # no time limit: all verified
-    assert len(s.points) == 8 and s.unverified == 0
+    assert len(s.points) == 8 and s.unverified == 0 and s.stopped_by == "candidates"
+
+
+def test_the_clock_starts_after_the_warm_up_so_a_cold_run_returns_what_a_warm_one_does(monkeypatch):
+    from grasptwist.engine.synthesis import search as search_module
+
+    clock, real = _FakeClock(), search_module.warm_up
+
+    def a_fresh_install_s_compile():  # 100 s on the search's clock, beyond its 60 s
+        clock.now += 100.0
+        real()
+
+    warm = synthesize(ball(), 0.8, count=3, candidates=300, seconds=60.0, clock=clock)
+    monkeypatch.setattr(search_module, "warm_up", a_fresh_install_s_compile)
+    cold = synthesize(ball(), 0.8, count=3, candidates=300, seconds=60.0, clock=clock)
+    assert clock.now == 100.0 and cold.seconds == warm.seconds == 0.0  # the search took none of its 60 s
+    assert cold.stopped_by == warm.stopped_by == "candidates" and cold.candidates == 300
+    np.testing.assert_array_equal(cold.points, warm.points)
+    np.testing.assert_array_equal(cold.total_normal_force, warm.total_normal_force)
+
+
+def test_epsilon_is_computed_at_each_grasp_s_turn_within_the_deadline(monkeypatch):
+    pytest.importorskip("scipy")
+    from grasptwist.engine.forces.closure import force_closure
+    from grasptwist.engine.synthesis import search as search_module
+
+    clock = _FakeClock()
+
+    def one_second_an_epsilon(*args, quality=False, **kwargs):  # a convex hull a grasp, slowed down
+        clock.now += 1.0 if quality else 0.0
+        return force_closure(*args, quality=quality, **kwargs)
+
+    monkeypatch.setattr(search_module, "force_closure", one_second_an_epsilon)
+    s = synthesize(ball(), 0.8, count=4, candidates=120, seconds=2.5, quality=True, min_spacing=0.0, clock=clock)
+    # grasps 1-3 take their epsilon at 0, 1 and 2 s; the 4th's turn comes at 3 s, past 2.5 s
+    assert len(s.points) == 3 and s.unverified == 1 and s.stopped_by == "seconds" and s.seconds == 3.0
+    np.testing.assert_allclose(s.epsilon, force_closure(s.points, s.normals, 0.8, quality=True).epsilon, rtol=1e-12)
 
 
 @pytest.mark.parametrize("chunk_seconds, returned", [(0.85, 2), (1.05, 0)])
@@ -280,9 +315,8 @@ def test_a_search_stops_at_its_share_of_the_time_and_verifies_before_the_deadlin
         clock.now += chunk_seconds
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(search_module, "_clock", clock)
     monkeypatch.setattr(search_module, "score_triples", slow)
-    s = synthesize(ball(), 0.8, count=2, candidates=10**6, seconds=1.0)
+    s = synthesize(ball(), 0.8, count=2, candidates=10**6, seconds=1.0, clock=clock)
     # the search stops after the chunk that passes 0.8 s (1 - VERIFY_SHARE): the first
     assert search_module.VERIFY_SHARE == 0.2 and s.candidates == 2048 and s.seconds == chunk_seconds
     assert len(s.points) == returned and s.unverified == 2 - returned

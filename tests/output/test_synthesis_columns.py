@@ -44,3 +44,11 @@ def test_a_grasp_without_the_run_s_hand_leaves_its_columns_empty():
     flat = SYNTHESIS_COLUMNS.flat(found, hand=hand)
     assert flat["reach_error1"].mask.all() and flat["q_east_east.1"].mask.all()
     assert "reach_error1" not in SYNTHESIS_COLUMNS.header(None).decode()
+
+
+def test_the_columns_say_which_limit_stopped_the_search_after_the_seed():
+    _, found = _found(None)
+    header = SYNTHESIS_COLUMNS.header(None).decode().strip().split(",")
+    assert header[-4:] == ["candidates", "seconds", "seed", "stopped_by"]
+    assert SYNTHESIS_COLUMNS.flat(found)["stopped_by"].tolist() == ["candidates", "candidates"]
+    assert SYNTHESIS_COLUMNS.typed_header(None)["stopped_by"] == "U"

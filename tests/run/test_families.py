@@ -10,7 +10,7 @@ from grasptwist.output.formats import FORMATS
 from grasptwist.run.batch import ZERO_TWIST
 from grasptwist.run.families import COMMANDS, FAMILIES, WRENCH, Command
 from grasptwist.run.forces import closure_fields
-from grasptwist.run.options import ForceOptions, TwistOptions
+from grasptwist.run.options import ForceOptions, SynthesisOptions, TwistOptions
 from grasptwist.run.pipeline import Job, outputs
 from places import GRASPS
 
@@ -63,3 +63,17 @@ def test_a_command_added_to_the_registry_alone_runs_through_every_layer():
     assert json.loads(_written(Job(command=command, fmt="json"), paths)) == recs
     csv = _written(Job(command=command, fmt="csv"), paths).decode().splitlines()
     assert csv[0].startswith("file,grasp,wrench,ok,error,") and len(csv) == 1 + len(recs)  # the family's columns
+
+
+@pytest.mark.parametrize(
+    ("options", "words"),
+    [
+        ({"mass": -1.0}, "mass must be a finite number > 0"),
+        ({"tip_radius": float("nan")}, "tip_radius must be a finite"),
+    ],
+)
+def test_the_run_s_options_check_what_changes_the_object_and_the_hand_for_every_way_in(options, words):
+    # grasptwist.dask passes its keywords straight to SynthesisOptions: they are refused there, as on the command line
+    assert SynthesisOptions(mass=2.0, tip_radius=0.01).mass == 2.0
+    with pytest.raises(ValueError, match=words):
+        SynthesisOptions(**options)

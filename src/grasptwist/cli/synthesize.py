@@ -1,5 +1,6 @@
 """``grasptwist synthesize``: search an object's surface for three-fingered grasps (issue 31)."""
 
+import sys
 from enum import Enum
 from typing import Annotated
 
@@ -47,22 +48,28 @@ class Objective(str, Enum):
     epsilon = "epsilon"
 
 
-def _checked(check):
-    """A typer callback that turns an engine check's ValueError into a usage error."""
+def _checked(name, module="checks"):
+    """A typer callback running the engine's check ``name`` (of ``engine.synthesis.<module>``, imported
+    when the option is given; or the function ``name``): the library's words, as a usage error
+    naming the option."""
 
     def callback(value):
+        if value is None:
+            return value
+        from importlib import import_module
+
+        check = name if callable(name) else getattr(import_module(f"grasptwist.engine.synthesis.{module}"), name)
         try:
-            return value if value is None else check(value)
+            return check(value)
         except ValueError as err:
             raise typer.BadParameter(str(err)) from None
 
     return callback
 
 
-def _min_conditioning(value):
-    from ..engine.synthesis.scores import check_min_conditioning
-
-    return check_min_conditioning(value)
+#: Seconds a warm-up may take before the command line says it is compiling: numba's import, its cache
+#: and a small search take 4 s on this project's machine at a load of 9 on 2 cores, a compile 20 s idle.
+COMPILE_NOTICE_AFTER = 10.0
 
 
 def _units(value):
@@ -83,23 +90,31 @@ def _reading(reading, grasp_file):
     return replace(reading, output=replaced_file(grasp_file))
 
 
-def _position_error(value):
-    from ..engine.synthesis.robustness import check_position_error
+def _warmed_up(quiet: bool) -> None:
+    """The grip's kernels compiled, or loaded from numba's cache, before any search's clock starts
+    (:func:`~grasptwist.engine.synthesis.search.warm_up`; the workers forked later inherit them);
+    a warm-up that outlasts :data:`COMPILE_NOTICE_AFTER` (a fresh install's compile) says so once on
+    stderr."""
+    import threading
 
-    return check_position_error(value)
+    from ..engine.synthesis.search import warm_up
 
+    def notice():
+        print(
+            "grasptwist: compiling the grip's numba kernels, once per install (about 20 s, longer on a busy "
+            "machine); --seconds counts from when it is done",
+            file=sys.stderr,
+            flush=True,
+        )
 
-def _friction_error(value):
-    from ..engine.synthesis.robustness import check_friction_error
-
-    return check_friction_error(value)
-
-
-def _positive(value):
-    """--mass, --seconds: the engine's checks (check_budget's seconds), in the command line's words."""
-    if not 0 < value < float("inf"):
-        raise ValueError(f"must be a finite number > 0, got {value:g}")
-    return value
+    timer = threading.Timer(COMPILE_NOTICE_AFTER, notice)
+    timer.daemon = True
+    if not quiet:
+        timer.start()
+    try:
+        warm_up()
+    finally:
+        timer.cancel()
 
 
 def synthesize(
@@ -110,14 +125,19 @@ def synthesize(
             help="Grasp files with an object (.yaml, .yml, .json), mesh files (.stl, .obj, .ply) or folders.",
         ),
     ],
-    count: Annotated[int, typer.Option("-n", "--count", min=1, max=10_000, help="Grasps wanted per object.")] = 5,
+    count: Annotated[
+        int,
+        typer.Option(
+            "-n", "--count", callback=_checked("check_count"), help="Grasps wanted per object (at most 10000)."
+        ),
+    ] = 5,
     friction: Friction = None,
     mass: Annotated[
         float | None,
         typer.Option(
             "--mass",
             metavar="KG",
-            callback=_checked(_positive),
+            callback=_checked("check_mass"),
             help="The object's mass: its weight is the wrench 'hold'.",
         ),
     ] = None,
@@ -138,7 +158,7 @@ def synthesize(
         typer.Option(
             "--position-error",
             metavar="E",
-            callback=_checked(_position_error),
+            callback=_checked("check_position_error", "robustness"),
             help="How far a perturbation moves each contact at most (robustness; default: half the smallest "
             "fingertip radius, or 2% of the object's size).",
         ),
@@ -148,7 +168,7 @@ def synthesize(
         typer.Option(
             "--friction-error",
             metavar="SHARE",
-            callback=_checked(_friction_error),
+            callback=_checked("check_friction_error", "robustness"),
             help="The largest share of the friction a perturbation takes away (0 to < 1).",
         ),
     ] = 0.2,
@@ -162,7 +182,7 @@ def synthesize(
         typer.Option(
             "--min-conditioning",
             metavar="C",
-            callback=_checked(_min_conditioning),
+            callback=_checked("check_min_conditioning", "scores"),
             help="Each decomposition's conditioning must be at least this (0 to 1).",
         ),
     ] = 1e-3,
@@ -171,7 +191,7 @@ def synthesize(
         typer.Option(
             "--min-spacing",
             metavar="D",
-            min=0,
+            callback=_checked("check_min_spacing"),
             help="Grasps returned are at least this far apart (default: 5% of the object's size).",
         ),
     ] = None,
@@ -189,7 +209,7 @@ def synthesize(
         typer.Option(
             "--tip-radius",
             metavar="R",
-            min=0,
+            callback=_checked("check_tip_radius"),
             help="Every fingertip's radius (default: the hand's tip_radius, or its URDF's tip spheres); "
             "an object without a hand warns that it is ignored.",
         ),
@@ -211,17 +231,28 @@ def synthesize(
             "--span-bodies", help="Let a grasp's contacts lie on different bodies of a mesh (default: one body)."
         ),
     ] = False,
-    seed: Annotated[int, typer.Option("--seed", min=0, help="Seed of the random numbers (reproducible runs).")] = 0,
+    seed: Annotated[
+        int,
+        typer.Option(
+            "--seed",
+            callback=_checked("check_seed"),
+            help="Seed of the random numbers, 0 to 2**63-1 (reproducible runs).",
+        ),
+    ] = 0,
     candidates: Annotated[
-        int, typer.Option("--candidates", min=1, max=10**9, help="Candidate triples scored at most, per object.")
+        int,
+        typer.Option(
+            "--candidates", callback=_checked("check_candidates"), help="Candidate triples scored at most, per object."
+        ),
     ] = 20000,
     seconds: Annotated[
         float,
         typer.Option(
             "--seconds",
             metavar="S",
-            callback=_checked(_positive),
-            help="Time allowed per object: the search stops at 80% of it, verification at the end (grasps left unverified are not reported).",
+            callback=_checked("check_seconds"),
+            help="Time allowed per object, counted after a fresh install's one-time compiling: the search stops "
+            "at 80% of it, verification at the end (grasps left unverified are not reported).",
         ),
     ] = 60.0,
     fmt: Annotated[
@@ -308,4 +339,9 @@ def synthesize(
         ),
     )
     settings = OutputSettings(records_to, quiet, Warnings.summary, workers, {"digits": digits}, reads=(hand,))
-    run_command(debug, lambda: write_records(job, paths, settings))
+
+    def search_all() -> int:
+        _warmed_up(quiet)
+        return write_records(job, paths, settings)
+
+    run_command(debug, search_all)

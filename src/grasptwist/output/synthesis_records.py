@@ -11,7 +11,7 @@ gives one record per grasp, best first::
      "joint_positions": {joint name: position} (null without a hand),
      "reach_error": [3] (null without a hand),
      "clearance": least distance of any finger from the environment (null without one),
-     "search": {"candidates", "seconds", "seed"}, "warnings": [the object's]}
+     "search": {"candidates", "seconds", "seed", "stopped_by"}, "warnings": [the object's]}
 
 With a hand, finger ``f`` touches contact ``f``; ``reach_error`` is each finger's distance, by
 forward kinematics at ``joint_positions``, from its tip link's origin to its fingertip's
@@ -60,7 +60,7 @@ def _float(v):
 def synthesis_records(found) -> list[dict]:
     """One record per grasp found, best first (module docstring)."""
     s = found.synthesis
-    search = {"candidates": int(s.candidates), "seconds": float(s.seconds), "seed": int(s.seed)}
+    search = _search(s)
     out = []
     for k in range(len(s.points)):
         contacts = [
@@ -125,7 +125,17 @@ def failure_record(found) -> dict:
         "ok": False,
         "error": error,
         "errors": [error],
-        "search": {"candidates": int(s.candidates), "seconds": float(s.seconds), "seed": int(s.seed)},
+        "search": _search(s),
+    }
+
+
+def _search(s) -> dict:
+    """What the search spent, its seed, and which limit stopped it (``candidates`` or ``seconds``)."""
+    return {
+        "candidates": int(s.candidates),
+        "seconds": float(s.seconds),
+        "seed": int(s.seed),
+        "stopped_by": s.stopped_by,
     }
 
 
@@ -297,7 +307,7 @@ def grasp_documents(found, folder: str) -> str:
 
 _XYZ = ("x", "y", "z")
 _OWN = ("file", "grasp", "rank", "ok", "error")
-_NUMBERS = (
+_COLUMNS = (
     *(f"p{i}_{a}" for i in (1, 2, 3) for a in _XYZ),
     *(f"n{i}_{a}" for i in (1, 2, 3) for a in _XYZ),
     *(f"surface_distance{i}" for i in (1, 2, 3)),
@@ -313,8 +323,9 @@ _NUMBERS = (
     "candidates",
     "seconds",
     "seed",
+    "stopped_by",
 )
-_HEADER = ",".join((*_OWN, *_NUMBERS)).encode() + b"\n"
+_HEADER = ",".join((*_OWN, *_COLUMNS)).encode() + b"\n"
 _REACH = tuple(f"reach_error{i}" for i in (1, 2, 3))
 
 
@@ -324,13 +335,13 @@ def _hand_columns(hand) -> tuple[str, ...]:
 
 
 def _header(hand=None) -> bytes:
-    return _HEADER if hand is None else ",".join((*_OWN, *_NUMBERS, *_hand_columns(hand))).encode() + b"\n"
+    return _HEADER if hand is None else ",".join((*_OWN, *_COLUMNS, *_hand_columns(hand))).encode() + b"\n"
 
 
 def _typed(hand=None) -> dict:
     types = {"file": "U", "grasp": "U", "rank": "int64", "ok": "?", "error": "U"}
-    types.update({name: "float64" for name in (*_NUMBERS, *_hand_columns(hand))})
-    types.update(candidates="int64", seed="int64")
+    types.update({name: "float64" for name in (*_COLUMNS, *_hand_columns(hand))})
+    types.update(candidates="int64", seed="int64", stopped_by="U")
     return types
 
 
@@ -370,6 +381,7 @@ def _flat(found, order="omega-v", hand=None, typed=False) -> dict:
     columns["candidates"] = np.full(k, s.candidates)
     columns["seconds"] = np.full(k, s.seconds)
     columns["seed"] = np.full(k, s.seed)
+    columns["stopped_by"] = np.array([s.stopped_by] * k, dtype=object)
     if hand is not None:
         columns.update(_joint_values(found, hand))
     for name, a in columns.items():
@@ -385,7 +397,7 @@ def _arrays(found, order="omega-v", hand=None) -> dict:
 def _error_row(rec: dict, hand=None) -> bytes:
     err = rec["error"]
     row = [rec["file"], rec.get("grasp", ""), "", "false", f"{err['code']}: {err['message']}"]
-    pad = [""] * (len(_NUMBERS) + len(_hand_columns(hand)))
+    pad = [""] * (len(_COLUMNS) + len(_hand_columns(hand)))
     return lines({str(j): np.array([v], dtype=object) for j, v in enumerate(row + pad)})[0]
 
 

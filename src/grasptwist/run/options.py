@@ -128,3 +128,11 @@ class SynthesisOptions:
     position_error: float | None = None
     friction_error: float = 0.2
     perturbations: int = 64
+
+    def __post_init__(self):
+        # the options the search never sees as such (they change the object and the hand), checked as
+        # the command line checks them, for every way in (grasptwist.dask passes them as keywords)
+        from ..engine.synthesis.checks import check_mass, check_tip_radius
+
+        check_mass(self.mass)
+        check_tip_radius(self.tip_radius)

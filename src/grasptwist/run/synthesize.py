@@ -63,6 +63,9 @@ NO_OBJECT, NOTHING_TO_HOLD, NO_FRICTION = "no-object", "nothing-to-hold", "no-fr
 #: fingers share joints (the search solves each finger on its own).
 NO_TIP_POINTS, UNSEARCHABLE_HAND = "no-tip-points", "unsearchable-hand"
 
+#: A weight beyond a double (``--mass`` times the file's gravity): the grasp file's own code for it.
+NON_FINITE = "non-finite"
+
 
 @dataclass(frozen=True, eq=False)
 class Found:
@@ -115,10 +118,19 @@ def _task(options: SynthesisOptions, grasp: Grasp):
     hold = None
     if options.mass is not None or grasp.mass is not None:
         gravity = np.asarray(GRAVITY if grasp.gravity is None else grasp.gravity, float)
-        weight = object_weight(obj, gravity)
+        with np.errstate(over="ignore", invalid="ignore"):  # an overflow is said below
+            weight = object_weight(obj, gravity)
         if weight is None:  # a weight apart from the object: the file's top-level mass and center_of_mass
             mass, center = grasp.mass, grasp.center_of_mass
             weight = Weight(mass, center, gravity, hold_wrench(mass, center, gravity))
+        if not np.isfinite(weight.wrench).all():  # --mass 1e308: as the same mass in the file is
+            return _problem(
+                grasp.file,
+                NON_FINITE,
+                f"grasp '{grasp.name}': the weight or its moment about the origin overflows "
+                "(mass x gravity, center_of_mass x weight)",
+                grasp.line,
+            )
         hold = (weight.mass, weight.center_of_mass, weight.gravity)
         named.insert(0, (HOLD, weight.wrench))
     if not named:

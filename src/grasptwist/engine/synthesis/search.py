@@ -17,12 +17,13 @@ r"""The search: candidate triples scored in chunks, the best refined on the surf
    ``gap``, ``n_i - G_i^T dual`` in every dual cone) proves the total optimal; one that
    fails is not returned.  The grasps returned get their margins (:func:`~.robustness.margins`).
 
-The budget holds: the search stops after ``candidates`` scored rows or ``(1 - VERIFY_SHARE)
-seconds``, whichever comes first, checked after every chunk; the rest of ``seconds`` is
-selection's and verification's, which stops at the deadline (checked before each grasp): the
-grasps verified by then are returned, the others counted as ``unverified``.  With the same
-``seed`` and a budget of candidates (no time limit reached) two runs return the same grasps bit
-for bit.
+The budget (:mod:`~.budget`) holds: the search stops after ``candidates`` scored rows or
+``(1 - VERIFY_SHARE) seconds``, whichever comes first, checked after every chunk; the rest of
+``seconds`` is selection's and verification's, which stops at the deadline (checked before each
+grasp): the grasps verified by then are returned, the others counted as ``unverified``.  The
+clock starts after the one-time warm-up (numba's compiling of the grip on a fresh install), and
+the result says which limit ended it (``stopped_by``).  With the same ``seed`` and a search that
+the candidates ended (``stopped_by == "candidates"``) two runs return the same grasps bit for bit.
 """
 
 from __future__ import annotations
@@ -39,15 +40,19 @@ from ..collision import collision_tolerance
 from ..degeneracy import DEGENERACY_TOL
 from ..environment import clearance_of
 from ..fingertips import tip_centers, tip_radii
+from ..forces import compiled
 from ..forces.closure import force_closure
-from ..forces.grasp_map import check_friction, check_safety, check_wrench
+from ..forces.grasp_map import check_safety
 from ..forces.grip import Grip, grip
 from ..forces.hold import object_weight
 from ..ik import home_tips, joint_limits
 from ..objects import object_size, project_to_surface, sample_surface
 from ..objects.creases import edge_distance
 from ..objects.geometry import body_areas, body_of
-from .candidates import candidate_triples, tangent_steps, triple_distance
+from .archive import Archive
+from .budget import Budget, Spending, check_budget
+from .candidates import candidate_triples, tangent_steps
+from .checks import check_count, check_min_spacing, check_search_friction, check_seed, check_tip_radius, check_wrenches
 from .clearance import environment_search
 from .reach import HandReach, check_hand_reach, reach_tolerance, tip_errors, violations
 from .robustness import (
@@ -66,6 +71,7 @@ __all__ = [
     "Surface",
     "Failure",
     "Synthesis",
+    "Budget",
     "search",
     "search_steps",
     "synthesize",
@@ -73,6 +79,7 @@ __all__ = [
     "hand_reach",
     "GRAVITY",
     "verified",
+    "warm_up",
     "check_budget",
     "CHUNK",
     "MIN_SPACING",
@@ -99,9 +106,6 @@ ELITES, CHILDREN = 16, 16
 
 #: The share of ``seconds`` kept for selecting and verifying the grasps found (the search stops before it).
 VERIFY_SHARE = 0.2
-
-#: The clock of the time budget (a module attribute: tests replace it).
-_clock = time.perf_counter
 
 #: A verified grip's duality gap must be within this of its total (relative).
 GAP_TOL = 1e-6
@@ -196,6 +200,10 @@ class Synthesis:
         the share of the perturbations under which it is still held.
     unverified : int
         Grasps selected but not verified, so not returned: ``seconds`` ran out before their turn.
+    stopped_by : str
+        What ended the search (``budget.STOPPED_BY``): ``candidates``, every candidate
+        scored and every grasp selected verified (reproducible bit for bit from ``seed``), or
+        ``seconds``, the time ran out first (the search's share, or verification's).
     candidates : int
         Candidates scored.
     seconds : float
@@ -226,93 +234,7 @@ class Synthesis:
     hold_friction: np.ndarray | None = None
     edge_distance: np.ndarray | None = None
     robustness: np.ndarray | None = None
-
-
-def check_budget(candidates, seconds) -> tuple[int, float | None]:
-    """A search's budget: ``candidates`` a positive integer, ``seconds`` None or a positive number.
-
-    >>> check_budget(1000, None)
-    (1000, None)
-    >>> check_budget(0, 1.0)
-    Traceback (most recent call last):
-    ValueError: candidates must be a positive integer, got 0
-    >>> check_budget(10, float("inf"))
-    Traceback (most recent call last):
-    ValueError: seconds must be a positive finite number or None, got inf
-    """
-    if not (isinstance(candidates, (int, np.integer)) and not isinstance(candidates, bool) and candidates > 0):
-        raise ValueError(f"candidates must be a positive integer, got {candidates!r}")
-    number = isinstance(seconds, (int, float, np.integer, np.floating)) and not isinstance(seconds, bool)
-    if seconds is not None and not (number and 0 < seconds < np.inf):
-        raise ValueError(f"seconds must be a positive finite number or None, got {seconds!r}")
-    return int(candidates), None if seconds is None else float(seconds)
-
-
-class _Budget:
-    """Candidates and time left (``deadline`` on :data:`_clock`, or None)."""
-
-    def __init__(self, candidates, deadline):
-        self.left, self.used = candidates, 0
-        self.deadline = deadline
-
-    def take(self, n) -> int:
-        """Up to ``n`` candidates, 0 when the budget is spent."""
-        if self.deadline is not None and _clock() >= self.deadline:
-            return 0
-        return max(0, min(n, self.left))
-
-    def spent(self, n):
-        self.left -= n
-        self.used += n
-
-
-class _Archive:
-    """The best feasible candidates so far (at most ``size``, each ``spacing`` or more from the better
-    ones, so that refinement and selection start from distinct grasps), and the furthest any got."""
-
-    def __init__(self, size, spacing, joints=None, tol=DEGENERACY_TOL):
-        self.size, self.spacing, self.tol = size, spacing, tol
-        self.points = np.empty((0, 3, 3))
-        self.normals = np.empty((0, 3, 3))
-        self.objective = np.empty(0)
-        self.furthest = 0
-        self.closest = np.inf  # the least closure friction of a row that failed closure, over every chunk
-        self.best_conditioning = 0.0
-        self.positions = None if joints is None else np.empty((0, joints))  # with a hand: (N, n_joints)
-        self.best_miss = {}  # a hand's constraint -> the closest a row failing it came
-
-    @property
-    def bound(self) -> float:
-        """An objective no better than this is never kept: the worst kept once the archive is full."""
-        return float(self.objective[-1]) if len(self.objective) >= self.size else np.inf
-
-    def add(self, p, n, s):
-        ok = s.failed == -1
-        if s.order is not None:  # contact f is finger f's
-            p, n = (np.take_along_axis(a, s.order[..., None], axis=1) for a in (p, n))
-            self.positions = np.concatenate((self.positions, s.joint_positions[ok]))
-            tested = (s.failed > CONSTRAINTS.index("grip")) & (s.failed < len(CONSTRAINTS))
-            for k in np.unique(s.failed[tested]):
-                best = float(np.nanmin(s.miss[s.failed == k], initial=np.inf))
-                self.best_miss[CONSTRAINTS[k]] = min(self.best_miss.get(CONSTRAINTS[k], np.inf), best)
-        self.points = np.concatenate((self.points, p[ok]))
-        self.normals = np.concatenate((self.normals, n[ok]))
-        self.objective = np.concatenate((self.objective, s.objective[ok]))
-        order = np.argsort(self.objective, kind="stable")[: 8 * self.size]
-        keep = order[_spread(self.points[order], self.size, self.spacing)]
-        self.points, self.normals, self.objective = self.points[keep], self.normals[keep], self.objective[keep]
-        if self.positions is not None:
-            self.positions = self.positions[keep]
-        reached = np.where(s.failed == -1, len(CONSTRAINTS), s.failed)
-        self.furthest = max(self.furthest, int(reached.max(initial=0)))
-        worst = np.fmin(s.conditioning[:, 0], s.conditioning[:, 1])  # the asked methods' smaller
-        self.best_conditioning = max(self.best_conditioning, float(np.nanmax(worst, initial=0.0)))
-        closure = CONSTRAINTS.index("force_closure")
-        at = reached == closure
-        # only while closure is the furthest constraint is it what a failed search reports
-        if at.any() and self.furthest == closure:
-            needed = force_closure(p[at], n[at], tol=self.tol).closure_friction
-            self.closest = min(self.closest, float(np.nanmin(needed, initial=np.inf)))
+    stopped_by: str = "candidates"
 
 
 def search(surface: Surface, wrenches, friction, **options) -> Synthesis:
@@ -363,6 +285,9 @@ def search(surface: Surface, wrenches, friction, **options) -> Synthesis:
     seconds : float or None, default None
         Time allowed: the search stops after the chunk of :data:`CHUNK` candidates that passes
         ``(1 - VERIFY_SHARE) seconds``, verification before the first grasp after ``seconds``.
+        The clock starts after :func:`~.budget.warm_up` (a fresh install's compiling).
+    clock : callable, default ``time.perf_counter``
+        What ``seconds`` are read on (:class:`~.budget.Budget`; a test gives a fake one).
     tol : float, default ``DEGENERACY_TOL``
         The degeneracy tolerance of the contacts (``DEGENERACY_TOL``).
     position_error : float or None, default None
@@ -421,6 +346,7 @@ def search_steps(
     seed=0,
     candidates=20000,
     seconds=None,
+    clock=time.perf_counter,
     tol=DEGENERACY_TOL,
     position_error=None,
     friction_error=FRICTION_ERROR,
@@ -428,13 +354,16 @@ def search_steps(
 ) -> Iterator:
     """:func:`search`, one step at a time: yields the candidates of each chunk scored (ints), then the
     :class:`Synthesis` (a progress bar's way through a long search)."""
-    w = check_wrench(wrenches).reshape(-1, 6)
-    mu = float(check_friction(friction))
+    w = check_wrenches(wrenches)
+    mu = check_search_friction(friction)
+    count = check_count(count)
     safety = check_safety(safety)
     objective = check_objective(objective)
     min_conditioning = check_min_conditioning(min_conditioning)
-    budget_size, seconds = check_budget(candidates, seconds)
-    spacing = MIN_SPACING * surface.size if min_spacing is None else float(min_spacing)
+    seed = check_seed(seed)
+    setting = Budget(candidates, seconds, clock)
+    min_spacing = check_min_spacing(min_spacing)
+    spacing = MIN_SPACING * surface.size if min_spacing is None else min_spacing
     hand = None if hand is None else check_hand_reach(hand)
     position_error = check_position_error(position_error)
     if position_error is None:
@@ -445,12 +374,12 @@ def search_steps(
         "perturbations": check_perturbations(perturbations),
         "seed": seed,
     }
-    started = _clock()
-    deadline = None if seconds is None else started + seconds
+    warm_up()  # before the clock starts: a first run's compiling is no part of its budget
+    budget = Spending(setting, 1 - VERIFY_SHARE)
+    budget_size = setting.candidates
     rng = np.random.default_rng(seed)
-    budget = _Budget(budget_size, None if seconds is None else started + (1 - VERIFY_SHARE) * seconds)
     joints = None if hand is None else len(hand.hand.joint_names)
-    archive = _Archive(max(ELITES, 4 * count), spacing, joints, tol)
+    archive = Archive(max(ELITES, 4 * count), spacing, joints, tol)
     # closure friction, epsilon: slower rows; a hand: the archive fills (and spares rows the hand's test) sooner
     chunk = CHUNK if objective in ("robust", "total_normal_force") and hand is None else CHUNK // 8
 
@@ -485,11 +414,12 @@ def search_steps(
     if objective == "robust" and rank.size:  # the finalists, most robust first, then the least total
         robust = robustness(surface, archive.points, archive.normals, w, mu, safety=safety, tol=tol, **perturbation)
         rank = np.lexsort((archive.objective, -robust))
-    picked = rank[_spread(archive.points[rank], count, spacing)]
+    # the archive's grasps are spacing apart already: the first count in rank are the selection
+    picked = rank[:count]
     points, normals = archive.points[picked], archive.normals[picked]
     positions = None if hand is None else archive.positions[picked]
     quality = quality or objective == "epsilon"
-    out = _results(surface, points, normals, w, mu, safety, wrist, methods, quality, tol, hand, positions, deadline)
+    out = _results(surface, points, normals, w, mu, safety, wrist, methods, quality, tol, hand, positions, budget)
     out.update(margins(surface, out["points"], out["normals"], w, mu, safety=safety, tol=tol, **perturbation)._asdict())
     failure = None
     if not len(out["points"]) and out["unverified"]:
@@ -504,9 +434,10 @@ def search_steps(
     yield Synthesis(
         **out,
         candidates=budget.used,
-        seconds=_clock() - started,
+        seconds=budget.seconds(),
         seed=seed,
         failure=failure,
+        stopped_by=budget.stopped_by,
     )
 
 
@@ -546,20 +477,6 @@ def _refine(surface, archive, score, budget, rng):
         step = np.where(better, step, step / 2)
 
 
-def _spread(points, count, spacing):
-    """Indices of up to ``count`` of the grasps ``points (N, 3, 3)``, in order, each ``spacing`` or more
-    from those picked before it (:func:`~.candidates.triple_distance`)."""
-    if spacing <= 0:  # every distance is at least 0: the first ``count`` (spared a quadratic loop)
-        return np.arange(min(count, len(points)))
-    picked = []
-    for i in range(len(points)):
-        if len(picked) == count:
-            break
-        if not picked or triple_distance(points[i], points[picked]).min() >= spacing:
-            picked.append(i)
-    return np.array(picked, int)
-
-
 def verified(points, normals, wrench, friction, safety, tol=DEGENERACY_TOL) -> Grip | None:
     r"""The exact grip of one grasp and wrench when its certificate proves it optimal, else None.
 
@@ -595,32 +512,37 @@ def verified(points, normals, wrench, friction, safety, tol=DEGENERACY_TOL) -> G
 
 
 def _results(
-    surface, points, normals, w, mu, safety, wrist, methods, quality, tol, hand=None, positions=None, deadline=None
+    surface, points, normals, w, mu, safety, wrist, methods, quality, tol, hand=None, positions=None, budget=None
 ):
     """The returned grasps' fields of :class:`Synthesis`, each grasp verified (the others dropped): the
     exact grip, and with a hand its tips by forward kinematics, its limits and its links clear; those
-    whose turn comes after ``deadline`` (on :data:`_clock`) are not verified, only counted."""
-    grips, keep, unverified = [], [], 0
+    whose turn comes after the ``budget``'s deadline (:meth:`~.budget.Spending.late`) are not verified,
+    only counted.  Epsilon (``quality``: a convex hull a grasp, milliseconds each) is computed at each
+    grasp's turn, within the deadline."""
+    grips, keep, epsilon, unverified = [], [], [], 0
     for i in range(len(points)):
-        if deadline is not None and _clock() >= deadline:
+        if budget is not None and budget.late():
             unverified = len(points) - i
             break
         found = tuple(verified(points[i], normals[i], wrench, mu, safety, tol) for wrench in w)
         if all(g is not None for g in found):
             grips.append(found)
             keep.append(i)
+            if quality:
+                epsilon.append(float(force_closure(points[i], normals[i], mu / safety, quality=True, tol=tol).epsilon))
     hand_fields = {}
     if hand is not None:
         error = tip_errors(hand, points[keep], normals[keep], positions[keep])
         good = _held(hand, error, positions[keep])
         grips, keep = [g for g, k in zip(grips, good) if k], [i for i, k in zip(keep, good) if k]
+        epsilon = [e for e, k in zip(epsilon, good) if k]
         hand_fields = {
             "joint_positions": positions[keep],
             "reach_error": error[good],
             "tip_center": tip_centers(points[keep], normals[keep], hand.radii),
         }
     p, n = points[keep], normals[keep]
-    closure = force_closure(p, n, mu / safety, quality=quality, tol=tol) if len(p) else None
+    closure = force_closure(p, n, mu / safety, tol=tol) if len(p) else None
     return {
         "points": p,
         "normals": n,
@@ -629,7 +551,7 @@ def _results(
             len(p), len(w)
         ),
         "closure_friction": closure.closure_friction if closure else np.empty(0),
-        "epsilon": (closure.epsilon if closure else np.empty(0)) if quality else None,
+        "epsilon": np.array(epsilon) if quality else None,
         "conditioning": conditionings(p, n, wrist, methods, tol) if len(p) else np.empty((0, 2)),
         "grips": tuple(grips),
         "unverified": unverified,
@@ -679,14 +601,9 @@ def _failure(archive, scored, mu, min_conditioning, tol) -> Failure:
             min_conditioning,
         )
     if name == "force_closure":
-        best = archive.closest
-        words = "no friction" if not np.isfinite(best) else f"friction {best:.3g}"
-        return Failure(
-            name,
-            f"no candidate is force closure at friction {mu:g} (friction / safety); the best needs {words}",
-            best,
-            mu,
-        )
+        best = archive.closest  # inf: no candidate is closure at any finite friction (a flat object's)
+        words = f"the best needs friction {best:.3g}" if np.isfinite(best) else "none is at any finite friction"
+        return Failure(name, f"no candidate is force closure at friction {mu:g} (friction / safety); {words}", best, mu)
     if name == "constraints":
         return Failure(name, "no force-closure candidate passed the further constraints", np.nan, np.nan)
     if name == "fingertips":
@@ -701,8 +618,10 @@ def _failure(archive, scored, mu, min_conditioning, tol) -> Failure:
         best = archive.best_miss.get(name, np.inf)
         return Failure(
             name,
-            f"the hand reaches no candidate's contacts within its joint limits: the best candidate leaves a "
-            f"fingertip {best:.3g} from where it must be",
+            "the hand reaches no candidate's contacts within its joint limits"
+            + (
+                f": the best candidate leaves a fingertip {best:.3g} from where it must be" if np.isfinite(best) else ""
+            ),
             best,
             0.0,
         )
@@ -710,8 +629,8 @@ def _failure(archive, scored, mu, min_conditioning, tol) -> Failure:
         best = archive.best_miss.get(name, np.inf)
         return Failure(
             name,
-            f"every grasp the hand reaches puts a finger link into the object or another finger, or within the "
-            f"clearance of the environment (the least by {best:.3g})",
+            "every grasp the hand reaches puts a finger link into the object or another finger, or within the "
+            "clearance of the environment" + (f" (the least by {best:.3g})" if np.isfinite(best) else ""),
             best,
             np.nan,
         )
@@ -761,7 +680,8 @@ def hand_reach(
     clearance : float, optional
         Default the environment's (``grasptwist.engine.environment.clearance_of``).
     """
-    radii = tip_radii(hand) if tip_radius is None else np.full(3, float(tip_radius))
+    tip_radius = check_tip_radius(tip_radius)
+    radii = tip_radii(hand) if tip_radius is None else np.full(3, tip_radius)
     tips = home_tips(hand) if tips is None else np.asarray(tips, float)
     room = 0.0 if environment is None else (clearance_of(environment) if clearance is None else float(clearance))
     project = partial(project_to_surface, obj)
@@ -846,11 +766,15 @@ def synthesize(
     >>> s.points.shape, bool((s.closure_friction < 0.8).all())
     ((2, 3, 3), True)
     """
-    listed = [np.asarray(w, float).reshape(6) for w in wrenches]
+    tip_radius = check_tip_radius(tip_radius)  # checked with or without a hand, as --tip-radius is
+    listed = list(check_wrenches(wrenches)) if len(wrenches) else []
     if hold:
-        weight = object_weight(obj, gravity)
+        with np.errstate(over="ignore", invalid="ignore"):
+            weight = object_weight(obj, gravity)
         if weight is None:
             raise ValueError("hold=True needs the object's mass (or density): its weight is the wrench to hold")
+        if not np.isfinite(weight.wrench).all():
+            raise ValueError("the object's weight or its moment about the origin overflows (mass x gravity)")
         listed.insert(0, weight.wrench)
     if not listed:
         raise ValueError("nothing to hold: give the object a mass (hold=True) or wrenches")
@@ -868,3 +792,33 @@ def synthesize(
     surface, clear = environment_search(surface_of(obj, span_bodies), environment, clearance, hand)
     options["constraints"] = (*options.get("constraints", ()), *clear)
     return search(surface, np.array(listed), friction, hand=hand, **options)
+
+
+#: Whether this process has warmed up (:func:`warm_up` runs once).
+_WARM = []
+
+
+def _ball_sample(n, rng):
+    """A unit ball's surface, area-weighted, with inward normals: :func:`warm_up`'s object."""
+    p = rng.normal(size=(n, 3))
+    p /= np.linalg.norm(p, axis=1, keepdims=True)
+    return p, -p
+
+
+def _ball_project(q):
+    r = np.linalg.norm(q, axis=-1, keepdims=True)
+    return q / r, -q / r, r[..., 0] - 1, np.zeros(q.shape[:-1], dtype=bool)
+
+
+def warm_up():
+    """The one-time work of a process's first search, done before any budget's clock starts: a small
+    search of a ball, which compiles the grip's numba kernels for the very arrays a search gives them
+    (its batches and its verification's single rows), or loads them from numba's cache; once a process,
+    and nothing on the numpy path.
+
+    >>> warm_up()
+    """
+    if _WARM or compiled.kernel() is None:  # done, or the numpy path: nothing to compile
+        return
+    _WARM.append(True)  # first: the search below warms up too
+    search(Surface(_ball_sample, _ball_project, 2 * 3**0.5), [[0, 0, 1.0, 0, 0, 0]], 0.5, candidates=200)

@@ -1,0 +1,102 @@
+"""A search's budget, a setting (candidates, seconds and the clock they are read on), and how it is spent.
+
+The clock starts after the one-time work every search needs before its first candidate
+(:func:`~.search.warm_up`: numba compiles the grip's kernels on a fresh install, tens of seconds),
+so that work never eats the budget, and a first run returns what every later run returns.  A search says
+which limit ended it (:data:`STOPPED_BY`): ``candidates``, every candidate scored and every grasp
+selected verified (the same ``seed`` gives the same grasps bit for bit), or ``seconds``, the time
+ran out first (the grasps depend on the machine's speed).
+
+>>> b = Budget(candidates=500, seconds=2.0)
+>>> b.candidates, b.seconds
+(500, 2.0)
+>>> Budget(candidates=0)
+Traceback (most recent call last):
+ValueError: candidates must be an integer from 1 to 1000000000, got 0
+"""
+
+from __future__ import annotations
+
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+
+from .checks import check_candidates, check_seconds
+
+__all__ = ["Budget", "Spending", "STOPPED_BY", "check_budget"]
+
+#: What ended a search: every candidate scored and every grasp verified, or the time.
+STOPPED_BY = ("candidates", "seconds")
+
+
+@dataclass(frozen=True)
+class Budget:
+    """How much a search may spend: ``candidates`` scored at most, ``seconds`` (None: no limit) on ``clock``.
+
+    Attributes
+    ----------
+    candidates : int, default 20000
+        From 1 to :data:`~.checks.MAX_CANDIDATES`.
+    seconds : float or None, default None
+        A finite number > 0, or None.
+    clock : callable, default ``time.perf_counter``
+        ``clock() -> float`` seconds; a test gives a fake one.
+    """
+
+    candidates: int = 20000
+    seconds: float | None = None
+    clock: Callable[[], float] = time.perf_counter
+
+    def __post_init__(self):
+        object.__setattr__(self, "candidates", check_candidates(self.candidates))
+        object.__setattr__(self, "seconds", check_seconds(self.seconds))
+
+
+def check_budget(candidates, seconds) -> tuple[int, float | None]:
+    """``(candidates, seconds)`` checked (:func:`~.checks.check_candidates`, :func:`~.checks.check_seconds`).
+
+    >>> check_budget(1000, None)
+    (1000, None)
+    """
+    return check_candidates(candidates), check_seconds(seconds)
+
+
+class Spending:
+    """A :class:`Budget` as a search spends it: the clock starts here.
+
+    The search stops taking candidates at ``share`` of ``seconds``; verification stops at
+    ``seconds`` (:meth:`late`).  ``stopped_by`` becomes ``seconds`` when either deadline cut
+    something short.
+    """
+
+    def __init__(self, budget: Budget, share: float):
+        self.clock = budget.clock
+        self.started = self.clock()
+        self.left, self.used = budget.candidates, 0
+        s = budget.seconds
+        self.search_deadline = None if s is None else self.started + share * s
+        self.deadline = None if s is None else self.started + s
+        self.stopped_by = "candidates"
+
+    def take(self, n) -> int:
+        """Up to ``n`` candidates, 0 when the budget is spent (the time only when some are left)."""
+        n = max(0, min(n, self.left))
+        if n and self.search_deadline is not None and self.clock() >= self.search_deadline:
+            self.stopped_by = "seconds"
+            return 0
+        return n
+
+    def spent(self, n):
+        self.left -= n
+        self.used += n
+
+    def late(self) -> bool:
+        """Whether verification's deadline has passed (then ``stopped_by`` is ``seconds``)."""
+        if self.deadline is not None and self.clock() >= self.deadline:
+            self.stopped_by = "seconds"
+            return True
+        return False
+
+    def seconds(self) -> float:
+        """Seconds since the clock started."""
+        return self.clock() - self.started
