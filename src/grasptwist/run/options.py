@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 from ..model import Twist, Wrench
 
-__all__ = ["TwistOptions", "ForceOptions", "FollowOptions", "SynthesisOptions"]
+__all__ = ["TwistOptions", "ForceOptions", "FollowOptions", "SynthesisOptions", "SimulateOptions"]
 
 
 def _count(given) -> int:
@@ -118,3 +118,25 @@ class SynthesisOptions:
     grasp_file: str | None = None
     tip_radius: float | None = None
     hand_file: str | None = None
+
+
+@dataclass(frozen=True)
+class SimulateOptions:
+    """The simulation family's options: what ``grasptwist simulate`` runs in MuJoCo, and how.
+
+    ``mass`` (``--mass``) and ``friction`` (``--friction``) replace the file's; ``table``
+    (``--table Z``) puts a table plane at height ``Z``; ``duration`` (``--duration``) is the
+    time each direction's load is applied; ``distance_tol`` and ``angle_tol`` (``--tolerance
+    D,DEG``, degrees) how far the object may move and turn and still be held; ``safety``
+    (``--safety``) the grip's safety factor; ``mjcf`` (``--mjcf OUT.xml``) where the scene is
+    written.
+    """
+
+    mass: float | None = None
+    friction: float | None = None
+    table: float | None = None
+    duration: float = 1.0
+    distance_tol: float = 0.002
+    angle_tol: float = 2.0
+    safety: float = 1.25
+    mjcf: str | None = None

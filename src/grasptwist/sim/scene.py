@@ -64,9 +64,11 @@ class Drive:
 
     ``stiffness`` (per joint) lets the whole load move the tip by :data:`COMPLIANCE` times the
     distance tolerance: a spring about the grasp that keeps the fingers where they are, soft
-    enough that following the object by the contacts' compression (a fraction of a millimetre)
+    enough that following the object by the contacts' compression (hundredths of a millimetre)
     costs a small part of the grip, so that the grip's torques, not the springs, hold the
-    object (ten times stiffer, a finger lets go where the object sinks into the others);
+    object.  Measured on the bundled grasps (``docs/guide/simulation.md``): 20 times stiffer, a
+    finger lets go where the object sinks into the others; 5 times softer, the fingertips give
+    way sideways and a ball rolls between them;
     ``armature`` makes that stiffness stable at the time step (``omega dt = STABLE``); damping
     is critical.
     """
@@ -77,7 +79,7 @@ class Drive:
 
 
 #: The tip's deflection under the whole load, in distance tolerances (:class:`Drive`).
-COMPLIANCE = 10.0
+COMPLIANCE = 2.0
 
 #: The drive's natural frequency times the time step (well inside explicit stability, 2).
 STABLE = 0.2
@@ -154,8 +156,10 @@ def mass_geom(obj: GraspObject, mass: float) -> tuple[str, dict]:
 
 
 def _primitive(kind, size) -> str:
-    half = {"box": size / 2, "sphere": size[:1], "cylinder": [size[0], size[1] / 2], "capsule": [size[0], size[1] / 2]}
-    return f'type="{kind}" size="{_v(half[kind])}"'
+    """MuJoCo's size of a primitive: a box's half edges, a sphere's radius, a cylinder's or capsule's
+    radius and half height (between its caps' centres: both conventions agree)."""
+    half = size / 2 if kind == "box" else (size[:1] if kind == "sphere" else np.array([size[0], size[1] / 2]))
+    return f'type="{kind}" size="{_v(half)}"'
 
 
 def _object_geoms(obj: GraspObject, mass: float, pieces=None) -> tuple[str, dict, str]:
@@ -192,9 +196,10 @@ def _quaternion(r) -> np.ndarray:
 
 
 def _drive(lever, load, tolerance, timestep) -> Drive:
-    """Joint stiffness from each joint's lever to its tip: the tip moves ``COMPLIANCE * tolerance``
-    under ``load`` (``k = load / (COMPLIANCE * tolerance)`` at the tip, ``k r^2`` at a hinge)."""
-    k = load / (COMPLIANCE * tolerance) * np.maximum(lever, tolerance) ** 2
+    """Joint stiffness from each joint's lever to its tip (NaN: a slide): the tip moves
+    ``COMPLIANCE * tolerance`` under ``load`` (``k = load / (COMPLIANCE * tolerance)`` at the tip and on
+    a slide, ``k r^2`` at a hinge ``r`` from the tip)."""
+    k = load / (COMPLIANCE * tolerance) * np.where(np.isnan(lever), 1.0, np.maximum(lever, tolerance) ** 2)
     armature = k * (timestep / STABLE) ** 2
     return Drive(k, 2 * np.sqrt(k * armature), armature)
 
@@ -221,7 +226,7 @@ def _hand_xml(grasp, radii, mu, load, tolerance, timestep, part) -> tuple[str, t
     hand = grasp.hand
     centres = tip_centers(grasp.points, grasp.normals, radii)
     if hand is None:  # three free fingertips, each on three slides
-        drive = _drive(np.zeros(9), load, tolerance, timestep)
+        drive = _drive(np.full(9, np.nan), load, tolerance, timestep)
         bodies, names = [], []
         for f in range(3):
             joints = [
@@ -238,7 +243,7 @@ def _hand_xml(grasp, radii, mu, load, tolerance, timestep, part) -> tuple[str, t
     lever = np.zeros(len(hand.joint_names))
     for f, finger in enumerate(hand.fingers):
         reach = np.linalg.norm(finger.points - (np.linalg.inv(moved[f]) @ np.append(centres[f], 1))[:3], axis=1)
-        lever[list(finger.joint_index)] = np.where([j.type == "prismatic" for j in finger.joints], 0.0, reach)
+        lever[list(finger.joint_index)] = np.where([j.type == "prismatic" for j in finger.joints], np.nan, reach)
     drive = _drive(lever, load, tolerance, timestep)
     bodies = []
     for f, finger in enumerate(hand.fingers):
@@ -249,11 +254,13 @@ def _hand_xml(grasp, radii, mu, load, tolerance, timestep, part) -> tuple[str, t
             screw = finger.screws[k]
             kind = "slide" if joint.type == "prismatic" else "hinge"
             axis = screw[3:] if kind == "slide" else screw[:3]
-            link = ""
+            # each link's mass at its joint (a link may be of zero length: joints through one point)
+            inertia = part * radii[f] ** 2
+            link = f'<inertial pos="{_v(ends[k])}" mass="{part:.17g}" diaginertia="{_v([inertia] * 3)}"/>'
             if np.linalg.norm(ends[k + 1] - ends[k]) > 0:
-                link = (
-                    f'<geom type="capsule" fromto="{_v(ends[k])} {_v(ends[k + 1])}" size="{radii[f] / 2 or tolerance:.17g}" '
-                    f'contype="0" conaffinity="0" group="1" mass="{part:.17g}"/>'
+                link += (
+                    f'\n<geom type="capsule" fromto="{_v(ends[k])} {_v(ends[k + 1])}" size="{radii[f] / 2:.17g}" '
+                    'contype="0" conaffinity="0" group="1"/>'
                 )
             opened.append(
                 f'<body name="f{f}_link{k}" gravcomp="1">\n'

@@ -1,0 +1,184 @@
+"""Simulate grasps in MuJoCo: grasp files in, one hold test per grasp out.
+
+Each grasp (hand placed, as every command reads it) needs an object, a mass (the object's,
+the file's ``mass``, or ``--mass``) and a friction (the file's or ``--friction``); its scene is
+:func:`grasptwist.sim.scene.build_scene`'s, its test :func:`grasptwist.sim.hold.hold_test`'s.
+With ``-j`` each input file is simulated in a worker process.  No math here: only reading,
+routing and labelling.
+"""
+
+from __future__ import annotations
+
+import itertools
+import os
+from collections.abc import Iterable, Iterator
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+from ..engine.objects.geometry import mass_properties
+from ..model import Grasp, GraspFileError
+from ..output import simulate_records as sr
+from ..output.records import diagnostics, dumps, error_record
+from ..sim.hold import HoldTest, hold_test
+from ..sim.scene import Scene, build_scene
+from .options import SimulateOptions
+from .outputs import Output
+from .placement import read
+from .pool import Pool, pool_size
+
+__all__ = [
+    "Simulated",
+    "simulate_grasp",
+    "simulate_inputs",
+    "simulate_outputs",
+    "write_mjcf",
+    "NO_OBJECT",
+    "NO_MASS",
+    "NO_FRICTION",
+    "SCENE_ERROR",
+    "UNSTABLE",
+    "GRAVITY",
+]
+
+#: Error codes of a grasp that cannot be simulated, and of a simulation that diverged.
+NO_OBJECT, NO_MASS, NO_FRICTION = "no-object", "no-mass", "no-friction"
+SCENE_ERROR, UNSTABLE = "scene-error", "simulation-unstable"
+
+#: Gravity when the file gives none.
+GRAVITY = (0.0, 0.0, -9.81)
+
+
+@dataclass(frozen=True, eq=False)
+class Simulated:
+    """One grasp's hold test, with what it was run with."""
+
+    grasp: Grasp
+    mass: float
+    friction: np.ndarray
+    test: HoldTest
+    options: SimulateOptions
+
+
+def _problem(grasp: Grasp, code: str, message: str) -> GraspFileError:
+    return GraspFileError(code, f"grasp '{grasp.name}': {message}", grasp.file, grasp.line, None, grasp.document)
+
+
+def _mass(options, grasp, obj):
+    if options.mass is not None:
+        return options.mass
+    return mass_properties(obj).mass if mass_properties(obj).mass is not None else grasp.mass
+
+
+def simulate_grasp(options: SimulateOptions, grasp: Grasp, mjcf: str | None = None) -> Simulated | GraspFileError:
+    """The hold test of one grasp, or why it cannot be run (module docstring); ``mjcf``: write its scene there."""
+    obj = grasp.object
+    if obj is None:
+        return _problem(grasp, NO_OBJECT, "has no object to simulate: add an 'object' key")
+    mass = _mass(options, grasp, obj)
+    if mass is None:
+        return _problem(grasp, NO_MASS, "has no mass: give the object a mass or density, the file a mass, or --mass")
+    if options.friction is None and grasp.friction is None:
+        return _problem(grasp, NO_FRICTION, "has no friction: give the file a friction, or --friction")
+    friction = np.full(3, options.friction) if options.friction is not None else np.asarray(grasp.friction, float)
+    gravity = np.asarray(GRAVITY if grasp.gravity is None else grasp.gravity, float)
+    load = mass * float(np.linalg.norm(gravity))
+    obj = replace(obj, mass=mass, density=None)
+    scene = build_scene(
+        replace(grasp, object=obj),
+        mass=mass,
+        friction=friction,
+        load=load,
+        tolerance=options.distance_tol,
+        table_height=options.table,
+        gravity=gravity,
+    )
+    if mjcf is not None:
+        write_mjcf(scene, mjcf)
+    try:
+        test = hold_test(
+            scene,
+            grasp,
+            center_of_mass=mass_properties(obj).center_of_mass,
+            friction=friction,
+            load=load,
+            duration=options.duration,
+            distance_tol=options.distance_tol,
+            angle_tol=np.radians(options.angle_tol),
+            safety=options.safety,
+        )
+    except ValueError as exc:  # MuJoCo's compiler: its reason
+        return _problem(grasp, SCENE_ERROR, f"MuJoCo cannot compile its scene: {exc}".strip())
+    if test.unstable is not None:
+        u = test.unstable
+        return _problem(
+            grasp,
+            UNSTABLE,
+            f"direction {u.where}: the simulation diverged at step {u.step} (t = {u.time:g} s): {u.reason}",
+        )
+    return Simulated(grasp, mass, friction, test, options)
+
+
+def write_mjcf(scene: Scene, path: str) -> None:
+    """The scene's MJCF at ``path``, its meshes beside it (``python -m mujoco.viewer --mjcf PATH``)."""
+    folder = os.path.dirname(os.path.abspath(path))
+    for name, data in scene.assets.items():
+        with open(os.path.join(folder, name), "wb") as out:
+            out.write(data)
+    with open(path, "w", encoding="utf-8") as out:
+        out.write(scene.xml)
+
+
+def _mjcf_name(path: str | None, k: int) -> str | None:
+    """``--mjcf OUT.xml`` for the first grasp simulated, ``OUT-2.xml``, ... for the next."""
+    if path is None or k == 1:
+        return path
+    stem, suffix = os.path.splitext(path)
+    return f"{stem}-{k}{suffix}"
+
+
+def simulate_inputs(job, inputs: Iterable, numbers=None) -> Iterator[Simulated | GraspFileError]:
+    """Every grasp of ``inputs`` (paths or the errors of ``expand``) simulated, in order; ``numbers``
+    (an iterator, default from 1) numbers the grasps read for ``--mjcf``."""
+    numbers = itertools.count(1) if numbers is None else numbers
+    for item in inputs:
+        if isinstance(item, GraspFileError):
+            yield item
+            continue
+        for entry in read(item, job.max_bytes, job.reading):
+            if isinstance(entry, Grasp):
+                yield simulate_grasp(job.options, entry, _mjcf_name(job.options.mjcf, next(numbers)))
+            else:
+                yield entry
+
+
+def _simulated(job, inputs: list, workers: int) -> Iterator[list]:
+    """The items of each input (:func:`simulate_inputs`), a list per input in order: each input on one
+    of ``workers`` forked processes when there are several (``--mjcf`` numbers its files in one)."""
+    if job.options.mjcf is not None or pool_size(workers, len(inputs)) <= 1:
+        numbers = itertools.count(1)
+        for item in inputs:
+            yield list(simulate_inputs(job, [item], numbers))
+        return
+    with Pool(lambda i: list(simulate_inputs(job, inputs[i : i + 1])), workers, in_flight=1) as pool:
+        yield from pool.results(len(inputs))
+
+
+def simulate_outputs(job, inputs: Iterable, w, workers: int = 1, tuning=None) -> Iterator[Output]:
+    """The :class:`~grasptwist.run.outputs.Output` of each grasp simulated (a record each), and of
+    each input done (the progress bar's unit)."""
+    for items in _simulated(job, list(inputs), workers):
+        for item in items:
+            error = isinstance(item, GraspFileError)
+            rec = error_record(item) if error else sr.simulate_record(item)
+            errors, warnings = diagnostics(rec)
+            out = Output(encoded=[_encode(job, rec)], errors=errors, warnings=warnings, records=1)
+            out.count(rec)
+            yield out
+        yield Output(done=1)
+
+
+def _encode(job, rec):
+    if job.fmt == "table":
+        return rec
+    return sr.csv_line(rec) if job.fmt == "csv" else dumps(rec)
