@@ -195,11 +195,11 @@ def _quaternion(r) -> np.ndarray:
     return q
 
 
-def _drive(lever, load, tolerance, timestep) -> Drive:
+def _drive(lever, load, tolerance, timestep, compliance=COMPLIANCE) -> Drive:
     """Joint stiffness from each joint's lever to its tip (NaN: a slide): the tip moves
     ``COMPLIANCE * tolerance`` under ``load`` (``k = load / (COMPLIANCE * tolerance)`` at the tip and on
     a slide, ``k r^2`` at a hinge ``r`` from the tip)."""
-    k = load / (COMPLIANCE * tolerance) * np.where(np.isnan(lever), 1.0, np.maximum(lever, tolerance) ** 2)
+    k = load / (compliance * tolerance) * np.where(np.isnan(lever), 1.0, np.maximum(lever, tolerance) ** 2)
     armature = k * (timestep / STABLE) ** 2
     return Drive(k, 2 * np.sqrt(k * armature), armature)
 
@@ -221,12 +221,12 @@ def _tip_geom(f, centre, radius, mu, mass) -> str:
     )
 
 
-def _hand_xml(grasp, radii, mu, load, tolerance, timestep, part) -> tuple[str, tuple, np.ndarray]:
+def _hand_xml(grasp, radii, mu, load, tolerance, timestep, part, compliance) -> tuple[str, tuple, np.ndarray]:
     """The fingers' bodies (each link and tip of mass ``part``), their joint names and positions at the grasp."""
     hand = grasp.hand
     centres = tip_centers(grasp.points, grasp.normals, radii)
     if hand is None:  # three free fingertips, each on three slides
-        drive = _drive(np.full(9, np.nan), load, tolerance, timestep)
+        drive = _drive(np.full(9, np.nan), load, tolerance, timestep, compliance)
         bodies, names = [], []
         for f in range(3):
             joints = [
@@ -244,7 +244,7 @@ def _hand_xml(grasp, radii, mu, load, tolerance, timestep, part) -> tuple[str, t
     for f, finger in enumerate(hand.fingers):
         reach = np.linalg.norm(finger.points - (np.linalg.inv(moved[f]) @ np.append(centres[f], 1))[:3], axis=1)
         lever[list(finger.joint_index)] = np.where([j.type == "prismatic" for j in finger.joints], np.nan, reach)
-    drive = _drive(lever, load, tolerance, timestep)
+    drive = _drive(lever, load, tolerance, timestep, compliance)
     bodies = []
     for f, finger in enumerate(hand.fingers):
         home_centre = (np.linalg.inv(moved[f]) @ np.append(centres[f], 1))[:3]
@@ -283,6 +283,7 @@ def build_scene(
     table_friction: float | None = None,
     gravity=(0.0, 0.0, -9.81),
     object_gravcomp: bool = True,
+    compliance: float = COMPLIANCE,
     settings: ContactSettings = CONTACT,
     pieces=None,
 ) -> Scene:
@@ -303,6 +304,9 @@ def build_scene(
     gravity : (3,) array
     object_gravcomp : bool
         The object's weight compensated (the hold test applies its load itself).
+    compliance : float
+        How far the whole load moves a fingertip against its joints' springs, in ``tolerance``
+        (:class:`Drive`; a path's execution tracks the fingers' targets more stiffly).
     pieces : list of (vertices, faces) or None
         A mesh object's convex pieces, given (else :func:`convex_pieces`).
 
@@ -316,7 +320,7 @@ def build_scene(
     radii = np.array([f.tip_radius for f in grasp.hand.fingers]) if grasp.hand is not None else np.zeros(3)
     radii = np.where(radii > 0, radii, POINT_TIP * size)
     geoms, assets, meshes = _object_geoms(obj, mass, pieces)
-    hand, joints, q = _hand_xml(grasp, radii, mu, load, tolerance, settings.timestep, PART * mass)
+    hand, joints, q = _hand_xml(grasp, radii, mu, load, tolerance, settings.timestep, PART * mass, compliance)
     table = ""
     if table_height is not None:
         tmu = float(np.min(mu)) if table_friction is None else table_friction
