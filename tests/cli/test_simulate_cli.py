@@ -116,3 +116,15 @@ def test_without_mujoco_one_line_says_how_to_install_it():
         "grasptwist: error: grasptwist simulate needs mujoco: pip install 'grasptwist[sim]' "
         "(from a clone of grasptwist: pip install -e '.[sim]')"
     )
+
+
+def test_synthesize_simulate_keeps_only_the_grasps_that_hold_and_counts_the_others(tmp_path):
+    found = tmp_path / "found.yaml"
+    args = ("synthesize", GRASPS / "cylinder.yaml", "--friction", "0.8", "--mass", "0.1", "-n", "4")
+    r, _ = run(*args, "--candidates", "400", "--simulate", "-o", found, "-f", "jsonl")
+    assert r.exit_code in (0, 1), r.stderr
+    kept = [rec for rec in jsonl(r.stdout) if rec["ok"]]
+    # the search finds 4 (seeded); MuJoCo drops one of them
+    assert len(kept) == 3 and "; 1 dropped: they did not hold in all six directions in MuJoCo" in r.stderr
+    sims, _ = run("simulate", found, *SHORT, "-f", "jsonl")  # each grasp kept holds, simulated from the file
+    assert [s["held"] for s in jsonl(sims.stdout)] == [True] * 3

@@ -98,7 +98,8 @@ class SynthesisOptions:
     ``count`` (``-n``) grasps are wanted, at least ``min_spacing`` apart; ``candidates`` and
     ``seconds`` bound the search; ``grasp_file`` (``-o FILE.yaml``) receives the grasps found;
     ``tip_radius`` (``--tip-radius``) replaces every fingertip's radius of the hand (the file's, or
-    the job's ``hand``: ``--hand``, read from ``hand_file``).
+    the job's ``hand``: ``--hand``, read from ``hand_file``); ``simulate`` (``--simulate``) keeps only
+    the grasps that hold in all six directions in MuJoCo (:func:`grasptwist.run.simulate.held_only`).
     The rest go to :func:`grasptwist.engine.synthesis.search.search`.
     """
 
@@ -118,6 +119,7 @@ class SynthesisOptions:
     grasp_file: str | None = None
     tip_radius: float | None = None
     hand_file: str | None = None
+    simulate: SimulateOptions | None = None
 
 
 @dataclass(frozen=True)

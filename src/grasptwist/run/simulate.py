@@ -10,6 +10,7 @@ routing and labelling.
 from __future__ import annotations
 
 import itertools
+import math
 import os
 from collections.abc import Iterable, Iterator
 from dataclasses import dataclass, replace
@@ -17,6 +18,7 @@ from dataclasses import dataclass, replace
 import numpy as np
 
 from ..engine.objects.geometry import mass_properties
+from ..engine.synthesis.search import Failure
 from ..model import Grasp, GraspFileError
 from ..output import simulate_records as sr
 from ..output.records import diagnostics, dumps, error_record
@@ -39,11 +41,16 @@ __all__ = [
     "SCENE_ERROR",
     "UNSTABLE",
     "GRAVITY",
+    "SIMULATED",
+    "held_only",
 ]
 
 #: Error codes of a grasp that cannot be simulated, and of a simulation that diverged.
 NO_OBJECT, NO_MASS, NO_FRICTION = "no-object", "no-mass", "no-friction"
 SCENE_ERROR, UNSTABLE = "scene-error", "simulation-unstable"
+
+#: The constraint a search's grasps failed when none held in MuJoCo (``synthesize --simulate``).
+SIMULATED = "simulation"
 
 #: Gravity when the file gives none.
 GRAVITY = (0.0, 0.0, -9.81)
@@ -182,3 +189,65 @@ def _encode(job, rec):
     if job.fmt == "table":
         return rec
     return sr.csv_line(rec) if job.fmt == "csv" else dumps(rec)
+
+
+def _found_grasp(found, k: int) -> Grasp:
+    """Grasp ``k`` that a search found, as a grasp file would give it (its hand at its joint positions)."""
+    s = found.synthesis
+    hand, positions = found.hand, None if s.joint_positions is None else s.joint_positions[k]
+    if found.joints_at is not None:  # an inline hand: its joints moved to this grasp, positions 0 there
+        hand = replace(
+            hand, fingers=tuple(replace(f, screws=j[0], points=j[1]) for f, j in zip(hand.fingers, found.joints_at[k]))
+        )
+        positions = np.zeros(len(hand.joint_names))
+    mass, center, gravity = found.hold if found.hold is not None else (None, None, None)
+    return Grasp(
+        f"{found.name}#{k + 1}",
+        found.units,
+        found.file,
+        0,
+        found.contact_names,
+        s.points[k],
+        s.normals[k],
+        found.wrist,
+        (),
+        found.line or 1,
+        hand=hand,
+        joint_positions=positions,
+        friction=np.full(3, found.friction),
+        mass=mass,
+        center_of_mass=center,
+        gravity=gravity,
+        object=found.object,
+    )
+
+
+def _rows(synthesis, keep: np.ndarray):
+    """The search's result with only the grasps ``keep`` (indices, best first kept so)."""
+    taken = {
+        name: None if getattr(synthesis, name) is None else getattr(synthesis, name)[keep]
+        for name in ("points", "normals", "surface_distance", "total_normal_force", "closure_friction", "epsilon")
+        + ("conditioning", "joint_positions", "reach_error", "tip_center")
+    }
+    return replace(synthesis, grips=tuple(synthesis.grips[k] for k in keep), **taken)
+
+
+def held_only(found, options: SimulateOptions):
+    """``found`` with only the grasps that hold in all six directions in MuJoCo, and how many were dropped
+    (``synthesize --simulate``); an object without a weight (no mass) has no load to test: all are kept."""
+    if not len(found) or found.hold is None:
+        return found, 0
+    keep = []
+    for k in range(len(found)):
+        sim = simulate_grasp(options, _found_grasp(found, k))
+        if isinstance(sim, Simulated) and sim.test.held:
+            keep.append(k)
+    keep = np.array(keep, dtype=int)
+    synthesis = _rows(found.synthesis, keep)
+    if not len(keep):  # the search's record says why there is none
+        message = f"none of the {len(found)} grasps found held in all six directions in MuJoCo (--simulate)"
+        synthesis = replace(synthesis, failure=Failure(SIMULATED, message, math.nan, math.nan))
+    kept = replace(found, synthesis=synthesis)
+    if found.joints_at is not None:
+        kept = replace(kept, joints_at=tuple(found.joints_at[k] for k in keep))
+    return kept, len(found) - len(keep)
