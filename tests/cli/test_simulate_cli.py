@@ -95,6 +95,7 @@ def test_a_grasp_without_an_object_is_an_error_record(tmp_path):
         ("--tolerance", "0.002,200"),
         ("--mass", "-1"),
         ("--table", "inf"),
+        ("--mjcf", "no-such-folder/scene.xml"),
     ],
 )
 def test_absurd_values_are_refused_before_any_work(args):

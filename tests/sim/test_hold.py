@@ -107,3 +107,14 @@ def test_a_simulation_that_diverges_is_a_record_naming_the_step():
     assert test.unstable is not None and not test.held
     assert test.unstable.where == "+x" and 0 < test.unstable.step <= round(SHORT / 0.001)
     assert options.duration == SHORT and UNSTABLE == "simulation-unstable"
+
+
+def test_gt_simulate_runs_the_hold_test_and_raises_what_it_cannot_simulate():
+    import grasptwist as gt
+
+    grasp = _grasp("sphere.yaml", 1)  # sphere-equator: mass 1, friction 0.5
+    sim = gt.simulate(grasp, mass=0.1, friction=0.8, duration=SHORT, tolerance=(0.002, 2.0))
+    assert sim.test.held and sim.mass == 0.1 and sim.options.duration == SHORT
+    with pytest.raises(gt.GraspFileError) as err:
+        gt.simulate(replace(grasp, object=None))
+    assert err.value.code == "no-object"

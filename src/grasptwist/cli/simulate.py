@@ -1,6 +1,7 @@
 """``grasptwist simulate``: run each grasp in MuJoCo, the six-direction hold test (issue 38)."""
 
 import math
+import os
 from typing import Annotated
 
 import typer
@@ -143,6 +144,8 @@ def simulate(
     from ..run.options import SimulateOptions
     from ..run.pipeline import Job
 
+    if mjcf is not None and not os.path.isdir(os.path.dirname(os.path.abspath(mjcf))):
+        raise typer.BadParameter(f"no folder {os.path.dirname(mjcf)!r} to write the scene in", param_hint="--mjcf")
     fmt = SimulateFormat.json if json_ else fmt
     not_binary_to_a_terminal(fmt.value, output)
     distance, angle = tolerance if tolerance is not None else (SimulateOptions.distance_tol, SimulateOptions.angle_tol)

@@ -43,6 +43,7 @@ __all__ = [
     "GRAVITY",
     "SIMULATED",
     "held_only",
+    "simulate",
 ]
 
 #: Error codes of a grasp that cannot be simulated, and of a simulation that diverged.
@@ -77,8 +78,11 @@ def _mass(options, grasp, obj):
     return mass_properties(obj).mass if mass_properties(obj).mass is not None else grasp.mass
 
 
-def simulate_grasp(options: SimulateOptions, grasp: Grasp, mjcf: str | None = None) -> Simulated | GraspFileError:
-    """The hold test of one grasp, or why it cannot be run (module docstring); ``mjcf``: write its scene there."""
+def simulate_grasp(
+    options: SimulateOptions, grasp: Grasp, mjcf: str | None = None, observe=None
+) -> Simulated | GraspFileError:
+    """The hold test of one grasp, or why it cannot be run (module docstring); ``mjcf``: write its scene
+    there; ``observe``: :func:`~grasptwist.sim.hold.hold_test`'s."""
     obj = grasp.object
     if obj is None:
         return _problem(grasp, NO_OBJECT, "has no object to simulate: add an 'object' key")
@@ -113,6 +117,7 @@ def simulate_grasp(options: SimulateOptions, grasp: Grasp, mjcf: str | None = No
             distance_tol=options.distance_tol,
             angle_tol=np.radians(options.angle_tol),
             safety=options.safety,
+            observe=observe,
         )
     except ValueError as exc:  # MuJoCo's compiler: its reason
         return _problem(grasp, SCENE_ERROR, f"MuJoCo cannot compile its scene: {exc}".strip())
@@ -251,3 +256,53 @@ def held_only(found, options: SimulateOptions):
     if found.joints_at is not None:
         kept = replace(kept, joints_at=tuple(found.joints_at[k] for k in keep))
     return kept, len(found) - len(keep)
+
+
+def simulate(
+    grasp: Grasp,
+    *,
+    mass: float | None = None,
+    friction: float | None = None,
+    table_height: float | None = None,
+    duration: float = 1.0,
+    tolerance: tuple[float, float] = (0.002, 2.0),
+    safety: float = 1.25,
+    mjcf: str | None = None,
+) -> Simulated:
+    """Run the six-direction hold test of one grasp in MuJoCo, as ``grasptwist simulate`` does.
+
+    Parameters
+    ----------
+    grasp : Grasp
+        With an object; a URDF hand placed (:func:`grasptwist.hand.place_grasp`), as
+        :func:`grasptwist.read_grasps` gives it.
+    mass, friction : float, optional
+        Replace the grasp's (its object's mass, density or the file's ``mass``; its ``friction``).
+    table_height : float, optional
+        A table plane ``z = table_height`` under the object.
+    duration : float
+        Seconds each direction's load is applied.
+    tolerance : (float, float)
+        The distance (length units) and angle (degrees) within which the object counts as held.
+    safety : float
+        The grip's safety factor.
+    mjcf : str, optional
+        Write the scene there (MJCF, meshes beside it).
+
+    Returns
+    -------
+    Simulated
+        ``test.held``, and ``test.directions``: each direction's displacement, rotation
+        (radians), MuJoCo's contact forces and the planned ones.
+
+    Raises
+    ------
+    GraspFileError
+        A grasp it cannot simulate (``no-object``, ``no-mass``, ``no-friction``, ``scene-error``)
+        or a simulation that diverged (``simulation-unstable``).
+    """
+    options = SimulateOptions(mass, friction, table_height, duration, *tolerance, safety)
+    result = simulate_grasp(options, grasp, mjcf)
+    if isinstance(result, GraspFileError):
+        raise result
+    return result

@@ -128,6 +128,7 @@ def hold_test(
     distance_tol: float = 0.002,
     angle_tol: float = math.radians(2.0),
     safety: float = 1.0,
+    observe=None,
 ) -> HoldTest:
     """The six-direction hold test of ``grasp`` in ``scene`` (module docstring).
 
@@ -147,6 +148,9 @@ def hold_test(
         How far the object may move and turn (radians) and still count as held.
     safety : float
         The grip's safety factor (:func:`~grasptwist.engine.forces.grip.grip`).
+    observe : callable or None
+        ``(direction, model, data)``, called at the end of each direction simulated (pictures:
+        ``docs/make_simulation_picture.py``).
 
     Returns
     -------
@@ -188,6 +192,8 @@ def hold_test(
                 return HoldTest(tuple(out), load, Unstable(name, done, done * model.opt.timestep, why))
             if np.linalg.norm(data.qpos[free : free + 3] - start) > gone:
                 break
+        if observe is not None:
+            observe(name, model, data)
         moved = float(np.linalg.norm(data.qpos[free : free + 3] - start))
         turned = _angle(mujoco, quat, data.qpos[free + 3 : free + 7])
         forces = contact_forces(mujoco, model, data, body, tips)

@@ -54,6 +54,9 @@ PART = 0.05
 #: A point tip's sphere radius, as a fraction of the object's size (MuJoCo needs a radius).
 POINT_TIP = 0.02
 
+#: The object's colour in MuJoCo's viewer.
+OBJECT_RGBA = "0.95 0.55 0.15 1"
+
 #: Names in the scene: the object's body, and fingertip ``f``'s geom (``TIP.format(f)``).
 OBJECT, TIP = "object", "tip{}"
 
@@ -167,13 +170,19 @@ def _object_geoms(obj: GraspObject, mass: float, pieces=None) -> tuple[str, dict
     shape = obj.shape
     carrier, assets = mass_geom(obj, mass)
     if shape.kind != "mesh":
-        return f'<geom name="piece0" {_primitive(shape.kind, shape.size)} mass="{mass:.17g}" friction="0"/>', {}, ""
+        return (
+            f'<geom name="piece0" {_primitive(shape.kind, shape.size)} mass="{mass:.17g}" friction="0" rgba="{OBJECT_RGBA}"/>',
+            {},
+            "",
+        )
     pieces = convex_pieces(shape.vertices, shape.faces) if pieces is None else pieces
     geoms, meshes = [carrier], ['<mesh name="solid" file="solid.stl" inertia="exact"/>']
     for k, (v, f) in enumerate(pieces):
         assets[f"piece{k}.stl"] = stl_bytes(v, f)
         meshes.append(f'<mesh name="piece{k}" file="piece{k}.stl"/>')
-        geoms.append(f'<geom name="piece{k}" type="mesh" mesh="piece{k}" density="0" friction="0"/>')
+        geoms.append(
+            f'<geom name="piece{k}" type="mesh" mesh="piece{k}" density="0" friction="0" rgba="{OBJECT_RGBA}"/>'
+        )
     return "\n".join(geoms), assets, "\n".join(meshes)
 
 
@@ -217,7 +226,7 @@ def _joint_xml(name, kind, point, axis, limits, drive, i, q0) -> str:
 def _tip_geom(f, centre, radius, mu, mass) -> str:
     return (
         f'<geom name="{TIP.format(f)}" type="sphere" size="{radius:.17g}" pos="{_v(centre)}" '
-        f'friction="{mu:.17g}" mass="{mass:.17g}"/>'
+        f'friction="{mu:.17g}" mass="{mass:.17g}" rgba="0.2 0.4 0.9 1"/>'
     )
 
 
@@ -324,15 +333,17 @@ def build_scene(
     table = ""
     if table_height is not None:
         tmu = float(np.min(mu)) if table_friction is None else table_friction
-        table = f'<geom name="table" type="plane" size="0 0 1" pos="0 0 {table_height:.17g}" friction="{tmu:.17g}"/>'
+        table = f'<geom name="table" type="plane" size="0 0 1" pos="0 0 {table_height:.17g}" friction="{tmu:.17g}" rgba="0.8 0.8 0.75 1"/>'
     pose = obj.pose
     xml = f"""<mujoco model="{_attribute(grasp.name)}">
 <compiler angle="radian"/>
 {option_xml(gravity, settings)}
+<visual><headlight ambient="0.35 0.35 0.35" diffuse="0.6 0.6 0.6"/></visual>
 <asset>
 {meshes}
 </asset>
 <worldbody>
+<light pos="0 0 {10 * size:.17g}" dir="0 0 -1" directional="true"/>
 {table}
 <body name="{OBJECT}" pos="{_v(pose[:3, 3])}" quat="{_v(_quaternion(pose[:3, :3]))}" gravcomp="{int(object_gravcomp)}">
 <freejoint name="{OBJECT}"/>
