@@ -119,6 +119,7 @@ def test_without_mujoco_one_line_says_how_to_install_it():
     )
 
 
+@pytest.mark.slow  # a search and four hold tests: over a second
 def test_synthesize_simulate_keeps_only_the_grasps_that_hold_and_counts_the_others(tmp_path):
     found = tmp_path / "found.yaml"
     args = ("synthesize", GRASPS / "cylinder.yaml", "--friction", "0.8", "--mass", "0.1", "-n", "4")

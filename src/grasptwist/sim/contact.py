@@ -3,7 +3,7 @@ r"""Contact settings that make MuJoCo's friction Coulomb's, with the grasp file'
 grasptwist's model is a point contact with Coulomb friction: a finger's force ``f`` at a
 contact with unit normal ``n`` holds while ``|f - (f . n) n| <= mu f . n`` and slides
 otherwise.  MuJoCo's contacts are soft and its friction cone is pyramidal unless told
-otherwise; each setting below brings it to the model, and ``tests/sim/test_contact.py``
+otherwise; each setting below brings it to the model, and ``tests/sim/test_sim_contact.py``
 holds the result: a block on a plane tilted just under ``atan(mu)`` stays, just over it
 slides.
 
