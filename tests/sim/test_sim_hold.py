@@ -118,3 +118,20 @@ def test_gt_simulate_runs_the_hold_test_and_raises_what_it_cannot_simulate():
     with pytest.raises(gt.GraspFileError) as err:
         gt.simulate(replace(grasp, object=None))
     assert err.value.code == "no-object"
+
+
+def test_box_obstacles_stand_in_the_scene_and_the_object_rests_on_one():
+    # the ball of sphere-equator on a box whose top is the ball's bottom: they touch
+    g = _grasp("sphere.yaml", 1)
+    box = ([0.0, 0.0, -0.035 - 0.01], [0.1, 0.1, 0.02])
+    scene = build_scene(g, mass=0.1, friction=np.full(3, 0.8), load=0.981, tolerance=0.002, boxes=[box])
+    model = load_model(scene)
+    geom = model.geom("box0")
+    np.testing.assert_allclose(model.geom_size[geom.id], [0.05, 0.05, 0.01])
+    np.testing.assert_allclose(model.geom_pos[geom.id], [0, 0, -0.045])
+    import mujoco
+
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    touching = {tuple(sorted((model.geom(c.geom1).name, model.geom(c.geom2).name))) for c in data.contact[: data.ncon]}
+    assert ("box0", "piece0") in touching

@@ -290,6 +290,7 @@ def build_scene(
     tolerance: float,
     table_height: float | None = None,
     table_friction: float | None = None,
+    boxes=(),
     gravity=(0.0, 0.0, -9.81),
     object_gravcomp: bool = True,
     compliance: float = COMPLIANCE,
@@ -310,6 +311,9 @@ def build_scene(
         The largest load on the object and the distance it may move: the joints' stiffness.
     table_height : float or None
         A table plane at this height (None: none), with ``table_friction`` (default: the least ``mu``).
+    boxes : sequence of (centre (3,), size (3,))
+        Fixed box obstacles, axis-aligned, edge lengths ``size``, with the table's friction (a grasp
+        file's environment is the table and these).
     gravity : (3,) array
     object_gravcomp : bool
         The object's weight compensated (the hold test applies its load itself).
@@ -330,10 +334,14 @@ def build_scene(
     radii = np.where(radii > 0, radii, POINT_TIP * size)
     geoms, assets, meshes = _object_geoms(obj, mass, pieces)
     hand, joints, q = _hand_xml(grasp, radii, mu, load, tolerance, settings.timestep, PART * mass, compliance)
-    table = ""
+    tmu = float(np.min(mu)) if table_friction is None else table_friction
+    table = "".join(
+        f'<geom name="box{k}" type="box" pos="{_v(centre)}" size="{_v(np.asarray(edges, float) / 2)}" '
+        f'friction="{tmu:.17g}" rgba="0.6 0.6 0.6 1"/>\n'
+        for k, (centre, edges) in enumerate(boxes)
+    )
     if table_height is not None:
-        tmu = float(np.min(mu)) if table_friction is None else table_friction
-        table = f'<geom name="table" type="plane" size="0 0 1" pos="0 0 {table_height:.17g}" friction="{tmu:.17g}" rgba="0.8 0.8 0.75 1"/>'
+        table += f'<geom name="table" type="plane" size="0 0 1" pos="0 0 {table_height:.17g}" friction="{tmu:.17g}" rgba="0.8 0.8 0.75 1"/>'
     pose = obj.pose
     xml = f"""<mujoco model="{_attribute(grasp.name)}">
 <compiler angle="radian"/>
