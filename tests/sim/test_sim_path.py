@@ -47,8 +47,9 @@ def test_the_fingers_hold_the_cube_still_along_a_path_that_stands_still():
 
 
 def test_a_slow_spin_lags_its_plan_and_the_contacts_slip():
-    # measured: 0.05 rad/s for 1 s ends 0.97 deg behind the plan, each tip 0.7-0.9 mm off its contact;
-    # the fingertips' own turning (the links') drags on the object where the plan has them roll
+    # measured: 0.05 rad/s for 1 s ends 0.97 deg behind the plan, each tip 0.7-0.9 mm off its contact:
+    # the fingers track their targets, but each tip sphere turns with its link, not with the object,
+    # so its surface slides at (omega_link - omega_object) x r n where the plan has it roll
     run = _spin(0.05)
     assert math.radians(0.5) < run.angle_error[-1] < math.radians(2.0)
     assert (run.slip[-1] > 2e-4).all()
