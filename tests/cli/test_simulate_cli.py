@@ -13,6 +13,7 @@ from hostile import jsonl, run
 from places import GRASPS
 
 CUBE = GRASPS / "trifinger-cube.yaml"
+SPHERE = GRASPS / "sphere.yaml"
 SHORT = ("--duration", "0.1")
 
 
@@ -130,3 +131,31 @@ def test_synthesize_simulate_keeps_only_the_grasps_that_hold_and_counts_the_othe
     assert len(kept) == 3 and "; 1 dropped: they did not hold in all six directions in MuJoCo" in r.stderr
     sims, _ = run("simulate", found, *SHORT, "-f", "jsonl")  # each grasp kept holds, simulated from the file
     assert [s["held"] for s in jsonl(sims.stdout)] == [True] * 3
+
+
+def test_path_lifts_the_ball_as_planned_and_the_record_has_its_samples():
+    # lift-z: 5 cm/s for one unit of time, the three slid tips carrying the ball (no turning: no rolling)
+    r, _ = run("simulate", SPHERE, "--mass", "0.1", "--friction", "0.8", "--path", "lift-z", "-f", "jsonl")
+    assert r.exit_code == 0, r.stderr
+    rec = jsonl(r.stdout)[1]  # sphere-equator
+    assert rec["followed"] and rec["path"] == "lift-z" and len(rec["samples"]) == 21
+    assert rec["samples"][-1]["time"] == 1.0 and rec["final"]["position_error"] < 5e-4
+    assert max(max(s["slip"]) for s in rec["samples"]) < 1e-3 and not any(any(s["slipped"]) for s in rec["samples"])
+
+
+def test_a_path_the_grasp_does_not_have_is_an_error_record():
+    r, _ = run("simulate", SPHERE, "--mass", "0.1", "--friction", "0.8", "--path", "nope", "-f", "jsonl")
+    assert r.exit_code == 1
+    rec = jsonl(r.stdout)[0]
+    assert rec["error"]["code"] == "no-path" and "'roll-x', 'spin-z', 'lift-z'" in rec["error"]["message"]
+    csv_run, _ = run("simulate", SPHERE, "--path", "lift-z", "-f", "csv")
+    assert csv_run.exit_code == 2 and "--path" in csv_run.stderr
+
+
+@pytest.mark.slow  # a second of tracking with the TriFinger
+def test_the_trifinger_spin_lags_its_plan_as_the_guide_says():
+    r, _ = run("simulate", CUBE, "--mass", "0.094", "--friction", "1", "--path", "spin", "-f", "jsonl")
+    assert r.exit_code == 1
+    (rec,) = jsonl(r.stdout)
+    assert not rec["followed"] and 5 < rec["final"]["angle_error_deg"] < 15  # measured 9.1 deg behind
+    assert all(rec["samples"][-1]["slipped"])

@@ -24,7 +24,6 @@ def _spin(rate):
     scene = build_scene(
         replace(g, object=obj), mass=mass, friction=mu, load=mass * 9.81, tolerance=0.002, object_gravcomp=False
     )
-    radii = np.array([f.tip_radius for f in g.hand.fingers])
     segments = [Segment(1.0, twist=np.array([0, 0, rate, 0, 0, 0]))]
     return run_path(
         scene,
@@ -34,7 +33,6 @@ def _spin(rate):
         friction=mu,
         center_of_mass=mass_properties(obj).center_of_mass,
         gravity=np.array([0, 0, -9.81]),
-        radii=radii,
         safety=1.25,
     )
 

@@ -105,6 +105,15 @@ def simulate(
         ),
     ] = None,
     safety: Safety = 1.25,
+    path: Annotated[
+        str | None,
+        typer.Option(
+            "--path",
+            metavar="NAME",
+            help="Execute the grasp's path (or twist, for one unit of time) NAME instead: the fingers driven "
+            "by follow's joint rates, the object's pose compared with the plan at 21 samples.",
+        ),
+    ] = None,
     mjcf: Annotated[
         str | None,
         typer.Option(
@@ -147,6 +156,8 @@ def simulate(
     if mjcf is not None and not os.path.isdir(os.path.dirname(os.path.abspath(mjcf))):
         raise typer.BadParameter(f"no folder {os.path.dirname(mjcf)!r} to write the scene in", param_hint="--mjcf")
     fmt = SimulateFormat.json if json_ else fmt
+    if path is not None and fmt == SimulateFormat.csv:
+        raise typer.BadParameter("a path's samples are records: give -f json or jsonl", param_hint="--path")
     not_binary_to_a_terminal(fmt.value, output)
     distance, angle = tolerance if tolerance is not None else (SimulateOptions.distance_tol, SimulateOptions.angle_tol)
     job = Job(
@@ -163,6 +174,7 @@ def simulate(
             angle_tol=angle,
             safety=safety,
             mjcf=mjcf,
+            path=path,
         ),
     )
     settings = OutputSettings(

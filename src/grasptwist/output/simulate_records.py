@@ -9,6 +9,13 @@ One record per grasp (:class:`grasptwist.run.simulate.Simulated`)::
                      "contact_forces": [[3] x 3], "planned_forces": [[3] x 3]}, x 6],
      "warnings": [...]}
 
+With ``--path NAME`` a record per grasp says how its path went instead::
+
+    {"file", "grasp", "ok" (= followed), "path", "followed", "mass", "friction", "tolerance",
+     "safety", "final": {"position_error", "angle_error_deg"},
+     "samples": [{"time", "position_error", "angle_error_deg", "slip": [3], "slipped": [3]}, ...],
+     "warnings": [...]}
+
 ``displacement`` is the object's centre's distance from where it started (length units),
 ``rotation_deg`` the angle it turned, at the end of the direction's ``duration``;
 ``contact_forces`` each finger's force on the object in MuJoCo then, ``planned_forces``
@@ -70,8 +77,54 @@ def _warnings(sim) -> list[str]:
     return said
 
 
+def _path_record(ps) -> dict:
+    """The record of one grasp's path executed (``simulate --path``)."""
+    o, r = ps.options, ps.run
+    slipped = r.slip >= o.distance_tol
+    angles = np.degrees(r.angle_error)
+    followed = bool(r.position_error[-1] < o.distance_tol and angles[-1] < o.angle_tol and not slipped.any())
+    said = list(ps.grasp.warnings)
+    names = ps.grasp.contact_names
+    if slipped.any():
+        worst = r.slip.max(axis=0)
+        said.append(
+            "contacts slipped: "
+            + ", ".join(f"{escaped(n)} ({fmt_number(w, 4)})" for n, w, s in zip(names, worst, slipped.any(axis=0)) if s)
+        )
+    if not followed:
+        said.append(
+            f"path '{escaped(ps.path)}' ended {fmt_number(r.position_error[-1], 4)} and "
+            f"{fmt_number(angles[-1], 2)} deg from the plan"
+        )
+    return {
+        "file": escaped(ps.grasp.file, controls=False),
+        "grasp": escaped(ps.grasp.name, controls=False),
+        "ok": followed,
+        "path": escaped(ps.path, controls=False),
+        "followed": followed,
+        "mass": ps.mass,
+        "friction": ps.friction.tolist(),
+        "tolerance": {"distance": o.distance_tol, "angle_deg": o.angle_tol},
+        "safety": o.safety,
+        "final": {"position_error": float(r.position_error[-1]), "angle_error_deg": float(angles[-1])},
+        "samples": [
+            {
+                "time": float(t),
+                "position_error": float(p),
+                "angle_error_deg": float(a),
+                "slip": s.tolist(),
+                "slipped": k.tolist(),
+            }
+            for t, p, a, s, k in zip(r.times, r.position_error, angles, r.slip, slipped)
+        ],
+        "warnings": said,
+    }
+
+
 def simulate_record(sim) -> dict:
-    """The record of one grasp's hold test (module docstring)."""
+    """The record of one grasp's hold test, or of its path executed (module docstring)."""
+    if hasattr(sim, "run"):
+        return _path_record(sim)
     o = sim.options
     return {
         "file": escaped(sim.grasp.file, controls=False),
@@ -170,8 +223,25 @@ class SimulateTable:
             return "-"
         return ", ".join(self._number(float(np.linalg.norm(f))) for f in forces)
 
+    def _path(self, rec: dict) -> None:
+        final = rec["final"]
+        self._line(
+            f"{escaped(rec['file'])}: grasp '{escaped(rec['grasp'])}', path '{escaped(rec['path'])}': "
+            f"{'followed' if rec['followed'] else 'NOT followed'} (ends {_small(final['position_error'])} and "
+            f"{_small(final['angle_error_deg'])} deg from the plan)"
+        )
+        self._line("  time      position error  angle error (deg)  slip (each contact)")
+        for s in rec["samples"]:
+            slips = ", ".join(_small(v) for v in s["slip"])
+            self._line(
+                f"  {self._number(s['time']):<8}  {_small(s['position_error']):<14}  {_small(s['angle_error_deg']):<17}  {slips}"
+            )
+
     def write(self, rec: dict) -> None:
         if "error" in rec:  # its line is on stderr; tables carry results only
+            return
+        if "path" in rec:
+            self._path(rec)
             return
         verdict = "held" if rec["held"] else "NOT held"
         self._line(

@@ -131,7 +131,7 @@ class SimulateOptions:
     time each direction's load is applied; ``distance_tol`` and ``angle_tol`` (``--tolerance
     D,DEG``, degrees) how far the object may move and turn and still be held; ``safety``
     (``--safety``) the grip's safety factor; ``mjcf`` (``--mjcf OUT.xml``) where the scene is
-    written.
+    written; ``path`` (``--path NAME``) a path (or twist) to execute instead of the hold test.
     """
 
     mass: float | None = None
@@ -142,3 +142,4 @@ class SimulateOptions:
     angle_tol: float = 2.0
     safety: float = 1.25
     mjcf: str | None = None
+    path: str | None = None

@@ -23,6 +23,7 @@ from ..model import Grasp, GraspFileError
 from ..output import simulate_records as sr
 from ..output.records import diagnostics, dumps, error_record
 from ..sim.hold import HoldTest, hold_test
+from ..sim.path import PathRun, run_path
 from ..sim.scene import Scene, build_scene
 from .options import SimulateOptions
 from .outputs import Output
@@ -31,13 +32,17 @@ from .pool import Pool, pool_size
 
 __all__ = [
     "Simulated",
+    "PathSimulated",
     "simulate_grasp",
+    "simulate_path",
     "simulate_inputs",
     "simulate_outputs",
     "write_mjcf",
     "NO_OBJECT",
     "NO_MASS",
     "NO_FRICTION",
+    "NO_PATH",
+    "PATH_SAMPLES",
     "SCENE_ERROR",
     "UNSTABLE",
     "GRAVITY",
@@ -47,7 +52,10 @@ __all__ = [
 ]
 
 #: Error codes of a grasp that cannot be simulated, and of a simulation that diverged.
-NO_OBJECT, NO_MASS, NO_FRICTION = "no-object", "no-mass", "no-friction"
+NO_OBJECT, NO_MASS, NO_FRICTION, NO_PATH = "no-object", "no-mass", "no-friction", "no-path"
+
+#: Samples of a path executed (``simulate --path``), ends included.
+PATH_SAMPLES = 21
 SCENE_ERROR, UNSTABLE = "scene-error", "simulation-unstable"
 
 #: The constraint a search's grasps failed when none held in MuJoCo (``synthesize --simulate``).
@@ -78,11 +86,9 @@ def _mass(options, grasp, obj):
     return mass_properties(obj).mass if mass_properties(obj).mass is not None else grasp.mass
 
 
-def simulate_grasp(
-    options: SimulateOptions, grasp: Grasp, mjcf: str | None = None, observe=None
-) -> Simulated | GraspFileError:
-    """The hold test of one grasp, or why it cannot be run (module docstring); ``mjcf``: write its scene
-    there; ``observe``: :func:`~grasptwist.sim.hold.hold_test`'s."""
+def _prepared(options: SimulateOptions, grasp: Grasp, mjcf: str | None, hold: bool):
+    """What a simulation of ``grasp`` needs: ``(mass, friction, gravity, load, centre of mass, scene)``,
+    or why it cannot be run; the scene compensates the object's weight for the hold test (``hold``)."""
     obj = grasp.object
     if obj is None:
         return _problem(grasp, NO_OBJECT, "has no object to simulate: add an 'object' key")
@@ -103,14 +109,40 @@ def simulate_grasp(
         tolerance=options.distance_tol,
         table_height=options.table,
         gravity=gravity,
+        object_gravcomp=hold,
     )
     if mjcf is not None:
         write_mjcf(scene, mjcf)
+    return mass, friction, gravity, load, mass_properties(obj).center_of_mass, scene
+
+
+def _unstable(grasp, where: str, u) -> GraspFileError:
+    return _problem(
+        grasp, UNSTABLE, f"{where}: the simulation diverged at step {u.step} (t = {u.time:g} s): {u.reason}"
+    )
+
+
+def _compile_error(grasp, exc) -> GraspFileError:
+    return _problem(grasp, SCENE_ERROR, f"MuJoCo cannot compile its scene: {exc}".strip())
+
+
+def simulate_grasp(
+    options: SimulateOptions, grasp: Grasp, mjcf: str | None = None, observe=None
+) -> Simulated | PathSimulated | GraspFileError:
+    """The hold test of one grasp (its path's execution with ``options.path``), or why it cannot be
+    run (module docstring); ``mjcf``: write its scene there; ``observe``:
+    :func:`~grasptwist.sim.hold.hold_test`'s."""
+    if options.path is not None:
+        return simulate_path(options, grasp, mjcf)
+    ready = _prepared(options, grasp, mjcf, hold=True)
+    if isinstance(ready, GraspFileError):
+        return ready
+    mass, friction, _, load, center, scene = ready
     try:
         test = hold_test(
             scene,
             grasp,
-            center_of_mass=mass_properties(obj).center_of_mass,
+            center_of_mass=center,
             friction=friction,
             load=load,
             duration=options.duration,
@@ -120,15 +152,65 @@ def simulate_grasp(
             observe=observe,
         )
     except ValueError as exc:  # MuJoCo's compiler: its reason
-        return _problem(grasp, SCENE_ERROR, f"MuJoCo cannot compile its scene: {exc}".strip())
+        return _compile_error(grasp, exc)
     if test.unstable is not None:
-        u = test.unstable
-        return _problem(
-            grasp,
-            UNSTABLE,
-            f"direction {u.where}: the simulation diverged at step {u.step} (t = {u.time:g} s): {u.reason}",
-        )
+        return _unstable(grasp, f"direction {test.unstable.where}", test.unstable)
     return Simulated(grasp, mass, friction, test, options)
+
+
+@dataclass(frozen=True, eq=False)
+class PathSimulated:
+    """One grasp's path executed in MuJoCo (``simulate --path``), with what it was run with."""
+
+    grasp: Grasp
+    path: str
+    mass: float
+    friction: np.ndarray
+    run: PathRun
+    options: SimulateOptions
+
+
+def _segments(grasp: Grasp, name: str):
+    """The segments of the grasp's path ``name``, or its twist ``name`` held for one unit of time."""
+    from ..model import Segment
+
+    for p in grasp.paths:
+        if p.name == name:
+            return p.segments
+    for t in grasp.twists:
+        if t.name == name:
+            return (Segment(1.0, twist=t.screw),)
+    names = ", ".join(f"'{n}'" for n in [p.name for p in grasp.paths] + [t.name for t in grasp.twists]) or "none"
+    return _problem(grasp, NO_PATH, f"has no path or twist named '{name}' (its paths and twists: {names})")
+
+
+def simulate_path(options: SimulateOptions, grasp: Grasp, mjcf: str | None = None) -> PathSimulated | GraspFileError:
+    """The grasp's path (or twist, held for one unit of time) ``options.path`` executed in MuJoCo
+    (:func:`grasptwist.sim.path.run_path`), :data:`PATH_SAMPLES` samples compared with the plan."""
+    segments = _segments(grasp, options.path)
+    if isinstance(segments, GraspFileError):
+        return segments
+    ready = _prepared(options, grasp, mjcf, hold=False)
+    if isinstance(ready, GraspFileError):
+        return ready
+    mass, friction, gravity, _, center, scene = ready
+    times = np.linspace(0.0, float(sum(s.duration for s in segments)), PATH_SAMPLES)
+    try:
+        run = run_path(
+            scene,
+            grasp,
+            segments,
+            times,
+            friction=friction,
+            center_of_mass=center,
+            gravity=gravity,
+            safety=options.safety,
+        )
+    except ValueError as exc:
+        return _compile_error(grasp, exc)
+    if run.unstable is not None:
+        return _unstable(grasp, f"path '{options.path}' at {run.unstable.where}", run.unstable)
+    return PathSimulated(grasp, options.path, mass, friction, run, options)
 
 
 def write_mjcf(scene: Scene, path: str) -> None:

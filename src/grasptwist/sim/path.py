@@ -73,7 +73,6 @@ def run_path(
     friction,
     center_of_mass,
     gravity,
-    radii,
     safety: float = 1.0,
 ) -> PathRun:
     """Execute ``segments`` (module docstring), sampled at ``times`` (increasing, from 0).
@@ -87,8 +86,6 @@ def run_path(
     times : (T,) array
     friction : (3,) array
     center_of_mass, gravity : (3,) arrays
-    radii : (3,) array
-        The fingertips' radii in the scene.
     safety : float
         The grip's safety factor.
 
@@ -102,7 +99,7 @@ def run_path(
     times = np.asarray(times, dtype=float)
     grid = _grid(times, CONTROL_DT)
     coarse = _grid(times, TRACK_DT)  # the hand's track, interpolated between its samples
-    tracked = _targets(grasp, scene, segments, coarse, radii)
+    tracked = _targets(grasp, scene, segments, coarse, scene.radii)
     q = np.stack([np.interp(grid, coarse, tracked[:, j]) for j in range(tracked.shape[1])], axis=1)
     rates = np.gradient(q, grid, axis=0) if len(grid) > 1 else np.zeros_like(q)
     poses, held = grip_along(

@@ -104,6 +104,8 @@ class Scene:
         Their positions at the grasp.
     mass : float
         The object's mass.
+    radii : (3,) array
+        The fingertips' radii in the scene.
     """
 
     xml: str
@@ -111,6 +113,7 @@ class Scene:
     joints: tuple[str, ...]
     positions: np.ndarray
     mass: float
+    radii: np.ndarray
 
 
 def _v(values) -> str:
@@ -361,7 +364,7 @@ def build_scene(
 </worldbody>
 </mujoco>
 """
-    return Scene(xml, assets, joints, q, float(mass))
+    return Scene(xml, assets, joints, q, float(mass), radii)
 
 
 def _attribute(text: str) -> str:
