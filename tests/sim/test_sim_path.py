@@ -1,4 +1,4 @@
-"""A path executed in MuJoCo (issue 38, item 3, partial): the machinery is there; the TriFinger's
+"""A path executed in MuJoCo (issue 38, item 3): a path that stands still holds; the TriFinger's
 spin does not yet track its plan (docs/guide/simulation.md, "Paths").  Slow: seconds of tracking."""
 
 import math

@@ -23,7 +23,17 @@ from ..engine.hold_test import DIRECTIONS, UNITS, direction_wrenches, held, join
 from ..extras import require
 from .scene import OBJECT, TIP, Scene
 
-__all__ = ["Direction", "HoldTest", "Unstable", "hold_test", "load_model", "contact_forces", "CHUNK"]
+__all__ = [
+    "Direction",
+    "HoldTest",
+    "Unstable",
+    "hold_test",
+    "load_model",
+    "contact_forces",
+    "rotation_angle",
+    "diverged",
+    "CHUNK",
+]
 
 #: Steps simulated between two checks for divergence (and for an object already gone).
 CHUNK = 50
@@ -100,7 +110,7 @@ def contact_forces(mujoco, model, data, body: int, tips) -> np.ndarray:
     return out
 
 
-def _angle(mujoco, q0, q1) -> float:
+def rotation_angle(mujoco, q0, q1) -> float:
     """The angle between two unit quaternions' rotations (radians), exact near zero."""
     rel, neg = np.zeros(4), np.zeros(4)
     mujoco.mju_negQuat(neg, q0)
@@ -108,7 +118,7 @@ def _angle(mujoco, q0, q1) -> float:
     return 2 * math.atan2(float(np.linalg.norm(rel[1:])), abs(float(rel[0])))
 
 
-def _diverged(mujoco, data) -> str | None:
+def diverged(mujoco, data) -> str | None:
     if not (np.isfinite(data.qpos).all() and np.isfinite(data.qvel).all()):
         return "a position or velocity is not finite"
     for name in _DIVERGED:
@@ -187,7 +197,7 @@ def hold_test(
             n = min(CHUNK, steps - done)
             mujoco.mj_step(model, data, nstep=n)
             done += n
-            why = _diverged(mujoco, data)
+            why = diverged(mujoco, data)
             if why is not None:
                 return HoldTest(tuple(out), load, Unstable(name, done, done * model.opt.timestep, why))
             if np.linalg.norm(data.qpos[free : free + 3] - start) > gone:
@@ -195,7 +205,7 @@ def hold_test(
         if observe is not None:
             observe(name, model, data)
         moved = float(np.linalg.norm(data.qpos[free : free + 3] - start))
-        turned = _angle(mujoco, quat, data.qpos[free + 3 : free + 7])
+        turned = rotation_angle(mujoco, quat, data.qpos[free + 3 : free + 7])
         forces = contact_forces(mujoco, model, data, body, tips)
         ok = bool(held(moved, turned, distance_tol, angle_tol))
         out.append(Direction(name, ok, moved, turned, forces, planned.force[d], 0, True))

@@ -24,7 +24,7 @@ from ..engine.hands import track
 from ..engine.hold_test import joint_torques
 from ..engine.path import integrate
 from ..extras import require
-from .hold import CHUNK, Unstable, _angle, _diverged, load_model
+from .hold import CHUNK, Unstable, diverged, load_model, rotation_angle
 from .scene import OBJECT, TIP, Scene
 
 __all__ = ["PathRun", "run_path", "CONTROL_DT"]
@@ -132,7 +132,7 @@ def run_path(
             rot = data.xmat[body].reshape(3, 3)
             out["time"].append(t)
             out["position"].append(float(np.linalg.norm(data.qpos[free : free + 3] - planned_origin)))
-            out["angle"].append(_angle(mujoco, planned, data.qpos[free + 3 : free + 7]))
+            out["angle"].append(rotation_angle(mujoco, planned, data.qpos[free + 3 : free + 7]))
             out["slip"].append(
                 np.linalg.norm(data.geom_xpos[tips] - (carried @ rot.T + data.qpos[free : free + 3]), axis=1)
             )
@@ -143,7 +143,7 @@ def run_path(
         n = max(1, round((grid[k + 1] - t) / model.opt.timestep))
         for start in range(0, n, CHUNK):
             mujoco.mj_step(model, data, nstep=min(CHUNK, n - start))
-            why = _diverged(mujoco, data)
+            why = diverged(mujoco, data)
             if why is not None:
                 step += start + min(CHUNK, n - start)
                 unstable = Unstable(f"t = {t:g}", step, step * model.opt.timestep, why)
