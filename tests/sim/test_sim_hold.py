@@ -135,3 +135,17 @@ def test_box_obstacles_stand_in_the_scene_and_the_object_rests_on_one():
     mujoco.mj_forward(model, data)
     touching = {tuple(sorted((model.geom(c.geom1).name, model.geom(c.geom2).name))) for c in data.contact[: data.ncon]}
     assert ("box0", "piece0") in touching
+
+
+@pytest.mark.slow  # CoACD and trimesh's boolean union load in 2 s
+def test_coacd_cuts_a_concave_mesh_into_convex_pieces_of_its_volume():
+    trimesh = pytest.importorskip("trimesh")
+    from grasptwist.sim.scene import convex_pieces
+
+    bar = trimesh.creation.box((0.1, 0.02, 0.02))
+    arm = trimesh.creation.box((0.02, 0.1, 0.02))
+    arm.apply_translation((0.04, 0.04, 0))
+    ell = bar.union(arm)  # an L: its convex hull would fill the corner (1.9 times its volume)
+    pieces = [trimesh.Trimesh(v, f) for v, f in convex_pieces(ell.vertices, ell.faces)]
+    assert len(pieces) == 2 and all(p.is_convex for p in pieces)
+    assert sum(p.volume for p in pieces) == pytest.approx(ell.volume, rel=0.01)

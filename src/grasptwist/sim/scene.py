@@ -32,6 +32,7 @@ import numpy as np
 from ..engine.fingertips import tip_centers
 from ..engine.hands import tip_poses
 from ..engine.objects.geometry import object_size
+from ..extras import require
 from ..model import Grasp, GraspObject
 from .contact import CONTACT, ContactSettings, option_xml
 
@@ -50,6 +51,9 @@ __all__ = [
 #: Each finger link's and fingertip's mass, as a fraction of the object's (their gravity is
 #: compensated and their joints' armature outweighs them: they barely matter).
 PART = 0.05
+
+#: Most convex pieces a mesh object collides as (:func:`convex_pieces`).
+MAX_PIECES = 32
 
 #: A point tip's sphere radius, as a fraction of the object's size (MuJoCo needs a radius).
 POINT_TIP = 0.02
@@ -137,13 +141,14 @@ def convex_pieces(vertices, faces) -> list[tuple[np.ndarray, np.ndarray]]:
 
     CoACD (Wei et al., SIGGRAPH 2022) cuts a mesh where its concavity exceeds a threshold
     and keeps the collision-aware pieces; its default threshold (0.05 of the size) keeps a
-    convex mesh in one piece.  Each piece is returned as ``(vertices, faces)``.
+    convex mesh in one piece.  At most :data:`MAX_PIECES` pieces (time and memory bounded),
+    seeded (the same pieces every run).  Each piece is returned as ``(vertices, faces)``.
     """
-    import coacd  # the sim extra: with the first mesh simulated
-
+    coacd = require("coacd", "a mesh object in grasptwist simulate")
     coacd.set_log_level("error")
     mesh = coacd.Mesh(np.asarray(vertices, dtype=float), np.asarray(faces, dtype=np.int64))
-    return [(np.asarray(v, float), np.asarray(f, int)) for v, f in coacd.run_coacd(mesh)]
+    pieces = coacd.run_coacd(mesh, max_convex_hull=MAX_PIECES, seed=0)
+    return [(np.asarray(v, float), np.asarray(f, int)) for v, f in pieces]
 
 
 def mass_geom(obj: GraspObject, mass: float) -> tuple[str, dict]:
