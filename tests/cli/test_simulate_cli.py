@@ -159,3 +159,18 @@ def test_the_trifinger_spin_lags_its_plan_as_the_guide_says():
     (rec,) = jsonl(r.stdout)
     assert not rec["followed"] and 5 < rec["final"]["angle_error_deg"] < 15  # measured 9.1 deg behind
     assert all(rec["samples"][-1]["slipped"])
+
+
+@pytest.mark.slow  # two worker processes: a second
+def test_workers_simulate_a_folder_file_by_file_with_the_same_records(tmp_path):
+    for name in ("sphere.yaml", "cylinder.yaml"):
+        (tmp_path / name).write_bytes((GRASPS / name).read_bytes())
+    args = ("simulate", tmp_path, "--mass", "0.1", "--friction", "0.8", *SHORT, "-f", "jsonl")
+    one, _ = run(*args)
+    two, _ = run(*args, "-j", "2")
+    assert one.exit_code == two.exit_code and one.stdout == two.stdout
+    assert [(r["grasp"], r["held"]) for r in jsonl(two.stdout)] == [
+        ("cylinder", True),
+        ("sphere-tripod", True),
+        ("sphere-equator", True),
+    ]
