@@ -19,7 +19,9 @@ import numpy as np
 
 from ..engine.objects.geometry import mass_properties
 from ..engine.synthesis.search import Failure
-from ..model import Grasp, GraspFileError
+from ..io.limits import DEFAULT_MAX_BYTES
+from ..io.urdf_meshes import grasp_folder, urdf_files
+from ..model import Grasp, GraspFileError, InputError
 from ..output import simulate_records as sr
 from ..output.records import diagnostics, dumps, error_record
 from ..sim.hold import HoldTest, hold_test
@@ -86,7 +88,7 @@ def _mass(options, grasp, obj):
     return mass_properties(obj).mass if mass_properties(obj).mass is not None else grasp.mass
 
 
-def _prepared(options: SimulateOptions, grasp: Grasp, mjcf: str | None, hold: bool):
+def _prepared(options: SimulateOptions, grasp: Grasp, mjcf: str | None, hold: bool, max_bytes=None):
     """What a simulation of ``grasp`` needs: ``(mass, friction, gravity, load, centre of mass, scene)``,
     or why it cannot be run; the scene compensates the object's weight for the hold test (``hold``)."""
     obj = grasp.object
@@ -101,16 +103,26 @@ def _prepared(options: SimulateOptions, grasp: Grasp, mjcf: str | None, hold: bo
     gravity = np.asarray(GRAVITY if grasp.gravity is None else grasp.gravity, float)
     load = mass * float(np.linalg.norm(gravity))
     obj = replace(obj, mass=mass, density=None)
-    scene = build_scene(
-        replace(grasp, object=obj),
-        mass=mass,
-        friction=friction,
-        load=load,
-        tolerance=options.distance_tol,
-        table_height=options.table,
-        gravity=gravity,
-        object_gravcomp=hold,
-    )
+    urdf = None
+    if grasp.hand is not None and grasp.hand.source is not None:  # MuJoCo reads the URDF and its meshes
+        try:
+            urdf = urdf_files(grasp.hand, folder=grasp_folder(grasp), max_bytes=max_bytes or DEFAULT_MAX_BYTES)
+        except InputError as exc:
+            return _problem(grasp, exc.code, f"hand: {exc.message}")
+    try:
+        scene = build_scene(
+            replace(grasp, object=obj),
+            mass=mass,
+            friction=friction,
+            load=load,
+            tolerance=options.distance_tol,
+            table_height=options.table,
+            urdf=urdf,
+            gravity=gravity,
+            object_gravcomp=hold,
+        )
+    except ValueError as exc:  # MuJoCo's URDF reader or compiler: its reason
+        return _compile_error(grasp, exc)
     if mjcf is not None:
         write_mjcf(scene, mjcf)
     return mass, friction, gravity, load, mass_properties(obj).center_of_mass, scene
@@ -291,7 +303,7 @@ def _found_grasp(found, k: int) -> Grasp:
     return Grasp(
         f"{found.name}#{k + 1}",
         found.units,
-        found.file,
+        found.hand_file or found.file,  # a URDF hand's files are found from the file that names it
         0,
         found.contact_names,
         s.points[k],

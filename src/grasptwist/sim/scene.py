@@ -6,11 +6,11 @@ r"""A grasp as a MuJoCo scene (MJCF): the object, the table, and the hand at the
   centre and inertia are those of the solid (:func:`mass_geom`: the one geom that carries
   them, MuJoCo integrating the solid exactly), uniform density.
 - **Table**: a plane ``z = table_height`` (normal +z) when asked for.
-- **Hand**: built from grasptwist's own kinematic model of it (the URDF as
-  :mod:`grasptwist.io.urdf` read it, or the joints given inline), so that MuJoCo moves the
-  very chains whose Jacobians plan the grip: each joint a hinge or a slide through its point
-  along its axis, with its limits; nested bodies whose frames coincide with the grasp frame
-  at home (the product of exponentials).  Links are capsules between successive joints, for
+- **Hand**: a URDF hand read by MuJoCo's URDF reader (:func:`_with_urdf_hand`: the description
+  and its meshes, which the run layer reads); otherwise built from grasptwist's own model of it
+  (joints given inline): each joint a hinge or a slide through its point along its axis, with
+  its limits; nested bodies whose frames coincide with the grasp frame at home (the product of
+  exponentials).  Links are capsules between successive joints, for
   the eye only (grasptwist checks the links against the object itself,
   ``finger-collides``); each fingertip is a sphere of the finger's tip radius touching its
   contact (:data:`POINT_TIP` of the object's size for a point tip).  A grasp without a hand
@@ -24,6 +24,7 @@ The contact settings are :mod:`.contact`'s.
 from __future__ import annotations
 
 import math
+import os
 import struct
 from dataclasses import dataclass
 
@@ -238,6 +239,19 @@ def _tip_geom(f, centre, radius, mu, mass) -> str:
     )
 
 
+def _hand_drive(grasp, centres, load, tolerance, timestep, compliance):
+    """Each finger's tip body frame at the grasp, ``g_f(q)`` (the product of exponentials), and the
+    hand's :class:`Drive` from each joint's lever to its fingertip's centre."""
+    hand = grasp.hand
+    q = np.asarray(grasp.joint_positions, dtype=float)
+    moved = tip_poses(hand, q, np.tile(np.eye(4), (3, 1, 1)))
+    lever = np.zeros(len(hand.joint_names))
+    for f, finger in enumerate(hand.fingers):
+        reach = np.linalg.norm(finger.points - (np.linalg.inv(moved[f]) @ np.append(centres[f], 1))[:3], axis=1)
+        lever[list(finger.joint_index)] = np.where([j.type == "prismatic" for j in finger.joints], np.nan, reach)
+    return moved, _drive(lever, load, tolerance, timestep, compliance)
+
+
 def _hand_xml(grasp, radii, mu, load, tolerance, timestep, part, compliance) -> tuple[str, tuple, np.ndarray]:
     """The fingers' bodies (each link and tip of mass ``part``), their joint names and positions at the grasp."""
     hand = grasp.hand
@@ -255,13 +269,7 @@ def _hand_xml(grasp, radii, mu, load, tolerance, timestep, part, compliance) -> 
             bodies.append(f'<body name="finger{f}" gravcomp="1">\n{body}\n</body>')
         return "\n".join(bodies), tuple(names), np.zeros(9)
     q = np.asarray(grasp.joint_positions, dtype=float)
-    # the tip body's frame at the grasp is the product of exponentials g_f(q): its sphere's centre at home
-    moved = tip_poses(hand, q, np.tile(np.eye(4), (3, 1, 1)))
-    lever = np.zeros(len(hand.joint_names))
-    for f, finger in enumerate(hand.fingers):
-        reach = np.linalg.norm(finger.points - (np.linalg.inv(moved[f]) @ np.append(centres[f], 1))[:3], axis=1)
-        lever[list(finger.joint_index)] = np.where([j.type == "prismatic" for j in finger.joints], np.nan, reach)
-    drive = _drive(lever, load, tolerance, timestep, compliance)
+    moved, drive = _hand_drive(grasp, centres, load, tolerance, timestep, compliance)
     bodies = []
     for f, finger in enumerate(hand.fingers):
         home_centre = (np.linalg.inv(moved[f]) @ np.append(centres[f], 1))[:3]
@@ -289,6 +297,52 @@ def _hand_xml(grasp, radii, mu, load, tolerance, timestep, part, compliance) -> 
     return "\n".join(bodies), tuple(f"joint{i}" for i in range(len(hand.joint_names))), q
 
 
+#: The prefix of a URDF hand's names in the scene.
+HAND = "hand/"
+
+
+def _with_urdf_hand(xml, grasp, urdf, radii, mu, load, tolerance, timestep, compliance, part):
+    """The scene ``xml`` with the hand as MuJoCo reads its URDF (``(text, meshes by file name)``):
+    its links' own masses and inertias, their meshes drawn but not colliding, each joint driven as
+    :class:`Drive` says, each tip link carrying a fingertip sphere at its origin.  The MJCF, its
+    mesh files, the hand's joints in the scene and their positions at the grasp."""
+    mujoco = require("mujoco", "grasptwist simulate")
+    text, meshes = urdf
+    hand = grasp.hand
+    try:
+        spec = mujoco.MjSpec.from_string(text, assets=meshes)
+    except ValueError as exc:  # MuJoCo's URDF reader: its reason, with the line
+        raise ValueError(f"MuJoCo cannot read the URDF {hand.source}: {exc}") from None
+    q = np.asarray(grasp.joint_positions, dtype=float)
+    _, drive = _hand_drive(
+        grasp, tip_centers(grasp.points, grasp.normals, radii), load, tolerance, timestep, compliance
+    )
+    for i, name in enumerate(hand.joint_names):
+        joint = spec.joint(name)
+        joint.stiffness, joint.damping = [drive.stiffness[i], 0, 0], [drive.damping[i], 0, 0]
+        joint.armature, joint.springref = drive.armature[i], q[i]
+    for body in spec.bodies:
+        body.gravcomp = 1
+    for geom in spec.geoms:
+        geom.contype = geom.conaffinity = 0
+        geom.group = 1
+    scene = mujoco.MjSpec.from_string(xml)
+    scene.attach(spec, frame=scene.worldbody.add_frame(), prefix=HAND)
+    for f, finger in enumerate(hand.fingers):
+        scene.body(HAND + finger.tip).add_geom(
+            name=TIP.format(f),
+            type=mujoco.mjtGeom.mjGEOM_SPHERE,
+            size=[radii[f], 0, 0],
+            friction=[mu[f], 0, 0],
+            mass=part,
+            rgba=[0.2, 0.4, 0.9, 1],
+        )
+    for mesh in scene.meshes:  # beside the scene, by file name (as MuJoCo's URDF reader finds them)
+        mesh.file = os.path.basename(mesh.file)
+    files = {os.path.basename(name): data for name, data in meshes.items()}
+    return scene.to_xml(), files, tuple(HAND + name for name in hand.joint_names), q
+
+
 def build_scene(
     grasp: Grasp,
     *,
@@ -299,6 +353,7 @@ def build_scene(
     table_height: float | None = None,
     table_friction: float | None = None,
     boxes=(),
+    urdf=None,
     gravity=(0.0, 0.0, -9.81),
     object_gravcomp: bool = True,
     compliance: float = COMPLIANCE,
@@ -322,6 +377,10 @@ def build_scene(
     boxes : sequence of (centre (3,), size (3,))
         Fixed box obstacles, axis-aligned, edge lengths ``size``, with the table's friction (a grasp
         file's environment is the table and these).
+    urdf : (str, dict) or None
+        A URDF hand's description and its mesh files by file name
+        (:func:`grasptwist.io.urdf_meshes.urdf_files`): MuJoCo reads the hand from them (else it is
+        built from grasptwist's model of it, as an inline hand is).
     gravity : (3,) array
     object_gravcomp : bool
         The object's weight compensated (the hold test applies its load itself).
@@ -341,7 +400,12 @@ def build_scene(
     radii = np.array([f.tip_radius for f in grasp.hand.fingers]) if grasp.hand is not None else np.zeros(3)
     radii = np.where(radii > 0, radii, POINT_TIP * size)
     geoms, assets, meshes = _object_geoms(obj, mass, pieces)
-    hand, joints, q = _hand_xml(grasp, radii, mu, load, tolerance, settings.timestep, PART * mass, compliance)
+    by_urdf = urdf is not None and grasp.hand is not None and grasp.hand.source is not None
+    hand, joints, q = (
+        ("", (), None)
+        if by_urdf
+        else _hand_xml(grasp, radii, mu, load, tolerance, settings.timestep, PART * mass, compliance)
+    )
     tmu = float(np.min(mu)) if table_friction is None else table_friction
     table = "".join(
         f'<geom name="box{k}" type="box" pos="{_v(centre)}" size="{_v(np.asarray(edges, float) / 2)}" '
@@ -369,6 +433,11 @@ def build_scene(
 </worldbody>
 </mujoco>
 """
+    if by_urdf:
+        xml, files, joints, q = _with_urdf_hand(
+            xml, grasp, urdf, radii, mu, load, tolerance, settings.timestep, compliance, PART * mass
+        )
+        assets = {**assets, **files}
     return Scene(xml, assets, joints, q, float(mass), radii)
 
 
