@@ -149,3 +149,15 @@ def test_coacd_cuts_a_concave_mesh_into_convex_pieces_of_its_volume():
     pieces = [trimesh.Trimesh(v, f) for v, f in convex_pieces(ell.vertices, ell.faces)]
     assert len(pieces) == 2 and all(p.is_convex for p in pieces)
     assert sum(p.volume for p in pieces) == pytest.approx(ell.volume, rel=0.01)
+
+
+def test_a_urdf_mujoco_cannot_read_is_its_reason_naming_the_urdf():
+    from grasptwist.io.urdf_meshes import grasp_folder, urdf_files
+
+    g = _grasp("trifinger-cube.yaml")
+    text, meshes = urdf_files(g.hand, folder=grasp_folder(g))
+    assert sorted(meshes)[:2] == ["center_axis_sim.stl", "int_sim.stl"]
+    with pytest.raises(
+        ValueError, match=r"MuJoCo cannot read the URDF package://robot_properties_fingers/.*prox-sim.stl"
+    ):
+        build_scene(g, mass=0.1, friction=np.ones(3), load=1.0, tolerance=0.002, urdf=(text, {}))  # no meshes

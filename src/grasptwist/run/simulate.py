@@ -1,8 +1,11 @@
-"""Simulate grasps in MuJoCo: grasp files in, one hold test per grasp out.
+"""Simulate grasps in MuJoCo: grasp files in, one hold test (or, with ``--path``, one path
+executed) per grasp out.
 
 Each grasp (hand placed, as every command reads it) needs an object, a mass (the object's,
-the file's ``mass``, or ``--mass``) and a friction (the file's or ``--friction``); its scene is
-:func:`grasptwist.sim.scene.build_scene`'s, its test :func:`grasptwist.sim.hold.hold_test`'s.
+the file's ``mass``, or ``--mass``) and a friction (the file's or ``--friction``); a URDF hand's
+description and meshes are read here for MuJoCo's URDF reader; its scene is
+:func:`grasptwist.sim.scene.build_scene`'s, its test :func:`grasptwist.sim.hold.hold_test`'s
+(:func:`grasptwist.sim.path.run_path`'s).
 With ``-j`` each input file is simulated in a worker process.  No math here: only reading,
 routing and labelling.
 """

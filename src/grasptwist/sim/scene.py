@@ -340,7 +340,11 @@ def _with_urdf_hand(xml, grasp, urdf, radii, mu, load, tolerance, timestep, comp
     for mesh in scene.meshes:  # beside the scene, by file name (as MuJoCo's URDF reader finds them)
         mesh.file = os.path.basename(mesh.file)
     files = {os.path.basename(name): data for name, data in meshes.items()}
-    return scene.to_xml(), files, tuple(HAND + name for name in hand.joint_names), q
+    try:
+        xml = scene.to_xml()  # compiles: a mesh it cannot open or read fails here
+    except ValueError as exc:
+        raise ValueError(f"MuJoCo cannot read the URDF {hand.source}: {exc}") from None
+    return xml, files, tuple(HAND + name for name in hand.joint_names), q
 
 
 def build_scene(
