@@ -96,7 +96,8 @@ def test_a_mesh_collides_as_convex_pieces_and_weighs_as_its_solid():
     np.testing.assert_allclose(np.sort(model.body_inertia[body]), expected, rtol=1e-4)
 
 
-def test_a_simulation_that_diverges_is_a_record_naming_the_step():
+def test_a_simulation_that_diverges_is_a_record_naming_the_step(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)  # MuJoCo would log its warning to MUJOCO_LOG.TXT here
     g = _grasp("sphere.yaml", 1)
     options = SimulateOptions(mass=0.1, friction=0.8, duration=SHORT)
     # the slides' springs 1e7 times stiffer than their armature allows: explicit springs blow up
@@ -107,6 +108,7 @@ def test_a_simulation_that_diverges_is_a_record_naming_the_step():
     assert test.unstable is not None and not test.held
     assert test.unstable.where == "+x" and 0 < test.unstable.step <= round(SHORT / 0.001)
     assert options.duration == SHORT and UNSTABLE == "simulation-unstable"
+    assert list(tmp_path.iterdir()) == []
 
 
 def test_gt_simulate_runs_the_hold_test_and_raises_what_it_cannot_simulate():

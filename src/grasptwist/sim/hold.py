@@ -84,10 +84,16 @@ class HoldTest:
         return self.unstable is None and all(d.held for d in self.directions)
 
 
+def _quiet(message: str) -> None:
+    """MuJoCo's warnings kept from stderr and from its log file (``MUJOCO_LOG.TXT`` in the working
+    folder): the simulation reads them from its data's counters (:func:`diverged`)."""
+
+
 def load_model(scene: Scene):
     """MuJoCo's model of ``scene``, its hand's joint springs at rest at the grasp; ``ValueError``:
     the reason MuJoCo cannot compile it."""
     mujoco = require("mujoco", "grasptwist simulate")
+    mujoco.set_mju_user_warning(_quiet)
     model = mujoco.MjModel.from_xml_string(scene.xml, scene.assets)
     adr = [model.jnt_qposadr[model.joint(j).id] for j in scene.joints]
     model.qpos_spring[adr] = scene.positions
