@@ -8,7 +8,7 @@ LAYERS = [
     ["grasptwist.engine"],  # the math on arrays
     ["grasptwist.io"],  # files in
     ["grasptwist.results"],  # the registry of result kinds and their fields
-    ["grasptwist.output", "grasptwist.plot"],  # records and tables out; pictures
+    ["grasptwist.output", "grasptwist.plot", "grasptwist.sim"],  # records and tables out; pictures; MuJoCo scenes
     ["grasptwist.run"],  # batches, workers, streams, the -o target: engine over inputs into outputs
     ["grasptwist.cli"],  # the command line
     # the public facades and entry points: nothing inside the package imports them

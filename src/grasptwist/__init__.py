@@ -61,6 +61,8 @@ _EXPORTS = {
     # finding grasps on an object's surface
     "synthesize": ".run.grasp_search",
     "Synthesis": ".engine.synthesis.search",
+    # a grasp run in MuJoCo (the sim extra)
+    "simulate": ".run.simulate",
     # the topics
     "screws": ".screws",
     "hand": ".hand",

@@ -20,6 +20,8 @@ EXTRAS = {
     "scipy": ("scipy", "quality"),
     "igl": ("libigl", "mesh"),
     "trimesh": ("trimesh", "mesh"),
+    "mujoco": ("'grasptwist[sim]'", "sim"),
+    "coacd": ("'grasptwist[sim]'", "sim"),
 }
 
 

@@ -22,8 +22,11 @@ SRC = ROOT / "src"
 PACKAGE = SRC / "grasptwist"
 
 #: Beyond the layers: pictures are drawn from the engine's geometry only; reading
-#: files and writing records is the command line's (issue 22).
-FORBIDDEN = {"grasptwist.plot": ("grasptwist.io", "grasptwist.output", "grasptwist.results", "grasptwist.run")}
+#: files and writing records is the command line's (issue 22).  So are MuJoCo's scenes (issue 38).
+FORBIDDEN = {
+    "grasptwist.plot": ("grasptwist.io", "grasptwist.output", "grasptwist.results", "grasptwist.run"),
+    "grasptwist.sim": ("grasptwist.io", "grasptwist.output", "grasptwist.results", "grasptwist.run"),
+}
 
 #: Facades only re-export: the public modules but the core, ``dask`` (which holds its own code) and the script.
 FACADES = tuple(m for m in LAYERS[-1] if m not in ("grasptwist", "grasptwist.dask", "grasptwist.__main__"))
@@ -222,6 +225,8 @@ NOT_FOR_JSON_RESOLVE = (
     "grasptwist.output.table",
     "grasptwist.output.follow_table",
     "grasptwist.plot",
+    "grasptwist.sim",
+    "mujoco",
     "rich",
     "matplotlib",
     "scipy",

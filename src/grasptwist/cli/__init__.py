@@ -22,7 +22,7 @@ __all__ = ["app", "app_for", "command", "COMMANDS", "main"]
 #: The commands by name, in the order of ``grasptwist -h``: each is the function of the same
 #: name in the module of the same name, imported only when a command line needs it (a run of
 #: one command does not pay for the others' modules at start-up).
-COMMANDS = ("resolve", "basis", "check", "follow", "forces", "synthesize", "schema", "plot")
+COMMANDS = ("resolve", "basis", "check", "follow", "forces", "synthesize", "simulate", "schema", "plot")
 
 
 def command(name: str):

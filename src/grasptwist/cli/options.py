@@ -70,6 +70,7 @@ RecordFormat = _choices("RecordFormat", COMMANDS["basis"].formats)
 FollowFormat = _choices("FollowFormat", COMMANDS["follow"].formats)
 ForcesFormat = _choices("ForcesFormat", COMMANDS["forces"].formats)
 SynthesizeFormat = _choices("SynthesizeFormat", COMMANDS["synthesize"].formats)
+SimulateFormat = _choices("SimulateFormat", COMMANDS["simulate"].formats)
 #: ``plot --method``: the bases that can be drawn.
 PlotMethod = _choices("PlotMethod", [k.label for k in KINDS if k.method])
 #: The default of ``--method``: every method.

@@ -231,6 +231,14 @@ def synthesize(
             "--span-bodies", help="Let a grasp's contacts lie on different bodies of a mesh (default: one body)."
         ),
     ] = False,
+    simulate: Annotated[
+        bool,
+        typer.Option(
+            "--simulate",
+            help="Keep only the grasps that hold in all six directions in MuJoCo (grasptwist simulate's "
+            "defaults); stderr counts the others. Needs MuJoCo: pip install 'grasptwist[sim]'.",
+        ),
+    ] = False,
     seed: Annotated[
         int,
         typer.Option(
@@ -290,14 +298,15 @@ def synthesize(
         grasptwist synthesize grasps/trifinger-cube.yaml --friction 0.8 --mass 0.1 -o found.yaml
         grasptwist synthesize objects/ -j 2 -f jsonl      # a folder: one object a process
     """
+    from ..extras import require
     from ..run.families import COMMANDS
-    from ..run.options import SynthesisOptions
+    from ..run.options import SimulateOptions, SynthesisOptions
     from ..run.pipeline import Job
 
     if quality or objective == Objective.epsilon:
-        from ..extras import require
-
         require("scipy", "--quality")
+    if simulate:
+        require("mujoco", "--simulate")
     wrenches = wrenches_option(wrench, at, wrench_name)
     grasp_file = output if output is not None and output.lower().endswith(GRASP_FILE_SUFFIXES) else None
     records_to = None if grasp_file is not None else output
@@ -336,6 +345,7 @@ def synthesize(
             position_error=position_error,
             friction_error=friction_error,
             perturbations=perturbations,
+            simulate=SimulateOptions() if simulate else None,
         ),
     )
     settings = OutputSettings(records_to, quiet, Warnings.summary, workers, {"digits": digits}, reads=(hand,))

@@ -40,7 +40,7 @@ from ..model import InputError
 from .limits import MAX_MESH_BYTES, MAX_TRIANGLES, MAX_URDF_BYTES, MESH_SUFFIXES
 from .urdf import _library, _parse, _read, resolve_urdf
 
-__all__ = ["decoded_size", "gltf_bytes", "grasp_folder", "hand_meshes", "link_geometry"]
+__all__ = ["decoded_size", "gltf_bytes", "grasp_folder", "hand_meshes", "link_geometry", "urdf_files"]
 
 #: Compressed streams by their first bytes, and how to open one.
 _STREAMS = {b"\x1f\x8b": gzip.open, b"BZh": bz2.open, b"\xfd7zXZ\x00": lzma.open}
@@ -330,3 +330,32 @@ def _check_mesh_file(name, path):
 def grasp_folder(grasp) -> Path | None:
     """The folder of the file a grasp was read from (None for standard input or a string)."""
     return None if grasp.file.startswith("<") else Path(grasp.file).parent
+
+
+def urdf_files(hand, *, folder=None, max_bytes=MAX_URDF_BYTES) -> tuple[str, dict]:
+    """A URDF hand's description and its mesh files by file name, for MuJoCo's URDF reader (which
+    looks a mesh up by its file name alone): every mesh resolved (``package://`` and paths, as
+    yourdfpy's are) and within :data:`MAX_MESH_BYTES`.
+
+    Raises
+    ------
+    InputError
+        The URDF's, or one of its meshes': unreadable, outside its folder, too large.
+    """
+    urdf = resolve_urdf(hand.source, folder)
+    data = _read(urdf, max_bytes, hand.source)
+    root = _parse(data, hand.source)
+    meshes = {}
+    for element in root.iter("mesh"):
+        name = element.get("filename", "")
+        try:
+            path = resolve_urdf(name, urdf.parent)
+        except InputError as exc:  # the error is the URDF's, about one of its meshes
+            raise InputError(exc.code, f"mesh {exc.message}", hand.source) from None
+        try:
+            if path.stat().st_size > MAX_MESH_BYTES:
+                raise InputError("too-large", f"mesh {name!r}: larger than {MAX_MESH_BYTES} bytes", hand.source)
+            meshes[os.path.basename(name)] = path.read_bytes()
+        except OSError as exc:
+            raise InputError("read-error", f"mesh {name!r}: cannot read: {exc.strerror}", hand.source) from None
+    return data.decode("utf-8"), meshes

@@ -58,7 +58,7 @@ from ..output.formats import FORMATS
 from ..output.json_rows import encode_records
 from ..output.records import basis_record, check_record, dumps, records, talking_rows
 from .batch import ZERO_TWIST, dataset_blocks, resolve
-from .options import FollowOptions, ForceOptions, SynthesisOptions, TwistOptions
+from .options import FollowOptions, ForceOptions, SimulateOptions, SynthesisOptions, TwistOptions
 from .stream import twist_stream
 
 __all__ = [
@@ -71,6 +71,7 @@ __all__ = [
     "WRENCH",
     "PATH",
     "SYNTHESIS",
+    "SIMULATION",
     "CLOSURE",
 ]
 
@@ -329,8 +330,31 @@ SYNTHESIS = Family(
     suffixes=OBJECT_SUFFIXES,
 )
 
+# -- grasps simulated ------------------------------------------------------------
+
+
+def _simulation_outputs(job, inputs, w, workers, tuning):
+    from .simulate import simulate_outputs  # the scene and MuJoCo, with the first simulate
+
+    return simulate_outputs(job, inputs, w, workers, tuning)
+
+
+def _simulation_columns():
+    from ..output.simulate_records import SIMULATE_COLUMNS
+
+    return SIMULATE_COLUMNS
+
+
+SIMULATION = Family(
+    name="simulation",
+    options=SimulateOptions,
+    columns=_simulation_columns,
+    outputs=_simulation_outputs,
+    long_inputs=True,
+)
+
 #: Every family.
-FAMILIES: tuple[Family, ...] = (TWIST, WRENCH, PATH, SYNTHESIS)
+FAMILIES: tuple[Family, ...] = (TWIST, WRENCH, PATH, SYNTHESIS, SIMULATION)
 
 # -- commands -----------------------------------------------------------------
 
@@ -367,6 +391,12 @@ def _synthesis_records(found, job):
     from ..output.synthesis_records import synthesis_records
 
     return synthesis_records(found)
+
+
+def _simulate_records(sim, job):
+    from ..output.simulate_records import simulate_record
+
+    return [simulate_record(sim)]
 
 
 def _force_records(block, job):
@@ -410,5 +440,6 @@ COMMANDS: dict[str, Command] = {
             _synthesis_records,
             "synthesis_records.SynthesisTable",
         ),
+        Command("simulate", SIMULATION, (*_RECORDS, "csv"), _simulate_records, "simulate_records.SimulateTable"),
     )
 }

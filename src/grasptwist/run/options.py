@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 from ..model import Twist, Wrench
 
-__all__ = ["TwistOptions", "ForceOptions", "FollowOptions", "SynthesisOptions"]
+__all__ = ["TwistOptions", "ForceOptions", "FollowOptions", "SynthesisOptions", "SimulateOptions"]
 
 
 def _count(given) -> int:
@@ -103,7 +103,9 @@ class SynthesisOptions:
     the job's ``hand``: ``--hand``, read from ``hand_file``); ``units`` (``--units``) is the length
     unit of the mesh files given directly (a grasp file says its own); ``span_bodies``
     (``--span-bodies``) lets a grasp's contacts lie on different bodies of a mesh; ``position_error``,
-    ``friction_error`` and ``perturbations`` (``--position-error``, ...) make each grasp's robustness.
+    ``friction_error`` and ``perturbations`` (``--position-error``, ...) make each grasp's robustness;
+    ``simulate`` (``--simulate``) keeps only the grasps that hold in all six directions in MuJoCo
+    (:func:`grasptwist.run.simulate.held_only`).
     The rest go to :func:`grasptwist.engine.synthesis.search.search`.
     """
 
@@ -129,6 +131,8 @@ class SynthesisOptions:
     friction_error: float = 0.2
     perturbations: int = 64
 
+    simulate: SimulateOptions | None = None
+
     def __post_init__(self):
         # the options the search never sees as such (they change the object and the hand), checked as
         # the command line checks them, for every way in (grasptwist.dask passes them as keywords)
@@ -136,3 +140,26 @@ class SynthesisOptions:
 
         check_mass(self.mass)
         check_tip_radius(self.tip_radius)
+
+
+@dataclass(frozen=True)
+class SimulateOptions:
+    """The simulation family's options: what ``grasptwist simulate`` runs in MuJoCo, and how.
+
+    ``mass`` (``--mass``) and ``friction`` (``--friction``) replace the file's; ``table``
+    (``--table Z``) puts a table plane at height ``Z``; ``duration`` (``--duration``) is the
+    time each direction's load is applied; ``distance_tol`` and ``angle_tol`` (``--tolerance
+    D,DEG``, degrees) how far the object may move and turn and still be held; ``safety``
+    (``--safety``) the grip's safety factor; ``mjcf`` (``--mjcf OUT.xml``) where the scene is
+    written; ``path`` (``--path NAME``) a path (or twist) to execute instead of the hold test.
+    """
+
+    mass: float | None = None
+    friction: float | None = None
+    table: float | None = None
+    duration: float = 1.0
+    distance_tol: float = 0.002
+    angle_tol: float = 2.0
+    safety: float = 1.25
+    mjcf: str | None = None
+    path: str | None = None

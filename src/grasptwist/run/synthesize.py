@@ -92,6 +92,7 @@ class Found:
     warnings: tuple = ()  # of the object: a mesh's as read (mesh-repaired, mesh-open, mesh-bodies), its size, its pose
     environment: Environment | None = None  # the table and boxes the grasps keep clear of
     clearance: np.ndarray | None = None  # each grasp's least distance of a finger from them (None: no environment)
+    dropped: int = 0  # --simulate: grasps found that did not hold in MuJoCo, left out
 
     def __len__(self) -> int:
         return len(self.synthesis.points)
@@ -316,7 +317,7 @@ def synthesize_inputs(job, inputs: Iterable) -> Iterator[GraspFileError | Found 
                 if isinstance(step, int):
                     yield Progress(0, step)
             yield Progress(0, o.candidates - step.candidates)  # the budget left unspent
-            yield Found(
+            found = Found(
                 entry.file,
                 entry.name,
                 entry.line,
@@ -338,6 +339,12 @@ def synthesize_inputs(job, inputs: Iterable) -> Iterator[GraspFileError | Found 
                 environment=entry.environment,
                 clearance=grasp_clearance(step.points, entry.environment, reach, step.joint_positions),
             )
+            if o.simulate is not None:
+                from .simulate import held_only  # MuJoCo, with the first synthesize --simulate
+
+                found, dropped = held_only(found, o.simulate)
+                found = replace(found, dropped=dropped)
+            yield found
         yield Progress(0, 1)
 
 
@@ -433,6 +440,8 @@ def _summary(job, found) -> str:
         spacing = "default" if o.min_spacing is None else f"{o.min_spacing:g}"
         found_count = f"{len(found)} of {o.count} grasps wanted (min spacing {spacing})"
     late = f"; {s.unverified} found but not verified before --seconds ran out" if s.unverified else ""
+    if found.dropped:
+        late += f"; {found.dropped} dropped: they did not hold in all six directions in MuJoCo (--simulate)"
     return (
         f"{found.file}: grasp '{found.name}': {found_count} from {s.candidates} candidates scored "
         f"in {s.seconds:.2f} s ({s.candidates / max(s.seconds, 1e-9):.3g} per second){late}"

@@ -1,0 +1,83 @@
+r"""The six-direction hold test's math: the loads, the grips that resist them, the joint torques.
+
+The protocol (BODex's, made exact): the object's weight ``m |g|`` is applied at its centre of
+mass along each of ``+x, -x, +y, -y, +z, -z`` in turn; for each, the fingers exert the grip that
+balances it (:func:`~grasptwist.engine.forces.grip.grip` of :func:`direction_wrenches`), through
+joint torques ``tau = J^T f`` (:func:`joint_torques`); the grasp holds in a direction when the
+object moves less than the tolerances (:func:`held`).  The simulation itself is
+:mod:`grasptwist.sim`'s.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from .forces.hold import hold_wrench
+from .hands import finger_states
+from .kinematics import finger_jacobian
+
+__all__ = ["DIRECTIONS", "UNITS", "direction_wrenches", "joint_torques", "held"]
+
+#: The six directions, in the order they are tested, and their unit vectors ``(6, 3)``.
+DIRECTIONS = ("+x", "-x", "+y", "-y", "+z", "-z")
+UNITS = np.array([[1.0, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]])
+
+
+def direction_wrenches(mass, center_of_mass, load) -> np.ndarray:
+    r"""The wrenches the fingers must exert to balance a load of size ``load`` at the centre of mass
+    along each of the six directions, ``(6, 6)``: :func:`hold_wrench` with gravity ``load / m * u``.
+
+    .. math:: w_d = \left(-L u_d;\; -c \times L u_d\right)
+
+    >>> direction_wrenches(2.0, [1.0, 0, 0], 19.62)[4].tolist()
+    [0.0, 0.0, -19.62, 0.0, 19.62, 0.0]
+    """
+    return hold_wrench(mass, center_of_mass, UNITS * (float(load) / float(mass)))
+
+
+def joint_torques(hand, positions, points, forces) -> np.ndarray:
+    r"""The joint torques by which each finger exerts its force at its contact: ``tau = J^T f``.
+
+    .. math:: \tau_f = J_f(q)^\top f_f, \qquad J_f = [\,v_j + \omega_j \times p_f\,]_j
+
+    Parameters
+    ----------
+    hand : Hand or None
+        None: each finger is a point on three slides (x, y, z), whose torques are the forces.
+    positions : (n_joints,) array
+        The hand's joint positions.
+    points : (3, 3) array
+        The contacts, row ``f`` touched by finger ``f``.
+    forces : (..., 3, 3) array
+        Row ``f`` the force finger ``f`` exerts on the object.
+
+    Returns
+    -------
+    (..., n_joints) array, in ``hand.joint_names`` order (``(..., 9)`` without a hand).
+
+    Examples
+    --------
+    A finger on one slide along x pushing with 2 N along x and 1 N along y: the slide carries 2 N.
+
+    >>> from grasptwist.hand import Finger, Hand, Joint
+    >>> f = Finger("1", None, (Joint("x", "prismatic", None, None, None, None),), np.array([[0, 0, 0, 1.0, 0, 0]]), np.zeros((1, 3)), None, 1.0, (0,))
+    >>> joint_torques(Hand((f, f, f), ("x",), None, None), [0.0], np.zeros((3, 3)), [[2.0, 1, 0], [0] * 3, [0] * 3]).tolist()
+    [2.0]
+    """
+    forces = np.asarray(forces, dtype=float)
+    if hand is None:
+        return forces.reshape(forces.shape[:-2] + (9,))
+    out = np.zeros(forces.shape[:-2] + (len(hand.joint_names),))
+    for f, (finger, state) in enumerate(zip(hand.fingers, finger_states(hand, np.asarray(positions, float)))):
+        jac = finger_jacobian(state.screws, np.asarray(points, float)[f])
+        out[..., list(finger.joint_index)] += np.einsum("ij,...i->...j", jac, forces[..., f, :])
+    return out
+
+
+def held(displacement, rotation, distance_tol, angle_tol) -> np.ndarray:
+    """Held where the object moved less than both tolerances (``rotation`` and ``angle_tol`` in radians).
+
+    >>> held([0.001, 0.003], [0.0, 0.0], 0.002, 0.035).tolist()
+    [True, False]
+    """
+    return (np.asarray(displacement) < distance_tol) & (np.asarray(rotation) < angle_tol)

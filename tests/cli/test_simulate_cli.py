@@ -1,0 +1,193 @@
+"""``grasptwist simulate`` (issue 38): records in every format, the scene written for MuJoCo's viewer,
+inputs it cannot simulate, options it refuses, and MuJoCo missing."""
+
+import csv
+import io
+import json
+import subprocess
+import sys
+
+import numpy as np
+import pytest
+
+from hostile import jsonl, run
+from places import GRASPS
+
+CUBE = GRASPS / "trifinger-cube.yaml"
+SPHERE = GRASPS / "sphere.yaml"
+SHORT = ("--duration", "0.1")
+
+
+def test_records_say_held_and_per_direction_how_far_the_object_moved_and_the_forces():
+    r, _ = run("simulate", CUBE, "--mass", "0.094", "--friction", "1", "--table", "0", *SHORT, "-f", "jsonl")
+    assert r.exit_code == 0, r.stderr
+    (rec,) = jsonl(r.stdout)
+    assert rec["ok"] and rec["held"] and rec["load"] == pytest.approx(0.094 * 9.81)
+    assert rec["tolerance"] == {"distance": 0.002, "angle_deg": 2.0} and rec["safety"] == 1.25
+    assert [d["direction"] for d in rec["directions"]] == ["+x", "-x", "+y", "-y", "+z", "-z"]
+    for d in rec["directions"]:
+        assert d["held"] and d["simulated"] and d["grip"] == "ok" and d["displacement"] < 5e-4
+        assert len(d["contact_forces"]) == 3 and len(d["planned_forces"][0]) == 3
+
+
+def test_a_grasp_without_a_grip_does_not_hold_and_says_so_on_stderr():
+    r, _ = run("simulate", CUBE, "--mass", "0.094", "--friction", "0.5", *SHORT, "-f", "json")
+    assert r.exit_code == 1
+    (rec,) = json.loads(r.stdout)
+    assert not rec["ok"] and not rec["held"]
+    assert {(d["simulated"], d["grip"], d["displacement"]) for d in rec["directions"]} == {(False, "cannot-hold", None)}
+    assert "no grip holds the load along +x, -x, +y, -y, +z, -z: not simulated there" in r.stderr
+
+
+def test_csv_and_the_table(tmp_path):
+    r, _ = run("simulate", CUBE, "--mass", "0.094", "--friction", "1", *SHORT, "-f", "csv")
+    assert r.exit_code == 0, r.stderr
+    (row,) = csv.DictReader(io.StringIO(r.stdout))
+    assert row["held"] == "true" and row["held_mz"] == "true" and float(row["displacement_px"]) < 5e-4
+    table, _ = run("simulate", CUBE, "--mass", "0.094", "--friction", "1", *SHORT)
+    assert table.exit_code == 0 and "grasp 'trifinger-cube': held" in table.stdout
+    assert table.stdout.count(" yes ") == 6
+
+
+def test_mjcf_writes_the_scene_mujoco_reads_back(tmp_path):
+    mujoco = pytest.importorskip("mujoco")
+    out = tmp_path / "scene.xml"
+    r, _ = run(
+        "simulate", GRASPS / "sphere.yaml", "--mass", "0.1", "--friction", "0.8", *SHORT, "--mjcf", out, "-f", "jsonl"
+    )
+    assert r.exit_code in (0, 1), r.stderr
+    for path in (out, tmp_path / "scene-2.xml"):  # one file per grasp: sphere-tripod, sphere-equator
+        model = mujoco.MjModel.from_xml_path(str(path))
+        assert model.body("object").id > 0 and model.ngeom == 4  # the ball, its three tips, no table
+
+
+@pytest.mark.parametrize(
+    ("args", "code"),
+    [
+        (("--friction", "1"), "no-mass"),
+        (("--mass", "1"), "no-friction"),
+    ],
+)
+def test_a_grasp_it_cannot_simulate_is_an_error_record(args, code):
+    r, _ = run("simulate", CUBE, *args, *SHORT, "-f", "jsonl")
+    assert r.exit_code == 1
+    (rec,) = jsonl(r.stdout)
+    assert rec["error"]["code"] == code and rec["error"]["line"] == 17
+    assert f"trifinger-cube.yaml:17: error: {code}: grasp 'trifinger-cube'" in r.stderr
+
+
+def test_a_grasp_without_an_object_is_an_error_record(tmp_path):
+    bare = tmp_path / "bare.yaml"
+    bare.write_text(
+        "contacts:\n  - {point: [1, 0, 0], normal: [-1, 0, 0]}\n  - {point: [-1, 0, 0], normal: [1, 0, 0]}\n"
+        "  - {point: [0, 1, 0], normal: [0, -1, 0]}\nfriction: 0.5\nmass: 1\ncenter_of_mass: [0, 0, 0]\n"
+    )
+    r, _ = run("simulate", bare, "-f", "jsonl")
+    assert r.exit_code == 1 and jsonl(r.stdout)[0]["error"]["code"] == "no-object"
+
+
+@pytest.mark.parametrize(
+    "args",
+    [
+        ("--duration", "0"),
+        ("--duration", "nan"),
+        ("--duration", "1e9"),
+        ("--tolerance", "0.002"),
+        ("--tolerance", "0,2"),
+        ("--tolerance", "0.002,200"),
+        ("--mass", "-1"),
+        ("--table", "inf"),
+        ("--mjcf", "no-such-folder/scene.xml"),
+    ],
+)
+def test_absurd_values_are_refused_before_any_work(args):
+    r, _ = run("simulate", CUBE, *args)
+    assert r.exit_code == 2 and args[0] in r.stderr
+
+
+def test_without_mujoco_one_line_says_how_to_install_it():
+    code = (
+        "import sys; sys.modules['mujoco'] = None\n"
+        "from typer.testing import CliRunner; from grasptwist.cli import app\n"
+        f"r = CliRunner().invoke(app, ['simulate', {str(CUBE)!r}])\n"
+        "print(r.exit_code); print(r.stderr, end='')\n"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=60)
+    status, line = out.stdout.splitlines()
+    assert status == "2"
+    assert line == (
+        "grasptwist: error: grasptwist simulate needs mujoco: pip install 'grasptwist[sim]' "
+        "(from a clone of grasptwist: pip install -e '.[sim]')"
+    )
+
+
+@pytest.mark.slow  # a search and four hold tests: over a second
+def test_synthesize_simulate_keeps_only_the_grasps_that_hold_and_counts_the_others(tmp_path):
+    found = tmp_path / "found.yaml"
+    args = ("synthesize", GRASPS / "cylinder.yaml", "--friction", "0.8", "--mass", "0.1", "-n", "4")
+    r, _ = run(*args, "--candidates", "400", "--simulate", "-o", found, "-f", "jsonl")
+    assert r.exit_code in (0, 1), r.stderr
+    kept = [rec for rec in jsonl(r.stdout) if rec["ok"]]
+    # the search finds 4 (seeded); MuJoCo drops one of them
+    assert len(kept) == 3 and "; 1 dropped: they did not hold in all six directions in MuJoCo" in r.stderr
+    sims, _ = run("simulate", found, *SHORT, "-f", "jsonl")  # each grasp kept holds, simulated from the file
+    assert [s["held"] for s in jsonl(sims.stdout)] == [True] * 3
+
+
+def test_path_lifts_the_ball_as_planned_and_the_record_has_its_samples():
+    # lift-z: 5 cm/s for one unit of time, the three slid tips carrying the ball (no turning: no rolling)
+    r, _ = run("simulate", SPHERE, "--mass", "0.1", "--friction", "0.8", "--path", "lift-z", "-f", "jsonl")
+    assert r.exit_code == 0, r.stderr
+    rec = jsonl(r.stdout)[1]  # sphere-equator
+    assert rec["followed"] and rec["path"] == "lift-z" and len(rec["samples"]) == 21
+    assert rec["samples"][-1]["time"] == 1.0 and rec["final"]["position_error"] < 5e-4
+    assert max(max(s["slip"]) for s in rec["samples"]) < 1e-3 and not any(any(s["slipped"]) for s in rec["samples"])
+
+
+def test_a_path_the_grasp_does_not_have_is_an_error_record():
+    r, _ = run("simulate", SPHERE, "--mass", "0.1", "--friction", "0.8", "--path", "nope", "-f", "jsonl")
+    assert r.exit_code == 1
+    rec = jsonl(r.stdout)[0]
+    assert rec["error"]["code"] == "no-path" and "'roll-x', 'spin-z', 'lift-z'" in rec["error"]["message"]
+    csv_run, _ = run("simulate", SPHERE, "--path", "lift-z", "-f", "csv")
+    assert csv_run.exit_code == 2 and "--path" in csv_run.stderr
+
+
+@pytest.mark.slow  # a second of tracking with the TriFinger
+def test_the_trifinger_spin_lags_its_plan_as_the_guide_says():
+    r, _ = run("simulate", CUBE, "--mass", "0.094", "--friction", "1", "--path", "spin", "-f", "jsonl")
+    assert r.exit_code == 1
+    (rec,) = jsonl(r.stdout)
+    assert not rec["followed"] and 5 < rec["final"]["angle_error_deg"] < 15  # measured 9 deg behind
+    assert all(rec["samples"][-1]["slipped"])
+
+
+@pytest.mark.slow  # two worker processes: a second
+def test_workers_simulate_a_folder_file_by_file_with_the_same_records(tmp_path):
+    for name in ("sphere.yaml", "cylinder.yaml"):
+        (tmp_path / name).write_bytes((GRASPS / name).read_bytes())
+    args = ("simulate", tmp_path, "--mass", "0.1", "--friction", "0.8", *SHORT, "-f", "jsonl")
+    one, _ = run(*args)
+    two, _ = run(*args, "-j", "2")
+    assert one.exit_code == two.exit_code and one.stdout == two.stdout
+    assert [(r["grasp"], r["held"]) for r in jsonl(two.stdout)] == [
+        ("cylinder", True),
+        ("sphere-tripod", True),
+        ("sphere-equator", True),
+    ]
+
+
+def test_mujoco_reads_the_trifinger_from_its_urdf_and_the_scene_is_written_beside_its_meshes(tmp_path):
+    mujoco = pytest.importorskip("mujoco")
+    out = tmp_path / "cube.xml"
+    r, _ = run("simulate", CUBE, "--mass", "0.094", "--friction", "1", *SHORT, "--mjcf", out, "-f", "jsonl")
+    assert r.exit_code == 0, r.stderr
+    assert {p.name for p in tmp_path.iterdir()} >= {"cube.xml", "tip_sim.stl", "prox-sim.stl"}
+    model = mujoco.MjModel.from_xml_path(str(out))
+    joints = [model.joint(k).name for k in range(model.njnt)]
+    assert joints[1:4] == [f"hand/finger_{j}_joint_0" for j in ("base_to_upper", "upper_to_middle", "middle_to_lower")]
+    np.testing.assert_allclose(model.jnt_range[model.joint("hand/finger_upper_to_middle_joint_0").id], [0, 1.57])
+    # the URDF's own link masses; only the object, the fingertip spheres (10 mm) and nothing else collide
+    assert model.body_mass[model.body("hand/finger_upper_link_0").id] == pytest.approx(0.26689)  # the URDF says
+    colliding = sorted(model.geom(k).name for k in range(model.ngeom) if model.geom_contype[k])
+    assert colliding == ["piece0", "tip0", "tip1", "tip2"] and model.geom_size[model.geom("tip0").id][0] == 0.01

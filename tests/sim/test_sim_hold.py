@@ -1,0 +1,165 @@
+"""The six-direction hold test, run in MuJoCo itself: grasps that hold, grips that do not exist, slip
+that the simulation sees, the scene's mass properties, a simulation that diverges."""
+
+import math
+import re
+from dataclasses import replace
+
+import numpy as np
+import pytest
+
+from grasptwist.engine.hold_test import DIRECTIONS
+from grasptwist.engine.objects.geometry import mass_properties
+from grasptwist.run.options import SimulateOptions
+from grasptwist.run.placement import read
+from grasptwist.run.simulate import UNSTABLE, simulate_grasp
+from grasptwist.sim.hold import hold_test, load_model
+from grasptwist.sim.scene import build_scene
+from places import GRASPS
+
+SHORT = 0.2  # seconds of simulated time per direction: the default run's tests stay short
+
+
+def _grasp(name, k=0):
+    return read(str(GRASPS / name))[k]
+
+
+def _simulated(name, k=0, **options):
+    return simulate_grasp(SimulateOptions(duration=SHORT, **options), _grasp(name, k))
+
+
+def test_the_trifinger_holds_the_cube_and_mujoco_exerts_the_planned_grip():
+    sim = _simulated("trifinger-cube.yaml", mass=0.094, friction=1.0)
+    assert sim.test.held and [d.name for d in sim.test.directions] == list(DIRECTIONS)
+    load = 0.094 * 9.81
+    assert sim.test.load == pytest.approx(load)
+    for d in sim.test.directions:
+        assert d.simulated and d.displacement < 5e-4 and d.rotation < math.radians(0.5)  # a quarter of the tolerances
+        # each finger's contact force in MuJoCo is grasptwist's grip, within 5% of the load
+        np.testing.assert_allclose(d.forces, d.planned, atol=0.05 * load)
+    # on its table too (which takes part of the load: the fingers' forces differ there)
+    assert _simulated("trifinger-cube.yaml", mass=0.094, friction=1.0, table=0.0).test.held
+
+
+def test_an_inline_hand_and_three_slid_fingertips_hold_too():
+    hand = _simulated("three-finger-hand.yaml", mass=0.1, friction=0.8)
+    ball = _simulated("sphere.yaml", 1, mass=0.1, friction=0.8)  # sphere-equator: no hand
+    for sim in (hand, ball):
+        assert sim.test.held, [(d.name, d.displacement) for d in sim.test.directions]
+
+
+def test_a_direction_without_a_grip_is_reported_not_simulated():
+    # at mu = 0.5 the three side contacts cannot carry the cube's weight sideways or up: no grip
+    sim = _simulated("trifinger-cube.yaml", mass=0.094, friction=0.5)
+    assert not sim.test.held
+    for d in sim.test.directions:
+        assert (d.simulated, d.held, d.grip_status) == (False, False, 20)  # cannot-hold
+        assert math.isnan(d.displacement) and np.isnan(d.planned).all()
+
+
+def test_a_grip_planned_with_more_friction_than_the_contacts_have_slips():
+    g = _grasp("trifinger-cube.yaml")
+    mass, load = 0.094, 0.094 * 9.81
+    scene = build_scene(g, mass=mass, friction=np.full(3, 0.3), load=load, tolerance=0.002)
+    com = mass_properties(replace(g.object, mass=mass)).center_of_mass
+    test = hold_test(scene, g, center_of_mass=com, friction=np.full(3, 1.0), load=load, duration=SHORT)
+    lift = test.directions[DIRECTIONS.index("+z")]
+    assert lift.simulated and not lift.held and lift.displacement > 0.002
+
+
+def test_the_objects_mass_centre_and_inertia_in_mujoco_are_the_solids():
+    g = _grasp("trifinger-cube.yaml")
+    scene = build_scene(g, mass=0.094, friction=np.ones(3), load=1.0, tolerance=0.002)
+    model = load_model(scene)
+    body = model.body("object")
+    a = 0.065
+    assert model.body_mass[body.id] == pytest.approx(0.094)
+    np.testing.assert_allclose(model.body_inertia[body.id], [0.094 * 2 * a * a / 12] * 3, rtol=1e-12)
+    np.testing.assert_allclose(model.body_pos[body.id], [0, 0, 0.0325], atol=1e-15)
+
+
+def test_a_mesh_collides_as_convex_pieces_and_weighs_as_its_solid():
+    trimesh = pytest.importorskip("trimesh")
+    g = _grasp("bottle.yaml")
+    shape = g.object.shape
+    box = trimesh.creation.box((0.05, 0.05, 0.1))  # two pieces given: the object's own
+    pieces = [(box.vertices + [0, 0, 0.05], box.faces), (box.vertices - [0, 0, 0.05], box.faces)]
+    scene = build_scene(g, mass=0.5, friction=np.ones(3), load=1.0, tolerance=0.002, pieces=pieces)
+    model = load_model(scene)
+    assert [model.geom(k).name for k in range(model.ngeom) if model.geom_contype[k]][:3] == ["piece0", "piece1", "tip0"]
+    solid = trimesh.Trimesh(shape.vertices, shape.faces)
+    solid.density = 0.5 / solid.volume
+    body = model.body("object").id
+    assert model.body_mass[body] == pytest.approx(0.5)
+    # the principal moments of inertia, about the centre: trimesh's of the same solid
+    expected = np.sort(np.linalg.eigvalsh(solid.moment_inertia))
+    np.testing.assert_allclose(np.sort(model.body_inertia[body]), expected, rtol=1e-4)
+
+
+def test_a_simulation_that_diverges_is_a_record_naming_the_step(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)  # MuJoCo would log its warning to MUJOCO_LOG.TXT here
+    g = _grasp("sphere.yaml", 1)
+    options = SimulateOptions(mass=0.1, friction=0.8, duration=SHORT)
+    # the slides' springs 1e7 times stiffer than their armature allows: explicit springs blow up
+    scene = build_scene(g, mass=0.1, friction=np.full(3, 0.8), load=0.981, tolerance=0.002)
+    bad = replace(scene, xml=re.sub(r'stiffness="[^"]+"', 'stiffness="1e9"', scene.xml))
+    assert bad.xml != scene.xml
+    test = hold_test(bad, g, center_of_mass=np.zeros(3), friction=np.full(3, 0.8), load=0.981, duration=SHORT)
+    assert test.unstable is not None and not test.held
+    assert test.unstable.where == "+x" and 0 < test.unstable.step <= round(SHORT / 0.001)
+    assert options.duration == SHORT and UNSTABLE == "simulation-unstable"
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_gt_simulate_runs_the_hold_test_and_raises_what_it_cannot_simulate():
+    import grasptwist as gt
+
+    grasp = _grasp("sphere.yaml", 1)  # sphere-equator: mass 1, friction 0.5
+    sim = gt.simulate(grasp, mass=0.1, friction=0.8, duration=SHORT, tolerance=(0.002, 2.0))
+    assert sim.test.held and sim.mass == 0.1 and sim.options.duration == SHORT
+    with pytest.raises(gt.GraspFileError) as err:
+        gt.simulate(replace(grasp, object=None))
+    assert err.value.code == "no-object"
+
+
+def test_box_obstacles_stand_in_the_scene_and_the_object_rests_on_one():
+    # the ball of sphere-equator on a box whose top is the ball's bottom: they touch
+    g = _grasp("sphere.yaml", 1)
+    box = ([0.0, 0.0, -0.035 - 0.01], [0.1, 0.1, 0.02])
+    scene = build_scene(g, mass=0.1, friction=np.full(3, 0.8), load=0.981, tolerance=0.002, boxes=[box])
+    model = load_model(scene)
+    geom = model.geom("box0")
+    np.testing.assert_allclose(model.geom_size[geom.id], [0.05, 0.05, 0.01])
+    np.testing.assert_allclose(model.geom_pos[geom.id], [0, 0, -0.045])
+    import mujoco
+
+    data = mujoco.MjData(model)
+    mujoco.mj_forward(model, data)
+    touching = {tuple(sorted((model.geom(c.geom1).name, model.geom(c.geom2).name))) for c in data.contact[: data.ncon]}
+    assert ("box0", "piece0") in touching
+
+
+@pytest.mark.slow  # CoACD and trimesh's boolean union load in 2 s
+def test_coacd_cuts_a_concave_mesh_into_convex_pieces_of_its_volume():
+    trimesh = pytest.importorskip("trimesh")
+    from grasptwist.sim.scene import convex_pieces
+
+    bar = trimesh.creation.box((0.1, 0.02, 0.02))
+    arm = trimesh.creation.box((0.02, 0.1, 0.02))
+    arm.apply_translation((0.04, 0.04, 0))
+    ell = bar.union(arm)  # an L: its convex hull would fill the corner (1.9 times its volume)
+    pieces = [trimesh.Trimesh(v, f) for v, f in convex_pieces(ell.vertices, ell.faces)]
+    assert len(pieces) == 2 and all(p.is_convex for p in pieces)
+    assert sum(p.volume for p in pieces) == pytest.approx(ell.volume, rel=0.01)
+
+
+def test_a_urdf_mujoco_cannot_read_is_its_reason_naming_the_urdf():
+    from grasptwist.io.urdf_meshes import grasp_folder, urdf_files
+
+    g = _grasp("trifinger-cube.yaml")
+    text, meshes = urdf_files(g.hand, folder=grasp_folder(g))
+    assert sorted(meshes)[:2] == ["center_axis_sim.stl", "int_sim.stl"]
+    with pytest.raises(
+        ValueError, match=r"MuJoCo cannot read the URDF package://robot_properties_fingers/.*prox-sim.stl"
+    ):
+        build_scene(g, mass=0.1, friction=np.ones(3), load=1.0, tolerance=0.002, urdf=(text, {}))  # no meshes
