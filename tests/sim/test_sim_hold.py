@@ -29,7 +29,9 @@ def _simulated(name, k=0, **options):
 
 
 def test_the_trifinger_holds_the_cube_and_mujoco_exerts_the_planned_grip():
-    sim = _simulated("trifinger-cube.yaml", mass=0.094, friction=1.0)
+    # the file's table takes part of the load: without it the fingers carry it all
+    grasp = replace(_grasp("trifinger-cube.yaml"), environment=None)
+    sim = simulate_grasp(SimulateOptions(duration=SHORT, mass=0.094, friction=1.0), grasp)
     assert sim.test.held and [d.name for d in sim.test.directions] == list(DIRECTIONS)
     load = 0.094 * 9.81
     assert sim.test.load == pytest.approx(load)
@@ -37,8 +39,8 @@ def test_the_trifinger_holds_the_cube_and_mujoco_exerts_the_planned_grip():
         assert d.simulated and d.displacement < 5e-4 and d.rotation < math.radians(0.5)  # a quarter of the tolerances
         # each finger's contact force in MuJoCo is grasptwist's grip, within 5% of the load
         np.testing.assert_allclose(d.forces, d.planned, atol=0.05 * load)
-    # on its table too (which takes part of the load: the fingers' forces differ there)
-    assert _simulated("trifinger-cube.yaml", mass=0.094, friction=1.0, table=0.0).test.held
+    # on its table too, the file's (which takes part of the load: the fingers' forces differ there)
+    assert _simulated("trifinger-cube.yaml", mass=0.094, friction=1.0).test.held
 
 
 def test_an_inline_hand_and_three_slid_fingertips_hold_too():
@@ -125,12 +127,18 @@ def test_gt_simulate_runs_the_hold_test_and_raises_what_it_cannot_simulate():
 def test_box_obstacles_stand_in_the_scene_and_the_object_rests_on_one():
     # the ball of sphere-equator on a box whose top is the ball's bottom: they touch
     g = _grasp("sphere.yaml", 1)
-    box = ([0.0, 0.0, -0.035 - 0.01], [0.1, 0.1, 0.02])
+    from grasptwist.model import Obstacle
+
+    pose = np.eye(4)
+    pose[:3, :3] = [[0, -1, 0], [1, 0, 0], [0, 0, 1]]  # a quarter turn about z: its size is along its own axes
+    pose[:3, 3] = [0.0, 0.0, -0.035 - 0.01]
+    box = Obstacle(np.array([0.1, 0.12, 0.02]), pose)
     scene = build_scene(g, mass=0.1, friction=np.full(3, 0.8), load=0.981, tolerance=0.002, boxes=[box])
     model = load_model(scene)
     geom = model.geom("box0")
-    np.testing.assert_allclose(model.geom_size[geom.id], [0.05, 0.05, 0.01])
+    np.testing.assert_allclose(model.geom_size[geom.id], [0.05, 0.06, 0.01])
     np.testing.assert_allclose(model.geom_pos[geom.id], [0, 0, -0.045])
+    np.testing.assert_allclose(abs(model.geom_quat[geom.id]), [0.5**0.5, 0, 0, 0.5**0.5], atol=1e-12)
     import mujoco
 
     data = mujoco.MjData(model)
@@ -163,3 +171,17 @@ def test_a_urdf_mujoco_cannot_read_is_its_reason_naming_the_urdf():
         ValueError, match=r"MuJoCo cannot read the URDF package://robot_properties_fingers/.*prox-sim.stl"
     ):
         build_scene(g, mass=0.1, friction=np.ones(3), load=1.0, tolerance=0.002, urdf=(text, {}))  # no meshes
+
+
+def test_a_grasp_files_environment_is_the_scenes_table_and_boxes_and_table_replaces_its_table(tmp_path):
+    from grasptwist.run.simulate import _prepared
+
+    text = (GRASPS / "sphere.yaml").read_text("utf-8").split("\n---")[0]
+    env = "environment:\n  table: {height: -0.05}\n  boxes:\n    - {size: [0.02, 0.02, 0.02], pose: {position: [0.2, 0, 0]}}\n"
+    (tmp_path / "g.yaml").write_text(text.rstrip() + "\n" + env, "utf-8")
+    grasp = read(str(tmp_path / "g.yaml"))[0]
+    for table, height in ((None, -0.05), (-0.07, -0.07)):
+        *_, scene = _prepared(SimulateOptions(mass=0.1, friction=0.8, table=table), grasp, None, hold=True)
+        model = load_model(scene)
+        assert model.geom_pos[model.geom("table").id][2] == pytest.approx(height, abs=1e-15)
+        np.testing.assert_allclose(model.geom_pos[model.geom("box0").id], [0.2, 0, 0])

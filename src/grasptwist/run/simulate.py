@@ -22,7 +22,6 @@ import numpy as np
 
 from ..engine.objects.geometry import mass_properties
 from ..engine.synthesis.search import Failure
-from ..io.limits import DEFAULT_MAX_BYTES
 from ..io.urdf_meshes import grasp_folder, urdf_files
 from ..model import Grasp, GraspFileError, InputError
 from ..output import simulate_records as sr
@@ -91,7 +90,7 @@ def _mass(options, grasp, obj):
     return mass_properties(obj).mass if mass_properties(obj).mass is not None else grasp.mass
 
 
-def _prepared(options: SimulateOptions, grasp: Grasp, mjcf: str | None, hold: bool, max_bytes=None):
+def _prepared(options: SimulateOptions, grasp: Grasp, mjcf: str | None, hold: bool):
     """What a simulation of ``grasp`` needs: ``(mass, friction, gravity, load, centre of mass, scene)``,
     or why it cannot be run; the scene compensates the object's weight for the hold test (``hold``)."""
     obj = grasp.object
@@ -106,10 +105,10 @@ def _prepared(options: SimulateOptions, grasp: Grasp, mjcf: str | None, hold: bo
     gravity = np.asarray(GRAVITY if grasp.gravity is None else grasp.gravity, float)
     load = mass * float(np.linalg.norm(gravity))
     obj = replace(obj, mass=mass, density=None)
-    urdf = None
+    urdf, env = None, grasp.environment  # the file's table and boxes; --table replaces its table
     if grasp.hand is not None and grasp.hand.source is not None:  # MuJoCo reads the URDF and its meshes
         try:
-            urdf = urdf_files(grasp.hand, folder=grasp_folder(grasp), max_bytes=max_bytes or DEFAULT_MAX_BYTES)
+            urdf = urdf_files(grasp.hand, folder=grasp_folder(grasp))
         except InputError as exc:
             return _problem(grasp, exc.code, f"hand: {exc.message}")
     try:
@@ -119,7 +118,8 @@ def _prepared(options: SimulateOptions, grasp: Grasp, mjcf: str | None, hold: bo
             friction=friction,
             load=load,
             tolerance=options.distance_tol,
-            table_height=options.table,
+            table_height=options.table if options.table is not None or env is None else env.table_height,
+            boxes=() if env is None else env.boxes,
             urdf=urdf,
             gravity=gravity,
             object_gravcomp=hold,

@@ -23,7 +23,6 @@ The contact settings are :mod:`.contact`'s.
 
 from __future__ import annotations
 
-import math
 import os
 import struct
 from dataclasses import dataclass
@@ -33,6 +32,7 @@ import numpy as np
 from ..engine.fingertips import tip_centers
 from ..engine.hands import tip_poses
 from ..engine.objects.geometry import object_size
+from ..engine.se3 import matrix_to_quaternion
 from ..extras import require
 from ..model import Grasp, GraspObject
 from .contact import CONTACT, ContactSettings, option_xml
@@ -193,24 +193,6 @@ def _object_geoms(obj: GraspObject, mass: float, pieces=None) -> tuple[str, dict
             f'<geom name="piece{k}" type="mesh" mesh="piece{k}" density="0" friction="0" rgba="{OBJECT_RGBA}"/>'
         )
     return "\n".join(geoms), assets, "\n".join(meshes)
-
-
-def _quaternion(r) -> np.ndarray:
-    """A rotation matrix's unit quaternion ``(w, x, y, z)`` (Shepperd's method)."""
-    r = np.asarray(r, dtype=float)
-    t = np.trace(r)
-    if t > 0:
-        s = 2 * math.sqrt(1 + t)
-        return np.array([s / 4, (r[2, 1] - r[1, 2]) / s, (r[0, 2] - r[2, 0]) / s, (r[1, 0] - r[0, 1]) / s])
-    i = int(np.argmax(np.diag(r)))
-    j, k = (i + 1) % 3, (i + 2) % 3
-    s = 2 * math.sqrt(1 + r[i, i] - r[j, j] - r[k, k])
-    q = np.empty(4)
-    q[0] = (r[k, j] - r[j, k]) / s
-    q[1 + i] = s / 4
-    q[1 + j] = (r[j, i] + r[i, j]) / s
-    q[1 + k] = (r[k, i] + r[i, k]) / s
-    return q
 
 
 def _drive(lever, load, tolerance, timestep, compliance=COMPLIANCE) -> Drive:
@@ -378,9 +360,8 @@ def build_scene(
         The largest load on the object and the distance it may move: the joints' stiffness.
     table_height : float or None
         A table plane at this height (None: none), with ``table_friction`` (default: the least ``mu``).
-    boxes : sequence of (centre (3,), size (3,))
-        Fixed box obstacles, axis-aligned, edge lengths ``size``, with the table's friction (a grasp
-        file's environment is the table and these).
+    boxes : sequence of Obstacle
+        Boxes (``grasptwist.model.Obstacle``: edge lengths and pose), with the table's friction.
     urdf : (str, dict) or None
         A URDF hand's description and its mesh files by file name
         (:func:`grasptwist.io.urdf_meshes.urdf_files`): MuJoCo reads the hand from them (else it is
@@ -412,9 +393,9 @@ def build_scene(
     )
     tmu = float(np.min(mu)) if table_friction is None else table_friction
     table = "".join(
-        f'<geom name="box{k}" type="box" pos="{_v(centre)}" size="{_v(np.asarray(edges, float) / 2)}" '
-        f'friction="{tmu:.17g}" rgba="0.6 0.6 0.6 1"/>\n'
-        for k, (centre, edges) in enumerate(boxes)
+        f'<geom name="box{k}" type="box" pos="{_v(box.pose[:3, 3])}" quat="{_v(matrix_to_quaternion(box.pose[:3, :3]))}" '
+        f'size="{_v(np.asarray(box.size, float) / 2)}" friction="{tmu:.17g}" rgba="0.6 0.6 0.6 1"/>\n'
+        for k, box in enumerate(boxes)
     )
     if table_height is not None:
         table += f'<geom name="table" type="plane" size="0 0 1" pos="0 0 {table_height:.17g}" friction="{tmu:.17g}" rgba="0.8 0.8 0.75 1"/>'
@@ -429,7 +410,7 @@ def build_scene(
 <worldbody>
 <light pos="0 0 {10 * size:.17g}" dir="0 0 -1" directional="true"/>
 {table}
-<body name="{OBJECT}" pos="{_v(pose[:3, 3])}" quat="{_v(_quaternion(pose[:3, :3]))}" gravcomp="{int(object_gravcomp)}">
+<body name="{OBJECT}" pos="{_v(pose[:3, 3])}" quat="{_v(matrix_to_quaternion(pose[:3, :3]))}" gravcomp="{int(object_gravcomp)}">
 <freejoint name="{OBJECT}"/>
 {geoms}
 </body>
