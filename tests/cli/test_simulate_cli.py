@@ -187,7 +187,7 @@ def test_mujoco_reads_the_trifinger_from_its_urdf_and_the_scene_is_written_besid
     joints = [model.joint(k).name for k in range(model.njnt)]
     assert joints[1:4] == [f"hand/finger_{j}_joint_0" for j in ("base_to_upper", "upper_to_middle", "middle_to_lower")]
     np.testing.assert_allclose(model.jnt_range[model.joint("hand/finger_upper_to_middle_joint_0").id], [0, 1.57])
-    # the URDF's own link masses; only the object, the fingertip spheres (10 mm) and nothing else collide
+    # the URDF's own link masses; only the object, the file's table, the fingertip spheres (10 mm) collide
     assert model.body_mass[model.body("hand/finger_upper_link_0").id] == pytest.approx(0.26689)  # the URDF says
     colliding = sorted(model.geom(k).name for k in range(model.ngeom) if model.geom_contype[k])
-    assert colliding == ["piece0", "tip0", "tip1", "tip2"] and model.geom_size[model.geom("tip0").id][0] == 0.01
+    assert colliding == ["piece0", "table", "tip0", "tip1", "tip2"] and model.geom_size[model.geom("tip0").id][0] == 0.01
