@@ -211,12 +211,13 @@ def test_no_layer_branches_on_a_command_name(name):
 
 #: Modules a one-file JSON ``resolve`` never needs: the force side, the hand's kinematics and
 #: inverse kinematics, URDF reading, tables (rich) and pictures; on a primitive object, the
-#: meshes' geometry and their winding-number solid; CSV rows.
+#: meshes' geometry and their winding-number solid; CSV rows; data sets.
 NOT_FOR_JSON_RESOLVE = (
     "grasptwist.engine.objects.mesh",
     "grasptwist.engine.objects.solid",
     "grasptwist.output.csv_rows",
     "csv",
+    "grasptwist.io.dataset",
     "grasptwist.engine.forces",
     "grasptwist.run.forces",
     "grasptwist.output.force_records",
