@@ -213,8 +213,14 @@ def test_no_layer_branches_on_a_command_name(name):
 # Issue 26.4: start-up pays for what the command and format in hand use (bench/startup.py times it)
 
 #: Modules a one-file JSON ``resolve`` never needs: the force side, the hand's kinematics and
-#: inverse kinematics, URDF reading, tables (rich) and pictures.
+#: inverse kinematics, URDF reading, tables (rich) and pictures; on a primitive object, the
+#: meshes' geometry and their winding-number solid; CSV rows; data sets.
 NOT_FOR_JSON_RESOLVE = (
+    "grasptwist.engine.objects.mesh",
+    "grasptwist.engine.objects.solid",
+    "grasptwist.output.csv_rows",
+    "csv",
+    "grasptwist.io.dataset",
     "grasptwist.engine.forces",
     "grasptwist.run.forces",
     "grasptwist.output.force_records",
@@ -263,13 +269,15 @@ def _among(modules: set[str], names) -> list[str]:
 
 
 def test_a_json_resolve_of_one_file_imports_no_force_hand_table_or_plot_module():
-    json_run, forces_run, table_run = _loaded(
+    json_run, forces_run, table_run, mesh_run = _loaded(
         ["resolve", "grasps/polyhedron.yaml", "--format", "json"],
         ["forces", "grasps/sphere.yaml", "--format", "json"],
         ["resolve", "grasps/three-finger-hand.yaml"],
+        ["resolve", "grasps/bottle.yaml", "--format", "csv"],
     )
     assert "grasptwist.engine.decompose" in json_run and "orjson" in json_run  # it did run
     assert _among(json_run, NOT_FOR_JSON_RESOLVE) == []
     # the names are right: the commands that need these modules load them
     assert {"grasptwist.engine.forces.grip", "grasptwist.run.forces"} <= forces_run
     assert {"grasptwist.output.table", "rich", "grasptwist.engine.kinematics"} <= table_run
+    assert {"grasptwist.engine.objects.solid", "grasptwist.output.csv_rows", "csv"} <= mesh_run

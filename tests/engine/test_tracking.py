@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 
 from grasptwist.engine.kinematics import forward_kinematics, joint_rates
+from grasptwist.engine.tracking import track_fingers
 from grasptwist.path import Segment, track_finger
 
 SCREWS = np.array([[0, 0, 1.0, 0, 0, 0], [0, 1.0, 0, 0, 0, 0], [0, 1.0, 0, 0, 0, 1.0]])
@@ -77,3 +78,39 @@ def test_the_conditioning_warning_and_the_rank_loss_are_located_where_the_geomet
     assert abs(track.rank_loss - 1) < 1e-8  # |y| <= RANK_TOL (1e-9) times the largest singular value, 1
     np.testing.assert_allclose(track.conditioning, [0.5, 0.25, 0], atol=1e-12)
     assert track.rank.tolist() == [3, 3, 2] and track.error.max() < 1e-12
+
+
+def test_fingers_stepped_together_track_as_each_alone_events_and_all():
+    # the batch (one forward kinematics and one decomposition per stage for every finger) against
+    # the finger alone: a finger's track, events included, never depends on the others beside it.
+    # Along x 0.3 t and y -0.5 t: the arm's elbow leaves its limit of 1.9 rad, the slides' finger
+    # (conditioning |y|) warns, then loses rank at t = 1; the arm turned by 0.5 also follows.
+    slides = [[1.0, 0, 0, 0, 0, 0], [0, 0, 0, 1.0, 0, 0], [0, 0, 0, 0, 1.0, 0]]
+    tip = np.eye(4)
+    tip[:3, 3] = [1.0, 0, 0]
+    fingers = [  # screws, points, tip, q0, contact, lower
+        (SCREWS, POINTS, TIP, Q0, START, [np.nan, np.nan, 1.9]),
+        (slides, np.zeros((3, 3)), tip, [0, 0, 0.5], [1.0, 0.5, 0], [np.nan] * 3),
+        (SCREWS, POINTS, TIP, [0.5, Q0[1], Q0[2]], [math.cos(0.5), math.sin(0.5), 0], [np.nan] * 3),
+    ]
+    path, times = [Segment(1.0, twist=[0, 0, 0, 0.3, -0.5, 0])], [0.0, 0.5, 1.0]
+    batch = track_fingers(*(np.array(a, float) for a in list(zip(*fingers))[:5]), path, times,
+                          lower=np.array([f[5] for f in fingers]), steps=4)  # fmt: skip
+    for got, (screws, points, home, q0, contact, lower) in zip(batch, fingers):
+        alone = track_finger(screws, points, home, q0, contact, path, times, lower=np.array(lower), steps=4)
+        for name in ("positions", "rates", "conditioning", "error"):
+            np.testing.assert_allclose(getattr(got, name), getattr(alone, name), rtol=0, atol=1e-12)
+        assert got.rank.tolist() == alone.rank.tolist()
+        for name in ("rank_loss", "warning"):
+            assert (getattr(got, name) is None) == (getattr(alone, name) is None)
+            assert getattr(alone, name) is None or abs(getattr(got, name) - getattr(alone, name)) < 1e-12
+        assert (got.limit_exit is None) == (alone.limit_exit is None)
+        assert got.limit_exit is None or (
+            got.limit_exit[1] == alone.limit_exit[1] and abs(got.limit_exit[0] - alone.limit_exit[0]) < 1e-12
+        )
+    (limit, joint), slid = batch[0].limit_exit, batch[1]
+    r2 = 2 + 2 * math.cos(1.9)  # the arm's elbow at 1.9 rad: (1 + 0.3 t)^2 + (0.5 t)^2 = r2
+    exact = (-0.6 + math.sqrt(0.36 - 4 * 0.34 * (1 - r2))) / (2 * 0.34)
+    assert joint == 2 and abs(limit - exact) < 1e-4  # to the integration's accuracy (4 steps a sample)
+    assert abs(slid.warning - (1 - 2e-3)) < 1e-9 and abs(slid.rank_loss - 1) < 1e-8
+    assert batch[2].limit_exit is None and batch[2].warning is None and batch[2].error.max() < 1e-9

@@ -15,7 +15,7 @@ import numpy as np
 from .fingertips import tip_centers, tip_radii
 from .kinematics import ChainState, forward_kinematics
 from .path import check_segments
-from .tracking import FingerTrack, track_finger
+from .tracking import FingerTrack, track_fingers
 
 __all__ = [
     "joint_positions",
@@ -283,31 +283,37 @@ def track(hand, positions, points, segments, times, *, normals=None, steps=16) -
         extra = extra[(gap > 1e-9 * ends[-1]) & (extra < times[-1])]
     grid = np.union1d(times, extra)
     rows = np.searchsorted(grid, times)
-    fingers = []
     out = np.tile(q0, (len(times), 1))
-    for f, finger in enumerate(hand.fingers):
-        tip = finger.tip_pose
-        if tip is None:
-            tip = np.eye(4)
-            tip[:3, 3] = points[f]
-        index = list(finger.joint_index)
-        fingers.append(
-            track_finger(
-                finger.screws,
-                finger.points,
-                tip,
-                q0[index],
-                points[f],
-                segments,
-                grid,
-                lower=_limits(finger, "lower"),
-                upper=_limits(finger, "upper"),
-                segment_steps=SEGMENT_INTERVALS * steps,
-            )
+    fingers = [None] * len(hand.fingers)
+    sizes = [len(finger.joint_index) for finger in hand.fingers]
+    for n in sorted(set(sizes)):  # the fingers of n joints step together, in one batch
+        group = [f for f, size in enumerate(sizes) if size == n]
+        chains = [_chain(hand.fingers[f], points[f]) for f in group]
+        index = [list(hand.fingers[f].joint_index) for f in group]
+        tracks = track_fingers(
+            *(np.array(a, dtype=float) for a in zip(*chains)),
+            np.array([q0[i] for i in index]).reshape(len(group), n),
+            points[group],
+            segments,
+            grid,
+            lower=np.array([_limits(hand.fingers[f], "lower") for f in group]).reshape(len(group), n),
+            upper=np.array([_limits(hand.fingers[f], "upper") for f in group]).reshape(len(group), n),
+            segment_steps=SEGMENT_INTERVALS * steps,
         )
-        fingers[-1] = fingers[-1]._replace(**{k: getattr(fingers[-1], k)[rows] for k in _PER_SAMPLE})
-        out[:, index] = fingers[-1].positions
+        for f, i, got in zip(group, index, tracks):
+            fingers[f] = got._replace(**{k: getattr(got, k)[rows] for k in _PER_SAMPLE})
+            out[:, i] = fingers[f].positions
     return HandTrack(out, tuple(fingers))
+
+
+def _chain(finger, point):
+    """A finger's home screws, points and tip pose; a finger given inline has no tip link: its tip
+    is its contact's point at ``t = 0``, unturned."""
+    tip = finger.tip_pose
+    if tip is None:
+        tip = np.eye(4)
+        tip[:3, 3] = point
+    return finger.screws, finger.points, tip
 
 
 #: The fields of a FingerTrack that hold one row per grid time.

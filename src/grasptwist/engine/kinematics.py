@@ -34,13 +34,14 @@ joint positions ``(..., n)``; leading shapes broadcast.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 from typing import NamedTuple
 
 import numpy as np
 
 from . import se3
 from .degeneracy import Status
-from .screws import cross, field_at, norm, unit
+from .screws import cross, dot, field_at, norm, unit
 
 __all__ = [
     "RANK_TOL",
@@ -521,10 +522,11 @@ _UNIT_TOL = 1e-12
 
 
 def joint_motion(screw, q):
-    r"""``exp([S] q)`` of one joint's home screw ``S (6,)`` at positions ``q (...)``: ``(R (..., 3, 3), x (..., 3))``.
+    r"""``exp([S] q)`` of one joint's home screw ``S (..., 6)`` at positions ``q (...)``: ``(R (..., 3, 3), x (..., 3))``.
 
-    :func:`~grasptwist.engine.se3.exp` in general; for the two kinds of joint, whose screw is
-    the same for the whole batch, the closed forms with the screw's matrices formed once
+    :func:`~grasptwist.engine.se3.exp` in general; for the two kinds of joint (every screw of
+    the batch of one kind: the same joint at many positions, or one joint of each of a batch of
+    fingers stepped together), the closed forms with the screw's matrices formed once
     (forward kinematics' inner loop, the inverse kinematics' cost): a revolute joint, the unit
     line ``(omega; v)`` (``omega . v = 0``), turns about it by Rodrigues' formula,
 
@@ -537,14 +539,35 @@ def joint_motion(screw, q):
     >>> (x.round(12) + 0.0).tolist(), (r[0] @ [1.0, 0, 0] + x[0]).round(12).tolist()
     ([[1.0, -1.0, 0.0]], [1.0, 0.0, 0.0])
     """
-    w, v = screw[:3], screw[3:]
-    if screw.ndim == 1 and abs(w @ w - 1) <= _UNIT_TOL and abs(w @ v) <= _UNIT_TOL:
-        k = se3.skew(w)
+    screw = np.asarray(screw, dtype=float)
+    kind, k, kk, v, wv = _joint_terms(screw.tobytes(), screw.shape)
+    if kind == "revolute":
         s, c = np.sin(q)[..., None], 1 - np.cos(q)[..., None]
-        return np.eye(3) + s[..., None] * k + c[..., None] * (k @ k), s * v + c * cross(w, v)
-    if screw.ndim == 1 and not w.any():
-        return np.broadcast_to(np.eye(3), np.shape(q) + (3, 3)), np.asarray(q, float)[..., None] * v
+        return np.eye(3) + s[..., None] * k + c[..., None] * kk, s * v + c * wv
+    if kind == "prismatic":
+        shape = np.broadcast_shapes(np.shape(q), screw.shape[:-1])
+        return np.broadcast_to(np.eye(3), shape + (3, 3)), np.asarray(q, float)[..., None] * v
     return se3.exp(screw, q)
+
+
+@lru_cache(maxsize=256)
+def _joint_terms(data, shape):
+    """The kind of a batch of home screws (``data`` their bytes) and, for :func:`joint_motion`'s
+    closed forms, ``[omega]``, ``[omega]^2``, ``v`` and ``omega x v``: a chain's screws are the
+    same at every call (a tracker's thousands of steps), so they are formed once (read-only)."""
+    screw = np.frombuffer(data).reshape(shape)
+    w, v = screw[..., :3], screw[..., 3:]
+    if (np.abs(dot(w, w) - 1) <= _UNIT_TOL).all() and (np.abs(dot(w, v)) <= _UNIT_TOL).all():
+        k = se3.skew(w)
+        terms = ("revolute", k, k @ k, v, cross(w, v))
+    elif not w.any():
+        terms = ("prismatic", None, None, v, None)
+    else:
+        return ("other", None, None, None, None)
+    for a in terms[1:]:
+        if a is not None:
+            a.flags.writeable = False
+    return terms
 
 
 def forward_kinematics(home_screws, home_points, home_tip, positions):

@@ -87,9 +87,11 @@ def skew(a):
     [[0.0, -3.0, 2.0], [3.0, 0.0, -1.0], [-2.0, 1.0, 0.0]]
     """
     a = _shaped(a, (3,), "a")
-    z = np.zeros_like(a[..., 0])
-    a0, a1, a2 = a[..., 0], a[..., 1], a[..., 2]
-    return np.stack((np.stack((z, -a2, a1), -1), np.stack((a2, z, -a0), -1), np.stack((-a1, a0, z), -1)), -2)
+    out = np.zeros(a.shape + (3,))  # filled in place: np.stack costs more than the entries
+    out[..., 0, 1], out[..., 0, 2] = -a[..., 2], a[..., 1]
+    out[..., 1, 0], out[..., 1, 2] = a[..., 2], -a[..., 0]
+    out[..., 2, 0], out[..., 2, 1] = -a[..., 1], a[..., 0]
+    return out
 
 
 def rotate(rotation, v):

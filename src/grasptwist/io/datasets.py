@@ -34,13 +34,14 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 from ..model import GraspFileError
-from .dataset import Dataset
 from .limits import MAX_INFLATION, check_inflation
 
-if TYPE_CHECKING:  # zipfile is imported where an .npz is read (see open_dataset)
+if TYPE_CHECKING:  # zipfile and Dataset are imported where a data set is read (see open_dataset)
     import zipfile
 
-__all__ = ["DATASET_SUFFIXES", "EXTRA_POINT_ROLES", "Dataset", "Member", "open_dataset", "MAX_INFLATION"]
+    from .dataset import Dataset
+
+__all__ = ["DATASET_SUFFIXES", "EXTRA_POINT_ROLES", "Member", "open_dataset", "MAX_INFLATION"]
 
 DATASET_SUFFIXES = (".npz", ".npy", ".parquet")
 EXTRA_POINT_ROLES = ("wrist", "at")
@@ -106,6 +107,8 @@ def _numeric(path, name, a, tail):
 
 
 def _open_npy(path, a, extra_point):
+    from .dataset import Dataset  # only when a data set is read: a grasp file's run never needs it (start-up)
+
     if a.ndim != 2 or a.shape[1] not in (18, 21):
         raise _bad(path, f"expected rows of 18 or 21 numbers (p1 p2 p3 n1 n2 n3 [point]), got shape {a.shape}")
     _numeric(path, "rows", a, (a.shape[1],))
@@ -125,6 +128,8 @@ def _open_npy(path, a, extra_point):
 
 
 def _open_npz(path, arrays):
+    from .dataset import Dataset  # only when a data set is read (see _open_npy)
+
     unknown = sorted(set(arrays) - set(_NPZ_KEYS))
     if unknown:
         raise _bad(path, f"unknown array(s) {', '.join(unknown)}; expected {', '.join(_NPZ_KEYS)}")

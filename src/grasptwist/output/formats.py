@@ -24,7 +24,6 @@ from dataclasses import dataclass
 from importlib import import_module
 from typing import IO, Any
 
-from . import csv_rows
 from .records import dumps
 from .writers import JsonArray, Lines
 
@@ -105,6 +104,8 @@ def json_rows(block, job) -> tuple[list[bytes], list[dict]]:
 
 def csv_lines(block, job) -> tuple[list[bytes], list[dict]]:
     """The CSV line of each row (the family's columns), and the records with something to say."""
+    from . import csv_rows  # the csv module only when CSV is asked for (start-up, bench/startup.py)
+
     return csv_rows.lines(job.family.columns().flat(block, job.order, job.hand)), job.command.talking(block, job)
 
 

@@ -12,7 +12,7 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Iterator, Sequence
 from dataclasses import dataclass, field, replace
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -20,9 +20,11 @@ from ..engine.decompose import contact_velocities
 from ..engine.degeneracy import Status
 from ..engine.judgements import outward_contacts
 from ..engine.screws import direction, twist_at
-from ..io.dataset import Dataset
 from ..model import CONTACT_NAMES, Grasp, GraspFileError, Twist
 from ..results import ALL_METHODS, BY_KEY, KINDS, METHOD_CHOICES, STATUS, Field, ResultKind, selected
+
+if TYPE_CHECKING:  # a data set's type, for its annotation: a grasp file's run never loads it (start-up)
+    from ..io.dataset import Dataset
 
 __all__ = [
     "METHODS",

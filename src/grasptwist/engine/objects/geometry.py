@@ -30,9 +30,18 @@ import numpy as np
 
 from ...model import GraspObject
 from ..se3 import rotate
-from . import mesh, primitives
+from . import primitives
 from .checks import accept, check_pose, check_size, checked
 from .tolerances import EDGE_TOL
+
+
+def _mesh():
+    """:mod:`.mesh` (and the winding-number solid it brings, :mod:`.solid`), imported at first use:
+    a run whose objects are all primitives never needs them (start-up, ``bench/startup.py``)."""
+    from . import mesh
+
+    return mesh
+
 
 __all__ = [
     "SurfacePoints",
@@ -108,7 +117,7 @@ def object_size(obj: GraspObject) -> float:
     """
     shape = checked(obj).shape
     if shape.kind == "mesh":
-        return mesh.diagonal(shape.vertices)
+        return _mesh().diagonal(shape.vertices)
     return primitives.diagonal(shape.kind, check_size(shape.kind, shape.size))
 
 
@@ -198,7 +207,7 @@ def signed_distance(obj: GraspObject, points) -> np.ndarray:
 def _nearest(obj, local):
     shape = obj.shape
     if shape.kind == "mesh":
-        return mesh.nearest(shape, local)
+        return _mesh().nearest(shape, local)
     return primitives.nearest(shape.kind, check_size(shape.kind, shape.size), local, EDGE_TOL * object_size(obj))
 
 
@@ -235,7 +244,7 @@ def mass_properties(obj: GraspObject) -> MassProperties:
     obj = checked(obj)
     shape = obj.shape
     if shape.kind == "mesh":
-        volume, centroid, second = mesh.mass_moments(shape)
+        volume, centroid, second = _mesh().mass_moments(shape)
     else:
         size = check_size(shape.kind, shape.size)
         volume, centroid, second = (
@@ -275,7 +284,7 @@ def sample_surface(obj: GraspObject, n: int, rng: np.random.Generator, *, body=N
     obj = checked(obj)
     shape = obj.shape
     if shape.kind == "mesh":
-        points, outward = mesh.sample(shape, n, rng, body=body)
+        points, outward = _mesh().sample(shape, n, rng, body=body)
     else:
         points, outward = primitives.sample(shape.kind, check_size(shape.kind, shape.size), n, rng)
     rotation, translation = obj.pose[:3, :3], obj.pose[:3, 3]
@@ -290,7 +299,7 @@ def body_areas(obj: GraspObject) -> np.ndarray:
     >>> body_areas(GraspObject(Shape("sphere", np.ones(1)), np.eye(4))).tolist()
     [1.0]
     """
-    return mesh.body_areas(obj.shape) if obj.shape.kind == "mesh" else np.ones(1)
+    return _mesh().body_areas(obj.shape) if obj.shape.kind == "mesh" else np.ones(1)
 
 
 def body_of(obj: GraspObject, points) -> np.ndarray:
@@ -304,7 +313,7 @@ def body_of(obj: GraspObject, points) -> np.ndarray:
     if obj.shape.kind != "mesh":
         return np.zeros(p.shape[:-1], dtype=np.int64)
     local = rotate(obj.pose[:3, :3].T, p - obj.pose[:3, 3]).reshape(-1, 3)
-    return mesh.body_of(obj.shape, local).reshape(p.shape[:-1])
+    return _mesh().body_of(obj.shape, local).reshape(p.shape[:-1])
 
 
 def on_hidden_face(obj: GraspObject, points, distance, tolerance: float) -> np.ndarray:
@@ -322,7 +331,7 @@ def on_hidden_face(obj: GraspObject, points, distance, tolerance: float) -> np.n
     if obj.shape.kind != "mesh" or not deep.any():
         return np.zeros(p.shape[:-1], dtype=bool)
     local = rotate(obj.pose[:3, :3].T, p - obj.pose[:3, 3]).reshape(-1, 3)
-    near = mesh.face_distance(obj.shape, local).reshape(p.shape[:-1]) <= tolerance
+    near = _mesh().face_distance(obj.shape, local).reshape(p.shape[:-1]) <= tolerance
     return deep & near
 
 
