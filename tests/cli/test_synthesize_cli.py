@@ -569,3 +569,31 @@ def test_a_cold_run_returns_what_a_warm_run_returns(tmp_path):
     for c, w in scores:
         assert c["total_normal_force"] == pytest.approx(w["total_normal_force"], rel=1e-12)
         assert c["closure_friction"] == pytest.approx(w["closure_friction"], rel=1e-12)
+
+
+@pytest.mark.parametrize("workers", ["1", "2"])
+def test_an_object_whose_search_raises_is_its_internal_error_record_and_the_folder_runs_on(
+    tmp_path, monkeypatch, workers
+):
+    from grasptwist.run import synthesize as run_synthesize
+
+    for name in ("box-edge.yaml", "sphere.yaml"):
+        (tmp_path / name).write_bytes((GRASPS / name).read_bytes())
+    real = run_synthesize.surface_of
+
+    def fails_on_a_box(obj, span_bodies):  # a fault of ours on one object (0.5.0: IndexError in mesh_creases)
+        if obj.shape.kind == "box":
+            raise IndexError("index 22 is out of bounds for axis 0 with size 22")
+        return real(obj, span_bodies)
+
+    monkeypatch.setattr(run_synthesize, "surface_of", fails_on_a_box)
+    r, _ = run("synthesize", tmp_path, "--friction", "0.6", "--mass", "1", *FAST, "-f", "jsonl", "-j", workers)
+    assert r.exit_code == 1 and "Traceback" not in r.stderr and "WorkerFailed" not in r.stderr
+    recs = jsonl(r.stdout)
+    assert [(x["file"].rsplit("/", 1)[1], x["ok"]) for x in recs] == [("box-edge.yaml", False)] + [
+        ("sphere.yaml", True)
+    ] * 4  # box-edge's one object, then both balls' two grasps each
+    error = recs[0]["error"]
+    assert error["code"] == "internal-error" and error["line"] == 17  # the document's first line
+    assert error["message"] == "IndexError: index 22 is out of bounds for axis 0 with size 22"
+    assert f"box-edge.yaml:17: error: internal-error: {error['message']}" in r.stderr
