@@ -177,7 +177,11 @@ def test_the_creases_are_the_outer_surface_s():
     o = any_object("shared_planes")
     # box A's top face: its nearest creases are its rim, 20 mm off (the face B shares with it is no crease)
     np.testing.assert_allclose(edge_distance(o, [[-0.03, 0.0, 0.02], [0.03, 0.05, 0.02]]), [0.02, 0.02], atol=1e-15)
-    assert internal_counts(o) == (0, 4)  # B's face x = 0.01 and A's y = 0.02, two triangles each, partly inside
+    assert internal_counts(o) == (0, 4)
+    # the new user's point inside both boxes: to the walls 20 mm off (before: onto B's face x = 0.01, -0.0113)
+    np.testing.assert_allclose(
+        project_to_surface(o, [[0.012, 0.0, 0.0]]).distance, [-0.02], atol=1e-15
+    )  # B's face x = 0.01 and A's y = 0.02, two triangles each, partly inside
 
 
 def internal_counts(o):
