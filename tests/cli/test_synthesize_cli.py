@@ -618,3 +618,30 @@ def test_a_folder_of_meshes_with_internal_faces_cavities_and_bodies_is_searched(
     names = ["box_with_cavity", "open_cylinder", "overlapping_boxes", "pieces", "shared_planes", "two_bodies"]
     assert [x["grasp"] for x in recs] == names and all(x["ok"] for x in recs)
     assert "mesh-internal: " in r.stderr and "4 faces inside the solid, 0 partly, and 0 cavities" in r.stderr
+
+
+@pytest.mark.parametrize(
+    "mesh",
+    [
+        "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1 2 3\nf 1 3 4\n",  # a sheet: the winding number nowhere above 1/2
+        "v 0 0 0\nv 1 0 0\nv 2 0 0\nv 3 0 0\nf 1 2 3\nf 1 3 4\n",  # every triangle of zero area
+    ],
+)
+def test_mesh_not_solid_has_the_same_repair_hint_from_a_grasp_file_a_mesh_file_and_python(tmp_path, mesh):
+    from grasptwist.engine.objects.checks import NOT_SOLID_HINT
+    from grasptwist.objects import GraspObject, Shape, check_object
+
+    (tmp_path / "m.obj").write_text(mesh)
+    (tmp_path / "g.yaml").write_text("object:\n  mesh: m.obj\n  mass: 1\nfriction: 0.5\n")
+    messages = []
+    for args in ((tmp_path / "m.obj", "--friction", "0.5", "--mass", "1"), (tmp_path / "g.yaml",)):
+        r, _ = run("synthesize", *args, "-f", "jsonl")
+        (rec,) = jsonl(r.stdout)
+        assert r.exit_code == 1 and rec["error"]["code"] == "mesh-not-solid"
+        messages.append(rec["error"]["message"])
+    v = np.array([[float(x) for x in line.split()[1:]] for line in mesh.splitlines() if line.startswith("v")])
+    with pytest.raises(ValueError) as caught:
+        check_object(GraspObject(Shape("mesh", np.zeros(0), v, np.array([[0, 1, 2], [0, 2, 3]])), np.eye(4)))
+    messages.append(str(caught.value))
+    assert NOT_SOLID_HINT == "repair it (docs/guide/objects.md, Meshes as they come)"
+    assert all(m.endswith(f": {NOT_SOLID_HINT}") for m in messages), messages  # 0.5.0: only the sheet's two

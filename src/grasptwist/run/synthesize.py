@@ -251,7 +251,7 @@ def _object_warnings(entry: Grasp, obj: GraspObject, hand: Hand | None) -> tuple
     shape = obj.shape
     extent = largest_extent(shape.kind, shape.size, shape.vertices)
     if hand is not None:
-        said.append(hand_fit_warning(extent, fingers_reach(hand), entry.units))
+        said.append(hand_fit_warning(extent, fingers_reach(hand), entry.units, urdf=hand.source is not None))
     elif shape.kind == "mesh":
         said.append(mesh_span_warning(extent, entry.units))
     return tuple(w for w in said if w)
