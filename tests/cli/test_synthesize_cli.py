@@ -617,7 +617,9 @@ def test_a_folder_of_meshes_with_internal_faces_cavities_and_bodies_is_searched(
     recs = jsonl(r.stdout)
     names = ["box_with_cavity", "open_cylinder", "overlapping_boxes", "pieces", "shared_planes", "two_bodies"]
     assert [x["grasp"] for x in recs] == names and all(x["ok"] for x in recs)
-    assert "mesh-internal: " in r.stderr and "4 faces inside the solid, 0 partly, and 0 cavities" in r.stderr
+    assert "overlapping_boxes.obj: 4 faces inside the solid, 0 partly, and 0 cavities" in r.stderr
+    # its boxes' equal corners merged as read: before, one piece, '2 faces inside the solid' and none split
+    assert "shared_planes.obj: 0 faces inside the solid, 4 partly, and 0 cavities" in r.stderr
 
 
 @pytest.mark.parametrize(

@@ -109,7 +109,10 @@ def crossing_shape(name):
         "box_and_cylinder": [box([0.1, 0.04, 0.04]), trimesh.creation.cylinder(0.01, 0.1, sections=32)],
     }[name]
     m = trimesh.util.concatenate(parts)
-    return check_object(GraspObject(Shape("mesh", np.zeros(0), m.vertices, m.faces, name), np.eye(4))).shape
+    # as an OBJ file writes them: the boxes' equal corners (0.05, -0.02, +-0.02) merged, which joined the two
+    # boxes into one piece whose faces were never split (387 of 20,000 samples inside, up to 47 mm deep)
+    v = np.round(m.vertices, 9)
+    return check_object(GraspObject(Shape("mesh", np.zeros(0), v, m.faces, name), np.eye(4))).shape
 
 
 def any_object(name, **kw):

@@ -217,6 +217,28 @@ def _face_components(faces, n_vertices):
     return label.reshape(-1)
 
 
+def _pieces(faces):
+    """Each face's piece: faces joined across the edges of two faces exactly (``(F,)`` labels 0, 1, ...).  Pieces
+    that share only a vertex, or an edge of more than two faces (two boxes with a corner or an edge in common,
+    once a file's equal vertices are merged), stay apart: where they cross, their faces are split.
+
+    >>> from grasptwist.engine.objects.primitives import triangles
+    >>> v, f = triangles("box", [2.0, 2.0, 2.0], 0)
+    >>> w, g = np.concatenate([v, v + 2.0]), np.concatenate([f, f + len(v)])
+    >>> g[g == len(v) + int(np.argmin(v.sum(axis=1)))] = int(np.argmax(v.sum(axis=1)))  # the corner (1, 1, 1) shared
+    >>> int(_face_components(g, len(w)).max()) + 1, int(_pieces(g).max()) + 1
+    (1, 2)
+    """
+    f = np.asarray(faces, dtype=np.int64)
+    _, _, undirected, _ = _edges(f)
+    order = np.argsort(undirected, kind="stable")
+    _, start, count = np.unique(undirected[order], return_index=True, return_counts=True)
+    two = start[count == 2]
+    pairs = np.stack([order[two] // 3, order[two + 1] // 3], axis=1)
+    _, label = np.unique(components(len(f), pairs), return_inverse=True)
+    return label.reshape(-1)
+
+
 def _edges(faces):
     """Directed edge keys of the faces, the undirected ones and their counts."""
     f = np.asarray(faces, dtype=np.int64)
@@ -310,7 +332,7 @@ def solid(vertices, faces) -> Solid:
     size = float(np.linalg.norm(v.max(axis=0) - v.min(axis=0)))
     closed, open_edges = _open(f)
     hole = _hole_size(v, open_edges)
-    piece = _face_components(f, len(v))
+    piece = _pieces(f)
     count = int(piece.max()) + 1
     apart, lo, hi = _boxes_apart(v, f, piece, count)
     if closed and apart and (_volumes(v, f, piece, count) > 0).all():
