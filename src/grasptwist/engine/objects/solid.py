@@ -20,8 +20,9 @@ piece), on neither it bounds nothing.  A face partly inside another piece is spl
 again where a part is partly inside, :data:`SPLIT_DEPTH` times, each part kept where it bounds the
 solid; a part still crossed at the last split is cut along the plane of each face crossing it
 (:data:`CUTS` times), and each side kept by its centre: the outer surface follows the pieces'
-intersection exactly where they are flat (no sample and no nearest point inside the solid; before,
-the last split's parts were kept whole by their centres, up to 1/64 of a face inside).  A connected
+intersection exactly where they are flat (before, the last split's parts were kept whole by their
+centres, up to 1/64 of a face inside).  A piece is the faces joined across edges of two faces
+exactly: pieces sharing a vertex or an edge (a file's equal vertices merged) stay apart.  A connected
 part of that surface that encloses a negative volume (faces turned inwards, round a void) is a
 cavity, out of reach.  Connected pieces of the mesh that overlap or touch are one body.
 
