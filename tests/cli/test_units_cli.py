@@ -137,9 +137,13 @@ def test_a_search_judges_its_object_against_the_hand_it_is_given():
     cube = GraspObject(Shape("box", np.full(3, 65.0)), np.eye(4))
     nan = np.full((3, 3), np.nan)
     entry = Grasp("cube", "mm", "cube.yaml", 0, CONTACT_NAMES, nan, nan, None, (), 1, object=cube)
-    urdf_sized = Hand((finger(0.382),) * 3, (), None, None)  # a TriFinger's reach, in metres
+    urdf_sized = Hand((finger(0.382),) * 3, (), "trifinger.urdf", None)  # a TriFinger's reach, in metres
     (said,) = _object_warnings(entry, cube, urdf_sized)
-    assert said.startswith("hand-size-mismatch: the object's largest extent (65 mm) is 170 times")
+    assert said == (  # the reach in the URDF's metres and the object's unit (0.5.0: "(0.382 mm)")
+        "hand-size-mismatch: the object's largest extent (65 mm) is 170 times the fingers' reach (the URDF's "
+        "0.382 m, 382 mm, taken as 0.382 mm: lengths are never converted): is the object in another unit than "
+        "the hand (a URDF is in metres)?"
+    )
     assert _object_warnings(entry, cube, Hand((finger(382.0),) * 3, (), None, None)) == ()
     assert _object_warnings(entry, cube, None) == ()  # a primitive without a hand: no unit to judge by
 

@@ -44,10 +44,25 @@ def test_a_closed_mesh_is_read_with_its_volume_outwards(tmp_path):
     assert not vertices.flags.writeable and not faces.flags.writeable
 
 
-def test_a_mesh_wound_inwards_is_turned_outwards(tmp_path):
+def test_a_mesh_wound_inwards_is_turned_outwards_and_said(tmp_path):
     inward = [f"f {a} {c} {b}" for _, a, b, c in (f.split() for f in TETRA_F)]
-    vertices, faces = read_mesh(obj(tmp_path, tetra(inward)), tmp_path)
+    said = []
+    vertices, faces = read_mesh(obj(tmp_path, tetra(inward)), tmp_path, warnings=said)
     assert volume(vertices, faces) == pytest.approx(1 / 6)
+    assert said == ["mesh-repaired: faces re-wound outwards (the geometry is unchanged)"]  # 0.5.0: silent
+    said = []
+    read_mesh(obj(tmp_path, tetra()), tmp_path, warnings=said)
+    assert said == []  # wound outwards already
+    # an STL wound inwards, as a binary STL gives it (its vertices repeated: their merging not said)
+    a, b, c = vertices[faces[:, ::-1]].transpose(1, 0, 2)
+    n = np.cross(b - a, c - a)
+    records = np.zeros(len(a), dtype=[("n", "<f4", 3), ("v", "<f4", (3, 3)), ("attr", "<u2")])
+    records["n"], records["v"] = n, np.stack([a, b, c], axis=1)
+    (tmp_path / "in.stl").write_bytes(bytes(80) + np.uint32(len(a)).tobytes() + records.tobytes())
+    said = []
+    vertices, faces = read_mesh("in.stl", tmp_path, warnings=said)
+    assert volume(vertices, faces) == pytest.approx(1 / 6, rel=1e-6)
+    assert said == ["mesh-repaired: faces re-wound outwards (the geometry is unchanged)"]
 
 
 @pytest.mark.slow  # over a second: docs/reference/development.md, Test time

@@ -91,16 +91,19 @@ def fingers_reach(hand) -> float:
     return max(float(f.length) for f in hand.fingers)
 
 
-def hand_fit_warning(extent: float, reach: float, units: str | None) -> str | None:
+def hand_fit_warning(extent: float, reach: float, units: str | None, urdf: bool = False) -> str | None:
     r"""The warning for an object that does not fit its hand, None when it does.
 
     It does not fit when its largest extent :math:`e` and the fingers' reach :math:`L`
-    (both in the file's unit) are far apart, :math:`e > 10 L` or :math:`e < L / 10`
-    (:data:`HAND_FIT`): a URDF is in metres, so an object in millimetres is 1000 times too
-    big for it.  It starts with its code.
+    (as numbers, in the grasp frame: lengths are never converted) are far apart, :math:`e > 10 L`
+    or :math:`e < L / 10` (:data:`HAND_FIT`): a URDF is in metres, so an object in millimetres
+    is 1000 times too big for it.  ``urdf``: the hand is a URDF's, its reach in metres, said
+    in metres and in the object's unit too.  It starts with its code.
 
-    >>> print(hand_fit_warning(65.0, 0.3, "mm"))
-    hand-size-mismatch: the object's largest extent (65 mm) is 217 times the fingers' reach (0.3 mm): is the object in another unit than the hand (a URDF is in metres)?
+    >>> print(hand_fit_warning(65.0, 0.382, "mm", urdf=True))
+    hand-size-mismatch: the object's largest extent (65 mm) is 170 times the fingers' reach (the URDF's 0.382 m, 382 mm, taken as 0.382 mm: lengths are never converted): is the object in another unit than the hand (a URDF is in metres)?
+    >>> print(hand_fit_warning(200.0, 1.5, "mm"))  # an inline hand: in the file's unit
+    hand-size-mismatch: the object's largest extent (200 mm) is 133 times the fingers' reach (1.5 mm): is the object in another unit than the hand (a URDF is in metres)?
     >>> hand_fit_warning(0.065, 0.3, "m") is None
     True
     """
@@ -109,9 +112,15 @@ def hand_fit_warning(extent: float, reach: float, units: str | None) -> str | No
     unit = f" {units}" if units else ""
     ratio = extent / reach
     times = f"{ratio:.3g} times" if ratio > 1 else f"1/{1 / ratio:.3g} of"
+    said = f"{reach:.3g}{unit}"
+    metres = unit_length(units)
+    if urdf and metres is not None and metres != 1.0:
+        said = f"the URDF's {reach:.3g} m, {reach / metres:.3g}{unit}, taken as {reach:.3g}{unit}: lengths are never converted"
+    elif urdf:
+        said = f"the URDF's {reach:.3g} m"
     return (
         f"hand-size-mismatch: the object's largest extent ({extent:.3g}{unit}) is {times} the fingers' reach "
-        f"({reach:.3g}{unit}): is the object in another unit than the hand (a URDF is in metres)?"
+        f"({said}): is the object in another unit than the hand (a URDF is in metres)?"
     )
 
 

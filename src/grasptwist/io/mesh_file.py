@@ -26,7 +26,7 @@ for a URDF (:mod:`grasptwist.io.urdf`, whose path rule this shares):
   (:mod:`grasptwist.engine.objects.checks`).  It is repaired without changing its geometry
   (equal vertices merged, zero-area triangles dropped: ``mesh-repaired``) and may be open or
   made of pieces: the solid it bounds is the engine's (:mod:`grasptwist.engine.objects.solid`).
-  A mesh wound inwards is turned outwards.
+  A mesh wound inwards is turned outwards (``mesh-repaired``: "faces re-wound outwards").
 
 Every refusal is a :class:`~grasptwist.model.InputError` with a code:
 
@@ -163,9 +163,13 @@ def check_mesh(vertices, faces, max_triangles, file, warnings=None):
     >>> float(np.einsum("ij,ij->", a, np.cross(b, c)) / 6)  # the tetrahedron's volume, now positive
     0.16666666666666666
     >>> said = []
+    >>> _ = check_mesh(tetra, faces, 10, "t.obj", said)
+    >>> said
+    ['mesh-repaired: faces re-wound outwards (the geometry is unchanged)']
+    >>> said = []
     >>> _ = check_mesh(np.concatenate([tetra, tetra[:1]]), np.concatenate([faces, [[4, 1, 2]]]), 10, "t.obj", said)
     >>> said
-    ['mesh-repaired: 1 duplicate vertex merged (the geometry is unchanged)']
+    ['mesh-repaired: 1 duplicate vertex merged, faces re-wound outwards (the geometry is unchanged)']
     """
     if not len(faces):
         raise InputError("empty-mesh", "no triangles in the mesh", file)
@@ -175,21 +179,24 @@ def check_mesh(vertices, faces, max_triangles, file, warnings=None):
         raise InputError("invalid-mesh", "a face names a vertex the file does not have", file)
     if not np.isfinite(vertices).all():
         raise InputError("non-finite", "a vertex coordinate is NaN or infinite", file)
-    from ..engine.objects.checks import repair_mesh
+    from ..engine.objects.checks import NOT_SOLID_HINT, repair_mesh
 
     _check_geometry(vertices, faces, file)
     repaired = repair_mesh(vertices, faces)  # equal vertices merged, zero-area faces dropped
     if str(file).lower().endswith(".stl"):  # the format repeats each vertex: merging them repairs nothing
         repaired = repaired._replace(merged=0)
-    if warnings is not None and repaired.warning():
-        warnings.append(repaired.warning())
     vertices, faces = repaired.vertices, repaired.faces
     if not len(faces):
-        raise InputError("mesh-not-solid", "every triangle has zero area: the mesh bounds no solid", file)
+        raise InputError(
+            "mesh-not-solid", f"every triangle has zero area: the mesh bounds no solid: {NOT_SOLID_HINT}", file
+        )
     a, b, c = vertices[faces].transpose(1, 0, 2)
     if np.einsum("ij,ij->", a, np.cross(b, c)) < 0:
         faces = np.ascontiguousarray(faces[:, ::-1])
         faces.setflags(write=False)
+        repaired = repaired._replace(faces=faces, turned=True)
+    if warnings is not None and repaired.warning():
+        warnings.append(repaired.warning())
     return vertices, faces
 
 

@@ -252,7 +252,7 @@ def _object_warnings(entry: Grasp, obj: GraspObject, hand: Hand | None) -> tuple
     shape = obj.shape
     extent = largest_extent(shape.kind, shape.size, shape.vertices)
     if hand is not None:
-        said.append(hand_fit_warning(extent, fingers_reach(hand), entry.units))
+        said.append(hand_fit_warning(extent, fingers_reach(hand), entry.units, urdf=hand.source is not None))
     elif shape.kind == "mesh":
         said.append(mesh_span_warning(extent, entry.units))
     return tuple(w for w in said if w)
@@ -267,8 +267,8 @@ class Progress(NamedTuple):
 
 def synthesize_inputs(job, inputs: Iterable) -> Iterator[GraspFileError | Found | Progress]:
     """Every object of ``inputs`` (paths or the errors of ``expand``) searched, in order, with the
-    progress of each search (its candidates) and of each input (one unit)."""
-    o = job.options
+    progress of each search (its candidates) and of each input (one unit).  An object whose search
+    raises (a fault of ours, not of the input) is its ``internal-error`` record, and the others run on."""
     for item in inputs:
         if isinstance(item, GraspFileError):
             yield item
@@ -278,74 +278,99 @@ def synthesize_inputs(job, inputs: Iterable) -> Iterator[GraspFileError | Found 
         mesh = item.lower().endswith(MESH_SUFFIXES)
         # the contacts are found: a document need not give them (an object and the weight suffice)
         reading = replace(job.reading, contacts=False)
-        entries = [_mesh_grasp(item, job)] if mesh else read_unplaced(item, job.max_bytes, reading)
+        try:
+            entries = [_mesh_grasp(item, job)] if mesh else read_unplaced(item, job.max_bytes, reading)
+        except Exception as exc:  # noqa: BLE001 - this input's record; the others run on
+            entries = [_internal(item, None, exc)]
         for entry in entries:
-            task = _task(o, entry) if isinstance(entry, Grasp) else entry
-            if isinstance(task, GraspFileError):
-                yield task
+            if isinstance(entry, GraspFileError):
+                yield entry
                 continue
-            obj, friction, names, wrenches, hold = task
-            hand = _hand(job, entry, obj)
-            if isinstance(hand, GraspFileError):
-                yield hand
-                continue
-            reach, hand = hand if hand is not None else (None, None)
-            said = _object_warnings(entry, obj, hand)
-            yield Progress(o.candidates, 0)
-            surface, clear = environment_search(surface_of(obj, o.span_bodies), entry.environment, None, reach)
-            for step in search_steps(
-                surface,
-                wrenches,
-                friction,
-                count=o.count,
-                safety=o.safety,
-                objective=o.objective,
-                wrist=entry.wrist,
-                methods=METHODS if o.method == "both" else (o.method.replace("-", "_"),),
-                min_conditioning=o.min_conditioning,
-                min_spacing=o.min_spacing,
-                constraints=clear,
-                hand=reach,
-                quality=o.quality,
-                seed=o.seed,
-                candidates=o.candidates,
-                seconds=o.seconds,
-                position_error=o.position_error,
-                friction_error=o.friction_error,
-                perturbations=o.perturbations,
-            ):
-                if isinstance(step, int):
-                    yield Progress(0, step)
-            yield Progress(0, o.candidates - step.candidates)  # the budget left unspent
-            found = Found(
-                entry.file,
-                entry.name,
-                entry.line,
-                entry.units,
-                entry.wrist,
-                obj,
-                friction,
-                names,
-                wrenches,
-                hold,
-                step,
-                entry.contact_names,
-                hand=hand,
-                hand_file=None if hand is None else (o.hand_file or entry.file),
-                joints_at=_inline_joints(hand, step),
-                twists=entry.twists,
-                paths=entry.paths,
-                warnings=said,
-                environment=entry.environment,
-                clearance=grasp_clearance(step.points, entry.environment, reach, step.joint_positions),
-            )
-            if o.simulate is not None:
-                from .simulate import held_only  # MuJoCo, with the first synthesize --simulate
-
-                found, dropped = held_only(found, o.simulate)
-                found = replace(found, dropped=dropped)
-            yield found
+            extra = done = 0
+            try:
+                for step in _searched_entry(job, entry):
+                    if isinstance(step, Progress):
+                        extra, done = extra + step.extra, done + step.done
+                    yield step
+            except Exception as exc:  # noqa: BLE001 - this object's record; the others run on
+                yield _internal(entry.file, entry.line, exc)
+                yield Progress(0, extra - done)  # its search's budget, unspent
         yield Progress(0, 1)
+
+
+def _internal(file, line, exc: Exception) -> GraspFileError:
+    """The ``internal-error`` record of an object whose reading or search raised ``exc``."""
+    return _problem(file, "internal-error", f"{type(exc).__name__}: {exc}", line)
+
+
+def _searched_entry(job, entry: Grasp) -> Iterator[GraspFileError | Found | Progress]:
+    """One grasp document's search (:func:`synthesize_inputs`): its errors, or its progress and what it found."""
+    o = job.options
+    task = _task(o, entry)
+    if isinstance(task, GraspFileError):
+        yield task
+        return
+    obj, friction, names, wrenches, hold = task
+    hand = _hand(job, entry, obj)
+    if isinstance(hand, GraspFileError):
+        yield hand
+        return
+    reach, hand = hand if hand is not None else (None, None)
+    said = _object_warnings(entry, obj, hand)
+    yield Progress(o.candidates, 0)
+    surface, clear = environment_search(surface_of(obj, o.span_bodies), entry.environment, None, reach)
+    for step in search_steps(
+        surface,
+        wrenches,
+        friction,
+        count=o.count,
+        safety=o.safety,
+        objective=o.objective,
+        wrist=entry.wrist,
+        methods=METHODS if o.method == "both" else (o.method.replace("-", "_"),),
+        min_conditioning=o.min_conditioning,
+        min_spacing=o.min_spacing,
+        constraints=clear,
+        hand=reach,
+        quality=o.quality,
+        seed=o.seed,
+        candidates=o.candidates,
+        seconds=o.seconds,
+        position_error=o.position_error,
+        friction_error=o.friction_error,
+        perturbations=o.perturbations,
+    ):
+        if isinstance(step, int):
+            yield Progress(0, step)
+    yield Progress(0, o.candidates - step.candidates)  # the budget left unspent
+    found = Found(
+        entry.file,
+        entry.name,
+        entry.line,
+        entry.units,
+        entry.wrist,
+        obj,
+        friction,
+        names,
+        wrenches,
+        hold,
+        step,
+        entry.contact_names,
+        hand=hand,
+        hand_file=None if hand is None else (o.hand_file or entry.file),
+        joints_at=_inline_joints(hand, step),
+        twists=entry.twists,
+        paths=entry.paths,
+        warnings=said,
+        environment=entry.environment,
+        clearance=grasp_clearance(step.points, entry.environment, reach, step.joint_positions),
+    )
+    if o.simulate is not None:
+        from .simulate import held_only  # MuJoCo, with the first synthesize --simulate
+
+        found, dropped = held_only(found, o.simulate)
+        found = replace(found, dropped=dropped)
+    yield found
 
 
 def searched(job, inputs: list, workers: int = 1) -> Iterator[GraspFileError | Found | Progress]:

@@ -21,6 +21,7 @@ from .primitives import PRIMITIVES, diagonal
 
 __all__ = [
     "KINDS",
+    "NOT_SOLID_HINT",
     "RIGID_TOL",
     "SIZE_RANGE",
     "AREA_TOL",
@@ -36,6 +37,10 @@ __all__ = [
     "MeshRepair",
     "repair_mesh",
 ]
+
+#: What every ``mesh-not-solid`` error ends with, however the mesh came (a grasp file, a mesh file
+#: given to ``synthesize``, Python).
+NOT_SOLID_HINT = "repair it (docs/guide/objects.md, Meshes as they come)"
 
 #: The shapes an object may have.
 KINDS = (*PRIMITIVES, "mesh")
@@ -119,7 +124,7 @@ def check_shape(shape: Shape) -> Shape:
         try:
             solid_of(checked)
         except ValueError as exc:  # no inside can be told
-            raise ObjectError("mesh-not-solid", str(exc)) from None
+            raise ObjectError("mesh-not-solid", f"{exc}: {NOT_SOLID_HINT}") from None
         return checked
     return replace(shape, size=check_size(shape.kind, shape.size))
 
@@ -206,23 +211,29 @@ class MeshRepair(NamedTuple):
         Vertices merged into an equal one.
     dropped : int
         Faces dropped: of zero area (:func:`degenerate_faces`) or with a repeated corner.
+    turned : bool
+        Every face re-wound outwards (the mesh was wound inwards: a mesh file's reader turns it).
     """
 
     vertices: np.ndarray
     faces: np.ndarray
     merged: int
     dropped: int
+    turned: bool = False
 
     def warning(self) -> str | None:
         """The ``mesh-repaired`` warning (None when nothing was repaired); it starts with its code.
 
         >>> MeshRepair(np.zeros((4, 3)), np.zeros((4, 3), int), 2, 1).warning()
         'mesh-repaired: 2 duplicate vertices merged, 1 zero-area face dropped (the geometry is unchanged)'
+        >>> MeshRepair(np.zeros((4, 3)), np.zeros((4, 3), int), 0, 0, turned=True).warning()
+        'mesh-repaired: faces re-wound outwards (the geometry is unchanged)'
         """
-        if not (self.merged or self.dropped):
+        if not (self.merged or self.dropped or self.turned):
             return None
         said = [f"{self.merged} duplicate vert{'ex' if self.merged == 1 else 'ices'} merged"] if self.merged else []
         said += [f"{self.dropped} zero-area face{'s' * (self.dropped != 1)} dropped"] if self.dropped else []
+        said += ["faces re-wound outwards"] if self.turned else []
         return f"mesh-repaired: {', '.join(said)} (the geometry is unchanged)"
 
 
@@ -277,7 +288,7 @@ def _check_mesh(vertices, faces):
     check_extent(np.linalg.norm(v.max(axis=0) - v.min(axis=0)), "mesh")
     repaired = repair_mesh(v, f.astype(np.int64))
     if len(repaired.faces) == 0:
-        raise ObjectError("mesh-not-solid", "mesh bounds no solid: every face has zero area")
+        raise ObjectError("mesh-not-solid", f"mesh bounds no solid: every face has zero area: {NOT_SOLID_HINT}")
     return repaired.vertices, repaired.faces
 
 

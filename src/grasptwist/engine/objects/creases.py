@@ -44,7 +44,10 @@ _CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 
 def mesh_creases(shape, angle_deg=CREASE_ANGLE_DEG):
-    """The creases of a closed mesh: ``(E, 2, 3)`` segments whose faces turn more than ``angle_deg``.
+    """The creases of a mesh's outer surface (the one its nearest points lie on, :func:`~.solid.solid`'s:
+    internal faces and cavities left out, faces another piece crosses split): ``(E, 2, 3)`` segments
+    whose two faces turn more than ``angle_deg`` (an edge of one face only, such as where a split
+    face meets the piece that crosses it, is none).
 
     >>> from grasptwist.model import Shape
     >>> from grasptwist.engine.objects.primitives import triangles
@@ -56,14 +59,14 @@ def mesh_creases(shape, angle_deg=CREASE_ANGLE_DEG):
     if angle_deg in known:
         return known[angle_deg]
     d = _derived(shape)
-    faces = np.asarray(shape.faces)
+    faces = d.faces
     normals = d.face_normals
     # side i of face f (opposite vertex i) joins vertices (i + 1, i + 2); each edge once (f < its partner)
     mine = np.repeat(np.arange(len(faces)), 3).reshape(-1, 3)
     turned = np.einsum("fsi,fsi->fs", normals[mine], normals[d.partner]) < np.cos(np.radians(angle_deg))
     face, side = np.nonzero(turned & (mine < d.partner))
     ends = np.stack([faces[face, (side + 1) % 3], faces[face, (side + 2) % 3]], axis=1)
-    segments = np.asarray(shape.vertices, float)[ends]
+    segments = d.vertices[ends]
     known[angle_deg] = segments
     return segments
 

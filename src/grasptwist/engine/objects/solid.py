@@ -18,7 +18,11 @@ side, at :data:`SIDE_OFFSET` of the mesh's size: with the solid on one side it b
 to face away from the solid), on both sides it is internal (a face of a piece inside another
 piece), on neither it bounds nothing.  A face partly inside another piece is split in four, and
 again where a part is partly inside, :data:`SPLIT_DEPTH` times, each part kept where it bounds the
-solid (at the last split, by its centre).  A connected
+solid; a part still crossed at the last split is cut along the plane of each face crossing it
+(:data:`CUTS` times), and each side kept by its centre: the outer surface follows the pieces'
+intersection exactly where they are flat (before, the last split's parts were kept whole by their
+centres, up to 1/64 of a face inside).  A piece is the faces joined across edges of two faces
+exactly: pieces sharing a vertex or an edge (a file's equal vertices merged) stay apart.  A connected
 part of that surface that encloses a negative volume (faces turned inwards, round a void) is a
 cavity, out of reach.  Connected pieces of the mesh that overlap or touch are one body.
 
@@ -38,6 +42,7 @@ __all__ = [
     "SIDE_OFFSET",
     "SPLIT_DEPTH",
     "SPLIT_PARTS",
+    "CUTS",
     "GAP_BODIES",
     "MOMENT_RAYS",
     "Solid",
@@ -55,14 +60,18 @@ __all__ = [
 SIDE_OFFSET = 1e-5
 
 #: A face another piece crosses is split in four, and each part that it crosses again, at most
-#: this many times; a part outside is kept, and at the last split a part whose centre is: the outer
-#: surface follows the pieces' intersection to 1/64 of a face's size.
+#: this many times; a part the other piece no longer crosses is kept where it bounds the solid, and
+#: at the last split each part still crossed is cut along the crossing faces' planes (:data:`CUTS`).
 SPLIT_DEPTH = 6
 
-#: The splitting stops sooner (the parts at that depth kept by their centres) where its next
+#: The splitting stops sooner (the parts at that depth cut) where its next
 #: depth would hold more parts than this or twice the mesh's faces (a mesh of many pieces that
 #: cross along long curves): the time stays a few times the probes' of the faces themselves.
 SPLIT_PARTS = 20_000
+
+#: The times a part still crossed is cut along the plane of a face crossing it (:func:`_cut`): a part by a
+#: corner where three faces of another piece meet needs three.
+CUTS = 4
 
 #: The rays per side of the grid that integrates the solid's mass properties when the mesh is
 #: not one closed surface: the volume is then within about 3e-3 of the exact (overlapping boxes').
@@ -91,6 +100,9 @@ class Solid(NamedTuple):
         The largest extent along an axis of the largest loop of open edges (0 closed).
     internal : int
         Faces of the given mesh with the solid on both sides, wholly.
+    partly : int
+        Faces of the given mesh partly inside the solid (crossed by another piece, the part inside
+        left out of the outer surface).
     cavities : int
         Closed parts of the boundary round a void inside the solid.
     loose : int
@@ -115,6 +127,7 @@ class Solid(NamedTuple):
     open_edges: int
     largest_hole: float
     internal: int
+    partly: int
     cavities: int
     loose: int
     closed: bool
@@ -202,6 +215,28 @@ def _face_components(faces, n_vertices):
     f = np.asarray(faces)
     vertex = components(n_vertices, np.concatenate([f[:, [0, 1]], f[:, [1, 2]]]))
     _, label = np.unique(vertex[f[:, 0]], return_inverse=True)
+    return label.reshape(-1)
+
+
+def _pieces(faces):
+    """Each face's piece: faces joined across the edges of two faces exactly (``(F,)`` labels 0, 1, ...).  Pieces
+    that share only a vertex, or an edge of more than two faces (two boxes with a corner or an edge in common,
+    once a file's equal vertices are merged), stay apart: where they cross, their faces are split.
+
+    >>> from grasptwist.engine.objects.primitives import triangles
+    >>> v, f = triangles("box", [2.0, 2.0, 2.0], 0)
+    >>> w, g = np.concatenate([v, v + 2.0]), np.concatenate([f, f + len(v)])
+    >>> g[g == len(v) + int(np.argmin(v.sum(axis=1)))] = int(np.argmax(v.sum(axis=1)))  # the corner (1, 1, 1) shared
+    >>> int(_face_components(g, len(w)).max()) + 1, int(_pieces(g).max()) + 1
+    (1, 2)
+    """
+    f = np.asarray(faces, dtype=np.int64)
+    _, _, undirected, _ = _edges(f)
+    order = np.argsort(undirected, kind="stable")
+    _, start, count = np.unique(undirected[order], return_index=True, return_counts=True)
+    two = start[count == 2]
+    pairs = np.stack([order[two] // 3, order[two + 1] // 3], axis=1)
+    _, label = np.unique(components(len(f), pairs), return_inverse=True)
     return label.reshape(-1)
 
 
@@ -298,15 +333,15 @@ def solid(vertices, faces) -> Solid:
     size = float(np.linalg.norm(v.max(axis=0) - v.min(axis=0)))
     closed, open_edges = _open(f)
     hole = _hole_size(v, open_edges)
-    piece = _face_components(f, len(v))
+    piece = _pieces(f)
     count = int(piece.max()) + 1
     apart, lo, hi = _boxes_apart(v, f, piece, count)
     if closed and apart and (_volumes(v, f, piece, count) > 0).all():
         body = piece
-        internal = cavities = loose = 0
+        internal = partly = cavities = loose = 0
         outer_v, outer_f, source_f = v, f, f
     else:
-        outer_v, outer_f, body, internal, cavities, loose, source_f, whole = _classify(
+        outer_v, outer_f, body, internal, partly, cavities, loose, source_f, whole = _classify(
             v, f, piece, size, lo, hi, closed
         )
         closed = closed and whole
@@ -329,6 +364,7 @@ def solid(vertices, faces) -> Solid:
         len(open_edges),
         hole,
         internal,
+        partly,
         cavities,
         loose,
         closed,
@@ -371,17 +407,26 @@ def _classify(v, f, piece, size, lo, hi, closed):
     pieces = [v[kept]]
     owner = [piece[whole]]
     small, mine, parent = corners[crossed], piece[crossed], np.flatnonzero(crossed)
+    inner = [np.zeros(0, np.int64)]  # the crossed faces with a part inside the solid
     for level in range(SPLIT_DEPTH):  # the faces another piece crosses, split where it does
         small, mine, parent = _split(small, 1), np.repeat(mine, 4), np.repeat(parent, 4)
+        if level == SPLIT_DEPTH - 1 or 4 * len(small) > max(SPLIT_PARTS, 2 * len(f)):
+            break
         fr, bk = sides(small.mean(axis=1), _normals(small), mine)
-        last = level == SPLIT_DEPTH - 1 or 4 * len(small) > max(SPLIT_PARTS, 2 * len(f))
-        again = _crossed(small, parent, corners, partners) if not last else np.zeros(len(small), bool)
+        again = _crossing_face(small, parent, corners, partners) >= 0
         take = ~again & (fr != bk)
         pieces.append(np.where(bk[take, None, None], small[take], small[take][:, ::-1]))
         owner.append(mine[take])
+        inner.append(parent[~again & fr & bk])
         small, mine, parent = small[again], mine[again], parent[again]
-        if last:
-            break
+    # the last split's parts: those still crossed cut along the planes of the faces crossing them, each part
+    # then on one side of every face near it, kept by its centre
+    small, mine, parent = _cut(small, parent, corners, partners, mine)
+    fr, bk = sides(small.mean(axis=1), _normals(small), mine)
+    take = fr != bk
+    pieces.append(np.where(bk[take, None, None], small[take], small[take][:, ::-1]))
+    owner.append(mine[take])
+    inner.append(parent[fr & bk])
     # the source: the faces that bound the solid wound outwards, the others as given
     source = f.copy()
     source[whole] = kept
@@ -406,11 +451,87 @@ def _classify(v, f, piece, size, lo, hi, closed):
         remap.reshape(-1, 3),
         body.reshape(-1),
         int(internal.sum()),
+        len(np.unique(np.concatenate(inner))),
         int(cavity.sum()),
         int(loose.sum()),
         source,
         bool(whole.all()),
     )
+
+
+def _cut(small, parent, corners, partners, mine):
+    """The parts ``small (K, 3, 3)`` of faces ``parent (K,)`` of pieces ``mine (K,)`` cut along the plane of a face
+    crossing each, again while one does (:data:`CUTS` times): ``(parts (M, 3, 3), their pieces (M,), their faces
+    (M,))``, none of zero area."""
+    done, owners, parents = [], [], []
+    for _ in range(CUTS):
+        if not len(small):
+            break
+        plane = _crossing_face(small, parent, corners, partners)
+        cut = plane >= 0
+        done.append(small[~cut])
+        owners.append(mine[~cut])
+        parents.append(parent[~cut])
+        small, parent, mine = small[cut], parent[cut], mine[cut]
+        small, k = _cut_by_plane(small, corners[plane[cut]])
+        parent, mine = np.repeat(parent, k), np.repeat(mine, k)
+    done.append(small)
+    owners.append(mine)
+    parents.append(parent)
+    empty = np.zeros(0, np.int64)
+    return (
+        np.concatenate([np.zeros((0, 3, 3)), *done]),
+        np.concatenate([empty, *owners]),
+        np.concatenate([empty, *parents]),
+    )
+
+
+def _crossing_face(small, parent, corners, partners):
+    """For each part ``small (K, 3, 3)`` of face ``parent (K,)``, a face of another piece crossing it (-1 none)."""
+    first, count = np.unique(partners[0], return_index=True)[1], np.bincount(partners[0], minlength=len(corners))
+    start = np.zeros(len(corners), dtype=np.int64)
+    start[partners[0][first]] = first
+    k = count[parent]
+    row = np.repeat(np.arange(len(small)), k)
+    other = partners[1][np.repeat(start[parent], k) + np.arange(len(row)) - np.repeat(np.cumsum(k) - k, k)]
+    near = (small.min(axis=1)[row] <= corners.max(axis=1)[other]).all(axis=1)
+    near &= (corners.min(axis=1)[other] <= small.max(axis=1)[row]).all(axis=1)
+    row, other = row[near], other[near]
+    out = np.full(len(small), -1, dtype=np.int64)
+    hit = _triangles_cross(small[row], corners[other])
+    out[row[hit][::-1]] = other[hit][::-1]  # the first crossing face of each
+    return out
+
+
+def _cut_by_plane(t, by):
+    """Each triangle ``t (K, 3, 3)`` cut along the plane of ``by (K, 3, 3)`` into three, wound as it (the lone
+    corner's side one, the other side two; those of zero area dropped): ``(parts, how many of each (K,))``.
+
+    >>> t = np.array([[[0.0, 0, 0], [2, 0, 0], [0, 2, 0]]])
+    >>> parts, k = _cut_by_plane(t, np.array([[[1.0, 0, 0], [1, 1, 0], [1, 0, 1]]]))  # the plane x = 1
+    >>> k.tolist(), sorted(round(float(np.linalg.norm(np.cross(p[1] - p[0], p[2] - p[0]))) / 2, 6) for p in parts)
+    ([3], [0.5, 0.5, 1.0])
+    """
+    n = np.cross(by[:, 1] - by[:, 0], by[:, 2] - by[:, 0])
+    d = np.einsum("kij,kj->ki", t - by[:, :1], n)  # (K, 3): each corner's side
+    s = np.sign(d)
+    differs = (s[:, :, None] != s[:, None, :]).sum(axis=2)  # (K, 3): the other corners on another side
+    lone = np.argmax(np.where(s != 0, differs, -1), axis=1)
+    rows = np.arange(len(t))
+    i, j, k = lone, (lone + 1) % 3, (lone + 2) % 3
+    a, b, c = t[rows, i], t[rows, j], t[rows, k]
+    da, db, dc = d[rows, i], d[rows, j], d[rows, k]
+    with np.errstate(invalid="ignore", divide="ignore"):
+        pb = a + np.clip(np.nan_to_num(da / (da - db)), 0.0, 1.0)[:, None] * (b - a)
+        pc = a + np.clip(np.nan_to_num(da / (da - dc)), 0.0, 1.0)[:, None] * (c - a)
+    parts = np.stack([np.stack(x, axis=1) for x in ((a, pb, pc), (pb, b, c), (pb, c, pc))], axis=1)  # (K, 3, 3, 3)
+    # a triangle the plane does not cross to round-off (no corner strictly on each side) is kept whole
+    uncut = ~((s > 0).any(axis=1) & (s < 0).any(axis=1))
+    parts[uncut] = np.stack([t[uncut], t[uncut], t[uncut]], axis=1)
+    area = np.linalg.norm(np.cross(parts[:, :, 1] - parts[:, :, 0], parts[:, :, 2] - parts[:, :, 0]), axis=2)
+    whole = np.linalg.norm(np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0]), axis=1)
+    keep = (area > 1e-12 * whole[:, None]) & ~(uncut[:, None] & (np.arange(3) > 0))
+    return parts[keep], keep.sum(axis=1)
 
 
 def _normals(corners):
@@ -461,19 +582,6 @@ def _crossings(corners, piece, lo, hi, chunk=200_000):
             found.append(np.stack([pa[hit], pb[hit]]))
     pairs = np.concatenate([np.zeros((2, 0), np.int64), *found, *(x[::-1] for x in found)], axis=1)
     return pairs[:, np.argsort(pairs[0], kind="stable")]
-
-
-def _crossed(small, parent, corners, partners):
-    """Whether each part ``small (K, 3, 3)`` of face ``parent (K,)`` crosses a face that crosses its parent."""
-    first, count = np.unique(partners[0], return_index=True)[1], np.bincount(partners[0], minlength=len(corners))
-    start = np.zeros(len(corners), dtype=np.int64)
-    start[partners[0][first]] = first
-    k = count[parent]
-    row = np.repeat(np.arange(len(small)), k)
-    other = partners[1][np.repeat(start[parent], k) + np.arange(len(row)) - np.repeat(np.cumsum(k) - k, k)]
-    out = np.zeros(len(small), dtype=bool)
-    np.logical_or.at(out, row, _triangles_cross(small[row], corners[other]))
-    return out
 
 
 def _judge(v, f, piece, lo, hi, offset, closed):
@@ -717,9 +825,9 @@ def solid_warnings(s: Solid, scale: float = 1.0) -> list:
             f"mesh-open: {s.open_edges} open edge{'s' * (s.open_edges != 1)} (the largest hole {s.largest_hole * scale:.3g} "
             "across): the inside is where the winding number is above 1/2"
         )
-    if s.internal or s.cavities:
+    if s.internal or s.partly or s.cavities:
         said.append(
-            f"mesh-internal: {s.internal} face{'s' * (s.internal != 1)} inside the solid and {s.cavities} "
+            f"mesh-internal: {s.internal} face{'s' * (s.internal != 1)} inside the solid, {s.partly} partly, and {s.cavities} "
             f"cavit{'y' if s.cavities == 1 else 'ies'}: out of a finger's reach"
         )
     if s.bodies > 1:

@@ -428,6 +428,7 @@ def _read(fields, found, problems):
             largest_extent(obj.shape.kind, obj.shape.size, obj.shape.vertices),
             fingers_reach(hand[0]),
             found.get("units"),
+            urdf=hand[0].source is not None,
         )
         out["warnings"] = (*found.get("warnings", ()), *([said] if said else []))
     return out

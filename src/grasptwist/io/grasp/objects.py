@@ -280,13 +280,14 @@ def mesh_solid(shape, file, repaired=()):
     """The warnings of a mesh shape read from ``file`` (its reader's ``repaired`` ones, then its solid's:
     :func:`~grasptwist.engine.objects.solid.solid_warnings`), each naming the file, or the
     ``mesh-not-solid`` InputError where no inside can be told."""
+    from ...engine.objects.checks import NOT_SOLID_HINT
     from ...engine.objects.mesh import solid_of
     from ...engine.objects.solid import solid_warnings
 
     try:
         found = solid_of(shape)
     except ValueError as err:
-        return InputError("mesh-not-solid", f"{err}: repair it (docs/guide/objects.md, Meshes as they come)", file)
+        return InputError("mesh-not-solid", f"{err}: {NOT_SOLID_HINT}", file)
     said = [*repaired, *solid_warnings(found)]
     return [f"{code}: {file}:{rest}" for code, _, rest in (w.partition(":") for w in said)]
 
