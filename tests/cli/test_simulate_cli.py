@@ -190,4 +190,6 @@ def test_mujoco_reads_the_trifinger_from_its_urdf_and_the_scene_is_written_besid
     # the URDF's own link masses; only the object, the file's table, the fingertip spheres (10 mm) collide
     assert model.body_mass[model.body("hand/finger_upper_link_0").id] == pytest.approx(0.26689)  # the URDF says
     colliding = sorted(model.geom(k).name for k in range(model.ngeom) if model.geom_contype[k])
-    assert colliding == ["piece0", "table", "tip0", "tip1", "tip2"] and model.geom_size[model.geom("tip0").id][0] == 0.01
+    assert (
+        colliding == ["piece0", "table", "tip0", "tip1", "tip2"] and model.geom_size[model.geom("tip0").id][0] == 0.01
+    )
