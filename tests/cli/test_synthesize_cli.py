@@ -256,7 +256,7 @@ hand:  # each finger slides along its contact's normal: it reaches a line, never
 
 def test_a_hand_s_joint_positions_are_in_the_records_and_the_grasp_file_read_back(tmp_path):
     found = tmp_path / "found.yaml"
-    args = ("--mass", "1", "--friction", "0.8", "--tip-radius", "0.1", *FAST, "-o", found, "-f", "jsonl")
+    args = ("--mass", "1", "--friction", "0.8", "--tip-radius", "0.1", *ONE, "-o", found, "-f", "jsonl")
     r, _ = run("synthesize", HAND, *args)
     assert r.exit_code == 0, r.stderr
     rec = jsonl(r.stdout)[0]
