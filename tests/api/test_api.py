@@ -269,6 +269,32 @@ def test_a_doctest_after_a_docstring_section_is_under_examples():
 # --- the reference, built ----------------------------------------------------------------------
 
 
+def documented_names():
+    """``module.name`` of each ``.. autofunction::``/``autoclass``/... in the reference's pages, under its
+    ``.. currentmodule::``, unless ``:no-index:`` (what the build gives an anchor to)."""
+    directive = re.compile(r"^\.\. (currentmodule|auto\w+):: *([\w.]+).*\n((?:   .*\n)*)", re.M)
+    found = set()
+    for page in sorted(API.glob("*.rst")):
+        current = None
+        for kind, name, options in directive.findall(page.read_text("utf-8")):
+            if kind == "currentmodule":
+                current = name
+            elif kind != "automodule" and ":no-index:" not in options:
+                found.add(name if name.startswith("grasptwist.") else f"{current}.{name}")
+    return found
+
+
+def test_every_public_name_has_a_directive_in_the_reference():
+    # the fast half of the build below (slow): a name added to an __all__ and to no page fails here
+    documented = documented_names()
+    want = {f"{m}.{n}" for m, n, o in public_names() if not inspect.ismodule(o)}
+    second = {core for core, _ in TWO_HOMES}  # shown on the core page without an anchor of their own
+    assert sorted(want - documented) == sorted(second)
+    assert {topic for _, topic in TWO_HOMES} <= documented
+    assert sorted(n for n in documented - want if not is_public(n)) == []
+
+
+@pytest.mark.slow  # the Sphinx build, 4-6 s of CPU: docs/reference/development.md, Test time
 def test_the_api_reference_builds_without_warnings_and_has_every_public_name(tmp_path):
     pytest.importorskip("sphinx", reason="the docs extra builds the API reference: pip install -e '.[docs]'")
     pytest.importorskip("numpydoc", reason="the docs extra builds the API reference: pip install -e '.[docs]'")

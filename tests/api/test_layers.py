@@ -40,8 +40,10 @@ def module_name(path: Path) -> str:
 MODULES = {module_name(p): p for p in sorted(PACKAGE.rglob("*.py"))}
 
 
+@functools.cache
 def imports(name: str) -> set[str]:
-    """The package's modules ``name`` imports anywhere in its code."""
+    """The package's modules ``name`` imports anywhere in its code (parsed once per process: a
+    module's test parses its own file, not the whole package's)."""
     path = MODULES[name]
     package = name if path.name == "__init__.py" else name.rpartition(".")[0]
     found = set()
@@ -93,7 +95,7 @@ def test_the_walk_sees_deferred_and_relative_imports():
 def test_imports_go_down_the_layers(name):
     layer, own = group(name)
     upward = []
-    for target in sorted(graph()[name]):
+    for target in sorted(imports(name)):
         their_layer, theirs = group(target)
         if theirs == own:
             continue

@@ -13,12 +13,20 @@ from places import GRASPS, ROOT
 
 SPHERE = GRASPS / "sphere.yaml"  # two balls: 'sphere-tripod' has no friction or mass, 'sphere-equator' both
 FAST = ("--candidates", "120", "-n", "2")
+ONE = ("--candidates", "120", "-n", "1")  # each grasp's hold friction is bisected: one grasp where one shows it
 
 
-def test_records_carry_every_score_and_the_grasp_file_is_read_back_by_every_command(tmp_path):
-    found = tmp_path / "found.yaml"
+@pytest.fixture(scope="module")
+def sphere_found(tmp_path_factory):
+    """One search on both balls, its records and its grasp file, shared by the tests that read them."""
+    found = tmp_path_factory.mktemp("synthesize") / "found.yaml"
     r, _ = run("synthesize", SPHERE, "--friction", "0.5", "--mass", "1", *FAST, "-o", found, "-f", "jsonl")
     assert r.exit_code == 0, r.stderr
+    return r, found
+
+
+def test_records_carry_every_score_and_the_grasp_file_is_read_back_by_every_command(sphere_found):
+    r, found = sphere_found
     recs = jsonl(r.stdout)
     assert [(x["grasp"], x["rank"]) for x in recs] == [
         (g, k) for g in ("sphere-tripod", "sphere-equator") for k in (1, 2)
@@ -54,7 +62,7 @@ def test_the_robustness_options_are_checked_and_change_the_robustness_only(tmp_p
         assert r.exit_code == 2 and option in r.stderr, r.stderr
     box = tmp_path / "box.yaml"
     box.write_text("name: box\nobject:\n  box: [0.065, 0.065, 0.065]\n  mass: 0.1\nfriction: 0.8\n")
-    plain = ("--objective", "total_normal_force", "-f", "csv", "--candidates", "500", "-n", "3")
+    plain = ("--objective", "total_normal_force", "-f", "csv", "--candidates", "500", "-n", "2")
     rows = []
     for more in ((), ("--position-error", "0.01", "--friction-error", "0.5", "--perturbations", "16")):
         r, _ = run("synthesize", box, *plain, *more)
@@ -62,29 +70,18 @@ def test_the_robustness_options_are_checked_and_change_the_robustness_only(tmp_p
         rows.append(list(csv.DictReader(io.StringIO(r.stdout))))
     assert [row["p1_x"] for row in rows[0]] == [row["p1_x"] for row in rows[1]]  # the same grasps
     assert all(float(row["edge_distance1"]) >= 0 and float(row["hold_friction"]) < 0.8 for row in rows[0])
-    assert [float(row["robustness"]) * 16 % 1 for row in rows[1]] == [0.0] * 3
+    assert [float(row["robustness"]) * 16 % 1 for row in rows[1]] == [0.0] * 2
     assert sum(float(r["robustness"]) for r in rows[1]) < sum(float(r["robustness"]) for r in rows[0])
 
 
-def test_the_synthesis_guide_s_first_example_runs_as_printed(monkeypatch):
-    from docs_blocks import ROOT, blocks, commands
-
-    monkeypatch.chdir(ROOT)
-    first = next(b for b in blocks(ROOT / "docs" / "guide" / "synthesis.md") if b.lang in ("console", "sh"))
-    (command, *_) = commands(first)
-    assert command.args[:2] == ["synthesize", "grasps/sphere.yaml"]
-    r, _ = run(*command.args)
-    assert r.exit_code == 0, r.stderr
-
-
 def test_csv_has_a_row_per_grasp_and_the_table_names_them():
-    r, _ = run("synthesize", SPHERE, "--friction", "0.5", "--mass", "1", *FAST, "-f", "csv")
+    r, _ = run("synthesize", SPHERE, "--friction", "0.5", "--mass", "1", *ONE, "-f", "csv")
     assert r.exit_code == 0, r.stderr
     rows = list(csv.DictReader(io.StringIO(r.stdout)))
-    assert [row["rank"] for row in rows] == ["1", "2", "1", "2"]
+    assert [row["rank"] for row in rows] == ["1", "1"]
     assert float(rows[0]["total_normal_force"]) > 0 and rows[0]["ok"] == "true"
-    table, _ = run("synthesize", SPHERE, "--friction", "0.5", "--mass", "1", *FAST)
-    assert "grasp 'sphere-equator'" in table.stdout and "#2  total normal force: hold" in table.stdout
+    table, _ = run("synthesize", SPHERE, "--friction", "0.5", "--mass", "1", *ONE)
+    assert "grasp 'sphere-equator'" in table.stdout and "#1  total normal force: hold" in table.stdout
 
 
 def test_no_feasible_grasp_is_one_record_with_the_tightest_constraint_and_exit_1():
@@ -103,7 +100,7 @@ def test_a_file_without_object_or_friction_is_an_error_of_its_own(tmp_path):
         "contacts:\n  - {point: [1, 0, 0], normal: [-1, 0, 0]}\n  - {point: [0, 1, 0], normal: [0, -1, 0]}\n"
         "  - {point: [0, 0, 1], normal: [0, 0, -1]}\n"
     )
-    r, _ = run("synthesize", plain, SPHERE, *FAST, "-f", "jsonl")
+    r, _ = run("synthesize", plain, SPHERE, *ONE, "-f", "jsonl")
     assert r.exit_code == 1
     codes = [x["error"]["code"] for x in jsonl(r.stdout) if not x["ok"]]
     assert codes[:2] == ["no-object", "no-friction"]  # the tripod ball: no friction (nor mass)
@@ -197,10 +194,8 @@ def test_parquet_has_the_csv_columns(tmp_path):
     assert table.column("epsilon").null_count == 4  # not asked for
 
 
-def test_follow_reads_the_grasp_file_back(tmp_path):
-    found = tmp_path / "found.yaml"
-    r, _ = run("synthesize", SPHERE, "--friction", "0.5", "--mass", "1", *FAST, "-o", found, "-q")
-    assert r.exit_code == 0, r.stderr
+def test_follow_reads_the_grasp_file_back(sphere_found):
+    _, found = sphere_found
     follow, _ = run("follow", found, "--twist", "0,0,1,0,0,0", "--duration", "1", "--samples", "2", "-f", "jsonl")
     # two samples and a summary (its first_warning null: none) per grasp
     assert follow.exit_code == 0 and len(follow.stdout.splitlines()) == 4 * 3, follow.stderr
@@ -261,7 +256,7 @@ hand:  # each finger slides along its contact's normal: it reaches a line, never
 
 def test_a_hand_s_joint_positions_are_in_the_records_and_the_grasp_file_read_back(tmp_path):
     found = tmp_path / "found.yaml"
-    args = ("--mass", "1", "--friction", "0.8", "--tip-radius", "0.1", *FAST, "-o", found, "-f", "jsonl")
+    args = ("--mass", "1", "--friction", "0.8", "--tip-radius", "0.1", *ONE, "-o", found, "-f", "jsonl")
     r, _ = run("synthesize", HAND, *args)
     assert r.exit_code == 0, r.stderr
     rec = jsonl(r.stdout)[0]
@@ -310,7 +305,7 @@ def test_a_folder_on_two_workers_gives_the_records_of_one(tmp_path):
             "--candidates",
             "60",
             "-n",
-            "2",
+            "1",
             "-f",
             "jsonl",
             "-j",
@@ -318,7 +313,7 @@ def test_a_folder_on_two_workers_gives_the_records_of_one(tmp_path):
         )
         assert r.exit_code == 0, r.stderr
         got.append([{**x, "search": {**x["search"], "seconds": None}} for x in jsonl(r.stdout)])
-    assert got[0] == got[1] and len(got[0]) == 6
+    assert got[0] == got[1] and len(got[0]) == 3
 
 
 TRIFINGER = GRASPS / "trifinger-cube.yaml"
@@ -426,10 +421,10 @@ def test_a_folder_s_mesh_files_are_searched_beside_its_grasp_files(tmp_path):
 
 
 def test_wrench_adds_to_the_object_s_weight_never_replaces_it():
-    r, _ = run("synthesize", SPHERE, "--friction", "0.5", "--wrench", "0,0,0,0,0,0.02", *FAST, "-f", "jsonl")
+    r, _ = run("synthesize", SPHERE, "--friction", "0.5", "--wrench", "0,0,0,0,0,0.02", *ONE, "-f", "jsonl")
     recs = jsonl(r.stdout)
     assert set(recs[0]["scores"]["total_normal_force"]) == {"0,0,0,0,0,0.02"}  # the tripod ball has no mass
-    totals = recs[2]["scores"]["total_normal_force"]
+    totals = recs[1]["scores"]["total_normal_force"]
     assert set(totals) == {"hold", "0,0,0,0,0,0.02"}  # the file's turn-z replaced, its 1 kg still held
     assert totals["hold"] >= 9.81 / np.sqrt(1 + 0.5**2) * (1 - 1e-9)  # no grip holds 1 kg with less
 
@@ -472,13 +467,13 @@ def test_csv_with_a_hand_has_its_reach_errors_and_joint_positions():
 
 def test_the_off_tangent_method_without_a_wrist_is_said_once_per_object(tmp_path):
     (tmp_path / "oct.obj").write_text(OCTAHEDRON)
-    args = ("--friction", "0.6", "--mass", "0.2", "--candidates", "60", "-n", "2", "--method", "off-tangent")
+    args = ("--friction", "0.6", "--mass", "0.2", "--candidates", "60", "-n", "1", "--method", "off-tangent")
     r, _ = run("synthesize", tmp_path / "oct.obj", SPHERE, *args)
     assert r.exit_code == 0, r.stderr
     said = "grasp 'oct': warning: off-tangent conditioning not checked without a wrist"
     assert r.stderr.count(said) == 1 and r.stderr.count("not checked without a wrist") == 1  # the balls have one
     table = r.stdout.split("grasp 'sphere-tripod'")
-    assert "#2  total normal force" in table[0] and "conditioning" not in table[0]  # nothing to print
+    assert "#1  total normal force" in table[0] and "conditioning" not in table[0]  # nothing to print
     assert "conditioning: off_tangent" in table[1]
 
 

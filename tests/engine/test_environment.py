@@ -132,7 +132,7 @@ def test_a_contact_on_the_face_the_object_rests_on_or_too_near_the_table_is_not_
 def test_a_search_on_a_table_never_touches_within_the_clearance_and_reports_each_grasps_clearance():
     cube = GraspObject(Shape("box", np.full(3, 0.065)), pose([0, 0, 0.0325]), mass=0.094)
     env = Environment(0.0, clearance=0.002)
-    s = synthesize(cube, 0.8, environment=env, count=3, candidates=1500)
-    assert len(s.points) == 3
+    s = synthesize(cube, 0.8, environment=env, count=2, candidates=1500)
+    assert len(s.points) == 2
     low = grasp_clearance(s.points, env)
     assert (low >= 0.002).all() and low == pytest.approx(s.points[..., 2].min(axis=1), abs=1e-15)

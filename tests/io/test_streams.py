@@ -250,7 +250,7 @@ def test_a_twist_line_is_checked_as_a_grasp_files_twist():
     assert error.code == "not-a-mapping" and error.message.startswith("expected a twist [wx, wy, wz, vx, vy, vz]")
 
 
-@settings(max_examples=200, deadline=None)
+@settings(max_examples=50, deadline=None)
 @given(
     st.lists(
         st.one_of(st.floats(allow_nan=False, allow_infinity=False), st.integers(-(2**63), 2**63 - 1)),
@@ -275,7 +275,7 @@ class Chunks:
         return self.pieces.pop(0) if self.pieces else b""
 
 
-@settings(max_examples=300, deadline=None)
+@settings(max_examples=60, deadline=None)
 @given(
     st.lists(st.sampled_from([b"", b" ", b"ab", b"abcdefgh", b"abcdefghijkl", b"x" * 30]), max_size=12),
     st.lists(st.integers(1, 40), min_size=1, max_size=20),

@@ -3,8 +3,9 @@ plot drawn (coloured pixels in its plot area, which only WebGL's lines and meshe
 text and the dropdown are grey), and no JavaScript error reached the console.
 
 Needs Debian's chromium (`apt-get install chromium`; .ci/run installs it as root) and the test
-extra's websocket-client; skipped, saying so, without them.  One page by default (a Chromium
-start and plotly.js's 5 MB parse: several seconds on a busy machine), the rest with -m slow.
+extra's websocket-client; skipped, saying so, without them.  All with -m slow (a Chromium
+start and plotly.js's 5 MB parse: several seconds on a busy machine); the default run checks the
+pages' HTML in test_plot_html.py.
 """
 
 import tempfile
@@ -46,6 +47,7 @@ def chromium_leftovers():
     return {*tmp.glob("org.chromium.Chromium.*"), *tmp.glob("grasptwist-chromium-*")}
 
 
+@pytest.mark.slow  # a Chromium start, 3-6 s (the page's HTML: test_plot_html.py): docs/reference/development.md, Test time
 def test_a_grasp_page_is_drawn_without_javascript_errors(tmp_path):
     before = chromium_leftovers()
     shot = capture(page(tmp_path, "box-edge"), tmp_path / "box-edge.png", size=(1000, 800))

@@ -192,15 +192,15 @@ def test_synthesize_on_a_table_from_the_command_line_reports_each_clearance_and_
     path = tmp_path / "cube.yaml"
     path.write_text(yaml.safe_dump(doc), "utf-8")
     found = tmp_path / "found.yaml"
-    args = ["synthesize", str(path), "-n", "2", "--candidates", "500", "--table", "-0.0325", "--clearance", "0.004"]
+    args = ["synthesize", str(path), "-n", "1", "--candidates", "500", "--table", "-0.0325", "--clearance", "0.004"]
     result = CliRunner().invoke(app, [*args, "-f", "jsonl", "-o", str(found)])
     records = [json.loads(line) for line in result.stdout.splitlines()]
-    assert [r["ok"] for r in records] == [True, True]
+    assert [r["ok"] for r in records] == [True]
     for r in records:  # without a hand, the contacts' least height above the table
         lowest = min(c["point"][2] for c in r["contacts"]) + 0.0325
         assert r["clearance"] == pytest.approx(lowest, abs=1e-15) and lowest >= 0.004
     back = gt.read_grasps(found)
-    assert [(g.environment.table_height, g.environment.clearance) for g in back] == [(-0.0325, 0.004)] * 2
+    assert [(g.environment.table_height, g.environment.clearance) for g in back] == [(-0.0325, 0.004)]
     csv = CliRunner().invoke(app, [*args, "-f", "csv"]).stdout.splitlines()
     column = csv[0].split(",").index("clearance")
     assert [float(line.split(",")[column]) for line in csv[1:]] == pytest.approx([r["clearance"] for r in records])
