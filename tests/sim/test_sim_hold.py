@@ -121,6 +121,14 @@ def test_gt_simulate_runs_the_hold_test_and_raises_what_it_cannot_simulate():
     with pytest.raises(gt.GraspFileError) as err:
         gt.simulate(replace(grasp, object=None))
     assert err.value.code == "no-object"
+    # the command line's bounds, in the same words
+    with pytest.raises(ValueError, match=r"^duration: must be at least 0\.05 s \(50 time steps\)"):
+        gt.simulate(grasp, mass=0.1, friction=0.8, duration=1e-9)
+    with pytest.raises(ValueError, match=r"^tolerance: the angle must be in degrees, > 0 and at most 45, got 179"):
+        gt.simulate(grasp, mass=0.1, friction=0.8, tolerance=(1e6, 179))
+    with pytest.raises(gt.GraspFileError) as err:
+        gt.simulate(grasp, mass=0.1, friction=0.8, duration=SHORT, tolerance=(1e6, 2))
+    assert err.value.code == "tolerance-too-large"
 
 
 def _ball_on_the_table(mu, **environment):
