@@ -407,7 +407,11 @@ def simulate(
     ------
     GraspFileError
         A grasp it cannot simulate (``no-object``, ``no-mass``, ``no-friction``, ``scene-error``)
-        or a simulation that diverged (``simulation-unstable``).
+        or a simulation that diverged (``simulation-unstable``), or a distance tolerance not below the
+        object's size (``tolerance-too-large``).
+    ValueError
+        A duration or tolerance out of bounds (:func:`~grasptwist.engine.hold_test.check_duration`,
+        :func:`~grasptwist.engine.hold_test.check_tolerance`), in the command line's words.
     """
     options = SimulateOptions(mass, friction, table_height, duration, *tolerance, safety)
     result = simulate_grasp(options, grasp, mjcf)
