@@ -24,6 +24,7 @@ NULLABLE |= {"surface_distance"}  # a contact of a grasp without an object
 NULLABLE |= {"joint_positions", "reach_error"}  # a grasp synthesized without a hand
 NULLABLE |= {"edge_distance"}  # a contact on a smooth object (no crease)
 NULLABLE |= {"clearance"}  # a grasp synthesized without an environment
+NULLABLE |= {"simulation"}  # a grasp synthesized without --simulate
 
 
 def run(*args, input=None):

@@ -37,6 +37,8 @@ def test_a_grasp_without_a_grip_does_not_hold_and_says_so_on_stderr():
     assert not rec["ok"] and not rec["held"]
     assert {(d["simulated"], d["grip"], d["displacement"]) for d in rec["directions"]} == {(False, "cannot-hold", None)}
     assert "no grip holds the load along +x, -x, +y, -y, +z, -z: not simulated there" in r.stderr
+    # simulate's own words in the closing line (its Command's), not "with a degenerate method"
+    assert r.stderr.splitlines()[-1] == "1 record: 1 not held, 0 inputs failed"
 
 
 def test_csv_and_the_table(tmp_path):
@@ -92,9 +94,14 @@ def test_a_grasp_without_an_object_is_an_error_record(tmp_path):
         ("--duration", "0"),
         ("--duration", "nan"),
         ("--duration", "1e9"),
+        ("--duration", "1e-9"),  # under one step: every grasp "held"
+        ("--duration", "0.049"),  # under 50 steps
         ("--tolerance", "0.002"),
         ("--tolerance", "0,2"),
         ("--tolerance", "0.002,200"),
+        ("--tolerance", "1e6,179"),
+        ("--tolerance", "0.002,45.5"),
+        ("--tolerance", "inf,2"),
         ("--mass", "-1"),
         ("--table", "inf"),
         ("--mjcf", "no-such-folder/scene.xml"),
@@ -103,6 +110,28 @@ def test_a_grasp_without_an_object_is_an_error_record(tmp_path):
 def test_absurd_values_are_refused_before_any_work(args):
     r, _ = run("simulate", CUBE, *args)
     assert r.exit_code == 2 and args[0] in r.stderr
+
+
+def test_the_bounds_are_said_and_met_at_their_edges():
+    r, _ = run("simulate", CUBE, "--duration", "1e-9")
+    assert "must be at least 0.05 s (50 time steps) and at most 600 s, got 1e-09" in r.stderr
+    r, _ = run("simulate", CUBE, "--tolerance", "0.002,46")
+    assert "the angle must be in degrees, > 0 and at most 45, got 46" in r.stderr
+    # at the edges: 0.05 s and 45 degrees are run
+    r, _ = run("simulate", CUBE, "--mass", "0.094", "--friction", "1", "--duration", "0.05", "--tolerance", "0.002,45")
+    assert r.exit_code == 0, r.stderr
+
+
+def test_a_distance_tolerance_as_large_as_the_object_is_an_error_record():
+    # the cube's size (its bounding box's diagonal) is 0.065 sqrt(3) = 0.113: 1e6 is refused for it,
+    # where before it reported held for a cube that moved 4.8 m
+    r, _ = run("simulate", CUBE, "--mass", "0.094", "--friction", "1", *SHORT, "--tolerance", "1e6,2", "-f", "jsonl")
+    assert r.exit_code == 1
+    (rec,) = jsonl(r.stdout)
+    assert rec["error"]["code"] == "tolerance-too-large"
+    assert "the distance tolerance 1e+06 is not less than the object's size 0.113" in rec["error"]["message"]
+    ok, _ = run("simulate", CUBE, "--mass", "0.094", "--friction", "1", *SHORT, "--tolerance", "0.11,2", "-f", "jsonl")
+    assert ok.exit_code == 0, ok.stderr
 
 
 def test_without_mujoco_one_line_says_how_to_install_it():
@@ -130,6 +159,12 @@ def test_synthesize_simulate_keeps_only_the_grasps_that_hold_and_counts_the_othe
     kept = [rec for rec in jsonl(r.stdout) if rec["ok"]]
     # the search finds 4 (seeded); MuJoCo drops one of them
     assert len(kept) == 3 and "; 1 dropped: they did not hold in all six directions in MuJoCo" in r.stderr
+    for rec in kept:  # each record says how it held
+        sim = rec["simulation"]
+        assert sim["held"] and [d["direction"] for d in sim["directions"]] == ["+x", "-x", "+y", "-y", "+z", "-z"]
+        assert all(d["held"] and d["displacement"] < 0.002 and d["rotation_deg"] < 2 for d in sim["directions"])
+    plain, _ = run(*args, "--candidates", "400", "-f", "jsonl")  # without --simulate: null
+    assert {rec["simulation"] for rec in jsonl(plain.stdout)} == {None}
     sims, _ = run("simulate", found, *SHORT, "-f", "jsonl")  # each grasp kept holds, simulated from the file
     assert [s["held"] for s in jsonl(sims.stdout)] == [True] * 3
 

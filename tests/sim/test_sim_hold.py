@@ -29,7 +29,6 @@ def _simulated(name, k=0, **options):
 
 
 def test_the_trifinger_holds_the_cube_and_mujoco_exerts_the_planned_grip():
-    # the file's table takes part of the load: without it the fingers carry it all
     grasp = replace(_grasp("trifinger-cube.yaml"), environment=None)
     sim = simulate_grasp(SimulateOptions(duration=SHORT, mass=0.094, friction=1.0), grasp)
     assert sim.test.held and [d.name for d in sim.test.directions] == list(DIRECTIONS)
@@ -39,7 +38,7 @@ def test_the_trifinger_holds_the_cube_and_mujoco_exerts_the_planned_grip():
         assert d.simulated and d.displacement < 5e-4 and d.rotation < math.radians(0.5)  # a quarter of the tolerances
         # each finger's contact force in MuJoCo is grasptwist's grip, within 5% of the load
         np.testing.assert_allclose(d.forces, d.planned, atol=0.05 * load)
-    # on its table too, the file's (which takes part of the load: the fingers' forces differ there)
+    # on its table too, the file's (which carries none of the load)
     assert _simulated("trifinger-cube.yaml", mass=0.094, friction=1.0).test.held
 
 
@@ -122,29 +121,83 @@ def test_gt_simulate_runs_the_hold_test_and_raises_what_it_cannot_simulate():
     with pytest.raises(gt.GraspFileError) as err:
         gt.simulate(replace(grasp, object=None))
     assert err.value.code == "no-object"
+    # the command line's bounds, in the same words
+    with pytest.raises(ValueError, match=r"^duration: must be at least 0\.05 s \(50 time steps\)"):
+        gt.simulate(grasp, mass=0.1, friction=0.8, duration=1e-9)
+    with pytest.raises(ValueError, match=r"^tolerance: the angle must be in degrees, > 0 and at most 45, got 179"):
+        gt.simulate(grasp, mass=0.1, friction=0.8, tolerance=(1e6, 179))
+    with pytest.raises(gt.GraspFileError) as err:
+        gt.simulate(grasp, mass=0.1, friction=0.8, duration=SHORT, tolerance=(1e6, 2))
+    assert err.value.code == "tolerance-too-large"
 
 
-def test_box_obstacles_stand_in_the_scene_and_the_object_rests_on_one():
-    # the ball of sphere-equator on a box whose top is the ball's bottom: they touch
+def _ball_on_the_table(mu, **environment):
+    """sphere-equator's ball (radius 0.035) with its weight, the tips at its equator with friction ``mu``."""
     g = _grasp("sphere.yaml", 1)
+    scene = build_scene(
+        g, mass=0.1, friction=np.full(3, mu), load=0.981, tolerance=0.002, object_gravcomp=False, **environment
+    )
+    return scene, load_model(scene)
+
+
+def _box_under_the_ball():
     from grasptwist.model import Obstacle
 
     pose = np.eye(4)
     pose[:3, :3] = [[0, -1, 0], [1, 0, 0], [0, 0, 1]]  # a quarter turn about z: its size is along its own axes
-    pose[:3, 3] = [0.0, 0.0, -0.035 - 0.01]
-    box = Obstacle(np.array([0.1, 0.12, 0.02]), pose)
-    scene = build_scene(g, mass=0.1, friction=np.full(3, 0.8), load=0.981, tolerance=0.002, boxes=[box])
-    model = load_model(scene)
+    pose[:3, 3] = [0.0, 0.0, -0.035 - 0.01]  # its top the ball's bottom
+    return Obstacle(np.array([0.1, 0.12, 0.02]), pose)
+
+
+def test_boxes_stand_in_the_scene_at_their_poses():
+    _, model = _ball_on_the_table(0.8, boxes=[_box_under_the_ball()])
     geom = model.geom("box0")
     np.testing.assert_allclose(model.geom_size[geom.id], [0.05, 0.06, 0.01])
     np.testing.assert_allclose(model.geom_pos[geom.id], [0, 0, -0.045])
     np.testing.assert_allclose(abs(model.geom_quat[geom.id]), [0.5**0.5, 0, 0, 0.5**0.5], atol=1e-12)
+
+
+@pytest.mark.parametrize("environment", [{"table_height": -0.035}, {"boxes": [_box_under_the_ball()]}])
+def test_the_table_and_boxes_never_carry_the_object_it_falls_through_them(environment):
+    # the ball resting on the table (or a box), the fingertips at its equator without friction (no
+    # grip): it falls freely through the table, z = -g t^2 / 2, as if there were none
     import mujoco
 
+    scene, model = _ball_on_the_table(0.0, **environment)
     data = mujoco.MjData(model)
-    mujoco.mj_forward(model, data)
-    touching = {tuple(sorted((model.geom(c.geom1).name, model.geom(c.geom2).name))) for c in data.contact[: data.ncon]}
-    assert ("box0", "piece0") in touching
+    data.qpos[[model.jnt_qposadr[model.joint(j).id] for j in scene.joints]] = scene.positions
+    mujoco.mj_step(model, data, nstep=100)  # 0.1 s
+    z = data.body("object").xpos[2]
+    assert z == pytest.approx(-9.81 * 0.1**2 / 2, rel=0.03)  # 49 mm below: through the table's plane
+    names = {tuple(sorted((model.geom(c.geom1).name, model.geom(c.geom2).name))) for c in data.contact[: data.ncon]}
+    assert not any("piece0" in pair and ("table" in pair or "box0" in pair) for pair in names)
+
+
+def test_a_fingertip_pushed_onto_the_table_stands_on_it():
+    # the environment is there for the hand: tip0 (radius 2% of the ball's size) pushed down by 20 N
+    # stops on the table, its centre one radius above it (sinking 0.2 mm, a soft contact under 12 N;
+    # without the table the push would take it 82 mm down)
+    import mujoco
+
+    scene, model = _ball_on_the_table(0.8, table_height=-0.035)
+    data = mujoco.MjData(model)
+    data.qfrc_applied[model.jnt_dofadr[model.joint("tip0_z").id]] = -20.0
+    mujoco.mj_step(model, data, nstep=300)
+    tip = model.geom("tip0").id
+    assert data.geom_xpos[tip][2] == pytest.approx(-0.035 + scene.radii[0], abs=5e-4)
+
+
+def test_the_trifinger_cube_holds_on_its_table_as_without_one():
+    # the file's table under the cube carries none of it: at safety 1 (a grip on the cones' edge) the
+    # same directions slip with the table as without (before: 2 with it, 5 without)
+    grasp = _grasp("trifinger-cube.yaml")
+    assert grasp.environment is not None and grasp.environment.table_height == 0
+    on, off = (
+        simulate_grasp(SimulateOptions(duration=SHORT, mass=0.094, friction=1.0, safety=1.0), g).test.directions
+        for g in (grasp, replace(grasp, environment=None))
+    )
+    assert [d.held for d in on] == [d.held for d in off] and not all(d.held for d in on)
+    np.testing.assert_allclose([d.displacement for d in on], [d.displacement for d in off], rtol=1e-6, atol=1e-9)
 
 
 @pytest.mark.slow  # CoACD and trimesh's boolean union load in 2 s

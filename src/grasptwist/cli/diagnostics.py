@@ -66,10 +66,17 @@ class Diagnostics:
     :data:`WARNINGS_SHOWN` of each, then one line counting the rest by kind
     or code); ``-q`` drops warnings, the table hint and the summary.
     ``hint`` is the line said once when a table passes :data:`TABLE_HINT_AT`
-    records.
+    records; ``failed_words`` what the summary says of the records not ok (the command's,
+    :class:`~grasptwist.run.families.Command`).
     """
 
-    def __init__(self, quiet: bool = False, warnings: Warnings = Warnings.summary, hint: str | None = None):
+    def __init__(
+        self,
+        quiet: bool = False,
+        warnings: Warnings = Warnings.summary,
+        hint: str | None = None,
+        failed_words: str = "with a degenerate method",
+    ):
         self.failed = 0  # records not ok
         self.inputs_failed = 0  # of ``failed``: inputs that could not be read
         self.degenerate: dict[tuple[str, str], int] = {}  # the other failed records, per (kind, code)
@@ -82,6 +89,7 @@ class Diagnostics:
         self.rows_unshown: dict[str, int] = {}  # row errors not printed, by code
         self.hint = None if quiet else hint
         self.color = _stderr_is_terminal() and not os.environ.get("NO_COLOR")
+        self.failed_words = failed_words
 
     def take(self, out) -> None:
         """Count a pipeline Output and print its lines."""
@@ -134,23 +142,32 @@ class Diagnostics:
             to_stderr(_not_shown(self.rows_unshown, "row error"))
         if self.unshown:
             to_stderr(_not_shown(self.unshown, "warning"))
-        to_stderr(summary_line(self.records, self.failed - self.inputs_failed, self.inputs_failed, self.degenerate))
+        to_stderr(
+            summary_line(
+                self.records, self.failed - self.inputs_failed, self.inputs_failed, self.degenerate, self.failed_words
+            )
+        )
 
 
-def summary_line(records: int, degenerate: int = 0, inputs_failed: int = 0, codes=None) -> str:
+def summary_line(
+    records: int, degenerate: int = 0, inputs_failed: int = 0, codes=None, words: str = "with a degenerate method"
+) -> str:
     """The closing line: how many records were written, how many of them hold a degenerate
-    method (a grasp, or a data set's row, that was read: the other methods' results are there)
-    and by which codes, and how many inputs could not be read (each one record).
+    method (a grasp, or a data set's row, that was read: the other methods' results are there;
+    ``words`` say it, a command's own: ``not held``) and by which codes, and how many inputs
+    could not be read (each one record).
 
     >>> summary_line(1), summary_line(4, 0, 1)
     ('1 record: all ok', '4 records: 0 with a degenerate method, 1 input failed')
     >>> summary_line(3, 3, 0, {("tangent", "normals-rank-deficient"): 2, ("tangent", "theta-not-unique"): 1})
     '3 records: 3 with a degenerate method (tangent: 2 normals-rank-deficient, 1 theta-not-unique), 0 inputs failed'
+    >>> summary_line(2, 1, 0, words="not held")
+    '2 records: 1 not held, 0 inputs failed'
     """
     line = f"{records} record{'' if records == 1 else 's'}: "
     if not degenerate and not inputs_failed:
         return line + "all ok"
-    line += f"{degenerate} with a degenerate method"
+    line += f"{degenerate} {words}"
     kinds: dict[str, list[str]] = {}
     for (kind, code), n in sorted((codes or {}).items(), key=lambda kv: (-kv[1], kv[0])):
         kinds.setdefault(kind, []).append(f"{n} {code}")

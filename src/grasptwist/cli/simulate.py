@@ -28,19 +28,25 @@ from .records import OutputSettings, write_records
 
 __all__ = ["simulate"]
 
-#: The longest ``--duration`` per direction (seconds of simulated time): a hold test's CPU is about
-#: 0.03 s per simulated second and direction, so this bounds one grasp's test to a few minutes.
-MAX_DURATION = 600.0
 
-
-def _finite_positive(value, name, most=math.inf):
-    if not 0 < value <= most or not math.isfinite(value):
-        raise typer.BadParameter(f"must be a finite number > 0 and at most {most:g}, got {value:g}", param_hint=name)
+def _finite_positive(value, name):
+    if not 0 < value < math.inf:
+        raise typer.BadParameter(f"must be a finite number > 0, got {value:g}", param_hint=name)
     return value
 
 
+def _checked(check, name, *values):
+    """``check(*values)`` (:mod:`grasptwist.engine.hold_test`'s), its ``ValueError`` a usage error naming ``name``."""
+    try:
+        return check(*values)
+    except ValueError as exc:
+        raise typer.BadParameter(str(exc), param_hint=name) from None
+
+
 def _duration(value):
-    return value if value is None else _finite_positive(value, "--duration", MAX_DURATION)
+    from ..engine.hold_test import check_duration
+
+    return value if value is None else _checked(check_duration, "--duration", value)
 
 
 def _mass(value):
@@ -54,19 +60,16 @@ def _table(value):
 
 
 def _tolerance(value):
-    """``D,DEG``: a distance > 0 and an angle in degrees, in (0, 180)."""
+    """``D,DEG``: a distance > 0 and an angle in degrees (:func:`~grasptwist.engine.hold_test.check_tolerance`)."""
+    from ..engine.hold_test import check_tolerance
+
     if value is None:
         return None
     try:
         distance, angle = (float(v) for v in value.split(","))
     except ValueError:
         raise typer.BadParameter(f"must be D,DEG (a distance and an angle in degrees), got {value!r}") from None
-    _finite_positive(distance, "--tolerance")
-    if not 0 < angle < 180:
-        raise typer.BadParameter(
-            f"the angle must be in degrees, > 0 and < 180, got {angle:g}", param_hint="--tolerance"
-        )
-    return distance, angle
+    return _checked(check_tolerance, "--tolerance", distance, angle)
 
 
 def simulate(
@@ -91,7 +94,7 @@ def simulate(
             "--duration",
             metavar="T",
             callback=_duration,
-            help=f"Seconds of simulated time each direction's load is applied (at most {MAX_DURATION:g}).",
+            help="Seconds of simulated time each direction's load is applied (0.05 to 600).",
         ),
     ] = 1.0,
     tolerance: Annotated[
@@ -101,7 +104,7 @@ def simulate(
             metavar="D,DEG",
             callback=_tolerance,
             help="Held when the object moves less than D (length units) and turns less than DEG degrees "
-            "(default 0.002,2: 2 mm in metres, 2 degrees).",
+            "(default 0.002,2: 2 mm in metres, 2 degrees; D below the object's size, DEG at most 45).",
         ),
     ] = None,
     safety: Safety = 1.25,
@@ -142,7 +145,7 @@ def simulate(
     One record per grasp: held or not, and per direction how far the object moved and turned and each
     finger's contact force beside the planned one. The grasp needs an object, a mass and a friction
     (the file's, or --mass, --friction). Exit 1 when a grasp does not hold. Needs MuJoCo:
-    pip install 'grasptwist[sim]'. Examples:
+    pip install 'grasptwist[sim]' (from a clone: .venv/bin/pip install -e '.[sim]'). Examples:
 
     \b
         grasptwist simulate grasps/trifinger-cube.yaml --mass 0.094 --friction 1 --table 0

@@ -16,11 +16,77 @@ from .forces.hold import hold_wrench
 from .hands import finger_states
 from .kinematics import finger_jacobian
 
-__all__ = ["DIRECTIONS", "UNITS", "direction_wrenches", "joint_torques", "held"]
+__all__ = [
+    "DIRECTIONS",
+    "UNITS",
+    "MIN_DURATION",
+    "MAX_DURATION",
+    "MAX_ANGLE_TOL",
+    "direction_wrenches",
+    "joint_torques",
+    "held",
+    "check_duration",
+    "check_tolerance",
+    "check_distance_tol",
+]
 
 #: The six directions, in the order they are tested, and their unit vectors ``(6, 3)``.
 DIRECTIONS = ("+x", "-x", "+y", "-y", "+z", "-z")
 UNITS = np.array([[1.0, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]])
+
+#: The shortest time a direction's load is applied (seconds): 50 of the simulation's 1 ms steps,
+#: long enough for an object that slips to leave the tolerance (it falls 12 mm in 0.05 s under its
+#: weight); shorter, every grasp would "hold".
+MIN_DURATION = 0.05
+
+#: The longest (seconds of simulated time): a hold test's CPU is about 0.03 s per simulated second
+#: and direction, so this bounds one grasp's test to a few minutes.
+MAX_DURATION = 600.0
+
+#: The largest angle tolerance (degrees): an object turned further has not been held.
+MAX_ANGLE_TOL = 45.0
+
+
+def check_duration(duration) -> float:
+    """``duration`` (seconds per direction), or ``ValueError``: at least :data:`MIN_DURATION`, at most
+    :data:`MAX_DURATION`.
+
+    >>> check_duration(0.05)
+    0.05
+    """
+    d = float(duration)
+    if not MIN_DURATION <= d <= MAX_DURATION:
+        raise ValueError(
+            f"must be at least {MIN_DURATION:g} s (50 time steps) and at most {MAX_DURATION:g} s, got {d:g}"
+        )
+    return d
+
+
+def check_tolerance(distance, angle) -> tuple[float, float]:
+    """``(distance, angle)``, the hold's tolerances (angle in degrees), or ``ValueError``: a finite
+    distance > 0 and an angle in ``(0, MAX_ANGLE_TOL]``.
+
+    >>> check_tolerance(0.002, 2)
+    (0.002, 2.0)
+    """
+    distance, angle = float(distance), float(angle)
+    if not 0 < distance < np.inf:
+        raise ValueError(f"the distance must be a finite number > 0, got {distance:g}")
+    if not 0 < angle <= MAX_ANGLE_TOL:
+        raise ValueError(f"the angle must be in degrees, > 0 and at most {MAX_ANGLE_TOL:g}, got {angle:g}")
+    return distance, angle
+
+
+def check_distance_tol(distance, size) -> str | None:
+    """Why the distance tolerance does not fit an object of ``size`` (its bounding box's diagonal), or
+    None: the object may not move as far as its own size and still count as held.
+
+    >>> check_distance_tol(1e6, 0.11)
+    "the distance tolerance 1e+06 is not less than the object's size 0.11 (its bounding box's diagonal)"
+    """
+    if distance < size:
+        return None
+    return f"the distance tolerance {distance:g} is not less than the object's size {size:.3g} (its bounding box's diagonal)"
 
 
 def direction_wrenches(mass, center_of_mass, load) -> np.ndarray:

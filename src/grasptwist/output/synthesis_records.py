@@ -11,6 +11,8 @@ gives one record per grasp, best first::
      "joint_positions": {joint name: position} (null without a hand),
      "reach_error": [3] (null without a hand),
      "clearance": least distance of any finger from the environment (null without one),
+     "simulation": {"held": true, "directions": [{"direction": "+x", "held",
+                    "displacement", "rotation_deg"}, x 6]} (with --simulate; else null),
      "search": {"candidates", "seconds", "seed", "stopped_by"}, "warnings": [the object's]}
 
 With a hand, finger ``f`` touches contact ``f``; ``reach_error`` is each finger's distance, by
@@ -94,11 +96,28 @@ def synthesis_records(found) -> list[dict]:
                 "joint_positions": _joint_positions(found, k),
                 "reach_error": None if s.reach_error is None else s.reach_error[k].tolist(),
                 "clearance": None if found.clearance is None else _float(found.clearance[k]),
+                "simulation": None if found.simulated is None else _simulation(found.simulated[k]),
                 "search": search,
                 "warnings": list(found.warnings),
             }
         )
     return out
+
+
+def _simulation(test) -> dict:
+    """A grasp's hold test in MuJoCo (``synthesize --simulate``): held, and each direction's movement."""
+    return {
+        "held": test.held,
+        "directions": [
+            {
+                "direction": d.name,
+                "held": d.held,
+                "displacement": _float(d.displacement),
+                "rotation_deg": _float(np.degrees(d.rotation)),
+            }
+            for d in test.directions
+        ],
+    }
 
 
 def _joint_positions(found, k):

@@ -182,6 +182,9 @@ class Command:
         What other families add to its records.
     fixed : mapping
         Options of its family that the command fixes.
+    failed_words : str
+        What the closing summary line says of its records that are not ok (and not an input that
+        failed): ``3 records: 1 with a degenerate method``, ``2 records: 1 not held``.
     """
 
     name: str
@@ -193,6 +196,7 @@ class Command:
     talking: Callable[[Any, Any], list[dict]] = _all_talking
     contributions: tuple[Contribution, ...] = ()
     fixed: Mapping[str, Any] = field(default_factory=dict)
+    failed_words: str = "with a degenerate method"
 
     def __post_init__(self):
         unknown = [f for f in self.formats if f not in FORMATS]
@@ -440,6 +444,13 @@ COMMANDS: dict[str, Command] = {
             _synthesis_records,
             "synthesis_records.SynthesisTable",
         ),
-        Command("simulate", SIMULATION, (*_RECORDS, "csv"), _simulate_records, "simulate_records.SimulateTable"),
+        Command(
+            "simulate",
+            SIMULATION,
+            (*_RECORDS, "csv"),
+            _simulate_records,
+            "simulate_records.SimulateTable",
+            failed_words="not held",
+        ),
     )
 }

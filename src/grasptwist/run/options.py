@@ -163,3 +163,16 @@ class SimulateOptions:
     safety: float = 1.25
     mjcf: str | None = None
     path: str | None = None
+
+    def __post_init__(self):
+        # checked as the command line checks them, for every way in (grasptwist.simulate, synthesize)
+        from ..engine.hold_test import check_duration, check_tolerance
+
+        for name, check, values in (
+            ("duration", check_duration, (self.duration,)),
+            ("tolerance", check_tolerance, (self.distance_tol, self.angle_tol)),
+        ):
+            try:
+                check(*values)
+            except ValueError as exc:
+                raise ValueError(f"{name}: {exc}") from None

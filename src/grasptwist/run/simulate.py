@@ -20,7 +20,8 @@ from dataclasses import dataclass, replace
 
 import numpy as np
 
-from ..engine.objects.geometry import mass_properties
+from ..engine.hold_test import check_distance_tol
+from ..engine.objects.geometry import mass_properties, object_size
 from ..engine.synthesis.search import Failure
 from ..io.urdf_meshes import grasp_folder, urdf_files
 from ..model import Grasp, GraspFileError, InputError
@@ -46,6 +47,7 @@ __all__ = [
     "NO_MASS",
     "NO_FRICTION",
     "NO_PATH",
+    "BAD_TOLERANCE",
     "PATH_SAMPLES",
     "SCENE_ERROR",
     "UNSTABLE",
@@ -57,6 +59,9 @@ __all__ = [
 
 #: Error codes of a grasp that cannot be simulated, and of a simulation that diverged.
 NO_OBJECT, NO_MASS, NO_FRICTION, NO_PATH = "no-object", "no-mass", "no-friction", "no-path"
+
+#: The error code of a distance tolerance not below the object's size.
+BAD_TOLERANCE = "tolerance-too-large"
 
 #: Samples of a path executed (``simulate --path``), ends included.
 PATH_SAMPLES = 21
@@ -96,6 +101,9 @@ def _prepared(options: SimulateOptions, grasp: Grasp, mjcf: str | None, hold: bo
     obj = grasp.object
     if obj is None:
         return _problem(grasp, NO_OBJECT, "has no object to simulate: add an 'object' key")
+    too_large = check_distance_tol(options.distance_tol, object_size(obj))
+    if too_large is not None:
+        return _problem(grasp, BAD_TOLERANCE, f"{too_large}: give --tolerance a smaller distance")
     mass = _mass(options, grasp, obj)
     if mass is None:
         return _problem(grasp, NO_MASS, "has no mass: give the object a mass or density, the file a mass, or --mass")
@@ -321,6 +329,7 @@ def _found_grasp(found, k: int) -> Grasp:
         center_of_mass=center,
         gravity=gravity,
         object=found.object,
+        environment=found.environment,  # the fingers keep out of its table and boxes, as in simulate
     )
 
 
@@ -335,21 +344,23 @@ def _rows(synthesis, keep: np.ndarray):
 
 
 def held_only(found, options: SimulateOptions):
-    """``found`` with only the grasps that hold in all six directions in MuJoCo, and how many were dropped
+    """``found`` with only the grasps that hold in all six directions in MuJoCo, each kept grasp's
+    :class:`~grasptwist.sim.hold.HoldTest` (``found.simulated``), and how many were dropped
     (``synthesize --simulate``); an object without a weight (no mass) has no load to test: all are kept."""
     if not len(found) or found.hold is None:
         return found, 0
-    keep = []
+    keep, tests = [], []
     for k in range(len(found)):
         sim = simulate_grasp(options, _found_grasp(found, k))
         if isinstance(sim, Simulated) and sim.test.held:
             keep.append(k)
+            tests.append(sim.test)
     keep = np.array(keep, dtype=int)
     synthesis = _rows(found.synthesis, keep)
     if not len(keep):  # the search's record says why there is none
         message = f"none of the {len(found)} grasps found held in all six directions in MuJoCo (--simulate)"
         synthesis = replace(synthesis, failure=Failure(SIMULATED, message, math.nan, math.nan))
-    kept = replace(found, synthesis=synthesis)
+    kept = replace(found, synthesis=synthesis, simulated=tuple(tests))
     if found.joints_at is not None:
         kept = replace(kept, joints_at=tuple(found.joints_at[k] for k in keep))
     return kept, len(found) - len(keep)
@@ -396,7 +407,11 @@ def simulate(
     ------
     GraspFileError
         A grasp it cannot simulate (``no-object``, ``no-mass``, ``no-friction``, ``scene-error``)
-        or a simulation that diverged (``simulation-unstable``).
+        or a simulation that diverged (``simulation-unstable``), or a distance tolerance not below the
+        object's size (``tolerance-too-large``).
+    ValueError
+        A duration or tolerance out of bounds (:func:`~grasptwist.engine.hold_test.check_duration`,
+        :func:`~grasptwist.engine.hold_test.check_tolerance`), in the command line's words.
     """
     options = SimulateOptions(mass, friction, table_height, duration, *tolerance, safety)
     result = simulate_grasp(options, grasp, mjcf)

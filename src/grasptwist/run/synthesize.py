@@ -93,6 +93,7 @@ class Found:
     environment: Environment | None = None  # the table and boxes the grasps keep clear of
     clearance: np.ndarray | None = None  # each grasp's least distance of a finger from them (None: no environment)
     dropped: int = 0  # --simulate: grasps found that did not hold in MuJoCo, left out
+    simulated: tuple | None = None  # --simulate: each grasp's hold test in MuJoCo (a HoldTest), else None
 
     def __len__(self) -> int:
         return len(self.synthesis.points)

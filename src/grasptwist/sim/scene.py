@@ -5,7 +5,10 @@ r"""A grasp as a MuJoCo scene (MJCF): the object, the table, and the hand at the
   pieces (:func:`convex_pieces`: MuJoCo collides a mesh's convex hull only).  Its mass,
   centre and inertia are those of the solid (:func:`mass_geom`: the one geom that carries
   them, MuJoCo integrating the solid exactly), uniform density.
-- **Table**: a plane ``z = table_height`` (normal +z) when asked for.
+- **Table** and **boxes** (the grasp file's ``environment``): a plane ``z = table_height``
+  (normal +z) when asked for, and boxes.  They are there for the hand, never to carry the
+  object (:data:`COLLIDES`): the fingertips touch them, the object passes through them, so
+  that a hold test or a path credits the fingers alone.
 - **Hand**: a URDF hand read by MuJoCo's URDF reader (:func:`_with_urdf_hand`: the description
   and its meshes, which the run layer reads); otherwise built from grasptwist's own model of it
   (joints given inline): each joint a hinge or a slide through its point along its axis, with
@@ -47,6 +50,7 @@ __all__ = [
     "POINT_TIP",
     "OBJECT",
     "TIP",
+    "COLLIDES",
 ]
 
 #: Each finger link's and fingertip's mass, as a fraction of the object's (their gravity is
@@ -64,6 +68,18 @@ OBJECT_RGBA = "0.95 0.55 0.15 1"
 
 #: Names in the scene: the object's body, and fingertip ``f``'s geom (``TIP.format(f)``).
 OBJECT, TIP = "object", "tip{}"
+
+#: Each colliding part's MuJoCo ``(contype, conaffinity)`` bits: two geoms collide when one's
+#: ``contype`` shares a bit with the other's ``conaffinity``.  The object touches the fingertips
+#: only; the environment (table, boxes) touches the fingertips only; the fingertips touch all,
+#: each other too.  So the environment never supports the object (a grasp that "holds" only on
+#: its table does not hold), and a finger cannot go through it.
+COLLIDES = {"object": (1, 2), "tip": (2, 7), "environment": (4, 2)}
+
+
+def _bits(part: str) -> str:
+    contype, conaffinity = COLLIDES[part]
+    return f'contype="{contype}" conaffinity="{conaffinity}"'
 
 
 @dataclass(frozen=True)
@@ -180,7 +196,7 @@ def _object_geoms(obj: GraspObject, mass: float, pieces=None) -> tuple[str, dict
     carrier, assets = mass_geom(obj, mass)
     if shape.kind != "mesh":
         return (
-            f'<geom name="piece0" {_primitive(shape.kind, shape.size)} mass="{mass:.17g}" friction="0" rgba="{OBJECT_RGBA}"/>',
+            f'<geom name="piece0" {_primitive(shape.kind, shape.size)} mass="{mass:.17g}" friction="0" {_bits("object")} rgba="{OBJECT_RGBA}"/>',
             {},
             "",
         )
@@ -190,7 +206,7 @@ def _object_geoms(obj: GraspObject, mass: float, pieces=None) -> tuple[str, dict
         assets[f"piece{k}.stl"] = stl_bytes(v, f)
         meshes.append(f'<mesh name="piece{k}" file="piece{k}.stl"/>')
         geoms.append(
-            f'<geom name="piece{k}" type="mesh" mesh="piece{k}" density="0" friction="0" rgba="{OBJECT_RGBA}"/>'
+            f'<geom name="piece{k}" type="mesh" mesh="piece{k}" density="0" friction="0" {_bits("object")} rgba="{OBJECT_RGBA}"/>'
         )
     return "\n".join(geoms), assets, "\n".join(meshes)
 
@@ -217,7 +233,7 @@ def _joint_xml(name, kind, point, axis, limits, drive, i, q0) -> str:
 def _tip_geom(f, centre, radius, mu, mass) -> str:
     return (
         f'<geom name="{TIP.format(f)}" type="sphere" size="{radius:.17g}" pos="{_v(centre)}" '
-        f'friction="{mu:.17g}" mass="{mass:.17g}" rgba="0.2 0.4 0.9 1"/>'
+        f'friction="{mu:.17g}" mass="{mass:.17g}" {_bits("tip")} rgba="0.2 0.4 0.9 1"/>'
     )
 
 
@@ -317,6 +333,8 @@ def _with_urdf_hand(xml, grasp, urdf, radii, mu, load, tolerance, timestep, comp
             size=[radii[f], 0, 0],
             friction=[mu[f], 0, 0],
             mass=part,
+            contype=COLLIDES["tip"][0],
+            conaffinity=COLLIDES["tip"][1],
             rgba=[0.2, 0.4, 0.9, 1],
         )
     for mesh in scene.meshes:  # beside the scene, by file name (as MuJoCo's URDF reader finds them)
@@ -394,11 +412,11 @@ def build_scene(
     tmu = float(np.min(mu)) if table_friction is None else table_friction
     table = "".join(
         f'<geom name="box{k}" type="box" pos="{_v(box.pose[:3, 3])}" quat="{_v(matrix_to_quaternion(box.pose[:3, :3]))}" '
-        f'size="{_v(np.asarray(box.size, float) / 2)}" friction="{tmu:.17g}" rgba="0.6 0.6 0.6 1"/>\n'
+        f'size="{_v(np.asarray(box.size, float) / 2)}" friction="{tmu:.17g}" {_bits("environment")} rgba="0.6 0.6 0.6 1"/>\n'
         for k, box in enumerate(boxes)
     )
     if table_height is not None:
-        table += f'<geom name="table" type="plane" size="0 0 1" pos="0 0 {table_height:.17g}" friction="{tmu:.17g}" rgba="0.8 0.8 0.75 1"/>'
+        table += f'<geom name="table" type="plane" size="0 0 1" pos="0 0 {table_height:.17g}" friction="{tmu:.17g}" {_bits("environment")} rgba="0.8 0.8 0.75 1"/>'
     pose = obj.pose
     xml = f"""<mujoco model="{_attribute(grasp.name)}">
 <compiler angle="radian"/>
