@@ -447,7 +447,9 @@ def test_a_cube_on_a_table_is_held_just_above_m_g_over_mu_and_off_the_conditioni
     least = 0.1 * 9.81 / 0.8
     assert MIN_CONDITIONING == 0.05 and len(s.points) == 3
     assert (s.conditioning >= MIN_CONDITIONING).all()  # off-tangent and tangent
-    assert (s.total_normal_force[:, 0] >= least * (1 - 1e-6)).all() and (s.total_normal_force[:, 0] < 1.02 * least).all()
+    assert (s.total_normal_force[:, 0] >= least * (1 - 1e-6)).all() and (
+        s.total_normal_force[:, 0] < 1.02 * least
+    ).all()
 
 
 def test_equal_objectives_are_ranked_by_the_larger_conditioning():

@@ -218,7 +218,7 @@ class Synthesis:
     seed : int
     failure : Failure or None
         Why nothing was found (``K = 0``): ``constraint`` (the tightest: ``degenerate``,
-        ``conditioning``, ``force_closure``, ``constraints``, ``grip``, with a hand ``fingertips``,
+        ``conditioning``, ``force_closure``, ``clearance`` (the environment's), ``constraints``, ``grip``, with a hand ``fingertips``,
         ``reach`` or ``collision``; or ``budget``, ``verification``: ``Failure``), ``message``,
         ``best`` and ``needed``.
     """
