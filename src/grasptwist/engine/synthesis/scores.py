@@ -69,7 +69,7 @@ METHODS = ("off_tangent", "tangent")
 #: search to its conditioning floor (on the TriFinger cube on its table the least total, ``m g / mu``,
 #: is reached only as the tangent conditioning goes to 0, the total above it growing as its square):
 #: at 0.001 (the degeneracy warnings' threshold) the grasps found turn the cube at 0.5 rad/s with
-#: tangent amplitudes up to 161; at 0.05 up to 1.2 (the bundled grasp's: about 1) for 0.6-0.8% more force.
+#: tangent amplitudes up to 166; at 0.05 up to 1.17 (the bundled grasp's: 1.24) for 0.6-0.8% more force.
 MIN_CONDITIONING = 0.05
 
 #: Objectives within this share of each other are ties, broken by the larger conditioning (:func:`tie_broken`).
