@@ -151,3 +151,17 @@ def test_a_take_is_sized_by_the_rate_measured_to_end_at_the_search_deadline():
     b.spent(PROBE)
     now[0] = 0.004 * PROBE  # 0.128 s
     assert b.take(2048) == 168 and b.stopped_by == "seconds"  # (0.8 - 0.128) / 0.004 = 168
+
+
+def test_the_command_line_and_python_share_one_conditioning_floor():
+    """Python's ``min_conditioning`` defaulted to 0 while ``--min-conditioning`` was 0.001."""
+    import inspect
+
+    from grasptwist.cli.synthesize import synthesize as command
+    from grasptwist.engine.synthesis.scores import MIN_CONDITIONING, score_triples
+    from grasptwist.engine.synthesis.search import search_steps
+
+    option = inspect.signature(command).parameters["min_conditioning"].default
+    assert MIN_CONDITIONING == 0.05 == option
+    for f in (search_steps, score_triples):
+        assert inspect.signature(f).parameters["min_conditioning"].default == MIN_CONDITIONING
