@@ -205,7 +205,7 @@ def synthesize_bag(objects, *, hand: str | None = None, **options):
         As ``--hand``: a YAML file holding just ``hand:`` that must reach every grasp.
     **options
         As the command line's, by their names in ``grasptwist.run.options.SynthesisOptions``: ``count`` (5), ``friction``,
-        ``mass``, ``safety``, ``objective``, ``method``, ``min_conditioning`` (0.001),
+        ``mass``, ``safety``, ``objective``, ``method``, ``min_conditioning`` (0.05),
         ``min_spacing``, ``quality``, ``seed`` (0), ``candidates`` (20000), ``seconds`` (60),
         ``position_error``, ``friction_error`` (0.2), ``perturbations`` (64),
         ``tip_radius``.

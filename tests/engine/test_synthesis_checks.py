@@ -122,14 +122,16 @@ def test_a_surface_no_finite_friction_closes_is_said_so_not_that_it_needs_no_fri
 
 
 def test_spending_stops_on_the_time_only_while_candidates_are_left():
-    from grasptwist.engine.synthesis.budget import Spending
+    from grasptwist.engine.synthesis.budget import PROBE, Spending
 
     now = [0.0]
     b = Spending(Budget(100, 10.0, lambda: now[0]), 0.8)
+    assert b.take(60) == PROBE == 32 and b.stopped_by == "candidates"  # no rate yet: a probe
+    b.spent(32)  # in no time: no limit from the rate
     assert b.take(60) == 60 and b.stopped_by == "candidates"
     b.spent(60)
-    assert b.take(60) == 40
-    b.spent(40)
+    assert b.take(60) == 8
+    b.spent(8)
     now[0] = 9.0  # past the search's 8 s, but every candidate is spent: not the time's doing
     assert b.take(60) == 0 and b.stopped_by == "candidates" and not b.late()
     now[0] = 10.0
@@ -137,3 +139,29 @@ def test_spending_stops_on_the_time_only_while_candidates_are_left():
     early = Spending(Budget(100, 10.0, lambda: now[0]), 0.8)
     now[0] = 18.0
     assert early.take(10) == 0 and early.stopped_by == "seconds"
+
+
+def test_a_take_is_sized_by_the_rate_measured_to_end_at_the_search_deadline():
+    """At 4 ms a candidate (a TriFinger hand's rate) a 2048 chunk took 8 s past a 0.8 s deadline."""
+    from grasptwist.engine.synthesis.budget import PROBE, Spending
+
+    now = [0.0]
+    b = Spending(Budget(10**6, 1.0, lambda: now[0]), 0.8)
+    assert b.take(2048) == PROBE
+    b.spent(PROBE)
+    now[0] = 0.004 * PROBE  # 0.128 s
+    assert b.take(2048) == 168 and b.stopped_by == "seconds"  # (0.8 - 0.128) / 0.004 = 168
+
+
+def test_the_command_line_and_python_share_one_conditioning_floor():
+    """Python's ``min_conditioning`` defaulted to 0 while ``--min-conditioning`` was 0.001."""
+    import inspect
+
+    from grasptwist.cli.synthesize import synthesize as command
+    from grasptwist.engine.synthesis.scores import MIN_CONDITIONING, score_triples
+    from grasptwist.engine.synthesis.search import search_steps
+
+    option = inspect.signature(command).parameters["min_conditioning"].default
+    assert MIN_CONDITIONING == 0.05 == option
+    for f in (search_steps, score_triples):
+        assert inspect.signature(f).parameters["min_conditioning"].default == MIN_CONDITIONING

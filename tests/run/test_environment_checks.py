@@ -159,6 +159,36 @@ def test_gt_synthesize_puts_the_command_lines_checks_on_a_hand(monkeypatch):
     assert hand.environment.table_height == -1.0 and hand.clearance == 0.001 and hand.hulls is not None
 
 
+def test_gt_synthesize_of_a_grasp_takes_its_files_object_hand_environment_and_wrist(monkeypatch):
+    """``gt.synthesize(g.object, mu, hand=g.hand)`` ignored the file's table; a ``Grasp`` brings it."""
+    import grasptwist.run.grasp_search as search
+
+    (g,) = gt.read_grasps(GRASPS / "three-finger-hand.yaml")
+    g = replace(g, environment=Environment(-1.5), wrist=np.array([0.0, 0, 3.0]))
+    seen = {}
+    monkeypatch.setattr(search, "search_object", lambda obj, friction, **kw: seen.update(kw, obj=obj))
+    gt.synthesize(g, 0.8, count=1)
+    tips = gt.hand.home_tips(g.hand, g.points)  # the inline tips at home on the file's contacts (tip radius 0)
+    assert seen["obj"] is g.object and seen["environment"] is g.environment and seen["wrist"].tolist() == [0, 0, 3.0]
+    assert seen["hand"].environment.table_height == -1.5 and seen["hand"].hand is g.hand
+    np.testing.assert_allclose(seen["tips"], tips, atol=1e-12)
+    gt.synthesize(g, 0.8, environment=Environment(-2.0), wrist=None)  # what is given wins
+    assert seen["environment"].table_height == -2.0 and seen["wrist"] is None
+    with pytest.raises(ValueError, match="has no object to search"):
+        gt.synthesize(replace(g, object=None), 0.8)
+
+
+def test_a_grasp_files_table_keeps_gt_synthesizes_contacts_off_it(tmp_path):
+    doc = {"object": {"box": [0.065, 0.065, 0.065], "pose": {"position": [0, 0, 0.0325]}, "mass": 0.1}}
+    doc["contacts"] = [{"point": [0.0325, 0, 0.03]}, {"point": [-0.0325, 0.01, 0.03]}, {"point": [0, 0.0325, 0.04]}]
+    doc["environment"] = {"table": {"height": 0}, "clearance": 0.01}
+    path = tmp_path / "cube.yaml"
+    path.write_text(yaml.safe_dump(doc), "utf-8")
+    (g,) = gt.read_grasps(path)
+    s = gt.synthesize(g, 0.8, count=2, candidates=800)
+    assert len(s.points) == 2 and (s.points[..., 2] >= 0.01 - 1e-12).all()  # never the face on the table
+
+
 @needs_trifinger
 def test_the_trifinger_picture_draws_its_table(placed):
     from grasptwist.plot.scene import grasp_scene

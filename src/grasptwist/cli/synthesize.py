@@ -6,6 +6,7 @@ from typing import Annotated
 
 import typer
 
+from ..engine.synthesis.scores import MIN_CONDITIONING
 from .diagnostics import Warnings
 from .exits import checked_output, run_command
 from .options import (
@@ -185,7 +186,7 @@ def synthesize(
             callback=_checked("check_min_conditioning", "scores"),
             help="Each decomposition's conditioning must be at least this (0 to 1).",
         ),
-    ] = 1e-3,
+    ] = MIN_CONDITIONING,
     min_spacing: Annotated[
         float | None,
         typer.Option(

@@ -9,11 +9,14 @@ Python caller gets the grasps ``grasptwist synthesize`` would give.  No math her
 
 from __future__ import annotations
 
+from ..engine.fingertips import tip_centers, tip_radii
+from ..engine.ik import home_tips
 from ..engine.synthesis.reach import HandReach
 from ..engine.synthesis.search import synthesize as search_object
 from ..io.limits import MAX_URDF_BYTES
+from ..model import Grasp
 
-__all__ = ["synthesize"]
+__all__ = ["synthesize", "file_tips"]
 
 
 def synthesize(
@@ -42,8 +45,11 @@ def synthesize(
 
     Parameters
     ----------
-    obj : GraspObject
-        With a ``mass`` or ``density`` when ``hold`` (the weight ``m g`` at its centre of mass).
+    obj : GraspObject or Grasp
+        With a ``mass`` or ``density`` when ``hold`` (the weight ``m g`` at its centre of mass).  A
+        ``Grasp`` (``grasptwist.read_grasps``) stands for its file: its ``object`` is searched, and
+        its ``hand``, ``environment`` and ``wrist`` are taken, with its file's folder as ``folder``,
+        unless given here (as ``grasptwist synthesize FILE`` takes them).
     friction : float
         ``mu`` at every contact.
     hand : Hand or HandReach, optional
@@ -70,7 +76,7 @@ def synthesize(
         (False: each grasp on one body of the object), and the search's: ``count`` (grasps
         wanted, 1), ``safety`` (1), ``objective`` (``robust``, ``total_normal_force``,
         ``closure_friction`` or ``epsilon``), ``wrist`` (None), ``methods``,
-        ``min_conditioning`` (0), ``min_spacing`` (None: 5% of the object's size),
+        ``min_conditioning`` (0.05), ``min_spacing`` (None: 5% of the object's size),
         ``quality`` (False), ``seed`` (0), ``candidates`` (20000), ``seconds`` (None),
         ``position_error``, ``friction_error`` (0.2), ``perturbations`` (64); and
         ``collide``, ``hulls``: the hand's tests given as functions instead
@@ -99,6 +105,10 @@ def synthesize(
     >>> s.points.shape, bool((s.closure_friction < 0.8).all()), bool((s.points[..., 2] >= -0.0315).all())
     ((2, 3, 3), True, True)
     """
+    if isinstance(obj, Grasp):
+        if hand is None and tips is None and obj.hand is not None and any(f.tip_pose is None for f in obj.hand.fingers):
+            tips = file_tips(obj, obj.hand)  # an inline hand's tips: at the file's contacts, as the command line's
+        obj, hand, environment, folder, options = _from_file(obj, hand, environment, folder, options)
     if hand is not None and not isinstance(hand, HandReach) and "collide" not in options and "hulls" not in options:
         from .collisions import hand_constraints  # the finger links' meshes: with the first hand
 
@@ -122,3 +132,26 @@ def synthesize(
         clearance=clearance,
         **options,
     )
+
+
+def _from_file(grasp, hand, environment, folder, options):
+    """What a grasp file gives a search (:func:`synthesize`'s ``obj``): its object, and its hand,
+    environment, wrist and folder where the caller gives none."""
+    if grasp.object is None:
+        raise ValueError(f"grasp '{grasp.name}' of {grasp.file} has no object to search")
+    from ..io.urdf_meshes import grasp_folder
+
+    options.setdefault("wrist", grasp.wrist)
+    return (
+        grasp.object,
+        grasp.hand if hand is None else hand,
+        grasp.environment if environment is None else environment,
+        grasp_folder(grasp) if folder is None else folder,
+        options,
+    )
+
+
+def file_tips(grasp, hand):
+    """Each finger's tip link pose at home ``(3, 4, 4)`` for a hand given inline in ``grasp``'s file:
+    where its fingertip sphere's centre is on the file's contact (its joints are given there)."""
+    return home_tips(hand, tip_centers(grasp.points, grasp.normals, tip_radii(hand)))

@@ -116,7 +116,7 @@ class SynthesisOptions:
     safety: float = 1.0
     objective: str = "robust"
     method: str = "both"
-    min_conditioning: float = 1e-3
+    min_conditioning: float | None = None  # None: the engine's (engine.synthesis.scores.MIN_CONDITIONING)
     min_spacing: float | None = None
     quality: bool = False
     seed: int = 0

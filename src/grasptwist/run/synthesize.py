@@ -21,11 +21,9 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..engine.fingertips import tip_centers, tip_radii
 from ..engine.forces.hold import Weight, hold_wrench, object_weight
-from ..engine.ik import home_tips
 from ..engine.synthesis.clearance import environment_search, grasp_clearance
-from ..engine.synthesis.scores import METHODS
+from ..engine.synthesis.scores import METHODS, MIN_CONDITIONING
 from ..engine.synthesis.search import GRAVITY, Synthesis, search_steps, surface_of
 from ..engine.units import fingers_reach, hand_fit_warning, largest_extent, mesh_span_warning
 from ..io.grasp.forces import HOLD
@@ -37,6 +35,7 @@ from ..output import synthesis_records as sr
 from ..output.formats import FORMATS
 from ..output.names import escaped
 from ..output.records import diagnostics, dumps, error_record
+from .grasp_search import file_tips
 from .options import SynthesisOptions
 from .outputs import Output
 from .pool import Pool, pool_size
@@ -165,7 +164,7 @@ def _hand(job, grasp: Grasp, obj: GraspObject):
                 "an inline hand has no tip points without the contacts its fingers touch: put it in a grasp file",
                 grasp.line,
             )
-        tips = home_tips(hand, tip_centers(grasp.points, grasp.normals, tip_radii(hand)))
+        tips = file_tips(grasp, hand)
     from ..io.urdf_meshes import grasp_folder  # the finger links' meshes: with the first URDF hand
     from .collisions import hand_constraints
 
@@ -329,7 +328,7 @@ def _searched_entry(job, entry: Grasp) -> Iterator[GraspFileError | Found | Prog
         objective=o.objective,
         wrist=entry.wrist,
         methods=METHODS if o.method == "both" else (o.method.replace("-", "_"),),
-        min_conditioning=o.min_conditioning,
+        min_conditioning=MIN_CONDITIONING if o.min_conditioning is None else o.min_conditioning,
         min_spacing=o.min_spacing,
         constraints=clear,
         hand=reach,

@@ -23,7 +23,7 @@ from dataclasses import dataclass
 
 from .checks import check_candidates, check_seconds
 
-__all__ = ["Budget", "Spending", "STOPPED_BY", "check_budget"]
+__all__ = ["Budget", "Spending", "STOPPED_BY", "PROBE", "check_budget"]
 
 #: What ended a search: every candidate scored and every grasp verified, or the time.
 STOPPED_BY = ("candidates", "seconds")
@@ -61,12 +61,26 @@ def check_budget(candidates, seconds) -> tuple[int, float | None]:
     return check_candidates(candidates), check_seconds(seconds)
 
 
+#: The first take of a search with ``seconds``, before its rate is known (a hand scores a few hundred a second).
+PROBE = 32
+
+
 class Spending:
     """A :class:`Budget` as a search spends it: the clock starts here.
 
     The search stops taking candidates at ``share`` of ``seconds``; verification stops at
-    ``seconds`` (:meth:`late`).  ``stopped_by`` becomes ``seconds`` when either deadline cut
-    something short.
+    ``seconds`` (:meth:`late`).  With ``seconds``, a take is sized to end by that deadline at the
+    rate measured so far (seconds per candidate scored; the first take, before any is measured,
+    at most :data:`PROBE`), so that a slow row (a hand's) overruns it by a fraction of one take, not
+    by a whole chunk.  ``stopped_by`` becomes ``seconds`` when either deadline cut something short.
+
+    >>> t = [0.0]
+    >>> s = Spending(Budget(10000, 1.0, clock=lambda: t[0]), 0.8)
+    >>> s.take(2048)  # no rate yet: a probe
+    32
+    >>> s.spent(32); t[0] = 0.16  # 5 ms a candidate
+    >>> s.take(2048)  # 0.64 s left to 0.8 s: 128 more
+    128
     """
 
     def __init__(self, budget: Budget, share: float):
@@ -81,10 +95,18 @@ class Spending:
     def take(self, n) -> int:
         """Up to ``n`` candidates, 0 when the budget is spent (the time only when some are left)."""
         n = max(0, min(n, self.left))
-        if n and self.search_deadline is not None and self.clock() >= self.search_deadline:
+        if not n or self.search_deadline is None:
+            return n
+        now = self.clock()
+        if now >= self.search_deadline:
             self.stopped_by = "seconds"
             return 0
-        return n
+        if not self.used:  # no rate yet
+            return min(n, PROBE)
+        fits = int((self.search_deadline - now) * self.used / max(now - self.started, 1e-12))
+        if fits < n:  # the time, not the candidates, sizes this take
+            self.stopped_by = "seconds"
+        return max(1, min(n, fits))
 
     def spent(self, n):
         self.left -= n

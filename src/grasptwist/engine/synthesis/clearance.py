@@ -20,7 +20,7 @@ import numpy as np
 from ..environment import clearance_of, environment_distance, has_obstacles, sphere_distance
 from .reach import hand_clearance
 
-__all__ = ["clear_contacts", "clear_surface", "clear_triples", "environment_search", "grasp_clearance"]
+__all__ = ["clear_contacts", "clear_surface", "ClearTriples", "environment_search", "grasp_clearance"]
 
 
 def clear_contacts(points, normals, environment, radius, clearance):
@@ -36,20 +36,38 @@ def clear_contacts(points, normals, environment, radius, clearance):
     return sphere_distance(p - radius * n, radius, environment)[0] >= clearance
 
 
-def clear_triples(environment, radius, clearance):
-    """The search's constraint (``constraints``): ``(N, 3, 3), (N, 3, 3) -> (N,)`` every contact clear."""
+class ClearTriples:
+    """The search's constraint (``constraints``): ``(N, 3, 3), (N, 3, 3) -> (N,)`` every contact clear.
 
-    def clear(points, normals):
-        return clear_contacts(points, normals, environment, radius, clearance).all(axis=-1)
+    It remembers how close the candidates it saw came (:attr:`best`: the largest over the triples of
+    their contacts' least clearance, ``-inf`` before any), so that a search that no candidate
+    passed names it, ``clearance``, with that distance and the clearance it needed.
 
-    return clear
+    >>> from grasptwist.model import Environment
+    >>> clear = ClearTriples(Environment(0.0), 0.0, 0.5)
+    >>> p = np.array([[[0.1, 0, 0.2], [0, 0.1, 0.3], [0, 0, 0.4]]])
+    >>> clear(p, -p).tolist(), clear.best, clear.needed
+    ([False], 0.2, 0.5)
+    """
+
+    name = "clearance"
+
+    def __init__(self, environment, radius, clearance):
+        self.environment, self.radius, self.needed = environment, radius, clearance
+        self.best = -np.inf
+
+    def __call__(self, points, normals):
+        p, n = np.asarray(points, float), np.asarray(normals, float)
+        least = sphere_distance(p - self.radius * n, self.radius, self.environment)[0].min(axis=-1)
+        self.best = max(self.best, float(least.max(initial=-np.inf)))
+        return least >= self.needed
 
 
 def clear_surface(surface, environment, radius, clearance):
     """A search's surface (``Surface``) whose samples are clear contacts, and whose projection
     marks a point that is not as one with no normal (``on_edge``), so that refinement never steps
     onto it.  Where no sample of a draw is clear, the draw is given whole: the constraint
-    (:func:`clear_triples`) then rejects its candidates.
+    (:class:`ClearTriples`) then rejects its candidates.
 
     >>> from grasptwist.model import Environment, GraspObject, Shape
     >>> from grasptwist.engine.synthesis.search import surface_of
@@ -76,14 +94,14 @@ def environment_search(surface, environment, clearance, hand=None):
     """A search's surface and its further constraints with an environment: ``(surface, constraints)``.
 
     Contacts clear for the hand's least fingertip radius (a point without a hand) are sampled
-    (:func:`clear_surface`) and required (:func:`clear_triples`); without a table or a box, the
+    (:func:`clear_surface`) and required (:class:`ClearTriples`); without a table or a box, the
     surface as it is and no constraint.
     """
     if not has_obstacles(environment):
         return surface, ()
     room = clearance_of(environment) if clearance is None else float(clearance)
     radius = 0.0 if hand is None else float(np.min(hand.radii))
-    return clear_surface(surface, environment, radius, room), (clear_triples(environment, radius, room),)
+    return clear_surface(surface, environment, radius, room), (ClearTriples(environment, radius, room),)
 
 
 def grasp_clearance(points, environment, hand=None, positions=None):

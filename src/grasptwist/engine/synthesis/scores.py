@@ -45,7 +45,10 @@ __all__ = [
     "OBJECTIVES",
     "CONSTRAINTS",
     "METHODS",
+    "MIN_CONDITIONING",
+    "TIE_TOL",
     "Scores",
+    "tie_broken",
     "check_objective",
     "check_min_conditioning",
     "score_triples",
@@ -61,6 +64,16 @@ CONSTRAINTS = ("degenerate", "conditioning", "force_closure", "constraints", "gr
 
 #: The decompositions whose conditioning a grasp must keep above ``min_conditioning``.
 METHODS = ("off_tangent", "tangent")
+
+#: The default ``min_conditioning`` of the command line and of Python.  Least total force pulls a
+#: search to its conditioning floor (on the TriFinger cube on its table the least total, ``m g / mu``,
+#: is reached only as the tangent conditioning goes to 0, the total above it growing as its square):
+#: at 0.001 (the degeneracy warnings' threshold) the grasps found turn the cube at 0.5 rad/s with
+#: tangent amplitudes up to 166; at 0.05 up to 1.17 (the bundled grasp's: 1.24) for 0.6-0.8% more force.
+MIN_CONDITIONING = 0.05
+
+#: Objectives within this share of each other are ties, broken by the larger conditioning (:func:`tie_broken`).
+TIE_TOL = 1e-6
 
 
 class Scores(NamedTuple):
@@ -152,7 +165,7 @@ def score_triples(
     objective="total_normal_force",
     wrist=None,
     methods=METHODS,
-    min_conditioning=0.0,
+    min_conditioning=MIN_CONDITIONING,
     constraints=(),
     hand=None,
     bound=np.inf,
@@ -221,7 +234,8 @@ def score_triples(
         held &= g.ok
     live = live[held]
     failed[live] = -1
-    objective_value[live] = objective_values(p[live], n[live], total[live], friction / safety, objective, tol)
+    value = objective_values(p[live], n[live], total[live], friction / safety, objective, tol)
+    objective_value[live] = tie_broken(value, cond[live])
     if hand is None:
         return Scores(objective_value, total, cond, failed)
     # rows no better than ``bound`` are never kept: the hand, the costliest test, is spared them
@@ -237,6 +251,37 @@ def score_triples(
         order[live], positions[live], miss[live] = r.order, r.positions, r.miss
         objective_value[live[r.failed != -1]] = np.inf
     return Scores(objective_value, total, cond, failed, order, positions, miss)
+
+
+def tie_broken(value, conditioning):
+    r"""The objective a search ranks by: ``value`` with its ties broken by the larger conditioning.
+
+    .. math:: v + \tau\, |v|\, (1 - c), \qquad \tau = 10^{-6}\ (:data:`TIE_TOL`)
+
+    with ``c`` the worse conditioning of the decompositions asked (NaN where not asked).  Grasps
+    whose objectives differ by more than ``tau |v|`` keep their order; among those within it (a
+    plateau: on a box held by side faces every grasp with a balanced grip needs ``m g / mu``) the
+    better conditioned one comes first, so that a search no longer ends on its conditioning floor.
+
+    Parameters
+    ----------
+    value : (N,) array
+        The objective (less is better).
+    conditioning : (N, 2) array
+        As :attr:`Scores.conditioning`.
+
+    Returns
+    -------
+    (N,) array
+
+    Examples
+    --------
+    >>> tie_broken(np.array([2.0, 2.0, 2.0000001]), np.array([[np.nan, 0.001], [0.6, 0.5], [np.nan, 0.9]])).round(8).tolist()
+    [2.000002, 2.000001, 2.0000003]
+    """
+    c = np.nanmin(np.asarray(conditioning, float), axis=1, initial=np.inf)
+    c = np.where(np.isfinite(c), c, 1.0)  # no decomposition asked: no tie to break
+    return value + TIE_TOL * np.abs(value) * (1.0 - c)
 
 
 def objective_values(points, normals, total, mu, objective, tol=DEGENERACY_TOL):

@@ -65,7 +65,15 @@ from .robustness import (
     margins,
     robustness,
 )
-from .scores import CONSTRAINTS, METHODS, check_min_conditioning, check_objective, conditionings, score_triples
+from .scores import (
+    CONSTRAINTS,
+    METHODS,
+    MIN_CONDITIONING,
+    check_min_conditioning,
+    check_objective,
+    conditionings,
+    score_triples,
+)
 
 __all__ = [
     "Surface",
@@ -210,7 +218,7 @@ class Synthesis:
     seed : int
     failure : Failure or None
         Why nothing was found (``K = 0``): ``constraint`` (the tightest: ``degenerate``,
-        ``conditioning``, ``force_closure``, ``constraints``, ``grip``, with a hand ``fingertips``,
+        ``conditioning``, ``force_closure``, ``clearance`` (the environment's), ``constraints``, ``grip``, with a hand ``fingertips``,
         ``reach`` or ``collision``; or ``budget``, ``verification``: ``Failure``), ``message``,
         ``best`` and ``needed``.
     """
@@ -264,7 +272,7 @@ def search(surface: Surface, wrenches, friction, **options) -> Synthesis:
         With a wrist the off-tangent decomposition's conditioning counts too.
     methods : tuple of str, default both
         Decompositions that must stay non-degenerate (:data:`~.scores.METHODS`).
-    min_conditioning : float, default 0
+    min_conditioning : float, default :data:`~.scores.MIN_CONDITIONING` (0.05)
         Their conditioning must be at least this (0 to 1).
     min_spacing : float or None, default None
         Returned grasps are at least this far apart (:func:`~.candidates.triple_distance`);
@@ -338,7 +346,7 @@ def search_steps(
     objective="robust",
     wrist=None,
     methods=METHODS,
-    min_conditioning=0.0,
+    min_conditioning=MIN_CONDITIONING,
     min_spacing=None,
     constraints=(),
     hand=None,
@@ -430,7 +438,7 @@ def search_steps(
             np.nan,
         )
     elif not len(out["points"]):
-        failure = _failure(archive, budget.used, mu / safety, min_conditioning, tol)
+        failure = _failure(archive, budget.used, mu / safety, min_conditioning, tol, constraints)
     yield Synthesis(
         **out,
         candidates=budget.used,
@@ -570,7 +578,7 @@ def _held(hand, error, positions):
     return good & (violations(hand, positions) <= 0)
 
 
-def _failure(archive, scored, mu, min_conditioning, tol) -> Failure:
+def _failure(archive, scored, mu, min_conditioning, tol, constraints=()) -> Failure:
     """Why no candidate was feasible: the furthest constraint any reached, and how close the best came
     (a hand's constraints are reached only with a hand: after the grip a row without one is feasible)."""
     if archive.furthest == 0 and scored < FEW_CANDIDATES:
@@ -605,6 +613,16 @@ def _failure(archive, scored, mu, min_conditioning, tol) -> Failure:
         words = f"the best needs friction {best:.3g}" if np.isfinite(best) else "none is at any finite friction"
         return Failure(name, f"no candidate is force closure at friction {mu:g} (friction / safety); {words}", best, mu)
     if name == "constraints":
+        # a named constraint (the environment's clearance) that no candidate it saw passed is the one
+        for c in constraints:
+            if np.isfinite(getattr(c, "best", np.nan)) and c.best < c.needed:
+                return Failure(
+                    c.name,
+                    f"no force-closure candidate keeps every fingertip (a contact, without a hand) {c.needed:g} "
+                    f"from the environment (the best: {c.best:.3g})",
+                    c.best,
+                    c.needed,
+                )
         return Failure(name, "no force-closure candidate passed the further constraints", np.nan, np.nan)
     if name == "fingertips":
         return Failure(
@@ -747,7 +765,7 @@ def synthesize(
     **options
         The search's keyword options: ``count`` (grasps wanted, 1), ``safety`` (1), ``objective``
         (``robust``, ``total_normal_force``, ``closure_friction`` or ``epsilon``), ``wrist`` (None),
-        ``methods``, ``min_conditioning`` (0), ``min_spacing`` (None: 5% of the object's size),
+        ``methods``, ``min_conditioning`` (0.05), ``min_spacing`` (None: 5% of the object's size),
         ``quality`` (False), ``seed`` (0), ``candidates`` (20000), ``seconds`` (None),
         ``position_error`` (None: half a tip radius, or 2% of the object's size),
         ``friction_error`` (0.2), ``perturbations`` (64).
