@@ -38,6 +38,8 @@ Every array is components-first: cone vectors ``(k, K, n)`` (component, cone, ro
 
 from __future__ import annotations
 
+import contextlib
+
 import numpy as np
 
 __all__ = ["GAP", "START_MARGIN", "phase_one", "minimise", "dual_polish"]
@@ -287,6 +289,24 @@ def dual_polish(A, b, c, s, z):
     omega = np.linalg.norm(z, axis=-1) / np.maximum(np.linalg.norm(y, axis=-1), 1e-300)
     h = np.einsum("nm,nmkd,nmke->nde", omega, A, A)
     with np.errstate(all="ignore"):
-        delta = np.linalg.solve(h + 1e-300 * np.eye(A.shape[-1]), res[..., None])[..., 0]
+        delta = _solved(h + 1e-300 * np.eye(A.shape[-1]), res)
         dz = omega[..., None] * np.einsum("nmkd,nd->nmk", A, delta)
     return np.where(np.isfinite(dz).all(axis=(1, 2))[:, None, None], z + dz, z)
+
+
+def _solved(h, res):
+    """``h^-1 res`` row by row, NaN for a row whose ``h`` LAPACK finds exactly singular (every cone
+    idle: nothing to polish there).  Which rows are exactly singular depends on the processor's
+    kernel (OpenBLAS rounds differently), and one such row fails a batched solve whole.
+
+    >>> _solved(np.array([[[2.0, 0], [0, 2]], [[0.0, 0], [0, 0]]]), np.ones((2, 2))).tolist()
+    [[0.5, 0.5], [nan, nan]]
+    """
+    try:
+        return np.linalg.solve(h, res[..., None])[..., 0]
+    except np.linalg.LinAlgError:
+        delta = np.full(res.shape, np.nan)
+        for i in range(len(h)):
+            with contextlib.suppress(np.linalg.LinAlgError):
+                delta[i] = np.linalg.solve(h[i], res[i])
+        return delta
