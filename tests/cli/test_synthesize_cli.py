@@ -503,6 +503,7 @@ def test_a_grasp_file_needs_no_contacts_for_synthesize_only(tmp_path):
     assert resolved.exit_code == 1 and "bare.yaml:1:1: error: missing-key: contacts" in resolved.stderr
 
 
+@pytest.mark.slow  # development.md, Test time: the engine's count is test_synthesis.py's, in the default run
 def test_grasps_left_unverified_when_the_time_runs_out_are_counted_on_stderr(monkeypatch):
     from functools import partial
 
@@ -566,7 +567,8 @@ def test_a_cold_run_returns_what_a_warm_run_returns(tmp_path):
         assert c["closure_friction"] == pytest.approx(w["closure_friction"], rel=1e-12)
 
 
-@pytest.mark.parametrize("workers", ["1", "2"])
+# two workers: slow (development.md, Test time); a folder on two workers is the default run's too
+@pytest.mark.parametrize("workers", ["1", pytest.param("2", marks=pytest.mark.slow)])
 def test_an_object_whose_search_raises_is_its_internal_error_record_and_the_folder_runs_on(
     tmp_path, monkeypatch, workers
 ):

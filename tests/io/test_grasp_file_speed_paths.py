@@ -390,7 +390,8 @@ _SETTINGS = settings(max_examples=25, deadline=None, suppress_health_check=[Heal
 
 @_SETTINGS
 @_examples(NUMBERS, number=number)
-@pytest.mark.parametrize("slot", SLOTS)
+# a number last in a list in the default run, first and between in the slow one (development.md, Test time)
+@pytest.mark.parametrize("slot", [pytest.param(s, marks=pytest.mark.slow) for s in SLOTS[:2]] + [SLOTS[2]])
 def test_a_number_reads_the_same_both_ways_wherever_it_stands(number, slot, parser):
     for doc in _number_places(number, slot):
         both_paths(doc, Reading(parser=parser), file="g.yaml")
