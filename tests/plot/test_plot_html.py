@@ -370,7 +370,9 @@ def test_an_honest_zipped_mesh_is_read(tmp_path):
 
 
 @pytest.mark.slow  # over a second: docs/reference/development.md, Test time
-def test_plot_draws_a_page_without_a_malformed_mesh_with_a_warning(tmp_path):
+def test_a_malformed_link_mesh_is_the_grasps_located_error_and_no_page(tmp_path):
+    # the finger links are checked against the object and each other (issue 37), which needs their
+    # meshes: one the mesh reader refuses (issue 36) is the grasp's error, located, not a crash
     pytest.importorskip("yourdfpy")
     from test_follow_hand import NORMALS, SPIN, _grasp, _turntable
 
@@ -380,13 +382,8 @@ def test_plot_draws_a_page_without_a_malformed_mesh_with_a_warning(tmp_path):
     (tmp_path / "hand.urdf").write_text(urdf.replace('<link name="f0_l0"/>', visual))
     (tmp_path / "bad.ply").write_bytes(MALFORMED_MESHES["bad.ply"])
     r = run("plot", grasp, "-o", tmp_path / "g.html")
-    assert r.exit_code == 0 and "internal error" not in r.output, r.output
-    assert "hand.urdf: warning: no link meshes: mesh 'bad.ply', line 3: the header declares 100 vertex " in r.stderr
-    from grasptwist.plot.traces import MESH_NAME
-
-    figures = read_figures((tmp_path / "g.html").read_text("utf-8"))
-    assert figures and not any(t["name"] == MESH_NAME for t in figures[0]["data"])
-    assert any(t["name"].startswith("finger") for t in figures[0]["data"])  # the chains, drawn all the same
+    assert r.exit_code == 1 and "internal error" not in r.output and "Traceback" not in r.output, r.output
+    assert "error: invalid-mesh: hand: mesh 'bad.ply', line 3: the header declares 100 vertex" in r.stderr
 
 
 def test_a_grasp_without_twists_is_drawn(tmp_path):

@@ -410,8 +410,8 @@ def simulate(
         or a simulation that diverged (``simulation-unstable``), or a distance tolerance not below the
         object's size (``tolerance-too-large``).
     ValueError
-        A duration or tolerance out of bounds (:func:`~grasptwist.engine.hold_test.check_duration`,
-        :func:`~grasptwist.engine.hold_test.check_tolerance`), in the command line's words.
+        A duration or tolerance out of bounds (``grasptwist.engine.hold_test.check_duration``,
+        ``check_tolerance``), in the command line's words.
     """
     options = SimulateOptions(mass, friction, table_height, duration, *tolerance, safety)
     result = simulate_grasp(options, grasp, mjcf)
