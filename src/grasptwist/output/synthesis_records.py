@@ -34,6 +34,7 @@ from typing import IO
 import numpy as np
 import yaml
 
+from ..engine.se3 import matrix_to_quaternion
 from ..results import joint_column_names
 from .columns import ColumnSet
 from .csv_rows import lines
@@ -176,7 +177,7 @@ def _object_node(obj, folder, file):
         node = {shape.kind: {"radius": float(shape.size[0]), "height": float(shape.size[1])}}
     rotation, position = obj.pose[:3, :3], obj.pose[:3, 3]
     if not np.array_equal(obj.pose, np.eye(4)):
-        node["pose"] = {"position": position.tolist(), "rotation": _quaternion(rotation)}
+        node["pose"] = {"position": position.tolist(), "rotation": _quaternion_of(rotation)}
     if obj.mass is not None:
         node["mass"] = float(obj.mass)
     elif obj.density is not None:
@@ -205,7 +206,7 @@ def _environment_node(env) -> dict:
         node["boxes"] = [
             {
                 "size": box.size.tolist(),
-                "pose": {"position": box.pose[:3, 3].tolist(), "rotation": _quaternion(box.pose[:3, :3])},
+                "pose": {"position": box.pose[:3, 3].tolist(), "rotation": _quaternion_of(box.pose[:3, :3])},
             }
             for box in env.boxes
         ]
@@ -214,21 +215,9 @@ def _environment_node(env) -> dict:
     return node
 
 
-def _quaternion(r):
-    """``(w, x, y, z)`` of a rotation matrix (Shepperd's method: the largest of four first)."""
-    t = np.trace(r)
-    q = np.array([1 + t, 1 + 2 * r[0, 0] - t, 1 + 2 * r[1, 1] - t, 1 + 2 * r[2, 2] - t])
-    i = int(np.argmax(q))
-    s = np.sqrt(q[i])
-    if i == 0:
-        v = [s, (r[2, 1] - r[1, 2]) / s, (r[0, 2] - r[2, 0]) / s, (r[1, 0] - r[0, 1]) / s]
-    elif i == 1:
-        v = [(r[2, 1] - r[1, 2]) / s, s, (r[0, 1] + r[1, 0]) / s, (r[0, 2] + r[2, 0]) / s]
-    elif i == 2:
-        v = [(r[0, 2] - r[2, 0]) / s, (r[0, 1] + r[1, 0]) / s, s, (r[1, 2] + r[2, 1]) / s]
-    else:
-        v = [(r[1, 0] - r[0, 1]) / s, (r[0, 2] + r[2, 0]) / s, (r[1, 2] + r[2, 1]) / s, s]
-    return (np.array(v) / 2).tolist()
+def _quaternion_of(r) -> list:
+    """``(w, x, y, z)``, ``w >= 0``, of a rotation matrix, as a YAML list (the engine's Shepperd)."""
+    return matrix_to_quaternion(np.asarray(r, float)).tolist()
 
 
 def _hand_node(found, k, folder):
@@ -269,7 +258,7 @@ def _path_node(path) -> dict:
             if seg.rotvec is not None:
                 pose["rotvec"] = np.asarray(seg.rotvec).tolist()  # as written: its size is judged on reading
             else:
-                pose["rotation"] = _quaternion(np.asarray(seg.rotation))
+                pose["rotation"] = _quaternion_of(np.asarray(seg.rotation))
             node["pose"] = pose
         segments.append(node)
     frames = {seg.frame for seg in path.segments if seg.twist is not None}
