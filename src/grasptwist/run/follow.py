@@ -33,6 +33,7 @@ from ..engine.hands import HandTrack
 from ..engine.judgements import rotation_over_pi
 from ..engine.path import PathDegeneracies, Poses, degeneracies, follow, pose_overflowed
 from ..io.datasets import DATASET_SUFFIXES
+from ..io.limits import MAX_SAMPLES
 from ..model import Grasp, InputError, ObjectPath
 from ..output import follow_records as fr
 from ..output.formats import FORMATS
@@ -53,7 +54,6 @@ __all__ = [
     "sample_times",
     "NO_PATH",
     "COMMAND_LINE",
-    "MAX_SAMPLES",
 ]
 
 #: Error code of a grasp with no path to follow (or none of the name asked for).
@@ -61,9 +61,6 @@ NO_PATH = "no-path"
 
 #: Name of the path given on the command line (``--twist``/``--duration``).
 COMMAND_LINE = "command-line"
-
-#: Most samples of one path (the per-path analysis holds them all at once).
-MAX_SAMPLES = 1_000_000
 
 #: Samples per engine call.
 CHUNK = 4096
