@@ -224,3 +224,15 @@ def test_the_exit_statuses_the_command_line_page_lists_are_the_table_s():
     numbers = re.findall(r"^\| (\d+) \|", section, re.M)
     assert sorted(map(int, numbers)) == sorted(EXIT)
     assert "128 + the signal's number" in section
+
+
+def test_a_status_s_number_in_the_docs_is_the_table_s():
+    numbers = {s.code: s.number for s in STATUSES}
+    said = [
+        (str(path.relative_to(DOCS)), code, int(n))
+        for path in sorted(DOCS.rglob("*.md"))
+        for code, n in re.findall(r"`([a-z]+(?:-[a-z]+)*)` (?:is )?(\d+)\b", path.read_text("utf-8"))
+        if code in numbers
+    ]
+    assert len(said) >= 10  # forces.md's list of statuses, the output contract's
+    assert [(page, code, n) for page, code, n in said if numbers[code] != n] == []
