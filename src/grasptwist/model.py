@@ -378,7 +378,7 @@ class InputError(Exception):
     Attributes
     ----------
     code : str
-        Stable kebab-case code, one of :data:`grasptwist.codes.ERRORS` (documented in
+        Stable kebab-case code, one of ``grasptwist.codes.ERRORS`` (documented in
         docs/reference/bad-input-and-faults.md, "Every code").
     message : str
         What is wrong, starting with the field path when there is one.

@@ -52,7 +52,15 @@ IN_PLANE_TOL = 1e-9
 
 
 # the twist engine's statuses of grasptwist.codes.STATUSES, each with its stable kebab-case ``code``
-Status = status_enum("Status", "twist", __name__, "Why a grasp could not be resolved by a method (0: it could).")
+Status = status_enum(
+    "Status",
+    "twist",
+    __name__,
+    (
+        "Why a grasp could not be resolved by a method (0: it could); a member's ``code`` is its stable kebab-case "
+        "name in JSON output, e.g. ``wrist-coplanar``."
+    ),
+)
 
 _MESSAGES = status_messages("twist")
 

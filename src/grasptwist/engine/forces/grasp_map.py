@@ -64,7 +64,15 @@ __all__ = [
 
 
 # the force engine's statuses of grasptwist.codes.STATUSES, each with its stable kebab-case ``code``
-Status = status_enum("Status", "force", __name__, "Why a row of a force result has no numbers (0: it has).")
+Status = status_enum(
+    "Status",
+    "force",
+    __name__,
+    (
+        "Why a row of a force result has no numbers (0: it has); a member's ``code`` is its stable kebab-case "
+        "name in JSON output, e.g. ``cannot-hold``."
+    ),
+)
 
 #: The layers' name for it, beside the twist engine's :class:`~grasptwist.Status`.
 ForceStatus = Status
