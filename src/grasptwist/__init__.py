@@ -48,7 +48,7 @@ _EXPORTS = {
     "read_line": ".io.grasp",
     "read_twist_line": ".io.grasp",
     "grasp_schema": ".io.grasp",
-    "GraspFileError": ".model",
+    "InputError": ".model",
     "Grasp": ".model",
     "Twist": ".model",
     "Wrench": ".model",
@@ -76,23 +76,26 @@ _EXPORTS = {
 #: Names above that are modules themselves.
 _MODULES = {"screws", "hand", "forces", "path", "pictures", "objects", "dask"}
 
-#: 0.3's names that moved to a topic module: old name -> (topic, name there).
-#: They still work, with a DeprecationWarning naming their new place.
+#: Names that moved or were renamed: old name -> (the release that deprecated it, its new name,
+#: from ``grasptwist``).  They still work, with a DeprecationWarning naming their new place.
 _MOVED = {
-    "finger_jacobian": ("hand", "finger_jacobian"),
-    "joint_rates": ("hand", "joint_rates"),
-    "JointRates": ("hand", "JointRates"),
-    "force_closure": ("forces", "force_closure"),
-    "Closure": ("forces", "Closure"),
-    "manipulating_forces": ("forces", "manipulating_forces"),
-    "ManipulatingForces": ("forces", "ManipulatingForces"),
-    "squeeze_forces": ("forces", "squeeze_forces"),
-    "grasp_map": ("forces", "grasp_map"),
-    "ForceStatus": ("forces", "Status"),
-    "force_status_message": ("forces", "status_message"),
-    "check_wrench": ("forces", "check_wrench"),
-    "check_friction": ("forces", "check_friction"),
-    "check_safety": ("forces", "check_safety"),
+    # 0.3's names that moved to a topic module
+    "finger_jacobian": ("0.4", "hand.finger_jacobian"),
+    "joint_rates": ("0.4", "hand.joint_rates"),
+    "JointRates": ("0.4", "hand.JointRates"),
+    "force_closure": ("0.4", "forces.force_closure"),
+    "Closure": ("0.4", "forces.Closure"),
+    "manipulating_forces": ("0.4", "forces.manipulating_forces"),
+    "ManipulatingForces": ("0.4", "forces.ManipulatingForces"),
+    "squeeze_forces": ("0.4", "forces.squeeze_forces"),
+    "grasp_map": ("0.4", "forces.grasp_map"),
+    "ForceStatus": ("0.4", "forces.Status"),
+    "force_status_message": ("0.4", "forces.status_message"),
+    "check_wrench": ("0.4", "forces.check_wrench"),
+    "check_friction": ("0.4", "forces.check_friction"),
+    "check_safety": ("0.4", "forces.check_safety"),
+    # one name for the error of every input, not only a grasp file's
+    "GraspFileError": ("0.6", "InputError"),
 }
 
 __all__ = list(_EXPORTS)
@@ -100,13 +103,12 @@ __all__ = list(_EXPORTS)
 
 def __getattr__(name: str):
     if name in _MOVED:
-        topic, new = _MOVED[name]
+        since, new = _MOVED[name]
         _warnings.warn(
-            f"grasptwist.{name} is deprecated since 0.4: use grasptwist.{topic}.{new}",
-            DeprecationWarning,
-            stacklevel=2,
+            f"grasptwist.{name} is deprecated since {since}: use grasptwist.{new}", DeprecationWarning, stacklevel=2
         )
-        return getattr(__getattr__(topic), new)
+        topic, _, new = new.rpartition(".")
+        return getattr(__getattr__(topic), new) if topic else __getattr__(new)
     if name not in _EXPORTS:
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
     module = _importlib.import_module(_EXPORTS[name], __name__)

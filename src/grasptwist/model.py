@@ -22,7 +22,6 @@ __all__ = [
     "Segment",
     "ObjectPath",
     "InputError",
-    "GraspFileError",
     "CONTACT_NAMES",
     "Joint",
     "Finger",
@@ -369,17 +368,18 @@ class ObjectPath:
     line: int | None
 
 
-class GraspFileError(Exception):
+class InputError(Exception):
     """An input (a grasp file or one document of it, a data set, a path, a URDF) that cannot be used.
 
     ``str(error)`` is one printable line, ``file:line:column: message``
-    (``:line:column`` left out when unknown).
+    (``:line:column`` left out when unknown).  0.5 and before called it ``GraspFileError``,
+    a deprecated alias now (``grasptwist.GraspFileError`` warns).
 
     Attributes
     ----------
     code : str
-        Stable kebab-case code (the tables of docs/guide/grasp-files.md, "Errors", and
-        docs/guide/command-line.md, "Exit codes and diagnostics").
+        Stable kebab-case code, one of ``grasptwist.codes.ERRORS`` (documented in
+        docs/reference/bad-input-and-faults.md, "Every code").
     message : str
         What is wrong, starting with the field path when there is one.
     file : str
@@ -387,7 +387,7 @@ class GraspFileError(Exception):
         1-based position.
     document : int or None
         0-based document index; None for whole-file errors.
-    problems : tuple of GraspFileError
+    problems : tuple of InputError
         Every problem of the input, this error (its first) included: one
         record per failed document lists them all.
     """
@@ -418,11 +418,6 @@ class GraspFileError(Exception):
             if self.column is not None:
                 where += f":{self.column}"
         return f"{where}: {self.message}"
-
-
-#: The layers' name for it: any input, not only a grasp file (the Python API has always
-#: called it GraspFileError, which the reference documents).
-InputError = GraspFileError
 
 
 @dataclass(frozen=True, eq=False)

@@ -2,7 +2,7 @@
 bytes, through the loader and through the command line on stdin.
 
 What must hold whatever the input: the loader raises nothing but
-GraspFileError (and what it returns is sound), the command exits 0 or 1,
+InputError (and what it returns is sound), the command exits 0 or 1,
 never shows a traceback or an internal error, writes parseable records with no
 NaN in an ok one, and only one-line diagnostics.
 
@@ -18,7 +18,7 @@ import yaml
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from grasptwist.io.grasp import Grasp, GraspFileError, load_grasps, read_grasps
+from grasptwist.io.grasp import Grasp, InputError, load_grasps, read_grasps
 from hostile import assert_no_crash, jsonl, run, summary
 
 # --------------------------------------------------------------------------
@@ -129,19 +129,19 @@ raw_bytes = st.one_of(st.binary(max_size=300), st.binary(max_size=40).map(lambda
 
 
 def check_loader(data):
-    """Only GraspFileError escapes; every result is sound; every error one line."""
-    with contextlib.suppress(GraspFileError):
+    """Only InputError escapes; every result is sound; every error one line."""
+    with contextlib.suppress(InputError):
         load_grasps(data, file="fuzz.yaml")
     entries = read_grasps(data, file="fuzz.yaml")
     # in file order: by document, and each document's problems by position
-    errors = [e for e in entries if isinstance(e, GraspFileError)]
+    errors = [e for e in entries if isinstance(e, InputError)]
     located = [(e.document, e.line, e.column) for e in errors if e.line is not None]
     assert located == sorted(located)
     assert [e.document for e in entries if e.document is not None] == sorted(
         e.document for e in entries if e.document is not None
     )
     for entry in entries:
-        if isinstance(entry, GraspFileError):
+        if isinstance(entry, InputError):
             assert "\n" not in str(entry) and "\r" not in str(entry) and str(entry).startswith("fuzz.yaml")
             continue
         assert isinstance(entry, Grasp)
@@ -211,7 +211,7 @@ def test_the_generator_makes_valid_grasps_too():
     @settings(max_examples=60, deadline=None, database=None)
     @given(yaml_documents())
     def hostile(data):
-        seen["error"] += any(isinstance(e, GraspFileError) for e in read_grasps(data, file="x.yaml"))
+        seen["error"] += any(isinstance(e, InputError) for e in read_grasps(data, file="x.yaml"))
 
     hostile()
     assert seen["grasp"] == 25 and seen["error"] > 12

@@ -23,7 +23,7 @@ from grasptwist.io.grasp import (
     MAX_ERRORS,
     READING,
     Grasp,
-    GraspFileError,
+    InputError,
     Reading,
     grasp_schema,
     load_grasps,
@@ -46,7 +46,7 @@ def read(text, name="g.yaml", **kw):
 
 def only_error(text, **kw):
     (entry,) = read(text, **kw)
-    assert isinstance(entry, GraspFileError), entry
+    assert isinstance(entry, InputError), entry
     return entry
 
 
@@ -58,7 +58,7 @@ def only_grasp(text, **kw):
 
 def summary(entry):
     """What must agree between the two parsers: everything but YAML's own wording."""
-    if isinstance(entry, GraspFileError):
+    if isinstance(entry, InputError):
         message = None if entry.code == "yaml-syntax" else entry.message
         return ("error", entry.code, message, entry.file, entry.line, entry.column, entry.document)
     return (
@@ -107,7 +107,7 @@ def test_fixtures_cover_every_rejection():
 def test_invalid_fixture_is_rejected_where_its_header_says(path, loader):
     code, line, column, _ = fixture_header(path)
     entries = placement.read_grasps(path, reading=loader)  # a hand's fixtures: placed on their contacts
-    error = next(e for e in entries if isinstance(e, GraspFileError))
+    error = next(e for e in entries if isinstance(e, InputError))
     assert (error.code, error.line, error.column) == (code, line, column)
     where = f"{path}:{line}:{column}: " if line else f"{path}: "
     assert str(error).startswith(where)
@@ -242,7 +242,7 @@ def test_oversized_content_is_refused_before_parsing():
     error = only_error(b"[" * 101, max_bytes=100)
     assert (error.code, error.line, error.document) == ("too-large", None, None)
     assert str(error) == "g.yaml: larger than the size limit of 100 bytes"
-    assert isinstance(read(b"#" * 100, max_bytes=100)[0], GraspFileError)  # at the cap: parsed (empty)
+    assert isinstance(read(b"#" * 100, max_bytes=100)[0], InputError)  # at the cap: parsed (empty)
     assert read(b"#" * 100, max_bytes=100)[0].code == "empty-document"
 
 
@@ -277,7 +277,7 @@ def test_utf8_bom_is_accepted(loader):
 
 
 def test_random_bytes_never_raise(loader):
-    # Every outcome is a Grasp or a GraspFileError, whatever the input.
+    # Every outcome is a Grasp or a InputError, whatever the input.
     rng = np.random.default_rng(3)
     seeds = [CONTACTS.encode(), b"- [{a: *b}, !!x 1, &c ~]\n", b"\t\x00\xff---\n..."]
     for _ in range(300):
@@ -286,7 +286,7 @@ def test_random_bytes_never_raise(loader):
         for _ in range(rng.integers(1, 6)):
             data[rng.integers(len(data))] = rng.integers(256)
         for entry in read_grasps(bytes(data), reading=loader):
-            assert isinstance(entry, (Grasp, GraspFileError))
+            assert isinstance(entry, (Grasp, InputError))
 
 
 @settings(max_examples=150, deadline=None)
@@ -294,7 +294,7 @@ def test_random_bytes_never_raise(loader):
 def test_random_yaml_like_text_never_raises(text):
     for parser in LOADERS:
         for entry in read(text, reading=Reading(parser=parser)):
-            assert isinstance(entry, (Grasp, GraspFileError))
+            assert isinstance(entry, (Grasp, InputError))
 
 
 # --------------------------------------------------------------------------
@@ -514,7 +514,7 @@ def test_every_problem_of_a_document_is_reported(loader):
     # The JSON Schema says the misspelling twice (unknown key, missing key); the suggestion says it once.
     validator = jsonschema.Draft202012Validator(grasp_schema())
     assert len(list(validator.iter_errors(yaml.safe_load(THREE_MISTAKES)))) == 4
-    with pytest.raises(GraspFileError) as caught:
+    with pytest.raises(InputError) as caught:
         load_grasps(THREE_MISTAKES, file="g.yaml", reading=loader)
     assert str(caught.value) == "g.yaml:2:15: wrist[2]: expected a number, got the string '1'"
 
@@ -719,7 +719,7 @@ def test_default_names(loader):
     assert [e.name for e in read(CONTACTS, reading=loader)] == ["g"]
     assert [e.name for e in read(CONTACTS + "---\n" + CONTACTS, reading=loader)] == ["g#1", "g#2"]
     assert [e.name for e in read("name: g\n" + CONTACTS + "---\n" + CONTACTS, reading=loader)] == ["g", "g#2"]
-    labels = lambda entries: [e.code if isinstance(e, GraspFileError) else e.name for e in entries]  # noqa: E731
+    labels = lambda entries: [e.code if isinstance(e, InputError) else e.name for e in entries]  # noqa: E731
     assert labels(read(CONTACTS + "---\n[", reading=loader)) == ["g#1", "yaml-syntax"]
     assert labels(read("- 1\n---\n" + CONTACTS, reading=loader)) == ["not-a-mapping", "g#2"]
     # a file name's undecodable bytes (surrogate escapes) and controls are shown escaped
@@ -772,17 +772,15 @@ def test_sources(tmp_path, monkeypatch, loader):
 
 def test_load_grasps_raises_the_first_error():
     assert len(load_grasps(CONTACTS + "---\n" + CONTACTS, file="a.yaml")) == 2
-    with pytest.raises(GraspFileError) as caught:
+    with pytest.raises(InputError) as caught:
         load_grasps(CONTACTS + "---\nwrist: 1\n" + CONTACTS + "---\n- 1\n", file="a.yaml")
     assert str(caught.value) == "a.yaml:9:8: wrist: expected 3 numbers, got the number 1"
 
 
 def test_error_is_one_line_and_pickles():
-    error = GraspFileError(
-        "vector-length", "contacts[2].normal: expected 3 numbers, got 2", "grasps/mug.yaml", 7, 13, 0
-    )
+    error = InputError("vector-length", "contacts[2].normal: expected 3 numbers, got 2", "grasps/mug.yaml", 7, 13, 0)
     assert str(error) == "grasps/mug.yaml:7:13: contacts[2].normal: expected 3 numbers, got 2"
-    assert str(GraspFileError("read-error", "cannot read: x", "f.yaml")) == "f.yaml: cannot read: x"
+    assert str(InputError("read-error", "cannot read: x", "f.yaml")) == "f.yaml: cannot read: x"
     copy = pickle.loads(pickle.dumps(error))
     assert (copy.code, copy.message, copy.file, copy.line, copy.column, copy.document, str(copy)) == (
         error.code, error.message, error.file, error.line, error.column, error.document, str(error),

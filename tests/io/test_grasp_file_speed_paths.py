@@ -28,7 +28,7 @@ import yaml
 from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 
-from grasptwist.io.grasp import READING, Grasp, GraspFileError, Reading, read_grasps, reader, text
+from grasptwist.io.grasp import READING, Grasp, InputError, Reading, read_grasps, reader, text
 from loaders import CONTACTS, LOADERS
 from places import TESTS
 
@@ -58,7 +58,7 @@ def _fields(value):
 def signature(entries):
     out = []
     for e in entries:
-        if isinstance(e, GraspFileError):
+        if isinstance(e, InputError):
             out.append(("error", e.code, e.message, e.file, e.line, e.column, e.document, str(e)))
         else:
             assert type(e) is Grasp

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from grasptwist.io.grasp import GraspFileError, load_grasps, read_grasps
+from grasptwist.io.grasp import InputError, load_grasps, read_grasps
 from places import ROOT
 
 CONTACTS = """contacts:
@@ -26,7 +26,7 @@ def grasp(top="", f1="", f2="", f3=""):
 
 
 def error(text):
-    with pytest.raises(GraspFileError) as caught:
+    with pytest.raises(InputError) as caught:
         load_grasps(text + CONTACTS.format(f1="", f2="", f3=""), file="g.yaml")
     return caught.value
 
@@ -96,7 +96,7 @@ def test_each_bad_force_value_is_a_located_coded_error(top, code, where, match):
     e = error(top)
     assert (e.code, (e.line, e.column)) == (code, where)
     assert e.file == "g.yaml"
-    with pytest.raises(GraspFileError, match=match):
+    with pytest.raises(InputError, match=match):
         raise e
 
 

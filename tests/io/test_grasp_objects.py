@@ -9,7 +9,7 @@ from typer.testing import CliRunner
 
 from grasptwist.cli import app
 from grasptwist.io.grasp import Reading, load_grasps, read_grasps
-from grasptwist.model import GraspFileError
+from grasptwist.model import InputError
 
 # A 2 x 2 x 2 cube at the origin touched on three faces; {OBJECT} is the object's lines.
 CUBE_GRASP = """\
@@ -407,7 +407,7 @@ def test_surface_tol_and_allow_outside_on_the_command_line(tmp_path):
 
 
 def test_a_grasp_file_error_is_a_grasp_file_error():
-    with pytest.raises(GraspFileError, match=r"^g\.yaml:2:11: object\.sphere: must be > 0, got -1\.0$"):
+    with pytest.raises(InputError, match=r"^g\.yaml:2:11: object\.sphere: must be > 0, got -1\.0$"):
         grasp("  sphere: -1")
 
 
@@ -435,7 +435,7 @@ def test_any_object_gives_a_grasp_or_located_errors(obj):
 
     text = CUBE_GRASP.format(object="  " + json.dumps(obj).replace('".nan"', ".nan"))
     for entry in read_grasps(text, file="g.yaml"):
-        if isinstance(entry, GraspFileError):
+        if isinstance(entry, InputError):
             assert entry.line is not None and entry.column is not None, entry
         else:
             assert entry.object is not None and np.isfinite(entry.points).all()

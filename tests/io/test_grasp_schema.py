@@ -18,7 +18,7 @@ import pytest
 import yaml
 
 from grasptwist.io import grasp
-from grasptwist.io.grasp import DEFAULT_MAX_BYTES, GraspFileError, grasp_schema, read_grasps
+from grasptwist.io.grasp import DEFAULT_MAX_BYTES, InputError, grasp_schema, read_grasps
 from grasptwist.io.grasp.compose import PARSER, compose
 from grasptwist.io.grasp.problems import Problems, Reject, StreamStop
 from grasptwist.io.grasp.text import file_text
@@ -90,7 +90,7 @@ def loader_codes(path):
     """``{document (None: the whole file): the codes of its problems}`` of the loader's reading."""
     codes = {}
     for entry in read_grasps(path):
-        if isinstance(entry, GraspFileError):
+        if isinstance(entry, InputError):
             codes.setdefault(entry.document, set()).add(entry.code)
     return codes
 

@@ -260,3 +260,17 @@ def test_the_docs_table_of_caps_gives_io_limits_own_numbers():
     caps = {name for name in limits.__all__ if name.isupper()} - {"MESH_SUFFIXES", "NOT_REGULAR", "OUTPUT_IS_INPUT"}
     assert set(said) == caps
     assert all(getattr(limits, name) == value for name, value in said.items()), said
+
+
+def test_a_path_s_samples_have_one_cap_whichever_option_asks_for_them():
+    from typer.testing import CliRunner
+
+    from grasptwist.cli import app
+    from grasptwist.io.limits import MAX_SAMPLES
+    from grasptwist.run.follow import sample_times
+
+    with pytest.raises(ValueError, match=f"gives more than {MAX_SAMPLES} samples"):
+        sample_times(1.0, dt=1 / MAX_SAMPLES)  # --dt: a too-many-samples record
+    assert len(sample_times(1.0, dt=2 / MAX_SAMPLES)) == MAX_SAMPLES // 2 + 1
+    r = CliRunner().invoke(app, ["follow", "x.yaml", "--samples", str(MAX_SAMPLES + 1)])  # --samples: a usage error
+    assert r.exit_code == 2 and f"2<=x<={MAX_SAMPLES}" in r.stderr

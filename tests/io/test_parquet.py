@@ -15,7 +15,7 @@ import grasptwist as gt
 from grasp_gen import grasps
 from grasptwist.cli import app
 from grasptwist.io import parquet
-from grasptwist.model import GraspFileError
+from grasptwist.model import InputError
 from grasptwist.output.columns import CSV_COLUMNS, TYPED_COLUMNS
 from grasptwist.output.parquet_writer import ParquetWriter, table
 from grasptwist.run.batch import resolve_arrays
@@ -412,7 +412,7 @@ def test_a_footer_whose_row_counts_lie_is_one_error_record(tmp_path, files, new,
 def test_a_footer_declaring_10_to_the_15_rows_is_refused_unread(tmp_path):
     # 0.3: past 500 MB within 2 s (a task list for 10^15 rows)
     path = footer_lies(tmp_path, 10**15, None)
-    with pytest.raises(GraspFileError, match=f"its 18 columns read declares {10**15 * 18 * 8:,} bytes decoded from"):
+    with pytest.raises(InputError, match=f"its 18 columns read declares {10**15 * 18 * 8:,} bytes decoded from"):
         parquet.open_parquet(str(path))
 
 
@@ -430,7 +430,7 @@ def test_a_decompression_bomb_is_refused_from_its_footer(tmp_path):
     path = zeros_bomb(tmp_path, rows=1_000_000)  # 144 MB: over the 64 MiB any file may decode to
     size = path.stat().st_size
     assert size < 1_000_000
-    with pytest.raises(GraspFileError, match="refused unread, as a likely decompression bomb") as err:
+    with pytest.raises(InputError, match="refused unread, as a likely decompression bomb") as err:
         parquet.open_parquet(str(path))
     assert str(err.value).endswith(
         f"its 18 columns read declares {1_000_000 * 18 * 8:,} bytes decoded from {size:,} (over 100 times): "

@@ -173,7 +173,7 @@ def test_a_urdf_without_collision_geometry_falls_back_to_its_visual_geometry(tmp
 
 
 def test_a_hand_mesh_that_cannot_be_read_fails_its_grasp_located(grasp, monkeypatch):
-    from grasptwist.model import GraspFileError, InputError
+    from grasptwist.model import InputError
     from grasptwist.run import collisions
 
     def unreadable(hand, folder=None, max_bytes=None):
@@ -182,7 +182,7 @@ def test_a_hand_mesh_that_cannot_be_read_fails_its_grasp_located(grasp, monkeypa
     monkeypatch.setattr(collisions, "link_geometry", unreadable)
     monkeypatch.setattr(collisions, "_GEOMETRY", {})
     error = collisions.with_collisions(grasp)
-    assert isinstance(error, GraspFileError)
+    assert isinstance(error, InputError)
     assert (error.code, error.file, error.line) == ("read-error", grasp.file, grasp.line)
     assert error.message == "hand: mesh 'prox-sim.stl': cannot read: no such file"
     assert collisions.with_collisions(replace(grasp, object=None)) is not None  # nothing to read: no error

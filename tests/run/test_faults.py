@@ -37,7 +37,7 @@ from grasptwist.cli import app
 from grasptwist.cli.exits import EXIT_USAGE, EXIT_WORKER, EXIT_WRITE
 from grasptwist.io.datasets import MAX_INFLATION, Member, open_dataset
 from grasptwist.io.inputs import read
-from grasptwist.model import GraspFileError
+from grasptwist.model import InputError
 from grasptwist.run.pipeline import TUNING, Spool
 from grasptwist.run.pool import Pool, WorkerDied, WorkerFailed
 from grasptwist.run.scratch import owned_prefix
@@ -594,7 +594,7 @@ def test_what_an_npz_member_declares_is_checked_before_it_is_read(tmp_path, memb
                     f.write(a.tobytes())
                 else:
                     np.lib.format.write_array(f, a, allow_pickle=True)
-    with pytest.raises(GraspFileError, match=re.escape(message)) as err:
+    with pytest.raises(InputError, match=re.escape(message)) as err:
         open_dataset(str(path))
     assert err.value.code == "bad-dataset"
 

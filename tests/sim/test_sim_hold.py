@@ -118,7 +118,7 @@ def test_gt_simulate_runs_the_hold_test_and_raises_what_it_cannot_simulate():
     grasp = _grasp("sphere.yaml", 1)  # sphere-equator: mass 1, friction 0.5
     sim = gt.simulate(grasp, mass=0.1, friction=0.8, duration=SHORT, tolerance=(0.002, 2.0))
     assert sim.test.held and sim.mass == 0.1 and sim.options.duration == SHORT
-    with pytest.raises(gt.GraspFileError) as err:
+    with pytest.raises(gt.InputError) as err:
         gt.simulate(replace(grasp, object=None))
     assert err.value.code == "no-object"
     # the command line's bounds, in the same words
@@ -126,7 +126,7 @@ def test_gt_simulate_runs_the_hold_test_and_raises_what_it_cannot_simulate():
         gt.simulate(grasp, mass=0.1, friction=0.8, duration=1e-9)
     with pytest.raises(ValueError, match=r"^tolerance: the angle must be in degrees, > 0 and at most 45, got 179"):
         gt.simulate(grasp, mass=0.1, friction=0.8, tolerance=(1e6, 179))
-    with pytest.raises(gt.GraspFileError) as err:
+    with pytest.raises(gt.InputError) as err:
         gt.simulate(grasp, mass=0.1, friction=0.8, duration=SHORT, tolerance=(1e6, 2))
     assert err.value.code == "tolerance-too-large"
 

@@ -1,6 +1,6 @@
 """How a command ends: where its records go (``-o``) and the exit status of every way out.
 
-Exit codes: 0 all records ok, 1 some record not ok (a method degenerate on a
+Exit codes (their numbers are :mod:`grasptwist.codes`'s ``EXIT``): 0 all records ok, 1 some record not ok (a method degenerate on a
 grasp that was read, or an input that could not be read; the others are
 still written in full), 2 usage error, 3 the output could not be written, 4 a
 worker process died, 128 + the signal's number when SIGINT, SIGTERM or
@@ -17,6 +17,7 @@ from contextlib import contextmanager
 
 import typer
 
+from ..codes import EXIT_BROKEN_PIPE, EXIT_FAILED, EXIT_OK, EXIT_USAGE, EXIT_WORKER, EXIT_WRITE
 from .diagnostics import to_stderr
 
 __all__ = [
@@ -37,7 +38,6 @@ __all__ = [
     "usage_error",
 ]
 
-EXIT_OK, EXIT_FAILED, EXIT_USAGE, EXIT_WRITE, EXIT_WORKER, EXIT_BROKEN_PIPE = 0, 1, 2, 3, 4, 141
 
 # The base of the usage errors of typer's click (typer 0.2x carries its own copy of click, so it is
 # found from the one typer exports, whichever click that is).

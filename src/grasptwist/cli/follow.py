@@ -4,6 +4,7 @@ from typing import Annotated
 
 import typer
 
+from ..io.limits import MAX_SAMPLES
 from .diagnostics import Warnings
 from .exits import run_command
 from .options import (
@@ -59,7 +60,7 @@ def follow(
     samples: Annotated[
         int | None,
         typer.Option(
-            "--samples", min=2, max=1_000_000, help="Samples per path, evenly spaced, ends included (default 21)."
+            "--samples", min=2, max=MAX_SAMPLES, help="Samples per path, evenly spaced, ends included (default 21)."
         ),
     ] = None,
     dt: Annotated[

@@ -13,9 +13,9 @@ the same verdict.
 
 from __future__ import annotations
 
-from enum import IntEnum
-
 import numpy as np
+
+from ..codes import status_enum, status_messages
 
 __all__ = [
     "Status",
@@ -51,90 +51,18 @@ CONDITION_WARNING = 1e-3
 IN_PLANE_TOL = 1e-9
 
 
-class Status(IntEnum):
-    """Why a grasp could not be resolved by a method (0: it could)."""
+# the twist engine's statuses of grasptwist.codes.STATUSES, each with its stable kebab-case ``code``
+Status = status_enum(
+    "Status",
+    "twist",
+    __name__,
+    (
+        "Why a grasp could not be resolved by a method (0: it could); a member's ``code`` is its stable kebab-case "
+        "name in JSON output, e.g. ``wrist-coplanar``."
+    ),
+)
 
-    OK = 0
-    NONFINITE_INPUT = 1
-    COINCIDENT_CONTACTS = 2
-    COLLINEAR_CONTACTS = 3
-    WRIST_COPLANAR = 4
-    ZERO_NORMAL = 5
-    NORMALS_RANK_DEFICIENT = 6
-    THETA_NOT_UNIQUE = 7
-    THETA_SIGMA_ZERO = 8
-    OVERFLOW = 9
-    NORMAL_IN_CONTACT_PLANE = 10
-    FINGER_CANNOT_FOLLOW = 11
-    NO_WRIST = 12  # set where a grasp has none (see grasptwist.results), never by a decomposition
-    CONTACT_OFF_FINGER = 13  # a hand's: a contact farther from its finger's tip than the finger is long
-    UNREACHABLE = 14  # a hand's inverse kinematics (grasptwist.engine.ik)
-    OUTSIDE_LIMITS = 15
-    NONFINITE_POSE = 16  # a path's: its pose at a sample overflows (grasptwist.engine.path), never a decomposition's
-
-    @property
-    def code(self) -> str:
-        """Stable kebab-case name used in JSON output, e.g. ``wrist-coplanar``."""
-        return self.name.lower().replace("_", "-")
-
-
-_MESSAGES = {
-    Status.OK: "ok",
-    Status.NONFINITE_INPUT: "the input holds NaN or infinity: give finite numbers",
-    Status.COINCIDENT_CONTACTS: "contacts {j} and {k} coincide, so Sigma_{n} has no axis: three distinct contacts are needed",
-    Status.COLLINEAR_CONTACTS: (
-        "the contacts are collinear: {i} lies on the line through {j} and {k}; "
-        "neither method can work until a contact is moved off that line"
-    ),
-    Status.WRIST_COPLANAR: (
-        "the wrist lies in the plane of the contacts, so every [Sigma_i|Psi_i] is 0 (Proposition 1 needs it off the plane): "
-        "move the wrist off that plane, or use the tangent method"
-    ),
-    Status.ZERO_NORMAL: "the normal at contact {i} has zero length: give its direction",
-    Status.NORMALS_RANK_DEFICIENT: (
-        "the three normal lines have rank < 3, so the tangent twists are not a three-system "
-        "(a normal lies in the contacts' plane): tilt a normal out of that plane, or use the off-tangent method"
-    ),
-    Status.THETA_NOT_UNIQUE: (
-        "Theta_{n} is not unique: the normals at {j} and {k} leave more than one axis through contact {i} "
-        "that keeps them in their tangent planes: tilt the normal at {j} or {k} out of the contacts' plane, "
-        "or use the off-tangent method"
-    ),
-    Status.THETA_SIGMA_ZERO: (
-        "[Theta_{n}|Sigma_{n}] = 0: the axis of Theta_{n} (through contact {i}) meets or is parallel to the line "
-        "through {j} and {k}: tilt a normal out of the contacts' plane, or use the off-tangent method"
-    ),
-    Status.OVERFLOW: "the numbers overflow double precision (coordinates or twist too large): rescale them",
-    Status.NORMAL_IN_CONTACT_PLANE: (
-        "the normal at contact {i} lies in the plane of the contacts, so no tangent-plus-Sigma motion "
-        "can move contact {i} along it: tilt it out of that plane, or use the off-tangent method"
-    ),
-    Status.FINGER_CANNOT_FOLLOW: (
-        "finger {i} cannot follow its contact: no joint rates move it with the object's velocity there "
-        "(relative residual above 1e-6): move the finger away from that pose, or use a method "
-        "whose components it can follow"
-    ),
-    Status.CONTACT_OFF_FINGER: (
-        "contact {i} is farther from its finger's tip than the finger is long at the row's joint positions: "
-        "give the contacts in the hand's root frame and the joint positions of that row"
-    ),
-    Status.UNREACHABLE: (
-        "finger {i}'s tip cannot reach its contact within the finger's joint limits: move the contact within its reach"
-    ),
-    Status.OUTSIDE_LIMITS: (
-        "finger {i}'s tip reaches its contact only with a joint outside its position limits: "
-        "move the contact, or widen the limits where the hand allows it"
-    ),
-    Status.NONFINITE_POSE: (
-        "the object's pose overflows double precision here (a turn through more than about 1e154 radians, "
-        "a distance or a twist beyond 1.8e308): "
-        "rescale the twist or shorten the path"
-    ),
-    Status.NO_WRIST: (
-        "the grasp has no wrist, and each Psi_i is a line from it: give one "
-        "('wrist: [x, y, z]' in a grasp file, a 'wrist' array in a data set)"
-    ),
-}
+_MESSAGES = status_messages("twist")
 
 
 def status_message(status, culprit=-1, names=("1", "2", "3")) -> str:

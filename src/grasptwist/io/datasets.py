@@ -33,7 +33,7 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from ..model import GraspFileError
+from ..model import InputError
 from .limits import MAX_INFLATION, check_inflation
 
 if TYPE_CHECKING:  # zipfile and Dataset are imported where a data set is read (see open_dataset)
@@ -48,8 +48,8 @@ EXTRA_POINT_ROLES = ("wrist", "at")
 _NPZ_KEYS = ("points", "normals", "wrist", "twist", "names", "joint_positions", "wrench", "friction")
 
 
-def _bad(path, message) -> GraspFileError:
-    return GraspFileError(code="bad-dataset", message=message, file=path)
+def _bad(path, message) -> InputError:
+    return InputError(code="bad-dataset", message=message, file=path)
 
 
 def open_dataset(path: str, extra_point: str = "wrist") -> Dataset:
@@ -57,7 +57,7 @@ def open_dataset(path: str, extra_point: str = "wrist") -> Dataset:
 
     Raises
     ------
-    GraspFileError
+    InputError
         ``read-error`` when it cannot be read, ``bad-dataset`` when its
         arrays do not have the documented names, shapes or a numeric type.
     """
@@ -77,11 +77,11 @@ def open_dataset(path: str, extra_point: str = "wrist") -> Dataset:
                 # unknown members are reported by name, unread
                 members[key] = Member.declared(path, zf, info, key) if key in _NPZ_KEYS else None
         return _open_npz(path, members)
-    except GraspFileError:
+    except InputError:
         raise
     # zipfile: RuntimeError for an encrypted member, NotImplementedError for an unknown compression
     except (OSError, ValueError, EOFError, zipfile.BadZipFile, NotImplementedError, RuntimeError) as exc:
-        raise GraspFileError(code="read-error", message=f"cannot read as a numpy file: {exc}", file=path) from None
+        raise InputError(code="read-error", message=f"cannot read as a numpy file: {exc}", file=path) from None
 
 
 _NPY_MAGIC = b"\x93NUMPY"
@@ -193,7 +193,7 @@ class Member:
 
         Raises
         ------
-        GraspFileError
+        InputError
             ``bad-dataset`` when it would inflate more than :data:`MAX_INFLATION`
             times, when its header's shape and type do not match its size, or
             when it holds Python objects or is stored column-major.
@@ -237,7 +237,7 @@ class Member:
             data = f.read((stop - start) * row)
         except (OSError, EOFError, zipfile.BadZipFile, zlib.error) as exc:
             # the archive's checksum is checked only once a member has been read to its end
-            raise GraspFileError(
+            raise InputError(
                 code="read-error", message=f"{self.name}: {exc} (damaged, or changed while being read)", file=self.path
             ) from None
         return np.frombuffer(data, self.dtype).reshape((stop - start, *self.shape[1:]))

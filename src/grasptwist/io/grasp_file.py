@@ -3,7 +3,7 @@
 Deprecated since 0.4: importing it warns.  The loader's public names are in the
 core, ``import grasptwist as gt``: ``gt.read_grasps``, ``gt.load_grasps``,
 ``gt.read_line``, ``gt.read_twist_line``, ``gt.grasp_schema``, ``gt.Grasp``,
-``gt.Twist``, ``gt.GraspFileError``.  Nothing inside grasptwist imports this module.
+``gt.Twist``, ``gt.InputError`` (this module's ``GraspFileError``).  Nothing inside grasptwist imports this module.
 """
 
 import warnings
@@ -15,7 +15,7 @@ from .grasp import (
     MAX_ERRORS,
     READING,
     Grasp,
-    GraspFileError,
+    InputError,
     Reading,
     Twist,
     grasp_schema,
@@ -24,6 +24,9 @@ from .grasp import (
     read_line,
     read_twist_line,
 )
+
+#: 0.5's name of :class:`~grasptwist.model.InputError`.
+GraspFileError = InputError
 
 __all__ = [
     "read_line",
@@ -44,7 +47,7 @@ __all__ = [
 
 warnings.warn(
     "grasptwist.io.grasp_file is deprecated since 0.4: use grasptwist's own names, "
-    "e.g. `import grasptwist as gt; gt.load_grasps(...)` (gt.read_grasps, gt.GraspFileError, ...)",
+    "e.g. `import grasptwist as gt; gt.load_grasps(...)` (gt.read_grasps, gt.InputError, ...)",
     DeprecationWarning,
     stacklevel=2,
 )

@@ -8,7 +8,7 @@ of recursing, so no depth of folders can exhaust Python's recursion limit.
 Symbolic links are followed, but a folder reached twice (a link cycle, or two
 links to one place) is read only the first time.  A path that cannot be read,
 a folder that cannot be listed, and a folder with no grasp file at all each
-become a :class:`GraspFileError` in its place, so that the rest of the batch
+become a :class:`InputError` in its place, so that the rest of the batch
 goes on.  JSON Lines files (``*.jsonl``) are read when named, not found
 in folders (:mod:`~grasptwist.io.lines` reads them, and ``-``, a line at a
 time).  Names are ``str`` throughout: bytes that are not UTF-8 are kept
@@ -21,7 +21,7 @@ import errno
 import os
 from collections.abc import Iterable, Iterator
 
-from ..model import Grasp, GraspFileError
+from ..model import Grasp, InputError
 from .grasp import READING, Reading, one_per_document, read_grasps
 from .limits import DEFAULT_MAX_BYTES, MESH_SUFFIXES, NOT_REGULAR
 
@@ -44,7 +44,7 @@ def is_grasp_file(name: str, suffixes: tuple[str, ...] = GRASP_SUFFIXES) -> bool
     return name.lower().endswith(suffixes)
 
 
-def expand(paths: Iterable[str], suffixes: tuple[str, ...] = GRASP_SUFFIXES) -> Iterator[str | GraspFileError]:
+def expand(paths: Iterable[str], suffixes: tuple[str, ...] = GRASP_SUFFIXES) -> Iterator[str | InputError]:
     """Every file named by ``paths``, folders expanded (their files ending in ``suffixes``), in order."""
     stdin_seen = False
     for path in paths:
@@ -71,14 +71,14 @@ def _not_a_file(path: str) -> str:
     return NOT_REGULAR
 
 
-def _walk(top: str, suffixes: tuple[str, ...]) -> Iterator[str | GraspFileError]:
+def _walk(top: str, suffixes: tuple[str, ...]) -> Iterator[str | InputError]:
     """The files ending in ``suffixes`` under the folder ``top``, depth first in name order.
 
     Visiting each folder's entries in name order, a subfolder's files at its
     name's place, gives the files sorted by their path's components.
     """
     seen: set[tuple[int, int]] = set()  # (device, inode) of the folders listed
-    pending: list[tuple[bool, str | GraspFileError]] = [(True, top)]  # (a folder?, path or error), next last
+    pending: list[tuple[bool, str | InputError]] = [(True, top)]  # (a folder?, path or error), next last
     empty = True
     while pending:
         folder, item = pending.pop()
@@ -106,7 +106,7 @@ def _walk(top: str, suffixes: tuple[str, ...]) -> Iterator[str | GraspFileError]
                 )
     if empty:
         names = ", ".join(suffixes[:-1]) + " or " + suffixes[-1]
-        yield GraspFileError(
+        yield InputError(
             "no-grasp-files",
             f"no grasp files in this folder or below it (looked for names ending in {names}, in any letter case)",
             top,
@@ -127,12 +127,12 @@ def _is_file(entry: os.DirEntry) -> bool:
         return False
 
 
-def read(path: str, max_bytes: int | None = None, reading: Reading = READING) -> list[Grasp | GraspFileError]:
+def read(path: str, max_bytes: int | None = None, reading: Reading = READING) -> list[Grasp | InputError]:
     """The grasps (or errors: one per failed document, every problem in its ``problems``)
     of one file; ``-`` reads standard input; ``reading`` as for :func:`~grasptwist.read_grasps`."""
     cap = DEFAULT_MAX_BYTES if max_bytes is None else max_bytes
     return one_per_document(read_grasps(path, max_bytes=cap, reading=reading))
 
 
-def _io_error(path: str, why: str) -> GraspFileError:
-    return GraspFileError(code="read-error", message=f"cannot read: {why}", file=path, line=None, column=None)
+def _io_error(path: str, why: str) -> InputError:
+    return InputError(code="read-error", message=f"cannot read: {why}", file=path, line=None, column=None)

@@ -11,6 +11,7 @@ URDF               a grasp file's ``hand: {urdf: ...}``, a hand   :data:`MAX_URD
 mesh               an object's ``mesh:``, a path or a folder's    :data:`MAX_MESH_BYTES` (decoded),
                    file (``synthesize``), a URDF link's           :data:`MAX_TRIANGLES`, :data:`MAX_VERTICES`
 data set           ``.npy``, ``.npz``, ``.parquet``               streamed; :func:`check_inflation`
+path's samples     ``follow --samples``, ``--dt``                 :data:`MAX_SAMPLES`
 =================  =============================================  ==========================================
 
 Here, not in any one reader, so that each (the URDF reader, which the grasp
@@ -27,6 +28,7 @@ __all__ = [
     "MAX_ERRORS",
     "MAX_INFLATION",
     "MAX_MESH_BYTES",
+    "MAX_SAMPLES",
     "MAX_TRIANGLES",
     "MAX_URDF_BYTES",
     "MAX_VERTICES",
@@ -79,6 +81,11 @@ MAX_VERTICES = 3 * MAX_TRIANGLES
 """Most vertices of a mesh file: a triangle soup's (an STL's three per triangle) at the triangle
 cap; a file that holds more (an OBJ of ``v`` lines, a PLY header's count) is refused before they
 are parsed."""
+
+MAX_SAMPLES = 1_000_000
+"""Most samples of one path, whether ``--samples`` asks for them or ``--dt`` cuts them (the
+per-path analysis holds them all at once): a larger ``--samples`` is a usage error, a path that
+``--dt`` cuts into more a ``too-many-samples`` error record."""
 
 #: Why a path that is not a regular file (or folder) is not read.
 NOT_REGULAR = "not a regular file (a pipe, socket or device)"

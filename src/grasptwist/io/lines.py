@@ -21,7 +21,7 @@ import os
 import stat
 from collections.abc import Iterator
 
-from ..model import Grasp, GraspFileError, Twist
+from ..model import Grasp, InputError, Twist
 from .grasp import READING, Reading, one_per_document, read_grasps, read_line, read_twist_line
 from .grasp.text import standard_input
 from .inputs import STDIN
@@ -127,7 +127,7 @@ def _opened(path: str):
 
 def grasp_batches(
     path: str, max_bytes: int | None = None, per_batch: int = 64, reading: Reading = READING
-) -> Iterator[list[Grasp | GraspFileError]]:
+) -> Iterator[list[Grasp | InputError]]:
     """The grasps (and errors) of a JSON Lines file, or of standard input
     (``-``: JSON Lines or a YAML grasp file, as its first character says),
     in lists: one per line when the lines may come one by one; ``reading``
@@ -139,9 +139,7 @@ def grasp_batches(
     return _stream(path, max_bytes, per_batch, read, sniff=path == STDIN, reading=reading)
 
 
-def twist_batches(
-    path: str, max_bytes: int | None = None, per_batch: int = 64
-) -> Iterator[list[Twist | GraspFileError]]:
+def twist_batches(path: str, max_bytes: int | None = None, per_batch: int = 64) -> Iterator[list[Twist | InputError]]:
     """The twists (and errors) of a JSON Lines stream of twists (``-``: standard
     input), in lists: one per line when the lines may come one by one."""
 
@@ -161,7 +159,7 @@ def _stream(path, max_bytes, per_batch, read, sniff, reading):
     try:
         handle = standard_input() if path == STDIN else _opened(path)
     except OSError as exc:
-        yield [GraspFileError("read-error", f"cannot read: {exc.strerror or exc}", file)]
+        yield [InputError("read-error", f"cannot read: {exc.strerror or exc}", file)]
         return
     try:
         head = b""

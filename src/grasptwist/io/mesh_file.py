@@ -109,7 +109,7 @@ def read_mesh(
     --------
     >>> read_mesh("box.step", ".")
     Traceback (most recent call last):
-    grasptwist.model.GraspFileError: box.step: expected a mesh file ending in .stl, .obj or .ply
+    grasptwist.model.InputError: box.step: expected a mesh file ending in .stl, .obj or .ply
     """
     text = os.fspath(reference)
     suffix = Path(text).suffix.lower()

@@ -46,7 +46,7 @@ def parse_mesh(data, suffix, file, max_triangles=MAX_TRIANGLES):
 
     >>> parse_mesh(b"v 0 0 0\\nf 1 1 0\\n", ".obj", "a.obj")
     Traceback (most recent call last):
-    grasptwist.model.GraspFileError: a.obj:2: a face names vertex 0, which the file does not have
+    grasptwist.model.InputError: a.obj:2: a face names vertex 0, which the file does not have
     """
     check_counts(data, suffix, file, max_triangles)
     try:
@@ -77,7 +77,7 @@ def _obj(data, max_triangles, file):
     [[0, 1, 3], [0, 3, 2]]
     >>> _obj(b"v 0 0 0\\nf 1 2 99999999999999999999999\\n", 10, "a.obj")
     Traceback (most recent call last):
-    grasptwist.model.GraspFileError: a.obj:2: a face names vertex 99999999999999999999999, which the file does not have
+    grasptwist.model.InputError: a.obj:2: a face names vertex 99999999999999999999999, which the file does not have
     """
     if data.count(b"\r") > data.count(b"\r\n"):  # lines that end in \r alone (a copy for those files only)
         data = data.replace(b"\r\n", b"\n").replace(b"\r", b"\n")
@@ -204,7 +204,7 @@ def _declared(data, suffix, file):
     (1, 2)
     >>> _declared(b"not a mesh", ".stl", "junk.stl")
     Traceback (most recent call last):
-    grasptwist.model.GraspFileError: junk.stl: not a readable STL file (neither a binary STL of the length its count gives nor text starting with 'solid')
+    grasptwist.model.InputError: junk.stl: not a readable STL file (neither a binary STL of the length its count gives nor text starting with 'solid')
     """
     if suffix == ".ply":
         elements = _ply_elements(data, file)
@@ -239,7 +239,7 @@ def check_counts(data, suffix, file, max_triangles=MAX_TRIANGLES):
 
     >>> check_counts(b"v 0 0 0\\n" * 3 + b"f 1 2 3\\n" * 2, ".obj", "a.obj", max_triangles=1)
     Traceback (most recent call last):
-    grasptwist.model.GraspFileError: a.obj: the file declares 2 faces, more than the limit of 1 triangles
+    grasptwist.model.InputError: a.obj: the file declares 2 faces, more than the limit of 1 triangles
     """
     vertices, triangles = _declared(data, suffix, file)
     if vertices > MAX_VERTICES:
@@ -309,7 +309,7 @@ def _ply_elements(data, file):
     >>> header = b"ply\nformat ascii 1.0\nelement vertex 2000000000\nproperty float x\nend_header\n"
     >>> _ply_elements(header + b"0\n1\n", "m.ply")
     Traceback (most recent call last):
-    grasptwist.model.GraspFileError: m.ply:3: the header declares 2,000,000,000 vertex elements, one a line, but the body holds 2 lines
+    grasptwist.model.InputError: m.ply:3: the header declares 2,000,000,000 vertex elements, one a line, but the body holds 2 lines
     """
     form, body, elements = _ply_header(data, file)
     text = form == 0

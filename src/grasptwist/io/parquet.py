@@ -26,7 +26,7 @@ import os
 import numpy as np
 
 from ..extras import MissingExtra, require
-from ..model import GraspFileError
+from ..model import InputError
 from .dataset import Dataset
 from .limits import check_inflation
 
@@ -123,8 +123,8 @@ def grasp_table(points, normals, wrist=None, twist=None, names=None):
     return pa.table(columns)
 
 
-def _bad(path: str, message: str) -> GraspFileError:
-    return GraspFileError(code="bad-dataset", message=message, file=path)
+def _bad(path: str, message: str) -> InputError:
+    return InputError(code="bad-dataset", message=message, file=path)
 
 
 def open_parquet(path: str):
@@ -135,7 +135,7 @@ def open_parquet(path: str):
 
     Raises
     ------
-    GraspFileError
+    InputError
         ``bad-dataset`` when the file is not Parquet, or lacks a column, or
         a column has the wrong type; ``read-error`` when it cannot be opened
         or without pyarrow.
@@ -143,7 +143,7 @@ def open_parquet(path: str):
     try:
         require("pyarrow", "reading Parquet")
     except MissingExtra as exc:
-        raise GraspFileError(code="read-error", message=str(exc), file=path) from None
+        raise InputError(code="read-error", message=str(exc), file=path) from None
     reader = _RowGroups(path)
     return _dataset(path, reader.file.schema_arrow, reader)
 
@@ -153,7 +153,7 @@ def table_dataset(table, path: str = ""):
 
     Raises
     ------
-    GraspFileError
+    InputError
         ``bad-dataset`` as :func:`open_parquet`.
     """
     return _dataset(path, table.schema, _Table(table, path))
@@ -237,7 +237,7 @@ class _RowGroups:
             # a page written with a checksum is read only if it matches (a file without them reads as it is)
             self.file = pq.ParquetFile(self.path, page_checksum_verification=True)
         except OSError as exc:  # the file itself: gone, a folder, no permission
-            raise GraspFileError(code="read-error", message=f"cannot read: {exc}", file=self.path) from None
+            raise InputError(code="read-error", message=f"cannot read: {exc}", file=self.path) from None
         except Exception as exc:  # noqa: BLE001 - pyarrow raises several kinds for a file that is not Parquet
             raise _bad(self.path, f"cannot read as Parquet: {exc}") from None
         meta = self.file.metadata
@@ -257,7 +257,7 @@ class _RowGroups:
 
         Raises
         ------
-        GraspFileError
+        InputError
             ``bad-dataset`` saying which count disagrees, or what the rows would decode to.
         """
         self.columns = columns
@@ -304,7 +304,7 @@ class _RowGroups:
             self.cursor = _Cursor(self, group)
         try:
             return self.cursor.take(lo, hi)
-        except GraspFileError:
+        except InputError:
             raise
         except Exception as exc:  # noqa: BLE001 - corrupt pages, failed checksums: any of pyarrow's errors
             raise _bad(self.path, f"row group {group}: cannot read: {exc}") from None

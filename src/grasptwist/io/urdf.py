@@ -337,7 +337,7 @@ def load_urdf_hand(urdf, tips, *, names=None, folder=None, max_bytes=MAX_URDF_BY
 
     Raises
     ------
-    GraspFileError
+    InputError
         With one of the codes of the URDF's errors (docs/guide/hands.md).
 
     Examples

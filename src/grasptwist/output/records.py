@@ -23,7 +23,7 @@ from ..engine.degeneracy import (
     skipped_warning,
     status_message,
 )
-from ..model import GraspFileError
+from ..model import InputError
 from ..results import CONDITIONING, CULPRIT, KINDS, STATUS, Field
 from . import kind_records
 from .columns import ORDERS, in_order
@@ -306,7 +306,7 @@ def check_record(block, i: int, contributed: dict | None = None) -> dict:
     return rec
 
 
-def error_record(err: GraspFileError) -> dict:
+def error_record(err: InputError) -> dict:
     """The record of an input that could not be read, validated or paired with a twist:
     its first problem under ``error``, every problem (that one first) under ``errors``."""
     errors = [

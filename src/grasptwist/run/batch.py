@@ -20,7 +20,7 @@ from ..engine.decompose import contact_velocities
 from ..engine.degeneracy import Status
 from ..engine.judgements import outward_contacts
 from ..engine.screws import direction, twist_at
-from ..model import CONTACT_NAMES, Grasp, GraspFileError, Twist
+from ..model import CONTACT_NAMES, Grasp, InputError, Twist
 from ..results import ALL_METHODS, BY_KEY, KINDS, METHOD_CHOICES, STATUS, Field, ResultKind, selected
 
 if TYPE_CHECKING:  # a data set's type, for its annotation: a grasp file's run never loads it (start-up)
@@ -274,12 +274,12 @@ def with_reasons(block: Block) -> Block:
 
 
 def resolve(
-    items: Iterable[Grasp | GraspFileError],
+    items: Iterable[Grasp | InputError],
     twists: Sequence[Twist] | None = None,
     method: str = "both",
     chunk: int = 2048,
     select: Sequence[str] | None = None,
-) -> Iterator[Block | GraspFileError]:
+) -> Iterator[Block | InputError]:
     """Resolve every grasp against its twists, in order.
 
     Parameters
@@ -296,7 +296,7 @@ def resolve(
     error with code :data:`NO_TWIST` for each grasp without a twist and one
     with code :data:`UNKNOWN_TWIST` for each grasp without a twist ``select`` names.
     """
-    pending: list[Grasp | GraspFileError] = []
+    pending: list[Grasp | InputError] = []
     rows = 0
     for item in items:
         if select is not None and isinstance(item, Grasp):
@@ -445,7 +445,7 @@ def hand_placement(hand, points, normals, positions=None, *, home=None, width=No
     }
 
 
-def selected_twists(grasp: Grasp, names: Sequence[str]) -> Grasp | GraspFileError:
+def selected_twists(grasp: Grasp, names: Sequence[str]) -> Grasp | InputError:
     """The grasp with its twists named ``names`` only, in that order, or an error with code
     :data:`UNKNOWN_TWIST` naming those it lacks and those it has."""
     own = {t.name: t for t in grasp.twists}
@@ -453,7 +453,7 @@ def selected_twists(grasp: Grasp, names: Sequence[str]) -> Grasp | GraspFileErro
     if not missing:
         return replace(grasp, twists=tuple(own[n] for n in dict.fromkeys(names)))
     has = ", ".join(f"'{n}'" for n in own) or "none"
-    return GraspFileError(
+    return InputError(
         code=UNKNOWN_TWIST,
         message=f"grasp '{grasp.name}' has no twist {', '.join(repr(n) for n in missing)} (its twists: {has})",
         file=grasp.file,
@@ -462,8 +462,8 @@ def selected_twists(grasp: Grasp, names: Sequence[str]) -> Grasp | GraspFileErro
     )
 
 
-def _no_twist(grasp: Grasp) -> GraspFileError:
-    return GraspFileError(
+def _no_twist(grasp: Grasp) -> InputError:
+    return InputError(
         code=NO_TWIST,
         message=(
             f"grasp '{grasp.name}' has no twist to resolve: add a 'twists:' list to the file "
@@ -500,13 +500,13 @@ def dataset_blocks(
 
     Raises
     ------
-    GraspFileError
+    InputError
         ``no-twist`` when neither gives a twist; ``bad-dataset`` when
         ``joint_positions`` does not fit the hand, or comes without one.
     """
     check_positions(ds, hand_of_rows)
     if twists is None and ds.twist is None:
-        raise GraspFileError(
+        raise InputError(
             code=NO_TWIST,
             message="the data set has no 'twist' array: pass --twist W1,W2,W3,V1,V2,V3 (repeatable)",
             file=ds.path,
@@ -524,11 +524,9 @@ def check_positions(ds, hand_of_rows) -> None:
     if ds.joint_positions is None:
         return
     if hand_of_rows is None:
-        raise GraspFileError(
-            "bad-dataset", "joint_positions: give the hand they belong to with --hand FILE.yaml", ds.path
-        )
+        raise InputError("bad-dataset", "joint_positions: give the hand they belong to with --hand FILE.yaml", ds.path)
     if ds.joint_positions.shape[1] != len(hand_of_rows.joint_names):
-        raise GraspFileError(
+        raise InputError(
             "bad-dataset",
             f"joint_positions: {ds.joint_positions.shape[1]} columns, but the hand has "
             f"{len(hand_of_rows.joint_names)} joints ({', '.join(hand_of_rows.joint_names)})",

@@ -42,7 +42,7 @@ from ..engine.fingertips import tip_centers, tip_radii
 from ..engine.ik import home_tips
 from ..io.limits import MAX_URDF_BYTES
 from ..io.urdf_meshes import grasp_folder, link_geometry
-from ..model import Grasp, GraspFileError, InputError
+from ..model import Grasp, InputError
 from ..output.names import escaped
 
 __all__ = [
@@ -439,7 +439,7 @@ def _first(found, key) -> tuple:
     return tuple(seen.values())
 
 
-def with_collisions(grasp: Grasp) -> Grasp | GraspFileError:
+def with_collisions(grasp: Grasp) -> Grasp | InputError:
     """A placed grasp with a warning per link inside its object (``finger-collides``), per pair of
     fingers into each other (``fingers-collide``) and per part too near its environment
     (``finger-hits-environment``), and its ``clearance`` from that environment; or the error of its
@@ -458,7 +458,7 @@ def with_collisions(grasp: Grasp) -> Grasp | GraspFileError:
         found = finger_collisions(grasp, grasp.joint_positions) if grasp.hand is not None else ()
         overlaps, hits, clearance = hand_checks_along(grasp)
     except InputError as exc:
-        return GraspFileError(exc.code, f"hand: {exc.message}", grasp.file, grasp.line, None, grasp.document)
+        return InputError(exc.code, f"hand: {exc.message}", grasp.file, grasp.line, None, grasp.document)
     said = (
         *(collision_warning(c) for c in found),
         *(overlap_warning(o) for o in overlaps[0]),

@@ -33,7 +33,8 @@ from ..engine.hands import HandTrack
 from ..engine.judgements import rotation_over_pi
 from ..engine.path import PathDegeneracies, Poses, degeneracies, follow, pose_overflowed
 from ..io.datasets import DATASET_SUFFIXES
-from ..model import Grasp, GraspFileError, ObjectPath
+from ..io.limits import MAX_SAMPLES
+from ..model import Grasp, InputError, ObjectPath
 from ..output import follow_records as fr
 from ..output.formats import FORMATS
 from ..output.records import diagnostics, error_record
@@ -53,7 +54,6 @@ __all__ = [
     "sample_times",
     "NO_PATH",
     "COMMAND_LINE",
-    "MAX_SAMPLES",
 ]
 
 #: Error code of a grasp with no path to follow (or none of the name asked for).
@@ -61,9 +61,6 @@ NO_PATH = "no-path"
 
 #: Name of the path given on the command line (``--twist``/``--duration``).
 COMMAND_LINE = "command-line"
-
-#: Most samples of one path (the per-path analysis holds them all at once).
-MAX_SAMPLES = 1_000_000
 
 #: Samples per engine call.
 CHUNK = 4096
@@ -123,14 +120,14 @@ def sample_times(duration: float, samples: int | None = None, dt: float | None =
     return np.append(np.arange(count) * dt, duration)
 
 
-def follow_inputs(job, inputs: Iterable) -> Iterator[GraspFileError | Samples | Summary]:
+def follow_inputs(job, inputs: Iterable) -> Iterator[InputError | Samples | Summary]:
     """Every path of every grasp of ``inputs`` (paths or the errors of ``expand``), in order;
     ``job`` a :class:`~grasptwist.run.pipeline.Job` of the path family."""
     for item in inputs:
-        if isinstance(item, GraspFileError):
+        if isinstance(item, InputError):
             yield item
         elif item.endswith(DATASET_SUFFIXES):
-            yield GraspFileError("read-error", "follow reads grasp files, not data sets", item)
+            yield InputError("read-error", "follow reads grasp files, not data sets", item)
         else:
             for entry in read(item, job.max_bytes, job.reading):
                 yield from follow_grasp(job.options, entry) if isinstance(entry, Grasp) else (entry,)
@@ -154,7 +151,7 @@ def follow_outputs(job, inputs: Iterable, w, workers: int = 1, tuning=None) -> I
             failed = int(item.block.failed_rows().sum())
             yield Output(encoded=encoded, records=len(item), failed=failed, degenerate=item.block.failure_codes())
             continue
-        error = isinstance(item, GraspFileError)
+        error = isinstance(item, InputError)
         rec = error_record(item) if error else fr.summary_record(item)
         encode = encoding.error if error else encoding.summary
         errors, warnings = diagnostics(rec) if error else fr.diagnostics(rec, item.grasp.contact_names)
@@ -163,7 +160,7 @@ def follow_outputs(job, inputs: Iterable, w, workers: int = 1, tuning=None) -> I
         yield out
 
 
-def follow_grasp(job: FollowOptions, grasp: Grasp) -> Iterator[GraspFileError | Samples | Summary]:
+def follow_grasp(job: FollowOptions, grasp: Grasp) -> Iterator[InputError | Samples | Summary]:
     """Every path of one grasp (or the options' own): its samples, then its summary; an error for a path not
     there."""
     paths = (ObjectPath(COMMAND_LINE, job.segments, None),) if job.segments else grasp.paths
@@ -182,7 +179,7 @@ def _path(job, grasp, p):
     try:
         times = sample_times(duration, job.samples, job.dt)
     except ValueError as exc:
-        yield GraspFileError("too-many-samples", f"path '{p.name}': {exc}", grasp.file, p.line, None)
+        yield InputError("too-many-samples", f"path '{p.name}': {exc}", grasp.file, p.line, None)
         return
     tracked = (
         None
@@ -270,7 +267,7 @@ def _block(grasp, name, f, bases, method, positions=None) -> Block:
     return with_reasons(block)  # a method asked for by name that cannot run fails, as in resolve
 
 
-def _no_path(grasp: Grasp, name: str | None) -> GraspFileError:
+def _no_path(grasp: Grasp, name: str | None) -> InputError:
     if grasp.paths:  # a name that is not among them: say which there are
         names = ", ".join(f"'{p.name}'" for p in grasp.paths)
         message = f"grasp '{grasp.name}' has no path named '{name}' (its paths: {names})"
@@ -279,7 +276,7 @@ def _no_path(grasp: Grasp, name: str | None) -> GraspFileError:
             f"grasp '{grasp.name}' has no path to follow: add a 'paths:' list to the file "
             "or pass --twist W1,W2,W3,V1,V2,V3 --duration T (repeatable)"
         )
-    return GraspFileError(
+    return InputError(
         code=NO_PATH,
         message=message,
         file=grasp.file,

@@ -21,7 +21,7 @@ from ..engine.forces.grasp_map import GRIP_NUMBERS, manipulating_forces
 from ..engine.forces.grip import grip
 from ..engine.judgements import outward_contacts
 from ..engine.screws import direction
-from ..model import Grasp, GraspFileError
+from ..model import Grasp, InputError
 from .batch import clearances, surface_distances
 from .options import ForceOptions
 
@@ -250,9 +250,7 @@ def force_arrays(
     )
 
 
-def force_blocks(
-    items: Iterable[Grasp | GraspFileError], options: ForceOptions
-) -> Iterator[ForceBlock | GraspFileError]:
+def force_blocks(items: Iterable[Grasp | InputError], options: ForceOptions) -> Iterator[ForceBlock | InputError]:
     """Every grasp's rows (one per wrench: the options' ``wrenches``, the command line's, replace
     each grasp's own) in one block per run of consecutive grasps, the loader's errors in their
     places.  The options' ``friction`` (``--friction``) replaces the grasps' own."""
@@ -338,7 +336,7 @@ def force_dataset_blocks(
             mu = np.full((n, 3), np.nan)
         negative = (mu < 0).any(axis=1)
         refused = [
-            GraspFileError("invalid-friction", _negative(index[r], mu[r]), ds.path) for r in np.flatnonzero(negative)
+            InputError("invalid-friction", _negative(index[r], mu[r]), ds.path) for r in np.flatnonzero(negative)
         ]
         mu[negative] = np.nan  # computed as rows without a friction, then cut out
         labels = ds.names[first:last][picked] if ds.names is not None else index

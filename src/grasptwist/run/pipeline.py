@@ -27,7 +27,7 @@ from typing import Any
 from ..io.datasets import DATASET_SUFFIXES, open_dataset
 from ..io.grasp import READING, Reading
 from ..io.lines import grasp_batches
-from ..model import GraspFileError, Hand
+from ..model import Hand, InputError
 from ..output.formats import FORMATS
 from ..output.records import error_record
 from .batch import check_positions
@@ -287,12 +287,12 @@ def blocks(job: Job, paths: Sequence, tuning: Tuning = TUNING) -> Iterator[tuple
                 ds = open_dataset(g, job.extra_point)
                 extra_work = len(ds) * job.options.rows_per_grasp() - 1
                 for block in job.family.dataset(ds, job, 0, None, bases):
-                    if isinstance(block, GraspFileError):  # one row's (a negative friction): one unit
+                    if isinstance(block, InputError):  # one row's (a negative friction): one unit
                         yield block, None, True
                         continue
                     yield block, extra_work, True
                     extra_work = 0
-            except GraspFileError as err:
+            except InputError as err:
                 yield err, None, False
         else:
             yield from ((x, None, False) for x in job.family.rows(_read(job, g), job))
@@ -302,7 +302,7 @@ def _encode_into(job: Job, x, out: Output, at_once: int) -> None:
     """Records of ``x`` (a block, or an input's error) encoded into ``out``, by the command's
     records and the format's encoding."""
     fmt = FORMATS[job.fmt]
-    if isinstance(x, GraspFileError):
+    if isinstance(x, InputError):
         out.add(error_record(x), partial(fmt.error, job=job))
         return
     # a few thousand records at a time: their floats as Python objects would otherwise fill memory
@@ -317,7 +317,7 @@ def _dataset(job: Job, path: str, workers: int, tuning: Tuning) -> Iterator[Outp
         ds = open_dataset(path, job.extra_point)
         check_positions(ds, job.hand)
         job.family.check_dataset(ds, job)
-    except GraspFileError as err:
+    except InputError as err:
         out = Output(done=1)
         _encode_into(job, err, out, tuning.records_at_once)
         yield _sealed(job, out)
@@ -354,7 +354,7 @@ def _dataset_task(job: Job, ds, rows: tuple[int, int], tuning: Tuning, spool: Sp
     made = job.family.dataset(ds, job, rows[0], rows[1], FORMATS[job.fmt].bases)
     try:
         for block in made:
-            if isinstance(block, GraspFileError):  # one row's (a negative friction), in its place
+            if isinstance(block, InputError):  # one row's (a negative friction), in its place
                 out = Output()
                 _encode_into(job, block, out, at_once)
                 outs.append(_sealed(job, out, spool))
@@ -363,7 +363,7 @@ def _dataset_task(job: Job, ds, rows: tuple[int, int], tuning: Tuning, spool: Sp
                 out = Output(rows=True)
                 _encode_into(job, block.part(start, start + at_once), out, at_once)
                 outs.append(_sealed(job, out, spool))
-    except GraspFileError as err:  # a damaged .npz member or Parquet row group, found only as it is read
+    except InputError as err:  # a damaged .npz member or Parquet row group, found only as it is read
         out = Output()
         _encode_into(job, err, out, at_once)
         outs.append(_sealed(job, out, spool))
@@ -401,7 +401,7 @@ def write_blocks(job: Job, paths: Sequence, w, tuning: Tuning = TUNING) -> Itera
     """
     for x, extra_work, rows in blocks(job, paths, tuning):
         o = Output(done=len(x) if extra_work is not None else 1, extra_work=extra_work or 0, rows=rows)
-        if not isinstance(x, GraspFileError):
+        if not isinstance(x, InputError):
             w.write(x)
             for rec in job.command.talking(x, job):
                 o.add(rec, lambda rec: None)

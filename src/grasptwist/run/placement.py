@@ -24,12 +24,12 @@ from ..io import inputs
 from ..io.grasp import READING, Reading
 from ..io.grasp.problems import MAX_ERRORS, Problems, Reject
 from ..io.grasp.values import readonly
-from ..model import Grasp, GraspFileError, Hand
+from ..model import Grasp, Hand, InputError
 
 __all__ = ["place_grasp", "placed", "read", "read_grasps", "run_hand"]
 
 
-def place_grasp(grasp: Grasp) -> Grasp | GraspFileError:
+def place_grasp(grasp: Grasp) -> Grasp | InputError:
     """A grasp with its URDF hand put on its contacts, as every command reads it.
 
     The loader only reads (:func:`grasptwist.read_grasps`): a URDF hand comes at the
@@ -48,7 +48,7 @@ def place_grasp(grasp: Grasp) -> Grasp | GraspFileError:
 
     Returns
     -------
-    Grasp or GraspFileError
+    Grasp or InputError
         The grasp at its checked or solved joint positions (``placement`` None), or the error of
         its document: ``contact-off-finger``, ``unreachable`` or ``outside-limits`` located at
         each failing finger's ``tip`` in the file, every such problem in its ``problems``.
@@ -84,7 +84,7 @@ def place_grasp(grasp: Grasp) -> Grasp | GraspFileError:
             problems.add(Reject(status.code, f"hand.fingers[{f}].tip", message, line, column))
     if problems.count:
         errors = [reject.error(grasp.file, grasp.document) for reject in problems.first()[0]]
-        return GraspFileError(*errors[0].args[:6], errors)  # one per document, as the reader gives them
+        return InputError(*errors[0].args[:6], errors)  # one per document, as the reader gives them
     from .collisions import with_collisions  # as the inverse kinematics: with the first URDF hand
 
     return with_collisions(replace(grasp, joint_positions=readonly(solved.positions), placement=None))

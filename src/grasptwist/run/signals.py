@@ -13,6 +13,8 @@ from __future__ import annotations
 import signal
 from contextlib import contextmanager
 
+from ..codes import EXIT_SIGNAL
+
 __all__ = ["STOP_SIGNALS", "Interrupted", "stop_on_signals", "finishing", "signals_blocked"]
 
 #: The signals that end a run; the parent handles them, workers ignore them.
@@ -31,7 +33,7 @@ class Interrupted(BaseException):
         super().__init__(signum)
         self.signum = signum
         self.name = signal.Signals(signum).name
-        self.exit_status = 128 + signum
+        self.exit_status = EXIT_SIGNAL + signum
 
 
 class _Stop:

@@ -24,7 +24,7 @@ from ..engine.hold_test import check_distance_tol
 from ..engine.objects.geometry import mass_properties, object_size
 from ..engine.synthesis.search import Failure
 from ..io.urdf_meshes import grasp_folder, urdf_files
-from ..model import Grasp, GraspFileError, InputError
+from ..model import Grasp, InputError
 from ..output import simulate_records as sr
 from ..output.records import diagnostics, dumps, error_record
 from ..sim.hold import HoldTest, hold_test
@@ -85,8 +85,8 @@ class Simulated:
     options: SimulateOptions
 
 
-def _problem(grasp: Grasp, code: str, message: str) -> GraspFileError:
-    return GraspFileError(code, f"grasp '{grasp.name}': {message}", grasp.file, grasp.line, None, grasp.document)
+def _problem(grasp: Grasp, code: str, message: str) -> InputError:
+    return InputError(code, f"grasp '{grasp.name}': {message}", grasp.file, grasp.line, None, grasp.document)
 
 
 def _mass(options, grasp, obj):
@@ -139,26 +139,26 @@ def _prepared(options: SimulateOptions, grasp: Grasp, mjcf: str | None, hold: bo
     return mass, friction, gravity, load, mass_properties(obj).center_of_mass, scene
 
 
-def _unstable(grasp, where: str, u) -> GraspFileError:
+def _unstable(grasp, where: str, u) -> InputError:
     return _problem(
         grasp, UNSTABLE, f"{where}: the simulation diverged at step {u.step} (t = {u.time:g} s): {u.reason}"
     )
 
 
-def _compile_error(grasp, exc) -> GraspFileError:
+def _compile_error(grasp, exc) -> InputError:
     return _problem(grasp, SCENE_ERROR, f"MuJoCo cannot compile its scene: {exc}".strip())
 
 
 def simulate_grasp(
     options: SimulateOptions, grasp: Grasp, mjcf: str | None = None, observe=None
-) -> Simulated | PathSimulated | GraspFileError:
+) -> Simulated | PathSimulated | InputError:
     """The hold test of one grasp (its path's execution with ``options.path``), or why it cannot be
     run (module docstring); ``mjcf``: write its scene there; ``observe``:
     :func:`~grasptwist.sim.hold.hold_test`'s."""
     if options.path is not None:
         return simulate_path(options, grasp, mjcf)
     ready = _prepared(options, grasp, mjcf, hold=True)
-    if isinstance(ready, GraspFileError):
+    if isinstance(ready, InputError):
         return ready
     mass, friction, _, load, center, scene = ready
     try:
@@ -207,14 +207,14 @@ def _segments(grasp: Grasp, name: str):
     return _problem(grasp, NO_PATH, f"has no path or twist named '{name}' (its paths and twists: {names})")
 
 
-def simulate_path(options: SimulateOptions, grasp: Grasp, mjcf: str | None = None) -> PathSimulated | GraspFileError:
+def simulate_path(options: SimulateOptions, grasp: Grasp, mjcf: str | None = None) -> PathSimulated | InputError:
     """The grasp's path (or twist, held for one unit of time) ``options.path`` executed in MuJoCo
     (:func:`grasptwist.sim.path.run_path`), :data:`PATH_SAMPLES` samples compared with the plan."""
     segments = _segments(grasp, options.path)
-    if isinstance(segments, GraspFileError):
+    if isinstance(segments, InputError):
         return segments
     ready = _prepared(options, grasp, mjcf, hold=False)
-    if isinstance(ready, GraspFileError):
+    if isinstance(ready, InputError):
         return ready
     mass, friction, gravity, _, center, scene = ready
     times = np.linspace(0.0, float(sum(s.duration for s in segments)), PATH_SAMPLES)
@@ -254,12 +254,12 @@ def _mjcf_name(path: str | None, k: int) -> str | None:
     return f"{stem}-{k}{suffix}"
 
 
-def simulate_inputs(job, inputs: Iterable, numbers=None) -> Iterator[Simulated | GraspFileError]:
+def simulate_inputs(job, inputs: Iterable, numbers=None) -> Iterator[Simulated | InputError]:
     """Every grasp of ``inputs`` (paths or the errors of ``expand``) simulated, in order; ``numbers``
     (an iterator, default from 1) numbers the grasps read for ``--mjcf``."""
     numbers = itertools.count(1) if numbers is None else numbers
     for item in inputs:
-        if isinstance(item, GraspFileError):
+        if isinstance(item, InputError):
             yield item
             continue
         for entry in read(item, job.max_bytes, job.reading):
@@ -286,7 +286,7 @@ def simulate_outputs(job, inputs: Iterable, w, workers: int = 1, tuning=None) ->
     each input done (the progress bar's unit)."""
     for items in _simulated(job, list(inputs), workers):
         for item in items:
-            error = isinstance(item, GraspFileError)
+            error = isinstance(item, InputError)
             rec = error_record(item) if error else sr.simulate_record(item)
             errors, warnings = diagnostics(rec)
             out = Output(encoded=[_encode(job, rec)], errors=errors, warnings=warnings, records=1)
@@ -405,7 +405,7 @@ def simulate(
 
     Raises
     ------
-    GraspFileError
+    InputError
         A grasp it cannot simulate (``no-object``, ``no-mass``, ``no-friction``, ``scene-error``)
         or a simulation that diverged (``simulation-unstable``), or a distance tolerance not below the
         object's size (``tolerance-too-large``).
@@ -415,6 +415,6 @@ def simulate(
     """
     options = SimulateOptions(mass, friction, table_height, duration, *tolerance, safety)
     result = simulate_grasp(options, grasp, mjcf)
-    if isinstance(result, GraspFileError):
+    if isinstance(result, InputError):
         raise result
     return result

@@ -15,7 +15,7 @@ from collections.abc import Iterator, Sequence
 from ..io.grasp import READING, Reading
 from ..io.inputs import STDIN
 from ..io.lines import grasp_batches, is_json_lines, twist_batches
-from ..model import Grasp, GraspFileError, Twist
+from ..model import Grasp, InputError, Twist
 from .batch import Block, resolve
 from .placement import placed, read
 
@@ -43,7 +43,7 @@ def twist_stream(
             (grasps if isinstance(item, Grasp) else errors).append(item)
     yield errors
     for batch in twist_batches(twists_from, max_bytes, per_batch):
-        out: list[Block | GraspFileError] = []
+        out: list[Block | InputError] = []
         run: list[Twist] = []  # consecutive good twists, resolved together
         for twist in [*batch, None]:
             if isinstance(twist, Twist):

@@ -30,7 +30,7 @@ from ..io.grasp.forces import HOLD
 from ..io.inputs import read as read_unplaced
 from ..io.limits import MESH_SUFFIXES, OUTPUT_IS_INPUT
 from ..io.mesh_file import read_mesh
-from ..model import CONTACT_NAMES, Environment, Grasp, GraspFileError, GraspObject, Hand, InputError, Shape
+from ..model import CONTACT_NAMES, Environment, Grasp, GraspObject, Hand, InputError, Shape
 from ..output import synthesis_records as sr
 from ..output.formats import FORMATS
 from ..output.names import escaped
@@ -98,8 +98,8 @@ class Found:
         return len(self.synthesis.points)
 
 
-def _problem(file, code, message, line=None) -> GraspFileError:
-    return GraspFileError(code, message, file, line, None)
+def _problem(file, code, message, line=None) -> InputError:
+    return InputError(code, message, file, line, None)
 
 
 def _task(options: SynthesisOptions, grasp: Grasp):
@@ -180,7 +180,7 @@ def _hand(job, grasp: Grasp, obj: GraspObject):
         )
         return reach, hand
     except InputError as exc:
-        return GraspFileError(exc.code, f"hand: {exc.message}", grasp.file, grasp.line, None, grasp.document)
+        return InputError(exc.code, f"hand: {exc.message}", grasp.file, grasp.line, None, grasp.document)
     except ValueError as exc:
         return _problem(grasp.file, UNSEARCHABLE_HAND, str(exc), grasp.line)
 
@@ -197,7 +197,7 @@ def _inline_joints(hand, synthesis):
     )
 
 
-def _mesh_grasp(path: str, job) -> Grasp | GraspFileError:
+def _mesh_grasp(path: str, job) -> Grasp | InputError:
     """A mesh file as a grasp document with only its object (the command line gives the rest), in
     ``--units`` (metres without it)."""
     from ..io.grasp.objects import mesh_solid
@@ -265,12 +265,12 @@ class Progress(NamedTuple):
     done: int
 
 
-def synthesize_inputs(job, inputs: Iterable) -> Iterator[GraspFileError | Found | Progress]:
+def synthesize_inputs(job, inputs: Iterable) -> Iterator[InputError | Found | Progress]:
     """Every object of ``inputs`` (paths or the errors of ``expand``) searched, in order, with the
     progress of each search (its candidates) and of each input (one unit).  An object whose search
     raises (a fault of ours, not of the input) is its ``internal-error`` record, and the others run on."""
     for item in inputs:
-        if isinstance(item, GraspFileError):
+        if isinstance(item, InputError):
             yield item
             yield Progress(0, 1)
             continue
@@ -283,7 +283,7 @@ def synthesize_inputs(job, inputs: Iterable) -> Iterator[GraspFileError | Found 
         except Exception as exc:  # noqa: BLE001 - this input's record; the others run on
             entries = [_internal(item, None, exc)]
         for entry in entries:
-            if isinstance(entry, GraspFileError):
+            if isinstance(entry, InputError):
                 yield entry
                 continue
             extra = done = 0
@@ -298,21 +298,21 @@ def synthesize_inputs(job, inputs: Iterable) -> Iterator[GraspFileError | Found 
         yield Progress(0, 1)
 
 
-def _internal(file, line, exc: Exception) -> GraspFileError:
+def _internal(file, line, exc: Exception) -> InputError:
     """The ``internal-error`` record of an object whose reading or search raised ``exc``."""
     return _problem(file, "internal-error", f"{type(exc).__name__}: {exc}", line)
 
 
-def _searched_entry(job, entry: Grasp) -> Iterator[GraspFileError | Found | Progress]:
+def _searched_entry(job, entry: Grasp) -> Iterator[InputError | Found | Progress]:
     """One grasp document's search (:func:`synthesize_inputs`): its errors, or its progress and what it found."""
     o = job.options
     task = _task(o, entry)
-    if isinstance(task, GraspFileError):
+    if isinstance(task, InputError):
         yield task
         return
     obj, friction, names, wrenches, hold = task
     hand = _hand(job, entry, obj)
-    if isinstance(hand, GraspFileError):
+    if isinstance(hand, InputError):
         yield hand
         return
     reach, hand = hand if hand is not None else (None, None)
@@ -373,7 +373,7 @@ def _searched_entry(job, entry: Grasp) -> Iterator[GraspFileError | Found | Prog
     yield found
 
 
-def searched(job, inputs: list, workers: int = 1) -> Iterator[GraspFileError | Found | Progress]:
+def searched(job, inputs: list, workers: int = 1) -> Iterator[InputError | Found | Progress]:
     """:func:`synthesize_inputs`, each input on one of ``workers`` forked processes
     (:class:`~grasptwist.run.pool.Pool`) when there are several: the same items in the same order
     (a search depends on its seed alone), each input's as its search ends."""
@@ -390,7 +390,7 @@ def input_records(job, path: str) -> list[dict]:
     (``grasptwist.dask``'s unit of work)."""
     out = []
     for item in synthesize_inputs(job, [path]):
-        if isinstance(item, GraspFileError):
+        if isinstance(item, InputError):
             out.append(error_record(item))
         elif isinstance(item, Found):
             out.extend(sr.synthesis_records(item) if len(item) else [sr.failure_record(item)])
@@ -409,7 +409,7 @@ def synthesize_outputs(job, inputs: Iterable, w, workers: int = 1, tuning=None) 
         if isinstance(item, Progress):
             yield Output(extra_work=item.extra, done=item.done)
             continue
-        if isinstance(item, GraspFileError):
+        if isinstance(item, InputError):
             reads_output = reads_output or any(p.code == OUTPUT_IS_INPUT for p in item.problems)
             rec = error_record(item)
             out = Output(encoded=[_encode(job, rec, error=True)], records=1)

@@ -20,18 +20,19 @@ Contact ``i`` pushes on the object with a force ``f_i`` at ``p_i``; as a wrench
   ``Sigma_i`` (eq. 8): ``f_j = s_i e_i``, ``f_k = -s_i e_i``, ``e_i = (p_k - p_j)/|p_k - p_j|``.
   As wrenches the two halves are ``+s_i Sigma_i`` and ``-s_i Sigma_i``.
 
-The statuses (:class:`~grasptwist.forces.Status`) share their numbers with the twist engine's
-:class:`~grasptwist.engine.degeneracy.Status` where the condition is the same.
+The statuses (:class:`~grasptwist.forces.Status`) and the twist engine's
+(:class:`~grasptwist.engine.degeneracy.Status`) are built from one table, :mod:`grasptwist.codes`:
+a number is one condition in both.
 """
 
 from __future__ import annotations
 
 from dataclasses import replace
-from enum import IntEnum
 from typing import NamedTuple
 
 import numpy as np
 
+from ...codes import status_enum, status_messages
 from ..checks import check_points
 from ..degeneracy import DEGENERACY_TOL
 from ..screws import J, K, cross, dot, norm
@@ -62,50 +63,21 @@ __all__ = [
 ]
 
 
-class Status(IntEnum):
-    """Why a row of a force result has no numbers (0: it has)."""
-
-    OK = 0
-    NONFINITE_INPUT = 1
-    COINCIDENT_CONTACTS = 2
-    COLLINEAR_CONTACTS = 3
-    ZERO_NORMAL = 5
-    NONFINITE_RESULT = 9
-    NONFINITE_POSE = 16  # along a path: the pose overflows (grasptwist.engine.path.pose_overflowed)
-    CANNOT_HOLD = 20
-    NO_CLOSURE = 21
-    MIXED_FRICTIONLESS = 22
-
-    @property
-    def code(self) -> str:
-        """Kebab-case name for JSON output, e.g. ``cannot-hold``."""
-        return self.name.lower().replace("_", "-")
-
+# the force engine's statuses of grasptwist.codes.STATUSES, each with its stable kebab-case ``code``
+Status = status_enum(
+    "Status",
+    "force",
+    __name__,
+    (
+        "Why a row of a force result has no numbers (0: it has); a member's ``code`` is its stable kebab-case "
+        "name in JSON output, e.g. ``cannot-hold``."
+    ),
+)
 
 #: The layers' name for it, beside the twist engine's :class:`~grasptwist.Status`.
 ForceStatus = Status
 
-_MESSAGES = {
-    ForceStatus.OK: "ok",
-    ForceStatus.NONFINITE_INPUT: "the input holds NaN or infinity",
-    ForceStatus.COINCIDENT_CONTACTS: "contacts {j} and {k} coincide, so the grasp map has rank < 6",
-    ForceStatus.COLLINEAR_CONTACTS: (
-        "the contacts are collinear, so no finger forces make a moment about their line (rank G < 6)"
-    ),
-    ForceStatus.ZERO_NORMAL: "the normal at contact {i} has zero length",
-    ForceStatus.NONFINITE_RESULT: (
-        "the result overflows double precision (a force is infinite or NaN): rescale the wrench, mass or coordinates"
-    ),
-    ForceStatus.NONFINITE_POSE: "the object's pose overflows double precision here: rescale the twist or shorten the path",
-    ForceStatus.NO_CLOSURE: "no friction makes the grasp force closure: {why}",
-    ForceStatus.MIXED_FRICTIONLESS: (
-        "contacts with and without friction in one grasp are not solved yet (give every contact mu > 0, or all 0)"
-    ),
-}
-_CANNOT_HOLD = {
-    True: "cannot-hold: the wrench needs a finger to pull (no pushing forces make it, whatever the friction)",
-    False: "cannot-hold: the friction cone at contact {i} is too narrow (mu/safety) for any forces that make the wrench",
-}
+_MESSAGES = status_messages("force")
 
 
 def force_status_message(status, culprit=-1, names=("1", "2", "3")) -> str:
@@ -139,14 +111,8 @@ def force_status_message(status, culprit=-1, names=("1", "2", "3")) -> str:
     s = ForceStatus(int(status))
     c = int(culprit)
     i, j, k = names[c if c >= 0 else 0], names[(c + 1) % 3], names[(c + 2) % 3]
-    if s == ForceStatus.CANNOT_HOLD:
-        return _CANNOT_HOLD[c < 0].format(i=i)
-    why = (
-        f"the normal at contact {i} is at right angles to the contacts' plane"
-        if c >= 0
-        else "no internal force pushes at all three contacts"
-    )
-    return _MESSAGES[s].format(i=i, j=j, k=k, why=why)
+    message = _MESSAGES[s]
+    return (message[c < 0] if isinstance(message, tuple) else message).format(i=i, j=j, k=k)
 
 
 # --- validators ------------------------------------------------------------------

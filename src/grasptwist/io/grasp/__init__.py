@@ -3,7 +3,7 @@
 A grasp file holds one grasp per YAML document (see "Grasp files" in README.md
 for the format).  Reading never constructs arbitrary Python objects and
 never lets a parser exception escape: every problem becomes a
-:class:`GraspFileError` that names the file, line, column and field path.
+:class:`InputError` that names the file, line, column and field path.
 Every problem of a document is reported, in file order, not just its
 first: each at its own place, four misspelt keys as four entries; nothing
 inside the value of a key reported unknown (at most ``MAX_ERRORS`` entries
@@ -52,7 +52,7 @@ The modules
 ``lines``      one line of a JSON Lines stream (the stream: :mod:`grasptwist.io.lines`)
 """
 
-from ...model import Grasp, GraspFileError, Twist
+from ...model import Grasp, InputError, Twist
 from ..limits import DEFAULT_MAX_BYTES, NOT_REGULAR
 from .compose import MAX_DEPTH
 from .contacts import CONTACT_KEYS
@@ -77,7 +77,7 @@ __all__ = [
     "Reading",
     "READING",
     "Grasp",
-    "GraspFileError",
+    "InputError",
     "Twist",
     "DEFAULT_MAX_BYTES",
     "NOT_REGULAR",

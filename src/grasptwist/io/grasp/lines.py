@@ -9,7 +9,7 @@ import orjson
 import yaml
 
 from ...engine import screws
-from ...model import Grasp, GraspFileError, Twist
+from ...model import Grasp, InputError, Twist
 from ..limits import DEFAULT_MAX_BYTES
 from .compose import PARSER, compose, syntax_error
 from .problems import MAX_ERRORS, Problems, Reject, located, located_mark
@@ -54,7 +54,7 @@ def read_twist_line(data, *, file, line, max_bytes=DEFAULT_MAX_BYTES):
 
     Returns
     -------
-    Twist or list of GraspFileError
+    Twist or list of InputError
 
     Examples
     --------
@@ -157,4 +157,4 @@ def _on_line(entry, line):
         placement = p if p is None else replace(p, tips=tuple((line, column) for _, column in p.tips))
         twists = tuple(replace(t, line=line) for t in entry.twists)
         return replace(entry, line=line, document=line - 1, twists=twists, placement=placement)
-    return GraspFileError(entry.code, entry.message, entry.file, line, entry.column, line - 1)
+    return InputError(entry.code, entry.message, entry.file, line, entry.column, line - 1)

@@ -2,21 +2,21 @@
 
 Every check of the loader adds its problems to a :class:`Problems` and goes
 on, so one pass finds them all; each becomes a
-:class:`~grasptwist.model.GraspFileError` when the document is done.
+:class:`~grasptwist.model.InputError` when the document is done.
 """
 
 from __future__ import annotations
 
 import re
 
-from ...model import GraspFileError
+from ...model import InputError
 from ..limits import MAX_ERRORS
 
 __all__ = ["MAX_ERRORS", "Reject", "StreamStop", "Problems", "located", "located_mark", "join"]
 
 
 class Reject(Exception):
-    """Internal: one located problem, turned into a GraspFileError later."""
+    """Internal: one located problem, turned into a InputError later."""
 
     def __init__(self, code, path, problem, line=None, column=None):
         super().__init__(code)
@@ -26,7 +26,7 @@ class Reject(Exception):
         self.column = column
 
     def error(self, file, document):
-        return GraspFileError(self.code, self.message, file, self.line, self.column, document)
+        return InputError(self.code, self.message, file, self.line, self.column, document)
 
 
 class StreamStop(Reject):

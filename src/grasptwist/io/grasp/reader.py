@@ -2,7 +2,7 @@
 
 Each document is composed (:mod:`.compose`) and checked (:mod:`.document`)
 as soon as it is parsed; every problem becomes a located
-:class:`~grasptwist.model.GraspFileError` entry among the grasps.
+:class:`~grasptwist.model.InputError` entry among the grasps.
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from pathlib import Path
 
 import yaml
 
-from ...model import GraspFileError
+from ...model import InputError
 from ..limits import DEFAULT_MAX_BYTES, MAX_DOCUMENTS, MAX_MESH_BYTES, MAX_TRIANGLES
 from .compose import PARSER, compose, syntax_error
 from .document import read_document
@@ -126,7 +126,7 @@ def read_grasps(
 
     Returns
     -------
-    list of Grasp or GraspFileError
+    list of Grasp or InputError
         In file order: a Grasp for each good document and an error for each
         problem of a bad one (several per document, each with its own
         position).  A syntax error, a too-deep document or more than
@@ -158,7 +158,7 @@ def read_grasps(
 def load_grasps(
     source, *, file=None, max_bytes=DEFAULT_MAX_BYTES, reading=READING, surface_tol=None, allow_outside=None
 ):
-    """Like :func:`read_grasps` (the same keywords), but raise its first :class:`GraspFileError`.
+    """Like :func:`read_grasps` (the same keywords), but raise its first :class:`InputError`.
 
     Returns
     -------
@@ -167,20 +167,20 @@ def load_grasps(
 
     Raises
     ------
-    GraspFileError
+    InputError
         The first problem :func:`read_grasps` finds.
 
     Examples
     --------
     >>> load_grasps(b"contacts: []\\n", file="g.yaml")
     Traceback (most recent call last):
-    grasptwist.model.GraspFileError: g.yaml:1:11: contacts: expected exactly 3 contacts, got 0
+    grasptwist.model.InputError: g.yaml:1:11: contacts: expected exactly 3 contacts, got 0
     """
     entries = read_grasps(
         source, file=file, max_bytes=max_bytes, reading=reading, surface_tol=surface_tol, allow_outside=allow_outside
     )
     for entry in entries:
-        if isinstance(entry, GraspFileError):
+        if isinstance(entry, InputError):
             raise entry
     return entries
 
@@ -226,14 +226,14 @@ def one_per_document(entries):
     for entry in entries:
         last = out[-1] if out else None
         joins = (
-            isinstance(entry, GraspFileError)
-            and isinstance(last, GraspFileError)
+            isinstance(entry, InputError)
+            and isinstance(last, InputError)
             and last.file == entry.file
             and last.document is not None
             and (entry.document == last.document or entry.code == "too-many-errors")
         )
         if joins:
-            out[-1] = GraspFileError(*last.args[:6], (*last.problems, entry))
+            out[-1] = InputError(*last.args[:6], (*last.problems, entry))
         else:
             out.append(entry)
     return out
@@ -342,10 +342,10 @@ class _Entries:
             self._number_the_first()
             self.entries.append(stop.error(self.file, self.documents))
         elif not self.documents:
-            return [GraspFileError("empty-document", "no YAML document in the file", self.file)]
+            return [InputError("empty-document", "no YAML document in the file", self.file)]
         if self.unreported:
             self.entries.append(
-                GraspFileError(
+                InputError(
                     "too-many-errors",
                     f"{self.unreported} more problems in this file not reported (only the first {self.max_errors} are)",
                     self.file,
