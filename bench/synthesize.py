@@ -92,7 +92,7 @@ def trifinger():
 
 def hand_search(grasp, deepest, count, candidates, seed=0, objective="robust"):
     """The search with the hand: ``(Synthesis, wall seconds, CPU seconds)``."""
-    from grasptwist.engine.synthesis.search import hand_reach
+    from grasptwist.engine.synthesis.problem import hand_reach
 
     reach = hand_reach(grasp.object, grasp.hand, collide=deepest)
     t, cpu = time.perf_counter(), time.process_time()

@@ -141,6 +141,7 @@ DATA = {
     "grasptwist.pictures.twist_figure": {"twists"},
     "grasptwist.pictures.image_name": {"twist_name"},
     "grasptwist.dask.resolve_dataframe": {"twists"},
+    "grasptwist.synthesize": {"friction"},  # a Grasp brings its own
 }
 
 

@@ -38,8 +38,8 @@ from ..engine.collision import (
     tip_sphere,
 )
 from ..engine.environment import clearance_of, has_obstacles, needs_checks, obstacle_name, parts_distance
-from ..engine.fingertips import tip_centers, tip_radii
-from ..engine.ik import home_tips
+from ..engine.fingertips import tip_radii
+from ..engine.placement import home_at
 from ..io.limits import MAX_URDF_BYTES
 from ..io.urdf_meshes import grasp_folder, link_geometry
 from ..model import Grasp, GraspFileError, InputError
@@ -294,7 +294,7 @@ def hand_constraints(
     >>> len(reach.hulls.links), reach.environment.table_height, reach.clearance
     (12, 0.0, 0.001)
     """
-    from ..engine.synthesis.search import hand_reach  # the search's: with the first one asked for
+    from ..engine.synthesis.problem import hand_reach  # the search's: with the first one asked for
 
     checked = _checked(hand, obj, folder, max_bytes)
     collide = None
@@ -357,7 +357,7 @@ def _parts(grasp, max_bytes):
     hulls = _hulls(hand, grasp_folder(grasp), max_bytes)
     radii = tip_radii(hand)
     # an inline hand is at home where its file gives it: its tip points on the contacts' sphere centres
-    tips = home_tips(hand, tip_centers(grasp.points, grasp.normals, radii))
+    tips = home_at(hand, grasp.points, grasp.normals)
     labels = [(names[g.finger], g.link) for g in hulls.links]
     labels += [(names[f], finger.tip or "fingertip") for f, finger in enumerate(hand.fingers)]
     return hulls, tips, radii, labels

@@ -22,7 +22,7 @@ import numpy as np
 
 from ..engine.hold_test import check_distance_tol
 from ..engine.objects.geometry import mass_properties, object_size
-from ..engine.synthesis.search import Failure
+from ..engine.synthesis.diagnosis import Failure
 from ..io.urdf_meshes import grasp_folder, urdf_files
 from ..model import Grasp, GraspFileError, InputError
 from ..output import simulate_records as sr
