@@ -143,7 +143,7 @@ def hand_baseline(grasp, wanted, seed=0, tries=40):
             else:
                 continue
             placed = replace(grasp, points=p[list(order)], normals=n[list(order)])
-            if not gt.hand.finger_collisions(placed, ik.positions):
+            if not gt.finger_collisions(placed, ik.positions):
                 found += 1
                 break
     return found, spent, time.perf_counter() - t

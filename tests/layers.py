@@ -4,7 +4,7 @@
 #: Lowest first.  A module may import its own group and any group of a lower layer;
 #: groups of one layer are independent of each other.
 LAYERS = [
-    ["grasptwist.model", "grasptwist.extras", "grasptwist._version"],  # data types, no math
+    ["grasptwist.model", "grasptwist.extras", "grasptwist._version", "grasptwist._moved"],  # data types, no math
     ["grasptwist.engine"],  # the math on arrays
     ["grasptwist.io"],  # files in
     ["grasptwist.results"],  # the registry of result kinds and their fields

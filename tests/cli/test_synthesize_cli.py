@@ -328,8 +328,9 @@ def _trifinger_available():
 @pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 @pytest.mark.skipif(not _trifinger_available(), reason="needs the urdf extra and robot-properties-fingers")
 def test_trifinger_grasps_on_the_cube_are_reached_within_limits_without_collision(tmp_path):
+    from grasptwist import finger_collisions
     from grasptwist.engine.ik import IK_TOL, joint_limits
-    from grasptwist.hand import finger_collisions, forward_kinematics
+    from grasptwist.hand import forward_kinematics
 
     found = tmp_path / "found.yaml"
     args = ("--friction", "0.8", "--mass", "0.1", "-n", "4", "--candidates", "1500", "-f", "jsonl", "-o", found)

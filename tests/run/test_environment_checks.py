@@ -31,7 +31,7 @@ TRIFINGER = ROOT / "grasps" / "trifinger-cube.yaml"
 def placed():
     """The bundled TriFinger grasp, placed on its cube on its table."""
     (g,) = gt.read_grasps(TRIFINGER)
-    return gt.hand.place_grasp(g)
+    return gt.place_grasp(g)
 
 
 @needs_trifinger

@@ -290,7 +290,7 @@ def hand_constraints(
     --------
     >>> import grasptwist as gt
     >>> (g,) = gt.read_grasps("grasps/trifinger-cube.yaml")
-    >>> reach = gt.hand.hand_constraints(g.object, g.hand, environment=g.environment, folder="grasps")
+    >>> reach = hand_constraints(g.object, g.hand, environment=g.environment, folder="grasps")
     >>> len(reach.hulls.links), reach.environment.table_height, reach.clearance
     (12, 0.0, 0.001)
     """
@@ -331,19 +331,19 @@ def finger_collisions(grasp: Grasp, joint_positions) -> tuple[Collision, ...]:
     Returns
     -------
     tuple of Collision
-        Each link deeper than :data:`~grasptwist.hand.COLLISION_TOL` times the object's size, naming its
+        Each link deeper than :data:`~grasptwist.engine.collision.COLLISION_TOL` times the object's size, naming its
         finger, link and depth; the fingertip spheres touching their contacts are no collision
         (docs/guide/hands.md, "Fingers through the object").
 
     Raises
     ------
     InputError
-        The URDF's or a mesh's, as :func:`~grasptwist.hand.place_grasp` reports them.
+        The URDF's or a mesh's, as :func:`~grasptwist.place_grasp` reports them.
 
     Examples
     --------
     >>> import grasptwist as gt
-    >>> g = gt.hand.place_grasp(gt.read_grasps("grasps/trifinger-cube.yaml")[0])
+    >>> g = gt.place_grasp(gt.read_grasps("grasps/trifinger-cube.yaml")[0])
     >>> finger_collisions(g, g.joint_positions)  # the fingertips touch the cube, nothing else does
     ()
     """
@@ -392,7 +392,7 @@ def hand_checks_along(grasp: Grasp, *, joint_positions=None, max_bytes=MAX_URDF_
     Examples
     --------
     >>> import grasptwist as gt
-    >>> g = gt.hand.place_grasp(gt.read_grasps("grasps/trifinger-cube.yaml")[0])
+    >>> g = gt.place_grasp(gt.read_grasps("grasps/trifinger-cube.yaml")[0])
     >>> overlaps, hits, clearance = hand_checks_along(g)
     >>> overlaps, hits, clearance.round(4).tolist()  # its lowest fingertip sphere is 5 mm above the table
     ([()], [()], [0.005])
@@ -448,7 +448,7 @@ def with_collisions(grasp: Grasp) -> Grasp | GraspFileError:
     Examples
     --------
     >>> import grasptwist as gt
-    >>> g = gt.hand.place_grasp(gt.read_grasps("grasps/trifinger-cube.yaml")[0])  # checked there
+    >>> g = gt.place_grasp(gt.read_grasps("grasps/trifinger-cube.yaml")[0])  # checked there
     >>> g.warnings
     ()
     """

@@ -268,7 +268,7 @@ def synthesize(
     can take as the command line checks it: fingertips on the surface, joints within their
     limits, no finger link (a URDF's collision meshes) in the object, no two fingers into each
     other (their links' convex hulls and fingertip spheres), every part ``clearance`` from the
-    ``environment`` (:func:`grasptwist.hand.hand_constraints`).  The problem is built as the
+    ``environment`` (``grasptwist.run.collisions.hand_constraints``).  The problem is built as the
     command line and :func:`grasptwist.dask.synthesize_bag` build it (:func:`grasp_problem`): the
     same options give the same grasps through all three.
 
@@ -287,7 +287,7 @@ def synthesize(
         A hand that must reach every grasp; the grasps then list contact ``f`` for finger ``f``
         (the fingers are assigned to the contacts in every order), and ``joint_positions``,
         ``reach_error`` and ``tip_center`` say where the hand holds each.  A ``HandReach``
-        (:func:`grasptwist.hand.hand_constraints`) is taken as it is.
+        (``grasptwist.run.collisions.hand_constraints``) is taken as it is.
     environment : Environment, optional
         A table and boxes (``grasptwist.objects.Environment``; a grasp file's ``environment``):
         every contact's fingertip sphere (a point without a hand) and every part of the hand

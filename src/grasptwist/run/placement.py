@@ -38,7 +38,7 @@ def place_grasp(grasp: Grasp) -> Grasp | GraspFileError:
     positions are solved from the seed (inverse kinematics): each tip link's origin, the
     centre of its fingertip's sphere, on ``point - tip_radius * normal``
     (:func:`grasptwist.hand.tip_centers`).  Every grasp's fingers are then checked
-    (:func:`grasptwist.hand.with_collisions`: links in the object, fingers into each other,
+    (``grasptwist.run.collisions.with_collisions``: links in the object, fingers into each other,
     parts too near its environment: warnings).
 
     Parameters
@@ -57,7 +57,7 @@ def place_grasp(grasp: Grasp) -> Grasp | GraspFileError:
     --------
     >>> import grasptwist as gt
     >>> (g,) = gt.read_grasps("grasps/three-finger-hand.yaml")  # an inline hand: nothing to place
-    >>> gt.hand.place_grasp(g) is g
+    >>> gt.place_grasp(g) is g
     True
     """
     p = grasp.placement

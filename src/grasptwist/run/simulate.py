@@ -382,7 +382,7 @@ def simulate(
     Parameters
     ----------
     grasp : Grasp
-        With an object; a URDF hand placed (:func:`grasptwist.hand.place_grasp`), as
+        With an object; a URDF hand placed (:func:`grasptwist.place_grasp`), as
         :func:`grasptwist.read_grasps` gives it.
     mass, friction : float, optional
         Replace the grasp's (its object's mass, density or the file's ``mass``; its ``friction``).
