@@ -24,8 +24,9 @@ import numpy as np
 from .fingertips import TipContacts, tip_centers, tip_contacts, tip_radii
 from .hands import padded_positions, tip_poses
 from .ik import HandIK, home_tips, place_hand
+from .kinematics import forward_kinematics
 
-__all__ = ["Placement", "place", "home_at"]
+__all__ = ["Placement", "place", "home_at", "joints_at"]
 
 
 def home_at(hand, points, normals):
@@ -39,6 +40,20 @@ def home_at(hand, points, normals):
     [[1.01, 0.0, 0.0], [0.0, 1.01, 0.0], [0.0, 0.0, 1.01]]
     """
     return home_tips(hand, tip_centers(points, normals, tip_radii(hand)))
+
+
+def joints_at(hand, positions) -> tuple:
+    """Each finger's joints moved to ``positions`` ``(n_joints,)``, per finger ``(screws (n, 6), points (n, 3))``:
+    the hand as a grasp file gives it inline at that configuration (its joints at 0 there).
+
+    >>> from grasptwist.hand import Finger, Hand, Joint
+    >>> slides = (Joint("x", "prismatic", None, None, None, None), Joint("y", "prismatic", None, None, None, None))
+    >>> f = Finger("a", None, slides, np.array([[0, 0, 0, 1.0, 0, 0], [0, 0, 0, 0, 1.0, 0]]), np.zeros((2, 3)), None, 1.0, (0, 1))
+    >>> joints_at(Hand((f, f, f), ("x", "y"), None, None), [0.5, 0])[0][1].tolist()  # the second rides the first
+    [[0.0, 0.0, 0.0], [0.5, 0.0, 0.0]]
+    """
+    q = np.asarray(positions, dtype=float)
+    return tuple(forward_kinematics(f.screws, f.points, None, q[list(f.joint_index)])[:2] for f in hand.fingers)
 
 
 @dataclass(frozen=True, eq=False)
@@ -111,8 +126,8 @@ def place(hand, points, normals, positions=None, *, seed=None, home=None) -> Pla
     >>> slide = (Joint("x", "prismatic", None, None, None, None),)
     >>> f = Finger("a", "tip", slide, np.array([[0, 0, 0, 1.0, 0, 0]]), np.zeros((1, 3)), np.eye(4), 2.0, (0,))
     >>> p = place(Hand((f, f, f), ("x",), None, None), np.eye(3) * 0.5, -np.eye(3), [0.5])
-    >>> p.ik.tip_error.tolist(), p.touch.gap.tolist()
-    ([0.0, 0.7071067811865476, 0.7071067811865476], [0.0, 0.7071067811865476, 0.7071067811865476])
+    >>> p.ik.tip_error.round(4).tolist(), p.centers[1].tolist()  # every tip at x = 0.5: on contact 0 only
+    ([0.0, 0.7071, 0.7071], [0.0, 0.5, 0.0])
     """
     radii = tip_radii(hand)
     points, normals = np.asarray(points, dtype=float), np.asarray(normals, dtype=float)

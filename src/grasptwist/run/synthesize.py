@@ -84,12 +84,9 @@ def _inline_joints(hand, synthesis):
     """An inline hand's joints moved to each grasp's joint positions (its file gives them there)."""
     if hand is None or hand.source is not None:
         return None
-    from ..engine.kinematics import forward_kinematics
+    from ..engine.placement import joints_at
 
-    return tuple(
-        tuple(forward_kinematics(f.screws, f.points, None, q[list(f.joint_index)])[:2] for f in hand.fingers)
-        for q in synthesis.joint_positions
-    )
+    return tuple(joints_at(hand, q) for q in synthesis.joint_positions)
 
 
 def _mesh_grasp(path: str, job) -> Grasp | GraspFileError:

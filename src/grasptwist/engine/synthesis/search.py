@@ -396,7 +396,7 @@ def synthesize(
         finger ``f`` (the fingers are assigned to the contacts in every order), and
         ``joint_positions`` and ``reach_error`` say where the hand holds each.
     tips, tip_radius, collide, hulls
-        As ``grasptwist.engine.synthesis.search.hand_reach``: each finger's tip link pose at home (needed for a finger
+        As ``grasptwist.engine.synthesis.problem.hand_reach``: each finger's tip link pose at home (needed for a finger
         given inline), every fingertip's radius (default each finger's ``tip_radius``),
         the depth of the deepest link at joint positions and the links' convex hulls (default:
         links not checked, only the fingertip spheres; ``grasptwist.synthesize`` and the command
@@ -411,7 +411,7 @@ def synthesize(
         The weight held when ``obj`` has no mass (a grasp file's ``mass`` apart from its object).
     span_bodies : bool
         Let a grasp's contacts lie on different bodies of the object (a mesh's pieces apart);
-        by default each grasp keeps to one (``grasptwist.engine.synthesis.search.surface_of``).
+        by default each grasp keeps to one (``grasptwist.engine.synthesis.problem.surface_of``).
     **options
         The search's keyword options: ``count`` (grasps wanted, 1), ``safety`` (1), ``objective``
         (``robust``, ``total_normal_force``, ``closure_friction`` or ``epsilon``), ``wrist`` (None),
