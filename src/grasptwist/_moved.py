@@ -44,12 +44,7 @@ MOVED = {
     "hand.HandPlacement": ("model.HandPlacement", "0.6", "a grasp's 'placement', read by grasptwist.place_grasp"),
     "hand.tip_poses": ("engine.hands.tip_poses", "0.6", "use grasptwist.hand.place"),
     "hand.sphere_radius": ("engine.fingertips.sphere_radius", "0.6", "a URDF's fingertip radius is read for you"),
-    "hand.SEGMENT_INTERVALS": ("engine.hands.SEGMENT_INTERVALS", "0.6", "a tolerance of grasptwist.hand.track"),
-    "hand.IK_TOL": ("engine.ik.IK_TOL", "0.6", "a tolerance of grasptwist.hand.hand_ik"),
     "hand.RANK_TOL": ("engine.kinematics.RANK_TOL", "0.6", "a tolerance of grasptwist.hand.joint_rates"),
-    "hand.FOLLOW_TOL": ("engine.kinematics.FOLLOW_TOL", "0.6", "a tolerance of grasptwist.hand.joint_rates"),
-    "hand.OFF_TANGENT_FIXED": ("engine.kinematics.OFF_TANGENT_FIXED", "0.6", "see grasptwist.hand.JointRates"),
-    "hand.TANGENT_FIXED": ("engine.kinematics.TANGENT_FIXED", "0.6", "see grasptwist.hand.JointRates"),
     "hand.COLLISION_TOL": ("engine.collision.COLLISION_TOL", "0.6", "a tolerance of grasptwist.finger_collisions"),
 }
 

@@ -21,9 +21,12 @@ from __future__ import annotations
 
 from ._moved import topic_getattr
 from .engine.fingertips import TipContacts, tip_centers, tip_contacts, tip_radii
-from .engine.hands import HandTrack, finger_states, joint_positions, track, velocity_limits
-from .engine.ik import HandIK, hand_ik, home_tips
+from .engine.hands import SEGMENT_INTERVALS, HandTrack, finger_states, joint_positions, track, velocity_limits
+from .engine.ik import IK_TOL, HandIK, hand_ik, home_tips
 from .engine.kinematics import (
+    FOLLOW_TOL,
+    OFF_TANGENT_FIXED,
+    TANGENT_FIXED,
     ChainState,
     JointRates,
     component_joint_rates,
@@ -47,6 +50,7 @@ __all__ = [
     "velocity_limits",
     "HandTrack",
     "track",
+    "SEGMENT_INTERVALS",
     "tip_radii",
     "tip_centers",
     "tip_contacts",
@@ -59,8 +63,12 @@ __all__ = [
     "forward_kinematics",
     "JointRates",
     "ChainState",
+    "FOLLOW_TOL",
+    "OFF_TANGENT_FIXED",
+    "TANGENT_FIXED",
     "hand_ik",
     "HandIK",
+    "IK_TOL",
     "home_tips",
     "place",
     "Placement",

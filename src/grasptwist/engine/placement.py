@@ -111,9 +111,9 @@ def place(hand, points, normals, positions=None, *, seed=None, home=None) -> Pla
         The contacts and their normals.
     positions : (..., n_joints) array, optional
         Joint positions to check (forward kinematics); without them they are solved from ``seed``
-        (inverse kinematics, :func:`~.ik.place_hand`).
+        (inverse kinematics, ``grasptwist.engine.ik.place_hand``).
     home : (3, 4, 4) array, optional
-        Each finger's tip pose at home (:func:`home_at`); None: a finger given inline is
+        Each finger's tip pose at home (``home_at``: an inline finger's on a grasp file's contact); None: a finger given inline is
         unchecked (tip error NaN), its tip point taken where its sphere's centre is now.
 
     Returns

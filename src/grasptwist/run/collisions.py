@@ -331,7 +331,7 @@ def finger_collisions(grasp: Grasp, joint_positions) -> tuple[Collision, ...]:
     Returns
     -------
     tuple of Collision
-        Each link deeper than :data:`~grasptwist.engine.collision.COLLISION_TOL` times the object's size, naming its
+        Each link deeper than ``grasptwist.engine.collision.COLLISION_TOL`` times the object's size, naming its
         finger, link and depth; the fingertip spheres touching their contacts are no collision
         (docs/guide/hands.md, "Fingers through the object").
 

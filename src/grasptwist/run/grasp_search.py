@@ -269,7 +269,7 @@ def synthesize(
     limits, no finger link (a URDF's collision meshes) in the object, no two fingers into each
     other (their links' convex hulls and fingertip spheres), every part ``clearance`` from the
     ``environment`` (``grasptwist.run.collisions.hand_constraints``).  The problem is built as the
-    command line and :func:`grasptwist.dask.synthesize_bag` build it (:func:`grasp_problem`): the
+    command line and :func:`grasptwist.dask.synthesize_bag` build it (``grasp_problem``): the
     same options give the same grasps through all three.
 
     Parameters

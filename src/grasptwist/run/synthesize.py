@@ -7,7 +7,9 @@ every grasp: its fingertips (``--tip-radius``, else each finger's ``tip_radius``
 surface, its joints within their limits, its links (a URDF's meshes) out of the object; a
 hand given inline has its tips where the file's contacts are (its joints are given there).  The command
 line's ``--friction`` and ``--mass`` replace the file's; ``--wrench`` replaces its other wrenches, beside
-the weight (``hold``), which is held whenever there is a mass.  The search is :func:`grasptwist.engine.synthesis.search.search`; with ``-o
+the weight (``hold``), which is held whenever there is a mass.  Each document's problem is
+:func:`grasptwist.run.grasp_search.grasp_problem`'s (the library's and Dask's too), searched by
+:func:`grasptwist.engine.synthesis.search.solve_steps`; with ``-o
 FILE.yaml`` the grasps found are also written as a grasp file (atomically, at the end).
 No math here: only reading, routing and labelling.
 """
