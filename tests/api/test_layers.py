@@ -146,6 +146,12 @@ def test_facades_only_re_export(name):
         )
 
 
+@pytest.mark.parametrize("name", FACADES)
+def test_a_topic_imports_nothing_that_runs_the_command_line(name):
+    # ARCHITECTURE.md, "The public API": what runs run/ (gt.place_grasp, gt.synthesize, ...) is the core's (issue 39)
+    assert not {m for m in imports(name) if m.startswith(("grasptwist.run", "grasptwist.cli"))}
+
+
 @pytest.mark.parametrize(
     "name", [n for n, p in MODULES.items() if p.name != "__init__.py" and not p.name.startswith("_")]
 )
