@@ -92,7 +92,7 @@ def trifinger():
 
 def hand_search(grasp, deepest, count, candidates, seed=0, objective="robust"):
     """The search with the hand: ``(Synthesis, wall seconds, CPU seconds)``."""
-    from grasptwist.engine.synthesis.search import hand_reach
+    from grasptwist.engine.synthesis.problem import hand_reach
 
     reach = hand_reach(grasp.object, grasp.hand, collide=deepest)
     t, cpu = time.perf_counter(), time.process_time()
@@ -143,7 +143,7 @@ def hand_baseline(grasp, wanted, seed=0, tries=40):
             else:
                 continue
             placed = replace(grasp, points=p[list(order)], normals=n[list(order)])
-            if not gt.hand.finger_collisions(placed, ik.positions):
+            if not gt.finger_collisions(placed, ik.positions):
                 found += 1
                 break
     return found, spent, time.perf_counter() - t

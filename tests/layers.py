@@ -9,6 +9,7 @@ LAYERS = [
         "grasptwist.codes",
         "grasptwist.extras",
         "grasptwist._version",
+        "grasptwist._moved",
     ],  # data types and codes, no math
     ["grasptwist.engine"],  # the math on arrays
     ["grasptwist.io"],  # files in

@@ -15,8 +15,8 @@ internal (``docs/api/index.rst`` says which).
 """
 
 import importlib as _importlib
-import warnings as _warnings
 
+from . import _moved
 from ._version import __version__ as __version__
 
 #: Public name -> the module defining it; imported on first use, so that the
@@ -61,6 +61,14 @@ _EXPORTS = {
     # finding grasps on an object's surface
     "synthesize": ".run.grasp_search",
     "Synthesis": ".engine.synthesis.search",
+    # a grasp file's hand put on its contacts and its fingers checked, as every command does
+    # (the command line's machinery, run/: the core's, never a topic's)
+    "place_grasp": ".run.placement",
+    "finger_collisions": ".run.collisions",
+    "hand_checks_along": ".run.collisions",
+    "Collision": ".run.collisions",
+    "Overlap": ".run.collisions",
+    "EnvironmentHit": ".run.collisions",
     # a grasp run in MuJoCo (the sim extra)
     "simulate": ".run.simulate",
     # the topics
@@ -76,39 +84,21 @@ _EXPORTS = {
 #: Names above that are modules themselves.
 _MODULES = {"screws", "hand", "forces", "path", "pictures", "objects", "dask"}
 
-#: Names that moved or were renamed: old name -> (the release that deprecated it, its new name,
-#: from ``grasptwist``).  They still work, with a DeprecationWarning naming their new place.
-_MOVED = {
-    # 0.3's names that moved to a topic module
-    "finger_jacobian": ("0.4", "hand.finger_jacobian"),
-    "joint_rates": ("0.4", "hand.joint_rates"),
-    "JointRates": ("0.4", "hand.JointRates"),
-    "force_closure": ("0.4", "forces.force_closure"),
-    "Closure": ("0.4", "forces.Closure"),
-    "manipulating_forces": ("0.4", "forces.manipulating_forces"),
-    "ManipulatingForces": ("0.4", "forces.ManipulatingForces"),
-    "squeeze_forces": ("0.4", "forces.squeeze_forces"),
-    "grasp_map": ("0.4", "forces.grasp_map"),
-    "ForceStatus": ("0.4", "forces.Status"),
-    "force_status_message": ("0.4", "forces.status_message"),
-    "check_wrench": ("0.4", "forces.check_wrench"),
-    "check_friction": ("0.4", "forces.check_friction"),
-    "check_safety": ("0.4", "forces.check_safety"),
-    # one name for the error of every input, not only a grasp file's
-    "GraspFileError": ("0.6", "InputError"),
-}
+#: The names that moved or went, each a deprecated alias for a release (``_moved.py``): the
+#: core's old names, and ``topic.name`` for a topic's (whose ``__getattr__`` looks there).
+_MOVED = _moved.MOVED
+
+#: Names of a topic module that the core re-exports as well: by the rule of ARCHITECTURE.md ("The
+#: public API"), only a whole job's one call, with the types it takes and gives; today the grip, a
+#: control loop's one call (issue 29).  Every other public name has one home.
+_REEXPORTED = {"grip": "forces", "Grip": "forces", "prepare_grip": "forces", "PreparedGrip": "forces"}
 
 __all__ = list(_EXPORTS)
 
 
 def __getattr__(name: str):
     if name in _MOVED:
-        since, new = _MOVED[name]
-        _warnings.warn(
-            f"grasptwist.{name} is deprecated since {since}: use grasptwist.{new}", DeprecationWarning, stacklevel=2
-        )
-        topic, _, new = new.rpartition(".")
-        return getattr(__getattr__(topic), new) if topic else __getattr__(new)
+        return _moved.moved(name)
     if name not in _EXPORTS:
         raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
     module = _importlib.import_module(_EXPORTS[name], __name__)

@@ -369,6 +369,7 @@ ERRORS = {
     "no-friction": Code("neither the document nor `--friction` gives a friction", _SEARCH),
     "no-mass": Code("neither the object, the document nor `--mass` gives a mass", _SIMULATION),
     "nothing-to-hold": Code("no weight and no wrench: nothing to hold", _SEARCH),
+    "no-weight": Code("`gt.synthesize(..., hold=True)` on an object without a mass or density", _SEARCH),
     "no-tip-points": Code("an inline hand with no contacts for its tips to start at", _SEARCH),
     "unsearchable-hand": Code("a hand whose fingers share a joint", _SEARCH),
     "tolerance-too-large": Code("`--tolerance`'s distance not below the object's size", _SIMULATION),

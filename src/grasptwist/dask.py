@@ -195,6 +195,10 @@ def _synthesized(path: str, options: dict, hand_file: str | None) -> list[dict]:
 def synthesize_bag(objects, *, hand: str | None = None, **options):
     """Synthesize grasps for every object of a data set, lazily: a Dask bag of records, one object a task.
 
+    Each object's problem is built as the command line and :func:`grasptwist.synthesize` build it
+    (one builder, ``grasptwist.run.grasp_search.grasp_problem``): the same options give the same
+    grasps through all three.
+
     Parameters
     ----------
     objects : dask.bag.Bag or sequence of str

@@ -2,8 +2,11 @@
 
 A hand is three fingers, each a serial chain of joint screws in the grasp's
 frame (:class:`Hand`).  The math lives in ``grasptwist.engine.kinematics``,
-``grasptwist.engine.hands`` and ``grasptwist.engine.ik``, URDF reading in
-``grasptwist.io.urdf``; this module gathers them.
+``grasptwist.engine.hands``, ``grasptwist.engine.ik`` and ``grasptwist.engine.placement``
+(:func:`place`: a hand put on its contacts, the one placement every command uses), URDF
+reading in ``grasptwist.io.urdf``; this module gathers them, and imports nothing that runs the
+command line: a grasp file's hand placed and its fingers checked as every command does is the
+core's (:func:`grasptwist.place_grasp`, :func:`grasptwist.finger_collisions`).
 
 >>> import numpy as np
 >>> from grasptwist import hand
@@ -16,22 +19,13 @@ frame (:class:`Hand`).  The math lives in ``grasptwist.engine.kinematics``,
 
 from __future__ import annotations
 
-from .engine.collision import COLLISION_TOL
-from .engine.fingertips import TipContacts, sphere_radius, tip_centers, tip_contacts, tip_radii
-from .engine.hands import (
-    SEGMENT_INTERVALS,
-    HandTrack,
-    finger_states,
-    joint_positions,
-    tip_poses,
-    track,
-    velocity_limits,
-)
-from .engine.ik import IK_TOL, HandIK, hand_ik, home_tips, place_hand
+from ._moved import topic_getattr
+from .engine.fingertips import TipContacts, tip_centers, tip_contacts, tip_radii
+from .engine.hands import SEGMENT_INTERVALS, HandTrack, finger_states, joint_positions, track, velocity_limits
+from .engine.ik import IK_TOL, HandIK, hand_ik, home_tips
 from .engine.kinematics import (
     FOLLOW_TOL,
     OFF_TANGENT_FIXED,
-    RANK_TOL,
     TANGENT_FIXED,
     ChainState,
     JointRates,
@@ -42,18 +36,9 @@ from .engine.kinematics import (
     joint_screw,
     velocity_limit_ratio,
 )
+from .engine.placement import Placement, place
 from .io.urdf import load_urdf_hand
-from .model import Finger, Hand, HandPlacement, Joint
-from .run.collisions import (
-    Collision,
-    EnvironmentHit,
-    Overlap,
-    finger_collisions,
-    hand_checks_along,
-    hand_constraints,
-    with_collisions,
-)
-from .run.placement import place_grasp
+from .model import Finger, Hand, Joint
 
 __all__ = [
     "Hand",
@@ -65,13 +50,11 @@ __all__ = [
     "velocity_limits",
     "HandTrack",
     "track",
+    "SEGMENT_INTERVALS",
     "tip_radii",
     "tip_centers",
     "tip_contacts",
     "TipContacts",
-    "tip_poses",
-    "sphere_radius",
-    "SEGMENT_INTERVALS",
     "joint_screw",
     "finger_jacobian",
     "joint_rates",
@@ -80,23 +63,17 @@ __all__ = [
     "forward_kinematics",
     "JointRates",
     "ChainState",
-    "hand_ik",
-    "place_hand",
-    "place_grasp",
-    "HandPlacement",
-    "home_tips",
-    "HandIK",
-    "IK_TOL",
-    "RANK_TOL",
     "FOLLOW_TOL",
     "OFF_TANGENT_FIXED",
     "TANGENT_FIXED",
-    "finger_collisions",
-    "Collision",
-    "hand_checks_along",
-    "Overlap",
-    "EnvironmentHit",
-    "with_collisions",
-    "hand_constraints",
-    "COLLISION_TOL",
+    "hand_ik",
+    "HandIK",
+    "IK_TOL",
+    "home_tips",
+    "place",
+    "Placement",
 ]
+
+#: The names that moved out (a grasp file's hand placed and checked: ``grasptwist.place_grasp``, ...)
+#: or went (tolerances, internal now), deprecated aliases for a release (``grasptwist/_moved.py``).
+__getattr__ = topic_getattr(__name__)

@@ -129,7 +129,7 @@ class Grasp:
         ``(0, 0, -9.81)``); None without it.
     placement : HandPlacement or None
         A URDF hand not yet placed on the contacts, as the file gives it (the
-        loader only reads: :func:`grasptwist.hand.place_grasp` checks or
+        loader only reads: :func:`grasptwist.place_grasp` checks or
         solves the joint positions); None once placed, or for an inline hand.
     object : GraspObject or None
         The object the fingers hold, None when the file gives none.

@@ -60,9 +60,9 @@ def test_every_public_name_is_in_the_api_reference_and_nothing_else_is():
     assert sorted(have - want) == [], "in docs/api/*.rst but not in a public module's __all__"
 
 
-#: Names in two homes on purpose: issue 29 (later than issue 28) names the grip in the core, a
-#: control loop's one call, as well as in its topic.
-TWO_HOMES = [[f"grasptwist.{n}", f"grasptwist.forces.{n}"] for n in ("grip", "Grip", "prepare_grip", "PreparedGrip")]
+#: Names in two homes on purpose, by the core's rule (``_REEXPORTED``): issue 29 names the grip in the
+#: core, a control loop's one call, as well as in its topic.
+TWO_HOMES = [[f"grasptwist.{n}", f"grasptwist.{t}.{n}"] for n, t in gt._REEXPORTED.items()]
 
 
 def test_each_public_function_and_class_has_one_home():
@@ -82,16 +82,42 @@ def test_dir_of_the_core_shows_its_public_names_only():
         gt.nothing  # noqa: B018
 
 
+def home(place: str):
+    """The module a dotted place under ``grasptwist`` is in, and its name there."""
+    where, _, name = place.rpartition(".")
+    return module(f"grasptwist.{where}" if where else "grasptwist"), name
+
+
 @pytest.mark.parametrize("old", sorted(gt._MOVED))
-def test_a_name_moved_out_of_the_core_warns_and_is_its_new_home(old):
-    since, new = gt._MOVED[old]
+def test_a_name_moved_or_dropped_warns_and_is_its_new_home(old):
+    new, since, advice = gt._MOVED[old]
+    words = f"use grasptwist\\.{re.escape(new)}" if advice is None else re.escape(f"it is internal now ({advice})")
+    at, name = home(old)
     with pytest.warns(
-        DeprecationWarning, match=rf"^grasptwist\.{old} is deprecated since {since}: use grasptwist\.{new}$"
+        DeprecationWarning, match=rf"^grasptwist\.{re.escape(old)} is deprecated since {since}: {words}$"
     ):
-        value = getattr(gt, old)
-    topic, _, name = new.rpartition(".")
-    assert value is getattr(module(TOPICS[topic]) if topic else gt, name)
-    assert old not in gt.__all__ and old not in dir(gt)
+        value = getattr(at, name)
+    there, new_name = home(new)
+    assert value is getattr(there, new_name)
+    assert name not in at.__all__ and name not in dir(at)
+    # a moved name's new place is public, a dropped one's is not
+    assert (advice is None) == (there.__name__ in PUBLIC and new_name in there.__all__)
+
+
+def test_a_topic_s_unknown_name_is_an_attribute_error():
+    with pytest.raises(AttributeError, match="module 'grasptwist.hand' has no attribute 'nothing'"):
+        gt.hand.nothing  # noqa: B018
+
+
+def test_a_name_is_re_exported_at_the_top_level_only_by_the_rule():
+    # ARCHITECTURE.md, "The public API": a topic's name in the core too only when the core lists it (a whole
+    # job's one call and its types); it is the topic's object, and the core names the topic as its home
+    for name, topic in gt._REEXPORTED.items():
+        assert name in gt.__all__ and name in module(TOPICS[topic]).__all__
+        assert getattr(gt, name) is getattr(module(TOPICS[topic]), name)
+    topics = {id(getattr(module(m), n)) for m in PUBLIC[1:] for n in module(m).__all__}
+    twice = {n for n in gt.__all__ if not inspect.ismodule(getattr(gt, n)) and id(getattr(gt, n)) in topics}
+    assert twice == set(gt._REEXPORTED)  # not gt.Status, a name of its own beside gt.forces.Status
 
 
 def test_the_0_1_loader_path_warns_and_gives_the_core_loader():
@@ -131,7 +157,7 @@ DATA = {
     "grasptwist.forces.hold_wrench": {"rotation", "position"},  # the object's pose
     "grasptwist.forces.cannot_hold": {"times"},
     "grasptwist.hand.finger_states": {"positions"},
-    "grasptwist.hand.place_hand": {"positions"},
+    "grasptwist.hand.place": {"positions"},
     "grasptwist.hand.home_tips": {"points"},
     "grasptwist.hand.joint_screw": {"prismatic"},  # per joint, an array like the axes
     "grasptwist.path.degeneracies": {"times"},
@@ -142,6 +168,7 @@ DATA = {
     "grasptwist.pictures.twist_figure": {"twists"},
     "grasptwist.pictures.image_name": {"twist_name"},
     "grasptwist.dask.resolve_dataframe": {"twists"},
+    "grasptwist.synthesize": {"friction"},  # a Grasp brings its own
 }
 
 

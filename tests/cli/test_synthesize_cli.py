@@ -328,8 +328,9 @@ def _trifinger_available():
 @pytest.mark.slow  # over a second: docs/reference/development.md, Test time
 @pytest.mark.skipif(not _trifinger_available(), reason="needs the urdf extra and robot-properties-fingers")
 def test_trifinger_grasps_on_the_cube_are_reached_within_limits_without_collision(tmp_path):
+    from grasptwist import finger_collisions
     from grasptwist.engine.ik import IK_TOL, joint_limits
-    from grasptwist.hand import finger_collisions, forward_kinematics
+    from grasptwist.hand import forward_kinematics
 
     found = tmp_path / "found.yaml"
     args = ("--friction", "0.8", "--mass", "0.1", "-n", "4", "--candidates", "1500", "-f", "jsonl", "-o", found)
@@ -505,19 +506,23 @@ def test_a_grasp_file_needs_no_contacts_for_synthesize_only(tmp_path):
 
 @pytest.mark.slow  # development.md, Test time: the engine's count is test_synthesis.py's, in the default run
 def test_grasps_left_unverified_when_the_time_runs_out_are_counted_on_stderr(monkeypatch):
-    from functools import partial
+    from dataclasses import replace
 
     from grasptwist.engine.synthesis import search as search_module
+    from grasptwist.engine.synthesis import verify as verify_module
     from grasptwist.run import synthesize as run_synthesize
 
-    now, real = [0.0], search_module.verified
+    now, real = [0.0], verify_module.verified
 
     def one_second_each(*args, **kwargs):  # a clock moved by hand: no wall-clock assertion
         now[0] += 1.0
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(run_synthesize, "search_steps", partial(search_module.search_steps, clock=lambda: now[0]))
-    monkeypatch.setattr(search_module, "verified", one_second_each)
+    def on_our_clock(problem):  # the budget's clock is a setting of the problem: no module clock
+        return search_module.solve_steps(replace(problem, budget=replace(problem.budget, clock=lambda: now[0])))
+
+    monkeypatch.setattr(run_synthesize, "solve_steps", on_our_clock)
+    monkeypatch.setattr(verify_module, "verified", one_second_each)
     # 'sphere-tripod' one wrench: 1 s a grasp, three verified by 3 s; 'sphere-equator' two: 2 s a grasp, the
     # second verified from 2 s to 4 s (the slack: one grasp's grips), the third left
     r, _ = run("synthesize", SPHERE, "--friction", "0.5", "--mass", "1", *FAST, "-n", "3", "--seconds", "3")
@@ -576,14 +581,14 @@ def test_an_object_whose_search_raises_is_its_internal_error_record_and_the_fold
 
     for name in ("box-edge.yaml", "sphere.yaml"):
         (tmp_path / name).write_bytes((GRASPS / name).read_bytes())
-    real = run_synthesize.surface_of
+    real = run_synthesize.solve_steps
 
-    def fails_on_a_box(obj, span_bodies):  # a fault of ours on one object (0.5.0: IndexError in mesh_creases)
-        if obj.shape.kind == "box":
+    def fails_on_a_box(problem):  # a fault of ours on one object (0.5.0: IndexError in mesh_creases)
+        if problem.object.shape.kind == "box":
             raise IndexError("index 22 is out of bounds for axis 0 with size 22")
-        return real(obj, span_bodies)
+        return real(problem)
 
-    monkeypatch.setattr(run_synthesize, "surface_of", fails_on_a_box)
+    monkeypatch.setattr(run_synthesize, "solve_steps", fails_on_a_box)
     r, _ = run("synthesize", tmp_path, "--friction", "0.6", "--mass", "1", *FAST, "-f", "jsonl", "-j", workers)
     assert r.exit_code == 1 and "Traceback" not in r.stderr and "WorkerFailed" not in r.stderr
     recs = jsonl(r.stdout)

@@ -9,6 +9,7 @@ from conic import least_grip
 from grasptwist.engine.forces.closure import force_closure
 from grasptwist.engine.objects.creases import CREASE_ANGLE_DEG, edge_distance, mesh_creases
 from grasptwist.engine.objects.primitives import triangles
+from grasptwist.engine.synthesis.problem import surface_of
 from grasptwist.engine.synthesis.robustness import (
     check_friction_error,
     check_perturbations,
@@ -19,7 +20,7 @@ from grasptwist.engine.synthesis.robustness import (
     perturbation_draws,
     robustness,
 )
-from grasptwist.engine.synthesis.search import surface_of, synthesize
+from grasptwist.engine.synthesis.search import synthesize
 from grasptwist.objects import GraspObject, Shape
 
 LIFT = [[0, 0, 9.81, 0, 0, 0]]

@@ -273,7 +273,7 @@ def test_a_synthesized_grasp_keeps_to_one_body_unless_told():
 
 
 def test_span_bodies_draws_from_every_body_and_one_body_from_one():
-    from grasptwist.engine.synthesis.search import surface_of
+    from grasptwist.engine.synthesis.problem import surface_of
 
     o = mesh_object("two_bodies.obj")
     rng = np.random.default_rng(3)

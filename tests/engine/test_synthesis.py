@@ -7,14 +7,17 @@ import pytest
 from conic import closure_margin, least_grip
 from grasptwist.engine.forces.grasp_map import grasp_map
 from grasptwist.engine.objects import project_to_surface
+from grasptwist.engine.synthesis.budget import check_budget
 from grasptwist.engine.synthesis.candidates import antipodality, candidate_triples, triple_distance
+from grasptwist.engine.synthesis.problem import surface_of
 from grasptwist.engine.synthesis.scores import (
     CONSTRAINTS,
     check_min_conditioning,
     check_objective,
     score_triples,
 )
-from grasptwist.engine.synthesis.search import check_budget, surface_of, synthesize, verified
+from grasptwist.engine.synthesis.search import synthesize
+from grasptwist.engine.synthesis.verify import verified
 from grasptwist.model import GraspObject, Shape
 
 G = 9.81
@@ -251,15 +254,15 @@ class _FakeClock:
 
 
 def test_verification_stops_at_the_deadline_and_counts_the_grasps_left(monkeypatch):
-    from grasptwist.engine.synthesis import search as search_module
+    from grasptwist.engine.synthesis import verify as verify_module
 
-    clock, real = _FakeClock(), search_module.verified
+    clock, real = _FakeClock(), verify_module.verified
 
     def one_second_each(*args, **kwargs):
         clock.now += 1.0
         return real(*args, **kwargs)
 
-    monkeypatch.setattr(search_module, "verified", one_second_each)
+    monkeypatch.setattr(verify_module, "verified", one_second_each)
     # the search (no verification) takes no time on this clock: its candidates end it
     s = synthesize(ball(), 0.8, count=5, candidates=600, seconds=3.0, min_spacing=0.0, clock=clock)
     assert s.candidates == 600 and s.seconds == 3.0  # the budget, exactly
@@ -290,7 +293,7 @@ def test_the_clock_starts_after_the_warm_up_so_a_cold_run_returns_what_a_warm_on
 def test_epsilon_is_computed_at_each_grasp_s_turn_within_the_deadline(monkeypatch):
     pytest.importorskip("scipy")
     from grasptwist.engine.forces.closure import force_closure
-    from grasptwist.engine.synthesis import search as search_module
+    from grasptwist.engine.synthesis import verify as verify_module
 
     clock = _FakeClock()
 
@@ -298,7 +301,7 @@ def test_epsilon_is_computed_at_each_grasp_s_turn_within_the_deadline(monkeypatc
         clock.now += 1.0 if quality else 0.0
         return force_closure(*args, quality=quality, **kwargs)
 
-    monkeypatch.setattr(search_module, "force_closure", one_second_an_epsilon)
+    monkeypatch.setattr(verify_module, "force_closure", one_second_an_epsilon)
     s = synthesize(ball(), 0.8, count=4, candidates=120, seconds=2.5, quality=True, min_spacing=0.0, clock=clock)
     # grasps 1-3 take their epsilon at 0, 1 and 2 s; the 4th's turn comes at 3 s, past 2.5 s
     assert len(s.points) == 3 and s.unverified == 1 and s.stopped_by == "seconds" and s.seconds == 3.0
@@ -389,9 +392,9 @@ def test_a_budget_too_small_to_judge_is_the_reason_not_degeneracy(budget):
 
 
 def test_candidates_that_pass_every_test_unverified_are_not_said_to_fail_a_hand_s(monkeypatch):
-    from grasptwist.engine.synthesis import search as search_module
+    from grasptwist.engine.synthesis import verify as verify_module
 
-    monkeypatch.setattr(search_module, "verified", lambda *a, **k: None)  # no certificate proves anything
+    monkeypatch.setattr(verify_module, "verified", lambda *a, **k: None)  # no certificate proves anything
     s = synthesize(ball(), 0.6, candidates=200)
     assert len(s.points) == 0 and s.failure.constraint == "verification"
     assert "collision" not in s.failure.message and "finger" not in s.failure.message

@@ -107,7 +107,8 @@ def test_a_budget_checks_its_candidates_and_seconds():
 
 def test_a_surface_no_finite_friction_closes_is_said_so_not_that_it_needs_no_friction():
     # a plane seen from one side: every normal +z, so no friction pulls the object down (closure friction inf)
-    from grasptwist.engine.synthesis.search import Surface, search
+    from grasptwist.engine.synthesis.problem import Surface
+    from grasptwist.engine.synthesis.search import search
 
     def sample(n, rng):
         return np.c_[rng.uniform(-1, 1, (n, 2)), np.zeros(n)], np.tile([0, 0, 1.0], (n, 1))
@@ -158,10 +159,10 @@ def test_the_command_line_and_python_share_one_conditioning_floor():
     import inspect
 
     from grasptwist.cli.synthesize import synthesize as command
+    from grasptwist.engine.synthesis.problem import surface_problem
     from grasptwist.engine.synthesis.scores import MIN_CONDITIONING, score_triples
-    from grasptwist.engine.synthesis.search import search_steps
 
     option = inspect.signature(command).parameters["min_conditioning"].default
     assert MIN_CONDITIONING == 0.05 == option
-    for f in (search_steps, score_triples):
+    for f in (surface_problem, score_triples):
         assert inspect.signature(f).parameters["min_conditioning"].default == MIN_CONDITIONING

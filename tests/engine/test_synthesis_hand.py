@@ -8,8 +8,9 @@ import pytest
 
 from grasptwist.engine.ik import IK_TOL, joint_limits
 from grasptwist.engine.kinematics import forward_kinematics
+from grasptwist.engine.synthesis.problem import hand_reach
 from grasptwist.engine.synthesis.reach import HAND_CONSTRAINTS, HandReach, check_hand_reach, reach
-from grasptwist.engine.synthesis.search import hand_reach, synthesize
+from grasptwist.engine.synthesis.search import synthesize
 from grasptwist.io.grasp import read_grasps
 from grasptwist.model import Finger, GraspObject, Hand, Joint, Shape
 from places import GRASPS

@@ -50,7 +50,7 @@ PINNED_ERRORS = """
     invalid-density invalid-duration invalid-frame invalid-friction invalid-key invalid-limit invalid-mass
     invalid-mesh invalid-name invalid-object invalid-pose invalid-radius invalid-rotation invalid-scale
     invalid-size invalid-torsion invalid-urdf invalid-utf8 mesh-not-solid mesh-unavailable missing-key
-    no-friction no-grasp no-grasp-files no-mass no-object no-path no-tip-points no-twist non-finite
+    no-friction no-grasp no-grasp-files no-mass no-object no-path no-tip-points no-twist no-weight non-finite
     not-a-list not-a-mapping not-a-number not-a-string nothing-to-hold object-below-table outside-limits
     output-is-input outward-normal package-not-found path-outside read-error scene-error
     simulation-unstable tolerance-too-large too-deep too-large too-many-documents too-many-errors
@@ -142,16 +142,16 @@ def test_a_search_s_constraints_are_the_table_s():
     from grasptwist.engine.synthesis.clearance import ClearTriples
     from grasptwist.engine.synthesis.scores import CONSTRAINTS
 
-    search = (SRC / "engine" / "synthesis" / "search.py").read_text("utf-8")
-    failures = set(re.findall(r'Failure\(\s*"(\w+)"', search))  # those the search names itself
+    diagnosis = (SRC / "engine" / "synthesis" / "diagnosis.py").read_text("utf-8")
+    failures = set(re.findall(r'Failure\(\s*"(\w+)"', diagnosis))  # those the search names itself
     assert set(NO_GRASP_CONSTRAINTS) == {*CONSTRAINTS, ClearTriples.name, *failures}
     assert failures == {"budget", "verification"}
 
 
 def test_one_name_for_the_error_of_every_input():
     said = [str(path.relative_to(SRC)) for path in SRC.rglob("*.py") if "GraspFileError" in path.read_text("utf-8")]
-    # the core's deprecated alias, the 0.1 path's, and the class's own word of its old name
-    assert sorted(said) == ["__init__.py", "io/grasp_file.py", "model.py"]
+    # the deprecated alias (_moved.py), the 0.1 path's, and the class's own word of its old name
+    assert sorted(said) == ["_moved.py", "io/grasp_file.py", "model.py"]
     with pytest.warns(
         DeprecationWarning, match=r"GraspFileError is deprecated since 0\.6: use grasptwist\.InputError$"
     ):

@@ -252,7 +252,7 @@ def test_a_comment_and_script_opening_in_a_name_stay_in_the_figures_json(tmp_pat
 def test_a_urdf_hands_meshes_are_posed_at_its_joint_positions_touching_the_contacts():
     pytest.importorskip("yourdfpy")
     pytest.importorskip("robot_properties_fingers")
-    from grasptwist.hand import place_grasp
+    from grasptwist import place_grasp
     from grasptwist.io.urdf_meshes import hand_meshes
     from grasptwist.plot import grasp_page
     from grasptwist.plot.traces import MESH_NAME

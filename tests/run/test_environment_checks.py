@@ -31,7 +31,7 @@ TRIFINGER = ROOT / "grasps" / "trifinger-cube.yaml"
 def placed():
     """The bundled TriFinger grasp, placed on its cube on its table."""
     (g,) = gt.read_grasps(TRIFINGER)
-    return gt.hand.place_grasp(g)
+    return gt.place_grasp(g)
 
 
 @needs_trifinger
@@ -152,10 +152,11 @@ def test_gt_synthesize_puts_the_command_lines_checks_on_a_hand(monkeypatch):
 
     (g,) = gt.read_grasps(GRASPS / "three-finger-hand.yaml")
     seen = {}
-    monkeypatch.setattr(search, "search_object", lambda obj, friction, **kw: seen.update(kw))
+    monkeypatch.setattr(search, "solve", lambda problem: seen.update(problem=problem))
     tips = gt.hand.home_tips(g.hand, g.points)
-    gt.synthesize(g.object, 0.8, hand=g.hand, tips=tips, environment=Environment(-1.0), count=1)
-    hand = seen["hand"]
+    up = [[0, 0, 1.0, 0, 0, 0]]  # the object has no mass: a wrench to hold
+    gt.synthesize(g.object, 0.8, hand=g.hand, tips=tips, environment=Environment(-1.0), wrenches=up, hold=False)
+    hand = seen["problem"].hand
     assert hand.environment.table_height == -1.0 and hand.clearance == 0.001 and hand.hulls is not None
 
 
@@ -166,16 +167,18 @@ def test_gt_synthesize_of_a_grasp_takes_its_files_object_hand_environment_and_wr
     (g,) = gt.read_grasps(GRASPS / "three-finger-hand.yaml")
     g = replace(g, environment=Environment(-1.5), wrist=np.array([0.0, 0, 3.0]))
     seen = {}
-    monkeypatch.setattr(search, "search_object", lambda obj, friction, **kw: seen.update(kw, obj=obj))
-    gt.synthesize(g, 0.8, count=1)
+    monkeypatch.setattr(search, "solve", lambda problem: seen.update(problem=problem))
+    gt.synthesize(g, 0.8, count=1, wrenches=[[0, 0, 1.0, 0, 0, 0]])  # its object has no mass
     tips = gt.hand.home_tips(g.hand, g.points)  # the inline tips at home on the file's contacts (tip radius 0)
-    assert seen["obj"] is g.object and seen["environment"] is g.environment and seen["wrist"].tolist() == [0, 0, 3.0]
-    assert seen["hand"].environment.table_height == -1.5 and seen["hand"].hand is g.hand
-    np.testing.assert_allclose(seen["tips"], tips, atol=1e-12)
-    gt.synthesize(g, 0.8, environment=Environment(-2.0), wrist=None)  # what is given wins
-    assert seen["environment"].table_height == -2.0 and seen["wrist"] is None
-    with pytest.raises(ValueError, match="has no object to search"):
+    p = seen["problem"]
+    assert p.object is g.object and p.environment is g.environment and p.wrist.tolist() == [0, 0, 3.0]
+    assert p.hand.environment.table_height == -1.5 and p.hand.hand is g.hand
+    np.testing.assert_allclose(p.hand.tips, tips, atol=1e-12)
+    gt.synthesize(g, 0.8, environment=Environment(-2.0), wrist=None, wrenches=[[0, 0, 1.0, 0, 0, 0]])  # given wins
+    assert seen["problem"].environment.table_height == -2.0 and seen["problem"].wrist is None
+    with pytest.raises(gt.InputError, match="has no object to search") as raised:
         gt.synthesize(replace(g, object=None), 0.8)
+    assert raised.value.code == "no-object"
 
 
 def test_a_grasp_files_table_keeps_gt_synthesizes_contacts_off_it(tmp_path):

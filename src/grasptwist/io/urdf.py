@@ -309,7 +309,7 @@ def load_urdf_hand(urdf, tips, *, names=None, folder=None, max_bytes=MAX_URDF_BY
     ``tip_radius`` is that of the tip link's spherical collision geometry
     about the link's origin: a ``<sphere>`` centred there, or a mesh that is
     a sphere or a cap of one about it
-    (:func:`grasptwist.hand.sphere_radius`, the TriFinger's
+    (``grasptwist.engine.fingertips.sphere_radius``, the TriFinger's
     fingertips); 0 (a point tip) without one, or when the mesh cannot be
     read (a ``package://`` of no installed Python package, a format trimesh
     does not read): a grasp file's ``tip_radius`` then gives it.

@@ -34,7 +34,6 @@ __all__ = [
     "with_reasons",
     "dataset_blocks",
     "check_positions",
-    "hand_placement",
     "ROWS_PER_BLOCK",
     "NO_TWIST",
     "UNKNOWN_TWIST",
@@ -225,7 +224,7 @@ def resolve_arrays(
     outputs that do not show them (npz).  ``hands`` (per row a Hand or None)
     with ``joint_screws (N, 3, J, 6)`` and ``joint_limits (N, 3, J)``
     (:func:`grasptwist.engine.hands.padded`) adds the kinds that need them;
-    ``placement`` (:func:`hand_placement`) says where the hands are.
+    ``placement`` (:meth:`~grasptwist.engine.placement.Placement.fields`) says where the hands are.
     ``has_wrist`` (per row) says which rows have a wrist; by default those
     whose wrist is finite.
     """
@@ -384,7 +383,7 @@ def _hand_inputs(grasps) -> dict:
 
     # the hand math loads with the first hand: runs without one never pay for it (bench/startup.py)
     from ..engine import hands
-    from ..engine.fingertips import tip_centers, tip_radii
+    from ..engine.placement import home_at, place
 
     width = max(len(f.joints) for g in grasps if g.hand is not None for f in g.hand.fingers)
     made = {}  # each grasp's fingers once, whatever its number of twists
@@ -392,8 +391,8 @@ def _hand_inputs(grasps) -> dict:
         if g.hand is not None and id(g) not in made:
             states = hands.finger_states(g.hand, g.joint_positions)
             # the loader placed the hand (given and checked, or solved): its tip errors at those positions
-            home = tip_centers(g.points, g.normals, tip_radii(g.hand))
-            placement = hand_placement(g.hand, g.points, g.normals, g.joint_positions, home=home, width=width)[1]
+            home = home_at(g.hand, g.points, g.normals)
+            placement = place(g.hand, g.points, g.normals, g.joint_positions, home=home).fields(width)
             made[id(g)] = (hands.padded(g.hand, [s.screws for s in states], width), placement)
     nan3 = np.full(3, np.nan)
     none = ((np.zeros((3, width, 6)), np.full((3, width), np.nan)), {})
@@ -409,40 +408,6 @@ def _hand_inputs(grasps) -> dict:
     }
     placement = {k: np.stack([r[1].get(k, v) for r in rows]) for k, v in empty.items()}
     return {"hands": [g.hand for g in grasps], "joint_screws": screws, "joint_limits": limits, "placement": placement}
-
-
-def hand_placement(hand, points, normals, positions=None, *, home=None, width=None) -> tuple:
-    """A hand placed with each fingertip's centre on ``p - r n`` (:mod:`grasptwist.engine.fingertips`),
-    and a block's ``placement`` of it.
-
-    ``positions`` are checked, or else solved for (:func:`~grasptwist.engine.ik.place_hand`);
-    ``home`` ``(3, 3)``: the centres the fingers given inline touch at home (None: those
-    fingers are unchecked).
-
-    Returns
-    -------
-    placed : HandIK
-    placement : dict
-        ``joint_positions (..., 3, width)``, ``tip_error (..., 3)``, ``within_limits (..., 3)``,
-        ``tip_center (..., 3, 3)``, ``tip_gap (..., 3)`` and ``tip_contact (..., 3, 3)``.
-    """
-    from ..engine import hands
-    from ..engine.fingertips import tip_centers, tip_contacts, tip_radii
-    from ..engine.ik import home_tips, place_hand
-
-    radii = tip_radii(hand)
-    centers = tip_centers(points, normals, radii)
-    placed = place_hand(hand, centers, positions, tips=None if home is None else home_tips(hand, home))
-    at_home = home_tips(hand, centers if home is None else home)
-    touch = tip_contacts(hands.tip_poses(hand, placed.positions, at_home), points, normals, radii)
-    return placed, {
-        "joint_positions": hands.padded_positions(hand, placed.positions, width),
-        "tip_error": placed.tip_error,
-        "within_limits": placed.within_limits,
-        "tip_center": centers,
-        "tip_gap": touch.gap,
-        "tip_contact": touch.contact,
-    }
 
 
 def selected_twists(grasp: Grasp, names: Sequence[str]) -> Grasp | InputError:
@@ -536,14 +501,17 @@ def check_positions(ds, hand_of_rows) -> None:
 
 def _rows_hand(ds, hand_of_rows, start, stop, rows, points, normals):
     """The hand keywords of :func:`resolve_arrays` for rows ``start:stop`` of a data set, and the
-    hand placed on each row's contacts (:func:`~grasptwist.engine.ik.place_hand`: the rows' joint
+    hand placed on each row's contacts (:func:`~grasptwist.engine.placement.place`: the rows' joint
     positions checked, or solved for when the data set has none)."""
     if hand_of_rows is None:
         return {}, None
     from ..engine import hands
 
     q = None if ds.joint_positions is None else np.asarray(ds.joint_positions[start:stop], dtype=float)[rows]
-    placed, placement = hand_placement(hand_of_rows, points, normals, q)
+    from ..engine.placement import place
+
+    placement = place(hand_of_rows, points, normals, q)
+    placed = placement.ik
     states = hands.finger_states(hand_of_rows, placed.positions)
     screws, limits = hands.padded(hand_of_rows, [s.screws for s in states])
     n = len(points)
@@ -551,7 +519,7 @@ def _rows_hand(ds, hand_of_rows, start, stop, rows, points, normals):
         "hands": [hand_of_rows] * n,
         "joint_screws": screws,
         "joint_limits": np.broadcast_to(limits, (n, *limits.shape)),
-        "placement": placement,
+        "placement": placement.fields(),
     }, placed
 
 

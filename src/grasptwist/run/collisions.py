@@ -38,8 +38,8 @@ from ..engine.collision import (
     tip_sphere,
 )
 from ..engine.environment import clearance_of, has_obstacles, needs_checks, obstacle_name, parts_distance
-from ..engine.fingertips import tip_centers, tip_radii
-from ..engine.ik import home_tips
+from ..engine.fingertips import tip_radii
+from ..engine.placement import home_at
 from ..io.limits import MAX_URDF_BYTES
 from ..io.urdf_meshes import grasp_folder, link_geometry
 from ..model import Grasp, InputError
@@ -290,11 +290,11 @@ def hand_constraints(
     --------
     >>> import grasptwist as gt
     >>> (g,) = gt.read_grasps("grasps/trifinger-cube.yaml")
-    >>> reach = gt.hand.hand_constraints(g.object, g.hand, environment=g.environment, folder="grasps")
+    >>> reach = hand_constraints(g.object, g.hand, environment=g.environment, folder="grasps")
     >>> len(reach.hulls.links), reach.environment.table_height, reach.clearance
     (12, 0.0, 0.001)
     """
-    from ..engine.synthesis.search import hand_reach  # the search's: with the first one asked for
+    from ..engine.synthesis.problem import hand_reach  # the search's: with the first one asked for
 
     checked = _checked(hand, obj, folder, max_bytes)
     collide = None
@@ -331,19 +331,19 @@ def finger_collisions(grasp: Grasp, joint_positions) -> tuple[Collision, ...]:
     Returns
     -------
     tuple of Collision
-        Each link deeper than :data:`~grasptwist.hand.COLLISION_TOL` times the object's size, naming its
+        Each link deeper than ``grasptwist.engine.collision.COLLISION_TOL`` times the object's size, naming its
         finger, link and depth; the fingertip spheres touching their contacts are no collision
         (docs/guide/hands.md, "Fingers through the object").
 
     Raises
     ------
     InputError
-        The URDF's or a mesh's, as :func:`~grasptwist.hand.place_grasp` reports them.
+        The URDF's or a mesh's, as :func:`~grasptwist.place_grasp` reports them.
 
     Examples
     --------
     >>> import grasptwist as gt
-    >>> g = gt.hand.place_grasp(gt.read_grasps("grasps/trifinger-cube.yaml")[0])
+    >>> g = gt.place_grasp(gt.read_grasps("grasps/trifinger-cube.yaml")[0])
     >>> finger_collisions(g, g.joint_positions)  # the fingertips touch the cube, nothing else does
     ()
     """
@@ -357,7 +357,7 @@ def _parts(grasp, max_bytes):
     hulls = _hulls(hand, grasp_folder(grasp), max_bytes)
     radii = tip_radii(hand)
     # an inline hand is at home where its file gives it: its tip points on the contacts' sphere centres
-    tips = home_tips(hand, tip_centers(grasp.points, grasp.normals, radii))
+    tips = home_at(hand, grasp.points, grasp.normals)
     labels = [(names[g.finger], g.link) for g in hulls.links]
     labels += [(names[f], finger.tip or "fingertip") for f, finger in enumerate(hand.fingers)]
     return hulls, tips, radii, labels
@@ -392,7 +392,7 @@ def hand_checks_along(grasp: Grasp, *, joint_positions=None, max_bytes=MAX_URDF_
     Examples
     --------
     >>> import grasptwist as gt
-    >>> g = gt.hand.place_grasp(gt.read_grasps("grasps/trifinger-cube.yaml")[0])
+    >>> g = gt.place_grasp(gt.read_grasps("grasps/trifinger-cube.yaml")[0])
     >>> overlaps, hits, clearance = hand_checks_along(g)
     >>> overlaps, hits, clearance.round(4).tolist()  # its lowest fingertip sphere is 5 mm above the table
     ([()], [()], [0.005])
@@ -448,7 +448,7 @@ def with_collisions(grasp: Grasp) -> Grasp | InputError:
     Examples
     --------
     >>> import grasptwist as gt
-    >>> g = gt.hand.place_grasp(gt.read_grasps("grasps/trifinger-cube.yaml")[0])  # checked there
+    >>> g = gt.place_grasp(gt.read_grasps("grasps/trifinger-cube.yaml")[0])  # checked there
     >>> g.warnings
     ()
     """

@@ -26,12 +26,12 @@ import numpy as np
 
 from ..engine import hands
 from ..engine.degeneracy import radians_warning
-from ..engine.fingertips import tip_centers, tip_radii
 from ..engine.forces.grip import Grip
 from ..engine.forces.hold import HoldStretch, Unjudged, grip_along, hold_verdicts
 from ..engine.hands import HandTrack
 from ..engine.judgements import rotation_over_pi
 from ..engine.path import PathDegeneracies, Poses, degeneracies, follow, pose_overflowed
+from ..engine.placement import home_at, place
 from ..io.datasets import DATASET_SUFFIXES
 from ..io.limits import MAX_SAMPLES
 from ..model import Grasp, InputError, ObjectPath
@@ -39,7 +39,7 @@ from ..output import follow_records as fr
 from ..output.formats import FORMATS
 from ..output.records import diagnostics, error_record
 from ..results import BY_KEY, selected
-from .batch import Block, hand_placement, with_reasons
+from .batch import Block, with_reasons
 from .collisions import CODES, PathCollisions
 from .options import FollowOptions
 from .outputs import Output
@@ -236,8 +236,8 @@ def _block(grasp, name, f, bases, method, positions=None) -> Block:
         states = hands.finger_states(grasp.hand, positions)
         screws, limits = hands.padded(grasp.hand, [s.screws for s in states])
         # where each fingertip is against its moving contact (the tracker's error, the gap), in the records
-        home = tip_centers(grasp.points, grasp.normals, tip_radii(grasp.hand))
-        placement = hand_placement(grasp.hand, f.points, f.normals, positions, home=home)[1]
+        home = home_at(grasp.hand, grasp.points, grasp.normals)
+        placement = place(grasp.hand, f.points, f.normals, positions, home=home).fields()
         inputs = {"joint_screws": screws, "joint_limits": limits, "points": f.points, "twist": f.poses.twist}
         inputs["placement"] = placement
         # where the pose overflows, the hand's rates are no result of the path either (as the methods')

@@ -4,7 +4,7 @@ The loader only reads (:mod:`grasptwist.io.grasp.hand`): a grasp whose URDF
 hand is not yet on its contacts carries a :class:`~grasptwist.model.HandPlacement`,
 the joint positions the file gives (to check) or its seed (to solve from),
 and where each finger's ``tip`` stood in the file.  :func:`place_grasp` runs the
-engine (:func:`grasptwist.engine.ik.place_hand`) and gives the grasp at its
+engine (:func:`grasptwist.engine.placement.place`) and gives the grasp at its
 placed joint positions, or its error: each finger that cannot be put on
 its contact (``contact-off-finger``, ``unreachable``, ``outside-limits``)
 located at its ``tip``, coded and worded as a loader's problem.  Every
@@ -38,7 +38,7 @@ def place_grasp(grasp: Grasp) -> Grasp | InputError:
     positions are solved from the seed (inverse kinematics): each tip link's origin, the
     centre of its fingertip's sphere, on ``point - tip_radius * normal``
     (:func:`grasptwist.hand.tip_centers`).  Every grasp's fingers are then checked
-    (:func:`grasptwist.hand.with_collisions`: links in the object, fingers into each other,
+    (``grasptwist.run.collisions.with_collisions``: links in the object, fingers into each other,
     parts too near its environment: warnings).
 
     Parameters
@@ -57,7 +57,7 @@ def place_grasp(grasp: Grasp) -> Grasp | InputError:
     --------
     >>> import grasptwist as gt
     >>> (g,) = gt.read_grasps("grasps/three-finger-hand.yaml")  # an inline hand: nothing to place
-    >>> gt.hand.place_grasp(g) is g
+    >>> gt.place_grasp(g) is g
     True
     """
     p = grasp.placement
@@ -68,13 +68,13 @@ def place_grasp(grasp: Grasp) -> Grasp | InputError:
 
         return with_collisions(grasp)
     # inverse kinematics loads with the first URDF hand
-    from ..engine.fingertips import tip_centers, tip_radii
-    from ..engine.ik import place_hand
+    from ..engine.placement import place
 
     hand, q = grasp.hand, grasp.joint_positions
     # each tip link's origin, the centre of its fingertip's sphere, goes r behind the contact
-    centers = tip_centers(grasp.points, grasp.normals, tip_radii(hand))
-    solved = place_hand(hand, centers, q) if p.given else place_hand(hand, centers, seed=q)
+    solved = (
+        place(hand, grasp.points, grasp.normals, q) if p.given else place(hand, grasp.points, grasp.normals, seed=q)
+    ).ik
     problems = Problems(MAX_ERRORS)
     for f, finger in enumerate(hand.fingers):
         status = Status(int(solved.status[f]))

@@ -22,7 +22,7 @@ import numpy as np
 
 from ..engine.hold_test import check_distance_tol
 from ..engine.objects.geometry import mass_properties, object_size
-from ..engine.synthesis.search import Failure
+from ..engine.synthesis.diagnosis import Failure
 from ..io.urdf_meshes import grasp_folder, urdf_files
 from ..model import Grasp, InputError
 from ..output import simulate_records as sr
@@ -382,7 +382,7 @@ def simulate(
     Parameters
     ----------
     grasp : Grasp
-        With an object; a URDF hand placed (:func:`grasptwist.hand.place_grasp`), as
+        With an object; a URDF hand placed (:func:`grasptwist.place_grasp`), as
         :func:`grasptwist.read_grasps` gives it.
     mass, friction : float, optional
         Replace the grasp's (its object's mass, density or the file's ``mass``; its ``friction``).

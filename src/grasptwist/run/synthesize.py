@@ -7,7 +7,9 @@ every grasp: its fingertips (``--tip-radius``, else each finger's ``tip_radius``
 surface, its joints within their limits, its links (a URDF's meshes) out of the object; a
 hand given inline has its tips where the file's contacts are (its joints are given there).  The command
 line's ``--friction`` and ``--mass`` replace the file's; ``--wrench`` replaces its other wrenches, beside
-the weight (``hold``), which is held whenever there is a mass.  The search is :func:`grasptwist.engine.synthesis.search.search`; with ``-o
+the weight (``hold``), which is held whenever there is a mass.  Each document's problem is
+:func:`grasptwist.run.grasp_search.grasp_problem`'s (the library's and Dask's too), searched by
+:func:`grasptwist.engine.synthesis.search.solve_steps`; with ``-o
 FILE.yaml`` the grasps found are also written as a grasp file (atomically, at the end).
 No math here: only reading, routing and labelling.
 """
@@ -21,10 +23,8 @@ from typing import NamedTuple
 
 import numpy as np
 
-from ..engine.forces.hold import Weight, hold_wrench, object_weight
-from ..engine.synthesis.clearance import environment_search, grasp_clearance
-from ..engine.synthesis.scores import METHODS, MIN_CONDITIONING
-from ..engine.synthesis.search import GRAVITY, Synthesis, search_steps, surface_of
+from ..engine.synthesis.clearance import grasp_clearance
+from ..engine.synthesis.search import Synthesis, solve_steps
 from ..engine.units import fingers_reach, hand_fit_warning, largest_extent, mesh_span_warning
 from ..io.grasp.forces import HOLD
 from ..io.inputs import read as read_unplaced
@@ -35,8 +35,7 @@ from ..output import synthesis_records as sr
 from ..output.formats import FORMATS
 from ..output.names import escaped
 from ..output.records import diagnostics, dumps, error_record
-from .grasp_search import file_tips
-from .options import SynthesisOptions
+from .grasp_search import grasp_problem, search_options
 from .outputs import Output
 from .pool import Pool, pool_size
 from .target import opened
@@ -48,22 +47,7 @@ __all__ = [
     "synthesize_outputs",
     "searched",
     "input_records",
-    "NO_OBJECT",
-    "NOTHING_TO_HOLD",
-    "NO_FRICTION",
-    "NO_TIP_POINTS",
-    "UNSEARCHABLE_HAND",
 ]
-
-#: Error codes of an input the search cannot start from.
-NO_OBJECT, NOTHING_TO_HOLD, NO_FRICTION = "no-object", "nothing-to-hold", "no-friction"
-
-#: An inline hand without the contacts its tips touch (``--hand`` with a mesh); a hand whose
-#: fingers share joints (the search solves each finger on its own).
-NO_TIP_POINTS, UNSEARCHABLE_HAND = "no-tip-points", "unsearchable-hand"
-
-#: A weight beyond a double (``--mass`` times the file's gravity): the grasp file's own code for it.
-NON_FINITE = "non-finite"
 
 
 @dataclass(frozen=True, eq=False)
@@ -98,103 +82,13 @@ class Found:
         return len(self.synthesis.points)
 
 
-def _problem(file, code, message, line=None) -> InputError:
-    return InputError(code, message, file, line, None)
-
-
-def _task(options: SynthesisOptions, grasp: Grasp):
-    """What one grasp document asks: ``(object, friction, names, wrenches, hold)``, or its error."""
-    if grasp.object is None:
-        return _problem(grasp.file, NO_OBJECT, f"grasp '{grasp.name}' has no object to search", grasp.line)
-    obj = grasp.object if options.mass is None else replace(grasp.object, mass=options.mass, density=None)
-    if options.friction is not None:
-        friction = options.friction
-    elif grasp.friction is not None:
-        friction = float(np.min(grasp.friction))  # the contacts found are none of the file's: the least
-    else:
-        return _problem(grasp.file, NO_FRICTION, f"grasp '{grasp.name}' has no friction: give --friction", grasp.line)
-    # --wrench replaces the file's other wrenches; the weight is always held (beside them)
-    named = [] if options.wrenches is not None else [(w.name, w.wrench) for w in grasp.wrenches if w.name != HOLD]
-    named += [(w.name, w.wrench) for w in options.wrenches or ()]
-    hold = None
-    if options.mass is not None or grasp.mass is not None:
-        gravity = np.asarray(GRAVITY if grasp.gravity is None else grasp.gravity, float)
-        with np.errstate(over="ignore", invalid="ignore"):  # an overflow is said below
-            weight = object_weight(obj, gravity)
-        if weight is None:  # a weight apart from the object: the file's top-level mass and center_of_mass
-            mass, center = grasp.mass, grasp.center_of_mass
-            weight = Weight(mass, center, gravity, hold_wrench(mass, center, gravity))
-        if not np.isfinite(weight.wrench).all():  # --mass 1e308: as the same mass in the file is
-            return _problem(
-                grasp.file,
-                NON_FINITE,
-                f"grasp '{grasp.name}': the weight or its moment about the origin overflows "
-                "(mass x gravity, center_of_mass x weight)",
-                grasp.line,
-            )
-        hold = (weight.mass, weight.center_of_mass, weight.gravity)
-        named.insert(0, (HOLD, weight.wrench))
-    if not named:
-        return _problem(
-            grasp.file,
-            NOTHING_TO_HOLD,
-            f"grasp '{grasp.name}' has nothing to hold: give the object a mass (--mass) or --wrench",
-            grasp.line,
-        )
-    return obj, friction, tuple(n for n, _ in named), np.array([w for _, w in named]), hold
-
-
-def _hand(job, grasp: Grasp, obj: GraspObject):
-    """The hand that must reach the grasps of ``grasp`` (``(HandReach, Hand, its file)``), None
-    without one, or the error of the document."""
-    given = job.options.hand_file is not None  # --hand; else job.hand only names the columns (the file's)
-    hand = job.hand if given else grasp.hand
-    if hand is None:
-        return None
-    radius = job.options.tip_radius
-    if radius is not None:
-        hand = replace(hand, fingers=tuple(replace(f, tip_radius=radius) for f in hand.fingers))
-    # an inline finger's tip point is where the file's contact is (its joints are given at that configuration)
-    tips = None
-    if any(f.tip_pose is None for f in hand.fingers):
-        if given or np.isnan(grasp.points).any():  # --hand, a mesh, a document without contacts
-            return _problem(
-                grasp.file,
-                NO_TIP_POINTS,
-                "an inline hand has no tip points without the contacts its fingers touch: put it in a grasp file",
-                grasp.line,
-            )
-        tips = file_tips(grasp, hand)
-    from ..io.urdf_meshes import grasp_folder  # the finger links' meshes: with the first URDF hand
-    from .collisions import hand_constraints
-
-    # a URDF's meshes are found from the file that names it: the grasp file, or --hand's
-    named_by = replace(grasp, file=job.options.hand_file if given else grasp.file)
-    try:
-        reach = hand_constraints(
-            obj,
-            hand,
-            environment=grasp.environment,
-            tips=tips,
-            folder=grasp_folder(named_by),
-        )
-        return reach, hand
-    except InputError as exc:
-        return InputError(exc.code, f"hand: {exc.message}", grasp.file, grasp.line, None, grasp.document)
-    except ValueError as exc:
-        return _problem(grasp.file, UNSEARCHABLE_HAND, str(exc), grasp.line)
-
-
 def _inline_joints(hand, synthesis):
     """An inline hand's joints moved to each grasp's joint positions (its file gives them there)."""
     if hand is None or hand.source is not None:
         return None
-    from ..engine.kinematics import forward_kinematics
+    from ..engine.placement import joints_at
 
-    return tuple(
-        tuple(forward_kinematics(f.screws, f.points, None, q[list(f.joint_index)])[:2] for f in hand.fingers)
-        for q in synthesis.joint_positions
-    )
+    return tuple(joints_at(hand, q) for q in synthesis.joint_positions)
 
 
 def _mesh_grasp(path: str, job) -> Grasp | InputError:
@@ -300,46 +194,31 @@ def synthesize_inputs(job, inputs: Iterable) -> Iterator[InputError | Found | Pr
 
 def _internal(file, line, exc: Exception) -> InputError:
     """The ``internal-error`` record of an object whose reading or search raised ``exc``."""
-    return _problem(file, "internal-error", f"{type(exc).__name__}: {exc}", line)
+    return InputError("internal-error", f"{type(exc).__name__}: {exc}", file, line, None)
 
 
 def _searched_entry(job, entry: Grasp) -> Iterator[InputError | Found | Progress]:
     """One grasp document's search (:func:`synthesize_inputs`): its errors, or its progress and what it found."""
     o = job.options
-    task = _task(o, entry)
+    given = o.hand_file is not None  # --hand; else job.hand only names the columns (the file's)
+    task = grasp_problem(
+        entry,
+        friction=o.friction,
+        mass=o.mass,
+        wrenches=o.wrenches,
+        hand=job.hand if given else None,
+        hand_file=o.hand_file,
+        tip_radius=o.tip_radius,
+        **search_options(o),
+    )
     if isinstance(task, InputError):
         yield task
         return
-    obj, friction, names, wrenches, hold = task
-    hand = _hand(job, entry, obj)
-    if isinstance(hand, InputError):
-        yield hand
-        return
-    reach, hand = hand if hand is not None else (None, None)
+    problem, hand = task.problem, task.hand
+    obj, reach = problem.object, problem.hand
     said = _object_warnings(entry, obj, hand)
     yield Progress(o.candidates, 0)
-    surface, clear = environment_search(surface_of(obj, o.span_bodies), entry.environment, None, reach)
-    for step in search_steps(
-        surface,
-        wrenches,
-        friction,
-        count=o.count,
-        safety=o.safety,
-        objective=o.objective,
-        wrist=entry.wrist,
-        methods=METHODS if o.method == "both" else (o.method.replace("-", "_"),),
-        min_conditioning=MIN_CONDITIONING if o.min_conditioning is None else o.min_conditioning,
-        min_spacing=o.min_spacing,
-        constraints=clear,
-        hand=reach,
-        quality=o.quality,
-        seed=o.seed,
-        candidates=o.candidates,
-        seconds=o.seconds,
-        position_error=o.position_error,
-        friction_error=o.friction_error,
-        perturbations=o.perturbations,
-    ):
+    for step in solve_steps(problem):
         if isinstance(step, int):
             yield Progress(0, step)
     yield Progress(0, o.candidates - step.candidates)  # the budget left unspent
@@ -350,10 +229,10 @@ def _searched_entry(job, entry: Grasp) -> Iterator[InputError | Found | Progress
         entry.units,
         entry.wrist,
         obj,
-        friction,
-        names,
-        wrenches,
-        hold,
+        task.friction,
+        task.names,
+        problem.wrenches,
+        None if problem.weight is None else tuple(problem.weight[:3]),
         step,
         entry.contact_names,
         hand=hand,

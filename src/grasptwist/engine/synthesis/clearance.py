@@ -70,7 +70,7 @@ def clear_surface(surface, environment, radius, clearance):
     (:class:`ClearTriples`) then rejects its candidates.
 
     >>> from grasptwist.model import Environment, GraspObject, Shape
-    >>> from grasptwist.engine.synthesis.search import surface_of
+    >>> from grasptwist.engine.synthesis.problem import surface_of
     >>> cube = GraspObject(Shape("box", np.full(3, 0.065)), np.eye(4))  # its bottom face on z = -0.0325
     >>> s = clear_surface(surface_of(cube), Environment(-0.0325), 0.0, 0.001)
     >>> p, n = s.sample(600, np.random.default_rng(0))

@@ -230,7 +230,7 @@ def robustness(
     Parameters
     ----------
     surface : Surface
-        :class:`~grasptwist.engine.synthesis.search.Surface`: its ``project`` puts the moved
+        :class:`~grasptwist.engine.synthesis.problem.Surface`: its ``project`` puts the moved
         contacts back, its ``edges`` (None: no creases) says which landed on a crease.
     points, normals : (K, 3, 3)
     wrenches : (W, 6)

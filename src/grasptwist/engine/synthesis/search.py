@@ -17,6 +17,11 @@ r"""The search: candidate triples scored in chunks, the best refined on the surf
    ``gap``, ``n_i - G_i^T dual`` in every dual cone) proves the total optimal; one that
    fails is not returned.  The grasps returned get their margins (:func:`~.robustness.margins`).
 
+The problem (:mod:`~.problem`: the object's surface, the wrenches, the hand, the environment, the
+options and the budget) is built once, by :func:`~.problem.synthesis_problem` for every front door;
+this module is the loop that runs it (:func:`solve`).  Verification is :mod:`~.verify`'s, the
+reason for finding nothing :mod:`~.diagnosis`'s, the grasps kept apart :mod:`~.archive`'s.
+
 The budget (:mod:`~.budget`) holds: the search stops after ``candidates`` scored rows or
 ``(1 - VERIFY_SHARE) seconds``, whichever comes first, checked after every chunk; the rest of
 ``seconds`` is selection's and verification's, which stops at the deadline (checked before each
@@ -28,83 +33,36 @@ the candidates ended (``stopped_by == "candidates"``) two runs return the same g
 
 from __future__ import annotations
 
-import time
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from dataclasses import dataclass
-from functools import partial
-from typing import NamedTuple
 
 import numpy as np
 
-from ..collision import collision_tolerance
-from ..degeneracy import DEGENERACY_TOL
-from ..environment import clearance_of
-from ..fingertips import tip_centers, tip_radii
 from ..forces import compiled
-from ..forces.closure import force_closure
-from ..forces.grasp_map import check_safety
-from ..forces.grip import Grip, grip
-from ..forces.hold import object_weight
-from ..ik import home_tips, joint_limits
-from ..objects import object_size, project_to_surface, sample_surface
-from ..objects.creases import edge_distance
-from ..objects.geometry import body_areas, body_of
 from .archive import Archive
-from .budget import Budget, Spending, check_budget
+from .budget import Spending
 from .candidates import candidate_triples, tangent_steps
-from .checks import check_count, check_min_spacing, check_search_friction, check_seed, check_tip_radius, check_wrenches
-from .clearance import environment_search
-from .reach import HandReach, check_hand_reach, reach_tolerance, tip_errors, violations
-from .robustness import (
-    FRICTION_ERROR,
-    PERTURBATIONS,
-    check_friction_error,
-    check_perturbations,
-    check_position_error,
-    default_position_error,
-    margins,
-    robustness,
-)
-from .scores import (
-    CONSTRAINTS,
-    METHODS,
-    MIN_CONDITIONING,
-    check_min_conditioning,
-    check_objective,
-    conditionings,
-    score_triples,
-)
+from .diagnosis import Failure, diagnose, unverified
+from .problem import GRAVITY, Problem, Surface, surface_problem, synthesis_problem
+from .robustness import margins, robustness
+from .scores import score_triples
+from .verify import verify
 
 __all__ = [
-    "Surface",
-    "Failure",
     "Synthesis",
-    "Budget",
     "search",
     "search_steps",
+    "solve",
+    "solve_steps",
     "synthesize",
-    "surface_of",
-    "hand_reach",
-    "GRAVITY",
-    "verified",
     "warm_up",
-    "check_budget",
     "CHUNK",
-    "MIN_SPACING",
     "REFINE_SHARE",
-    "GAP_TOL",
-    "FEW_CANDIDATES",
     "VERIFY_SHARE",
 ]
 
-#: Gravity when none is given: 9.81 down the z axis (as grasp files').
-GRAVITY = (0.0, 0.0, -9.81)
-
 #: Candidates scored together (the grip's batches stay in cache; the budget is checked after each).
 CHUNK = 2048
-
-#: The default ``min_spacing``, relative to the object's size.
-MIN_SPACING = 0.05
 
 #: The share of the candidate budget spent refining the best grasps found by sampling.
 REFINE_SHARE = 0.3
@@ -114,65 +72,6 @@ ELITES, CHILDREN = 16, 16
 
 #: The share of ``seconds`` kept for selecting and verifying the grasps found (the search stops before it).
 VERIFY_SHARE = 0.2
-
-#: A verified grip's duality gap must be within this of its total (relative).
-GAP_TOL = 1e-6
-
-#: Fewer candidates than this, every one degenerate, say nothing of the object: the budget is the reason
-#: (a chunk of ``k`` candidates draws its contacts from ``k`` surface points, all alike when ``k < 3``).
-FEW_CANDIDATES = 100
-
-
-class Surface(NamedTuple):
-    """An object's surface as the search needs it (in the grasp frame).
-
-    Attributes
-    ----------
-    sample : callable
-        ``sample(n, rng) -> (points (n, 3), normals (n, 3))``: area-weighted points and unit
-        inward normals, reproducible for a ``numpy.random.Generator``.
-    project : callable
-        ``project(points (..., 3)) -> (points, normals, distance, on_edge)``: the nearest surface
-        points, their unit inward normals, the signed distance and whether each is on an edge or
-        corner (where the surface has no one normal).
-    size : float
-        The object's size (the diagonal of its bounding box): the scale of steps and spacing.
-    body : callable, optional
-        ``body(points (..., 3)) -> (...)`` int: the body of the object each surface point is on,
-        when a grasp keeps to one (``sample`` then draws each call's points from one body); None:
-        contacts anywhere.
-    edges : callable or None
-        ``edges(points (..., 3)) -> (...)``: each point's distance to the nearest crease
-        (:func:`~grasptwist.engine.objects.creases.edge_distance`); None: a smooth surface.
-    """
-
-    sample: Callable
-    project: Callable
-    size: float
-    body: Callable | None = None
-    edges: Callable | None = None
-
-
-class Failure(NamedTuple):
-    """Why a search found no feasible grasp.
-
-    Attributes
-    ----------
-    constraint : str
-        The tightest constraint (:data:`~.scores.CONSTRAINTS`): the furthest any candidate got;
-        ``budget`` when fewer than :data:`FEW_CANDIDATES` were scored, all degenerate (``best``:
-        how many); ``verification`` when candidates passed every test but none was verified.
-    message : str
-        In words, with how close the best candidate came.
-    best, needed : float
-        That constraint's best value among the candidates and the value it needed
-        (NaN where it has no number: the grip).
-    """
-
-    constraint: str
-    message: str
-    best: float
-    needed: float
 
 
 @dataclass(frozen=True, eq=False)
@@ -276,7 +175,7 @@ def search(surface: Surface, wrenches, friction, **options) -> Synthesis:
         Their conditioning must be at least this (0 to 1).
     min_spacing : float or None, default None
         Returned grasps are at least this far apart (:func:`~.candidates.triple_distance`);
-        None: :data:`MIN_SPACING` times the object's size.
+        None: :data:`~.problem.MIN_SPACING` times the object's size.
     constraints : sequence of callables, default none
         Further constraints (a table, a region), each ``(points (n, 3, 3), normals (n, 3, 3))
         -> (n,) bool``, tested after closure and before the grip.
@@ -314,6 +213,7 @@ def search(surface: Surface, wrenches, friction, **options) -> Synthesis:
     See Also
     --------
     search_steps : the same search, telling its progress.
+    solve : the search of a :class:`~.problem.Problem`.
 
     Examples
     --------
@@ -332,62 +232,33 @@ def search(surface: Surface, wrenches, friction, **options) -> Synthesis:
     >>> bool(0.894 < s.total_normal_force[0, 0] < 1.0), s.failure
     (True, None)
     """
-    *_, found = search_steps(surface, wrenches, friction, **options)
+    return solve(surface_problem(surface, wrenches, friction, **options))
+
+
+def search_steps(surface: Surface, wrenches, friction, **options) -> Iterator:
+    """:func:`search`, one step at a time: yields the candidates of each chunk scored (ints), then the
+    :class:`Synthesis` (a progress bar's way through a long search)."""
+    return solve_steps(surface_problem(surface, wrenches, friction, **options))
+
+
+def solve(problem: Problem) -> Synthesis:
+    """The grasps of a :class:`~.problem.Problem` (module docstring): the search's loop, and nothing
+    else (every option was checked when the problem was built)."""
+    *_, found = solve_steps(problem)
     return found
 
 
-def search_steps(
-    surface: Surface,
-    wrenches,
-    friction,
-    *,
-    count=1,
-    safety=1.0,
-    objective="robust",
-    wrist=None,
-    methods=METHODS,
-    min_conditioning=MIN_CONDITIONING,
-    min_spacing=None,
-    constraints=(),
-    hand=None,
-    quality=False,
-    seed=0,
-    candidates=20000,
-    seconds=None,
-    clock=time.perf_counter,
-    tol=DEGENERACY_TOL,
-    position_error=None,
-    friction_error=FRICTION_ERROR,
-    perturbations=PERTURBATIONS,
-) -> Iterator:
-    """:func:`search`, one step at a time: yields the candidates of each chunk scored (ints), then the
-    :class:`Synthesis` (a progress bar's way through a long search)."""
-    w = check_wrenches(wrenches)
-    mu = check_search_friction(friction)
-    count = check_count(count)
-    safety = check_safety(safety)
-    objective = check_objective(objective)
-    min_conditioning = check_min_conditioning(min_conditioning)
-    seed = check_seed(seed)
-    setting = Budget(candidates, seconds, clock)
-    min_spacing = check_min_spacing(min_spacing)
-    spacing = MIN_SPACING * surface.size if min_spacing is None else min_spacing
-    hand = None if hand is None else check_hand_reach(hand)
-    position_error = check_position_error(position_error)
-    if position_error is None:
-        position_error = default_position_error(surface.size, None if hand is None else hand.radii)
-    perturbation = {
-        "position_error": position_error,
-        "friction_error": check_friction_error(friction_error),
-        "perturbations": check_perturbations(perturbations),
-        "seed": seed,
-    }
+def solve_steps(problem: Problem) -> Iterator:
+    """:func:`solve`, one step at a time: yields the candidates of each chunk scored (ints), then the
+    :class:`Synthesis`."""
+    surface, w, mu, hand, count = problem.surface, problem.wrenches, problem.friction, problem.hand, problem.count
+    safety, objective, tol = problem.safety, problem.objective, problem.tol
     warm_up()  # before the clock starts: a first run's compiling is no part of its budget
-    budget = Spending(setting, 1 - VERIFY_SHARE)
-    budget_size = setting.candidates
-    rng = np.random.default_rng(seed)
+    budget = Spending(problem.budget, 1 - VERIFY_SHARE)
+    budget_size = problem.budget.candidates
+    rng = np.random.default_rng(problem.seed)
     joints = None if hand is None else len(hand.hand.joint_names)
-    archive = Archive(max(ELITES, 4 * count), spacing, joints, tol)
+    archive = Archive(max(ELITES, 4 * count), problem.spacing, joints, tol)
     # closure friction, epsilon: slower rows; a hand: the archive fills (and spares rows the hand's test) sooner
     chunk = CHUNK if objective in ("robust", "total_normal_force") and hand is None else CHUNK // 8
 
@@ -399,10 +270,10 @@ def search_steps(
             mu,
             safety=safety,
             objective=objective,
-            wrist=wrist,
-            methods=methods,
-            min_conditioning=min_conditioning,
-            constraints=constraints,
+            wrist=problem.wrist,
+            methods=problem.methods,
+            min_conditioning=problem.min_conditioning,
+            constraints=problem.constraints,
             hand=hand,
             bound=archive.bound if bound is None else bound,
             tol=tol,
@@ -418,6 +289,7 @@ def search_steps(
             budget.spent(k)
             yield k
         yield from _refine(surface, archive, score, budget, rng)
+    perturbation = problem.perturbation
     rank = np.arange(len(archive.objective))
     if objective == "robust" and rank.size:  # the finalists, most robust first, then the least total
         robust = robustness(surface, archive.points, archive.normals, w, mu, safety=safety, tol=tol, **perturbation)
@@ -426,24 +298,21 @@ def search_steps(
     picked = rank[:count]
     points, normals = archive.points[picked], archive.normals[picked]
     positions = None if hand is None else archive.positions[picked]
-    quality = quality or objective == "epsilon"
-    out = _results(surface, points, normals, w, mu, safety, wrist, methods, quality, tol, hand, positions, budget)
+    quality = problem.quality or objective == "epsilon"
+    out = verify(
+        surface, points, normals, w, mu, safety, problem.wrist, problem.methods, quality, tol, hand, positions, budget
+    )
     out.update(margins(surface, out["points"], out["normals"], w, mu, safety=safety, tol=tol, **perturbation)._asdict())
     failure = None
     if not len(out["points"]) and out["unverified"]:
-        failure = Failure(
-            "verification",
-            f"the time ran out before a grasp found was verified ({out['unverified']} not verified: allow more seconds)",
-            np.nan,
-            np.nan,
-        )
+        failure = unverified(out["unverified"])
     elif not len(out["points"]):
-        failure = _failure(archive, budget.used, mu / safety, min_conditioning, tol, constraints)
+        failure = diagnose(archive, budget.used, mu / safety, problem.min_conditioning, tol, problem.constraints)
     yield Synthesis(
         **out,
         candidates=budget.used,
         seconds=budget.seconds(),
-        seed=seed,
+        seed=problem.seed,
         failure=failure,
         stopped_by=budget.stopped_by,
     )
@@ -485,228 +354,6 @@ def _refine(surface, archive, score, budget, rng):
         step = np.where(better, step, step / 2)
 
 
-def verified(points, normals, wrench, friction, safety, tol=DEGENERACY_TOL) -> Grip | None:
-    r"""The exact grip of one grasp and wrench when its certificate proves it optimal, else None.
-
-    One row through :func:`~grasptwist.engine.forces.grip.grip`; its ``dual`` must close the gap
-    (``|total - w . dual| <= GAP_TOL max(total, 1)``) and be dual feasible:
-    ``n_i - G_i^T dual`` (``G_i^T dual = dual_F + dual_M x p_i``) in each dual cone
-    ``(mu / s) |z_t| <= z_n``, to :data:`GAP_TOL`; with ``mu = inf`` (the half-space
-    ``f . n >= 0``, no limit) the dual cone is the ray along ``n``: ``|z_t| = 0 <= z_n``.
-
-    >>> p = np.array([[1.0, 0, 0], [-0.5, 0.75**0.5, -0.2], [-0.5, -(0.75**0.5), -0.2]])
-    >>> g = verified(p, -p / np.linalg.norm(p, axis=1, keepdims=True), [0, 0, 1.0, 0, 0, 0], 0.5, 1.0)
-    >>> g is not None and bool(g.ok)
-    True
-    >>> g = verified(p, -p / np.linalg.norm(p, axis=1, keepdims=True), [0, 0, 1.0, 0, 0, 0], np.inf, 1.0)
-    >>> g is not None and bool(g.total_normal_force < 1e-6)  # tangential forces alone hold it
-    True
-    """
-    g = grip(points, normals, wrench, friction, safety=safety, tol=tol)
-    if not g.ok:
-        return None
-    total = float(g.total_normal_force)
-    if not abs(float(g.gap)) <= GAP_TOL * max(total, 1.0):
-        return None
-    n = np.asarray(normals, float)
-    n = n / np.linalg.norm(n, axis=-1, keepdims=True)
-    z = n - (g.dual[:3] + np.cross(g.dual[3:], np.asarray(points, float)))
-    zn = np.sum(z * n, axis=-1)
-    zt = np.linalg.norm(z - zn[:, None] * n, axis=-1)
-    limit = friction / safety
-    # no limit: (mu / s) |z_t| is inf * 0 on the ray, so ask for the ray itself
-    inside = (zt <= GAP_TOL) & (zn >= -GAP_TOL) if np.isinf(limit) else limit * zt - zn <= GAP_TOL
-    return g if inside.all() else None
-
-
-def _results(
-    surface, points, normals, w, mu, safety, wrist, methods, quality, tol, hand=None, positions=None, budget=None
-):
-    """The returned grasps' fields of :class:`Synthesis`, each grasp verified (the others dropped): the
-    exact grip, and with a hand its tips by forward kinematics, its limits and its links clear; those
-    whose turn comes after the ``budget``'s deadline (:meth:`~.budget.Spending.late`) are not verified,
-    only counted.  Epsilon (``quality``: a convex hull a grasp, milliseconds each) is computed at each
-    grasp's turn, within the deadline."""
-    grips, keep, epsilon, unverified = [], [], [], 0
-    for i in range(len(points)):
-        if budget is not None and budget.late():
-            unverified = len(points) - i
-            break
-        found = tuple(verified(points[i], normals[i], wrench, mu, safety, tol) for wrench in w)
-        if all(g is not None for g in found):
-            grips.append(found)
-            keep.append(i)
-            if quality:
-                epsilon.append(float(force_closure(points[i], normals[i], mu / safety, quality=True, tol=tol).epsilon))
-    hand_fields = {}
-    if hand is not None:
-        error = tip_errors(hand, points[keep], normals[keep], positions[keep])
-        good = _held(hand, error, positions[keep])
-        grips, keep = [g for g, k in zip(grips, good) if k], [i for i, k in zip(keep, good) if k]
-        epsilon = [e for e, k in zip(epsilon, good) if k]
-        hand_fields = {
-            "joint_positions": positions[keep],
-            "reach_error": error[good],
-            "tip_center": tip_centers(points[keep], normals[keep], hand.radii),
-        }
-    p, n = points[keep], normals[keep]
-    closure = force_closure(p, n, mu / safety, tol=tol) if len(p) else None
-    return {
-        "points": p,
-        "normals": n,
-        "surface_distance": surface.project(p)[2] if len(p) else np.empty((0, 3)),
-        "total_normal_force": np.array([[float(g.total_normal_force) for g in row] for row in grips]).reshape(
-            len(p), len(w)
-        ),
-        "closure_friction": closure.closure_friction if closure else np.empty(0),
-        "epsilon": np.array(epsilon) if quality else None,
-        "conditioning": conditionings(p, n, wrist, methods, tol) if len(p) else np.empty((0, 2)),
-        "grips": tuple(grips),
-        "unverified": unverified,
-        **hand_fields,
-    }
-
-
-def _held(hand, error, positions):
-    """Which placed hands are verified: every tip on its target (:func:`~.reach.reach_tolerance`), every
-    joint within its limits, no collision (:func:`~.reach.violations`: ``(K, 3)``, ``(K, n_joints)`` -> ``(K,)``)."""
-    good = (error <= reach_tolerance(hand)).all(axis=1)
-    for finger in hand.hand.fingers:
-        lower, upper = joint_limits(finger)
-        q = positions[:, list(finger.joint_index)]
-        good &= ((q >= lower) & (q <= upper)).all(axis=1)
-    return good & (violations(hand, positions) <= 0)
-
-
-def _failure(archive, scored, mu, min_conditioning, tol, constraints=()) -> Failure:
-    """Why no candidate was feasible: the furthest constraint any reached, and how close the best came
-    (a hand's constraints are reached only with a hand: after the grip a row without one is feasible)."""
-    if archive.furthest == 0 and scored < FEW_CANDIDATES:
-        return Failure(
-            "budget",
-            f"{scored} scored {'is' if scored == 1 else 'are'} too few to judge the object, none with three "
-            f"distinct contacts off one line (allow {FEW_CANDIDATES} candidates or more)",
-            float(scored),
-            float(FEW_CANDIDATES),
-        )
-    if archive.furthest >= len(CONSTRAINTS):  # feasible, or spared as no better than the grasps kept
-        return Failure(
-            "verification",
-            "candidates passed every test, but the exact grip's certificate (or the hand's forward "
-            "kinematics) verified none",
-            np.nan,
-            np.nan,
-        )
-    name = CONSTRAINTS[archive.furthest]
-    if name == "degenerate":
-        return Failure(name, "every candidate's contacts were degenerate (coincident or collinear)", 0.0, tol)
-    if name == "conditioning":
-        best = archive.best_conditioning
-        return Failure(
-            name,
-            f"no candidate's conditioning reached {min_conditioning:g} (the best: {best:.3g})",
-            best,
-            min_conditioning,
-        )
-    if name == "force_closure":
-        best = archive.closest  # inf: no candidate is closure at any finite friction (a flat object's)
-        words = f"the best needs friction {best:.3g}" if np.isfinite(best) else "none is at any finite friction"
-        return Failure(name, f"no candidate is force closure at friction {mu:g} (friction / safety); {words}", best, mu)
-    if name == "constraints":
-        # a named constraint (the environment's clearance) that no candidate it saw passed is the one
-        for c in constraints:
-            if np.isfinite(getattr(c, "best", np.nan)) and c.best < c.needed:
-                return Failure(
-                    c.name,
-                    f"no force-closure candidate keeps every fingertip (a contact, without a hand) {c.needed:g} "
-                    f"from the environment (the best: {c.best:.3g})",
-                    c.best,
-                    c.needed,
-                )
-        return Failure(name, "no force-closure candidate passed the further constraints", np.nan, np.nan)
-    if name == "fingertips":
-        return Failure(
-            name,
-            "on every candidate some fingertip sphere would go into the object (concave there) or within the "
-            "clearance of the environment",
-            np.nan,
-            np.nan,
-        )
-    if name == "reach":
-        best = archive.best_miss.get(name, np.inf)
-        return Failure(
-            name,
-            "the hand reaches no candidate's contacts within its joint limits"
-            + (
-                f": the best candidate leaves a fingertip {best:.3g} from where it must be" if np.isfinite(best) else ""
-            ),
-            best,
-            0.0,
-        )
-    if name == "collision":
-        best = archive.best_miss.get(name, np.inf)
-        return Failure(
-            name,
-            "every grasp the hand reaches puts a finger link into the object or another finger, or within the "
-            "clearance of the environment" + (f" (the least by {best:.3g})" if np.isfinite(best) else ""),
-            best,
-            np.nan,
-        )
-    return Failure(name, "no candidate's grip holds every wrench within the friction cones", np.nan, np.nan)
-
-
-def surface_of(obj, span_bodies=False) -> Surface:
-    """The :class:`Surface` of a :class:`~grasptwist.model.GraspObject` (``grasptwist.engine.objects``).
-
-    An object of several bodies (a mesh's pieces apart) keeps each grasp on one body unless
-    ``span_bodies``: each call of ``sample`` draws from one body, chosen by its area.
-    """
-    areas = body_areas(obj)
-    edges = partial(edge_distance, obj)
-    if span_bodies or len(areas) < 2:
-        return Surface(partial(sample_surface, obj), partial(project_to_surface, obj), object_size(obj), edges=edges)
-
-    def sample(n, rng):
-        return sample_surface(obj, n, rng, body=int(rng.choice(len(areas), p=areas / areas.sum())))
-
-    return Surface(sample, partial(project_to_surface, obj), object_size(obj), partial(body_of, obj), edges)
-
-
-def hand_reach(
-    obj, hand, *, tips=None, tip_radius=None, collide=None, hulls=None, environment=None, clearance=None
-) -> HandReach:
-    """A hand as the search takes it (:class:`~.reach.HandReach`) against ``obj``.
-
-    Parameters
-    ----------
-    obj : GraspObject
-    hand : Hand
-        Three fingers that share no joint, in the grasp frame.
-    tips : (3, 4, 4) array, optional
-        Each finger's tip link pose at home; default its tip link's (a finger given inline has
-        none: give where its tip point is at home, :func:`~grasptwist.engine.ik.home_tips`).
-    tip_radius : float, optional
-        Every fingertip's radius; default each finger's ``tip_radius``.
-    collide : callable, optional
-        ``collide(positions (N, n_joints)) -> (N,)`` the deepest any finger link goes into the
-        object (the command line's, from a URDF's meshes); None: links not checked.
-    hulls : LinkHulls, optional
-        The finger links' convex hulls (``grasptwist.engine.collision.link_hulls``), kept out of each
-        other and clear of the environment; None: the fingertip spheres alone.
-    environment : Environment, optional
-        The table and boxes every part of the hand keeps ``clearance`` from.
-    clearance : float, optional
-        Default the environment's (``grasptwist.engine.environment.clearance_of``).
-    """
-    tip_radius = check_tip_radius(tip_radius)
-    radii = tip_radii(hand) if tip_radius is None else np.full(3, tip_radius)
-    tips = home_tips(hand) if tips is None else np.asarray(tips, float)
-    room = 0.0 if environment is None else (clearance_of(environment) if clearance is None else float(clearance))
-    project = partial(project_to_surface, obj)
-    reach = HandReach(hand, tips, radii, project, collision_tolerance(obj), collide, hulls, environment, room)
-    return check_hand_reach(reach)
-
-
 def synthesize(
     obj,
     friction,
@@ -722,6 +369,7 @@ def synthesize(
     hulls=None,
     environment=None,
     clearance=None,
+    weight=None,
     **options,
 ) -> Synthesis:
     r"""Grasps of an object: its surface searched for grasps that hold its weight and ``wrenches``.
@@ -748,7 +396,7 @@ def synthesize(
         finger ``f`` (the fingers are assigned to the contacts in every order), and
         ``joint_positions`` and ``reach_error`` say where the hand holds each.
     tips, tip_radius, collide, hulls
-        As ``grasptwist.engine.synthesis.search.hand_reach``: each finger's tip link pose at home (needed for a finger
+        As ``grasptwist.engine.synthesis.problem.hand_reach``: each finger's tip link pose at home (needed for a finger
         given inline), every fingertip's radius (default each finger's ``tip_radius``),
         the depth of the deepest link at joint positions and the links' convex hulls (default:
         links not checked, only the fingertip spheres; ``grasptwist.synthesize`` and the command
@@ -759,9 +407,11 @@ def synthesize(
         that cannot are never sampled (``grasptwist.engine.synthesis.clearance``).
     clearance : float, optional
         Default the environment's, else ``grasptwist.engine.environment.CLEARANCE``.
+    weight : Weight, optional
+        The weight held when ``obj`` has no mass (a grasp file's ``mass`` apart from its object).
     span_bodies : bool
         Let a grasp's contacts lie on different bodies of the object (a mesh's pieces apart);
-        by default each grasp keeps to one (``grasptwist.engine.synthesis.search.surface_of``).
+        by default each grasp keeps to one (``grasptwist.engine.synthesis.problem.surface_of``).
     **options
         The search's keyword options: ``count`` (grasps wanted, 1), ``safety`` (1), ``objective``
         (``robust``, ``total_normal_force``, ``closure_friction`` or ``epsilon``), ``wrist`` (None),
@@ -784,32 +434,24 @@ def synthesize(
     >>> s.points.shape, bool((s.closure_friction < 0.8).all())
     ((2, 3, 3), True)
     """
-    tip_radius = check_tip_radius(tip_radius)  # checked with or without a hand, as --tip-radius is
-    listed = list(check_wrenches(wrenches)) if len(wrenches) else []
-    if hold:
-        with np.errstate(over="ignore", invalid="ignore"):
-            weight = object_weight(obj, gravity)
-        if weight is None:
-            raise ValueError("hold=True needs the object's mass (or density): its weight is the wrench to hold")
-        if not np.isfinite(weight.wrench).all():
-            raise ValueError("the object's weight or its moment about the origin overflows (mass x gravity)")
-        listed.insert(0, weight.wrench)
-    if not listed:
-        raise ValueError("nothing to hold: give the object a mass (hold=True) or wrenches")
-    if hand is not None and not isinstance(hand, HandReach):
-        hand = hand_reach(
-            obj,
-            hand,
-            tips=tips,
-            tip_radius=tip_radius,
-            collide=collide,
-            hulls=hulls,
-            environment=environment,
-            clearance=clearance,
-        )
-    surface, clear = environment_search(surface_of(obj, span_bodies), environment, clearance, hand)
-    options["constraints"] = (*options.get("constraints", ()), *clear)
-    return search(surface, np.array(listed), friction, hand=hand, **options)
+    problem = synthesis_problem(
+        obj,
+        friction,
+        wrenches=wrenches,
+        hold=hold,
+        gravity=gravity,
+        weight=weight,
+        hand=hand,
+        tips=tips,
+        tip_radius=tip_radius,
+        collide=collide,
+        hulls=hulls,
+        environment=environment,
+        clearance=clearance,
+        span_bodies=span_bodies,
+        **options,
+    )
+    return solve(problem)
 
 
 #: Whether this process has warmed up (:func:`warm_up` runs once).
