@@ -190,12 +190,12 @@ def test_a_path_the_grasp_does_not_have_is_an_error_record():
 
 
 @pytest.mark.slow  # a second of tracking with the TriFinger
-def test_the_trifinger_spin_lags_its_plan_as_the_guide_says():
+def test_the_trifinger_spins_the_cube_as_planned_as_the_guide_says():
     r, _ = run("simulate", CUBE, "--mass", "0.094", "--friction", "1", "--path", "spin", "-f", "jsonl")
-    assert r.exit_code == 1
+    assert r.exit_code == 0, r.stderr
     (rec,) = jsonl(r.stdout)
-    assert not rec["followed"] and 5 < rec["final"]["angle_error_deg"] < 15  # measured 9 deg behind
-    assert all(rec["samples"][-1]["slipped"])
+    assert rec["followed"] and rec["final"]["angle_error_deg"] < 2  # measured 0.4 deg (9 before it rolled)
+    assert not any(rec["samples"][-1]["slipped"])
 
 
 @pytest.mark.slow  # two worker processes: a second
