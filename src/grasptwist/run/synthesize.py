@@ -22,6 +22,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ..engine.forces.hold import Weight, hold_wrench, object_weight
+from ..engine.hold_test import DIRECTIONS, direction_wrenches
 from ..engine.synthesis.clearance import environment_search, grasp_clearance
 from ..engine.synthesis.scores import METHODS, MIN_CONDITIONING
 from ..engine.synthesis.search import GRAVITY, Synthesis, search_steps, surface_of
@@ -134,6 +135,10 @@ def _task(options: SynthesisOptions, grasp: Grasp):
             )
         hold = (weight.mass, weight.center_of_mass, weight.gravity)
         named.insert(0, (HOLD, weight.wrench))
+        if options.simulate is not None:  # a grip for each load of the hold test too (BODex's six directions)
+            load = weight.mass * float(np.linalg.norm(weight.gravity))
+            loads = direction_wrenches(weight.mass, weight.center_of_mass, load)
+            named += [(f"load {d}", w) for d, w in zip(DIRECTIONS, loads) if not np.allclose(w, weight.wrench)]
     if not named:
         return _problem(
             grasp.file,
