@@ -22,13 +22,13 @@ def test_spheres_on_slides_roll_round_a_turning_ball_like_planet_gears():
     ball = GraspObject(Shape("sphere", np.array([R])), np.eye(4))
     angles = np.radians([0.0, 120.0, 240.0])
     p = R * np.stack((np.cos(angles), np.sin(angles), np.zeros(3)), axis=1)
-    w, times = 0.5, np.linspace(0.0, 1.0, 41)
+    w, times = 0.5, np.linspace(0.0, 1.0, 21)
     out = roll(None, None, ball, p, -p / R, np.full(3, TIP), [Segment(1.0, twist=[0, 0, w, 0, 0, 0])], times)
     turned = w * R / (R + TIP) * times[-1]
     expected = (R + TIP) * np.stack((np.cos(angles + turned), np.sin(angles + turned), np.zeros(3)), axis=1)
-    np.testing.assert_allclose(out.centers[-1], expected, atol=1e-7)  # RK4, 40 steps: 2e-8
-    np.testing.assert_allclose(out.positions[-1].reshape(3, 3), expected - (R + TIP) * p / R, atol=1e-7)
-    np.testing.assert_allclose(out.points[-1], expected * R / (R + TIP), atol=1e-7)
+    np.testing.assert_allclose(out.centers[-1], expected, atol=1e-6)  # RK4, 20 steps: 3e-7
+    np.testing.assert_allclose(out.positions[-1].reshape(3, 3), expected - (R + TIP) * p / R, atol=1e-6)
+    np.testing.assert_allclose(out.points[-1], expected * R / (R + TIP), atol=1e-6)
     # the rates are the contact's velocity, w z x p, for each slide
     np.testing.assert_allclose(out.rates[-1].reshape(3, 3), np.cross([0, 0, w], out.points[-1]), atol=1e-12)
 
