@@ -2,7 +2,8 @@ r"""The six-direction hold test's math: the loads, the grips that resist them, t
 
 The protocol (BODex's, made exact): the object's weight ``m |g|`` is applied at its centre of
 mass along each of ``+x, -x, +y, -y, +z, -z`` in turn; for each, the fingers exert the grip that
-balances it (:func:`~grasptwist.engine.forces.grip.grip` of :func:`direction_wrenches`), through
+balances it (:func:`~grasptwist.engine.forces.grip.grip` of :func:`direction_wrenches`), squeezed so
+that every finger presses (:func:`squeezed`), through
 joint torques ``tau = J^T f`` (:func:`joint_torques`); the grasp holds in a direction when the
 object moves less than the tolerances (:func:`held`).  The simulation itself is
 :mod:`grasptwist.sim`'s.
