@@ -263,3 +263,24 @@ def test_a_grasp_files_environment_is_the_scenes_table_and_boxes_and_table_repla
         model = load_model(scene)
         assert model.geom_pos[model.geom("table").id][2] == pytest.approx(height, abs=1e-15)
         np.testing.assert_allclose(model.geom_pos[model.geom("box0").id], [0.2, 0, 0])
+
+
+@pytest.mark.slow  # a search and eight short hold tests: a second
+def test_held_only_keeps_the_grasps_that_hold_within_the_tolerance_and_counts_the_others():
+    # synthesize --simulate's filter, held to a tolerance so strict (0.2 mm, then 20 um in 0.1 s) that
+    # MuJoCo drops some of the 4 cylinder grasps the seeded search finds, then all
+    from grasptwist.run.families import COMMANDS
+    from grasptwist.run.options import SynthesisOptions
+    from grasptwist.run.pipeline import Job
+    from grasptwist.run.simulate import SIMULATED, held_only
+    from grasptwist.run.synthesize import Found, synthesize_inputs
+
+    job = Job(command=COMMANDS["synthesize"], options=SynthesisOptions(count=4, friction=0.8, mass=0.1, candidates=400))
+    (found,) = [x for x in synthesize_inputs(job, [str(GRASPS / "cylinder.yaml")]) if isinstance(x, Found)]
+    assert len(found) == 4
+    kept, dropped = held_only(found, SimulateOptions(duration=0.1, distance_tol=2e-4))
+    assert 1 <= dropped < 4 and len(kept) == 4 - dropped == len(kept.simulated)
+    for test in kept.simulated:
+        assert test.held and max(d.displacement for d in test.directions) < 2e-4
+    kept, dropped = held_only(found, SimulateOptions(duration=0.1, distance_tol=2e-5))
+    assert (len(kept), dropped, kept.synthesis.failure.constraint) == (0, 4, SIMULATED)
