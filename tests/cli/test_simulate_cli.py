@@ -157,9 +157,15 @@ def test_synthesize_simulate_keeps_only_the_grasps_that_hold_and_counts_the_othe
     r, _ = run(*args, "--candidates", "400", "--simulate", "-o", found, "-f", "jsonl")
     assert r.exit_code in (0, 1), r.stderr
     kept = [rec for rec in jsonl(r.stdout) if rec["ok"]]
-    # the search finds 4 (seeded); MuJoCo drops some of them, and stderr counts them
+    # the search finds 4 (seeded), each with a grip for the six loads of the hold test beside the weight;
+    # MuJoCo drops those that do not hold, and stderr counts them (measured: none is dropped; before the
+    # search asked for the six loads and the hold test squeezed, 1 to 3 were)
     dropped = 4 - len(kept)
-    assert 1 <= dropped < 4 and f"; {dropped} dropped: they did not hold in all six directions in MuJoCo" in r.stderr
+    assert (f"; {dropped} dropped: they did not hold in all six directions in MuJoCo" in r.stderr) == (dropped > 0)
+    assert dropped == 0
+    for rec in kept:
+        loads = ["hold"] + [f"load {d}" for d in ("+x", "-x", "+y", "-y", "+z")]
+        assert list(rec["scores"]["total_normal_force"]) == loads
     for rec in kept:  # each record says how it held
         sim = rec["simulation"]
         assert sim["held"] and [d["direction"] for d in sim["directions"]] == ["+x", "-x", "+y", "-y", "+z", "-z"]
@@ -190,12 +196,12 @@ def test_a_path_the_grasp_does_not_have_is_an_error_record():
 
 
 @pytest.mark.slow  # a second of tracking with the TriFinger
-def test_the_trifinger_spin_lags_its_plan_as_the_guide_says():
+def test_the_trifinger_spins_the_cube_as_planned_as_the_guide_says():
     r, _ = run("simulate", CUBE, "--mass", "0.094", "--friction", "1", "--path", "spin", "-f", "jsonl")
-    assert r.exit_code == 1
+    assert r.exit_code == 0, r.stderr
     (rec,) = jsonl(r.stdout)
-    assert not rec["followed"] and 5 < rec["final"]["angle_error_deg"] < 15  # measured 9 deg behind
-    assert all(rec["samples"][-1]["slipped"])
+    assert rec["followed"] and rec["final"]["angle_error_deg"] < 2  # measured 0.4 deg (9 before it rolled)
+    assert not any(rec["samples"][-1]["slipped"])
 
 
 @pytest.mark.slow  # two worker processes: a second

@@ -36,8 +36,10 @@ def test_the_trifinger_holds_the_cube_and_mujoco_exerts_the_planned_grip():
     assert sim.test.load == pytest.approx(load)
     for d in sim.test.directions:
         assert d.simulated and d.displacement < 5e-4 and d.rotation < math.radians(0.5)  # a quarter of the tolerances
-        # each finger's contact force in MuJoCo is grasptwist's grip, within 5% of the load
+        # each finger's contact force in MuJoCo is grasptwist's grip, squeezed so that every finger
+        # presses at least half the load along its normal, within 5% of the load
         np.testing.assert_allclose(d.forces, d.planned, atol=0.05 * load)
+        assert ((d.planned * grasp.normals).sum(axis=1) >= 0.5 * load - 1e-9).all()
     # on its table too, the file's (which carries none of the load)
     assert _simulated("trifinger-cube.yaml", mass=0.094, friction=1.0).test.held
 
@@ -47,6 +49,24 @@ def test_an_inline_hand_and_three_slid_fingertips_hold_too():
     ball = _simulated("sphere.yaml", 1, mass=0.1, friction=0.8)  # sphere-equator: no hand
     for sim in (hand, ball):
         assert sim.test.held, [(d.name, d.displacement) for d in sim.test.directions]
+
+
+def test_a_ball_squeezed_hard_sideways_holds_with_its_drive_stiffened_to_the_grip(tmp_path):
+    # sphere-equator's ball with the tips below its equator (a grasp synthesize returned for its weight):
+    # sideways its grip pushes up to 36 N for a 0.98 N load; fingers that push F on a ball of radius r
+    # roll it away unless their springs' tangential stiffness k exceeds F / r (the rotation's moment
+    # grows by F r per radian, the springs' by k r^2).  With the drive stiff against the load alone it
+    # rolled away in five directions (45-97 mm); stiffened to each direction's largest force, it holds
+    text = (GRASPS / "sphere.yaml").read_text("utf-8").split("\n---")[0].split("contacts:")[0]
+    contacts = """contacts:
+  - {point: [0.0274471694, 0.0071187816, -0.0205176958], normal: [-0.7842048401, -0.2033937604, 0.5862198793]}
+  - {point: [-0.0305279926, -0.0007110992, -0.0171036839], normal: [0.8722283613, 0.0203171206, 0.4886766829]}
+  - {point: [0.0156566775, -0.0275191804, -0.0149185509], normal: [-0.4473336441, 0.786262296, 0.4262443112]}
+"""
+    (tmp_path / "ball.yaml").write_text(text + contacts, "utf-8")
+    sim = simulate_grasp(SimulateOptions(duration=SHORT, mass=0.1, friction=0.8), read(str(tmp_path / "ball.yaml"))[0])
+    assert max(np.linalg.norm(d.planned, axis=1).max() for d in sim.test.directions) > 20 * sim.test.load
+    assert sim.test.held, [(d.name, d.displacement) for d in sim.test.directions]
 
 
 def test_a_direction_without_a_grip_is_reported_not_simulated():
@@ -188,16 +208,21 @@ def test_a_fingertip_pushed_onto_the_table_stands_on_it():
 
 
 def test_the_trifinger_cube_holds_on_its_table_as_without_one():
-    # the file's table under the cube carries none of it: at safety 1 (a grip on the cones' edge) the
-    # same directions slip with the table as without (before: 2 with it, 5 without)
+    # the file's table under the cube carries none of it: at safety 1 and without a squeeze (a grip on the
+    # cones' edge) the same directions slip with the table as without (before: 2 with it, 5 without)
+    from grasptwist.run.simulate import _prepared
+
     grasp = _grasp("trifinger-cube.yaml")
     assert grasp.environment is not None and grasp.environment.table_height == 0
+    options = SimulateOptions(duration=SHORT, mass=0.094, friction=1.0, safety=1.0)
     on, off = (
-        simulate_grasp(SimulateOptions(duration=SHORT, mass=0.094, friction=1.0, safety=1.0), g).test.directions
+        hold_test(scene, g, center_of_mass=com, friction=mu, load=load, duration=SHORT, safety=1.0, squeeze=0.0)
         for g in (grasp, replace(grasp, environment=None))
+        for _, mu, _, load, com, scene in [_prepared(options, g, None, hold=True)]
     )
-    assert [d.held for d in on] == [d.held for d in off] and not all(d.held for d in on)
-    np.testing.assert_allclose([d.displacement for d in on], [d.displacement for d in off], rtol=1e-6, atol=1e-9)
+    assert [d.held for d in on.directions] == [d.held for d in off.directions] and not on.held
+    moved = [[d.displacement for d in t.directions] for t in (on, off)]
+    np.testing.assert_allclose(moved[0], moved[1], rtol=1e-6, atol=1e-9)
 
 
 @pytest.mark.slow  # CoACD and trimesh's boolean union load in 2 s
@@ -238,3 +263,24 @@ def test_a_grasp_files_environment_is_the_scenes_table_and_boxes_and_table_repla
         model = load_model(scene)
         assert model.geom_pos[model.geom("table").id][2] == pytest.approx(height, abs=1e-15)
         np.testing.assert_allclose(model.geom_pos[model.geom("box0").id], [0.2, 0, 0])
+
+
+@pytest.mark.slow  # a search and eight short hold tests: a second
+def test_held_only_keeps_the_grasps_that_hold_within_the_tolerance_and_counts_the_others():
+    # synthesize --simulate's filter, held to a tolerance so strict (0.2 mm, then 20 um in 0.1 s) that
+    # MuJoCo drops some of the 4 cylinder grasps the seeded search finds, then all
+    from grasptwist.run.families import COMMANDS
+    from grasptwist.run.options import SynthesisOptions
+    from grasptwist.run.pipeline import Job
+    from grasptwist.run.simulate import SIMULATED, held_only
+    from grasptwist.run.synthesize import Found, synthesize_inputs
+
+    job = Job(command=COMMANDS["synthesize"], options=SynthesisOptions(count=4, friction=0.8, mass=0.1, candidates=400))
+    (found,) = [x for x in synthesize_inputs(job, [str(GRASPS / "cylinder.yaml")]) if isinstance(x, Found)]
+    assert len(found) == 4
+    kept, dropped = held_only(found, SimulateOptions(duration=0.1, distance_tol=2e-4))
+    assert 1 <= dropped < 4 and len(kept) == 4 - dropped == len(kept.simulated)
+    for test in kept.simulated:
+        assert test.held and max(d.displacement for d in test.directions) < 2e-4
+    kept, dropped = held_only(found, SimulateOptions(duration=0.1, distance_tol=2e-5))
+    assert (len(kept), dropped, kept.synthesis.failure.constraint) == (0, 4, SIMULATED)

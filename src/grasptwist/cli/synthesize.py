@@ -237,7 +237,8 @@ def synthesize(
         typer.Option(
             "--simulate",
             help="Keep only the grasps that hold in all six directions in MuJoCo (grasptwist simulate's "
-            "defaults); stderr counts the others. Needs MuJoCo: pip install 'grasptwist[sim]'.",
+            "defaults), the search asking for a grip for each direction's load beside the weight ('load +x', "
+            "...); stderr counts the others. Needs MuJoCo: pip install 'grasptwist[sim]'.",
         ),
     ] = False,
     seed: Annotated[

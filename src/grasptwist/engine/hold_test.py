@@ -2,7 +2,8 @@ r"""The six-direction hold test's math: the loads, the grips that resist them, t
 
 The protocol (BODex's, made exact): the object's weight ``m |g|`` is applied at its centre of
 mass along each of ``+x, -x, +y, -y, +z, -z`` in turn; for each, the fingers exert the grip that
-balances it (:func:`~grasptwist.engine.forces.grip.grip` of :func:`direction_wrenches`), through
+balances it (:func:`~grasptwist.engine.forces.grip.grip` of :func:`direction_wrenches`), squeezed so
+that every finger presses (:func:`squeezed`), through
 joint torques ``tau = J^T f`` (:func:`joint_torques`); the grasp holds in a direction when the
 object moves less than the tolerances (:func:`held`).  The simulation itself is
 :mod:`grasptwist.sim`'s.
@@ -12,6 +13,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from .forces.closure import internal_inside
+from .forces.grasp_map import geometry, squeeze_forces
 from .forces.hold import hold_wrench
 from .hands import finger_states
 from .kinematics import finger_jacobian
@@ -23,6 +26,7 @@ __all__ = [
     "MAX_DURATION",
     "MAX_ANGLE_TOL",
     "direction_wrenches",
+    "squeezed",
     "joint_torques",
     "held",
     "check_duration",
@@ -99,6 +103,52 @@ def direction_wrenches(mass, center_of_mass, load) -> np.ndarray:
     [0.0, 0.0, -19.62, 0.0, 19.62, 0.0]
     """
     return hold_wrench(mass, center_of_mass, UNITS * (float(load) / float(mass)))
+
+
+def direction_loads(weight) -> tuple[tuple[str, ...], np.ndarray]:
+    """The hold test's loads besides the weight itself (:func:`direction_wrenches` of the weight's size),
+    named ``load +x`` ...: ``(k,)`` names and ``(k, 6)`` wrenches, ``k`` 5 where the weight is one of them.
+
+    >>> from grasptwist.engine.forces.hold import Weight, hold_wrench
+    >>> g = np.array([0, 0, -9.81])
+    >>> names, loads = direction_loads(Weight(1.0, np.zeros(3), g, hold_wrench(1.0, np.zeros(3), g)))
+    >>> names, loads[0].tolist()
+    (('load +x', 'load -x', 'load +y', 'load -y', 'load +z'), [-9.81, 0.0, 0.0, 0.0, 0.0, 0.0])
+    """
+    load = weight.mass * float(np.linalg.norm(weight.gravity))
+    loads = direction_wrenches(weight.mass, weight.center_of_mass, load)
+    other = ~np.isclose(loads, weight.wrench).all(axis=-1)
+    return tuple(f"load {d}" for d, o in zip(DIRECTIONS, other, strict=True) if o), loads[other]
+
+
+def squeezed(points, normals, forces, friction, floor) -> np.ndarray:
+    r"""The forces ``f`` with a squeeze added, so that every finger presses at least ``floor`` along its
+    normal: ``f + lambda s``, ``s`` an internal force (a squeeze, in the null space of the grasp map)
+    strictly inside every cone ``friction`` (:func:`~grasptwist.engine.forces.closure.internal_inside`),
+    ``lambda >= 0`` the least that lifts every normal force to the floor.
+
+    .. math:: \lambda = \max\Bigl(0,\; \max_i \frac{F - f_i \cdot n_i}{s_i \cdot n_i}\Bigr)
+
+    The sum exerts the same wrench, and stays inside the cones that hold ``f`` and ``s`` (a cone is
+    convex).  Where no squeeze is inside the cones (no force closure) ``f`` is returned unchanged, and
+    NaN forces stay NaN.  ``(..., 3, 3)`` arrays; ``normals`` unit, into the object; ``friction`` a
+    scalar or ``(..., 3)``.
+
+    >>> p = [[1.0, 0, 0], [-0.5, 0.75**0.5, 0], [-0.5, -(0.75**0.5), 0]]
+    >>> f = squeezed(p, -np.array(p), np.zeros((3, 3)), 0.5, 2.0)
+    >>> (f * -np.array(p)).sum(axis=-1).round(12).tolist()
+    [2.0, 2.0, 2.0]
+    """
+    p, n, f = (np.asarray(a, dtype=float) for a in (points, normals, forces))
+    p, n = np.broadcast_to(p, f.shape), np.broadcast_to(n, f.shape)
+    rows = p.reshape(-1, 3, 3)
+    mu = np.broadcast_to(np.asarray(friction, dtype=float), f.shape[:-1]).reshape(-1, 3)
+    unit = squeeze_forces(rows, internal_inside(rows, n.reshape(-1, 3, 3), geometry(rows), mu)).reshape(f.shape)
+    pressed, pushes = (f * n).sum(axis=-1), (unit * n).sum(axis=-1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        scale = np.maximum(0.0, ((float(floor) - pressed) / pushes).max(axis=-1))
+    scale = np.where(np.isnan(scale), 0.0, scale)[..., None, None]
+    return f + np.where(np.isnan(unit), 0.0, scale * unit)
 
 
 def joint_torques(hand, positions, points, forces) -> np.ndarray:

@@ -19,7 +19,7 @@ With ``--path NAME`` a record per grasp says how its path went instead::
 ``displacement`` is the object's centre's distance from where it started (length units),
 ``rotation_deg`` the angle it turned, at the end of the direction's ``duration``;
 ``contact_forces`` each finger's force on the object in MuJoCo then, ``planned_forces``
-grasptwist's grip (null, with the grip's status, where none exists: not simulated).  A
+grasptwist's grip with the hold test's squeeze (null, with the grip's status, where none exists: not simulated).  A
 warning names the directions that did not hold.  Nothing is computed here.
 """
 

@@ -20,6 +20,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ..engine.forces.hold import Weight, hold_wrench
+from ..engine.hold_test import direction_loads
 from ..engine.placement import home_at
 from ..engine.synthesis.problem import (
     GRAVITY,
@@ -137,6 +138,7 @@ def grasp_problem(
     environment=None,
     folder=None,
     max_bytes=MAX_URDF_BYTES,
+    directions=False,
     **options,
 ) -> Task | InputError:
     """The synthesis problem a grasp document poses, or its error: the command line's, the
@@ -158,6 +160,9 @@ def grasp_problem(
         An inline ``hand``'s tip poses at home (without them it needs the file's contacts).
     folder, max_bytes
         Where a URDF hand's files are found (default: its file's folder), its size cap.
+    directions : bool
+        A grip for the hold test's loads too (``synthesize --simulate``): the weight's size along
+        ``+-x``, ``+-y``, ``+-z`` (:func:`~grasptwist.engine.hold_test.direction_loads`), BODex's protocol.
     **options
         The search's (:func:`~grasptwist.engine.synthesis.problem.surface_problem`), and
         ``clearance``, ``span_bodies``, ``gravity`` (default the file's), ``hold`` (default:
@@ -223,6 +228,9 @@ def grasp_problem(
     except ProblemError as exc:
         return _problem(grasp, *_words(grasp, exc))
     names = ((HOLD,) if held else ()) + tuple(n for n, _ in named)
+    if directions and problem.weight is not None:
+        loads, wrenches = direction_loads(problem.weight)
+        problem, names = replace(problem, wrenches=np.vstack([problem.wrenches, wrenches])), names + loads
     return Task(problem, names, hand, friction)
 
 

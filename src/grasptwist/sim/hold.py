@@ -2,8 +2,11 @@ r"""The six-direction hold test, run in MuJoCo.
 
 For each direction ``d`` of :data:`~grasptwist.engine.hold_test.DIRECTIONS`, from the grasp
 afresh: the hand stands at the grasp's joint positions, held there by stiff joint springs
-(:class:`~grasptwist.sim.scene.Drive`), its own gravity compensated; its joints exert the
-torques ``tau = J^T f_d`` of grasptwist's grip ``f_d`` for the load; the object, released,
+(:class:`~grasptwist.sim.scene.Drive`, stiffened by the ratio of the direction's largest finger force
+to the load when that exceeds 1: fingers pushing ``F`` on an object of radius ``r`` roll it away
+unless their springs' stiffness exceeds ``F / r``), its own gravity compensated; its joints exert
+the torques ``tau = J^T f_d`` of grasptwist's grip ``f_d`` for the load, squeezed so that every
+finger presses at least ``squeeze`` times the load (:func:`~grasptwist.engine.hold_test.squeezed`); the object, released,
 carries its weight ``m |g|`` along ``d`` (its own gravity compensated) for ``duration``.
 The grasp holds in ``d`` when the object's centre moved less than the distance tolerance and
 it turned less than the angle tolerance.  A direction whose grip does not exist is not
@@ -19,7 +22,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..engine.forces.grip import grip
-from ..engine.hold_test import DIRECTIONS, UNITS, direction_wrenches, held, joint_torques
+from ..engine.hold_test import DIRECTIONS, UNITS, direction_wrenches, held, joint_torques, squeezed
 from ..extras import require
 from .scene import OBJECT, TIP, Scene
 
@@ -33,7 +36,13 @@ __all__ = [
     "rotation_angle",
     "diverged",
     "CHUNK",
+    "SQUEEZE",
 ]
+
+#: Each finger's least normal force in the hold test, in loads (:func:`hold_test`'s ``squeeze``): the
+#: least grip leaves a finger idle where two suffice, and the object turns about them
+#: (``docs/guide/simulation.md``, "Choices measured").
+SQUEEZE = 0.5
 
 #: Steps simulated between two checks for divergence (and for an object already gone).
 CHUNK = 50
@@ -144,6 +153,7 @@ def hold_test(
     distance_tol: float = 0.002,
     angle_tol: float = math.radians(2.0),
     safety: float = 1.0,
+    squeeze: float = SQUEEZE,
     observe=None,
 ) -> HoldTest:
     """The six-direction hold test of ``grasp`` in ``scene`` (module docstring).
@@ -164,6 +174,8 @@ def hold_test(
         How far the object may move and turn (radians) and still count as held.
     safety : float
         The grip's safety factor (:func:`~grasptwist.engine.forces.grip.grip`).
+    squeeze : float
+        Each finger's least normal force, in loads (:data:`SQUEEZE`).
     observe : callable or None
         ``(direction, model, data)``, called at the end of each direction simulated (pictures:
         ``docs/make_simulation_picture.py``).
@@ -182,7 +194,13 @@ def hold_test(
     vadr = [model.jnt_dofadr[model.joint(j).id] for j in scene.joints]
     wrenches = direction_wrenches(scene.mass, center_of_mass, load)
     planned = grip(grasp.points, grasp.normals, wrenches, friction, safety=safety)
-    torques = joint_torques(grasp.hand, scene.positions, grasp.points, np.nan_to_num(planned.force))
+    unit = grasp.normals / np.linalg.norm(grasp.normals, axis=-1, keepdims=True)
+    forces = squeezed(grasp.points, unit, planned.force, np.asarray(friction) / safety, squeeze * load)
+    torques = joint_torques(grasp.hand, scene.positions, grasp.points, np.nan_to_num(forces))
+    # each direction's drive as stiff against its largest finger force as the scene's against the load
+    stiffer = np.maximum(1.0, np.nan_to_num(np.linalg.norm(forces, axis=-1).max(axis=-1)) / load)
+    jnt = [model.joint(j).id for j in scene.joints]
+    drive = model.jnt_stiffness[jnt].copy(), model.dof_damping[vadr].copy(), model.dof_armature[vadr].copy()
     steps = max(1, round(duration / model.opt.timestep))
     # gone: the object moved this far, so that it cannot come back within the tolerances
     gone = 10 * distance_tol + 1e-9
@@ -192,6 +210,7 @@ def hold_test(
             nan = np.full((3, 3), np.nan)
             out.append(Direction(name, False, math.nan, math.nan, nan, nan, int(planned.status[d]), False))
             continue
+        model.jnt_stiffness[jnt], model.dof_damping[vadr], model.dof_armature[vadr] = (a * stiffer[d] for a in drive)
         mujoco.mj_resetData(model, data)
         data.qpos[qadr] = scene.positions
         mujoco.mj_forward(model, data)
@@ -212,7 +231,7 @@ def hold_test(
             observe(name, model, data)
         moved = float(np.linalg.norm(data.qpos[free : free + 3] - start))
         turned = rotation_angle(mujoco, quat, data.qpos[free + 3 : free + 7])
-        forces = contact_forces(mujoco, model, data, body, tips)
+        exerted = contact_forces(mujoco, model, data, body, tips)
         ok = bool(held(moved, turned, distance_tol, angle_tol))
-        out.append(Direction(name, ok, moved, turned, forces, planned.force[d], 0, True))
+        out.append(Direction(name, ok, moved, turned, exerted, forces[d], 0, True))
     return HoldTest(tuple(out), load)

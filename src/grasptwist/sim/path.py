@@ -1,14 +1,23 @@
-r"""A path executed in MuJoCo: the fingers driven by grasptwist's joint rates, the object carried.
+r"""A path executed in MuJoCo: the fingers driven by grasptwist's resolved joint rates, the object carried.
 
-The object carries its own weight (gravity acts on it).  Every control step (:data:`CONTROL_DT`)
-each joint is driven to the hand's track (:func:`grasptwist.engine.hands.track`, the joint
-positions ``follow`` integrates): velocity control, the joint's damping pulling its rate to the
-track's ``qdot(t)`` and its spring to ``q(t)``, plus the torques ``J^T f(t)`` of the grip that
-holds the weight at the pose the path plans (:func:`grasptwist.engine.forces.hold.grip_along`).
-A grasp without a hand drives its fingertips' slides along the contacts' paths.  At each
-sample the object's pose is compared with the planned one, and each contact's slip is the
-distance from the fingertip's centre to where the path carries it (``p(t) - r n(t)``, a point
-fixed on the object): a contact that rolled as planned has none.
+The object carries its own weight (gravity acts on it).  The fingers' plan is
+:func:`grasptwist.engine.rolling.roll`'s: the paper's resolved rates, each finger's point at its
+contact moving with the object's twist there, integrated with the contact taken afresh where the
+fingertip sphere touches, so that each sphere rolls on the object without slipping.  Every
+control step (:data:`CONTROL_DT`) each joint is driven to that plan: velocity control, the joint's
+damping pulling its rate to the plan's ``qdot(t)`` (feed-forward) and its spring to ``q(t)``,
+plus the torques ``J^T f(t)`` of the grip (:func:`~grasptwist.engine.forces.grip.grip`) that holds
+the weight at the planned pose with the planned contacts.  A grasp without a hand drives its
+fingertips' slides the same way.  At each sample the object's pose is compared with the planned
+one, and each contact's slip is the distance, in the object's frame, from the fingertip's centre to
+the plan's: a contact that rolled as planned has none.
+
+Why the plan rolls (measured on the TriFinger's 0.5 rad ``spin`` of the bundled cube): driven to
+``follow``'s track (:func:`grasptwist.engine.hands.track`, each contact held fixed on the object),
+the plan asks each 10 mm tip to slide 5.1 mm over the cube while its link turns; friction holds
+instead (the tips slid 0.3 to 0.9 mm), so they rolled and dragged the cube back: it ended 9.0
+degrees behind the plan, though the joints tracked theirs within 0.004 rad.  Driven to the
+rolling plan, it ends 0.5 degree and 0.14 mm from it.
 """
 
 from __future__ import annotations
@@ -18,22 +27,23 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..engine import se3
-from ..engine.fingertips import tip_centers
-from ..engine.forces.hold import grip_along
-from ..engine.hands import track
+from ..engine.forces.grip import grip
+from ..engine.forces.hold import hold_wrench
 from ..engine.hold_test import joint_torques
 from ..engine.path import integrate
+from ..engine.rolling import roll
 from ..extras import require
 from .hold import CHUNK, Unstable, diverged, load_model, rotation_angle
 from .scene import OBJECT, TIP, Scene
 
-__all__ = ["PathRun", "run_path", "CONTROL_DT"]
+__all__ = ["PathRun", "run_path", "CONTROL_DT", "PLAN_DT"]
 
 #: Time between two updates of the joints' targets and torques (seconds).
 CONTROL_DT = 0.01
 
-#: Time between two samples of the hand's track (its joint positions are interpolated between).
-TRACK_DT = 0.05
+#: Time between two samples of the rolling plan (its joint positions, rates and torques are
+#: interpolated between them).
+PLAN_DT = 0.05
 
 
 @dataclass(frozen=True, eq=False)
@@ -52,16 +62,6 @@ class PathRun:
 def _grid(times, dt):
     end = float(times[-1])
     return np.union1d(np.append(np.arange(0.0, end, dt), end), times)
-
-
-def _targets(grasp, scene, segments, grid, radii):
-    """The joints' positions along the path ``(G, n)``: the hand's track, or the tips' slides."""
-    if grasp.hand is not None:
-        return track(grasp.hand, scene.positions, grasp.points, segments, grid, normals=grasp.normals).positions
-    poses = integrate(segments, grid)
-    centres = tip_centers(grasp.points, grasp.normals, radii)
-    moved = se3.transform(poses.rotation[:, None], poses.position[:, None], centres)
-    return (moved - centres).reshape(len(grid), 9)
 
 
 def run_path(
@@ -98,16 +98,17 @@ def run_path(
     data = mujoco.MjData(model)
     times = np.asarray(times, dtype=float)
     grid = _grid(times, CONTROL_DT)
-    coarse = _grid(times, TRACK_DT)  # the hand's track, interpolated between its samples
-    tracked = _targets(grasp, scene, segments, coarse, scene.radii)
-    q = np.stack([np.interp(grid, coarse, tracked[:, j]) for j in range(tracked.shape[1])], axis=1)
-    rates = np.gradient(q, grid, axis=0) if len(grid) > 1 else np.zeros_like(q)
-    poses, held = grip_along(
-        grasp.points, grasp.normals, friction, scene.mass, center_of_mass, gravity, segments, grid, safety=safety
-    )
-    moved = se3.transform(poses.rotation[:, None], poses.position[:, None], np.asarray(grasp.points, float))
+    coarse = _grid(times, PLAN_DT)  # the plan, interpolated between its samples
+    plan = roll(grasp.hand, scene.positions, grasp.object, grasp.points, grasp.normals, scene.radii, segments, coarse)
+    poses = integrate(segments, coarse)
+    wrench = hold_wrench(scene.mass, center_of_mass, gravity, poses.rotation, poses.position)
+    held = grip(plan.points, plan.normals, wrench, friction, safety=safety)
     forces = np.nan_to_num(held.force)
-    torques = np.array([joint_torques(grasp.hand, q[k], moved[k], forces[k]) for k in range(len(grid))])
+    torques = np.array([joint_torques(grasp.hand, *row) for row in zip(plan.positions, plan.points, forces)])
+    q, rates, torques = (
+        np.stack([np.interp(grid, coarse, a[:, j]) for j in range(a.shape[1])], axis=1)
+        for a in (plan.positions, plan.rates, torques)
+    )
     body = model.body(OBJECT).id
     free = model.jnt_qposadr[model.joint(OBJECT).id]
     qadr = [model.jnt_qposadr[model.joint(j).id] for j in scene.joints]
@@ -118,24 +119,30 @@ def run_path(
     mujoco.mj_forward(model, data)
     origin = data.qpos[free : free + 3].copy()
     rot0 = data.xmat[body].reshape(3, 3).copy()
-    # each tip's centre in the object's frame at the start: where the path carries it
-    carried = (data.geom_xpos[tips] - origin) @ rot0
+    index = np.searchsorted(coarse, times)
+    # each planned centre where the object was at the start (the planned pose undone)
+    back = se3.inverse(poses.rotation[index], poses.position[index])
+    planned_centres = se3.transform(back[0][:, None], back[1][:, None], plan.centers[index])
     sampled = np.isin(grid, times)
     out = {"time": [], "position": [], "angle": [], "slip": []}
     unstable = None
     step = 0
+    s = 0
     for k, t in enumerate(grid):
         if sampled[k]:
-            planned_origin = poses.rotation[k] @ origin + poses.position[k]
+            j = index[s]
+            planned_origin = poses.rotation[j] @ origin + poses.position[j]
             planned = np.zeros(4)
-            mujoco.mju_mat2Quat(planned, (poses.rotation[k] @ rot0).ravel())
+            mujoco.mju_mat2Quat(planned, (poses.rotation[j] @ rot0).ravel())
             rot = data.xmat[body].reshape(3, 3)
+            here = data.qpos[free : free + 3]
             out["time"].append(t)
-            out["position"].append(float(np.linalg.norm(data.qpos[free : free + 3] - planned_origin)))
+            out["position"].append(float(np.linalg.norm(here - planned_origin)))
             out["angle"].append(rotation_angle(mujoco, planned, data.qpos[free + 3 : free + 7]))
-            out["slip"].append(
-                np.linalg.norm(data.geom_xpos[tips] - (carried @ rot.T + data.qpos[free : free + 3]), axis=1)
-            )
+            # each tip's centre where the object was at the start (its actual pose undone)
+            at_start = (data.geom_xpos[tips] - here) @ rot @ rot0.T + origin
+            out["slip"].append(np.linalg.norm(at_start - planned_centres[s], axis=1))
+            s += 1
         if k + 1 == len(grid):
             break
         model.qpos_spring[qadr] = q[k + 1]
@@ -152,5 +159,5 @@ def run_path(
             break
         step += n
     slip = np.array(out["slip"]).reshape(-1, 3)
-    status = held.status[sampled][: len(out["time"])]
+    status = held.status[index][: len(out["time"])]
     return PathRun(np.array(out["time"]), np.array(out["position"]), np.array(out["angle"]), slip, status, unstable)

@@ -93,6 +93,8 @@ class Drive:
     object.  Measured on the bundled grasps (``docs/guide/simulation.md``): 20 times stiffer, a
     finger lets go where the object sinks into the others; 5 times softer, the fingertips give
     way sideways and a ball rolls between them;
+    The hold test stiffens each direction's drive by its largest finger force over the load,
+    when above 1 (:func:`grasptwist.sim.hold.hold_test`);
     ``armature`` makes that stiffness stable at the time step (``omega dt = STABLE``); damping
     is critical.
     """
