@@ -142,3 +142,19 @@ def test_synthesize_bag_on_the_synchronous_scheduler_gives_the_library_s_grasps(
     api = gt.synthesize(equator(), **OPTIONS)
     recs = gt.dask.synthesize_bag([str(SPHERE)], **OPTIONS).compute(scheduler="synchronous")
     np.testing.assert_array_equal(points_of([r for r in recs if r.get("grasp") == "sphere-equator"]), api.points)
+
+
+def test_simulate_s_six_loads_are_held_beside_the_weight():
+    # synthesize --simulate (grasp_problem's directions): the weight's size along +-x, +-y, +-z at the
+    # centre of mass, the one equal to the weight left out
+    g = equator()
+    plain, six = (grasp_problem(g, directions=d, **OPTIONS) for d in (False, True))
+    loads = ["load +x", "load -x", "load +y", "load -y", "load +z"]
+    assert six.names == (*plain.names, *loads)
+    np.testing.assert_array_equal(six.problem.wrenches[: len(plain.names)], plain.problem.wrenches)
+    weight = plain.problem.weight
+    size = weight.mass * np.linalg.norm(weight.gravity)
+    force = six.problem.wrenches[len(plain.names) :, :3]
+    np.testing.assert_allclose(force, -size * np.array([[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1]]))
+    moment = six.problem.wrenches[len(plain.names) :, 3:]
+    np.testing.assert_allclose(moment, np.cross(weight.center_of_mass, force), atol=1e-15)
