@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 import grasptwist as gt
-from conic import least_soft_grip
+from conic import closure_friction as clarabel_closure_friction
+from conic import closure_margin, least_soft_grip, soft_grasp_map
 from grasptwist.engine.forces import compiled
 from grasptwist.engine.forces.grasp_map import check_torsion
 
@@ -164,3 +165,110 @@ def test_odd_rows_with_soft_contacts_get_statuses_never_warnings():
     assert odd.status.tolist() == [code.NONFINITE_INPUT, code.NONFINITE_INPUT, code.COINCIDENT_CONTACTS, 0, 0]
     assert odd.torsion[3, 0] == 0 and abs(odd.force[3, 0] @ [1, 0, 0]) == pytest.approx(np.linalg.norm(odd.force[3, 0]))
     assert float(odd.total_normal_force[4]) == pytest.approx(0, abs=1e-9)  # no limit: friction alone holds it
+
+
+# --- force closure, epsilon and certificates with soft contacts -------------------------------------------
+
+
+def _closure_grasps(n, seed):
+    """:func:`grasps` spread wider (a third of them not closure at their own friction)."""
+    p, normals, _, friction, torsion = grasps(n, seed)
+    rng = np.random.default_rng(seed + 1)
+    return p, normals + rng.normal(0, 0.4, normals.shape), friction, torsion
+
+
+def test_zero_torsion_closure_is_point_contacts_bit_for_bit():
+    """``torsion=0`` (and rows of a mixed batch without a soft contact) take the point contacts' way."""
+    p, n, mu, e = _closure_grasps(30, 51)
+    e[::2] = 0.0
+    point = gt.forces.force_closure(p, n, mu)
+    zero = gt.forces.force_closure(p, n, mu, torsion=0.0)
+    mixed = gt.forces.force_closure(p, n, mu, torsion=e)
+    assert 0.2 < point.force_closure.mean() < 0.9 and zero.certificate is None
+    for name in ("closure_friction", "force_closure", "status", "culprit"):
+        np.testing.assert_array_equal(getattr(zero, name), getattr(point, name))
+        np.testing.assert_array_equal(getattr(mixed, name)[::2], getattr(point, name)[::2])
+    pytest.importorskip("scipy")
+    few = slice(0, 6)
+    quality = gt.forces.force_closure(p[few], n[few], mu[few], quality=True)
+    np.testing.assert_array_equal(
+        gt.forces.force_closure(p[few], n[few], mu[few], torsion=0.0, quality=True).epsilon, quality.epsilon
+    )
+
+
+@pytest.mark.parametrize("count", [6, pytest.param(1000, marks=pytest.mark.slow)])
+def test_soft_closure_friction_equals_clarabels_bisection(count):
+    """The least common friction of closure, soft and point contacts mixed, to 1e-6 of Clarabel's bisection on
+    the same conic programme (with numpy's rank of the forces' and torsions' grasp map), and never above the
+    point contacts' (a soft cone holds the point cone)."""
+    p, n, _, e = _closure_grasps(count, 53)
+    soft = gt.forces.force_closure(p, n, torsion=e).closure_friction
+    ref = np.array([clarabel_closure_friction(p[k], n[k], torsion=e[k]) for k in range(count)])
+    assert (np.isnan(ref) == np.isnan(soft)).all() and np.isfinite(ref).mean() >= 0.6
+    ok = np.isfinite(ref)
+    np.testing.assert_allclose(soft[ok], ref[ok], rtol=1e-6)
+    point = gt.forces.force_closure(p, n).closure_friction
+    assert (soft[ok] <= point[ok] * (1 + 1e-9)).all() and (soft[ok] < point[ok] * (1 - 1e-3)).any()
+
+
+@pytest.mark.parametrize("count", [40, pytest.param(1000, marks=pytest.mark.slow)])
+def test_soft_closure_verdicts_equal_clarabels_and_their_certificates_verify(count):
+    """With each grasp's own friction: force closure where Clarabel's margin over the internal forces is positive
+    (and the grasp map onto); elsewhere a certificate ``y`` that no forces within the cones reach
+    (``-G_i^T y`` in every dual cone, ``y != 0``: the grasp cannot exert ``y``)."""
+    p, n, mu, e = _closure_grasps(count, 55)
+    c = gt.forces.force_closure(p, n, mu, torsion=e, certificate=True)
+    margin = np.array([closure_margin(p[k], n[k], mu[k], e[k]) for k in range(count)])
+    onto = np.array([np.linalg.matrix_rank(soft_grasp_map(p[k], n[k], e[k])) == 6 for k in range(count)])
+    clear = np.abs(margin) > 1e-7  # Clarabel decides: a margin of 0 is the cones' edge
+    assert (c.force_closure == ((margin > 0) & onto))[clear].all() and 0.2 < c.force_closure.mean() < 0.9
+    assert np.isnan(c.certificate[c.force_closure]).all()
+    y = c.certificate[~c.force_closure]
+    assert np.isfinite(y).all()
+    forces, torsions = _field(y, p[~c.force_closure], n[~c.force_closure])
+    excess = _dual_cone_excess(
+        p[~c.force_closure], n[~c.force_closure], e[~c.force_closure], mu[~c.force_closure], -forces, -torsions
+    )
+    assert (excess <= 1e-9).all()
+
+
+def test_two_soft_contacts_close_a_grasp_on_a_line_that_point_contacts_cannot():
+    """Two fingers pinching a rod along its axis, a third pushing up: point contacts exert no moment about the
+    line (collinear-contacts, a certificate along that moment); soft pads close with any friction, one pad
+    alone too, and their epsilon (the inscribed bipyramids) is positive where the point contacts' is 0."""
+    point = gt.forces.force_closure(LINE, ACROSS, 0.5, certificate=True, quality=True)
+    assert int(point.status) == gt.forces.Status.COLLINEAR_CONTACTS and not point.force_closure
+    np.testing.assert_allclose(point.certificate, [0, 0, 0, 20, 0, 0], atol=1e-9)  # |L y_M| = 1, L = 0.05
+    assert float(point.epsilon) == 0
+    for e in ([0.01, 0.01, 0], [0.01, 0, 0]):
+        soft = gt.forces.force_closure(LINE, ACROSS, 0.5, torsion=e, quality=True)
+        assert int(soft.status) == 0 and soft.force_closure and float(soft.closure_friction) < 1e-6
+        assert float(soft.epsilon) > 0.01
+    lying = gt.forces.force_closure(LINE, [[0, 0, 1]] * 3, 0.5, torsion=0.01, certificate=True)
+    assert int(lying.status) == gt.forces.Status.COLLINEAR_CONTACTS  # normals across the line: no such torsion
+    np.testing.assert_allclose(np.abs(lying.certificate), [0, 0, 0, 20, 0, 0], atol=1e-9)
+
+
+def test_soft_epsilon_holds_the_point_contacts():
+    """A soft contact's wrenches hold its point contact's, so its epsilon is never smaller; ``e = 0`` is equal."""
+    pytest.importorskip("scipy")
+    p, n, mu, e = _closure_grasps(8, 57)
+    point = gt.forces.force_closure(p, n, mu, quality=True).epsilon
+    soft = gt.forces.force_closure(p, n, mu, torsion=np.maximum(e, 0.05), quality=True).epsilon
+    assert (soft >= point - 1e-12).all() and (soft > point * 1.01).any() and (point > 0).sum() >= 2
+
+
+def test_odd_closure_rows_with_soft_contacts():
+    """NaN torsion is nonfinite-input; a certificate needs a friction; coincident contacts keep their status."""
+    p = np.stack([EQ] * 3)
+    p[1, 1] = p[1, 0]
+    c = gt.forces.force_closure(
+        p, -EQ, [0.5, 0.5, np.nan], torsion=[[np.nan, 0.01, 0.01], [0.01] * 3, [0.01] * 3], certificate=True
+    )
+    code = gt.forces.Status
+    assert c.status.tolist() == [code.NONFINITE_INPUT, code.COINCIDENT_CONTACTS, 0]
+    assert not c.force_closure.any() and np.isnan(c.certificate).all()
+    with pytest.raises(ValueError, match="certificate=True needs the grasp's friction"):
+        gt.forces.force_closure(EQ, -EQ, certificate=True)
+    with pytest.raises(ValueError, match="torsion must be a finite length"):
+        gt.forces.force_closure(EQ, -EQ, torsion=-0.01)
