@@ -165,7 +165,7 @@ def closure_fields(block, torsion=None) -> list[dict]:
         friction,
         has,
         ForceOptions(torsion=torsion),
-        block.torsion,
+        getattr(block, "torsion", None),  # a twist block's; a block of another family has no soft contacts
     )
     least = result.closure_friction.tolist()
     verdict = result.force_closure.tolist()
