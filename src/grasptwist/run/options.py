@@ -131,6 +131,7 @@ class SynthesisOptions:
     position_error: float | None = None
     friction_error: float = 0.2
     perturbations: int = 64
+    torsion: float | None = None  # --contact soft --torsion E: every contact soft (None: the file's, else point)
 
     simulate: SimulateOptions | None = None
 

@@ -93,6 +93,7 @@ class Found:
     clearance: np.ndarray | None = None  # each grasp's least distance of a finger from them (None: no environment)
     dropped: int = 0  # --simulate: grasps found that did not hold in MuJoCo, left out
     simulated: tuple | None = None  # --simulate: each grasp's hold test in MuJoCo (a HoldTest), else None
+    torsion: float | None = None  # soft contacts' torsional radius the search used (None: point contacts)
 
     def __len__(self) -> int:
         return len(self.synthesis.points)
@@ -298,6 +299,17 @@ def synthesize_inputs(job, inputs: Iterable) -> Iterator[GraspFileError | Found 
         yield Progress(0, 1)
 
 
+def _torsion(options, entry: Grasp, friction: float) -> float | None:
+    """The soft contacts' radius of a search: ``--torsion``, else the least of the document's contacts' when
+    every one is ``model: soft`` (as its friction, the least), else None (point contacts); None with a
+    friction of 0 (``--friction 0`` over a file's soft contacts: frictionless, as the engine's models)."""
+    if options.torsion is not None:
+        return options.torsion
+    soft = entry.torsion
+    every = soft is not None and (np.asarray(soft) > 0).all() and friction > 0
+    return float(np.min(soft)) if every else None
+
+
 def _internal(file, line, exc: Exception) -> GraspFileError:
     """The ``internal-error`` record of an object whose reading or search raised ``exc``."""
     return _problem(file, "internal-error", f"{type(exc).__name__}: {exc}", line)
@@ -317,6 +329,7 @@ def _searched_entry(job, entry: Grasp) -> Iterator[GraspFileError | Found | Prog
         return
     reach, hand = hand if hand is not None else (None, None)
     said = _object_warnings(entry, obj, hand)
+    torsion = _torsion(o, entry, friction)
     yield Progress(o.candidates, 0)
     surface, clear = environment_search(surface_of(obj, o.span_bodies), entry.environment, None, reach)
     for step in search_steps(
@@ -339,6 +352,7 @@ def _searched_entry(job, entry: Grasp) -> Iterator[GraspFileError | Found | Prog
         position_error=o.position_error,
         friction_error=o.friction_error,
         perturbations=o.perturbations,
+        torsion=torsion,
     ):
         if isinstance(step, int):
             yield Progress(0, step)
@@ -364,6 +378,7 @@ def _searched_entry(job, entry: Grasp) -> Iterator[GraspFileError | Found | Prog
         warnings=said,
         environment=entry.environment,
         clearance=grasp_clearance(step.points, entry.environment, reach, step.joint_positions),
+        torsion=torsion,
     )
     if o.simulate is not None:
         from .simulate import held_only  # MuJoCo, with the first synthesize --simulate

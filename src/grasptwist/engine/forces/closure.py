@@ -88,6 +88,7 @@ __all__ = [
     "force_closure",
     "closure_test",
     "epsilon_quality",
+    "soft_closure_verdict",
     "BISECTIONS",
     "MAX_FRICTION",
     "MAX_CONE_EDGES",
@@ -719,6 +720,27 @@ def _own_closure(p, unit, mu, e):
         setup = cones.cone_grasp(p[rows[out]], unit[rows[out]], np.ones((out.size, 3)), e[rows[out]], model[out])
         y[rows[out]] = _unreachable(setup)
     return closes, y
+
+
+def soft_closure_verdict(points, normals, friction, torsion, tol=DEGENERACY_TOL):
+    """Whether each grasp is force closure with its own friction over the contacts' cones, without its least
+    friction (one phase I, as :func:`force_closure`'s soft rows' ``force_closure`` less its ``~none``; a
+    synthesis's filter): ``(n, 3, 3), (n, 3, 3), (n, 3), (n, 3) -> (n)`` bool, False where a status is not 0.
+
+    >>> p, n = [[[-0.05, 0, 0], [0.05, 0, 0], [0, 0, 0]]], [[[1, 0, 0], [-1, 0, 0], [0, 0, 1]]]
+    >>> soft_closure_verdict(p, n, np.full((1, 3), 0.5), np.full((1, 3), 0.01)).tolist()
+    [True]
+    """
+    p, n = np.asarray(points, float), np.asarray(normals, float)
+    e = np.asarray(torsion, float)
+    _, unit, status, _ = _statuses(p, n, tol)
+    status[status == ForceStatus.COLLINEAR_CONTACTS] = 0
+    closes = np.zeros(len(p), bool)
+    rows = np.flatnonzero((status == 0) & ~np.isnan(e).any(axis=1))
+    if rows.size:
+        with np.errstate(all="ignore"):
+            closes[rows] = _own_closure(p[rows], unit[rows], np.asarray(friction, float)[rows], e[rows])[0]
+    return closes
 
 
 def _certificates(p, n, mu, e, out, tol):

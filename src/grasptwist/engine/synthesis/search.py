@@ -52,7 +52,15 @@ from ..objects.geometry import body_areas, body_of
 from .archive import Archive
 from .budget import Budget, Spending, check_budget
 from .candidates import candidate_triples, tangent_steps
-from .checks import check_count, check_min_spacing, check_search_friction, check_seed, check_tip_radius, check_wrenches
+from .checks import (
+    check_count,
+    check_min_spacing,
+    check_search_friction,
+    check_search_torsion,
+    check_seed,
+    check_tip_radius,
+    check_wrenches,
+)
 from .clearance import environment_search
 from .reach import HandReach, check_hand_reach, reach_tolerance, tip_errors, violations
 from .robustness import (
@@ -306,6 +314,10 @@ def search(surface: Surface, wrenches, friction, **options) -> Synthesis:
         The largest share of ``friction`` a perturbation takes away.
     perturbations : int, default 64
         Perturbations per grasp (seeded by ``seed``).
+    torsion : float or None, default None
+        Soft-finger contacts' torsional radius ``e > 0`` at every contact (a length, in the surface's
+        units; ``friction > 0``): closure, the grips, the hold friction, the robustness, the closure
+        friction and epsilon over the soft cones (:mod:`~grasptwist.engine.forces.cones`); None: point contacts.
 
     Returns
     -------
@@ -359,11 +371,13 @@ def search_steps(
     position_error=None,
     friction_error=FRICTION_ERROR,
     perturbations=PERTURBATIONS,
+    torsion=None,
 ) -> Iterator:
     """:func:`search`, one step at a time: yields the candidates of each chunk scored (ints), then the
     :class:`Synthesis` (a progress bar's way through a long search)."""
     w = check_wrenches(wrenches)
     mu = check_search_friction(friction)
+    torsion = check_search_torsion(torsion, mu)
     count = check_count(count)
     safety = check_safety(safety)
     objective = check_objective(objective)
@@ -387,7 +401,7 @@ def search_steps(
     budget_size = setting.candidates
     rng = np.random.default_rng(seed)
     joints = None if hand is None else len(hand.hand.joint_names)
-    archive = Archive(max(ELITES, 4 * count), spacing, joints, tol)
+    archive = Archive(max(ELITES, 4 * count), spacing, joints, tol, torsion)
     # closure friction, epsilon: slower rows; a hand: the archive fills (and spares rows the hand's test) sooner
     chunk = CHUNK if objective in ("robust", "total_normal_force") and hand is None else CHUNK // 8
 
@@ -405,6 +419,7 @@ def search_steps(
             constraints=constraints,
             hand=hand,
             bound=archive.bound if bound is None else bound,
+            torsion=torsion,
             tol=tol,
         )
 
@@ -420,15 +435,22 @@ def search_steps(
         yield from _refine(surface, archive, score, budget, rng)
     rank = np.arange(len(archive.objective))
     if objective == "robust" and rank.size:  # the finalists, most robust first, then the least total
-        robust = robustness(surface, archive.points, archive.normals, w, mu, safety=safety, tol=tol, **perturbation)
+        robust = robustness(
+            surface, archive.points, archive.normals, w, mu, safety=safety, torsion=torsion, tol=tol, **perturbation
+        )
         rank = np.lexsort((archive.objective, -robust))
     # the archive's grasps are spacing apart already: the first count in rank are the selection
     picked = rank[:count]
     points, normals = archive.points[picked], archive.normals[picked]
     positions = None if hand is None else archive.positions[picked]
     quality = quality or objective == "epsilon"
-    out = _results(surface, points, normals, w, mu, safety, wrist, methods, quality, tol, hand, positions, budget)
-    out.update(margins(surface, out["points"], out["normals"], w, mu, safety=safety, tol=tol, **perturbation)._asdict())
+    out = _results(
+        surface, points, normals, w, mu, safety, wrist, methods, quality, tol, hand, positions, budget, torsion
+    )
+    held = margins(
+        surface, out["points"], out["normals"], w, mu, safety=safety, torsion=torsion, tol=tol, **perturbation
+    )
+    out.update(held._asdict())
     failure = None
     if not len(out["points"]) and out["unverified"]:
         failure = Failure(
@@ -485,14 +507,16 @@ def _refine(surface, archive, score, budget, rng):
         step = np.where(better, step, step / 2)
 
 
-def verified(points, normals, wrench, friction, safety, tol=DEGENERACY_TOL) -> Grip | None:
+def verified(points, normals, wrench, friction, safety, tol=DEGENERACY_TOL, torsion=None) -> Grip | None:
     r"""The exact grip of one grasp and wrench when its certificate proves it optimal, else None.
 
     One row through :func:`~grasptwist.engine.forces.grip.grip`; its ``dual`` must close the gap
     (``|total - w . dual| <= GAP_TOL max(total, 1)``) and be dual feasible:
     ``n_i - G_i^T dual`` (``G_i^T dual = dual_F + dual_M x p_i``) in each dual cone
     ``(mu / s) |z_t| <= z_n``, to :data:`GAP_TOL`; with ``mu = inf`` (the half-space
-    ``f . n >= 0``, no limit) the dual cone is the ray along ``n``: ``|z_t| = 0 <= z_n``.
+    ``f . n >= 0``, no limit) the dual cone is the ray along ``n``: ``|z_t| = 0 <= z_n``.  With ``torsion``
+    (soft contacts' radius ``e``) the grip is over the soft cones and ``|z_t|`` is ``|(z_t, e z_tau)|``,
+    ``z_tau = -n_i . dual_M``.
 
     >>> p = np.array([[1.0, 0, 0], [-0.5, 0.75**0.5, -0.2], [-0.5, -(0.75**0.5), -0.2]])
     >>> g = verified(p, -p / np.linalg.norm(p, axis=1, keepdims=True), [0, 0, 1.0, 0, 0, 0], 0.5, 1.0)
@@ -502,7 +526,7 @@ def verified(points, normals, wrench, friction, safety, tol=DEGENERACY_TOL) -> G
     >>> g is not None and bool(g.total_normal_force < 1e-6)  # tangential forces alone hold it
     True
     """
-    g = grip(points, normals, wrench, friction, safety=safety, tol=tol)
+    g = grip(points, normals, wrench, friction, safety=safety, torsion=torsion, tol=tol)
     if not g.ok:
         return None
     total = float(g.total_normal_force)
@@ -513,6 +537,8 @@ def verified(points, normals, wrench, friction, safety, tol=DEGENERACY_TOL) -> G
     z = n - (g.dual[:3] + np.cross(g.dual[3:], np.asarray(points, float)))
     zn = np.sum(z * n, axis=-1)
     zt = np.linalg.norm(z - zn[:, None] * n, axis=-1)
+    if torsion is not None:  # the soft cones' dual: the torsion's multiplier beside the tangential ones
+        zt = np.hypot(zt, torsion * np.sum(n * g.dual[3:], axis=-1))
     limit = friction / safety
     # no limit: (mu / s) |z_t| is inf * 0 on the ray, so ask for the ray itself
     inside = (zt <= GAP_TOL) & (zn >= -GAP_TOL) if np.isinf(limit) else limit * zt - zn <= GAP_TOL
@@ -520,7 +546,20 @@ def verified(points, normals, wrench, friction, safety, tol=DEGENERACY_TOL) -> G
 
 
 def _results(
-    surface, points, normals, w, mu, safety, wrist, methods, quality, tol, hand=None, positions=None, budget=None
+    surface,
+    points,
+    normals,
+    w,
+    mu,
+    safety,
+    wrist,
+    methods,
+    quality,
+    tol,
+    hand=None,
+    positions=None,
+    budget=None,
+    torsion=None,
 ):
     """The returned grasps' fields of :class:`Synthesis`, each grasp verified (the others dropped): the
     exact grip, and with a hand its tips by forward kinematics, its limits and its links clear; those
@@ -532,12 +571,13 @@ def _results(
         if budget is not None and budget.late():
             unverified = len(points) - i
             break
-        found = tuple(verified(points[i], normals[i], wrench, mu, safety, tol) for wrench in w)
+        found = tuple(verified(points[i], normals[i], wrench, mu, safety, tol, torsion) for wrench in w)
         if all(g is not None for g in found):
             grips.append(found)
             keep.append(i)
             if quality:
-                epsilon.append(float(force_closure(points[i], normals[i], mu / safety, quality=True, tol=tol).epsilon))
+                c = force_closure(points[i], normals[i], mu / safety, torsion=torsion, quality=True, tol=tol)
+                epsilon.append(float(c.epsilon))
     hand_fields = {}
     if hand is not None:
         error = tip_errors(hand, points[keep], normals[keep], positions[keep])
@@ -550,7 +590,7 @@ def _results(
             "tip_center": tip_centers(points[keep], normals[keep], hand.radii),
         }
     p, n = points[keep], normals[keep]
-    closure = force_closure(p, n, mu / safety, tol=tol) if len(p) else None
+    closure = force_closure(p, n, mu / safety, torsion=torsion, tol=tol) if len(p) else None
     return {
         "points": p,
         "normals": n,
