@@ -529,6 +529,7 @@ def test_soft_contacts_from_a_grasp_file_and_their_errors_located(tmp_path):
         "torsion: 0.01": "missing-key: contacts[0].model",
         "model: hard, torsion: 0.01": "invalid-contact-model: contacts[0].model: must be point or soft, got 'hard'",
         "model: soft, torsion: 0": "invalid-torsion: contacts[0].torsion: must be a length > 0",
+        "model: soft, torsion: 0.01, friction: 0": "invalid-torsion: contacts[0].torsion: a soft contact needs friction",
     }
     for keys, message in cases.items():
         bad = tmp_path / "bad.yaml"

@@ -272,3 +272,53 @@ def test_odd_closure_rows_with_soft_contacts():
         gt.forces.force_closure(EQ, -EQ, certificate=True)
     with pytest.raises(ValueError, match="torsion must be a finite length"):
         gt.forces.force_closure(EQ, -EQ, torsion=-0.01)
+
+
+# --- synthesis over the soft cones ----------------------------------------------------------------------------
+
+LATITUDE = np.radians(20)
+TRIPOD = np.stack(
+    [
+        np.cos(LATITUDE) * np.cos(np.radians([90, 210, 330])),
+        np.cos(LATITUDE) * np.sin(np.radians([90, 210, 330])),
+        np.full(3, np.sin(LATITUDE)),
+    ],
+    axis=1,
+)
+
+
+def test_synthesis_scores_hold_friction_and_verification_use_the_soft_cones_when_asked():
+    """Three fingers above a unit ball's equator lift it and turn it about a horizontal axis: the scores' totals are
+    Clarabel's soft grips, below the point contacts'; the hold friction of the lift is the point contacts'
+    (tan 20 deg); the verified grip's dual lies in the soft dual cones."""
+    from grasptwist.engine.synthesis.robustness import hold_friction
+    from grasptwist.engine.synthesis.scores import score_triples
+    from grasptwist.engine.synthesis.search import verified
+
+    w = np.array([[0, 0, 9.81, 0, 0, 0], [0, 0, 9.81, 0.5, 0, 0]])
+    with compiled.numpy_path():
+        point = score_triples(TRIPOD[None], -TRIPOD[None], w, 0.8, methods=("off_tangent",))
+        soft = score_triples(TRIPOD[None], -TRIPOD[None], w, 0.8, methods=("off_tangent",), torsion=0.2)
+        assert soft.failed.tolist() == [-1] == point.failed.tolist()
+        refs = [least_soft_grip(TRIPOD, -TRIPOD, wrench, 0.8, 0.2)[0] for wrench in w]
+        np.testing.assert_allclose(soft.total_normal_force[0], refs, rtol=1e-6)
+        assert soft.total_normal_force[0, 1] < point.total_normal_force[0, 1] * 0.999
+        # torsions about the normals cannot lift: tan 20 deg, to the 12 halvings' 0.8 / 2^12 (the soft grip, with no
+        # facial reduction, is cannot-hold within about 1e-5 of the edge, where the point contacts' is exact)
+        lift = hold_friction(TRIPOD[None], -TRIPOD[None], w[:1], 0.8, steps=12, torsion=0.2)
+        assert float(lift[0]) == pytest.approx(np.tan(LATITUDE), abs=0.8 / 2**12)
+        g = verified(TRIPOD, -TRIPOD, w[1], 0.8, 1.0, torsion=0.2)
+    assert g is not None and float(g.total_normal_force) == pytest.approx(refs[1], rel=1e-6)
+
+
+def test_a_search_with_soft_contacts_needs_friction():
+    from grasptwist.engine.synthesis.checks import check_search_torsion
+
+    assert check_search_torsion(None, 0.0) is None and check_search_torsion(0.01, 0.5) == 0.01
+    for torsion, friction, message in (
+        (0.0, 0.5, "finite length > 0"),
+        (np.inf, 0.5, "finite length > 0"),
+        (0.01, 0.0, "need friction > 0"),
+    ):
+        with pytest.raises(ValueError, match=message):
+            check_search_torsion(torsion, friction)
