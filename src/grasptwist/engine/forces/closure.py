@@ -389,7 +389,9 @@ def _least_soft_friction(group):
     ``1 / f_{n,i}(x_{k-1})``, Crouzeix-Ferland-Schaible's form, which converges superlinearly),
     ``mu_{k+1} = max_i |h_i(x_k)| / f_{n,i}(x_k)``: each ``mu_k`` is the friction some internal force needs, so
     an upper bound on ``mu*``, falling to it; a row stops once a step gains less than ``1e-12`` of it,
-    phase I finds no force strictly inside (the margin is 0: ``mu_k = mu*``) or ``mu_k < 1e-6`` (``_FLOOR``).
+    phase I finds no force strictly inside (the margin is 0: ``mu_k = mu*``; weighted, then plain) or
+    ``mu_k < 1e-6`` (``_FLOOR``).  Where a vanishing normal force's weight (at most ``1e6`` of the mean,
+    ``_WEIGHTS``) stalls phase I or leaves its force outside a cone, the step is the plain margin's.
     """
     mu = np.full(len(group.rows), np.nan)
     r, _, x = group.phase_one(np.full(len(mu), np.arctan(MAX_FRICTION)))
@@ -400,9 +402,16 @@ def _least_soft_friction(group):
         if not live.size:
             break
         sub = group.part(live)
-        r, _, x = sub.phase_one(np.arctan(mu[live]), fn.mean(axis=1, keepdims=True) / fn)
+        theta = np.arctan(mu[live])
+        mean = fn.mean(axis=1, keepdims=True)
+        r, _, x = sub.phase_one(theta, mean / np.maximum(fn, _WEIGHTS * mean))
+        # a normal force vanishing at the optimum (as one often does) gives a weight far from one, which can
+        # stall phase I or leave it a force just outside a cone: there the plain margin decides
+        again = np.flatnonzero(~((r < 0) & (sub.ratios(x)[1] > 0).all(axis=1)))
+        if again.size:
+            r[again], _, x[again] = sub.part(again).phase_one(theta[again])
         ratio, fn = sub.ratios(x)
-        new = np.where(r < 0, ratio.max(axis=1), np.inf)
+        new = np.where((r < 0) & (fn > 0).all(axis=1), ratio.max(axis=1), np.inf)
         gains = new < mu[live] * (1 - 1e-12)
         mu[live[gains]] = new[gains]
         gains &= new > _FLOOR
@@ -412,6 +421,9 @@ def _least_soft_friction(group):
 
 #: A cap on :func:`_least_soft_friction`'s steps (rows take 3 to 12).
 _STEPS = 40
+
+#: Dinkelbach's weights ``1 / f_n`` are at most ``1 / _WEIGHTS`` of their mean.
+_WEIGHTS = 1e-6
 
 #: A soft closure friction below this stops there (an upper bound: where the infimum is 0, each step only
 #: divides it by a few).
