@@ -322,3 +322,27 @@ def test_a_search_with_soft_contacts_needs_friction():
     ):
         with pytest.raises(ValueError, match=message):
             check_search_torsion(torsion, friction)
+
+
+def test_a_weight_off_the_line_of_the_contacts_is_held_along_a_path_by_soft_pads_alone():
+    """follow's grip of the weight (grip_along, hold_verdicts): a rod pinched along its axis whose centre of mass lies
+    1 cm beside it needs a moment about the line, which point contacts cannot make (unjudged: collinear-contacts)
+    and soft pads can, at every sample of a lift; the follow record says so."""
+    from grasptwist.engine.forces.hold import grip_along, hold_verdicts
+    from grasptwist.output.follow_records import grip_record
+    from grasptwist.path import Segment
+
+    weight = (LINE, ACROSS, 0.5, 1.0, [0, 0.01, 0], [0, 0, -9.81], [Segment(1.0, twist=[0, 0, 0, 0, 0, 0.1])])
+    times = [0.0, 0.5, 1.0]
+    with compiled.numpy_path():
+        point = grip_along(*weight, times)[1]
+        soft = grip_along(*weight, times, torsion=[0.01, 0.01, 0])[1]
+        falls, unjudged = hold_verdicts(*weight, times, torsion=[0.01, 0.01, 0])
+    assert (point.status == gt.forces.Status.COLLINEAR_CONTACTS).all() and soft.ok.all()
+    assert falls == () and unjudged == ()
+    reference = least_soft_grip(LINE, ACROSS, [0, 0, 9.81, 0.0981, 0, 0], 0.5, [0.01, 0.01, 0])[0]
+    np.testing.assert_allclose(soft.total_normal_force, reference, rtol=1e-6)  # a lift: the same wrench all along
+    np.testing.assert_allclose(soft.torsion[:, 0] - soft.torsion[:, 1], 0.0981, rtol=1e-9)
+    record = grip_record(soft, 0)
+    assert record["contact_model"] == "soft" and record["torsion"] == pytest.approx(soft.torsion[0].tolist())
+    assert "contact_model" not in grip_record(grip_along(EQ, -EQ, 0.5, *weight[3:], times)[1], 0)
