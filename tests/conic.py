@@ -44,26 +44,37 @@ def least_grip(points, normals, wrench, friction, safety=1.0):
     return float(sol.obj_val), np.array(sol.x).reshape(3, 3)
 
 
-def closure_margin(points, normals, mu):
-    """The largest ``min_i (mu n_i.f_i - |f_t,i|)`` over internal forces with ``sum_i n_i . f_i = 1``."""
+def closure_margin(points, normals, mu, torsion=None):
+    """The largest ``min_i (mu_i n_i.f_i - |f_t,i|)`` over internal forces with ``sum_i n_i . f_i = 1``.
+
+    ``torsion (3,)``: soft contacts (``e_i > 0``) add ``tau_i`` (the moment ``tau_i n_i``) and the margin is
+    ``mu n_i . f_i - |(f_t,i, tau_i / e_i)|``.
+    """
     n = _unit(normals)
+    mu = np.broadcast_to(np.asarray(mu, float), (3,))
+    e = np.zeros(3) if torsion is None else np.broadcast_to(np.asarray(torsion, float), (3,))
     b1, b2 = tangent_bases(n)
-    # variables (f (9), t): maximise t s.t. G f = 0, sum n.f = 1, (mu n.f - t, f_t) in SOC
-    eq = np.zeros((7, 10))
+    # variables (f (9), tau (3), t): maximise t s.t. G f + (0; tau n) = 0, sum n.f = 1, tau_i = 0 at point
+    # contacts, (mu n.f - t, f_t, tau / e) in SOC
+    eq = np.zeros((7, 13))
     eq[:6, :9] = grasp_map(points)
+    eq[3:6, 9:12] = n.T
     eq[6, :9] = n.reshape(9)
+    fixed = [np.eye(13)[9 + i] for i in range(3) if not e[i] > 0]
     rows = []
     for i in range(3):
-        block = np.zeros((3, 10))
-        block[:, 3 * i : 3 * i + 3] = -np.stack((mu * n[i], b1[i], b2[i]))
-        block[0, 9] = 1.0
+        block = np.zeros((4 if e[i] > 0 else 3, 13))
+        block[:3, 3 * i : 3 * i + 3] = -np.stack((mu[i] * n[i], b1[i], b2[i]))
+        block[0, 12] = 1.0
+        if e[i] > 0:
+            block[3, 9 + i] = -1 / e[i]
         rows.append(block)
-    A = sparse.csc_matrix(np.vstack([eq] + rows))
-    b = np.concatenate((np.zeros(6), [1.0], np.zeros(9)))
-    q = np.zeros(10)
-    q[9] = -1.0
-    cones = [clarabel.ZeroConeT(7)] + [clarabel.SecondOrderConeT(3)] * 3
-    sol = clarabel.DefaultSolver(sparse.csc_matrix((10, 10)), q, A, b, cones, _settings()).solve()
+    A = sparse.csc_matrix(np.vstack([eq] + fixed + rows))
+    b = np.concatenate((np.zeros(6), [1.0], np.zeros(len(fixed)), np.zeros(sum(len(r) for r in rows))))
+    q = np.zeros(13)
+    q[12] = -1.0
+    cones = [clarabel.ZeroConeT(7 + len(fixed))] + [clarabel.SecondOrderConeT(len(r)) for r in rows]
+    sol = clarabel.DefaultSolver(sparse.csc_matrix((13, 13)), q, A, b, cones, _settings()).solve()
     if str(sol.status) not in ("Solved", "AlmostSolved"):
         return -np.inf
     return -float(sol.obj_val)
@@ -74,15 +85,28 @@ def closure_margin(points, normals, mu):
 STRICT = 1e-10
 
 
-def closure_friction(points, normals, hi=1e3, iterations=45):
-    """The least common ``mu`` with a positive closure margin, by bisection on ``mu``; NaN when none below ``hi``."""
-    if closure_margin(points, normals, hi) <= STRICT:
+def closure_friction(points, normals, hi=1e3, iterations=45, torsion=None):
+    """The least common ``mu`` with a positive closure margin, by bisection on ``mu``; NaN when none below ``hi``
+    (``torsion``: soft contacts, as :func:`closure_margin`'s; the grasp map of the forces and torsions must
+    have rank 6, by numpy's ``matrix_rank``)."""
+    if torsion is not None and np.linalg.matrix_rank(soft_grasp_map(points, normals, torsion)) < 6:
+        return np.nan
+    if closure_margin(points, normals, hi, torsion) <= STRICT:
         return np.nan
     lo = 0.0
     for _ in range(iterations):
         mid = 0.5 * (lo + hi)
-        lo, hi = (lo, mid) if closure_margin(points, normals, mid) > STRICT else (mid, hi)
+        lo, hi = (lo, mid) if closure_margin(points, normals, mid, torsion) > STRICT else (mid, hi)
     return hi
+
+
+def soft_grasp_map(points, normals, torsion):
+    """``(6, 9 + s)``: the grasp map of the forces and the ``s`` soft contacts' torsions (``e_i > 0``)."""
+    n = _unit(normals)
+    e = np.broadcast_to(np.asarray(torsion, float), (3,))
+    torsions = np.zeros((6, 3))
+    torsions[3:] = n.T
+    return np.hstack((grasp_map(points), torsions[:, e > 0]))
 
 
 def least_soft_grip(points, normals, wrench, friction, torsion, safety=1.0):

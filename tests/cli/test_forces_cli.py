@@ -59,6 +59,7 @@ def test_the_bundled_ball_is_held_with_m_g_over_mu_as_the_engine_says():
         "closure_friction": pytest.approx(0, abs=1e-9),
         "epsilon": None,
         "safety": 1.0,
+        "contact_model": "point",
     }
     turn = by(recs, "sphere-equator", "turn-z")
     # 0.01 N m about the vertical: |f_t| = 0.01 / (3 r) at each finger, f_n = |f_t| / mu
@@ -327,7 +328,13 @@ def test_antipodal_and_coincident_contacts_through_forces_and_check(tmp_path):
     r, (rec,) = records(tmp_path / "same.yaml", "--quality")
     assert r.exit_code == 1 and "internal error" not in r.stderr
     assert rec["grip"]["error"]["code"] == rec["manipulating"]["error"]["code"] == "coincident-contacts"
-    assert rec["closure"] == {"force_closure": False, "closure_friction": None, "epsilon": 0.0, "safety": 1.0}
+    assert rec["closure"] == {
+        "force_closure": False,
+        "closure_friction": None,
+        "epsilon": 0.0,
+        "safety": 1.0,
+        "contact_model": "point",
+    }
 
 
 def test_closure_is_judged_with_the_friction_the_safety_factor_leaves():
@@ -471,7 +478,11 @@ def test_soft_contacts_from_the_command_line_twist_a_rod_point_contacts_cannot(t
     w = "0,0,1,0.004,0,0"
     r, (rec,) = records(line, "--wrench", w)
     assert r.exit_code == 1 and rec["grip"]["error"]["code"] == "collinear-contacts"
+    assert rec["closure"]["force_closure"] is False and rec["closure"]["contact_model"] == "point"
     r, (rec,) = records(line, "--wrench", w, "--contact", "soft", "--torsion", "0.01")
+    # soft pads close the line with any friction: the closure record says its model
+    assert rec["closure"]["force_closure"] is True and rec["closure"]["contact_model"] == "soft"
+    assert rec["closure"]["closure_friction"] < 1e-6
     # the manipulating forces are the point contacts' split (G^+ w), which the line still lacks
     assert rec["manipulating"]["error"]["code"] == "collinear-contacts" and "error" not in rec["grip"]
     points, normals = [[-0.05, 0, 0], [0.05, 0, 0], [0, 0, 0]], [[1, 0, 0], [-1, 0, 0], [0, 0, 1]]
@@ -518,6 +529,7 @@ def test_soft_contacts_from_a_grasp_file_and_their_errors_located(tmp_path):
         "torsion: 0.01": "missing-key: contacts[0].model",
         "model: hard, torsion: 0.01": "invalid-contact-model: contacts[0].model: must be point or soft, got 'hard'",
         "model: soft, torsion: 0": "invalid-torsion: contacts[0].torsion: must be a length > 0",
+        "model: soft, torsion: 0.01, friction: 0": "invalid-torsion: contacts[0].torsion: a soft contact needs friction",
     }
     for keys, message in cases.items():
         bad = tmp_path / "bad.yaml"
@@ -527,3 +539,25 @@ def test_soft_contacts_from_a_grasp_file_and_their_errors_located(tmp_path):
         )
         r, _ = run("forces", bad)
         assert r.exit_code == 1 and "bad.yaml:3:" in r.stderr and message in r.stderr, r.stderr
+
+
+def test_check_judges_closure_with_soft_contacts_and_says_the_model(tmp_path):
+    """Issue 39: check's closure with a grasp file's soft contacts, or --contact soft --torsion E for every contact;
+    soft records say their contact_model (point grasps' are as before: tests/golden/check.jsonl); soft needs friction."""
+    line = tmp_path / "line.yaml"
+    line.write_text(
+        "friction: 0.5\ncontacts:\n  - {point: [-0.05, 0, 0], normal: [1, 0, 0], model: soft, torsion: 0.01}\n"
+        "  - {point: [0.05, 0, 0], normal: [-1, 0, 0], model: soft, torsion: 0.01}\n"
+        "  - {point: [0, 0, 0], normal: [0, 0, 1]}\n"
+    )
+    (rec,) = jsonl(run("check", line, "-f", "jsonl")[0].stdout)
+    assert rec["force_closure"] is True and rec["contact_model"] == "soft" and rec["closure_friction"] < 1e-6
+    soft = jsonl(run("check", SPHERE, "-f", "jsonl", "--contact", "soft", "--torsion", "0.005")[0].stdout)
+    assert [s["contact_model"] for s in soft] == ["soft", "soft"]
+    tripod = read_grasps(SPHERE)[0]
+    expected = gt.forces.force_closure(tripod.points, tripod.normals, torsion=0.005).closure_friction
+    assert soft[0]["closure_friction"] == pytest.approx(float(expected), rel=1e-12)
+    point = gt.forces.force_closure(tripod.points, tripod.normals).closure_friction  # golden/check.jsonl's
+    assert soft[0]["closure_friction"] <= float(point)
+    r, _ = run("forces", SPHERE, "--contact", "soft", "--torsion", "0.01", "--friction", "0")
+    assert r.exit_code == 2 and "soft contacts need friction" in r.stderr and not r.stdout

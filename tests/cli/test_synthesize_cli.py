@@ -119,6 +119,53 @@ def test_bad_options_are_usage_errors(args, message):
     assert r.exit_code == 2 and message in r.stderr and "None" not in r.stderr
 
 
+@pytest.mark.slow  # 6-8 s: a soft grip of one row is 0.1 s of numpy, and a grasp's hold friction bisects 30 of them
+def test_soft_contacts_are_searched_said_and_written_soft(tmp_path):
+    """Issue 39: --contact soft --torsion E; each record says its contact_model, the grasp file written has soft
+    contacts, and forces reads them back to the same grip."""
+    one = tmp_path / "ball.yaml"
+    one.write_text(SPHERE.read_text().split("---")[-1])  # the equator ball alone (friction 0.5, mass 1)
+    found = tmp_path / "found.yaml"
+    r, _ = run(
+        "synthesize",
+        one,
+        "--candidates",
+        "60",
+        "-n",
+        "1",
+        "--contact",
+        "soft",
+        "--torsion",
+        "0.005",
+        "-o",
+        found,
+        "-f",
+        "jsonl",
+    )
+    assert r.exit_code == 0, r.stderr
+    (rec,) = jsonl(r.stdout)
+    assert rec["contact_model"] == "soft"
+    (grasp,) = read_grasps(found)
+    assert grasp.torsion.tolist() == [0.005] * 3
+    forces, _ = run("forces", found, "-f", "jsonl")
+    held = [x for x in jsonl(forces.stdout) if x["wrench"]["name"] == "hold"][0]
+    assert held["grip"]["contact_model"] == "soft"
+    assert held["grip"]["total_normal_force"] == pytest.approx(rec["scores"]["total_normal_force"]["hold"], rel=1e-9)
+
+
+@pytest.mark.parametrize(
+    ("args", "message"),
+    [
+        (("--contact", "soft"), "--contact soft needs --torsion E"),
+        (("--torsion", "0.01"), "give --contact soft too"),
+        (("--contact", "soft", "--torsion", "0.01", "--friction", "0"), "soft contacts need friction"),
+    ],
+)
+def test_soft_contact_options_are_usage_errors_as_forces_ones(args, message):
+    r, _ = run("synthesize", SPHERE, *args)
+    assert r.exit_code == 2 and message in r.stderr and not r.stdout
+
+
 #: Options the engine checks (engine/synthesis/checks.py): (option, library keyword, value given, as the library gets it).
 REFUSED = [
     ("-n", "count", "0", 0),

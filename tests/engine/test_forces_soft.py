@@ -7,7 +7,8 @@ import numpy as np
 import pytest
 
 import grasptwist as gt
-from conic import least_soft_grip
+from conic import closure_friction as clarabel_closure_friction
+from conic import closure_margin, least_soft_grip, soft_grasp_map
 from grasptwist.engine.forces import compiled
 from grasptwist.engine.forces.grasp_map import check_torsion
 
@@ -164,3 +165,184 @@ def test_odd_rows_with_soft_contacts_get_statuses_never_warnings():
     assert odd.status.tolist() == [code.NONFINITE_INPUT, code.NONFINITE_INPUT, code.COINCIDENT_CONTACTS, 0, 0]
     assert odd.torsion[3, 0] == 0 and abs(odd.force[3, 0] @ [1, 0, 0]) == pytest.approx(np.linalg.norm(odd.force[3, 0]))
     assert float(odd.total_normal_force[4]) == pytest.approx(0, abs=1e-9)  # no limit: friction alone holds it
+
+
+# --- force closure, epsilon and certificates with soft contacts -------------------------------------------
+
+
+def _closure_grasps(n, seed):
+    """:func:`grasps` spread wider (a third of them not closure at their own friction)."""
+    p, normals, _, friction, torsion = grasps(n, seed)
+    rng = np.random.default_rng(seed + 1)
+    return p, normals + rng.normal(0, 0.4, normals.shape), friction, torsion
+
+
+def test_zero_torsion_closure_is_point_contacts_bit_for_bit():
+    """``torsion=0`` (and rows of a mixed batch without a soft contact) take the point contacts' way."""
+    p, n, mu, e = _closure_grasps(16, 51)
+    e[::2] = 0.0
+    point = gt.forces.force_closure(p, n, mu)
+    zero = gt.forces.force_closure(p, n, mu, torsion=0.0)
+    mixed = gt.forces.force_closure(p, n, mu, torsion=e)
+    assert 0.2 < point.force_closure.mean() < 0.9 and zero.certificate is None
+    for name in ("closure_friction", "force_closure", "status", "culprit"):
+        np.testing.assert_array_equal(getattr(zero, name), getattr(point, name))
+        np.testing.assert_array_equal(getattr(mixed, name)[::2], getattr(point, name)[::2])
+    pytest.importorskip("scipy")
+    few = slice(0, 3)
+    quality = gt.forces.force_closure(p[few], n[few], mu[few], quality=True)
+    np.testing.assert_array_equal(
+        gt.forces.force_closure(p[few], n[few], mu[few], torsion=0.0, quality=True).epsilon, quality.epsilon
+    )
+
+
+@pytest.mark.parametrize("count", [3, pytest.param(1000, marks=pytest.mark.slow)])
+def test_soft_closure_friction_equals_clarabels_bisection(count):
+    """The least common friction of closure, soft and point contacts mixed, to 1e-6 of Clarabel's bisection on
+    the same conic programme (with numpy's rank of the forces' and torsions' grasp map), and never above the
+    point contacts' (a soft cone holds the point cone)."""
+    p, n, _, e = _closure_grasps(count, 53)
+    soft = gt.forces.force_closure(p, n, torsion=e).closure_friction
+    ref = np.array([clarabel_closure_friction(p[k], n[k], torsion=e[k]) for k in range(count)])
+    assert (np.isnan(ref) == np.isnan(soft)).all() and np.isfinite(ref).mean() >= 0.6
+    ok = np.isfinite(ref)
+    np.testing.assert_allclose(soft[ok], ref[ok], rtol=1e-6)
+    point = gt.forces.force_closure(p, n).closure_friction
+    assert (soft[ok] <= point[ok] * (1 + 1e-9)).all() and (soft[ok] < point[ok] * (1 - 1e-3)).any()
+
+
+@pytest.mark.parametrize("count", [24, pytest.param(1000, marks=pytest.mark.slow)])
+def test_soft_closure_verdicts_equal_clarabels_and_their_certificates_verify(count):
+    """With each grasp's own friction: force closure where Clarabel's margin over the internal forces is positive
+    (and the grasp map onto); elsewhere a certificate ``y`` that no forces within the cones reach
+    (``-G_i^T y`` in every dual cone, ``y != 0``: the grasp cannot exert ``y``)."""
+    p, n, mu, e = _closure_grasps(count, 55)
+    c = gt.forces.force_closure(p, n, mu, torsion=e, certificate=True)
+    margin = np.array([closure_margin(p[k], n[k], mu[k], e[k]) for k in range(count)])
+    onto = np.array([np.linalg.matrix_rank(soft_grasp_map(p[k], n[k], e[k])) == 6 for k in range(count)])
+    clear = np.abs(margin) > 1e-7  # Clarabel decides: a margin of 0 is the cones' edge
+    assert (c.force_closure == ((margin > 0) & onto))[clear].all() and 0.2 < c.force_closure.mean() < 0.9
+    assert np.isnan(c.certificate[c.force_closure]).all()
+    y = c.certificate[~c.force_closure]
+    assert np.isfinite(y).all()
+    forces, torsions = _field(y, p[~c.force_closure], n[~c.force_closure])
+    excess = _dual_cone_excess(
+        p[~c.force_closure], n[~c.force_closure], e[~c.force_closure], mu[~c.force_closure], -forces, -torsions
+    )
+    assert (excess <= 1e-9).all()
+
+
+def test_two_soft_contacts_close_a_grasp_on_a_line_that_point_contacts_cannot():
+    """Two fingers pinching a rod along its axis, a third pushing up: point contacts exert no moment about the
+    line (collinear-contacts, a certificate along that moment); soft pads close with any friction, one pad
+    alone too, and their epsilon (the inscribed bipyramids) is positive where the point contacts' is 0."""
+    point = gt.forces.force_closure(LINE, ACROSS, 0.5, certificate=True, quality=True)
+    assert int(point.status) == gt.forces.Status.COLLINEAR_CONTACTS and not point.force_closure
+    np.testing.assert_allclose(point.certificate, [0, 0, 0, 20, 0, 0], atol=1e-9)  # |L y_M| = 1, L = 0.05
+    assert float(point.epsilon) == 0
+    for e in ([0.01, 0.01, 0], [0.01, 0, 0]):
+        soft = gt.forces.force_closure(LINE, ACROSS, 0.5, torsion=e, quality=True)
+        assert int(soft.status) == 0 and soft.force_closure and float(soft.closure_friction) < 1e-6
+        assert float(soft.epsilon) > 0.01
+    lying = gt.forces.force_closure(LINE, [[0, 0, 1]] * 3, 0.5, torsion=0.01, certificate=True)
+    assert int(lying.status) == gt.forces.Status.COLLINEAR_CONTACTS  # normals across the line: no such torsion
+    np.testing.assert_allclose(np.abs(lying.certificate), [0, 0, 0, 20, 0, 0], atol=1e-9)
+
+
+def test_soft_epsilon_holds_the_point_contacts():
+    """A soft contact's wrenches hold its point contact's, so its epsilon is never smaller; ``e = 0`` is equal."""
+    pytest.importorskip("scipy")
+    p, n, mu, e = _closure_grasps(8, 57)
+    point = gt.forces.force_closure(p, n, mu, quality=True).epsilon
+    soft = gt.forces.force_closure(p, n, mu, torsion=np.maximum(e, 0.05), quality=True).epsilon
+    assert (soft >= point - 1e-12).all() and (soft > point * 1.01).any() and (point > 0).sum() >= 2
+
+
+def test_odd_closure_rows_with_soft_contacts():
+    """NaN torsion is nonfinite-input; a certificate needs a friction; coincident contacts keep their status."""
+    p = np.stack([EQ] * 3)
+    p[1, 1] = p[1, 0]
+    c = gt.forces.force_closure(
+        p, -EQ, [0.5, 0.5, np.nan], torsion=[[np.nan, 0.01, 0.01], [0.01] * 3, [0.01] * 3], certificate=True
+    )
+    code = gt.forces.Status
+    assert c.status.tolist() == [code.NONFINITE_INPUT, code.COINCIDENT_CONTACTS, 0]
+    assert not c.force_closure.any() and np.isnan(c.certificate).all()
+    with pytest.raises(ValueError, match="certificate=True needs the grasp's friction"):
+        gt.forces.force_closure(EQ, -EQ, certificate=True)
+    with pytest.raises(ValueError, match="torsion must be a finite length"):
+        gt.forces.force_closure(EQ, -EQ, torsion=-0.01)
+
+
+# --- synthesis over the soft cones ----------------------------------------------------------------------------
+
+LATITUDE = np.radians(20)
+TRIPOD = np.stack(
+    [
+        np.cos(LATITUDE) * np.cos(np.radians([90, 210, 330])),
+        np.cos(LATITUDE) * np.sin(np.radians([90, 210, 330])),
+        np.full(3, np.sin(LATITUDE)),
+    ],
+    axis=1,
+)
+
+
+def test_synthesis_scores_hold_friction_and_verification_use_the_soft_cones_when_asked():
+    """Three fingers above a unit ball's equator lift it and turn it about a horizontal axis: the scores' totals are
+    Clarabel's soft grips, below the point contacts'; the hold friction of the lift is the point contacts'
+    (tan 20 deg); the verified grip's dual lies in the soft dual cones."""
+    from grasptwist.engine.synthesis.robustness import hold_friction
+    from grasptwist.engine.synthesis.scores import score_triples
+    from grasptwist.engine.synthesis.verify import verified
+
+    w = np.array([[0, 0, 9.81, 0, 0, 0], [0, 0, 9.81, 0.5, 0, 0]])
+    with compiled.numpy_path():
+        point = score_triples(TRIPOD[None], -TRIPOD[None], w, 0.8, methods=("off_tangent",))
+        soft = score_triples(TRIPOD[None], -TRIPOD[None], w, 0.8, methods=("off_tangent",), torsion=0.2)
+        assert soft.failed.tolist() == [-1] == point.failed.tolist()
+        refs = [least_soft_grip(TRIPOD, -TRIPOD, wrench, 0.8, 0.2)[0] for wrench in w]
+        np.testing.assert_allclose(soft.total_normal_force[0], refs, rtol=1e-6)
+        assert soft.total_normal_force[0, 1] < point.total_normal_force[0, 1] * 0.999
+        # torsions about the normals cannot lift: tan 20 deg, to the 12 halvings' 0.8 / 2^12 (the soft grip, with no
+        # facial reduction, is cannot-hold within about 1e-5 of the edge, where the point contacts' is exact)
+        lift = hold_friction(TRIPOD[None], -TRIPOD[None], w[:1], 0.8, steps=12, torsion=0.2)
+        assert float(lift[0]) == pytest.approx(np.tan(LATITUDE), abs=0.8 / 2**12)
+        g = verified(TRIPOD, -TRIPOD, w[1], 0.8, 1.0, torsion=0.2)
+    assert g is not None and float(g.total_normal_force) == pytest.approx(refs[1], rel=1e-6)
+
+
+def test_a_search_with_soft_contacts_needs_friction():
+    from grasptwist.engine.synthesis.checks import check_search_torsion
+
+    assert check_search_torsion(None, 0.0) is None and check_search_torsion(0.01, 0.5) == 0.01
+    for torsion, friction, message in (
+        (0.0, 0.5, "finite length > 0"),
+        (np.inf, 0.5, "finite length > 0"),
+        (0.01, 0.0, "need friction > 0"),
+    ):
+        with pytest.raises(ValueError, match=message):
+            check_search_torsion(torsion, friction)
+
+
+def test_a_weight_off_the_line_of_the_contacts_is_held_along_a_path_by_soft_pads_alone():
+    """follow's grip of the weight (grip_along, hold_verdicts): a rod pinched along its axis whose centre of mass lies
+    1 cm beside it needs a moment about the line, which point contacts cannot make (unjudged: collinear-contacts)
+    and soft pads can, at every sample of a lift; the follow record says so."""
+    from grasptwist.engine.forces.hold import grip_along, hold_verdicts
+    from grasptwist.output.follow_records import grip_record
+    from grasptwist.path import Segment
+
+    weight = (LINE, ACROSS, 0.5, 1.0, [0, 0.01, 0], [0, 0, -9.81], [Segment(1.0, twist=[0, 0, 0, 0, 0, 0.1])])
+    times = [0.0, 0.5, 1.0]
+    with compiled.numpy_path():
+        point = grip_along(*weight, times)[1]
+        soft = grip_along(*weight, times, torsion=[0.01, 0.01, 0])[1]
+        falls, unjudged = hold_verdicts(*weight, times, torsion=[0.01, 0.01, 0])
+    assert (point.status == gt.forces.Status.COLLINEAR_CONTACTS).all() and soft.ok.all()
+    assert falls == () and unjudged == ()
+    reference = least_soft_grip(LINE, ACROSS, [0, 0, 9.81, 0.0981, 0, 0], 0.5, [0.01, 0.01, 0])[0]
+    np.testing.assert_allclose(soft.total_normal_force, reference, rtol=1e-6)  # a lift: the same wrench all along
+    np.testing.assert_allclose(soft.torsion[:, 0] - soft.torsion[:, 1], 0.0981, rtol=1e-9)
+    record = grip_record(soft, 0)
+    assert record["contact_model"] == "soft" and record["torsion"] == pytest.approx(soft.torsion[0].tolist())
+    assert "contact_model" not in grip_record(grip_along(EQ, -EQ, 0.5, *weight[3:], times)[1], 0)

@@ -5,6 +5,8 @@ from .exits import run_command
 from .options import (
     ALL,
     AllowOutside,
+    Contact,
+    ContactOption,
     Debug,
     Json,
     MaxBytes,
@@ -15,8 +17,10 @@ from .options import (
     RecordFormat,
     RecordFormatOption,
     SurfaceTol,
+    Torsion,
     WarningsOption,
     Workers,
+    contact_torsion,
     reading_option,
 )
 from .records import OutputSettings, write_records
@@ -33,6 +37,8 @@ def check(
     max_bytes: MaxBytes = None,
     surface_tol: SurfaceTol = None,
     allow_outside: AllowOutside = False,
+    contact: ContactOption = Contact.point,
+    torsion: Torsion = None,
     workers: Workers = 0,
     quiet: Quiet = False,
     warnings: WarningsOption = Warnings.summary,
@@ -49,11 +55,12 @@ def check(
     from ..run.options import TwistOptions
     from ..run.pipeline import Job
 
+    torsion = contact_torsion(contact, torsion)
     job = Job(
         command=COMMANDS["check"],
         fmt="json" if json_ else fmt.value,
         max_bytes=max_bytes,
         reading=reading_option(surface_tol, allow_outside),
-        options=TwistOptions(method=method.value),
+        options=TwistOptions(method=method.value, torsion=torsion),
     )
     run_command(debug, lambda: write_records(job, paths, OutputSettings(output, quiet, warnings, workers)))

@@ -104,7 +104,7 @@ def forces(
     from ..run.pipeline import Job
 
     wrenches = wrenches_option(wrench, at, wrench_name)
-    torsion = contact_torsion(contact, torsion)
+    torsion = contact_torsion(contact, torsion, friction)
     if quality:
         from ..extras import require
 

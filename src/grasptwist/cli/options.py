@@ -312,8 +312,8 @@ ContactOption = Annotated[
     Contact,
     typer.Option(
         "--contact",
-        help="Contact model of the grip: point (Coulomb cones) or soft (finger pads that also resist turning "
-        "about the normal, |(f_t, tau / E)| <= mu f_n; needs --torsion).",
+        help="Contact model of the grip and the closure: point (Coulomb cones) or soft (finger pads that also "
+        "resist turning about the normal, |(f_t, tau / E)| <= mu f_n; needs --torsion).",
     ),
 ]
 Torsion = Annotated[
@@ -327,9 +327,9 @@ Torsion = Annotated[
 ]
 
 
-def contact_torsion(contact: Contact, torsion: float | None) -> float | None:
-    """``--contact`` and ``--torsion`` as the grip's torsional radius (None: point contacts); a usage error when
-    one is given without the other."""
+def contact_torsion(contact: Contact, torsion: float | None, friction: float | None = None) -> float | None:
+    """``--contact`` and ``--torsion`` as the torsional radius (None: point contacts); a usage error when one is
+    given without the other, or soft contacts with ``--friction 0`` (torsional friction is friction)."""
     if contact is Contact.soft and torsion is None:
         raise typer.BadParameter(
             "--contact soft needs --torsion E (the torsional radius, a length > 0)", param_hint="'--contact'"
@@ -337,6 +337,11 @@ def contact_torsion(contact: Contact, torsion: float | None) -> float | None:
     if contact is Contact.point and torsion is not None:
         raise typer.BadParameter(
             "--torsion is the soft contacts' radius: give --contact soft too", param_hint="'--torsion'"
+        )
+    if contact is Contact.soft and friction == 0:
+        raise typer.BadParameter(
+            "soft contacts need friction (their torsion is friction): --friction 0 makes every contact frictionless",
+            param_hint="'--contact'",
         )
     return torsion
 

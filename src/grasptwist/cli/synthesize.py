@@ -14,6 +14,8 @@ from .options import (
     AllowOutside,
     At,
     Clearance,
+    Contact,
+    ContactOption,
     Debug,
     Digits,
     Friction,
@@ -26,9 +28,11 @@ from .options import (
     SurfaceTol,
     SynthesizeFormat,
     Table,
+    Torsion,
     Workers,
     WrenchName,
     WrenchOption,
+    contact_torsion,
     hand_option,
     not_binary_to_a_terminal,
     reading_option,
@@ -146,6 +150,8 @@ def synthesize(
     wrench_name: WrenchName = None,
     at: At = None,
     safety: Safety = 1.0,
+    contact: ContactOption = Contact.point,
+    torsion: Torsion = None,
     objective: Annotated[
         Objective,
         typer.Option(
@@ -310,6 +316,7 @@ def synthesize(
     if simulate:
         require("mujoco", "--simulate")
     wrenches = wrenches_option(wrench, at, wrench_name)
+    torsion = contact_torsion(contact, torsion, friction)
     grasp_file = output if output is not None and output.lower().endswith(GRASP_FILE_SUFFIXES) else None
     records_to = None if grasp_file is not None else output
     if grasp_file is not None:  # written at the end of the run: refused before any work, as a records file is
@@ -331,6 +338,7 @@ def synthesize(
             mass=mass,
             wrenches=None if wrenches is None else tuple(wrenches),
             safety=safety,
+            torsion=torsion,
             objective=objective.value,
             method=method.value,
             min_conditioning=min_conditioning,

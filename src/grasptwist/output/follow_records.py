@@ -109,10 +109,14 @@ def sample_records(samples, order: str = "omega-v") -> list[dict]:
 def grip_record(grip, i) -> dict:
     """Row ``i`` of a :class:`~grasptwist.engine.forces.grip.Grip` as the ``forces`` record's
     ``grip`` object: the forces (row ``j`` contact ``j``), squeezes, normal and tangential
-    forces, friction used, their total and the safety factor; or ``{"error": {code, message}}``."""
+    forces, friction used, their total and the safety factor; or ``{"error": {code, message}}``.  With soft
+    contacts (a grasp file's ``model: soft``) also its ``contact_model`` and each contact's ``torsion``."""
     if grip.status[i] != ForceStatus.OK:
         return grip_error(grip.status[i], grip.culprit[i])
-    return {**{k: getattr(grip, k)[i] + 0.0 for k in GRIP_FIELDS}, "safety": grip.safety}
+    rec = {**{k: getattr(grip, k)[i] + 0.0 for k in GRIP_FIELDS}, "safety": grip.safety}
+    if grip.torsion is not None:
+        rec |= {"contact_model": "soft", "torsion": (grip.torsion[i] + 0.0).tolist()}
+    return rec
 
 
 def hold_text(c: dict, digits: int = 4) -> str:

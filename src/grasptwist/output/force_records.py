@@ -23,7 +23,7 @@ __all__ = ["WRENCH_COLUMNS", "force_records", "GRIP_FIELDS", "CLOSURE_FIELDS", "
 GRIP_FIELDS = ("force", "squeeze", "normal_force", "tangential_force", "friction_used", "total_normal_force")
 
 #: The closure object's fields (``force_closure`` and ``epsilon`` judged with ``mu / safety``).
-CLOSURE_FIELDS = ("force_closure", "closure_friction", "epsilon", "safety")
+CLOSURE_FIELDS = ("force_closure", "closure_friction", "epsilon", "safety", "contact_model")
 
 NO_FRICTION_WARNING = "grip skipped: the grasp has no friction (give 'friction:' in the file or --friction MU)"
 
@@ -64,6 +64,7 @@ def force_records(block) -> list[dict]:
     certificate = [None if c[0] != c[0] else c for c in _lists(r.certificate)]
     closure_friction, epsilon = r.closure_friction.tolist(), r.epsilon.tolist()
     force_closure = r.force_closure.tolist()
+    model = ["point"] * len(block) if r.contact_model is None else r.contact_model.tolist()
     outward = block.outward().any(axis=-1).tolist()
     distance = surface_distances(block)
     clearance = clearances(block)
@@ -105,13 +106,14 @@ def force_records(block) -> list[dict]:
                 rec["grip"]["squeeze"] = None
             rec["grip"]["safety"] = r.safety
             rec["grip"]["dual"], rec["grip"]["gap"] = grip["dual"][i], grip["gap"][i]
-            rec["grip"]["contact_model"] = "point" if r.contact_model is None else str(r.contact_model[i])
+            rec["grip"]["contact_model"] = model[i]
             rec["grip"]["torsion"] = grip["torsion"][i]
         rec["closure"] = {
             "force_closure": force_closure[i] if has_friction[i] else None,
             "closure_friction": _number(closure_friction[i]),
             "epsilon": _number(epsilon[i]),
             "safety": r.safety,
+            "contact_model": model[i],
         }
         status = ForceStatus(int(r.closure_status[i]))
         if status not in (ForceStatus.OK, ForceStatus.NO_CLOSURE):

@@ -8,6 +8,7 @@ gives one record per grasp, best first::
      "contacts": [{"name", "point", "normal", "surface_distance"}, x3],
      "scores": {"total_normal_force": {wrench name: N}, "closure_friction",
                 "epsilon" (or null), "conditioning": {"off_tangent", "tangent"} (null: not asked)},
+     "contact_model": "point", or "soft" (--contact soft --torsion E, or the file's soft contacts),
      "joint_positions": {joint name: position} (null without a hand),
      "reach_error": [3] (null without a hand),
      "clearance": least distance of any finger from the environment (null without one),
@@ -94,6 +95,7 @@ def synthesis_records(found) -> list[dict]:
                 "ok": True,
                 "contacts": contacts,
                 "scores": scores,
+                "contact_model": "point" if found.torsion is None else "soft",
                 "joint_positions": _joint_positions(found, k),
                 "reach_error": None if s.reach_error is None else s.reach_error[k].tolist(),
                 "clearance": None if found.clearance is None else _float(found.clearance[k]),
@@ -282,8 +284,10 @@ def grasp_documents(found, folder: str) -> str:
         if found.wrist is not None:
             doc["wrist"] = np.asarray(found.wrist).tolist()
         doc["object"] = _object_node(found.object, folder, found.file)
+        soft = {} if found.torsion is None else {"model": "soft", "torsion": float(found.torsion)}
         doc["contacts"] = [
             {"name": found.contact_names[i], "point": s.points[k, i].tolist(), "normal": s.normals[k, i].tolist()}
+            | soft
             for i in range(3)
         ]
         if found.twists:

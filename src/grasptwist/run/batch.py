@@ -89,6 +89,7 @@ class Block:
     bases: bool = True  # False: resolved without the basis screws (fields that need them are left out)
     method: str = ALL_METHODS  # the --method asked for
     friction: np.ndarray | None = None  # (n, 3) the grasps' friction, NaN rows where none; None: no row has one
+    torsion: np.ndarray | None = None  # (n, 3) soft contacts' torsional radii (0: a point contact); None: none soft
     center_of_mass: np.ndarray | None = (
         None  # (n, 3) the grasps' centre of mass, NaN rows where none; None: no row has one
     )
@@ -183,6 +184,7 @@ _ROW_FIELDS = (
     "velocity",
     "hands",
     "friction",
+    "torsion",
     "center_of_mass",
     "surface_distance",
     "grasp_warnings",
@@ -343,7 +345,9 @@ def _stack(jobs, method) -> Block:
         units=[g.units for g in grasps],
         **_hand_inputs(grasps),
     )
-    friction = center = None
+    friction = center = torsion = None
+    if any(g.torsion is not None for g in grasps):
+        torsion = np.stack([np.zeros(3) if g.torsion is None else g.torsion for g in grasps])
     if any(g.friction is not None for g in grasps):
         friction = np.stack([nan if g.friction is None else g.friction for g in grasps])
     if any(g.center_of_mass is not None for g in grasps):
@@ -353,6 +357,7 @@ def _stack(jobs, method) -> Block:
         block,
         contact_names=[g.contact_names for g in grasps],
         friction=friction,
+        torsion=torsion,
         center_of_mass=center,
         surface_distance=surface_distances(grasps),
         grasp_warnings=said,

@@ -139,7 +139,7 @@ class Contribution:
     family : Family
         The family that computes it.
     fields : callable
-        ``block -> list of dict``: the fields it adds to each row's record.
+        ``(block, options) -> list of dict``: the fields it adds to each row's record (the command's options).
     header : str
         Its column in the command's table.
     cell : str
@@ -147,7 +147,7 @@ class Contribution:
     """
 
     family: Family
-    fields: Callable[[Any], list[dict]]
+    fields: Callable[[Any, Any], list[dict]]
     header: str
     cell: str
 
@@ -270,10 +270,10 @@ def _wrench_columns():
     return WRENCH_COLUMNS
 
 
-def _closure(block):
+def _closure(block, options):
     from .forces import closure_fields  # check's closure: the force engine, with the first check
 
-    return closure_fields(block)
+    return closure_fields(block, options.torsion)
 
 
 WRENCH = Family(
@@ -381,7 +381,7 @@ def _basis_records(block, job):
 
 
 def _check_records(block, job):
-    added = [c.fields(block) for c in job.command.contributions]
+    added = [c.fields(block, job.options) for c in job.command.contributions]
     return [check_record(block, i, {k: v for part in added for k, v in part[i].items()}) for i in range(len(block))]
 
 

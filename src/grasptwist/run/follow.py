@@ -196,7 +196,7 @@ def _path(job, grasp, p):
     collided = PathCollisions(grasp)
     for start in range(0, len(times), CHUNK):
         q = None if tracked is None else tracked.positions[start : start + CHUNK]
-        grip = None if weight is None else grip_along(*weight, times[start : start + CHUNK])[1]
+        grip = None if weight is None else grip_along(*weight, times[start : start + CHUNK], torsion=grasp.torsion)[1]
         f = follow(
             grasp.points,
             grasp.normals,
@@ -213,7 +213,7 @@ def _path(job, grasp, p):
             largest = seen if largest is None else np.maximum(largest, seen)
         yield Samples(p.name, block, f.poses, q, grip)
     found = degeneracies(grasp.points, grasp.normals, grasp.wrist, p.segments, times)
-    stretches, unjudged = (None, None) if weight is None else hold_verdicts(*weight, times)
+    stretches, unjudged = (None, None) if weight is None else hold_verdicts(*weight, times, torsion=grasp.torsion)
     # the grasp's own warnings as read (its object's pose, its normals), not its collisions at rest:
     # the samples' own (t = 0 among them) say those
     read_warnings = tuple(w for w in grasp.warnings if not w.startswith(tuple(f"{code}:" for code in CODES)))

@@ -132,6 +132,7 @@ def compute_forces(
             points[rows],
             normals[rows],
             None if mu is None else mu[rows],
+            torsion=None if torsion is None else torsion[rows],
             quality=quality,
             cone_edges=options.cone_edges,
         )
@@ -148,21 +149,31 @@ def compute_forces(
     return ForceResult(safety=float(options.safety), contact_model=model, **out)
 
 
-def closure_fields(block) -> list[dict]:
+def closure_fields(block, torsion=None) -> list[dict]:
     """The wrench family's contribution to ``check`` records: per row of a twist block its
     ``closure_friction`` (the least friction for force closure; None: none does) and, where the
-    grasp gives a friction, ``force_closure`` with it."""
+    grasp gives a friction, ``force_closure`` with it.  With soft contacts (the grasps' ``model: soft``,
+    or ``torsion``, ``--contact soft --torsion E``, for every contact) also each row's ``contact_model``."""
     n = len(block)
     friction = block.friction
     has = np.zeros(n, bool) if friction is None else ~np.isnan(friction).any(axis=-1)
     result = compute_forces(
-        block.points, block.normals, np.full((n, 6), np.nan), np.zeros(n, bool), friction, has, ForceOptions()
+        block.points,
+        block.normals,
+        np.full((n, 6), np.nan),
+        np.zeros(n, bool),
+        friction,
+        has,
+        ForceOptions(torsion=torsion),
+        getattr(block, "torsion", None),  # a twist block's; a block of another family has no soft contacts
     )
     least = result.closure_friction.tolist()
     verdict = result.force_closure.tolist()
+    model = [{}] * n if result.contact_model is None else [{"contact_model": m} for m in result.contact_model.tolist()]
     return [
         {"closure_friction": None if least[i] != least[i] else least[i]}
         | ({"force_closure": verdict[i]} if has[i] else {})
+        | model[i]
         for i in range(n)
     ]
 

@@ -101,6 +101,7 @@ def search_options(options) -> dict:
         "friction_error": o.friction_error,
         "perturbations": o.perturbations,
         "span_bodies": o.span_bodies,
+        "torsion": o.torsion,
     }
 
 
@@ -115,6 +116,17 @@ def _friction(grasp, friction):
     if grasp.friction is not None:
         return float(np.min(grasp.friction))
     return _problem(grasp, NO_FRICTION, f"grasp '{grasp.name}' has no friction: give --friction")
+
+
+def _torsion(grasp, friction, torsion):
+    """The soft contacts' radius of a search: ``torsion`` given, else the least of the document's contacts'
+    when every one is ``model: soft`` (as its friction, the least), else None (point contacts); None with a
+    friction of 0 (``--friction 0`` over a file's soft contacts: frictionless, as the engine's models)."""
+    if torsion is not None:
+        return torsion
+    soft = grasp.torsion
+    every = soft is not None and (np.asarray(soft) > 0).all() and friction > 0
+    return float(np.min(soft)) if every else None
 
 
 def _wrenches(grasp, wrenches):
@@ -166,7 +178,8 @@ def grasp_problem(
     **options
         The search's (:func:`~grasptwist.engine.synthesis.problem.surface_problem`), and
         ``clearance``, ``span_bodies``, ``gravity`` (default the file's), ``hold`` (default:
-        whenever there is a mass).
+        whenever there is a mass), ``torsion`` (soft contacts' radius; default the least of the
+        document's when every contact is ``model: soft``).
 
     Returns
     -------
@@ -180,6 +193,7 @@ def grasp_problem(
     friction = _friction(grasp, friction)
     if isinstance(friction, InputError):
         return friction
+    options["torsion"] = _torsion(grasp, friction, options.get("torsion"))
     named = _wrenches(grasp, wrenches)
     gravity = np.asarray(options.pop("gravity", None) or (GRAVITY if grasp.gravity is None else grasp.gravity), float)
     held = options.pop("hold", None)  # None: whenever there is a mass
@@ -317,7 +331,8 @@ def synthesize(
         ``total_normal_force``, ``closure_friction`` or ``epsilon``), ``wrist`` (None),
         ``methods``, ``min_conditioning`` (0.05), ``min_spacing`` (None: 5% of the object's
         size), ``quality`` (False), ``seed`` (0), ``candidates`` (20000), ``seconds`` (None),
-        ``position_error``, ``friction_error`` (0.2), ``perturbations`` (64); and
+        ``position_error``, ``friction_error`` (0.2), ``perturbations`` (64), ``torsion`` (None:
+        point contacts; soft contacts' radius, a ``Grasp``'s when all its contacts are soft); and
         ``collide``, ``hulls``: the hand's tests given as functions instead
         (``grasptwist.engine.synthesis.search.synthesize``).
 

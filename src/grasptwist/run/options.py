@@ -35,6 +35,7 @@ class TwistOptions:
     method: str = "both"
     twists_from: str | None = None
     select: tuple[str, ...] | None = None
+    torsion: float | None = None  # check's --contact soft --torsion E: every contact soft for the closure
 
     def rows_per_grasp(self) -> int:
         """Rows each grasp of a data set gives: one per twist of the command line, else its own."""
@@ -130,6 +131,7 @@ class SynthesisOptions:
     position_error: float | None = None
     friction_error: float = 0.2
     perturbations: int = 64
+    torsion: float | None = None  # --contact soft --torsion E: every contact soft (None: the file's, else point)
 
     simulate: SimulateOptions | None = None
 

@@ -77,6 +77,7 @@ class Found:
     clearance: np.ndarray | None = None  # each grasp's least distance of a finger from them (None: no environment)
     dropped: int = 0  # --simulate: grasps found that did not hold in MuJoCo, left out
     simulated: tuple | None = None  # --simulate: each grasp's hold test in MuJoCo (a HoldTest), else None
+    torsion: float | None = None  # soft contacts' torsional radius the search used (None: point contacts)
 
     def __len__(self) -> int:
         return len(self.synthesis.points)
@@ -244,6 +245,7 @@ def _searched_entry(job, entry: Grasp) -> Iterator[InputError | Found | Progress
         warnings=said,
         environment=entry.environment,
         clearance=grasp_clearance(step.points, entry.environment, reach, step.joint_positions),
+        torsion=problem.torsion,
     )
     if o.simulate is not None:
         from .simulate import held_only  # MuJoCo, with the first synthesize --simulate

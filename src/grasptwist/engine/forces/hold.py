@@ -166,7 +166,18 @@ def object_weight(obj, gravity) -> Weight | None:
 
 
 def grip_along(
-    points, normals, friction, mass, center_of_mass, gravity, segments, times, *, safety=1.0, tol=DEGENERACY_TOL
+    points,
+    normals,
+    friction,
+    mass,
+    center_of_mass,
+    gravity,
+    segments,
+    times,
+    *,
+    safety=1.0,
+    torsion=None,
+    tol=DEGENERACY_TOL,
 ) -> tuple[Poses, Grip]:
     """The grip that holds the weight at each time of a path.
 
@@ -181,6 +192,8 @@ def grip_along(
     times : (T,) array-like
     safety : float
         As for :func:`grip`.
+    torsion : None, scalar or (3,) array
+        Soft contacts' torsional radii, as for :func:`grip` (None: point contacts).
     tol : float
         Degeneracy tolerance of the contacts.
 
@@ -208,7 +221,7 @@ def grip_along(
     moved = se3.transform(poses.rotation[..., None, :, :], poses.position[..., None, :], p)
     turned = np.einsum("...ij,kj->...ki", poses.rotation, n)
     wrench = hold_wrench(mass, center_of_mass, gravity, poses.rotation, poses.position)
-    held = grip(moved, turned, wrench, friction, safety=safety, tol=tol)
+    held = grip(moved, turned, wrench, friction, safety=safety, torsion=torsion, tol=tol)
     lost = overflowing(poses, np.concatenate((p, n)), np.concatenate((moved, turned), axis=-2))
     return poses, pose_overflowed(held, lost)
 
@@ -224,6 +237,7 @@ def cannot_hold(
     times=None,
     *,
     safety=1.0,
+    torsion=None,
     tol=DEGENERACY_TOL,
 ) -> tuple[HoldStretch, ...]:
     """Every stretch of a path where no grip holds the weight, its ends located between samples.
@@ -238,7 +252,7 @@ def cannot_hold(
 
     Parameters
     ----------
-    points, normals, friction, mass, center_of_mass, gravity, segments, safety, tol
+    points, normals, friction, mass, center_of_mass, gravity, segments, safety, torsion, tol
         As for :func:`grip_along`.
     times : (T,) array-like or None
         The samples; None: the segments' ends only.
@@ -261,11 +275,22 @@ def cannot_hold(
     (0.463647609, 0.463647609, 0.463647609)
     """
     weight = (points, normals, friction, mass, center_of_mass, gravity, segments)
-    return _Verdicts(weight, times, safety, tol).cannot_hold()
+    return _Verdicts(weight, times, safety, tol, torsion).cannot_hold()
 
 
 def hold_verdicts(
-    points, normals, friction, mass, center_of_mass, gravity, segments, times=None, *, safety=1.0, tol=DEGENERACY_TOL
+    points,
+    normals,
+    friction,
+    mass,
+    center_of_mass,
+    gravity,
+    segments,
+    times=None,
+    *,
+    safety=1.0,
+    torsion=None,
+    tol=DEGENERACY_TOL,
 ) -> tuple[tuple[HoldStretch, ...], tuple[Unjudged, ...]]:
     """Where the weight is not held along a path, and where that cannot be judged.
 
@@ -276,7 +301,7 @@ def hold_verdicts(
 
     Parameters
     ----------
-    points, normals, friction, mass, center_of_mass, gravity, segments, times, safety, tol
+    points, normals, friction, mass, center_of_mass, gravity, segments, times, safety, torsion, tol
         As for :func:`cannot_hold`.
 
     Returns
@@ -298,7 +323,8 @@ def hold_verdicts(
     >>> falls, ForceStatus(u.status).code, round(u.t_start, 9), u.t_end
     ((), 'nonfinite-pose', 0.0, 1.0)
     """
-    verdicts = _Verdicts((points, normals, friction, mass, center_of_mass, gravity, segments), times, safety, tol)
+    weight = (points, normals, friction, mass, center_of_mass, gravity, segments)
+    verdicts = _Verdicts(weight, times, safety, tol, torsion)
     return verdicts.cannot_hold(), verdicts.unjudged()
 
 
@@ -306,8 +332,8 @@ class _Verdicts:
     """The grip's status along one path: at its nodes (the samples and the segments'
     ends) once, and the runs of a kind of status located between them."""
 
-    def __init__(self, weight, times, safety, tol):
-        self.weight, self.safety, self.tol = weight, safety, tol
+    def __init__(self, weight, times, safety, tol, torsion=None):
+        self.weight, self.safety, self.tol, self.torsion = weight, safety, tol, torsion
         durations = np.array([s.duration for s in check_segments(weight[-1])])
         self.ends = np.concatenate(([0.0], np.cumsum(durations)))
         self.eps = PRECISION * durations.min()
@@ -316,7 +342,7 @@ class _Verdicts:
         self.at = self.status(self.nodes).status
 
     def status(self, t) -> Grip:
-        return grip_along(*self.weight, t, safety=self.safety, tol=self.tol)[1]
+        return grip_along(*self.weight, t, safety=self.safety, torsion=self.torsion, tol=self.tol)[1]
 
     def cannot_hold(self) -> tuple[HoldStretch, ...]:
         t_start, t_end = self._runs(lambda s: s == ForceStatus.CANNOT_HOLD)

@@ -40,8 +40,8 @@ class Archive:
     [1.0, 3.0]
     """
 
-    def __init__(self, size, spacing, joints=None, tol=DEGENERACY_TOL):
-        self.size, self.spacing, self.tol = size, spacing, tol
+    def __init__(self, size, spacing, joints=None, tol=DEGENERACY_TOL, torsion=None):
+        self.size, self.spacing, self.tol, self.torsion = size, spacing, tol, torsion
         slots = size + 1  # a newcomer's slot before the worst leaves
         self._points, self._normals = np.empty((slots, 3, 3)), np.empty((slots, 3, 3))
         self._objective = np.full(slots, np.inf)
@@ -109,7 +109,7 @@ class Archive:
         at = reached == closure
         # only while closure is the furthest constraint is it what a failed search reports
         if at.any() and self.furthest == closure:
-            needed = force_closure(p[at], n[at], tol=self.tol).closure_friction
+            needed = force_closure(p[at], n[at], torsion=self.torsion, tol=self.tol).closure_friction
             self.closest = min(self.closest, float(np.nanmin(needed, initial=np.inf)))
 
     def _offer(self, p, n, value, positions):

@@ -152,6 +152,25 @@ def check_search_friction(friction) -> float:
     return float(friction)
 
 
+def check_search_torsion(torsion, friction) -> float | None:
+    """Soft contacts' torsional radius ``e > 0`` (a finite length; None: point contacts), which needs a friction
+    ``> 0`` (torsional friction is friction).
+
+    >>> check_search_torsion(0.01, 0.5)
+    0.01
+    >>> check_search_torsion(0.01, 0.0)
+    Traceback (most recent call last):
+    ValueError: soft contacts (torsion=0.01) need friction > 0: their torsion is friction
+    """
+    if torsion is None:
+        return None
+    if not (_is_number(torsion) and 0 < torsion < np.inf):
+        raise ValueError(f"torsion must be a finite length > 0 (soft contacts' radius), got {torsion!r}")
+    if not friction > 0:
+        raise ValueError(f"soft contacts (torsion={torsion!r}) need friction > 0: their torsion is friction")
+    return float(torsion)
+
+
 def check_wrenches(wrenches) -> np.ndarray:
     """The wrenches every grasp must exert, ``(W, 6)`` finite numbers (one ``(6,)`` is ``W = 1``).
 

@@ -33,7 +33,15 @@ from ..objects import object_size, project_to_surface, sample_surface
 from ..objects.creases import edge_distance
 from ..objects.geometry import body_areas, body_of
 from .budget import Budget
-from .checks import check_count, check_min_spacing, check_search_friction, check_seed, check_tip_radius, check_wrenches
+from .checks import (
+    check_count,
+    check_min_spacing,
+    check_search_friction,
+    check_search_torsion,
+    check_seed,
+    check_tip_radius,
+    check_wrenches,
+)
 from .clearance import environment_search
 from .reach import HandReach, check_hand_reach
 from .robustness import (
@@ -199,6 +207,8 @@ class Problem:
     weight : Weight or None
         The weight held (``wrenches[0]``).
     environment : Environment or None
+    torsion : float or None
+        Soft contacts' torsional radius at every contact (None: point contacts).
     """
 
     surface: Surface
@@ -221,6 +231,7 @@ class Problem:
     object: object = None
     weight: Weight | None = None
     environment: object = None
+    torsion: float | None = None
 
 
 def surface_problem(
@@ -246,6 +257,7 @@ def surface_problem(
     position_error=None,
     friction_error=FRICTION_ERROR,
     perturbations=PERTURBATIONS,
+    torsion=None,
 ) -> Problem:
     """The :class:`Problem` of a surface given as functions, every option checked (their meaning:
     :func:`~.search.search`).
@@ -256,6 +268,7 @@ def surface_problem(
     (500, 0.1, 'robust')
     """
     seed = check_seed(seed)
+    friction = check_search_friction(friction)
     min_spacing = check_min_spacing(min_spacing)
     hand = None if hand is None else check_hand_reach(hand)
     position_error = check_position_error(position_error)
@@ -264,7 +277,7 @@ def surface_problem(
     return Problem(
         surface=surface,
         wrenches=check_wrenches(wrenches),
-        friction=check_search_friction(friction),
+        friction=friction,
         budget=Budget(candidates, seconds, clock),
         count=check_count(count),
         safety=check_safety(safety),
@@ -284,6 +297,7 @@ def surface_problem(
             "perturbations": check_perturbations(perturbations),
             "seed": seed,
         },
+        torsion=check_search_torsion(torsion, friction),
     )
 
 

@@ -145,24 +145,28 @@ def default_position_error(size, radii=None) -> float:
     return POSITION_SHARE * float(size)
 
 
-def _held(points, normals, wrenches, friction, safety, tol):
-    """``(N,)`` whether a grip of every wrench ``(W, 6)`` exists, rows ``(N, 3, 3)``, ``friction (N,)`` or ``(N, 3)``."""
+def _held(points, normals, wrenches, friction, safety, tol, torsion=None):
+    """``(N,)`` whether a grip of every wrench ``(W, 6)`` exists, rows ``(N, 3, 3)``, ``friction (N,)`` or ``(N, 3)``
+    (``torsion``: soft contacts' radius, as :func:`~grasptwist.engine.forces.grip.grip`'s)."""
     held = np.ones(len(points), bool)
     mu = np.asarray(friction, float)
     mu = mu[:, None] if mu.ndim == 1 else mu
     for wrench in wrenches if len(points) else ():  # the grip of no rows: nothing to hold
         rows = np.flatnonzero(held)
-        held[rows] = grip(points[rows], normals[rows], wrench, mu[rows], safety=safety, tol=tol).ok
+        held[rows] = grip(points[rows], normals[rows], wrench, mu[rows], safety=safety, torsion=torsion, tol=tol).ok
     return held
 
 
-def hold_friction(points, normals, wrenches, upper, *, steps=HOLD_STEPS, tol=DEGENERACY_TOL) -> np.ndarray:
+def hold_friction(
+    points, normals, wrenches, upper, *, steps=HOLD_STEPS, torsion=None, tol=DEGENERACY_TOL
+) -> np.ndarray:
     r"""The least friction at which a grip of every wrench exists (module docstring), by bisection.
 
     ``points, normals (K, 3, 3)``, ``wrenches (W, 6)``, ``upper`` a friction at which to start
     (every grasp is held there, else its answer is NaN; ``inf``: a bracket is found first,
     doubling from 1 at most ``steps`` times) -> ``(K,)``, to ``2^-steps`` of the bracket above
-    the least (0 where no friction is needed).
+    the least (0 where no friction is needed); ``torsion``: soft contacts' radius (the grips over the soft
+    cones, :func:`~grasptwist.engine.forces.grip.grip`'s).
 
     Three contacts at latitude ``phi`` above a ball's equator lift its weight when
     ``mu cos phi > sin phi``: the hold friction is ``tan phi``.
@@ -179,20 +183,20 @@ def hold_friction(points, normals, wrenches, upper, *, steps=HOLD_STEPS, tol=DEG
     k = len(p)
     hi = np.full(k, float(upper))
     lo = np.zeros(k)
-    free = _held(p, n, w, lo, 1.0, tol)
+    free = _held(p, n, w, lo, 1.0, tol, torsion)
     hi[free] = 0.0
     if np.isinf(upper):  # no limit (the half-spaces f . n >= 0): a finite bracket first
         hi[~free] = 1.0
         for _ in range(steps):
-            out = np.flatnonzero(~free)[~_held(p[~free], n[~free], w, hi[~free], 1.0, tol)]
+            out = np.flatnonzero(~free)[~_held(p[~free], n[~free], w, hi[~free], 1.0, tol, torsion)]
             if not out.size:
                 break
             lo[out], hi[out] = hi[out], 2 * hi[out]
-    hi[~free & ~_held(p, n, w, hi, 1.0, tol)] = np.nan
+    hi[~free & ~_held(p, n, w, hi, 1.0, tol, torsion)] = np.nan
     live = np.flatnonzero(~free & ~np.isnan(hi))
     for _ in range(steps if live.size else 0):
         mid = 0.5 * (lo[live] + hi[live])
-        ok = _held(p[live], n[live], w, mid, 1.0, tol)
+        ok = _held(p[live], n[live], w, mid, 1.0, tol, torsion)
         hi[live[ok]], lo[live[~ok]] = mid[ok], mid[~ok]
     return hi
 
@@ -223,6 +227,7 @@ def robustness(
     friction_error=FRICTION_ERROR,
     perturbations=PERTURBATIONS,
     seed=0,
+    torsion=None,
     tol=DEGENERACY_TOL,
 ) -> np.ndarray:
     """The share of perturbations under which each grasp is still held (module docstring).
@@ -240,6 +245,8 @@ def robustness(
     position_error, friction_error : float
         ``e`` and the largest share of ``mu`` lost.
     perturbations, seed : int
+    torsion : None or float
+        Soft contacts' torsional radius (the grips over the soft cones); None: point contacts.
 
     Returns
     -------
@@ -282,17 +289,20 @@ def robustness(
     mu = np.tile(friction * factors, (k, 1))  # (K N, 3)
     held = ~crease.any(axis=1)
     rows = np.flatnonzero(held)
-    held[rows] = _held(q[rows], m[rows], w, mu[rows], safety, tol)
+    held[rows] = _held(q[rows], m[rows], w, mu[rows], safety, tol, torsion)
     return held.reshape(k, perturbations).mean(axis=1)
 
 
-def margins(surface, points, normals, wrenches, friction, *, safety=1.0, tol=DEGENERACY_TOL, **perturbation):
+def margins(
+    surface, points, normals, wrenches, friction, *, safety=1.0, torsion=None, tol=DEGENERACY_TOL, **perturbation
+):
     """The :class:`Margins` of ``K`` grasps each held at ``friction / safety``; ``perturbation``:
-    :func:`robustness`'s ``position_error``, ``friction_error``, ``perturbations`` and ``seed``."""
+    :func:`robustness`'s ``position_error``, ``friction_error``, ``perturbations`` and ``seed``; ``torsion``:
+    soft contacts' radius."""
     p, n = np.asarray(points, float), np.asarray(normals, float)
     edges = np.full(p.shape[:2], np.inf) if surface.edges is None else surface.edges(p)
     return Margins(
-        hold_friction(p, n, wrenches, friction / safety, tol=tol),
+        hold_friction(p, n, wrenches, friction / safety, torsion=torsion, tol=tol),
         edges,
-        robustness(surface, p, n, wrenches, friction, safety=safety, tol=tol, **perturbation),
+        robustness(surface, p, n, wrenches, friction, safety=safety, torsion=torsion, tol=tol, **perturbation),
     )

@@ -36,7 +36,7 @@ import numpy as np
 
 from ..decompose import decompose_off_tangent, decompose_tangent
 from ..degeneracy import DEGENERACY_TOL
-from ..forces.closure import force_closure, internal_inside
+from ..forces.closure import force_closure, internal_inside, soft_closure_verdict
 from ..forces.grasp_map import geometry
 from ..forces.grip import grip
 from .reach import HAND_CONSTRAINTS, reach
@@ -169,6 +169,7 @@ def score_triples(
     constraints=(),
     hand=None,
     bound=np.inf,
+    torsion=None,
     tol=DEGENERACY_TOL,
 ) -> Scores:
     """Score ``N`` candidate triples against every constraint and the objective (module docstring).
@@ -183,6 +184,9 @@ def score_triples(
         ``mu``, the same at every contact.
     safety, objective, wrist, methods, min_conditioning, constraints, hand, tol
         As :func:`~grasptwist.engine.synthesis.search.search`.
+    torsion : None or float
+        Soft-finger contacts' torsional radius ``e > 0`` at every contact (None: point contacts): closure,
+        the grip and the objective over the soft cones (:func:`~grasptwist.engine.forces.closure.force_closure`).
     bound : float
         With a hand: rows whose objective is at least this are not put to the hand's test
         (a search's archive would not keep them); their ``failed`` is ``len(CONSTRAINTS)``,
@@ -220,8 +224,10 @@ def score_triples(
     live = live[good & (cond[live][:, asked] >= min_conditioning).all(axis=1)]
     failed[live] = CONSTRAINTS.index("force_closure")
     mu = np.full((live.size, 3), friction / safety)
-    inside = internal_inside(p[live], n[live], type(geo)(*(a[live] for a in geo)), mu)
-    live = live[~np.isnan(inside).any(axis=1)]
+    if torsion is None:
+        live = live[~np.isnan(internal_inside(p[live], n[live], type(geo)(*(a[live] for a in geo)), mu)).any(axis=1)]
+    else:
+        live = live[soft_closure_verdict(p[live], n[live], mu, np.full((live.size, 3), float(torsion)), tol)]
     failed[live] = CONSTRAINTS.index("constraints")
     for constraint in constraints:  # a hand's reach, a table, ...: after the cheap tests, before the grip
         if live.size:
@@ -229,12 +235,12 @@ def score_triples(
     failed[live] = CONSTRAINTS.index("grip")
     held = np.ones(live.size, bool)
     for k, wrench in enumerate(w if live.size else ()):  # the grip of no rows fails (an empty batch)
-        g = grip(p[live], n[live], wrench, friction, safety=safety, tol=tol)
+        g = grip(p[live], n[live], wrench, friction, safety=safety, torsion=torsion, tol=tol)
         total[live, k] = g.total_normal_force
         held &= g.ok
     live = live[held]
     failed[live] = -1
-    value = objective_values(p[live], n[live], total[live], friction / safety, objective, tol)
+    value = objective_values(p[live], n[live], total[live], friction / safety, objective, tol, torsion)
     objective_value[live] = tie_broken(value, cond[live])
     if hand is None:
         return Scores(objective_value, total, cond, failed)
@@ -284,9 +290,9 @@ def tie_broken(value, conditioning):
     return value + TIE_TOL * np.abs(value) * (1.0 - c)
 
 
-def objective_values(points, normals, total, mu, objective, tol=DEGENERACY_TOL):
+def objective_values(points, normals, total, mu, objective, tol=DEGENERACY_TOL, torsion=None):
     """The objective of feasible rows (less is better): ``(N, 3, 3), (N, 3, 3), (N, W)`` -> ``(N,)``."""
     if objective in ("robust", "total_normal_force"):
         return total.max(axis=1, initial=-np.inf)
-    c = force_closure(points, normals, mu, quality=objective == "epsilon", tol=tol)
+    c = force_closure(points, normals, mu, torsion=torsion, quality=objective == "epsilon", tol=tol)
     return -c.epsilon if objective == "epsilon" else c.closure_friction

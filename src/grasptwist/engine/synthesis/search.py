@@ -205,6 +205,10 @@ def search(surface: Surface, wrenches, friction, **options) -> Synthesis:
         The largest share of ``friction`` a perturbation takes away.
     perturbations : int, default 64
         Perturbations per grasp (seeded by ``seed``).
+    torsion : float or None, default None
+        Soft-finger contacts' torsional radius ``e > 0`` at every contact (a length, in the surface's
+        units; ``friction > 0``): closure, the grips, the hold friction, the robustness, the closure
+        friction and epsilon over the soft cones (:mod:`~grasptwist.engine.forces.cones`); None: point contacts.
 
     Returns
     -------
@@ -252,13 +256,13 @@ def solve_steps(problem: Problem) -> Iterator:
     """:func:`solve`, one step at a time: yields the candidates of each chunk scored (ints), then the
     :class:`Synthesis`."""
     surface, w, mu, hand, count = problem.surface, problem.wrenches, problem.friction, problem.hand, problem.count
-    safety, objective, tol = problem.safety, problem.objective, problem.tol
+    safety, objective, tol, torsion = problem.safety, problem.objective, problem.tol, problem.torsion
     warm_up()  # before the clock starts: a first run's compiling is no part of its budget
     budget = Spending(problem.budget, 1 - VERIFY_SHARE)
     budget_size = problem.budget.candidates
     rng = np.random.default_rng(problem.seed)
     joints = None if hand is None else len(hand.hand.joint_names)
-    archive = Archive(max(ELITES, 4 * count), problem.spacing, joints, tol)
+    archive = Archive(max(ELITES, 4 * count), problem.spacing, joints, tol, torsion)
     # closure friction, epsilon: slower rows; a hand: the archive fills (and spares rows the hand's test) sooner
     chunk = CHUNK if objective in ("robust", "total_normal_force") and hand is None else CHUNK // 8
 
@@ -276,6 +280,7 @@ def solve_steps(problem: Problem) -> Iterator:
             constraints=problem.constraints,
             hand=hand,
             bound=archive.bound if bound is None else bound,
+            torsion=torsion,
             tol=tol,
         )
 
@@ -292,7 +297,9 @@ def solve_steps(problem: Problem) -> Iterator:
     perturbation = problem.perturbation
     rank = np.arange(len(archive.objective))
     if objective == "robust" and rank.size:  # the finalists, most robust first, then the least total
-        robust = robustness(surface, archive.points, archive.normals, w, mu, safety=safety, tol=tol, **perturbation)
+        robust = robustness(
+            surface, archive.points, archive.normals, w, mu, safety=safety, torsion=torsion, tol=tol, **perturbation
+        )
         rank = np.lexsort((archive.objective, -robust))
     # the archive's grasps are spacing apart already: the first count in rank are the selection
     picked = rank[:count]
@@ -300,9 +307,25 @@ def solve_steps(problem: Problem) -> Iterator:
     positions = None if hand is None else archive.positions[picked]
     quality = problem.quality or objective == "epsilon"
     out = verify(
-        surface, points, normals, w, mu, safety, problem.wrist, problem.methods, quality, tol, hand, positions, budget
+        surface,
+        points,
+        normals,
+        w,
+        mu,
+        safety,
+        problem.wrist,
+        problem.methods,
+        quality,
+        tol,
+        hand,
+        positions,
+        budget,
+        torsion,
     )
-    out.update(margins(surface, out["points"], out["normals"], w, mu, safety=safety, tol=tol, **perturbation)._asdict())
+    held = margins(
+        surface, out["points"], out["normals"], w, mu, safety=safety, torsion=torsion, tol=tol, **perturbation
+    )
+    out.update(held._asdict())
     failure = None
     if not len(out["points"]) and out["unverified"]:
         failure = unverified(out["unverified"])

@@ -26,14 +26,16 @@ __all__ = ["GAP_TOL", "verified", "verify", "held"]
 GAP_TOL = 1e-6
 
 
-def verified(points, normals, wrench, friction, safety, tol=DEGENERACY_TOL) -> Grip | None:
+def verified(points, normals, wrench, friction, safety, tol=DEGENERACY_TOL, torsion=None) -> Grip | None:
     r"""The exact grip of one grasp and wrench when its certificate proves it optimal, else None.
 
     One row through :func:`~grasptwist.engine.forces.grip.grip`; its ``dual`` must close the gap
     (``|total - w . dual| <= GAP_TOL max(total, 1)``) and be dual feasible:
     ``n_i - G_i^T dual`` (``G_i^T dual = dual_F + dual_M x p_i``) in each dual cone
     ``(mu / s) |z_t| <= z_n``, to :data:`GAP_TOL`; with ``mu = inf`` (the half-space
-    ``f . n >= 0``, no limit) the dual cone is the ray along ``n``: ``|z_t| = 0 <= z_n``.
+    ``f . n >= 0``, no limit) the dual cone is the ray along ``n``: ``|z_t| = 0 <= z_n``.  With ``torsion``
+    (soft contacts' radius ``e``) the grip is over the soft cones and ``|z_t|`` is ``|(z_t, e z_tau)|``,
+    ``z_tau = -n_i . dual_M``.
 
     >>> p = np.array([[1.0, 0, 0], [-0.5, 0.75**0.5, -0.2], [-0.5, -(0.75**0.5), -0.2]])
     >>> g = verified(p, -p / np.linalg.norm(p, axis=1, keepdims=True), [0, 0, 1.0, 0, 0, 0], 0.5, 1.0)
@@ -43,7 +45,7 @@ def verified(points, normals, wrench, friction, safety, tol=DEGENERACY_TOL) -> G
     >>> g is not None and bool(g.total_normal_force < 1e-6)  # tangential forces alone hold it
     True
     """
-    g = grip(points, normals, wrench, friction, safety=safety, tol=tol)
+    g = grip(points, normals, wrench, friction, safety=safety, torsion=torsion, tol=tol)
     if not g.ok:
         return None
     total = float(g.total_normal_force)
@@ -54,6 +56,8 @@ def verified(points, normals, wrench, friction, safety, tol=DEGENERACY_TOL) -> G
     z = n - (g.dual[:3] + np.cross(g.dual[3:], np.asarray(points, float)))
     zn = np.sum(z * n, axis=-1)
     zt = np.linalg.norm(z - zn[:, None] * n, axis=-1)
+    if torsion is not None:  # the soft cones' dual: the torsion's multiplier beside the tangential ones
+        zt = np.hypot(zt, torsion * np.sum(n * g.dual[3:], axis=-1))
     limit = friction / safety
     # no limit: (mu / s) |z_t| is inf * 0 on the ray, so ask for the ray itself
     inside = (zt <= GAP_TOL) & (zn >= -GAP_TOL) if np.isinf(limit) else limit * zt - zn <= GAP_TOL
@@ -61,7 +65,20 @@ def verified(points, normals, wrench, friction, safety, tol=DEGENERACY_TOL) -> G
 
 
 def verify(
-    surface, points, normals, w, mu, safety, wrist, methods, quality, tol, hand=None, positions=None, budget=None
+    surface,
+    points,
+    normals,
+    w,
+    mu,
+    safety,
+    wrist,
+    methods,
+    quality,
+    tol,
+    hand=None,
+    positions=None,
+    budget=None,
+    torsion=None,
 ) -> dict:
     """The returned grasps' fields of :class:`Synthesis`, each grasp verified (the others dropped): the
     exact grip, and with a hand its tips by forward kinematics, its limits and its links clear; those
@@ -73,12 +90,13 @@ def verify(
         if budget is not None and budget.late():
             unverified = len(points) - i
             break
-        found = tuple(verified(points[i], normals[i], wrench, mu, safety, tol) for wrench in w)
+        found = tuple(verified(points[i], normals[i], wrench, mu, safety, tol, torsion) for wrench in w)
         if all(g is not None for g in found):
             grips.append(found)
             keep.append(i)
             if quality:
-                epsilon.append(float(force_closure(points[i], normals[i], mu / safety, quality=True, tol=tol).epsilon))
+                c = force_closure(points[i], normals[i], mu / safety, torsion=torsion, quality=True, tol=tol)
+                epsilon.append(float(c.epsilon))
     hand_fields = {}
     if hand is not None:
         error = tip_errors(hand, points[keep], normals[keep], positions[keep])
@@ -91,7 +109,7 @@ def verify(
             "tip_center": tip_centers(points[keep], normals[keep], hand.radii),
         }
     p, n = points[keep], normals[keep]
-    closure = force_closure(p, n, mu / safety, tol=tol) if len(p) else None
+    closure = force_closure(p, n, mu / safety, torsion=torsion, tol=tol) if len(p) else None
     return {
         "points": p,
         "normals": n,

@@ -194,6 +194,18 @@ def _read(fields, found, problems):
             out["friction"] = readonly(np.where(missing, mu, own))
     elif mu is not None:
         out["friction"] = readonly([mu, mu, mu])
+    soft = found.get("torsion")
+    frictionless = np.flatnonzero((soft > 0) & (out["friction"] == 0)) if soft is not None and "friction" in out else ()
+    if len(frictionless):  # torsional friction is friction
+        i = int(frictionless[0])
+        problems.add(
+            Reject(
+                "invalid-torsion",
+                f"contacts[{i}].torsion",
+                "a soft contact needs friction > 0 (its torsion is friction), and this one's friction is 0",
+                **located(fields["contacts"].value[i]),
+            )
+        )
     wrenches = read_wrenches(fields["wrenches"], problems) if "wrenches" in fields else []
     hold = _read_hold(fields, found.get("object"), problems)
     if wrenches is None or problems.count:
