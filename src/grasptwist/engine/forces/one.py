@@ -17,7 +17,17 @@ import math
 
 from .socp import _EDGE, _ITERATIONS, _RESIDUAL, GAP, START_MARGIN
 
-__all__ = ["phase_one", "minimise", "newton_matrices", "solve", "approach", "scaling", "w_inv", "w_mul"]
+__all__ = [
+    "phase_one",
+    "minimise",
+    "newton_matrices",
+    "solve",
+    "approach",
+    "scaling",
+    "w_inv",
+    "w_mul",
+    "least_on_line",
+]
 
 
 def approach(x0, x1, x2, d0, d1, d2, s):
@@ -34,6 +44,85 @@ def approach(x0, x1, x2, d0, d1, d2, s):
     f = (rho0 + d0) / (x0 + 1)
     e1, e2 = d1 - f * x1, d2 - f * x2
     return math.sqrt(e1 * e1 + e2 * e2) - rho0
+
+
+def least_on_line(a, b, count):
+    """The least ``c t`` over the line ``a_m t + b_m`` in the cones ``Q^3`` (``m < count``), ``c = sum_m a_m0``:
+    ``(t, m, coef)``, the cone ``m`` that ends the line there and its multiplier ``coef J (a_m t + b_m)``
+    (the only one: ``sum_m a_m^T z_m = c``), or ``(nan, -1, nan)``: no least, or not sharply.
+
+    Each cone holds on an interval of ``t``: ``g(t) = (a t + b)^T J (a t + b) = alpha t^2 + 2 beta t +
+    gamma >= 0`` with ``a_0 t + b_0 >= 0``, between the roots of ``g`` (``alpha < 0``), beyond the one on
+    the cone's side (``alpha > 0``: ``a`` inside the cone or its opposite), or a half-line (``alpha = 0``).
+    Where ``c = 0`` every feasible ``t`` is least: the interval's analytic centre (the maximum of
+    ``sum_m log g_m(t)``, where the interior-point method's central path goes) and no multiplier.
+    The facial reduction's last step (``grip._on_the_edge``), in closed form: the same source as
+    Python floats and, compiled, in :mod:`~grasptwist.engine.forces.kernel`.  ``a, b`` are ``(count, 3)``
+    (lists, or arrays: indexed ``a[m][k]``).
+
+    >>> least_on_line([[0.0, 1.0, 0.0]], [[1.0, 0.0, 0.0]], 1)  # |t| <= 1 and c = 0: the centre
+    (0.0, 0, 0.0)
+    >>> least_on_line([[1.0, 0.0, 0.0], [1.0, 0.5, 0.0]], [[0.0, 0.0, 0.0], [0.0, -1.0, 0.0]], 2)  # t >= 2 / 3
+    (0.6666666666666666, 1, 2.0)
+    """
+    lo, hi, low, high, c = -math.inf, math.inf, -1, -1, 0.0
+    for m in range(count):
+        a0, a1, a2, b0, b1, b2 = a[m][0], a[m][1], a[m][2], b[m][0], b[m][1], b[m][2]
+        c += a0
+        alpha, beta, gamma = a0 * a0 - a1 * a1 - a2 * a2, a0 * b0 - a1 * b1 - a2 * b2, b0 * b0 - b1 * b1 - b2 * b2
+        disc = beta * beta - alpha * gamma
+        start, end = -math.inf, math.inf
+        if alpha == 0:  # a on the cone's edge: g is linear
+            if beta > 0:
+                start = -gamma / (2 * beta)
+            elif beta < 0:
+                end = -gamma / (2 * beta)
+            elif not (gamma >= 0 and b0 >= 0):
+                start, end = math.inf, -math.inf
+        elif disc < 0:
+            if alpha < 0:
+                start, end = math.inf, -math.inf
+        else:
+            far = -(beta + math.copysign(math.sqrt(disc), beta))  # roots far / alpha, gamma / far: no cancellation
+            t1, t2 = (far / alpha, gamma / far) if far != 0 else (0.0, 0.0)
+            t1, t2 = min(t1, t2), max(t1, t2)
+            if alpha > 0 and a0 > 0:
+                start = t2
+            elif alpha > 0:
+                end = t1
+            elif a0 * (t1 + t2) / 2 + b0 >= 0:
+                start, end = t1, t2
+            else:
+                start, end = math.inf, -math.inf
+        if start > lo:
+            lo, low = start, m
+        if end < hi:
+            hi, high = end, m
+    t, m = (lo, low) if c > 0 else (hi, high)
+    if c == 0 and lo < hi and math.isfinite(lo) and math.isfinite(hi):
+        # the total is the same all along: the analytic centre, where the central path goes, by bisection on
+        # the derivative of sum_m log g_m(t), which falls (sqrt(g) is concave on the cone)
+        for _ in range(200):
+            t = (lo + hi) / 2
+            if not lo < t < hi:
+                break
+            slope = 0.0
+            for m in range(count):
+                y0, y1, y2 = a[m][0] * t + b[m][0], a[m][1] * t + b[m][1], a[m][2] * t + b[m][2]
+                slope += (a[m][0] * y0 - a[m][1] * y1 - a[m][2] * y2) / (y0 * y0 - y1 * y1 - y2 * y2)
+            if slope == 0:
+                break
+            lo, hi = (t, hi) if slope > 0 else (lo, t)
+        return (lo + hi) / 2, 0, 0.0
+    if c == 0 or not lo <= hi or not math.isfinite(t):
+        return math.nan, -1, math.nan
+    y0 = a[m][0] * t + b[m][0]
+    y1 = a[m][1] * t + b[m][1]
+    y2 = a[m][2] * t + b[m][2]
+    coef = c / (a[m][0] * y0 - a[m][1] * y1 - a[m][2] * y2)
+    if not (coef > 0 and math.isfinite(coef)):
+        return math.nan, -1, math.nan
+    return t, m, coef
 
 
 def _edge(x, d):
