@@ -44,8 +44,8 @@ _ALLOC = {"cache": True}
 
 
 # the scalar pieces are one.py's functions, compiled: the two paths share them line for line
-_approach, _scaling, _w_inv, _w_mul, _least_on_line = (
-    njit(**_JIT)(f) for f in (one.approach, one.scaling, one.w_inv, one.w_mul, one.least_on_line)
+_approach, _scaling, _w_inv, _w_mul, _least_on_line, _dual_polish = (
+    njit(**_JIT)(f) for f in (one.approach, one.scaling, one.w_inv, one.w_mul, one.least_on_line, one.dual_polish)
 )
 
 
@@ -437,45 +437,6 @@ def _culprit(A, b, x):
     for m in range(3):
         scale *= math.sqrt(A[m, 0, 0] ** 2 + A[m, 0, 1] ** 2 + A[m, 0, 2] ** 2)
     return blame, not abs(det) > 1e-9 * scale
-
-
-@njit(**_JIT)
-def _dual_polish(A, b, c, x, z, omega, h, res, delta, dz):
-    """``grip._dual_polish`` for one row (``z`` in place; ``h (d, d, 1)``, ``res``, ``delta (d, 1)``: one lane
-    of :func:`_spd_solve`)."""
-    K, d = A.shape[0], A.shape[2]
-    for j in range(d):
-        res[j, 0] = c[j]
-    for m in range(K):
-        ny, nz = 0.0, 0.0
-        for k in range(3):
-            t = b[m, k]
-            for j in range(d):
-                t += A[m, k, j] * x[j]
-                res[j, 0] -= A[m, k, j] * z[m, k]
-            ny += t * t
-            nz += z[m, k] * z[m, k]
-        omega[m] = math.sqrt(nz) / max(math.sqrt(ny), 1e-300)
-    for i in range(d):
-        for j in range(d):
-            t = 0.0
-            for m in range(K):
-                for k in range(3):
-                    t += omega[m] * A[m, k, i] * A[m, k, j]
-            h[i, j, 0] = t
-        h[i, i, 0] += 1e-300
-    _spd_solve(h, res, d, 1, delta)
-    for m in range(K):
-        for k in range(3):
-            t = 0.0
-            for j in range(d):
-                t += A[m, k, j] * delta[j, 0]
-            dz[m, k] = t * omega[m]
-            if not math.isfinite(dz[m, k]):
-                return
-    for m in range(K):
-        for k in range(3):
-            z[m, k] += dz[m, k]
 
 
 @njit(**_JIT)
@@ -982,7 +943,7 @@ def _grip_workspace():
         np.empty((3, 3)),
         np.empty(6),
         (np.empty(3), np.empty((3, 3, 1)), np.empty((3, 1)), np.empty((3, 1)), np.empty((3, 3))),
-        (np.empty((2, 3)), np.empty((2, 3))),
+        (np.empty((2, 3)), np.empty((2, 3)), np.empty((3, 4))),
     )
 
 
@@ -993,7 +954,7 @@ def _grip_rows(p, n, limit, w, tol, out, codes, chunk, gw):
     (q, mv, g, unit, fm, frame), (M, A, b, c, x, z), (wide, bw, cw, xw, zw, inside), sizes, lists = chunk
     t, size2, scale = sizes[:, 0], sizes[:, 1], sizes[:, 2]
     stage, blame, one, two, again = lists
-    e, corners, d, lam, (omega, h, res, delta, dz), (line_a, line_b) = gw
+    e, corners, d, lam, (omega, h, res, delta, dz), (line_a, line_b, polish) = gw
     for first in range(0, p.shape[0], _CHUNK):  # no rows: no chunk
         rows = min(_CHUNK, p.shape[0] - first)
         ones, twos, agains = 0, 0, 0
@@ -1065,7 +1026,7 @@ def _grip_rows(p, n, limit, w, tol, out, codes, chunk, gw):
             if stage[i] == _SKIP:
                 continue
             if stage[i] == _HOLD:
-                _dual_polish(A[i], b[i], c[i], x[i], z[i], omega, h, res, delta, dz)
+                _dual_polish(A[i], b[i], c[i], x[i], z[i], omega, polish, dz)
             r = first + i
             _finish(
                 r,

@@ -15,6 +15,8 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from .socp import _EDGE, _ITERATIONS, _RESIDUAL, GAP, START_MARGIN
 
 __all__ = [
@@ -353,26 +355,57 @@ def _cone_value(a, bm, x):
     return [bm[k] + sum(a[k][j] * x[j] for j in range(len(x))) for k in range(3)]
 
 
-def _dual_polish(A, b, c, x, z):
-    """``grip._dual_polish`` for one row."""
-    d = len(x)
-    y = [_cone_value(A[m], b[m], x) for m in range(len(A))]
-    res = [c[j] - sum(A[m][k][j] * z[m][k] for m in range(len(A)) for k in range(3)) for j in range(d)]
-    omega = [
-        math.sqrt(sum(v * v for v in z[m])) / max(math.sqrt(sum(v * v for v in y[m])), 1e-300) for m in range(len(A))
-    ]
-    h = [
-        [sum(omega[m] * A[m][k][i] * A[m][k][j] for m in range(len(A)) for k in range(3)) for j in range(d)]
-        for i in range(d)
-    ]
-    try:
-        delta = _solve(h, res)
-    except ZeroDivisionError:
-        return z
-    dz = [[omega[m] * sum(A[m][k][j] * delta[j] for j in range(d)) for k in range(3)] for m in range(len(A))]
-    if not all(math.isfinite(v) for t in dz for v in t):
-        return z
-    return [[z[m][k] + dz[m][k] for k in range(3)] for m in range(len(A))]
+def dual_polish(A, b, c, x, z, omega, h, dz):
+    """:func:`socp.dual_polish` for one row: ``z (K, 3)`` moved in place to ``sum_m A_m^T z_m = c`` again.
+
+    ``A (K, 3, d)``, ``b (K, 3)``, ``c (d)``, ``x (d)``; workspaces ``omega (K)``, ``h (d, d + 1)``
+    (the matrix, then the right-hand side), ``dz (K, 3)``.  Elimination without pivoting; a row
+    whose correction is not finite (every cone idle) is left as it is.  Arrays indexed
+    element by element: :mod:`~grasptwist.engine.forces.kernel` compiles this same function,
+    and :func:`solve` runs it as Python.
+    """
+    K, d = A.shape[0], A.shape[2]
+    for j in range(d):
+        h[j, d] = c[j]
+    for m in range(K):
+        ny, nz = 0.0, 0.0
+        for k in range(3):
+            t = b[m, k]
+            for j in range(d):
+                t += A[m, k, j] * x[j]
+                h[j, d] -= A[m, k, j] * z[m, k]
+            ny += t * t
+            nz += z[m, k] * z[m, k]
+        omega[m] = math.sqrt(nz) / max(math.sqrt(ny), 1e-300)
+    for i in range(d):
+        for j in range(d):
+            t = 0.0
+            for m in range(K):
+                for k in range(3):
+                    t += omega[m] * A[m, k, i] * A[m, k, j]
+            h[i, j] = t
+        h[i, i] += 1e-300
+    for k in range(d):
+        for i in range(k + 1, d):
+            f = h[i, k] / h[k, k]
+            for j in range(k + 1, d + 1):
+                h[i, j] -= f * h[k, j]
+    for i in range(d - 1, -1, -1):
+        v = h[i, d]
+        for j in range(i + 1, d):
+            v -= h[i, j] * h[j, d]
+        h[i, d] = v / h[i, i]
+    for m in range(K):
+        for k in range(3):
+            t = 0.0
+            for j in range(d):
+                t += A[m, k, j] * h[j, d]
+            dz[m, k] = t * omega[m]
+            if not math.isfinite(dz[m, k]):
+                return
+    for m in range(K):
+        for k in range(3):
+            z[m, k] += dz[m, k]
 
 
 def solve(A, b, c, P, inside, normal_det, rays):
@@ -399,4 +432,8 @@ def solve(A, b, c, P, inside, normal_det, rays):
             blame = -1
         return [math.nan] * d, z, True, blame
     s, z = minimise(A, b, c, x, P)
-    return s, _dual_polish(A, b, c, s, z), False, -1
+    A, b, x, z = np.array(A), np.array(b), np.array(s), np.array(z)
+    K, d = A.shape[0], A.shape[2]
+    with np.errstate(all="ignore"):  # a zero pivot: the correction is not finite, z stays
+        dual_polish(A, b, np.array(c), x, z, np.empty(K), np.empty((d, d + 1)), np.empty((K, 3)))
+    return s, z.tolist(), False, -1
