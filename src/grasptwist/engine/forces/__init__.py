@@ -4,11 +4,10 @@
   in closed form, the squeezes (internal forces) along the sides of the contact
   triangle, the status codes and the ``check_*`` validators;
 - ``socp``: a batched primal-dual interior-point method over second-order cones of any size (no loop over grasps);
-  ``one``: the same method for one row in Python floats, and the scalar pieces the kernel compiles;
-  ``kernel``: the whole grip of a row compiled by numba (the ``fast`` extra), and the method's
-  iterations for any rows of ``Q^3`` cones, loaded through ``compiled`` at the first grip;
+  ``one``: the same method for one row in Python floats; ``kernel``: the whole grip of a row
+  compiled by numba (the ``fast`` extra), loaded through ``compiled`` at the first grip;
 - ``cones``: the contact models as cones (frictionless, point, soft finger) and the grip over any
-  mix of them (the rows with a soft contact; their iterations compiled where numba is there);
+  mix of them (the rows with a soft contact, numpy only);
 - ``grip``: the least total normal force that holds a wrench within the friction cones;
 - ``hold``: holding a weight along an object path (gravity fixed in space): the grip at each
   pose, and the stretches where none exists;

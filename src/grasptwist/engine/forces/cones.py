@@ -31,12 +31,9 @@ certificate ``y = -D^T y'`` with ``B^T (y'; .) = sum_i C_i^T z_i`` (phase I's ``
 
 :func:`~grasptwist.engine.forces.grip.grip` sends here the rows with a soft contact (``torsion=``);
 rows of point or frictionless contacts keep their own way (the squeezes in closed form, the
-compiled kernel), so ``torsion=0`` is point contacts to the last bit.  The set-up and the
-finish are numpy's on both paths; the interior-point iterations are :mod:`socp`'s over the
-``Q^4`` cones (numpy, the reference) or, where numba is there, the compiled kernel's
-(:func:`~grasptwist.engine.forces.kernel.iterate_rows`, the point contacts' method), each ``Q^4``
-written as two ``Q^3`` (:func:`_split`).  No facial reduction here: a grip that exists only on
-the cones' edge (no internal force strictly inside them) is ``cannot-hold``.
+compiled kernel), so ``torsion=0`` is point contacts to the last bit.  This way is numpy only
+(no compiled twin yet), and has no facial reduction: a grip that exists only on the cones'
+edge (no internal force strictly inside them) is ``cannot-hold`` here.
 """
 
 from __future__ import annotations
@@ -46,7 +43,7 @@ from typing import NamedTuple
 import numpy as np
 
 from ..screws import cross
-from . import compiled, socp
+from . import socp
 from .grasp_map import tangent_bases
 
 __all__ = ["FRICTIONLESS", "POINT", "SOFT", "contact_models", "ConeGrasp", "cone_grasp", "cone_solve"]
@@ -206,10 +203,14 @@ def _solve_rows(setup, ws, scale, rows, d, out):
     g0 = np.einsum("njk,nk->nj", setup.pinv[rows], ws).reshape(-1, 3, _SIZE)
     A = frame @ null  # (n, 3, 4, d)
     b = np.einsum("nmkc,nmc->nmk", frame, g0)
-    fast = compiled.kernel()
-    x, z, fail = _conic(A, b) if fast is None else _conic_compiled(A, b, fast)
+    c = A[:, :, 0, :].sum(axis=1)
+    x, r, z = socp.phase_one(A, b)
+    fail = ~(r < 0)
     good = np.flatnonzero(~fail)
-    s = np.where(fail[:, None], np.nan, x)
+    s = np.full((len(rows), d), np.nan)
+    if good.size:
+        s[good], z[good] = socp.minimise(A[good], b[good], c[good], x[good])
+        z[good] = socp.dual_polish(A[good], b[good], c[good], s[good], z[good])
     g = g0 + (null @ s[:, None, :, None])[..., 0] if d else g0
     # the coordinates a model holds at zero are zero, not round-off: no torsion but a soft contact's, and a
     # frictionless contact's force along its normal
@@ -237,79 +238,6 @@ def _solve_rows(setup, ws, scale, rows, d, out):
         blame = np.argmax(np.sqrt((cone[..., 1:] ** 2).sum(axis=-1)) - cone[..., 0], axis=1)
         rays = socp.phase_one(A[bad][:, :, :1], b[bad][:, :, :1])[1]  # unlimited friction: n . f >= 0 alone
         out["blame"][rows[bad]] = np.where(rays < 0, blame, -1)
-
-
-def _conic(A, b):
-    """The grip's programme over the cones ``A (n, K, k, d)``, ``b``: phase I, then phase II and the dual polish where
-    it holds (:mod:`socp`, numpy: the reference).  Returns phase I's end or the optimum ``x (n, d)``, the
-    multipliers (phase I's where it fails) and ``fail``."""
-    c = A[:, :, 0, :].sum(axis=1)
-    x, r, z = socp.phase_one(A, b)
-    fail = ~(r < 0)
-    good = np.flatnonzero(~fail)
-    if good.size:
-        at = (A[good], b[good], c[good])
-        x[good], z[good] = socp.minimise(*at, x[good])
-        z[good] = socp.dual_polish(*at, x[good], z[good])
-    return x, z, fail
-
-
-def _conic_compiled(A, b, fast):
-    """:func:`_conic` with the kernel's iterations (:func:`kernel.iterate_rows`), which take ``Q^3`` cones: each
-    ``Q^4`` as two (:func:`_split`), the unknowns padded with zero columns to :data:`_PADDED` (one compiled size
-    for every mix of contact models: a zero column moves no cone and stays 0)."""
-    n, _, _, d = A.shape
-    pairs, bp = _split(A, b)
-    wide = np.zeros((n, 6, 3, _PADDED))
-    wide[..., : d + 3] = pairs
-    c = np.zeros((n, _PADDED))
-    c[:, :d] = A[:, :, 0, :].sum(axis=1)
-    x, r, z = socp.phase_one(wide, bp, fast)
-    fail = ~(r < 0)
-    good = np.flatnonzero(~fail)
-    if good.size:
-        x[good], z[good] = socp.minimise(wide[good], bp[good], c[good], x[good], _dual_start(good.size), fast)
-        # polished without the zero columns (each would make its matrix singular)
-        z[good] = socp.dual_polish(pairs[good], bp[good], c[good, : d + 3], x[good, : d + 3], z[good])
-    return x[:, :d], _joined(z), fail
-
-
-#: The unknowns of a compiled row of cones: 12 coordinates less a rank of at least 5, and a ``Q^4``'s inner ``s_m`` each.
-_PADDED = 10
-
-
-def _split(A, b):
-    """Each contact's cone ``Q^4`` as two ``Q^3``: ``|(u_1, u_2)| <= s_m`` (inner) and ``|(s_m, u_3)| <= t``
-    (outer), ``s_m`` an unknown of its own; a ``Q^3`` or a ray (``u_3 = 0``, or all zero) stays itself.
-    ``(n, 3, 4, d), (n, 3, 4) -> (n, 6, 3, d + 3), (n, 6, 3)``: the outer cones first.
-
-    >>> A, b = _split(np.zeros((1, 3, 4, 1)), np.tile([2.0, 1, 1, 1], (1, 3, 1)))
-    >>> b[0, 0].tolist(), b[0, 3].tolist(), A[0, 0, :, 1].tolist(), A[0, 3, :, 1].tolist()
-    ([2.0, 0.0, 1.0], [0.0, 1.0, 1.0], [0.0, 1.0, 0.0], [1.0, 0.0, 0.0])
-    """
-    n, _, _, d = A.shape
-    pairs, bp = np.zeros((n, 6, 3, d + 3)), np.zeros((n, 6, 3))
-    pairs[:, :3, 0, :d], bp[:, :3, 0] = A[:, :, 0], b[:, :, 0]
-    pairs[:, :3, 2, :d], bp[:, :3, 2] = A[:, :, 3], b[:, :, 3]
-    pairs[:, 3:, 1:, :d], bp[:, 3:, 1:] = A[:, :, 1:3], b[:, :, 1:3]
-    for m in range(3):
-        pairs[:, m, 1, d + m] = pairs[:, 3 + m, 0, d + m] = 1.0
-    return pairs, bp
-
-
-def _dual_start(n):
-    """A strictly feasible dual start of :func:`_split`'s problem: ``(1, -1/2, 0)`` outer, ``(1/2, 0, 0)`` inner
-    (the ``s_m`` columns cancel; ``t``'s is the objective's 1)."""
-    z = np.zeros((n, 6, 3))
-    z[:, :3, 0], z[:, :3, 1], z[:, 3:, 0] = 1.0, -0.5, 0.5
-    return z
-
-
-def _joined(z):
-    """:func:`_split`'s multipliers as the ``Q^4`` cones': ``(t, u_1, u_2, u_3)`` from the outer's ``t, u_3`` and the
-    inner's ``u_1, u_2``, ``(n, 6, 3) -> (n, 3, 4)`` (in ``Q^4`` where the pair's are in ``Q^3`` and the ``s_m``
-    columns cancel)."""
-    return np.concatenate((z[:, :3, :1], z[:, 3:, 1:], z[:, :3, 2:]), axis=2)
 
 
 def _at(setup, rows):

@@ -19,11 +19,6 @@ that need them in step, :data:`_LANES` at a time, :func:`_iterate`), finish (eac
 keeps its own iterations and stopping, and its answer is the same to the last bit in any order or
 company; alone (fewer rows than lanes: :func:`_iterate` compiled for one lane) to round-off
 (``test_the_compiled_grip_answers_each_row_as_alone``).
-
-:func:`iterate_rows` is the same iterations (:func:`_in_lanes`) on any rows of ``Q^3`` cones set up by
-:mod:`~grasptwist.engine.forces.socp` (``fast=``): the contact cones' rows with a soft contact
-(:mod:`~grasptwist.engine.forces.cones`) come through it, so point and soft contacts share one
-compiled method.
 """
 
 from __future__ import annotations
@@ -39,7 +34,7 @@ from .closure import _PAIRS, _STRICT
 from .grasp_map import GRIP_COLUMNS
 from .socp import _EDGE, _ITERATIONS, _RESIDUAL, GAP, START_MARGIN
 
-__all__ = ["grip_rows", "iterate_rows", "WIDTH"]
+__all__ = ["grip_rows", "WIDTH"]
 
 # no reference counting (numba's runtime) in the arithmetic: its atomic increments and decrements
 # on every array passed or sliced were a fifth of a row's time; the workspaces are allocated by
@@ -138,26 +133,25 @@ def _edge(y, z, dy, dz, ys, zs, K, width, out):
 
 
 @njit(**_ALLOC, inline="always")
-def _lanes(lanes, most_d, most_k):
-    """The arrays :func:`_iterate` works in, ``lanes`` rows at once (the last axis), for up to ``most_d``
-    unknowns and ``most_k`` cones, indexed below ``d`` and ``K`` only: eight allocations, the arrays of a
-    shape views of one."""
-    wide, unknowns, cones = np.empty((11, most_k, 3, lanes)), np.empty((5, most_d, lanes)), np.empty((4, most_k, lanes))
-    square, pair, counts = np.empty((2, most_d, most_d, lanes)), np.empty((2, lanes)), np.empty((2, lanes), np.int64)
+def _lanes(lanes):
+    """The arrays :func:`_iterate` works in, ``lanes`` rows at once (the last axis), indexed below ``d`` and
+    ``K`` only: eight allocations, the arrays of a shape views of one."""
+    wide, unknowns, cones = np.empty((11, _K, 3, lanes)), np.empty((5, _D, lanes)), np.empty((4, _K, lanes))
+    square, pair, counts = np.empty((2, _D, _D, lanes)), np.empty((2, lanes)), np.empty((2, lanes), np.int64)
     return (
-        np.empty((most_k, 3, most_d, lanes)),
+        np.empty((_K, 3, _D, lanes)),
         wide[0],
         unknowns[0],
         unknowns[1],
         wide[1],
-        np.empty((most_k, most_d, most_d, lanes)),
+        np.empty((_K, _D, _D, lanes)),
         counts[0],
         counts[1],
         unknowns[2],
         wide[2],
         wide[3],
         wide[4],
-        np.empty((most_k, most_d, lanes)),
+        np.empty((_K, _D, lanes)),
         cones[0],
         cones[1],
         square[0],
@@ -218,7 +212,7 @@ def _iterate(A, b, c, x, z, order, phase_one, d, K, width):
         zs,
         mu,
         step,
-    ) = _lanes(width, max(d, _D), max(K, _K))  # the grip's rows: its own sizes, as they were tuned
+    ) = _lanes(width)
     for ln in range(width):
         row[ln] = -1
     taken = 0
@@ -365,16 +359,6 @@ def _in_lanes(A, b, c, x, z, order, phase_one, d, K):
         _iterate(A, b, c, x, z, order, phase_one, d, K, 1)
     else:
         _iterate(A, b, c, x, z, order, phase_one, d, K, _LANES)
-
-
-@njit(**_ALLOC)
-def iterate_rows(A, b, c, x, z, phase_one, d, K):
-    """:func:`socp.phase_one`'s (``phase_one``) or :func:`socp.minimise`'s iterations on every row of a
-    problem already set up, compiled: ``A (n, K, 3, d)``, ``b (n, K, 3)``, ``c (n, d)``; ``x (n, d)`` and
-    ``z (n, K, 3)`` (the starts) in place.  ``d, K`` (Python ints): the sizes, compiled as constants
-    (each pair once).  The contact cones' rows (:mod:`~grasptwist.engine.forces.cones`) come here."""
-    d, K = literally(d), literally(K)
-    _in_lanes(A, b, c, x, z, np.arange(A.shape[0]), phase_one, d, K)
 
 
 @njit(**_JIT)

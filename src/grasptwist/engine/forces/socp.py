@@ -220,12 +220,10 @@ def _layout(A, b):
     return np.ascontiguousarray(A.transpose(2, 3, 1, 0)), np.ascontiguousarray(b.transpose(2, 1, 0))
 
 
-def phase_one(A, b, fast=None):
+def phase_one(A, b):
     """A strictly feasible ``x`` per row, the margin ``r`` reached (``r < 0``: feasible) and the dual.
 
-    ``A (n, K, k, d)``, ``b (n, K, k)`` -> ``x (n, d)``, ``r (n)``, ``z (n, K, k)``.  ``fast``: the
-    compiled kernel (:mod:`~grasptwist.engine.forces.compiled`), which iterates ``Q^3`` cones (``k = 3``)
-    from the same start, or None (numpy).  With
+    ``A (n, K, k, d)``, ``b (n, K, k)`` -> ``x (n, d)``, ``r (n)``, ``z (n, K, k)``.  With
     ``r < 0`` every cone holds ``t_m - |z_m| >= -r > 0`` at ``x``.  Where ``r > 0`` the cones'
     dual ``z_m`` (inside ``Q^k``, ``sum_m A_m^T z_m = 0`` to the residual) has
     ``-sum_m b_m . z_m > 0``: a proof that no ``x`` puts every ``A_m x + b_m`` in its cone
@@ -246,10 +244,6 @@ def phase_one(A, b, fast=None):
     z[0] = 0.25  # makes the r column of the dual, not yet the squeezes' columns
     c = np.zeros((d + 1, n))
     c[d] = 1.0
-    if fast is not None and k == 3:
-        x, z = np.ascontiguousarray(x.T), np.ascontiguousarray(z.transpose(2, 1, 0))
-        fast.iterate_rows(wide, bw, np.ascontiguousarray(c.T), x, z, True, d + 1, K + 1)
-        return x[:, :d], x[:, d], z[:, :K]
     wide, bw = _layout(wide, bw)
 
     def leave(x, closed, dual):
@@ -260,28 +254,21 @@ def phase_one(A, b, fast=None):
     return np.ascontiguousarray(x[:d].T), x[d], np.ascontiguousarray(z[:, :K].transpose(2, 1, 0))
 
 
-def minimise(A, b, c, x, z=None, fast=None):
+def minimise(A, b, c, x):
     """The optimum from the strictly feasible ``x (n, d)``; returns ``x (n, d)`` and the dual ``z (n, K, k)``.
 
     ``A (n, K, k, d)``, ``b (n, K, k)``, ``c (n, d)`` with ``c = sum_m A_m^T e`` (``e = (1, 0,
     0)``: the objective is the sum of the cones' first components, as the grip's is), so
-    ``z_m = e`` is a strictly feasible dual start; or ``z (n, K, k)``, another (``sum_m A_m^T z_m = c``,
-    each strictly inside its cone).  ``fast`` as :func:`phase_one`'s.  The dual stays feasible
+    ``z_m = e`` is a strictly feasible dual start.  The dual stays feasible
     (``sum_m A_m^T z_m = c`` to round-off); the gap ``sum_m y_m . z_m`` is below ``GAP``
     of the objective's scale where a row closed.
     """
-    n, K, k, d = A.shape
-    if z is None:
-        z = np.zeros((n, K, k))
-        z[..., 0] = 1.0
-    if fast is not None and k == 3:
-        x, z = np.array(x, order="C"), np.array(z, order="C")
-        fast.iterate_rows(np.ascontiguousarray(A), np.ascontiguousarray(b), np.ascontiguousarray(c), x, z, False, d, K)
-        return x, z
+    n = len(x)
     A, b = _layout(A, b)
     c = np.ascontiguousarray(c.T)
     x = np.ascontiguousarray(x.T)
-    z = np.ascontiguousarray(z.transpose(2, 1, 0))
+    z = np.zeros((A.shape[0], A.shape[2], n))
+    z[0] = 1.0
 
     def leave(x, closed, dual):
         return closed & (dual > -np.inf)
