@@ -873,25 +873,42 @@ def _kernel_as_python():
     return module
 
 
+def _edge_rows():
+    """Grips on the cones' edge (no internal force strictly inside every cone): a weight whose line passes
+    through two fingers' line (the third bare), the same on a tilted grasp and with the normals leant along
+    x (the squeeze between the two moves no normal force: a flat total, the centre), a push along one finger
+    (two bare).  No normal lies in the contacts' plane (Python's 0 / 0 in the kernel's source)."""
+    up = np.array([[0, 0, 1.0]] * 3) - 0.2 * EQ
+    p = np.stack((0.05 * EQ, 0.05 * EQ + [0.01, 0.02, 0.3], 0.05 * EQ, EQ))
+    n = np.stack((up, up + [[0.1, 0, 0], [0, 0.1, 0], [0, 0, 0]], [[0.2, 0, 1.0]] * 3, up))
+    lines = ((p[0, 1] + p[0, 2]) / 2, (p[1, 0] + p[1, 1]) / 2, (p[2, 1] + p[2, 2]) / 2)
+    w = [np.concatenate(([0, 0, 9.81], np.cross(c, [0, 0, 9.81]))) for c in lines]
+    w.append(np.concatenate((n[3, 2], np.cross(p[3, 2], n[3, 2]))))
+    return p, n, np.array(w), np.full((4, 3), 0.7)
+
+
 def test_the_compiled_grips_source_follows_the_numpy_path_in_the_default_run():
     """Issue 39, item 8: the kernel numba compiles (the path every [fast] install takes) held to the numpy path
     without a compile: its own source, run as Python, on held and cannot-hold rows, a row it leaves to numpy (a
     NaN wrench) and a row with no wrench; the same verdicts and culprits, totals to 1e-9 (the slow tests compile
     it; Python's floats raise on 0 / 0 where numba's error model gives NaN, so no degenerate row here)."""
     kernel = _kernel_as_python()
-    p, n, w, mu = grasps(10, 19)
+    p, n, w, mu = (np.concatenate(pair) for pair in zip(grasps(10, 19), _edge_rows()))
     w[0, 2] = np.nan
     w[1] = 0.0
-    limit = np.ascontiguousarray(np.broadcast_to(mu / 1.3, (10, 3)))
-    out, codes = np.empty((10, kernel.WIDTH)), np.empty((10, 3), np.int8)
+    limit = np.ascontiguousarray(np.broadcast_to(mu / 1.3, (14, 3)))
+    out, codes = np.empty((14, kernel.WIDTH)), np.empty((14, 3), np.int8)
     with np.errstate(all="ignore"):  # numba's error model is numpy's: a 0 / 0 is NaN, quietly
         kernel.grip_rows(p, n, limit, w, 1e-9, out, codes)
     with compiled.numpy_path():
         reference = gt.grip(p, n, w, mu, safety=1.3)
     plain = codes[:, 2] == 1
-    assert plain.tolist() == [False] + [True] * 9  # the NaN row goes to numpy
+    assert plain.tolist() == [False] + [True] * 13  # the NaN row goes to numpy; the edge's rows are the kernel's
     assert (codes[plain, 0] == reference.status[plain]).all() and (codes[plain, 1] == reference.culprit[plain]).all()
-    assert 2 <= reference.ok[plain].sum() <= 7
+    assert 2 <= reference.ok[plain].sum() <= 10 and reference.ok[10:].all()
+    # the edge's facial reduction in closed form, the same as numpy's: its multipliers too
+    np.testing.assert_allclose(out[10:, kernel._DUAL : kernel._DUAL + 6], reference.dual[10:], rtol=1e-9, atol=1e-12)
+    assert (np.abs(out[10:, kernel._GAP]) < 1e-9 * out[10:, kernel._TOTAL]).all()
     total = out[:, kernel._TOTAL]
     np.testing.assert_allclose(total[plain], reference.total_normal_force[plain], rtol=1e-9, atol=0)
     forces = out[:, kernel._F : kernel._F + 9].reshape(-1, 3, 3)

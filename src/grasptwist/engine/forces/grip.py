@@ -725,7 +725,9 @@ def _on_the_edge(frame, m, fm, z):
 
     Phase I's multipliers ``z_i`` give ``-G_i^T y``; where that lies strictly inside the
     dual cone, ``0 = y . w = -sum_i u_i . f_i`` forces ``f_i = 0``.  The other contacts'
-    cones are then solved over the internal forces that leave those contacts bare.  Returns
+    cones are then solved over the internal forces that leave those contacts bare: where these
+    are a line (one bare contact, as a rule), in closed form (:func:`one.least_on_line`, which
+    the compiled kernel's own reduction, ``kernel._on_the_edge``, shares).  Returns
     the internal-force coordinates and the kept cones' multipliers (``(3, 3)``, zero at
     the bare contacts), or None (no contact is forced bare, infinite friction, or the
     smaller problem has no strictly feasible point either).
@@ -750,7 +752,15 @@ def _on_the_edge(frame, m, fm, z):
         if not (b[:, 0] >= np.hypot(b[:, 1], b[:, 2]) - 1e-12 * np.abs(b).max()).all():
             return None
         return s0, multipliers, bare  # one grip only: every kept cone's multiplier 0 closes the gap
-    # one row: the method in floats (the batched one's numpy calls on one row were 16 ms of a 17 ms grip)
+    if free.shape[1] == 1:  # a line through the kept cones (one bare contact, as a rule): its least in closed form
+        line = (A @ free)[..., 0]
+        t, m, coef = one.least_on_line(line.tolist(), b.tolist(), len(b))
+        if m < 0:
+            return None
+        y = line[m] * t + b[m]
+        multipliers[np.flatnonzero(kept)[m]] = coef * y * [1, -1, -1]
+        return s0 + free[:, 0] * t, multipliers, bare
+    # more freedom (a rank-deficient bare contact): the method in floats
     reduced, b = (A @ free).tolist(), b.tolist()
     x, r, _ = one.phase_one(reduced, b)
     if not r < 0:

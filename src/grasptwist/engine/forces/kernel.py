@@ -7,7 +7,8 @@ inside them (:func:`~grasptwist.engine.forces.closure.internal_inside`), the int
 method of :mod:`~grasptwist.engine.forces.socp` step for step (Mehrotra's predictor-corrector
 with Nesterov-Todd scaling, 0.99 of the way to the cones' edge, the same stopping rules, phase
 I, dual polish and culprits; its scalar pieces are :mod:`~grasptwist.engine.forces.one`'s
-functions, compiled), then the dual or the certificate and the figures.  The numpy path stays
+functions, compiled), the facial reduction of a grip on the cones' edge (:func:`_on_the_edge`, in
+closed form), then the dual or the certificate and the figures.  The numpy path stays
 the reference: ``tests/engine/test_forces.py`` holds the two to the same verdicts and totals to
 ``1e-9``.  A row of the method is ``A[m, k, j]`` (cone ``m``, component ``k``, unknown ``j``),
 ``b[m, k]``, ``c[j]``; ``d`` unknowns, ``K`` cones.  numpy's error model: a division by zero
@@ -43,7 +44,9 @@ _ALLOC = {"cache": True}
 
 
 # the scalar pieces are one.py's functions, compiled: the two paths share them line for line
-_approach, _scaling, _w_inv, _w_mul = (njit(**_JIT)(f) for f in (one.approach, one.scaling, one.w_inv, one.w_mul))
+_approach, _scaling, _w_inv, _w_mul, _least_on_line, _dual_polish = (
+    njit(**_JIT)(f) for f in (one.approach, one.scaling, one.w_inv, one.w_mul, one.least_on_line, one.dual_polish)
+)
 
 
 #: Rows the interior-point method takes in step, each in a lane (the last axis of its workspace): the
@@ -437,42 +440,169 @@ def _culprit(A, b, x):
 
 
 @njit(**_JIT)
-def _dual_polish(A, b, c, x, z, omega, h, res, delta, dz):
-    """``grip._dual_polish`` for one row (``z`` in place; ``h (d, d, 1)``, ``res``, ``delta (d, 1)``: one lane
-    of :func:`_spd_solve`)."""
-    K, d = A.shape[0], A.shape[2]
-    for j in range(d):
-        res[j, 0] = c[j]
-    for m in range(K):
-        ny, nz = 0.0, 0.0
+def _bare(z, m, top):
+    """Whether phase I's multiplier ``z_m`` is strictly inside its cone: contact ``m`` carries nothing."""
+    return z[m, 0] - math.hypot(z[m, 1], z[m, 2]) > 1e-6 * top
+
+
+@njit(**_JIT)
+def _on_the_edge(A, b, M, fm, scale, frame, z, s, zk, h, res, delta, line_a, line_b):
+    """``grip._on_the_edge`` for a kernel row (three squeezes) in closed form; False leaves the row to numpy.
+
+    Phase I's ``z`` says which contacts are bare.  Their forces ``fm_m / scale + M_m s = 0`` give the
+    squeezes ``s0`` (least squares by the normal equations; one bare contact ``i`` leaves squeeze ``i``,
+    which moves no force at ``i``, free and 0 in ``s0``, as ``lstsq``'s least norm).  One bare contact:
+    ``s0 + t e_i`` is a line through the two other cones, each holding on an interval of ``t``
+    (:func:`_line_in_cone`); the least total is at the end the objective falls towards, and the cone
+    ending there carries the only multiplier, ``z = c / (a^T J y) J y``.  Two bare contacts: ``s0``,
+    where the third cone must hold.  Into ``s (3)`` and the kept cones' multipliers ``zk (3, 3)``.
+    """
+    top = _top(z)
+    for m in range(3):
+        if not _kappa(frame, m) > 0:  # no friction limit: the cones are half-spaces (numpy's)
+            return False
+    count, free = 0, -1
+    for i in range(3):
+        res[i, 0] = 0.0
+        for j in range(3):
+            h[i, j, 0] = 0.0
+    for m in range(3):
         for k in range(3):
-            t = b[m, k]
-            for j in range(d):
-                t += A[m, k, j] * x[j]
-                res[j, 0] -= A[m, k, j] * z[m, k]
-            ny += t * t
-            nz += z[m, k] * z[m, k]
-        omega[m] = math.sqrt(nz) / max(math.sqrt(ny), 1e-300)
-    for i in range(d):
-        for j in range(d):
-            t = 0.0
-            for m in range(K):
+            zk[m, k] = 0.0
+        if _bare(z, m, top):
+            count += 1
+            free = m
+            for i in range(3):
                 for k in range(3):
-                    t += omega[m] * A[m, k, i] * A[m, k, j]
-            h[i, j, 0] = t
-        h[i, i, 0] += 1e-300
-    _spd_solve(h, res, d, 1, delta)
-    for m in range(K):
+                    res[i, 0] -= M[m, k, i] * fm[m, k] / scale
+                    for j in range(3):
+                        h[i, j, 0] += M[m, k, i] * M[m, k, j]
+    if count == 0 or count == 3:
+        return False
+    if count == 1:
+        h[free, free, 0] = 1.0  # squeeze `free` is no unknown of the bare contact's force: 0 in s0
+    _spd_solve(h, res, 3, 1, delta)
+    for m in range(3):
+        if _bare(z, m, top):
+            for k in range(3):
+                if (
+                    not abs(
+                        fm[m, k] / scale
+                        + M[m, k, 0] * delta[0, 0]
+                        + M[m, k, 1] * delta[1, 0]
+                        + M[m, k, 2] * delta[2, 0]
+                    )
+                    <= 1e-9
+                ):
+                    return False
+    for j in range(3):
+        s[j] = delta[j, 0]
+    kept = 0
+    for m in range(3):
+        if _bare(z, m, top):
+            continue
         for k in range(3):
-            t = 0.0
-            for j in range(d):
-                t += A[m, k, j] * delta[j, 0]
-            dz[m, k] = t * omega[m]
-            if not math.isfinite(dz[m, k]):
-                return
-    for m in range(K):
+            line_a[kept, k] = A[m, k, free]
+            line_b[kept, k] = b[m, k] + A[m, k, 0] * s[0] + A[m, k, 1] * s[1] + A[m, k, 2] * s[2]
+        if count == 2:  # no freedom left: the kept cone holds at s0, its multiplier 0 closes the gap
+            y0, y1, y2 = line_b[0, 0], line_b[0, 1], line_b[0, 2]
+            return y0 >= math.hypot(y1, y2) - 1e-12 * max(abs(y0), abs(y1), abs(y2))
+        kept += 1
+    t, m, coef = _least_on_line(line_a, line_b, 2)
+    if m < 0:
+        return False
+    s[free] += t
+    m = m + (m >= free)  # the kept cones' m-th
+    y0 = b[m, 0] + A[m, 0, 0] * s[0] + A[m, 0, 1] * s[1] + A[m, 0, 2] * s[2]
+    y1 = b[m, 1] + A[m, 1, 0] * s[0] + A[m, 1, 1] * s[1] + A[m, 1, 2] * s[2]
+    y2 = b[m, 2] + A[m, 2, 0] * s[0] + A[m, 2, 1] * s[1] + A[m, 2, 2] * s[2]
+    zk[m, 0], zk[m, 1], zk[m, 2] = coef * y0, -coef * y1, -coef * y2
+    return True
+
+
+@njit(**_JIT)
+def _edge_dual(q, g, unit, frame, z, zk, y, out):
+    """``grip._edge_dual`` in closed form: the least-norm twist ``lambda`` whose field at the kept contacts is
+    ``n_m - u_m`` (``u_m = F_m^T zk_m``), plus ``alpha y`` enough for the bare contacts' dual cones.
+
+    Two kept contacts ``i, j`` (``v = p_i - p_j``, ``r = d_i - d_j``): ``lambda_M = v x r / |v|^2 + a v``,
+    ``lambda_F = mean(d) - lambda_M x mean(p)``, ``a`` the least norm's; one kept contact ``i``:
+    ``lambda_M = p_i x d_i / (1 + |p_i|^2)``, ``lambda_F = d_i - lambda_M x p_i``."""
+    top, kept, first, last = _top(z), 0, -1, -1
+    for m in range(3):
+        if not _bare(z, m, top):
+            kept += 1
+            first = m if first < 0 else first
+            last = m
+    d0, d1, d2 = _rest(unit, frame, zk, first)
+    e0, e1, e2 = _rest(unit, frame, zk, last)
+    pi0, pi1, pi2 = q[first, 0] + g[0], q[first, 1] + g[1], q[first, 2] + g[2]
+    if kept == 1:
+        m0, m1, m2 = _cross(pi0, pi1, pi2, d0, d1, d2)
+        pp = 1 + pi0 * pi0 + pi1 * pi1 + pi2 * pi2
+        m0, m1, m2 = m0 / pp, m1 / pp, m2 / pp
+        c0, c1, c2 = _cross(m0, m1, m2, pi0, pi1, pi2)
+        f0, f1, f2 = d0 - c0, d1 - c1, d2 - c2
+    else:
+        pj0, pj1, pj2 = q[last, 0] + g[0], q[last, 1] + g[1], q[last, 2] + g[2]
+        v0, v1, v2 = pi0 - pj0, pi1 - pj1, pi2 - pj2
+        vv = v0 * v0 + v1 * v1 + v2 * v2
+        m0, m1, m2 = _cross(v0, v1, v2, d0 - e0, d1 - e1, d2 - e2)
+        m0, m1, m2 = m0 / vv, m1 / vv, m2 / vv
+        a0, a1, a2 = (pi0 + pj0) / 2, (pi1 + pj1) / 2, (pi2 + pj2) / 2
+        c0, c1, c2 = _cross(m0, m1, m2, a0, a1, a2)
+        f0, f1, f2 = (d0 + e0) / 2 - c0, (d1 + e1) / 2 - c1, (d2 + e2) / 2 - c2
+        w0, w1, w2 = _cross(v0, v1, v2, a0, a1, a2)
+        along = (f0 * w0 + f1 * w1 + f2 * w2) / (w0 * w0 + w1 * w1 + w2 * w2 + vv)
+        m0, m1, m2 = m0 + along * v0, m1 + along * v1, m2 + along * v2
+        f0, f1, f2 = f0 - along * w0, f1 - along * w1, f2 - along * w2
+    out[0], out[1], out[2], out[3], out[4], out[5] = f0, f1, f2, m0, m1, m2
+    alpha = 0.0
+    for m in range(3):
+        if not _bare(z, m, top):
+            continue
+        pm0, pm1, pm2 = q[m, 0] + g[0], q[m, 1] + g[1], q[m, 2] + g[2]
+        c0, c1, c2 = _cross(m0, m1, m2, pm0, pm1, pm2)
+        need = -_margin(unit[m, 0] - f0 - c0, unit[m, 1] - f1 - c1, unit[m, 2] - f2 - c2, unit[m], _kappa(frame, m))
+        c0, c1, c2 = _cross(y[3], y[4], y[5], pm0, pm1, pm2)
+        gain = _margin(-y[0] - c0, -y[1] - c1, -y[2] - c2, unit[m], _kappa(frame, m))
+        alpha = max(alpha, max(need, 0.0) / gain)
+    for k in range(6):
+        out[k] += alpha * y[k]
+
+
+@njit(**_JIT)
+def _margin(v0, v1, v2, n, kappa):
+    """``v_n - |v_t| / kappa`` (``kappa = 1 / limit``): ``> 0`` inside the dual cone (``grip._dual_cone_margin``)."""
+    vn = v0 * n[0] + v1 * n[1] + v2 * n[2]
+    t0, t1, t2 = v0 - vn * n[0], v1 - vn * n[1], v2 - vn * n[2]
+    return vn - math.sqrt(t0 * t0 + t1 * t1 + t2 * t2) / kappa
+
+
+@njit(**_JIT)
+def _top(z):
+    """The largest ``|z_mk|``."""
+    top = 0.0
+    for m in range(3):
         for k in range(3):
-            z[m, k] += dz[m, k]
+            top = max(top, abs(z[m, k]))
+    return top
+
+
+@njit(**_JIT)
+def _kappa(frame, m):
+    """``|F_m[1]| = 1 / limit``: the cone's slope (0: no friction limit)."""
+    return math.sqrt(frame[m, 1, 0] ** 2 + frame[m, 1, 1] ** 2 + frame[m, 1, 2] ** 2)
+
+
+@njit(**_JIT)
+def _rest(unit, frame, zk, m):
+    """``n_m - F_m^T zk_m``: what the dual twist's field must be at a kept contact."""
+    return (
+        unit[m, 0] - (frame[m, 0, 0] * zk[m, 0] + frame[m, 1, 0] * zk[m, 1] + frame[m, 2, 0] * zk[m, 2]),
+        unit[m, 1] - (frame[m, 0, 1] * zk[m, 0] + frame[m, 1, 1] * zk[m, 1] + frame[m, 2, 1] * zk[m, 2]),
+        unit[m, 2] - (frame[m, 0, 2] * zk[m, 0] + frame[m, 1, 2] * zk[m, 1] + frame[m, 2, 2] * zk[m, 2]),
+    )
 
 
 # where each of grasp_map.GRIP_COLUMNS starts, and the row's width
@@ -709,7 +839,7 @@ def _set_up(r, p, n, limit, w, tol, o, codes, q, mv, g, unit, e, fm, frame, M, A
 
 
 @njit(**_JIT)
-def _finish(r, w, o, codes, fail, blame, q, mv, t, g, size2, unit, fm, frame, M, scale, s, z, d, lam):
+def _finish(r, w, o, codes, fail, blame, q, mv, t, g, size2, unit, fm, frame, M, scale, s, z, d, lam, A, b, work):
     """Row ``r``'s last pass: the dual or the certificate (``z``: the multipliers of phase II or of a
     failed phase I), the forces of the squeezes ``s`` and their figures into ``o`` (its row of ``out``)."""
     if scale:
@@ -724,14 +854,19 @@ def _finish(r, w, o, codes, fail, blame, q, mv, t, g, size2, unit, fm, frame, M,
                 yw += lam[k] * w[r, k]
                 yy += lam[k] * lam[k]
                 ww += w[r, k] * w[r, k]
-            if not yw > 1e-8 * math.sqrt(yy) * math.sqrt(ww):  # grip._EDGE_OF_HOLD: facial reduction in numpy
-                return
-            length = math.sqrt(
-                lam[0] ** 2 + lam[1] ** 2 + lam[2] ** 2 + size2 * (lam[3] ** 2 + lam[4] ** 2 + lam[5] ** 2)
-            )
-            for k in range(6):
-                o[_CERT + k] = lam[k] / length
-                o[_DUAL + k] = math.nan
+            if yw > 1e-8 * math.sqrt(yy) * math.sqrt(ww):  # grip._EDGE_OF_HOLD
+                length = math.sqrt(
+                    lam[0] ** 2 + lam[1] ** 2 + lam[2] ** 2 + size2 * (lam[3] ** 2 + lam[4] ** 2 + lam[5] ** 2)
+                )
+                for k in range(6):
+                    o[_CERT + k] = lam[k] / length
+                    o[_DUAL + k] = math.nan
+            else:  # on the edge of what the fingers exert: the facial reduction, else the row is numpy's
+                h, res, delta, zk, line_a, line_b = work
+                if not _on_the_edge(A, b, M, fm, scale, frame, z, s, zk, h, res, delta, line_a, line_b):
+                    return
+                _edge_dual(q, g, unit, frame, z, zk, lam, o[_DUAL : _DUAL + 6])
+                fail = False
         else:
             for i in range(3):
                 for k in range(3):
@@ -801,13 +936,14 @@ def _chunk(rows):
 
 @njit(**_ALLOC)
 def _grip_workspace():
-    """One row's scratch arrays: ``e``, ``corners``, ``d``, ``lam``, and :func:`_dual_polish`'s."""
+    """One row's scratch arrays: ``e``, ``corners``, ``d``, ``lam``, :func:`_dual_polish`'s and :func:`_on_the_edge`'s."""
     return (
         np.empty((3, 3)),
         np.empty((6, 3)),
         np.empty((3, 3)),
         np.empty(6),
         (np.empty(3), np.empty((3, 3, 1)), np.empty((3, 1)), np.empty((3, 1)), np.empty((3, 3))),
+        (np.empty((2, 3)), np.empty((2, 3)), np.empty((3, 4))),
     )
 
 
@@ -818,7 +954,7 @@ def _grip_rows(p, n, limit, w, tol, out, codes, chunk, gw):
     (q, mv, g, unit, fm, frame), (M, A, b, c, x, z), (wide, bw, cw, xw, zw, inside), sizes, lists = chunk
     t, size2, scale = sizes[:, 0], sizes[:, 1], sizes[:, 2]
     stage, blame, one, two, again = lists
-    e, corners, d, lam, (omega, h, res, delta, dz) = gw
+    e, corners, d, lam, (omega, h, res, delta, dz), (line_a, line_b, polish) = gw
     for first in range(0, p.shape[0], _CHUNK):  # no rows: no chunk
         rows = min(_CHUNK, p.shape[0] - first)
         ones, twos, agains = 0, 0, 0
@@ -890,7 +1026,7 @@ def _grip_rows(p, n, limit, w, tol, out, codes, chunk, gw):
             if stage[i] == _SKIP:
                 continue
             if stage[i] == _HOLD:
-                _dual_polish(A[i], b[i], c[i], x[i], z[i], omega, h, res, delta, dz)
+                _dual_polish(A[i], b[i], c[i], x[i], z[i], omega, polish, dz)
             r = first + i
             _finish(
                 r,
@@ -913,4 +1049,7 @@ def _grip_rows(p, n, limit, w, tol, out, codes, chunk, gw):
                 z[i],
                 d,
                 lam,
+                A[i],
+                b[i],
+                (h, res, delta, dz, line_a, line_b),
             )

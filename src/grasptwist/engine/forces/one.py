@@ -15,9 +15,21 @@ from __future__ import annotations
 
 import math
 
+import numpy as np
+
 from .socp import _EDGE, _ITERATIONS, _RESIDUAL, GAP, START_MARGIN
 
-__all__ = ["phase_one", "minimise", "newton_matrices", "solve", "approach", "scaling", "w_inv", "w_mul"]
+__all__ = [
+    "phase_one",
+    "minimise",
+    "newton_matrices",
+    "solve",
+    "approach",
+    "scaling",
+    "w_inv",
+    "w_mul",
+    "least_on_line",
+]
 
 
 def approach(x0, x1, x2, d0, d1, d2, s):
@@ -34,6 +46,85 @@ def approach(x0, x1, x2, d0, d1, d2, s):
     f = (rho0 + d0) / (x0 + 1)
     e1, e2 = d1 - f * x1, d2 - f * x2
     return math.sqrt(e1 * e1 + e2 * e2) - rho0
+
+
+def least_on_line(a, b, count):
+    """The least ``c t`` over the line ``a_m t + b_m`` in the cones ``Q^3`` (``m < count``), ``c = sum_m a_m0``:
+    ``(t, m, coef)``, the cone ``m`` that ends the line there and its multiplier ``coef J (a_m t + b_m)``
+    (the only one: ``sum_m a_m^T z_m = c``), or ``(nan, -1, nan)``: no least, or not sharply.
+
+    Each cone holds on an interval of ``t``: ``g(t) = (a t + b)^T J (a t + b) = alpha t^2 + 2 beta t +
+    gamma >= 0`` with ``a_0 t + b_0 >= 0``, between the roots of ``g`` (``alpha < 0``), beyond the one on
+    the cone's side (``alpha > 0``: ``a`` inside the cone or its opposite), or a half-line (``alpha = 0``).
+    Where ``c = 0`` every feasible ``t`` is least: the interval's analytic centre (the maximum of
+    ``sum_m log g_m(t)``, where the interior-point method's central path goes) and no multiplier.
+    The facial reduction's last step (``grip._on_the_edge``), in closed form: the same source as
+    Python floats and, compiled, in :mod:`~grasptwist.engine.forces.kernel`.  ``a, b`` are ``(count, 3)``
+    (lists, or arrays: indexed ``a[m][k]``).
+
+    >>> least_on_line([[0.0, 1.0, 0.0]], [[1.0, 0.0, 0.0]], 1)  # |t| <= 1 and c = 0: the centre
+    (0.0, 0, 0.0)
+    >>> least_on_line([[1.0, 0.0, 0.0], [1.0, 0.5, 0.0]], [[0.0, 0.0, 0.0], [0.0, -1.0, 0.0]], 2)  # t >= 2 / 3
+    (0.6666666666666666, 1, 2.0)
+    """
+    lo, hi, low, high, c = -math.inf, math.inf, -1, -1, 0.0
+    for m in range(count):
+        a0, a1, a2, b0, b1, b2 = a[m][0], a[m][1], a[m][2], b[m][0], b[m][1], b[m][2]
+        c += a0
+        alpha, beta, gamma = a0 * a0 - a1 * a1 - a2 * a2, a0 * b0 - a1 * b1 - a2 * b2, b0 * b0 - b1 * b1 - b2 * b2
+        disc = beta * beta - alpha * gamma
+        start, end = -math.inf, math.inf
+        if alpha == 0:  # a on the cone's edge: g is linear
+            if beta > 0:
+                start = -gamma / (2 * beta)
+            elif beta < 0:
+                end = -gamma / (2 * beta)
+            elif not (gamma >= 0 and b0 >= 0):
+                start, end = math.inf, -math.inf
+        elif disc < 0:
+            if alpha < 0:
+                start, end = math.inf, -math.inf
+        else:
+            far = -(beta + math.copysign(math.sqrt(disc), beta))  # roots far / alpha, gamma / far: no cancellation
+            t1, t2 = (far / alpha, gamma / far) if far != 0 else (0.0, 0.0)
+            t1, t2 = min(t1, t2), max(t1, t2)
+            if alpha > 0 and a0 > 0:
+                start = t2
+            elif alpha > 0:
+                end = t1
+            elif a0 * (t1 + t2) / 2 + b0 >= 0:
+                start, end = t1, t2
+            else:
+                start, end = math.inf, -math.inf
+        if start > lo:
+            lo, low = start, m
+        if end < hi:
+            hi, high = end, m
+    t, m = (lo, low) if c > 0 else (hi, high)
+    if c == 0 and lo < hi and math.isfinite(lo) and math.isfinite(hi):
+        # the total is the same all along: the analytic centre, where the central path goes, by bisection on
+        # the derivative of sum_m log g_m(t), which falls (sqrt(g) is concave on the cone)
+        for _ in range(200):
+            t = (lo + hi) / 2
+            if not lo < t < hi:
+                break
+            slope = 0.0
+            for m in range(count):
+                y0, y1, y2 = a[m][0] * t + b[m][0], a[m][1] * t + b[m][1], a[m][2] * t + b[m][2]
+                slope += (a[m][0] * y0 - a[m][1] * y1 - a[m][2] * y2) / (y0 * y0 - y1 * y1 - y2 * y2)
+            if slope == 0:
+                break
+            lo, hi = (t, hi) if slope > 0 else (lo, t)
+        return (lo + hi) / 2, 0, 0.0
+    if c == 0 or not lo <= hi or not math.isfinite(t):
+        return math.nan, -1, math.nan
+    y0 = a[m][0] * t + b[m][0]
+    y1 = a[m][1] * t + b[m][1]
+    y2 = a[m][2] * t + b[m][2]
+    coef = c / (a[m][0] * y0 - a[m][1] * y1 - a[m][2] * y2)
+    if not (coef > 0 and math.isfinite(coef)):
+        return math.nan, -1, math.nan
+    return t, m, coef
 
 
 def _edge(x, d):
@@ -264,26 +355,57 @@ def _cone_value(a, bm, x):
     return [bm[k] + sum(a[k][j] * x[j] for j in range(len(x))) for k in range(3)]
 
 
-def _dual_polish(A, b, c, x, z):
-    """``grip._dual_polish`` for one row."""
-    d = len(x)
-    y = [_cone_value(A[m], b[m], x) for m in range(len(A))]
-    res = [c[j] - sum(A[m][k][j] * z[m][k] for m in range(len(A)) for k in range(3)) for j in range(d)]
-    omega = [
-        math.sqrt(sum(v * v for v in z[m])) / max(math.sqrt(sum(v * v for v in y[m])), 1e-300) for m in range(len(A))
-    ]
-    h = [
-        [sum(omega[m] * A[m][k][i] * A[m][k][j] for m in range(len(A)) for k in range(3)) for j in range(d)]
-        for i in range(d)
-    ]
-    try:
-        delta = _solve(h, res)
-    except ZeroDivisionError:
-        return z
-    dz = [[omega[m] * sum(A[m][k][j] * delta[j] for j in range(d)) for k in range(3)] for m in range(len(A))]
-    if not all(math.isfinite(v) for t in dz for v in t):
-        return z
-    return [[z[m][k] + dz[m][k] for k in range(3)] for m in range(len(A))]
+def dual_polish(A, b, c, x, z, omega, h, dz):
+    """:func:`socp.dual_polish` for one row: ``z (K, 3)`` moved in place to ``sum_m A_m^T z_m = c`` again.
+
+    ``A (K, 3, d)``, ``b (K, 3)``, ``c (d)``, ``x (d)``; workspaces ``omega (K)``, ``h (d, d + 1)``
+    (the matrix, then the right-hand side), ``dz (K, 3)``.  Elimination without pivoting; a row
+    whose correction is not finite (every cone idle) is left as it is.  Arrays indexed
+    element by element: :mod:`~grasptwist.engine.forces.kernel` compiles this same function,
+    and :func:`solve` runs it as Python.
+    """
+    K, d = A.shape[0], A.shape[2]
+    for j in range(d):
+        h[j, d] = c[j]
+    for m in range(K):
+        ny, nz = 0.0, 0.0
+        for k in range(3):
+            t = b[m, k]
+            for j in range(d):
+                t += A[m, k, j] * x[j]
+                h[j, d] -= A[m, k, j] * z[m, k]
+            ny += t * t
+            nz += z[m, k] * z[m, k]
+        omega[m] = math.sqrt(nz) / max(math.sqrt(ny), 1e-300)
+    for i in range(d):
+        for j in range(d):
+            t = 0.0
+            for m in range(K):
+                for k in range(3):
+                    t += omega[m] * A[m, k, i] * A[m, k, j]
+            h[i, j] = t
+        h[i, i] += 1e-300
+    for k in range(d):
+        for i in range(k + 1, d):
+            f = h[i, k] / h[k, k]
+            for j in range(k + 1, d + 1):
+                h[i, j] -= f * h[k, j]
+    for i in range(d - 1, -1, -1):
+        v = h[i, d]
+        for j in range(i + 1, d):
+            v -= h[i, j] * h[j, d]
+        h[i, d] = v / h[i, i]
+    for m in range(K):
+        for k in range(3):
+            t = 0.0
+            for j in range(d):
+                t += A[m, k, j] * h[j, d]
+            dz[m, k] = t * omega[m]
+            if not math.isfinite(dz[m, k]):
+                return
+    for m in range(K):
+        for k in range(3):
+            z[m, k] += dz[m, k]
 
 
 def solve(A, b, c, P, inside, normal_det, rays):
@@ -310,4 +432,8 @@ def solve(A, b, c, P, inside, normal_det, rays):
             blame = -1
         return [math.nan] * d, z, True, blame
     s, z = minimise(A, b, c, x, P)
-    return s, _dual_polish(A, b, c, s, z), False, -1
+    A, b, x, z = np.array(A), np.array(b), np.array(s), np.array(z)
+    K, d = A.shape[0], A.shape[2]
+    with np.errstate(all="ignore"):  # a zero pivot: the correction is not finite, z stays
+        dual_polish(A, b, np.array(c), x, z, np.empty(K), np.empty((d, d + 1)), np.empty((K, 3)))
+    return s, z.tolist(), False, -1
