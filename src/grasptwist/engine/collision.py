@@ -46,7 +46,7 @@ from typing import NamedTuple
 import numpy as np
 
 from . import se3
-from .kinematics import forward_kinematics
+from .kinematics import forward_kinematics, joint_motion
 from .objects.geometry import object_size, signed_distance
 
 __all__ = [
@@ -233,7 +233,7 @@ def link_poses(hand, geometry, positions, frames=None):
         # g_j = g_(j-1) e^([S_j] q_j), one exponential per joint shared by the finger's links
         rotation, translation = np.eye(3), np.zeros(3)
         for j in range(max((joints for _, joints in mine), default=0)):
-            r, t = se3.exp(finger.screws[j], q[..., finger.joint_index[j]])
+            r, t = joint_motion(finger.screws[j], q[..., finger.joint_index[j]])
             rotation, translation = rotation @ r, (rotation @ t[..., None])[..., 0] + translation
             for i in (i for i, joints in mine if joints == j + 1):
                 out[..., i, :3, :3], out[..., i, :3, 3] = rotation, translation
@@ -303,7 +303,7 @@ def penetration_depths(obj, parts: LinkClusters, poses, n_links: int | None = No
     open_ = -phi + radius >= bound[rows, link]
     rows, cols, link = rows[open_], cols[open_], link[open_]
     r, t = rotation[rows, link], translation[rows, link]
-    v = np.einsum("kij,kmj->kmi", r, parts.vertices[cols]) + t[:, None]
+    v = parts.vertices[cols] @ r.swapaxes(-1, -2) + t[:, None]
     deepest = -signed_distance(here, v).min(axis=1)
     np.maximum.at(depth, (rows, link), deepest)
     return depth
