@@ -47,6 +47,7 @@ import numpy as np
 
 from . import se3
 from .kinematics import forward_kinematics, joint_motion
+from .objects import primitives
 from .objects.geometry import object_size, signed_distance
 
 __all__ = [
@@ -293,8 +294,8 @@ def penetration_depths(obj, parts: LinkClusters, poses, n_links: int | None = No
     if len(rows) == 0:
         return depth
     cols, center = np.concatenate([f[1] for f in found]), np.concatenate([f[2] for f in found])
-    here = replace(obj, pose=np.eye(4))
-    phi = signed_distance(here, center)
+    distance = _own_distance(obj)
+    phi = distance(center)
     radius, link = parts.radius[cols], parts.link[cols]
     # branch and bound: every vertex of a cluster is at least -phi - r deep and at most -phi + r
     # (the signed distance is 1-Lipschitz), so only a cluster that may hold the deepest vertex is opened
@@ -304,9 +305,19 @@ def penetration_depths(obj, parts: LinkClusters, poses, n_links: int | None = No
     rows, cols, link = rows[open_], cols[open_], link[open_]
     r, t = rotation[rows, link], translation[rows, link]
     v = parts.vertices[cols] @ r.swapaxes(-1, -2) + t[:, None]
-    deepest = -signed_distance(here, v).min(axis=1)
+    deepest = -distance(v).min(axis=1)
     np.maximum.at(depth, (rows, link), deepest)
     return depth
+
+
+def _own_distance(obj):
+    """The object's signed distance of points in its own frame, ``(..., 3) -> (...)``: a primitive's
+    closed form straight (the points are finite: a link's vertices moved by finite poses)."""
+    if obj.shape.kind == "mesh":
+        here = replace(obj, pose=np.eye(4))
+        return lambda x: signed_distance(here, x)
+    kind, size = obj.shape.kind, np.asarray(obj.shape.size, dtype=float)
+    return lambda x: primitives.signed_distance(kind, size, x.reshape(-1, 3)).reshape(x.shape[:-1])
 
 
 def _near(parts, link, rotation, translation, box):
