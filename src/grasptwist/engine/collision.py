@@ -336,7 +336,14 @@ def _near(parts, link, rotation, translation, box):
 def _outside(points, box):
     """How far points are outside an axis-aligned box ``(low, high)`` (0 inside)."""
     low, high = box
-    return np.linalg.norm(np.maximum(np.maximum(low - points, points - high), 0.0), axis=-1)
+    return _length(np.maximum(np.maximum(low - points, points - high), 0.0))
+
+
+def _length(v):
+    """``|v|`` over the last axis of 3, summed in ``numpy.linalg.norm``'s order (the same numbers),
+    without its reduction over a short last axis (three times slower: the collision tests' inner loop)."""
+    x, y, z = v[..., 0], v[..., 1], v[..., 2]
+    return np.sqrt(x * x + y * y + z * z)
 
 
 def _apply(r, x):
@@ -496,7 +503,7 @@ def finger_overlaps(hulls: LinkHulls, poses, centers, radii):
     a, b = np.triu_indices(parts, 1)
     keep = (finger[a] != finger[b]) & (reach[a] + reach[b] > 0)
     a, b = a[keep], b[keep]
-    rows, pair = np.nonzero(np.linalg.norm(ball[:, a] - ball[:, b], axis=-1) < (reach[a] + reach[b])[None])
+    rows, pair = np.nonzero(_length(ball[:, a] - ball[:, b]) < (reach[a] + reach[b])[None])
     a, b = a[pair], b[pair]  # a < b: a link before a sphere
     found = np.zeros(len(rows))
     both = b < links
@@ -557,5 +564,5 @@ def _sphere_in_hull(hulls, poses, rows, link, centers, radii):
     out = s[np.arange(len(x)), top]  # the distance where the centre is inside or over a face
     foot = x - out[:, None] * planes[np.arange(len(x)), top, :3]
     over_face = (out <= 0) | (hull_depth(foot, planes) >= -1e-9 * (1 + np.abs(out)))
-    nearest = np.linalg.norm(hulls.vertices[link] - x[:, None], axis=-1).min(axis=1)
+    nearest = _length(hulls.vertices[link] - x[:, None]).min(axis=1)
     return radii - np.where(over_face, out, nearest)
