@@ -27,12 +27,15 @@ finger and then as a whole:
 With an environment, a fingertip sphere must keep its clearance from it in the first test
 too (``fingertips``), before any inverse kinematics.
 
-The nine (finger, contact) pairs of a candidate are solved once each, batched over
-every candidate, and the six assignments are read off them; the assignments that reach
-are checked for collisions nearest first (the least total distance from each finger's first
-joint to its target: a finger reaching around the object to a far contact is the one whose
-links go through it), the first clear one kept.  Fingers must not
-share joints (each finger's inverse kinematics is its own).
+The six assignments are tried nearest first (the least total distance from each finger's
+first joint to its target: a finger reaching around the object to a far contact is the one
+whose links go through it), the first that reaches and is clear of collisions kept.  The
+nine (finger, contact) pairs of a candidate are solved at most once each, in two batches over
+every candidate, all fingers in one (:func:`~grasptwist.engine.ik.fingers_ik`): first the
+three pairs of each candidate's nearest assignment (which holds most candidates), then every
+pair of the candidates it does not hold; each batch's assignments that reach are checked for
+collisions in one call.  The assignment kept is the one an exhaustive solve of all nine pairs
+would keep.  Fingers must not share joints (each finger's inverse kinematics is its own).
 """
 
 from __future__ import annotations
