@@ -456,12 +456,13 @@ def _finger(chain, target, start, lower, upper, unlimited, spread, iterations, c
     missed = np.flatnonzero(err > tol)
     limited = np.isfinite(lower).any() or np.isfinite(upper).any()
     if classify and missed.size and limited:  # reachable outside the limits?
-        sub = _rows(chain, missed, stacked)
+        sub, within = _rows(chain, missed, stacked), _rows(tol, missed, stacked)
         free = chain_ik(*sub, target[missed], start[missed], iterations=iterations)
         fq, fe = free.positions, free.error
-        seeds = _rows(spread, missed, stacked)
-        _restart(sub, target[missed], start[missed], seeds, None, None, _rows(tol, missed, stacked), iterations, fq, fe)
-        outside = fe <= tol if not stacked else fe <= tol[missed]
+        _restart(
+            sub, target[missed], start[missed], _rows(spread, missed, stacked), None, None, within, iterations, fq, fe
+        )
+        outside = fe <= within
         q[missed[outside]], err[missed[outside]] = fq[outside], fe[outside]
         status[missed[outside]] = Status.OUTSIDE_LIMITS
     q = _wrap(q, start, unlimited)
