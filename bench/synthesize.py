@@ -17,7 +17,7 @@ Both figures are candidates fully scored per second of wall time.
 
 ``--hand`` (needs ``robot-properties-fingers`` and the ``urdf`` extra) measures verified
 grasps per second with the TriFinger Pro (its fingertip spheres of 10 mm, joint limits and
-link meshes) on the same cube where ``grasps/trifinger-cube.yaml`` puts it:
+link meshes) on the same cube where ``grasps/trifinger-cube.yaml`` puts it, on its table:
 
 - **the search** with the hand: ``--hand-grasps`` grasps wanted, every one reached within the
   joint limits (inverse kinematics over the finger assignments), fingertips on the surface, no
@@ -30,8 +30,8 @@ link meshes) on the same cube where ``grasps/trifinger-cube.yaml`` puts it:
   perturbations of each finalist, batched) against the same search ranked by the least total
   normal force (robustness then only on the grasps returned), in CPU seconds;
 - **the command line**: ``grasptwist synthesize grasps/trifinger-cube.yaml -n 20`` in a fresh
-  process (``--hand-candidates``), its wall and CPU seconds (start-up, the URDF and its meshes,
-  numba's cache included).
+  process, with ``--hand-candidates`` (the synthesis guide's 4,000) and with the default 20,000,
+  its wall and CPU seconds (start-up, the URDF and its meshes, numba's cache included).
 
 Every figure with its CPU time beside the wall time (the machine may be shared).  ``--memory``
 also runs the search at 10x and 100x fewer candidates and prints the peak resident memory of each
@@ -79,40 +79,28 @@ def baseline(candidates, seed=0, closure=True):
 
 
 def trifinger():
-    """The bundled TriFinger grasp file's hand and cube (of 100 g), and the link-depth function."""
+    """The bundled TriFinger grasp file's grasp, its cube of 100 g on its table."""
     from dataclasses import replace
 
-    from grasptwist.io.inputs import read
-    from grasptwist.run.collisions import deepest_link
-
-    g = read("grasps/trifinger-cube.yaml")[0]
-    g = replace(g, object=replace(g.object, mass=0.1))
-    return g, deepest_link(g)
+    g = gt.read_grasps("grasps/trifinger-cube.yaml")[0]
+    return replace(g, object=replace(g.object, mass=0.1))
 
 
-def hand_search(grasp, deepest, count, candidates, seed=0, objective="robust"):
-    """The search with the hand: ``(Synthesis, wall seconds, CPU seconds)``."""
-    from grasptwist.engine.synthesis.problem import hand_reach
-
-    reach = hand_reach(grasp.object, grasp.hand, collide=deepest)
+def hand_search(grasp, count, candidates, seed=0, objective="robust"):
+    """The search with the hand, as the command line makes it (``gt.synthesize`` of the grasp: its
+    hand's link meshes, the fingers against each other, its table; the default options):
+    ``(Synthesis, wall seconds, CPU seconds)``."""
     t, cpu = time.perf_counter(), time.process_time()
-    s = synthesize(
-        grasp.object,
-        MU,
-        hand=reach,
-        count=count,
-        candidates=candidates,
-        seed=seed,
-        min_conditioning=1e-3,
-        objective=objective,
-    )
+    s = gt.synthesize(grasp, MU, count=count, candidates=candidates, seed=seed, objective=objective)
     return s, time.perf_counter() - t, time.process_time() - cpu
 
 
-def command_line(count, candidates):
-    """``grasptwist synthesize`` of the TriFinger cube in a fresh process: ``(wall, CPU seconds)``."""
+def command_line(count, candidates=None):
+    """``grasptwist synthesize`` of the TriFinger cube on its table in a fresh process (the synthesis
+    guide's command; ``candidates`` None: the default): ``(wall, CPU seconds)``."""
     args = ["grasps/trifinger-cube.yaml", "--friction", str(MU), "--mass", "0.1", "-n", str(count)]
-    args += ["--candidates", str(candidates), "-f", "jsonl", "-q"]
+    args += [] if candidates is None else ["--candidates", str(candidates)]
+    args += ["-f", "jsonl", "-q"]
     before = resource.getrusage(resource.RUSAGE_CHILDREN)
     t = time.perf_counter()
     subprocess.run([sys.executable, "-m", "grasptwist", "synthesize", *args], capture_output=True, check=True)
@@ -150,9 +138,9 @@ def hand_baseline(grasp, wanted, seed=0, tries=40):
 
 
 def hand_bench(args):
-    grasp, deepest = trifinger()
-    hand_search(grasp, deepest, 2, 300)  # the compiled grip and the link meshes loaded before any timing
-    s, seconds, cpu = hand_search(grasp, deepest, args.hand_grasps, args.hand_candidates)
+    grasp = trifinger()
+    hand_search(grasp, 2, 300)  # the compiled grip and the link meshes loaded before any timing
+    s, seconds, cpu = hand_search(grasp, args.hand_grasps, args.hand_candidates)
     rate = len(s.points) / seconds
     print(
         f"search with the hand:  {len(s.points)} verified grasps in {seconds:.2f} s ({cpu:.2f} s CPU): "
@@ -160,14 +148,18 @@ def hand_bench(args):
         f"({s.candidates} candidates; largest tip error {np.max(s.reach_error):.1e} m)"
     )
     _, plain_seconds, plain_cpu = hand_search(
-        grasp, deepest, args.hand_grasps, args.hand_candidates, objective="total_normal_force"
+        grasp, args.hand_grasps, args.hand_candidates, objective="total_normal_force"
     )
     print(
         f"robustness (64 perturbations of the finalists): {cpu:.2f} s CPU against {plain_cpu:.2f} s ranked by "
         f"total normal force: {cpu / plain_cpu:.2f}x (wall {seconds / plain_seconds:.2f}x)"
     )
-    wall, cli_cpu = command_line(args.hand_grasps, args.hand_candidates)
-    print(f"command line:  {args.hand_grasps} grasps in {wall:.2f} s wall, {cli_cpu:.2f} s CPU (a fresh process)")
+    for candidates in (args.hand_candidates, None):
+        wall, cli_cpu = command_line(args.hand_grasps, candidates)
+        print(
+            f"command line:  {args.hand_grasps} grasps in {wall:.2f} s wall, {cli_cpu:.2f} s CPU (a fresh process; "
+            f"{'the default' if candidates is None else candidates} candidates)"
+        )
     found, spent, base_seconds = hand_baseline(grasp, args.hand_baseline)
     base_rate = found / base_seconds
     print(

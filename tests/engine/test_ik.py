@@ -212,3 +212,24 @@ def test_the_guide_page_runs_as_printed(monkeypatch):
         runner = doctest.DocTestRunner(optionflags=doctest.ELLIPSIS)
         runner.run(test)
         assert runner.summarize(verbose=False).failed == 0
+
+
+def test_fingers_stepped_together_solve_each_row_as_alone(trifinger, inline):
+    # fingers_ik (one chain a row, the search's batch) against finger_ik one finger at a time:
+    # the same positions, errors and statuses, bit for bit, reached targets and unreachable ones
+    from grasptwist.engine.ik import finger_ik, fingers_ik
+
+    rng = np.random.default_rng(5)
+    for grasp in (trifinger, inline):
+        hand, tips = grasp.hand, home_tips(grasp.hand, grasp.points)
+        targets, _ = reachable(hand, tips, rng, 40, np.pi)
+        targets = targets.reshape(-1, 3)
+        targets[::7] *= 3.0  # beyond the fingers' reach: unreachable, their least distance
+        which = np.tile(np.arange(3), 40)
+        q, error, status = fingers_ik(hand.fingers, tips, which, targets, seeds=2)
+        assert (status == Status.UNREACHABLE).any() and (status == Status.OK).any()
+        for f, finger in enumerate(hand.fingers):
+            alone = finger_ik(finger, tips[f], targets[which == f], seeds=2, classify=False)
+            np.testing.assert_array_equal(q[which == f, : len(finger.joints)], alone[0])
+            np.testing.assert_array_equal(error[which == f], alone[1])
+            np.testing.assert_array_equal(status[which == f], alone[3])

@@ -214,7 +214,7 @@ def parts_distance(parts, links, poses, centers, radii, environment):
         rows = np.repeat(np.arange(n), len(parts.link))
         np.minimum.at(bound, (rows, np.tile(parts.link, n)), (d + parts.radius).reshape(-1))
         rows, cols = np.nonzero(d - parts.radius <= bound[:, parts.link])
-        v = np.einsum("kij,kmj->kmi", rotation[rows, cols], parts.vertices[cols]) + translation[rows, cols, None]
+        v = parts.vertices[cols] @ rotation[rows, cols].swapaxes(-1, -2) + translation[rows, cols, None]
         vd, vk = environment_distance(v, environment)
         low = vd.argmin(axis=1)
         least, which = vd[np.arange(len(low)), low], vk[np.arange(len(low)), low]

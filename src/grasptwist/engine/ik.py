@@ -53,6 +53,7 @@ __all__ = [
     "HandIK",
     "hand_ik",
     "finger_ik",
+    "fingers_ik",
     "joint_limits",
     "home_tips",
     "contact_off_finger",
@@ -109,14 +110,16 @@ def chain_ik(home_screws, home_points, home_tip, targets, seeds, lower=None, upp
 
     Parameters
     ----------
-    home_screws : (n, 6) array
-    home_points : (n, 3) array
-    home_tip : (4, 4) array
+    home_screws : (n, 6) or (B, n, 6) array
+        One chain for every row, or one chain a row (several fingers of ``n`` joints of the
+        same kinds solved in one batch).
+    home_points : (n, 3) or (B, n, 3) array
+    home_tip : (4, 4) or (B, 4, 4) array
         The tip link's pose at home; its origin is the tip point.
     targets : (B, 3) array
     seeds : (B, n) array
         Where each row's iteration starts, within the limits.
-    lower, upper : (n,) arrays, optional
+    lower, upper : (n,) or (B, n) arrays, optional
         Joint position limits, ``-inf``/``inf`` (or NaN) where none.
     iterations : int
 
@@ -139,8 +142,12 @@ def chain_ik(home_screws, home_points, home_tip, targets, seeds, lower=None, upp
     targets = np.asarray(targets, dtype=float)
     q = np.array(np.broadcast_to(seeds, targets.shape[:-1] + (n,)), dtype=float)
     lower, upper = _bounds(lower, n, -np.inf), _bounds(upper, n, np.inf)
+    stacked = chain[0].ndim == 3
+    if stacked:  # every per-chain array a row's, taken for the rows still iterating
+        lower, upper = np.broadcast_to(lower, q.shape), np.broadcast_to(upper, q.shape)
     length = _length(chain)
-    scale = np.where(chain[0][:, :3].any(axis=-1), 1.0, 1.0 / length)  # per unit of step: rad, or L
+    # per unit of step: rad, or L
+    scale = np.where(chain[0][..., :3].any(axis=-1), 1.0, 1.0 / np.asarray(length)[..., None])
     screws, tip = _tip(chain, q)
     error = norm(targets - tip)
     mu = np.ones(len(q))
@@ -149,15 +156,16 @@ def chain_ik(home_screws, home_points, home_tip, targets, seeds, lower=None, upp
     for _ in range(iterations):
         if not active.size:
             break
+        size = _rows(length, active, stacked)
         e = targets[active] - tip[active]
         jac = finger_jacobian(screws[active], tip[active])
-        damping = mu[active] * (np.einsum("...i,...i", e, e) + _FLOOR * length**2)
+        damping = mu[active] * (np.einsum("...i,...i", e, e) + _FLOOR * size**2)
         normal = jac @ np.swapaxes(jac, -1, -2) + damping[:, None, None] * np.eye(3)
         step = (np.swapaxes(jac, -1, -2) @ np.linalg.solve(normal, e[..., None]))[..., 0]
-        big = np.abs(step * scale).max(axis=-1) / _MAX_STEP
+        big = np.abs(step * _rows(scale, active, stacked)).max(axis=-1) / _MAX_STEP
         step /= np.maximum(big, 1.0)[:, None]
-        trial = np.clip(q[active] + step, lower, upper)
-        trial_screws, trial_tip = _tip(chain, trial)
+        trial = np.clip(q[active] + step, _rows(lower, active, stacked), _rows(upper, active, stacked))
+        trial_screws, trial_tip = _tip(_rows(chain, active, stacked), trial)
         trial_error = norm(targets[active] - trial_tip)
         better = trial_error < error[active]
         slow[active] = np.where(trial_error < 0.99 * error[active], 0, slow[active] + 1)
@@ -171,8 +179,15 @@ def chain_ik(home_screws, home_points, home_tip, targets, seeds, lower=None, upp
         mu[active] = np.where(better, np.maximum(mu[active] / 10, 1.0), mu[active] * 10)
         # done: converged, or stuck (no step shrinks the error however damped, or barely any
         # for _STALL iterations: against a limit, or at a local minimum of the distance)
-        active = active[(error[active] > _DONE * length) & (mu[active] < 1e12) & (slow[active] < _STALL)]
+        active = active[(error[active] > _DONE * size) & (mu[active] < 1e12) & (slow[active] < _STALL)]
     return ChainIK(q, error)
+
+
+def _rows(a, rows, stacked):
+    """Rows ``rows`` of a per-chain array (or of each of a tuple of them) when there is one chain a row."""
+    if not stacked:
+        return a
+    return tuple(x[rows] for x in a) if isinstance(a, tuple) else a[rows]
 
 
 def _bounds(b, n, none):
@@ -182,10 +197,12 @@ def _bounds(b, n, none):
 
 
 def _length(chain):
-    """The chain's length (at least its reach from the first joint, never 0)."""
+    """The chain's length (at least its reach from the first joint, never 0); ``(B,)`` for one chain a row."""
     screws, points, tip = chain
-    path = np.concatenate((points, tip[None, :3, 3]))
-    return max(float(norm(np.diff(path, axis=0)).sum()), float(np.abs(path).max()) * 1e-6, 1e-300)
+    path = np.concatenate((points, tip[..., None, :3, 3]), axis=-2)
+    reach = norm(np.diff(path, axis=-2)).sum(axis=-1)
+    out = np.maximum(np.maximum(reach, np.abs(path).max(axis=(-2, -1)) * 1e-6), 1e-300)
+    return out if out.ndim else float(out)
 
 
 @dataclass(frozen=True, eq=False)
@@ -315,7 +332,8 @@ def hand_ik(hand, points, *, seed=None, tips=None, iterations=IK_ITERATIONS) -> 
         lower, upper = joint_limits(finger)
         target = points[..., f, :].reshape(-1, 3)
         start = np.clip(seed[..., index].reshape(-1, len(index)), lower, upper)
-        q, err, inside, code = _finger(chain, target, start, lower, upper, finger, iterations)
+        spread = spread_seeds(finger)
+        q, err, inside, code = _finger(chain, target, start, lower, upper, _unlimited(finger), spread, iterations)
         positions[..., index] = q.reshape(lead + (len(index),))
         tip_error[..., f], within[..., f], status[..., f] = (a.reshape(lead) for a in (err, inside, code))
     return HandIK(positions, tip_error, within, status)
@@ -353,17 +371,84 @@ def finger_ik(finger, tip, targets, *, seeds=IK_SEEDS, classify=True, iterations
     lower, upper = joint_limits(finger)
     start = np.clip(np.zeros((len(targets), len(finger.joints))), lower, upper)
     chain = (finger.screws, finger.points, np.asarray(tip, dtype=float))
-    return _finger(chain, targets, start, lower, upper, finger, iterations, seeds, classify)
+    return _finger(
+        chain, targets, start, lower, upper, _unlimited(finger), spread_seeds(finger)[:seeds], iterations, classify
+    )
 
 
-def _finger(chain, target, start, lower, upper, finger, iterations, seeds=IK_SEEDS, classify=True):
-    """One finger over flat rows: positions, tip error, within limits, status (per row)."""
+def fingers_ik(fingers, tips, which, targets, *, seeds=IK_SEEDS, iterations=IK_ITERATIONS):
+    """Several fingers' inverse kinematics in one batch, from home: row ``k`` puts finger ``which[k]``'s
+    tip point on ``targets[k]`` (:func:`finger_ik` without ``classify``, each row as it would solve it).
+
+    Fingers whose joints are of the same kinds, in the same order (the TriFinger's three), are
+    stepped together, one chain a row, so that a batch pays the iterations' overhead once.
+
+    Parameters
+    ----------
+    fingers : sequence of Finger
+    tips : (F, 4, 4) array
+        Their tip links' poses at home.
+    which : (B,) int array
+    targets : (B, 3) array
+    seeds, iterations
+        As :func:`finger_ik`.
+
+    Returns
+    -------
+    (positions (B, n_max) (NaN past a finger's joints), tip error (B,), status (B,) int8)
+
+    >>> from grasptwist.hand import Finger, Joint
+    >>> s = np.array([[0, 0, 1.0, 0, 0, 0], [0, 0, 1.0, 0, -1.0, 0]])
+    >>> j = (Joint("a", "revolute", None, None, None, None), Joint("b", "revolute", None, None, None, None))
+    >>> tip = np.eye(4); tip[0, 3] = 2.0
+    >>> f = Finger("1", "tip", j, s, np.array([[0, 0, 0], [1.0, 0, 0]]), tip, 2.0, (0, 1))
+    >>> q, error, status = fingers_ik([f, f], np.array([tip, tip]), [0, 1], [[1.0, 1, 0], [3.0, 0, 0]])
+    >>> [Status(int(c)).code for c in status], (q[0].round(9) + 0.0).tolist(), error.round(9).tolist()
+    (['ok', 'unreachable'], [0.0, 1.570796327], [0.0, 1.0])
+    """
+    which = np.asarray(which, dtype=int)
+    targets = np.asarray(targets, dtype=float).reshape(-1, 3)
+    tips = np.asarray(tips, dtype=float)
+    q = np.full((len(targets), max((len(f.joints) for f in fingers), default=0)), np.nan)
+    error, status = np.full(len(targets), np.nan), np.zeros(len(targets), np.int8)
+    kinds = {}
+    for f, finger in enumerate(fingers):
+        kinds.setdefault(tuple(j.type for j in finger.joints), []).append(f)
+    for members in kinds.values():
+        rows = np.flatnonzero(np.isin(which, members))
+        if not rows.size:
+            continue
+        local = np.searchsorted(members, which[rows])  # each row's finger among ``members``
+
+        def per_row(values, local=local):
+            return np.array(values)[local]
+
+        mine = [fingers[k] for k in members]
+        lower, upper = (per_row(b) for b in zip(*map(joint_limits, mine)))
+        chain = per_row([f.screws for f in mine]), per_row([f.points for f in mine]), tips[members][local]
+        spread = per_row([spread_seeds(f)[:seeds] for f in mine])
+        start = np.clip(np.zeros(lower.shape), lower, upper)
+        got, err, _, code = _finger(
+            chain, targets[rows], start, lower, upper, per_row([_unlimited(f) for f in mine]), spread, iterations, False
+        )
+        q[rows, : lower.shape[1]], error[rows], status[rows] = got, err, code
+    return q, error, status
+
+
+def _unlimited(finger):
+    """Which of a finger's joints are revolute without limits (brought within ``pi`` of the seed)."""
+    lower, upper = joint_limits(finger)
+    return np.array([j.type != "prismatic" for j in finger.joints]) & ~np.isfinite(lower) & ~np.isfinite(upper)
+
+
+def _finger(chain, target, start, lower, upper, unlimited, spread, iterations, classify=True):
+    """One finger over flat rows (or one chain a row, :func:`chain_ik`): positions, tip error, within
+    limits, status (per row); ``spread`` its seeds ``(S, n)`` (``(B, S, n)``, one chain a row)."""
+    stacked = chain[0].ndim == 3
     length = _length(chain)
     tol = IK_TOL * length
     finite = np.isfinite(target).all(axis=-1)
     target = np.where(finite[:, None], target, 0.0)
-    unlimited = np.array([j.type != "prismatic" for j in finger.joints]) & ~np.isfinite(lower) & ~np.isfinite(upper)
-    spread = spread_seeds(finger)[:seeds]
     best = chain_ik(*chain, target, start, lower, upper, iterations=iterations)
     q, err = best.positions, np.where(finite, best.error, 0.0)
     _restart(chain, target, start, spread, lower, upper, tol, iterations, q, err)
@@ -371,10 +456,13 @@ def _finger(chain, target, start, lower, upper, finger, iterations, seeds=IK_SEE
     missed = np.flatnonzero(err > tol)
     limited = np.isfinite(lower).any() or np.isfinite(upper).any()
     if classify and missed.size and limited:  # reachable outside the limits?
-        free = chain_ik(*chain, target[missed], start[missed], iterations=iterations)
+        sub, within = _rows(chain, missed, stacked), _rows(tol, missed, stacked)
+        free = chain_ik(*sub, target[missed], start[missed], iterations=iterations)
         fq, fe = free.positions, free.error
-        _restart(chain, target[missed], start[missed], spread, None, None, tol, iterations, fq, fe)
-        outside = fe <= tol
+        _restart(
+            sub, target[missed], start[missed], _rows(spread, missed, stacked), None, None, within, iterations, fq, fe
+        )
+        outside = fe <= within
         q[missed[outside]], err[missed[outside]] = fq[outside], fe[outside]
         status[missed[outside]] = Status.OUTSIDE_LIMITS
     q = _wrap(q, start, unlimited)
@@ -386,12 +474,16 @@ def _finger(chain, target, start, lower, upper, finger, iterations, seeds=IK_SEE
 def _restart(chain, target, start, spread, lower, upper, tol, iterations, q, err):
     """Rows that miss (``err > tol``) start again from the spread seeds, nearest to their own
     start first, while they miss; each row keeps its best (``q`` and ``err`` updated in place)."""
-    order = np.argsort(np.linalg.norm(spread[None, :, :] - start[:, None, :], axis=-1), axis=-1)
-    for k in range(len(spread)):
+    stacked = chain[0].ndim == 3
+    seeds = spread if stacked else spread[None]
+    order = np.argsort(np.linalg.norm(seeds - start[:, None, :], axis=-1), axis=-1)
+    for k in range(spread.shape[-2]):
         missed = np.flatnonzero(err > tol)
         if not missed.size:
             return
-        got = chain_ik(*chain, target[missed], spread[order[missed, k]], lower, upper, iterations=iterations)
+        seed = spread[missed, order[missed, k]] if stacked else spread[order[missed, k]]
+        limits = (None, None) if lower is None else (_rows(lower, missed, stacked), _rows(upper, missed, stacked))
+        got = chain_ik(*_rows(chain, missed, stacked), target[missed], seed, *limits, iterations=iterations)
         better = got.error < err[missed]
         q[missed[better]], err[missed[better]] = got.positions[better], got.error[better]
 

@@ -173,7 +173,10 @@ def _box_distance(half, q):
     """``nearest``'s distance for the box ``|q_i| <= half_i`` alone: ``(N, k) -> (N,)``."""
     gap = np.abs(q) - half  # > 0: outside along that axis
     outside = _norm(np.maximum(gap, 0.0))
-    return np.where(outside > 0, outside, np.max(gap, axis=-1)) + 0.0
+    deepest = gap[..., 0]
+    for k in range(1, gap.shape[-1]):  # the largest gap, column by column: a reduction over a short
+        deepest = np.maximum(deepest, gap[..., k])  # last axis is numpy's slowest path (collision tests' inner loop)
+    return np.where(outside > 0, outside, deepest) + 0.0
 
 
 def _round_distance(radius, half, q):

@@ -83,5 +83,13 @@ def triple_distance(a, b):
     >>> float(triple_distance(p, p[::-1])), float(triple_distance(p, p + 0.5))
     (0.0, 0.8660254037844386)
     """
-    d = np.linalg.norm(a[..., None, :, :] - np.asarray(b)[..., _ORDERS, :], axis=-1)  # (..., 6, 3)
-    return d.max(axis=-1).min(axis=-1)
+    diff = a[..., None, :, :] - np.asarray(b)[..., _ORDERS, :]  # (..., 6, 3, 3)
+    x, y, z = diff[..., 0], diff[..., 1], diff[..., 2]
+    square = x * x + y * y + z * z  # (..., 6, 3), summed as numpy.linalg.norm sums it
+    # the largest over the fingers, the least over the orders, column by column (numpy's reductions
+    # over a short last axis are its slow path), the root last: it keeps the order
+    worst = np.maximum(np.maximum(square[..., 0], square[..., 1]), square[..., 2])
+    least = worst[..., 0]
+    for k in range(1, len(_ORDERS)):
+        least = np.minimum(least, worst[..., k])
+    return np.sqrt(least)

@@ -27,12 +27,15 @@ finger and then as a whole:
 With an environment, a fingertip sphere must keep its clearance from it in the first test
 too (``fingertips``), before any inverse kinematics.
 
-The nine (finger, contact) pairs of a candidate are solved once each, batched over
-every candidate, and the six assignments are read off them; the assignments that reach
-are checked for collisions nearest first (the least total distance from each finger's first
-joint to its target: a finger reaching around the object to a far contact is the one whose
-links go through it), the first clear one kept.  Fingers must not
-share joints (each finger's inverse kinematics is its own).
+The six assignments are tried nearest first (the least total distance from each finger's
+first joint to its target: a finger reaching around the object to a far contact is the one
+whose links go through it), the first that reaches and is clear of collisions kept.  The
+nine (finger, contact) pairs of a candidate are solved at most once each, in two batches over
+every candidate, all fingers in one (:func:`~grasptwist.engine.ik.fingers_ik`): first the
+three pairs of each candidate's nearest assignment (which holds most candidates), then every
+pair of the candidates it does not hold; each batch's assignments that reach are checked for
+collisions in one call.  The assignment kept is the one an exhaustive solve of all nine pairs
+would keep.  Fingers must not share joints (each finger's inverse kinematics is its own).
 """
 
 from __future__ import annotations
@@ -46,7 +49,7 @@ import numpy as np
 from ..collision import LinkHulls, finger_overlaps, link_hulls, link_poses, tip_centers_at
 from ..degeneracy import Status
 from ..environment import has_obstacles, parts_distance, sphere_distance
-from ..ik import IK_TOL, finger_ik
+from ..ik import IK_TOL, fingers_ik
 from ..kinematics import forward_kinematics
 
 __all__ = [
@@ -180,55 +183,79 @@ def reach(hand_reach: HandReach, points, normals) -> Reached:
     clear = hr.project(centre)[2] >= radii - hr.tolerance  # (N, 3, 3)
     if has_obstacles(hr.environment):  # and clear of the table and the boxes
         clear &= sphere_distance(centre, radii, hr.environment)[0] >= hr.clearance
+    # each pair's distance from reaching: inf off the surface, how far out of a revolute chain's
+    # reach (no solve needed), 0 until solved (``unsolved``)
     error = np.full((rows, 3, 3), np.inf)
-    q = np.full((rows, 3, 3, max(len(f.joints) for f in fingers)), np.nan)
+    unsolved = np.zeros((rows, 3, 3), bool)
     for f, finger in enumerate(fingers):
-        # a revolute chain reaches no farther from its first joint than it is long: no solve needed
         revolute = all(j.type == "revolute" for j in finger.joints)
         gap = np.linalg.norm(centre[:, :, f] - finger.points[0], axis=-1) - finger.length if revolute else -1.0
         gap = np.broadcast_to(gap, (rows, 3))
         error[:, :, f] = np.where(clear[:, :, f], np.maximum(gap, 0.0), np.inf)
-        todo = np.flatnonzero((clear[:, :, f] & (gap <= 0)).reshape(-1))
-        if todo.size:
-            got, err, _, status = finger_ik(
-                finger, hr.tips[f], centre[:, :, f].reshape(-1, 3)[todo], seeds=IK_RESTARTS, classify=False
-            )
-            flat_q, flat_e = q[:, :, f].reshape(-1, q.shape[-1]), error[:, :, f].reshape(-1)
-            flat_q[todo, : len(finger.joints)] = got
-            flat_e[todo] = np.where(status == Status.OK, 0.0, err)
-            q[:, :, f], error[:, :, f] = flat_q.reshape(rows, 3, -1), flat_e.reshape(rows, 3)
+        unsolved[:, :, f] = clear[:, :, f] & (gap <= 0)
+    q = np.full((rows, 3, 3, max(len(f.joints) for f in fingers)), np.nan)
     pick = (slice(None), _SHIFTS[:, :], np.arange(3)[None, :])  # (N, 6 assignments, 3 fingers)
     touches = clear[pick].all(axis=-1)
-    worst = error[pick].max(axis=-1)  # (N, 6): 0 where every finger reaches
-    reached = worst == 0.0
-    failed = np.full(rows, HAND_CONSTRAINTS.index("fingertips"), np.int8)
-    failed[touches.any(axis=1)] = HAND_CONSTRAINTS.index("reach")
-    miss = np.where(touches.any(axis=1), worst.min(axis=1, initial=np.inf), np.nan)
-    order = np.tile(np.arange(3), (rows, 1))
-    positions = np.full((rows, len(hr.hand.joint_names)), np.nan)
-    depth = np.full(rows, np.inf)
     # the assignments tried nearest first (the fingers' first joints to their targets, in all): a finger
     # that reaches around the object to a far contact is the one whose links go through it
     base = np.array([f.points[0] for f in fingers])  # (3, 3)
     spread = np.linalg.norm(centre - base, axis=-1)[pick].sum(axis=-1)  # (N, 6)
-    ranked = np.argsort(np.where(reached, spread, np.inf), axis=1, kind="stable")
-    for rank in range(len(_ORDERS)):  # the first assignment clear of the object is kept
-        k = ranked[:, rank]
-        todo = np.flatnonzero(reached[np.arange(rows), k] & (failed != -1))
-        if not todo.size:
-            continue
-        k = k[todo]
-        trial = np.empty((todo.size, len(hr.hand.joint_names)))
-        for f, finger in enumerate(fingers):
-            trial[:, list(finger.joint_index)] = q[todo, _SHIFTS[k, f], f, : len(finger.joints)]
-        deep = violations(hr, trial)
-        depth[todo] = np.minimum(depth[todo], deep)
-        ok = deep <= 0
-        failed[todo[~ok]] = HAND_CONSTRAINTS.index("collision")
-        won = todo[ok]
-        failed[won], order[won], positions[won] = -1, _ORDERS[k[ok]], trial[ok]
+    ranked = np.argsort(np.where((error[pick] == 0).all(axis=-1), spread, np.inf), axis=1, kind="stable")
+    # the nearest assignment's pairs solved first: most candidates are held by it, and never need the rest
+    first = np.zeros((rows, 3, 3), bool)
+    first[np.arange(rows)[:, None], _SHIFTS[ranked[:, 0]], np.arange(3)] = True
+    _solve(hr, centre, unsolved & first, q, error)
+    failed = np.full(rows, HAND_CONSTRAINTS.index("fingertips"), np.int8)
+    failed[touches.any(axis=1)] = HAND_CONSTRAINTS.index("reach")
+    order = np.tile(np.arange(3), (rows, 1))
+    positions = np.full((rows, len(hr.hand.joint_names)), np.nan)
+    depth = np.full(rows, np.inf)
+    _assign(hr, q, error, ranked[:, :1], failed, order, positions, depth)
+    rest = (failed != -1) & touches.any(axis=1)  # then every pair of the rows still without one
+    _solve(hr, centre, unsolved & ~first & rest[:, None, None], q, error)
+    _assign(hr, q, error, np.where(rest[:, None], ranked[:, 1:], -1), failed, order, positions, depth)
+    worst = error[pick].max(axis=-1)  # (N, 6): 0 where every finger reaches
+    miss = np.where(touches.any(axis=1), worst.min(axis=1, initial=np.inf), np.nan)
     miss = np.where(failed == HAND_CONSTRAINTS.index("collision"), depth, miss)
     return Reached(failed, order, positions, np.where(failed == -1, np.nan, miss))
+
+
+def _solve(hand_reach, centre, todo, q, error):
+    """The fingers' inverse kinematics on the ``(N, 3, 3)`` pairs ``todo``, in one batch
+    (:func:`~grasptwist.engine.ik.fingers_ik`), into ``q`` (joint positions) and ``error`` (0 where
+    the finger reaches, else its tip's least distance)."""
+    row, shift, finger = np.nonzero(todo)
+    if row.size:
+        got, err, status = fingers_ik(
+            hand_reach.hand.fingers, hand_reach.tips, finger, centre[row, shift, finger], seeds=IK_RESTARTS
+        )
+        q[row, shift, finger, : got.shape[1]] = got
+        error[row, shift, finger] = np.where(status == Status.OK, 0.0, err)
+
+
+def _assign(hand_reach, q, error, ranked, failed, order, positions, depth):
+    """Of each row's assignments ``ranked`` (``(N, R)``, nearest first, -1: none), the first whose
+    fingers reach and whose hand is clear (:func:`violations`, one batch for them all) is kept: its
+    ``order`` and joint ``positions``, ``failed`` -1; a row whose reached ones all collide gets
+    ``failed`` ``collision`` and in ``depth`` the least of their violations."""
+    hr = hand_reach
+    row, rank = np.nonzero(ranked >= 0)
+    k = ranked[row, rank]
+    reached = (error[row[:, None], _SHIFTS[k], np.arange(3)] == 0).all(axis=1) & (failed[row] != -1)
+    row, rank, k = row[reached], rank[reached], k[reached]
+    if not row.size:
+        return
+    trial = np.empty((row.size, len(hr.hand.joint_names)))
+    for f, finger in enumerate(hr.hand.fingers):
+        trial[:, list(finger.joint_index)] = q[row, _SHIFTS[k, f], f, : len(finger.joints)]
+    deep = violations(hr, trial)
+    np.minimum.at(depth, row, deep)
+    failed[row] = HAND_CONSTRAINTS.index("collision")
+    ok = np.flatnonzero(deep <= 0)
+    # each row's first clear assignment: ``ok`` is in row-major order, nearest first within a row
+    ok = ok[np.unique(row[ok], return_index=True)[1]]
+    won = row[ok]
+    failed[won], order[won], positions[won] = -1, _ORDERS[k[ok]], trial[ok]
 
 
 def violations(hand_reach: HandReach, positions):
