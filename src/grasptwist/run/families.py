@@ -63,6 +63,7 @@ from .stream import twist_stream
 
 __all__ = [
     "Family",
+    "NOT_SIMULATED",
     "Contribution",
     "Command",
     "FAMILIES",
@@ -185,6 +186,9 @@ class Command:
     failed_words : str
         What the closing summary line says of its records that are not ok (and not an input that
         failed): ``3 records: 1 with a degenerate method``, ``2 records: 1 not held``.
+    apart : tuple of str
+        Kinds of its failed records counted in a clause of their own in the summary (``simulate``'s
+        ``not simulated``: ``3 records: 1 not held, 2 not simulated (2 no-mass), 0 inputs failed``).
     """
 
     name: str
@@ -197,6 +201,7 @@ class Command:
     contributions: tuple[Contribution, ...] = ()
     fixed: Mapping[str, Any] = field(default_factory=dict)
     failed_words: str = "with a degenerate method"
+    apart: tuple[str, ...] = ()
 
     def __post_init__(self):
         unknown = [f for f in self.formats if f not in FORMATS]
@@ -362,6 +367,10 @@ FAMILIES: tuple[Family, ...] = (TWIST, WRENCH, PATH, SYNTHESIS, SIMULATION)
 
 # -- commands -----------------------------------------------------------------
 
+#: ``simulate``'s summary word for grasps read but not simulated, counted by code apart from those not
+#: held (``3 records: 1 not held, 2 not simulated (2 no-mass), 0 inputs failed``).
+NOT_SIMULATED = "not simulated"
+
 
 def _resolve_records(block, job):
     return records(block, job.order)
@@ -451,6 +460,7 @@ COMMANDS: dict[str, Command] = {
             _simulate_records,
             "simulate_records.SimulateTable",
             failed_words="not held",
+            apart=(NOT_SIMULATED,),
         ),
     )
 }
