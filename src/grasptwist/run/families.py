@@ -58,12 +58,11 @@ from ..output.formats import FORMATS
 from ..output.json_rows import encode_records
 from ..output.records import basis_record, check_record, dumps, records, talking_rows
 from .batch import ZERO_TWIST, dataset_blocks, resolve
-from .options import FollowOptions, ForceOptions, SimulateOptions, SynthesisOptions, TwistOptions
+from .options import NOT_SIMULATED, FollowOptions, ForceOptions, SimulateOptions, SynthesisOptions, TwistOptions
 from .stream import twist_stream
 
 __all__ = [
     "Family",
-    "NOT_SIMULATED",
     "Contribution",
     "Command",
     "FAMILIES",
@@ -366,10 +365,6 @@ SIMULATION = Family(
 FAMILIES: tuple[Family, ...] = (TWIST, WRENCH, PATH, SYNTHESIS, SIMULATION)
 
 # -- commands -----------------------------------------------------------------
-
-#: ``simulate``'s summary word for grasps read but not simulated, counted by code apart from those not
-#: held (``3 records: 1 not held, 2 not simulated (2 no-mass), 0 inputs failed``).
-NOT_SIMULATED = "not simulated"
 
 
 def _resolve_records(block, job):

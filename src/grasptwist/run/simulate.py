@@ -30,8 +30,7 @@ from ..output.records import diagnostics, dumps, error_record
 from ..sim.hold import HoldTest, hold_test
 from ..sim.path import PathRun, run_path
 from ..sim.scene import Scene, build_scene
-from .families import NOT_SIMULATED
-from .options import SimulateOptions
+from .options import NOT_SIMULATED, SimulateOptions
 from .outputs import Output
 from .placement import read
 from .pool import Pool, pool_size
