@@ -10,6 +10,7 @@ import pytest
 
 from grasptwist.engine.hold_test import DIRECTIONS
 from grasptwist.engine.objects.geometry import mass_properties
+from grasptwist.output.simulate_records import simulate_record
 from grasptwist.run.options import SimulateOptions
 from grasptwist.run.placement import read
 from grasptwist.run.simulate import UNSTABLE, simulate_grasp
@@ -296,27 +297,28 @@ def test_soft_pads_hold_a_rod_by_their_torsion_which_mujoco_exerts_as_planned():
 
     grasp = read(str(ROD))[0]
     options = SimulateOptions(duration=0.1)
-    tests = []
-    for torsion in (grasp.torsion, None):  # the scene's contacts soft (condim 4), then points (condim 3)
+    for torsion in (grasp.torsion, None):  # the scene's contacts soft (condim 4), or points (condim 3)
         _, mu, _, load, com, scene, _ = _prepared(options, replace(grasp, torsion=torsion), None, hold=True)
-        tests.append(
-            hold_test(
-                scene,
-                grasp,
-                center_of_mass=com,
-                friction=mu,
-                load=load,
-                duration=0.1,
-                safety=1.25,
-                torsion=grasp.torsion,
-            )
-        )
-    soft, point = tests
+        model = load_model(scene)
+        tips = [model.geom(f"tip{f}").id for f in range(3)]
+        soft = torsion is not None  # the soft pads' MuJoCo friction (mu, mu e, 0), the point finger's (mu, 0, 0)
+        assert model.geom_condim[tips].tolist() == ([4, 4, 3] if soft else [3, 3, 3])
+        assert model.geom_friction[tips, :2].tolist() == [[0.5, 0.0025 if soft else 0]] * 2 + [[0.5, 0]]
+    sim = simulate_grasp(options, grasp)  # as the command runs it: the soft scene, the soft grip
+    soft = sim.test
     assert soft.held and max(math.degrees(d.rotation) for d in soft.directions) < 0.01  # 0.0006 deg at most
     for d in soft.directions[4:]:  # +z, -z: each pad's moment about its normal, 1.2 and 0.35 mN m
         assert d.torsion[:2] == pytest.approx(d.planned_torsion[:2], rel=0.06)  # MuJoCo's within 4%
         assert abs(d.planned_torsion[0]) > 3e-4 and d.torsion[2] == 0
     # the same torques with point contacts (MuJoCo's condim 3, as before soft contacts were simulated):
     # nothing resists the moment about the pads' line, and the rod turns (15 and 22 degrees in 0.1 s)
+    point = hold_test(
+        scene, grasp, center_of_mass=com, friction=mu, load=load, duration=0.1, safety=1.25, torsion=grasp.torsion
+    )
     assert [d.held for d in point.directions] == [True] * 4 + [False] * 2
     assert min(math.degrees(d.rotation) for d in point.directions[4:]) > 5
+    # the record says what was simulated
+    rec = simulate_record(sim)
+    assert rec["contact_model"] == "soft" and rec["torsion"] == [0.005, 0.005, 0.0] and rec["scene"] is None
+    up = rec["directions"][4]
+    assert up["contact_torsion"] == soft.directions[4].torsion.tolist() and len(up["planned_torsion"]) == 3
