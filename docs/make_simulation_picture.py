@@ -2,7 +2,7 @@
 
 The TriFinger Pro holding the 65 mm cube (``grasps/trifinger-cube.yaml``, 94 g, ``mu = 1``) on its
 table at the end of each of the six directions of the hold test, the load drawn as a red arrow
-through the cube's centre; rendered offscreen by MuJoCo (``MUJOCO_GL=egl``; Debian's
+through the cube's centre on the camera's side (onto the near face where the load points away); rendered offscreen by MuJoCo (``MUJOCO_GL=egl``; Debian's
 libgl1-mesa-dri where there is no GPU) and tiled by matplotlib.
 
     MUJOCO_GL=egl .venv/bin/python docs/make_simulation_picture.py
@@ -33,17 +33,25 @@ def main():
     renderer = {}
 
     def observe(name, model, data):
-        if "r" not in renderer:
-            renderer["r"] = mujoco.Renderer(model, 360, 360)
-        r = renderer["r"]
         camera = mujoco.MjvCamera()
         camera.lookat[:] = [0, 0, 0.04]
         camera.distance, camera.azimuth, camera.elevation = 0.38, 150, -30
+        if "r" not in renderer:
+            renderer["r"] = mujoco.Renderer(model, 360, 360)
+            # a first frame drawn and dropped: the first (mesa's EGL) has stripes of shadow across the sky
+            renderer["r"].update_scene(data, camera)
+            renderer["r"].render()
+        r = renderer["r"]
         r.update_scene(data, camera)
         centre = data.xpos[model.body("object").id]
         arrow = r.scene.geoms[r.scene.ngeom]
         u = UNITS[DIRECTIONS.index(name)]
-        start, tip = centre + 0.035 * u, centre + 0.1 * u  # from the cube's face outwards
+        # on the camera's side of the cube: from its face outwards, or, where that side faces away
+        # (-x, +y, -z: the cube or the table would hide it), pushing onto the near face
+        eye = r.scene.camera[0].pos
+        start, tip = centre + 0.035 * u, centre + 0.1 * u
+        if np.dot(u, eye - centre) < 0:
+            start, tip = centre - 0.1 * u, centre - 0.035 * u
         mujoco.mjv_initGeom(arrow, mujoco.mjtGeom.mjGEOM_ARROW, np.zeros(3), np.zeros(3), np.zeros(9), [1, 0, 0, 1])
         mujoco.mjv_connector(arrow, mujoco.mjtGeom.mjGEOM_ARROW, 0.006, start, tip)
         r.scene.ngeom += 1

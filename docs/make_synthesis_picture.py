@@ -46,7 +46,7 @@ def found_grasp(folder):
 def main():
     with tempfile.TemporaryDirectory() as folder:
         grasp = found_grasp(folder)
-        *_, scene = _prepared(SimulateOptions(mass=MASS, friction=MU), grasp, None, hold=True)
+        *_, scene, _ = _prepared(SimulateOptions(mass=MASS, friction=MU), grasp, None, hold=True)
     model = load_model(scene)
     data = mujoco.MjData(model)
     data.qpos[[model.jnt_qposadr[model.joint(j).id] for j in scene.joints]] = scene.positions

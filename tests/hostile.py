@@ -25,6 +25,7 @@ NULLABLE |= {"joint_positions", "reach_error"}  # a grasp synthesized without a 
 NULLABLE |= {"edge_distance"}  # a contact on a smooth object (no crease)
 NULLABLE |= {"clearance"}  # a grasp synthesized without an environment
 NULLABLE |= {"simulation"}  # a grasp synthesized without --simulate
+NULLABLE |= {"torsion", "contact_torsion", "planned_torsion", "scene"}  # simulate: point contacts, no --mjcf
 
 
 def run(*args, input=None):

@@ -10,6 +10,7 @@ import sys
 import numpy as np
 import pytest
 
+from grasptwist.output.simulate_records import SIMULATE_COLUMNS, csv_line
 from hostile import jsonl, run
 from places import GRASPS
 
@@ -39,28 +40,49 @@ def test_a_grasp_without_a_grip_does_not_hold_and_says_so_on_stderr():
     assert "no grip holds the load along +x, -x, +y, -y, +z, -z: not simulated there" in r.stderr
     # simulate's own words in the closing line (its Command's), not "with a degenerate method"
     assert r.stderr.splitlines()[-1] == "1 record: 1 not held, 0 inputs failed"
+    # the table: each direction's row in its columns, what was not simulated said across the rest
+    table, _ = run("simulate", CUBE, "--mass", "0.094", "--friction", "0.5", *SHORT)
+    rows = table.stdout.splitlines()[2:]
+    assert rows == [f"  {d:<9}  no    not simulated (grip: cannot-hold)" for d in ("+x", "-x", "+y", "-y", "+z", "-z")]
 
 
 def test_csv_and_the_table(tmp_path):
-    r, _ = run("simulate", CUBE, "--mass", "0.094", "--friction", "1", *SHORT, "-f", "csv")
+    from grasptwist.output.simulate_records import SimulateTable
+
+    # one simulation, its record in both (the command line's -f csv and table: the --mjcf test and the
+    # grip test below)
+    r, _ = run("simulate", CUBE, "--mass", "0.094", "--friction", "1", *SHORT, "-f", "jsonl")
     assert r.exit_code == 0, r.stderr
-    (row,) = csv.DictReader(io.StringIO(r.stdout))
+    (rec,) = jsonl(r.stdout)
+    (row,) = csv.DictReader(io.StringIO((SIMULATE_COLUMNS.header() + csv_line(rec)).decode()))
     assert row["held"] == "true" and row["held_mz"] == "true" and float(row["displacement_px"]) < 5e-4
-    table, _ = run("simulate", CUBE, "--mass", "0.094", "--friction", "1", *SHORT)
-    assert table.exit_code == 0 and "grasp 'trifinger-cube': held" in table.stdout
-    assert table.stdout.count(" yes ") == 6
+    out = io.BytesIO()
+    SimulateTable(out).write(rec)
+    table = out.getvalue().decode()
+    assert "grasp 'trifinger-cube': held" in table and table.count(" yes ") == 6
 
 
 def test_mjcf_writes_the_scene_mujoco_reads_back(tmp_path):
     mujoco = pytest.importorskip("mujoco")
     out = tmp_path / "scene.xml"
-    r, _ = run(
-        "simulate", GRASPS / "sphere.yaml", "--mass", "0.1", "--friction", "0.8", *SHORT, "--mjcf", out, "-f", "jsonl"
-    )
-    assert r.exit_code in (0, 1), r.stderr
-    for path in (out, tmp_path / "scene-2.xml"):  # one file per grasp: sphere-tripod, sphere-equator
-        model = mujoco.MjModel.from_xml_path(str(path))
+    # the handle has no object (no scene): the sphere's two grasps' scenes are scene.xml and scene-2.xml
+    inputs = (GRASPS / "handle.yaml", SPHERE)
+    r, _ = run("simulate", *inputs, "--mass", "0.1", "--friction", "0.8", *SHORT, "--mjcf", out, "-f", "jsonl")
+    assert r.exit_code == 1, r.stderr
+    records = jsonl(r.stdout)
+    assert [rec["scene"] for rec in records] == [None, str(out), str(tmp_path / "scene-2.xml")]
+    assert sorted(p.name for p in tmp_path.glob("*.xml")) == ["scene-2.xml", "scene.xml"]
+    for rec in records[1:]:  # one file per grasp: sphere-tripod, sphere-equator
+        model = mujoco.MjModel.from_xml_path(rec["scene"])
         assert model.body("object").id > 0 and model.ngeom == 4  # the ball, its three tips, no table
+        assert model.names.decode().split("\0")[0] == rec["grasp"]  # the scene's model is its grasp
+    # and in CSV, the last column
+    r, _ = run("simulate", *inputs, "--mass", "0.1", "--friction", "0.8", *SHORT, "--mjcf", out, "-f", "csv")
+    assert [row["scene"] for row in csv.DictReader(io.StringIO(r.stdout))] == [
+        "",
+        str(out),
+        str(tmp_path / "scene-2.xml"),
+    ]
 
 
 @pytest.mark.parametrize(
@@ -75,7 +97,12 @@ def test_a_grasp_it_cannot_simulate_is_an_error_record(args, code):
     assert r.exit_code == 1
     (rec,) = jsonl(r.stdout)
     assert rec["error"]["code"] == code and rec["error"]["line"] == 17
+    assert rec["grasp"] == "trifinger-cube" and rec["scene"] is None  # read: its name, as stderr says it
     assert f"trifinger-cube.yaml:17: error: {code}: grasp 'trifinger-cube'" in r.stderr
+    # read but not simulated, by code: not "0 not held, 1 input failed"
+    assert r.stderr.splitlines()[-1] == f"1 record: 0 not held, 1 not simulated (1 {code}), 0 inputs failed"
+    (row,) = csv.DictReader(io.StringIO((SIMULATE_COLUMNS.header() + csv_line(rec)).decode()))
+    assert row["grasp"] == "trifinger-cube" and row["error"].startswith(f"{code}: ")
 
 
 def test_a_grasp_without_an_object_is_an_error_record(tmp_path):
@@ -84,8 +111,11 @@ def test_a_grasp_without_an_object_is_an_error_record(tmp_path):
         "contacts:\n  - {point: [1, 0, 0], normal: [-1, 0, 0]}\n  - {point: [-1, 0, 0], normal: [1, 0, 0]}\n"
         "  - {point: [0, 1, 0], normal: [0, -1, 0]}\nfriction: 0.5\nmass: 1\ncenter_of_mass: [0, 0, 0]\n"
     )
-    r, _ = run("simulate", bare, "-f", "jsonl")
+    r, _ = run("simulate", bare, tmp_path / "missing.yaml", "-f", "jsonl")
     assert r.exit_code == 1 and jsonl(r.stdout)[0]["error"]["code"] == "no-object"
+    # a grasp read but not simulated, and an input that could not be read (no grasp to name)
+    assert jsonl(r.stdout)[0]["grasp"] == "bare" and "grasp" not in jsonl(r.stdout)[1]
+    assert r.stderr.splitlines()[-1] == "2 records: 0 not held, 1 not simulated (1 no-object), 1 input failed"
 
 
 @pytest.mark.parametrize(

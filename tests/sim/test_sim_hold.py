@@ -10,12 +10,13 @@ import pytest
 
 from grasptwist.engine.hold_test import DIRECTIONS
 from grasptwist.engine.objects.geometry import mass_properties
+from grasptwist.output.simulate_records import simulate_record
 from grasptwist.run.options import SimulateOptions
 from grasptwist.run.placement import read
 from grasptwist.run.simulate import UNSTABLE, simulate_grasp
 from grasptwist.sim.hold import hold_test, load_model
 from grasptwist.sim.scene import build_scene
-from places import GRASPS
+from places import GRASPS, TESTS
 
 SHORT = 0.2  # seconds of simulated time per direction: the default run's tests stay short
 
@@ -218,7 +219,7 @@ def test_the_trifinger_cube_holds_on_its_table_as_without_one():
     on, off = (
         hold_test(scene, g, center_of_mass=com, friction=mu, load=load, duration=SHORT, safety=1.0, squeeze=0.0)
         for g in (grasp, replace(grasp, environment=None))
-        for _, mu, _, load, com, scene in [_prepared(options, g, None, hold=True)]
+        for _, mu, _, load, com, scene, _ in [_prepared(options, g, None, hold=True)]
     )
     assert [d.held for d in on.directions] == [d.held for d in off.directions] and not on.held
     moved = [[d.displacement for d in t.directions] for t in (on, off)]
@@ -259,7 +260,7 @@ def test_a_grasp_files_environment_is_the_scenes_table_and_boxes_and_table_repla
     (tmp_path / "g.yaml").write_text(text.rstrip() + "\n" + env, "utf-8")
     grasp = read(str(tmp_path / "g.yaml"))[0]
     for table, height in ((None, -0.05), (-0.07, -0.07)):
-        *_, scene = _prepared(SimulateOptions(mass=0.1, friction=0.8, table=table), grasp, None, hold=True)
+        *_, scene, _ = _prepared(SimulateOptions(mass=0.1, friction=0.8, table=table), grasp, None, hold=True)
         model = load_model(scene)
         assert model.geom_pos[model.geom("table").id][2] == pytest.approx(height, abs=1e-15)
         np.testing.assert_allclose(model.geom_pos[model.geom("box0").id], [0.2, 0, 0])
@@ -284,3 +285,40 @@ def test_held_only_keeps_the_grasps_that_hold_within_the_tolerance_and_counts_th
         assert test.held and max(d.displacement for d in test.directions) < 2e-4
     kept, dropped = held_only(found, SimulateOptions(duration=0.1, distance_tol=2e-5))
     assert (len(kept), dropped, kept.synthesis.failure.constraint) == (0, 4, SIMULATED)
+
+
+# A rod pinched at its ends by two soft pads on a line 5 mm beside its centre, a third finger below that
+# line: held along +z or -z, its weight's moment about the pads' line is the pads' torsion alone.
+ROD = TESTS / "sim" / "soft-rod.yaml"
+
+
+def test_soft_pads_hold_a_rod_by_their_torsion_which_mujoco_exerts_as_planned():
+    from grasptwist.run.simulate import _prepared
+
+    grasp = read(str(ROD))[0]
+    options = SimulateOptions(duration=0.1)
+    for torsion in (grasp.torsion, None):  # the scene's contacts soft (condim 4), or points (condim 3)
+        _, mu, _, load, com, scene, _ = _prepared(options, replace(grasp, torsion=torsion), None, hold=True)
+        model = load_model(scene)
+        tips = [model.geom(f"tip{f}").id for f in range(3)]
+        soft = torsion is not None  # the soft pads' MuJoCo friction (mu, mu e, 0), the point finger's (mu, 0, 0)
+        assert model.geom_condim[tips].tolist() == ([4, 4, 3] if soft else [3, 3, 3])
+        assert model.geom_friction[tips, :2].tolist() == [[0.5, 0.0025 if soft else 0]] * 2 + [[0.5, 0]]
+    sim = simulate_grasp(options, grasp)  # as the command runs it: the soft scene, the soft grip
+    soft = sim.test
+    assert soft.held and max(math.degrees(d.rotation) for d in soft.directions) < 0.01  # 0.0006 deg at most
+    for d in soft.directions[4:]:  # +z, -z: each pad's moment about its normal, 1.2 and 0.35 mN m
+        assert d.torsion[:2] == pytest.approx(d.planned_torsion[:2], rel=0.06)  # MuJoCo's within 4%
+        assert abs(d.planned_torsion[0]) > 3e-4 and d.torsion[2] == 0
+    # the same torques with point contacts (MuJoCo's condim 3, as before soft contacts were simulated):
+    # nothing resists the moment about the pads' line, and the rod turns (15 and 22 degrees in 0.1 s)
+    point = hold_test(
+        scene, grasp, center_of_mass=com, friction=mu, load=load, duration=0.1, safety=1.25, torsion=grasp.torsion
+    )
+    assert [d.held for d in point.directions] == [True] * 4 + [False] * 2
+    assert min(math.degrees(d.rotation) for d in point.directions[4:]) > 5
+    # the record says what was simulated
+    rec = simulate_record(sim)
+    assert rec["contact_model"] == "soft" and rec["torsion"] == [0.005, 0.005, 0.0] and rec["scene"] is None
+    up = rec["directions"][4]
+    assert up["contact_torsion"] == soft.directions[4].torsion.tolist() and len(up["planned_torsion"]) == 3

@@ -66,8 +66,8 @@ class Diagnostics:
     :data:`WARNINGS_SHOWN` of each, then one line counting the rest by kind
     or code); ``-q`` drops warnings, the table hint and the summary.
     ``hint`` is the line said once when a table passes :data:`TABLE_HINT_AT`
-    records; ``failed_words`` what the summary says of the records not ok (the command's,
-    :class:`~grasptwist.run.families.Command`).
+    records; ``failed_words`` what the summary says of the records not ok, ``apart`` the kinds
+    of them counted on their own (the command's, :class:`~grasptwist.run.families.Command`).
     """
 
     def __init__(
@@ -76,6 +76,7 @@ class Diagnostics:
         warnings: Warnings = Warnings.summary,
         hint: str | None = None,
         failed_words: str = "with a degenerate method",
+        apart: tuple[str, ...] = (),
     ):
         self.failed = 0  # records not ok
         self.inputs_failed = 0  # of ``failed``: inputs that could not be read
@@ -90,6 +91,7 @@ class Diagnostics:
         self.hint = None if quiet else hint
         self.color = _stderr_is_terminal() and not os.environ.get("NO_COLOR")
         self.failed_words = failed_words
+        self.apart = apart
 
     def take(self, out) -> None:
         """Count a pipeline Output and print its lines."""
@@ -144,18 +146,29 @@ class Diagnostics:
             to_stderr(_not_shown(self.unshown, "warning"))
         to_stderr(
             summary_line(
-                self.records, self.failed - self.inputs_failed, self.inputs_failed, self.degenerate, self.failed_words
+                self.records,
+                self.failed - self.inputs_failed,
+                self.inputs_failed,
+                self.degenerate,
+                self.failed_words,
+                self.apart,
             )
         )
 
 
 def summary_line(
-    records: int, degenerate: int = 0, inputs_failed: int = 0, codes=None, words: str = "with a degenerate method"
+    records: int,
+    degenerate: int = 0,
+    inputs_failed: int = 0,
+    codes=None,
+    words: str = "with a degenerate method",
+    apart: tuple[str, ...] = (),
 ) -> str:
     """The closing line: how many records were written, how many of them hold a degenerate
     method (a grasp, or a data set's row, that was read: the other methods' results are there;
     ``words`` say it, a command's own: ``not held``) and by which codes, and how many inputs
-    could not be read (each one record).
+    could not be read (each one record).  The codes of a kind in ``apart`` are a clause of their
+    own, ``N kind (codes)``, and not among ``words``' (``simulate``'s grasps read but not simulated).
 
     >>> summary_line(1), summary_line(4, 0, 1)
     ('1 record: all ok', '4 records: 0 with a degenerate method, 1 input failed')
@@ -163,16 +176,21 @@ def summary_line(
     '3 records: 3 with a degenerate method (tangent: 2 normals-rank-deficient, 1 theta-not-unique), 0 inputs failed'
     >>> summary_line(2, 1, 0, words="not held")
     '2 records: 1 not held, 0 inputs failed'
+    >>> summary_line(3, 3, 0, {("not simulated", "no-mass"): 2}, "not held", apart=("not simulated",))
+    '3 records: 1 not held, 2 not simulated (2 no-mass), 0 inputs failed'
     """
     line = f"{records} record{'' if records == 1 else 's'}: "
     if not degenerate and not inputs_failed:
         return line + "all ok"
-    line += f"{degenerate} {words}"
     kinds: dict[str, list[str]] = {}
     for (kind, code), n in sorted((codes or {}).items(), key=lambda kv: (-kv[1], kv[0])):
         kinds.setdefault(kind, []).append(f"{n} {code}")
-    if kinds:
-        line += " (" + "; ".join(f"{kind}: {', '.join(counts)}" for kind, counts in kinds.items()) + ")"
+    own = {kind: sum(n for (k, _), n in (codes or {}).items() if k == kind) for kind in apart if kind in kinds}
+    line += f"{degenerate - sum(own.values())} {words}"
+    if shared := {kind: counts for kind, counts in kinds.items() if kind not in own}:
+        line += " (" + "; ".join(f"{kind}: {', '.join(counts)}" for kind, counts in shared.items()) + ")"
+    for kind, n in own.items():
+        line += f", {n} {kind} ({', '.join(kinds[kind])})"
     return line + f", {inputs_failed} input{'' if inputs_failed == 1 else 's'} failed"
 
 

@@ -41,7 +41,9 @@ def write_records(job, paths: list[str], settings: OutputSettings) -> int:
 
     counted = job.family.tells_progress
     hint = table_hint(job.command.formats) if job.fmt == "table" and counted else None
-    stderr = Diagnostics(settings.quiet, settings.warnings, hint=hint, failed_words=job.command.failed_words)
+    stderr = Diagnostics(
+        settings.quiet, settings.warnings, hint=hint, failed_words=job.command.failed_words, apart=job.command.apart
+    )
     inputs = list(expand(paths, job.family.suffixes))
     fmt = FORMATS[job.fmt]
     replaced = replaced_file(settings.output)

@@ -122,7 +122,8 @@ def simulate(
         typer.Option(
             "--mjcf",
             metavar="OUT.xml",
-            help="Write the scene (MJCF, its meshes beside it) for MuJoCo's viewer; OUT-2.xml, ... for the next grasps.",
+            help="Write the scene (MJCF, its meshes beside it) for MuJoCo's viewer; OUT-2.xml, ... for the next "
+            "scenes written (each record's scene names its file).",
         ),
     ] = None,
     fmt: Annotated[

@@ -151,10 +151,12 @@ def squeezed(points, normals, forces, friction, floor) -> np.ndarray:
     return f + np.where(np.isnan(unit), 0.0, scale * unit)
 
 
-def joint_torques(hand, positions, points, forces) -> np.ndarray:
-    r"""The joint torques by which each finger exerts its force at its contact: ``tau = J^T f``.
+def joint_torques(hand, positions, points, forces, moments=None) -> np.ndarray:
+    r"""The joint torques by which each finger exerts its force at its contact, and its moment
+    (a soft contact's torsion ``tau_n n``): ``tau = J^T (f; m)``, ``J`` the finger's twist Jacobian at
+    the contact.
 
-    .. math:: \tau_f = J_f(q)^\top f_f, \qquad J_f = [\,v_j + \omega_j \times p_f\,]_j
+    .. math:: \tau_{f,j} = (v_j + \omega_j \times p_f) \cdot f_f + \omega_j \cdot m_f
 
     Parameters
     ----------
@@ -166,6 +168,9 @@ def joint_torques(hand, positions, points, forces) -> np.ndarray:
         The contacts, row ``f`` touched by finger ``f``.
     forces : (..., 3, 3) array
         Row ``f`` the force finger ``f`` exerts on the object.
+    moments : (..., 3, 3) array or None
+        Row ``f`` the moment finger ``f`` exerts on the object (None: none).  Without a hand the
+        fingertips cannot turn (three slides each): the slides' structure bears it, no torque.
 
     Returns
     -------
@@ -179,14 +184,24 @@ def joint_torques(hand, positions, points, forces) -> np.ndarray:
     >>> f = Finger("1", None, (Joint("x", "prismatic", None, None, None, None),), np.array([[0, 0, 0, 1.0, 0, 0]]), np.zeros((1, 3)), None, 1.0, (0,))
     >>> joint_torques(Hand((f, f, f), ("x",), None, None), [0.0], np.zeros((3, 3)), [[2.0, 1, 0], [0] * 3, [0] * 3]).tolist()
     [2.0]
+
+    A fingertip on a hinge about z through the origin, turning the object about z with 0.5 N m: the
+    hinge carries it.
+
+    >>> f = Finger("1", None, (Joint("z", "revolute", None, None, None, None),), np.array([[0, 0, 1.0, 0, 0, 0]]), np.zeros((1, 3)), None, 1.0, (0,))
+    >>> joint_torques(Hand((f, f, f), ("z",), None, None), [0.0], np.zeros((3, 3)), np.zeros((3, 3)), [[0, 0, 0.5], [0] * 3, [0] * 3]).tolist()
+    [0.5]
     """
     forces = np.asarray(forces, dtype=float)
+    moments = None if moments is None else np.asarray(moments, dtype=float)
     if hand is None:
         return forces.reshape(forces.shape[:-2] + (9,))
     out = np.zeros(forces.shape[:-2] + (len(hand.joint_names),))
     for f, (finger, state) in enumerate(zip(hand.fingers, finger_states(hand, np.asarray(positions, float)))):
         jac = finger_jacobian(state.screws, np.asarray(points, float)[f])
         out[..., list(finger.joint_index)] += np.einsum("ij,...i->...j", jac, forces[..., f, :])
+        if moments is not None:
+            out[..., list(finger.joint_index)] += np.einsum("ji,...i->...j", state.screws[:, :3], moments[..., f, :])
     return out
 
 

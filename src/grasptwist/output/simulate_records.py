@@ -3,23 +3,30 @@
 One record per grasp (:class:`grasptwist.run.simulate.Simulated`)::
 
     {"file", "grasp", "ok" (= held), "held", "mass", "load", "friction": [3], "duration",
-     "tolerance": {"distance", "angle_deg"}, "safety",
+     "tolerance": {"distance", "angle_deg"}, "safety", "contact_model", "torsion": [3] or null, "scene",
      "directions": [{"direction": "+x", "held", "simulated", "grip": "ok" or its status code,
                      "displacement", "rotation_deg",
-                     "contact_forces": [[3] x 3], "planned_forces": [[3] x 3]}, x 6],
+                     "contact_forces": [[3] x 3], "planned_forces": [[3] x 3],
+                     "contact_torsion": [3] or null, "planned_torsion": [3] or null}, x 6],
      "warnings": [...]}
+
+A grasp read but not simulated (no object, mass or friction, ...) is an error record with its
+``grasp`` and ``scene`` (:func:`not_simulated_record`).
 
 With ``--path NAME`` a record per grasp says how its path went instead::
 
     {"file", "grasp", "ok" (= followed), "path", "followed", "mass", "friction", "tolerance",
-     "safety", "final": {"position_error", "angle_error_deg"},
+     "safety", "contact_model", "torsion", "scene", "final": {"position_error", "angle_error_deg"},
      "samples": [{"time", "position_error", "angle_error_deg", "slip": [3], "slipped": [3]}, ...],
      "warnings": [...]}
 
 ``displacement`` is the object's centre's distance from where it started (length units),
 ``rotation_deg`` the angle it turned, at the end of the direction's ``duration``;
 ``contact_forces`` each finger's force on the object in MuJoCo then, ``planned_forces``
-grasptwist's grip with the hold test's squeeze (null, with the grip's status, where none exists: not simulated).  A
+grasptwist's grip with the hold test's squeeze (null, with the grip's status, where none exists: not
+simulated); with soft contacts (``contact_model`` ``soft``, ``torsion`` each contact's radius ``e``)
+``contact_torsion`` and ``planned_torsion`` each contact's moment about its normal, in MuJoCo and
+planned (null with point contacts); ``scene`` the MJCF file of its scene (``--mjcf``; null without).  A
 warning names the directions that did not hold.  Nothing is computed here.
 """
 
@@ -38,7 +45,7 @@ from .csv_rows import lines
 from .names import escaped
 from .numbers import fmt_number
 
-__all__ = ["simulate_record", "csv_line", "SIMULATE_COLUMNS", "SimulateTable"]
+__all__ = ["simulate_record", "not_simulated_record", "csv_line", "SIMULATE_COLUMNS", "SimulateTable"]
 
 
 def _float(v):
@@ -46,7 +53,29 @@ def _float(v):
 
 
 def _forces(f):
-    return None if not np.isfinite(f).all() else np.asarray(f, float).tolist()
+    return None if f is None or not np.isfinite(f).all() else np.asarray(f, float).tolist()
+
+
+def _contacts(sim) -> dict:
+    """The contact model simulated, each contact's torsional radius (null: point contacts) and the scene's file."""
+    e = sim.grasp.torsion
+    soft = e is not None and bool(np.any(e > 0))
+    return {
+        "contact_model": "soft" if soft else "point",
+        "torsion": np.asarray(e, float).tolist() if soft else None,
+        "scene": None if sim.scene is None else escaped(sim.scene, controls=False),
+    }
+
+
+def not_simulated_record(rec: dict, grasp: str, scene: str | None) -> dict:
+    """The error record ``rec`` of a grasp read but not simulated, with its ``grasp`` (after ``file``) and
+    ``scene`` (the MJCF file written before it failed, or null).
+
+    >>> not_simulated_record({"file": "a.yaml", "ok": False, "error": {}, "errors": []}, "g", None)
+    {'file': 'a.yaml', 'grasp': 'g', 'ok': False, 'error': {}, 'errors': [], 'scene': None}
+    """
+    named = {"file": rec["file"], "grasp": escaped(grasp, controls=False)}
+    return {**named, **rec, "scene": None if scene is None else escaped(scene, controls=False)}
 
 
 def _direction(d) -> dict:
@@ -59,6 +88,8 @@ def _direction(d) -> dict:
         "rotation_deg": _float(math.degrees(d.rotation)),
         "contact_forces": _forces(d.forces),
         "planned_forces": _forces(d.planned),
+        "contact_torsion": _forces(d.torsion),
+        "planned_torsion": _forces(d.planned_torsion),
     }
 
 
@@ -106,6 +137,7 @@ def _path_record(ps) -> dict:
         "friction": ps.friction.tolist(),
         "tolerance": {"distance": o.distance_tol, "angle_deg": o.angle_tol},
         "safety": o.safety,
+        **_contacts(ps),
         "final": {"position_error": float(r.position_error[-1]), "angle_error_deg": float(angles[-1])},
         "samples": [
             {
@@ -137,6 +169,7 @@ def simulate_record(sim) -> dict:
         "duration": o.duration,
         "tolerance": {"distance": o.distance_tol, "angle_deg": o.angle_tol},
         "safety": o.safety,
+        **_contacts(sim),
         "directions": [_direction(d) for d in sim.test.directions],
         "warnings": _warnings(sim),
     }
@@ -146,16 +179,17 @@ def simulate_record(sim) -> dict:
 _SAFE = {d: ("p" if d[0] == "+" else "m") + d[1] for d in DIRECTIONS}
 _OWN = ("file", "grasp", "ok", "error", "held", "mass", "load")
 _PER = ("held", "displacement", "rotation_deg")
-_COLUMNS = _OWN + tuple(f"{c}_{_SAFE[d]}" for d in DIRECTIONS for c in _PER)
+_COLUMNS = _OWN + tuple(f"{c}_{_SAFE[d]}" for d in DIRECTIONS for c in _PER) + ("scene",)
 
 
 def _cells(rec: dict) -> dict:
     row = dict.fromkeys(_COLUMNS)
     if "error" in rec:
         err = rec["error"]
-        row.update(file=rec["file"], ok=False, error=f"{err['code']}: {err['message']}")
+        row.update(file=rec["file"], grasp=rec.get("grasp"), scene=rec.get("scene"), ok=False)
+        row.update(error=f"{err['code']}: {err['message']}")
         return row
-    row.update({c: rec[c] for c in ("file", "grasp", "ok", "held", "mass", "load")})
+    row.update({c: rec[c] for c in ("file", "grasp", "ok", "held", "mass", "load", "scene")})
     for d in rec["directions"]:
         row.update({f"{c}_{_SAFE[d['direction']]}": d[c] for c in _PER})
     return row
@@ -168,7 +202,11 @@ def _flat(records, order="omega-v", hand=None, typed=False) -> dict:
     for c in _COLUMNS:
         values = [row[c] for row in cells]
         missing = [v is None for v in values]
-        kind = bool if c == "ok" or c.startswith("held") else (object if c in ("file", "grasp", "error") else float)
+        kind = (
+            bool
+            if c == "ok" or c.startswith("held")
+            else (object if c in ("file", "grasp", "error", "scene") else float)
+        )
         filled = [(kind() if kind is not object else "") if m else v for v, m in zip(values, missing)]
         columns[c] = np.ma.masked_array(np.array(filled, dtype=kind), mask=missing)
     return columns
@@ -177,7 +215,7 @@ def _flat(records, order="omega-v", hand=None, typed=False) -> dict:
 def csv_line(rec: dict) -> bytes:
     """The CSV line of one grasp's record, or of an input that failed: the verdict, and per direction
     whether it held and how far the object moved and turned (``held_px``, ``displacement_px``,
-    ``rotation_deg_px``, ...: ``px`` is ``+x``, ``mx`` is ``-x``)."""
+    ``rotation_deg_px``, ...: ``px`` is ``+x``, ``mx`` is ``-x``), and its ``scene``'s file (``--mjcf``)."""
     return lines(_flat([rec]))[0]
 
 
@@ -251,7 +289,10 @@ class SimulateTable:
         )
         self._line("  direction  held  moved       turned (deg)  |f| MuJoCo (each finger)  |f| planned")
         for d in rec["directions"]:
-            held = "yes" if d["held"] else ("no" if d["simulated"] else d["grip"])
+            held = "yes" if d["held"] else "no"
+            if not d["simulated"]:  # no grip: what it is, across the columns of what was not simulated
+                self._line(f"  {d['direction']:<9}  {held:<4}  not simulated (grip: {d['grip']})")
+                continue
             self._line(
                 f"  {d['direction']:<9}  {held:<4}  {_small(d['displacement']):<10}  "
                 f"{_small(d['rotation_deg']):<12}  {self._norms(d['contact_forces']):<24}  "

@@ -58,7 +58,7 @@ from ..output.formats import FORMATS
 from ..output.json_rows import encode_records
 from ..output.records import basis_record, check_record, dumps, records, talking_rows
 from .batch import ZERO_TWIST, dataset_blocks, resolve
-from .options import FollowOptions, ForceOptions, SimulateOptions, SynthesisOptions, TwistOptions
+from .options import NOT_SIMULATED, FollowOptions, ForceOptions, SimulateOptions, SynthesisOptions, TwistOptions
 from .stream import twist_stream
 
 __all__ = [
@@ -185,6 +185,9 @@ class Command:
     failed_words : str
         What the closing summary line says of its records that are not ok (and not an input that
         failed): ``3 records: 1 with a degenerate method``, ``2 records: 1 not held``.
+    apart : tuple of str
+        Kinds of its failed records counted in a clause of their own in the summary (``simulate``'s
+        ``not simulated``: ``3 records: 1 not held, 2 not simulated (2 no-mass), 0 inputs failed``).
     """
 
     name: str
@@ -197,6 +200,7 @@ class Command:
     contributions: tuple[Contribution, ...] = ()
     fixed: Mapping[str, Any] = field(default_factory=dict)
     failed_words: str = "with a degenerate method"
+    apart: tuple[str, ...] = ()
 
     def __post_init__(self):
         unknown = [f for f in self.formats if f not in FORMATS]
@@ -451,6 +455,7 @@ COMMANDS: dict[str, Command] = {
             _simulate_records,
             "simulate_records.SimulateTable",
             failed_words="not held",
+            apart=(NOT_SIMULATED,),
         ),
     )
 }

@@ -10,7 +10,7 @@ from dataclasses import dataclass
 
 from ..model import Twist, Wrench
 
-__all__ = ["TwistOptions", "ForceOptions", "FollowOptions", "SynthesisOptions", "SimulateOptions"]
+__all__ = ["TwistOptions", "ForceOptions", "FollowOptions", "SynthesisOptions", "SimulateOptions", "NOT_SIMULATED"]
 
 
 def _count(given) -> int:
@@ -142,6 +142,11 @@ class SynthesisOptions:
 
         check_mass(self.mass)
         check_tip_radius(self.tip_radius)
+
+
+#: ``simulate``'s summary word for grasps read but not simulated, counted by code apart from those not
+#: held (``3 records: 1 not held, 2 not simulated (2 no-mass), 0 inputs failed``).
+NOT_SIMULATED = "not simulated"
 
 
 @dataclass(frozen=True)

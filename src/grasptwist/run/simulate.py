@@ -15,7 +15,7 @@ from __future__ import annotations
 import itertools
 import math
 import os
-from collections.abc import Iterable, Iterator
+from collections.abc import Callable, Iterable, Iterator
 from dataclasses import dataclass, replace
 
 import numpy as np
@@ -30,7 +30,7 @@ from ..output.records import diagnostics, dumps, error_record
 from ..sim.hold import HoldTest, hold_test
 from ..sim.path import PathRun, run_path
 from ..sim.scene import Scene, build_scene
-from .options import SimulateOptions
+from .options import NOT_SIMULATED, SimulateOptions
 from .outputs import Output
 from .placement import read
 from .pool import Pool, pool_size
@@ -38,6 +38,7 @@ from .pool import Pool, pool_size
 __all__ = [
     "Simulated",
     "PathSimulated",
+    "NotSimulated",
     "simulate_grasp",
     "simulate_path",
     "simulate_inputs",
@@ -83,6 +84,17 @@ class Simulated:
     friction: np.ndarray
     test: HoldTest
     options: SimulateOptions
+    scene: str | None = None  # the MJCF file its scene was written to (--mjcf)
+
+
+@dataclass(frozen=True, eq=False)
+class NotSimulated:
+    """A grasp that was read but could not be simulated: the grasp, why, and its scene's file if one
+    was written before it failed (a simulation that diverged)."""
+
+    grasp: Grasp
+    error: InputError
+    scene: str | None = None
 
 
 def _problem(grasp: Grasp, code: str, message: str) -> InputError:
@@ -95,9 +107,10 @@ def _mass(options, grasp, obj):
     return mass_properties(obj).mass if mass_properties(obj).mass is not None else grasp.mass
 
 
-def _prepared(options: SimulateOptions, grasp: Grasp, mjcf: str | None, hold: bool):
-    """What a simulation of ``grasp`` needs: ``(mass, friction, gravity, load, centre of mass, scene)``,
-    or why it cannot be run; the scene compensates the object's weight for the hold test (``hold``)."""
+def _prepared(options: SimulateOptions, grasp: Grasp, mjcf, hold: bool):
+    """What a simulation of ``grasp`` needs: ``(mass, friction, gravity, load, centre of mass, scene, its
+    file)``, or why it cannot be run; the scene compensates the object's weight for the hold test
+    (``hold``); ``mjcf`` (a path, or a callable giving one) is where its scene is written, if not None."""
     obj = grasp.object
     if obj is None:
         return _problem(grasp, NO_OBJECT, "has no object to simulate: add an 'object' key")
@@ -126,6 +139,7 @@ def _prepared(options: SimulateOptions, grasp: Grasp, mjcf: str | None, hold: bo
             friction=friction,
             load=load,
             tolerance=options.distance_tol,
+            torsion=grasp.torsion,
             table_height=options.table if options.table is not None or env is None else env.table_height,
             boxes=() if env is None else env.boxes,
             urdf=urdf,
@@ -134,9 +148,10 @@ def _prepared(options: SimulateOptions, grasp: Grasp, mjcf: str | None, hold: bo
         )
     except ValueError as exc:  # MuJoCo's URDF reader or compiler: its reason
         return _compile_error(grasp, exc)
-    if mjcf is not None:
-        write_mjcf(scene, mjcf)
-    return mass, friction, gravity, load, mass_properties(obj).center_of_mass, scene
+    written = None if mjcf is None else (mjcf() if callable(mjcf) else mjcf)
+    if written is not None:
+        write_mjcf(scene, written)
+    return mass, friction, gravity, load, mass_properties(obj).center_of_mass, scene, written
 
 
 def _unstable(grasp, where: str, u) -> InputError:
@@ -150,17 +165,18 @@ def _compile_error(grasp, exc) -> InputError:
 
 
 def simulate_grasp(
-    options: SimulateOptions, grasp: Grasp, mjcf: str | None = None, observe=None
+    options: SimulateOptions, grasp: Grasp, mjcf: str | Callable[[], str] | None = None, observe=None
 ) -> Simulated | PathSimulated | InputError:
     """The hold test of one grasp (its path's execution with ``options.path``), or why it cannot be
-    run (module docstring); ``mjcf``: write its scene there; ``observe``:
+    run (module docstring); ``mjcf``: write its scene there (a callable: called for the file's name once
+    the scene is built, so that only scenes written are numbered); ``observe``:
     :func:`~grasptwist.sim.hold.hold_test`'s."""
     if options.path is not None:
         return simulate_path(options, grasp, mjcf)
     ready = _prepared(options, grasp, mjcf, hold=True)
     if isinstance(ready, InputError):
         return ready
-    mass, friction, _, load, center, scene = ready
+    mass, friction, _, load, center, scene, written = ready
     try:
         test = hold_test(
             scene,
@@ -172,13 +188,14 @@ def simulate_grasp(
             distance_tol=options.distance_tol,
             angle_tol=np.radians(options.angle_tol),
             safety=options.safety,
+            torsion=grasp.torsion,
             observe=observe,
         )
     except ValueError as exc:  # MuJoCo's compiler: its reason
         return _compile_error(grasp, exc)
     if test.unstable is not None:
         return _unstable(grasp, f"direction {test.unstable.where}", test.unstable)
-    return Simulated(grasp, mass, friction, test, options)
+    return Simulated(grasp, mass, friction, test, options, written)
 
 
 @dataclass(frozen=True, eq=False)
@@ -191,6 +208,7 @@ class PathSimulated:
     friction: np.ndarray
     run: PathRun
     options: SimulateOptions
+    scene: str | None = None  # the MJCF file its scene was written to (--mjcf)
 
 
 def _segments(grasp: Grasp, name: str):
@@ -207,7 +225,9 @@ def _segments(grasp: Grasp, name: str):
     return _problem(grasp, NO_PATH, f"has no path or twist named '{name}' (its paths and twists: {names})")
 
 
-def simulate_path(options: SimulateOptions, grasp: Grasp, mjcf: str | None = None) -> PathSimulated | InputError:
+def simulate_path(
+    options: SimulateOptions, grasp: Grasp, mjcf: str | Callable[[], str] | None = None
+) -> PathSimulated | InputError:
     """The grasp's path (or twist, held for one unit of time) ``options.path`` executed in MuJoCo
     (:func:`grasptwist.sim.path.run_path`), :data:`PATH_SAMPLES` samples compared with the plan."""
     segments = _segments(grasp, options.path)
@@ -216,7 +236,7 @@ def simulate_path(options: SimulateOptions, grasp: Grasp, mjcf: str | None = Non
     ready = _prepared(options, grasp, mjcf, hold=False)
     if isinstance(ready, InputError):
         return ready
-    mass, friction, gravity, _, center, scene = ready
+    mass, friction, gravity, _, center, scene, written = ready
     times = np.linspace(0.0, float(sum(s.duration for s in segments)), PATH_SAMPLES)
     try:
         run = run_path(
@@ -228,12 +248,13 @@ def simulate_path(options: SimulateOptions, grasp: Grasp, mjcf: str | None = Non
             center_of_mass=center,
             gravity=gravity,
             safety=options.safety,
+            torsion=grasp.torsion,
         )
     except ValueError as exc:
         return _compile_error(grasp, exc)
     if run.unstable is not None:
         return _unstable(grasp, f"path '{options.path}' at {run.unstable.where}", run.unstable)
-    return PathSimulated(grasp, options.path, mass, friction, run, options)
+    return PathSimulated(grasp, options.path, mass, friction, run, options, written)
 
 
 def write_mjcf(scene: Scene, path: str) -> None:
@@ -246,27 +267,46 @@ def write_mjcf(scene: Scene, path: str) -> None:
         out.write(scene.xml)
 
 
-def _mjcf_name(path: str | None, k: int) -> str | None:
-    """``--mjcf OUT.xml`` for the first grasp simulated, ``OUT-2.xml``, ... for the next."""
-    if path is None or k == 1:
+def _mjcf_name(path: str, k: int) -> str:
+    """``--mjcf OUT.xml`` for the first scene written, ``OUT-2.xml``, ... for the next.
+
+    >>> _mjcf_name("out.xml", 1), _mjcf_name("out.xml", 2)
+    ('out.xml', 'out-2.xml')
+    """
+    if k == 1:
         return path
     stem, suffix = os.path.splitext(path)
     return f"{stem}-{k}{suffix}"
 
 
-def simulate_inputs(job, inputs: Iterable, numbers=None) -> Iterator[Simulated | InputError]:
-    """Every grasp of ``inputs`` (paths or the errors of ``expand``) simulated, in order; ``numbers``
-    (an iterator, default from 1) numbers the grasps read for ``--mjcf``."""
+def _simulated_one(options: SimulateOptions, grasp: Grasp, numbers):
+    """One grasp simulated, its scene numbered by ``numbers`` when it is written (``--mjcf``)."""
+    written = []
+
+    def scene_file() -> str:
+        written.append(_mjcf_name(options.mjcf, next(numbers)))
+        return written[-1]
+
+    result = simulate_grasp(options, grasp, None if options.mjcf is None else scene_file)
+    if isinstance(result, InputError):
+        return NotSimulated(grasp, result, written[0] if written else None)
+    return result
+
+
+def simulate_inputs(
+    job, inputs: Iterable, numbers=None
+) -> Iterator[Simulated | PathSimulated | NotSimulated | InputError]:
+    """Every grasp of ``inputs`` (paths or the errors of ``expand``) simulated, in order (an input that
+    cannot be read: its :class:`InputError`; a grasp read but not simulated: :class:`NotSimulated`);
+    ``numbers`` (an iterator, default from 1) numbers the scenes written for ``--mjcf``, so that they
+    are ``OUT.xml``, ``OUT-2.xml``, ... without gaps."""
     numbers = itertools.count(1) if numbers is None else numbers
     for item in inputs:
         if isinstance(item, InputError):
             yield item
             continue
         for entry in read(item, job.max_bytes, job.reading):
-            if isinstance(entry, Grasp):
-                yield simulate_grasp(job.options, entry, _mjcf_name(job.options.mjcf, next(numbers)))
-            else:
-                yield entry
+            yield _simulated_one(job.options, entry, numbers) if isinstance(entry, Grasp) else entry
 
 
 def _simulated(job, inputs: list, workers: int) -> Iterator[list]:
@@ -286,8 +326,14 @@ def simulate_outputs(job, inputs: Iterable, w, workers: int = 1, tuning=None) ->
     each input done (the progress bar's unit)."""
     for items in _simulated(job, list(inputs), workers):
         for item in items:
-            error = isinstance(item, InputError)
-            rec = error_record(item) if error else sr.simulate_record(item)
+            if isinstance(item, NotSimulated):  # read, but not simulated: counted by its code, not as an input failed
+                rec = sr.not_simulated_record(error_record(item.error), item.grasp.name, item.scene)
+                errors, warnings = diagnostics(rec)
+                code = (NOT_SIMULATED, rec["error"]["code"])
+                out = Output(encoded=[_encode(job, rec)], errors=errors, records=1, failed=1, degenerate={code: 1})
+                yield out
+                continue
+            rec = error_record(item) if isinstance(item, InputError) else sr.simulate_record(item)
             errors, warnings = diagnostics(rec)
             out = Output(encoded=[_encode(job, rec)], errors=errors, warnings=warnings, records=1)
             out.count(rec)
@@ -325,6 +371,7 @@ def _found_grasp(found, k: int) -> Grasp:
         hand=hand,
         joint_positions=positions,
         friction=np.full(3, found.friction),
+        torsion=None if found.torsion is None else np.full(3, found.torsion),
         mass=mass,
         center_of_mass=center,
         gravity=gravity,

@@ -9,6 +9,12 @@ slides.
 
 - ``condim = 3``: a point contact with tangential friction, no torsional or rolling
   friction (the paper's model; a fingertip rolls freely).
+- ``condim = 4`` for a soft contact (a grasp file's ``model: soft``, torsional radius ``e``):
+  MuJoCo adds torsional friction, its elliptic cone over the contact's force and its moment
+  about the normal ``sqrt((f_t1 / mu_1)^2 + (f_t2 / mu_2)^2 + (tau_n / mu_spin)^2) <= f_n``
+  (``mu_spin`` a length, the geom's second ``friction`` number).  grasptwist's soft cone
+  ``|(f_t, tau_n / e)| <= mu f_n`` is that cone with ``mu_1 = mu_2 = mu`` and
+  ``mu_spin = mu e`` (:func:`tip_friction`); rolling friction stays 0.
 - ``cone = elliptic``: the cone ``|f_t| <= mu f_n`` itself, not a pyramid inside it
   (a pyramid's faces cut the cone by up to ``1 - cos(pi / 4)``, 29%, with four edges).
 - ``impratio``: the ratio of the frictional to the normal constraints' impedance; large,
@@ -21,15 +27,18 @@ slides.
   which the hold test would count as movement).
 - ``timestep``: 1 ms, a quarter of ``solref``'s time constant (MuJoCo asks for at least two steps).
 
-Friction between two geoms is the larger of theirs (MuJoCo's default), so the object's
-geoms carry none and each fingertip carries its contact's ``mu``; the table carries its own.
+Friction between two geoms is the larger of theirs, number by number, and their contact's
+``condim`` the larger of theirs (MuJoCo's defaults), so the object's geoms carry none
+(``0 0 0``: MuJoCo's default torsional and rolling friction, 0.005 and 0.0001, would otherwise
+be the larger) and each fingertip carries its contact's (:func:`tip_friction`); the table
+carries its own sliding friction, none other.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
 
-__all__ = ["ContactSettings", "CONTACT", "option_xml"]
+__all__ = ["ContactSettings", "CONTACT", "option_xml", "tip_friction", "SOFT_CONDIM"]
 
 
 @dataclass(frozen=True)
@@ -52,6 +61,25 @@ class ContactSettings:
 
 #: The settings every scene uses.
 CONTACT = ContactSettings()
+
+#: MuJoCo's ``condim`` of a soft contact: tangential and torsional friction.
+SOFT_CONDIM = 4
+
+
+def tip_friction(mu, torsion=None, settings: ContactSettings = CONTACT) -> tuple[tuple[float, float, float], int]:
+    """A fingertip's MuJoCo ``friction`` (sliding, torsional, rolling) and ``condim`` for a contact
+    with Coulomb coefficient ``mu`` and torsional radius ``torsion`` (``e``, a length; None or 0: a
+    point contact): ``(mu, mu e, 0)`` with ``condim`` 4 for a soft contact, so that MuJoCo's
+    elliptic cone is ``|(f_t, tau_n / e)| <= mu f_n`` (module docstring); ``(mu, 0, 0)`` and
+    ``settings.condim`` for a point contact.
+
+    >>> tip_friction(0.5, 0.01), tip_friction(0.5)
+    (((0.5, 0.005, 0.0), 4), ((0.5, 0.0, 0.0), 3))
+    """
+    e = 0.0 if torsion is None else float(torsion)
+    if e > 0:
+        return (float(mu), float(mu) * e, 0.0), SOFT_CONDIM
+    return (float(mu), 0.0, 0.0), settings.condim
 
 
 def _numbers(values) -> str:

@@ -5,7 +5,8 @@ afresh: the hand stands at the grasp's joint positions, held there by stiff join
 (:class:`~grasptwist.sim.scene.Drive`, stiffened by the ratio of the direction's largest finger force
 to the load when that exceeds 1: fingers pushing ``F`` on an object of radius ``r`` roll it away
 unless their springs' stiffness exceeds ``F / r``), its own gravity compensated; its joints exert
-the torques ``tau = J^T f_d`` of grasptwist's grip ``f_d`` for the load, squeezed so that every
+the torques ``tau = J^T f_d`` of grasptwist's grip ``f_d`` for the load (with soft contacts, the soft
+grip: each finger's force and its torsion about its normal, ``tau = J^T (f; tau_n n)``), squeezed so that every
 finger presses at least ``squeeze`` times the load (:func:`~grasptwist.engine.hold_test.squeezed`); the object, released,
 carries its weight ``m |g|`` along ``d`` (its own gravity compensated) for ``duration``.
 The grasp holds in ``d`` when the object's centre moved less than the distance tolerance and
@@ -67,7 +68,9 @@ class Direction:
 
     ``displacement`` (length) and ``rotation`` (radians) of the object at the end (NaN when not
     simulated); ``forces`` ``(3, 3)`` each finger's contact force on the object in MuJoCo at the
-    end, ``planned`` grasptwist's grip; ``grip_status`` the grip's status (0: it exists).
+    end, ``planned`` grasptwist's grip; ``grip_status`` the grip's status (0: it exists);
+    ``torsion`` and ``planned_torsion`` ``(3,)`` each soft contact's moment about its normal on the
+    object, in MuJoCo and planned (None with point contacts).
     """
 
     name: str
@@ -78,6 +81,8 @@ class Direction:
     planned: np.ndarray
     grip_status: int
     simulated: bool
+    torsion: np.ndarray | None = None
+    planned_torsion: np.ndarray | None = None
 
 
 @dataclass(frozen=True, eq=False)
@@ -109,8 +114,10 @@ def load_model(scene: Scene):
     return model
 
 
-def contact_forces(mujoco, model, data, body: int, tips) -> np.ndarray:
-    """Each fingertip's contact force on ``body`` (world frame), summed over its contacts, ``(3, 3)``."""
+def contact_forces(mujoco, model, data, body: int, tips, torsion=None) -> np.ndarray:
+    """Each fingertip's contact force on ``body`` (world frame), summed over its contacts, ``(3, 3)``;
+    with ``torsion`` (an array ``(3,)``, filled) also each one's moment about its contact's normal
+    (a soft contact's torsional friction; 0 for a point contact), signed about the normal into ``body``."""
     out = np.zeros((len(tips), 3))
     local = np.zeros(6)
     for i in range(data.ncon):
@@ -122,6 +129,8 @@ def contact_forces(mujoco, model, data, body: int, tips) -> np.ndarray:
                 mujoco.mj_contactForce(model, data, i, local)
                 world = c.frame.reshape(3, 3).T @ local[:3]  # the force geom1 exerts on geom2
                 out[f] += world if g1 == tip else -world
+                if torsion is not None:  # about the frame's normal, which points from geom1 to geom2
+                    torsion[f] += local[3] if g1 == tip else -local[3]
     return out
 
 
@@ -142,6 +151,14 @@ def diverged(mujoco, data) -> str | None:
     return None
 
 
+def _torsions(planned, d):
+    """A direction's ``(torsion, planned_torsion)`` before it is simulated: NaN and the grip's (None, None
+    with point contacts)."""
+    if planned.torsion is None:
+        return None, None
+    return np.full(3, np.nan), planned.torsion[d]
+
+
 def hold_test(
     scene: Scene,
     grasp,
@@ -154,6 +171,7 @@ def hold_test(
     angle_tol: float = math.radians(2.0),
     safety: float = 1.0,
     squeeze: float = SQUEEZE,
+    torsion=None,
     observe=None,
 ) -> HoldTest:
     """The six-direction hold test of ``grasp`` in ``scene`` (module docstring).
@@ -176,6 +194,10 @@ def hold_test(
         The grip's safety factor (:func:`~grasptwist.engine.forces.grip.grip`).
     squeeze : float
         Each finger's least normal force, in loads (:data:`SQUEEZE`).
+    torsion : (3,) array or None
+        Soft contacts' torsional radii ``e`` (the scene built with them): the grip is the soft one
+        (:func:`~grasptwist.engine.forces.grip.grip`'s ``torsion``), its moments about the normals
+        exerted through the joints too.
     observe : callable or None
         ``(direction, model, data)``, called at the end of each direction simulated (pictures:
         ``docs/make_simulation_picture.py``).
@@ -193,10 +215,11 @@ def hold_test(
     qadr = [model.jnt_qposadr[model.joint(j).id] for j in scene.joints]
     vadr = [model.jnt_dofadr[model.joint(j).id] for j in scene.joints]
     wrenches = direction_wrenches(scene.mass, center_of_mass, load)
-    planned = grip(grasp.points, grasp.normals, wrenches, friction, safety=safety)
+    planned = grip(grasp.points, grasp.normals, wrenches, friction, safety=safety, torsion=torsion)
     unit = grasp.normals / np.linalg.norm(grasp.normals, axis=-1, keepdims=True)
     forces = squeezed(grasp.points, unit, planned.force, np.asarray(friction) / safety, squeeze * load)
-    torques = joint_torques(grasp.hand, scene.positions, grasp.points, np.nan_to_num(forces))
+    moments = None if planned.torsion is None else np.nan_to_num(planned.torsion)[..., None] * unit
+    torques = joint_torques(grasp.hand, scene.positions, grasp.points, np.nan_to_num(forces), moments)
     # each direction's drive as stiff against its largest finger force as the scene's against the load
     stiffer = np.maximum(1.0, np.nan_to_num(np.linalg.norm(forces, axis=-1).max(axis=-1)) / load)
     jnt = [model.joint(j).id for j in scene.joints]
@@ -208,7 +231,11 @@ def hold_test(
     for d, name in enumerate(DIRECTIONS):
         if planned.status[d] != 0:
             nan = np.full((3, 3), np.nan)
-            out.append(Direction(name, False, math.nan, math.nan, nan, nan, int(planned.status[d]), False))
+            out.append(
+                Direction(
+                    name, False, math.nan, math.nan, nan, nan, int(planned.status[d]), False, *_torsions(planned, d)
+                )
+            )
             continue
         model.jnt_stiffness[jnt], model.dof_damping[vadr], model.dof_armature[vadr] = (a * stiffer[d] for a in drive)
         mujoco.mj_resetData(model, data)
@@ -231,7 +258,8 @@ def hold_test(
             observe(name, model, data)
         moved = float(np.linalg.norm(data.qpos[free : free + 3] - start))
         turned = rotation_angle(mujoco, quat, data.qpos[free + 3 : free + 7])
-        exerted = contact_forces(mujoco, model, data, body, tips)
+        twisted = None if planned.torsion is None else np.zeros(3)
+        exerted = contact_forces(mujoco, model, data, body, tips, twisted)
         ok = bool(held(moved, turned, distance_tol, angle_tol))
-        out.append(Direction(name, ok, moved, turned, exerted, forces[d], 0, True))
+        out.append(Direction(name, ok, moved, turned, exerted, forces[d], 0, True, twisted, _torsions(planned, d)[1]))
     return HoldTest(tuple(out), load)

@@ -74,6 +74,7 @@ def run_path(
     center_of_mass,
     gravity,
     safety: float = 1.0,
+    torsion=None,
 ) -> PathRun:
     """Execute ``segments`` (module docstring), sampled at ``times`` (increasing, from 0).
 
@@ -88,6 +89,9 @@ def run_path(
     center_of_mass, gravity : (3,) arrays
     safety : float
         The grip's safety factor.
+    torsion : (3,) array or None
+        Soft contacts' torsional radii (the scene built with them): the soft grip, its moments about
+        the planned normals exerted through the joints too.
 
     Returns
     -------
@@ -102,9 +106,11 @@ def run_path(
     plan = roll(grasp.hand, scene.positions, grasp.object, grasp.points, grasp.normals, scene.radii, segments, coarse)
     poses = integrate(segments, coarse)
     wrench = hold_wrench(scene.mass, center_of_mass, gravity, poses.rotation, poses.position)
-    held = grip(plan.points, plan.normals, wrench, friction, safety=safety)
+    held = grip(plan.points, plan.normals, wrench, friction, safety=safety, torsion=torsion)
     forces = np.nan_to_num(held.force)
-    torques = np.array([joint_torques(grasp.hand, *row) for row in zip(plan.positions, plan.points, forces)])
+    unit = plan.normals / np.linalg.norm(plan.normals, axis=-1, keepdims=True)
+    moments = np.zeros_like(forces) if held.torsion is None else np.nan_to_num(held.torsion)[..., None] * unit
+    torques = np.array([joint_torques(grasp.hand, *row) for row in zip(plan.positions, plan.points, forces, moments)])
     q, rates, torques = (
         np.stack([np.interp(grid, coarse, a[:, j]) for j in range(a.shape[1])], axis=1)
         for a in (plan.positions, plan.rates, torques)

@@ -38,7 +38,7 @@ from ..engine.objects.geometry import object_size
 from ..engine.se3 import matrix_to_quaternion
 from ..extras import require
 from ..model import Grasp, GraspObject
-from .contact import CONTACT, ContactSettings, option_xml
+from .contact import CONTACT, ContactSettings, option_xml, tip_friction
 
 __all__ = [
     "Scene",
@@ -198,7 +198,7 @@ def _object_geoms(obj: GraspObject, mass: float, pieces=None) -> tuple[str, dict
     carrier, assets = mass_geom(obj, mass)
     if shape.kind != "mesh":
         return (
-            f'<geom name="piece0" {_primitive(shape.kind, shape.size)} mass="{mass:.17g}" friction="0" {_bits("object")} rgba="{OBJECT_RGBA}"/>',
+            f'<geom name="piece0" {_primitive(shape.kind, shape.size)} mass="{mass:.17g}" friction="0 0 0" {_bits("object")} rgba="{OBJECT_RGBA}"/>',
             {},
             "",
         )
@@ -208,7 +208,7 @@ def _object_geoms(obj: GraspObject, mass: float, pieces=None) -> tuple[str, dict
         assets[f"piece{k}.stl"] = stl_bytes(v, f)
         meshes.append(f'<mesh name="piece{k}" file="piece{k}.stl"/>')
         geoms.append(
-            f'<geom name="piece{k}" type="mesh" mesh="piece{k}" density="0" friction="0" {_bits("object")} rgba="{OBJECT_RGBA}"/>'
+            f'<geom name="piece{k}" type="mesh" mesh="piece{k}" density="0" friction="0 0 0" {_bits("object")} rgba="{OBJECT_RGBA}"/>'
         )
     return "\n".join(geoms), assets, "\n".join(meshes)
 
@@ -232,10 +232,11 @@ def _joint_xml(name, kind, point, axis, limits, drive, i, q0) -> str:
     )
 
 
-def _tip_geom(f, centre, radius, mu, mass) -> str:
+def _tip_geom(f, centre, radius, mu, mass, torsion=None) -> str:
+    friction, condim = tip_friction(mu, torsion)
     return (
         f'<geom name="{TIP.format(f)}" type="sphere" size="{radius:.17g}" pos="{_v(centre)}" '
-        f'friction="{mu:.17g}" mass="{mass:.17g}" {_bits("tip")} rgba="0.2 0.4 0.9 1"/>'
+        f'friction="{_v(friction)}" condim="{condim}" mass="{mass:.17g}" {_bits("tip")} rgba="0.2 0.4 0.9 1"/>'
     )
 
 
@@ -252,7 +253,7 @@ def _hand_drive(grasp, centres, load, tolerance, timestep, compliance):
     return moved, _drive(lever, load, tolerance, timestep, compliance)
 
 
-def _hand_xml(grasp, radii, mu, load, tolerance, timestep, part, compliance) -> tuple[str, tuple, np.ndarray]:
+def _hand_xml(grasp, radii, mu, torsion, load, tolerance, timestep, part, compliance) -> tuple[str, tuple, np.ndarray]:
     """The fingers' bodies (each link and tip of mass ``part``), their joint names and positions at the grasp."""
     hand = grasp.hand
     centres = tip_centers(grasp.points, grasp.normals, radii)
@@ -265,7 +266,7 @@ def _hand_xml(grasp, radii, mu, load, tolerance, timestep, part, compliance) -> 
                 for i, a in enumerate("xyz")
             ]
             names += [f"tip{f}_{a}" for a in "xyz"]
-            body = "\n".join(joints) + "\n" + _tip_geom(f, centres[f], radii[f], mu[f], part)
+            body = "\n".join(joints) + "\n" + _tip_geom(f, centres[f], radii[f], mu[f], part, torsion[f])
             bodies.append(f'<body name="finger{f}" gravcomp="1">\n{body}\n</body>')
         return "\n".join(bodies), tuple(names), np.zeros(9)
     q = np.asarray(grasp.joint_positions, dtype=float)
@@ -292,7 +293,7 @@ def _hand_xml(grasp, radii, mu, load, tolerance, timestep, part, compliance) -> 
                 + _joint_xml(f"joint{i}", kind, finger.points[k], axis, (joint.lower, joint.upper), drive, i, q[i])
                 + f"\n{link}"
             )
-        tip = _tip_geom(f, home_centre, radii[f], mu[f], part)
+        tip = _tip_geom(f, home_centre, radii[f], mu[f], part, torsion[f])
         bodies.append("\n".join(opened) + "\n" + tip + "\n" + "</body>" * len(opened))
     return "\n".join(bodies), tuple(f"joint{i}" for i in range(len(hand.joint_names))), q
 
@@ -301,7 +302,7 @@ def _hand_xml(grasp, radii, mu, load, tolerance, timestep, part, compliance) -> 
 HAND = "hand/"
 
 
-def _with_urdf_hand(xml, grasp, urdf, radii, mu, load, tolerance, timestep, compliance, part):
+def _with_urdf_hand(xml, grasp, urdf, radii, mu, torsion, load, tolerance, timestep, compliance, part):
     """The scene ``xml`` with the hand as MuJoCo reads its URDF (``(text, meshes by file name)``):
     its links' own masses and inertias, their meshes drawn but not colliding, each joint driven as
     :class:`Drive` says, each tip link carrying a fingertip sphere at its origin.  The MJCF, its
@@ -329,11 +330,13 @@ def _with_urdf_hand(xml, grasp, urdf, radii, mu, load, tolerance, timestep, comp
     scene = mujoco.MjSpec.from_string(xml)
     scene.attach(spec, frame=scene.worldbody.add_frame(), prefix=HAND)
     for f, finger in enumerate(hand.fingers):
+        friction, condim = tip_friction(mu[f], torsion[f])
         scene.body(HAND + finger.tip).add_geom(
             name=TIP.format(f),
             type=mujoco.mjtGeom.mjGEOM_SPHERE,
             size=[radii[f], 0, 0],
-            friction=[mu[f], 0, 0],
+            friction=list(friction),
+            condim=condim,
             mass=part,
             contype=COLLIDES["tip"][0],
             conaffinity=COLLIDES["tip"][1],
@@ -356,6 +359,7 @@ def build_scene(
     friction,
     load: float,
     tolerance: float,
+    torsion=None,
     table_height: float | None = None,
     table_friction: float | None = None,
     boxes=(),
@@ -376,6 +380,10 @@ def build_scene(
         The object's mass.
     friction : (3,) array
         Each contact's ``mu``, carried by its fingertip.
+    torsion : (3,) array or None
+        Each contact's torsional radius ``e`` (0: a point contact; None: all are): a soft
+        contact's fingertip carries MuJoCo's torsional friction ``mu e`` (``condim`` 4,
+        :func:`~grasptwist.sim.contact.tip_friction`).
     load, tolerance : float
         The largest load on the object and the distance it may move: the joints' stiffness.
     table_height : float or None
@@ -404,21 +412,22 @@ def build_scene(
     mu = np.broadcast_to(np.asarray(friction, dtype=float), (3,))
     radii = np.array([f.tip_radius for f in grasp.hand.fingers]) if grasp.hand is not None else np.zeros(3)
     radii = np.where(radii > 0, radii, POINT_TIP * size)
+    torsion = np.zeros(3) if torsion is None else np.broadcast_to(np.asarray(torsion, dtype=float), (3,))
     geoms, assets, meshes = _object_geoms(obj, mass, pieces)
     by_urdf = urdf is not None and grasp.hand is not None and grasp.hand.source is not None
     hand, joints, q = (
         ("", (), None)
         if by_urdf
-        else _hand_xml(grasp, radii, mu, load, tolerance, settings.timestep, PART * mass, compliance)
+        else _hand_xml(grasp, radii, mu, torsion, load, tolerance, settings.timestep, PART * mass, compliance)
     )
     tmu = float(np.min(mu)) if table_friction is None else table_friction
     table = "".join(
         f'<geom name="box{k}" type="box" pos="{_v(box.pose[:3, 3])}" quat="{_v(matrix_to_quaternion(box.pose[:3, :3]))}" '
-        f'size="{_v(np.asarray(box.size, float) / 2)}" friction="{tmu:.17g}" {_bits("environment")} rgba="0.6 0.6 0.6 1"/>\n'
+        f'size="{_v(np.asarray(box.size, float) / 2)}" friction="{tmu:.17g} 0 0" {_bits("environment")} rgba="0.6 0.6 0.6 1"/>\n'
         for k, box in enumerate(boxes)
     )
     if table_height is not None:
-        table += f'<geom name="table" type="plane" size="0 0 1" pos="0 0 {table_height:.17g}" friction="{tmu:.17g}" {_bits("environment")} rgba="0.8 0.8 0.75 1"/>'
+        table += f'<geom name="table" type="plane" size="0 0 1" pos="0 0 {table_height:.17g}" friction="{tmu:.17g} 0 0" {_bits("environment")} rgba="0.8 0.8 0.75 1"/>'
     pose = obj.pose
     xml = f"""<mujoco model="{_attribute(grasp.name)}">
 <compiler angle="radian"/>
@@ -440,7 +449,7 @@ def build_scene(
 """
     if by_urdf:
         xml, files, joints, q = _with_urdf_hand(
-            xml, grasp, urdf, radii, mu, load, tolerance, settings.timestep, compliance, PART * mass
+            xml, grasp, urdf, radii, mu, torsion, load, tolerance, settings.timestep, compliance, PART * mass
         )
         assets = {**assets, **files}
     return Scene(xml, assets, joints, q, float(mass), radii)
