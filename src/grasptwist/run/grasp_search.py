@@ -119,11 +119,11 @@ def _friction(grasp, friction):
 
 
 def _torsion(grasp, friction, torsion):
-    """The soft contacts' radius of a search: ``torsion`` given, else the least of the document's contacts'
+    """The soft contacts' radius of a search: ``torsion`` given (0: point contacts), else the least of the document's contacts'
     when every one is ``model: soft`` (as its friction, the least), else None (point contacts); None with a
     friction of 0 (``--friction 0`` over a file's soft contacts: frictionless, as the engine's models)."""
-    if torsion is not None:
-        return torsion
+    if torsion is not None:  # given (--contact): every contact soft, or every one a point (0)
+        return torsion or None
     soft = grasp.torsion
     every = soft is not None and (np.asarray(soft) > 0).all() and friction > 0
     return float(np.min(soft)) if every else None
