@@ -330,7 +330,8 @@ def synthesize(
         search's: ``count`` (grasps wanted, 1), ``safety`` (1), ``objective`` (``robust``,
         ``total_normal_force``, ``closure_friction`` or ``epsilon``), ``wrist`` (None),
         ``methods``, ``min_conditioning`` (0.05), ``min_spacing`` (None: 5% of the object's
-        size), ``quality`` (False), ``seed`` (0), ``candidates`` (20000), ``seconds`` (None),
+        size), ``quality`` (False), ``seed`` (0), ``candidates`` (20000), ``seconds`` (None; the
+        command line's 60 s give the same grasps unless they run out: ``budget.Spending.take``),
         ``position_error``, ``friction_error`` (0.2), ``perturbations`` (64), ``torsion`` (None:
         point contacts; soft contacts' radius, a ``Grasp``'s when all its contacts are soft); and
         ``collide``, ``hulls``: the hand's tests given as functions instead
