@@ -584,6 +584,17 @@ def test_soft_contacts_from_a_grasp_file_and_their_errors_located(tmp_path):
         "model: soft, torsion: 0": "invalid-torsion: contacts[0].torsion: must be a length > 0",
         "model: soft, torsion: 0.01, friction: 0": "invalid-torsion: contacts[0].torsion: a soft contact needs friction",
     }
+    # every soft contact without friction is located, as every bad torsion is
+    both = tmp_path / "both.yaml"
+    both.write_text(
+        "friction: 0\ncontacts:\n  - {point: [-0.05, 0, 0], normal: [1, 0, 0], model: soft, torsion: 0.01}\n"
+        "  - {point: [0.05, 0, 0], normal: [-1, 0, 0], model: soft, torsion: 0.01}\n"
+        "  - {point: [0, 0, 0], normal: [0, 0, 1]}\n"
+    )
+    r, _ = run("forces", both)
+    assert r.exit_code == 1 and "both.yaml:3:" in r.stderr and "both.yaml:4:" in r.stderr, r.stderr
+    assert "contacts[0].torsion: a soft contact needs friction" in r.stderr and "contacts[1].torsion" in r.stderr
+    assert "contacts[2]" not in r.stderr  # a point contact needs none
     for keys, message in cases.items():
         bad = tmp_path / "bad.yaml"
         bad.write_text(

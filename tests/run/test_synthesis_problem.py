@@ -136,6 +136,23 @@ def test_a_document_the_search_cannot_start_from_is_its_located_error(change, co
     assert isinstance(error, gt.InputError) and error.code == code and error.line == g.line
 
 
+def test_the_builder_s_errors_name_the_keyword_and_the_option_that_mend_them():
+    """One builder, two callers: gt.synthesize's error says ``friction=`` where the command line's says
+    ``--friction`` (both, one message); the codes are the same."""
+    g = equator()
+    with pytest.raises(gt.InputError) as err:
+        gt.synthesize(replace(g, friction=None))
+    assert err.value.code == "no-friction"
+    assert err.value.message == "grasp 'sphere-equator' has no friction: give friction= (--friction)"
+    none = replace(g, mass=None, wrenches=(), object=replace(g.object, mass=None, density=None))
+    with pytest.raises(gt.InputError) as err:
+        gt.synthesize(none)
+    assert err.value.code == "nothing-to-hold" and err.value.message == (
+        "grasp 'sphere-equator' has nothing to hold: give the object a mass (mass=, --mass) "
+        "or a wrench (wrenches=, --wrench)"
+    )
+
+
 def test_tip_radius_replaces_every_fingertip_s_radius_once_for_the_library_and_the_command_line():
     from grasptwist.engine.synthesis.problem import with_tip_radius
 

@@ -115,7 +115,7 @@ def _friction(grasp, friction):
         return friction
     if grasp.friction is not None:
         return float(np.min(grasp.friction))
-    return _problem(grasp, NO_FRICTION, f"grasp '{grasp.name}' has no friction: give --friction")
+    return _problem(grasp, NO_FRICTION, f"grasp '{grasp.name}' has no friction: give friction= (--friction)")
 
 
 def _torsion(grasp, friction, torsion):
@@ -249,9 +249,13 @@ def grasp_problem(
 
 
 def _words(grasp, exc: ProblemError) -> tuple[str, str]:
-    """A problem's error in a document's words: its code and the options that would mend it."""
+    """A problem's error in a document's words: its code and what would mend it, in its callers' words (the
+    library's keyword, the command line's option)."""
     if exc.code in (NOTHING_TO_HOLD, NO_WEIGHT):
-        return NOTHING_TO_HOLD, f"grasp '{grasp.name}' has nothing to hold: give the object a mass (--mass) or --wrench"
+        return NOTHING_TO_HOLD, (
+            f"grasp '{grasp.name}' has nothing to hold: give the object a mass (mass=, --mass) "
+            "or a wrench (wrenches=, --wrench)"
+        )
     return WEIGHT_OVERFLOWS, (
         f"grasp '{grasp.name}': the weight or its moment about the origin overflows "
         "(mass x gravity, center_of_mass x weight)"
