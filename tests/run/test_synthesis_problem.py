@@ -136,6 +136,21 @@ def test_a_document_the_search_cannot_start_from_is_its_located_error(change, co
     assert isinstance(error, gt.InputError) and error.code == code and error.line == g.line
 
 
+def test_a_soft_document_is_searched_soft_unless_contact_point_makes_every_contact_a_point():
+    from grasptwist.run.options import POINT_CONTACTS
+
+    contacts = "".join(
+        f"  - {{point: {p}, normal: {n}, model: soft, torsion: {e}}}\n"
+        for p, n, e in (("[0.035, 0, 0]", "[-1, 0, 0]", 0.005), ("[-0.035, 0, 0]", "[1, 0, 0]", 0.004))
+    )
+    text = "object: {sphere: 0.035, mass: 0.1}\nfriction: 0.8\ncontacts:\n" + contacts
+    text += "  - {point: [0, 0.035, 0], normal: [0, -1, 0], model: soft, torsion: 0.006}\n"
+    (g,) = gt.read_grasps(text.encode())
+    assert grasp_problem(g).problem.torsion == 0.004  # the file's: the least radius
+    assert grasp_problem(g, torsion=0.01).problem.torsion == 0.01  # --contact soft --torsion 0.01
+    assert grasp_problem(g, torsion=POINT_CONTACTS).problem.torsion is None  # --contact point
+
+
 def test_the_builder_s_errors_name_the_keyword_and_the_option_that_mend_them():
     """One builder, two callers: gt.synthesize's error says ``friction=`` where the command line's says
     ``--friction`` (both, one message); the codes are the same."""

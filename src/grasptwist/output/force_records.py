@@ -12,7 +12,7 @@ import numpy as np
 
 from ..engine.forces.grasp_map import ForceStatus, force_status_message
 from ..engine.forces.grip import load_words
-from .columns import ColumnSet, force_arrays, force_columns, force_typed_header
+from .columns import ColumnSet, contact_models, force_arrays, force_columns, force_typed_header
 from .csv_rows import FORCE_HEADER, force_error_row
 from .names import escaped, escaped_each
 from .records import clearances, outward_warning, surface_distances
@@ -72,7 +72,7 @@ def force_records(block) -> list[dict]:
     certificate = [None if c[0] != c[0] else c for c in _lists(r.certificate)]
     closure_friction, epsilon = r.closure_friction.tolist(), r.epsilon.tolist()
     force_closure = r.force_closure.tolist()
-    model = ["point"] * len(block) if r.contact_model is None else r.contact_model.tolist()
+    model = contact_models(block).tolist()
     outward = block.outward().any(axis=-1).tolist()
     soft, ok = block.soft_rows().tolist(), (~block.failed_rows()).tolist()
     distance = surface_distances(block)

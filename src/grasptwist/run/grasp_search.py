@@ -337,7 +337,8 @@ def synthesize(
         size), ``quality`` (False), ``seed`` (0), ``candidates`` (20000), ``seconds`` (None; the
         command line's 60 s give the same grasps unless they run out: ``budget.Spending.take``),
         ``position_error``, ``friction_error`` (0.2), ``perturbations`` (64), ``torsion`` (None:
-        point contacts; soft contacts' radius, a ``Grasp``'s when all its contacts are soft); and
+        point contacts; soft contacts' radius, a ``Grasp``'s when all its contacts are soft; 0: a
+        ``Grasp``'s soft contacts searched as points, ``--contact point``); and
         ``collide``, ``hulls``: the hand's tests given as functions instead
         (``grasptwist.engine.synthesis.search.synthesize``).
 
