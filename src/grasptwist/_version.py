@@ -1,3 +1,3 @@
 """The package version, in a module of its own so that the command line reads it without the public facade."""
 
-__version__ = "0.5.0"
+__version__ = "0.6.0"

@@ -314,7 +314,9 @@ ERRORS = {
         "a friction below 0 (a file's, or a data set's row)", (*_FILES, "reference/bad-input-and-faults.md")
     ),
     "invalid-contact-model": Code("a contact's `model` that is not `point` or `soft`", _FILES),
-    "invalid-torsion": Code("a soft contact's `torsion` that is not above 0", _FILES),
+    "invalid-torsion": Code(
+        "a soft contact's `torsion` that is not above 0, or a soft contact with friction 0", _FILES
+    ),
     "invalid-mass": Code("a mass that is not above 0", (*_FILES, *_PYTHON)),
     # the object and the world around it
     "invalid-size": Code("an object's or a box's size that is not a size", (*_FILES, *_PYTHON)),

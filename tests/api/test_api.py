@@ -142,9 +142,9 @@ def test_the_version_is_the_one_the_deprecations_and_the_package_say():
     version = tuple(int(n) for n in gt.__version__.split("."))
     assert version[:2] >= tuple(map(int, since))  # a release that deprecates is at least that release
     pyproject = tomllib.loads((ROOT / "pyproject.toml").read_text())
-    assert pyproject["project"]["version"] == gt.__version__ == "0.5.0"
+    assert pyproject["project"]["version"] == gt.__version__ == "0.6.0"
     r = CliRunner().invoke(app, ["--version"])
-    assert (r.exit_code, r.stdout) == (0, "grasptwist 0.5.0\n")
+    assert (r.exit_code, r.stdout) == (0, "grasptwist 0.6.0\n")
 
 
 #: Parameters with a default that are data, not options: they may be given by position.

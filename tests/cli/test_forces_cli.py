@@ -468,31 +468,73 @@ def test_a_negative_mu_in_a_parquet_data_set_is_one_error_record(tmp_path):
     assert recs[1]["error"]["message"] == "friction: row 1: -2.0 must be >= 0"
 
 
-def test_soft_contacts_from_the_command_line_twist_a_rod_point_contacts_cannot(tmp_path):
-    """Issue 39: --contact soft --torsion E; the grip record says its contact model and each torsion."""
-    line = tmp_path / "line.yaml"
-    line.write_text(
-        "friction: 0.5\ncontacts:\n  - {point: [-0.05, 0, 0], normal: [1, 0, 0]}\n"
-        "  - {point: [0.05, 0, 0], normal: [-1, 0, 0]}\n  - {point: [0, 0, 0], normal: [0, 0, 1]}\n"
-    )
-    w = "0,0,1,0.004,0,0"
-    r, (rec,) = records(line, "--wrench", w)
-    assert r.exit_code == 1 and rec["grip"]["error"]["code"] == "collinear-contacts"
-    assert rec["closure"]["force_closure"] is False and rec["closure"]["contact_model"] == "point"
-    r, (rec,) = records(line, "--wrench", w, "--contact", "soft", "--torsion", "0.01")
+ROD = (
+    "friction: 0.5\ncontacts:\n  - {point: [-0.05, 0, 0], normal: [1, 0, 0], model: soft, torsion: 0.01}\n"
+    "  - {point: [0.05, 0, 0], normal: [-1, 0, 0], model: soft, torsion: 0.01}\n"
+    "  - {point: [0, 0, 0], normal: [0, 0, 1], model: point}\nwrenches:\n  - wrench: [0, 0, 1, 0.004, 0, 0]\n"
+)  # the forces guide's rod: two soft pads pinching along x, a point contact from below, a twist about x
+
+
+def test_soft_pads_twist_a_rod_point_contacts_cannot_and_contact_point_makes_them_points(tmp_path):
+    """Issue 39: a grasp file's soft contacts; the grip record says its contact model and each torsion. With a
+    soft contact the record's ok is its grip's (the point contacts' G^+ w a warning); --contact's default is the
+    files' contacts, and --contact point makes a file's soft contacts points."""
+    rod = tmp_path / "rod.yaml"
+    rod.write_text(ROD)
+    r, (rec,) = records(rod)
     # soft pads close the line with any friction: the closure record says its model
     assert rec["closure"]["force_closure"] is True and rec["closure"]["contact_model"] == "soft"
     assert rec["closure"]["closure_friction"] < 1e-6
-    # the manipulating forces are the point contacts' split (G^+ w), which the line still lacks
-    assert rec["manipulating"]["error"]["code"] == "collinear-contacts" and "error" not in rec["grip"]
+    # the manipulating forces are the point contacts' split (G^+ w), which the line still lacks: null and a
+    # warning, not the record's failure: the soft grip holds, the record is ok (exit 0, no error line)
+    assert rec["manipulating"] is None and "error" not in rec["grip"] and rec["ok"] is True and r.exit_code == 0
+    assert rec["warnings"] == [
+        "manipulating: collinear-contacts: the contacts are collinear, so no finger forces make a moment about "
+        "their line (rank G < 6) (G^+ w of point contacts, not the soft ones': the record's ok is its grip's)"
+    ]
+    assert "error:" not in r.stderr and "1 record: all ok" in r.stderr
     points, normals = [[-0.05, 0, 0], [0.05, 0, 0], [0, 0, 0]], [[1, 0, 0], [-1, 0, 0], [0, 0, 1]]
-    engine = gt.grip(points, normals, [0, 0, 1, 0.004, 0, 0], 0.5, torsion=0.01)
+    engine = gt.grip(points, normals, [0, 0, 1, 0.004, 0, 0], 0.5, torsion=[0.01, 0.01, 0])
     assert rec["grip"]["contact_model"] == "soft" and rec["grip"]["squeeze"] is None
     assert rec["grip"]["total_normal_force"] == pytest.approx(float(engine.total_normal_force), rel=1e-12)
+    assert rec["grip"]["total_normal_force"] == pytest.approx(1.6928203230, rel=1e-9)  # the guide's 1.6928 N
     assert rec["grip"]["torsion"] == pytest.approx([0.002, -0.002, 0], abs=1e-9)
+    # --contact point: every contact a point contact, which cannot twist the rod (as before: not ok, exit 1)
+    r, (point,) = records(rod, "--contact", "point")
+    assert r.exit_code == 1 and point["ok"] is False and point["grip"]["error"]["code"] == "collinear-contacts"
+    assert point["closure"]["force_closure"] is False and point["closure"]["contact_model"] == "point"
+    assert point["manipulating"]["error"]["code"] == "collinear-contacts"  # point contacts: an error, as before
+    # check's closure too: the file's soft pads close the line, --contact point does not
+    (rec,) = jsonl(run("check", rod, "-f", "jsonl", "--contact", "point")[0].stdout)
+    assert rec["force_closure"] is False and "contact_model" not in rec  # as a point file's record
+    assert "[default: the files' (model: soft, else point)]" in " ".join(run("forces", "--help")[0].stdout.split())
     _, recs = records(SPHERE)  # point contacts say so, with no torsion
     grip = by(recs, "sphere-equator", "hold")["grip"]
     assert grip["contact_model"] == "point" and grip["torsion"] == [0.0, 0.0, 0.0]
+
+
+def test_a_soft_grip_s_table_says_soft_and_its_torsions_and_csv_leaves_its_squeezes_empty(tmp_path):
+    """--contact soft --torsion E makes every contact soft; the table says so where point contacts' says their
+    squeezes, and CSV leaves a cell that does not apply empty (never nan) and says each row's contact_model."""
+    line = tmp_path / "line.yaml"  # the rod's contacts, all points
+    line.write_text(ROD.replace("model: soft, torsion: 0.01", "model: point"))
+    r, _ = run("forces", line, "--contact", "soft", "--torsion", "0.01", "--digits", "3")
+    shown = " ".join(r.stdout.split())  # as wide as the terminal: lines may wrap
+    assert r.exit_code == 0 and "closure (soft contacts): force closure yes" in shown
+    assert "total normal force 1.693 N (safety 1); soft contacts, torsions (0.002, -0.002, 0.000) N length" in shown
+    assert "collinear contacts)" not in shown
+    rod = tmp_path / "rod.yaml"
+    rod.write_text(ROD)
+    r, _ = run("forces", rod, "-f", "csv")
+    (cell,) = csv.DictReader(io.StringIO(r.stdout))
+    assert list(cell)[-1] == "contact_model" and cell["contact_model"] == "soft" and cell["ok"] == "true"
+    assert [cell[f"squeeze{i}"] for i in (1, 2, 3)] == ["", "", ""] and cell["grip_error"] == ""
+    assert cell["fm1_x"] == "" and float(cell["total_normal_force"]) == pytest.approx(1.6928203230, rel=1e-9)
+    # point contacts on a line lifted: no three squeezes either, an empty cell (not nan)
+    r, _ = run("forces", line, "--wrench", "0,0,1,0,0,0", "-f", "csv")
+    (cell,) = csv.DictReader(io.StringIO(r.stdout))
+    assert cell["contact_model"] == "point" and cell["ok"] == "true" and float(cell["total_normal_force"]) > 0
+    assert "nan" not in r.stdout and [cell[f"squeeze{i}"] for i in (1, 2, 3)] == ["", "", ""]
 
 
 @pytest.mark.parametrize(
@@ -500,6 +542,7 @@ def test_soft_contacts_from_the_command_line_twist_a_rod_point_contacts_cannot(t
     [
         (["--contact", "soft"], "--contact soft needs --torsion E"),
         (["--torsion", "0.01"], "give --contact soft too"),
+        (["--contact", "point", "--torsion", "0.01"], "give --contact soft too"),
         (["--contact", "soft", "--torsion", "0"], "must be a finite length > 0"),
         (["--contact", "soft", "--torsion", "nan"], "must be a finite length > 0"),
         (["--contact", "hard", "--torsion", "0.01"], "--contact"),
@@ -513,17 +556,9 @@ def test_soft_contact_options_are_usage_errors_when_half_given(args, message):
 def test_soft_contacts_from_a_grasp_file_and_their_errors_located(tmp_path):
     """A contact's model: soft with torsion: E (issue 39); half of it, or a bad value, is a located error."""
     good = tmp_path / "soft.yaml"
-    good.write_text(
-        "friction: 0.5\ncontacts:\n"
-        "  - {point: [-0.05, 0, 0], normal: [1, 0, 0], model: soft, torsion: 0.01}\n"
-        "  - {point: [0.05, 0, 0], normal: [-1, 0, 0], model: soft, torsion: 0.01}\n"
-        "  - {point: [0, 0, 0], normal: [0, 0, 1], model: point}\n"
-        "wrenches:\n  - {name: twist, force: [0, 0, 1], moment: [0.004, 0, 0]}\n"
-    )
+    good.write_text(ROD)  # its grip and records: test_soft_pads_twist_a_rod_point_contacts_cannot_...
     (grasp,) = read_grasps(good)
     assert grasp.torsion.tolist() == [0.01, 0.01, 0.0]
-    _, (rec,) = records(good)
-    assert rec["grip"]["contact_model"] == "soft" and rec["grip"]["torsion"] == pytest.approx([0.002, -0.002, 0])
     cases = {
         "model: soft": "missing-key: contacts[0].torsion",
         "torsion: 0.01": "missing-key: contacts[0].model",
@@ -531,6 +566,17 @@ def test_soft_contacts_from_a_grasp_file_and_their_errors_located(tmp_path):
         "model: soft, torsion: 0": "invalid-torsion: contacts[0].torsion: must be a length > 0",
         "model: soft, torsion: 0.01, friction: 0": "invalid-torsion: contacts[0].torsion: a soft contact needs friction",
     }
+    # every soft contact without friction is located, as every bad torsion is
+    both = tmp_path / "both.yaml"
+    both.write_text(
+        "friction: 0\ncontacts:\n  - {point: [-0.05, 0, 0], normal: [1, 0, 0], model: soft, torsion: 0.01}\n"
+        "  - {point: [0.05, 0, 0], normal: [-1, 0, 0], model: soft, torsion: 0.01}\n"
+        "  - {point: [0, 0, 0], normal: [0, 0, 1]}\n"
+    )
+    r, _ = run("forces", both)
+    assert r.exit_code == 1 and "both.yaml:3:" in r.stderr and "both.yaml:4:" in r.stderr, r.stderr
+    assert "contacts[0].torsion: a soft contact needs friction" in r.stderr and "contacts[1].torsion" in r.stderr
+    assert "contacts[2]" not in r.stderr  # a point contact needs none
     for keys, message in cases.items():
         bad = tmp_path / "bad.yaml"
         bad.write_text(

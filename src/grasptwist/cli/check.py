@@ -5,7 +5,6 @@ from .exits import run_command
 from .options import (
     ALL,
     AllowOutside,
-    Contact,
     ContactOption,
     Debug,
     Json,
@@ -37,7 +36,7 @@ def check(
     max_bytes: MaxBytes = None,
     surface_tol: SurfaceTol = None,
     allow_outside: AllowOutside = False,
-    contact: ContactOption = Contact.point,
+    contact: ContactOption = None,
     torsion: Torsion = None,
     workers: Workers = 0,
     quiet: Quiet = False,

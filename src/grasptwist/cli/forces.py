@@ -10,7 +10,6 @@ from .options import (
     AllowOutside,
     At,
     Clearance,
-    Contact,
     ContactOption,
     Debug,
     Digits,
@@ -55,7 +54,7 @@ def forces(
     at: At = None,
     friction: Friction = None,
     safety: Safety = 1.0,
-    contact: ContactOption = Contact.point,
+    contact: ContactOption = None,
     torsion: Torsion = None,
     quality: Annotated[
         bool, typer.Option("--quality", help="Also Ferrari-Canny's epsilon (needs scipy: grasptwist[quality]).")

@@ -17,6 +17,7 @@ import typer
 from ..output.formats import FORMATS
 from ..results import ALL_METHODS, KINDS, METHOD_CHOICES
 from ..run.families import COMMANDS
+from ..run.options import POINT_CONTACTS
 from .diagnostics import WARNINGS_SHOWN, Warnings
 
 __all__ = [
@@ -309,11 +310,13 @@ class Contact(str, Enum):
 
 
 ContactOption = Annotated[
-    Contact,
+    Contact | None,
     typer.Option(
         "--contact",
-        help="Contact model of the grip and the closure: point (Coulomb cones) or soft (finger pads that also "
-        "resist turning about the normal, |(f_t, tau / E)| <= mu f_n; needs --torsion).",
+        show_default=False,
+        help="Contact model of every contact, replacing the files': point (Coulomb cones; a file's soft "
+        "contacts too) or soft (finger pads that also resist turning about the normal, "
+        "|(f_t, tau / E)| <= mu f_n; needs --torsion). [default: the files' (model: soft, else point)]",
     ),
 ]
 Torsion = Annotated[
@@ -327,14 +330,21 @@ Torsion = Annotated[
 ]
 
 
-def contact_torsion(contact: Contact, torsion: float | None, friction: float | None = None) -> float | None:
-    """``--contact`` and ``--torsion`` as the torsional radius (None: point contacts); a usage error when one is
-    given without the other, or soft contacts with ``--friction 0`` (torsional friction is friction)."""
+def contact_torsion(contact: Contact | None, torsion: float | None, friction: float | None = None) -> float | None:
+    """``--contact`` and ``--torsion`` as every contact's torsional radius: None without ``--contact`` (the
+    files' contacts as they are), :data:`~grasptwist.run.options.POINT_CONTACTS` (0) with ``--contact point``
+    (every contact a point, a file's soft ones too), ``E`` with ``--contact soft --torsion E``; a usage error
+    when ``--torsion`` comes without ``--contact soft`` or the reverse, or soft contacts with ``--friction 0``
+    (torsional friction is friction).
+
+    >>> contact_torsion(None, None), contact_torsion(Contact.point, None), contact_torsion(Contact.soft, 0.01)
+    (None, 0.0, 0.01)
+    """
     if contact is Contact.soft and torsion is None:
         raise typer.BadParameter(
             "--contact soft needs --torsion E (the torsional radius, a length > 0)", param_hint="'--contact'"
         )
-    if contact is Contact.point and torsion is not None:
+    if contact is not Contact.soft and torsion is not None:
         raise typer.BadParameter(
             "--torsion is the soft contacts' radius: give --contact soft too", param_hint="'--torsion'"
         )
@@ -343,7 +353,7 @@ def contact_torsion(contact: Contact, torsion: float | None, friction: float | N
             "soft contacts need friction (their torsion is friction): --friction 0 makes every contact frictionless",
             param_hint="'--contact'",
         )
-    return torsion
+    return POINT_CONTACTS if contact is Contact.point else torsion
 
 
 Safety = Annotated[

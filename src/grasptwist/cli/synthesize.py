@@ -14,7 +14,6 @@ from .options import (
     AllowOutside,
     At,
     Clearance,
-    Contact,
     ContactOption,
     Debug,
     Digits,
@@ -150,7 +149,7 @@ def synthesize(
     wrench_name: WrenchName = None,
     at: At = None,
     safety: Safety = 1.0,
-    contact: ContactOption = Contact.point,
+    contact: ContactOption = None,
     torsion: Torsion = None,
     objective: Annotated[
         Objective,

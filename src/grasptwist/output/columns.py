@@ -43,6 +43,7 @@ __all__ = [
     "force_typed_header",
     "force_arrays",
     "grip_errors",
+    "contact_models",
 ]
 
 
@@ -314,6 +315,16 @@ def _gripped(b):
     return b.result.grip_status == 0
 
 
+def _squeezed(b):
+    """Rows whose grip has three squeezes: none for collinear contacts, none over soft cones (the grip's ``squeeze``)."""
+    return _gripped(b) & ~np.isnan(b.result.squeeze).any(axis=-1)
+
+
+def contact_models(block) -> np.ndarray:
+    """``(N,)`` each row's contact model, ``soft`` where a contact is soft, else ``point`` (the records' ``contact_model``)."""
+    return np.where(block.soft_rows(), "soft", "point")
+
+
 #: The force rows' column groups, CSV order; ``valid(block) -> (N,) bool`` rows where the flat values hold.
 FORCE_COLUMNS = (
     (Column("file", _block(lambda b: b.file), ("file",), dtype="U", only_where_ok=False), None),
@@ -327,7 +338,7 @@ FORCE_COLUMNS = (
     (CLEARANCE, lambda b: ~np.isnan(clearance(b))),
     (Column("manipulating", _r("manipulating"), _xyz("fm")), _manipulated),
     (Column("force", _r("force"), _xyz("f")), _gripped),
-    (Column("squeeze", _r("squeeze"), ("squeeze1", "squeeze2", "squeeze3")), _gripped),
+    (Column("squeeze", _r("squeeze"), ("squeeze1", "squeeze2", "squeeze3")), _squeezed),
     (Column("normal_force", _r("normal_force"), ("fn1", "fn2", "fn3")), _gripped),
     (Column("tangential_force", _r("tangential_force"), ("ft1", "ft2", "ft3")), _gripped),
     (Column("friction_used", _r("friction_used"), ("friction_used1", "friction_used2", "friction_used3")), _gripped),
@@ -338,6 +349,7 @@ FORCE_COLUMNS = (
     (Column("force_closure", _r("force_closure"), ("force_closure",), dtype="?"), lambda b: b.has_friction),
     (Column("closure_friction", _r("closure_friction"), ("closure_friction",)), lambda b: ~np.isnan(b.result.closure_friction)),
     (Column("epsilon", _r("epsilon"), ("epsilon",)), lambda b: ~np.isnan(b.result.epsilon)),
+    (Column("contact_model", _block(contact_models), ("contact_model",), dtype="U"), None),
 )  # fmt: skip
 
 #: The CSV header of ``grasptwist forces``.
@@ -345,12 +357,13 @@ FORCE_CSV_COLUMNS = [name for c, _ in FORCE_COLUMNS for name in c.flat]
 
 
 def grip_errors(block) -> np.ndarray:
-    """``code: message`` where the grip failed, or the manipulating forces did (the contacts' degeneracy)."""
+    """``code: message`` where the grip failed, or the manipulating forces did where every contact is a point
+    (the contacts' degeneracy; the rows that are not ok, ``failed_rows``)."""
     from ..engine.forces.grasp_map import ForceStatus, force_status_message  # with the first force run
 
     r = block.result
     texts = np.full(len(block), "", dtype=object)
-    for i in np.flatnonzero((r.manipulating_status > 0) | (r.grip_status > 0)):
+    for i in np.flatnonzero(block.failed_rows()):
         status, culprit = (
             (r.grip_status[i], r.grip_culprit[i])
             if r.grip_status[i] > 0

@@ -12,7 +12,7 @@ import numpy as np
 
 from ..engine.forces.grasp_map import ForceStatus, force_status_message
 from ..engine.forces.grip import load_words
-from .columns import ColumnSet, force_arrays, force_columns, force_typed_header
+from .columns import ColumnSet, contact_models, force_arrays, force_columns, force_typed_header
 from .csv_rows import FORCE_HEADER, force_error_row
 from .names import escaped, escaped_each
 from .records import clearances, outward_warning, surface_distances
@@ -41,6 +41,14 @@ def _error(status, culprit):
     return {"error": {"code": s.code, "message": message.removeprefix(f"{s.code}: ")}}
 
 
+def _soft_manipulating(status, culprit) -> str:
+    """The warning of a soft grip's manipulating forces that failed: they are the point contacts' ``G^+ w``
+    (``collinear-contacts`` for a pinch the soft pads' torsions hold), so the record stays ok on its grip."""
+    s = ForceStatus(int(status))
+    message = force_status_message(s, culprit).removeprefix(f"{s.code}: ")
+    return f"manipulating: {s.code}: {message} (G^+ w of point contacts, not the soft ones': the record's ok is its grip's)"
+
+
 def _grip_error(status, culprit, certificate, points):
     """The grip's error object; with a Farkas ``certificate`` (where one exists) in numbers and in words."""
     rec = _error(status, culprit)
@@ -64,8 +72,9 @@ def force_records(block) -> list[dict]:
     certificate = [None if c[0] != c[0] else c for c in _lists(r.certificate)]
     closure_friction, epsilon = r.closure_friction.tolist(), r.epsilon.tolist()
     force_closure = r.force_closure.tolist()
-    model = ["point"] * len(block) if r.contact_model is None else r.contact_model.tolist()
+    model = contact_models(block).tolist()
     outward = block.outward().any(axis=-1).tolist()
+    soft, ok = block.soft_rows().tolist(), (~block.failed_rows()).tolist()
     distance = surface_distances(block)
     clearance = clearances(block)
     out = []
@@ -89,6 +98,9 @@ def force_records(block) -> list[dict]:
         }
         if not has_wrench[i]:
             rec["manipulating"] = None
+        elif r.manipulating_status[i] and soft[i]:  # the point contacts' G^+ w: a warning, the grip answers
+            rec["manipulating"] = None
+            warnings.append(_soft_manipulating(r.manipulating_status[i], r.manipulating_culprit[i]))
         elif r.manipulating_status[i]:
             rec["manipulating"] = _error(r.manipulating_status[i], r.manipulating_culprit[i])
         else:
@@ -119,7 +131,7 @@ def force_records(block) -> list[dict]:
         if status not in (ForceStatus.OK, ForceStatus.NO_CLOSURE):
             warnings.append(f"closure: {status.code}: {force_status_message(status, r.closure_culprit[i])}")
         rec["warnings"] = warnings
-        rec["ok"] = not any(isinstance(rec[k], dict) and "error" in rec[k] for k in ("manipulating", "grip"))
+        rec["ok"] = ok[i]
         out.append(rec)
     return out
 

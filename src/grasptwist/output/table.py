@@ -659,17 +659,24 @@ class ForceTableWriter(_Writer):
         for name, part in (("manipulating", m), ("grip", grip)):
             if part is not None and "error" in part:
                 self.add(lines, Text(f"{name}: {part['error']['code']}: {part['error']['message']}", style="red"))
+        length = escaped(rec["units"] or "length")
         if shown_g:
+            if grip["contact_model"] == "soft":  # no three squeezes over soft cones: each contact's torsion instead
+                inner = f"soft contacts, torsions {fmt_vector(grip['torsion'], d)} N {length}"
+            elif grip["squeeze"] is None:
+                inner = "no squeezes (collinear contacts)"
+            else:
+                inner = f"squeezes {fmt_vector(grip['squeeze'], d)} N"
             self.add(
                 lines,
-                f"total normal force {fmt_number(grip['total_normal_force'], d)} N (safety {grip['safety']:g}); "
-                + ("no squeezes (collinear contacts)" if grip["squeeze"] is None else "")
-                + (f"squeezes {fmt_vector(grip['squeeze'], d)} N" if grip["squeeze"] is not None else ""),
+                f"total normal force {fmt_number(grip['total_normal_force'], d)} N (safety {grip['safety']:g}); {inner}",
             )
         c = rec["closure"]
         verdict = {True: "yes", False: "no", None: "- (no friction)"}[c["force_closure"]]
         least = "none" if c["closure_friction"] is None else fmt_number(c["closure_friction"], d)
-        judged = "" if c["safety"] == 1 or c["force_closure"] is None else f" (with mu/{c['safety']:g})"
+        judged = [] if c["safety"] == 1 or c["force_closure"] is None else [f"with mu/{c['safety']:g}"]
+        judged += ["soft contacts"] if c.get("contact_model") == "soft" else []
+        judged = f" ({', '.join(judged)})" if judged else ""
         text = f"closure{judged}: force closure {verdict}; closure friction {least}"
         if c["epsilon"] is not None:
             text += f"; epsilon {fmt_number(c['epsilon'], d)}"

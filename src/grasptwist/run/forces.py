@@ -81,8 +81,8 @@ def compute_forces(
     friction), never once per row.  ``torsion (N, 3)``: the contacts' torsional radii (grasp
     files' ``model: soft``); the options' ``torsion`` (``--torsion``) replaces them; None: point contacts.
     """
-    if options.torsion is not None:
-        torsion = np.full((len(points), 3), float(options.torsion))
+    if options.torsion is not None:  # --contact: every contact soft, or every one a point (POINT_CONTACTS)
+        torsion = np.full((len(points), 3), float(options.torsion)) if options.torsion else None
     n = len(points)
     out = {
         "manipulating": np.full((n, 3, 3), np.nan),
@@ -233,8 +233,15 @@ class ForceBlock:
         return outward_contacts(self.points, self.normals, self.center_of_mass)
 
     def failed_rows(self) -> np.ndarray:
-        """Rows whose manipulating forces or grip failed."""
-        return (self.result.manipulating_status > 0) | (self.result.grip_status > 0)
+        """Rows whose grip failed, or whose manipulating forces did where every contact is a point
+        (with a soft contact the grip answers; the point contacts' ``G^+ w`` is a warning: :meth:`soft_rows`)."""
+        r = self.result
+        return ((r.manipulating_status > 0) & ~self.soft_rows()) | (r.grip_status > 0)
+
+    def soft_rows(self) -> np.ndarray:
+        """Rows with a soft contact (``contact_model`` ``soft``), ``(N,)`` bool."""
+        model = self.result.contact_model
+        return np.zeros(len(self.points), bool) if model is None else model == "soft"
 
 
 def force_arrays(

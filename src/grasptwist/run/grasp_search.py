@@ -115,15 +115,15 @@ def _friction(grasp, friction):
         return friction
     if grasp.friction is not None:
         return float(np.min(grasp.friction))
-    return _problem(grasp, NO_FRICTION, f"grasp '{grasp.name}' has no friction: give --friction")
+    return _problem(grasp, NO_FRICTION, f"grasp '{grasp.name}' has no friction: give friction= (--friction)")
 
 
 def _torsion(grasp, friction, torsion):
-    """The soft contacts' radius of a search: ``torsion`` given, else the least of the document's contacts'
+    """The soft contacts' radius of a search: ``torsion`` given (0: point contacts), else the least of the document's contacts'
     when every one is ``model: soft`` (as its friction, the least), else None (point contacts); None with a
     friction of 0 (``--friction 0`` over a file's soft contacts: frictionless, as the engine's models)."""
-    if torsion is not None:
-        return torsion
+    if torsion is not None:  # given (--contact): every contact soft, or every one a point (0)
+        return torsion or None
     soft = grasp.torsion
     every = soft is not None and (np.asarray(soft) > 0).all() and friction > 0
     return float(np.min(soft)) if every else None
@@ -249,9 +249,13 @@ def grasp_problem(
 
 
 def _words(grasp, exc: ProblemError) -> tuple[str, str]:
-    """A problem's error in a document's words: its code and the options that would mend it."""
+    """A problem's error in a document's words: its code and what would mend it, in its callers' words (the
+    library's keyword, the command line's option)."""
     if exc.code in (NOTHING_TO_HOLD, NO_WEIGHT):
-        return NOTHING_TO_HOLD, f"grasp '{grasp.name}' has nothing to hold: give the object a mass (--mass) or --wrench"
+        return NOTHING_TO_HOLD, (
+            f"grasp '{grasp.name}' has nothing to hold: give the object a mass (mass=, --mass) "
+            "or a wrench (wrenches=, --wrench)"
+        )
     return WEIGHT_OVERFLOWS, (
         f"grasp '{grasp.name}': the weight or its moment about the origin overflows "
         "(mass x gravity, center_of_mass x weight)"
@@ -330,9 +334,11 @@ def synthesize(
         search's: ``count`` (grasps wanted, 1), ``safety`` (1), ``objective`` (``robust``,
         ``total_normal_force``, ``closure_friction`` or ``epsilon``), ``wrist`` (None),
         ``methods``, ``min_conditioning`` (0.05), ``min_spacing`` (None: 5% of the object's
-        size), ``quality`` (False), ``seed`` (0), ``candidates`` (20000), ``seconds`` (None),
+        size), ``quality`` (False), ``seed`` (0), ``candidates`` (20000), ``seconds`` (None; the
+        command line's 60 s give the same grasps unless they run out: ``budget.Spending.take``),
         ``position_error``, ``friction_error`` (0.2), ``perturbations`` (64), ``torsion`` (None:
-        point contacts; soft contacts' radius, a ``Grasp``'s when all its contacts are soft); and
+        point contacts; soft contacts' radius, a ``Grasp``'s when all its contacts are soft; 0: a
+        ``Grasp``'s soft contacts searched as points, ``--contact point``); and
         ``collide``, ``hulls``: the hand's tests given as functions instead
         (``grasptwist.engine.synthesis.search.synthesize``).
 

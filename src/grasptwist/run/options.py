@@ -10,7 +10,19 @@ from dataclasses import dataclass
 
 from ..model import Twist, Wrench
 
-__all__ = ["TwistOptions", "ForceOptions", "FollowOptions", "SynthesisOptions", "SimulateOptions", "NOT_SIMULATED"]
+__all__ = [
+    "TwistOptions",
+    "ForceOptions",
+    "FollowOptions",
+    "SynthesisOptions",
+    "SimulateOptions",
+    "NOT_SIMULATED",
+    "POINT_CONTACTS",
+]
+
+#: The options' ``torsion`` of ``--contact point``: every contact a point contact, a file's ``model: soft`` ones
+#: too (None, without ``--contact``, takes the files' contacts as they are).
+POINT_CONTACTS = 0.0
 
 
 def _count(given) -> int:
@@ -35,7 +47,9 @@ class TwistOptions:
     method: str = "both"
     twists_from: str | None = None
     select: tuple[str, ...] | None = None
-    torsion: float | None = None  # check's --contact soft --torsion E: every contact soft for the closure
+    torsion: float | None = (
+        None  # check's --contact: every contact soft for the closure, or a point (0); None: the files'
+    )
 
     def rows_per_grasp(self) -> int:
         """Rows each grasp of a data set gives: one per twist of the command line, else its own."""
@@ -49,7 +63,8 @@ class ForceOptions:
     ``wrenches`` (``--wrench``) replace each grasp's own, ``friction``
     (``--friction``) its friction; ``safety``, ``quality`` and ``cone_edges``
     go to the engine; ``torsion`` (``--contact soft --torsion E``), every
-    contact's torsional radius: soft-finger contacts for the grip (None: point contacts).
+    contact's torsional radius: soft-finger contacts for the grip, :data:`POINT_CONTACTS` (``--contact
+    point``) every contact a point, None the files' contacts (``model: soft``, else point).
     """
 
     wrenches: tuple[Wrench, ...] | None = None
@@ -131,7 +146,7 @@ class SynthesisOptions:
     position_error: float | None = None
     friction_error: float = 0.2
     perturbations: int = 64
-    torsion: float | None = None  # --contact soft --torsion E: every contact soft (None: the file's, else point)
+    torsion: float | None = None  # --contact soft --torsion E: every contact soft; 0: point; None: the file's
 
     simulate: SimulateOptions | None = None
 

@@ -32,7 +32,7 @@ from ..sim.path import PathRun, run_path
 from ..sim.scene import Scene, build_scene
 from .options import NOT_SIMULATED, SimulateOptions
 from .outputs import Output
-from .placement import read
+from .placement import place_grasp, read
 from .pool import Pool, pool_size
 
 __all__ = [
@@ -429,8 +429,9 @@ def simulate(
     Parameters
     ----------
     grasp : Grasp
-        With an object; a URDF hand placed (:func:`grasptwist.place_grasp`), as
-        :func:`grasptwist.read_grasps` gives it.
+        With an object, as :func:`grasptwist.read_grasps` gives it: a URDF hand not yet on its
+        contacts is placed first (:func:`grasptwist.place_grasp`, as every command places it), one
+        placed already is taken as it is.
     mass, friction : float, optional
         Replace the grasp's (its object's mass, density or the file's ``mass``; its ``friction``).
     table_height : float, optional
@@ -453,7 +454,8 @@ def simulate(
     Raises
     ------
     InputError
-        A grasp it cannot simulate (``no-object``, ``no-mass``, ``no-friction``, ``scene-error``)
+        A grasp it cannot simulate (``no-object``, ``no-mass``, ``no-friction``, ``scene-error``), a hand
+        that cannot be put on its contacts (``contact-off-finger``, ``unreachable``, ``outside-limits``)
         or a simulation that diverged (``simulation-unstable``), or a distance tolerance not below the
         object's size (``tolerance-too-large``).
     ValueError
@@ -461,6 +463,9 @@ def simulate(
         ``check_tolerance``), in the command line's words.
     """
     options = SimulateOptions(mass, friction, table_height, duration, *tolerance, safety)
+    grasp = place_grasp(grasp)  # the one placement, as the command line reads every grasp
+    if isinstance(grasp, InputError):
+        raise grasp
     result = simulate_grasp(options, grasp, mjcf)
     if isinstance(result, InputError):
         raise result

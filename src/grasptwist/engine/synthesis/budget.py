@@ -69,9 +69,10 @@ class Spending:
     """A :class:`Budget` as a search spends it: the clock starts here.
 
     The search stops taking candidates at ``share`` of ``seconds``; verification stops at
-    ``seconds`` (:meth:`late`).  With ``seconds``, a take is sized to end by that deadline at the
-    rate measured so far (seconds per candidate scored; the first take, before any is measured,
-    at most :data:`PROBE`), so that a slow row (a hand's) overruns it by a fraction of one take, not
+    ``seconds`` (:meth:`late`).  The first take is at most :data:`PROBE` (with ``seconds``, before
+    any rate is measured; without, the same, so that the draws do not depend on a limit not
+    reached).  With ``seconds``, a later take is sized to end by that deadline at the
+    rate measured so far (seconds per candidate scored), so that a slow row (a hand's) overruns it by a fraction of one take, not
     by a whole chunk.  ``stopped_by`` becomes ``seconds`` when either deadline cut something short.
 
     >>> t = [0.0]
@@ -93,16 +94,30 @@ class Spending:
         self.stopped_by = "candidates"
 
     def take(self, n) -> int:
-        """Up to ``n`` candidates, 0 when the budget is spent (the time only when some are left)."""
+        """Up to ``n`` candidates, 0 when the budget is spent (the time only when some are left).
+
+        The first take is a probe with or without ``seconds``, and a later one is cut short only by a
+        deadline it would pass (then ``stopped_by`` is ``seconds``): a search the candidates ended
+        draws the same takes, so the same grasps, whether or not a time limit was set
+        (``grasptwist synthesize``'s 60 s and ``grasptwist.synthesize``'s none).
+
+        >>> s = Spending(Budget(10000), 0.8)  # no time limit: the same takes
+        >>> s.take(2048), s.spent(32), s.take(2048)
+        (32, None, 2048)
+        """
         n = max(0, min(n, self.left))
-        if not n or self.search_deadline is None:
+        if not n:
+            return n
+        if not self.used:  # a first take, a probe (no rate yet where there is a deadline)
+            n = min(n, PROBE)
+        if self.search_deadline is None:
             return n
         now = self.clock()
         if now >= self.search_deadline:
             self.stopped_by = "seconds"
             return 0
-        if not self.used:  # no rate yet
-            return min(n, PROBE)
+        if not self.used:
+            return n
         fits = int((self.search_deadline - now) * self.used / max(now - self.started, 1e-12))
         if fits < n:  # the time, not the candidates, sizes this take
             self.stopped_by = "seconds"

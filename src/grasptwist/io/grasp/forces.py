@@ -196,8 +196,7 @@ def _read(fields, found, problems):
         out["friction"] = readonly([mu, mu, mu])
     soft = found.get("torsion")
     frictionless = np.flatnonzero((soft > 0) & (out["friction"] == 0)) if soft is not None and "friction" in out else ()
-    if len(frictionless):  # torsional friction is friction
-        i = int(frictionless[0])
+    for i in frictionless:  # torsional friction is friction: each such contact located
         problems.add(
             Reject(
                 "invalid-torsion",
