@@ -403,6 +403,10 @@ def _read_only(a):
     writeable flag is part of it: the grasp read-only and the wrenches writable (:func:`_grip_of`
     copies them, :class:`PreparedGrip` has a copy) keep every call to one signature, one load
     (50 ms of a process's start) and never a compile for a caller's flags.
+
+    >>> a = _read_only([[0, 0, 1]])
+    >>> a.dtype, a.flags.c_contiguous, a.flags.writeable
+    (dtype('float64'), True, False)
     """
     a = np.ascontiguousarray(a, dtype=float).view()
     a.flags.writeable = False
