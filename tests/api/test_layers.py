@@ -239,6 +239,7 @@ NOT_FOR_JSON_RESOLVE = (
     "grasptwist.engine.ik",
     "grasptwist.engine.kinematics",
     "grasptwist.engine.hands",
+    "grasptwist.engine.path",
     "grasptwist.io.urdf",
     "grasptwist.output.table",
     "grasptwist.output.follow_table",
