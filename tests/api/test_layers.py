@@ -280,8 +280,9 @@ def _loaded(*command_lines) -> list[set[str]]:
 #: The most dataclasses the modules of a JSON resolve define.  Python compiles a dataclass's
 #: methods from source as its module loads (0.5 ms each: 38 of them were a tenth of the start-up
 #: over the import floor, bench/startup.py), so the registries that need none of it (columns,
-#: formats, sections, families, output settings, tuning) are NamedTuples.
-DATACLASSES_FOR_JSON_RESOLVE = 29
+#: formats, sections, families, output settings, tuning) are NamedTuples, and a path's checks
+#: (engine.segments) load without the path's engine and its results.
+DATACLASSES_FOR_JSON_RESOLVE = 27
 
 
 def _dataclasses(modules: set[str]) -> list[str]:
