@@ -61,6 +61,17 @@ def timed(command, repeats=1):
     return best
 
 
+def byte_compiled():
+    """grasptwist's modules byte-compiled, as ``pip install`` leaves them: an editable install under
+    ``PYTHONDONTWRITEBYTECODE`` would otherwise compile every module from source at every run."""
+    import compileall
+    import os
+
+    import grasptwist
+
+    compileall.compile_dir(os.path.dirname(grasptwist.__file__), quiet=1)
+
+
 def grasptwist_command():
     """The installed ``grasptwist`` script next to this interpreter (else ``python -m grasptwist``)."""
     import shutil

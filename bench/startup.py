@@ -16,7 +16,7 @@ import subprocess
 import sys
 import time
 
-from _data import grasptwist_command
+from _data import byte_compiled, grasptwist_command
 
 EXAMPLE = os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "grasps", "polyhedron.yaml")
 
@@ -35,11 +35,7 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--runs", type=int, default=15)
     args = ap.parse_args()
-    import compileall
-
-    import grasptwist
-
-    compileall.compile_dir(os.path.dirname(grasptwist.__file__), quiet=1)
+    byte_compiled()
     base_cmd = [sys.executable, "-c", "import numpy, yaml, typer"]
     ours_cmd = grasptwist_command() + ["resolve", EXAMPLE, "--format", "json"]
     wall(base_cmd), wall(ours_cmd)  # warm the file cache

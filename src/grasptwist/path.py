@@ -5,21 +5,20 @@
 >>> integrate([Segment(1.0, twist=[0, 0, 0, 1, 0, 0])], [0.5]).position.tolist()
 [[0.5, 0.0, 0.0]]
 
-The math is in ``grasptwist.engine.path``; rigid motions in ``grasptwist.engine.se3``.
+The math is in ``grasptwist.engine.path`` (a path's segments checked in ``grasptwist.engine.segments``); rigid motions in ``grasptwist.engine.se3``.
 """
 
 from .engine.path import (
-    FRAMES,
     METHODS,
     Crossing,
     FollowResult,
     PathDegeneracies,
     Poses,
-    check_segments,
     degeneracies,
     follow,
     integrate,
 )
+from .engine.segments import FRAMES, check_segments
 from .engine.tracking import FingerTrack, track_finger
 from .model import ObjectPath, Segment
 

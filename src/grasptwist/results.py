@@ -36,7 +36,7 @@ from __future__ import annotations
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, replace
 from functools import partial
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -100,8 +100,7 @@ class Field:
         return np.asarray(getattr(result, self.name) if self.get is None else self.get(result))
 
 
-@dataclass(frozen=True)
-class Column:
+class Column(NamedTuple):
     """A group of flat columns that one array holds (see :mod:`grasptwist.output.columns`).
 
     Attributes
@@ -141,8 +140,7 @@ class Column:
         return self.flat(hand) if callable(self.flat) else self.flat
 
 
-@dataclass(frozen=True)
-class ResultKind:
+class ResultKind(NamedTuple):
     """One result kind: how it is computed, named, recorded and shown.
 
     Attributes

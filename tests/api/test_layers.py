@@ -239,6 +239,7 @@ NOT_FOR_JSON_RESOLVE = (
     "grasptwist.engine.ik",
     "grasptwist.engine.kinematics",
     "grasptwist.engine.hands",
+    "grasptwist.engine.path",
     "grasptwist.io.urdf",
     "grasptwist.output.table",
     "grasptwist.output.follow_table",
@@ -276,6 +277,28 @@ def _loaded(*command_lines) -> list[set[str]]:
     return found
 
 
+#: The most dataclasses the modules of a JSON resolve define.  Python compiles a dataclass's
+#: methods from source as its module loads (0.5 ms each: 38 of them were a tenth of the start-up
+#: over the import floor, bench/startup.py), so the registries that need none of it (columns,
+#: formats, sections, families, output settings, tuning) are NamedTuples, and a path's checks
+#: (engine.segments) load without the path's engine and its results.
+DATACLASSES_FOR_JSON_RESOLVE = 27
+
+
+def _dataclasses(modules: set[str]) -> list[str]:
+    """The dataclasses defined (not imported) by those of ``modules`` that are grasptwist's."""
+    import dataclasses
+    import importlib
+
+    return sorted(
+        f"{name}.{k}"
+        for name in modules
+        if name == "grasptwist" or name.startswith("grasptwist.")
+        for k, v in vars(importlib.import_module(name)).items()
+        if isinstance(v, type) and dataclasses.is_dataclass(v) and v.__module__ == name
+    )
+
+
 def _among(modules: set[str], names) -> list[str]:
     return sorted(m for m in modules for n in names if m == n or m.startswith(n + "."))
 
@@ -289,6 +312,7 @@ def test_a_json_resolve_of_one_file_imports_no_force_hand_table_or_plot_module()
     )
     assert "grasptwist.engine.decompose" in json_run and "orjson" in json_run  # it did run
     assert _among(json_run, NOT_FOR_JSON_RESOLVE) == []
+    assert len(_dataclasses(json_run)) <= DATACLASSES_FOR_JSON_RESOLVE, _dataclasses(json_run)
     # the names are right: the commands that need these modules load them
     assert {"grasptwist.engine.forces.grip", "grasptwist.run.forces"} <= forces_run
     assert {"grasptwist.output.table", "rich", "grasptwist.engine.kinematics"} <= table_run

@@ -772,6 +772,30 @@ def test_the_compiled_grip_answers_each_row_as_alone(compiled_path):
         assert alone[0, kernel._TOTAL] == pytest.approx(out[i, kernel._TOTAL], rel=1e-12, abs=0)
 
 
+@pytest.mark.slow  # over a second: numba's first load (a compile where its cache is cold)
+def test_grips_of_any_array_flags_share_one_compiled_signature():
+    """numba loads (or compiles) one function per signature and an array's writeable flag is part of it:
+    read-only and writable grasps and wrenches, one friction or one per contact, a prepared grip, all
+    call the kernel with one signature (each more was 50 ms of a process's start)."""
+    pytest.importorskip("numba")
+    code = """if True:
+        import numpy as np, grasptwist as gt
+        from grasptwist.engine.forces import compiled
+        p = np.array({p}); n = -p; w = np.array([[0, 0, 1.0, 0, 0, 0]] * 2)
+        gt.grip(p, n, w, 0.5)
+        for a in (p, n, w):
+            a.flags.writeable = False
+        gt.grip(p, n, w, [0.5, 0.6, 0.7])
+        gt.grip(p[None].repeat(2, 0), n[None].repeat(2, 0), w, np.full((2, 3), 0.5))
+        gt.forces.prepare_grip(p, n, 0.5).grip(w[0])
+        signatures = compiled.kernel().grip_rows.signatures
+        assert len(signatures) == 1, signatures
+    """
+    env = dict(os.environ, GRASPTWIST_NUMBA="1")
+    done = subprocess.run([sys.executable, "-c", code.format(p=EQ.tolist())], capture_output=True, text=True, env=env)
+    assert done.returncode == 0, done.stderr
+
+
 def test_importing_grasptwist_imports_no_numba():
     """The compiled kernel is loaded on the first grip, never at import (the CLI's start-up stays short)."""
     code = "import sys, grasptwist, grasptwist.cli; assert 'numba' not in sys.modules, 'numba imported'"

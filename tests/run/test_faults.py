@@ -307,8 +307,8 @@ def test_a_stop_signal_ends_a_parallel_run_cleanly(tmp_path, rows, sig, group, t
 def test_a_stop_signal_removes_the_npz_spill(tmp_path, rows):
     # the npz format with a spill threshold of 1 MiB instead of 512 MiB, so that a small data set spills
     launcher = (
-        "import dataclasses; from grasptwist.output import formats, npz; "
-        "formats.FORMATS['npz'] = dataclasses.replace(formats.FORMATS['npz'], "
+        "from grasptwist.output import formats, npz; "
+        "formats.FORMATS['npz'] = formats.FORMATS['npz']._replace("
         "open=lambda out, kind, order='omega-v', **_: npz.NpzWriter(out, order, spill_bytes=1 << 20)); "
         "from grasptwist.cli import main; main()"
     )

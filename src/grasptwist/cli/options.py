@@ -477,7 +477,7 @@ def segments_option(twists, durations, frame):
             f"each --twist needs a --duration: got {len(twists or ())} and {len(durations or ())}",
             param_hint="--duration",
         )
-    from ..engine.path import check_segments
+    from ..engine.segments import check_segments
     from ..model import Segment
 
     segments = [Segment(d, twist=parse_floats(t, 6, "--twist"), frame=frame) for t, d in zip(twists, durations)]

@@ -3,7 +3,8 @@
 from __future__ import annotations
 
 import os
-from dataclasses import dataclass, field, replace
+from dataclasses import replace
+from typing import NamedTuple
 
 from ..output.formats import FORMATS
 from .diagnostics import Diagnostics, Warnings, error_code, progress_bar, table_hint
@@ -12,8 +13,7 @@ from .exits import EXIT_FAILED, EXIT_OK, EXIT_USAGE, failed, output_target
 __all__ = ["OutputSettings", "worker_count", "write_records"]
 
 
-@dataclass(frozen=True)
-class OutputSettings:
+class OutputSettings(NamedTuple):
     """What a command takes beyond its job: where the records go,
     how many processes make them, what stderr says, and how tables print numbers."""
 
@@ -21,7 +21,7 @@ class OutputSettings:
     quiet: bool
     warnings: Warnings
     workers: int
-    table_options: dict = field(default_factory=dict)
+    table_options: dict = {}  # read, never written: a table writer's keywords
     reads: tuple = ()  # files read besides the paths (--twists-from, --hand): never the output either
 
 

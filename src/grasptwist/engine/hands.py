@@ -14,7 +14,7 @@ import numpy as np
 
 from .fingertips import tip_centers, tip_radii
 from .kinematics import ChainState, forward_kinematics
-from .path import check_segments
+from .segments import check_segments
 from .tracking import FingerTrack, track_fingers
 
 __all__ = [

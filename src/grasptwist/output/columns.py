@@ -15,9 +15,8 @@ them empty, Parquet as nulls.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
 from enum import IntEnum
-from typing import Any
+from typing import Any, NamedTuple
 
 import numpy as np
 
@@ -47,8 +46,7 @@ __all__ = [
 ]
 
 
-@dataclass(frozen=True)
-class ColumnSet:
+class ColumnSet(NamedTuple):
     """A family's rows as columns: the CSV header and lines, Parquet's typed columns, npz's arrays.
 
     Every function takes the run's ``hand`` (whose joints name columns of

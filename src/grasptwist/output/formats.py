@@ -20,9 +20,8 @@ run's job, never from the command's name:
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
 from importlib import import_module
-from typing import IO, Any
+from typing import IO, Any, NamedTuple
 
 from .records import dumps
 from .writers import JsonArray, Lines
@@ -30,8 +29,7 @@ from .writers import JsonArray, Lines
 __all__ = ["OutputFormat", "FORMATS", "json_rows", "csv_lines"]
 
 
-@dataclass(frozen=True)
-class OutputFormat:
+class OutputFormat(NamedTuple):
     """One output format.
 
     Attributes

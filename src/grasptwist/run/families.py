@@ -51,7 +51,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field
-from typing import Any
+from typing import Any, NamedTuple
 
 from ..io.inputs import GRASP_SUFFIXES, OBJECT_SUFFIXES
 from ..output.formats import FORMATS
@@ -76,8 +76,7 @@ __all__ = [
 ]
 
 
-@dataclass(frozen=True)
-class Family:
+class Family(NamedTuple):
     """One family of rows: its options, how they are computed, their columns.
 
     Attributes
@@ -130,8 +129,7 @@ class Family:
     suffixes: tuple[str, ...] = GRASP_SUFFIXES
 
 
-@dataclass(frozen=True)
-class Contribution:
+class Contribution(NamedTuple):
     """What a family adds to another command's records: fields per row and a table column.
 
     Attributes

@@ -22,7 +22,7 @@ from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
 from functools import partial
-from typing import Any
+from typing import Any, NamedTuple
 
 from ..io.datasets import DATASET_SUFFIXES, open_dataset
 from ..io.grasp import READING, Reading
@@ -83,8 +83,7 @@ class Job:
         return self.command.family
 
 
-@dataclass(frozen=True, kw_only=True)
-class Tuning:
+class Tuning(NamedTuple):
     """How work is cut up and how much of it may wait: sizes that change
     speed and memory, never output.
 

@@ -23,8 +23,9 @@ import numpy as np
 from .. import se3
 from ..degeneracy import DEGENERACY_TOL
 from ..objects import mass_properties
-from ..path import Poses, check_segments, integrate, overflowing, pose_overflowed
+from ..path import Poses, integrate, overflowing, pose_overflowed
 from ..screws import cross
+from ..segments import check_segments
 from .grasp_map import ForceStatus
 from .grip import Grip, grip
 

@@ -41,7 +41,7 @@ def _frame(node, path, problems):
     """``space`` or ``body``."""
     if node.kind == "invalid":
         return None
-    from ...engine.path import FRAMES  # paths, their engine and SE(3) only for documents with paths
+    from ...engine.segments import FRAMES  # paths checked only for documents with paths
 
     if node.kind != "scalar" or node.value not in FRAMES:
         problems.add(Reject("invalid-frame", path, f"expected space or body, got {describe(node)}", **located(node)))
@@ -60,7 +60,7 @@ def _segments(node, path, frame, problems):
     segments = [_segment(item, f"{path}[{k}]", frame, problems) for k, item in enumerate(items)]
     if problems.count:
         return None
-    from ...engine.path import check_segments
+    from ...engine.segments import check_segments
 
     try:
         return check_segments(segments)
