@@ -138,7 +138,7 @@ class Closure:
         wrench ``y`` that no forces within the cones have a positive component along
         (``y . G_i g_i <= 0`` for every admissible ``g_i`` of every contact: ``-G_i^T y`` in each dual
         cone), so the grasp cannot exert ``y`` (nor resist the load ``-y``); scaled to
-        ``|(y_F, L y_M)| = 1`` as :attr:`~grasptwist.engine.forces.grip.Grip.certificate`.  NaN where it
+        ``|(y_F, L y_M)| = 1`` as ``Grip.certificate``.  NaN where it
         is force closure, where the status is a degeneracy, and where the friction is NaN.
     """
 
@@ -552,11 +552,11 @@ def force_closure(
         The grasp's own ``mu_i`` (for ``force_closure`` and ``epsilon``).
     torsion : None, scalar or (..., 3) array
         Soft-finger contacts' torsional radii ``e_i >= 0`` (a length; 0 a point contact), as
-        :func:`~grasptwist.engine.forces.grip.grip`'s: rows with a soft contact are judged over the
+        :func:`grasptwist.forces.grip`'s: rows with a soft contact are judged over the
         contacts' cones (module docstring), the others as point contacts, bit for bit.
     certificate : bool
         Also a certificate for each grasp that is not force closure with ``friction`` (needs it):
-        :attr:`Closure.certificate`.
+        ``Closure.certificate``.
     quality : bool
         Also compute Ferrari-Canny's ``epsilon`` (needs ``friction`` and scipy;
         one Qhull call per grasp).
