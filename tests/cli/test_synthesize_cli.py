@@ -36,7 +36,8 @@ def test_records_carry_every_score_and_the_grasp_file_is_read_back_by_every_comm
     assert set(rec["contacts"][0]) == {"name", "point", "normal", "surface_distance", "edge_distance"}
     assert rec["contacts"][0]["edge_distance"] is None  # a ball has no crease
     assert rec["contacts"][0]["name"] == "thumb" and rec["contacts"][0]["surface_distance"] < 1e-12
-    assert set(rec["scores"]["total_normal_force"]) == {"hold", "turn-z"}  # --mass replaces the file's weight
+    loads = {"load +x", "load -x", "load +y", "load -y", "load +z"}  # the hold test's, beside the weight (-z)
+    assert set(rec["scores"]["total_normal_force"]) == {"hold", "turn-z", *loads}  # --mass replaces the file's weight
     assert rec["scores"]["epsilon"] is None and rec["scores"]["closure_friction"] < 0.5
     assert set(rec["scores"]["conditioning"]) == {"off_tangent", "tangent"}
     assert 0 <= rec["scores"]["hold_friction"] <= rec["scores"]["closure_friction"] + 1e-9  # bisected to 2^-30 mu
@@ -50,8 +51,19 @@ def test_records_carry_every_score_and_the_grasp_file_is_read_back_by_every_comm
     assert grasps[2].object is not None and float(grasps[2].friction[0]) == 0.5
     forces, _ = run("forces", found, "-f", "jsonl")
     assert forces.exit_code == 0, forces.stderr
-    held = [x for x in jsonl(forces.stdout) if x["grasp"] == "sphere-equator-1" and x["wrench"]["name"] == "hold"]
-    assert held[0]["grip"]["total_normal_force"] == pytest.approx(rec["scores"]["total_normal_force"]["hold"])
+    held = {x["wrench"]["name"]: x for x in jsonl(forces.stdout) if x["grasp"] == "sphere-equator-1"}
+    assert set(held) == {"hold", "turn-z", *loads}  # the grasp file keeps every wrench the grasp holds
+    for name, total in rec["scores"]["total_normal_force"].items():  # each load's grip, found again by forces
+        assert held[name]["grip"]["total_normal_force"] == pytest.approx(total)
+    units = {
+        "load +x": [1, 0, 0],
+        "load -x": [-1, 0, 0],
+        "load +y": [0, 1, 0],
+        "load -y": [0, -1, 0],
+        "load +z": [0, 0, 1],
+    }
+    for name, u in units.items():  # 1 kg: 9.81 N against each direction, at the ball's centre (the origin)
+        np.testing.assert_allclose(held[name]["wrench"]["wrench"], [*(-9.81 * np.array(u)), 0, 0, 0], atol=1e-12)
     resolved, _ = run("resolve", found, "--twist", "0,0,1,0,0,0", "-f", "jsonl")
     assert resolved.exit_code == 0 and len(jsonl(resolved.stdout)) == 4, resolved.stderr
 
@@ -80,8 +92,9 @@ def test_csv_has_a_row_per_grasp_and_the_table_names_them():
     rows = list(csv.DictReader(io.StringIO(r.stdout)))
     assert [row["rank"] for row in rows] == ["1", "1"]
     assert float(rows[0]["total_normal_force"]) > 0 and rows[0]["ok"] == "true"
-    table, _ = run("synthesize", SPHERE, "--friction", "0.5", "--mass", "1", *ONE)
+    table, _ = run("synthesize", SPHERE, "--friction", "0.5", "--mass", "1", *ONE, "--loads", "weight")
     assert "grasp 'sphere-equator'" in table.stdout and "#1  total normal force: hold" in table.stdout
+    assert "turn-z" in table.stdout and "load +" not in table.stdout  # the weight alone, and the file's own wrench
 
 
 def test_no_feasible_grasp_is_one_record_with_the_tightest_constraint_and_exit_1():
@@ -111,6 +124,7 @@ def test_a_file_without_object_or_friction_is_an_error_of_its_own(tmp_path):
     ("args", "message"),
     [
         (("--objective", "speed"), "speed"),
+        (("--loads", "all"), "--loads"),
         (("--hand", "missing-hand.yaml"), "--hand"),
     ],
 )
@@ -473,7 +487,8 @@ def test_wrench_adds_to_the_object_s_weight_never_replaces_it():
     recs = jsonl(r.stdout)
     assert set(recs[0]["scores"]["total_normal_force"]) == {"0,0,0,0,0,0.02"}  # the tripod ball has no mass
     totals = recs[1]["scores"]["total_normal_force"]
-    assert set(totals) == {"hold", "0,0,0,0,0,0.02"}  # the file's turn-z replaced, its 1 kg still held
+    loads = {"load +x", "load -x", "load +y", "load -y", "load +z"}
+    assert set(totals) == {"hold", "0,0,0,0,0,0.02", *loads}  # the file's turn-z replaced, its 1 kg still held
     assert totals["hold"] >= 9.81 / np.sqrt(1 + 0.5**2) * (1 - 1e-9)  # no grip holds 1 kg with less
 
 
