@@ -6,13 +6,12 @@ Run: ``python bench/simulate.py [-n 10] [-j 2] [--candidates 2000] [--seconds 12
 1. For each object (the bundled ball's two grasp files, box, cylinder and bottle (a mesh), with
    fingertip spheres on slides, no hand; and the TriFinger on the bundled cube on its table),
    ``grasptwist synthesize -n N -o FOLDER/NAME.yaml`` (100 g, ``mu = 0.8``; the cube 94 g,
-   ``mu = 1``): the grasps the search returns for the object's weight, as a grasp file; then
+   ``mu = 1``): the grasps the search returns by default (``--loads six``: a grip for the weight
+   and for each of the hold test's other loads, BODex's protocol), as a grasp file; then
    ``grasptwist simulate FOLDER -j J -f jsonl``, a file a process: how many hold in all six
    directions, and which directions the others lose (a direction without a grip is not
-   simulated: the search asked only for the weight, downwards).
-2. The same searches with ``--simulate`` (the search asks for a grip for each of the six loads,
-   BODex's protocol, and MuJoCo keeps those that hold): how many of the grasps found held
-   (stderr counts those dropped).
+   simulated).
+2. The same with ``--loads weight`` (the search asks for the weight alone, downwards).
 3. One hold test of the TriFinger holding the cube on its table (``grasps/trifinger-cube.yaml``,
    94 g, ``mu = 1``): the process CPU of ``simulate_grasp``, best of five (6 s of simulated time).
 """
@@ -20,7 +19,6 @@ Run: ``python bench/simulate.py [-n 10] [-j 2] [--candidates 2000] [--seconds 12
 import argparse
 import json
 import os
-import re
 import subprocess
 import sys
 import tempfile
@@ -51,11 +49,12 @@ def _search(file, mass, friction, count, candidates, seconds, *more):
     )  # fmt: skip
 
 
-def held_fraction(objects, count, workers, candidates, seconds):
-    """Of the grasps the search returns for the weight: how many hold, which directions the others lose."""
+def held_fraction(objects, count, workers, candidates, seconds, loads):
+    """Of the grasps the search returns for ``--loads``: how many hold, which directions the others lose."""
     with tempfile.TemporaryDirectory() as folder:
         for name, (file, mass, friction) in objects.items():
-            found = _search(file, mass, friction, count, candidates, seconds, "-o", Path(folder) / f"{name}.yaml")
+            grasps = Path(folder) / f"{name}.yaml"
+            found = _search(file, mass, friction, count, candidates, seconds, "--loads", loads, "-o", grasps)
             if found.returncode not in (0, 1):
                 sys.exit(found.stderr)
         start = time.perf_counter()
@@ -74,16 +73,6 @@ def held_fraction(objects, count, workers, candidates, seconds):
     no_grip_held = sum(rec["held"] and any(not d["simulated"] for d in rec["directions"]) for rec in records)
     held = sum(rec.get("held", False) for rec in records)
     return held, len(records), lost, no_grip, no_grip_held, wall
-
-
-def simulated_fraction(objects, count, candidates, seconds):
-    """Of the grasps the search finds with ``--simulate`` (a grip for every load): how many held."""
-    kept = dropped = 0
-    for file, mass, friction in objects.values():
-        run = _search(file, mass, friction, count, candidates, seconds, "--simulate", "-f", "jsonl")
-        kept += sum(json.loads(line).get("ok", False) for line in run.stdout.splitlines())
-        dropped += sum(int(n) for n in re.findall(r"; (\d+) dropped: they did not hold", run.stderr))
-    return kept, kept + dropped
 
 
 def trifinger_cpu(repeat=5):
@@ -113,17 +102,14 @@ def main():
         ("fingertips on slides (ball, box, cylinder, bottle)", FINGERTIPS),
         ("TriFinger", TRIFINGER),
     ):
-        held, total, lost, no_grip, no_grip_held, wall = held_fraction(
-            objects, args.n, args.j, args.candidates, args.seconds
-        )
-        print(f"{title}, searched for the weight: {held} of {total} hold in all six directions "
-              f"({held / max(total, 1):.0%}; {no_grip} without a grip in some direction, {no_grip_held} of them held), "
-              f"simulated in {wall:.1f} s of wall with -j {args.j} on {os.cpu_count()} cores")  # fmt: skip
-        print("  directions lost: " + (", ".join(f"{d} {n}" for d, n in sorted(lost.items())) or "none"))
-        kept, found = simulated_fraction(objects, args.n, args.candidates, args.seconds)
-        print(
-            f"{title}, searched with --simulate (a grip for each load): {kept} of {found} held ({kept / max(found, 1):.0%})"
-        )
+        for loads in ("six", "weight"):
+            held, total, lost, no_grip, no_grip_held, wall = held_fraction(
+                objects, args.n, args.j, args.candidates, args.seconds, loads
+            )
+            print(f"{title}, --loads {loads}: {held} of {total} hold in all six directions "
+                  f"({held / max(total, 1):.0%}; {no_grip} without a grip in some direction, {no_grip_held} of them held), "
+                  f"simulated in {wall:.1f} s of wall with -j {args.j} on {os.cpu_count()} cores")  # fmt: skip
+            print("  directions lost: " + (", ".join(f"{d} {n}" for d, n in sorted(lost.items())) or "none"))
     cpu, ok = trifinger_cpu()
     print(f"one TriFinger hold test (6 s simulated): {cpu:.3f} s of CPU, held: {ok}")
 

@@ -81,11 +81,8 @@ def baseline(candidates, seed=0, closure=True):
 
 
 def trifinger():
-    """The bundled TriFinger grasp file's grasp, its cube of 100 g on its table."""
-    from dataclasses import replace
-
-    g = gt.read_grasps("grasps/trifinger-cube.yaml")[0]
-    return replace(g, object=replace(g.object, mass=0.1))
+    """The bundled TriFinger grasp file's grasp, its cube on its table (100 g: :func:`hand_search`'s ``mass``)."""
+    return gt.read_grasps("grasps/trifinger-cube.yaml")[0]
 
 
 def hand_search(grasp, count, candidates, seed=0, objective="robust"):
@@ -93,7 +90,7 @@ def hand_search(grasp, count, candidates, seed=0, objective="robust"):
     hand's link meshes, the fingers against each other, its table; the default options):
     ``(Synthesis, wall seconds, CPU seconds)``."""
     t, cpu = time.perf_counter(), time.process_time()
-    s = gt.synthesize(grasp, MU, count=count, candidates=candidates, seed=seed, objective=objective)
+    s = gt.synthesize(grasp, MU, mass=0.1, count=count, candidates=candidates, seed=seed, objective=objective)
     return s, time.perf_counter() - t, time.process_time() - cpu
 
 

@@ -212,7 +212,7 @@ def synthesize_bag(objects, *, hand: str | None = None, **options):
         ``mass``, ``safety``, ``objective``, ``method``, ``min_conditioning`` (0.05),
         ``min_spacing``, ``quality``, ``seed`` (0), ``candidates`` (20000), ``seconds`` (60),
         ``position_error``, ``friction_error`` (0.2), ``perturbations`` (64),
-        ``tip_radius``.
+        ``tip_radius``, ``loads`` (``"six"``: a grip for the hold test's loads too; ``"weight"``).
 
     Returns
     -------

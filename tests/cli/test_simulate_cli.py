@@ -187,7 +187,8 @@ def test_synthesize_simulate_keeps_only_the_grasps_that_hold_and_counts_the_othe
     r, _ = run(*args, "--candidates", "400", "--simulate", "-o", found, "-f", "jsonl")
     assert r.exit_code in (0, 1), r.stderr
     kept = [rec for rec in jsonl(r.stdout) if rec["ok"]]
-    # the search finds 4 (seeded), each with a grip for the six loads of the hold test beside the weight;
+    # the search finds 4 (seeded), each with a grip for the six loads of the hold test beside the weight (the
+    # default, --loads six);
     # MuJoCo drops those that do not hold, and stderr counts them (measured: none is dropped; before the
     # search asked for the six loads and the hold test squeezed, 1 to 3 were)
     dropped = 4 - len(kept)
@@ -202,6 +203,8 @@ def test_synthesize_simulate_keeps_only_the_grasps_that_hold_and_counts_the_othe
         assert all(d["held"] and d["displacement"] < 0.002 and d["rotation_deg"] < 2 for d in sim["directions"])
     plain, _ = run(*args, "--candidates", "400", "-f", "jsonl")  # without --simulate: null
     assert {rec["simulation"] for rec in jsonl(plain.stdout)} == {None}
+    # --simulate changes nothing in the search (the six loads are the default, --loads six): the same grasps
+    assert [r["contacts"] for r in jsonl(plain.stdout)] == [r["contacts"] for r in kept]
     sims, _ = run("simulate", found, *SHORT, "-f", "jsonl")  # each grasp kept holds, simulated from the file
     assert [s["held"] for s in jsonl(sims.stdout)] == [True] * len(kept)
 

@@ -12,16 +12,41 @@ from hostile import jsonl, on_a_terminal, run, run_installed
 from places import GRASPS, ROOT
 
 SPHERE = GRASPS / "sphere.yaml"  # two balls: 'sphere-tripod' has no friction or mass, 'sphere-equator' both
-FAST = ("--candidates", "120", "-n", "2")
-ONE = ("--candidates", "120", "-n", "1")  # each grasp's hold friction is bisected: one grasp where one shows it
+#: The weight alone where the hold test's loads (the default, --loads six) are beside the point: with numpy's
+#: grip (the tests') the five loads cost each grasp's margins and robustness five more grips each; the loads
+#: are tested in sphere_found's search.
+WEIGHT = ("--loads", "weight")
+FAST = ("--candidates", "120", "-n", "2", *WEIGHT)
+ONE = (
+    "--candidates",
+    "120",
+    "-n",
+    "1",
+    *WEIGHT,
+)  # each grasp's hold friction is bisected: one grasp where one shows it
 
 
 @pytest.fixture(scope="module")
 def sphere_found(tmp_path_factory):
     """One search on both balls, its records and its grasp file, shared by the tests that read them."""
     found = tmp_path_factory.mktemp("synthesize") / "found.yaml"
-    r, _ = run("synthesize", SPHERE, "--friction", "0.5", "--mass", "1", *FAST, "-o", found, "-f", "jsonl")
-    assert r.exit_code == 0, r.stderr
+    r, _ = run(
+        "synthesize",
+        SPHERE,
+        "--friction",
+        "0.5",
+        "--mass",
+        "1",
+        "--candidates",
+        "120",
+        "-n",
+        "2",
+        "-o",
+        found,
+        "-f",
+        "jsonl",
+    )
+    assert r.exit_code == 0, r.stderr  # the default --loads six
     return r, found
 
 
@@ -36,7 +61,8 @@ def test_records_carry_every_score_and_the_grasp_file_is_read_back_by_every_comm
     assert set(rec["contacts"][0]) == {"name", "point", "normal", "surface_distance", "edge_distance"}
     assert rec["contacts"][0]["edge_distance"] is None  # a ball has no crease
     assert rec["contacts"][0]["name"] == "thumb" and rec["contacts"][0]["surface_distance"] < 1e-12
-    assert set(rec["scores"]["total_normal_force"]) == {"hold", "turn-z"}  # --mass replaces the file's weight
+    loads = {"load +x", "load -x", "load +y", "load -y", "load +z"}  # the hold test's, beside the weight (-z)
+    assert set(rec["scores"]["total_normal_force"]) == {"hold", "turn-z", *loads}  # --mass replaces the file's weight
     assert rec["scores"]["epsilon"] is None and rec["scores"]["closure_friction"] < 0.5
     assert set(rec["scores"]["conditioning"]) == {"off_tangent", "tangent"}
     assert 0 <= rec["scores"]["hold_friction"] <= rec["scores"]["closure_friction"] + 1e-9  # bisected to 2^-30 mu
@@ -50,8 +76,19 @@ def test_records_carry_every_score_and_the_grasp_file_is_read_back_by_every_comm
     assert grasps[2].object is not None and float(grasps[2].friction[0]) == 0.5
     forces, _ = run("forces", found, "-f", "jsonl")
     assert forces.exit_code == 0, forces.stderr
-    held = [x for x in jsonl(forces.stdout) if x["grasp"] == "sphere-equator-1" and x["wrench"]["name"] == "hold"]
-    assert held[0]["grip"]["total_normal_force"] == pytest.approx(rec["scores"]["total_normal_force"]["hold"])
+    held = {x["wrench"]["name"]: x for x in jsonl(forces.stdout) if x["grasp"] == "sphere-equator-1"}
+    assert set(held) == {"hold", "turn-z", *loads}  # the grasp file keeps every wrench the grasp holds
+    for name, total in rec["scores"]["total_normal_force"].items():  # each load's grip, found again by forces
+        assert held[name]["grip"]["total_normal_force"] == pytest.approx(total)
+    units = {
+        "load +x": [1, 0, 0],
+        "load -x": [-1, 0, 0],
+        "load +y": [0, 1, 0],
+        "load -y": [0, -1, 0],
+        "load +z": [0, 0, 1],
+    }
+    for name, u in units.items():  # 1 kg: 9.81 N against each direction, at the ball's centre (the origin)
+        np.testing.assert_allclose(held[name]["wrench"]["wrench"], [*(-9.81 * np.array(u)), 0, 0, 0], atol=1e-12)
     resolved, _ = run("resolve", found, "--twist", "0,0,1,0,0,0", "-f", "jsonl")
     assert resolved.exit_code == 0 and len(jsonl(resolved.stdout)) == 4, resolved.stderr
 
@@ -62,7 +99,7 @@ def test_the_robustness_options_are_checked_and_change_the_robustness_only(tmp_p
         assert r.exit_code == 2 and option in r.stderr, r.stderr
     box = tmp_path / "box.yaml"
     box.write_text("name: box\nobject:\n  box: [0.065, 0.065, 0.065]\n  mass: 0.1\nfriction: 0.8\n")
-    plain = ("--objective", "total_normal_force", "-f", "csv", "--candidates", "500", "-n", "2")
+    plain = ("--objective", "total_normal_force", "-f", "csv", "--candidates", "500", "-n", "2", *WEIGHT)
     rows = []
     for more in ((), ("--position-error", "0.01", "--friction-error", "0.5", "--perturbations", "16")):
         r, _ = run("synthesize", box, *plain, *more)
@@ -82,6 +119,7 @@ def test_csv_has_a_row_per_grasp_and_the_table_names_them():
     assert float(rows[0]["total_normal_force"]) > 0 and rows[0]["ok"] == "true"
     table, _ = run("synthesize", SPHERE, "--friction", "0.5", "--mass", "1", *ONE)
     assert "grasp 'sphere-equator'" in table.stdout and "#1  total normal force: hold" in table.stdout
+    assert "turn-z" in table.stdout and "load +" not in table.stdout  # the weight alone, and the file's own wrench
 
 
 def test_no_feasible_grasp_is_one_record_with_the_tightest_constraint_and_exit_1():
@@ -111,6 +149,7 @@ def test_a_file_without_object_or_friction_is_an_error_of_its_own(tmp_path):
     ("args", "message"),
     [
         (("--objective", "speed"), "speed"),
+        (("--loads", "all"), "--loads"),
         (("--hand", "missing-hand.yaml"), "--hand"),
     ],
 )
@@ -357,6 +396,7 @@ def test_a_folder_on_two_workers_gives_the_records_of_one(tmp_path):
             "jsonl",
             "-j",
             j,
+            *WEIGHT,
         )
         assert r.exit_code == 0, r.stderr
         got.append([{**x, "search": {**x["search"], "seconds": None}} for x in jsonl(r.stdout)])
@@ -460,7 +500,7 @@ def test_a_folder_s_mesh_files_are_searched_beside_its_grasp_files(tmp_path):
     (tmp_path / "bad.yaml").write_text("contacts: [\n")
     (tmp_path / "oct.obj").write_text(OCTAHEDRON)
     (tmp_path / "notes.txt").write_text("not an object")
-    args = ("--friction", "0.6", "--mass", "0.2", "--candidates", "60", "-n", "1", "-j", "2", "-f", "jsonl")
+    args = ("--friction", "0.6", "--mass", "0.2", "--candidates", "60", "-n", "1", "-j", "2", "-f", "jsonl", *WEIGHT)
     r, _ = run("synthesize", tmp_path, *args)
     assert r.exit_code == 1  # bad.yaml's error
     recs = jsonl(r.stdout)
@@ -515,7 +555,7 @@ def test_csv_with_a_hand_has_its_reach_errors_and_joint_positions():
 
 def test_the_off_tangent_method_without_a_wrist_is_said_once_per_object(tmp_path):
     (tmp_path / "oct.obj").write_text(OCTAHEDRON)
-    args = ("--friction", "0.6", "--mass", "0.2", "--candidates", "60", "-n", "1", "--method", "off-tangent")
+    args = ("--friction", "0.6", "--mass", "0.2", "--candidates", "60", "-n", "1", "--method", "off-tangent", *WEIGHT)
     r, _ = run("synthesize", tmp_path / "oct.obj", SPHERE, *args)
     assert r.exit_code == 0, r.stderr
     said = "grasp 'oct': warning: off-tangent conditioning not checked without a wrist"
@@ -527,7 +567,7 @@ def test_the_off_tangent_method_without_a_wrist_is_said_once_per_object(tmp_path
 
 def test_the_summary_says_how_many_of_the_grasps_wanted_and_tip_radius_without_a_hand_warns(tmp_path):
     (tmp_path / "oct.obj").write_text(OCTAHEDRON)
-    args = ("--friction", "0.6", "--mass", "0.2", "--candidates", "60", "--method", "tangent")
+    args = ("--friction", "0.6", "--mass", "0.2", "--candidates", "60", "--method", "tangent", *WEIGHT)
     r, _ = run("synthesize", tmp_path / "oct.obj", *args, "-n", "50", "--min-spacing", "0.2", "--tip-radius", "0.01")
     assert r.exit_code == 0, r.stderr
     assert "grasp 'oct': 1 of 50 grasps wanted (min spacing 0.2) from 60 candidates scored" in r.stderr

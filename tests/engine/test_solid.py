@@ -170,7 +170,7 @@ def test_synthesized_grasps_are_verified_on_the_outer_surface_of_every_mesh(name
     """0.5.0: IndexError in mesh_creases (the given faces against the outer surface's) on every mesh with
     faces inside its solid, a broadcast ValueError on crossing pieces."""
     o = any_object(name, density=700.0)
-    s = gt.synthesize(o, 0.8, count=2, candidates=300, perturbations=8)
+    s = gt.synthesize(o, 0.8, count=2, candidates=300, perturbations=8, loads="weight")  # the surface's test
     assert len(s.points) == 2 and s.unverified == 0
     assert on_the_outer_surface(o, s.points.reshape(-1, 3), s.normals.reshape(-1, 3)).all()
     assert np.isfinite(s.edge_distance).all() and (s.edge_distance >= 0).all()  # every mesh here has creases
@@ -267,7 +267,7 @@ def test_an_open_mesh_warns_its_hole(tmp_path):
 
 def test_a_synthesized_grasp_keeps_to_one_body_unless_told():
     o = mesh_object("two_bodies.obj", density=700.0)
-    s = gt.synthesize(o, 0.8, count=2, candidates=1500)
+    s = gt.synthesize(o, 0.8, count=2, candidates=1500, loads="weight")  # the bodies' test: the weight is enough
     bodies = body_of(o, s.points)
     assert len(s.points) and (bodies == bodies[:, :1]).all()
 

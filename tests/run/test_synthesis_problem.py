@@ -14,6 +14,7 @@ import grasptwist as gt
 from grasptwist.cli import app
 from grasptwist.engine.synthesis.problem import Problem
 from grasptwist.run.grasp_search import grasp_problem
+from grasptwist.run.options import SynthesisOptions
 from places import GRASPS
 
 SPHERE = GRASPS / "sphere.yaml"  # 'sphere-equator': friction, a mass and a second wrench of its own
@@ -90,13 +91,18 @@ def test_the_library_the_command_line_and_dask_s_task_give_the_same_grasps():
     np.testing.assert_array_equal(points_of(bag), api.points)
 
 
+LOADS = ("load +x", "load -x", "load +y", "load -y", "load +z")  # the weight's size; -z is the weight
+
+
 def test_the_command_line_s_default_seconds_and_the_library_s_none_give_the_same_grasps():
     """``synthesize`` limits a search to 60 s by default, ``gt.synthesize`` to none: a limit not reached
     draws the same candidates (the first take a probe either way), so the same options give the same
     grasps (before: 1.5332 N on the command line, 1.1626 N in Python, on this box)."""
     box = GRASPS / "box-edge.yaml"
-    api = gt.synthesize(gt.read_grasps(box)[0], 0.5, mass=0.1, count=1, candidates=300)
+    # the weight alone, as the trial that found it asked (the six loads draw the same way)
+    api = gt.synthesize(gt.read_grasps(box)[0], 0.5, mass=0.1, count=1, candidates=300, loads="weight")
     args = ["synthesize", str(box), "-n", "1", "--friction", "0.5", "--mass", "0.1", "--candidates", "300"]
+    args += ["--loads", "weight"]
     r = CliRunner().invoke(app, [*args, "-f", "jsonl", "-q"])
     (rec,) = map(json.loads, r.stdout.splitlines())
     assert r.exit_code == 0 and api.stopped_by == rec["search"]["stopped_by"] == "candidates"
@@ -109,12 +115,12 @@ def test_the_command_line_s_default_seconds_and_the_library_s_none_give_the_same
 def test_a_grasp_document_s_problem_holds_its_weight_first_and_its_own_wrenches_after():
     task = grasp_problem(equator(), count=2)
     p = task.problem
-    assert isinstance(p, Problem) and task.names == ("hold", "turn-z") and p.wrenches.shape == (2, 6)
+    assert isinstance(p, Problem) and task.names == ("hold", "turn-z", *LOADS) and p.wrenches.shape == (7, 6)
     g = equator()
     np.testing.assert_allclose(p.wrenches[0, :3], [0, 0, 9.81 * g.mass], rtol=1e-12)  # -m g, gravity -z
     assert p.friction == task.friction == float(np.min(g.friction)) and p.weight.mass == g.mass
     # --mass replaces the object's, --wrench the file's others, --friction its friction
-    task = grasp_problem(g, mass=2.0, wrenches=[[1.0, 0, 0, 0, 0, 0]], friction=0.3)
+    task = grasp_problem(g, mass=2.0, wrenches=[[1.0, 0, 0, 0, 0, 0]], friction=0.3, loads="weight")
     assert task.names == ("hold", "1") and task.problem.weight.mass == 2.0 and task.problem.friction == 0.3
     np.testing.assert_array_equal(task.problem.wrenches[1], [1.0, 0, 0, 0, 0, 0])
 
@@ -192,13 +198,12 @@ def test_synthesize_bag_on_the_synchronous_scheduler_gives_the_library_s_grasps(
     np.testing.assert_array_equal(points_of([r for r in recs if r.get("grasp") == "sphere-equator"]), api.points)
 
 
-def test_simulate_s_six_loads_are_held_beside_the_weight():
-    # synthesize --simulate (grasp_problem's directions): the weight's size along +-x, +-y, +-z at the
-    # centre of mass, the one equal to the weight left out
+def test_the_hold_test_s_six_loads_are_held_beside_the_weight_unless_loads_is_weight():
+    # the default (--loads six): the weight's size along +-x, +-y, +-z at the centre of mass, the one
+    # equal to the weight left out, after the document's own wrenches
     g = equator()
-    plain, six = (grasp_problem(g, directions=d, **OPTIONS) for d in (False, True))
-    loads = ["load +x", "load -x", "load +y", "load -y", "load +z"]
-    assert six.names == (*plain.names, *loads)
+    plain, six = (grasp_problem(g, loads=loads, **OPTIONS) for loads in ("weight", "six"))
+    assert plain.names == ("hold", "turn-z") and six.names == (*plain.names, *LOADS)
     np.testing.assert_array_equal(six.problem.wrenches[: len(plain.names)], plain.problem.wrenches)
     weight = plain.problem.weight
     size = weight.mass * np.linalg.norm(weight.gravity)
@@ -206,3 +211,23 @@ def test_simulate_s_six_loads_are_held_beside_the_weight():
     np.testing.assert_allclose(force, -size * np.array([[1, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1]]))
     moment = six.problem.wrenches[len(plain.names) :, 3:]
     np.testing.assert_allclose(moment, np.cross(weight.center_of_mass, force), atol=1e-15)
+
+
+def test_without_a_weight_there_are_no_loads_and_an_unknown_loads_is_refused():
+    g = equator()
+    task = grasp_problem(g, hold=False, **OPTIONS)  # the file's wrench alone: nothing to turn
+    assert task.names == ("turn-z",) and task.problem.wrenches.shape == (1, 6)
+    with pytest.raises(ValueError, match="loads must be one of six, weight"):
+        grasp_problem(g, loads="all", **OPTIONS)
+    with pytest.raises(ValueError, match="loads must be one of six, weight"):
+        SynthesisOptions(loads="all")
+
+
+def test_an_object_with_a_mass_of_its_own_is_held_without_mass_given():
+    # the document's object weighs 0.1 kg, the document has no top-level mass and none is given:
+    # its weight is held all the same (it was 'nothing-to-hold')
+    g = next(iter(gt.read_grasps(GRASPS / "box-edge.yaml")))
+    g = replace(g, object=replace(g.object, mass=0.1, density=None), mass=None)
+    task = grasp_problem(g, friction=0.5, **OPTIONS)
+    assert task.names[0] == "hold" and task.problem.weight.mass == 0.1
+    np.testing.assert_allclose(task.problem.wrenches[0, :3], [0, 0, 0.981])

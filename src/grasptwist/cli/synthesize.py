@@ -52,6 +52,11 @@ class Objective(str, Enum):
     epsilon = "epsilon"
 
 
+class Loads(str, Enum):
+    six = "six"
+    weight = "weight"
+
+
 def _checked(name, module="checks"):
     """A typer callback running the engine's check ``name`` (of ``engine.synthesis.<module>``, imported
     when the option is given; or the function ``name``): the library's words, as a usage error
@@ -237,13 +242,20 @@ def synthesize(
             "--span-bodies", help="Let a grasp's contacts lie on different bodies of a mesh (default: one body)."
         ),
     ] = False,
+    loads: Annotated[
+        Loads,
+        typer.Option(
+            "--loads",
+            help="What every grasp holds when a weight is held: six (a grip for the weight's size along "
+            "+x, -x, +y, -y, +z, -z too, the hold test's loads 'load +x' ... beside the weight), or the weight alone.",
+        ),
+    ] = Loads.six,
     simulate: Annotated[
         bool,
         typer.Option(
             "--simulate",
             help="Keep only the grasps that hold in all six directions in MuJoCo (grasptwist simulate's "
-            "defaults), the search asking for a grip for each direction's load beside the weight ('load +x', "
-            "...); stderr counts the others. Needs MuJoCo: pip install 'grasptwist[sim]'.",
+            "defaults); stderr counts the others. Needs MuJoCo: pip install 'grasptwist[sim]'.",
         ),
     ] = False,
     seed: Annotated[
@@ -354,6 +366,7 @@ def synthesize(
             position_error=position_error,
             friction_error=friction_error,
             perturbations=perturbations,
+            loads=loads.value,
             simulate=SimulateOptions() if simulate else None,
         ),
     )

@@ -22,10 +22,13 @@ from .kinematics import finger_jacobian
 __all__ = [
     "DIRECTIONS",
     "UNITS",
+    "LOADS",
     "MIN_DURATION",
     "MAX_DURATION",
     "MAX_ANGLE_TOL",
     "direction_wrenches",
+    "direction_loads",
+    "check_loads",
     "squeezed",
     "joint_torques",
     "held",
@@ -37,6 +40,11 @@ __all__ = [
 #: The six directions, in the order they are tested, and their unit vectors ``(6, 3)``.
 DIRECTIONS = ("+x", "-x", "+y", "-y", "+z", "-z")
 UNITS = np.array([[1.0, 0, 0], [-1, 0, 0], [0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1]])
+
+#: What the grasps a search returns must hold (``loads=``, ``--loads``): ``six``, the weight and
+#: the hold test's loads beside it (:func:`direction_loads`), BODex's protocol; ``weight``, the
+#: weight alone.
+LOADS = ("six", "weight")
 
 #: The shortest time a direction's load is applied (seconds): 50 of the simulation's 1 ms steps,
 #: long enough for an object that slips to leave the tolerance (it falls 12 mm in 0.05 s under its
@@ -64,6 +72,17 @@ def check_duration(duration) -> float:
             f"must be at least {MIN_DURATION:g} s (50 time steps) and at most {MAX_DURATION:g} s, got {d:g}"
         )
     return d
+
+
+def check_loads(loads) -> str:
+    """``loads``, one of :data:`LOADS`, or ``ValueError``.
+
+    >>> check_loads("six")
+    'six'
+    """
+    if loads not in LOADS:
+        raise ValueError(f"loads must be one of {', '.join(LOADS)}, got {loads!r}")
+    return loads
 
 
 def check_tolerance(distance, angle) -> tuple[float, float]:

@@ -102,6 +102,7 @@ def search_options(options) -> dict:
         "perturbations": o.perturbations,
         "span_bodies": o.span_bodies,
         "torsion": o.torsion,
+        "loads": o.loads,
     }
 
 
@@ -150,7 +151,7 @@ def grasp_problem(
     environment=None,
     folder=None,
     max_bytes=MAX_URDF_BYTES,
-    directions=False,
+    loads="six",
     **options,
 ) -> Task | InputError:
     """The synthesis problem a grasp document poses, or its error: the command line's, the
@@ -172,9 +173,11 @@ def grasp_problem(
         An inline ``hand``'s tip poses at home (without them it needs the file's contacts).
     folder, max_bytes
         Where a URDF hand's files are found (default: its file's folder), its size cap.
-    directions : bool
-        A grip for the hold test's loads too (``synthesize --simulate``): the weight's size along
-        ``+-x``, ``+-y``, ``+-z`` (:func:`~grasptwist.engine.hold_test.direction_loads`), BODex's protocol.
+    loads : {"six", "weight"}
+        ``six`` (the default, ``--loads six``): whenever a weight is held, a grip for the hold test's
+        loads too, named ``load +x`` ... after the other wrenches: the weight's size along ``+-x``,
+        ``+-y``, ``+-z`` at its centre (:func:`~grasptwist.engine.hold_test.direction_loads`), BODex's
+        protocol; ``weight``: the weight alone.
     **options
         The search's (:func:`~grasptwist.engine.synthesis.problem.surface_problem`), and
         ``clearance``, ``span_bodies``, ``gravity`` (default the file's), ``hold`` (default:
@@ -197,7 +200,9 @@ def grasp_problem(
     named = _wrenches(grasp, wrenches)
     gravity = np.asarray(options.pop("gravity", None) or (GRAVITY if grasp.gravity is None else grasp.gravity), float)
     held = options.pop("hold", None)  # None: whenever there is a mass
-    held = mass is not None or grasp.mass is not None if held is None else held
+    if held is None:  # the object's mass or density, the file's top-level mass, or mass=
+        weighed = grasp.object.mass is not None or grasp.object.density is not None
+        held = mass is not None or grasp.mass is not None or weighed
     fallback = None  # a weight apart from the object: the file's top-level mass and center_of_mass
     if held and grasp.mass is not None:
         with np.errstate(over="ignore", invalid="ignore"):  # an overflow is the problem's error
@@ -235,6 +240,7 @@ def grasp_problem(
             hold=held,
             gravity=gravity,
             weight=fallback,
+            loads=loads,
             hand=reach,
             environment=environment,
             **options,
@@ -242,9 +248,8 @@ def grasp_problem(
     except ProblemError as exc:
         return _problem(grasp, *_words(grasp, exc))
     names = ((HOLD,) if held else ()) + tuple(n for n, _ in named)
-    if directions and problem.weight is not None:
-        loads, wrenches = direction_loads(problem.weight)
-        problem, names = replace(problem, wrenches=np.vstack([problem.wrenches, wrenches])), names + loads
+    if held and loads == "six":
+        names += direction_loads(problem.weight)[0]
     return Task(problem, names, hand, friction)
 
 
@@ -283,9 +288,11 @@ def synthesize(
     max_bytes=MAX_URDF_BYTES,
     tips=None,
     tip_radius=None,
+    loads="six",
     **options,
 ) -> Synthesis:
-    r"""Grasps of an object: its surface searched for grasps that hold its weight and ``wrenches``.
+    r"""Grasps of an object: its surface searched for grasps that hold its weight and ``wrenches``, and
+    by default (``loads="six"``) the weight's size along each of the six axis directions.
 
     The search scores candidate triples in batches against the constraints (degeneracy and
     conditioning of the decompositions, force closure at ``friction / safety``, a grip for every
@@ -327,6 +334,11 @@ def synthesize(
     tips, tip_radius
         Each finger's tip link pose at home (needed for a finger given inline), every
         fingertip's radius (default each finger's ``tip_radius``).
+    loads : {"six", "weight"}
+        What every grasp holds besides ``wrenches`` when a weight is held: ``six`` (the default), a
+        grip for the weight's size along each of ``+-x, +-y, +-z`` at the centre of mass too (the hold
+        test's loads, BODex's protocol: ``grasptwist.engine.hold_test.direction_loads``), after the
+        other wrenches; ``weight``, the weight alone.
     **options
         ``wrenches`` (more wrenches every grasp must exert, ``(force; moment about the
         origin)``), ``hold`` (True: the weight comes first), ``gravity``, ``span_bodies``
@@ -377,6 +389,7 @@ def synthesize(
             clearance=clearance,
             folder=folder,
             max_bytes=max_bytes,
+            loads=loads,
             **options,
         )
         if isinstance(task, InputError):
@@ -396,6 +409,7 @@ def synthesize(
             tip_radius=tip_radius,
             environment=environment,
             clearance=clearance,
+            loads=loads,
             **options,
         )
     )

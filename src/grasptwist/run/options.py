@@ -120,8 +120,9 @@ class SynthesisOptions:
     unit of the mesh files given directly (a grasp file says its own); ``span_bodies``
     (``--span-bodies``) lets a grasp's contacts lie on different bodies of a mesh; ``position_error``,
     ``friction_error`` and ``perturbations`` (``--position-error``, ...) make each grasp's robustness;
-    ``simulate`` (``--simulate``) keeps only the grasps that hold in all six directions in MuJoCo
-    (:func:`grasptwist.run.simulate.held_only`).
+    ``loads`` (``--loads``: ``six``, a grip for the hold test's six loads beside the weight, or
+    ``weight``); ``simulate`` (``--simulate``) keeps only the grasps that hold in all six directions in
+    MuJoCo (:func:`grasptwist.run.simulate.held_only`).
     The rest go to :func:`grasptwist.engine.synthesis.search.search`.
     """
 
@@ -147,16 +148,19 @@ class SynthesisOptions:
     friction_error: float = 0.2
     perturbations: int = 64
     torsion: float | None = None  # --contact soft --torsion E: every contact soft; 0: point; None: the file's
+    loads: str = "six"  # engine.hold_test.LOADS
 
     simulate: SimulateOptions | None = None
 
     def __post_init__(self):
         # the options the search never sees as such (they change the object and the hand), checked as
         # the command line checks them, for every way in (grasptwist.dask passes them as keywords)
+        from ..engine.hold_test import check_loads
         from ..engine.synthesis.checks import check_mass, check_tip_radius
 
         check_mass(self.mass)
         check_tip_radius(self.tip_radius)
+        check_loads(self.loads)
 
 
 #: ``simulate``'s summary word for grasps read but not simulated, counted by code apart from those not

@@ -210,7 +210,6 @@ def _searched_entry(job, entry: Grasp) -> Iterator[InputError | Found | Progress
         hand=job.hand if given else None,
         hand_file=o.hand_file,
         tip_radius=o.tip_radius,
-        directions=o.simulate is not None,  # a grip for each load the hold test applies
         **search_options(o),
     )
     if isinstance(task, InputError):

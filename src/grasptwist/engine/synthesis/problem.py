@@ -28,6 +28,7 @@ from ..environment import clearance_of
 from ..fingertips import tip_radii
 from ..forces.grasp_map import check_safety
 from ..forces.hold import Weight, object_weight
+from ..hold_test import check_loads, direction_loads
 from ..ik import home_tips
 from ..objects import object_size, project_to_surface, sample_surface
 from ..objects.creases import edge_distance
@@ -301,11 +302,15 @@ def surface_problem(
     )
 
 
-def held_wrenches(obj, wrenches=(), *, hold=True, gravity=GRAVITY, weight=None) -> tuple[np.ndarray, Weight | None]:
+def held_wrenches(
+    obj, wrenches=(), *, hold=True, gravity=GRAVITY, weight=None, loads="weight"
+) -> tuple[np.ndarray, Weight | None]:
     r"""The wrenches a grasp of ``obj`` must exert, ``(W, 6)``, its weight first when ``hold``, and that weight.
 
     The weight is ``obj``'s (:func:`~grasptwist.engine.forces.hold.object_weight`: ``(-m g; -c x m g)``),
-    else ``weight`` (a grasp file's ``mass`` and ``center_of_mass`` apart from its object).
+    else ``weight`` (a grasp file's ``mass`` and ``center_of_mass`` apart from its object).  With
+    ``loads="six"`` the hold test's loads follow ``wrenches`` when a weight is held: the weight's size
+    along ``+-x, +-y, +-z`` at its centre (:func:`~grasptwist.engine.hold_test.direction_loads`).
 
     Raises
     ------
@@ -317,7 +322,10 @@ def held_wrenches(obj, wrenches=(), *, hold=True, gravity=GRAVITY, weight=None) 
     >>> w, weight = held_wrenches(ball, [[1.0, 0, 0, 0, 0, 0]])
     >>> w.tolist(), weight.mass
     ([[0.0, 0.0, 9.81, 0.0, 0.0, 0.0], [1.0, 0.0, 0.0, 0.0, 0.0, 0.0]], 1.0)
+    >>> held_wrenches(ball, loads="six")[0][:, :3].tolist()  # the weight, then the others of its size
+    [[0.0, 0.0, 9.81], [-9.81, 0.0, 0.0], [9.81, 0.0, 0.0], [0.0, -9.81, 0.0], [0.0, 9.81, 0.0], [0.0, 0.0, -9.81]]
     """
+    loads = check_loads(loads)
     listed = list(check_wrenches(wrenches)) if len(wrenches) else []
     held = None
     if hold:
@@ -333,6 +341,8 @@ def held_wrenches(obj, wrenches=(), *, hold=True, gravity=GRAVITY, weight=None) 
                 WEIGHT_OVERFLOWS, "the object's weight or its moment about the origin overflows (mass x gravity)"
             )
         listed.insert(0, held.wrench)
+        if loads == "six":
+            listed.extend(direction_loads(held)[1])
     if not listed:
         raise ProblemError(NOTHING_TO_HOLD, "nothing to hold: give the object a mass (hold=True) or wrenches")
     return np.array(listed), held
@@ -361,6 +371,7 @@ def synthesis_problem(
     hold=True,
     gravity=GRAVITY,
     weight=None,
+    loads="weight",
     hand=None,
     tips=None,
     tip_radius=None,
@@ -381,6 +392,8 @@ def synthesis_problem(
         collision tests built by the caller: the command line's, from a URDF's meshes).
     weight : Weight, optional
         The weight held when ``obj`` has no mass (:func:`held_wrenches`).
+    loads : {"weight", "six"}
+        ``six``: a grip for the hold test's loads too (:func:`held_wrenches`; the front doors' default).
     constraints : sequence of callables
         Further constraints (:func:`~.search.search`), before the environment's.
     **options
@@ -398,7 +411,7 @@ def synthesis_problem(
         An option out of its range, a hand that is not three fingers sharing no joint.
     """
     tip_radius = check_tip_radius(tip_radius)  # checked with or without a hand, as --tip-radius is
-    listed, held = held_wrenches(obj, wrenches, hold=hold, gravity=gravity, weight=weight)
+    listed, held = held_wrenches(obj, wrenches, hold=hold, gravity=gravity, weight=weight, loads=loads)
     if hand is not None and not isinstance(hand, HandReach):
         hand = hand_reach(
             obj,

@@ -162,6 +162,10 @@ def hold_friction(
 ) -> np.ndarray:
     r"""The least friction at which a grip of every wrench exists (module docstring), by bisection.
 
+    The largest of each wrench's least, found one wrench after another: a wrench held at the least
+    friction of those before it costs one grip, and only the others are bisected (a grasp's hold test
+    loads, :func:`~grasptwist.engine.hold_test.direction_loads`, cost about one bisection, not six).
+
     ``points, normals (K, 3, 3)``, ``wrenches (W, 6)``, ``upper`` a friction at which to start
     (every grasp is held there, else its answer is NaN; ``inf``: a bracket is found first,
     doubling from 1 at most ``steps`` times) -> ``(K,)``, to ``2^-steps`` of the bracket above
@@ -179,24 +183,31 @@ def hold_friction(
     (0.36397, 0.36397)
     """
     p, n = np.asarray(points, float), np.asarray(normals, float)
-    w = np.asarray(wrenches, float).reshape(-1, 6)
-    k = len(p)
-    hi = np.full(k, float(upper))
-    lo = np.zeros(k)
-    free = _held(p, n, w, lo, 1.0, tol, torsion)
-    hi[free] = 0.0
+    least = np.zeros(len(p))  # the least friction holding the wrenches so far: 0 before any
+    for wrench in np.asarray(wrenches, float).reshape(-1, 1, 6):
+        rows = np.flatnonzero(~np.isnan(least))
+        rows = rows[~_held(p[rows], n[rows], wrench, least[rows], 1.0, tol, torsion)]  # it needs more
+        least[rows] = _bisected(p[rows], n[rows], wrench, least[rows], float(upper), steps, tol, torsion)
+    return least
+
+
+def _bisected(p, n, wrench, lo, upper, steps, tol, torsion):
+    """:func:`hold_friction` of one wrench ``(1, 6)`` on rows not held at ``lo (K,)``: bisection between ``lo``
+    and ``upper`` (NaN where ``upper`` does not hold; ``inf``: a bracket found first, doubling from 1)."""
+    hi = np.full(len(p), upper)
     if np.isinf(upper):  # no limit (the half-spaces f . n >= 0): a finite bracket first
-        hi[~free] = 1.0
+        hi = np.maximum(1.0, 2 * lo)
+        out = np.arange(len(p))
         for _ in range(steps):
-            out = np.flatnonzero(~free)[~_held(p[~free], n[~free], w, hi[~free], 1.0, tol, torsion)]
+            out = out[~_held(p[out], n[out], wrench, hi[out], 1.0, tol, torsion)]
             if not out.size:
                 break
             lo[out], hi[out] = hi[out], 2 * hi[out]
-    hi[~free & ~_held(p, n, w, hi, 1.0, tol, torsion)] = np.nan
-    live = np.flatnonzero(~free & ~np.isnan(hi))
+    hi[~_held(p, n, wrench, hi, 1.0, tol, torsion)] = np.nan
+    live = np.flatnonzero(~np.isnan(hi))
     for _ in range(steps if live.size else 0):
         mid = 0.5 * (lo[live] + hi[live])
-        ok = _held(p[live], n[live], w, mid, 1.0, tol, torsion)
+        ok = _held(p[live], n[live], wrench, mid, 1.0, tol, torsion)
         hi[live[ok]], lo[live[~ok]] = mid[ok], mid[~ok]
     return hi
 
