@@ -111,6 +111,7 @@ def test_the_robustness_options_are_checked_and_change_the_robustness_only(tmp_p
     assert sum(float(r["robustness"]) for r in rows[1]) < sum(float(r["robustness"]) for r in rows[0])
 
 
+@pytest.mark.slow  # the default run's 40 s: development.md, Test time
 def test_csv_has_a_row_per_grasp_and_the_table_names_them():
     r, _ = run("synthesize", SPHERE, "--friction", "0.5", "--mass", "1", *ONE, "-f", "csv")
     assert r.exit_code == 0, r.stderr
@@ -517,6 +518,7 @@ def test_wrench_adds_to_the_object_s_weight_never_replaces_it():
     assert totals["hold"] >= 9.81 / np.sqrt(1 + 0.5**2) * (1 - 1e-9)  # no grip holds 1 kg with less
 
 
+@pytest.mark.slow  # the default run's 40 s: development.md, Test time
 def test_the_grasp_file_keeps_the_input_s_twists_and_paths(tmp_path):
     source = GRASPS / "polyhedron.yaml"  # a body-frame path with a pose target, a twist about the diagonal
     found = tmp_path / "found.yaml"
@@ -553,6 +555,7 @@ def test_csv_with_a_hand_has_its_reach_errors_and_joint_positions():
     assert "reach_error1" not in plain.stdout.splitlines()[0]  # no hand, no hand columns
 
 
+@pytest.mark.slow  # the default run's 40 s: development.md, Test time
 def test_the_off_tangent_method_without_a_wrist_is_said_once_per_object(tmp_path):
     (tmp_path / "oct.obj").write_text(OCTAHEDRON)
     args = ("--friction", "0.6", "--mass", "0.2", "--candidates", "60", "-n", "1", "--method", "off-tangent", *WEIGHT)
@@ -576,6 +579,7 @@ def test_the_summary_says_how_many_of_the_grasps_wanted_and_tip_radius_without_a
     assert "grasp 'oct': 1 grasp from 60 candidates" in one.stderr and "wanted" not in one.stderr
 
 
+@pytest.mark.slow  # the default run's 40 s: development.md, Test time
 def test_a_grasp_file_needs_no_contacts_for_synthesize_only(tmp_path):
     bare = tmp_path / "bare.yaml"
     bare.write_text(
@@ -620,6 +624,7 @@ def test_grasps_left_unverified_when_the_time_runs_out_are_counted_on_stderr(mon
     assert equator.endswith("; 1 found but not verified before --seconds ran out")
 
 
+@pytest.mark.slow  # the default run's 40 s: development.md, Test time
 def test_a_slow_warm_up_is_said_once_on_stderr_and_not_with_quiet(monkeypatch, capsys):
     import time
 

@@ -23,6 +23,7 @@ def objects(tmp_path):
     return folder
 
 
+@pytest.mark.slow  # the default run's 40 s: development.md, Test time
 def test_a_mesh_in_millimetres_and_one_in_metres_give_the_same_grasps_up_to_scale(objects):
     mm, _ = run("synthesize", objects / "cube_mm.obj", "--units", "mm", *SEARCH, "-f", "jsonl")
     m, _ = run("synthesize", objects / "cube_m.obj", *SEARCH, "-f", "jsonl")
@@ -67,6 +68,7 @@ def test_a_grasp_file_written_from_another_folder_reads_back_from_anywhere(objec
     )
 
 
+@pytest.mark.slow  # the default run's 40 s: development.md, Test time
 def test_a_scaled_mesh_is_written_with_its_scale(objects, tmp_path):
     (objects / "scaled.yaml").write_text(
         "units: m\nobject:\n  mesh: {file: cube_mm.obj, units: mm, scale: [1, 1, 2]}\n  mass: 0.2\nfriction: 0.8\n"

@@ -162,6 +162,7 @@ def test_follow_without_a_mass_or_a_friction_has_no_grip_fields(tmp_path):
         assert "cannot_hold" not in recs[-1]["summary"] and "hold_unjudged" not in recs[-1]["summary"]
 
 
+@pytest.mark.slow  # the default run's 40 s: development.md, Test time
 def test_where_the_grip_fails_otherwise_the_weight_is_unjudged_not_held():
     # a full turn about x (the tray slides off between atan(mu) and 2 pi - atan(mu)), then a
     # spin at 1e300 rad/s, whose pose overflows at once: cannot-hold and unjudged, each located

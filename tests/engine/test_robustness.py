@@ -147,6 +147,7 @@ def test_the_draws_are_seeded_and_the_margins_of_no_grasp_are_empty():
     assert m.hold_friction.shape == (0,) and m.edge_distance.shape == (0, 3) and m.robustness.shape == (0,)
 
 
+@pytest.mark.slow  # the default run's 40 s: development.md, Test time
 def test_the_robust_objective_ranks_the_most_robust_first_and_keeps_a_margin_of_friction():
     robust = synthesize(CUBE, 0.8, count=3, candidates=2000, position_error=0.006)
     plain = synthesize(CUBE, 0.8, count=3, candidates=2000, position_error=0.006, objective="total_normal_force")

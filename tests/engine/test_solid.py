@@ -265,6 +265,7 @@ def test_an_open_mesh_warns_its_hole(tmp_path):
     assert g.warnings[0].startswith("mesh-open: open_cylinder.obj: 64 open edges (the largest hole 0.06 across)")
 
 
+@pytest.mark.slow  # the default run's 40 s: development.md, Test time
 def test_a_synthesized_grasp_keeps_to_one_body_unless_told():
     o = mesh_object("two_bodies.obj", density=700.0)
     s = gt.synthesize(o, 0.8, count=2, candidates=1500, loads="weight")  # the bodies' test: the weight is enough

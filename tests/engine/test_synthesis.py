@@ -181,6 +181,7 @@ def test_every_grasp_returned_on_a_box_is_force_closure_and_passes_independent_c
     assert triple_distance(s.points[0], s.points[1]) >= 0.05 * 0.065 * np.sqrt(3)
 
 
+@pytest.mark.slow  # the default run's 40 s: development.md, Test time
 def test_a_seed_makes_a_search_reproducible_bit_for_bit():
     a = synthesize(box(), 0.8, count=1, candidates=500, seed=7)
     b = synthesize(box(), 0.8, count=1, candidates=500, seed=7)
@@ -363,6 +364,7 @@ def test_a_ball_held_against_its_weight_reaches_the_least_total_and_its_latitude
     _independent_checks(obj, s, [[0, 0, 0.1 * G, 0, 0, 0]], mu)
 
 
+@pytest.mark.slow  # the default run's 40 s: development.md, Test time
 def test_further_constraints_are_kept_and_one_nothing_passes_is_named():
     above = 0.0325 - 0.065 / 2 + 0.01  # a table under the cube: every contact 10 mm above its bottom
 
@@ -402,6 +404,7 @@ def test_candidates_that_pass_every_test_unverified_are_not_said_to_fail_a_hand_
     assert "collision" not in s.failure.message and "finger" not in s.failure.message
 
 
+@pytest.mark.slow  # the default run's 40 s: development.md, Test time
 def test_a_cube_mesh_holds_as_its_box_with_no_contact_on_an_edge():
     """Refined contacts put on a mesh's edge once kept its averaged normal, (0, 0.71, 0.71) on a cube: each
     newton there lifts 0.71 (1 + mu), more than any face can, and the grip fell to 0.80 of the weight."""
@@ -442,6 +445,7 @@ def test_a_slow_search_overruns_its_seconds_by_a_row_not_a_chunk(monkeypatch):
 # -- the conditioning floor and its ties (issue 37's trial) ---------------------------------------
 
 
+@pytest.mark.slow  # the default run's 40 s: development.md, Test time
 def test_a_cube_on_a_table_is_held_just_above_m_g_over_mu_and_off_the_conditioning_floor():
     """Side contacts hold the weight by friction alone: sum f_n >= m g / mu, reached only as the tangent
     conditioning goes to 0 (the total above it grows as its square).  At the old floor 0.001 every grasp

@@ -181,6 +181,7 @@ def test_gt_synthesize_of_a_grasp_takes_its_files_object_hand_environment_and_wr
     assert raised.value.code == "no-object"
 
 
+@pytest.mark.slow  # the default run's 40 s: development.md, Test time
 def test_a_grasp_files_table_keeps_gt_synthesizes_contacts_off_it(tmp_path):
     doc = {"object": {"box": [0.065, 0.065, 0.065], "pose": {"position": [0, 0, 0.0325]}, "mass": 0.1}}
     doc["contacts"] = [{"point": [0.0325, 0, 0.03]}, {"point": [-0.0325, 0.01, 0.03]}, {"point": [0, 0.0325, 0.04]}]

@@ -375,6 +375,7 @@ def test_a_pool_starts_no_more_processes_than_its_cap(monkeypatch):
     assert not children() & started
 
 
+@pytest.mark.slow  # the default run's 40 s: development.md, Test time
 def test_j_10000_starts_a_worker_per_task_only(tmp_path, monkeypatch):
     sizes = []
 

@@ -374,7 +374,7 @@ def synthesize(
     >>> import numpy as np
     >>> from grasptwist.objects import Environment, GraspObject, Shape
     >>> cube = GraspObject(Shape("box", np.full(3, 0.065)), np.eye(4), mass=0.1)
-    >>> s = synthesize(cube, 0.8, count=2, candidates=1000, environment=Environment(table_height=-0.0325))
+    >>> s = synthesize(cube, 0.8, count=2, candidates=500, environment=Environment(table_height=-0.0325))
     >>> s.points.shape, bool((s.closure_friction < 0.8).all()), bool((s.points[..., 2] >= -0.0315).all())
     ((2, 3, 3), True, True)
     """
