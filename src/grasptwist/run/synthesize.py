@@ -342,11 +342,12 @@ def _unchecked(job, found) -> list[str]:
 def _summary(job, found) -> str:
     s, o = found.synthesis, job.options
     found_count = f"{len(found)} grasp" if len(found) == 1 else f"{len(found)} grasps"
-    if 0 < len(found) < o.count:  # fewer distinct feasible grasps than wanted: the spacing may be why
+    if 0 < len(found) < o.count:  # fewer than wanted: the spacing may be why, unless MuJoCo dropped them
         spacing = "default" if o.min_spacing is None else f"{o.min_spacing:g}"
-        found_count = f"{len(found)} of {o.count} grasps wanted (min spacing {spacing})"
+        why = "" if len(found) + found.dropped >= o.count else f" (min spacing {spacing})"
+        found_count = f"{len(found)} of {o.count} grasps wanted{why}"
     late = f"; {s.unverified} found but not verified before --seconds ran out" if s.unverified else ""
-    if found.dropped:
+    if o.simulate is not None:  # said even when none: the filter ran
         late += f"; {found.dropped} dropped: they did not hold in all six directions in MuJoCo (--simulate)"
     return (
         f"{found.file}: grasp '{found.name}': {found_count} from {s.candidates} candidates scored "
