@@ -136,19 +136,24 @@ MaxBytes = Annotated[
 ]
 
 
+def _nonnegative(text: str, what: str) -> float:
+    """A finite number >= 0 (``what`` says which, in the usage error)."""
+    try:
+        value = float(text)
+    except ValueError:
+        value = -1.0
+    if not 0 <= value < float("inf"):
+        raise typer.BadParameter(f"expected {what}, got {text!r}")
+    return value
+
+
 def surface_tol(text: str) -> float:
     """A surface tolerance: a finite number >= 0, relative to the object's size.
 
     >>> surface_tol("1e-3")
     0.001
     """
-    try:
-        value = float(text)
-    except ValueError:
-        value = -1.0
-    if not 0 <= value < float("inf"):
-        raise typer.BadParameter(f"expected a finite number >= 0 (a fraction of the object's size), got {text!r}")
-    return value
+    return _nonnegative(text, "a finite number >= 0 (a fraction of the object's size)")
 
 
 SurfaceTol = Annotated[
@@ -201,13 +206,7 @@ def clearance(text: str) -> float:
     >>> clearance("0.002")
     0.002
     """
-    try:
-        value = float(text)
-    except ValueError:
-        value = -1.0
-    if not 0 <= value < float("inf"):
-        raise typer.BadParameter(f"expected a finite length >= 0, got {text!r}")
-    return value
+    return _nonnegative(text, "a finite length >= 0")
 
 
 Table = Annotated[
