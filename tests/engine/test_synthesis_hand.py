@@ -26,6 +26,7 @@ def tips_of(grasp, radius):
     return tips
 
 
+@pytest.mark.slow  # the default run's 40 s: development.md, Test time
 def test_every_grasp_puts_each_tip_centre_one_radius_out_by_forward_kinematics():
     r = 0.1
     hand = replace(INLINE.hand, fingers=tuple(replace(f, tip_radius=r) for f in INLINE.hand.fingers))
