@@ -233,3 +233,32 @@ def test_fingers_stepped_together_solve_each_row_as_alone(trifinger, inline):
             np.testing.assert_array_equal(q[which == f, : len(finger.joints)], alone[0])
             np.testing.assert_array_equal(error[which == f], alone[1])
             np.testing.assert_array_equal(status[which == f], alone[3])
+
+
+def test_the_iterations_forward_kinematics_is_the_product_of_exponentials(trifinger):
+    """The inverse kinematics' prepared chain (each joint's Rodrigues terms formed once, every joint's motion at
+    once) gives forward_kinematics' tip point and finger_jacobian's columns, for one chain over the rows and for
+    one chain a row (the TriFinger's three fingers stacked); a chain with a prismatic joint keeps the general path."""
+    from grasptwist.engine.ik import _prepared, _Revolute, _tip_and_jacobian
+    from grasptwist.engine.kinematics import finger_jacobian
+
+    hand, tips = trifinger.hand, home_tips(trifinger.hand)
+    rng = np.random.default_rng(5)
+    q = rng.uniform(-2, 2, (40, 3))
+    which = rng.integers(0, 3, 40)
+    for stacked in (False, True):
+        f = [hand.fingers[0]] * 40 if not stacked else [hand.fingers[k] for k in which]
+        t = tips[[0] * 40 if not stacked else which]
+        screws, points = np.array([g.screws for g in f]), np.array([g.points for g in f])
+        chain = (screws[0], points[0], t[0]) if not stacked else (screws, points, t)
+        prepared = _prepared(chain)
+        assert isinstance(prepared, _Revolute)
+        tip, jacobian = _tip_and_jacobian(prepared, q)
+        state = forward_kinematics(screws, points, t, q)
+        np.testing.assert_allclose(tip, state.tip[:, :3, 3], rtol=0, atol=1e-14)
+        np.testing.assert_allclose(jacobian, finger_jacobian(state.screws, tip), rtol=0, atol=1e-14)
+        assert np.abs(jacobian).max() > 0.05  # a real finger's columns, not zeros
+    slide = (np.array([[0, 0, 0, 0, 0, 1.0], [0, 0, 1.0, 0, 0, 0]]), np.zeros((2, 3)), np.eye(4))
+    assert _prepared(slide) is slide
+    tip, jacobian = _tip_and_jacobian(slide, np.array([[0.5, 0.0]]))
+    assert tip.tolist() == [[0.0, 0.0, 0.5]] and jacobian[0, 2].tolist() == [1.0, 0.0]

@@ -289,11 +289,9 @@ def penetration_depths(obj, parts: LinkClusters, poses, n_links: int | None = No
     rotation = back @ poses[..., :3, :3]  # (N, L, 3, 3)
     translation = _apply(back, poses[..., :3, 3]) + shift
     box = _box(obj.shape)
-    found = [_near(parts, i, rotation[:, i], translation[:, i], box) for i in np.unique(parts.link)]
-    rows = np.concatenate([f[0] for f in found])
+    rows, cols, center = _near(parts, rotation, translation, box)
     if len(rows) == 0:
         return depth
-    cols, center = np.concatenate([f[1] for f in found]), np.concatenate([f[2] for f in found])
     distance = _own_distance(obj)
     phi = distance(center)
     radius, link = parts.radius[cols], parts.link[cols]
@@ -320,17 +318,23 @@ def _own_distance(obj):
     return lambda x: primitives.signed_distance(kind, size, x.reshape(-1, 3)).reshape(x.shape[:-1])
 
 
-def _near(parts, link, rotation, translation, box):
-    """The (configuration, cluster) pairs of one link whose balls reach the object's bounding box,
-    and the clusters' centres there: first the link's ball (holding its clusters'), then theirs."""
-    (mine,) = np.nonzero(parts.link == link)
-    center, radius = parts.center[mine], parts.radius[mine]
-    middle = 0.5 * (center.min(axis=0) + center.max(axis=0))
-    reach = np.max(np.linalg.norm(center - middle, axis=-1) + radius)
-    (rows,) = np.nonzero(_outside(_apply(rotation, middle) + translation, box) <= reach)
-    moved = np.einsum("nij,cj->nci", rotation[rows], center) + translation[rows, None]
-    hit, which = np.nonzero(_outside(moved, box) <= radius)
-    return rows[hit], mine[which], moved[hit, which]
+def _near(parts, rotation, translation, box):
+    """The (configuration, cluster) pairs whose balls reach the object's bounding box, and the clusters'
+    centres there: first each link's ball (holding its clusters'), then theirs, every link at once
+    (``rotation (N, L, 3, 3)``, ``translation (N, L, 3)``; a link's clusters are consecutive)."""
+    links, first, count = np.unique(parts.link, return_index=True, return_counts=True)
+    middle = 0.5 * (np.minimum.reduceat(parts.center, first) + np.maximum.reduceat(parts.center, first))
+    reach = np.maximum.reduceat(_length(parts.center - np.repeat(middle, count, axis=0)) + parts.radius, first)
+    ball = (rotation[:, links] @ middle[:, :, None])[..., 0] + translation[:, links]
+    rows, which = np.nonzero(_outside(ball, box) <= reach)
+    # every cluster of each such (configuration, link)
+    k = count[which]
+    pair = np.repeat(np.arange(len(rows)), k)
+    cols = first[which][pair] + np.arange(k.sum()) - np.repeat(np.cumsum(k) - k, k)
+    rows, link = rows[pair], parts.link[cols]
+    moved = (rotation[rows, link] @ parts.center[cols, :, None])[..., 0] + translation[rows, link]
+    hit = _outside(moved, box) <= parts.radius[cols]
+    return rows[hit], cols[hit], moved[hit]
 
 
 def _outside(points, box):
@@ -542,10 +546,10 @@ def _hull_overlaps(hulls, poses, rows, a, b):
             # the planes carried to link ``one``'s home frame: n' = R^T n, d' = d + n . t
             planes = hulls.planes[other[k]]
             normal = planes[..., :3] @ rotation[k]  # (k, K, 3)
-            offset = planes[..., 3] + np.einsum("kmi,ki->km", planes[..., :3], translation[k])
+            offset = planes[..., 3] + (planes[..., :3] @ translation[k, :, None])[..., 0]
             # the clusters of link ``one`` that reach into the other's hull: (pair, cluster)
             pair, cluster = np.nonzero(parts.link[None, :] == one[k, None])
-            s = np.einsum("ci,cki->ck", parts.center[cluster], normal[pair]) + offset[pair]
+            s = (normal[pair] @ parts.center[cluster, :, None])[..., 0] + offset[pair]
             opened = -s.max(axis=1) >= -parts.radius[cluster]
             pair, cluster = pair[opened], cluster[opened]
             depth = parts.vertices[cluster] @ normal[pair].swapaxes(1, 2) + offset[pair, None]  # (m, 16, K)

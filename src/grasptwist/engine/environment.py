@@ -208,7 +208,7 @@ def parts_distance(parts, links, poses, centers, radii, environment):
     if len(parts.link) and n:
         mine = poses[:, parts.link]  # (N, C, 4, 4): each cluster's link's pose
         rotation, translation = mine[..., :3, :3], mine[..., :3, 3]
-        middle = np.einsum("ncij,cj->nci", rotation, parts.center) + translation
+        middle = (rotation @ parts.center[:, :, None])[..., 0] + translation
         d = environment_distance(middle, environment)[0]
         bound = np.full((n, links), np.inf)
         rows = np.repeat(np.arange(n), len(parts.link))

@@ -36,12 +36,14 @@ Revolute joints without limits are brought within ``pi`` of the seed.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import NamedTuple
 
 import numpy as np
 
 from .degeneracy import Status
-from .kinematics import finger_jacobian, forward_kinematics
-from .screws import norm
+from .kinematics import _UNIT_TOL, finger_jacobian, forward_kinematics
+from .screws import cross, dot, norm
+from .se3 import skew
 
 __all__ = [
     "IK_TOL",
@@ -99,10 +101,61 @@ class ChainIK:
     error: np.ndarray
 
 
-def _tip(chain, q):
-    """Joint screws and tip point of ``chain`` at ``q``."""
-    state = forward_kinematics(*chain, q)
-    return state.screws, state.tip[..., :3, 3]
+class _Revolute(NamedTuple):
+    """A chain of revolute joints prepared for the iteration's forward kinematics: each joint's
+    Rodrigues terms (:func:`~.kinematics.joint_motion`) formed once, not at every step.  Per joint
+    ``(..., n, ...)``: ``[omega]``, ``[omega]^2``, ``v``, ``omega x v``, ``omega``, and the home tip point."""
+
+    k: np.ndarray
+    kk: np.ndarray
+    v: np.ndarray
+    wv: np.ndarray
+    w: np.ndarray
+    tip: np.ndarray
+
+
+def _prepared(chain):
+    """``chain`` as :func:`_tip_and_jacobian` takes it: a :class:`_Revolute` where every joint is a unit
+    line (a revolute joint), else the chain itself (:func:`~.kinematics.forward_kinematics` each step)."""
+    screws, _, tip = chain
+    w, v = screws[..., :3], screws[..., 3:]
+    if not ((np.abs(dot(w, w) - 1) <= _UNIT_TOL).all() and (np.abs(dot(w, v)) <= _UNIT_TOL).all()):
+        return chain
+    k = skew(w)
+    return _Revolute(k, k @ k, v, cross(w, v), w, tip[..., :3, 3])
+
+
+def _tip_and_jacobian(chain, q):
+    r"""The tip point ``(B, 3)`` and its Jacobian ``(B, 3, n)`` (:func:`~.kinematics.finger_jacobian`) of a
+    :func:`_prepared` chain at ``q (B, n)``.
+
+    For revolute joints, every joint's motion at once (Rodrigues: ``R_j = I + sin q_j [omega_j] +
+    (1 - cos q_j) [omega_j]^2``, ``x_j = sin q_j v_j + (1 - cos q_j) omega_j x v_j``), then their product
+    ``g_j = g_{j-1} (R_j, x_j)``; joint ``j``'s column is ``R_{<j} v_j + t_{<j} x omega'_j + omega'_j x p``
+    with ``omega'_j = R_{<j} omega_j`` (the product before it, ``(R_{<j}, t_{<j})``): the same numbers as
+    :func:`~.kinematics.forward_kinematics` in a quarter of its numpy calls (tests/engine/test_ik.py).
+    """
+    if not isinstance(chain, _Revolute):
+        state = forward_kinematics(*chain, q)
+        tip = state.tip[..., :3, 3]
+        return tip, finger_jacobian(state.screws, tip)
+    s, c = np.sin(q)[..., None], 1 - np.cos(q)[..., None]
+    rotation = np.eye(3) + s[..., None] * chain.k + c[..., None] * chain.kk
+    shift = s * chain.v + c * chain.wv
+    n = q.shape[-1]
+    before = np.empty(q.shape + (3, 3))  # R_{<j}
+    moved = np.empty(q.shape + (3,))  # t_{<j}
+    before[..., 0, :, :], moved[..., 0, :] = np.eye(3), 0.0
+    for j in range(1, n):
+        before[..., j, :, :] = before[..., j - 1, :, :] @ rotation[..., j - 1, :, :]
+        moved[..., j, :] = (before[..., j - 1, :, :] @ shift[..., j - 1, :, None])[..., 0] + moved[..., j - 1, :]
+    last = before[..., -1, :, :] @ rotation[..., -1, :, :]
+    tip = (last @ chain.tip[..., None])[..., 0] + (before[..., -1, :, :] @ shift[..., -1, :, None])[..., 0]
+    tip += moved[..., -1, :]
+    w = (before @ np.broadcast_to(chain.w, q.shape + (3,))[..., None])[..., 0]
+    v = (before @ np.broadcast_to(chain.v, q.shape + (3,))[..., None])[..., 0]
+    columns = v + cross(moved - tip[..., None, :], w)
+    return tip, np.swapaxes(columns, -1, -2)
 
 
 def chain_ik(home_screws, home_points, home_tip, targets, seeds, lower=None, upper=None, *, iterations=IK_ITERATIONS):
@@ -148,7 +201,8 @@ def chain_ik(home_screws, home_points, home_tip, targets, seeds, lower=None, upp
     length = _length(chain)
     # per unit of step: rad, or L
     scale = np.where(chain[0][..., :3].any(axis=-1), 1.0, 1.0 / np.asarray(length)[..., None])
-    screws, tip = _tip(chain, q)
+    prepared = _prepared(chain)
+    tip, jacobian = _tip_and_jacobian(prepared, q)
     error = norm(targets - tip)
     mu = np.ones(len(q))
     slow = np.zeros(len(q), int)  # iterations in a row that shrank the error by less than 1 %
@@ -158,21 +212,21 @@ def chain_ik(home_screws, home_points, home_tip, targets, seeds, lower=None, upp
             break
         size = _rows(length, active, stacked)
         e = targets[active] - tip[active]
-        jac = finger_jacobian(screws[active], tip[active])
+        jac = jacobian[active]
         damping = mu[active] * (np.einsum("...i,...i", e, e) + _FLOOR * size**2)
         normal = jac @ np.swapaxes(jac, -1, -2) + damping[:, None, None] * np.eye(3)
         step = (np.swapaxes(jac, -1, -2) @ np.linalg.solve(normal, e[..., None]))[..., 0]
         big = np.abs(step * _rows(scale, active, stacked)).max(axis=-1) / _MAX_STEP
         step /= np.maximum(big, 1.0)[:, None]
         trial = np.clip(q[active] + step, _rows(lower, active, stacked), _rows(upper, active, stacked))
-        trial_screws, trial_tip = _tip(_rows(chain, active, stacked), trial)
+        trial_tip, trial_jacobian = _tip_and_jacobian(_rows(prepared, active, stacked), trial)
         trial_error = norm(targets[active] - trial_tip)
         better = trial_error < error[active]
         slow[active] = np.where(trial_error < 0.99 * error[active], 0, slow[active] + 1)
         took = active[better]
-        q[took], screws[took], tip[took], error[took] = (
+        q[took], jacobian[took], tip[took], error[took] = (
             trial[better],
-            trial_screws[better],
+            trial_jacobian[better],
             trial_tip[better],
             trial_error[better],
         )
@@ -187,7 +241,9 @@ def _rows(a, rows, stacked):
     """Rows ``rows`` of a per-chain array (or of each of a tuple of them) when there is one chain a row."""
     if not stacked:
         return a
-    return tuple(x[rows] for x in a) if isinstance(a, tuple) else a[rows]
+    if isinstance(a, tuple):
+        return type(a)(*(x[rows] for x in a)) if isinstance(a, _Revolute) else tuple(x[rows] for x in a)
+    return a[rows]
 
 
 def _bounds(b, n, none):
