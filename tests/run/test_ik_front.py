@@ -154,8 +154,10 @@ def test_a_finger_that_cannot_reach_fails_the_grasp_at_its_tip(fixture, code, ma
         normals = np.array([c["normal"] for c in doc["contacts"]])
         solved = hand_ik(g.hand, points - 0.01 * normals, seed=seed)  # the centres, 10 mm behind
         assert Status(int(solved.status[0])) == Status.UNREACHABLE
-        assert float(found.group(1)) == pytest.approx(solved.tip_error[0], rel=1e-5)
-        assert 0.7 < solved.tip_error[0] < 0.9
+        assert float(found.group(1)) == pytest.approx(solved.tip_error[0], rel=1e-4)  # printed to 4 digits
+        # the least distance within the limits is 0.7260517 (a 70^3 grid of the joints refined by scipy's
+        # L-BFGS-B, at the limits of the first two joints): the iteration stalls within 2e-5 of it
+        assert 0.7260517 <= solved.tip_error[0] < 0.7260517 * (1 + 2e-5)
 
 
 @urdf
