@@ -75,7 +75,6 @@ class UrdfShape(NamedTuple):
     size: tuple = ()
     filename: str | None = None
     scale: np.ndarray | None = None
-    line: int | None = None
 
 
 class UrdfLink(NamedTuple):
@@ -84,7 +83,6 @@ class UrdfLink(NamedTuple):
     name: str
     collisions: tuple
     visuals: tuple
-    line: int
 
 
 class UrdfModel(NamedTuple):
@@ -133,7 +131,7 @@ def read_model(root, file) -> UrdfModel:
             tuple(_shape(child, f"link {name!r}: <{tag}>", file) for child in element.iterfind(tag))
             for tag in ("collision", "visual")
         ]
-        links[name] = UrdfLink(name, *shapes, element.sourceline)
+        links[name] = UrdfLink(name, *shapes)
     return UrdfModel(links, joints)
 
 
@@ -157,13 +155,7 @@ def _joint(element, file):
     axis = np.array([1.0, 0.0, 0.0]) if axis is None else _vector(axis, "xyz", "1 0 0", what, file)
     limit = element.find("limit")
     if limit is not None:
-        texts = {a: limit.get(a) for a in _LIMITS}
-        limit = UrdfLimit(
-            *(
-                None if t is None else _numbers(t, 1, f"{what}: <limit {a}>", file, limit.sourceline)[0]
-                for a, t in texts.items()
-            )
-        )
+        limit = UrdfLimit(*(_number(limit, attribute, what, file) for attribute in _LIMITS))
     return UrdfJoint(name, kind, *ends, origin, axis, limit, element.find("mimic") is not None, line)
 
 
@@ -174,6 +166,14 @@ def _origin(element, what, file):
         pose[:3, 3] = _vector(element, "xyz", "0 0 0", what, file)
         pose[:3, :3] = rpy_to_matrix(_vector(element, "rpy", "0 0 0", what, file))
     return pose
+
+
+def _number(element, attribute, what, file):
+    """An attribute's one number, None when the element leaves it out."""
+    text = element.get(attribute)
+    return (
+        None if text is None else _numbers(text, 1, f"{what}: <{element.tag} {attribute}>", file, element.sourceline)[0]
+    )
 
 
 def _vector(element, attribute, default, what, file):
@@ -195,19 +195,17 @@ def _shape(element, what, file):
         filename = first.get("filename")
         if not filename:
             raise InputError("invalid-urdf", f"{what}: <mesh> without a filename", file, line)
-        words = first.get("scale", "").replace(",", " ")
-        count = 1 if len(words.split()) == 1 else 3
-        scale = (
-            np.broadcast_to(_numbers(words, count, f"{what}: <mesh scale>", file, line), 3) if words.strip() else None
-        )
-        return UrdfShape(kind, origin, filename=filename, scale=None if scale is None else scale.copy(), line=line)
+        text = first.get("scale", "").replace(",", " ")
+        count = 1 if len(text.split()) == 1 else 3
+        scale = np.broadcast_to(_numbers(text, count, f"{what}: <mesh scale>", file, line), 3) if text.strip() else None
+        return UrdfShape(kind, origin, filename=filename, scale=None if scale is None else scale.copy())
     size = []
     for attribute, count in _SHAPES[kind]:
         text = first.get(attribute)
         if text is None:
             raise InputError("invalid-urdf", f"{what}: <{kind}> without {attribute}", file, line)
         size += _numbers(text.replace(",", " "), count, f"{what}: <{kind} {attribute}>", file, line)
-    return UrdfShape(kind, origin, tuple(size), line=line)
+    return UrdfShape(kind, origin, tuple(size))
 
 
 def _numbers(text, count, what, file, line):
