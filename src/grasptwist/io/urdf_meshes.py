@@ -227,6 +227,7 @@ def link_geometry(hand, *, folder=None, max_bytes=MAX_URDF_BYTES) -> tuple[LinkG
     """
     if hand.source is None:
         return ()
+    _library(hand.source)  # trimesh (yourdfpy's) makes the primitives and reads other formats
     urdf = resolve_urdf(hand.source, folder)
     model = read_model(_parse(_read(urdf, max_bytes, hand.source), hand.source), hand.source)
     collision = any(link.collisions for link in model.links.values())
