@@ -213,6 +213,14 @@ def test_primitives_scales_mirrors_and_origins_are_yourdfpys(tmp_path):
     assert [g.link for g in ours] == ["a3", "b3"]
 
 
+@pytest.mark.parametrize("kind", ["obj", "ply", "glb"])  # grasptwist's OBJ and PLY readers; glb: trimesh's
+def test_a_link_mesh_in_another_format_is_yourdfpys(tmp_path, kind):
+    toy = _toy(tmp_path, _shape("collision", f'<mesh filename="m.{kind}" scale="1 2 1"/>'), "")
+    data = trimesh.load(tmp_path / "m.stl").export(file_type=kind)
+    (tmp_path / f"m.{kind}").write_bytes(data.encode() if isinstance(data, str) else data)
+    assert [g.link for g in _same_as_yourdfpy(toy, tmp_path)] == ["a3"]
+
+
 def test_without_collision_geometry_the_visual_meshes_are_yourdfpys(tmp_path):
     a3 = _shape("visual", '<mesh filename="m.stl" scale="0.5"/>') + _shape("visual", '<box size="0.01 0.02 0.05"/>')
     b3 = _shape("visual", '<mesh filename="m.stl"/>') + _shape("visual", '<sphere radius="0.01"/>')  # turned, here
