@@ -359,7 +359,7 @@ ERRORS = {
     "urdf-syntax": Code("a URDF that is not well-formed XML", _HANDS),
     "forbidden-dtd": Code("a URDF with a DTD or entities", _HANDS),
     "invalid-urdf": Code("a URDF that is no robot description grasptwist can use", _HANDS),
-    "urdf-unavailable": Code("a URDF hand without yourdfpy installed", _HANDS),
+    "urdf-unavailable": Code("a URDF hand without the extra `urdf` (lxml, yourdfpy) installed", _HANDS),
     # data sets and the twists of a grasp
     "bad-dataset": Code("a data set whose arrays or file cannot be read as the documented layout", _COMMANDS),
     "no-twist": Code("a grasp or data set with no twist to resolve", _COMMANDS),

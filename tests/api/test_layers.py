@@ -7,6 +7,7 @@ fast or an optional dependency optional; it never hides a circle).
 
 import ast
 import functools
+import importlib.util
 import json
 import os
 import subprocess
@@ -317,3 +318,18 @@ def test_a_json_resolve_of_one_file_imports_no_force_hand_table_or_plot_module()
     assert {"grasptwist.engine.forces.grip", "grasptwist.run.forces"} <= forces_run
     assert {"grasptwist.output.table", "rich", "grasptwist.engine.kinematics"} <= table_run
     assert {"grasptwist.engine.objects.solid", "grasptwist.output.csv_rows", "csv"} <= mesh_run
+
+
+@pytest.mark.skipif(
+    any(importlib.util.find_spec(m) is None for m in ("yourdfpy", "robot_properties_fingers")),
+    reason="needs the TriFinger URDF",
+)
+def test_a_urdf_hand_is_read_and_searched_without_importing_trimesh_or_yourdfpy():
+    # yourdfpy imports trimesh (scipy.optimize, networkx, ...): 0.43 s of issue 37's 4 s synthesis
+    search = ["--friction", "0.8", "--mass", "0.1", "-n", "1", "--candidates", "20", "--perturbations", "1"]
+    resolve_run, search_run = _loaded(
+        ["resolve", "grasps/trifinger-cube.yaml", "-f", "json"],
+        ["synthesize", "grasps/trifinger-cube.yaml", *search, "-f", "jsonl", "-q"],
+    )
+    assert "grasptwist.io.urdf_model" in resolve_run and "grasptwist.engine.collision" in search_run  # they did run
+    assert _among(search_run, ("trimesh", "yourdfpy")) == []

@@ -138,3 +138,17 @@ def test_inverse_transform_and_compose():
 def test_wrong_shapes_raise_value_errors_naming_the_argument(call, name):
     with pytest.raises(ValueError, match=f"^{name} must have shape"):
         call()
+
+
+def test_rpy_to_matrix_is_yaw_pitch_roll_about_the_fixed_axes_row_by_row():
+    rpy = np.random.default_rng(7).uniform(-4, 4, (2, 5, 3))
+    got = se3.rpy_to_matrix(rpy)
+    for (i, j), (r, p, y) in zip(np.ndindex(2, 5), rpy.reshape(-1, 3), strict=True):
+        c, s = np.cos, np.sin
+        rx = np.array([[1, 0, 0], [0, c(r), -s(r)], [0, s(r), c(r)]])
+        ry = np.array([[c(p), 0, s(p)], [0, 1, 0], [-s(p), 0, c(p)]])
+        rz = np.array([[c(y), -s(y), 0], [s(y), c(y), 0], [0, 0, 1]])
+        np.testing.assert_allclose(got[i, j], rz @ ry @ rx, rtol=0, atol=1e-15)
+        assert np.array_equal(got[i, j], se3.rpy_to_matrix([r, p, y]))  # a row's bits whatever its batch
+    with pytest.raises(ValueError, match=r"rpy must have shape \(\.\.\., 3\)"):
+        se3.rpy_to_matrix([0.0, 1.0])

@@ -247,7 +247,7 @@ def errors_of(path):
 
 
 def test_without_the_urdf_extra_the_bundled_trifinger_says_what_to_install(monkeypatch):
-    monkeypatch.setitem(sys.modules, "yourdfpy", None)  # import yourdfpy -> ImportError
+    monkeypatch.setitem(sys.modules, "yourdfpy", None)  # find_spec("yourdfpy") -> None, as when not installed
     result = CliRunner().invoke(app, ["resolve", str(TRIFINGER), "-f", "jsonl"])
     assert result.exit_code != 0
     assert "urdf-unavailable" in result.stderr and "pip install -e '.[urdf]'" in result.stderr

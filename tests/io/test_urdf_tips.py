@@ -38,11 +38,13 @@ def test_a_sphere_elsewhere_is_no_fingertip(tmp_path):
     assert radii(tmp_path, '<origin xyz="0 0 0.01"/><geometry><sphere radius="0.012"/></geometry>') == [0.0] * 3
 
 
-def test_a_hemisphere_mesh_gives_its_radius_scaled(tmp_path):
+@pytest.mark.parametrize("kind", ["stl", "obj", "ply", "glb"])  # grasptwist's readers; glb: trimesh's, imported for it
+def test_a_hemisphere_mesh_gives_its_radius_scaled(tmp_path, kind):
     cap = trimesh.creation.icosphere(subdivisions=3, radius=1.0)
     cap = cap.slice_plane([0, 0, 0], [0, 0, -1], cap=True)  # the lower half, closed
-    (tmp_path / "cap.stl").write_bytes(cap.export(file_type="stl"))
-    got = radii(tmp_path, '<geometry><mesh filename="cap.stl" scale="0.008 0.008 0.008"/></geometry>')
+    data = cap.export(file_type=kind)
+    (tmp_path / f"cap.{kind}").write_bytes(data.encode() if isinstance(data, str) else data)
+    got = radii(tmp_path, f'<geometry><mesh filename="cap.{kind}" scale="0.008 0.008 0.008"/></geometry>')
     assert got == pytest.approx([0.008] * 3, rel=1e-6)
 
 

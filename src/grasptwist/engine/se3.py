@@ -63,6 +63,7 @@ __all__ = [
     "rotvec_to_matrix",
     "quaternion_to_matrix",
     "matrix_to_quaternion",
+    "rpy_to_matrix",
 ]
 
 #: Below this angle the coefficients ``C`` and ``D`` come from their Taylor
@@ -248,6 +249,37 @@ def quaternion_to_matrix(quaternion):
         (1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)),
         (2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)),
         (2 * (x * z - w * y), 2 * (y * z + w * x), 1 - 2 * (x * x + y * y)),
+    )
+    return np.stack([np.stack(row, -1) for row in rows], -2)
+
+
+def rpy_to_matrix(rpy):
+    """The rotation of a URDF ``rpy`` (roll, pitch, yaw about the fixed x, y, z axes): ``(..., 3) -> (..., 3, 3)``.
+
+    .. math::
+
+        R = R_z(y)\\, R_y(p)\\, R_x(r) = \\begin{pmatrix}
+        c_p c_y & s_r s_p c_y - c_r s_y & c_r s_p c_y + s_r s_y \\\\
+        c_p s_y & s_r s_p s_y + c_r c_y & c_r s_p s_y - s_r c_y \\\\
+        -s_p & s_r c_p & c_r c_p
+        \\end{pmatrix}
+
+    written term for term as ``trimesh.transformations.euler_matrix(r, p, y, "sxyz")`` (which
+    yourdfpy reads a URDF's origins with), so that both give the same bits.
+
+    >>> (rpy_to_matrix([0, 0, np.pi / 2]).round(12) + 0.0).tolist()
+    [[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]
+    >>> bool(np.allclose(rpy_to_matrix([0.3, 0, 0]) @ [0, 1, 0], [0, np.cos(0.3), np.sin(0.3)]))
+    True
+    """
+    a = _shaped(rpy, (3,), "rpy")
+    si, sj, sk = np.sin(a[..., 0]), np.sin(a[..., 1]), np.sin(a[..., 2])
+    ci, cj, ck = np.cos(a[..., 0]), np.cos(a[..., 1]), np.cos(a[..., 2])
+    cc, cs, sc, ss = ci * ck, ci * sk, si * ck, si * sk
+    rows = (
+        (cj * ck, sj * sc - cs, sj * cc + ss),
+        (cj * sk, sj * ss + cc, sj * cs - sc),
+        (-sj, cj * si, cj * ci),
     )
     return np.stack([np.stack(row, -1) for row in rows], -2)
 

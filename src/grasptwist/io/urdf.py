@@ -2,8 +2,11 @@
 
 A URDF names its links and the joints between them; a finger is the chain of
 joints from the root link to the link that touches the object (its tip).
-The robot model is read by yourdfpy (the optional extra ``grasptwist[urdf]``),
-never with its scene graph, so meshes are never opened.  Around it:
+The robot model is read from lxml's tree by :mod:`.urdf_model`, with yourdfpy's
+conventions but without importing it (it imports trimesh: 0.43 s a command);
+reading a URDF needs the optional extra ``grasptwist[urdf]`` all the same (lxml,
+and yourdfpy for pictures of the hand).  Only the tip link's collision mesh is
+opened, for the fingertip's radius.  Around it:
 
 * the reference: ``package://PKG/path`` is resolved inside the installed
   Python package ``PKG``, any other path relative to the referring file's
@@ -11,7 +14,7 @@ never with its scene graph, so meshes are never opened.  Around it:
   or folder is refused (``path-outside``);
 * the bytes: at most ``max_bytes`` are read (a regular file only), and the XML
   is parsed by lxml with entity resolution, DTD loading and network access
-  off and its size limits on, before yourdfpy sees it; a document type
+  off and its size limits on; a document type
   declaration (DTDs, entities, external references: a robot description needs
   none) is refused outright (``forbidden-dtd``);
 * the joints: mimic, floating and planar joints on a finger are refused
@@ -30,7 +33,7 @@ Every refusal is a :class:`~grasptwist.model.InputError` with a code:
 ``invalid-urdf``       not a URDF tree (root element, links, joints, numbers)
 ``unknown-link``       a tip that is no link of the URDF
 ``unsupported-joint``  a mimic, floating or planar joint on a finger
-``urdf-unavailable``   yourdfpy is not installed
+``urdf-unavailable``   the extra ``grasptwist[urdf]`` (lxml, yourdfpy) is not installed
 =====================  ==========================================================
 """
 
@@ -38,7 +41,6 @@ from __future__ import annotations
 
 import errno
 import io
-import math
 import os
 import re
 import stat
@@ -51,7 +53,8 @@ import numpy as np
 
 from ..engine.kinematics import chain_from_origins, chain_length
 from ..model import Finger, Hand, InputError, Joint
-from .limits import MAX_URDF_BYTES, OUTPUT_IS_INPUT
+from .limits import MAX_URDF_BYTES, MESH_SUFFIXES, OUTPUT_IS_INPUT
+from .urdf_model import merged, read_model
 
 __all__ = ["load_urdf_hand", "resolve_urdf"]
 
@@ -227,76 +230,16 @@ def _dtd_error(file, line, column):
     )
 
 
-#: Attributes yourdfpy reads with float(): how many numbers each holds.
-_NUMBERS = {("origin", "xyz"): 3, ("origin", "rpy"): 3, ("axis", "xyz"): 3}
-_LIMITS = ("effort", "velocity", "lower", "upper")
-
-
-def _check_joint_elements(root, file):
-    """Located checks of what yourdfpy reads from each <joint> without checking it."""
-    for element in root.iterfind("joint"):
-        line = element.sourceline
-        name = element.get("name")
-        if not name:
-            raise InputError("invalid-urdf", "a <joint> without a name", file, line)
-        if element.get("type") is None:
-            raise InputError("invalid-urdf", f"joint {name!r}: no type", file, line)
-        for tag in ("parent", "child"):
-            child = element.find(tag)
-            if child is None or not child.get("link"):
-                raise InputError("invalid-urdf", f"joint {name!r}: no <{tag} link=...>", file, line)
-        for (tag, attribute), count in _NUMBERS.items():
-            child = element.find(tag)
-            if child is not None and child.get(attribute) is not None:
-                _numbers(child.get(attribute), count, f"joint {name!r}: <{tag} {attribute}>", file, child.sourceline)
-        limit = element.find("limit")
-        for attribute in _LIMITS if limit is not None else ():
-            if limit.get(attribute) is not None:
-                _numbers(limit.get(attribute), 1, f"joint {name!r}: <limit {attribute}>", file, limit.sourceline)
-
-
-def _numbers(text, count, what, file, line):
-    try:
-        values = [float(word) for word in text.split()]
-    except ValueError:
-        values = None
-    if values is None or len(values) != count or not all(map(math.isfinite, values)):
-        raise InputError("invalid-urdf", f"{what}: expected {count} finite number(s), got {text[:40]!r}", file, line)
-
-
-def _never_open(fname):
-    """yourdfpy's hook for mesh files: never called without a scene graph; refuse if it ever is."""
-    raise PermissionError(f"grasptwist never opens meshes ({fname})")
-
-
 def _library(file):
-    """yourdfpy (and lxml, which it brings), or the error that says which extra to install."""
-    try:
-        import lxml.etree  # noqa: F401 - _parse's parser
-        import yourdfpy
-    except ImportError:
+    """Refuse (``urdf-unavailable``) unless the extra ``grasptwist[urdf]`` is installed: lxml (which
+    :func:`_parse` reads with) and yourdfpy (pictures of the hand), found without importing them
+    (yourdfpy imports trimesh, 0.43 s: :mod:`.urdf_model` reads the URDF without it)."""
+    if find_spec("lxml") is None or find_spec("yourdfpy") is None:
         raise InputError(
             "urdf-unavailable",
             "reading a URDF needs yourdfpy: pip install yourdfpy (from a clone of grasptwist: pip install -e '.[urdf]')",
             file,
-        ) from None
-    return yourdfpy
-
-
-def _model(data, file):
-    yourdfpy = _library(file)
-    try:
-        # The bytes passed _parse: no DTD, so yourdfpy's own lxml parse has no entity to expand.
-        return yourdfpy.URDF.load(
-            io.BytesIO(data),
-            build_scene_graph=False,
-            build_collision_scene_graph=False,
-            load_meshes=False,
-            load_collision_meshes=False,
-            filename_handler=_never_open,
         )
-    except Exception as exc:  # whatever yourdfpy trips on is a bad file, not a crash
-        raise InputError("invalid-urdf", f"yourdfpy cannot read it: {type(exc).__name__}: {exc}", file) from None
 
 
 def load_urdf_hand(urdf, tips, *, names=None, folder=None, max_bytes=MAX_URDF_BYTES, allow_outside=False, output=None):
@@ -311,8 +254,9 @@ def load_urdf_hand(urdf, tips, *, names=None, folder=None, max_bytes=MAX_URDF_BY
     a sphere or a cap of one about it
     (``grasptwist.engine.fingertips.sphere_radius``, the TriFinger's
     fingertips); 0 (a point tip) without one, or when the mesh cannot be
-    read (a ``package://`` of no installed Python package, a format trimesh
-    does not read): a grasp file's ``tip_radius`` then gives it.
+    read (a ``package://`` of no installed Python package, a file outside the
+    mesh caps, a format trimesh does not read): a grasp file's ``tip_radius``
+    then gives it.
 
     Parameters
     ----------
@@ -355,20 +299,17 @@ def load_urdf_hand(urdf, tips, *, names=None, folder=None, max_bytes=MAX_URDF_BY
     _library(file)  # before the reference: a package:// one may be missing for the same reason
     where = resolve_urdf(urdf, folder, allow_outside=allow_outside, output=output)
     data = _read(where, max_bytes, file, output)
-    root = _parse(data, file)
-    _check_joint_elements(root, file)
-    model = _model(data, file)
-    lines = {element.get("name"): element.sourceline for element in root.iterfind("joint")}
-    parent_joint = _tree(model, lines, file)
+    model = read_model(_parse(data, file), file)
+    parent_joint = _tree(model, file)
     names = [str(i + 1) for i in range(len(tips))] if names is None else list(names)
     if len(names) != len(tips):
         raise ValueError(f"names: expected {len(tips)} finger names, got {len(names)}")
     fingers, joint_names, meshes = [], {}, {}
     for name, tip in zip(names, tips, strict=True):
-        path = _path(model, parent_joint, tip, lines, file)
-        finger = _finger(name, tip, path, lines, file, joint_names)
+        path = _path(model, parent_joint, tip, file)
+        finger = _finger(name, tip, path, file, joint_names)
         fingers.append(replace(finger, tip_radius=_tip_radius(model, tip, where, max_bytes, meshes)))
-    roots = [link for link in model.link_map if link not in parent_joint]
+    roots = [link for link in model.links if link not in parent_joint]
     return Hand(tuple(fingers), tuple(joint_names), text, roots[0])
 
 
@@ -377,85 +318,90 @@ def _tip_radius(model, tip, urdf, max_bytes, meshes):
     ``meshes`` keeps each mesh file's vertices read so far (a hand's fingers share their tip's)."""
     from ..engine.fingertips import SPHERE_TOL, sphere_radius
 
-    for collision in model.link_map[tip].collisions:
-        origin = np.eye(4) if collision.origin is None else np.asarray(collision.origin, dtype=float)
-        sphere, mesh = collision.geometry.sphere, collision.geometry.mesh
-        if sphere is not None and float(np.linalg.norm(origin[:3, 3])) <= SPHERE_TOL * sphere.radius:
-            return float(sphere.radius)
-        if mesh is not None and mesh.filename not in meshes:
-            meshes[mesh.filename] = _mesh_vertices(mesh, urdf, max_bytes)
-        vertices = None if mesh is None else meshes[mesh.filename]
+    for shape in model.links[tip].collisions:
+        origin = shape.origin
+        if shape.kind == "sphere" and float(np.linalg.norm(origin[:3, 3])) <= SPHERE_TOL * shape.size[0]:
+            return shape.size[0]
+        if shape.kind == "mesh" and shape.filename not in meshes:
+            meshes[shape.filename] = _mesh_vertices(shape.filename, urdf, max_bytes)
+        vertices = meshes[shape.filename] if shape.kind == "mesh" else None
         if vertices is not None:
-            scale = np.ones(3) if mesh.scale is None else np.broadcast_to(np.asarray(mesh.scale, dtype=float), 3)
+            scale = np.ones(3) if shape.scale is None else shape.scale
             radius = sphere_radius(vertices * scale @ origin[:3, :3].T + origin[:3, 3])
             if radius is not None:  # digits past the sphere's own tolerance are the file's round-off
                 return float(f"{radius:.{-int(np.log10(SPHERE_TOL))}g}")
     return 0.0
 
 
-def _mesh_vertices(mesh, urdf, max_bytes):
+def _mesh_vertices(filename, urdf, max_bytes):
     """A collision mesh's vertices ``(V, 3)`` in its own frame, None when it cannot be read.
 
     Resolved as a URDF is (:func:`resolve_urdf`: ``package://`` inside its Python package, a
-    path inside the URDF's folder), at most ``max_bytes``, parsed by trimesh (yourdfpy's own
-    dependency) from the bytes, so that it opens no other file.
+    path inside the URDF's folder), at most ``max_bytes``, an STL, OBJ or PLY parsed within the
+    mesh caps (:func:`~grasptwist.io.mesh_formats.parse_mesh`), another format by trimesh (imported
+    only then) from the bytes, so that it opens no other file; its vertices merged as trimesh
+    merges them (:func:`~grasptwist.io.urdf_model.merged`).
     """
-    import trimesh
+    from .mesh_formats import parse_mesh
 
     try:
-        path = resolve_urdf(mesh.filename, None if mesh.filename.startswith(_PACKAGE) else urdf.parent)
-        data = _read(path, max_bytes, mesh.filename)
-        loaded = trimesh.load(io.BytesIO(data), file_type=path.suffix.lstrip(".").lower(), force="mesh")
-        return np.asarray(loaded.vertices, dtype=float)
-    except Exception:  # an unreadable mesh only gives no radius: the hand's kinematics do not need it
+        path = resolve_urdf(filename, urdf.parent)
+        data = _read(path, max_bytes, filename)
+        suffix = path.suffix.lower()
+        if suffix in MESH_SUFFIXES:
+            return merged(*parse_mesh(data, suffix, filename))[0]
+        import trimesh
+
+        loaded = trimesh.load(io.BytesIO(data), file_type=suffix[1:], force="mesh", process=False)
+        return merged(loaded.vertices, loaded.faces)[0]
+    except Exception:  # noqa: BLE001 - an unreadable mesh only gives no radius: the hand's kinematics do not need it
         return None
 
 
-def _tree(model, lines, file):
+def _tree(model, file):
     """Each link's parent joint, after checking that the links form one tree."""
     parent_joint = {}
-    for joint in model.robot.joints:
-        where = lines.get(joint.name)
+    for joint in model.joints:
         for link in (joint.parent, joint.child):
-            if link not in model.link_map:
-                raise InputError("invalid-urdf", f"joint {joint.name!r}: no link named {link!r}", file, where)
+            if link not in model.links:
+                raise InputError("invalid-urdf", f"joint {joint.name!r}: no link named {link!r}", file, joint.line)
         if joint.child in parent_joint:
-            raise InputError("invalid-urdf", f"link {joint.child!r} is the child of two joints", file, where)
+            raise InputError("invalid-urdf", f"link {joint.child!r} is the child of two joints", file, joint.line)
         parent_joint[joint.child] = joint
-    roots = [link for link in model.link_map if link not in parent_joint]
+    roots = [link for link in model.links if link not in parent_joint]
     if len(roots) != 1:
         raise InputError("invalid-urdf", f"expected one root link, found {len(roots)}: {', '.join(roots[:5])}", file)
     return parent_joint
 
 
-def _path(model, parent_joint, tip, lines, file):
+def _path(model, parent_joint, tip, file):
     """The joints from the root to ``tip``."""
-    if tip not in model.link_map:
+    if tip not in model.links:
         raise InputError("unknown-link", f"no link named {tip!r} in the URDF", file)
     path, link = [], tip
     while link in parent_joint:
         joint = parent_joint[link]
         if len(path) > len(parent_joint):  # every link has one parent, so only a cycle can get here
-            raise InputError("invalid-urdf", f"the joints above link {tip!r} form a cycle", file, lines.get(joint.name))
+            raise InputError("invalid-urdf", f"the joints above link {tip!r} form a cycle", file, joint.line)
         path.append(joint)
         link = joint.parent
     return path[::-1]
 
 
-def _finger(name, tip, path, lines, file, joint_names):
+def _finger(name, tip, path, file, joint_names):
     origins, axes, kinds, joints = [], [], [], []
     for joint in path:
-        where = lines.get(joint.name)
-        if joint.type in _UNSUPPORTED or joint.mimic is not None:
-            what = "a mimic joint" if joint.mimic is not None else f"a {joint.type} joint"
+        where = joint.line
+        if joint.type in _UNSUPPORTED or joint.mimic:
+            what = "a mimic joint" if joint.mimic else f"a {joint.type} joint"
             raise InputError("unsupported-joint", f"joint {joint.name!r} on finger {name!r} is {what}", file, where)
         kind = _MOVABLE.get(joint.type)
         if kind is None:
             raise InputError("invalid-urdf", f"joint {joint.name!r}: unknown type {joint.type!r}", file, where)
-        axis = np.asarray(joint.axis, dtype=float)
+        axis = joint.axis
         if kind != "fixed" and not np.any(axis):
             raise InputError("invalid-urdf", f"joint {joint.name!r}: zero axis", file, where)
-        origins.append(np.eye(4) if joint.origin is None else joint.origin)
+        origins.append(joint.origin)
         axes.append(axis)
         kinds.append(kind)
         if kind != "fixed":

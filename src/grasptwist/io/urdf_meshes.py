@@ -1,10 +1,14 @@
-"""The visual meshes of a hand's URDF, posed at joint positions, for pictures.
+"""The meshes of a hand's URDF: its finger links' collision geometry, and its visual meshes for pictures.
 
-:mod:`grasptwist.io.urdf` reads a URDF for its joints and never opens a
-mesh; a picture of the hand wants the links' shapes.  This reads the same
-URDF again with the same checks (size cap, no DTD), then lets yourdfpy load
-its visual meshes (through trimesh, which yourdfpy brings) and pose them by
-its own forward kinematics of the same joints.  Each mesh file is resolved
+:mod:`grasptwist.io.urdf` reads a URDF for its joints and opens no mesh but
+the tip's; the collision checks want the finger links' shapes
+(:func:`link_geometry`: read from the same model, :mod:`.urdf_model`, its
+STL, OBJ and PLY meshes by :func:`~grasptwist.io.mesh_formats.parse_mesh`,
+so that neither yourdfpy nor trimesh is imported), and a picture of the hand
+its visual meshes (:func:`hand_meshes`: this reads the same URDF again with
+the same checks, size cap and no DTD, then lets yourdfpy load them, through
+trimesh, and pose them by its own forward kinematics of the same joints).
+Each mesh file is resolved
 as the URDF itself is (:func:`~grasptwist.io.urdf.resolve_urdf`: inside its
 ``package://`` package, or inside the URDF's folder) and must be a regular
 file that decodes to at most :data:`~grasptwist.io.limits.MAX_MESH_BYTES`
@@ -39,8 +43,22 @@ from ..engine.collision import LinkGeometry
 from ..model import InputError
 from .limits import MAX_MESH_BYTES, MAX_TRIANGLES, MAX_URDF_BYTES, MESH_SUFFIXES
 from .urdf import _library, _parse, _read, resolve_urdf
+from .urdf_model import merged, read_model
 
-__all__ = ["decoded_size", "gltf_bytes", "grasp_folder", "hand_meshes", "link_geometry", "urdf_files"]
+__all__ = [
+    "MERGE_DECIMALS",
+    "decoded_size",
+    "gltf_bytes",
+    "grasp_folder",
+    "hand_meshes",
+    "link_geometry",
+    "mesh_file",
+    "urdf_files",
+]
+
+#: A link mesh's vertices that round to the same multiples of ``10**-MERGE_DECIMALS`` are one (as
+#: trimesh merges a mesh it loads: ``trimesh.tol.merge`` 1e-8).
+MERGE_DECIMALS = 8
 
 #: Compressed streams by their first bytes, and how to open one.
 _STREAMS = {b"\x1f\x8b": gzip.open, b"BZh": bz2.open, b"\xfd7zXZ\x00": lzma.open}
@@ -156,7 +174,7 @@ def hand_meshes(hand, positions=None, *, folder=None, max_bytes=MAX_URDF_BYTES) 
     """
     if hand.source is None:
         return []
-    model = _loaded(hand, folder, max_bytes, collision=False)
+    model = _loaded(hand, folder, max_bytes)
     if positions is not None:
         moved = dict(zip(hand.joint_names, map(float, positions)))
         model.update_cfg({j: moved.get(j, 0.0) for j in model.actuated_joint_names})
@@ -172,6 +190,14 @@ def link_geometry(hand, *, folder=None, max_bytes=MAX_URDF_BYTES) -> tuple[LinkG
     scales); a URDF with no ``<collision>`` at all falls back to its ``<visual>`` ones.  Only one
     of the two is read: a URDF that has collision geometry keeps its visual-only links (the
     TriFinger's ``*_visuals_*`` decorations) out of the check.
+
+    The URDF is read by :func:`~grasptwist.io.urdf_model.read_model` (not yourdfpy, which imports
+    trimesh) and only the finger links' meshes are opened, each by :func:`mesh_file`; the links'
+    poses at home are the products of the joints' origins down the tree.  The vertices and faces
+    are those yourdfpy's collision scene gives (a link's shapes in the file's order, each mesh's
+    vertices merged to 8 decimals as trimesh merges them, a scale whose product is negative
+    re-winding the faces), to round-off; boxes, spheres and cylinders are trimesh's
+    (``trimesh.primitives``), which is imported for them only.
 
     Parameters
     ----------
@@ -201,91 +227,146 @@ def link_geometry(hand, *, folder=None, max_bytes=MAX_URDF_BYTES) -> tuple[LinkG
     """
     if hand.source is None:
         return ()
-    model = _loaded(hand, folder, max_bytes, collision=True)
-    scene = model.collision_scene
-    if not scene.graph.nodes_geometry:
-        model = _loaded(hand, folder, max_bytes, collision=False)
-        scene = model.scene
-    model.update_cfg({j: 0.0 for j in model.actuated_joint_names})
-    owners = _finger_links(hand, model)
-    meshes = {}  # link -> [(vertices, faces)], in the root frame at home
-    for node in scene.graph.nodes_geometry:
-        link = scene.graph.transforms.parents.get(node)
-        if link not in owners:
+    _library(hand.source)  # trimesh (yourdfpy's) makes the primitives and reads other formats
+    urdf = resolve_urdf(hand.source, folder)
+    model = read_model(_parse(_read(urdf, max_bytes, hand.source), hand.source), hand.source)
+    collision = any(link.collisions for link in model.links.values())
+    meshes, out = {}, []  # each mesh file read once
+    for link, (finger, joints, pose) in _finger_links(hand, model).items():
+        shapes = model.links[link].collisions if collision else model.links[link].visuals
+        parts = [_shape_mesh(shape, urdf, hand.source, meshes, turn=not collision) for shape in shapes]
+        if not parts:
             continue
-        pose, name = scene.graph[node]
-        mesh = scene.geometry[name]
-        v = np.asarray(mesh.vertices, dtype=float) @ pose[:3, :3].T + pose[:3, 3]
-        meshes.setdefault(link, []).append((v, np.asarray(mesh.faces, dtype=int)))
-    out = []
-    for link, (finger, joints) in owners.items():
-        if link not in meshes:
-            continue
-        parts = meshes[link]
         offsets = np.cumsum([0] + [len(v) for v, _ in parts[:-1]])
-        vertices = np.concatenate([v for v, _ in parts])
+        vertices = np.concatenate([v for v, _ in parts]) @ pose[:3, :3].T + pose[:3, 3]
         faces = np.concatenate([f + o for (_, f), o in zip(parts, offsets)])
         out.append(LinkGeometry(finger, link, joints, vertices, faces))
     return tuple(sorted(out, key=lambda g: (g.finger, g.joints)))
 
 
+def _shape_mesh(shape, urdf, source, meshes, turn):
+    """A ``<collision>`` (or ``<visual>``) shape's ``(vertices, faces)`` in its link's frame:
+    its mesh scaled (a scale of 1 to ``np.allclose`` left alone, as trimesh does) or trimesh's
+    primitive, moved by its origin.  A sphere's tessellation is only moved, not turned, unless
+    ``turn`` (trimesh turns the primitive's pose but makes its sphere's mesh from the centre alone;
+    a visual shape is posed by the scene)."""
+    if shape.kind == "mesh":
+        if shape.filename not in meshes:
+            meshes[shape.filename] = mesh_file(shape.filename, urdf, source)
+        v, f = meshes[shape.filename]
+        if shape.scale is not None and not np.allclose(shape.scale, 1.0):
+            v = v * shape.scale
+            f = f[:, ::-1] if np.prod(shape.scale) < 0 else f  # a mirror turns the faces inside out
+    else:
+        v, f = _primitive(shape)
+    origin = shape.origin
+    if shape.kind == "sphere" and not turn:
+        return v + origin[:3, 3], f
+    return v @ origin[:3, :3].T + origin[:3, 3], f
+
+
+def _primitive(shape):
+    """trimesh's box, sphere or cylinder (``trimesh.primitives``, as yourdfpy makes them): ``(vertices, faces)``."""
+    import trimesh
+
+    size = shape.size
+    if shape.kind == "box":
+        made = trimesh.primitives.Box(extents=np.asarray(size, dtype=float))
+    elif shape.kind == "sphere":
+        made = trimesh.primitives.Sphere(radius=size[0])
+    else:
+        made = trimesh.primitives.Cylinder(radius=size[0], height=size[1])
+    return np.asarray(made.vertices, dtype=float), np.asarray(made.faces, dtype=np.int64)
+
+
 def _finger_links(hand, model) -> dict:
-    """Each link moved by some finger's first joints: ``{link: (finger, joints)}`` (the first finger
-    whose joints they are, when fingers share joints)."""
-    parent = {j.child: j for j in model.robot.joints}
+    """Each link moved by some finger's first joints: ``{link: (finger, joints, pose)}`` (the first
+    finger whose joints they are, when fingers share joints; ``pose`` ``(4, 4)`` the link's at home,
+    in the root's frame)."""
+    parent = {j.child: j for j in model.joints}
     prefixes = {}
     for f, finger in enumerate(hand.fingers):
         names = tuple(j.name for j in finger.joints)
         for k in range(1, len(names) + 1):
             prefixes.setdefault(names[:k], (f, k))
     owners = {}
-    for link in model.link_map:
-        above, at = [], link
-        while at in parent:
-            joint = parent[at]
-            if joint.type != "fixed":
-                above.append(joint.name)
-            at = joint.parent
-        owner = prefixes.get(tuple(reversed(above)))
-        if owner is not None:
-            owners[link] = owner
+    for link in model.links:
+        chain, at = [], link
+        while at in parent and len(chain) <= len(parent):  # a cycle (no hand's link) ends the walk
+            chain.append(parent[at])
+            at = parent[at].parent
+        owner = prefixes.get(tuple(j.name for j in reversed(chain) if j.type != "fixed"))
+        if owner is not None and at not in parent:
+            pose = np.eye(4)
+            for joint in reversed(chain):
+                pose = pose @ joint.origin
+            owners[link] = (*owner, pose)
     return owners
 
 
-def _loaded(hand, folder, max_bytes, *, collision):
-    """``hand``'s URDF read by yourdfpy with its visual (or collision) meshes loaded, every mesh file
-    resolved and size-checked first (see the module's docstring)."""
+def mesh_file(name, urdf, source):
+    """A URDF's mesh file ``name`` as ``(vertices (V, 3), faces (F, 3))`` in its own frame.
+
+    Resolved as the URDF's meshes are (:func:`~grasptwist.io.urdf.resolve_urdf`, from the folder
+    of the URDF at ``urdf``) and within the mesh caps (:func:`_checked_mesh`); an STL, OBJ or PLY
+    read by :func:`~grasptwist.io.mesh_formats.parse_mesh`, another format by trimesh (imported
+    only then).  As trimesh loads a mesh (:func:`~grasptwist.io.urdf_model.merged`): faces with a
+    corner that is not finite dropped, vertices equal to 8 decimals merged into the first of them,
+    unused ones left out.  (An OBJ's vertices merge by position alone, where trimesh keeps apart
+    those of different normals.)
+
+    Raises
+    ------
+    InputError
+        The URDF's (``source``), naming the mesh: ``path-outside``, ``read-error``, ``too-large``
+        or a mesh format's.
+    """
+    path, parsed = _checked_mesh(name, urdf, source)
+    if parsed is None:
+        import trimesh
+
+        try:
+            loaded = trimesh.load(str(path), force="mesh", ignore_broken=True, skip_materials=True)
+            parsed = np.asarray(loaded.vertices, dtype=float), np.asarray(loaded.faces, dtype=np.int64)
+        except Exception as exc:  # noqa: BLE001 - a malformed mesh: each format's parser raises its own kinds
+            raise InputError("read-error", f"mesh {name!r}: cannot read: {type(exc).__name__}: {exc}", source) from None
+    return merged(*parsed)
+
+
+def _checked_mesh(name, urdf, source):
+    """The mesh file ``name`` of the URDF at ``urdf``: its path, resolved and within the mesh caps
+    (:func:`_check_mesh_file`), and its ``(vertices, faces)`` when it is an STL, OBJ or PLY (None
+    for another format); errors are the URDF's (``source``), naming the mesh."""
+    try:
+        path = resolve_urdf(name, urdf.parent)
+    except InputError as exc:  # the error is the URDF's, about one of its meshes
+        raise InputError(exc.code, f"mesh {exc.message}", source) from None
+    try:
+        return path, _check_mesh_file(name, path)
+    except InputError as exc:
+        where = f", line {exc.line}" if exc.line else ""
+        raise InputError(exc.code, f"mesh {name!r}{where}: {exc.message}", source) from None
+
+
+def _loaded(hand, folder, max_bytes):
+    """``hand``'s URDF read by yourdfpy with its visual meshes loaded, every mesh file resolved and
+    size-checked first (see the module's docstring)."""
     urdf = resolve_urdf(hand.source, folder)
     data = _read(urdf, max_bytes, hand.source)
     _parse(data, hand.source)  # refuses a DTD, as the joints' reading did
-    yourdfpy = _library(hand.source)
+    _library(hand.source)
+    import yourdfpy
 
-    def mesh_file(fname):  # yourdfpy passes it by this name
-        name = fname
-        try:
-            path = resolve_urdf(name, urdf.parent)
-        except InputError as exc:  # the error is the URDF's, about one of its meshes
-            raise InputError(exc.code, f"mesh {exc.message}", hand.source) from None
-        try:
-            _check_mesh_file(name, path)
-        except InputError as exc:
-            where = f", line {exc.line}" if exc.line else ""
-            raise InputError(exc.code, f"mesh {name!r}{where}: {exc.message}", hand.source) from None
-        asked.append(name)
+    def handler(fname):  # yourdfpy passes it by this name
+        path, _ = _checked_mesh(fname, urdf, hand.source)
+        asked.append(fname)
         return str(path)
 
     asked = []  # the mesh files handed to the library, the one it is reading last
     try:
         with warnings.catch_warnings():  # yourdfpy's own call of a trimesh method trimesh deprecates
             warnings.filterwarnings("ignore", r".*Scene\.dump", DeprecationWarning)
-            return yourdfpy.URDF.load(
-                io.BytesIO(data),
-                build_scene_graph=not collision,
-                load_meshes=not collision,
-                build_collision_scene_graph=collision,
-                load_collision_meshes=collision,
-                filename_handler=mesh_file,
-            )
+            return yourdfpy.URDF.load(io.BytesIO(data), filename_handler=handler)
     except InputError:
         raise
     except Exception as exc:  # noqa: BLE001 - a malformed mesh: each format's parser raises its own kinds
@@ -296,7 +377,8 @@ def _loaded(hand, folder, max_bytes, *, collision):
 def _check_mesh_file(name, path):
     """Refuse the mesh file ``name`` (at ``path``) unless it is a regular file within the mesh caps:
     :data:`~grasptwist.io.limits.MAX_MESH_BYTES` held, decoded or read with the files a glTF names,
-    and an STL's, OBJ's or PLY's declared vertices and triangles; errors name the file as ``name``."""
+    and an STL's, OBJ's or PLY's declared vertices and triangles; errors name the file as ``name``.
+    Returns an STL's, OBJ's or PLY's ``(vertices, faces)`` as read within the caps (None for another format)."""
     from .mesh_formats import parse_mesh
 
     cap = MAX_MESH_BYTES
@@ -320,7 +402,8 @@ def _check_mesh_file(name, path):
                 )
                 raise InputError("too-large", f"{what}, more than {cap} bytes", name)
         if suffix in MESH_SUFFIXES:
-            parse_mesh(_read(path, cap, name), suffix, name, MAX_TRIANGLES)
+            return parse_mesh(_read(path, cap, name), suffix, name, MAX_TRIANGLES)
+        return None
     except (OSError, EOFError, zipfile.BadZipFile, zlib.error, lzma.LZMAError) as exc:
         raise InputError("read-error", f"cannot read: {getattr(exc, 'strerror', None) or exc}", name) from None
     except (ValueError, KeyError, TypeError, AttributeError) as exc:  # JSON that is no glTF's

@@ -35,6 +35,7 @@ __all__ = [
     "check_extent",
     "degenerate_faces",
     "MeshRepair",
+    "merge_vertices",
     "repair_mesh",
 ]
 
@@ -237,6 +238,31 @@ class MeshRepair(NamedTuple):
         return f"mesh-repaired: {', '.join(said)} (the geometry is unchanged)"
 
 
+def merge_vertices(vertices, faces, decimals=None):
+    """Equal vertices merged into the first of them, in the order they come, unused ones left out.
+
+    Vertices are equal when their coordinates are (``decimals`` None), or when they round to the
+    same multiples of ``10**-decimals`` (``round(v * 10**decimals)``, as trimesh merges a mesh it
+    loads with ``decimals=8``).  ``vertices (V, 3)`` floats, ``faces (F, 3)`` ints indexing them;
+    returns ``(vertices (U, 3), faces (F, 3))``, the same triangles.
+
+    >>> v = np.array([[0.0, 0, 0], [5, 5, 5], [1, 0, 0], [0, 1, 0], [1, 1e-9, 0]])
+    >>> u, f = merge_vertices(v, [[0, 2, 3], [2, 4, 3]], decimals=8)
+    >>> u.tolist(), f.tolist()
+    ([[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [0.0, 1.0, 0.0]], [[0, 1, 2], [1, 1, 2]])
+    """
+    v = np.asarray(vertices, dtype=float)
+    f = np.asarray(faces, dtype=np.int64).reshape(-1, 3)
+    used = np.unique(f)
+    key = v[used] if decimals is None else np.round(v[used] * 10**decimals).astype(np.int64)
+    _, first, merged = np.unique(key, axis=0, return_index=True, return_inverse=True)
+    rank = np.empty(len(first), dtype=np.int64)
+    rank[np.argsort(first)] = np.arange(len(first))  # in the order the vertices come
+    index = np.zeros(len(v), dtype=np.int64)
+    index[used] = rank[merged.reshape(-1)]
+    return v[used[np.sort(first)]], index[f]
+
+
 def repair_mesh(vertices, faces) -> MeshRepair:
     """Equal vertices merged, faces of zero area or with a repeated corner dropped, unused vertices left out.
 
@@ -249,16 +275,8 @@ def repair_mesh(vertices, faces) -> MeshRepair:
     >>> len(r.vertices), r.faces.tolist(), r.merged, r.dropped
     (4, [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]], 1, 1)
     """
-    v = np.asarray(vertices, dtype=float)
-    f = np.asarray(faces, dtype=np.int64)
-    used = np.unique(f)
-    _, first, merged = np.unique(v[used], axis=0, return_index=True, return_inverse=True)
-    rank = np.empty(len(first), dtype=np.int64)
-    rank[np.argsort(first)] = np.arange(len(first))  # in the order the vertices come
-    unique = v[used[np.sort(first)]]
-    index = np.zeros(len(v), dtype=np.int64)
-    index[used] = rank[merged.reshape(-1)]
-    f = index[f]
+    unique, f = merge_vertices(vertices, faces)
+    used = np.unique(np.asarray(faces, dtype=np.int64))
     repeated = (f[:, 0] == f[:, 1]) | (f[:, 1] == f[:, 2]) | (f[:, 2] == f[:, 0])
     keep = ~repeated
     keep[np.flatnonzero(keep)[degenerate_faces(unique, f[keep])]] = False
