@@ -282,7 +282,7 @@ def _loaded(*command_lines) -> list[set[str]]:
 #: over the import floor, bench/startup.py), so the registries that need none of it (columns,
 #: formats, sections, families, output settings, tuning) are NamedTuples, and a path's checks
 #: (engine.segments) load without the path's engine and its results.
-DATACLASSES_FOR_JSON_RESOLVE = 27
+DATACLASSES_FOR_JSON_RESOLVE = 23
 
 
 def _dataclasses(modules: set[str]) -> list[str]:

@@ -71,10 +71,10 @@ class Job:
     options: Any = None
 
     def __post_init__(self):
-        family = self.command.family
-        options = self.options if self.options is not None else family.options()
-        if not isinstance(options, family.options):
-            raise TypeError(f"{self.command.name} takes {family.options.__name__}, got {type(options).__name__}")
+        kind = self.command.family.options()
+        options = self.options if self.options is not None else kind()
+        if not isinstance(options, kind):
+            raise TypeError(f"{self.command.name} takes {kind.__name__}, got {type(options).__name__}")
         object.__setattr__(self, "options", replace(options, **self.command.fixed))
 
     @property
