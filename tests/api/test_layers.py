@@ -226,13 +226,17 @@ def test_no_layer_branches_on_a_command_name(name):
 
 #: Modules a one-file JSON ``resolve`` never needs: the force side, the hand's kinematics and
 #: inverse kinematics, URDF reading, tables (rich) and pictures; on a primitive object, the
-#: meshes' geometry and their winding-number solid; CSV rows; data sets.
+#: meshes' geometry and their winding-number solid; CSV rows; data sets; the hand's and the
+#: environment's types, and the other families' options.
 NOT_FOR_JSON_RESOLVE = (
     "grasptwist.engine.objects.mesh",
     "grasptwist.engine.objects.solid",
     "grasptwist.output.csv_rows",
     "csv",
     "grasptwist.io.dataset",
+    "grasptwist.model.hands",
+    "grasptwist.model.environment",
+    "grasptwist.run.family_options",
     "grasptwist.engine.forces",
     "grasptwist.run.forces",
     "grasptwist.output.force_records",
@@ -280,9 +284,10 @@ def _loaded(*command_lines) -> list[set[str]]:
 #: The most dataclasses the modules of a JSON resolve define.  Python compiles a dataclass's
 #: methods from source as its module loads (0.5 ms each: 38 of them were a tenth of the start-up
 #: over the import floor, bench/startup.py), so the registries that need none of it (columns,
-#: formats, sections, families, output settings, tuning) are NamedTuples, and a path's checks
-#: (engine.segments) load without the path's engine and its results.
-DATACLASSES_FOR_JSON_RESOLVE = 23
+#: formats, sections, families, output settings, tuning) are NamedTuples, a path's checks
+#: (engine.segments) load without the path's engine and its results, and the hand's, the
+#: environment's and the other families' options types live in modules of their own.
+DATACLASSES_FOR_JSON_RESOLVE = 17
 
 
 def _dataclasses(modules: set[str]) -> list[str]:

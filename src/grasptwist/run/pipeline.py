@@ -22,12 +22,12 @@ from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
 from functools import partial
-from typing import Any, NamedTuple
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 from ..io.datasets import DATASET_SUFFIXES, open_dataset
 from ..io.grasp import READING, Reading
 from ..io.lines import grasp_batches
-from ..model import Hand, InputError
+from ..model import InputError
 from ..output.formats import FORMATS
 from ..output.records import error_record
 from .batch import check_positions
@@ -37,6 +37,9 @@ from .placement import placed, read
 from .pool import Pool, pool_size
 from .scratch import owned_prefix, remove_orphans
 from .stream import is_stream
+
+if TYPE_CHECKING:
+    from ..model.hands import Hand
 
 __all__ = [
     "Job",
