@@ -157,7 +157,7 @@ def _all_talking(block, job) -> list[dict]:
     return [rec for rec in job.command.records(block, job) if not rec["ok"] or rec["warnings"]]
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # one per command (COMMANDS): compared by identity
 class Command:
     """One command: the family whose rows it shows, its records, its table and formats.
 

@@ -58,7 +58,7 @@ __all__ = [
 SPOOL_STEM = "grasptwist-"
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False)  # never compared (its options are)
 class Job:
     """What a command asks for (everything a worker needs): what every command shares, and
     ``options``, its family's own (None: the family's defaults; the options a command fixes,
