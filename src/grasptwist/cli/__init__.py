@@ -9,6 +9,7 @@ stdout carries data only; every diagnostic goes to stderr as one line
 ``path:line:col: error: message``.
 """
 
+import gc
 import importlib
 import sys
 
@@ -95,7 +96,12 @@ def main() -> None:
     stop_on_signals()
     try:
         try:
-            code = app_for(sys.argv[1:])(standalone_mode=False)
+            app = app_for(sys.argv[1:])
+            # the start-up's objects, the command's modules loaded, out of the cyclic collector's
+            # sight (grasptwist.__main__ turned it off for them), and the collector on for the run's
+            gc.freeze()
+            gc.enable()
+            code = app(standalone_mode=False)
         except CLICK_ERROR as exc:
             code = usage_error(exc)
     except Interrupted as stop:  # while typer parsed the command line

@@ -94,7 +94,7 @@ def _index(a, i):
     return None if a is None else a[i]
 
 
-@dataclass(frozen=True, eq=False)
+@dataclass(frozen=True, eq=False, init=False, repr=False)  # never made itself: each result makes its own
 class _Result:
     """What both results share: per-row status, conditioning and inputs (each result's
     Attributes list them), row access and the lazily computed residual."""

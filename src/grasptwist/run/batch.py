@@ -61,7 +61,7 @@ OUTWARD = (None, "outward_contacts")
 ROWS_PER_BLOCK = 65536
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # arrays: equality would fail; a block is compared by identity
 class Block:
     """Consecutive (grasp, twist) rows with every result kind's results, as columns.
 

@@ -20,8 +20,9 @@ How to add a family
 -------------------
 Say, grasps synthesised on an object's surface (``grasptwist synthesise``):
 
-1. Its options in :mod:`.options`: a frozen dataclass whose defaults are
-   a command line without options (``rows_per_grasp()`` if it reads data sets).
+1. Its options in :mod:`.family_options` (named in :mod:`.options`' ``_ELSEWHERE``): a frozen
+   dataclass whose defaults are a command line without options (``rows_per_grasp()`` if it
+   reads data sets).
 2. Compute its rows in a module of ``run/``: its block type (``__len__`` and
    ``part(start, stop)``) and ``rows(items, job)``: read grasps and errors
    in, blocks and errors (:class:`~grasptwist.model.InputError`, written as
@@ -51,6 +52,7 @@ from __future__ import annotations
 
 from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field
+from functools import partial
 from typing import Any, NamedTuple
 
 from ..io.inputs import GRASP_SUFFIXES, OBJECT_SUFFIXES
@@ -58,7 +60,7 @@ from ..output.formats import FORMATS
 from ..output.json_rows import encode_records
 from ..output.records import basis_record, check_record, dumps, records, talking_rows
 from .batch import ZERO_TWIST, dataset_blocks, resolve
-from .options import NOT_SIMULATED, FollowOptions, ForceOptions, SimulateOptions, SynthesisOptions, TwistOptions
+from .options import NOT_SIMULATED
 from .stream import twist_stream
 
 __all__ = [
@@ -83,8 +85,9 @@ class Family(NamedTuple):
     ----------
     name : str
         What its rows are (``twist``, ``wrench``, ``path``).
-    options : type
-        Its options (:mod:`.options`): a frozen dataclass, defaults when called without arguments.
+    options : callable
+        ``() -> type``: its options (:mod:`.options`), a frozen dataclass, defaults when called
+        without arguments (the other families' are defined when first asked for).
     columns : callable
         ``() -> ColumnSet``: its rows as CSV, npz and Parquet columns (loaded when a format
         writes columns).
@@ -117,7 +120,7 @@ class Family(NamedTuple):
     """
 
     name: str
-    options: type
+    options: Callable[[], type]
     columns: Callable[[], Any]
     rows: Callable[[list, Any], Iterator] | None = None
     dataset: Callable[..., Iterator] | None = None
@@ -154,7 +157,7 @@ def _all_talking(block, job) -> list[dict]:
     return [rec for rec in job.command.records(block, job) if not rec["ok"] or rec["warnings"]]
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)  # one per command (COMMANDS): compared by identity
 class Command:
     """One command: the family whose rows it shows, its records, its table and formats.
 
@@ -210,6 +213,15 @@ class Command:
 # small functions below: a JSON resolve never imports the force engine, follow's
 # paths or the hand's kinematics (tests/api/test_layers.py, bench/startup.py).
 
+
+def _options(name: str) -> type:
+    """The options class ``name`` of :mod:`.options` (a family other than the twist rows' defines
+    its own when first asked for: a ``resolve`` compiles none of their dataclasses)."""
+    from . import options
+
+    return getattr(options, name)
+
+
 # -- twist rows ---------------------------------------------------------------
 
 
@@ -243,7 +255,7 @@ def _twist_columns():
 
 TWIST = Family(
     name="twist",
-    options=TwistOptions,
+    options=partial(_options, "TwistOptions"),
     columns=_twist_columns,
     rows=_twist_rows,
     dataset=_twist_dataset,
@@ -280,7 +292,7 @@ def _closure(block, options):
 
 WRENCH = Family(
     name="wrench",
-    options=ForceOptions,
+    options=partial(_options, "ForceOptions"),
     columns=_wrench_columns,
     rows=_wrench_rows,
     dataset=_wrench_dataset,
@@ -306,7 +318,7 @@ def _path_columns():
 
 PATH = Family(
     name="path",
-    options=FollowOptions,
+    options=partial(_options, "FollowOptions"),
     columns=_path_columns,
     outputs=_path_outputs,
     tells_progress=False,
@@ -329,7 +341,7 @@ def _synthesis_columns():
 
 SYNTHESIS = Family(
     name="synthesis",
-    options=SynthesisOptions,
+    options=partial(_options, "SynthesisOptions"),
     columns=_synthesis_columns,
     outputs=_synthesis_outputs,
     long_inputs=True,
@@ -353,7 +365,7 @@ def _simulation_columns():
 
 SIMULATION = Family(
     name="simulation",
-    options=SimulateOptions,
+    options=partial(_options, "SimulateOptions"),
     columns=_simulation_columns,
     outputs=_simulation_outputs,
     long_inputs=True,

@@ -14,7 +14,7 @@ from ..output.records import diagnostics, failure_codes
 __all__ = ["Output"]
 
 
-@dataclass
+@dataclass(eq=False)  # never compared: a run adds to it
 class Output:
     """The encoded records of one group, with their stderr lines and counts."""
 

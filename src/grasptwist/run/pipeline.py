@@ -22,12 +22,12 @@ from collections.abc import Iterator, Sequence
 from contextlib import contextmanager
 from dataclasses import dataclass, field, replace
 from functools import partial
-from typing import Any, NamedTuple
+from typing import TYPE_CHECKING, Any, NamedTuple
 
 from ..io.datasets import DATASET_SUFFIXES, open_dataset
 from ..io.grasp import READING, Reading
 from ..io.lines import grasp_batches
-from ..model import Hand, InputError
+from ..model import InputError
 from ..output.formats import FORMATS
 from ..output.records import error_record
 from .batch import check_positions
@@ -37,6 +37,9 @@ from .placement import placed, read
 from .pool import Pool, pool_size
 from .scratch import owned_prefix, remove_orphans
 from .stream import is_stream
+
+if TYPE_CHECKING:
+    from ..model.hands import Hand
 
 __all__ = [
     "Job",
@@ -55,7 +58,7 @@ __all__ = [
 SPOOL_STEM = "grasptwist-"
 
 
-@dataclass(frozen=True, kw_only=True)
+@dataclass(frozen=True, kw_only=True, eq=False)  # never compared (its options are)
 class Job:
     """What a command asks for (everything a worker needs): what every command shares, and
     ``options``, its family's own (None: the family's defaults; the options a command fixes,
@@ -71,10 +74,10 @@ class Job:
     options: Any = None
 
     def __post_init__(self):
-        family = self.command.family
-        options = self.options if self.options is not None else family.options()
-        if not isinstance(options, family.options):
-            raise TypeError(f"{self.command.name} takes {family.options.__name__}, got {type(options).__name__}")
+        kind = self.command.family.options()
+        options = self.options if self.options is not None else kind()
+        if not isinstance(options, kind):
+            raise TypeError(f"{self.command.name} takes {kind.__name__}, got {type(options).__name__}")
         object.__setattr__(self, "options", replace(options, **self.command.fixed))
 
     @property

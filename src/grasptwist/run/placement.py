@@ -16,6 +16,7 @@ from __future__ import annotations
 import os
 from collections.abc import Iterable
 from dataclasses import replace
+from typing import TYPE_CHECKING
 
 from ..engine.degeneracy import Status
 from ..engine.environment import needs_checks
@@ -24,7 +25,10 @@ from ..io import inputs
 from ..io.grasp import READING, Reading
 from ..io.grasp.problems import MAX_ERRORS, Problems, Reject
 from ..io.grasp.values import readonly
-from ..model import Grasp, Hand, InputError
+from ..model import Grasp, InputError
+
+if TYPE_CHECKING:
+    from ..model.hands import Hand
 
 __all__ = ["place_grasp", "placed", "read", "read_grasps", "run_hand"]
 

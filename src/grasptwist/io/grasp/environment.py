@@ -14,12 +14,16 @@ table or above it.  The geometry is :mod:`grasptwist.engine.environment`'s.
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 import numpy as np
 
-from ...model import Environment, Obstacle
 from .paths import read_pose
 from .problems import Reject, located
 from .values import Section, read_mapping, read_number, read_sequence, read_vector, readonly
+
+if TYPE_CHECKING:
+    from ...model.environment import Environment
 
 __all__ = ["ENVIRONMENT_KEYS", "BOX_KEYS", "SECTION", "OBJECT_BELOW_TABLE", "read_environment"]
 
@@ -32,6 +36,8 @@ OBJECT_BELOW_TABLE = "object-below-table"
 
 def read_environment(node, problems) -> Environment | None:
     """The :class:`~grasptwist.model.Environment` of an ``environment`` node (None after a problem)."""
+    from ...model.environment import Environment, Obstacle  # with the first environment: most grasps have none
+
     fields = read_mapping(node, "environment", ENVIRONMENT_KEYS, (), problems)
     if fields is None:
         return None
@@ -84,6 +90,8 @@ def _read(fields, found, problems):
     if "environment" in fields and env is None:
         return None
     if reading.table is not None or reading.clearance is not None:
+        from ...model.environment import Environment
+
         env = env or Environment()
         table = env.table_height if reading.table is None else reading.table
         clearance = env.clearance if reading.clearance is None else reading.clearance

@@ -35,7 +35,7 @@ from pathlib import Path
 import numpy as np
 import yaml
 
-from ...model import Finger, Hand, HandPlacement, InputError, Joint
+from ...model import InputError
 from ..limits import DEFAULT_MAX_BYTES
 from .compose import PARSER, compose, syntax_error
 from .problems import MAX_ERRORS, Problems, Reject, join, located
@@ -264,8 +264,9 @@ def inline_hand(names, fingers, points):
     >>> h.joint_names, h.fingers[0].screws.tolist(), h.fingers[1].length
     (('a.1', 'b.1', 'c.1'), [[0.0, 0.0, 1.0, 0.0, 0.0, 0.0]], 1.0)
     """
-    # a hand's kinematics load with the first hand: grasp files without one never pay for them
+    # a hand's kinematics and types load with the first hand: grasp files without one never pay for them
     from ...engine.kinematics import chain_length, joint_screw
+    from ...model.hands import Finger, Hand, Joint
 
     out, joint_names = [], []
     contacts = [None] * 3 if points is None else np.asarray(points, dtype=float)
@@ -301,6 +302,7 @@ def _urdf_hand(fields, fingers, names, hand_file, file, problems, allow_outside=
     (``hand_file``), at its joint positions."""
     # URDF reading loads with the first such hand (bench/startup.py)
     from ...engine.hands import joint_positions
+    from ...model.hands import HandPlacement
     from ..urdf import load_urdf_hand
 
     node = fields["urdf"]

@@ -2,14 +2,22 @@
 
 No parsing and no math here: the loaders in :mod:`grasptwist.io` build these,
 the runner in :mod:`grasptwist.run` feeds them to the engine, and the
-writers in :mod:`grasptwist.output` report them.
+writers in :mod:`grasptwist.output` report them.  A hand's types (:mod:`.hands`) and the
+environment's (:mod:`.environment`) are named here too, their modules imported on first use:
+Python compiles a dataclass's methods as its module loads, and a grasp without a hand or an
+environment needs none of theirs (bench/startup.py).
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from .environment import Environment
+    from .hands import Hand, HandPlacement
 
 __all__ = [
     "Twist",
@@ -245,71 +253,6 @@ class GraspObject:
 
 
 @dataclass(frozen=True, eq=False)
-class Obstacle:
-    """A box the fingers must keep clear of, in the grasp frame.
-
-    Attributes
-    ----------
-    size : numpy.ndarray
-        ``(3,)`` edge lengths along the box's own x, y, z (centred at its origin).
-    pose : numpy.ndarray
-        ``(4, 4)`` rigid transform from the box's frame to the grasp's frame.
-    line : int or None
-        1-based line of its entry in the file.
-    """
-
-    size: np.ndarray
-    pose: np.ndarray
-    line: int | None = None
-
-
-@dataclass(frozen=True, eq=False)
-class Environment:
-    """The world around the object: a table under it and boxes beside it (a grasp file's ``environment``).
-
-    The geometry (distances, which finger hits what) is in
-    ``grasptwist.engine.environment``.
-
-    Attributes
-    ----------
-    table_height : float or None
-        The table, a horizontal plane ``z = table_height`` of the grasp frame (gravity along
-        -z) that the object rests on or above; None: no table.
-    boxes : tuple of Obstacle
-        Obstacles.
-    clearance : float or None
-        The least distance every part of a finger keeps from the table and the boxes (its
-        ``clearance``, or ``--clearance``); None: ``grasptwist.engine.environment.CLEARANCE``.
-    line : int or None
-        1-based line where the ``environment``'s mapping starts in the file.
-    """
-
-    table_height: float | None = None
-    boxes: tuple[Obstacle, ...] = ()
-    clearance: float | None = None
-    line: int | None = None
-
-
-@dataclass(frozen=True)
-class HandPlacement:
-    """Where a grasp file puts its URDF hand, as the file says it (nothing solved yet).
-
-    Attributes
-    ----------
-    given : bool
-        The file gives ``joint_positions`` (checked against the contacts);
-        else the grasp's joint positions are the ``seed`` that inverse
-        kinematics starts from.
-    tips : tuple of (int, int)
-        ``(line, column)`` of each finger's ``tip`` in the file: where a finger
-        that cannot be put on its contact is reported.
-    """
-
-    given: bool
-    tips: tuple[tuple[int | None, int | None], ...]
-
-
-@dataclass(frozen=True, eq=False)
 class Segment:
     """One piece of an object path, held for ``duration``: a constant twist or a pose target.
 
@@ -420,92 +363,20 @@ class InputError(Exception):
         return f"{where}: {self.message}"
 
 
-@dataclass(frozen=True, eq=False)
-class Joint:
-    """One movable joint of a finger.
-
-    Attributes
-    ----------
-    name : str
-    type : str
-        ``"revolute"`` (URDF ``continuous`` too) or ``"prismatic"``.
-    velocity_limit : float or None
-        Largest rate (rad or length per unit time), None when not given.
-    lower, upper : float or None
-        Position limits, None when not given.
-    line : int or None
-        1-based line of its definition (URDF element or grasp-file entry).
-    """
-
-    name: str
-    type: str
-    velocity_limit: float | None
-    lower: float | None
-    upper: float | None
-    line: int | None
+#: The names of the submodules' types -> their module, imported when first asked for.
+_ELSEWHERE = {
+    "Obstacle": ".environment",
+    "Environment": ".environment",
+    "HandPlacement": ".hands",
+    "Joint": ".hands",
+    "Finger": ".hands",
+    "Hand": ".hands",
+}
 
 
-@dataclass(frozen=True, eq=False)
-class Finger:
-    """A finger: a serial chain of joints at its home configuration (every joint at 0).
+def __getattr__(name: str):
+    if name in _ELSEWHERE:
+        from importlib import import_module
 
-    Arrays are read-only, in the hand's root frame (the grasp's frame).
-    :func:`~grasptwist.hand.forward_kinematics` moves them to
-    other joint positions.
-
-    Attributes
-    ----------
-    name : str
-    tip : str or None
-        The link whose body touches the contact (URDF), None for inline joints.
-    joints : tuple of Joint
-        Base to tip.
-    screws : numpy.ndarray
-        ``(n, 6)`` joint screws ``(omega; v)``: unit lines for revolute joints,
-        ``(0; d)`` for prismatic ones.
-    points : numpy.ndarray
-        ``(n, 3)`` a point of each joint (its frame's origin; on a revolute axis).
-    tip_pose : numpy.ndarray or None
-        ``(4, 4)`` pose of the tip link, None for inline joints.
-    length : float
-        From the first joint through the others to the tip link's origin: a
-        contact farther than this from the tip is a frame mix-up.
-    joint_index : tuple of int
-        Position of each joint in ``Hand.joint_names``.
-    tip_radius : float
-        Radius of the fingertip's sphere, centred at the tip link's origin (0: a
-        point tip). The tip's centre sits at ``point - tip_radius * normal``
-        (normal into the object), so the sphere touches the object at the contact.
-    """
-
-    name: str
-    tip: str | None
-    joints: tuple[Joint, ...]
-    screws: np.ndarray
-    points: np.ndarray
-    tip_pose: np.ndarray | None
-    length: float
-    joint_index: tuple[int, ...]
-    tip_radius: float = 0.0
-
-
-@dataclass(frozen=True, eq=False)
-class Hand:
-    """A hand: its fingers in contact order, and the joints that move them.
-
-    Attributes
-    ----------
-    fingers : tuple of Finger
-    joint_names : tuple of str
-        Every finger's joints, each once, in finger then joint order: the
-        columns of a ``joint_positions`` array.
-    source : str or None
-        The robot description it was read from (as referenced), None for inline joints.
-    root : str or None
-        The URDF's root link, whose frame is the grasp's frame.
-    """
-
-    fingers: tuple[Finger, ...]
-    joint_names: tuple[str, ...]
-    source: str | None
-    root: str | None
+        return getattr(import_module(_ELSEWHERE[name], __name__), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
