@@ -372,3 +372,11 @@ def test_the_script_freezes_the_start_up_s_objects_and_collects_the_run_s():
     # numpy's, typer's and grasptwist's tracked objects (about 29,000) are never gone through again; the
     # run's own are: the collector is on while the command works
     assert enabled == "True" and int(frozen) > 10_000 and int(passes) > 0, proc.stderr
+
+
+def test_a_command_run_from_python_leaves_the_callers_collector_alone():
+    """Only the script's start freezes: a notebook or a test calling grasptwist.cli.main keeps its heap in sight."""
+    script = _COLLECTED.replace("from grasptwist.__main__ import main", "from grasptwist.cli import main")
+    proc = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, cwd=ROOT, timeout=60)
+    (line,) = [line for line in proc.stderr.splitlines() if line.startswith("GC ")]
+    assert line.split()[1:3] == ["True", "0"], proc.stderr

@@ -97,10 +97,11 @@ def main() -> None:
     try:
         try:
             app = app_for(sys.argv[1:])
-            # the start-up's objects, the command's modules loaded, out of the cyclic collector's
-            # sight (grasptwist.__main__ turned it off for them), and the collector on for the run's
-            gc.freeze()
-            gc.enable()
+            if not gc.isenabled():  # the script's start (grasptwist.__main__ turned the collector off)
+                # its objects, the command's modules loaded, out of the cyclic collector's sight, and
+                # the collector on for the run's; a caller in Python keeps its own collector as it is
+                gc.freeze()
+                gc.enable()
             code = app(standalone_mode=False)
         except CLICK_ERROR as exc:
             code = usage_error(exc)
