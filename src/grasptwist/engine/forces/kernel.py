@@ -32,7 +32,10 @@ from numba import literally, njit
 from . import one
 from .closure import _PAIRS, _STRICT
 from .grasp_map import GRIP_COLUMNS
-from .socp import _EDGE, _ITERATIONS, _RESIDUAL, GAP, START_MARGIN
+from .ipm import EDGE as _EDGE
+from .ipm import GAP, START_MARGIN
+from .ipm import ITERATIONS as _ITERATIONS
+from .ipm import RESIDUAL as _RESIDUAL
 
 __all__ = ["grip_rows", "WIDTH"]
 

@@ -17,7 +17,10 @@ import math
 
 import numpy as np
 
-from .socp import _EDGE, _ITERATIONS, _RESIDUAL, GAP, START_MARGIN
+from .ipm import EDGE as _EDGE
+from .ipm import GAP, START_MARGIN
+from .ipm import ITERATIONS as _ITERATIONS
+from .ipm import RESIDUAL as _RESIDUAL
 
 __all__ = [
     "phase_one",
