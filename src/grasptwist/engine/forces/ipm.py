@@ -396,32 +396,8 @@ def step(a, b, c, x, z, P, phase_one, work, done, d, K, k, width):
     ``work``: :func:`workspace`'s arrays; ``P``: :func:`newton_part`'s.  The predictor (the affine step
     ``lambda o (W dz + W^-1 dy) = -lambda o lambda``), the centring weight, the corrector through the
     same Newton matrix, and the step 0.99 of the way to the cones' edge (:func:`edge`, in closed form)."""
-    (
-        res,
-        y,
-        v,
-        beta,
-        scale,
-        lam,
-        ys,
-        zs,
-        G,
-        H,
-        Hw,
-        U,
-        WU,
-        rhs,
-        square,
-        g,
-        dx,
-        dy,
-        dz,
-        mu,
-        to_edge,
-        sigma,
-        each,
-        other,
-    ) = work
+    res, y, v, beta, scale, lam, ys, zs, G, H, Hw, U = work[:12]
+    WU, rhs, square, g, dx, dy, dz, mu, to_edge, sigma, each, other = work[12:]
     _residual(a, c, z, res, each, d, K, k, width)
     _scaling(a, b, x, z, y, v, beta, scale, lam, ys, zs, G, d, K, k, width)
     _newton(G, P, scale, H, each, d, K, width)
