@@ -48,7 +48,6 @@ import functools
 import numpy as np
 
 from . import ipm
-from ._twin import twins
 from .ipm import GAP, ITERATIONS, START_MARGIN
 
 __all__ = ["GAP", "START_MARGIN", "phase_one", "minimise", "dual_polish"]
@@ -57,6 +56,8 @@ __all__ = ["GAP", "START_MARGIN", "phase_one", "minimise", "dual_polish"]
 @functools.cache
 def _twins():
     """:mod:`~grasptwist.engine.forces.ipm`'s numpy twins (made at the first solve, not at import: some 20 ms)."""
+    from ._twin import twins  # ast and inspect: not at start-up
+
     return twins(ipm.LANE_FORM)
 
 
