@@ -1,6 +1,9 @@
 """The interior-point method written once (issue 39, item 1): engine/forces/ipm.py's lane form, run as it is
 (numba compiles this source) and through its numpy twin (engine/forces/_twin.py, the numpy path)."""
 
+import ast
+import inspect
+
 import numpy as np
 import pytest
 
@@ -32,6 +35,9 @@ def test_the_twin_runs_each_lane_loop_over_every_row_at_once_with_a_scalars_mean
     np.testing.assert_array_equal(y, expected)
     np.testing.assert_array_equal(out, expected[0] + expected[1] + expected[2])
     np.testing.assert_array_equal(x, kept)  # t *= 2 rebinds t, never writes through to x
+    code = ast.unparse(_twin._Twin().visit(ast.parse(inspect.getsource(_lanes))))
+    assert "every" not in code and "for ln" not in code and "for m in range(K)" in code  # the sum stays a loop
+    assert "y[:, :] = np.where(t > 1, t, -t)".replace("np", "_np") in code
 
 
 def _branchy(x, width):
@@ -40,9 +46,17 @@ def _branchy(x, width):
             x[ln] = 0.0
 
 
-def test_the_twin_refuses_a_branch_in_lane_form():
+def _part(x, K, width):
+    for m in ipm.every(1, K):
+        for ln in range(width):
+            x[m, ln] = 0.0
+
+
+def test_the_twin_refuses_a_branch_and_a_part_of_an_axis_in_lane_form():
     with pytest.raises(ValueError, match="lane form has no If"):
         _twin.twins([_branchy])
+    with pytest.raises(ValueError, match="every"):  # m a full slice would run over the whole axis
+        _twin.twins([_part])
 
 
 def _problem(rng, K, k, d, n):

@@ -61,7 +61,8 @@ class _Twin(ast.NodeTransformer):
 
     def visit_For(self, node):
         name = node.target.id if isinstance(node.target, ast.Name) else None
-        every = isinstance(node.iter, ast.Call) and getattr(node.iter.func, "id", None) == EVERY
+        call = node.iter.func if isinstance(node.iter, ast.Call) else None
+        every = EVERY in (getattr(call, "id", None), getattr(call, "attr", None))  # every(K) or ipm.every(K)
         if name == LANE or every:
             if every and len(node.iter.args) != 1:
                 raise ValueError(f"{EVERY}(n) runs over a whole axis: one argument (line {node.lineno})")
