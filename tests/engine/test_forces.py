@@ -471,22 +471,33 @@ def test_any_grip_found_makes_the_wrench_within_every_cone_and_beats_no_clarabel
             assert (g.friction_used[k] <= mu[k] / safety * (1 + 1e-9)).all()
 
 
-def test_the_interior_point_step_stops_at_the_cones_edge_even_for_a_ray():
-    from grasptwist.engine.forces.socp import _edge
+def _edge(x, d):
+    """The longest step along ``d (k, n)`` from ``x (k, n)`` in the cone: ``ipm.edge``'s numpy twin on one cone."""
+    from grasptwist.engine.forces import socp
 
+    x, d = x[None], d[None]
+    s = np.sqrt(x[:, 0] ** 2 - (x[:, 1:] ** 2).sum(axis=1))
+    out = np.empty(x.shape[-1])
+    with np.errstate(divide="ignore"):
+        socp._twins()["edge"](x, x, d, d, s, s, out, np.empty_like(s), np.empty_like(s), 1, x.shape[1], None)
+    return out
+
+
+def test_the_interior_point_step_stops_at_the_cones_edge_even_for_a_ray():
     rng = np.random.default_rng(7)
-    x = rng.normal(size=(3, 1, 500))
-    x[0] = np.hypot(x[1], x[2]) + rng.uniform(0.01, 1, (1, 500))
-    d = 3 * rng.normal(size=(3, 1, 500))
+    x = rng.normal(size=(3, 500))
+    x[0] = np.hypot(x[1], x[2]) + rng.uniform(0.01, 1, 500)
+    d = 3 * rng.normal(size=(3, 500))
     alpha = _edge(x, d)
     hit = np.isfinite(alpha)
-    y = x[:, 0, hit] + alpha[hit] * d[:, 0, hit]
+    y = x[:, hit] + alpha[hit] * d[:, hit]
     np.testing.assert_allclose(y[0], np.hypot(y[1], y[2]), atol=1e-9)  # on the boundary
-    far = x[:, 0, ~hit] + 1e6 * d[:, 0, ~hit]
+    far = x[:, ~hit] + 1e6 * d[:, ~hit]
     assert hit.any() and (~hit).any() and (far[0] >= np.hypot(far[1], far[2]) - 1e-6).all()  # never leaves
     # a half-space's cone (t, 0, 0): stopped exactly at t = 0, where a difference of squares loses it
-    ray = _edge(np.array([[[0.3]], [[0.0]], [[0.0]]]), np.array([[[-0.7]], [[0.0]], [[0.0]]]))
+    ray = _edge(np.array([[0.3], [0.0], [0.0]]), np.array([[-0.7], [0.0], [0.0]]))
     assert ray[0] == pytest.approx(0.3 / 0.7, rel=1e-15)
+    assert _edge(np.array([[0.3]]), np.array([[-0.7]]))[0] == pytest.approx(0.3 / 0.7, rel=1e-15)  # a ray, k = 1
 
 
 # --- certificates, the prepared grip, collinear contacts (issue 29, issue 26 item 2.6) ---------------

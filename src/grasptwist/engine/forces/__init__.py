@@ -4,8 +4,9 @@
   in closed form, the squeezes (internal forces) along the sides of the contact
   triangle, the status codes and the ``check_*`` validators;
 - ``socp``: a batched primal-dual interior-point method over second-order cones of any size (no loop over grasps);
+  its iteration is ``ipm``'s, written once in lane form, run by numpy as the twin ``_twin`` makes;
   ``one``: the same method for one row in Python floats; ``kernel``: the whole grip of a row
-  compiled by numba (the ``fast`` extra), loaded through ``compiled`` at the first grip;
+  compiled by numba (the ``fast`` extra; ``ipm``'s iteration compiled), loaded through ``compiled`` at the first grip;
 - ``cones``: the contact models as cones (frictionless, point, soft finger) and the grip over any
   mix of them (the rows with a soft contact, numpy only);
 - ``grip``: the least total normal force that holds a wrench within the friction cones;

@@ -4,10 +4,11 @@ which loads it at the first grip).
 :func:`grip_rows` does for each row what the numpy path does for the rows it solves by cones:
 the geometry and ``G^+ w`` (:mod:`~grasptwist.engine.forces.grasp_map`), the cones and a start
 inside them (:func:`~grasptwist.engine.forces.closure.internal_inside`), the interior-point
-method of :mod:`~grasptwist.engine.forces.socp` step for step (Mehrotra's predictor-corrector
-with Nesterov-Todd scaling, 0.99 of the way to the cones' edge, the same stopping rules, phase
-I, dual polish and culprits; its scalar pieces are :mod:`~grasptwist.engine.forces.one`'s
-functions, compiled), the facial reduction of a grip on the cones' edge (:func:`_on_the_edge`, in
+method of :mod:`~grasptwist.engine.forces.socp` (its iteration is
+:mod:`~grasptwist.engine.forces.ipm`'s source compiled, whose numpy twin the numpy path runs:
+Mehrotra's predictor-corrector with Nesterov-Todd scaling, 0.99 of the way to the cones' edge,
+the same stopping rules; phase I, dual polish and culprits, the polish's scalar pieces
+:mod:`~grasptwist.engine.forces.one`'s functions, compiled), the facial reduction of a grip on the cones' edge (:func:`_on_the_edge`, in
 closed form), then the dual or the certificate and the figures.  The numpy path stays
 the reference: ``tests/engine/test_forces.py`` holds the two to the same verdicts and totals to
 ``1e-9``.  A row of the method is ``A[m, k, j]`` (cone ``m``, component ``k``, unknown ``j``),
@@ -24,15 +25,17 @@ company; alone (fewer rows than lanes: :func:`_iterate` compiled for one lane) t
 from __future__ import annotations
 
 import math
+import types
 from itertools import accumulate
 
 import numpy as np
 from numba import literally, njit
 
-from . import one
+from . import ipm, one
 from .closure import _PAIRS, _STRICT
 from .grasp_map import GRIP_COLUMNS
-from .socp import _EDGE, _ITERATIONS, _RESIDUAL, GAP, START_MARGIN
+from .ipm import ITERATIONS as _ITERATIONS
+from .ipm import START_MARGIN
 
 __all__ = ["grip_rows", "WIDTH"]
 
@@ -43,10 +46,24 @@ _JIT = {"cache": True, "error_model": "numpy", "fastmath": {"arcp", "contract"},
 _ALLOC = {"cache": True}
 
 
-# the scalar pieces are one.py's functions, compiled: the two paths share them line for line
-_approach, _scaling, _w_inv, _w_mul, _least_on_line, _dual_polish = (
-    njit(**_JIT)(f) for f in (one.approach, one.scaling, one.w_inv, one.w_mul, one.least_on_line, one.dual_polish)
-)
+def _compiled(functions, **options):
+    """numba's compile of functions that call each other (:mod:`~grasptwist.engine.forces.ipm`'s lane form):
+    each one's globals hold the others compiled, and LLVM inlines each into its callers (``forceinline``:
+    numba's own inlining of so many bodies took minutes to compile)."""
+    namespace = dict(functions[0].__globals__)
+    out = {}
+    for f in functions:
+        twin = types.FunctionType(f.__code__, namespace, f.__name__, f.__defaults__, f.__closure__)
+        namespace[f.__name__] = out[f.__name__] = njit(**options, forceinline=True)(twin)
+    return out
+
+
+# the interior-point method's iteration is ipm.py's source, compiled (the numpy path runs its twin); the
+# facial reduction's and the dual polish's scalar pieces are one.py's functions, compiled
+_ipm = _compiled(ipm.LANE_FORM, **_JIT)
+_step, _newton_part, _spd_solve = _ipm["step"], _ipm["newton_part"], _ipm["spd_solve"]
+_workspace = njit(**_ALLOC, inline="always")(ipm.workspace)
+_least_on_line, _dual_polish = (njit(**_JIT)(f) for f in (one.least_on_line, one.dual_polish))
 
 
 #: Rows the interior-point method takes in step, each in a lane (the last axis of its workspace): the
@@ -56,165 +73,29 @@ _LANES = 32
 #: The most unknowns and cones a row has: phase I's three squeezes and a margin, four cones.
 _D, _K = 4, 4
 
-# The kernel's rows: three squeezes, three cones (phase I: one more of each).  _iterate is compiled for
-# these sizes and its width as constants (numba's literally; its loops over them unrolled).
-_SQUEEZES, _CONES = 3, 3
-
-
-@njit(**_JIT, inline="always")
-def _spd_solve(H, g, d, width, out):
-    """``H^-1 g`` by elimination without pivoting in every lane (``H (d, d, lanes)`` symmetric positive
-    definite and ``g (d, lanes)`` overwritten; ``out (d, lanes)``)."""
-    for k in range(d):
-        for i in range(k + 1, d):
-            for ln in range(width):
-                f = H[i, k, ln] / H[k, k, ln]
-                for j in range(k + 1, d):
-                    H[i, j, ln] -= f * H[k, j, ln]
-                g[i, ln] -= f * g[k, ln]
-    for i in range(d - 1, -1, -1):
-        for ln in range(width):
-            v = g[i, ln]
-            for j in range(i + 1, d):
-                v -= H[i, j, ln] * out[j, ln]
-            out[i, ln] = v / H[i, i, ln]
-
-
-@njit(**_JIT, inline="always")
-def _direction(A, L, V, beta, rhs, res, H, d, K, width, U, WU, g, Hw, dx, dy, dz):
-    """``lambda o (W dz + W^-1 dy) = rhs``, ``dy = A dx``, ``sum_m A_m^T dz_m = res`` in every lane: into ``dx, dy, dz``."""
-    for m in range(K):
-        for ln in range(width):
-            l0, l1, l2 = L[m, 0, ln], L[m, 1, ln], L[m, 2, ln]
-            r0, r1, r2 = rhs[m, 0, ln], rhs[m, 1, ln], rhs[m, 2, ln]
-            u0 = (l0 * r0 - l1 * r1 - l2 * r2) / (l0 * l0 - l1 * l1 - l2 * l2)
-            u1, u2 = (r1 - u0 * l1) / l0, (r2 - u0 * l2) / l0
-            U[m, 0, ln], U[m, 1, ln], U[m, 2, ln] = u0, u1, u2
-            WU[m, 0, ln], WU[m, 1, ln], WU[m, 2, ln] = _w_inv(
-                V[m, 0, ln], V[m, 1, ln], V[m, 2, ln], beta[m, ln], u0, u1, u2
-            )
-    for j in range(d):
-        for ln in range(width):
-            t = res[j, ln]
-            for m in range(K):
-                t -= A[m, 0, j, ln] * WU[m, 0, ln] + A[m, 1, j, ln] * WU[m, 1, ln] + A[m, 2, j, ln] * WU[m, 2, ln]
-            g[j, ln] = -t
-        for i in range(d):
-            for ln in range(width):
-                Hw[j, i, ln] = H[j, i, ln]
-    _spd_solve(Hw, g, d, width, dx)
-    for m in range(K):
-        for k in range(3):
-            for ln in range(width):
-                t = 0.0
-                for j in range(d):
-                    t += A[m, k, j, ln] * dx[j, ln]
-                dy[m, k, ln] = t
-        for ln in range(width):
-            v0, v1, v2, bt = V[m, 0, ln], V[m, 1, ln], V[m, 2, ln], beta[m, ln]
-            q0, q1, q2 = _w_inv(v0, v1, v2, bt, dy[m, 0, ln], dy[m, 1, ln], dy[m, 2, ln])
-            dz[m, 0, ln], dz[m, 1, ln], dz[m, 2, ln] = _w_inv(
-                v0, v1, v2, bt, U[m, 0, ln] - q0, U[m, 1, ln] - q1, U[m, 2, ln] - q2
-            )
-
-
-@njit(**_JIT, inline="always")
-def _edge(y, z, dy, dz, ys, zs, K, width, out):
-    """The largest step along ``(dy, dz)`` that keeps every ``y_m`` and ``z_m`` in its cone (``inf``: none), in
-    every lane: ``1 / max t`` of :func:`one.approach`'s rates (a NaN rate is no limit, as in ``socp._edge``)."""
-    for ln in range(width):
-        top = 0.0
-        for m in range(K):
-            t = _approach(y[m, 0, ln], y[m, 1, ln], y[m, 2, ln], dy[m, 0, ln], dy[m, 1, ln], dy[m, 2, ln], ys[m, ln])
-            top = t if t > top else top
-            t = _approach(z[m, 0, ln], z[m, 1, ln], z[m, 2, ln], dz[m, 0, ln], dz[m, 1, ln], dz[m, 2, ln], zs[m, ln])
-            top = t if t > top else top
-        out[ln] = 1 / top if top > 0 else math.inf
-
-
-@njit(**_ALLOC, inline="always")
-def _lanes(lanes):
-    """The arrays :func:`_iterate` works in, ``lanes`` rows at once (the last axis), indexed below ``d`` and
-    ``K`` only: eight allocations, the arrays of a shape views of one."""
-    wide, unknowns, cones = np.empty((11, _K, 3, lanes)), np.empty((5, _D, lanes)), np.empty((4, _K, lanes))
-    square, pair, counts = np.empty((2, _D, _D, lanes)), np.empty((2, lanes)), np.empty((2, lanes), np.int64)
-    return (
-        np.empty((_K, 3, _D, lanes)),
-        wide[0],
-        unknowns[0],
-        unknowns[1],
-        wide[1],
-        np.empty((_K, _D, _D, lanes)),
-        counts[0],
-        counts[1],
-        unknowns[2],
-        wide[2],
-        wide[3],
-        wide[4],
-        np.empty((_K, _D, lanes)),
-        cones[0],
-        cones[1],
-        square[0],
-        square[1],
-        wide[5],
-        wide[6],
-        wide[7],
-        wide[8],
-        unknowns[3],
-        unknowns[4],
-        wide[9],
-        wide[10],
-        cones[2],
-        cones[3],
-        pair[0],
-        pair[1],
-    )
+# The kernel's rows: three squeezes, three cones of three components (phase I: one more squeeze and cone).
+# _iterate is compiled for these sizes and its width as constants (numba's literally; its loops unrolled).
+_SQUEEZES, _CONES, _COMPONENTS = 3, 3, 3
 
 
 @njit(**(_JIT | {"_nrt": True}))
-def _iterate(A, b, c, x, z, order, phase_one, d, K, width):
+def _iterate(A, b, c, x, z, order, phase_one, d, K, k, width):
     """``socp._iterate`` (``phase_one``: its leaving rule, else phase II's) on the rows ``order`` of
-    ``A (R, K, 3, d)``, ``b (R, K, 3)``, ``c (R, d)``; their ``x (R, d)``, ``z (R, K, 3)`` in place.
+    ``A (R, K, k, d)``, ``b (R, K, k)``, ``c (R, d)``; their ``x (R, d)``, ``z (R, K, k)`` in place.
 
-    The rows go through :func:`_lanes`' arrays in step, a row a lane; a lane whose row has finished (by
-    its own count and rules, exactly as alone) takes the next.  Nothing mixes lanes, so a row's answer
-    is the same in any company; an empty lane's numbers are never read.  Its arrays are its own
-    (:func:`_lanes`): their shapes constants, the lanes' loops vectorise (passed in: 2.2 us a row of
-    phase II, against 1.4).
+    The rows go through lanes (:func:`ipm.step`'s arrays, the last axis) in step, a row a lane; a lane
+    whose row has finished (by its own count and rules, exactly as alone) takes the next.  Nothing mixes
+    lanes, so a row's answer is the same in any company; an empty lane's numbers are never read.  Its
+    arrays are its own, their shapes constants (``d, K, k, width`` literal), so the lanes' loops of
+    :func:`ipm.step`, inlined, vectorise.
     """
-    (
-        a,
-        bl,
-        cl,
-        xl,
-        zl,
-        P,
-        row,
-        it,
-        res,
-        y,
-        L,
-        V,
-        G,
-        beta,
-        scale,
-        H,
-        Hw,
-        U,
-        WU,
-        rhs,
-        square,
-        g,
-        dx,
-        dy,
-        dz,
-        ys,
-        zs,
-        mu,
-        step,
-    ) = _lanes(width)
+    a, P = np.empty((K, k, d, width)), np.empty((K, d, d, width))
+    bl, zl, cl, xl = np.empty((K, k, width)), np.empty((K, k, width)), np.empty((d, width)), np.empty((d, width))
+    row, it, done = np.empty(width, np.int64), np.empty(width, np.int64), np.empty(width, np.bool_)
+    last = np.empty(width, np.int64)
+    work = _workspace(d, K, k, width)
     for ln in range(width):
-        row[ln] = -1
+        row[ln], last[ln] = -1, -1
     taken = 0
     while True:
         busy = 0
@@ -224,141 +105,47 @@ def _iterate(A, b, c, x, z, order, phase_one, d, K, width):
                 taken += 1
                 row[ln], it[ln] = r, 0
                 for m in range(K):
-                    for k in range(3):
-                        bl[m, k, ln], zl[m, k, ln] = b[r, m, k], z[r, m, k]
+                    for i in range(k):
+                        bl[m, i, ln], zl[m, i, ln] = b[r, m, i], z[r, m, i]
                         for j in range(d):
-                            a[m, k, j, ln] = A[r, m, k, j]
-                    for i in range(d):
-                        for j in range(d):
-                            P[m, i, j, ln] = (
-                                A[r, m, 0, i] * A[r, m, 0, j]
-                                - A[r, m, 1, i] * A[r, m, 1, j]
-                                - A[r, m, 2, i] * A[r, m, 2, j]
-                            )
+                            a[m, i, j, ln] = A[r, m, i, j]
                 for j in range(d):
                     cl[j, ln], xl[j, ln] = c[r, j], x[r, j]
+                _newton_part(a[:, :, :, ln : ln + 1], P[:, :, :, ln : ln + 1], d, K, k, 1)
             busy += row[ln] >= 0
         if busy == 0:
             return
-        for j in range(d):
-            for ln in range(width):
-                t = cl[j, ln]
-                for m in range(K):
-                    t -= a[m, 0, j, ln] * zl[m, 0, ln] + a[m, 1, j, ln] * zl[m, 1, ln] + a[m, 2, j, ln] * zl[m, 2, ln]
-                res[j, ln] = t
-        for m in range(K):
-            for k in range(3):
-                for ln in range(width):
-                    t = bl[m, k, ln]
-                    for j in range(d):
-                        t += a[m, k, j, ln] * xl[j, ln]
-                    y[m, k, ln] = t
-            for ln in range(width):
-                w0, w1, w2, v0, v1, v2, bt, L[m, 0, ln], L[m, 1, ln], L[m, 2, ln], ys[m, ln], zs[m, ln] = _scaling(
-                    y[m, 0, ln], y[m, 1, ln], y[m, 2, ln], zl[m, 0, ln], zl[m, 1, ln], zl[m, 2, ln]
-                )
-                for j in range(d):
-                    G[m, j, ln] = a[m, 0, j, ln] * w0 - a[m, 1, j, ln] * w1 - a[m, 2, j, ln] * w2
-                V[m, 0, ln], V[m, 1, ln], V[m, 2, ln] = v0, v1, v2
-                beta[m, ln] = bt
-                scale[m, ln] = 1 / (bt * bt)
+        _step(a, bl, cl, xl, zl, P, phase_one, work, done, d, K, k, width)
         for ln in range(width):
-            top = -math.inf
-            for i in range(d):
-                for j in range(i + 1):
-                    h = 0.0
+            if row[ln] < 0:  # an empty lane keeps its last row's end (stepping on, it would near 0 and slow down)
+                r = last[ln]
+                if r >= 0:
+                    for j in range(d):
+                        xl[j, ln] = x[r, j]
                     for m in range(K):
-                        h += (2 * G[m, i, ln] * G[m, j, ln] - P[m, i, j, ln]) * scale[m, ln]
-                    H[i, j, ln] = h
-                    H[j, i, ln] = h
-                top = max(top, H[i, i, ln])
-            for i in range(d):
-                H[i, i, ln] += 1e-14 * top
-            s = 0.0
-            for m in range(K):
-                l0, l1, l2 = L[m, 0, ln], L[m, 1, ln], L[m, 2, ln]
-                square[m, 0, ln], square[m, 1, ln], square[m, 2, ln] = (
-                    l0 * l0 + l1 * l1 + l2 * l2,
-                    2 * l0 * l1,
-                    2 * l0 * l2,
-                )
-                rhs[m, 0, ln], rhs[m, 1, ln], rhs[m, 2, ln] = -square[m, 0, ln], -square[m, 1, ln], -square[m, 2, ln]
-                s += y[m, 0, ln] * zl[m, 0, ln] + y[m, 1, ln] * zl[m, 1, ln] + y[m, 2, ln] * zl[m, 2, ln]
-            mu[ln] = s / K
-        for corrector in range(2):  # Mehrotra: the predictor, then the corrector through the same code
-            _direction(a, L, V, beta, rhs, res, H, d, K, width, U, WU, g, Hw, dx, dy, dz)
-            _edge(y, zl, dy, dz, ys, zs, K, width, step)
-            if corrector:
-                break
-            for ln in range(width):
-                st = min(1.0, step[ln])
-                s = 0.0
-                for m in range(K):
-                    for k in range(3):
-                        s += (y[m, k, ln] + st * dy[m, k, ln]) * (zl[m, k, ln] + st * dz[m, k, ln])
-                sigma = min(max(s / K / mu[ln], 0.0), 1.0) ** 3
-                for m in range(K):
-                    v0, v1, v2, bt = V[m, 0, ln], V[m, 1, ln], V[m, 2, ln], beta[m, ln]
-                    p0, p1, p2 = _w_inv(v0, v1, v2, bt, dy[m, 0, ln], dy[m, 1, ln], dy[m, 2, ln])
-                    q0, q1, q2 = _w_mul(v0, v1, v2, bt, dz[m, 0, ln], dz[m, 1, ln], dz[m, 2, ln])
-                    rhs[m, 0, ln] = -square[m, 0, ln] - (p0 * q0 + p1 * q1 + p2 * q2) + sigma * mu[ln]
-                    rhs[m, 1, ln] = -square[m, 1, ln] - (p0 * q1 + q0 * p1)
-                    rhs[m, 2, ln] = -square[m, 2, ln] - (p0 * q2 + q0 * p2)
-        for ln in range(width):
-            if row[ln] < 0:
+                        for i in range(k):
+                            zl[m, i, ln] = z[r, m, i]
                 continue
-            st = min(1.0, _EDGE * step[ln])
-            finite = math.isfinite(st)
-            for j in range(d):
-                finite = finite and math.isfinite(dx[j, ln])
-            for m in range(K):
-                for k in range(3):
-                    finite = finite and math.isfinite(dz[m, k, ln])
-            done = not finite
-            if finite:
-                for j in range(d):
-                    xl[j, ln] += st * dx[j, ln]
-                gap = 0.0
-                for m in range(K):
-                    for k in range(3):
-                        zl[m, k, ln] += st * dz[m, k, ln]
-                        gap += (y[m, k, ln] + st * dy[m, k, ln]) * zl[m, k, ln]
-                obj = 0.0
-                big = 0.0
-                for j in range(d):
-                    obj += cl[j, ln] * xl[j, ln]
-                    big = max(big, abs(res[j, ln]))
-                dual = obj - gap if big * (1 - st) <= _RESIDUAL else -math.inf
-                closed = gap <= GAP * (1 + abs(obj))
-                it[ln] += 1
-                if phase_one:
-                    size = 1.0
-                    for j in range(d):
-                        size += abs(xl[j, ln])
-                    if xl[d - 1, ln] <= -START_MARGIN or dual > _RESIDUAL * size or (closed and dual > -math.inf):
-                        done = True
-                elif closed and dual > -math.inf:
-                    done = True
-                done = done or it[ln] >= _ITERATIONS
-            if done:
+            it[ln] += 1
+            if done[ln] or it[ln] >= _ITERATIONS:
                 r = row[ln]
                 for j in range(d):
                     x[r, j] = xl[j, ln]
                 for m in range(K):
-                    for k in range(3):
-                        z[r, m, k] = zl[m, k, ln]
-                row[ln] = -1
+                    for i in range(k):
+                        z[r, m, i] = zl[m, i, ln]
+                row[ln], last[ln] = -1, r
 
 
 @njit(**_JIT)
-def _in_lanes(A, b, c, x, z, order, phase_one, d, K):
+def _in_lanes(A, b, c, x, z, order, phase_one, d, K, k):
     """:func:`_iterate` on the rows ``order``: in :data:`_LANES` lanes where they fill them, else one at a time
     (the lanes' loops compiled for a constant width: a row alone pays no vector code's set-up)."""
-    d, K = literally(d), literally(K)
+    d, K, k = literally(d), literally(K), literally(k)
     if order.size < _LANES:
-        _iterate(A, b, c, x, z, order, phase_one, d, K, 1)
+        _iterate(A, b, c, x, z, order, phase_one, d, K, k, 1)
     else:
-        _iterate(A, b, c, x, z, order, phase_one, d, K, _LANES)
+        _iterate(A, b, c, x, z, order, phase_one, d, K, k, _LANES)
 
 
 @njit(**_JIT)
@@ -481,7 +268,7 @@ def _on_the_edge(A, b, M, fm, scale, frame, z, s, zk, h, res, delta, line_a, lin
         return False
     if count == 1:
         h[free, free, 0] = 1.0  # squeeze `free` is no unknown of the bare contact's force: 0 in s0
-    _spd_solve(h, res, 3, 1, delta)
+    _spd_solve(h, res, delta, 3, 1)
     for m in range(3):
         if _bare(z, m, top):
             for k in range(3):
@@ -994,7 +781,7 @@ def _grip_rows(p, n, limit, w, tol, out, codes, chunk, gw):
                     _phase_one_problem(A[i], b[i], False, wide[i], bw[i], cw[i], xw[i], zw[i])
                     one[ones] = i
                     ones += 1
-        _in_lanes(wide, bw, cw, xw, zw, one[:ones], True, _D, _K)
+        _in_lanes(wide, bw, cw, xw, zw, one[:ones], True, _D, _K, _COMPONENTS)
         for k in range(ones):
             i = one[k]
             for j in range(3):
@@ -1014,14 +801,14 @@ def _grip_rows(p, n, limit, w, tol, out, codes, chunk, gw):
                 agains += 1
             for j in range(3):
                 x[i, j] = math.nan
-        _in_lanes(wide, bw, cw, xw, zw, again[:agains], True, _D, _K)
+        _in_lanes(wide, bw, cw, xw, zw, again[:agains], True, _D, _K, _COMPONENTS)
         for k in range(agains):
             if not xw[again[k], 3] < 0:
                 blame[again[k]] = -1
         for k in range(twos):
             for m in range(3):
                 z[two[k], m, 0], z[two[k], m, 1], z[two[k], m, 2] = 1.0, 0.0, 0.0
-        _in_lanes(A, b, c, x, z, two[:twos], False, _SQUEEZES, _CONES)
+        _in_lanes(A, b, c, x, z, two[:twos], False, _SQUEEZES, _CONES, _COMPONENTS)
         for i in range(rows):
             if stage[i] == _SKIP:
                 continue

@@ -1,7 +1,12 @@
 r"""The interior-point method of :mod:`~grasptwist.engine.forces.socp` for one row, in Python floats.
 
+The batched method's iteration is written once (:mod:`~grasptwist.engine.forces.ipm`, run by numpy
+and compiled by numba); this copy for Q3 rows stays because one row through that source is slow:
+0.75 ms a step as Python on one lane and 0.97 ms through the numpy twin, where this whole solve takes
+about 2 ms.
+
 For one grasp numpy's cost per call (a microsecond or more, on arrays of three numbers)
-is all there is: an iteration of the batched method makes some 300 numpy calls.  This is
+is all there is: an iteration of the batched method makes some 700 numpy calls.  This is
 the same method, step for step (Mehrotra's predictor-corrector with Nesterov-Todd
 scaling, 0.99 of the way to the cones' edge, the same stopping rules), on lists of
 floats: a few hundred multiplications an iteration.  ``tests/engine/test_forces.py`` holds it to
@@ -17,7 +22,10 @@ import math
 
 import numpy as np
 
-from .socp import _EDGE, _ITERATIONS, _RESIDUAL, GAP, START_MARGIN
+from .ipm import EDGE as _EDGE
+from .ipm import GAP, START_MARGIN
+from .ipm import ITERATIONS as _ITERATIONS
+from .ipm import RESIDUAL as _RESIDUAL
 
 __all__ = [
     "phase_one",
@@ -37,8 +45,6 @@ def approach(x0, x1, x2, d0, d1, d2, s):
     ``1 / t`` where ``t > 0`` (none otherwise), as :func:`socp._edge`; ``s = sqrt(x0^2 - x1^2 - x2^2)``,
     which :func:`scaling` has computed already.  A step's length is ``1 / max t`` over its cones: one
     division, not one a cone.
-
-    Plain floats in and out: :mod:`~grasptwist.engine.forces.kernel` compiles this same function.
     """
     x0, x1, x2 = x0 / s, x1 / s, x2 / s
     d0, d1, d2 = d0 / s, d1 / s, d2 / s
@@ -136,8 +142,6 @@ def scaling(y0, y1, y2, z0, z1, z2):
     """Nesterov-Todd scaling of one cone (``W z = W^-1 y = lambda``, ``W = beta (2 v v^T - J)``):
     ``(w0, w1, w2, v0, v1, v2, beta, lambda0, lambda1, lambda2, ys, zs)`` (``w`` the scaling point,
     ``ys = sqrt(y^T J y)`` and ``zs`` the cones' own norms of ``y`` and ``z``, for :func:`approach`).
-
-    Plain floats, compiled as it is by :mod:`~grasptwist.engine.forces.kernel`.
     """
     ys = math.sqrt(y0 * y0 - y1 * y1 - y2 * y2)
     zs = math.sqrt(z0 * z0 - z1 * z1 - z2 * z2)
@@ -151,13 +155,13 @@ def scaling(y0, y1, y2, z0, z1, z2):
 
 
 def w_inv(v0, v1, v2, beta, u0, u1, u2):
-    """``W^-1 u`` (plain floats; compiled as it is by :mod:`~grasptwist.engine.forces.kernel`)."""
+    """``W^-1 u`` (plain floats)."""
     t = 2 * (v0 * u0 - v1 * u1 - v2 * u2)
     return (t * v0 - u0) / beta, (u1 - t * v1) / beta, (u2 - t * v2) / beta
 
 
 def w_mul(v0, v1, v2, beta, u0, u1, u2):
-    """``W u`` (plain floats; compiled as it is by :mod:`~grasptwist.engine.forces.kernel`)."""
+    """``W u`` (plain floats)."""
     t = 2 * (v0 * u0 + v1 * u1 + v2 * u2)
     return beta * (t * v0 - u0), beta * (t * v1 + u1), beta * (t * v2 + u2)
 
