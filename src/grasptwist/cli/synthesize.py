@@ -77,7 +77,7 @@ def _checked(name, module="checks"):
 
 
 #: Seconds a warm-up may take before the command line says it is compiling: numba's import, its cache
-#: and a small search take 4 s on this project's machine at a load of 9 on 2 cores, a compile 20 s idle.
+#: and a small search take 4 s on this project's machine at a load of 9 on 2 cores, a compile about 60 s.
 COMPILE_NOTICE_AFTER = 10.0
 
 
@@ -110,7 +110,7 @@ def _warmed_up(quiet: bool) -> None:
 
     def notice():
         print(
-            "grasptwist: compiling the grip's numba kernels, once per install (about 20 s, longer on a busy "
+            "grasptwist: compiling the grip's numba kernels, once per install (about a minute, longer on a busy "
             "machine); --seconds counts from when it is done",
             file=sys.stderr,
             flush=True,
