@@ -607,3 +607,58 @@ def test_check_judges_closure_with_soft_contacts_and_says_the_model(tmp_path):
     assert soft[0]["closure_friction"] <= float(point)
     r, _ = run("forces", SPHERE, "--contact", "soft", "--torsion", "0.01", "--friction", "0")
     assert r.exit_code == 2 and "soft contacts need friction" in r.stderr and not r.stdout
+
+
+def test_a_first_grip_that_compiles_long_is_said_once_on_stderr_and_not_with_quiet(monkeypatch):
+    """A fresh install's first grip compiles numba's kernel (about a minute): forces says so, as synthesize does,
+    through the kernel's first load (engine.hooks); shortened here to a 0.3 s load past a notice time of 0."""
+    import time
+
+    from grasptwist.cli import diagnostics
+    from grasptwist.engine import hooks
+    from grasptwist.engine.forces import compiled
+
+    loads = []
+
+    def kernel():  # the first load, watched as the real one is, then the numpy path
+        if not loads:
+            loads.append(True)
+            with hooks.first_load():
+                time.sleep(0.3)
+
+    monkeypatch.setattr(diagnostics, "COMPILE_NOTICE_AFTER", 0.0)
+    monkeypatch.setattr(compiled, "kernel", kernel)
+    r, recs = records(SPHERE, "-j", "1")
+    assert r.exit_code == 0 and recs, r.stderr
+    assert r.stderr.count("compiling the grip's numba kernels, once per install") == 1
+    assert "--seconds" not in r.stderr  # synthesize's budget is no part of forces
+    loads.clear()
+    r, _ = records(SPHERE, "-j", "1", "-q")
+    assert r.exit_code == 0 and "compiling" not in r.stderr
+
+
+def test_the_kernels_first_load_runs_inside_the_callers_watch(monkeypatch):
+    """compiled.kernel() loads the kernel and makes its first grip inside engine.hooks.first_load (a fake kernel
+    module here: no numba)."""
+    import contextlib
+    import sys
+    import types
+
+    from grasptwist.engine import hooks
+    from grasptwist.engine.forces import compiled
+
+    fake = types.ModuleType("grasptwist.engine.forces.kernel")
+    monkeypatch.setitem(sys.modules, "grasptwist.engine.forces.kernel", fake)
+    monkeypatch.setattr(compiled, "_state", {"on": True, "module": None})
+    events = []
+    monkeypatch.setattr(compiled, "_first_grip", lambda module: events.append("first grip"))
+
+    @contextlib.contextmanager
+    def watch():
+        events.append("watch on")
+        yield
+        events.append("watch off")
+
+    with hooks.watching_first_load(watch):
+        assert compiled.kernel() is fake and compiled.kernel() is fake  # loaded once
+    assert events == ["watch on", "first grip", "watch off"]

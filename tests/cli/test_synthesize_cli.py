@@ -628,13 +628,20 @@ def test_grasps_left_unverified_when_the_time_runs_out_are_counted_on_stderr(mon
 def test_a_slow_warm_up_is_said_once_on_stderr_and_not_with_quiet(monkeypatch, capsys):
     import time
 
+    from grasptwist.cli import diagnostics
     from grasptwist.cli import synthesize as cli_synthesize
+    from grasptwist.engine import hooks
     from grasptwist.engine.synthesis import search as search_module
 
     cli_synthesize._warmed_up(quiet=False)  # the numpy path's warm-up: a grip, no compile, no word
     assert capsys.readouterr().err == ""
-    monkeypatch.setattr(cli_synthesize, "COMPILE_NOTICE_AFTER", 0.0)
-    monkeypatch.setattr(search_module, "warm_up", lambda: time.sleep(0.3))  # a fresh install's compile, shortened
+    monkeypatch.setattr(diagnostics, "COMPILE_NOTICE_AFTER", 0.0)
+
+    def compiling():  # a fresh install's compile, shortened, where the kernel's first load runs
+        with hooks.first_load():
+            time.sleep(0.3)
+
+    monkeypatch.setattr(search_module, "warm_up", compiling)
     cli_synthesize._warmed_up(quiet=False)
     said = capsys.readouterr()
     assert said.err.count("compiling the grip's numba kernels, once per install") == 1 and said.out == ""

@@ -24,6 +24,8 @@ __all__ = [
     "warning_kind",
     "table_hint",
     "progress_bar",
+    "COMPILE_NOTICE_AFTER",
+    "compile_notice",
 ]
 
 
@@ -269,3 +271,32 @@ def progress_bar(inputs: list, command: str, out, shown: bool = True, long_input
             bar.advance(task, output.done)
 
         yield advance
+
+
+#: Seconds the compiled grip's first load may take before the command line says it is compiling: numba's
+#: import and its cache take under 2 s on this project's machine, even at a load of 9 on 2 cores; a compile
+#: about a minute.
+COMPILE_NOTICE_AFTER = 10.0
+
+
+@contextmanager
+def compile_notice(quiet: bool, more: str = ""):
+    """Around the compiled grip's first load (:func:`~grasptwist.engine.hooks.watching_first_load`): one line on
+    stderr once it outlasts :data:`COMPILE_NOTICE_AFTER` (a fresh install's compile), ending with ``more``;
+    none with ``quiet``."""
+    import threading
+
+    def notice():
+        to_stderr(
+            "grasptwist: compiling the grip's numba kernels, once per install (about a minute, longer on a busy "
+            f"machine){more}"
+        )
+
+    timer = threading.Timer(COMPILE_NOTICE_AFTER, notice)
+    timer.daemon = True
+    if not quiet:
+        timer.start()
+    try:
+        yield
+    finally:
+        timer.cancel()

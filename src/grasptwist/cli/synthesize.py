@@ -1,13 +1,12 @@
 """``grasptwist synthesize``: search an object's surface for three-fingered grasps (issue 31)."""
 
-import sys
 from enum import Enum
 from typing import Annotated
 
 import typer
 
 from ..engine.synthesis.scores import MIN_CONDITIONING
-from .diagnostics import Warnings
+from .diagnostics import Warnings, compile_notice
 from .exits import checked_output, run_command
 from .options import (
     ALL,
@@ -76,11 +75,6 @@ def _checked(name, module="checks"):
     return callback
 
 
-#: Seconds a warm-up may take before the command line says it is compiling: numba's import, its cache
-#: and a small search take 4 s on this project's machine at a load of 9 on 2 cores, a compile about 60 s.
-COMPILE_NOTICE_AFTER = 10.0
-
-
 def _units(value):
     """--units: a length unit the engine knows (its length is what the mesh's size is judged by)."""
     from ..engine.units import LENGTH_UNITS
@@ -101,29 +95,13 @@ def _reading(reading, grasp_file):
 
 def _warmed_up(quiet: bool) -> None:
     """The grip's kernels compiled, or loaded from numba's cache, before any search's clock starts
-    (:func:`~grasptwist.engine.synthesis.search.warm_up`; the workers forked later inherit them);
-    a warm-up that outlasts :data:`COMPILE_NOTICE_AFTER` (a fresh install's compile) says so once on
-    stderr."""
-    import threading
-
+    (:func:`~grasptwist.engine.synthesis.search.warm_up`; the workers forked later inherit them),
+    under the command line's notice of a long compile (:func:`~.diagnostics.compile_notice`)."""
+    from ..engine.hooks import watching_first_load
     from ..engine.synthesis.search import warm_up
 
-    def notice():
-        print(
-            "grasptwist: compiling the grip's numba kernels, once per install (about a minute, longer on a busy "
-            "machine); --seconds counts from when it is done",
-            file=sys.stderr,
-            flush=True,
-        )
-
-    timer = threading.Timer(COMPILE_NOTICE_AFTER, notice)
-    timer.daemon = True
-    if not quiet:
-        timer.start()
-    try:
+    with watching_first_load(lambda: compile_notice(quiet, "; --seconds counts from when it is done")):
         warm_up()
-    finally:
-        timer.cancel()
 
 
 def synthesize(

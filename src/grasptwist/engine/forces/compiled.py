@@ -4,7 +4,8 @@ numba is imported, and :mod:`~grasptwist.engine.forces.kernel` compiled, on the 
 that needs it, never when ``grasptwist`` is imported.  Compiled functions are cached on
 disk (numba's ``cache=True``: in ``__pycache__`` beside the source, or where that is not
 writable in numba's per-user cache directory; ``NUMBA_CACHE_DIR`` chooses another), so
-only a fresh install pays the compile (some seconds).  ``GRASPTWIST_NUMBA=0`` in the
+only a fresh install pays the compile (about a minute), inside
+:func:`~grasptwist.engine.hooks.first_load` (the command line's notice).  ``GRASPTWIST_NUMBA=0`` in the
 environment, or :func:`numpy_path`, keeps to the numpy path, which is the reference.
 """
 
@@ -14,6 +15,10 @@ import importlib.util
 import os
 import warnings
 from contextlib import contextmanager
+
+import numpy as np
+
+from ..hooks import first_load
 
 __all__ = ["kernel", "numpy_path"]
 
@@ -30,13 +35,28 @@ def kernel():
             _state["on"] = False
             return None
         try:
-            from . import kernel as module
+            with first_load():  # the caller's watch (the command line's notice of a long compile)
+                from . import kernel as module
+
+                _state["module"] = module
+                _first_grip(module)
         except (ImportError, RuntimeError, OSError) as error:  # e.g. no directory numba may cache in
-            _state["on"] = False
+            _state["on"], _state["module"] = False, None
             warnings.warn(f"the compiled grip is unavailable ({error}); the numpy path is used", stacklevel=3)
             return None
-        _state["module"] = module
     return _state["module"]
+
+
+def _first_grip(module):
+    """One grip of a tripod: the kernel's one signature (:func:`~.grip._read_only`'s: the grasp read-only, the
+    wrench writable) compiled on a fresh install, or loaded from numba's cache, here, inside the watched first
+    load, not in the middle of the caller's first grip."""
+    p = np.array([[[1.0, 0, 0], [-0.5, 0.866, 0], [-0.5, -0.866, 0]]])
+    grasp = [a.view() for a in (p, -p, np.full((1, 3), 0.5))]
+    for a in grasp:
+        a.flags.writeable = False
+    wrench, out, codes = np.array([[0, 0, 1.0, 0, 0, 0]]), np.empty((1, module.WIDTH)), np.empty((1, 3), np.int8)
+    module.grip_rows(*grasp, wrench, 1e-9, out, codes)
 
 
 @contextmanager
