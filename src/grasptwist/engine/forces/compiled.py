@@ -4,7 +4,7 @@ numba is imported, and :mod:`~grasptwist.engine.forces.kernel` compiled, on the 
 that needs it, never when ``grasptwist`` is imported.  Compiled functions are cached on
 disk (numba's ``cache=True``: in ``__pycache__`` beside the source, or where that is not
 writable in numba's per-user cache directory; ``NUMBA_CACHE_DIR`` chooses another), so
-only a fresh install pays the compile (some seconds).  ``GRASPTWIST_NUMBA=0`` in the
+only a fresh install pays the compile (about a minute).  ``GRASPTWIST_NUMBA=0`` in the
 environment, or :func:`numpy_path`, keeps to the numpy path, which is the reference.
 """
 
