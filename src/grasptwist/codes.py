@@ -411,6 +411,9 @@ WARNINGS = {
     "finger-collides": Code("a finger link inside the object", _HANDS),
     "fingers-collide": Code("two fingers' links overlap", _HANDS),
     "finger-hits-environment": Code("a finger within the clearance of the table or a box", _HANDS),
+    "tip-off-contact": Code(
+        "given joint positions leave a fingertip off its contact by over 1% of its finger's length", _HANDS
+    ),
     "hand-size-mismatch": Code("an object over 10 times its hand's reach, or under a tenth of it", _SIMULATION),
     "mesh-size-unlikely": Code("a mesh in metres over 5 m or under 1 mm across", _SIMULATION),
     "mesh-repaired": Code("a mesh's faces re-wound outwards, or degenerate ones dropped", _PYTHON),

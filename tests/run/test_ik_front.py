@@ -239,3 +239,63 @@ def test_a_hand_files_seed_is_refused_not_dropped(tmp_path):
     result = run("resolve", TRIFINGER, "--hand", hand_file)
     assert result.exit_code == 2
     assert "conflicting-keys" in result.stderr and "hand.seed: only in a grasp file" in " ".join(result.stderr.split())
+
+
+def given(tmp_path, **moved):
+    """The bundled TriFinger grasp at the positions once typed, joints ``moved`` by so many radians."""
+    doc = yaml.safe_load(TRIFINGER.read_text("utf-8"))
+    doc["hand"]["joint_positions"] = {j: q + moved.get(j, 0.0) for j, q in FILE_POSITIONS.items()}
+    path = tmp_path / "trifinger-given.yaml"
+    path.write_text(yaml.safe_dump(doc, sort_keys=False), "utf-8")
+    return path
+
+
+@urdf
+def test_given_positions_that_leave_a_tip_off_its_contact_are_warned_of(tmp_path):
+    # the trial's: finger 0's joints moved ~0.2 rad said 'all ok' with its tip 47 mm off; now a warning
+    # past 1% of the finger's length (3.8 mm), in the record and on stderr, naming finger, distance, tolerance
+    path = given(tmp_path, finger_upper_to_middle_joint_0=0.2)
+    (g,) = read_grasps(path)
+    off = np.linalg.norm(tips(g.hand, g.joint_positions) - (g.points - 0.01 * g.normals), axis=-1)
+    assert off[0] > 0.02 and off[1] < 1e-4 and off[2] < 1e-4  # the moved finger only
+    want = f"tip-off-contact: finger 1's tip link 'finger_tip_link_0' is {off[0]:.3g} from where its contact puts it"
+    assert [w[: len(want)] for w in g.warnings] == [want]
+    assert "over the tolerance 0.00382 (1% of the finger's length)" in g.warnings[0]
+    result = run("check", path)
+    assert result.exit_code == 0 and f"warning: {want}" in result.stderr  # a warning: the exit status stays 0
+    (rec, _) = jsonl("resolve", path)
+    assert [w[: len(want)] for w in rec["warnings"]] == [want]
+
+
+@urdf
+def test_positions_typed_to_a_few_decimals_or_just_off_are_not_warned_of(tmp_path):
+    # the positions once typed (tips 1e-5 m off) and a joint moved 0.005 rad (2.4 mm, under 3.8 mm)
+    for moved in ({}, {"finger_upper_to_middle_joint_120": 0.005}):
+        (g,) = read_grasps(given(tmp_path, **moved))
+        off = np.linalg.norm(tips(g.hand, g.joint_positions) - (g.points - 0.01 * g.normals), axis=-1)
+        assert off.max() < 0.0038 and g.warnings == (), (off, g.warnings)
+    assert off.max() > 0.001  # the moved joint moved its tip
+
+
+@urdf
+def test_a_data_set_s_rows_off_their_contacts_are_warned_of_each(tmp_path):
+    (g,) = read_grasps(TRIFINGER)
+    q = np.tile(g.joint_positions, (3, 1))
+    q[1, 1] += 0.2  # row 1: finger 0's middle joint moved
+    points = np.repeat(g.points[None], 3, axis=0)
+    data = tmp_path / "rows.npz"
+    np.savez(
+        data,
+        points=points,
+        normals=np.repeat(g.normals[None], 3, axis=0),
+        twist=[0, 0, 0.5, 0, 0, 0],
+        joint_positions=q,
+        wrist=np.tile(g.wrist, (3, 1)),
+    )
+    hand_file = tmp_path / "trifinger.yaml"
+    fingers = "".join(f"    - {{name: '{f.name}', tip: {f.tip}}}\n" for f in g.hand.fingers)
+    hand_file.write_text(f"hand:\n  urdf: {g.hand.source}\n  fingers:\n{fingers}", "utf-8")
+    off = np.linalg.norm(tips(g.hand, q[1])[0] - (g.points[0] - 0.01 * g.normals[0]))
+    recs = jsonl("resolve", data, "--hand", hand_file)
+    assert [len(r["warnings"]) for r in recs] == [0, 1, 0] and all(r["ok"] for r in recs)
+    assert recs[1]["warnings"][0].startswith(f"tip-off-contact: finger 1's tip link 'finger_tip_link_0' is {off:.3g} ")

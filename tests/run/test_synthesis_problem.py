@@ -231,3 +231,19 @@ def test_an_object_with_a_mass_of_its_own_is_held_without_mass_given():
     task = grasp_problem(g, friction=0.5, **OPTIONS)
     assert task.names[0] == "hold" and task.problem.weight.mass == 0.1
     np.testing.assert_allclose(task.problem.wrenches[0, :3], [0, 0, 0.981])
+
+
+def test_mass_given_with_an_object_weighs_it_as_with_its_grasp():
+    # the trial's: gt.synthesize(g.object, mu, mass=0.1) raised "hold=True needs the object's mass": the
+    # keyword was taken for a Grasp alone; the object with that mass now, the grasp form's same grasps
+    g = gt.read_grasps(GRASPS / "box-edge.yaml")[0]
+    bare = replace(g.object, mass=None, density=None)  # neither the object nor its file weighs anything
+    kw = {"count": 1, "candidates": 300, "loads": "weight"}
+    by_grasp = gt.synthesize(replace(g, object=bare, mass=None), 0.5, mass=0.1, **kw)
+    by_object = gt.synthesize(bare, 0.5, mass=0.1, wrist=g.wrist, **kw)
+    assert by_object.total_normal_force.shape == (1, 1)  # the weight alone: 0.1 kg's
+    np.testing.assert_array_equal(by_object.points, by_grasp.points)
+    np.testing.assert_allclose(by_object.total_normal_force, by_grasp.total_normal_force, rtol=1e-12)
+    # and as the mass the object already has (mass= replaces a density too)
+    dense = gt.synthesize(replace(bare, density=7.0e6), 0.5, mass=0.1, wrist=g.wrist, **kw)
+    np.testing.assert_array_equal(dense.points, by_grasp.points)

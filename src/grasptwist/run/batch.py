@@ -462,7 +462,8 @@ def dataset_blocks(
     linear part is the velocity of the row's ``at`` point.  ``bases=False``
     leaves the basis screws out (see :func:`resolve_arrays`).
     ``hand_of_rows`` (a Hand, e.g. from ``--hand``) holds every row: at the
-    data set's ``joint_positions``, each row's checked (``contact-off-finger``),
+    data set's ``joint_positions``, each row's checked (``contact-off-finger``; a warning
+    ``tip-off-contact`` where a tip is off its contact by over 1% of its finger's length),
     or without them at joint positions solved per row by inverse kinematics
     (``unreachable``, ``outside-limits`` where they fail; a hand given inline
     is at the configuration its screws describe), its joint rates are computed
@@ -582,7 +583,25 @@ def _dataset_block(ds, given, twists, method, start, stop, k, bases, hand_of_row
         has_wrist=None if ds.wrist is None else np.ones(len(index), bool),
         **hand_inputs,
     )
-    return _placed(block, placed)
+    return _tip_warned(_placed(block, placed), hand_of_rows, placed if ds.joint_positions is not None else None)
+
+
+def _tip_warned(block, hand, placed):
+    """``block`` with a ``tip-off-contact`` warning on each row whose given joint positions leave a
+    tip off its contact (within its finger's reach: farther is the row's ``contact-off-finger``)."""
+    if placed is None:
+        return block
+    from ..engine.ik import tip_off_contact
+    from .placement import tip_warnings
+
+    error = np.where(placed.status == Status.OK, placed.tip_error, np.nan)
+    off = np.flatnonzero(tip_off_contact(error, [f.length for f in hand.fingers]).any(axis=-1))
+    if not off.size:
+        return block
+    said = [()] * len(block)
+    for i in off.tolist():
+        said[i] = tip_warnings(hand, block.contact_names[i], error[i])
+    return replace(block, grasp_warnings=said)
 
 
 def _labels(names: np.ndarray) -> np.ndarray:

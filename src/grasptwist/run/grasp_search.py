@@ -192,7 +192,7 @@ def grasp_problem(
     """
     if grasp.object is None:
         return _problem(grasp, NO_OBJECT, f"grasp '{grasp.name}' has no object to search")
-    obj = grasp.object if mass is None else replace(grasp.object, mass=mass, density=None)
+    obj = weighed(grasp.object, mass)
     friction = _friction(grasp, friction)
     if isinstance(friction, InputError):
         return friction
@@ -201,8 +201,8 @@ def grasp_problem(
     gravity = np.asarray(options.pop("gravity", None) or (GRAVITY if grasp.gravity is None else grasp.gravity), float)
     held = options.pop("hold", None)  # None: whenever there is a mass
     if held is None:  # the object's mass or density, the file's top-level mass, or mass=
-        weighed = grasp.object.mass is not None or grasp.object.density is not None
-        held = mass is not None or grasp.mass is not None or weighed
+        own = grasp.object.mass is not None or grasp.object.density is not None
+        held = mass is not None or grasp.mass is not None or own
     fallback = None  # a weight apart from the object: the file's top-level mass and center_of_mass
     if held and grasp.mass is not None:
         with np.errstate(over="ignore", invalid="ignore"):  # an overflow is the problem's error
@@ -267,6 +267,18 @@ def _words(grasp, exc: ProblemError) -> tuple[str, str]:
     )
 
 
+def weighed(obj, mass):
+    """``obj`` with ``mass`` (``mass=``, ``--mass``) in place of its mass or density; as it is when None.
+
+    >>> from grasptwist.objects import GraspObject, Shape
+    >>> ball = GraspObject(Shape("sphere", np.array([0.05])), np.eye(4), density=1000.0)
+    >>> w = weighed(ball, 0.1)
+    >>> w.mass, w.density, weighed(ball, None) is ball
+    (0.1, None, True)
+    """
+    return obj if mass is None else replace(obj, mass=mass, density=None)
+
+
 def hand_reach(obj, hand, environment, clearance, tips, folder, max_bytes) -> HandReach:
     """A hand as the search takes it, with every check the command line makes
     (:func:`~grasptwist.run.collisions.hand_constraints`)."""
@@ -308,7 +320,7 @@ def synthesize(
     Parameters
     ----------
     obj : GraspObject or Grasp
-        With a ``mass`` or ``density`` when ``hold`` (the weight ``m g`` at its centre of mass).  A
+        With a ``mass`` or ``density`` (or ``mass=``) when ``hold`` (the weight ``m g`` at its centre of mass).  A
         ``Grasp`` (``grasptwist.read_grasps``) stands for its file, as ``grasptwist synthesize FILE``
         takes it: its ``object`` is searched, with its friction (the least of its contacts') unless
         ``friction`` is given, its weight (``mass`` replaces the object's), its other wrenches
@@ -342,7 +354,8 @@ def synthesize(
     **options
         ``wrenches`` (more wrenches every grasp must exert, ``(force; moment about the
         origin)``), ``hold`` (True: the weight comes first), ``gravity``, ``span_bodies``
-        (False: each grasp on one body of the object), ``mass`` (a ``Grasp``'s), and the
+        (False: each grasp on one body of the object), ``mass`` (in place of the object's mass or
+        density, a ``Grasp``'s object's as a ``GraspObject``'s: ``--mass``), and the
         search's: ``count`` (grasps wanted, 1), ``safety`` (1), ``objective`` (``robust``,
         ``total_normal_force``, ``closure_friction`` or ``epsilon``), ``wrist`` (None),
         ``methods``, ``min_conditioning`` (0.05), ``min_spacing`` (None: 5% of the object's
@@ -397,6 +410,7 @@ def synthesize(
         return solve(task.problem)
     if friction is None:
         raise ValueError("friction: give mu at every contact (only a Grasp brings its own)")
+    obj = weighed(obj, options.pop("mass", None))  # as a Grasp's: the object with that mass
     if hand is not None and not isinstance(hand, HandReach) and "collide" not in options and "hulls" not in options:
         hand = with_tip_radius(hand, tip_radius)
         hand = hand_reach(obj, hand, environment, clearance, tips, folder, max_bytes)

@@ -18,6 +18,8 @@ from collections.abc import Iterable
 from dataclasses import replace
 from typing import TYPE_CHECKING
 
+import numpy as np
+
 from ..engine.degeneracy import Status
 from ..engine.environment import needs_checks
 from ..io import grasp as loader
@@ -26,11 +28,15 @@ from ..io.grasp import READING, Reading
 from ..io.grasp.problems import MAX_ERRORS, Problems, Reject
 from ..io.grasp.values import readonly
 from ..model import Grasp, InputError
+from ..output.names import escaped
 
 if TYPE_CHECKING:
     from ..model.hands import Hand
 
-__all__ = ["place_grasp", "placed", "read", "read_grasps", "run_hand"]
+__all__ = ["TIP_CODE", "place_grasp", "placed", "read", "read_grasps", "run_hand", "tip_warnings"]
+
+#: The warning of given joint positions that leave a tip off its contact (within the finger's reach).
+TIP_CODE = "tip-off-contact"
 
 
 def place_grasp(grasp: Grasp) -> Grasp | InputError:
@@ -91,7 +97,42 @@ def place_grasp(grasp: Grasp) -> Grasp | InputError:
         return InputError(*errors[0].args[:6], errors)  # one per document, as the reader gives them
     from .collisions import with_collisions  # as the inverse kinematics: with the first URDF hand
 
-    return with_collisions(replace(grasp, joint_positions=readonly(solved.positions), placement=None))
+    said = tip_warnings(hand, grasp.contact_names, solved.tip_error) if p.given else ()
+    placed = replace(grasp, joint_positions=readonly(solved.positions), placement=None, warnings=grasp.warnings + said)
+    return with_collisions(placed)
+
+
+def tip_warnings(hand, names, tip_error) -> tuple[str, ...]:
+    """The ``tip-off-contact`` warnings of a hand at given joint positions: one per finger whose tip
+    point is farther from where it must be than :func:`~grasptwist.engine.ik.tip_tolerance` (1% of
+    the finger's length), naming the finger (its contact's name), the distance and the tolerance.
+
+    Parameters
+    ----------
+    hand : Hand
+    names : sequence of 3 str
+        The contacts' names.
+    tip_error : (3,) array
+        Each finger's distance from where it must be (NaN: unchecked).
+
+    Examples
+    --------
+    >>> import grasptwist as gt
+    >>> (g,) = gt.read_grasps("grasps/trifinger-cube.yaml")
+    >>> tip_warnings(g.hand, ("0", "1", "2"), [0.0474, 0.0, float("nan")])  # doctest: +NORMALIZE_WHITESPACE
+    ("tip-off-contact: finger 0's tip link 'finger_tip_link_0' is 0.0474 from where its contact puts it,
+    over the tolerance 0.00382 (1% of the finger's length): are the joint_positions this grasp's?",)
+    """
+    from ..engine.ik import TIP_OFF_TOL, tip_off_contact, tip_tolerance
+
+    lengths = [f.length for f in hand.fingers]
+    off, tol = tip_off_contact(tip_error, lengths), tip_tolerance(lengths)
+    return tuple(
+        f"{TIP_CODE}: finger {escaped(names[f])}'s tip link {escaped(hand.fingers[f].tip)!r} is {tip_error[f]:.3g} "
+        f"from where its contact puts it, over the tolerance {tol[f]:.3g} ({TIP_OFF_TOL:.0%} of the finger's "
+        "length): are the joint_positions this grasp's?"
+        for f in np.flatnonzero(off)
+    )
 
 
 def placed(items: Iterable) -> list:

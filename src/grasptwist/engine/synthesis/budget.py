@@ -1,7 +1,7 @@
 """A search's budget, a setting (candidates, seconds and the clock they are read on), and how it is spent.
 
 The clock starts after the one-time work every search needs before its first candidate
-(:func:`~.search.warm_up`: numba compiles the grip's kernels on a fresh install, tens of seconds),
+(:func:`~.search.warm_up`: numba compiles the grip's kernels on a fresh install, about a minute),
 so that work never eats the budget, and a first run returns what every later run returns.  A search says
 which limit ended it (:data:`STOPPED_BY`): ``candidates``, every candidate scored and every grasp
 selected verified (the same ``seed`` gives the same grasps bit for bit), or ``seconds``, the time
