@@ -229,7 +229,9 @@ def grasp_problem(
         try:
             reach = hand_reach(obj, hand, environment, options.get("clearance"), tips, folder, max_bytes)
         except InputError as exc:
-            return InputError(exc.code, f"hand: {exc.message}", grasp.file, grasp.line, None, grasp.document)
+            from .collisions import hand_error  # with the first URDF hand, as hand_reach's
+
+            return hand_error(exc, grasp, hand)
         except ValueError as exc:
             return _problem(grasp, UNSEARCHABLE_HAND, str(exc))
     try:
