@@ -217,7 +217,7 @@ def test_a_hull_of_no_volume_is_a_thin_solid_about_it(points):
             "package-not-found",
             "mesh 'package://nosuchpkg_xyz/tip.stl': no installed",
         ),
-        ("../tip.stl", "path-outside", "mesh '../tip.stl': '../tip.stl' resolves outside"),
+        ("../tip.stl", "path-outside", "mesh '../tip.stl' resolves outside"),
     ],
 )
 def test_a_link_mesh_s_error_is_at_the_urdf_key_naming_the_urdf_line(tmp_path, mesh, code, words):

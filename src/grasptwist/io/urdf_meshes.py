@@ -344,8 +344,16 @@ def _checked_mesh(name, urdf, source, line=None):
         path = resolve_urdf(name, urdf.parent)
         return path, _check_mesh_file(name, path)
     except InputError as exc:  # the error is the URDF's, about one of its meshes
-        inside = f", line {exc.line}" if exc.line else ""
-        raise InputError(exc.code, f"mesh {name!r}{inside}: {exc.message}", source, line) from None
+        raise InputError(exc.code, _about(name, exc), source, line) from None
+
+
+def _about(name, exc):
+    """A mesh file's error said as the URDF's: ``mesh 'm.stl' resolves outside ...`` (an error that
+    names it first), else ``mesh 'm.stl', line 4: <what>`` (the mesh file's own line, when it has one)."""
+    if exc.message.startswith(repr(name)):
+        return f"mesh {exc.message}"
+    inside = f", line {exc.line}" if exc.line else ""
+    return f"mesh {name!r}{inside}: {exc.message}"
 
 
 def _loaded(hand, folder, max_bytes):
@@ -434,7 +442,7 @@ def urdf_files(hand, *, folder=None, max_bytes=MAX_URDF_BYTES) -> tuple[str, dic
         try:
             path = resolve_urdf(name, urdf.parent)
         except InputError as exc:  # the error is the URDF's, about one of its meshes
-            raise InputError(exc.code, f"mesh {name!r}: {exc.message}", hand.source, line) from None
+            raise InputError(exc.code, _about(name, exc), hand.source, line) from None
         try:
             if path.stat().st_size > MAX_MESH_BYTES:
                 raise InputError("too-large", f"mesh {name!r}: larger than {MAX_MESH_BYTES} bytes", hand.source, line)
