@@ -188,7 +188,8 @@ def grasp_problem(
     -------
     Task or InputError
         ``no-object``, ``no-friction``, ``nothing-to-hold``, ``non-finite``, ``no-tip-points``,
-        ``unsearchable-hand``, or a URDF's error, located at the document.
+        ``unsearchable-hand``, located at the document, or a URDF's meshes' error, at the ``urdf``
+        key of the file that names it (:func:`~grasptwist.run.collisions.hand_error`).
     """
     if grasp.object is None:
         return _problem(grasp, NO_OBJECT, f"grasp '{grasp.name}' has no object to search")
