@@ -356,6 +356,8 @@ ERRORS = {
     "package-not-found": Code("a URDF's `package://` names no installed package", _HANDS),
     "unsupported-url": Code("a URDF reference that is neither a `package://` URL nor a file path", _HANDS),
     "unknown-link": Code("a finger's `tip` that is no link of the URDF", _HANDS),
+    "fixed-finger": Code("a finger's `tip` that no movable joint moves (the URDF's root, or fixed to it)", _HANDS),
+    "shared-joint": Code("two fingers moved by one joint: the same `tip` link, or a link above both", _HANDS),
     "urdf-syntax": Code("a URDF that is not well-formed XML", _HANDS),
     "forbidden-dtd": Code("a URDF with a DTD or entities", _HANDS),
     "invalid-urdf": Code("a URDF that is no robot description grasptwist can use", _HANDS),

@@ -237,8 +237,8 @@ def test_a_urdf_outside_the_folder_is_read_with_allow_outside(tmp_path):
     path.write_text(CONTACTS + f"hand:\n  urdf: ../hand.urdf\n  fingers:\n{fingers}", "utf-8")
     assert errors_of(path)[:3] == ("path-outside", 6, 9)
     result = CliRunner().invoke(app, ["resolve", str(path), "--allow-outside", "-f", "jsonl"])
-    # read now: its one-link fingers cannot reach these contacts, which the run says after reading it
-    assert json.loads(result.stdout)["error"]["code"] == "unreachable" and "path-outside" not in result.stderr
+    # read now: its three fingers on one tip link are refused, which only reading it can say
+    assert json.loads(result.stdout)["error"]["code"] == "shared-joint" and "path-outside" not in result.stderr
 
 
 def errors_of(path):

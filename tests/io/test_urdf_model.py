@@ -3,6 +3,7 @@ and shape of the TriFinger URDFs (read from robot_properties_fingers) and of the
 finger links' collision geometry (io/urdf_meshes.py ``link_geometry``) against the scene yourdfpy and
 trimesh build of it (meshes, primitives, scales, mirrors, origins, the visual fallback)."""
 
+import os
 import warnings
 from importlib.util import find_spec
 
@@ -235,7 +236,10 @@ def test_a_finger_links_mesh_outside_the_caps_is_the_urdfs_error_naming_it(tmp_p
     (tmp_path / "bad.stl").write_bytes(b"not a mesh")
     with pytest.raises(InputError, match=r"mesh 'bad\.stl': not a readable STL file") as caught:
         link_geometry(toy, folder=tmp_path)
-    assert (caught.value.code, caught.value.file) == ("invalid-mesh", toy.source)
+    text = (tmp_path / toy.source).read_text().splitlines()
+    line = next(i for i, row in enumerate(text, 1) if 'filename="bad.stl"' in row)
+    error = caught.value  # the URDF as its reading names it, at the <mesh>'s line
+    assert (error.code, error.file, error.line) == ("invalid-mesh", os.path.join(tmp_path, toy.source), line)
 
 
 def test_a_mesh_is_merged_as_trimesh_merges_what_it_loads(tmp_path):

@@ -46,13 +46,13 @@ PINNED_EXITS = {"ok": 0, "failed": 1, "usage": 2, "write": 3, "worker": 4, "brok
 PINNED_ERRORS = """
     alias bad-dataset bad-scalar conflicting-keys contact-count contact-inside-object contact-off-finger
     contact-off-surface control-character duplicate-key duplicate-name empty-document empty-mesh empty-path
-    finger-count forbidden-dtd forbidden-tag internal-error invalid-clearance invalid-contact-model
+    finger-count fixed-finger forbidden-dtd forbidden-tag internal-error invalid-clearance invalid-contact-model
     invalid-density invalid-duration invalid-frame invalid-friction invalid-key invalid-limit invalid-mass
     invalid-mesh invalid-name invalid-object invalid-pose invalid-radius invalid-rotation invalid-scale
     invalid-size invalid-torsion invalid-urdf invalid-utf8 mesh-not-solid mesh-unavailable missing-key
     no-friction no-grasp no-grasp-files no-mass no-object no-path no-tip-points no-twist no-weight non-finite
     not-a-list not-a-mapping not-a-number not-a-string nothing-to-hold object-below-table outside-limits
-    output-is-input outward-normal package-not-found path-outside read-error scene-error
+    output-is-input outward-normal package-not-found path-outside read-error scene-error shared-joint
     simulation-unstable tolerance-too-large too-deep too-large too-many-documents too-many-errors
     too-many-samples too-many-triangles too-many-vertices unknown-joint unknown-key unknown-link
     unknown-twist unknown-units unreachable unsearchable-hand unsupported-joint unsupported-mesh

@@ -6,6 +6,7 @@ geometry read (the visual geometry when it has none)."""
 import json
 from dataclasses import replace
 from importlib.util import find_spec
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -183,8 +184,14 @@ def test_a_hand_mesh_that_cannot_be_read_fails_its_grasp_located(grasp, monkeypa
     monkeypatch.setattr(collisions, "_GEOMETRY", {})
     error = collisions.with_collisions(grasp)
     assert isinstance(error, InputError)
-    assert (error.code, error.file, error.line) == ("read-error", grasp.file, grasp.line)
-    assert error.message == "hand: mesh 'prox-sim.stl': cannot read: no such file"
+    # at the grasp file's urdf key, the URDF named in the message
+    lines = Path(grasp.file).read_text("utf-8").splitlines()
+    line = next(i for i, row in enumerate(lines, 1) if row.lstrip().startswith("urdf:"))
+    column = lines[line - 1].index("urdf:") + len("urdf: ") + 1
+    assert (error.code, error.file, error.line, error.column) == ("read-error", grasp.file, line, column)
+    assert error.message == f"hand.urdf: {grasp.hand.source}: mesh 'prox-sim.stl': cannot read: no such file"
+    bare = replace(grasp, hand=replace(grasp.hand, urdf_at=None))  # a hand read in Python: at the document
+    assert (collisions.with_collisions(bare).line, collisions.with_collisions(bare).column) == (grasp.line, None)
     assert collisions.with_collisions(replace(grasp, object=None)) is not None  # nothing to read: no error
 
 

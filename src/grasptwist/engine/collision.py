@@ -397,24 +397,34 @@ class LinkHulls(NamedTuple):
 
 
 def convex_planes(vertices, merge=HULL_MERGE):
-    """The convex hull of points, its facets merged: its vertices ``(H, 3)`` and face planes ``(K, 4)`` (:class:`LinkHulls`).
+    r"""The convex hull of points, its facets merged: its vertices ``(H, 3)`` and face planes ``(K, 4)`` (:class:`LinkHulls`).
 
     Qhull (scipy) merges facets whose centrums are within ``merge`` times the points' extent of
     their neighbours' planes (``C-``): the hull it gives is the exact one to about that much
-    (a point's depth within 2.5 times it, tests/engine/test_environment.py).  Flat or straight
-    geometry is joggled (``QJ``) into a thin solid.
+    (a point's depth within 2.5 times it, tests/engine/test_environment.py).  Geometry that
+    bounds no solid (a point, a segment, a flat piece: Qhull refuses it) is thickened into one,
+    the points' hull grown by a cube of half-width ``merge`` times their extent (``1e-9`` times
+    their distance from the origin, at least ``1e-9``, for a single point), :math:`H \oplus
+    [-\epsilon, \epsilon]^3`: a thin solid about it.
 
     >>> v, planes = convex_planes(np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [0.1, 0.1, 0.1]]))
     >>> len(v), len(planes), float(hull_depth([0.1, 0.1, 0.1], planes).round(12))
     (4, 4, 0.1)
+    >>> v, planes = convex_planes([[0, 0, 0], [1, 0, 0]])  # a segment: a slab 2e-3 wide about it
+    >>> len(v), len(planes), float(hull_depth([0.5, 0, 0], planes).round(12))
+    (8, 6, 0.002)
     """
     from scipy.spatial import ConvexHull, QhullError  # as the closure's epsilon: with the first hull
 
     v = np.asarray(vertices, dtype=float).reshape(-1, 3)
+    extent = float(np.ptp(v, axis=0).max())
     try:
-        hull = ConvexHull(v, qhull_options=f"C-{merge * float(np.ptp(v, axis=0).max()):.6g}")
+        hull = ConvexHull(v, qhull_options=f"C-{merge * extent:.6g}")
     except QhullError:
-        hull = ConvexHull(v, qhull_options="QJ")
+        half = merge * extent or 1e-9 * max(1.0, float(np.abs(v).max()))
+        cube = half * np.array(np.meshgrid([-1, 1], [-1, 1], [-1, 1])).reshape(3, -1).T
+        v = (v[:, None] + cube).reshape(-1, 3)
+        hull = ConvexHull(v)
     return v[hull.vertices], np.unique(hull.equations, axis=0)
 
 

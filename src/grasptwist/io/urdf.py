@@ -32,6 +32,8 @@ Every refusal is a :class:`~grasptwist.model.InputError` with a code:
 ``forbidden-dtd``      a document type declaration
 ``invalid-urdf``       not a URDF tree (root element, links, joints, numbers)
 ``unknown-link``       a tip that is no link of the URDF
+``fixed-finger``       a tip that no movable joint moves (the root link, or fixed to it)
+``shared-joint``       two fingers moved by one joint (the same tip link, or a link above both)
 ``unsupported-joint``  a mimic, floating or planar joint on a finger
 ``urdf-unavailable``   the extra ``grasptwist[urdf]`` (lxml, yourdfpy) is not installed
 =====================  ==========================================================
@@ -56,7 +58,7 @@ from ..model import Finger, Hand, InputError, Joint
 from .limits import MAX_URDF_BYTES, MESH_SUFFIXES, OUTPUT_IS_INPUT
 from .urdf_model import merged, read_model
 
-__all__ = ["load_urdf_hand", "resolve_urdf"]
+__all__ = ["finger_problems", "load_urdf_hand", "resolve_urdf", "urdf_name"]
 
 _PACKAGE = "package://"
 _URL = re.compile(r"^[A-Za-z][A-Za-z0-9+.-]*://")
@@ -106,6 +108,17 @@ def resolve_urdf(reference, folder=None, *, allow_outside=False, output=None):
     if allow_outside:
         return _resolved(Path(folder) / text, text)
     return _inside(_resolved(Path(folder), text), text, text, output)
+
+
+def urdf_name(reference, folder=None):
+    """A URDF as its errors name it: its ``package://`` reference, else its path from the referring
+    file's ``folder`` (as given: relative when that is).
+
+    >>> urdf_name("hand.urdf", "."), urdf_name("package://pkg/hand.urdf", "grasps")
+    ('./hand.urdf', 'package://pkg/hand.urdf')
+    """
+    text = os.fspath(reference)
+    return text if text.startswith(_PACKAGE) or folder is None else os.path.join(os.fspath(folder), text)
 
 
 def _package_folder(package, reference):
@@ -242,7 +255,9 @@ def _library(file):
         )
 
 
-def load_urdf_hand(urdf, tips, *, names=None, folder=None, max_bytes=MAX_URDF_BYTES, allow_outside=False, output=None):
+def load_urdf_hand(
+    urdf, tips, *, names=None, folder=None, max_bytes=MAX_URDF_BYTES, allow_outside=False, output=None, check=True
+):
     """A hand from a URDF: one finger per tip link, its joints at home (all 0).
 
     The hand's frame (and so the grasp's) is the URDF's root link's frame.
@@ -274,6 +289,9 @@ def load_urdf_hand(urdf, tips, *, names=None, folder=None, max_bytes=MAX_URDF_BY
         Take a relative path wherever it leads (``--allow-outside``).
     output : (int, int), optional
         The ``(device, inode)`` of the file ``-o`` replaces: a URDF that is it is ``output-is-input``.
+    check : bool
+        Refuse a finger that cannot be placed (:func:`finger_problems`); False: the caller
+        reports them (a grasp file at each finger's ``tip``).
 
     Returns
     -------
@@ -295,7 +313,7 @@ def load_urdf_hand(urdf, tips, *, names=None, folder=None, max_bytes=MAX_URDF_BY
     [0.01, 0.01, 0.01]
     """
     text = os.fspath(urdf)
-    file = text if text.startswith(_PACKAGE) or folder is None else os.path.join(os.fspath(folder), text)
+    file = urdf_name(text, folder)
     _library(file)  # before the reference: a package:// one may be missing for the same reason
     where = resolve_urdf(urdf, folder, allow_outside=allow_outside, output=output)
     data = _read(where, max_bytes, file, output)
@@ -310,7 +328,60 @@ def load_urdf_hand(urdf, tips, *, names=None, folder=None, max_bytes=MAX_URDF_BY
         finger = _finger(name, tip, path, file, joint_names)
         fingers.append(replace(finger, tip_radius=_tip_radius(model, tip, where, max_bytes, meshes)))
     roots = [link for link in model.links if link not in parent_joint]
-    return Hand(tuple(fingers), tuple(joint_names), text, roots[0])
+    hand = Hand(tuple(fingers), tuple(joint_names), text, roots[0])
+    for _, code, message, line in finger_problems(hand) if check else ():
+        raise InputError(code, message, file, line)
+    return hand
+
+
+def finger_problems(hand):
+    """The fingers of a URDF hand that cannot be placed, as ``(finger index, code, message, line)``.
+
+    Inverse kinematics moves each finger by its own joints, alone: a finger whose tip no movable
+    joint moves (``fixed-finger``: the root link, or a link fixed to it) has nothing to move, and
+    a finger moved by a joint of an earlier finger (``shared-joint``: the same tip link, or a link
+    above both) would give that joint a second position.  ``line`` is the shared joint's in the
+    URDF (None for a fixed finger).
+
+    >>> hand = load_urdf_hand("package://robot_properties_fingers/urdf/pro/trifingerpro.urdf",
+    ...                       ["finger_tip_link_0", "base_link", "finger_lower_link_0"], check=False)
+    >>> [(f, code) for f, code, _, _ in finger_problems(hand)]
+    [(1, 'fixed-finger'), (2, 'shared-joint')]
+    """
+    out, owner = [], {}
+    for f, finger in enumerate(hand.fingers):
+        if not finger.joints:
+            out.append(
+                (
+                    f,
+                    "fixed-finger",
+                    f"finger {finger.name!r}: no movable joint moves its tip link {finger.tip!r} "
+                    f"(the root link, or fixed to it): it cannot be put on its contact",
+                    None,
+                )
+            )
+            continue
+        shared = [(k, joint) for k, joint in zip(finger.joint_index, finger.joints) if k in owner]
+        if shared:
+            k, joint = shared[-1]  # the joint nearest the tip: the link the two fingers part at is below it
+            other = hand.fingers[owner[k]]
+            what = (
+                f"has the same tip link {finger.tip!r} as"
+                if other.tip == finger.tip
+                else f"shares joint {joint.name!r} with"
+            )
+            out.append(
+                (
+                    f,
+                    "shared-joint",
+                    f"finger {finger.name!r} {what} finger {other.name!r}: each finger needs joints "
+                    "of its own (inverse kinematics moves each alone, so a shared joint would get two positions)",
+                    joint.line,
+                )
+            )
+        for k in finger.joint_index:
+            owner.setdefault(k, f)
+    return out
 
 
 def _tip_radius(model, tip, urdf, max_bytes, meshes):

@@ -42,7 +42,7 @@ import numpy as np
 from ..engine.collision import LinkGeometry
 from ..model import InputError
 from .limits import MAX_MESH_BYTES, MAX_TRIANGLES, MAX_URDF_BYTES, MESH_SUFFIXES
-from .urdf import _library, _parse, _read, resolve_urdf
+from .urdf import _library, _parse, _read, resolve_urdf, urdf_name
 from .urdf_model import merged, read_model
 
 __all__ = [
@@ -227,14 +227,15 @@ def link_geometry(hand, *, folder=None, max_bytes=MAX_URDF_BYTES) -> tuple[LinkG
     """
     if hand.source is None:
         return ()
-    _library(hand.source)  # trimesh (yourdfpy's) makes the primitives and reads other formats
+    source = urdf_name(hand.source, folder)  # as the hand's reading named it
+    _library(source)  # trimesh (yourdfpy's) makes the primitives and reads other formats
     urdf = resolve_urdf(hand.source, folder)
-    model = read_model(_parse(_read(urdf, max_bytes, hand.source), hand.source), hand.source)
+    model = read_model(_parse(_read(urdf, max_bytes, source), source), source)
     collision = any(link.collisions for link in model.links.values())
     meshes, out = {}, []  # each mesh file read once
     for link, (finger, joints, pose) in _finger_links(hand, model).items():
         shapes = model.links[link].collisions if collision else model.links[link].visuals
-        parts = [_shape_mesh(shape, urdf, hand.source, meshes, turn=not collision) for shape in shapes]
+        parts = [_shape_mesh(shape, urdf, source, meshes, turn=not collision) for shape in shapes]
         if not parts:
             continue
         offsets = np.cumsum([0] + [len(v) for v, _ in parts[:-1]])
@@ -252,7 +253,7 @@ def _shape_mesh(shape, urdf, source, meshes, turn):
     a visual shape is posed by the scene)."""
     if shape.kind == "mesh":
         if shape.filename not in meshes:
-            meshes[shape.filename] = mesh_file(shape.filename, urdf, source)
+            meshes[shape.filename] = mesh_file(shape.filename, urdf, source, shape.line)
         v, f = meshes[shape.filename]
         if shape.scale is not None and not np.allclose(shape.scale, 1.0):
             v = v * shape.scale
@@ -304,7 +305,7 @@ def _finger_links(hand, model) -> dict:
     return owners
 
 
-def mesh_file(name, urdf, source):
+def mesh_file(name, urdf, source, line=None):
     """A URDF's mesh file ``name`` as ``(vertices (V, 3), faces (F, 3))`` in its own frame.
 
     Resolved as the URDF's meshes are (:func:`~grasptwist.io.urdf.resolve_urdf`, from the folder
@@ -318,10 +319,10 @@ def mesh_file(name, urdf, source):
     Raises
     ------
     InputError
-        The URDF's (``source``), naming the mesh: ``path-outside``, ``read-error``, ``too-large``
-        or a mesh format's.
+        The URDF's (``source``, at ``line``, its ``<mesh>`` element's), naming the mesh:
+        ``path-outside``, ``read-error``, ``too-large`` or a mesh format's.
     """
-    path, parsed = _checked_mesh(name, urdf, source)
+    path, parsed = _checked_mesh(name, urdf, source, line)
     if parsed is None:
         import trimesh
 
@@ -329,23 +330,30 @@ def mesh_file(name, urdf, source):
             loaded = trimesh.load(str(path), force="mesh", ignore_broken=True, skip_materials=True)
             parsed = np.asarray(loaded.vertices, dtype=float), np.asarray(loaded.faces, dtype=np.int64)
         except Exception as exc:  # noqa: BLE001 - a malformed mesh: each format's parser raises its own kinds
-            raise InputError("read-error", f"mesh {name!r}: cannot read: {type(exc).__name__}: {exc}", source) from None
+            message = f"mesh {name!r}: cannot read: {type(exc).__name__}: {exc}"
+            raise InputError("read-error", message, source, line) from None
     return merged(*parsed)
 
 
-def _checked_mesh(name, urdf, source):
+def _checked_mesh(name, urdf, source, line=None):
     """The mesh file ``name`` of the URDF at ``urdf``: its path, resolved and within the mesh caps
     (:func:`_check_mesh_file`), and its ``(vertices, faces)`` when it is an STL, OBJ or PLY (None
-    for another format); errors are the URDF's (``source``), naming the mesh."""
+    for another format); errors are the URDF's (``source``, at ``line``, its ``<mesh>``'s),
+    naming the mesh (and the mesh file's own line, when it has one)."""
     try:
         path = resolve_urdf(name, urdf.parent)
-    except InputError as exc:  # the error is the URDF's, about one of its meshes
-        raise InputError(exc.code, f"mesh {exc.message}", source) from None
-    try:
         return path, _check_mesh_file(name, path)
-    except InputError as exc:
-        where = f", line {exc.line}" if exc.line else ""
-        raise InputError(exc.code, f"mesh {name!r}{where}: {exc.message}", source) from None
+    except InputError as exc:  # the error is the URDF's, about one of its meshes
+        raise InputError(exc.code, _about(name, exc), source, line) from None
+
+
+def _about(name, exc):
+    """A mesh file's error said as the URDF's: ``mesh 'm.stl' resolves outside ...`` (an error that
+    names it first), else ``mesh 'm.stl', line 4: <what>`` (the mesh file's own line, when it has one)."""
+    if exc.message.startswith(repr(name)):
+        return f"mesh {exc.message}"
+    inside = f", line {exc.line}" if exc.line else ""
+    return f"mesh {name!r}{inside}: {exc.message}"
 
 
 def _loaded(hand, folder, max_bytes):
@@ -430,15 +438,15 @@ def urdf_files(hand, *, folder=None, max_bytes=MAX_URDF_BYTES) -> tuple[str, dic
     root = _parse(data, hand.source)
     meshes = {}
     for element in root.iter("mesh"):
-        name = element.get("filename", "")
+        name, line = element.get("filename", ""), element.sourceline
         try:
             path = resolve_urdf(name, urdf.parent)
         except InputError as exc:  # the error is the URDF's, about one of its meshes
-            raise InputError(exc.code, f"mesh {exc.message}", hand.source) from None
+            raise InputError(exc.code, _about(name, exc), hand.source, line) from None
         try:
             if path.stat().st_size > MAX_MESH_BYTES:
-                raise InputError("too-large", f"mesh {name!r}: larger than {MAX_MESH_BYTES} bytes", hand.source)
+                raise InputError("too-large", f"mesh {name!r}: larger than {MAX_MESH_BYTES} bytes", hand.source, line)
             meshes[os.path.basename(name)] = path.read_bytes()
         except OSError as exc:
-            raise InputError("read-error", f"mesh {name!r}: cannot read: {exc.strerror}", hand.source) from None
+            raise InputError("read-error", f"mesh {name!r}: cannot read: {exc.strerror}", hand.source, line) from None
     return data.decode("utf-8"), meshes

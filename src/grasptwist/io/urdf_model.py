@@ -67,7 +67,8 @@ class UrdfShape(NamedTuple):
 
     ``kind`` is ``"box"`` (``size`` its three edges), ``"sphere"`` (``size`` its radius),
     ``"cylinder"`` (``size`` its radius and length, along z) or ``"mesh"`` (``filename`` as
-    written, ``scale`` ``(3,)``).
+    written, ``scale`` ``(3,)``); ``line`` the geometry element's (where a mesh's problems are
+    reported).
     """
 
     kind: str
@@ -75,6 +76,7 @@ class UrdfShape(NamedTuple):
     size: tuple = ()
     filename: str | None = None
     scale: np.ndarray | None = None
+    line: int | None = None
 
 
 class UrdfLink(NamedTuple):
@@ -105,8 +107,9 @@ def read_model(root, file) -> UrdfModel:
     Raises
     ------
     InputError
-        ``invalid-urdf`` at the element's line: a joint or link without a name, a joint without
-        a type, parent or child, a number that is none (or not finite), a ``<collision>`` or
+        ``invalid-urdf`` at the element's line: a joint or link without a name, two joints or
+        two links of one name, a joint without a type, parent or child, a number that is none
+        (or not finite), a box's, sphere's or cylinder's size not above 0, a ``<collision>`` or
         ``<visual>`` without a geometry.
 
     >>> from lxml import etree
@@ -122,17 +125,33 @@ def read_model(root, file) -> UrdfModel:
     [0.001, 0.001, 0.001]
     """
     joints = tuple(_joint(element, file) for element in root.iterfind("joint"))
-    links = {}
-    for element in root.iterfind("link"):
-        name = element.get("name")
-        if not name:
+    _unique("joint", [(j.name, j.line) for j in joints], file)
+    elements = list(root.iterfind("link"))
+    for element in elements:
+        if not element.get("name"):
             raise InputError("invalid-urdf", "a <link> without a name", file, element.sourceline)
+    _unique("link", [(e.get("name"), e.sourceline) for e in elements], file)
+    links = {}
+    for element in elements:
+        name = element.get("name")
         shapes = [
             tuple(_shape(child, f"link {name!r}: <{tag}>", file) for child in element.iterfind(tag))
             for tag in ("collision", "visual")
         ]
         links[name] = UrdfLink(name, *shapes)
     return UrdfModel(links, joints)
+
+
+def _unique(tag, named, file):
+    """Refuse a name given twice among ``named``'s ``(name, line)``: ``invalid-urdf`` at the second's
+    line, naming the first's (pinocchio refuses such a URDF; yourdfpy keeps the last of them)."""
+    first = {}
+    for name, line in named:
+        if name in first:
+            raise InputError(
+                "invalid-urdf", f"a second <{tag}> named {name!r} (the first at line {first[name]})", file, line
+            )
+        first[name] = line
 
 
 def _joint(element, file):
@@ -198,14 +217,19 @@ def _shape(element, what, file):
         text = first.get("scale", "").replace(",", " ")
         count = 1 if len(text.split()) == 1 else 3
         scale = np.broadcast_to(_numbers(text, count, f"{what}: <mesh scale>", file, line), 3) if text.strip() else None
-        return UrdfShape(kind, origin, filename=filename, scale=None if scale is None else scale.copy())
+        return UrdfShape(kind, origin, filename=filename, scale=None if scale is None else scale.copy(), line=line)
     size = []
     for attribute, count in _SHAPES[kind]:
         text = first.get(attribute)
         if text is None:
             raise InputError("invalid-urdf", f"{what}: <{kind}> without {attribute}", file, line)
-        size += _numbers(text.replace(",", " "), count, f"{what}: <{kind} {attribute}>", file, line)
-    return UrdfShape(kind, origin, tuple(size))
+        numbers = _numbers(text.replace(",", " "), count, f"{what}: <{kind} {attribute}>", file, line)
+        if min(numbers) <= 0:  # no solid: trimesh makes NaN or a flat mesh of it
+            raise InputError(
+                "invalid-urdf", f"{what}: <{kind} {attribute}> must be above 0, got {text[:40]!r}", file, line
+            )
+        size += numbers
+    return UrdfShape(kind, origin, tuple(size), line=line)
 
 
 def _numbers(text, count, what, file, line):

@@ -115,9 +115,14 @@ class Hand:
         The robot description it was read from (as referenced), None for inline joints.
     root : str or None
         The URDF's root link, whose frame is the grasp's frame.
+    urdf_at : (str, int, int) or None
+        ``(file, line, column)`` of the ``urdf`` key that names the URDF (in a grasp file or a
+        ``--hand`` file), where the problems of its meshes, read later, are reported; None when
+        not read from a file.
     """
 
     fingers: tuple[Finger, ...]
     joint_names: tuple[str, ...]
     source: str | None
     root: str | None
+    urdf_at: tuple[str, int | None, int | None] | None = None

@@ -60,6 +60,7 @@ __all__ = [
     "finger_collisions_along",
     "hand_checks_along",
     "hand_constraints",
+    "hand_error",
     "with_collisions",
     "PathCollisions",
 ]
@@ -458,7 +459,7 @@ def with_collisions(grasp: Grasp) -> Grasp | InputError:
         found = finger_collisions(grasp, grasp.joint_positions) if grasp.hand is not None else ()
         overlaps, hits, clearance = hand_checks_along(grasp)
     except InputError as exc:
-        return InputError(exc.code, f"hand: {exc.message}", grasp.file, grasp.line, None, grasp.document)
+        return hand_error(exc, grasp)
     said = (
         *(collision_warning(c) for c in found),
         *(overlap_warning(o) for o in overlaps[0]),
@@ -469,6 +470,24 @@ def with_collisions(grasp: Grasp) -> Grasp | InputError:
     if not said and least == grasp.clearance:
         return grasp
     return replace(grasp, warnings=grasp.warnings + said, clearance=least)
+
+
+def hand_error(exc: InputError, grasp: Grasp, hand=None) -> InputError:
+    """The error of a URDF hand's meshes (read after the hand, for its checks) where the file that names
+    the URDF says it: at ``hand``'s ``urdf`` key (``hand.urdf_at``: the grasp file's, or ``--hand``'s),
+    the URDF's file and its ``<mesh>``'s line in the message; at ``grasp``'s document for a hand
+    read elsewhere (Python).  ``hand``: default the grasp's.
+
+    >>> import grasptwist as gt
+    >>> (g,) = gt.read_grasps("grasps/trifinger-cube.yaml")
+    >>> str(hand_error(InputError("read-error", "mesh 'a.stl': cannot read", "t.urdf", 9), g))
+    "grasps/trifinger-cube.yaml:40:9: hand.urdf: t.urdf:9: mesh 'a.stl': cannot read"
+    """
+    at = (grasp.hand if hand is None else hand).urdf_at
+    if at is None:
+        return InputError(exc.code, f"hand: {exc}", grasp.file, grasp.line, None, grasp.document)
+    file, line, column = at
+    return InputError(exc.code, f"hand.urdf: {exc}", file, line, column, grasp.document if file == grasp.file else None)
 
 
 class PathCollisions:

@@ -188,7 +188,8 @@ def grasp_problem(
     -------
     Task or InputError
         ``no-object``, ``no-friction``, ``nothing-to-hold``, ``non-finite``, ``no-tip-points``,
-        ``unsearchable-hand``, or a URDF's error, located at the document.
+        ``unsearchable-hand``, located at the document, or a URDF's meshes' error, at the ``urdf``
+        key of the file that names it (:func:`~grasptwist.run.collisions.hand_error`).
     """
     if grasp.object is None:
         return _problem(grasp, NO_OBJECT, f"grasp '{grasp.name}' has no object to search")
@@ -229,7 +230,9 @@ def grasp_problem(
         try:
             reach = hand_reach(obj, hand, environment, options.get("clearance"), tips, folder, max_bytes)
         except InputError as exc:
-            return InputError(exc.code, f"hand: {exc.message}", grasp.file, grasp.line, None, grasp.document)
+            from .collisions import hand_error  # with the first URDF hand, as hand_reach's
+
+            return hand_error(exc, grasp, hand)
         except ValueError as exc:
             return _problem(grasp, UNSEARCHABLE_HAND, str(exc))
     try:

@@ -303,7 +303,7 @@ def _urdf_hand(fields, fingers, names, hand_file, file, problems, allow_outside=
     # URDF reading loads with the first such hand (bench/startup.py)
     from ...engine.hands import joint_positions
     from ...model.hands import HandPlacement
-    from ..urdf import load_urdf_hand
+    from ..urdf import finger_problems, load_urdf_hand
 
     node = fields["urdf"]
     reference = read_name(node, "hand.urdf", problems)
@@ -315,10 +315,15 @@ def _urdf_hand(fields, fingers, names, hand_file, file, problems, allow_outside=
         return None
     folder = Path(file).parent if not file.startswith("<") else Path.cwd()
     try:
-        hand = load_urdf_hand(reference, tips, names=names, folder=folder, allow_outside=allow_outside, output=output)
+        hand = load_urdf_hand(
+            reference, tips, names=names, folder=folder, allow_outside=allow_outside, output=output, check=False
+        )
     except InputError as err:
         problems.add(Reject(err.code, "hand.urdf", str(err), **located(node)))
         return None
+    hand = replace(hand, urdf_at=(file, node.line, node.column))  # where its meshes' problems are reported
+    for f, code, message, _ in finger_problems(hand):  # a finger inverse kinematics cannot place, at its tip
+        problems.add(Reject(code, f"hand.fingers[{f}].tip", message, **located(fingers[f]["tip"])))
     values = {}
     for name, (value, key_node) in positions.items():
         if name not in hand.joint_names:
