@@ -83,6 +83,9 @@ HULL_MERGE = 2e-3
 #: vertices in 8-16 clusters, of which a link near another opens a few.
 HULL_CLUSTER = 16
 
+#: How many of the least edge axes of a pair of hulls :func:`hull_penetration` measures by every vertex.
+_EDGE_AXES = 4
+
 #: Most vertices of one cluster (:func:`clusters`): small enough that a cluster near the
 #: object asks about few far vertices, large enough that far clusters are few (measured with
 #: ``bench/collisions.py``: 32 beats 16 and 64 by 1.5 to 2.5 times).
@@ -389,8 +392,8 @@ class LinkHulls(NamedTuple):
         The hulls' vertices in clusters of :data:`HULL_CLUSTER` (:func:`clusters`): a cluster whose
         ball lies beyond a face plane of another link has no vertex inside it.
     edges : numpy.ndarray
-        ``(L, E, 3, 3)`` each hull's edges between faces of different planes at home: its direction
-        and its two faces' normals (:func:`convex_edges`), padded by repeating its first.
+        ``(L, E, 4, 3)`` each hull's edges between faces of different planes at home: its direction,
+        its two faces' normals and its first end (:func:`convex_edges`), padded by repeating its first.
     """
 
     links: tuple
@@ -434,8 +437,8 @@ def _merged_hull(vertices, merge):
 
 
 def convex_edges(points, simplices, neighbors, normals):
-    """A triangulated convex hull's edges between faces of different normals: ``(E, 3, 3)``, each its
-    unit direction and its two faces' normals (the arc of the hull's Gauss map the edge is).
+    """A triangulated convex hull's edges between faces of different normals: ``(E, 4, 3)``, each its
+    unit direction, its two faces' normals (the arc of the hull's Gauss map the edge is) and its first end.
 
     ``simplices``, ``neighbors`` ``(T, 3)`` int (Qhull's: neighbour ``j`` is opposite vertex ``j``),
     ``normals`` ``(T, 3)``; an edge inside a merged facet (one normal on both sides) is none.
@@ -443,7 +446,7 @@ def convex_edges(points, simplices, neighbors, normals):
     >>> from scipy.spatial import ConvexHull
     >>> h = ConvexHull(np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.0]]))
     >>> convex_edges(h.points, h.simplices, h.neighbors, h.equations[:, :3]).shape
-    (6, 3, 3)
+    (6, 4, 3)
     """
     t, j = np.nonzero(np.arange(len(simplices))[:, None] < neighbors)
     start = simplices[t, (j + 1) % 3]
@@ -452,7 +455,7 @@ def convex_edges(points, simplices, neighbors, normals):
     bent = (one * two).sum(axis=1) < 1 - 1e-12
     d = points[end[bent]] - points[start[bent]]
     d /= np.linalg.norm(d, axis=1, keepdims=True)
-    return np.stack([d, one[bent], two[bent]], axis=1).reshape(-1, 3, 3)
+    return np.stack([d, one[bent], two[bent], points[start[bent]]], axis=1).reshape(-1, 4, 3)
 
 
 def hull_depth(points, planes):
@@ -480,7 +483,7 @@ def link_hulls(geometry) -> LinkHulls:
     """
     links = tuple(g for g in geometry if len(g.vertices))
     hulls = [_merged_hull(g.vertices, HULL_MERGE) for g in links]
-    vertices, planes, edges = (_padded([h[i] for h in hulls], shape) for i, shape in enumerate([(3,), (4,), (3, 3)]))
+    vertices, planes, edges = (_padded([h[i] for h in hulls], shape) for i, shape in enumerate([(3,), (4,), (4, 3)]))
     center = 0.5 * (vertices.min(axis=1) + vertices.max(axis=1)) if len(links) else np.zeros((0, 3))
     radius = np.linalg.norm(vertices - center[:, None], axis=-1).max(axis=1) if len(links) else np.zeros(0)
     parts = clusters([h[0] for h in hulls], HULL_CLUSTER)
@@ -509,11 +512,11 @@ def tip_centers_at(hand, tips, positions):
     return out
 
 
-def finger_overlaps(hulls: LinkHulls, poses, centers, radii, crossing=True):
+def finger_overlaps(hulls: LinkHulls, poses, centers, radii):
     r"""How deep the parts of different fingers go into each other (module docstring).
 
-    Two links: the deepest vertex of either inside the other; with none inside, and ``crossing``,
-    :func:`hull_penetration` (hulls crossing edge through edge), else 0.
+    Two links: the deepest vertex of either inside the other; with none inside, the least
+    translation that parts them, :func:`hull_penetration` (hulls crossing edge through edge).
 
     The parts are the links (``L``, :class:`LinkHulls`), then the fingertip spheres (``F``).
 
@@ -526,9 +529,6 @@ def finger_overlaps(hulls: LinkHulls, poses, centers, radii, crossing=True):
         The fingertip spheres' centres (:func:`tip_centers_at`); sphere ``f`` is finger ``f``'s.
     radii : (F,) array
         Their radii (0: a point, never in a collision of its own).
-    crossing : bool
-        Whether links with no vertex in each other are tried edge through edge (exact, and on the
-        TriFinger about 20 times slower than the vertices alone).
 
     Returns
     -------
@@ -559,7 +559,7 @@ def finger_overlaps(hulls: LinkHulls, poses, centers, radii, crossing=True):
     a, b = a[pair], b[pair]  # a < b: a link before a sphere
     found = np.zeros(len(rows))
     both = b < links
-    found[both] = _hull_overlaps(hulls, poses, rows[both], a[both], b[both], crossing)
+    found[both] = _hull_overlaps(hulls, poses, rows[both], a[both], b[both])
     mixed = (a < links) & (b >= links)
     found[mixed] = _sphere_in_hull(
         hulls, poses, rows[mixed], a[mixed], c[rows[mixed], b[mixed] - links], r[b[mixed] - links]
@@ -611,25 +611,36 @@ def _vertex_overlaps(hulls, poses, rows, a, b):
     return out, apart
 
 
-def _hull_overlaps(hulls, poses, rows, a, b, crossing):
+def _hull_overlaps(hulls, poses, rows, a, b):
     """How deep pairs of links go into each other: their deepest vertex inside the other
-    (:func:`_vertex_overlaps`), or with none inside and not apart, and ``crossing``,
-    :func:`hull_penetration` (in link ``a``'s home frame)."""
+    (:func:`_vertex_overlaps`), or with none inside and not apart, :func:`hull_penetration` (in
+    link ``a``'s home frame)."""
     out, apart = _vertex_overlaps(hulls, poses, rows, a, b)
-    todo = np.flatnonzero(~apart & (out <= 0) & crossing)
-    for start in range(0, len(todo), 64):
-        k = todo[start : start + 64]
+    todo = np.flatnonzero(~apart & (out <= 0))
+    if not todo.size:
+        return out
+    # each pair of links with its own vertices, faces and edges (not padded to the most of any link)
+    nv, nk, ne = (
+        1 + (x != x[:, :1]).reshape(len(x), x.shape[1], -1).any(axis=2).sum(axis=1) for x in hulls[1:3] + (hulls.edges,)
+    )
+    links, group = np.unique(np.stack([a[todo], b[todo]], axis=1), axis=0, return_inverse=True)
+    for (one, other), same in zip(links, np.arange(len(links))[:, None] == group.ravel()[None]):
+        k = todo[same]
         rotation, translation = _into(poses, rows[k], b[k], a[k])
-        edges = hulls.edges[b[k]] @ rotation[:, None].swapaxes(-1, -2)
+        edges = hulls.edges[other, : ne[other]] @ rotation[:, None].swapaxes(-1, -2)
+        edges[..., 3, :] += translation[:, None]
         out[k] = hull_penetration(
-            hulls.vertices[a[k]],
-            hulls.planes[a[k], :, :3],
-            hulls.edges[a[k]],
-            hulls.vertices[b[k]] @ rotation.swapaxes(-1, -2) + translation[:, None],
-            hulls.planes[b[k], :, :3] @ rotation.swapaxes(-1, -2),
+            *(np.broadcast_to(x, (len(k),) + x.shape) for x in _trimmed(hulls, one, nv, nk, ne)),
+            hulls.vertices[other, : nv[other]] @ rotation.swapaxes(-1, -2) + translation[:, None],
+            hulls.planes[other, : nk[other], :3] @ rotation.swapaxes(-1, -2),
             edges,
         )
     return out
+
+
+def _trimmed(hulls, link, nv, nk, ne):
+    """A link's hull vertices, face normals and edges at home, without padding."""
+    return hulls.vertices[link, : nv[link]], hulls.planes[link, : nk[link], :3], hulls.edges[link, : ne[link]]
 
 
 def hull_penetration(va, na, ea, vb, nb, eb):
@@ -642,8 +653,8 @@ def hull_penetration(va, na, ea, vb, nb, eb):
         D = \max\Bigl(0,\ \min_u \bigl(h_A(u) + h_B(-u)\bigr)\Bigr)
 
     over the axes :math:`u` of the faces of :math:`A - B` (its distance from the origin along them):
-    either hull's face normals and the cross products :math:`e_a \times e_b` of edges whose arcs on the
-    Gauss map cross (:func:`convex_edges`; every other axis gives more).  A face normal with
+    A's face normals, B's reversed, and the cross products :math:`e_a \times e_b` of edges whose arcs on
+    the Gauss map cross (:func:`convex_edges`; every other axis gives more, so any axis bounds it).  A face normal with
     :math:`h_A(u) + h_B(-u) \le 0` separates them, and then no edge is tried.
 
     Parameters
@@ -652,8 +663,8 @@ def hull_penetration(va, na, ea, vb, nb, eb):
         The hulls' vertices, both in one frame.
     na, nb : (P, K, 3) arrays
         Their faces' unit outward normals.
-    ea, eb : (P, E, 3, 3) arrays
-        Their edges: direction and its two faces' normals.
+    ea, eb : (P, E, 4, 3) arrays
+        Their edges: direction, its two faces' normals and a point of it (:func:`convex_edges`).
 
     Returns
     -------
@@ -691,11 +702,8 @@ def _edge_depth(va, ea, vb, eb):
     the arc of ``A``'s edge (normals ``p1``, ``p2``) and of ``-B``'s (``q1``, ``q2``): each straddles
     the other's great circle, on the same side (``inf``: none).  Arcs whose caps (about their
     middles, as wide as half the arc) are apart are not tried."""
-    ma, ca = _cap(ea[..., 1:, :])
-    mb, cb = _cap(-eb[..., 1:, :])
-    sa, sb = np.sqrt(1 - ca * ca), np.sqrt(1 - cb * cb)
-    near = ma @ mb.swapaxes(1, 2) >= ca[:, :, None] * cb[:, None] - sa[:, :, None] * sb[:, None]
-    pair, i, j = np.nonzero(near)
+    # caps apart: m_a . m_b < cos(r_a + r_b) = cos r_a cos r_b - sin r_a sin r_b, one product in 5-d
+    pair, i, j = np.nonzero(_cap(ea[..., 1:, :], -1) @ _cap(-eb[..., 1:, :], 1).swapaxes(1, 2) >= 0)
     p1, p2, q1, q2 = ea[pair, i, 1], ea[pair, i, 2], -eb[pair, j, 1], -eb[pair, j, 2]
     n1, n2 = np.cross(p1, p2), np.cross(q1, q2)
     s1, s2 = _dot(q1, n1), _dot(p2, n2)
@@ -705,18 +713,29 @@ def _edge_depth(va, ea, vb, eb):
     size = _length(u)
     ok = size > 1e-9
     pair, u = pair[ok], u[ok] / size[ok, None]
-    u *= np.sign(_dot(u, ea[pair, i[ok], 1] + ea[pair, i[ok], 2]))[:, None]
+    i, j = i[ok], j[ok]
+    u *= np.sign(_dot(u, ea[pair, i, 1] + ea[pair, i, 2]))[:, None]
+    # along a face of A - B the edges are the supports: h_A(u) + h_B(-u) = u . (a - b); the least
+    # few of each pair measured by every vertex (faces merged within HULL_MERGE bend the arcs a little)
+    guess = _dot(u, ea[pair, i, 3] - eb[pair, j, 3])
+    order = np.lexsort((guess, pair))
+    pair, u = pair[order], u[order]
+    first = np.flatnonzero(np.r_[True, pair[1:] != pair[:-1]])
+    keep = np.arange(len(pair)) - np.repeat(first, np.diff(np.r_[first, len(pair)])) < _EDGE_AXES
+    pair, u = pair[keep], u[keep]
     depth = (va[pair] @ u[..., None]).max(axis=(1, 2)) - (vb[pair] @ u[..., None]).min(axis=(1, 2))
     out = np.full(len(va), np.inf)
     np.minimum.at(out, pair, depth)
     return out
 
 
-def _cap(ends):
-    """The cap holding arcs of a sphere ``(..., 2, 3)``: its centre ``(..., 3)`` and the cosine of its radius."""
+def _cap(ends, sign):
+    """The cap holding arcs of a sphere ``(..., 2, 3)``: its centre, and the cosine and sine of its
+    radius, the first times ``sign``, ``(..., 5)``."""
     m = ends[..., 0, :] + ends[..., 1, :]
     size = _length(m)
-    return m / size[..., None], np.minimum(0.5 * size, 1.0)
+    c = np.minimum(0.5 * size, 1.0)
+    return np.concatenate([m / size[..., None], sign * c[..., None], np.sqrt(1 - c * c)[..., None]], axis=-1)
 
 
 def _dot(x, y):

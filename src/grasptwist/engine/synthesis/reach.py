@@ -279,7 +279,7 @@ def violations(hand_reach: HandReach, positions):
     live = np.flatnonzero(out <= 0)
     if live.size:
         hulls, poses, centers = _parts_at(hr, q[live])
-        overlap = finger_overlaps(hulls, poses, centers, hr.radii, crossing=False).reshape(live.size, -1)
+        overlap = finger_overlaps(hulls, poses, centers, hr.radii).reshape(live.size, -1)
         out[live] = np.maximum(out[live], overlap.max(axis=1, initial=0.0) - hr.tolerance)
         clear = out[live] <= 0
         if has_obstacles(hr.environment) and clear.any():
