@@ -63,7 +63,9 @@ __all__ = [
     "HULL_MERGE",
     "LinkHulls",
     "convex_planes",
+    "convex_edges",
     "hull_depth",
+    "hull_penetration",
     "link_hulls",
     "tip_centers_at",
     "finger_overlaps",
@@ -74,12 +76,15 @@ __all__ = [
 COLLISION_TOL = 1e-3
 
 #: How much of a link's extent Qhull may merge its hull's facets by (:func:`convex_planes`): the
-#: TriFinger's hulls keep 80-230 of 200-580 vertices, within 0.5 mm of the exact hull.
+#: TriFinger's hulls keep 80-230 of 200-580 vertices, each plane moved out to the farthest vertex.
 HULL_MERGE = 2e-3
 
 #: Most vertices of a hull's cluster (:class:`LinkHulls`): a TriFinger link's 80-230 hull
 #: vertices in 8-16 clusters, of which a link near another opens a few.
 HULL_CLUSTER = 16
+
+#: How many of the least edge axes of a pair of hulls :func:`hull_penetration` measures by every vertex.
+_EDGE_AXES = 4
 
 #: Most vertices of one cluster (:func:`clusters`): small enough that a cluster near the
 #: object asks about few far vertices, large enough that far clusters are few (measured with
@@ -386,6 +391,9 @@ class LinkHulls(NamedTuple):
     parts : LinkClusters
         The hulls' vertices in clusters of :data:`HULL_CLUSTER` (:func:`clusters`): a cluster whose
         ball lies beyond a face plane of another link has no vertex inside it.
+    edges : numpy.ndarray
+        ``(L, E, 4, 3)`` each hull's edges between faces of different planes at home: its direction,
+        its two faces' normals and its first end (:func:`convex_edges`), padded by repeating its first.
     """
 
     links: tuple
@@ -394,6 +402,7 @@ class LinkHulls(NamedTuple):
     center: np.ndarray
     radius: np.ndarray
     parts: LinkClusters
+    edges: np.ndarray
 
 
 def convex_planes(vertices, merge=HULL_MERGE):
@@ -401,7 +410,8 @@ def convex_planes(vertices, merge=HULL_MERGE):
 
     Qhull (scipy) merges facets whose centrums are within ``merge`` times the points' extent of
     their neighbours' planes (``C-``): the hull it gives is the exact one to about that much
-    (a point's depth within 2.5 times it, tests/engine/test_environment.py).  Geometry that
+    (a point's depth within 2.5 times it, tests/engine/test_environment.py).  Each merged plane is
+    moved out to the farthest vertex, so that the planes hold the exact hull.  Geometry that
     bounds no solid (a point, a segment, a flat piece: Qhull refuses it) is thickened into one,
     the points' hull grown by a cube of half-width ``merge`` times their extent (``1e-9`` times
     their distance from the origin, at least ``1e-9``, for a single point), :math:`H \oplus
@@ -414,6 +424,11 @@ def convex_planes(vertices, merge=HULL_MERGE):
     >>> len(v), len(planes), float(hull_depth([0.5, 0, 0], planes).round(12))
     (8, 6, 0.002)
     """
+    return _merged_hull(vertices, merge)[:2]
+
+
+def _merged_hull(vertices, merge):
+    """:func:`convex_planes`' vertices and planes, and the hull's edges (:func:`convex_edges`)."""
     from scipy.spatial import ConvexHull, QhullError  # as the closure's epsilon: with the first hull
 
     v = np.asarray(vertices, dtype=float).reshape(-1, 3)
@@ -425,7 +440,32 @@ def convex_planes(vertices, merge=HULL_MERGE):
         cube = half * np.array(np.meshgrid([-1, 1], [-1, 1], [-1, 1])).reshape(3, -1).T
         v = (v[:, None] + cube).reshape(-1, 3)
         hull = ConvexHull(v)
-    return v[hull.vertices], np.unique(hull.equations, axis=0)
+    planes = np.unique(hull.equations, axis=0)
+    kept = v[hull.vertices]
+    planes[:, 3] -= (kept @ planes[:, :3].T + planes[:, 3]).max(axis=0)
+    return kept, planes, convex_edges(v, hull.simplices, hull.neighbors, hull.equations[:, :3])
+
+
+def convex_edges(points, simplices, neighbors, normals):
+    """A triangulated convex hull's edges between faces of different normals: ``(E, 4, 3)``, each its
+    unit direction, its two faces' normals (the arc of the hull's Gauss map the edge is) and its first end.
+
+    ``simplices``, ``neighbors`` ``(T, 3)`` int (Qhull's: neighbour ``j`` is opposite vertex ``j``),
+    ``normals`` ``(T, 3)``; an edge inside a merged facet (one normal on both sides) is none.
+
+    >>> from scipy.spatial import ConvexHull
+    >>> h = ConvexHull(np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1.0]]))
+    >>> convex_edges(h.points, h.simplices, h.neighbors, h.equations[:, :3]).shape
+    (6, 4, 3)
+    """
+    t, j = np.nonzero(np.arange(len(simplices))[:, None] < neighbors)
+    start = simplices[t, (j + 1) % 3]
+    end = simplices[t, (j + 2) % 3]
+    one, two = normals[t], normals[neighbors[t, j]]
+    bent = (one * two).sum(axis=1) < 1 - 1e-12
+    d = points[end[bent]] - points[start[bent]]
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    return np.stack([d, one[bent], two[bent], points[start[bent]]], axis=1).reshape(-1, 4, 3)
 
 
 def hull_depth(points, planes):
@@ -452,15 +492,20 @@ def link_hulls(geometry) -> LinkHulls:
     ((1, 4, 3), (1, 4, 4), [[0.5, 0.5, 0.5]])
     """
     links = tuple(g for g in geometry if len(g.vertices))
-    hulls = [convex_planes(g.vertices) for g in links]
-    width = max((len(v) for v, _ in hulls), default=1)
-    faces = max((len(p) for _, p in hulls), default=1)
-    vertices = np.array([np.concatenate([v, np.repeat(v[:1], width - len(v), axis=0)]) for v, _ in hulls])
-    planes = np.array([np.concatenate([p, np.repeat(p[:1], faces - len(p), axis=0)]) for _, p in hulls])
-    vertices, planes = vertices.reshape(-1, width, 3), planes.reshape(-1, faces, 4)
+    hulls = [_merged_hull(g.vertices, HULL_MERGE) for g in links]
+    vertices, planes, edges = (_padded([h[i] for h in hulls], shape) for i, shape in enumerate([(3,), (4,), (4, 3)]))
     center = 0.5 * (vertices.min(axis=1) + vertices.max(axis=1)) if len(links) else np.zeros((0, 3))
     radius = np.linalg.norm(vertices - center[:, None], axis=-1).max(axis=1) if len(links) else np.zeros(0)
-    return LinkHulls(links, vertices, planes, center, radius, clusters([v for v, _ in hulls], HULL_CLUSTER))
+    parts = clusters([h[0] for h in hulls], HULL_CLUSTER)
+    return LinkHulls(links, vertices, planes, center, radius, parts, edges)
+
+
+def _padded(arrays, shape):
+    """Arrays of rows stacked ``(L, W, *shape)``, each padded to the widest by repeating its first row."""
+    width = max((len(a) for a in arrays), default=1)
+    return np.array([np.concatenate([a, np.repeat(a[:1], width - len(a), axis=0)]) for a in arrays]).reshape(
+        (-1, width) + shape
+    )
 
 
 def tip_centers_at(hand, tips, positions):
@@ -479,6 +524,9 @@ def tip_centers_at(hand, tips, positions):
 
 def finger_overlaps(hulls: LinkHulls, poses, centers, radii):
     r"""How deep the parts of different fingers go into each other (module docstring).
+
+    Two links: the deepest vertex of either inside the other; with none inside, the least
+    translation that parts them, :func:`hull_penetration` (hulls crossing edge through edge).
 
     The parts are the links (``L``, :class:`LinkHulls`), then the fingertip spheres (``F``).
 
@@ -542,29 +590,167 @@ def _into(poses, rows, a, b):
     return back @ poses[rows, a, :3, :3], _apply(back, poses[rows, a, :3, 3]) + shift
 
 
-def _hull_overlaps(hulls, poses, rows, a, b):
-    """The deepest vertex of either of two links inside the other (exact for the vertices); a link, or
-    a cluster of its vertices, whose ball lies beyond a face plane of the other is not opened."""
-    out = np.zeros(len(rows))
+def _vertex_overlaps(hulls, poses, rows, a, b):
+    """The deepest vertex of either of two links inside the other (exact for the vertices; a lower bound
+    of :func:`hull_penetration`), and which pairs are apart by a face plane of one: the other's ball, or
+    each ball of its vertices' clusters, beyond it (pairs not found apart may be apart all the same).
+    A cluster whose ball lies beyond a face plane of the other is not opened."""
+    out, apart = np.zeros(len(rows)), np.zeros(len(rows), dtype=bool)
     parts = hulls.parts
     for one, other in ((a, b), (b, a)):
         rotation, translation = _into(poses, rows, one, other)
         centre = _apply(rotation, hulls.center[one]) + translation
-        near = np.flatnonzero(hull_depth(centre, hulls.planes[other]) >= -hulls.radius[one])
+        near = hull_depth(centre, hulls.planes[other]) >= -hulls.radius[one]
+        apart |= ~near
+        near = np.flatnonzero(near)
         for start in range(0, len(near), 256):
             k = near[start : start + 256]
             # the planes carried to link ``one``'s home frame: n' = R^T n, d' = d + n . t
             planes = hulls.planes[other[k]]
             normal = planes[..., :3] @ rotation[k]  # (k, K, 3)
             offset = planes[..., 3] + (planes[..., :3] @ translation[k, :, None])[..., 0]
-            # the clusters of link ``one`` that reach into the other's hull: (pair, cluster)
+            # every cluster of link ``one`` (consecutive, so a pair's rows are consecutive): (pair, cluster)
             pair, cluster = np.nonzero(parts.link[None, :] == one[k, None])
-            s = (normal[pair] @ parts.center[cluster, :, None])[..., 0] + offset[pair]
-            opened = -s.max(axis=1) >= -parts.radius[cluster]
+            s = (normal[pair] @ parts.center[cluster, :, None])[..., 0] + offset[pair] - parts.radius[cluster, None]
+            first = np.flatnonzero(np.r_[True, pair[1:] != pair[:-1]])
+            apart[k[pair[first]]] |= (np.minimum.reduceat(s, first, axis=0) > 0).any(axis=1)
+            opened = s.max(axis=1) <= 0
             pair, cluster = pair[opened], cluster[opened]
             depth = parts.vertices[cluster] @ normal[pair].swapaxes(1, 2) + offset[pair, None]  # (m, 16, K)
             np.maximum.at(out, k[pair], -depth.max(axis=2).min(axis=1))
+    return out, apart
+
+
+def _hull_overlaps(hulls, poses, rows, a, b):
+    """How deep pairs of links go into each other: their deepest vertex inside the other
+    (:func:`_vertex_overlaps`), or with none inside and not apart, :func:`hull_penetration` (in
+    link ``a``'s home frame)."""
+    out, apart = _vertex_overlaps(hulls, poses, rows, a, b)
+    todo = np.flatnonzero(~apart & (out <= 0))
+    if not todo.size:
+        return out
+    # each pair of links with its own vertices, faces and edges (not padded to the most of any link)
+    nv, nk, ne = (
+        1 + (x != x[:, :1]).reshape(len(x), x.shape[1], -1).any(axis=2).sum(axis=1) for x in hulls[1:3] + (hulls.edges,)
+    )
+    links, group = np.unique(np.stack([a[todo], b[todo]], axis=1), axis=0, return_inverse=True)
+    for (one, other), same in zip(links, np.arange(len(links))[:, None] == group.ravel()[None]):
+        k = todo[same]
+        rotation, translation = _into(poses, rows[k], b[k], a[k])
+        edges = hulls.edges[other, : ne[other]] @ rotation[:, None].swapaxes(-1, -2)
+        edges[..., 3, :] += translation[:, None]
+        out[k] = hull_penetration(
+            *(np.broadcast_to(x, (len(k),) + x.shape) for x in _trimmed(hulls, one, nv, nk, ne)),
+            hulls.vertices[other, : nv[other]] @ rotation.swapaxes(-1, -2) + translation[:, None],
+            hulls.planes[other, : nk[other], :3] @ rotation.swapaxes(-1, -2),
+            edges,
+        )
     return out
+
+
+def _trimmed(hulls, link, nv, nk, ne):
+    """A link's hull vertices, face normals and edges at home, without padding."""
+    return hulls.vertices[link, : nv[link]], hulls.planes[link, : nk[link], :3], hulls.edges[link, : ne[link]]
+
+
+def hull_penetration(va, na, ea, vb, nb, eb):
+    r"""How far two convex hulls go into each other: the least translation that parts them (0 when apart).
+
+    By the separating axis theorem, with :math:`h_X(u) = \max_{v \in X} u \cdot v` a hull's support,
+
+    .. math::
+
+        D = \max\Bigl(0,\ \min_u \bigl(h_A(u) + h_B(-u)\bigr)\Bigr)
+
+    over the axes :math:`u` of the faces of :math:`A - B` (its distance from the origin along them):
+    A's face normals, B's reversed, and the cross products :math:`e_a \times e_b` of edges whose arcs on
+    the Gauss map cross (:func:`convex_edges`; every other axis gives more, so any axis bounds it).  A face normal with
+    :math:`h_A(u) + h_B(-u) \le 0` separates them, and then no edge is tried.
+
+    Parameters
+    ----------
+    va, vb : (P, H, 3) arrays
+        The hulls' vertices, both in one frame.
+    na, nb : (P, K, 3) arrays
+        Their faces' unit outward normals.
+    ea, eb : (P, E, 4, 3) arrays
+        Their edges: direction, its two faces' normals and a point of it (:func:`convex_edges`).
+
+    Returns
+    -------
+    (P,) array
+
+    Examples
+    --------
+    Two unit cubes, the second turned 45 degrees about x and about y and 1.2 above the first: no
+    corner of either is inside the other, its lowest edge crosses the first's top face, 0.154 deep
+    (the edges' axis):
+
+    >>> from scipy.spatial import ConvexHull
+    >>> from grasptwist.engine.se3 import rotvec_to_matrix
+    >>> def hull(points):
+    ...     h = ConvexHull(points)
+    ...     e = convex_edges(h.points, h.simplices, h.neighbors, h.equations[:, :3])
+    ...     return points[None], h.equations[None, :, :3], e[None]
+    >>> cube = np.array([[x, y, z] for x in (-0.5, 0.5) for y in (-0.5, 0.5) for z in (-0.5, 0.5)])
+    >>> turn = rotvec_to_matrix([0, np.pi / 4, 0]) @ rotvec_to_matrix([np.pi / 4, 0, 0])
+    >>> hull_penetration(*hull(cube), *hull(cube @ turn.T + [0, 0, 1.2])).round(4).tolist()
+    [0.1536]
+    """
+    va, vb = np.asarray(va, float), np.asarray(vb, float)
+    normals = np.concatenate([na, -np.asarray(nb, float)], axis=1)  # the faces of A - B: A's normals, -B's
+    face = (va @ normals.swapaxes(1, 2)).max(axis=1) - (vb @ normals.swapaxes(1, 2)).min(axis=1)
+    out = face.min(axis=1)
+    todo = np.flatnonzero(out > 0)
+    if todo.size:
+        out[todo] = np.minimum(out[todo], _edge_depth(va[todo], ea[todo], vb[todo], eb[todo]))
+    return np.maximum(out, 0.0)
+
+
+def _edge_depth(va, ea, vb, eb):
+    """The least :math:`h_A(u) + h_B(-u)` over the cross products of edges whose Gauss arcs cross,
+    the arc of ``A``'s edge (normals ``p1``, ``p2``) and of ``-B``'s (``q1``, ``q2``): each straddles
+    the other's great circle, on the same side (``inf``: none).  Arcs whose caps (about their
+    middles, as wide as half the arc) are apart are not tried."""
+    # caps apart: m_a . m_b < cos(r_a + r_b) = cos r_a cos r_b - sin r_a sin r_b, one product in 5-d
+    pair, i, j = np.nonzero(_cap(ea[..., 1:, :], -1) @ _cap(-eb[..., 1:, :], 1).swapaxes(1, 2) >= 0)
+    p1, p2, q1, q2 = ea[pair, i, 1], ea[pair, i, 2], -eb[pair, j, 1], -eb[pair, j, 2]
+    n1, n2 = np.cross(p1, p2), np.cross(q1, q2)
+    s1, s2 = _dot(q1, n1), _dot(p2, n2)
+    cross = (s1 * _dot(q2, n1) < 0) & (_dot(p1, n2) * s2 < 0) & (s1 * s2 > 0)
+    pair, i, j = pair[cross], i[cross], j[cross]
+    u = np.cross(ea[pair, i, 0], eb[pair, j, 0])
+    size = _length(u)
+    ok = size > 1e-9
+    pair, u = pair[ok], u[ok] / size[ok, None]
+    i, j = i[ok], j[ok]
+    u *= np.sign(_dot(u, ea[pair, i, 1] + ea[pair, i, 2]))[:, None]
+    # along a face of A - B the edges are the supports: h_A(u) + h_B(-u) = u . (a - b); the least
+    # few of each pair measured by every vertex (faces merged within HULL_MERGE bend the arcs a little)
+    guess = _dot(u, ea[pair, i, 3] - eb[pair, j, 3])
+    order = np.lexsort((guess, pair))
+    pair, u = pair[order], u[order]
+    first = np.flatnonzero(np.r_[True, pair[1:] != pair[:-1]])
+    keep = np.arange(len(pair)) - np.repeat(first, np.diff(np.r_[first, len(pair)])) < _EDGE_AXES
+    pair, u = pair[keep], u[keep]
+    depth = (va[pair] @ u[..., None]).max(axis=(1, 2)) - (vb[pair] @ u[..., None]).min(axis=(1, 2))
+    out = np.full(len(va), np.inf)
+    np.minimum.at(out, pair, depth)
+    return out
+
+
+def _cap(ends, sign):
+    """The cap holding arcs of a sphere ``(..., 2, 3)``: its centre, and the cosine and sine of its
+    radius, the first times ``sign``, ``(..., 5)``."""
+    m = ends[..., 0, :] + ends[..., 1, :]
+    size = _length(m)
+    c = np.minimum(0.5 * size, 1.0)
+    return np.concatenate([m / size[..., None], sign * c[..., None], np.sqrt(1 - c * c)[..., None]], axis=-1)
+
+
+def _dot(x, y):
+    """``x . y`` over the last axis of 3."""
+    return x[..., 0] * y[..., 0] + x[..., 1] * y[..., 1] + x[..., 2] * y[..., 2]
 
 
 def _sphere_in_hull(hulls, poses, rows, link, centers, radii):
