@@ -93,7 +93,7 @@ def test_the_float_twin_is_the_lane_source_on_one_row_of_nested_lists():
     made = one._twin()
     update, column = made["_update"].__source__, made["_column"].__source__
     assert "for ln" not in update and "np." not in update and "every" not in update
-    assert "good = good & _math.isfinite(dz[m][i])" in update
+    assert "good = good & _isfinite(dz[m][i])" in update
     assert "done[0] = (not good) | closed | phase_one & found" in update
     assert "size += abs(x[j])" in update and "big = max(big, abs(res[j]))" in update
     assert "t = a[m][0][j] * u[m][0]" in column

@@ -116,9 +116,9 @@ class _Twin(ast.NodeTransformer):
 
 #: numpy's names for one number's functions, and the float twin's (``not`` an operator); it refuses any other.
 SCALAR = {
-    "sqrt": "_math.sqrt",
-    "isfinite": "_math.isfinite",
-    "inf": "_math.inf",
+    "sqrt": "_sqrt",  # math's, bound in the twins' globals: no attribute to look up
+    "isfinite": "_isfinite",
+    "inf": "_inf",
     "minimum": "min",
     "maximum": "max",
     "abs": "abs",
@@ -223,12 +223,13 @@ def floats(functions):
     def clipped(x, y, out, K, width):
         for m in range(K):
             y[m] = min(x[m][0], 1.0)
-        out[0] = _math.sqrt(y[0]) if y[0] > 0 else _math.inf
+        out[0] = _sqrt(y[0]) if y[0] > 0 else _inf
     >>> y, out = [0.0, 0.0], [0.0]
     >>> twin([[4.0], [0.5]], y, out, 2, 1); y, out
     ([1.0, 0.5], [1.0])
     """
-    return _made(functions, _Float, dict(functions[0].__globals__, _math=math), "float")
+    scalar = {"_sqrt": math.sqrt, "_isfinite": math.isfinite, "_inf": math.inf}
+    return _made(functions, _Float, dict(functions[0].__globals__, **scalar), "float")
 
 
 def float_workspace(arrays):
