@@ -7,7 +7,7 @@ import inspect
 import numpy as np
 import pytest
 
-from grasptwist.engine.forces import _twin, ipm, socp
+from grasptwist.engine.forces import _twin, ipm, one, socp
 
 
 def _lanes(x, y, out, K, width):
@@ -57,6 +57,74 @@ def test_the_twin_refuses_a_branch_and_a_part_of_an_axis_in_lane_form():
         _twin.twins([_branchy])
     with pytest.raises(ValueError, match="every"):  # m a full slice would run over the whole axis
         _twin.twins([_part])
+
+
+def test_the_float_twin_refuses_what_one_number_in_python_floats_cannot_mean():
+    def branchy(x, width):
+        for ln in range(width):
+            if x[ln] > 0:
+                x[ln] = 0.0
+
+    def sliced(x, out, width):
+        for ln in range(width):
+            out[0, ln] = x[:, 0, ln]
+
+    def batched(x, width):
+        for ln in range(width):
+            x[0, ln] = np.einsum("i,i", x, x)
+
+    def bare(x, width):
+        for ln in range(width):
+            x[0, ln] = np.pi
+
+    with pytest.raises(ValueError, match="lane form has no If"):
+        _twin.floats([branchy])
+    with pytest.raises(ValueError, match="no slice"):
+        _twin.floats([sliced])
+    with pytest.raises(ValueError, match=r"no np\.einsum"):
+        _twin.floats([batched])
+    with pytest.raises(ValueError, match=r"no np\.pi"):
+        _twin.floats([bare])
+
+
+def test_the_float_twin_is_the_lane_source_on_one_row_of_nested_lists():
+    """The float twin's source: no lane loop, ``X[i, j, ln]`` as ``X[i][j]``, a lone lane index and a helper's
+    lane argument as ``0``, ``every`` as ``range``, numpy's scalar calls as math's and the builtins."""
+    made = one._twin()
+    update, column = made["_update"].__source__, made["_column"].__source__
+    assert "for ln" not in update and "np." not in update and "every" not in update
+    assert "good = good & _isfinite(dz[m][i])" in update
+    assert "done[0] = (not good) | closed | phase_one & found" in update
+    assert "size += abs(x[j])" in update and "big = max(big, abs(res[j]))" in update
+    assert "t = a[m][0][j] * u[m][0]" in column
+    assert "each[m] = _column(a, z, m, j, k, 0)" in made["_residual"].__source__
+
+
+@pytest.mark.parametrize(("K", "k", "d"), [(3, 3, 3), (4, 4, 7), (5, 1, 2)])  # Q3 grips, soft Q4 phase I, rays
+def test_the_float_twin_steps_as_the_numpy_twin_row_by_row(K, k, d):
+    """Five Mehrotra steps on three random rows of each cone size, phase II and phase I's rules: the float twin
+    (one row in nested lists, what one.py runs) moves ``x`` and ``z`` as the numpy twin does to 1e-12."""
+    n = 3
+    a, b, c, x, z = _problem(np.random.default_rng(K + k + d), K, k, d, n)
+    P = np.empty((K, d, d, n))
+    numpy_twin, float_twin = socp._twins(), one._twin()
+    numpy_twin["newton_part"](a, P, d, K, k, n)
+    for phase_one in (False, True):
+        xs, zs, done = x.copy(), z.copy(), np.zeros(n, bool)
+        rows = [
+            [a[..., r].tolist(), b[..., r].tolist(), c[:, r].tolist(), x[:, r].tolist(), z[..., r].tolist()]
+            for r in range(n)
+        ]
+        with np.errstate(all="ignore"):
+            for _ in range(5):
+                numpy_twin["step"](a, b, c, xs, zs, P, phase_one, ipm.workspace(d, K, k, n), done, d, K, k, n)
+                for r, (ar, br, cr, xr, zr) in enumerate(rows):
+                    work, ended = _twin.float_workspace(ipm.workspace(d, K, k, 1)), [None]
+                    float_twin["step"](ar, br, cr, xr, zr, one.newton_matrices(ar), phase_one, work, ended, d, K, k, 1)
+                    np.testing.assert_allclose(xr, xs[:, r], rtol=1e-12, atol=1e-12)
+                    np.testing.assert_allclose(zr, zs[..., r], rtol=1e-12, atol=1e-12)
+                    assert ended[0] == done[r]
+        assert (c * xs).sum(axis=0).min() < (c * x).sum(axis=0).min()  # the steps went somewhere
 
 
 def _problem(rng, K, k, d, n):

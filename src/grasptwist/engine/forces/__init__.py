@@ -5,7 +5,7 @@
   triangle, the status codes and the ``check_*`` validators;
 - ``socp``: a batched primal-dual interior-point method over second-order cones of any size (no loop over grasps);
   its iteration is ``ipm``'s, written once in lane form, run by numpy as the twin ``_twin`` makes;
-  ``one``: the same method for one row in Python floats; ``kernel``: the whole grip of a row
+  ``one``: the same method for one row in Python floats (``ipm``'s float twin, which ``_twin`` makes too); ``kernel``: the whole grip of a row
   compiled by numba (the ``fast`` extra; ``ipm``'s iteration compiled), loaded through ``compiled`` at the first grip;
 - ``cones``: the contact models as cones (frictionless, point, soft finger) and the grip over any
   mix of them (the rows with a soft contact, numpy only);

@@ -7,9 +7,10 @@ loop ``for ln in range(width):`` does one row's straight-line arithmetic on the 
 ``[..., ln]``.  numba compiles these functions as they are
 (:mod:`~grasptwist.engine.forces.kernel`: rows in 32 lanes, refilled as they finish); numpy
 runs their *twins* (:mod:`~grasptwist.engine.forces._twin`: each lane loop's body on all
-rows at once, :func:`socp._iterate`).  So the two paths share every formula: a new cone
-size ``k`` (a ray ``k = 1``, ``Q^3``, a soft contact's ``Q^4``) or a new number of cones or
-unknowns is the same source.
+rows at once, :func:`socp._iterate`), and one row alone goes through their *float twins*
+(the same source on nested lists of Python floats, :mod:`~grasptwist.engine.forces.one`).
+So the three share every formula: a new cone size ``k`` (a ray ``k = 1``, ``Q^3``, a soft
+contact's ``Q^4``) or a new number of cones or unknowns is the same source.
 
 A row's arrays (``K`` cones of ``k`` components, ``d`` unknowns, ``width`` rows):
 ``a (K, k, d, width)`` (cone ``m``'s ``A_m``), ``b (K, k, width)``, ``c (d, width)``, the
@@ -20,9 +21,12 @@ stays where it is, still inside), its gap is closed with a feasible dual (phase 
 phase I), or (phase I) its margin ``r = x[d - 1] <= -START_MARGIN`` or its dual bound is
 above 0 (infeasible).  The iterations' cap is the caller's (:data:`ITERATIONS`).
 
-Branches on a row's numbers are choices (``a if c else b``), so the twin computes both
+Branches on a row's numbers are choices (``a if c else b``), so the numpy twin computes both
 sides: division by zero and ``inf - inf`` happen on rows that then discard them (numpy's
-error model, which the kernel compiles with).
+error model, which the kernel compiles with).  In Python floats a division by zero raises
+where numpy gives ``inf`` or NaN, which ends the step as its not being finite does: the float
+twin's caller stops the row where it is.  Of numpy the functions use only its calls on one
+number that :data:`_twin.SCALAR` knows.
 """
 
 from __future__ import annotations

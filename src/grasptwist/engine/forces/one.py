@@ -1,16 +1,15 @@
 r"""The interior-point method of :mod:`~grasptwist.engine.forces.socp` for one row, in Python floats.
 
-The batched method's iteration is written once (:mod:`~grasptwist.engine.forces.ipm`, run by numpy
-and compiled by numba); this copy for Q3 rows stays because one row through that source is slow:
-0.75 ms a step as Python on one lane and 0.97 ms through the numpy twin, where this whole solve takes
-about 2 ms.
-
-For one grasp numpy's cost per call (a microsecond or more, on arrays of three numbers)
-is all there is: an iteration of the batched method makes some 700 numpy calls.  This is
-the same method, step for step (Mehrotra's predictor-corrector with Nesterov-Todd
-scaling, 0.99 of the way to the cones' edge, the same stopping rules), on lists of
-floats: a few hundred multiplications an iteration.  ``tests/engine/test_forces.py`` holds it to
-the batched solver on random rows (the verdicts, and the optimum to ``1e-9``).
+The iteration is :mod:`~grasptwist.engine.forces.ipm`'s lane form, the source numba compiles and
+numpy runs batched, through its *float twin* (:func:`_twin.floats`: one lane, nested lists of
+floats, ``math`` for numpy's scalar calls).  For one grasp numpy's cost per call (a microsecond
+or more, on arrays of three numbers) is all there is: an iteration of the batched twin makes
+some 700 numpy calls, where the float twin does a few hundred float operations.  This module is
+its driver (the start points, each phase's stopping rules, the cap) and the pieces that are
+its own: the facial reduction's closed form :func:`least_on_line` and :func:`dual_polish`, which
+:mod:`~grasptwist.engine.forces.kernel` compiles too.  ``tests/engine/test_ipm.py`` holds the
+float twin's iterates to the numpy twin's, ``tests/engine/test_forces.py`` this driver to the
+batched solver on random rows (the verdicts, and the optimum to ``1e-9``).
 
 A row is ``A[m][k][j]`` (cone ``m``, component ``k``, unknown ``j``), ``b[m][k]``,
 ``c[j]``; the unknowns ``x[j]`` and the cones' multipliers ``z[m][k]`` are lists updated in place.
@@ -18,40 +17,23 @@ A row is ``A[m][k][j]`` (cone ``m``, component ``k``, unknown ``j``), ``b[m][k]`
 
 from __future__ import annotations
 
+import functools
 import math
 
 import numpy as np
 
-from .ipm import EDGE as _EDGE
-from .ipm import GAP, START_MARGIN
-from .ipm import ITERATIONS as _ITERATIONS
-from .ipm import RESIDUAL as _RESIDUAL
+from . import ipm
+from .ipm import ITERATIONS, START_MARGIN
 
-__all__ = [
-    "phase_one",
-    "minimise",
-    "newton_matrices",
-    "solve",
-    "approach",
-    "scaling",
-    "w_inv",
-    "w_mul",
-    "least_on_line",
-]
+__all__ = ["phase_one", "minimise", "newton_matrices", "solve", "least_on_line", "dual_polish"]
 
 
-def approach(x0, x1, x2, d0, d1, d2, s):
-    """How fast ``x + alpha d`` nears the cone's edge: ``t`` with the largest ``alpha`` in the cone
-    ``1 / t`` where ``t > 0`` (none otherwise), as :func:`socp._edge`; ``s = sqrt(x0^2 - x1^2 - x2^2)``,
-    which :func:`scaling` has computed already.  A step's length is ``1 / max t`` over its cones: one
-    division, not one a cone.
-    """
-    x0, x1, x2 = x0 / s, x1 / s, x2 / s
-    d0, d1, d2 = d0 / s, d1 / s, d2 / s
-    rho0 = x0 * d0 - x1 * d1 - x2 * d2
-    f = (rho0 + d0) / (x0 + 1)
-    e1, e2 = d1 - f * x1, d2 - f * x2
-    return math.sqrt(e1 * e1 + e2 * e2) - rho0
+@functools.cache
+def _twin():
+    """:mod:`~grasptwist.engine.forces.ipm`'s float twins (made at the first solve, not at import)."""
+    from ._twin import floats  # ast and inspect: not at start-up
+
+    return floats(ipm.LANE_FORM)
 
 
 def least_on_line(a, b, count):
@@ -133,196 +115,31 @@ def least_on_line(a, b, count):
     return t, m, coef
 
 
-def _edge(x, d):
-    t = approach(x[0], x[1], x[2], d[0], d[1], d[2], math.sqrt(x[0] * x[0] - x[1] * x[1] - x[2] * x[2]))
-    return 1 / t if t > 0 else math.inf
-
-
-def scaling(y0, y1, y2, z0, z1, z2):
-    """Nesterov-Todd scaling of one cone (``W z = W^-1 y = lambda``, ``W = beta (2 v v^T - J)``):
-    ``(w0, w1, w2, v0, v1, v2, beta, lambda0, lambda1, lambda2, ys, zs)`` (``w`` the scaling point,
-    ``ys = sqrt(y^T J y)`` and ``zs`` the cones' own norms of ``y`` and ``z``, for :func:`approach`).
-    """
-    ys = math.sqrt(y0 * y0 - y1 * y1 - y2 * y2)
-    zs = math.sqrt(z0 * z0 - z1 * z1 - z2 * z2)
-    twice = 2 * math.sqrt((1 + (y0 * z0 + y1 * z1 + y2 * z2) / (ys * zs)) / 2)
-    w0, w1, w2 = (y0 / ys + z0 / zs) / twice, (y1 / ys - z1 / zs) / twice, (y2 / ys - z2 / zs) / twice
-    r = math.sqrt(2 * (w0 + 1))
-    v0, v1, v2 = (w0 + 1) / r, w1 / r, w2 / r
-    beta = math.sqrt(ys / zs)
-    vz = 2 * (v0 * z0 + v1 * z1 + v2 * z2)
-    return w0, w1, w2, v0, v1, v2, beta, beta * (v0 * vz - z0), beta * (v1 * vz + z1), beta * (v2 * vz + z2), ys, zs
-
-
-def w_inv(v0, v1, v2, beta, u0, u1, u2):
-    """``W^-1 u`` (plain floats)."""
-    t = 2 * (v0 * u0 - v1 * u1 - v2 * u2)
-    return (t * v0 - u0) / beta, (u1 - t * v1) / beta, (u2 - t * v2) / beta
-
-
-def w_mul(v0, v1, v2, beta, u0, u1, u2):
-    """``W u`` (plain floats)."""
-    t = 2 * (v0 * u0 + v1 * u1 + v2 * u2)
-    return beta * (t * v0 - u0), beta * (t * v1 + u1), beta * (t * v2 + u2)
-
-
 def newton_matrices(A):
-    """``P_m[i][j] = A_m[:, i]^T J A_m[:, j]`` per cone: the part of the Newton matrix that stays."""
-    d = len(A[0][0])
-    return [
-        [[a[0][i] * a[0][j] - a[1][i] * a[1][j] - a[2][i] * a[2][j] for j in range(d)] for i in range(d)] for a in A
-    ]
+    """``P_m[i][j] = A_m[:, i]^T J A_m[:, j]`` per cone: the part of the Newton matrix that stays
+    (:func:`ipm.newton_part`'s float twin)."""
+    K, k, d = len(A), len(A[0]), len(A[0][0])
+    P = [[[0.0] * d for _ in range(d)] for _ in range(K)]
+    _twin()["newton_part"](A, P, d, K, k, 1)
+    return P
 
 
-def _solve(h, g):
-    """``h^-1 g`` by elimination without pivoting (``h`` symmetric positive definite; copied)."""
-    d = len(g)
-    if d == 3:  # the grip's squeezes: the same elimination, written out
-        (h00, h01, h02), (h10, h11, h12), (h20, h21, h22) = h
-        g0, g1, g2 = g
-        f1, f2 = h10 / h00, h20 / h00
-        h11, h12, g1 = h11 - f1 * h01, h12 - f1 * h02, g1 - f1 * g0
-        h21, h22, g2 = h21 - f2 * h01, h22 - f2 * h02, g2 - f2 * g0
-        f = h21 / h11
-        h22, g2 = h22 - f * h12, g2 - f * g1
-        x2 = g2 / h22
-        x1 = (g1 - h12 * x2) / h11
-        return [(g0 - h01 * x1 - h02 * x2) / h00, x1, x2]
-    h = [row[:] for row in h]
-    g = g[:]
-    for k in range(d):
-        for i in range(k + 1, d):
-            f = h[i][k] / h[k][k]
-            for j in range(k + 1, d):
-                h[i][j] -= f * h[k][j]
-            g[i] -= f * g[k]
-    x = [0.0] * d
-    for i in reversed(range(d)):
-        v = g[i]
-        for j in range(i + 1, d):
-            v -= h[i][j] * x[j]
-        x[i] = v / h[i][i]
-    return x
+def _iterate(A, b, c, x, z, P, phase):
+    """:func:`socp._iterate` for one row: :func:`ipm.step`'s float twin moves ``x`` and ``z`` (lists, in place)
+    until the row is done (phase I's rules where ``phase``) or the cap.  A division by zero or the root of a
+    negative number (round-off at the cones' edge, NaN in numpy) stops the row where it is, as the batched
+    method's step that is not finite does."""
+    from ._twin import float_workspace
 
-
-def _iterate(A, b, c, x, z, P, leave):
-    """:func:`socp._iterate` for one row; ``leave(x, closed, dual)`` ends it.  Returns False when a step
-    was not finite (the row stops where it is, as the batched method's does)."""
-    AT = [[tuple(a[k][j] for k in range(3)) for j in range(len(x))] for a in A]  # columns: A_m[:, j]
-    for _ in range(_ITERATIONS):
+    K, k, d = len(A), len(A[0]), len(x)
+    step, work, done = _twin()["step"], float_workspace(ipm.workspace(d, K, k, 1)), [False]
+    for _ in range(ITERATIONS):
         try:
-            done = _step(AT, b, c, x, z, P, leave)
-        except (ValueError, ZeroDivisionError, OverflowError):  # round-off at the cones' edge, as NaN is in numpy
-            done = None
-        if done is None:
-            return False
-        if done:
-            return True
-    return True
-
-
-def _times(AT, b, x):
-    """``A_m x + b_m`` per cone (``b`` None: ``A_m x``)."""
-    out = []
-    for m, cols in enumerate(AT):
-        r0, r1, r2 = (0.0, 0.0, 0.0) if b is None else b[m]
-        for (a0, a1, a2), xj in zip(cols, x):
-            r0 += a0 * xj
-            r1 += a1 * xj
-            r2 += a2 * xj
-        out.append((r0, r1, r2))
-    return out
-
-
-def _transposed(AT, u, first):
-    """``first - sum_m A_m^T u_m``."""
-    out = list(first)
-    for cols, (u0, u1, u2) in zip(AT, u):
-        for j, (a0, a1, a2) in enumerate(cols):
-            out[j] -= a0 * u0 + a1 * u1 + a2 * u2
-    return out
-
-
-def _w_inv(v, beta, u):
-    return w_inv(v[0], v[1], v[2], beta, u[0], u[1], u[2])
-
-
-def _w_mul(v, beta, u):
-    return w_mul(v[0], v[1], v[2], beta, u[0], u[1], u[2])
-
-
-def _step(AT, b, c, x, z, P, leave):
-    """One iteration of :func:`_iterate`: True when ``leave`` says so, None when the step is not finite."""
-    K, d = len(AT), len(x)
-    res = _transposed(AT, z, c)
-    y = _times(AT, b, x)
-    V, B, L, G = [], [], [], []
-    for ym, zm, cols in zip(y, z, AT):
-        w0, w1, w2, v0, v1, v2, beta, l0, l1, l2, _, _ = scaling(*ym, *zm)
-        L.append((l0, l1, l2))
-        G.append([a0 * w0 - a1 * w1 - a2 * w2 for a0, a1, a2 in cols])
-        V.append((v0, v1, v2))
-        B.append(1 / (beta * beta))
-    H = [[0.0] * d for _ in range(d)]
-    for i in range(d):
-        for j in range(i + 1):
-            h = 0.0
-            for g, p, scale in zip(G, P, B):
-                h += (2 * g[i] * g[j] - p[i][j]) * scale
-            H[i][j] = H[j][i] = h
-    ridge = 1e-14 * max(H[i][i] for i in range(d))
-    for i in range(d):
-        H[i][i] += ridge
-    B = [1 / math.sqrt(scale) for scale in B]
-
-    def direction(rhs):
-        U, WU = [], []
-        for (l0, l1, l2), (r0, r1, r2), v, beta in zip(L, rhs, V, B):
-            u0 = (l0 * r0 - l1 * r1 - l2 * r2) / (l0 * l0 - l1 * l1 - l2 * l2)
-            u = (u0, (r1 - u0 * l1) / l0, (r2 - u0 * l2) / l0)
-            U.append(u)
-            WU.append(_w_inv(v, beta, u))
-        dx = _solve(H, [-g for g in _transposed(AT, WU, res)])
-        dy = _times(AT, None, dx)
-        dz = []
-        for u, q, v, beta in zip(U, dy, V, B):
-            q = _w_inv(v, beta, q)
-            dz.append(_w_inv(v, beta, (u[0] - q[0], u[1] - q[1], u[2] - q[2])))
-        return dx, dy, dz
-
-    square = [(q0 * q0 + q1 * q1 + q2 * q2, 2 * q0 * q1, 2 * q0 * q2) for q0, q1, q2 in L]
-    mu = sum(ym[0] * zm[0] + ym[1] * zm[1] + ym[2] * zm[2] for ym, zm in zip(y, z)) / K
-    dx, dy, dz = direction([(-s0, -s1, -s2) for s0, s1, s2 in square])
-    step = min(1.0, *(_edge(ym, dm) for ym, dm in zip(y, dy)), *(_edge(zm, dm) for zm, dm in zip(z, dz)))
-    mu_aff = 0.0
-    for ym, zm, dym, dzm in zip(y, z, dy, dz):
-        for k in range(3):
-            mu_aff += (ym[k] + step * dym[k]) * (zm[k] + step * dzm[k])
-    sigma = min(max(mu_aff / K / mu, 0.0), 1.0) ** 3
-    rhs = []
-    for dym, dzm, (s0, s1, s2), v, beta in zip(dy, dz, square, V, B):
-        p, q = _w_inv(v, beta, dym), _w_mul(v, beta, dzm)
-        rhs.append(
-            (
-                -s0 - (p[0] * q[0] + p[1] * q[1] + p[2] * q[2]) + sigma * mu,
-                -s1 - (p[0] * q[1] + q[0] * p[1]),
-                -s2 - (p[0] * q[2] + q[0] * p[2]),
-            )
-        )
-    dx, dy, dz = direction(rhs)
-    step = min(1.0, _EDGE * min(*(_edge(ym, dm) for ym, dm in zip(y, dy)), *(_edge(zm, dm) for zm, dm in zip(z, dz))))
-    if not (math.isfinite(step) and all(map(math.isfinite, dx)) and all(math.isfinite(v) for t in dz for v in t)):
-        return None
-    for j in range(d):
-        x[j] += step * dx[j]
-    gap = 0.0
-    for m in range(K):
-        zm = z[m] = [z[m][k] + step * dz[m][k] for k in range(3)]
-        ym, dym = y[m], dy[m]
-        gap += (ym[0] + step * dym[0]) * zm[0] + (ym[1] + step * dym[1]) * zm[1] + (ym[2] + step * dym[2]) * zm[2]
-    obj = sum(cj * xj for cj, xj in zip(c, x))
-    feasible = max(abs(r) for r in res) * (1 - step) <= _RESIDUAL
-    return leave(x, gap <= GAP * (1 + abs(obj)), obj - gap if feasible else -math.inf)
+            step(A, b, c, x, z, P, phase, work, done, d, K, k, 1)
+        except (ValueError, ZeroDivisionError, OverflowError):
+            return
+        if done[0]:
+            return
 
 
 def phase_one(A, b):
@@ -335,11 +152,7 @@ def phase_one(A, b):
     x = [0.0] * d + [max(over + 1, 0.0)]
     z = [[0.25, 0.0, 0.0] for _ in range(len(A) + 1)]
     c = [0.0] * d + [1.0]
-
-    def leave(x, closed, dual):
-        return x[d] <= -START_MARGIN or dual > _RESIDUAL * (1 + sum(abs(v) for v in x)) or (closed and dual > -math.inf)
-
-    _iterate(wide, bw, c, x, z, newton_matrices(wide), leave)
+    _iterate(wide, bw, c, x, z, newton_matrices(wide), True)
     return x[:d], x[d], z[: len(A)]
 
 
@@ -347,11 +160,7 @@ def minimise(A, b, c, x, P):
     """:func:`socp.minimise` for one row from the strictly feasible ``x``: ``(x, z)``; ``P`` of :func:`newton_matrices`."""
     z = [[1.0, 0.0, 0.0] for _ in A]
     x = list(x)
-
-    def leave(x, closed, dual):
-        return closed and dual > -math.inf
-
-    _iterate(A, b, c, x, z, P, leave)
+    _iterate(A, b, c, x, z, P, False)
     return x, z
 
 

@@ -24,7 +24,8 @@ optimum.  It takes 10-25 iterations a row, about a third of the Newton steps of 
 method with damped steps.  The iteration is written once, in
 :mod:`~grasptwist.engine.forces.ipm` (its lane form, which numba compiles); this module runs
 its numpy twin (:mod:`~grasptwist.engine.forces._twin`) over all the rows still iterating,
-gathering out those that are done.
+gathering out those that are done, and :mod:`~grasptwist.engine.forces.one` its float twin
+on one row.
 
 **Phase I** finds a strictly feasible point by minimising ``r`` with the cones widened to
 ``t_m + r >= |z_m|`` and ``r >= -1``, from ``x = 0`` and an ``r`` that makes the start
