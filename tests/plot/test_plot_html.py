@@ -383,7 +383,9 @@ def test_a_malformed_link_mesh_is_the_grasps_located_error_and_no_page(tmp_path)
     (tmp_path / "bad.ply").write_bytes(MALFORMED_MESHES["bad.ply"])
     r = run("plot", grasp, "-o", tmp_path / "g.html")
     assert r.exit_code == 1 and "internal error" not in r.output and "Traceback" not in r.output, r.output
-    assert "error: invalid-mesh: hand: mesh 'bad.ply', line 3: the header declares 100 vertex" in r.stderr
+    # at the grasp file's urdf key, then the URDF's own file and <mesh> line, then the mesh's fault
+    assert "g.yaml:7:9: error: invalid-mesh: hand.urdf: " in r.stderr and "hand.urdf:1: mesh 'bad.ply'" in r.stderr
+    assert "mesh 'bad.ply', line 3: the header declares 100 vertex" in r.stderr
 
 
 def test_a_grasp_without_twists_is_drawn(tmp_path):

@@ -290,7 +290,7 @@ def load_urdf_hand(
     output : (int, int), optional
         The ``(device, inode)`` of the file ``-o`` replaces: a URDF that is it is ``output-is-input``.
     check : bool
-        Refuse a finger that cannot be placed (:func:`finger_problems`); False: the caller
+        Refuse a finger that cannot be placed (``finger_problems``); False: the caller
         reports them (a grasp file at each finger's ``tip``).
 
     Returns
