@@ -53,8 +53,10 @@ def place_grasp(grasp: Grasp) -> Grasp | InputError:
 
     Parameters
     ----------
-    grasp : Grasp
-        As read; one without a pending placement (no hand, an inline hand, placed) is returned as it is.
+    grasp : Grasp or InputError
+        As read; one without a pending placement (no hand, an inline hand, placed) is returned as it is,
+        and so is a document's error that :func:`grasptwist.read_grasps` gave in its place (a list of
+        what was read places whole).
 
     Returns
     -------
@@ -69,7 +71,12 @@ def place_grasp(grasp: Grasp) -> Grasp | InputError:
     >>> (g,) = gt.read_grasps("grasps/three-finger-hand.yaml")  # an inline hand: nothing to place
     >>> gt.place_grasp(g) is g
     True
+    >>> error = gt.InputError("fixed-finger", "hand.fingers[2].tip: ...", "h.yaml", 16, 13)
+    >>> gt.place_grasp(error) is error
+    True
     """
+    if isinstance(grasp, InputError):  # read_grasps' entry for a document it could not read
+        return grasp
     p = grasp.placement
     if p is None:  # placed already, an inline hand or none: its fingers and contacts checked all the same
         if not needs_checks(grasp.hand, grasp.environment):
