@@ -41,9 +41,8 @@ from typing import NamedTuple
 import numpy as np
 
 from .degeneracy import Status
-from .kinematics import _UNIT_TOL, finger_jacobian, forward_kinematics
-from .screws import cross, dot, norm
-from .se3 import skew
+from .kinematics import finger_jacobian, forward_kinematics, rodrigues_terms
+from .screws import cross, norm
 
 __all__ = [
     "IK_TOL",
@@ -125,11 +124,8 @@ def _prepared(chain):
     """``chain`` as :func:`_tip_and_jacobian` takes it: a :class:`_Revolute` where every joint is a unit
     line (a revolute joint), else the chain itself (:func:`~.kinematics.forward_kinematics` each step)."""
     screws, _, tip = chain
-    w, v = screws[..., :3], screws[..., 3:]
-    if not ((np.abs(dot(w, w) - 1) <= _UNIT_TOL).all() and (np.abs(dot(w, v)) <= _UNIT_TOL).all()):
-        return chain
-    k = skew(w)
-    return _Revolute(k, k @ k, v, cross(w, v), w, tip[..., :3, 3])
+    terms = rodrigues_terms(screws)
+    return chain if terms is None else _Revolute(*terms, screws[..., :3], tip[..., :3, 3])
 
 
 def _tip_and_jacobian(chain, q):

@@ -58,6 +58,7 @@ __all__ = [
     "HandRates",
     "hand_joint_rates",
     "forward_kinematics",
+    "rodrigues_terms",
     "chain_from_origins",
     "chain_length",
 ]
@@ -550,18 +551,35 @@ def joint_motion(screw, q):
     return se3.exp(screw, q)
 
 
+def rodrigues_terms(screws):
+    """``[omega]``, ``[omega]^2``, ``v`` and ``omega x v`` of home screws ``(..., 6)`` that are all unit lines
+    (revolute joints: ``|omega| = 1``, ``omega . v = 0`` to round-off), the terms of :func:`joint_motion`'s
+    Rodrigues formula; None where one is not.
+
+    >>> k, kk, v, wv = rodrigues_terms(np.array([0, 0, 1.0, 0, -1.0, 0]))
+    >>> k.tolist()[0], (wv + 0.0).tolist()
+    ([0.0, -1.0, 0.0], [1.0, 0.0, 0.0])
+    >>> rodrigues_terms(np.array([0, 0, 0, 0, 0, 1.0])) is None  # a prismatic joint
+    True
+    """
+    w, v = screws[..., :3], screws[..., 3:]
+    if not ((np.abs(dot(w, w) - 1) <= _UNIT_TOL).all() and (np.abs(dot(w, v)) <= _UNIT_TOL).all()):
+        return None
+    k = se3.skew(w)
+    return k, k @ k, v, cross(w, v)
+
+
 @lru_cache(maxsize=256)
 def _joint_terms(data, shape):
     """The kind of a batch of home screws (``data`` their bytes) and, for :func:`joint_motion`'s
     closed forms, ``[omega]``, ``[omega]^2``, ``v`` and ``omega x v``: a chain's screws are the
     same at every call (a tracker's thousands of steps), so they are formed once (read-only)."""
     screw = np.frombuffer(data).reshape(shape)
-    w, v = screw[..., :3], screw[..., 3:]
-    if (np.abs(dot(w, w) - 1) <= _UNIT_TOL).all() and (np.abs(dot(w, v)) <= _UNIT_TOL).all():
-        k = se3.skew(w)
-        terms = ("revolute", k, k @ k, v, cross(w, v))
-    elif not w.any():
-        terms = ("prismatic", None, None, v, None)
+    rodrigues = rodrigues_terms(screw)
+    if rodrigues is not None:
+        terms = ("revolute", *rodrigues)
+    elif not screw[..., :3].any():
+        terms = ("prismatic", None, None, screw[..., 3:], None)
     else:
         return ("other", None, None, None, None)
     for a in terms[1:]:
