@@ -20,7 +20,7 @@ import numpy as np
 
 from ..hooks import first_load
 
-__all__ = ["kernel", "numpy_path"]
+__all__ = ["kernel", "numpy_path", "read_only"]
 
 
 _state = {"on": os.environ.get("GRASPTWIST_NUMBA", "1") != "0", "module": None}
@@ -48,15 +48,29 @@ def kernel():
 
 
 def _first_grip(module):
-    """One grip of a tripod: the kernel's one signature (:func:`~.grip._read_only`'s: the grasp read-only, the
-    wrench writable) compiled on a fresh install, or loaded from numba's cache, here, inside the watched first
-    load, not in the middle of the caller's first grip."""
+    """One grip of a tripod, in the kernel's one signature (:func:`read_only`): compiled on a fresh install, or
+    loaded from numba's cache, here, inside the watched first load, not in the middle of the caller's first grip."""
     p = np.array([[[1.0, 0, 0], [-0.5, 0.866, 0], [-0.5, -0.866, 0]]])
-    grasp = [a.view() for a in (p, -p, np.full((1, 3), 0.5))]
-    for a in grasp:
-        a.flags.writeable = False
+    grasp = [read_only(a) for a in (p, -p, np.full((1, 3), 0.5))]
     wrench, out, codes = np.array([[0, 0, 1.0, 0, 0, 0]]), np.empty((1, module.WIDTH)), np.empty((1, 3), np.int8)
     module.grip_rows(*grasp, wrench, 1e-9, out, codes)
+
+
+def read_only(a):
+    """``a`` as :func:`kernel.grip_rows` takes its grasp: C-contiguous floats, read-only (a view).
+
+    numba compiles, and loads from its cache, one function per signature, and an array's
+    writeable flag is part of it: the grasp read-only and the wrenches writable (the grip copies
+    them, a prepared grip has a copy) keep every call to one signature, one load
+    (50 ms of a process's start) and never a compile for a caller's flags.
+
+    >>> a = read_only([[0, 0, 1]])
+    >>> a.dtype, a.flags.c_contiguous, a.flags.writeable
+    (dtype('float64'), True, False)
+    """
+    a = np.ascontiguousarray(a, dtype=float).view()
+    a.flags.writeable = False
+    return a
 
 
 @contextmanager

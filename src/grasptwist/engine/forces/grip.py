@@ -390,27 +390,10 @@ def _grip_of(rows, s_f, tol, shape, prepared=None):
     if fast is None:
         out = (prepared or _Prepared(*rows[:3], s_f, tol)).solve(rows[3])
         return checked_grip(Grip(safety=s_f, **{k: v.reshape(shape + v.shape[1:]) for k, v in out.items()}))
-    p, n, mu = (_read_only(a) for a in rows[:3])
-    limit = _read_only(np.broadcast_to(mu / s_f, (len(p), 3)))
+    p, n, mu = (compiled.read_only(a) for a in rows[:3])
+    limit = compiled.read_only(np.broadcast_to(mu / s_f, (len(p), 3)))
     w = np.array(rows[3], dtype=float, order="C")
     return _compiled_grip(fast, (p, n, limit, w), s_f, tol, shape, lambda rest: (p[rest], n[rest], mu[rest]))
-
-
-def _read_only(a):
-    """``a`` as :func:`kernel.grip_rows` takes its grasp: C-contiguous floats, read-only (a view).
-
-    numba compiles, and loads from its cache, one function per signature, and an array's
-    writeable flag is part of it: the grasp read-only and the wrenches writable (:func:`_grip_of`
-    copies them, :class:`PreparedGrip` has a copy) keep every call to one signature, one load
-    (50 ms of a process's start) and never a compile for a caller's flags.
-
-    >>> a = _read_only([[0, 0, 1]])
-    >>> a.dtype, a.flags.c_contiguous, a.flags.writeable
-    (dtype('float64'), True, False)
-    """
-    a = np.ascontiguousarray(a, dtype=float).view()
-    a.flags.writeable = False
-    return a
 
 
 def _scaled_back(g, k, shape):
@@ -484,8 +467,8 @@ class PreparedGrip:
         self.points, self.normals, self.friction, self.safety = points, normals, friction, safety
         self.torsion = torsion
         self._prepared = _Prepared(points[None], normals[None], friction[None], safety, tol)
-        self._rows = (_read_only(points[None]), _read_only(normals[None]), friction[None])
-        self._limit = _read_only(friction[None] / safety)
+        self._rows = (compiled.read_only(points[None]), compiled.read_only(normals[None]), friction[None])
+        self._limit = compiled.read_only(friction[None] / safety)
         self._tol = float(tol)
 
     def grip(self, wrench) -> Grip:
