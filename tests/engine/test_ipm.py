@@ -163,9 +163,11 @@ def test_the_numpy_twin_steps_as_the_lane_source_run_by_python(K, k, d):
     assert np.isfinite(x).all() and (c * x).sum(axis=0).min() < 0  # the steps went somewhere: the objective fell
 
 
-def test_the_lane_source_solves_what_socp_solves():
-    """socp.minimise (the twin, with its driver) reaches the optimum the lane source reaches run to the end."""
-    K, k, d, n = 3, 4, 3, 4
+@pytest.mark.parametrize("n", [socp.ALONE, socp.ALONE + 4], ids=["floats", "numpy"])
+def test_the_lane_source_solves_what_socp_solves(n):
+    """socp.minimise (its driver, and the float twin row by row up to ALONE rows, else the numpy twin) reaches
+    the optimum the lane source reaches run to the end."""
+    K, k, d = 3, 4, 3
     a, b, c, x, z = _problem(np.random.default_rng(5), K, k, d, n)
     P = np.empty((K, d, d, n))
     ipm.newton_part(a, P, d, K, k, n)

@@ -25,7 +25,7 @@ import numpy as np
 from . import ipm
 from .ipm import ITERATIONS, START_MARGIN
 
-__all__ = ["phase_one", "minimise", "newton_matrices", "solve", "least_on_line", "dual_polish"]
+__all__ = ["iterate", "phase_one", "minimise", "newton_matrices", "solve", "least_on_line", "dual_polish"]
 
 
 @functools.cache
@@ -124,7 +124,7 @@ def newton_matrices(A):
     return P
 
 
-def _iterate(A, b, c, x, z, P, phase):
+def iterate(A, b, c, x, z, P, phase):
     """:func:`socp._iterate` for one row: :func:`ipm.step`'s float twin moves ``x`` and ``z`` (lists, in place)
     until the row is done (phase I's rules where ``phase``) or the cap.  A division by zero or the root of a
     negative number (round-off at the cones' edge, NaN in numpy) stops the row where it is, as the batched
@@ -152,7 +152,7 @@ def phase_one(A, b):
     x = [0.0] * d + [max(over + 1, 0.0)]
     z = [[0.25, 0.0, 0.0] for _ in range(len(A) + 1)]
     c = [0.0] * d + [1.0]
-    _iterate(wide, bw, c, x, z, newton_matrices(wide), True)
+    iterate(wide, bw, c, x, z, newton_matrices(wide), True)
     return x[:d], x[d], z[: len(A)]
 
 
@@ -160,7 +160,7 @@ def minimise(A, b, c, x, P):
     """:func:`socp.minimise` for one row from the strictly feasible ``x``: ``(x, z)``; ``P`` of :func:`newton_matrices`."""
     z = [[1.0, 0.0, 0.0] for _ in A]
     x = list(x)
-    _iterate(A, b, c, x, z, P, False)
+    iterate(A, b, c, x, z, P, False)
     return x, z
 
 

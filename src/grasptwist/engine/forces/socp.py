@@ -24,8 +24,8 @@ optimum.  It takes 10-25 iterations a row, about a third of the Newton steps of 
 method with damped steps.  The iteration is written once, in
 :mod:`~grasptwist.engine.forces.ipm` (its lane form, which numba compiles); this module runs
 its numpy twin (:mod:`~grasptwist.engine.forces._twin`) over all the rows still iterating,
-gathering out those that are done, and :mod:`~grasptwist.engine.forces.one` its float twin
-on one row.
+gathering out those that are done, and a few rows (:data:`ALONE`) through the float twin of
+:mod:`~grasptwist.engine.forces.one`, a row at a time (numpy's cost per call is then all there is).
 
 **Phase I** finds a strictly feasible point by minimising ``r`` with the cones widened to
 ``t_m + r >= |z_m|`` and ``r >= -1``, from ``x = 0`` and an ``r`` that makes the start
@@ -48,7 +48,7 @@ import functools
 
 import numpy as np
 
-from . import ipm
+from . import ipm, one
 from .ipm import GAP, ITERATIONS, START_MARGIN
 
 __all__ = ["GAP", "START_MARGIN", "phase_one", "minimise", "dual_polish"]
@@ -72,13 +72,32 @@ def _norm_z(p):
     return np.sqrt(out)
 
 
+#: The most rows :func:`_iterate` takes one at a time in Python floats: a step of the numpy twin costs some
+#: 600 us whatever the rows (700 calls of numpy on a few numbers), the float twin's some 75 us a row.
+ALONE = 8
+
+
+def _one_row(A, b, c, x, z, r, phase_one):
+    """Row ``r`` of :func:`_iterate`'s arrays (``A (K, k, d)``, ``b (K, k)``, ``c (d)`` its own) through the
+    float twin, its ``x[:, r]`` and ``z[..., r]`` moved in place."""
+    rows = A.tolist()
+    xr, zr = x[:, r].tolist(), z[..., r].tolist()
+    one.iterate(rows, b.tolist(), c.tolist(), xr, zr, one.newton_matrices(rows), phase_one)
+    x[:, r], z[..., r] = xr, zr
+
+
 @np.errstate(divide="ignore", invalid="ignore", over="ignore")
 def _iterate(A, b, c, x, z, phase_one):
     """Mehrotra steps (:func:`ipm.step`'s twin) on the rows of ``(A, b, c)`` from the strictly feasible primal
     ``x (d, n)`` and the dual ``z (K, k, n)`` inside the cones (in place), until each row is done (phase I's
     rules where ``phase_one``) or the cap.  A row that is done leaves the arrays (gathered only when some
-    leave: none do for the first 7 or so steps)."""
+    leave: none do for the first 7 or so steps).  Up to :data:`ALONE` rows go one at a time through the float
+    twin (:func:`one.iterate`), each as it would alone."""
     K, k, d, n = A.shape
+    if n <= ALONE:
+        for r in range(n):
+            _one_row(A[..., r], b[..., r], c[:, r], x, z, r, phase_one)
+        return x
     P = np.empty((K, d, d, n))
     lane = _twins()
     lane["newton_part"](A, P, d, K, k, n)
