@@ -384,13 +384,14 @@ def synthesize(
 
     Examples
     --------
-    A 65 mm cube of 100 g on a table, ``mu = 0.8``: no contact within 1 mm of the table (the
-    face it rests on is never touched):
+    A 65 mm cube of 100 g on a table, ``mu = 0.8``, held against its weight: no contact within 1 mm of
+    the table (the face it rests on is never touched):
 
     >>> import numpy as np
     >>> from grasptwist.objects import Environment, GraspObject, Shape
     >>> cube = GraspObject(Shape("box", np.full(3, 0.065)), np.eye(4), mass=0.1)
-    >>> s = synthesize(cube, 0.8, count=2, candidates=500, environment=Environment(table_height=-0.0325))
+    >>> table = Environment(table_height=-0.0325)
+    >>> s = synthesize(cube, 0.8, count=2, candidates=500, environment=table, loads="weight")
     >>> s.points.shape, bool((s.closure_friction < 0.8).all()), bool((s.points[..., 2] >= -0.0315).all())
     ((2, 3, 3), True, True)
     """
