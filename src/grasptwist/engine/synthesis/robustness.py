@@ -34,7 +34,7 @@ import numpy as np
 
 from ..degeneracy import DEGENERACY_TOL
 from ..forces.grasp_map import tangent_bases
-from ..forces.grip import grip
+from ..forces.grip import wrench_grips
 from ..objects.tolerances import MESH_EDGE_TOL
 
 __all__ = [
@@ -150,25 +150,10 @@ def default_position_error(size, radii=None) -> float:
     return POSITION_SHARE * float(size)
 
 
-#: The most grips :func:`_held` asks for at once (rows times wrenches): one call is cheaper than a call a
-#: wrench (on the numpy path a call costs its steps' ~0.6 ms whatever its rows), and this bounds its memory.
-_GRIPS_AT_ONCE = 4096
-
-
 def _held(points, normals, wrenches, friction, safety, tol, torsion=None):
     """``(N,)`` whether a grip of every wrench ``(W, 6)`` exists, rows ``(N, 3, 3)``, ``friction (N,)`` or ``(N, 3)``
-    (``torsion``: soft contacts' radius, as :func:`~grasptwist.engine.forces.grip.grip`'s): every row's
-    wrenches in one grip, :data:`_GRIPS_AT_ONCE` grips a call."""
-    w = np.asarray(wrenches, float).reshape(-1, 6)
-    held = np.ones(len(points), bool)
-    mu = np.asarray(friction, float)
-    mu = mu[:, None] if mu.ndim == 1 else mu
-    step = max(_GRIPS_AT_ONCE // len(w), 1)
-    for at in range(0, len(points), step):  # the grip of no rows: nothing to hold
-        rows = slice(at, at + step)
-        g = grip(points[rows, None], normals[rows, None], w, mu[rows, None], safety=safety, torsion=torsion, tol=tol)
-        held[rows] = g.ok.all(axis=1)
-    return held
+    (``torsion``: soft contacts' radius, as :func:`~grasptwist.engine.forces.grip.grip`'s)."""
+    return wrench_grips(points, normals, wrenches, friction, safety=safety, torsion=torsion, tol=tol)[1].all(axis=1)
 
 
 def hold_friction(

@@ -38,7 +38,7 @@ from ..decompose import decompose_off_tangent, decompose_tangent
 from ..degeneracy import DEGENERACY_TOL
 from ..forces.closure import force_closure, internal_inside, soft_closure_verdict
 from ..forces.grasp_map import geometry
-from ..forces.grip import grip
+from ..forces.grip import wrench_grips
 from .reach import HAND_CONSTRAINTS, reach
 
 __all__ = [
@@ -233,12 +233,8 @@ def score_triples(
         if live.size:
             live = live[np.asarray(constraint(p[live], n[live]), bool)]
     failed[live] = CONSTRAINTS.index("grip")
-    held = np.ones(live.size, bool)
-    for k, wrench in enumerate(w if live.size else ()):  # the grip of no rows fails (an empty batch)
-        g = grip(p[live], n[live], wrench, friction, safety=safety, torsion=torsion, tol=tol)
-        total[live, k] = g.total_normal_force
-        held &= g.ok
-    live = live[held]
+    total[live], ok = wrench_grips(p[live], n[live], w, friction, safety=safety, torsion=torsion, tol=tol)
+    live = live[ok.all(axis=1)]
     failed[live] = -1
     value = objective_values(p[live], n[live], total[live], friction / safety, objective, tol, torsion)
     objective_value[live] = tie_broken(value, cond[live])
