@@ -56,15 +56,22 @@ def test_each_python_block_runs(block, tmp_path, monkeypatch):
     exec(compile(block.text, block.where, "exec"), {"__name__": "__docs__"})
 
 
-# the pages in page order, from the blocks already read (reading the pages again cost each test worker 0.1 s)
-@pytest.mark.parametrize("page", list(dict.fromkeys(b.page for b in BLOCKS if b.lang == "pycon")), ids=name)
-def test_the_python_sessions_print_what_the_page_shows(page, tmp_path, monkeypatch):
+def sessions():
+    """``(page, session)`` of every ``pycon`` session, in page order, from the blocks already read (reading
+    the pages again cost each test worker 0.1 s): a page's blocks are one session, but those with
+    ``session=NAME`` (a topic that needs nothing above it) are the session ``NAME``."""
+    found = dict.fromkeys((b.page, b.options.get("session", "")) for b in BLOCKS if b.lang == "pycon")
+    return [pytest.param(page, session, id=name(page) + (f"[{session}]" if session else "")) for page, session in found]
+
+
+@pytest.mark.parametrize(("page", "session"), sessions())
+def test_the_python_sessions_print_what_the_page_shows(page, session, tmp_path, monkeypatch):
     monkeypatch.chdir(scratch(tmp_path, page))
     runner = doctest.DocTestRunner(optionflags=doctest.ELLIPSIS)
     report, names = [], {}
     parser = doctest.DocTestParser()
     for b in blocks(page):
-        if b.lang == "pycon":  # one session over the page: a block uses the names of those above it
+        if b.lang == "pycon" and b.options.get("session", "") == session:  # a block uses the names above it
             test = parser.get_doctest(b.text, names, b.where, str(page), b.line)
             runner.run(test, out=report.append, clear_globs=False)
             names = test.globs
