@@ -377,6 +377,7 @@ def test_an_inline_hand_from_hand_has_no_tip_points(tmp_path):
     assert r.exit_code == 1 and "no-tip-points: an inline hand has no tip points" in r.stderr
 
 
+@pytest.mark.slow  # the default run's 40 s (development.md, Test time): -j 2 is the mesh folder's test's too
 def test_a_folder_on_two_workers_gives_the_records_of_one(tmp_path):
     for name in ("sphere.yaml", "box-edge.yaml"):
         (tmp_path / name).write_bytes((GRASPS / name).read_bytes())
