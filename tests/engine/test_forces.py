@@ -949,3 +949,35 @@ def test_the_compiled_grips_source_follows_the_numpy_path_in_the_default_run():
     forces = out[:, kernel._F : kernel._F + 9].reshape(-1, 3, 3)
     held = plain & reference.ok
     np.testing.assert_allclose(forces[held], reference.force[held], rtol=1e-6, atol=1e-6)
+
+
+def test_the_compiled_iterations_source_follows_the_numpy_twin_on_soft_rows(monkeypatch):
+    """Issue 39, item 1: where numba is on, socp's iterations (the soft contacts' phase I, phase II, dual polish
+    and the rays' phase I for a culprit; the soft closure's phase I) run in kernel.iterate_rows and
+    kernel.polish_rows.  Their own source run as Python, held to socp's numpy twin without a compile: soft,
+    point and frictionless contacts mixed (other numbers of unknowns), held and cannot-hold rows, the same
+    verdicts and culprits, forces, torsions, duals and certificates to 1e-12."""
+    kernel = _kernel_as_python()
+    calls = []
+    iterate, polish = kernel.iterate_rows, kernel.polish_rows
+    monkeypatch.setattr(kernel, "iterate_rows", lambda *a: calls.append(a[0].shape[1:]) or iterate(*a))
+    monkeypatch.setattr(kernel, "polish_rows", lambda *a: calls.append("polish") or polish(*a))
+    p, n, w, mu = grasps(6, 3)
+    e = np.array([[0.01, 0.01, 0.01], [0.02, 0.0, 0.01], [0.0, 0.0, 0.05]] * 2)
+    mu[2, 0] = 0.0  # a frictionless contact beside a soft one
+    with compiled.numpy_path():
+        reference = gt.grip(p, n, w, mu, safety=1.3, torsion=e)
+        closure = gt.forces.force_closure(p[:2], n[:2], torsion=e[:2]).closure_friction
+    monkeypatch.setattr(compiled, "_state", {"on": True, "module": kernel, "iteration": True})
+    with np.errstate(all="ignore"):  # numba's error model is numpy's: a 0 / 0 is NaN, quietly
+        g = gt.grip(p, n, w, mu, safety=1.3, torsion=e)
+        # (K, k, d): all-soft phase I and II, a point contact's fewer unknowns, the rays' phase I (k = 1)
+        assert {(4, 4, 7), (3, 4, 6), (3, 4, 5), (4, 1, 5), "polish"} <= set(calls)
+        calls.clear()
+        np.testing.assert_allclose(gt.forces.force_closure(p[:2], n[:2], torsion=e[:2]).closure_friction, closure)
+        assert calls
+    assert g.status.tolist() == reference.status.tolist() and g.culprit.tolist() == reference.culprit.tolist()
+    assert 2 <= g.ok.sum() <= 4 and g.culprit[~g.ok].min() >= 0
+    scale = np.abs(w).max()
+    for name in ("force", "torsion", "total_normal_force", "dual", "certificate", "gap"):
+        np.testing.assert_allclose(getattr(g, name), getattr(reference, name), rtol=1e-12, atol=1e-12 * scale)

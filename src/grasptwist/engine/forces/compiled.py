@@ -20,7 +20,7 @@ import numpy as np
 
 from ..hooks import first_load
 
-__all__ = ["kernel", "numpy_path", "read_only"]
+__all__ = ["kernel", "iteration", "numpy_path", "read_only"]
 
 
 _state = {"on": os.environ.get("GRASPTWIST_NUMBA", "1") != "0", "module": None}
@@ -54,6 +54,38 @@ def _first_grip(module):
     grasp = [read_only(a) for a in (p, -p, np.full((1, 3), 0.5))]
     wrench, out, codes = np.array([[0, 0, 1.0, 0, 0, 0]]), np.empty((1, module.WIDTH)), np.empty((1, 3), np.int8)
     module.grip_rows(*grasp, wrench, 1e-9, out, codes)
+
+
+def iteration():
+    """The compiled module, where its iteration on rows of any sizes is loaded too (:func:`kernel.iterate_rows`,
+    :func:`kernel.polish_rows`: :mod:`~grasptwist.engine.forces.socp`'s), or None.
+
+    Compiled (some 20 s on a fresh install) or loaded from numba's cache at the first use in a process,
+    not with the grip's kernel: a process that grips point contacts only never pays it.  Inside
+    :func:`~grasptwist.engine.hooks.first_load` too (the command line's notice).
+    """
+    module = kernel()
+    if module is None or _state.get("iteration"):
+        return module
+    if _state.get("iteration") is None:
+        try:
+            with first_load():
+                _first_iteration(module)
+            _state["iteration"] = True
+        except (RuntimeError, OSError) as error:
+            _state["iteration"] = False
+            warnings.warn(f"the compiled iteration is unavailable ({error}); the numpy path is used", stacklevel=3)
+    return module if _state["iteration"] else None
+
+
+def _first_iteration(module):
+    """One phase I and one dual polish of a row with two cones ``t >= |z|``, ``z`` one unknown: in the
+    signatures :mod:`~grasptwist.engine.forces.socp` calls (C-contiguous writable floats)."""
+    A = np.array([[[[0.0], [1.0]], [[1.0], [0.0]]]])
+    b, c = np.array([[[1.0, 0.0], [1.0, 0.0]]]), np.ones((1, 1))
+    x, z = np.zeros((1, 1)), np.full((1, 2, 2), 0.25)
+    module.iterate_rows(A, b, c, x, z, True)
+    module.polish_rows(A, b, c, x, z)
 
 
 def read_only(a):
