@@ -5,8 +5,11 @@ that needs it, never when ``grasptwist`` is imported.  Compiled functions are ca
 disk (numba's ``cache=True``: in ``__pycache__`` beside the source, or where that is not
 writable in numba's per-user cache directory; ``NUMBA_CACHE_DIR`` chooses another), so
 only a fresh install pays the compile (about a minute), inside
-:func:`~grasptwist.engine.hooks.first_load` (the command line's notice).  ``GRASPTWIST_NUMBA=0`` in the
-environment, or :func:`numpy_path`, keeps to the numpy path, which is the reference.
+:func:`~grasptwist.engine.hooks.first_load` (the command line's notice).  The interior-point
+iterations of :mod:`~grasptwist.engine.forces.socp` (soft contacts' cones, and the rows the
+kernel leaves to numpy) are compiled apart, for any sizes, at their first use
+(:func:`iteration`: some 20 s more on a fresh install, inside the same notice).  ``GRASPTWIST_NUMBA=0``
+in the environment, or :func:`numpy_path`, keeps to the numpy path, which is the reference.
 """
 
 from __future__ import annotations

@@ -496,12 +496,14 @@ def _ball_project(q):
 def warm_up():
     """The one-time work of a process's first search, done before any budget's clock starts: a small
     search of a ball, which compiles the grip's numba kernels for the very arrays a search gives them
-    (its batches and its verification's single rows), or loads them from numba's cache; once a process,
-    and nothing on the numpy path.
+    (its batches and its verification's single rows), or loads them from numba's cache, and the compiled
+    interior-point iterations of soft contacts' cones (``compiled.iteration``); once a
+    process, and nothing on the numpy path.
 
     >>> warm_up()
     """
     if _WARM or compiled.kernel() is None:  # done, or the numpy path: nothing to compile
         return
     _WARM.append(True)  # first: the search below warms up too
+    compiled.iteration()  # soft contacts' cones, and any row the grip's kernel leaves to socp
     search(Surface(_ball_sample, _ball_project, 2 * 3**0.5), [[0, 0, 1.0, 0, 0, 0]], 0.5, candidates=200)
