@@ -4,10 +4,12 @@ Numbers are checked against LAPACK's pseudo-inverse, against Clarabel (an indepe
 solver on the nine contact-force numbers, tests/conic.py) and against cases worked by hand.
 """
 
+import contextlib
 import importlib.util
 import os
 import subprocess
 import sys
+import types
 import warnings
 
 import numpy as np
@@ -829,6 +831,49 @@ def test_a_numba_that_cannot_load_the_kernel_leaves_the_numpy_path_with_a_warnin
     with pytest.warns(UserWarning, match=r"^the compiled grip is unavailable \(.*\); the numpy path is used$"):
         g = gt.grip(EQ, -EQ, [0, 0, G, 0, 0, 0], 0.5)
     assert g.total_normal_force == pytest.approx(G / 0.5, rel=1e-9) and compiled.kernel() is None
+
+
+def test_iterations_that_cannot_load_leave_socp_on_the_numpy_path_with_a_warning(monkeypatch):
+    """compiled.iteration (socp's iterations compiled, at their first use) that fails to compile or load: one
+    warning, then the numpy twin for the process, the same grip."""
+
+    def fails(*args):
+        raise OSError("no directory numba may cache in")
+
+    module = types.SimpleNamespace(iterate_rows=fails, polish_rows=fails)
+    monkeypatch.setattr(compiled, "_state", {"on": True, "module": module})
+    with pytest.warns(UserWarning, match=r"^the compiled iteration is unavailable \(.*\); the numpy path is used$"):
+        g = gt.grip(EQ, -EQ, [0, 0, G, 0, 0, 0], 0.5, torsion=0.01)
+    assert float(g.total_normal_force) == pytest.approx(G / 0.5, rel=1e-9)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert compiled.iteration() is None and compiled.kernel() is module
+
+
+def test_socps_compiled_iterations_load_once_inside_the_first_load_watch(monkeypatch):
+    """A fresh install compiles socp's iterations (some 20 s) at their first use: inside hooks.first_load (the
+    command line's notice), once a process; later calls go straight to the compiled functions."""
+    from grasptwist.engine import hooks
+    from grasptwist.engine.forces import socp
+
+    watched, calls = [], []
+
+    @contextlib.contextmanager
+    def watch():
+        watched.append("open")
+        yield
+        watched.append("closed")
+
+    module = types.SimpleNamespace(
+        iterate_rows=lambda *a: calls.append(("iterate", watched[-1])),
+        polish_rows=lambda *a: calls.append(("polish", watched[-1])),
+    )
+    monkeypatch.setattr(compiled, "_state", {"on": True, "module": module})
+    A, b = np.zeros((2, 1, 3, 1)), np.ones((2, 1, 3))
+    with hooks.watching_first_load(watch):
+        socp.phase_one(A, b)
+        socp.minimise(A, b, np.ones((2, 1)), np.zeros((2, 1)))
+    assert calls == [("iterate", "open"), ("polish", "open"), ("iterate", "closed"), ("iterate", "closed")]
 
 
 def test_an_infinite_wrench_beside_a_huge_one_keeps_its_status_and_the_huge_one_is_solved():

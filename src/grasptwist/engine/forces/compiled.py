@@ -64,7 +64,8 @@ def iteration():
     :func:`kernel.polish_rows`: :mod:`~grasptwist.engine.forces.socp`'s), or None.
 
     Compiled (some 20 s on a fresh install) or loaded from numba's cache at the first use in a process,
-    not with the grip's kernel: a process that grips point contacts only never pays it.  Inside
+    not with the grip's kernel: a process whose grips the kernel solves whole (point contacts with
+    friction, not collinear) never pays it.  Inside
     :func:`~grasptwist.engine.hooks.first_load` too (the command line's notice).
     """
     module = kernel()
