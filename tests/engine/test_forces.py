@@ -789,7 +789,8 @@ def test_the_compiled_grip_answers_each_row_as_alone(compiled_path):
 def test_grips_of_any_array_flags_share_one_compiled_signature():
     """numba loads (or compiles) one function per signature and an array's writeable flag is part of it:
     read-only and writable grasps and wrenches, one friction or one per contact, a prepared grip, all
-    call the kernel with one signature (each more was 50 ms of a process's start)."""
+    call the kernel with one signature (each more was 50 ms of a process's start); soft grips and closure,
+    socp's compiled iterations with one each (each more would be a compile of some 20 s)."""
     pytest.importorskip("numba")
     code = """if True:
         import numpy as np, grasptwist as gt
@@ -803,6 +804,10 @@ def test_grips_of_any_array_flags_share_one_compiled_signature():
         gt.forces.prepare_grip(p, n, 0.5).grip(w[0])
         signatures = compiled.kernel().grip_rows.signatures
         assert len(signatures) == 1, signatures
+        gt.grip(p, n, w, 0.5, torsion=0.01)  # socp's iterations, compiled apart: one signature each too
+        gt.forces.force_closure(p, n, torsion=[0.01, 0.0, 0.02])
+        for f in (compiled.kernel().iterate_rows, compiled.kernel().polish_rows):
+            assert len(f.signatures) == 1, f.signatures
     """
     env = dict(os.environ, GRASPTWIST_NUMBA="1")
     done = subprocess.run([sys.executable, "-c", code.format(p=EQ.tolist())], capture_output=True, text=True, env=env)

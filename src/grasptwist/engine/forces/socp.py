@@ -22,9 +22,11 @@ A row leaves once its gap is below ``GAP`` of its objective's scale (``1 + |c^T 
 rows are scaled by their caller to order one, so the objective is then that close to the
 optimum.  It takes 10-25 iterations a row, about a third of the Newton steps of a barrier
 method with damped steps.  The iteration is written once, in
-:mod:`~grasptwist.engine.forces.ipm` (its lane form, which numba compiles); this module runs
-its numpy twin (:mod:`~grasptwist.engine.forces._twin`) over all the rows still iterating,
-gathering out those that are done, and :mod:`~grasptwist.engine.forces.one` its float twin
+:mod:`~grasptwist.engine.forces.ipm` (its lane form, which numba compiles); where numba is on
+(:func:`compiled.iteration`) this module's functions hand their rows to that compiled source
+(:func:`kernel.iterate_rows`, :func:`kernel.polish_rows`), else they run its numpy twin
+(:mod:`~grasptwist.engine.forces._twin`), the reference, over all the rows still iterating,
+gathering out those that are done; :mod:`~grasptwist.engine.forces.one` runs its float twin
 on one row.
 
 **Phase I** finds a strictly feasible point by minimising ``r`` with the cones widened to
