@@ -32,8 +32,7 @@ import numpy as np
 from numba import literally, njit
 
 from . import ipm, one
-from .closure import _PAIRS, _STRICT
-from .grasp_map import GRIP_COLUMNS
+from .grasp_map import _PAIRS, _STRICT, GRIP_COLUMNS
 from .ipm import ITERATIONS as _ITERATIONS
 from .ipm import START_MARGIN
 
