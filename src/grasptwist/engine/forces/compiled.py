@@ -31,23 +31,29 @@ _state = {"on": os.environ.get("GRASPTWIST_NUMBA", "1") != "0", "module": None}
 
 def kernel():
     """The compiled module (:mod:`~grasptwist.engine.forces.kernel`), or None: numba missing or switched off."""
-    if not _state["on"]:
-        return None
-    if _state["module"] is None:
-        if importlib.util.find_spec("numba") is None:
-            _state["on"] = False
-            return None
-        try:
-            with first_load():  # the caller's watch (the command line's notice of a long compile)
-                from . import kernel as module
+    if _state["on"] and _state["module"] is None and _numba():
+        with first_load():  # the caller's watch (the command line's notice of a long compile)
+            _load()
+    return _state["module"] if _state["on"] else None
 
-                _state["module"] = module
-                _first_grip(module)
-        except (ImportError, RuntimeError, OSError) as error:  # e.g. no directory numba may cache in
-            _state["on"], _state["module"] = False, None
-            warnings.warn(f"the compiled grip is unavailable ({error}); the numpy path is used", stacklevel=3)
-            return None
-    return _state["module"]
+
+def _numba():
+    """Whether numba is installed (if not, the numpy path for good)."""
+    if importlib.util.find_spec("numba") is None:
+        _state["on"] = False
+    return _state["on"]
+
+
+def _load():
+    """The kernel's first load in a process (its compile on a fresh install), else the numpy path, warned."""
+    try:
+        from . import kernel as module
+
+        _state["module"] = module
+        _first_grip(module)
+    except (ImportError, RuntimeError, OSError) as error:  # e.g. no directory numba may cache in
+        _state["on"], _state["module"] = False, None
+        warnings.warn(f"the compiled grip is unavailable ({error}); the numpy path is used", stacklevel=4)
 
 
 def _first_grip(module):
@@ -65,21 +71,24 @@ def iteration():
 
     Compiled (some 20 s on a fresh install) or loaded from numba's cache at the first use in a process,
     not with the grip's kernel: a process whose grips the kernel solves whole (point contacts with
-    friction, not collinear) never pays it.  Inside
-    :func:`~grasptwist.engine.hooks.first_load` too (the command line's notice).
+    friction, not collinear) never pays it.  Inside :func:`~grasptwist.engine.hooks.first_load` too,
+    one watch with the kernel's own first load where that comes first here (the command line's
+    notice said once).
     """
-    module = kernel()
-    if module is None or _state.get("iteration"):
-        return module
-    if _state.get("iteration") is None:
-        try:
-            with first_load():
-                _first_iteration(module)
-            _state["iteration"] = True
-        except (RuntimeError, OSError) as error:
-            _state["iteration"] = False
-            warnings.warn(f"the compiled iteration is unavailable ({error}); the numpy path is used", stacklevel=3)
-    return module if _state["iteration"] else None
+    if _state["on"] and _state.get("iteration") is None and _numba():
+        with first_load():
+            if _state["module"] is None:
+                _load()
+            if _state["on"]:
+                try:
+                    _first_iteration(_state["module"])
+                    _state["iteration"] = True
+                except (RuntimeError, OSError) as error:
+                    _state["iteration"] = False
+                    warnings.warn(
+                        f"the compiled iteration is unavailable ({error}); the numpy path is used", stacklevel=3
+                    )
+    return _state["module"] if _state["on"] and _state.get("iteration") else None
 
 
 def _first_iteration(module):
