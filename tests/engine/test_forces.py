@@ -826,16 +826,18 @@ def test_importing_grasptwist_imports_no_numba():
     assert done.returncode == 0, done.stderr
 
 
-def test_a_numba_that_cannot_load_the_kernel_leaves_the_numpy_path_with_a_warning(monkeypatch):
+@pytest.mark.parametrize(("torsion", "what"), [(None, "grip"), (0.01, "iteration")])  # kernel(), iteration()
+def test_a_numba_that_cannot_load_the_kernel_leaves_the_numpy_path_with_a_warning(torsion, what, monkeypatch):
     import grasptwist.engine.forces as package
 
     monkeypatch.setitem(sys.modules, "grasptwist.engine.forces.kernel", None)  # the import fails
     monkeypatch.delattr(package, "kernel", raising=False)  # (as it does where numba was never loaded)
     monkeypatch.setattr(compiled, "_state", {"on": True, "module": None})
     monkeypatch.setattr(importlib.util, "find_spec", lambda name: object())  # as if numba were installed
-    with pytest.warns(UserWarning, match=r"^the compiled grip is unavailable \(.*\); the numpy path is used$"):
-        g = gt.grip(EQ, -EQ, [0, 0, G, 0, 0, 0], 0.5)
-    assert g.total_normal_force == pytest.approx(G / 0.5, rel=1e-9) and compiled.kernel() is None
+    with pytest.warns(UserWarning, match=rf"^the compiled {what} is unavailable \(.*\); the numpy path is used$"):
+        g = gt.grip(EQ, -EQ, [0, 0, G, 0, 0, 0], 0.5, torsion=torsion)
+    assert g.total_normal_force == pytest.approx(G / 0.5, rel=1e-9)
+    assert compiled.kernel() is None and compiled.iteration() is None
 
 
 def test_iterations_that_cannot_load_leave_socp_on_the_numpy_path_with_a_warning(monkeypatch):
@@ -846,7 +848,7 @@ def test_iterations_that_cannot_load_leave_socp_on_the_numpy_path_with_a_warning
         raise OSError("no directory numba may cache in")
 
     module = types.SimpleNamespace(iterate_rows=fails, polish_rows=fails)
-    monkeypatch.setattr(compiled, "_state", {"on": True, "module": module})
+    monkeypatch.setattr(compiled, "_state", {"on": True, "module": module, "grip": True})
     monkeypatch.setattr(importlib.util, "find_spec", lambda name: object())  # as if numba were installed
     with pytest.warns(UserWarning, match=r"^the compiled iteration is unavailable \(.*\); the numpy path is used$"):
         g = gt.grip(EQ, -EQ, [0, 0, G, 0, 0, 0], 0.5, torsion=0.01)
@@ -858,8 +860,8 @@ def test_iterations_that_cannot_load_leave_socp_on_the_numpy_path_with_a_warning
 
 def test_socps_compiled_iterations_load_once_inside_the_first_load_watch(monkeypatch):
     """A fresh install compiles socp's iterations (some 20 s) at their first use: inside hooks.first_load (the
-    command line's notice), once a process, in one watch with the kernel's own first load where that comes
-    first there (one notice, not two); later calls go straight to the compiled functions."""
+    command line's notice), once a process, and apart from the grip's kernel (a soft grip alone never compiles
+    it); later calls go straight to the compiled functions."""
     from grasptwist.engine import hooks
     from grasptwist.engine.forces import socp
 
@@ -875,18 +877,15 @@ def test_socps_compiled_iterations_load_once_inside_the_first_load_watch(monkeyp
         iterate_rows=lambda *a: calls.append(("iterate", watched[-1])),
         polish_rows=lambda *a: calls.append(("polish", watched[-1])),
     )
-    state = {"on": True, "module": None}
+    state = {"on": True, "module": module}  # the kernel's module imported, its grip not loaded
     monkeypatch.setattr(compiled, "_state", state)
-    monkeypatch.setattr(compiled, "_load", lambda: calls.append(("kernel", watched[-1])) or state.update(module=module))
     monkeypatch.setattr(importlib.util, "find_spec", lambda name: object())  # as if numba were installed
     A, b = np.zeros((2, 1, 3, 1)), np.ones((2, 1, 3))
     with hooks.watching_first_load(watch):
         socp.phase_one(A, b)
         socp.minimise(A, b, np.ones((2, 1)), np.zeros((2, 1)))
-        assert compiled.kernel() is module
-    assert watched == ["open", "closed"]
-    first = [("kernel", "open"), ("iterate", "open"), ("polish", "open")]
-    assert calls == first + [("iterate", "closed"), ("iterate", "closed")]
+    assert watched == ["open", "closed"] and "grip" not in state
+    assert calls == [("iterate", "open"), ("polish", "open"), ("iterate", "closed"), ("iterate", "closed")]
 
 
 def test_an_infinite_wrench_beside_a_huge_one_keeps_its_status_and_the_huge_one_is_solved():

@@ -31,9 +31,9 @@ _state = {"on": os.environ.get("GRASPTWIST_NUMBA", "1") != "0", "module": None}
 
 def kernel():
     """The compiled module (:mod:`~grasptwist.engine.forces.kernel`), or None: numba missing or switched off."""
-    if _state["on"] and _state["module"] is None and _numba():
+    if _state["on"] and not _state.get("grip") and _numba():
         with first_load():  # the caller's watch (the command line's notice of a long compile)
-            _load()
+            _loaded(_first_grip, "grip", "the compiled grip")
     return _state["module"] if _state["on"] else None
 
 
@@ -44,16 +44,22 @@ def _numba():
     return _state["on"]
 
 
-def _load():
-    """The kernel's first load in a process (its compile on a fresh install), else the numpy path, warned."""
+def _loaded(first, part, name):
+    """``first(kernel)`` (the kernel's module imported where it is not yet): ``part`` compiled on a fresh
+    install, else loaded from numba's cache.  Where that fails, the numpy path, warned: for ``part`` alone,
+    or for everything where the grip fails or the module cannot be imported."""
     try:
-        from . import kernel as module
+        if _state["module"] is None:
+            from . import kernel as module
 
-        _state["module"] = module
-        _first_grip(module)
+            _state["module"] = module
+        first(_state["module"])
+        _state[part] = True
     except (ImportError, RuntimeError, OSError) as error:  # e.g. no directory numba may cache in
-        _state["on"], _state["module"] = False, None
-        warnings.warn(f"the compiled grip is unavailable ({error}); the numpy path is used", stacklevel=4)
+        _state[part] = False
+        if part == "grip" or _state["module"] is None:
+            _state["on"], _state["module"] = False, None
+        warnings.warn(f"{name} is unavailable ({error}); the numpy path is used", stacklevel=4)
 
 
 def _first_grip(module):
@@ -66,28 +72,18 @@ def _first_grip(module):
 
 
 def iteration():
-    """The compiled module, where its iteration on rows of any sizes is loaded too (:func:`kernel.iterate_rows`,
+    """The compiled module, where its iteration on rows of any sizes is loaded (:func:`kernel.iterate_rows`,
     :func:`kernel.polish_rows`: :mod:`~grasptwist.engine.forces.socp`'s), or None.
 
     Compiled (some 20 s on a fresh install) or loaded from numba's cache at the first use in a process,
-    not with the grip's kernel: a process whose grips the kernel solves whole (point contacts with
-    friction, not collinear) never pays it.  Inside :func:`~grasptwist.engine.hooks.first_load` too,
-    one watch with the kernel's own first load where that comes first here (the command line's
-    notice said once).
+    apart from the grip's kernel (:func:`kernel`): a process whose grips the kernel solves whole
+    (point contacts with friction, not collinear) never pays it, and one that grips soft contacts
+    only never pays the kernel's.  Inside :func:`~grasptwist.engine.hooks.first_load` too (the
+    command line's notice).
     """
     if _state["on"] and _state.get("iteration") is None and _numba():
         with first_load():
-            if _state["module"] is None:
-                _load()
-            if _state["on"]:
-                try:
-                    _first_iteration(_state["module"])
-                    _state["iteration"] = True
-                except (RuntimeError, OSError) as error:
-                    _state["iteration"] = False
-                    warnings.warn(
-                        f"the compiled iteration is unavailable ({error}); the numpy path is used", stacklevel=3
-                    )
+            _loaded(_first_iteration, "iteration", "the compiled iteration")
     return _state["module"] if _state["on"] and _state.get("iteration") else None
 
 
