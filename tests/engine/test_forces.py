@@ -888,6 +888,30 @@ def test_socps_compiled_iterations_load_once_inside_the_first_load_watch(monkeyp
     assert calls == [("iterate", "open"), ("polish", "open"), ("iterate", "closed"), ("iterate", "closed")]
 
 
+def test_a_first_load_inside_another_runs_in_the_outer_watch_alone():
+    """A search's warm-up loads the grip's kernel and socp's iterations (each its own first load) inside one
+    first load: one watch, so the command line says once that it compiles; after it, a first load watches anew."""
+    from grasptwist.engine import hooks
+
+    opened = []
+
+    @contextlib.contextmanager
+    def watch():
+        opened.append(len(opened))
+        yield
+
+    with hooks.watching_first_load(watch):
+        with hooks.first_load():
+            with hooks.first_load():
+                pass
+            with hooks.first_load():
+                pass
+        assert opened == [0]
+        with hooks.first_load():
+            pass
+    assert opened == [0, 1]
+
+
 def test_an_infinite_wrench_beside_a_huge_one_keeps_its_status_and_the_huge_one_is_solved():
     """wrench_scales leaves an infinite row unscaled (once, as the grip recursed on it forever)."""
     g = gt.grip(EQ, -EQ, [[0, 0, np.inf, 0, 0, 0], [0, 0, G * 1e300, 0, 0, 0]], 0.5)
