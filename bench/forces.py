@@ -1,6 +1,7 @@
 """Force-side speed: the engine against Clarabel called directly, on the same grasps, in one run.
 
-Run: ``python bench/forces.py [--n 100000] [--loop 1000] [--closure-loop 100] [--single 300] [--epsilon 200]``.
+Run: ``python bench/forces.py [--n 100000] [--loop 1000] [--closure-loop 100] [--single 300] [--epsilon 200]
+[--soft 20000]``.
 
 Grasps: three contacts near a unit ball's equator, normals towards its centre tilted at
 random, one friction per grasp (0.4..1), the wrench that holds a 0.2..2 kg weight plus a
@@ -16,6 +17,10 @@ disturbing moment; safety 1.5.  Baselines are Clarabel through its own Python AP
 - **agreement** on the loop's grasps: verdicts, total normal force, closure friction;
   on all: the wrench reproduced, the largest friction used over the cone's, and the
   certificates (dual gap, Farkas ``y . w > 0``).
+
+**Soft fingers** (``torsion`` 1 cm, the first ``--soft`` grasps): batched and single calls on each path,
+the batch's CPU split into the set-up in numpy (``B = [G'; E]`` and its SVD) and the interior-point
+iterations (compiled where numba is on), and the compiled path held to the numpy one.
 
 **The edge** (single calls, medians): a 1 kg tray held from below by three fingers (5 cm, normals
 up, mu 0.5) whose centre of mass lies on the line of two of them, so the third carries exactly
@@ -158,6 +163,70 @@ def batched(p, n, w, mu, k, kc):
         )
 
 
+def _timing(module, name, spent):
+    """``module.name`` wrapped to add its CPU time to ``spent[name]`` (a context)."""
+    f = getattr(module, name)
+
+    def timed(*args, **kwargs):
+        t = time.process_time()
+        try:
+            return f(*args, **kwargs)
+        finally:
+            spent[name] = spent.get(name, 0.0) + time.process_time() - t
+
+    @contextlib.contextmanager
+    def context():
+        setattr(module, name, timed)
+        try:
+            yield
+        finally:
+            setattr(module, name, f)
+
+    return context()
+
+
+def soft(p, n, w, mu, m, count):
+    """Soft fingers (torsional radius 1 cm) on the first ``m`` grasps, batched and single, each path; the batch's
+    CPU split into the set-up in numpy (``cones.cone_grasp``: B and its SVD) and the interior-point iterations
+    (``socp``'s, compiled where numba is on)."""
+    from grasptwist.engine.forces import cones, socp
+
+    p, n, w, mu = p[:m], n[:m], w[:m], mu[:m]
+    _, first = cpu(lambda: gt.grip(p[:2], n[:2], w[:2], mu[:2], safety=SAFETY, torsion=0.01))
+    if compiled.iteration() is not None:
+        print(
+            f"first soft grip (numba loads its cached iterations, or compiles them on a fresh install): {first:.2f} s"
+        )
+    grips, times = {}, {}
+    for name, path in paths():
+        with path():
+            runs = []
+            for _ in range(3):
+                spent = {}
+                with _timing(cones, "cone_grasp", spent), _timing(socp, "_iterated", spent):
+                    g, t = cpu(lambda: gt.grip(p, n, w, mu, safety=SAFETY, torsion=0.01))
+                runs.append((t, spent))
+            grips[name] = g
+            t, spent = sorted(runs, key=lambda r: r[0])[1]
+            one = median_us(lambda i: gt.grip(p[i], n[i], w[i], mu[i], safety=SAFETY, torsion=0.01), count)
+        times[name] = (t, one)
+        print(
+            f"soft grip (torsion 1 cm), {m} grasps, {name}: {1e6 * t / m:.1f} us a grasp (CPU, median of 3 calls): "
+            f"set-up (B, SVD) {1e6 * spent['cone_grasp'] / m:.1f}, iterations {1e6 * spent['_iterated'] / m:.1f}, "
+            f"the rest {1e6 * (t - spent['cone_grasp'] - spent['_iterated']) / m:.1f}; single gt.grip {one:.0f} us "
+            f"(median of {count}); held {g.ok.mean():.1%}"
+        )
+    if len(grips) == 2:
+        a, b = grips["compiled"], grips["numpy"]
+        ok = b.ok
+        print(
+            f"soft, compiled against numpy: batched {times['numpy'][0] / times['compiled'][0]:.2f}x, single "
+            f"{times['numpy'][1] / times['compiled'][1]:.1f}x; same status and culprit "
+            f"{((a.status == b.status) & (a.culprit == b.culprit)).mean():.3%}, total normal force max rel diff "
+            f"{np.abs(a.total_normal_force[ok] / b.total_normal_force[ok] - 1).max():.1e}"
+        )
+
+
 def epsilon(p, n, mu, m):
     """The engine's epsilon against the bare ``ConvexHull`` calls it makes (timed inside the same run)."""
     import scipy.spatial
@@ -192,6 +261,7 @@ def main():
     ap.add_argument("--closure-loop", type=int, default=100)
     ap.add_argument("--single", type=int, default=300)
     ap.add_argument("--epsilon", type=int, default=200)
+    ap.add_argument("--soft", type=int, default=20_000)
     args = ap.parse_args()
     p, n, w, mu = grasps(args.n)
     _, first = cpu(lambda: gt.grip(p[:2], n[:2], w[:2], mu[:2], safety=SAFETY))
@@ -200,6 +270,7 @@ def main():
     single(p, n, w, mu, args.single)
     edge(args.single)
     batched(p, n, w, mu, args.loop, args.closure_loop)
+    soft(p, n, w, mu, args.soft, args.single)
     epsilon(p, n, mu, args.epsilon)
 
 

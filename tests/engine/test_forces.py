@@ -4,10 +4,12 @@ Numbers are checked against LAPACK's pseudo-inverse, against Clarabel (an indepe
 solver on the nine contact-force numbers, tests/conic.py) and against cases worked by hand.
 """
 
+import contextlib
 import importlib.util
 import os
 import subprocess
 import sys
+import types
 import warnings
 
 import numpy as np
@@ -787,7 +789,8 @@ def test_the_compiled_grip_answers_each_row_as_alone(compiled_path):
 def test_grips_of_any_array_flags_share_one_compiled_signature():
     """numba loads (or compiles) one function per signature and an array's writeable flag is part of it:
     read-only and writable grasps and wrenches, one friction or one per contact, a prepared grip, all
-    call the kernel with one signature (each more was 50 ms of a process's start)."""
+    call the kernel with one signature (each more was 50 ms of a process's start); soft grips and closure,
+    socp's compiled iterations with one each (each more would be a compile of some 20 s)."""
     pytest.importorskip("numba")
     code = """if True:
         import numpy as np, grasptwist as gt
@@ -801,6 +804,10 @@ def test_grips_of_any_array_flags_share_one_compiled_signature():
         gt.forces.prepare_grip(p, n, 0.5).grip(w[0])
         signatures = compiled.kernel().grip_rows.signatures
         assert len(signatures) == 1, signatures
+        gt.grip(p, n, w, 0.5, torsion=0.01)  # socp's iterations, compiled apart: one signature each too
+        gt.forces.force_closure(p, n, torsion=[0.01, 0.0, 0.02])
+        for f in (compiled.kernel().iterate_rows, compiled.kernel().polish_rows):
+            assert len(f.signatures) == 1, f.signatures
     """
     env = dict(os.environ, GRASPTWIST_NUMBA="1")
     done = subprocess.run([sys.executable, "-c", code.format(p=EQ.tolist())], capture_output=True, text=True, env=env)
@@ -819,16 +826,90 @@ def test_importing_grasptwist_imports_no_numba():
     assert done.returncode == 0, done.stderr
 
 
-def test_a_numba_that_cannot_load_the_kernel_leaves_the_numpy_path_with_a_warning(monkeypatch):
+@pytest.mark.parametrize(("torsion", "what"), [(None, "grip"), (0.01, "iteration")])  # kernel(), iteration()
+def test_a_numba_that_cannot_load_the_kernel_leaves_the_numpy_path_with_a_warning(torsion, what, monkeypatch):
     import grasptwist.engine.forces as package
 
     monkeypatch.setitem(sys.modules, "grasptwist.engine.forces.kernel", None)  # the import fails
     monkeypatch.delattr(package, "kernel", raising=False)  # (as it does where numba was never loaded)
     monkeypatch.setattr(compiled, "_state", {"on": True, "module": None})
     monkeypatch.setattr(importlib.util, "find_spec", lambda name: object())  # as if numba were installed
-    with pytest.warns(UserWarning, match=r"^the compiled grip is unavailable \(.*\); the numpy path is used$"):
-        g = gt.grip(EQ, -EQ, [0, 0, G, 0, 0, 0], 0.5)
-    assert g.total_normal_force == pytest.approx(G / 0.5, rel=1e-9) and compiled.kernel() is None
+    with pytest.warns(UserWarning, match=rf"^the compiled {what} is unavailable \(.*\); the numpy path is used$"):
+        g = gt.grip(EQ, -EQ, [0, 0, G, 0, 0, 0], 0.5, torsion=torsion)
+    assert g.total_normal_force == pytest.approx(G / 0.5, rel=1e-9)
+    assert compiled.kernel() is None and compiled.iteration() is None
+
+
+def test_iterations_that_cannot_load_leave_socp_on_the_numpy_path_with_a_warning(monkeypatch):
+    """compiled.iteration (socp's iterations compiled, at their first use) that fails to compile or load: one
+    warning, then the numpy twin for the process, the same grip."""
+
+    def fails(*args):
+        raise OSError("no directory numba may cache in")
+
+    module = types.SimpleNamespace(iterate_rows=fails, polish_rows=fails)
+    monkeypatch.setattr(compiled, "_state", {"on": True, "module": module, "grip": True})
+    monkeypatch.setattr(importlib.util, "find_spec", lambda name: object())  # as if numba were installed
+    with pytest.warns(UserWarning, match=r"^the compiled iteration is unavailable \(.*\); the numpy path is used$"):
+        g = gt.grip(EQ, -EQ, [0, 0, G, 0, 0, 0], 0.5, torsion=0.01)
+    assert float(g.total_normal_force) == pytest.approx(G / 0.5, rel=1e-9)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert compiled.iteration() is None and compiled.kernel() is module
+
+
+def test_socps_compiled_iterations_load_once_inside_the_first_load_watch(monkeypatch):
+    """A fresh install compiles socp's iterations (some 20 s) at their first use: inside hooks.first_load (the
+    command line's notice), once a process, and apart from the grip's kernel (a soft grip alone never compiles
+    it); later calls go straight to the compiled functions."""
+    from grasptwist.engine import hooks
+    from grasptwist.engine.forces import socp
+
+    watched, calls = [], []
+
+    @contextlib.contextmanager
+    def watch():
+        watched.append("open")
+        yield
+        watched.append("closed")
+
+    module = types.SimpleNamespace(
+        iterate_rows=lambda *a: calls.append(("iterate", watched[-1])),
+        polish_rows=lambda *a: calls.append(("polish", watched[-1])),
+    )
+    state = {"on": True, "module": module}  # the kernel's module imported, its grip not loaded
+    monkeypatch.setattr(compiled, "_state", state)
+    monkeypatch.setattr(importlib.util, "find_spec", lambda name: object())  # as if numba were installed
+    A, b = np.zeros((2, 1, 3, 1)), np.ones((2, 1, 3))
+    with hooks.watching_first_load(watch):
+        socp.phase_one(A, b)
+        socp.minimise(A, b, np.ones((2, 1)), np.zeros((2, 1)))
+    assert watched == ["open", "closed"] and "grip" not in state
+    assert calls == [("iterate", "open"), ("polish", "open"), ("iterate", "closed"), ("iterate", "closed")]
+
+
+def test_a_first_load_inside_another_runs_in_the_outer_watch_alone():
+    """A search's warm-up loads the grip's kernel and socp's iterations (each its own first load) inside one
+    first load: one watch, so the command line says once that it compiles; after it, a first load watches anew."""
+    from grasptwist.engine import hooks
+
+    opened = []
+
+    @contextlib.contextmanager
+    def watch():
+        opened.append(len(opened))
+        yield
+
+    with hooks.watching_first_load(watch):
+        with hooks.first_load():
+            with hooks.first_load():
+                pass
+            with hooks.first_load():
+                pass
+        assert opened == [0]
+        with hooks.first_load():
+            pass
+    assert opened == [0, 1]
 
 
 def test_an_infinite_wrench_beside_a_huge_one_keeps_its_status_and_the_huge_one_is_solved():
@@ -949,3 +1030,35 @@ def test_the_compiled_grips_source_follows_the_numpy_path_in_the_default_run():
     forces = out[:, kernel._F : kernel._F + 9].reshape(-1, 3, 3)
     held = plain & reference.ok
     np.testing.assert_allclose(forces[held], reference.force[held], rtol=1e-6, atol=1e-6)
+
+
+def test_the_compiled_iterations_source_follows_the_numpy_twin_on_soft_rows(monkeypatch):
+    """Issue 39, item 1: where numba is on, socp's iterations (the soft contacts' phase I, phase II, dual polish
+    and the rays' phase I for a culprit; the soft closure's phase I) run in kernel.iterate_rows and
+    kernel.polish_rows.  Their own source run as Python, held to socp's numpy twin without a compile: soft,
+    point and frictionless contacts mixed (other numbers of unknowns), held and cannot-hold rows, the same
+    verdicts and culprits, forces, torsions, duals and certificates to 1e-12."""
+    kernel = _kernel_as_python()
+    calls = []
+    iterate, polish = kernel.iterate_rows, kernel.polish_rows
+    monkeypatch.setattr(kernel, "iterate_rows", lambda *a: calls.append(a[0].shape[1:]) or iterate(*a))
+    monkeypatch.setattr(kernel, "polish_rows", lambda *a: calls.append("polish") or polish(*a))
+    p, n, w, mu = grasps(6, 3)
+    e = np.array([[0.01, 0.01, 0.01], [0.02, 0.0, 0.01], [0.0, 0.0, 0.05]] * 2)
+    mu[2, 0] = 0.0  # a frictionless contact beside a soft one
+    with compiled.numpy_path():
+        reference = gt.grip(p, n, w, mu, safety=1.3, torsion=e)
+        closure = gt.forces.force_closure(p[:2], n[:2], torsion=e[:2]).closure_friction
+    monkeypatch.setattr(compiled, "_state", {"on": True, "module": kernel, "iteration": True})
+    with np.errstate(all="ignore"):  # numba's error model is numpy's: a 0 / 0 is NaN, quietly
+        g = gt.grip(p, n, w, mu, safety=1.3, torsion=e)
+        # (K, k, d): all-soft phase I and II, a point contact's fewer unknowns, the rays' phase I (k = 1)
+        assert {(4, 4, 7), (3, 4, 6), (3, 4, 5), (4, 1, 5), "polish"} <= set(calls)
+        calls.clear()
+        np.testing.assert_allclose(gt.forces.force_closure(p[:2], n[:2], torsion=e[:2]).closure_friction, closure)
+        assert calls
+    assert g.status.tolist() == reference.status.tolist() and g.culprit.tolist() == reference.culprit.tolist()
+    assert 2 <= g.ok.sum() <= 4 and g.culprit[~g.ok].min() >= 0
+    scale = np.abs(w).max()
+    for name in ("force", "torsion", "total_normal_force", "dual", "certificate", "gap"):
+        np.testing.assert_allclose(getattr(g, name), getattr(reference, name), rtol=1e-12, atol=1e-12 * scale)

@@ -1,6 +1,7 @@
 """Soft-finger contacts (issue 39): ``|(f_t, tau_n / e)| <= mu f_n``, over the contacts' cones
 (engine/forces/cones.py), held to Clarabel on the same conic programme (tests/conic.py)."""
 
+import contextlib
 import warnings
 
 import numpy as np
@@ -72,13 +73,27 @@ def test_zero_torsion_is_point_contacts_bit_for_bit(path, monkeypatch):
         np.testing.assert_array_equal(getattr(zero, name), getattr(point, name))
 
 
-@pytest.mark.parametrize("count", [100, pytest.param(1000, marks=pytest.mark.slow)])
-def test_soft_grips_equal_clarabels_and_their_certificates_verify(count):
+def _on(path, monkeypatch):
+    """The grip's numpy path, or the compiled one (numba, which conftest.py switches off for the default run)."""
+    if path == "numpy":
+        return compiled.numpy_path()
+    pytest.importorskip("numba")
+    monkeypatch.setitem(compiled._state, "on", True)
+    return contextlib.nullcontext()
+
+
+# over a second: numba compiles the kernel and socp's iterations once per process where its cache is cold
+PATHS = [(100, "numpy"), pytest.param(1000, "numpy", marks=pytest.mark.slow)]
+PATHS.append(pytest.param(1000, "compiled", marks=pytest.mark.slow))
+
+
+@pytest.mark.parametrize(("count", "path"), PATHS)
+def test_soft_grips_equal_clarabels_and_their_certificates_verify(count, path, monkeypatch):
     """Random grasps, soft and point contacts mixed: the verdict and the total to 1e-6 of Clarabel's on the same
     programme; every held row's dual puts each ``(n_i, 0) - G_i^T lambda`` in its dual cone with the gap closed,
     every cannot-hold row's ``y`` has ``y . w > 0`` and ``-G_i^T y`` in every dual cone (Farkas)."""
     p, n, w, mu, e = grasps(count, 43)
-    with compiled.numpy_path():
+    with _on(path, monkeypatch):
         g = gt.grip(p, n, w, mu, safety=1.3, torsion=e)
     refs = [least_soft_grip(p[i], n[i], w[i], mu[i], e[i], 1.3)[0] for i in range(count)]
     decided = np.array([r is None or r == r for r in refs])  # Clarabel's numerical errors: the certificates below
@@ -88,7 +103,12 @@ def test_soft_grips_equal_clarabels_and_their_certificates_verify(count):
     assert (held == clarabel_held)[decided].all() and 0.3 < held.mean() < 0.95
     both = held & decided
     np.testing.assert_allclose(g.total_normal_force[both], np.array([refs[i] for i in np.flatnonzero(both)]), rtol=1e-6)
-    # the forces and torsions make the wrench, within their cones
+    _verified(g, p, n, w, mu / 1.3, e)
+
+
+def _verified(g, p, n, w, limit, e):
+    """The grip's forces and torsions make the wrench within their cones, its dual and certificates verify."""
+    held = g.ok
     made = np.concatenate(
         (
             g.force.sum(axis=1),
@@ -97,17 +117,36 @@ def test_soft_grips_equal_clarabels_and_their_certificates_verify(count):
         axis=1,
     )
     np.testing.assert_allclose(made[held], w[held], atol=1e-8 * np.abs(w).max())
-    assert (g.friction_used[held] <= mu[held] / 1.3 * (1 + 1e-7)).all()
+    assert (g.friction_used[held] <= limit[held] * (1 + 1e-7)).all()
     forces, torsions = _field(g.dual, p, n)
     unit = n / np.linalg.norm(n, axis=-1, keepdims=True)
     total = g.total_normal_force[held]
-    excess = _dual_cone_excess(p, n, e, mu / 1.3, unit - forces, -torsions)[held]
+    excess = _dual_cone_excess(p, n, e, limit, unit - forces, -torsions)[held]
     assert (excess <= 1e-6 * total[:, None]).all()  # as the point contacts' (test_forces.py)
     assert np.median(np.abs(g.gap[held]) / total) < 1e-9 and (np.abs(g.gap[held]) <= 1e-4 * total).all()
     y = g.certificate[~held]
     forces, torsions = _field(y, p[~held], n[~held])
     assert (np.einsum("ni,ni->n", y, w[~held]) > 0).all()
-    assert (_dual_cone_excess(p[~held], n[~held], e[~held], mu[~held] / 1.3, -forces, -torsions) <= 1e-6).all()
+    assert (_dual_cone_excess(p[~held], n[~held], e[~held], limit[~held], -forces, -torsions) <= 1e-6).all()
+
+
+@pytest.mark.slow  # over a second: numba compiles the kernel and socp's iterations once per process (cold cache)
+def test_the_compiled_soft_grip_follows_the_numpy_path(monkeypatch):
+    """Issue 39, item 1: where numba is on, the soft rows' iterations run compiled (kernel.iterate_rows,
+    kernel.polish_rows): on 300 random grasps, soft and point contacts mixed, the same verdicts and culprits
+    as the numpy path, totals to 1e-9, and its duals and certificates verify."""
+    p, n, w, mu, e = grasps(300, 47)
+    with compiled.numpy_path():
+        reference = gt.grip(p, n, w, mu, safety=1.3, torsion=e)
+    with _on("compiled", monkeypatch):
+        g = gt.grip(p, n, w, mu, safety=1.3, torsion=e)
+        assert compiled.iteration() is not None
+    assert (g.status == reference.status).all() and (g.culprit == reference.culprit).all()
+    assert 0.3 < g.ok.mean() < 0.95 and (g.status == gt.forces.Status.CANNOT_HOLD).any()
+    np.testing.assert_allclose(g.total_normal_force, reference.total_normal_force, rtol=1e-9)
+    top = np.nanmax(np.abs(reference.force))
+    np.testing.assert_allclose(g.force, reference.force, rtol=1e-6, atol=1e-6 * top)
+    _verified(g, p, n, w, mu / 1.3, e)
 
 
 def test_two_soft_contacts_resist_a_moment_about_their_line_that_point_contacts_cannot():
@@ -196,13 +235,14 @@ def test_zero_torsion_closure_is_point_contacts_bit_for_bit():
     )
 
 
-@pytest.mark.parametrize("count", [3, pytest.param(1000, marks=pytest.mark.slow)])
-def test_soft_closure_friction_equals_clarabels_bisection(count):
+@pytest.mark.parametrize(("count", "path"), [(3, "numpy")] + PATHS[1:])
+def test_soft_closure_friction_equals_clarabels_bisection(count, path, monkeypatch):
     """The least common friction of closure, soft and point contacts mixed, to 1e-6 of Clarabel's bisection on
     the same conic programme (with numpy's rank of the forces' and torsions' grasp map), and never above the
     point contacts' (a soft cone holds the point cone)."""
     p, n, _, e = _closure_grasps(count, 53)
-    soft = gt.forces.force_closure(p, n, torsion=e).closure_friction
+    with _on(path, monkeypatch):
+        soft = gt.forces.force_closure(p, n, torsion=e).closure_friction
     ref = np.array([clarabel_closure_friction(p[k], n[k], torsion=e[k]) for k in range(count)])
     assert (np.isnan(ref) == np.isnan(soft)).all() and np.isfinite(ref).mean() >= 0.6
     ok = np.isfinite(ref)
@@ -211,13 +251,14 @@ def test_soft_closure_friction_equals_clarabels_bisection(count):
     assert (soft[ok] <= point[ok] * (1 + 1e-9)).all() and (soft[ok] < point[ok] * (1 - 1e-3)).any()
 
 
-@pytest.mark.parametrize("count", [24, pytest.param(1000, marks=pytest.mark.slow)])
-def test_soft_closure_verdicts_equal_clarabels_and_their_certificates_verify(count):
+@pytest.mark.parametrize(("count", "path"), [(24, "numpy")] + PATHS[1:])
+def test_soft_closure_verdicts_equal_clarabels_and_their_certificates_verify(count, path, monkeypatch):
     """With each grasp's own friction: force closure where Clarabel's margin over the internal forces is positive
     (and the grasp map onto); elsewhere a certificate ``y`` that no forces within the cones reach
     (``-G_i^T y`` in every dual cone, ``y != 0``: the grasp cannot exert ``y``)."""
     p, n, mu, e = _closure_grasps(count, 55)
-    c = gt.forces.force_closure(p, n, mu, torsion=e, certificate=True)
+    with _on(path, monkeypatch):
+        c = gt.forces.force_closure(p, n, mu, torsion=e, certificate=True)
     margin = np.array([closure_margin(p[k], n[k], mu[k], e[k]) for k in range(count)])
     onto = np.array([np.linalg.matrix_rank(soft_grasp_map(p[k], n[k], e[k])) == 6 for k in range(count)])
     clear = np.abs(margin) > 1e-7  # Clarabel decides: a margin of 0 is the cones' edge

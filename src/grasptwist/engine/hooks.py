@@ -15,15 +15,29 @@ from contextlib import AbstractContextManager
 __all__ = ["first_load", "watching_first_load"]
 
 _first_load: list[Callable[[], AbstractContextManager]] = [contextlib.nullcontext]
+_within = [0]  # first loads open: one inside another runs in the outer's context alone
 
 
-def first_load() -> AbstractContextManager:
+@contextlib.contextmanager
+def first_load() -> Iterator[None]:
     """The context the compiled kernel's first load runs in (nothing, unless a caller set one).
 
+    A first load inside another (the grip's kernel and the soft contacts' iterations inside a
+    search's warm-up) runs in the outer one's context alone: one watch, one notice.
+
     >>> with first_load():
-    ...     pass
+    ...     with first_load():
+    ...         pass
     """
-    return _first_load[0]()
+    if _within[0]:
+        yield
+        return
+    _within[0] += 1
+    try:
+        with _first_load[0]():
+            yield
+    finally:
+        _within[0] -= 1
 
 
 @contextlib.contextmanager

@@ -65,7 +65,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import partial
-from itertools import combinations
 
 import numpy as np
 
@@ -74,6 +73,8 @@ from ..degeneracy import DEGENERACY_TOL
 from ..screws import cross, dot, norm
 from . import cones, socp
 from .grasp_map import (
+    _PAIRS,
+    _STRICT,
     ForceStatus,
     check_friction,
     check_torsion,
@@ -109,11 +110,8 @@ MAX_CONE_EDGES = 64
 #: normal's line would point along round-off: the other contact's direction is taken.
 _ON_LINE = 1e-6
 
-_PAIRS = np.array(list(combinations(range(6), 2)))
-
 #: Rows per chunk of the closure test.
 CHUNK = 8192
-_STRICT = 1e-12  # margins of unit rows and directions below this are not strict
 
 
 @dataclass(frozen=True, eq=False)

@@ -5,8 +5,11 @@ that needs it, never when ``grasptwist`` is imported.  Compiled functions are ca
 disk (numba's ``cache=True``: in ``__pycache__`` beside the source, or where that is not
 writable in numba's per-user cache directory; ``NUMBA_CACHE_DIR`` chooses another), so
 only a fresh install pays the compile (about a minute), inside
-:func:`~grasptwist.engine.hooks.first_load` (the command line's notice).  ``GRASPTWIST_NUMBA=0`` in the
-environment, or :func:`numpy_path`, keeps to the numpy path, which is the reference.
+:func:`~grasptwist.engine.hooks.first_load` (the command line's notice).  The interior-point
+iterations of :mod:`~grasptwist.engine.forces.socp` (soft contacts' cones, and the rows the
+kernel leaves to numpy) are compiled apart, for any sizes, at their first use
+(:func:`iteration`: some 20 s more on a fresh install, inside the same notice).  ``GRASPTWIST_NUMBA=0``
+in the environment, or :func:`numpy_path`, keeps to the numpy path, which is the reference.
 """
 
 from __future__ import annotations
@@ -20,7 +23,7 @@ import numpy as np
 
 from ..hooks import first_load
 
-__all__ = ["kernel", "numpy_path", "read_only"]
+__all__ = ["kernel", "iteration", "numpy_path", "read_only"]
 
 
 _state = {"on": os.environ.get("GRASPTWIST_NUMBA", "1") != "0", "module": None}
@@ -28,23 +31,35 @@ _state = {"on": os.environ.get("GRASPTWIST_NUMBA", "1") != "0", "module": None}
 
 def kernel():
     """The compiled module (:mod:`~grasptwist.engine.forces.kernel`), or None: numba missing or switched off."""
-    if not _state["on"]:
-        return None
-    if _state["module"] is None:
-        if importlib.util.find_spec("numba") is None:
-            _state["on"] = False
-            return None
-        try:
-            with first_load():  # the caller's watch (the command line's notice of a long compile)
-                from . import kernel as module
+    if _state["on"] and not _state.get("grip") and _numba():
+        with first_load():  # the caller's watch (the command line's notice of a long compile)
+            _loaded(_first_grip, "grip", "the compiled grip")
+    return _state["module"] if _state["on"] else None
 
-                _state["module"] = module
-                _first_grip(module)
-        except (ImportError, RuntimeError, OSError) as error:  # e.g. no directory numba may cache in
+
+def _numba():
+    """Whether numba is installed (if not, the numpy path for good)."""
+    if importlib.util.find_spec("numba") is None:
+        _state["on"] = False
+    return _state["on"]
+
+
+def _loaded(first, part, name):
+    """``first(kernel)`` (the kernel's module imported where it is not yet): ``part`` compiled on a fresh
+    install, else loaded from numba's cache.  Where that fails, the numpy path, warned: for ``part`` alone,
+    or for everything where the grip fails or the module cannot be imported."""
+    try:
+        if _state["module"] is None:
+            from . import kernel as module
+
+            _state["module"] = module
+        first(_state["module"])
+        _state[part] = True
+    except (ImportError, RuntimeError, OSError) as error:  # e.g. no directory numba may cache in
+        _state[part] = False
+        if part == "grip" or _state["module"] is None:
             _state["on"], _state["module"] = False, None
-            warnings.warn(f"the compiled grip is unavailable ({error}); the numpy path is used", stacklevel=3)
-            return None
-    return _state["module"]
+        warnings.warn(f"{name} is unavailable ({error}); the numpy path is used", stacklevel=4)
 
 
 def _first_grip(module):
@@ -54,6 +69,32 @@ def _first_grip(module):
     grasp = [read_only(a) for a in (p, -p, np.full((1, 3), 0.5))]
     wrench, out, codes = np.array([[0, 0, 1.0, 0, 0, 0]]), np.empty((1, module.WIDTH)), np.empty((1, 3), np.int8)
     module.grip_rows(*grasp, wrench, 1e-9, out, codes)
+
+
+def iteration():
+    """The compiled module, where its iteration on rows of any sizes is loaded (:func:`kernel.iterate_rows`,
+    :func:`kernel.polish_rows`: :mod:`~grasptwist.engine.forces.socp`'s), or None.
+
+    Compiled (some 20 s on a fresh install) or loaded from numba's cache at the first use in a process,
+    apart from the grip's kernel (:func:`kernel`): a process whose grips the kernel solves whole
+    (point contacts with friction, not collinear) never pays it, and one that grips soft contacts
+    only never pays the kernel's.  Inside :func:`~grasptwist.engine.hooks.first_load` too (the
+    command line's notice).
+    """
+    if _state["on"] and _state.get("iteration") is None and _numba():
+        with first_load():
+            _loaded(_first_iteration, "iteration", "the compiled iteration")
+    return _state["module"] if _state["on"] and _state.get("iteration") else None
+
+
+def _first_iteration(module):
+    """One phase I and one dual polish of a row with two cones ``t >= |z|``, ``z`` one unknown: in the
+    signatures :mod:`~grasptwist.engine.forces.socp` calls (C-contiguous writable floats)."""
+    A = np.array([[[[0.0], [1.0]], [[1.0], [0.0]]]])
+    b, c = np.array([[[1.0, 0.0], [1.0, 0.0]]]), np.ones((1, 1))
+    x, z = np.zeros((1, 1)), np.full((1, 2, 2), 0.25)
+    module.iterate_rows(A, b, c, x, z, True)
+    module.polish_rows(A, b, c, x, z)
 
 
 def read_only(a):

@@ -31,9 +31,12 @@ certificate ``y = -D^T y'`` with ``B^T (y'; .) = sum_i C_i^T z_i`` (phase I's ``
 
 :func:`~grasptwist.engine.forces.grip.grip` sends here the rows with a soft contact (``torsion=``);
 rows of point or frictionless contacts keep their own way (the squeezes in closed form, the
-compiled kernel), so ``torsion=0`` is point contacts to the last bit.  This way is numpy only
-(no compiled twin yet), and has no facial reduction: a grip that exists only on the cones'
-edge (no internal force strictly inside them) is ``cannot-hold`` here.
+compiled kernel), so ``torsion=0`` is point contacts to the last bit.  The set-up and the finish
+here are numpy; the interior-point iterations (:mod:`~grasptwist.engine.forces.socp`'s phase I,
+phase II, dual polish) run compiled from :mod:`~grasptwist.engine.forces.ipm`'s source where
+numba is on (:func:`compiled.iteration`), its numpy twin otherwise.  There is no facial
+reduction: a grip that exists only on the cones' edge (no internal force strictly inside
+them) is ``cannot-hold`` here.
 """
 
 from __future__ import annotations

@@ -28,6 +28,7 @@ a number is one condition in both.
 from __future__ import annotations
 
 from dataclasses import replace
+from itertools import combinations
 from typing import NamedTuple
 
 import numpy as np
@@ -623,3 +624,11 @@ def contact_matrices(e):
         m[..., i, :, K[i]] = e[..., K[i], :]
         m[..., i, :, J[i]] = -e[..., J[i], :]
     return m
+
+
+# The closure test of the squeezes (closure.closure_test, and its compiled twin in kernel.py, which imports
+# them from here: a module below closure's cones and interior-point method): the pairs of the six unit rows
+# ``R`` (two a contact) whose cross products are the candidate rays, and the margin below which a row's or a
+# direction's is not strict.
+_PAIRS = np.array(list(combinations(range(6), 2)))
+_STRICT = 1e-12

@@ -32,12 +32,11 @@ import numpy as np
 from numba import literally, njit
 
 from . import ipm, one
-from .closure import _PAIRS, _STRICT
-from .grasp_map import GRIP_COLUMNS
+from .grasp_map import _PAIRS, _STRICT, GRIP_COLUMNS
 from .ipm import ITERATIONS as _ITERATIONS
 from .ipm import START_MARGIN
 
-__all__ = ["grip_rows", "WIDTH"]
+__all__ = ["grip_rows", "WIDTH", "iterate_rows", "polish_rows"]
 
 # no reference counting (numba's runtime) in the arithmetic: its atomic increments and decrements
 # on every array passed or sliced were a fifth of a row's time; the workspaces are allocated by
@@ -146,6 +145,33 @@ def _in_lanes(A, b, c, x, z, order, phase_one, d, K, k):
         _iterate(A, b, c, x, z, order, phase_one, d, K, k, 1)
     else:
         _iterate(A, b, c, x, z, order, phase_one, d, K, k, _LANES)
+
+
+@njit(**(_JIT | {"_nrt": True}))
+def iterate_rows(A, b, c, x, z, phase_one):
+    """:func:`socp._iterate` (``phase_one``: its leaving rule, else phase II's) on all the rows of
+    ``A (n, K, k, d)``, ``b (n, K, k)``, ``c (n, d)``, from ``x (n, d)`` and ``z (n, K, k)``, moved in place.
+
+    :func:`socp.phase_one`, :func:`~socp.minimise` (and so the soft contacts' grip,
+    :mod:`~grasptwist.engine.forces.cones`, and every other programme set up in numpy) run their
+    iterations here where numba is on: :func:`_iterate` with the sizes as numbers, not literal,
+    so one compile (some 20 s on a fresh install, :func:`compiled.iteration`) serves every
+    ``(d, K, k)``, at about 1.7 times the time of a literal size's unrolled loops
+    (:func:`_in_lanes`, a compile per size).  :data:`_LANES` lanes where the rows fill them,
+    else one.
+    """
+    n, K, k, d = A.shape
+    _iterate(A, b, c, x, z, np.arange(n), phase_one, d, K, k, _LANES if n >= _LANES else 1)
+
+
+@njit(**(_JIT | {"_nrt": True}))
+def polish_rows(A, b, c, s, z):
+    """:func:`socp.dual_polish` on all the rows (:func:`one.dual_polish` each): ``z (n, K, k)`` in place,
+    from ``A (n, K, k, d)``, ``b (n, K, k)``, ``c (n, d)`` and the optimum ``s (n, d)``."""
+    n, K, k, d = A.shape
+    omega, h, dz = np.empty(K), np.empty((d, d + 1)), np.empty((K, k))
+    for r in range(n):
+        _dual_polish(A[r], b[r], c[r], s[r], z[r], omega, h, dz)
 
 
 @njit(**_JIT)

@@ -169,56 +169,57 @@ def _cone_value(a, bm, x):
 
 
 def dual_polish(A, b, c, x, z, omega, h, dz):
-    """:func:`socp.dual_polish` for one row: ``z (K, 3)`` moved in place to ``sum_m A_m^T z_m = c`` again.
+    """:func:`socp.dual_polish` for one row: ``z (K, k)`` moved in place to ``sum_m A_m^T z_m = c`` again.
 
-    ``A (K, 3, d)``, ``b (K, 3)``, ``c (d)``, ``x (d)``; workspaces ``omega (K)``, ``h (d, d + 1)``
-    (the matrix, then the right-hand side), ``dz (K, 3)``.  Elimination without pivoting; a row
+    ``A (K, k, d)``, ``b (K, k)``, ``c (d)``, ``x (d)``; workspaces ``omega (K)``, ``h (d, d + 1)``
+    (the matrix, then the right-hand side), ``dz (K, k)``.  Elimination without pivoting; a row
     whose correction is not finite (every cone idle) is left as it is.  Arrays indexed
-    element by element: :mod:`~grasptwist.engine.forces.kernel` compiles this same function,
-    and :func:`solve` runs it as Python.
+    element by element: :mod:`~grasptwist.engine.forces.kernel` compiles this same function (for
+    the grip's rows, ``k = 3``, and for :func:`socp.dual_polish`'s of any cone), and :func:`solve`
+    runs it as Python.
     """
-    K, d = A.shape[0], A.shape[2]
+    K, k, d = A.shape
     for j in range(d):
         h[j, d] = c[j]
     for m in range(K):
         ny, nz = 0.0, 0.0
-        for k in range(3):
-            t = b[m, k]
+        for q in range(k):
+            t = b[m, q]
             for j in range(d):
-                t += A[m, k, j] * x[j]
-                h[j, d] -= A[m, k, j] * z[m, k]
+                t += A[m, q, j] * x[j]
+                h[j, d] -= A[m, q, j] * z[m, q]
             ny += t * t
-            nz += z[m, k] * z[m, k]
+            nz += z[m, q] * z[m, q]
         omega[m] = math.sqrt(nz) / max(math.sqrt(ny), 1e-300)
     for i in range(d):
         for j in range(d):
             t = 0.0
             for m in range(K):
-                for k in range(3):
-                    t += omega[m] * A[m, k, i] * A[m, k, j]
+                for q in range(k):
+                    t += omega[m] * A[m, q, i] * A[m, q, j]
             h[i, j] = t
         h[i, i] += 1e-300
-    for k in range(d):
-        for i in range(k + 1, d):
-            f = h[i, k] / h[k, k]
-            for j in range(k + 1, d + 1):
-                h[i, j] -= f * h[k, j]
+    for q in range(d):
+        for i in range(q + 1, d):
+            f = h[i, q] / h[q, q]
+            for j in range(q + 1, d + 1):
+                h[i, j] -= f * h[q, j]
     for i in range(d - 1, -1, -1):
         v = h[i, d]
         for j in range(i + 1, d):
             v -= h[i, j] * h[j, d]
         h[i, d] = v / h[i, i]
     for m in range(K):
-        for k in range(3):
+        for q in range(k):
             t = 0.0
             for j in range(d):
-                t += A[m, k, j] * h[j, d]
-            dz[m, k] = t * omega[m]
-            if not math.isfinite(dz[m, k]):
+                t += A[m, q, j] * h[j, d]
+            dz[m, q] = t * omega[m]
+            if not math.isfinite(dz[m, q]):
                 return
     for m in range(K):
-        for k in range(3):
-            z[m, k] += dz[m, k]
+        for q in range(k):
+            z[m, q] += dz[m, q]
 
 
 def solve(A, b, c, P, inside, normal_det, rays):

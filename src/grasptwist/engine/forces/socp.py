@@ -22,8 +22,10 @@ A row leaves once its gap is below ``GAP`` of its objective's scale (``1 + |c^T 
 rows are scaled by their caller to order one, so the objective is then that close to the
 optimum.  It takes 10-25 iterations a row, about a third of the Newton steps of a barrier
 method with damped steps.  The iteration is written once, in
-:mod:`~grasptwist.engine.forces.ipm` (its lane form, which numba compiles); this module runs
-its numpy twin (:mod:`~grasptwist.engine.forces._twin`) over all the rows still iterating,
+:mod:`~grasptwist.engine.forces.ipm` (its lane form, which numba compiles); where numba is on
+(:func:`compiled.iteration`) this module's functions hand their rows to that compiled source
+(:func:`kernel.iterate_rows`, :func:`kernel.polish_rows`), else they run its numpy twin
+(:mod:`~grasptwist.engine.forces._twin`), the reference, over all the rows still iterating,
 gathering out those that are done, and a few rows (:data:`ALONE`) through the float twin of
 :mod:`~grasptwist.engine.forces.one`, a row at a time (numpy's cost per call is then all there is).
 
@@ -48,7 +50,7 @@ import functools
 
 import numpy as np
 
-from . import ipm, one
+from . import compiled, ipm, one
 from .ipm import GAP, ITERATIONS, START_MARGIN
 
 __all__ = ["GAP", "START_MARGIN", "phase_one", "minimise", "dual_polish"]
@@ -123,9 +125,26 @@ def _iterate(A, b, c, x, z, phase_one):
     return x
 
 
-def _layout(A, b):
-    """``(n, K, k, d)``, ``(n, K, k)`` -> the lane form's ``(K, k, d, n)``, ``(K, k, n)``."""
-    return np.ascontiguousarray(A.transpose(1, 2, 3, 0)), np.ascontiguousarray(b.transpose(1, 2, 0))
+def _iterated(A, b, c, x, z, phase_one):
+    """:func:`_iterate` on rows first: ``A (n, K, k, d)``, ``b (n, K, k)``, ``c (n, d)`` from ``x (n, d)``,
+    ``z (n, K, k)``; returns the new ``x`` and ``z``.  Compiled where numba is on
+    (:func:`kernel.iterate_rows`, :mod:`~grasptwist.engine.forces.ipm`'s source too), else this
+    module's numpy twin, the reference."""
+    x, z = np.array(x, float), np.array(z, float)  # copies, C-contiguous: moved in place
+    module = compiled.iteration()
+    if module is not None:
+        A, b, c = (_plain(a) for a in (A, b, c))
+        module.iterate_rows(A, b, c, x, z, bool(phase_one))
+        return x, z
+    lanes = np.ascontiguousarray(A.transpose(1, 2, 3, 0)), np.ascontiguousarray(b.transpose(1, 2, 0))
+    x, z = np.ascontiguousarray(x.T), np.ascontiguousarray(z.transpose(1, 2, 0))
+    x = _iterate(*lanes, np.ascontiguousarray(c.T), x, z, phase_one)
+    return x.T, z.transpose(2, 0, 1)
+
+
+def _plain(a):
+    """``a`` as the compiled functions take it, in their one signature: C-contiguous writable floats."""
+    return np.require(a, float, ("C", "W"))
 
 
 def phase_one(A, b):
@@ -146,15 +165,14 @@ def phase_one(A, b):
     bw[:, :K] = b
     bw[:, K, 0] = 1.0
     over = _norm_z(np.moveaxis(b, -1, 0)) - b[..., 0]
-    x = np.zeros((d + 1, n))
-    x[d] = np.maximum(over.max(axis=-1) + 1, 0.0)
-    z = np.zeros((K + 1, k, n))
-    z[:, 0] = 0.25  # makes the r column of the dual, not yet the squeezes' columns
-    c = np.zeros((d + 1, n))
-    c[d] = 1.0
-    wide, bw = _layout(wide, bw)
-    x = _iterate(wide, bw, c, x, z, True)
-    return np.ascontiguousarray(x[:d].T), x[d], np.ascontiguousarray(z[:K].transpose(2, 0, 1))
+    x = np.zeros((n, d + 1))
+    x[:, d] = np.maximum(over.max(axis=-1) + 1, 0.0)
+    z = np.zeros((n, K + 1, k))
+    z[..., 0] = 0.25  # makes the r column of the dual, not yet the squeezes' columns
+    c = np.zeros((n, d + 1))
+    c[:, d] = 1.0
+    x, z = _iterated(wide, bw, c, x, z, True)
+    return np.ascontiguousarray(x[:, :d]), x[:, d], np.ascontiguousarray(z[:, :K])
 
 
 def minimise(A, b, c, x):
@@ -166,14 +184,9 @@ def minimise(A, b, c, x):
     (``sum_m A_m^T z_m = c`` to round-off); the gap ``sum_m y_m . z_m`` is below ``GAP``
     of the objective's scale where a row closed.
     """
-    n = len(x)
-    A, b = _layout(A, b)
-    c = np.ascontiguousarray(c.T)
-    x = np.ascontiguousarray(x.T)
-    z = np.zeros((A.shape[0], A.shape[1], n))
-    z[:, 0] = 1.0
-    x = _iterate(A, b, c, x, z, False)
-    return x.T, z.transpose(2, 0, 1)
+    z = np.zeros(A.shape[:3])
+    z[..., 0] = 1.0
+    return _iterated(A, b, c, x, z, False)
 
 
 def dual_polish(A, b, c, s, z):
@@ -181,8 +194,14 @@ def dual_polish(A, b, c, s, z):
 
     The correction ``dz_m = omega_m A_m delta`` with ``omega_m = |z_m| / |y_m|`` goes to the cones
     whose multipliers carry the optimum (``y_m`` on the edge, ``z_m`` large), not to idle ones
-    (``z_m`` near 0), so every ``z_m`` stays in its cone to round-off.
+    (``z_m`` near 0), so every ``z_m`` stays in its cone to round-off.  Compiled where numba is on
+    (:func:`kernel.polish_rows`: :func:`one.dual_polish`, by elimination without pivoting).
     """
+    module = compiled.iteration()
+    if module is not None:
+        z = np.array(z, float)
+        module.polish_rows(*(_plain(a) for a in (A, b, c, s)), z)
+        return z
     y = np.einsum("nmkd,nd->nmk", A, s) + b
     res = c - np.einsum("nmkd,nmk->nd", A, z)
     omega = np.linalg.norm(z, axis=-1) / np.maximum(np.linalg.norm(y, axis=-1), 1e-300)

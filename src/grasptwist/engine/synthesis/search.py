@@ -39,6 +39,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from ..forces import compiled
+from ..hooks import first_load
 from .archive import Archive
 from .budget import Spending
 from .candidates import candidate_triples, tangent_steps
@@ -496,12 +497,17 @@ def _ball_project(q):
 def warm_up():
     """The one-time work of a process's first search, done before any budget's clock starts: a small
     search of a ball, which compiles the grip's numba kernels for the very arrays a search gives them
-    (its batches and its verification's single rows), or loads them from numba's cache; once a process,
-    and nothing on the numpy path.
+    (its batches and its verification's single rows), or loads them from numba's cache, and the compiled
+    interior-point iterations of soft contacts' cones (``compiled.iteration``); once a
+    process, and nothing on the numpy path.
 
     >>> warm_up()
     """
-    if _WARM or compiled.kernel() is None:  # done, or the numpy path: nothing to compile
+    if _WARM:
         return
-    _WARM.append(True)  # first: the search below warms up too
+    with first_load():  # one watch (the command line's one notice) for both
+        if compiled.kernel() is None:  # the numpy path: nothing to compile
+            return
+        compiled.iteration()  # soft contacts' cones, and any row the grip's kernel leaves to socp
+    _WARM.append(True)  # before the search below, which warms up too
     search(Surface(_ball_sample, _ball_project, 2 * 3**0.5), [[0, 0, 1.0, 0, 0, 0]], 0.5, candidates=200)
