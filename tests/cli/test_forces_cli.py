@@ -637,6 +637,26 @@ def test_a_first_grip_that_compiles_long_is_said_once_on_stderr_and_not_with_qui
     assert r.exit_code == 0 and "compiling" not in r.stderr
 
 
+def test_one_command_says_its_compile_once_however_many_first_loads_it_has(monkeypatch, capsys):
+    """A fresh install's forces run of point and soft grasps loads the grip's kernel, then the soft contacts'
+    iterations (compiled apart): the command's notices (diagnostics.compile_notices) say one line."""
+    import time
+
+    from grasptwist.cli import diagnostics
+
+    monkeypatch.setattr(diagnostics, "COMPILE_NOTICE_AFTER", 0.0)
+    notices, said = diagnostics.compile_notices(False), []
+    for _ in range(2):
+        with notices():
+            deadline = time.monotonic() + 10
+            while not said and time.monotonic() < deadline:  # the first load's line, said by its timer
+                time.sleep(0.01)
+                said += [line for line in capsys.readouterr().err.splitlines() if "compiling" in line]
+            time.sleep(0.2)  # the second load: a timer of 0 s would have said it again by now
+        said += [line for line in capsys.readouterr().err.splitlines() if "compiling" in line]
+    assert len(said) == 1 and said[0].startswith("grasptwist: compiling the grip's numba kernels")
+
+
 def test_the_kernels_first_load_runs_inside_the_callers_watch(monkeypatch):
     """compiled.kernel() loads the kernel and makes its first grip inside engine.hooks.first_load (a fake kernel
     module here: no numba)."""

@@ -26,6 +26,7 @@ __all__ = [
     "progress_bar",
     "COMPILE_NOTICE_AFTER",
     "compile_notice",
+    "compile_notices",
 ]
 
 
@@ -280,10 +281,10 @@ COMPILE_NOTICE_AFTER = 10.0
 
 
 @contextmanager
-def compile_notice(quiet: bool, more: str = ""):
+def compile_notice(quiet: bool, more: str = "", said: list | None = None):
     """Around the compiled grip's first load (:func:`~grasptwist.engine.hooks.watching_first_load`): one line on
     stderr once it outlasts :data:`COMPILE_NOTICE_AFTER` (a fresh install's compile), ending with ``more``;
-    none with ``quiet``."""
+    none with ``quiet``, or where ``said`` (a list, appended to when the line is said) already holds one."""
     import threading
 
     def notice():
@@ -291,12 +292,22 @@ def compile_notice(quiet: bool, more: str = ""):
             "grasptwist: compiling the grip's numba kernels, once per install (about a minute, longer on a busy "
             f"machine){more}"
         )
+        if said is not None:
+            said.append(True)
 
     timer = threading.Timer(COMPILE_NOTICE_AFTER, notice)
     timer.daemon = True
-    if not quiet:
+    if not (quiet or said):
         timer.start()
     try:
         yield
     finally:
         timer.cancel()
+
+
+def compile_notices(quiet: bool, more: str = ""):
+    """One command's factory for :func:`~grasptwist.engine.hooks.watching_first_load`: a :func:`compile_notice`
+    around each first load, of which one at most says its line (the grip's kernel and the soft contacts'
+    iterations compile apart, one after the other, on a fresh install)."""
+    said: list = []
+    return lambda: compile_notice(quiet, more, said)

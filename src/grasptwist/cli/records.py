@@ -8,7 +8,7 @@ from typing import NamedTuple
 
 from ..engine.hooks import watching_first_load
 from ..output.formats import FORMATS
-from .diagnostics import Diagnostics, Warnings, compile_notice, error_code, progress_bar, table_hint
+from .diagnostics import Diagnostics, Warnings, compile_notices, error_code, progress_bar, table_hint
 from .exits import EXIT_FAILED, EXIT_OK, EXIT_USAGE, failed, output_target
 
 __all__ = ["OutputSettings", "worker_count", "write_records"]
@@ -52,7 +52,7 @@ def write_records(job, paths: list[str], settings: OutputSettings) -> int:
         job = replace(job, reading=replace(job.reading, output=replaced))
     reads_output = False
     with (
-        watching_first_load(lambda: compile_notice(settings.quiet)),  # a fresh install's first grip compiles
+        watching_first_load(compile_notices(settings.quiet)),  # a fresh install's first grip compiles
         output_target(settings.output, [*inputs, *settings.reads]) as out,
         progress_bar(inputs, job.command.name, out, counted, job.family.long_inputs) as advance,
     ):

@@ -6,7 +6,7 @@ from typing import Annotated
 import typer
 
 from ..engine.synthesis.scores import MIN_CONDITIONING
-from .diagnostics import Warnings, compile_notice
+from .diagnostics import Warnings, compile_notices
 from .exits import checked_output, run_command
 from .options import (
     ALL,
@@ -96,11 +96,11 @@ def _reading(reading, grasp_file):
 def _warmed_up(quiet: bool) -> None:
     """The grip's kernels compiled, or loaded from numba's cache, before any search's clock starts
     (:func:`~grasptwist.engine.synthesis.search.warm_up`; the workers forked later inherit them),
-    under the command line's notice of a long compile (:func:`~.diagnostics.compile_notice`)."""
+    under the command line's notice of a long compile (:func:`~.diagnostics.compile_notices`)."""
     from ..engine.hooks import watching_first_load
     from ..engine.synthesis.search import warm_up
 
-    with watching_first_load(lambda: compile_notice(quiet, "; --seconds counts from when it is done")):
+    with watching_first_load(compile_notices(quiet, "; --seconds counts from when it is done")):
         warm_up()
 
 
