@@ -611,21 +611,28 @@ def test_check_judges_closure_with_soft_contacts_and_says_the_model(tmp_path):
 
 def test_a_first_grip_that_compiles_long_is_said_once_on_stderr_and_not_with_quiet(monkeypatch):
     """A fresh install's first grip compiles numba's kernel (about a minute): forces says so, as synthesize does,
-    through the kernel's first load (engine.hooks); shortened here to a 0.3 s load past a notice time of 0."""
-    import time
+    through the kernel's first load (engine.hooks); shortened here to a load that lasts until the notice is
+    said (a notice time of 0), or 0.2 s with -q."""
+    import threading
 
     from grasptwist.cli import diagnostics
     from grasptwist.engine import hooks
     from grasptwist.engine.forces import compiled
 
-    loads = []
+    loads, noticed = [], threading.Event()
+    say = diagnostics.to_stderr
+
+    def to_stderr(line):
+        say(line)
+        noticed.set()
 
     def kernel():  # the first load, watched as the real one is, then the numpy path
         if not loads:
             loads.append(True)
             with hooks.first_load():
-                time.sleep(0.3)
+                noticed.wait(10)
 
+    monkeypatch.setattr(diagnostics, "to_stderr", to_stderr)
     monkeypatch.setattr(diagnostics, "COMPILE_NOTICE_AFTER", 0.0)
     monkeypatch.setattr(compiled, "kernel", kernel)
     r, recs = records(SPHERE, "-j", "1")
@@ -633,6 +640,8 @@ def test_a_first_grip_that_compiles_long_is_said_once_on_stderr_and_not_with_qui
     assert r.stderr.count("compiling the grip's numba kernels, once per install") == 1
     assert "--seconds" not in r.stderr  # synthesize's budget is no part of forces
     loads.clear()
+    noticed.clear()
+    monkeypatch.setattr(noticed, "wait", lambda timeout: threading.Event().wait(0.2))  # -q: none would come
     r, _ = records(SPHERE, "-j", "1", "-q")
     assert r.exit_code == 0 and "compiling" not in r.stderr
 
