@@ -60,6 +60,13 @@ def grasps(n, seed=0):
     return p, normals, wrench, friction
 
 
+def agreement(a, b):
+    """How two grips of the same grasps agree: statuses and culprits, and totals where ``b`` holds."""
+    same = ((a.status == b.status) & (a.culprit == b.culprit)).mean()
+    diff = np.abs(a.total_normal_force[b.ok] / b.total_normal_force[b.ok] - 1).max()
+    return f"same status and culprit {same:.3%}, total normal force max rel diff {diff:.1e}"
+
+
 def median_us(call, count):
     """Median wall time of ``call(i)`` for ``i < count``, in microseconds."""
     times = []
@@ -128,12 +135,7 @@ def batched(p, n, w, mu, k, kc):
             f"{per[0] * size / t_grip:.0f}x; held {grips[name].ok.mean():.1%}"
         )
     if len(grips) == 2:
-        a, b = grips["compiled"], grips["numpy"]
-        ok = b.ok
-        print(
-            f"compiled against numpy, all {size}: same status and culprit {((a.status == b.status) & (a.culprit == b.culprit)).mean():.3%}, "
-            f"total normal force max rel diff {np.abs(a.total_normal_force[ok] / b.total_normal_force[ok] - 1).max():.1e}"
-        )
+        print(f"compiled against numpy, all {size}: {agreement(grips['compiled'], grips['numpy'])}")
     c, t_closure = cpu(lambda: gt.forces.force_closure(p, n, mu))
     print(
         f"closure friction, {size} grasps: engine {1e6 * t_closure / size:.1f} us a grasp (CPU), Clarabel bisection "
@@ -217,13 +219,9 @@ def soft(p, n, w, mu, m, count):
             f"(median of {count}); held {g.ok.mean():.1%}"
         )
     if len(grips) == 2:
-        a, b = grips["compiled"], grips["numpy"]
-        ok = b.ok
         print(
             f"soft, compiled against numpy: batched {times['numpy'][0] / times['compiled'][0]:.2f}x, single "
-            f"{times['numpy'][1] / times['compiled'][1]:.1f}x; same status and culprit "
-            f"{((a.status == b.status) & (a.culprit == b.culprit)).mean():.3%}, total normal force max rel diff "
-            f"{np.abs(a.total_normal_force[ok] / b.total_normal_force[ok] - 1).max():.1e}"
+            f"{times['numpy'][1] / times['compiled'][1]:.1f}x; {agreement(grips['compiled'], grips['numpy'])}"
         )
 
 
