@@ -344,7 +344,8 @@ def _corrector(y, z, dy, dz, v, beta, square, rhs, mu, step, sigma, each, p, q, 
                 s += (y[m, i, ln] + st * dy[m, i, ln]) * (z[m, i, ln] + st * dz[m, i, ln])
             each[m, ln] = s
     for ln in range(width):
-        sigma[ln] = np.minimum(np.maximum(_cone_sum(each, K, ln) / K / mu[ln], 0.0), 1.0) ** 3
+        ratio = np.minimum(np.maximum(_cone_sum(each, K, ln) / K / mu[ln], 0.0), 1.0)
+        sigma[ln] = ratio * ratio * ratio  # not ** 3: numpy's power on arrays and Python's differ in the last bit
     for m in every(K):
         for ln in range(width):
             _w_inv(v, beta, dy, p, m, k, ln)
