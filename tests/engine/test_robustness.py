@@ -121,6 +121,8 @@ def test_on_a_ball_robustness_falls_as_the_contacts_approach_the_cone_edge():
     r = robustness(surface_of(BALL), p, n, LIFT, mu, position_error=0.002, perturbations=256)
     assert (np.diff(r) <= 0).all() and r[0] == 1.0 and r[-1] == 0.0
     assert 0 < r[3] < 1  # between: the draws decide
+    # no wrench to hold: every perturbation holds it (a division by the wrenches' count had raised)
+    assert robustness(surface_of(BALL), p, n, np.empty((0, 6)), mu, perturbations=8).tolist() == [1.0] * len(p)
 
 
 def test_a_disc_of_perturbations_crosses_a_box_edge_as_often_as_the_circular_segment_says():

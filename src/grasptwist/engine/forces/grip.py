@@ -309,7 +309,7 @@ def wrench_grips(points, normals, wrenches, friction, *, safety=1.0, torsion=Non
     mu = np.asarray(friction, float)
     mu = np.broadcast_to(mu[:, None] if mu.ndim == 1 else mu, (len(p), 3))
     total, ok = np.full((len(p), len(w)), np.nan), np.zeros((len(p), len(w)), bool)
-    step = max(CHUNK // len(w), 1)
+    step = max(CHUNK // max(len(w), 1), 1)  # no wrenches: (N, 0), every row holds them all
     for at in range(0, len(p), step):  # no rows: no grip (an empty batch)
         rows = slice(at, at + step)
         g = grip(p[rows, None], n[rows, None], w, mu[rows, None], safety=safety, torsion=torsion, tol=tol)

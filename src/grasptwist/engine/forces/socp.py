@@ -130,7 +130,7 @@ def _iterated(A, b, c, x, z, phase_one):
     ``z (n, K, k)``; returns the new ``x`` and ``z``.  Compiled where numba is on
     (:func:`kernel.iterate_rows`, :mod:`~grasptwist.engine.forces.ipm`'s source too), else this
     module's numpy twin, the reference."""
-    x, z = np.array(x, float), np.array(z, float)  # copies, C-contiguous: moved in place
+    x, z = np.array(x, float, order="C"), np.array(z, float, order="C")  # copies, moved in place
     module = compiled.iteration()
     if module is not None:
         A, b, c = (_plain(a) for a in (A, b, c))
@@ -199,7 +199,7 @@ def dual_polish(A, b, c, s, z):
     """
     module = compiled.iteration()
     if module is not None:
-        z = np.array(z, float)
+        z = np.array(z, float, order="C")
         module.polish_rows(*(_plain(a) for a in (A, b, c, s)), z)
         return z
     y = np.einsum("nmkd,nd->nmk", A, s) + b
