@@ -73,8 +73,8 @@ from ..degeneracy import DEGENERACY_TOL
 from ..screws import cross, dot, norm
 from . import cones, socp
 from .grasp_map import (
-    _PAIRS,
-    _STRICT,
+    CLOSURE_PAIRS,
+    STRICT_MARGIN,
     ForceStatus,
     check_friction,
     check_torsion,
@@ -198,7 +198,7 @@ def closure_test(rows):
 
 def _closure_chunk(r):
     """:func:`closure_test` on components-first rows ``(6, 3, n)``."""
-    a, b = r[_PAIRS[:, 0]], r[_PAIRS[:, 1]]  # (15, 3, n)
+    a, b = r[CLOSURE_PAIRS[:, 0]], r[CLOSURE_PAIRS[:, 1]]  # (15, 3, n)
     c = np.stack(
         (
             a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1],
@@ -210,13 +210,13 @@ def _closure_chunk(r):
     with np.errstate(invalid="ignore", divide="ignore"):
         c /= length
     d = r[:, 0, None] * c[0] + r[:, 1, None] * c[1] + r[:, 2, None] * c[2]  # (6, 15, n)
-    real = length > _STRICT
-    sign = ((d >= -_STRICT).all(axis=0) & real).astype(float) - ((d <= _STRICT).all(axis=0) & real)
+    real = length > STRICT_MARGIN
+    sign = ((d >= -STRICT_MARGIN).all(axis=0) & real).astype(float) - ((d <= STRICT_MARGIN).all(axis=0) & real)
     s = (np.nan_to_num(c) * sign).sum(axis=1)  # (3, n): the sum of the extreme rays found
     s_len = np.sqrt(s[0] ** 2 + s[1] ** 2 + s[2] ** 2)
     with np.errstate(invalid="ignore", divide="ignore"):
         s /= s_len
-        ok = (s_len > _STRICT) & ((r[:, 0] * s[0] + r[:, 1] * s[1] + r[:, 2] * s[2]) > _STRICT).all(axis=0)
+        ok = (s_len > STRICT_MARGIN) & ((r[:, 0] * s[0] + r[:, 1] * s[1] + r[:, 2] * s[2]) > STRICT_MARGIN).all(axis=0)
     return ok, s.T
 
 

@@ -39,6 +39,8 @@ from ..degeneracy import DEGENERACY_TOL
 from ..screws import J, K, cross, dot, norm
 
 __all__ = [
+    "CLOSURE_PAIRS",
+    "STRICT_MARGIN",
     "Status",
     "ForceStatus",
     "force_status_message",
@@ -626,9 +628,10 @@ def contact_matrices(e):
     return m
 
 
-# The closure test of the squeezes (closure.closure_test, and its compiled twin in kernel.py, which imports
-# them from here: a module below closure's cones and interior-point method): the pairs of the six unit rows
-# ``R`` (two a contact) whose cross products are the candidate rays, and the margin below which a row's or a
-# direction's is not strict.
-_PAIRS = np.array(list(combinations(range(6), 2)))
-_STRICT = 1e-12
+#: The closure test of the squeezes (closure.closure_test, and its compiled twin in kernel.py, which import
+#: them from here: a module below closure's cones and interior-point method): the pairs of the six unit rows
+#: ``R`` (two a contact) whose cross products are the candidate rays.
+CLOSURE_PAIRS = np.array(list(combinations(range(6), 2)))
+
+#: The closure test's margin below which a row's or a direction's is not strict.
+STRICT_MARGIN = 1e-12

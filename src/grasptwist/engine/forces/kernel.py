@@ -32,7 +32,7 @@ import numpy as np
 from numba import literally, njit
 
 from . import ipm, one
-from .grasp_map import _PAIRS, _STRICT, GRIP_COLUMNS
+from .grasp_map import CLOSURE_PAIRS, GRIP_COLUMNS, STRICT_MARGIN
 from .ipm import ITERATIONS as _ITERATIONS
 from .ipm import START_MARGIN
 
@@ -519,25 +519,25 @@ def _internal_inside(p, unit, mv, e, limit, out, rows):
             for sq in range(3):
                 rows[2 * i + edge, sq] /= length
     s0 = s1 = s2 = 0.0
-    for pair in range(len(_PAIRS)):  # in closure_test's order
-        a, c = _PAIRS[pair]
+    for pair in range(len(CLOSURE_PAIRS)):  # in closure_test's order
+        a, c = CLOSURE_PAIRS[pair]
         c0, c1, c2 = _cross(rows[a, 0], rows[a, 1], rows[a, 2], rows[c, 0], rows[c, 1], rows[c, 2])
         length = math.sqrt(c0 * c0 + c1 * c1 + c2 * c2)
-        if not length > _STRICT:
+        if not length > STRICT_MARGIN:
             continue
         c0, c1, c2 = c0 / length, c1 / length, c2 / length
         above, below = True, True
         for k in range(6):
             t = rows[k, 0] * c0 + rows[k, 1] * c1 + rows[k, 2] * c2
-            above = above and t >= -_STRICT
-            below = below and t <= _STRICT
+            above = above and t >= -STRICT_MARGIN
+            below = below and t <= STRICT_MARGIN
         sign = (1.0 if above else 0.0) - (1.0 if below else 0.0)
         s0, s1, s2 = s0 + c0 * sign, s1 + c1 * sign, s2 + c2 * sign
     length = math.sqrt(s0 * s0 + s1 * s1 + s2 * s2)
     s0, s1, s2 = s0 / length, s1 / length, s2 / length
-    good = good and length > _STRICT
+    good = good and length > STRICT_MARGIN
     for k in range(6):
-        good = good and rows[k, 0] * s0 + rows[k, 1] * s1 + rows[k, 2] * s2 > _STRICT
+        good = good and rows[k, 0] * s0 + rows[k, 1] * s1 + rows[k, 2] * s2 > STRICT_MARGIN
     out[0], out[1], out[2] = (s0, s1, s2) if good else (math.nan, math.nan, math.nan)
 
 
