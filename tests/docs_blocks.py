@@ -36,7 +36,8 @@ def pages() -> list[Path]:
 @dataclass(frozen=True)
 class Block:
     """One fenced block: its page, the 1-based line of its opening fence, the info string's first
-    word (``lang``) and the words after it (``options``: ``slow``, ``file=NAME``, ``requires=A,B``)."""
+    word (``lang``) and the words after it (``options``: ``slow``, ``file=NAME``, ``requires=A,B``,
+    ``session=NAME``)."""
 
     page: Path
     line: int

@@ -609,61 +609,67 @@ def test_check_judges_closure_with_soft_contacts_and_says_the_model(tmp_path):
     assert r.exit_code == 2 and "soft contacts need friction" in r.stderr and not r.stdout
 
 
+class _LongLoad:
+    """``threading.Timer`` for a load that outlasts the notice's time: ``start()`` says the notice at once;
+    ``started`` counts the timers started (none: no notice could come)."""
+
+    started: list = []
+
+    def __init__(self, interval, function):
+        self.function, self.daemon = function, False
+
+    def start(self):
+        self.started.append(self.function)
+        self.function()
+
+    def cancel(self):
+        pass
+
+
 def test_a_first_grip_that_compiles_long_is_said_once_on_stderr_and_not_with_quiet(monkeypatch):
     """A fresh install's first grip compiles numba's kernel (about a minute): forces says so, as synthesize does,
-    through the kernel's first load (engine.hooks); shortened here to a load that lasts until the notice is
-    said (a notice time of 0), or 0.2 s with -q."""
+    through the kernel's first load (engine.hooks), here a load that outlasts the notice's time."""
     import threading
 
-    from grasptwist.cli import diagnostics
     from grasptwist.engine import hooks
     from grasptwist.engine.forces import compiled
 
-    loads, noticed = [], threading.Event()
-    say = diagnostics.to_stderr
-
-    def to_stderr(line):
-        say(line)
-        noticed.set()
+    loads = []
 
     def kernel():  # the first load, watched as the real one is, then the numpy path
         if not loads:
             loads.append(True)
             with hooks.first_load():
-                noticed.wait(10)
+                pass
 
-    monkeypatch.setattr(diagnostics, "to_stderr", to_stderr)
-    monkeypatch.setattr(diagnostics, "COMPILE_NOTICE_AFTER", 0.0)
+    monkeypatch.setattr(threading, "Timer", _LongLoad)
+    monkeypatch.setattr(_LongLoad, "started", [])
     monkeypatch.setattr(compiled, "kernel", kernel)
     r, recs = records(SPHERE, "-j", "1")
     assert r.exit_code == 0 and recs, r.stderr
     assert r.stderr.count("compiling the grip's numba kernels, once per install") == 1
     assert "--seconds" not in r.stderr  # synthesize's budget is no part of forces
     loads.clear()
-    noticed.clear()
-    monkeypatch.setattr(noticed, "wait", lambda timeout: threading.Event().wait(0.2))  # -q: none would come
     r, _ = records(SPHERE, "-j", "1", "-q")
-    assert r.exit_code == 0 and "compiling" not in r.stderr
+    assert r.exit_code == 0 and "compiling" not in r.stderr and len(_LongLoad.started) == 1  # -q: no timer
 
 
 def test_one_command_says_its_compile_once_however_many_first_loads_it_has(monkeypatch, capsys):
     """A fresh install's forces run of point and soft grasps loads the grip's kernel, then the soft contacts'
     iterations (compiled apart): the command's notices (diagnostics.compile_notices) say one line."""
-    import time
+    import threading
 
     from grasptwist.cli import diagnostics
 
-    monkeypatch.setattr(diagnostics, "COMPILE_NOTICE_AFTER", 0.0)
-    notices, said = diagnostics.compile_notices(False), []
+    monkeypatch.setattr(threading, "Timer", _LongLoad)
+    monkeypatch.setattr(_LongLoad, "started", [])
+    notices = diagnostics.compile_notices(False)
     for _ in range(2):
         with notices():
-            deadline = time.monotonic() + 10
-            while not said and time.monotonic() < deadline:  # the first load's line, said by its timer
-                time.sleep(0.01)
-                said += [line for line in capsys.readouterr().err.splitlines() if "compiling" in line]
-            time.sleep(0.2)  # the second load: a timer of 0 s would have said it again by now
-        said += [line for line in capsys.readouterr().err.splitlines() if "compiling" in line]
+            pass
+    said = [line for line in capsys.readouterr().err.splitlines() if "compiling" in line]
     assert len(said) == 1 and said[0].startswith("grasptwist: compiling the grip's numba kernels")
+    assert len(_LongLoad.started) == 1  # the second load's timer never started
 
 
 def test_the_kernels_first_load_runs_inside_the_callers_watch(monkeypatch):
@@ -691,3 +697,34 @@ def test_the_kernels_first_load_runs_inside_the_callers_watch(monkeypatch):
     with hooks.watching_first_load(watch):
         assert compiled.kernel() is fake and compiled.kernel() is fake  # loaded once
     assert events == ["watch on", "first grip", "watch off"]
+
+
+def test_threads_that_need_the_kernel_at_once_load_it_once(monkeypatch):
+    """A second thread that needs the kernel while the first loads it waits for that load (a Dask worker's
+    threads), and neither loads it again (a fake kernel module: no numba)."""
+    import sys
+    import threading
+    import types
+
+    from grasptwist.engine.forces import compiled
+
+    fake = types.ModuleType("grasptwist.engine.forces.kernel")
+    monkeypatch.setitem(sys.modules, "grasptwist.engine.forces.kernel", fake)
+    monkeypatch.setattr(compiled, "_state", {"on": True, "module": None})
+    loads, entered, release, got = [], threading.Event(), threading.Event(), []
+
+    def first_grip(module):  # the first thread's load, held open until the second thread has come
+        loads.append(threading.current_thread().name)
+        entered.set()
+        release.wait(10)
+
+    monkeypatch.setattr(compiled, "_first_grip", first_grip)
+    threads = [threading.Thread(target=lambda: got.append(compiled.kernel()), name=f"t{i}") for i in range(2)]
+    threads[0].start()
+    assert entered.wait(10)
+    threads[1].start()
+    threads[1].join(0.3)  # without the lock it would be loading again by now
+    release.set()
+    for t in threads:
+        t.join(10)
+    assert loads == ["t0"] and got == [fake, fake]

@@ -25,7 +25,6 @@ __all__ = [
     "table_hint",
     "progress_bar",
     "COMPILE_NOTICE_AFTER",
-    "compile_notice",
     "compile_notices",
 ]
 
@@ -280,11 +279,19 @@ def progress_bar(inputs: list, command: str, out, shown: bool = True, long_input
 COMPILE_NOTICE_AFTER = 10.0
 
 
+def compile_notices(quiet: bool, more: str = ""):
+    """One command's factory for :func:`~grasptwist.engine.hooks.watching_first_load`: a :func:`_compile_notice`
+    around each first load, of which one at most says its line (the grip's kernel and the soft contacts'
+    iterations compile apart, one after the other, on a fresh install)."""
+    said: list = []
+    return lambda: _compile_notice(quiet, more, said)
+
+
 @contextmanager
-def compile_notice(quiet: bool, more: str = "", said: list | None = None):
-    """Around the compiled grip's first load (:func:`~grasptwist.engine.hooks.watching_first_load`): one line on
-    stderr once it outlasts :data:`COMPILE_NOTICE_AFTER` (a fresh install's compile), ending with ``more``;
-    none with ``quiet``, or where ``said`` (a list, appended to when the line is said) already holds one."""
+def _compile_notice(quiet: bool, more: str, said: list):
+    """Around one first load: one line on stderr once it outlasts :data:`COMPILE_NOTICE_AFTER` (a fresh install's
+    compile), ending with ``more``; none with ``quiet`` or once ``said`` (appended to when the line is said)
+    holds one."""
     import threading
 
     def notice():
@@ -292,8 +299,7 @@ def compile_notice(quiet: bool, more: str = "", said: list | None = None):
             "grasptwist: compiling the grip's numba kernels, once per install (about a minute, longer on a busy "
             f"machine){more}"
         )
-        if said is not None:
-            said.append(True)
+        said.append(True)
 
     timer = threading.Timer(COMPILE_NOTICE_AFTER, notice)
     timer.daemon = True
@@ -303,11 +309,3 @@ def compile_notice(quiet: bool, more: str = "", said: list | None = None):
         yield
     finally:
         timer.cancel()
-
-
-def compile_notices(quiet: bool, more: str = ""):
-    """One command's factory for :func:`~grasptwist.engine.hooks.watching_first_load`: a :func:`compile_notice`
-    around each first load, of which one at most says its line (the grip's kernel and the soft contacts'
-    iterations compile apart, one after the other, on a fresh install)."""
-    said: list = []
-    return lambda: compile_notice(quiet, more, said)

@@ -1,7 +1,8 @@
 """What the engine runs around long one-time work, set by its callers: the engine itself says nothing.
 
-The one such work is the compiled grip's first load in a process (numba compiles it on a fresh
-install, about a minute, and loads it from its cache after: :mod:`~grasptwist.engine.forces.compiled`).
+Such work is a first load of compiled code in a process: the grip's kernel, and apart from it the
+interior-point iterations on rows of any sizes (numba compiles them on a fresh install, about a minute
+and some 20 s, and loads them from its cache after: :mod:`~grasptwist.engine.forces.compiled`).
 The command line sets :func:`watching_first_load` so that a load that takes long says so on stderr;
 a library caller may set its own.
 """
@@ -9,13 +10,14 @@ a library caller may set its own.
 from __future__ import annotations
 
 import contextlib
+import threading
 from collections.abc import Callable, Iterator
 from contextlib import AbstractContextManager
 
 __all__ = ["first_load", "watching_first_load"]
 
 _first_load: list[Callable[[], AbstractContextManager]] = [contextlib.nullcontext]
-_within = [0]  # first loads open: one inside another runs in the outer's context alone
+_within = threading.local()  # a thread's first loads open: one inside another runs in the outer's context alone
 
 
 @contextlib.contextmanager
@@ -29,15 +31,15 @@ def first_load() -> Iterator[None]:
     ...     with first_load():
     ...         pass
     """
-    if _within[0]:
+    if getattr(_within, "open", 0):
         yield
         return
-    _within[0] += 1
+    _within.open = 1
     try:
         with _first_load[0]():
             yield
     finally:
-        _within[0] -= 1
+        _within.open = 0
 
 
 @contextlib.contextmanager

@@ -16,6 +16,7 @@ from __future__ import annotations
 
 import importlib.util
 import os
+import threading
 import warnings
 from contextlib import contextmanager
 
@@ -28,12 +29,16 @@ __all__ = ["kernel", "iteration", "numpy_path", "read_only"]
 
 _state = {"on": os.environ.get("GRASPTWIST_NUMBA", "1") != "0", "module": None}
 
+# one load at a time: threads that need a part while another loads it wait for it, and none loads it again
+_LOADING = threading.RLock()
+
 
 def kernel():
     """The compiled module (:mod:`~grasptwist.engine.forces.kernel`), or None: numba missing or switched off."""
     if _state["on"] and not _state.get("grip") and _numba():
-        with first_load():  # the caller's watch (the command line's notice of a long compile)
-            _loaded(_first_grip, "grip", "the compiled grip")
+        with _LOADING, first_load():  # the caller's watch (the command line's notice of a long compile)
+            if _state["on"] and not _state.get("grip"):  # not loaded by another thread meanwhile
+                _loaded(_first_grip, "grip", "the compiled grip")
     return _state["module"] if _state["on"] else None
 
 
@@ -77,13 +82,15 @@ def iteration():
 
     Compiled (some 20 s on a fresh install) or loaded from numba's cache at the first use in a process,
     apart from the grip's kernel (:func:`kernel`): a process whose grips the kernel solves whole
-    (point contacts with friction, not collinear) never pays it, and one that grips soft contacts
-    only never pays the kernel's.  Inside :func:`~grasptwist.engine.hooks.first_load` too (the
+    (point contacts with friction, not collinear) never pays it, unless a search's warm-up loads
+    both (:func:`~grasptwist.engine.synthesis.search.warm_up`: no compile inside its clock), and one
+    that grips soft contacts only never pays the kernel's.  Inside :func:`~grasptwist.engine.hooks.first_load` too (the
     command line's notice).
     """
     if _state["on"] and _state.get("iteration") is None and _numba():
-        with first_load():
-            _loaded(_first_iteration, "iteration", "the compiled iteration")
+        with _LOADING, first_load():
+            if _state["on"] and _state.get("iteration") is None:  # not loaded by another thread meanwhile
+                _loaded(_first_iteration, "iteration", "the compiled iteration")
     return _state["module"] if _state["on"] and _state.get("iteration") else None
 
 
