@@ -728,3 +728,35 @@ def test_threads_that_need_the_kernel_at_once_load_it_once(monkeypatch):
     for t in threads:
         t.join(10)
     assert loads == ["t0"] and got == [fake, fake]
+
+
+@pytest.mark.parametrize(
+    ("args", "module", "what"),
+    [
+        (("forces", SPHERE, "--contact", "soft", "--torsion", "0.01", "--quality"), "scipy", "--quality"),
+        (("synthesize", SPHERE, "--friction", "0.5", "--quality"), "scipy", "--quality"),
+        (("synthesize", SPHERE, "--friction", "0.5", "--objective", "epsilon"), "scipy", "--quality"),
+        (("synthesize", SPHERE, "--friction", "0.5", "--simulate"), "mujoco", "--simulate"),
+    ],
+    ids=["forces-quality", "synthesize-quality", "synthesize-epsilon", "synthesize-simulate"],
+)
+def test_an_option_whose_extra_is_missing_is_one_line_and_exit_2(monkeypatch, args, module, what):
+    """A trial's finding: these had ended in a traceback (the extra was required while typer parsed the
+    command, outside the command's one place for ways to end); now one line, as -f parquet's and simulate's."""
+    from grasptwist import extras
+
+    found = extras.import_module
+
+    def missing(name):
+        if name.partition(".")[0] == module:
+            raise ImportError(f"No module named {module!r}")
+        return found(name)
+
+    monkeypatch.setattr(extras, "import_module", missing)
+    r, _ = run(*args)
+    lines = r.stderr.splitlines()
+    assert r.exit_code == 2 and r.stdout == ""
+    assert lines == [
+        f"grasptwist: error: {what} needs {module}: pip install {extras.EXTRAS[module][0]} "
+        f"(from a clone of grasptwist: pip install -e '.[{extras.EXTRAS[module][1]}]')"
+    ]

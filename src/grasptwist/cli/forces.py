@@ -104,10 +104,6 @@ def forces(
 
     wrenches = wrenches_option(wrench, at, wrench_name)
     torsion = contact_torsion(contact, torsion, friction)
-    if quality:
-        from ..extras import require
-
-        require("scipy", "--quality")
     fmt = ForcesFormat.json if json_ else fmt
     not_binary_to_a_terminal(fmt.value, output)
     job = Job(
@@ -125,4 +121,12 @@ def forces(
         ),
     )
     settings = OutputSettings(output, quiet, warnings, workers, {"digits": digits})
-    run_command(debug, lambda: write_records(job, paths, settings))
+
+    def body() -> int:
+        if quality:  # a missing extra: one line (run_command's) before any input is read
+            from ..extras import require
+
+            require("scipy", "--quality")
+        return write_records(job, paths, settings)
+
+    run_command(debug, body)

@@ -300,10 +300,6 @@ def synthesize(
     from ..run.options import SimulateOptions, SynthesisOptions
     from ..run.pipeline import Job
 
-    if quality or objective == Objective.epsilon:
-        require("scipy", "--quality")
-    if simulate:
-        require("mujoco", "--simulate")
     wrenches = wrenches_option(wrench, at, wrench_name)
     torsion = contact_torsion(contact, torsion, friction)
     grasp_file = output if output is not None and output.lower().endswith(GRASP_FILE_SUFFIXES) else None
@@ -351,6 +347,11 @@ def synthesize(
     settings = OutputSettings(records_to, quiet, Warnings.summary, workers, {"digits": digits}, reads=(hand,))
 
     def search_all() -> int:
+        # a missing extra: one line (run_command's) before any input is read
+        if quality or objective == Objective.epsilon:
+            require("scipy", "--quality")
+        if simulate:
+            require("mujoco", "--simulate")
         _warmed_up(quiet)
         return write_records(job, paths, settings)
 
