@@ -71,6 +71,14 @@ def test_zero_torsion_is_point_contacts_bit_for_bit(path, monkeypatch):
         return
     for name in ("force", "squeeze", "total_normal_force", "friction_used", "dual", "gap", "certificate"):
         np.testing.assert_array_equal(getattr(zero, name), getattr(point, name))
+    # a prepared grasp with torsion 0 takes the point contacts' way too (it had set up the cones at every call)
+    for k in np.flatnonzero(point.ok)[:2].tolist() + np.flatnonzero(~point.ok)[:1].tolist():
+        prepared = gt.prepare_grip(p[k], n[k], mu[k], safety=1.2, torsion=0.0)
+        g, alone = prepared.grip(w[k]), gt.prepare_grip(p[k], n[k], mu[k], safety=1.2).grip(w[k])
+        assert not prepared._soft and bool(g.ok) == point.ok[k]
+        np.testing.assert_array_equal(g.torsion, np.zeros(3) if g.ok else np.full(3, np.nan))
+        for name in ("force", "total_normal_force", "dual", "certificate", "status"):
+            np.testing.assert_array_equal(getattr(g, name), getattr(alone, name))
 
 
 def _on(path, monkeypatch):

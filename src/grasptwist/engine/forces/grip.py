@@ -323,11 +323,14 @@ def _with_soft(rows, e, s_f, tol, shape):
     point contacts, bit for bit what :func:`grip` gives them without ``torsion``."""
     if not len(e):
         return replace(_no_rows(s_f, shape), torsion=np.empty(shape + (3,)))
+    mu = rows[2]
+    soft = ((e > 0) & (mu > 0)).any(axis=1) | np.isnan(e).any(axis=1)
+    if not soft.any():  # point contacts all: their grip, with no torsion (its cost, not the cones' split)
+        g = _grip_of(rows, s_f, tol, shape)
+        return replace(g, torsion=_point_torsion(g.ok))
     k = wrench_scales(rows[3])
     if k is not None:  # as _grip_of: solved scaled by a power of two, the grip scaled back
         return _scaled_back(_with_soft((*rows[:3], rows[3] / k[:, None]), e, s_f, tol, shape), k, shape)
-    mu = rows[2]
-    soft = ((e > 0) & (mu > 0)).any(axis=1) | np.isnan(e).any(axis=1)
     point = np.flatnonzero(~soft)
     g = _grip_of([a[point] for a in rows], s_f, tol, (point.size,))
     fields = {name: getattr(g, name) for name, _ in GRIP_COLUMNS + (("status", 1), ("culprit", 1))}
@@ -335,12 +338,17 @@ def _with_soft(rows, e, s_f, tol, shape):
     for name, v in fields.items():
         out[name][point] = v
     out["torsion"] = np.full((len(e), 3), np.nan)
-    out["torsion"][point] = np.where(g.ok[:, None], 0.0, np.nan)
+    out["torsion"][point] = _point_torsion(g.ok)
     rest = np.flatnonzero(soft)
     if rest.size:
         for name, v in _soft_rows(*(a[rest] for a in rows), e[rest], s_f, tol).items():
             out[name][rest] = v
     return checked_grip(Grip(safety=s_f, **{k: v.reshape(shape + v.shape[1:]) for k, v in out.items()}))
+
+
+def _point_torsion(ok):
+    """The torsions of point contacts' grips ``(..., 3)``: none exerted (0) where held, NaN where not."""
+    return np.where(np.asarray(ok)[..., None], np.zeros(3), np.nan)
 
 
 def _soft_rows(p, n, mu, w, e, s_f, tol):
@@ -492,6 +500,8 @@ class PreparedGrip:
     def __init__(self, points, normals, friction, safety, tol, torsion=None):
         self.points, self.normals, self.friction, self.safety = points, normals, friction, safety
         self.torsion = torsion
+        # point contacts all (torsion 0, or no friction where it is not): the point contacts' fast way
+        self._soft = torsion is not None and bool((((torsion > 0) & (friction > 0)) | np.isnan(torsion)).any())
         self._prepared = _Prepared(points[None], normals[None], friction[None], safety, tol)
         self._rows = (compiled.read_only(points[None]), compiled.read_only(normals[None]), friction[None])
         self._limit = compiled.read_only(friction[None] / safety)
@@ -503,10 +513,15 @@ class PreparedGrip:
         ``wrench (..., 6)``: any number of wrenches on this grasp.
         """
         w = check_wrench(wrench)
-        if self.torsion is not None:  # soft contacts: the cones' way, set up per call (numpy)
+        if self._soft:  # soft contacts: the cones' way, set up per call (numpy)
             return grip(
                 self.points, self.normals, w, self.friction, safety=self.safety, torsion=self.torsion, tol=self._tol
             )
+        g = self._point_grip(w)
+        return g if self.torsion is None else replace(g, torsion=_point_torsion(g.ok))
+
+    def _point_grip(self, w):
+        """:meth:`grip` of point contacts."""
         rows = w.reshape(-1, 6)
         k = len(rows)
         fast = compiled.kernel()
