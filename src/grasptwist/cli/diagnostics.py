@@ -296,7 +296,7 @@ def _compile_notice(quiet: bool, more: str, said: list):
 
     def notice():
         to_stderr(
-            "grasptwist: compiling the grip's numba kernels, once per install (about a minute, longer on a busy "
+            "grasptwist: compiling the grip's numba kernels, once per install (20 s to a minute and a half, longer on a busy "
             f"machine){more}"
         )
         said.append(True)
