@@ -439,11 +439,12 @@ def _unreachable(setup):
     """``y (n, 6)`` with ``y . G g = 0`` for every ``g`` the contacts' models exert (rows where ``G`` is not onto).
 
     ``E``'s rows are orthonormal, so ``P = I - E^T E`` projects on the exerted coordinates; ``y'`` is the
-    left singular vector of ``G' P`` with the least singular value, ``y = D^T y'``.
+    left singular vector of ``G' P`` with the least singular value (its long columns shortened,
+    :func:`~grasptwist.engine.forces.cones.shortened_columns`: the same left null space), ``y = D^T y'``.
     """
     E = setup.grasp[:, 6:]
     exerted = setup.grasp[:, :6] - np.einsum("nij,nkj,nkl->nil", setup.grasp[:, :6], E, E)
-    return _unscaled(setup, np.linalg.svd(exerted)[0][:, :, -1])
+    return _unscaled(setup, np.linalg.svd(cones.shortened_columns(exerted)[0])[0][:, :, -1])
 
 
 def check_cone_edges(cone_edges) -> int:
