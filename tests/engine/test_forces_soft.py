@@ -11,6 +11,7 @@ import grasptwist as gt
 from conic import closure_friction as clarabel_closure_friction
 from conic import closure_margin, least_soft_grip, soft_grasp_map
 from grasptwist.engine.forces import compiled
+from grasptwist.engine.forces.closure import epsilon_quality
 from grasptwist.engine.forces.grasp_map import check_torsion
 
 EQ = np.array([[1, 0, 0], [-0.5, 0.75**0.5, 0], [-0.5, -(0.75**0.5), 0]])
@@ -155,6 +156,44 @@ def test_the_compiled_soft_grip_follows_the_numpy_path(monkeypatch):
     top = np.nanmax(np.abs(reference.force))
     np.testing.assert_allclose(g.force, reference.force, rtol=1e-6, atol=1e-6 * top)
     _verified(g, p, n, w, mu / 1.3, e)
+
+
+BALL = 0.03 * np.stack(  # three contacts 20 deg below a 3 cm ball's equator
+    [
+        np.cos(np.radians(20)) * np.cos(np.radians([90, 210, 330])),
+        np.cos(np.radians(20)) * np.sin(np.radians([90, 210, 330])),
+        np.full(3, -np.sin(np.radians(20))),
+    ],
+    axis=1,
+)
+
+
+@pytest.mark.parametrize("e", [1e6, 1e8, 1e12])
+def test_a_torsional_radius_far_above_the_grasps_size_grips_and_closes(e):
+    """A soft contact's torsion column of ``B`` is ``(e / L) n``: at ``e / L`` of 3e7 and more it dwarfed the forces'
+    columns, so the round-off of its size made the wrench look unmade (collinear-contacts, NaN forces, from
+    ``e = 1e6``) and at 1e12 cut the rank (no closure); ``B``'s columns are now scaled to unit length first.
+    The tripod's lift and turn is Clarabel's soft grip; its closure friction is the tan 20 deg of the lift, as
+    with ``e = 1 cm``; a rod pinched along its axis holds a weight 1 cm beside it with both pads soft; epsilon
+    grows with ``e`` towards its limit."""
+    w = np.array([0, 0, 9.81, 0.01, 0, 0])
+    with compiled.numpy_path():
+        g = gt.grip(BALL[None], -BALL[None], w[None], 0.5, torsion=e)
+        rod = gt.grip(LINE, ACROSS, [0, 0, 9.81, 0.0981, 0, 0], 0.5, torsion=[e, e, 0])
+    assert g.ok.all() and rod.ok
+    reference = least_soft_grip(BALL, -BALL, w, 0.5, e)[0]
+    assert float(g.total_normal_force[0]) == pytest.approx(reference, rel=1e-9)
+    if e < 1e12:  # the dual's e mu |n_i . lambda_M| <= n_i . (n_i - lambda_F - ...): at 1e12, below its round-off
+        _verified(g, BALL[None], -BALL[None], w[None], np.full((1, 3), 0.5), np.full((1, 3), e))
+    rod_reference = least_soft_grip(LINE, ACROSS, [0, 0, 9.81, 0.0981, 0, 0], 0.5, [e, e, 0])[0]
+    assert float(rod.total_normal_force) == pytest.approx(rod_reference, rel=1e-9)
+    assert rod.torsion[0] - rod.torsion[1] == pytest.approx(0.0981, rel=1e-9)
+    c = gt.forces.force_closure([BALL, LINE], [-BALL, ACROSS], 0.5, torsion=[[e] * 3, [e, e, 0]], quality=True)
+    assert c.status.tolist() == [0, 0] and c.force_closure.all()
+    assert float(c.closure_friction[0]) == pytest.approx(np.tan(np.radians(20)), rel=1e-9)
+    # epsilon's torsion edges are capped (closure.py): Qhull lost the hull of e = 1e12's (epsilon 0)
+    assert float(c.epsilon[0]) == pytest.approx(epsilon_quality(BALL, -BALL, 0.5, torsion=1e6), rel=1e-6)
+    assert float(c.epsilon[0]) > epsilon_quality(BALL, -BALL, 0.5, torsion=1e3) > 0.113
 
 
 def test_two_soft_contacts_resist_a_moment_about_their_line_that_point_contacts_cannot():

@@ -57,7 +57,10 @@ multipliers ``z_i`` (``sum_i A_i^T z_i = alpha c``, ``alpha < 0``) give the wren
 Soft epsilon linearises each ``Q^4`` cone by the inscribed bipyramid: the ``m`` friction edges above
 (``tau = 0``) and two torsion edges ``f = n_i``, ``tau_i = +-mu_i e_i`` (the wrenches
 ``(n_i; (q_i x n_i +- mu_i e_i n_i) / L)``), so a soft contact's wrenches hold its point contact's and
-``e = 0`` is the point contact's hull.  Rows without a soft contact take the point contacts' way
+``e = 0`` is the point contact's hull.  A torsion edge's moment over ``L`` is at most ``1e10`` (the force
+edges' are of order one): Qhull loses a hull some ``1e13`` across, and edges longer than ``T`` add some
+``1.4 / T`` of epsilon (a tripod on a 3 cm ball: 0.1131513071118 from ``e = 1e9`` on, 0.1131513071282 at
+``e = 1e11`` uncapped, 0 at ``1e12`` uncapped).  Rows without a soft contact take the point contacts' way
 above, bit for bit.
 """
 
@@ -439,11 +442,12 @@ def _unreachable(setup):
     """``y (n, 6)`` with ``y . G g = 0`` for every ``g`` the contacts' models exert (rows where ``G`` is not onto).
 
     ``E``'s rows are orthonormal, so ``P = I - E^T E`` projects on the exerted coordinates; ``y'`` is the
-    left singular vector of ``G' P`` with the least singular value, ``y = D^T y'``.
+    left singular vector of ``G' P`` with the least singular value (its long columns shortened,
+    :func:`~grasptwist.engine.forces.cones.shortened_columns`: the same left null space), ``y = D^T y'``.
     """
     E = setup.grasp[:, 6:]
     exerted = setup.grasp[:, :6] - np.einsum("nij,nkj,nkl->nil", setup.grasp[:, :6], E, E)
-    return _unscaled(setup, np.linalg.svd(exerted)[0][:, :, -1])
+    return _unscaled(setup, np.linalg.svd(cones.shortened_columns(exerted)[0])[0][:, :, -1])
 
 
 def check_cone_edges(cone_edges) -> int:
@@ -486,6 +490,10 @@ def first_edges(points, normals):
     return b1 / np.linalg.norm(b1, axis=1, keepdims=True)
 
 
+#: The longest torsion edge of soft epsilon, over ``L`` (module docstring).
+_LONGEST = 1e10
+
+
 def epsilon_quality(points, normals, friction, cone_edges=8, *, torsion=None):
     """Ferrari-Canny epsilon of one grasp (module docstring); 0 when the hull is flat or misses the origin.
 
@@ -519,7 +527,7 @@ def epsilon_quality(points, normals, friction, cone_edges=8, *, torsion=None):
     if torsion is not None:  # the soft contacts' torsion edges: f = n_i, tau = +-mu_i e_i
         e = np.broadcast_to(np.asarray(torsion, float), (3,))
         soft = np.flatnonzero(e > 0)
-        tau = np.array([[1.0], [-1.0]]) * (mu * e / k)[soft]  # (2, s)
+        tau = np.array([[1.0], [-1.0]]) * np.minimum(mu * e / k, _LONGEST * length)[soft]  # (2, s)
         fs = np.broadcast_to(n[soft] / k, tau.shape + (3,))
         moment = np.cross(q[soft], fs) + tau[..., None] * n[soft]
         wrenches = np.vstack((wrenches, np.concatenate((fs, moment / length), axis=-1).reshape(-1, 6)))

@@ -25,7 +25,9 @@ moment divided by ``L`` and ``B = [G'; E]`` (``G'`` the grasp map of ``g``),
 .. math:: \min_s \sum_i n_i \cdot f_i \quad\text{s.t.}\quad g = B^+ (w'; 0) + N s,\quad C_i g_i \in K_i
 
 ``N`` the null space of ``B``; the set-up (``B``, its pseudo-inverse and null space, by
-SVD) is done once per grasp in numpy.  The dual ``lambda = D^T lambda'`` with
+SVD) is done once per grasp in numpy, on ``B``'s long columns scaled to unit length (:func:`shortened_columns`:
+a torsion column ``(e_i / L) n_i`` dwarfs the forces' for a large ``e``, and the rank, the null space
+and whether ``w`` is made would otherwise follow the round-off of its size).  The dual ``lambda = D^T lambda'`` with
 ``B^T (lambda'; .) = c - sum_i C_i^T z_i`` (``c_i = (n_i, 0)``), and a failed row's
 certificate ``y = -D^T y'`` with ``B^T (y'; .) = sum_i C_i^T z_i`` (phase I's ``z``).
 
@@ -49,7 +51,16 @@ from ..screws import cross
 from . import socp
 from .grasp_map import tangent_bases
 
-__all__ = ["FRICTIONLESS", "POINT", "SOFT", "contact_models", "ConeGrasp", "cone_grasp", "cone_solve"]
+__all__ = [
+    "FRICTIONLESS",
+    "POINT",
+    "SOFT",
+    "contact_models",
+    "ConeGrasp",
+    "cone_grasp",
+    "cone_solve",
+    "shortened_columns",
+]
 
 #: The contact models' codes (``contact_models``).
 FRICTIONLESS, POINT, SOFT = 0, 1, 2
@@ -75,8 +86,8 @@ class ConeGrasp(NamedTuple):
     """The wrench-free part of the grip of ``n`` grasps over contact cones (:func:`cone_grasp`)."""
 
     frame: np.ndarray  # (n, 3, 4, 4): contact, cone row, coordinate (f in the world, tau / e)
-    pinv: np.ndarray  # (n, 12, 6): g = pinv w' (the least-squares generalised forces)
-    null: np.ndarray  # (n, 12, 12): B's right singular vectors, the null space N last
+    pinv: np.ndarray  # (n, 12, 6): g = pinv w' (generalised forces that make w', shortened_columns)
+    null: np.ndarray  # (n, 12, 12): C^-1 times B C^-1's right singular vectors, the null space N last
     rank: np.ndarray  # (n,): B's rank (N has 12 - rank columns)
     grasp: np.ndarray  # (n, 18, 12): B
     torsion: np.ndarray  # (n, 3): e, 0 where the contact is not soft
@@ -122,13 +133,34 @@ def cone_grasp(points, unit, limit, torsion, model) -> ConeGrasp:
         grasp[:, 3:6, _SIZE * i + 3] = lever[:, i, None] * unit[:, i]
         idle = ~_EXERTS[model[:, i]]  # (n, 4): the coordinates the model holds at zero
         grasp[:, 6 + _SIZE * i : 6 + _SIZE * (i + 1), _SIZE * i : _SIZE * (i + 1)] = basis[:, i] * idle[..., None]
-    u, s, vt = np.linalg.svd(grasp, full_matrices=False)  # u (n, 18, 12), vt (n, 12, 12)
+    short, c = shortened_columns(grasp)
+    u, s, vt = np.linalg.svd(short, full_matrices=False)  # u (n, 18, 12), vt (n, 12, 12)
     rank = (s > 1e-12 * s[:, :1]).sum(axis=1)
     with np.errstate(divide="ignore"):
         inv = np.where(np.arange(s.shape[1]) < rank[:, None], 1 / s, 0.0)
-    pinv = np.einsum("nij,ni,nki->njk", vt, inv, u[:, :6])  # the first six columns of B^+
+    # the first six columns of X = C^-1 (B C^-1)^+, and the null space C^-1 N_s
+    pinv = np.einsum("nij,ni,nki->njk", vt, inv, u[:, :6]) / c[..., None]
+    null = np.swapaxes(vt, 1, 2) / c[..., None]
     e = np.where(model == SOFT, torsion, 0.0)
-    return ConeGrasp(frame, pinv, np.swapaxes(vt, 1, 2), rank, grasp, e, model, centroid, size)
+    return ConeGrasp(frame, pinv, null, rank, grasp, e, model, centroid, size)
+
+
+def shortened_columns(b):
+    r"""``(B C^{-1}, c)``: ``b (n, m, k)`` with its columns longer than one scaled to unit length, and the factors
+    ``c = max(|B_j|, 1)`` ``(n, k)``.
+
+    A soft contact's torsion column of ``B`` is ``(e_i / L) n_i``, any length against the forces' order-one
+    columns: ranks, null spaces and pseudo-inverses are taken of ``B C^{-1}`` (whose singular values then
+    mean the same however large ``e``) and mapped back, ``X = C^{-1} (B C^{-1})^+`` (``B X`` projects onto
+    ``B``'s range, as ``B B^+`` does) and ``N = C^{-1} N_s``.  A short column is kept: lengthened, the null
+    space's torsion ``tau / e`` would grow by ``L / e`` against the cones' rows of order ``1 / mu``.
+
+    >>> b, c = shortened_columns(np.array([[[3.0, 0.5], [4.0, 0.0]]]))
+    >>> b.tolist(), c.tolist()
+    ([[[0.6, 0.5], [0.8, 0.0]]], [[5.0, 1.0]])
+    """
+    c = np.maximum(np.sqrt((b**2).sum(axis=-2)), 1.0)
+    return b / c[..., None, :], c
 
 
 def _skew(v):
