@@ -735,7 +735,7 @@ def test_threads_that_need_the_kernel_at_once_load_it_once(monkeypatch):
     [
         (("forces", SPHERE, "--contact", "soft", "--torsion", "0.01", "--quality"), "scipy", "--quality"),
         (("synthesize", SPHERE, "--friction", "0.5", "--quality"), "scipy", "--quality"),
-        (("synthesize", SPHERE, "--friction", "0.5", "--objective", "epsilon"), "scipy", "--quality"),
+        (("synthesize", SPHERE, "--friction", "0.5", "--objective", "epsilon"), "scipy", "--objective epsilon"),
         (("synthesize", SPHERE, "--friction", "0.5", "--simulate"), "mujoco", "--simulate"),
     ],
     ids=["forces-quality", "synthesize-quality", "synthesize-epsilon", "synthesize-simulate"],

@@ -349,7 +349,7 @@ def synthesize(
     def search_all() -> int:
         # a missing extra: one line (run_command's) before any input is read
         if quality or objective == Objective.epsilon:
-            require("scipy", "--quality")
+            require("scipy", "--quality" if quality else "--objective epsilon")
         if simulate:
             require("mujoco", "--simulate")
         _warmed_up(quiet)
