@@ -1062,3 +1062,19 @@ def test_the_compiled_iterations_source_follows_the_numpy_twin_on_soft_rows(monk
     scale = np.abs(w).max()
     for name in ("force", "torsion", "total_normal_force", "dual", "certificate", "gap"):
         np.testing.assert_allclose(getattr(g, name), getattr(reference, name), rtol=1e-12, atol=1e-12 * scale)
+
+
+def test_epsilon_without_scipy_says_how_to_install_it(monkeypatch):
+    """A trial's finding: quality=True without scipy had raised a bare ModuleNotFoundError."""
+    from grasptwist import extras
+
+    found = extras.import_module
+    monkeypatch.setattr(extras, "import_module", lambda name: _hidden(name, found))
+    with pytest.raises(extras.MissingExtra, match=r"epsilon .* needs scipy: pip install scipy .*'\.\[quality\]'"):
+        gt.forces.force_closure(EQ, -EQ, 0.5, quality=True)
+
+
+def _hidden(name, found):
+    if name.partition(".")[0] == "scipy":
+        raise ImportError("No module named 'scipy'")
+    return found(name)

@@ -71,6 +71,7 @@ from functools import partial
 
 import numpy as np
 
+from ...extras import require
 from ..checks import check_normals, check_points
 from ..degeneracy import DEGENERACY_TOL
 from ..screws import cross, dot, norm
@@ -505,7 +506,8 @@ def epsilon_quality(points, normals, friction, cone_edges=8, *, torsion=None):
     >>> round(epsilon_quality(p, -p, [0.5, 0.5, 0.5]), 4), round(epsilon_quality(p, -p, 0.5, torsion=0.1), 4)
     (0.2759, 0.2889)
     """
-    from scipy.spatial import ConvexHull, QhullError
+    spatial = require("scipy.spatial", "Ferrari-Canny epsilon (quality=True, --quality)")
+    ConvexHull, QhullError = spatial.ConvexHull, spatial.QhullError  # noqa: N806 - scipy's names
 
     p = np.asarray(points, float)
     n = np.asarray(normals, float)
