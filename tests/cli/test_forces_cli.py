@@ -562,6 +562,7 @@ def test_soft_contacts_from_a_grasp_file_and_their_errors_located(tmp_path):
     cases = {
         "model: soft": "missing-key: contacts[0].torsion",
         "torsion: 0.01": "missing-key: contacts[0].model",
+        "model: point, torsion: 0.01": "conflicting-keys: contacts[0].model: a torsion is a soft contact's",
         "model: hard, torsion: 0.01": "invalid-contact-model: contacts[0].model: must be point or soft, got 'hard'",
         "model: soft, torsion: 0": "invalid-torsion: contacts[0].torsion: must be a length > 0",
         "model: soft, torsion: 0.01, friction: 0": "invalid-torsion: contacts[0].torsion: a soft contact needs friction",

@@ -88,9 +88,10 @@ def _read_model(fields, item, path, problems):
             )
         )
     elif model != "soft" and "torsion" in fields:
+        # model: point beside a torsion: the two exclude each other; no model: the soft one missing
         problems.add(
             Reject(
-                "missing-key",
+                "conflicting-keys" if "model" in fields else "missing-key",
                 path + ".model",
                 "a torsion is a soft contact's (give model: soft beside it)",
                 **located(item),
