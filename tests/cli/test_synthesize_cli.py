@@ -749,3 +749,22 @@ def test_mesh_not_solid_has_the_same_repair_hint_from_a_grasp_file_a_mesh_file_a
     messages.append(str(caught.value))
     assert NOT_SOLID_HINT == "repair it (docs/guide/objects.md, Meshes as they come)"
     assert all(m.endswith(f": {NOT_SOLID_HINT}") for m in messages), messages  # 0.5.0: only the sheet's two
+
+
+def test_a_document_soft_in_part_is_searched_with_point_contacts_and_says_so(tmp_path):
+    """A trial's finding: two of three contacts model: soft were searched as point contacts without a word."""
+    partly = tmp_path / "partly.yaml"
+    partly.write_text(
+        "name: partly\nobject: {box: [0.065, 0.065, 0.065], mass: 0.1}\nfriction: 0.8\ncontacts:\n"
+        "  - {point: [0.0325, 0, 0], normal: [-1, 0, 0], model: soft, torsion: 0.005}\n"
+        "  - {point: [-0.0325, 0, 0], normal: [1, 0, 0], model: soft, torsion: 0.005}\n"
+        "  - {point: [0, 0, -0.0325], normal: [0, 0, 1]}\n"
+    )
+    args = ("--candidates", "30", "-n", "1", *WEIGHT, "-f", "jsonl", "--method", "tangent", "--perturbations", "8")
+    r, _ = run("synthesize", partly, *args)
+    (rec,) = jsonl(r.stdout)
+    said = "its contacts are soft in part: searched as point contacts"
+    assert r.exit_code == 0 and rec["contact_model"] == "point" and rec["warnings"][0].startswith(said)
+    assert f"partly.yaml: grasp 'partly': warning: {said}" in r.stderr
+    point, _ = run("synthesize", partly, *args, "--contact", "point")  # asked for: nothing to say
+    assert point.exit_code == 0 and said not in point.stderr and jsonl(point.stdout)[0]["warnings"] == []

@@ -153,6 +153,18 @@ def _object_warnings(entry: Grasp, obj: GraspObject, hand: Hand | None) -> tuple
     return tuple(w for w in said if w)
 
 
+def _contacts_warnings(entry: Grasp, torsion) -> tuple[str, ...]:
+    """A document whose contacts are soft in part, searched without ``--contact``: with point contacts
+    (a search's contacts are all of one model), which the records' ``contact_model`` says, and this."""
+    e = entry.torsion
+    if torsion is not None or e is None or not (np.asarray(e) > 0).any() or (np.asarray(e) > 0).all():
+        return ()
+    return (
+        "its contacts are soft in part: searched as point contacts (give every contact model: soft, or "
+        "--contact soft --torsion E)",
+    )
+
+
 class Progress(NamedTuple):
     """Work for a progress bar: ``extra`` units found (a search's budget), ``done`` units done."""
 
@@ -217,7 +229,7 @@ def _searched_entry(job, entry: Grasp) -> Iterator[InputError | Found | Progress
         return
     problem, hand = task.problem, task.hand
     obj, reach = problem.object, problem.hand
-    said = _object_warnings(entry, obj, hand)
+    said = _object_warnings(entry, obj, hand) + _contacts_warnings(entry, o.torsion)
     yield Progress(o.candidates, 0)
     for step in solve_steps(problem):
         if isinstance(step, int):
