@@ -324,7 +324,7 @@ def _with_soft(rows, e, s_f, tol, shape):
     if not len(e):
         return replace(_no_rows(s_f, shape), torsion=np.empty(shape + (3,)))
     mu = rows[2]
-    soft = ((e > 0) & (mu > 0)).any(axis=1) | np.isnan(e).any(axis=1)
+    soft = _with_soft_contact(mu, e)
     if not soft.any():  # point contacts all: their grip, with no torsion (its cost, not the cones' split)
         g = _grip_of(rows, s_f, tol, shape)
         return replace(g, torsion=_point_torsion(g.ok))
@@ -344,6 +344,12 @@ def _with_soft(rows, e, s_f, tol, shape):
         for name, v in _soft_rows(*(a[rest] for a in rows), e[rest], s_f, tol).items():
             out[name][rest] = v
     return checked_grip(Grip(safety=s_f, **{k: v.reshape(shape + v.shape[1:]) for k, v in out.items()}))
+
+
+def _with_soft_contact(mu, e):
+    """``(...)`` whether a grasp of frictions and torsional radii ``(..., 3)`` has a soft contact (``e > 0`` with
+    friction; a NaN ``e``, the cones' way's ``nonfinite-input``): its grip goes over the contacts' cones."""
+    return (((e > 0) & (mu > 0)) | np.isnan(e)).any(axis=-1)
 
 
 def _point_torsion(ok):
@@ -501,7 +507,7 @@ class PreparedGrip:
         self.points, self.normals, self.friction, self.safety = points, normals, friction, safety
         self.torsion = torsion
         # point contacts all (torsion 0, or no friction where it is not): the point contacts' fast way
-        self._soft = torsion is not None and bool((((torsion > 0) & (friction > 0)) | np.isnan(torsion)).any())
+        self._soft = torsion is not None and bool(_with_soft_contact(friction, torsion))
         self._prepared = _Prepared(points[None], normals[None], friction[None], safety, tol)
         self._rows = (compiled.read_only(points[None]), compiled.read_only(normals[None]), friction[None])
         self._limit = compiled.read_only(friction[None] / safety)
