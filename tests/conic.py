@@ -6,8 +6,7 @@ import clarabel
 import numpy as np
 from scipy import sparse
 
-from grasptwist.engine.forces.grasp_map import grasp_map
-from grasptwist.engine.forces.grip import tangent_bases
+from grasptwist.engine.forces.grasp_map import grasp_map, tangent_bases
 
 SETTINGS = {"verbose": False, "tol_gap_abs": 1e-11, "tol_gap_rel": 1e-11, "tol_feas": 1e-11}
 

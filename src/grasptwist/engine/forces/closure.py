@@ -74,11 +74,9 @@ import numpy as np
 from ...extras import require
 from ..checks import check_normals, check_points
 from ..degeneracy import DEGENERACY_TOL
-from ..screws import cross, dot, norm
-from . import cones, socp
+from ..screws import cross
+from . import cones, set_up, socp
 from .grasp_map import (
-    CLOSURE_PAIRS,
-    STRICT_MARGIN,
     ForceStatus,
     check_friction,
     check_torsion,
@@ -153,40 +151,32 @@ class Closure:
 
 
 class _Plane:
-    """The planar reduction of a batch of grasps (rows ``n``)."""
+    """The planar reduction of a batch of grasps (rows ``n``): :func:`set_up.plane_reduction`'s twin, rows first."""
 
     def __init__(self, points, unit, geo):
-        nu = geo.m / norm(geo.m)[:, None]
-        x = points[:, 1] - points[:, 0]
-        x = x / norm(x)[:, None]
-        y = cross(nu, x)
-        self.sin = np.abs(dot(unit, nu[:, None, :]))
-        self.cos = np.sqrt(np.maximum(1 - self.sin**2, 0))
+        rows = len(points)
+        tilt, self.dirs, self.forces = np.empty((rows, 2, 3)), np.empty((rows, 3, 2)), np.empty((rows, 3, 3, 2))
+        lanes = (points, unit, geo.m, contact_matrices(geo.e), np.empty((rows, 3, 3)), tilt, self.dirs, self.forces)
+        set_up.twins()["plane_reduction"](*(np.moveaxis(a, 0, -1) for a in lanes), rows)
+        self.sin, self.cos = tilt[:, 0], tilt[:, 1]
         self.phi = np.arcsin(np.minimum(self.sin, 1.0))  # each normal's angle to the plane
-        proj = unit - dot(unit, nu[:, None, :])[..., None] * nu[:, None, :]
-        m2 = np.stack((dot(proj, x[:, None, :]), dot(proj, y[:, None, :])), axis=-1)
-        self.m = m2 / np.linalg.norm(m2, axis=-1, keepdims=True)  # (n, 3, 2)
-        self.perp = np.stack((-self.m[..., 1], self.m[..., 0]), axis=-1)
-        mats = contact_matrices(geo.e)  # (n, 3, 3 xyz, 3 squeezes)
-        self.M = np.stack(
-            (np.einsum("nixl,nx->nil", mats, x), np.einsum("nixl,nx->nil", mats, y)), axis=-2
-        )  # (n, 3, 2, 3)
 
     def rows(self, cos_beta, sin_beta):
-        """The six unit rows ``R (n, 6, 3)`` of the sectors with half-angles ``beta_i``."""
-        plus = sin_beta[..., None] * self.m - cos_beta[..., None] * self.perp
-        minus = sin_beta[..., None] * self.m + cos_beta[..., None] * self.perp
-        v = np.stack((plus, minus), axis=-2)  # (n, 3, 2 edges, 2 xy)
-        r = (self.M[:, :, None, 0, :] * v[..., 0, None] + self.M[:, :, None, 1, :] * v[..., 1, None]).reshape(-1, 6, 3)
-        return r / np.linalg.norm(r, axis=-1, keepdims=True)
+        """The six unit rows ``R (n, 6, 3)`` of the sectors with half-angles ``beta_i`` (``(n, 3)``)."""
+        out = np.empty((len(self.dirs), 3, 2, 3))
+        lanes = (
+            self.dirs,
+            self.forces,
+            np.broadcast_to(sin_beta, self.cos.shape),
+            np.broadcast_to(cos_beta, self.cos.shape),
+        )
+        set_up.twins()["sector_rows"](*(np.moveaxis(a, 0, -1) for a in lanes), np.moveaxis(out, 0, -1), len(out))
+        return out.reshape(-1, 6, 3)
 
 
 def closure_test(rows):
-    """Whether ``R s > 0`` has a solution, and one (``(n, 6, 3)`` unit rows -> ``(n)`` bool, ``(n, 3)``).
-
-    Candidates ``+-(r_a x r_b)``; those inside the closed cone are its extreme rays and
-    their sum is an interior point if there is any.  Computed components-first in
-    chunks of :data:`CHUNK` rows (the 6 x 15 products of a chunk stay in cache).
+    """Whether ``R s > 0`` has a solution, and one (``(n, 6, 3)`` unit rows -> ``(n)`` bool, ``(n, 3)``):
+    :func:`set_up.closure_test`'s twin, in chunks of :data:`CHUNK` rows (whose temporaries stay in cache).
 
     >>> ok, s = closure_test(np.array([np.eye(3).tolist() * 2]))
     >>> bool(ok[0]), s[0].round(4).tolist()
@@ -194,57 +184,39 @@ def closure_test(rows):
     """
     ok = np.empty(len(rows), bool)
     s = np.empty((len(rows), 3))
+    test = set_up.twins()["closure_test"]
     for start in range(0, len(rows), CHUNK):
         part = slice(start, start + CHUNK)
-        ok[part], s[part] = _closure_chunk(np.ascontiguousarray(np.moveaxis(rows[part], 0, -1)))
+        with np.errstate(invalid="ignore", divide="ignore"):
+            r = np.ascontiguousarray(np.moveaxis(rows[part], 0, -1))
+            test(r, np.empty((3, 15, r.shape[-1])), np.moveaxis(s[part], 0, -1), ok[part], None)
     return ok, s
 
 
-def _closure_chunk(r):
-    """:func:`closure_test` on components-first rows ``(6, 3, n)``."""
-    a, b = r[CLOSURE_PAIRS[:, 0]], r[CLOSURE_PAIRS[:, 1]]  # (15, 3, n)
-    c = np.stack(
-        (
-            a[:, 1] * b[:, 2] - a[:, 2] * b[:, 1],
-            a[:, 2] * b[:, 0] - a[:, 0] * b[:, 2],
-            a[:, 0] * b[:, 1] - a[:, 1] * b[:, 0],
-        )
-    )  # (3, 15, n)
-    length = np.sqrt(c[0] ** 2 + c[1] ** 2 + c[2] ** 2)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        c /= length
-    d = r[:, 0, None] * c[0] + r[:, 1, None] * c[1] + r[:, 2, None] * c[2]  # (6, 15, n)
-    real = length > STRICT_MARGIN
-    sign = ((d >= -STRICT_MARGIN).all(axis=0) & real).astype(float) - ((d <= STRICT_MARGIN).all(axis=0) & real)
-    s = (np.nan_to_num(c) * sign).sum(axis=1)  # (3, n): the sum of the extreme rays found
-    s_len = np.sqrt(s[0] ** 2 + s[1] ** 2 + s[2] ** 2)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        s /= s_len
-        ok = (s_len > STRICT_MARGIN) & ((r[:, 0] * s[0] + r[:, 1] * s[1] + r[:, 2] * s[2]) > STRICT_MARGIN).all(axis=0)
-    return ok, s.T
-
-
-def _own_rows(plane, mu):
-    """The sector rows with each contact's own ``mu_i``, and whether every cone reaches the plane.
-
-    Through the angles ``theta_i = atan(mu_i)``, so a huge or infinite ``mu_i`` is a
-    sector of half-angle up to a right angle (a half-plane), never ``inf / inf``.
-    """
-    theta = np.arctan(mu)
-    return _sector_rows(plane, theta), (theta > plane.phi).all(axis=1) & ~np.isnan(mu).any(axis=1)
+def _own_rows(plane, limit):
+    """The sector rows with each contact's own ``limit_i``, and whether every cone reaches the plane
+    (:func:`set_up.own_sectors`' twin: a huge or infinite limit is a half-plane, never ``inf / inf``)."""
+    rows = len(plane.cos)
+    sin_beta, cos_beta, reach = np.empty((rows, 3)), np.empty((rows, 3)), np.empty(rows, bool)
+    lanes = (np.stack((plane.sin, plane.cos), axis=1), limit, sin_beta, cos_beta)
+    set_up.twins()["own_sectors"](*(np.moveaxis(a, 0, -1) for a in lanes), reach, rows)
+    return plane.rows(cos_beta, sin_beta), reach
 
 
 def internal_inside(points, unit, geo, mu):
-    """A unit squeeze strictly inside every cone ``mu`` (``(n, 3)``), NaN where there is none.
+    """A unit squeeze strictly inside every cone ``mu`` (``(n, 3)``), NaN where there is none:
+    :func:`set_up.internal_inside`'s twin.
 
     ``points (n, 3, 3)``, unit normals, their :func:`~grasptwist.engine.forces.grasp_map.geometry`
     (every row non-degenerate) and ``mu (n, 3)``.
     """
+    rows = len(points)
+    out = np.empty((rows, 3))
+    lanes = (points, unit, geo.m, contact_matrices(geo.e), np.asarray(mu, dtype=float), out)
     with np.errstate(all="ignore"):
-        plane = _Plane(points, unit, geo)
-        rows, reach = _own_rows(plane, mu)
-        ok, s = closure_test(rows)
-    return np.where((ok & reach & (plane.cos > 0).all(axis=1))[:, None], s, np.nan)
+        lanes = tuple(np.moveaxis(a, 0, -1) for a in lanes)
+        set_up.twins()["internal_inside"](*lanes, set_up.inside_workspace(rows), rows)
+    return out
 
 
 def _sector_rows(plane, theta):

@@ -28,7 +28,6 @@ a number is one condition in both.
 from __future__ import annotations
 
 from dataclasses import replace
-from itertools import combinations
 from typing import NamedTuple
 
 import numpy as np
@@ -36,7 +35,9 @@ import numpy as np
 from ...codes import status_enum, status_messages
 from ..checks import check_points
 from ..degeneracy import DEGENERACY_TOL
-from ..screws import J, K, cross, dot, norm
+from ..screws import J, K, cross
+from . import set_up
+from .set_up import CLOSURE_PAIRS, STRICT_MARGIN
 
 __all__ = [
     "CLOSURE_PAIRS",
@@ -337,9 +338,11 @@ def squeeze_directions(points) -> np.ndarray:
     [-0.7071, 0.7071, 0.0]
     """
     p = np.asarray(points, dtype=float)
-    d = p[..., K, :] - p[..., J, :]
+    flat = np.ascontiguousarray(p.reshape(-1, 3, 3))
+    e, sides = np.empty(flat.shape), np.empty((len(flat), 3))
     with np.errstate(invalid="ignore", divide="ignore"):
-        return d / norm(d)[..., None]
+        set_up.twins()["squeeze_directions"](_lanes(flat), _lanes(e), _lanes(sides), len(flat))
+    return e.reshape(p.shape)
 
 
 def squeeze_forces(points, squeeze) -> np.ndarray:
@@ -382,23 +385,31 @@ class Geometry(NamedTuple):
     culprit: np.ndarray  # (...) int8
 
 
+def _lanes(a):
+    """A row-major array's lane-form view (rows last) for :mod:`~grasptwist.engine.forces.set_up`'s twins."""
+    return np.moveaxis(a, 0, -1)
+
+
 def geometry(points, tol=DEGENERACY_TOL) -> Geometry:
-    """The contacts' frame, conditioning and geometric status (non-finite, coincident, collinear)."""
+    """The contacts' frame, conditioning and geometric status (non-finite, coincident, collinear).
+
+    The numbers are :func:`set_up.contact_geometry`'s and :func:`set_up.squeeze_directions`' (their numpy twins).
+    """
     p = np.asarray(points, dtype=float)
+    shape = p.shape[:-2]
+    flat = np.ascontiguousarray(p.reshape(-1, 3, 3))
+    rows = len(flat)
+    g, q, m, sizes = np.empty((rows, 3)), np.empty((rows, 3, 3)), np.empty((rows, 3)), np.empty((rows, 3))
+    squeezes, sides = np.empty((rows, 3, 3)), np.empty((rows, 3))
+    lanes = set_up.twins()
     with np.errstate(all="ignore"):
-        g = p.mean(axis=-2)
-        q = p - g[..., None, :]
-        m = cross(p[..., 1, :] - p[..., 0, :], p[..., 2, :] - p[..., 0, :])
-        q2 = dot(q, q)
-        t = q2.sum(axis=-1)
-        size = np.sqrt(q2.max(axis=-1))
-        sides = norm(p[..., K, :] - p[..., J, :])
-        det = dot(m, m) / 3  # the product of the two in-plane eigenvalues of sum q_i q_i^T
-        lam = 2 * det / (t + np.sqrt(np.maximum(t * t - 4 * det, 0)))  # the smaller one, stably
-        conditioning = np.sqrt(2 * lam / t)
-        status = np.zeros(p.shape[:-2], np.int8)
-        culprit = np.full(p.shape[:-2], -1, np.int8)
-        coincident = sides <= tol * np.sqrt(t)[..., None]
+        lanes["contact_geometry"](_lanes(flat), _lanes(g), _lanes(q), _lanes(m), _lanes(sizes), rows)
+        lanes["squeeze_directions"](_lanes(flat), _lanes(squeezes), _lanes(sides), rows)
+        t, conditioning = sizes[:, 0], sizes[:, 2]
+        size = np.sqrt(sizes[:, 1])
+        status = np.zeros(rows, np.int8)
+        culprit = np.full(rows, -1, np.int8)
+        coincident = sides <= tol * np.sqrt(t)[:, None]
         worst = np.argmax(coincident, axis=-1).astype(np.int8)
         status[~(conditioning > tol)] = ForceStatus.COLLINEAR_CONTACTS
         hit = coincident.any(axis=-1) | ~(t > 0)
@@ -408,23 +419,32 @@ def geometry(points, tol=DEGENERACY_TOL) -> Geometry:
         # geometry to judge: an overflow, not the coincident contacts an infinite size would mimic
         over = ~np.isfinite(t)
         status[over] = ForceStatus.NONFINITE_RESULT
-        bad = ~np.isfinite(p).all(axis=(-1, -2))
+        bad = ~np.isfinite(flat).all(axis=(-1, -2))
         status[bad] = ForceStatus.NONFINITE_INPUT
         culprit[over | bad] = -1
         conditioning = np.where(status == 0, conditioning, np.where(bad | over, np.nan, 0.0))
-        squeezes = squeeze_directions(p)
-    return Geometry(g, q, m, t, size, conditioning, squeezes, status, culprit)
+    parts = (g, q, m, t, size, conditioning, squeezes, status, culprit)
+    return Geometry(*(a.reshape(shape + a.shape[1:]) for a in parts))
 
 
 def _manipulating(geo: Geometry, wrench):
-    """``G^+ w`` in closed form for prepared contacts (NaN where the contacts are degenerate)."""
-    w = np.asarray(wrench, dtype=float)
-    force, moment = w[..., :3], w[..., 3:]
+    """``G^+ w`` in closed form for prepared contacts (NaN where the contacts are degenerate):
+    :func:`set_up.manipulating`'s numpy twin."""
+    shape = geo.t.shape
+    w = np.broadcast_to(np.asarray(wrench, dtype=float), shape + (6,)).reshape(-1, 6)
+    f = np.empty(shape + (3, 3))
+    rows = len(w)
     with np.errstate(all="ignore"):
-        mg = moment - cross(geo.centroid, force)  # the moment about the centroid
-        spread = 3 * np.sum(geo.q * dot(geo.q, mg[..., None, :])[..., None], axis=-2)
-        omega = (geo.m * (dot(geo.m, mg) / geo.t)[..., None] + spread) / dot(geo.m, geo.m)[..., None]
-        f = force[..., None, :] / 3 + cross(omega[..., None, :], geo.q)
+        set_up.twins()["manipulating"](
+            _lanes(geo.centroid.reshape(-1, 3)),
+            _lanes(geo.q.reshape(-1, 3, 3)),
+            _lanes(geo.m.reshape(-1, 3)),
+            geo.t.reshape(1, -1),
+            _lanes(w),
+            _lanes(f.reshape(-1, 3, 3)),
+            np.empty((3, rows)),
+            rows,
+        )
     return np.where((geo.status == 0)[..., None, None], f, np.nan)
 
 
@@ -582,10 +602,10 @@ def manipulating_forces(points, wrench, *, tol=DEGENERACY_TOL) -> ManipulatingFo
 def unit_normals(normals):
     r"""The contacts' unit normals, which contacts' normals are zero, and which rows hold a non-finite normal.
 
-    ``(n, 3, 3) -> unit (n, 3, 3), zero (n, 3), nonfinite (n)``.  Each normal is first
-    scaled by the power of two nearest its largest component (exact), so the squares in its
-    length neither overflow (``1e200``) nor underflow (``1e-200``): ``n / |n|`` to the last bit
-    wherever that does not, and the same direction for any finite non-zero length.  A NaN or
+    ``(n, 3, 3) -> unit (n, 3, 3), zero (n, 3), nonfinite (n)``.  A normal whose squares
+    would overflow (``1e200``) or underflow (``1e-200``) is first scaled by a power of two
+    (exact; :func:`set_up.unit_normals`, whose twin this is): ``n / |n|`` to the last bit
+    wherever they do not, and the same direction for any finite non-zero length.  A NaN or
     infinite normal is non-finite, not zero (``unit`` is NaN there).
 
     >>> u, zero, bad = unit_normals(np.array([[[3e200, 4e200, 0], [0, 0, 1e-200], [0, 0, 0]]]))
@@ -593,13 +613,13 @@ def unit_normals(normals):
     ([[0.6, 0.8, 0.0], [0.0, 0.0, 1.0], [nan, nan, nan]], [[False, False, True]], [False])
     """
     n = np.asarray(normals, dtype=float)
+    flat = n.reshape(-1, 3, 3)
+    unit = np.empty(flat.shape)
+    with np.errstate(all="ignore"):
+        set_up.twins()["unit_normals"](_lanes(flat), _lanes(unit), len(flat))
     finite = np.isfinite(n).all(axis=-1)
-    big = np.abs(n).max(axis=-1, keepdims=True, initial=0.0)
-    scaled = np.ldexp(n, -np.frexp(np.where(np.isfinite(big), big, 1.0))[1])
-    length = norm(scaled)
-    zero = finite & (length == 0)
-    with np.errstate(invalid="ignore", divide="ignore"):
-        return scaled / length[..., None], zero, ~finite.all(axis=-1)
+    zero = finite & (n == 0).all(axis=-1)
+    return unit.reshape(n.shape), zero, ~finite.all(axis=-1)
 
 
 def tangent_bases(normals):
@@ -610,10 +630,9 @@ def tangent_bases(normals):
     ([0.0, 1.0, 0.0], [-1.0, 0.0, 0.0])
     """
     n = np.asarray(normals, dtype=float)
-    pick = np.where((np.abs(n[..., 0]) < 0.9)[..., None], [1.0, 0, 0], [0, 1.0, 0])
-    b1 = cross(n, pick)
-    b1 = b1 / norm(b1)[..., None]
-    return b1, cross(n, b1)
+    with np.errstate(invalid="ignore", divide="ignore"):
+        b = set_up.twins()["tangents"](n[..., 0], n[..., 1], n[..., 2])
+    return np.stack(b[:3], axis=-1), np.stack(b[3:], axis=-1)
 
 
 def contact_matrices(e):
@@ -621,17 +640,7 @@ def contact_matrices(e):
 
     Squeeze ``l`` pushes contact ``i`` (``i != l``) towards the third contact; ``M[i, :, i] = 0``.
     """
-    m = np.zeros(e.shape[:-2] + (3, 3, 3))
-    for i in range(3):
-        m[..., i, :, K[i]] = e[..., K[i], :]
-        m[..., i, :, J[i]] = -e[..., J[i], :]
-    return m
-
-
-#: The closure test of the squeezes (closure.closure_test, and its compiled twin in kernel.py, which import
-#: them from here: a module below closure's cones and interior-point method): the pairs of the six unit rows
-#: ``R`` (two a contact) whose cross products are the candidate rays.
-CLOSURE_PAIRS = np.array(list(combinations(range(6), 2)))
-
-#: The closure test's margin below which a row's or a direction's is not strict.
-STRICT_MARGIN = 1e-12
+    flat = np.ascontiguousarray(np.asarray(e, dtype=float).reshape(-1, 3, 3))
+    m = np.empty((len(flat), 3, 3, 3))
+    set_up.twins()["squeeze_map"](_lanes(flat), _lanes(m), len(flat))
+    return m.reshape(e.shape[:-2] + (3, 3, 3))

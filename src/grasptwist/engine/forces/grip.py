@@ -32,7 +32,7 @@ import numpy as np
 from ..checks import check_normals, check_points
 from ..degeneracy import DEGENERACY_TOL
 from ..screws import cross, dot, norm
-from . import closure, compiled, cones, one, socp
+from . import closure, compiled, cones, one, set_up, socp
 from .grasp_map import (
     GRIP_COLUMNS,
     WRENCH_SCALED_BEYOND,
@@ -47,7 +47,6 @@ from .grasp_map import (
     collinear_map,
     contact_matrices,
     geometry,
-    tangent_bases,
     unit_normals,
     wrench_scales,
 )
@@ -186,16 +185,13 @@ def _frictionless(nu, w, tol):
 
 
 def _twist_through(geo, d):
-    """The twist ``lambda (n, 6)`` whose field ``lambda_F + lambda_M x p_i`` is nearest ``d_i`` (least squares).
-
-    About the centroid the normal equations split: ``v = mean(d)``, ``J omega = sum q_i x d_i``,
-    ``J^-1`` in closed form as in :func:`~grasptwist.engine.forces.grasp_map.manipulating_forces`.
-    """
-    v = d.mean(axis=-2)
-    x = cross(geo.q, d).sum(axis=-2)
-    spread = 3 * np.sum(geo.q * dot(geo.q, x[..., None, :])[..., None], axis=-2)
-    omega = (geo.m * (dot(geo.m, x) / geo.t)[..., None] + spread) / dot(geo.m, geo.m)[..., None]
-    return np.concatenate((v - cross(omega, geo.centroid), omega), axis=-1)
+    """The twist ``lambda (n, 6)`` whose field ``lambda_F + lambda_M x p_i`` is nearest ``d_i`` (least squares):
+    :func:`set_up.twist_through`'s numpy twin (``J^-1`` in closed form, as for ``G^+ w``)."""
+    out = np.empty((len(d), 6))
+    lanes = (geo.centroid, geo.q, geo.m, geo.t[:, None], np.asarray(d, dtype=float), out)
+    with np.errstate(all="ignore"):
+        set_up.twins()["twist_through"](*(np.moveaxis(a, 0, -1) for a in lanes), len(d))
+    return out
 
 
 def _twist_through_line(cmap, d):
@@ -607,10 +603,10 @@ class _Prepared:
         # the cones and the squeezes' (internal forces') map of the rows with friction
         rows = np.concatenate((self.plane, self.lines))
         limit = mu[rows] / s_f
-        with np.errstate(divide="ignore"):
-            kappa = np.where(np.isinf(limit), 0.0, 1 / limit)
-        b1, b2 = tangent_bases(self.unit[rows])
-        self.frame = np.stack((self.unit[rows], kappa[..., None] * b1, kappa[..., None] * b2), axis=-2)
+        self.frame = np.empty((rows.size, 3, 3, 3))
+        with np.errstate(all="ignore"):
+            lanes = (self.unit[rows], limit, self.frame)
+            set_up.twins()["cone_frames"](*(np.moveaxis(a, 0, -1) for a in lanes), rows.size)
         self.inside = closure.internal_inside(
             p[self.plane], self.unit[self.plane], _rows(geo, self.plane), limit[: self.plane.size]
         )
@@ -664,9 +660,9 @@ class _Prepared:
                 frame, m = self.frame[k + part], maps[part]
                 inside = np.full((part.size, 4), np.nan) if on_line else self.inside[part]
                 if self.one is not None:  # one grasp: numpy's cost per call is all there is, so floats
-                    s, z, fail, blame = _solve_floats(self.one, frame, fm[r] / scale[r, None, None])
+                    s, z, fail, blame = _solve_floats(self.one, _cones(frame, m, fm[r], scale[r])[1])
                 else:
-                    s, z, fail, blame = _solve(frame, m, fm[r] / scale[r, None, None], inside)
+                    s, z, fail, blame = _solve(frame, m, fm[r], scale[r], inside)
                 force[r] = fm[r] + scale[r, None, None] * np.einsum("nixl,nl->nix", m, s)
                 u = np.einsum("nikx,nik->nix", frame, z)  # the cones' multipliers as forces' duals
                 if on_line:
@@ -731,7 +727,7 @@ class _Prepared:
 
 def _one_row(frame, m, inside):
     """What :func:`one.solve` needs of one grasp's row (with friction, not collinear), as lists of floats."""
-    A, _, c = _cones(frame, m, np.zeros((1, 3, 3)))
+    A, _, c = _cones(frame, m, np.zeros((1, 3, 3)), np.ones(1))
     rays = frame * np.array([1.0, 0.0, 0.0])[:, None]
     normal = A[0, :, 0, :]
     regular = abs(np.linalg.det(normal)) > 1e-9 * np.prod(np.linalg.norm(normal, axis=-1))
@@ -746,13 +742,14 @@ def _one_row(frame, m, inside):
         "P": one.newton_matrices(A_list),
         "inside": start,
         "regular": bool(regular),
-        "rays": _cones(rays, m, np.zeros((1, 3, 3)))[0][0].tolist(),
+        "rays": _cones(rays, m, np.zeros((1, 3, 3)), np.ones(1))[0][0].tolist(),
     }
 
 
-def _solve_floats(row, frame, fm):
-    """:func:`_solve` for one row through :func:`one.solve`, with :func:`_solve`'s shapes."""
-    b = np.einsum("nikx,nix->nik", frame, fm)[0].tolist()
+def _solve_floats(row, b):
+    """:func:`_solve` for one row through :func:`one.solve`, with :func:`_solve`'s shapes (``b (1, 3, 3)``: its
+    :func:`_cones`)."""
+    b = b[0].tolist()
     s, z, fail, blame = one.solve(row["A"], b, row["c"], row["P"], row["inside"], row["regular"], row["rays"])
     return np.array([s]), np.array([z]), np.array([fail]), np.array([blame], np.int8)
 
@@ -856,23 +853,27 @@ def _squeezes_of(e, internal):
     return (np.linalg.pinv(m) @ internal.reshape(len(e), 9)[..., None])[..., 0]
 
 
-def _cones(frame, m, fm):
-    """``A = F M``, ``b = F f_m`` and ``c = sum_i A_i[0]`` from the cones' frames ``F`` and the internal forces' map ``M``."""
-    A = frame @ m
-    b = np.einsum("nikx,nix->nik", frame, fm)
+def _cones(frame, m, fm, scale):
+    """``A = F M``, ``b = F f_m / scale`` and ``c = sum_i A_i[0]`` from the cones' frames ``F`` and the internal
+    forces' map ``M``: :func:`set_up.cone_rows`' numpy twin."""
+    rows, d = len(fm), m.shape[-1]
+    A, b = np.empty((rows, 3, 3, d)), np.empty((rows, 3, 3))
+    lanes = (frame, m, fm, scale, A, b)
+    with np.errstate(all="ignore"):  # a collinear row's map may hold huge or tiny numbers; it is judged after
+        set_up.twins()["cone_rows"](*(np.moveaxis(a, 0, -1) for a in lanes), d, rows)
     return A, b, A[:, :, 0, :].sum(axis=1)
 
 
-def _solve(frame, m, fm, inside):
-    """The grip's internal-force coordinates for rows scaled to order one, the cones' multipliers,
-    failing rows and their culprits.
+def _solve(frame, m, fm, scale, inside):
+    """The grip's internal-force coordinates for rows scaled to order one (``fm / scale``), the cones'
+    multipliers, failing rows and their culprits.
 
     ``inside (n, d)``: internal-force coordinates strictly inside every cone (NaN where
     the grasp is not force closure with its limit); far enough along it is a start for
     phase II, so phase I runs only for the other rows.  The multipliers ``z (n, 3, 3)`` are
     phase II's where the grip exists, phase I's (a proof that none does) where it fails.
     """
-    A, b, c = _cones(frame, m, fm)
+    A, b, c = _cones(frame, m, fm, scale)
     n, d = len(fm), m.shape[-1]
     x = np.zeros((n, d))
     r = np.full(n, -1.0)
@@ -902,12 +903,12 @@ def _solve(frame, m, fm, inside):
         normal = A[bad, :, 0, :]
         maybe = np.arange(bad.size)
         if d == 3:
-            scale = np.prod(np.linalg.norm(normal, axis=-1), axis=-1)
-            maybe = np.flatnonzero(~(np.abs(np.linalg.det(normal)) > 1e-9 * scale))
+            size = np.prod(np.linalg.norm(normal, axis=-1), axis=-1)
+            maybe = np.flatnonzero(~(np.abs(np.linalg.det(normal)) > 1e-9 * size))
         if maybe.size:
             rows = bad[maybe]
             ray = frame[rows] * np.array([1.0, 0.0, 0.0])[:, None]  # the cones with no friction limit
-            A0, b0, _ = _cones(ray, m[rows], fm[rows])
+            A0, b0, _ = _cones(ray, m[rows], fm[rows], scale[rows])
             r0 = socp.phase_one(A0, b0)[1]
             blame[rows] = np.where(r0 < 0, blame[rows], -1)
     return s, z, fail, blame

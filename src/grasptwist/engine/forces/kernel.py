@@ -31,8 +31,8 @@ from itertools import accumulate
 import numpy as np
 from numba import literally, njit
 
-from . import ipm, one
-from .grasp_map import CLOSURE_PAIRS, GRIP_COLUMNS, STRICT_MARGIN
+from . import ipm, one, set_up
+from .grasp_map import GRIP_COLUMNS
 from .ipm import ITERATIONS as _ITERATIONS
 from .ipm import START_MARGIN
 
@@ -63,6 +63,14 @@ _ipm = _compiled(ipm.LANE_FORM, **_JIT)
 _step, _newton_part, _spd_solve = _ipm["step"], _ipm["newton_part"], _ipm["spd_solve"]
 _workspace = njit(**_ALLOC, inline="always")(ipm.workspace)
 _least_on_line, _dual_polish = (njit(**_JIT)(f) for f in (one.least_on_line, one.dual_polish))
+
+# the set-up is set_up.py's source, compiled (the numpy path runs its twin), each row's arrays a lane of width 1
+_set = _compiled(set_up.LANE_FORM, **_JIT)
+_cross, _contact_geometry, _squeeze_directions = _set["_cross"], _set["contact_geometry"], _set["squeeze_directions"]
+_unit_normals, _manipulating, _twist_through = _set["unit_normals"], _set["manipulating"], _set["twist_through"]
+_cone_frames, _squeeze_map, _cone_rows = _set["cone_frames"], _set["squeeze_map"], _set["cone_rows"]
+_internal_inside = _set["internal_inside"]
+_inside_workspace = njit(**_ALLOC, inline="always")(set_up.inside_workspace)
 
 
 #: Rows the interior-point method takes in step, each in a lane (the last axis of its workspace): the
@@ -422,7 +430,6 @@ def _rest(unit, frame, zk, m):
 _F, _FM, _S, _FN, _FT, _USED, _TOTAL, _COND, _DUAL, _GAP, _CERT, WIDTH = accumulate(
     (w for _, w in GRIP_COLUMNS), initial=0
 )
-_JJ, _KK = (1, 2, 0), (2, 0, 1)  # screws.J, screws.K: side i joins contacts J[i] and K[i]
 
 #: A row's stage between the passes: left to numpy; no wrench (no force); phase I to find a start; phase
 #: II from a start; cannot hold (phase I found none).
@@ -433,235 +440,80 @@ _CHUNK = 2048
 
 
 @njit(**_JIT)
-def _cross(a0, a1, a2, b0, b1, b2):
-    return a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
-
-
-@njit(**_JIT)
-def _twist(q, mv, t, g, d, out, sign):
-    """``sign`` times ``grip._twist_through``: the twist whose field at the contacts is nearest ``d (3, 3)``."""
-    v0 = (d[0, 0] + d[1, 0] + d[2, 0]) / 3
-    v1 = (d[0, 1] + d[1, 1] + d[2, 1]) / 3
-    v2 = (d[0, 2] + d[1, 2] + d[2, 2]) / 3
-    x0, x1, x2 = 0.0, 0.0, 0.0
-    for i in range(3):
-        c0, c1, c2 = _cross(q[i, 0], q[i, 1], q[i, 2], d[i, 0], d[i, 1], d[i, 2])
-        x0, x1, x2 = x0 + c0, x1 + c1, x2 + c2
-    _omega(q, mv, t, x0, x1, x2, out)
-    o0, o1, o2 = out[3], out[4], out[5]
-    c0, c1, c2 = _cross(o0, o1, o2, g[0], g[1], g[2])
-    out[0], out[1], out[2] = v0 - c0, v1 - c1, v2 - c2
-    for k in range(6):
-        out[k] *= sign
-
-
-@njit(**_JIT)
-def _omega(q, mv, t, x0, x1, x2, out):
-    """``J^-1 x`` in closed form (``grasp_map._manipulating``) into ``out[3:]``."""
-    s0, s1, s2 = 0.0, 0.0, 0.0
-    for i in range(3):
-        qx = q[i, 0] * x0 + q[i, 1] * x1 + q[i, 2] * x2
-        s0, s1, s2 = s0 + q[i, 0] * qx, s1 + q[i, 1] * qx, s2 + q[i, 2] * qx
-    mm = mv[0] * mv[0] + mv[1] * mv[1] + mv[2] * mv[2]
-    mx = (mv[0] * x0 + mv[1] * x1 + mv[2] * x2) / t
-    out[3], out[4], out[5] = (mv[0] * mx + 3 * s0) / mm, (mv[1] * mx + 3 * s1) / mm, (mv[2] * mx + 3 * s2) / mm
-
-
-@njit(**_JIT)
-def _internal_inside(p, unit, mv, e, limit, out, rows):
-    """``closure.internal_inside`` for one row: a unit squeeze strictly inside every cone into ``out (3)``,
-    or NaN.  The planar reduction (``closure._Plane``), the sectors of half-angle ``atan(limit_i)``
-    (``closure._own_rows``) and the extreme rays of their cone of squeezes (``closure.closure_test``);
-    ``rows (6, 3)``: a workspace."""
-    ml = math.sqrt(mv[0] ** 2 + mv[1] ** 2 + mv[2] ** 2)
-    n0, n1, n2 = mv[0] / ml, mv[1] / ml, mv[2] / ml
-    x0, x1, x2 = p[1, 0] - p[0, 0], p[1, 1] - p[0, 1], p[1, 2] - p[0, 2]
-    xl = math.sqrt(x0 * x0 + x1 * x1 + x2 * x2)
-    x0, x1, x2 = x0 / xl, x1 / xl, x2 / xl
-    y0, y1, y2 = _cross(n0, n1, n2, x0, x1, x2)
-    good = True
-    for i in range(3):
-        un = unit[i, 0] * n0 + unit[i, 1] * n1 + unit[i, 2] * n2
-        sin = abs(un)
-        cos = math.sqrt(max(1 - sin * sin, 0.0))
-        p0, p1, p2 = unit[i, 0] - un * n0, unit[i, 1] - un * n1, unit[i, 2] - un * n2
-        a, c = p0 * x0 + p1 * x1 + p2 * x2, p0 * y0 + p1 * y1 + p2 * y2
-        h = math.sqrt(a * a + c * c)
-        m0, m1 = a / h, c / h
-        # theta = atan(limit), phi = asin(sin) without the angles (five libm calls a contact were a
-        # tenth of a row's set-up): sin(theta - phi) sin(theta + phi) = (sin t - sin p)(sin t + sin p)
-        radius = math.hypot(1.0, limit[i])  # no overflow for a huge limit
-        cos_theta = 1 / radius
-        sin_theta = 1.0 if math.isinf(limit[i]) else limit[i] / radius
-        sin_phi = min(sin, 1.0)
-        good = good and sin_theta > sin_phi and cos > 0
-        sin_beta = math.sqrt(max((sin_theta - sin_phi) * (sin_theta + sin_phi), 0.0)) / cos
-        cos_beta = min(cos_theta / cos, 1.0)
-        for edge in range(2):
-            sign = -1.0 if edge == 0 else 1.0
-            v0 = sin_beta * m0 + sign * cos_beta * -m1
-            v1 = sin_beta * m1 + sign * cos_beta * m0
-            length = 0.0
-            for sq in range(3):
-                # the squeeze sq's force on contact i, in the plane's (x, y): contact_matrices(e)
-                fx = fy = 0.0
-                if sq == _KK[i]:
-                    fx, fy = (
-                        e[sq, 0] * x0 + e[sq, 1] * x1 + e[sq, 2] * x2,
-                        e[sq, 0] * y0 + e[sq, 1] * y1 + e[sq, 2] * y2,
-                    )
-                elif sq == _JJ[i]:
-                    fx = -(e[sq, 0] * x0 + e[sq, 1] * x1 + e[sq, 2] * x2)
-                    fy = -(e[sq, 0] * y0 + e[sq, 1] * y1 + e[sq, 2] * y2)
-                rows[2 * i + edge, sq] = fx * v0 + fy * v1
-                length += rows[2 * i + edge, sq] ** 2
-            length = math.sqrt(length)
-            for sq in range(3):
-                rows[2 * i + edge, sq] /= length
-    s0 = s1 = s2 = 0.0
-    for pair in range(len(CLOSURE_PAIRS)):  # in closure_test's order
-        a, c = CLOSURE_PAIRS[pair]
-        c0, c1, c2 = _cross(rows[a, 0], rows[a, 1], rows[a, 2], rows[c, 0], rows[c, 1], rows[c, 2])
-        length = math.sqrt(c0 * c0 + c1 * c1 + c2 * c2)
-        if not length > STRICT_MARGIN:
-            continue
-        c0, c1, c2 = c0 / length, c1 / length, c2 / length
-        above, below = True, True
-        for k in range(6):
-            t = rows[k, 0] * c0 + rows[k, 1] * c1 + rows[k, 2] * c2
-            above = above and t >= -STRICT_MARGIN
-            below = below and t <= STRICT_MARGIN
-        sign = (1.0 if above else 0.0) - (1.0 if below else 0.0)
-        s0, s1, s2 = s0 + c0 * sign, s1 + c1 * sign, s2 + c2 * sign
-    length = math.sqrt(s0 * s0 + s1 * s1 + s2 * s2)
-    s0, s1, s2 = s0 / length, s1 / length, s2 / length
-    good = good and length > STRICT_MARGIN
-    for k in range(6):
-        good = good and rows[k, 0] * s0 + rows[k, 1] * s1 + rows[k, 2] * s2 > STRICT_MARGIN
-    out[0], out[1], out[2] = (s0, s1, s2) if good else (math.nan, math.nan, math.nan)
-
-
-@njit(**_JIT)
-def _set_up(r, p, n, limit, w, tol, o, codes, q, mv, g, unit, e, fm, frame, M, A, b, inside, corners, lam):
-    """Row ``r``'s set-up pass: its geometry, ``G^+ w``, cones and a squeeze inside them into the arrays
-    given (``o``: its row of ``out``); ``(stage, t, size2, scale)``, the stage one of :data:`_SKIP`,
-    :data:`_NONE`, :data:`_OPEN`."""
+def _set_up(r, p, n, limit, w, tol, o, codes, lane, q, mv, g, sizes, unit, fm, frame, M, A, b, inside, work):
+    """Row ``r``'s set-up pass: its geometry, ``G^+ w``, cones and a squeeze inside them
+    (:mod:`~grasptwist.engine.forces.set_up`'s functions on its arrays, lanes of width 1; ``lane``: its inputs
+    and scratch) into the arrays given (``o``: its row of ``out``); ``(stage, scale)``, the stage one of
+    :data:`_SKIP`, :data:`_NONE`, :data:`_OPEN`."""
+    pl, nl, ll, wl, e, side, scale1, omega = lane
     codes[r, 0], codes[r, 1], codes[r, 2] = 0, -1, 0
     plain = True
     for i in range(3):
         for k in range(3):
+            pl[i, k, 0], nl[i, k, 0] = p[r, i, k], n[r, i, k]
             plain = plain and math.isfinite(p[r, i, k]) and math.isfinite(n[r, i, k])
+        ll[i, 0] = limit[r, i]
         plain = plain and limit[r, i] > 0  # NaN and 0 (frictionless, mixed) to numpy
     for k in range(6):
+        wl[k, 0] = w[r, k]
         plain = plain and math.isfinite(w[r, k])
     if not plain:
-        return _SKIP, 0.0, 0.0, 0.0
-    # geometry (grasp_map.geometry): centroid, spread, conditioning; degenerate rows to numpy
-    for k in range(3):
-        g[k] = (p[r, 0, k] + p[r, 1, k] + p[r, 2, k]) / 3
-    t, size2 = 0.0, 0.0
+        return _SKIP, 0.0
+    # geometry (grasp_map.geometry): degenerate rows (coincident, collinear, a zero normal) to numpy
+    _contact_geometry(pl, g, q, mv, sizes, 1)
+    _squeeze_directions(pl, e, side, 1)
+    _unit_normals(nl, unit, 1)
+    t = sizes[0, 0]
+    plain = t > 0 and sizes[2, 0] > tol
     for i in range(3):
-        q2 = 0.0
-        for k in range(3):
-            q[i, k] = p[r, i, k] - g[k]
-            q2 += q[i, k] * q[i, k]
-        t += q2
-        size2 = max(size2, q2)
-    mv[0], mv[1], mv[2] = _cross(
-        p[r, 1, 0] - p[r, 0, 0],
-        p[r, 1, 1] - p[r, 0, 1],
-        p[r, 1, 2] - p[r, 0, 2],
-        p[r, 2, 0] - p[r, 0, 0],
-        p[r, 2, 1] - p[r, 0, 1],
-        p[r, 2, 2] - p[r, 0, 2],
-    )
-    mm = mv[0] * mv[0] + mv[1] * mv[1] + mv[2] * mv[2]
-    det = mm / 3
-    small = 2 * det / (t + math.sqrt(max(t * t - 4 * det, 0.0)))
-    conditioning = math.sqrt(2 * small / t)
-    plain = t > 0 and conditioning > tol
-    for i in range(3):
-        a, c = _JJ[i], _KK[i]
-        e0, e1, e2 = p[r, c, 0] - p[r, a, 0], p[r, c, 1] - p[r, a, 1], p[r, c, 2] - p[r, a, 2]
-        side = math.sqrt(e0 * e0 + e1 * e1 + e2 * e2)
-        plain = plain and side > tol * math.sqrt(t)
-        e[i, 0], e[i, 1], e[i, 2] = e0 / side, e1 / side, e2 / side
-        # grasp_map.unit_normals: where the squares may over- or underflow, scaled by a power of two first
-        # (exact, so the same bits as unscaled wherever they do not), so any finite length is a length
-        for k in range(3):
-            unit[i, k] = n[r, i, k]
-        squares = unit[i, 0] ** 2 + unit[i, 1] ** 2 + unit[i, 2] ** 2
-        if not 1e-290 < squares < 1e290:
-            power = math.frexp(max(abs(n[r, i, 0]), abs(n[r, i, 1]), abs(n[r, i, 2])))[1]
-            for k in range(3):
-                unit[i, k] = math.ldexp(n[r, i, k], -power)
-            squares = unit[i, 0] ** 2 + unit[i, 1] ** 2 + unit[i, 2] ** 2
-        length = math.sqrt(squares)
-        plain = plain and length > 0
-        for k in range(3):
-            unit[i, k] /= length
+        plain = plain and side[i, 0] > tol * math.sqrt(t) and not math.isnan(unit[i, 0, 0])
     if not plain:
-        return _SKIP, 0.0, 0.0, 0.0
-    # G^+ w (grasp_map._manipulating): the twist (omega; F/3) about the centroid
-    F0, F1, F2 = w[r, 0], w[r, 1], w[r, 2]
-    c0, c1, c2 = _cross(g[0], g[1], g[2], F0, F1, F2)
-    _omega(q, mv, t, w[r, 3] - c0, w[r, 4] - c1, w[r, 5] - c2, lam)
+        return _SKIP, 0.0
+    _manipulating(g, q, mv, sizes, wl, fm, omega, 1)
     scale = 0.0
     for i in range(3):
-        c0, c1, c2 = _cross(lam[3], lam[4], lam[5], q[i, 0], q[i, 1], q[i, 2])
-        fm[i, 0], fm[i, 1], fm[i, 2] = F0 / 3 + c0, F1 / 3 + c1, F2 / 3 + c2
         for k in range(3):
-            o[_FM + 3 * i + k] = fm[i, k]
-            scale = max(scale, abs(fm[i, k]))
-            plain = plain and math.isfinite(fm[i, k])
+            o[_FM + 3 * i + k] = fm[i, k, 0]
+            scale = max(scale, abs(fm[i, k, 0]))
+            plain = plain and math.isfinite(fm[i, k, 0])
     if not plain:  # overflow: nonfinite-result, said by the numpy path
-        return _SKIP, 0.0, 0.0, 0.0
-    o[_COND] = conditioning
+        return _SKIP, 0.0
+    o[_COND] = sizes[2, 0]
     for k in range(6):
         o[_CERT + k] = math.nan
     if scale == 0:  # no wrench: no force at all is the least
         for k in range(6):
             o[_DUAL + k] = 0.0
-        return _NONE, t, size2, scale
-    # the cones (grasp_map.tangent_bases, grip._cones) and the squeezes' map (contact_matrices)
-    for i in range(3):
-        kappa = 0.0 if math.isinf(limit[r, i]) else 1 / limit[r, i]
-        u0, u1, u2 = unit[i, 0], unit[i, 1], unit[i, 2]
-        b0, b1, b2 = _cross(u0, u1, u2, 1.0, 0.0, 0.0) if abs(u0) < 0.9 else _cross(u0, u1, u2, 0.0, 1.0, 0.0)
-        bl = math.sqrt(b0 * b0 + b1 * b1 + b2 * b2)
-        b0, b1, b2 = b0 / bl, b1 / bl, b2 / bl
-        t0, t1, t2 = _cross(u0, u1, u2, b0, b1, b2)
-        frame[i, 0, 0], frame[i, 0, 1], frame[i, 0, 2] = u0, u1, u2
-        frame[i, 1, 0], frame[i, 1, 1], frame[i, 1, 2] = kappa * b0, kappa * b1, kappa * b2
-        frame[i, 2, 0], frame[i, 2, 1], frame[i, 2, 2] = kappa * t0, kappa * t1, kappa * t2
-        for k in range(3):
-            M[i, k, _KK[i]] = e[_KK[i], k]
-            M[i, k, _JJ[i]] = -e[_JJ[i], k]
-            M[i, k, i] = 0.0
-    for i in range(3):
-        for k in range(3):
-            b[i, k] = (
-                frame[i, k, 0] * (fm[i, 0] / scale)
-                + frame[i, k, 1] * (fm[i, 1] / scale)
-                + frame[i, k, 2] * (fm[i, 2] / scale)
-            )
-            for j in range(3):
-                A[i, k, j] = frame[i, k, 0] * M[i, 0, j] + frame[i, k, 1] * M[i, 1, j] + frame[i, k, 2] * M[i, 2, j]
-    _internal_inside(p[r], unit, mv, e, limit[r], inside, corners)
-    return _OPEN, t, size2, scale
+        return _NONE, scale
+    # the cones, the squeezes' map and the method's rows (A, b in the iteration's layout); a squeeze inside
+    scale1[0] = scale
+    _cone_frames(unit, ll, frame, 1)
+    _squeeze_map(e, M, 1)
+    _cone_rows(frame, M, fm, scale1, A.reshape((3, 3, 3, 1)), b.reshape((3, 3, 1)), 3, 1)
+    _internal_inside(pl, unit, mv, M, ll, inside.reshape((3, 1)), work, 1)
+    return _OPEN, scale
 
 
 @njit(**_JIT)
-def _finish(r, w, o, codes, fail, blame, q, mv, t, g, size2, unit, fm, frame, M, scale, s, z, d, lam, A, b, work):
+def _finish(r, w, o, codes, fail, blame, q, mv, g, sizes, unit, fm, frame, M, scale, s, z, dl, twist, A, b, work):
     """Row ``r``'s last pass: the dual or the certificate (``z``: the multipliers of phase II or of a
-    failed phase I), the forces of the squeezes ``s`` and their figures into ``o`` (its row of ``out``)."""
+    failed phase I), the forces of the squeezes ``s`` and their figures into ``o`` (its row of ``out``).
+
+    Its set-up arrays are lanes of width 1 (:func:`_set_up`'s), seen here without the lane axis; ``dl (3, 3, 1)``
+    and ``twist (6, 1)``: the dual twist's lanes."""
+    lam, d = twist[:, 0], dl[:, :, 0]
+    dual = (g, q, mv, sizes, dl, twist)
+    q, g, unit, fm = q[:, :, 0], g[:, 0], unit[:, :, 0], fm[:, :, 0]
+    frame, M = frame[:, :, :, 0], M[:, :, :, 0]
     if scale:
         # the multipliers as forces' duals; the dual twist through n_i - u_i, phase I's y through -u_i
         for i in range(3):
             for k in range(3):
                 d[i, k] = frame[i, 0, k] * z[i, 0] + frame[i, 1, k] * z[i, 1] + frame[i, 2, k] * z[i, 2]
         if fail:
-            _twist(q, mv, t, g, d, lam, -1.0)
+            _twist_through(*dual, 1)
+            for k in range(6):
+                lam[k] = -lam[k]
             yw, yy, ww = 0.0, 0.0, 0.0
             for k in range(6):
                 yw += lam[k] * w[r, k]
@@ -669,7 +521,7 @@ def _finish(r, w, o, codes, fail, blame, q, mv, t, g, size2, unit, fm, frame, M,
                 ww += w[r, k] * w[r, k]
             if yw > 1e-8 * math.sqrt(yy) * math.sqrt(ww):  # grip._EDGE_OF_HOLD
                 length = math.sqrt(
-                    lam[0] ** 2 + lam[1] ** 2 + lam[2] ** 2 + size2 * (lam[3] ** 2 + lam[4] ** 2 + lam[5] ** 2)
+                    lam[0] ** 2 + lam[1] ** 2 + lam[2] ** 2 + sizes[1, 0] * (lam[3] ** 2 + lam[4] ** 2 + lam[5] ** 2)
                 )
                 for k in range(6):
                     o[_CERT + k] = lam[k] / length
@@ -684,7 +536,7 @@ def _finish(r, w, o, codes, fail, blame, q, mv, t, g, size2, unit, fm, frame, M,
             for i in range(3):
                 for k in range(3):
                     d[i, k] = unit[i, k] - d[i, k]
-            _twist(q, mv, t, g, d, lam, 1.0)
+            _twist_through(*dual, 1)
             for k in range(6):
                 o[_DUAL + k] = lam[k]
     codes[r, 0], codes[r, 1] = (20, blame) if fail else (0, -1)
@@ -735,26 +587,38 @@ def grip_rows(p, n, limit, w, tol, out, codes):
 
 @njit(**_ALLOC)
 def _chunk(rows):
-    """What the passes keep of each of ``rows`` rows: geometry, ``G^+ w``, cones (``M`` zero off its
-    squeezes' entries), both phases' problems and answers, stage, culprit, and the rows of each phase."""
+    """What the passes keep of each of ``rows`` rows: geometry, ``G^+ w``, cones (a row's each a lane of width 1,
+    as :mod:`~grasptwist.engine.forces.set_up` writes them), both phases' problems and answers (the method's
+    layout), sizes (``t``, the largest ``|q_i|^2``, the conditioning; the scale), stage, culprit, and the rows of
+    each phase."""
     f, i = np.empty, np.int64
     return (
-        (f((rows, 3, 3)), f((rows, 3)), f((rows, 3)), f((rows, 3, 3)), f((rows, 3, 3)), f((rows, 3, 3, 3))),
-        (np.zeros((rows, 3, 3, 3)), f((rows, 3, 3, 3)), f((rows, 3, 3)), f((rows, 3)), f((rows, 3)), f((rows, 3, 3))),
+        (
+            f((rows, 3, 3, 1)),
+            f((rows, 3, 1)),
+            f((rows, 3, 1)),
+            f((rows, 3, 3, 1)),
+            f((rows, 3, 3, 1)),
+            f((rows, 3, 3, 3, 1)),
+        ),
+        (f((rows, 3, 3, 3, 1)), f((rows, 3, 3, 3)), f((rows, 3, 3)), f((rows, 3)), f((rows, 3)), f((rows, 3, 3))),
         (f((rows, _K, 3, _D)), f((rows, _K, 3)), f((rows, _D)), f((rows, _D)), f((rows, _K, 3)), f((rows, 3))),
-        f((rows, 3)),
+        (f((rows, 3, 1)), f(rows)),
         (np.empty(rows, i), np.empty(rows, i), np.empty(rows, i), np.empty(rows, i), np.empty(rows, i)),
     )
 
 
 @njit(**_ALLOC)
 def _grip_workspace():
-    """One row's scratch arrays: ``e``, ``corners``, ``d``, ``lam``, :func:`_dual_polish`'s and :func:`_on_the_edge`'s."""
+    """One row's scratch arrays, lanes of width 1: its inputs and the set-up's (``p, n, limit, w, e``, the sides,
+    the scale, omega), :func:`set_up.internal_inside`'s, the dual twist's ``d`` and twist; :func:`_dual_polish`'s
+    and :func:`_on_the_edge`'s."""
+    f = np.empty
     return (
-        np.empty((3, 3)),
-        np.empty((6, 3)),
-        np.empty((3, 3)),
-        np.empty(6),
+        (f((3, 3, 1)), f((3, 3, 1)), f((3, 1)), f((6, 1)), f((3, 3, 1)), f((3, 1)), f(1), f((3, 1))),
+        _inside_workspace(1),
+        f((3, 3, 1)),
+        f((6, 1)),
         (np.empty(3), np.empty((3, 3, 1)), np.empty((3, 1)), np.empty((3, 1)), np.empty((3, 3))),
         (np.empty((2, 3)), np.empty((2, 3)), np.empty((3, 4))),
     )
@@ -764,16 +628,15 @@ def _grip_workspace():
 def _grip_rows(p, n, limit, w, tol, out, codes, chunk, gw):
     """:func:`grip_rows` a chunk of rows at a time, in passes: set-up, phase I (then phase I on the rays,
     for a culprit), phase II, finish; the phases' rows in step (:func:`_iterate`)."""
-    (q, mv, g, unit, fm, frame), (M, A, b, c, x, z), (wide, bw, cw, xw, zw, inside), sizes, lists = chunk
-    t, size2, scale = sizes[:, 0], sizes[:, 1], sizes[:, 2]
+    (q, mv, g, unit, fm, frame), (M, A, b, c, x, z), (wide, bw, cw, xw, zw, inside), (sizes, scale), lists = chunk
     stage, blame, one, two, again = lists
-    e, corners, d, lam, (omega, h, res, delta, dz), (line_a, line_b, polish) = gw
+    lane, inside_work, d, lam, (omega, h, res, delta, dz), (line_a, line_b, polish) = gw
     for first in range(0, p.shape[0], _CHUNK):  # no rows: no chunk
         rows = min(_CHUNK, p.shape[0] - first)
         ones, twos, agains = 0, 0, 0
         for i in range(rows):
             r = first + i
-            stage[i], t[i], size2[i], scale[i] = _set_up(
+            stage[i], scale[i] = _set_up(
                 r,
                 p,
                 n,
@@ -782,19 +645,19 @@ def _grip_rows(p, n, limit, w, tol, out, codes, chunk, gw):
                 tol,
                 out[r],
                 codes,
+                lane,
                 q[i],
                 mv[i],
                 g[i],
+                sizes[i],
                 unit[i],
-                e,
                 fm[i],
                 frame[i],
                 M[i],
                 A[i],
                 b[i],
                 inside[i],
-                corners,
-                lam,
+                inside_work,
             )
             blame[i] = -1
             if stage[i] == _NONE:
@@ -850,9 +713,8 @@ def _grip_rows(p, n, limit, w, tol, out, codes, chunk, gw):
                 blame[i],
                 q[i],
                 mv[i],
-                t[i],
                 g[i],
-                size2[i],
+                sizes[i],
                 unit[i],
                 fm[i],
                 frame[i],
