@@ -7,6 +7,7 @@ import pytest
 
 from grasptwist.engine.forces import set_up
 from grasptwist.engine.forces.grasp_map import contact_matrices, grasp_map, manipulating_reference
+from grasptwist.engine.forces.ipm import START_MARGIN
 
 WIDTH = 12
 
@@ -50,6 +51,7 @@ def _set_up(functions):
         np.empty((3, WIDTH)),
     )
     scale = np.abs(w).max(axis=0)
+    blame, pulling = np.empty(WIDTH, np.int64), np.empty(WIDTH, bool)
     work = set_up.inside_workspace(WIDTH)
     with np.errstate(all="ignore"):
         functions["contact_geometry"](p, g, q, mv, sizes, WIDTH)
@@ -61,10 +63,13 @@ def _set_up(functions):
         functions["squeeze_map"](e, M, WIDTH)
         functions["cone_rows"](frame, M, fm, scale, A, b, 3, WIDTH)
         functions["internal_inside"](p, unit, mv, M, limit, inside, work, WIDTH)
+        start = np.where(np.isnan(inside), 0.0, inside)  # a start from each row's squeeze, or from none
+        functions["start"](A, b, start, start, 3, WIDTH)
+        functions["culprit"](A, b, np.sin(np.arange(3 * WIDTH)).reshape(3, WIDTH), blame, pulling, 3, WIDTH)
     return {
         "g": g, "q": q, "m": mv, "sizes": sizes, "e": e, "side": side, "unit": unit, "fm": fm, "twist": twist,
         "frame": frame, "M": M, "A": A, "b": b, "inside": inside,
-        "rows": work[7], "rays": work[8], "tilt": work[1],
+        "rows": work[7], "rays": work[8], "tilt": work[1], "start": start, "blame": blame, "pulling": pulling,
     }  # fmt: skip
 
 
@@ -84,6 +89,7 @@ def test_the_twins_are_the_lane_source_to_the_bit():
     assert np.isnan(source["unit"][2, :, 4]).all() and not np.isnan(source["unit"][:, :, [2, 3]]).any()
     assert (source["frame"][0, 1:, :, 5] == 0).all()
     assert 0 < np.isfinite(source["inside"][0]).sum() < WIDTH
+    assert len(set(source["blame"][np.array([r not in (1, 4) for r in range(WIDTH)])])) > 1
 
 
 def test_the_set_up_meets_its_definitions():
@@ -125,6 +131,20 @@ def test_the_set_up_meets_its_definitions():
         fn = np.einsum("ik,ik->i", f, unit[r])
         ft = np.linalg.norm(f - fn[:, None] * unit[r], axis=1)
         assert (ft < limit[r] * fn).all()
+    # the start clears every cone by START_MARGIN, the culprit is the cone left furthest, and pulling is
+    # possible exactly where the normal rows are singular (LAPACK's determinant)
+    A, b = np.moveaxis(out["A"], -1, 0), np.moveaxis(out["b"], -1, 0)
+    start = np.moveaxis(out["start"], -1, 0)
+    x = np.sin(np.arange(3 * WIDTH)).reshape(3, WIDTH).T
+    for r in np.flatnonzero(good):
+        if np.isfinite(inside[r]).all():
+            y = A[r] @ start[r] + b[r]
+            assert (y[:, 0] - np.hypot(y[:, 1], y[:, 2]) >= START_MARGIN * (1 - 1e-12)).all()
+        y = A[r] @ x[r] + b[r]
+        assert out["blame"][r] == np.argmax(np.hypot(y[:, 1], y[:, 2]) - y[:, 0])
+        normal = A[r, :, 0, :]
+        singular = not abs(np.linalg.det(normal)) > 1e-9 * np.prod(np.linalg.norm(normal, axis=1))
+        assert out["pulling"][r] == singular
 
 
 @pytest.mark.slow

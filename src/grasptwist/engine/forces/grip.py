@@ -878,13 +878,12 @@ def _solve(frame, m, fm, scale, inside):
     x = np.zeros((n, d))
     r = np.full(n, -1.0)
     z = np.zeros((n, 3, 3))
-    closing = ~np.isnan(inside).any(axis=1)
-    if closing.any():
-        y = np.einsum("nmkd,nd->nmk", A[closing], inside[closing])
-        depth = y[..., 0] - np.sqrt(y[..., 1] ** 2 + y[..., 2] ** 2)  # > 0: strictly inside
-        reach = np.abs(b[closing, :, 0]) + np.sqrt(b[closing, :, 1] ** 2 + b[closing, :, 2] ** 2)
-        x[closing] = ((socp.START_MARGIN + reach) / depth).max(axis=1)[:, None] * inside[closing]
-    other = np.flatnonzero(~closing)
+    closing = np.flatnonzero(~np.isnan(inside).any(axis=1))
+    if closing.size:
+        lanes = (A[closing], b[closing], inside[closing], x[closing])
+        set_up.twins()["start"](*(np.moveaxis(a, 0, -1) for a in lanes), d, closing.size)
+        x[closing] = lanes[-1]
+    other = np.flatnonzero(np.isnan(inside).any(axis=1))
     if other.size:
         x[other], r[other], z[other] = socp.phase_one(A[other], b[other])
     fail = ~(r < 0)
@@ -896,15 +895,14 @@ def _solve(frame, m, fm, scale, inside):
     blame = np.full(n, -1, np.int8)
     bad = np.flatnonzero(fail)
     if bad.size:
-        y = np.einsum("nmkd,nd->nmk", A[bad], x[bad]) + b[bad]
-        blame[bad] = np.argmax(np.sqrt(y[..., 1] ** 2 + y[..., 2] ** 2) - y[..., 0], axis=1)
-        # Pulling: infeasible even with unlimited friction (half-spaces n.f >= 0).  When the
-        # squeezes reach every pattern of normal forces (an invertible 3 x 3 map) it never is.
-        normal = A[bad, :, 0, :]
-        maybe = np.arange(bad.size)
-        if d == 3:
-            size = np.prod(np.linalg.norm(normal, axis=-1), axis=-1)
-            maybe = np.flatnonzero(~(np.abs(np.linalg.det(normal)) > 1e-9 * size))
+        # the cone each leaves furthest, and whether it may be infeasible even with unlimited friction
+        # (half-spaces n.f >= 0: pulling), which it cannot be where the squeezes reach every normal force
+        culprit, pulling = np.empty(bad.size, np.int64), np.empty(bad.size, bool)
+        lanes = (A[bad], b[bad], x[bad])
+        with np.errstate(invalid="ignore"):
+            set_up.twins()["culprit"](*(np.moveaxis(a, 0, -1) for a in lanes), culprit, pulling, d, bad.size)
+        blame[bad] = culprit
+        maybe = np.flatnonzero(pulling)
         if maybe.size:
             rows = bad[maybe]
             ray = frame[rows] * np.array([1.0, 0.0, 0.0])[:, None]  # the cones with no friction limit

@@ -34,7 +34,6 @@ from numba import literally, njit
 from . import ipm, one, set_up
 from .grasp_map import GRIP_COLUMNS
 from .ipm import ITERATIONS as _ITERATIONS
-from .ipm import START_MARGIN
 
 __all__ = ["grip_rows", "WIDTH", "iterate_rows", "polish_rows"]
 
@@ -69,7 +68,7 @@ _set = _compiled(set_up.LANE_FORM, **_JIT)
 _cross, _contact_geometry, _squeeze_directions = _set["_cross"], _set["contact_geometry"], _set["squeeze_directions"]
 _unit_normals, _manipulating, _twist_through = _set["unit_normals"], _set["manipulating"], _set["twist_through"]
 _cone_frames, _squeeze_map, _cone_rows = _set["cone_frames"], _set["squeeze_map"], _set["cone_rows"]
-_internal_inside = _set["internal_inside"]
+_internal_inside, _start_lanes, _culprit = _set["internal_inside"], _set["start"], _set["culprit"]
 _inside_workspace = njit(**_ALLOC, inline="always")(set_up.inside_workspace)
 
 
@@ -209,55 +208,14 @@ def _phase_one_problem(A, b, rays, wide, bw, c, x, z):
 @njit(**_JIT)
 def _start(A, b, inside, c, x):
     """``grip._solve``'s objective ``c`` (the normal forces' sum) and, where the contacts are in force
-    closure (``inside`` finite), its start ``x``: ``inside`` scaled to clear every cone by ``START_MARGIN``;
-    whether there is one (else phase I finds it)."""
-    K, d = A.shape[0], A.shape[2]
-    for j in range(d):
-        c[j] = 0.0
-        for m in range(K):
-            c[j] += A[m, 0, j]
-    for j in range(d):
-        if math.isnan(inside[j]):
-            return False
-    reach = -math.inf
-    for m in range(K):
-        y0, y1, y2 = 0.0, 0.0, 0.0
-        for j in range(d):
-            y0 += A[m, 0, j] * inside[j]
-            y1 += A[m, 1, j] * inside[j]
-            y2 += A[m, 2, j] * inside[j]
-        depth = y0 - math.sqrt(y1 * y1 + y2 * y2)
-        reach = max(reach, (START_MARGIN + abs(b[m, 0]) + math.sqrt(b[m, 1] ** 2 + b[m, 2] ** 2)) / depth)
-    for j in range(d):
-        x[j] = reach * inside[j]
+    closure (``inside`` finite), its start ``x`` (:func:`set_up.start` on the row's lane); whether there is
+    one (else phase I finds it)."""
+    for j in range(3):
+        c[j] = A[0, 0, j] + A[1, 0, j] + A[2, 0, j]
+    if math.isnan(inside[0]):
+        return False
+    _start_lanes(A.reshape((3, 3, 3, 1)), b.reshape((3, 3, 1)), inside.reshape((3, 1)), x.reshape((3, 1)), 3, 1)
     return True
-
-
-@njit(**_JIT)
-def _culprit(A, b, x):
-    """``grip._solve``'s culprit of a row phase I found infeasible (``x``: its end): the cone it leaves
-    furthest; and whether the row may be infeasible with unlimited friction too (pulling), possible
-    unless the squeezes reach every normal force."""
-    K, d = A.shape[0], A.shape[2]
-    worst, blame = -math.inf, 0
-    for m in range(K):
-        y0, y1, y2 = b[m, 0], b[m, 1], b[m, 2]
-        for j in range(d):
-            y0 += A[m, 0, j] * x[j]
-            y1 += A[m, 1, j] * x[j]
-            y2 += A[m, 2, j] * x[j]
-        over = math.sqrt(y1 * y1 + y2 * y2) - y0
-        if over > worst or (math.isnan(over) and not math.isnan(worst)):  # argmax: NaN wins, as numpy's
-            worst, blame = over, m
-    det = (
-        A[0, 0, 0] * (A[1, 0, 1] * A[2, 0, 2] - A[1, 0, 2] * A[2, 0, 1])
-        - A[0, 0, 1] * (A[1, 0, 0] * A[2, 0, 2] - A[1, 0, 2] * A[2, 0, 0])
-        + A[0, 0, 2] * (A[1, 0, 0] * A[2, 0, 1] - A[1, 0, 1] * A[2, 0, 0])
-    )
-    scale = 1.0
-    for m in range(3):
-        scale *= math.sqrt(A[m, 0, 0] ** 2 + A[m, 0, 1] ** 2 + A[m, 0, 2] ** 2)
-    return blame, not abs(det) > 1e-9 * scale
 
 
 @njit(**_JIT)
@@ -611,8 +569,8 @@ def _chunk(rows):
 @njit(**_ALLOC)
 def _grip_workspace():
     """One row's scratch arrays, lanes of width 1: its inputs and the set-up's (``p, n, limit, w, e``, the sides,
-    the scale, omega), :func:`set_up.internal_inside`'s, the dual twist's ``d`` and twist; :func:`_dual_polish`'s
-    and :func:`_on_the_edge`'s."""
+    the scale, omega), :func:`set_up.internal_inside`'s, the dual twist's ``d`` and twist; :func:`_dual_polish`'s,
+    :func:`_on_the_edge`'s and :func:`set_up.culprit`'s."""
     f = np.empty
     return (
         (f((3, 3, 1)), f((3, 3, 1)), f((3, 1)), f((6, 1)), f((3, 3, 1)), f((3, 1)), f(1), f((3, 1))),
@@ -621,6 +579,7 @@ def _grip_workspace():
         f((6, 1)),
         (np.empty(3), np.empty((3, 3, 1)), np.empty((3, 1)), np.empty((3, 1)), np.empty((3, 3))),
         (np.empty((2, 3)), np.empty((2, 3)), np.empty((3, 4))),
+        (np.empty(1, np.int64), np.empty(1, np.bool_)),
     )
 
 
@@ -630,7 +589,7 @@ def _grip_rows(p, n, limit, w, tol, out, codes, chunk, gw):
     for a culprit), phase II, finish; the phases' rows in step (:func:`_iterate`)."""
     (q, mv, g, unit, fm, frame), (M, A, b, c, x, z), (wide, bw, cw, xw, zw, inside), (sizes, scale), lists = chunk
     stage, blame, one, two, again = lists
-    lane, inside_work, d, lam, (omega, h, res, delta, dz), (line_a, line_b, polish) = gw
+    lane, inside_work, d, lam, (omega, h, res, delta, dz), (line_a, line_b, polish), (who, pulling) = gw
     for first in range(0, p.shape[0], _CHUNK):  # no rows: no chunk
         rows = min(_CHUNK, p.shape[0] - first)
         ones, twos, agains = 0, 0, 0
@@ -683,8 +642,9 @@ def _grip_rows(p, n, limit, w, tol, out, codes, chunk, gw):
             for m in range(3):
                 for j in range(3):
                     z[i, m, j] = zw[i, m, j]
-            blame[i], maybe = _culprit(A[i], b[i], x[i])
-            if maybe:
+            _culprit(A[i].reshape((3, 3, 3, 1)), b[i].reshape((3, 3, 1)), x[i].reshape((3, 1)), who, pulling, 3, 1)
+            blame[i] = who[0]
+            if pulling[0]:
                 _phase_one_problem(A[i], b[i], True, wide[i], bw[i], cw[i], xw[i], zw[i])
                 again[agains] = i
                 agains += 1

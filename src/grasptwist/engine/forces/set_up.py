@@ -32,7 +32,7 @@ from itertools import combinations
 
 import numpy as np
 
-from .ipm import every
+from .ipm import START_MARGIN, every
 
 __all__ = [
     "CLOSURE_PAIRS",
@@ -51,6 +51,9 @@ __all__ = [
     "sector_rows",
     "closure_test",
     "internal_inside",
+    "inside_workspace",
+    "start",
+    "culprit",
 ]
 
 #: The closure test's pairs of its six unit rows ``R`` (two a contact) whose cross products are the candidate rays.
@@ -388,10 +391,62 @@ def inside_workspace(width):
     )
 
 
+def start(A, b, inside, x, d, width):
+    """Phase II's start from a squeeze strictly inside every cone: ``x (d, width)`` = ``inside (d, width)`` scaled
+    so that each ``A_m x + b_m`` clears its cone by :data:`~ipm.START_MARGIN` (``A (3, 3, d, width)``,
+    ``b (3, 3, width)``; NaN where ``inside`` is): ``max_m (START_MARGIN + |b_m0| + |b_mt|) / depth_m``,
+    ``depth_m = y_m0 - |y_mt|`` of ``y_m = A_m inside`` (positive: strictly inside)."""
+    for ln in range(width):
+        reach = -np.inf
+        for m in range(3):
+            y0, y1, y2 = 0.0, 0.0, 0.0
+            for j in range(d):
+                y0 += A[m, 0, j, ln] * inside[j, ln]
+                y1 += A[m, 1, j, ln] * inside[j, ln]
+                y2 += A[m, 2, j, ln] * inside[j, ln]
+            depth = y0 - np.sqrt(y1 * y1 + y2 * y2)
+            span = START_MARGIN + np.abs(b[m, 0, ln]) + np.sqrt(b[m, 1, ln] * b[m, 1, ln] + b[m, 2, ln] * b[m, 2, ln])
+            reach = np.maximum(reach, span / depth)
+        for j in range(d):
+            x[j, ln] = reach * inside[j, ln]
+
+
+def culprit(A, b, x, blame, pulling, d, width):
+    """Of rows phase I found infeasible (``x (d, width)`` its end): the cone each leaves furthest into ``blame
+    (width)`` (``argmax_m |y_mt| - y_m0``, NaN first, as numpy's ``argmax``), and into ``pulling (width)``
+    whether it may be infeasible with unlimited friction too, which it cannot be where the squeezes reach
+    every pattern of normal forces: ``|det N| > 1e-9 prod_m |N_m|`` of the 3 x 3 normal rows ``N_m = A_m0``
+    (``d = 3``; with more unknowns it may)."""
+    for ln in range(width):
+        worst, who = -np.inf, 0
+        for m in range(3):
+            y0, y1, y2 = b[m, 0, ln], b[m, 1, ln], b[m, 2, ln]
+            for j in range(d):
+                y0 += A[m, 0, j, ln] * x[j, ln]
+                y1 += A[m, 1, j, ln] * x[j, ln]
+                y2 += A[m, 2, j, ln] * x[j, ln]
+            over = np.sqrt(y1 * y1 + y2 * y2) - y0
+            take = (over > worst) | (np.isnan(over) & np.logical_not(np.isnan(worst))) if m > 0 else True
+            who = m if take else who
+            worst = over if take else worst
+        blame[ln] = who
+        det = (
+            A[0, 0, 0, ln] * (A[1, 0, 1, ln] * A[2, 0, 2, ln] - A[1, 0, 2, ln] * A[2, 0, 1, ln])
+            - A[0, 0, 1, ln] * (A[1, 0, 0, ln] * A[2, 0, 2, ln] - A[1, 0, 2, ln] * A[2, 0, 0, ln])
+            + A[0, 0, 2, ln] * (A[1, 0, 0, ln] * A[2, 0, 1, ln] - A[1, 0, 1, ln] * A[2, 0, 0, ln])
+        )
+        size = 1.0
+        for m in range(3):
+            size *= np.sqrt(
+                A[m, 0, 0, ln] * A[m, 0, 0, ln] + A[m, 0, 1, ln] * A[m, 0, 1, ln] + A[m, 0, 2, ln] * A[m, 0, 2, ln]
+            )
+        pulling[ln] = np.logical_not(np.abs(det) > 1e-9 * size) | (d != 3)
+
+
 #: The lane-form functions, in the order their twins are made (callers may call any of them).
 LANE_FORM = (_cross, contact_geometry, squeeze_directions, unit_normals, _spin, manipulating, twist_through, tangents)
 LANE_FORM += (cone_frames, squeeze_map, cone_rows, plane_reduction, sector_rows, closure_test, own_sectors)
-LANE_FORM += (internal_inside,)
+LANE_FORM += (internal_inside, start, culprit)
 
 
 @functools.cache
