@@ -157,7 +157,7 @@ class _Plane:
         rows = len(points)
         tilt, self.dirs, self.forces = np.empty((rows, 2, 3)), np.empty((rows, 3, 2)), np.empty((rows, 3, 3, 2))
         lanes = (points, unit, geo.m, contact_matrices(geo.e), np.empty((rows, 3, 3)), tilt, self.dirs, self.forces)
-        set_up.twins()["plane_reduction"](*(np.moveaxis(a, 0, -1) for a in lanes), rows)
+        set_up.twins()["plane_reduction"](*(set_up.lanes(a) for a in lanes), rows)
         self.sin, self.cos = tilt[:, 0], tilt[:, 1]
         self.phi = np.arcsin(np.minimum(self.sin, 1.0))  # each normal's angle to the plane
 
@@ -170,7 +170,7 @@ class _Plane:
             np.broadcast_to(sin_beta, self.cos.shape),
             np.broadcast_to(cos_beta, self.cos.shape),
         )
-        set_up.twins()["sector_rows"](*(np.moveaxis(a, 0, -1) for a in lanes), np.moveaxis(out, 0, -1), len(out))
+        set_up.twins()["sector_rows"](*(set_up.lanes(a) for a in lanes), set_up.lanes(out), len(out))
         return out.reshape(-1, 6, 3)
 
 
@@ -188,8 +188,8 @@ def closure_test(rows):
     for start in range(0, len(rows), CHUNK):
         part = slice(start, start + CHUNK)
         with np.errstate(invalid="ignore", divide="ignore"):
-            r = np.ascontiguousarray(np.moveaxis(rows[part], 0, -1))
-            test(r, np.empty((3, 15, r.shape[-1])), np.moveaxis(s[part], 0, -1), ok[part], None)
+            r = np.ascontiguousarray(set_up.lanes(rows[part]))
+            test(r, np.empty((3, 15, r.shape[-1])), set_up.lanes(s[part]), ok[part], None)
     return ok, s
 
 
@@ -199,7 +199,7 @@ def _own_rows(plane, limit):
     rows = len(plane.cos)
     sin_beta, cos_beta, reach = np.empty((rows, 3)), np.empty((rows, 3)), np.empty(rows, bool)
     lanes = (np.stack((plane.sin, plane.cos), axis=1), limit, sin_beta, cos_beta)
-    set_up.twins()["own_sectors"](*(np.moveaxis(a, 0, -1) for a in lanes), reach, rows)
+    set_up.twins()["own_sectors"](*(set_up.lanes(a) for a in lanes), reach, rows)
     return plane.rows(cos_beta, sin_beta), reach
 
 
@@ -214,7 +214,7 @@ def internal_inside(points, unit, geo, mu):
     out = np.empty((rows, 3))
     lanes = (points, unit, geo.m, contact_matrices(geo.e), np.asarray(mu, dtype=float), out)
     with np.errstate(all="ignore"):
-        lanes = tuple(np.moveaxis(a, 0, -1) for a in lanes)
+        lanes = tuple(set_up.lanes(a) for a in lanes)
         set_up.twins()["internal_inside"](*lanes, set_up.inside_workspace(rows), rows)
     return out
 
@@ -234,20 +234,59 @@ def _least_friction(plane):
     """Bisection on ``theta = atan(mu)``: ``(n)`` least common friction, NaN where none."""
     rows = len(plane.cos)
     lo = plane.phi.max(axis=1)
-    hi = np.full(rows, np.arctan(MAX_FRICTION))
-    some = _at_theta(plane, hi)
-    at_lo = _at_theta(plane, lo + 1e-9)  # then the answer is max tan(phi_i), to 1e-9 rad
+    ends = _at_theta(_subset(plane, np.tile(np.arange(rows), 2)), np.concatenate((np.full(rows, _TOP), lo + 1e-9)))
+    some, at_lo = ends[:rows], ends[rows:]  # at lo the answer is max tan(phi_i), to 1e-9 rad
     todo = np.flatnonzero(some & ~at_lo)
-    a, b = lo[todo], hi[todo]
+    a, b = lo[todo], np.full(todo.size, _TOP)
+    depth = _AT_ONCE if todo.size <= _FEW else 1
     sub = _subset(plane, todo)
-    for _ in range(BISECTIONS):
-        mid = 0.5 * (a + b)
-        ok = _at_theta(sub, mid)
-        a, b = np.where(ok, a, mid), np.where(ok, mid, b)
+    for done in range(0, BISECTIONS, depth):
+        a, b = _halvings(sub, a, b, min(depth, BISECTIONS - done))
     theta = np.where(at_lo, lo, np.nan)
     theta[todo] = b
     theta[~some] = np.nan
     return np.tan(theta)
+
+
+#: The bisection's upper end: ``atan(MAX_FRICTION)``.
+_TOP = float(np.arctan(MAX_FRICTION))
+
+#: Halvings a round of the bisection takes at once for at most :data:`_FEW` rows: the 15 angles 4 halvings
+#: could test, in one closure test of 15 lanes a row (a small batch's test costs its call, some 200 numpy
+#: calls, not its rows): 12 tests of one grasp instead of 45.
+_AT_ONCE, _FEW = 4, 128
+
+
+def _halvings(plane, a, b, depth):
+    """``depth`` halvings of each row's ``[a, b]`` at once, the same brackets as one at a time: the ``2^depth - 1``
+    midpoints those halvings could test, in one closure test of each row's plane that many times, then the path
+    the halvings take through them."""
+    mids = _midpoints(a, b, depth)
+    count = mids.shape[1]
+    lanes = plane if count == 1 else _subset(plane, np.repeat(np.arange(len(a)), count))
+    ok = _at_theta(lanes, mids.reshape(-1)).reshape(mids.shape)
+    at, size = np.zeros(len(a), int), count
+    for _ in range(depth):
+        node = at + size // 2
+        mid, held = mids[np.arange(len(a)), node], ok[np.arange(len(a)), node]
+        a, b = np.where(held, a, mid), np.where(held, mid, b)
+        at, size = np.where(held, at, node + 1), size // 2
+    return a, b
+
+
+def _midpoints(a, b, depth):
+    """The midpoints ``0.5 (a + b)`` that ``depth`` halvings of ``[a, b]`` may test, in order: ``(n, 2^depth - 1)``,
+    each of its interval's ends (those of the halvings, bit for bit).
+
+    >>> _midpoints(np.array([0.0]), np.array([8.0]), 2).tolist()
+    [[2.0, 4.0, 6.0]]
+    """
+    ends = np.stack((a, b), axis=1)
+    for _ in range(depth):
+        finer = np.empty((len(a), 2 * ends.shape[1] - 1))
+        finer[:, ::2], finer[:, 1::2] = ends, 0.5 * (ends[:, :-1] + ends[:, 1:])
+        ends = finer
+    return ends[:, 1:-1]
 
 
 def _subset(plane, rows):

@@ -38,6 +38,7 @@ from ..degeneracy import DEGENERACY_TOL
 from ..screws import J, K, cross
 from . import set_up
 from .set_up import CLOSURE_PAIRS, STRICT_MARGIN
+from .set_up import lanes as _lanes
 
 __all__ = [
     "CLOSURE_PAIRS",
@@ -383,11 +384,6 @@ class Geometry(NamedTuple):
     e: np.ndarray  # (..., 3, 3) squeeze directions
     status: np.ndarray  # (...) int8
     culprit: np.ndarray  # (...) int8
-
-
-def _lanes(a):
-    """A row-major array's lane-form view (rows last) for :mod:`~grasptwist.engine.forces.set_up`'s twins."""
-    return np.moveaxis(a, 0, -1)
 
 
 def geometry(points, tol=DEGENERACY_TOL) -> Geometry:

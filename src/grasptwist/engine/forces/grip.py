@@ -190,7 +190,7 @@ def _twist_through(geo, d):
     out = np.empty((len(d), 6))
     lanes = (geo.centroid, geo.q, geo.m, geo.t[:, None], np.asarray(d, dtype=float), out)
     with np.errstate(all="ignore"):
-        set_up.twins()["twist_through"](*(np.moveaxis(a, 0, -1) for a in lanes), len(d))
+        set_up.twins()["twist_through"](*(set_up.lanes(a) for a in lanes), len(d))
     return out
 
 
@@ -606,7 +606,7 @@ class _Prepared:
         self.frame = np.empty((rows.size, 3, 3, 3))
         with np.errstate(all="ignore"):
             lanes = (self.unit[rows], limit, self.frame)
-            set_up.twins()["cone_frames"](*(np.moveaxis(a, 0, -1) for a in lanes), rows.size)
+            set_up.twins()["cone_frames"](*(set_up.lanes(a) for a in lanes), rows.size)
         self.inside = closure.internal_inside(
             p[self.plane], self.unit[self.plane], _rows(geo, self.plane), limit[: self.plane.size]
         )
@@ -728,9 +728,8 @@ class _Prepared:
 def _one_row(frame, m, inside):
     """What :func:`one.solve` needs of one grasp's row (with friction, not collinear), as lists of floats."""
     A, _, c = _cones(frame, m, np.zeros((1, 3, 3)), np.ones(1))
-    rays = frame * np.array([1.0, 0.0, 0.0])[:, None]
-    normal = A[0, :, 0, :]
-    regular = abs(np.linalg.det(normal)) > 1e-9 * np.prod(np.linalg.norm(normal, axis=-1))
+    pulling = np.empty(1, bool)
+    set_up.twins()["pulling_possible"](set_up.lanes(A), pulling, 3, 1)
     start = None
     if not np.isnan(inside[0]).any():
         y = A[0] @ inside[0]
@@ -741,8 +740,8 @@ def _one_row(frame, m, inside):
         "c": c[0].tolist(),
         "P": one.newton_matrices(A_list),
         "inside": start,
-        "regular": bool(regular),
-        "rays": _cones(rays, m, np.zeros((1, 3, 3)), np.ones(1))[0][0].tolist(),
+        "regular": not pulling[0],
+        "rays": _rays(A)[0].tolist(),
     }
 
 
@@ -860,8 +859,15 @@ def _cones(frame, m, fm, scale):
     A, b = np.empty((rows, 3, 3, d)), np.empty((rows, 3, 3))
     lanes = (frame, m, fm, scale, A, b)
     with np.errstate(all="ignore"):  # a collinear row's map may hold huge or tiny numbers; it is judged after
-        set_up.twins()["cone_rows"](*(np.moveaxis(a, 0, -1) for a in lanes), d, rows)
+        set_up.twins()["cone_rows"](*(set_up.lanes(a) for a in lanes), d, rows)
     return A, b, A[:, :, 0, :].sum(axis=1)
+
+
+def _rays(a):
+    """The cones' rows ``A (n, 3, 3, d)`` or ``b (n, 3, 3)`` with no friction limit: their tangential rows 0."""
+    out = a.copy()
+    out[:, :, 1:] = 0.0
+    return out
 
 
 def _solve(frame, m, fm, scale, inside):
@@ -881,7 +887,7 @@ def _solve(frame, m, fm, scale, inside):
     closing = np.flatnonzero(~np.isnan(inside).any(axis=1))
     if closing.size:
         lanes = (A[closing], b[closing], inside[closing], x[closing])
-        set_up.twins()["start"](*(np.moveaxis(a, 0, -1) for a in lanes), d, closing.size)
+        set_up.twins()["start"](*(set_up.lanes(a) for a in lanes), d, closing.size)
         x[closing] = lanes[-1]
     other = np.flatnonzero(np.isnan(inside).any(axis=1))
     if other.size:
@@ -900,13 +906,11 @@ def _solve(frame, m, fm, scale, inside):
         culprit, pulling = np.empty(bad.size, np.int64), np.empty(bad.size, bool)
         lanes = (A[bad], b[bad], x[bad])
         with np.errstate(invalid="ignore"):
-            set_up.twins()["culprit"](*(np.moveaxis(a, 0, -1) for a in lanes), culprit, pulling, d, bad.size)
+            set_up.twins()["culprit"](*(set_up.lanes(a) for a in lanes), culprit, pulling, d, bad.size)
         blame[bad] = culprit
         maybe = np.flatnonzero(pulling)
         if maybe.size:
             rows = bad[maybe]
-            ray = frame[rows] * np.array([1.0, 0.0, 0.0])[:, None]  # the cones with no friction limit
-            A0, b0, _ = _cones(ray, m[rows], fm[rows], scale[rows])
-            r0 = socp.phase_one(A0, b0)[1]
+            r0 = socp.phase_one(_rays(A[rows]), _rays(b[rows]))[1]
             blame[rows] = np.where(r0 < 0, blame[rows], -1)
     return s, z, fail, blame

@@ -39,6 +39,7 @@ __all__ = [
     "STRICT_MARGIN",
     "LANE_FORM",
     "twins",
+    "lanes",
     "contact_geometry",
     "squeeze_directions",
     "unit_normals",
@@ -54,6 +55,7 @@ __all__ = [
     "inside_workspace",
     "start",
     "culprit",
+    "pulling_possible",
 ]
 
 #: The closure test's pairs of its six unit rows ``R`` (two a contact) whose cross products are the candidate rays.
@@ -69,6 +71,16 @@ _J, _K = np.array((1, 2, 0)), np.array((2, 0, 1))
 # normal's squares overflow or underflow; within them, n / |n| to the last bit
 _HUGE, _TINY = 1e290, 1e-290
 _DOWN, _UP = 2.0**-600, 2.0**600
+
+
+def lanes(a):
+    """A row-major array's view in lane form, its rows last, for the twins (``np.moveaxis(a, 0, -1)``, without
+    its checks: a tenth of its cost on the small arrays of one grasp).
+
+    >>> lanes(np.zeros((5, 3, 2))).shape
+    (3, 2, 5)
+    """
+    return a.transpose((*range(1, a.ndim), 0))
 
 
 def _cross(a0, a1, a2, b0, b1, b2):
@@ -413,10 +425,8 @@ def start(A, b, inside, x, d, width):
 
 def culprit(A, b, x, blame, pulling, d, width):
     """Of rows phase I found infeasible (``x (d, width)`` its end): the cone each leaves furthest into ``blame
-    (width)`` (``argmax_m |y_mt| - y_m0``, NaN first, as numpy's ``argmax``), and into ``pulling (width)``
-    whether it may be infeasible with unlimited friction too, which it cannot be where the squeezes reach
-    every pattern of normal forces: ``|det N| > 1e-9 prod_m |N_m|`` of the 3 x 3 normal rows ``N_m = A_m0``
-    (``d = 3``; with more unknowns it may)."""
+    (width)`` (``argmax_m |y_mt| - y_m0``, NaN first, as numpy's ``argmax``), and :func:`pulling_possible` into
+    ``pulling (width)``."""
     for ln in range(width):
         worst, who = -np.inf, 0
         for m in range(3):
@@ -430,6 +440,14 @@ def culprit(A, b, x, blame, pulling, d, width):
             who = m if take else who
             worst = over if take else worst
         blame[ln] = who
+    pulling_possible(A, pulling, d, width)
+
+
+def pulling_possible(A, out, d, width):
+    """Whether each row may be infeasible with unlimited friction too (the half-spaces ``n . f >= 0``), into
+    ``out (width)``: it cannot where the squeezes reach every pattern of normal forces, ``|det N| > 1e-9 prod_m
+    |N_m|`` of the 3 x 3 normal rows ``N_m = A_m0`` (``d = 3``; with more unknowns it may)."""
+    for ln in range(width):
         det = (
             A[0, 0, 0, ln] * (A[1, 0, 1, ln] * A[2, 0, 2, ln] - A[1, 0, 2, ln] * A[2, 0, 1, ln])
             - A[0, 0, 1, ln] * (A[1, 0, 0, ln] * A[2, 0, 2, ln] - A[1, 0, 2, ln] * A[2, 0, 0, ln])
@@ -440,13 +458,13 @@ def culprit(A, b, x, blame, pulling, d, width):
             size *= np.sqrt(
                 A[m, 0, 0, ln] * A[m, 0, 0, ln] + A[m, 0, 1, ln] * A[m, 0, 1, ln] + A[m, 0, 2, ln] * A[m, 0, 2, ln]
             )
-        pulling[ln] = np.logical_not(np.abs(det) > 1e-9 * size) | (d != 3)
+        out[ln] = np.logical_not(np.abs(det) > 1e-9 * size) | (d != 3)
 
 
 #: The lane-form functions, in the order their twins are made (callers may call any of them).
 LANE_FORM = (_cross, contact_geometry, squeeze_directions, unit_normals, _spin, manipulating, twist_through, tangents)
 LANE_FORM += (cone_frames, squeeze_map, cone_rows, plane_reduction, sector_rows, closure_test, own_sectors)
-LANE_FORM += (internal_inside, start, culprit)
+LANE_FORM += (internal_inside, start, culprit, pulling_possible)
 
 
 @functools.cache
