@@ -5,8 +5,15 @@ geometry, G^+ w, cones, dual twist and closure test)."""
 import numpy as np
 import pytest
 
-from grasptwist.engine.forces import set_up
-from grasptwist.engine.forces.grasp_map import contact_matrices, grasp_map, manipulating_reference
+from grasptwist.engine.forces import closure, set_up
+from grasptwist.engine.forces.closure import force_closure
+from grasptwist.engine.forces.grasp_map import (
+    contact_matrices,
+    geometry,
+    grasp_map,
+    manipulating_reference,
+    unit_normals,
+)
 from grasptwist.engine.forces.ipm import START_MARGIN
 
 WIDTH = 12
@@ -103,6 +110,9 @@ def test_the_set_up_meets_its_definitions():
     second = np.linalg.eigvalsh(np.einsum("nik,nil->nkl", q, q))
     t = second.sum(axis=1)
     np.testing.assert_allclose(out["sizes"][0][good], t[good], rtol=1e-12)
+    np.testing.assert_allclose(out["sizes"][1][good], (q**2).sum(axis=2).max(axis=1)[good], rtol=1e-12)
+    sides = np.linalg.norm(p[:, [2, 0, 1]] - p[:, [1, 2, 0]], axis=2)  # side i joins contacts j = i + 1 and k = i + 2
+    np.testing.assert_allclose(out["side"].T, sides, rtol=1e-12)
     np.testing.assert_allclose(out["sizes"][2][good], np.sqrt(2 * second[good, 1] / t[good]), rtol=1e-9)
     fm = np.moveaxis(out["fm"], -1, 0)
     np.testing.assert_allclose(fm[good], manipulating_reference(p, w)[good], rtol=1e-9, atol=1e-12)
@@ -145,6 +155,24 @@ def test_the_set_up_meets_its_definitions():
         normal = A[r, :, 0, :]
         singular = not abs(np.linalg.det(normal)) > 1e-9 * np.prod(np.linalg.norm(normal, axis=1))
         assert out["pulling"][r] == singular
+
+
+def test_a_squeeze_is_inside_exactly_where_the_common_friction_closes():
+    """Where every contact has the friction ``mu``, a squeeze strictly inside the cones exists exactly where the
+    least common friction of force closure (the bisection on the sectors' angle, not the limits' sines of
+    :func:`set_up.own_sectors`) is below ``mu``: on 400 random grasps, rows within 1e-6 of it aside."""
+    rng = np.random.default_rng(3)
+    angle = rng.uniform(0, 2 * np.pi, (400, 1)) + np.array([0, 2.1, 4.2]) + rng.normal(0, 0.4, (400, 3))
+    p = np.stack((np.cos(angle), np.sin(angle), rng.normal(0, 0.3, (400, 3))), axis=-1)
+    n = -p + rng.normal(0, 0.5, (400, 3, 3))
+    mu = 0.6
+    least = force_closure(p, n, mu).closure_friction
+    geo = geometry(p)
+    inside = closure.internal_inside(p, unit_normals(n)[0], geo, np.full((400, 3), mu))
+    clear = ~(np.abs(least / mu - 1) < 1e-6)
+    closes = least < mu  # NaN: never
+    assert 50 < closes.sum() < 350
+    np.testing.assert_array_equal(np.isfinite(inside).all(axis=1)[clear], closes[clear])
 
 
 @pytest.mark.slow

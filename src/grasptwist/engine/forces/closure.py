@@ -156,21 +156,18 @@ class _Plane:
     def __init__(self, points, unit, geo):
         rows = len(points)
         tilt, self.dirs, self.forces = np.empty((rows, 2, 3)), np.empty((rows, 3, 2)), np.empty((rows, 3, 3, 2))
-        lanes = (points, unit, geo.m, contact_matrices(geo.e), np.empty((rows, 3, 3)), tilt, self.dirs, self.forces)
-        set_up.twins()["plane_reduction"](*(set_up.lanes(a) for a in lanes), rows)
+        axes = np.empty((rows, 3, 3))
+        set_up.on_rows(
+            "plane_reduction", points, unit, geo.m, contact_matrices(geo.e), axes, tilt, self.dirs, self.forces, rows
+        )
         self.sin, self.cos = tilt[:, 0], tilt[:, 1]
         self.phi = np.arcsin(np.minimum(self.sin, 1.0))  # each normal's angle to the plane
 
     def rows(self, cos_beta, sin_beta):
         """The six unit rows ``R (n, 6, 3)`` of the sectors with half-angles ``beta_i`` (``(n, 3)``)."""
         out = np.empty((len(self.dirs), 3, 2, 3))
-        lanes = (
-            self.dirs,
-            self.forces,
-            np.broadcast_to(sin_beta, self.cos.shape),
-            np.broadcast_to(cos_beta, self.cos.shape),
-        )
-        set_up.twins()["sector_rows"](*(set_up.lanes(a) for a in lanes), set_up.lanes(out), len(out))
+        sines = (np.broadcast_to(sin_beta, self.cos.shape), np.broadcast_to(cos_beta, self.cos.shape))
+        set_up.on_rows("sector_rows", self.dirs, self.forces, *sines, out, len(out))
         return out.reshape(-1, 6, 3)
 
 
@@ -187,9 +184,9 @@ def closure_test(rows):
     test = set_up.twins()["closure_test"]
     for start in range(0, len(rows), CHUNK):
         part = slice(start, start + CHUNK)
-        with np.errstate(invalid="ignore", divide="ignore"):
-            r = np.ascontiguousarray(set_up.lanes(rows[part]))
-            test(r, np.empty((3, 15, r.shape[-1])), set_up.lanes(s[part]), ok[part], None)
+        r = np.ascontiguousarray(set_up.lanes(rows[part]))  # lanes in memory: the pairs' rows read whole
+        with np.errstate(all="ignore"):
+            test(r, np.empty((3, 15, r.shape[-1])), set_up.lanes(s[part]), ok[part], r.shape[-1])
     return ok, s
 
 
@@ -198,8 +195,7 @@ def _own_rows(plane, limit):
     (:func:`set_up.own_sectors`' twin: a huge or infinite limit is a half-plane, never ``inf / inf``)."""
     rows = len(plane.cos)
     sin_beta, cos_beta, reach = np.empty((rows, 3)), np.empty((rows, 3)), np.empty(rows, bool)
-    lanes = (np.stack((plane.sin, plane.cos), axis=1), limit, sin_beta, cos_beta)
-    set_up.twins()["own_sectors"](*(set_up.lanes(a) for a in lanes), reach, rows)
+    set_up.on_rows("own_sectors", np.stack((plane.sin, plane.cos), axis=1), limit, sin_beta, cos_beta, reach, rows)
     return plane.rows(cos_beta, sin_beta), reach
 
 
@@ -213,14 +209,13 @@ def internal_inside(points, unit, geo, mu):
     rows = len(points)
     out = np.empty((rows, 3))
     lanes = (points, unit, geo.m, contact_matrices(geo.e), np.asarray(mu, dtype=float), out)
-    with np.errstate(all="ignore"):
-        lanes = tuple(set_up.lanes(a) for a in lanes)
-        set_up.twins()["internal_inside"](*lanes, set_up.inside_workspace(rows), rows)
+    set_up.on_rows("internal_inside", *lanes, set_up.inside_workspace(rows), rows)
     return out
 
 
 def _sector_rows(plane, theta):
-    """The six rows of the sectors of the cones of half-angle ``theta`` (``(n, 1)`` or ``(n, 3)``)."""
+    """The six rows of the sectors of the cones of half-angle ``theta`` (``(n, 1)`` or ``(n, 3)``): the bisection's,
+    which runs on the angle itself (:func:`set_up.own_sectors` gives these sines from a friction limit, without it)."""
     # sin^2(beta) = (sin^2 theta - sin^2 phi) / cos^2 phi, as a product that keeps small angles exact
     sin_beta = np.sqrt(np.maximum(np.sin(theta - plane.phi) * np.sin(theta + plane.phi), 0)) / plane.cos
     return plane.rows(np.minimum(np.cos(theta) / plane.cos, 1.0), sin_beta)

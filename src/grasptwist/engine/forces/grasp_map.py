@@ -37,12 +37,8 @@ from ..checks import check_points
 from ..degeneracy import DEGENERACY_TOL
 from ..screws import J, K, cross
 from . import set_up
-from .set_up import CLOSURE_PAIRS, STRICT_MARGIN
-from .set_up import lanes as _lanes
 
 __all__ = [
-    "CLOSURE_PAIRS",
-    "STRICT_MARGIN",
     "Status",
     "ForceStatus",
     "force_status_message",
@@ -341,8 +337,7 @@ def squeeze_directions(points) -> np.ndarray:
     p = np.asarray(points, dtype=float)
     flat = np.ascontiguousarray(p.reshape(-1, 3, 3))
     e, sides = np.empty(flat.shape), np.empty((len(flat), 3))
-    with np.errstate(invalid="ignore", divide="ignore"):
-        set_up.twins()["squeeze_directions"](_lanes(flat), _lanes(e), _lanes(sides), len(flat))
+    set_up.on_rows("squeeze_directions", flat, e, sides, len(flat))
     return e.reshape(p.shape)
 
 
@@ -397,11 +392,10 @@ def geometry(points, tol=DEGENERACY_TOL) -> Geometry:
     rows = len(flat)
     g, q, m, sizes = np.empty((rows, 3)), np.empty((rows, 3, 3)), np.empty((rows, 3)), np.empty((rows, 3))
     squeezes, sides = np.empty((rows, 3, 3)), np.empty((rows, 3))
-    lanes = set_up.twins()
+    set_up.on_rows("contact_geometry", flat, g, q, m, sizes, rows)
+    set_up.on_rows("squeeze_directions", flat, squeezes, sides, rows)
+    t, conditioning = sizes[:, 0].copy(), sizes[:, 2]
     with np.errstate(all="ignore"):
-        lanes["contact_geometry"](_lanes(flat), _lanes(g), _lanes(q), _lanes(m), _lanes(sizes), rows)
-        lanes["squeeze_directions"](_lanes(flat), _lanes(squeezes), _lanes(sides), rows)
-        t, conditioning = sizes[:, 0], sizes[:, 2]
         size = np.sqrt(sizes[:, 1])
         status = np.zeros(rows, np.int8)
         culprit = np.full(rows, -1, np.int8)
@@ -419,8 +413,11 @@ def geometry(points, tol=DEGENERACY_TOL) -> Geometry:
         status[bad] = ForceStatus.NONFINITE_INPUT
         culprit[over | bad] = -1
         conditioning = np.where(status == 0, conditioning, np.where(bad | over, np.nan, 0.0))
-    parts = (g, q, m, t, size, conditioning, squeezes, status, culprit)
-    return Geometry(*(a.reshape(shape + a.shape[1:]) for a in parts))
+    g, q, m, conditioning, squeezes, status, culprit = (
+        a.reshape(shape + a.shape[1:]) for a in (g, q, m, conditioning, squeezes, status, culprit)
+    )
+    t, size = t.reshape(shape)[()], size.reshape(shape)[()]  # [()]: one grasp's sums as numbers, as numpy's sums are
+    return Geometry(g, q, m, t, size, conditioning, squeezes, status, culprit)
 
 
 def _manipulating(geo: Geometry, wrench):
@@ -430,17 +427,8 @@ def _manipulating(geo: Geometry, wrench):
     w = np.broadcast_to(np.asarray(wrench, dtype=float), shape + (6,)).reshape(-1, 6)
     f = np.empty(shape + (3, 3))
     rows = len(w)
-    with np.errstate(all="ignore"):
-        set_up.twins()["manipulating"](
-            _lanes(geo.centroid.reshape(-1, 3)),
-            _lanes(geo.q.reshape(-1, 3, 3)),
-            _lanes(geo.m.reshape(-1, 3)),
-            geo.t.reshape(1, -1),
-            _lanes(w),
-            _lanes(f.reshape(-1, 3, 3)),
-            np.empty((3, rows)),
-            rows,
-        )
+    g, q, m, t = geo.centroid.reshape(-1, 3), geo.q.reshape(-1, 3, 3), geo.m.reshape(-1, 3), np.reshape(geo.t, (-1, 1))
+    set_up.on_rows("manipulating", g, q, m, t, w, f.reshape(-1, 3, 3), np.empty((rows, 3)), rows)
     return np.where((geo.status == 0)[..., None, None], f, np.nan)
 
 
@@ -611,8 +599,7 @@ def unit_normals(normals):
     n = np.asarray(normals, dtype=float)
     flat = n.reshape(-1, 3, 3)
     unit = np.empty(flat.shape)
-    with np.errstate(all="ignore"):
-        set_up.twins()["unit_normals"](_lanes(flat), _lanes(unit), len(flat))
+    set_up.on_rows("unit_normals", flat, unit, len(flat))
     finite = np.isfinite(n).all(axis=-1)
     zero = finite & (n == 0).all(axis=-1)
     return unit.reshape(n.shape), zero, ~finite.all(axis=-1)
@@ -638,5 +625,5 @@ def contact_matrices(e):
     """
     flat = np.ascontiguousarray(np.asarray(e, dtype=float).reshape(-1, 3, 3))
     m = np.empty((len(flat), 3, 3, 3))
-    set_up.twins()["squeeze_map"](_lanes(flat), _lanes(m), len(flat))
+    set_up.on_rows("squeeze_map", flat, m, len(flat))
     return m.reshape(e.shape[:-2] + (3, 3, 3))

@@ -188,9 +188,7 @@ def _twist_through(geo, d):
     """The twist ``lambda (n, 6)`` whose field ``lambda_F + lambda_M x p_i`` is nearest ``d_i`` (least squares):
     :func:`set_up.twist_through`'s numpy twin (``J^-1`` in closed form, as for ``G^+ w``)."""
     out = np.empty((len(d), 6))
-    lanes = (geo.centroid, geo.q, geo.m, geo.t[:, None], np.asarray(d, dtype=float), out)
-    with np.errstate(all="ignore"):
-        set_up.twins()["twist_through"](*(set_up.lanes(a) for a in lanes), len(d))
+    set_up.on_rows("twist_through", geo.centroid, geo.q, geo.m, geo.t[:, None], np.asarray(d, dtype=float), out, len(d))
     return out
 
 
@@ -604,9 +602,7 @@ class _Prepared:
         rows = np.concatenate((self.plane, self.lines))
         limit = mu[rows] / s_f
         self.frame = np.empty((rows.size, 3, 3, 3))
-        with np.errstate(all="ignore"):
-            lanes = (self.unit[rows], limit, self.frame)
-            set_up.twins()["cone_frames"](*(set_up.lanes(a) for a in lanes), rows.size)
+        set_up.on_rows("cone_frames", self.unit[rows], limit, self.frame, rows.size)
         self.inside = closure.internal_inside(
             p[self.plane], self.unit[self.plane], _rows(geo, self.plane), limit[: self.plane.size]
         )
@@ -729,7 +725,7 @@ def _one_row(frame, m, inside):
     """What :func:`one.solve` needs of one grasp's row (with friction, not collinear), as lists of floats."""
     A, _, c = _cones(frame, m, np.zeros((1, 3, 3)), np.ones(1))
     pulling = np.empty(1, bool)
-    set_up.twins()["pulling_possible"](set_up.lanes(A), pulling, 3, 1)
+    set_up.on_rows("pulling_possible", A, pulling, 3, 1)
     start = None
     if not np.isnan(inside[0]).any():
         y = A[0] @ inside[0]
@@ -857,9 +853,7 @@ def _cones(frame, m, fm, scale):
     forces' map ``M``: :func:`set_up.cone_rows`' numpy twin."""
     rows, d = len(fm), m.shape[-1]
     A, b = np.empty((rows, 3, 3, d)), np.empty((rows, 3, 3))
-    lanes = (frame, m, fm, scale, A, b)
-    with np.errstate(all="ignore"):  # a collinear row's map may hold huge or tiny numbers; it is judged after
-        set_up.twins()["cone_rows"](*(set_up.lanes(a) for a in lanes), d, rows)
+    set_up.on_rows("cone_rows", frame, m, fm, scale, A, b, d, rows)
     return A, b, A[:, :, 0, :].sum(axis=1)
 
 
@@ -886,9 +880,9 @@ def _solve(frame, m, fm, scale, inside):
     z = np.zeros((n, 3, 3))
     closing = np.flatnonzero(~np.isnan(inside).any(axis=1))
     if closing.size:
-        lanes = (A[closing], b[closing], inside[closing], x[closing])
-        set_up.twins()["start"](*(set_up.lanes(a) for a in lanes), d, closing.size)
-        x[closing] = lanes[-1]
+        start = x[closing]
+        set_up.on_rows("start", A[closing], b[closing], inside[closing], start, d, closing.size)
+        x[closing] = start
     other = np.flatnonzero(np.isnan(inside).any(axis=1))
     if other.size:
         x[other], r[other], z[other] = socp.phase_one(A[other], b[other])
@@ -904,9 +898,7 @@ def _solve(frame, m, fm, scale, inside):
         # the cone each leaves furthest, and whether it may be infeasible even with unlimited friction
         # (half-spaces n.f >= 0: pulling), which it cannot be where the squeezes reach every normal force
         culprit, pulling = np.empty(bad.size, np.int64), np.empty(bad.size, bool)
-        lanes = (A[bad], b[bad], x[bad])
-        with np.errstate(invalid="ignore"):
-            set_up.twins()["culprit"](*(set_up.lanes(a) for a in lanes), culprit, pulling, d, bad.size)
+        set_up.on_rows("culprit", A[bad], b[bad], x[bad], culprit, pulling, d, bad.size)
         blame[bad] = culprit
         maybe = np.flatnonzero(pulling)
         if maybe.size:

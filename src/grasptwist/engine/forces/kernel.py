@@ -2,8 +2,9 @@ r"""The grip compiled by numba (imported only through :mod:`~grasptwist.engine.f
 which loads it at the first grip).
 
 :func:`grip_rows` does for each row what the numpy path does for the rows it solves by cones:
-the geometry and ``G^+ w`` (:mod:`~grasptwist.engine.forces.grasp_map`), the cones and a start
-inside them (:func:`~grasptwist.engine.forces.closure.internal_inside`), the interior-point
+the set-up (the geometry and ``G^+ w``, the cones, a squeeze inside them and the start it gives,
+the culprit of a row that cannot hold, the dual twist: :mod:`~grasptwist.engine.forces.set_up`'s
+source compiled, each row's arrays a lane of width 1, whose numpy twins the numpy path runs), the interior-point
 method of :mod:`~grasptwist.engine.forces.socp` (its iteration is
 :mod:`~grasptwist.engine.forces.ipm`'s source compiled, whose numpy twin the numpy path runs:
 Mehrotra's predictor-corrector with Nesterov-Todd scaling, 0.99 of the way to the cones' edge,

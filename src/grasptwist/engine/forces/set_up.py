@@ -40,6 +40,9 @@ __all__ = [
     "LANE_FORM",
     "twins",
     "lanes",
+    "on_rows",
+    "tangents",
+    "own_sectors",
     "contact_geometry",
     "squeeze_directions",
     "unit_normals",
@@ -137,8 +140,9 @@ def squeeze_directions(p, e, side, width):
 
 
 def unit_normals(n, unit, width):
-    """``n_i / |n_i|`` into ``unit (3, 3, width)``: NaN for a zero or non-finite normal.  A normal whose squares
-    would overflow or underflow is scaled by a power of two first (exact: the same direction)."""
+    """``n_i / |n_i|`` into ``unit (3, 3, width)``: NaN for a zero normal, not finite for a non-finite one.  A
+    normal whose squares would overflow or underflow is scaled by a power of two first (exact: the same
+    direction)."""
     for i in every(3):
         for ln in range(width):
             n0, n1, n2 = n[i, 0, ln], n[i, 1, ln], n[i, 2, ln]
@@ -465,6 +469,20 @@ def pulling_possible(A, out, d, width):
 LANE_FORM = (_cross, contact_geometry, squeeze_directions, unit_normals, _spin, manipulating, twist_through, tangents)
 LANE_FORM += (cone_frames, squeeze_map, cone_rows, plane_reduction, sector_rows, closure_test, own_sectors)
 LANE_FORM += (internal_inside, start, culprit, pulling_possible)
+
+
+def on_rows(name, *args):
+    """:data:`LANE_FORM`'s function ``name`` by its numpy twin on arrays given rows first (each seen as lanes,
+    :func:`lanes`; other arguments, the sizes and the width, as they are), numpy's warnings off: a twin
+    computes both sides of its choices, and a row's division by zero is discarded with the side it is on.
+
+    >>> e, sides = np.empty((1, 3, 3)), np.empty((1, 3))
+    >>> on_rows("squeeze_directions", np.array([[[0, 0, 0], [2.0, 0, 0], [0, 2.0, 0]]]), e, sides, 1)
+    >>> sides.round(4).tolist()
+    [[2.8284, 2.0, 2.0]]
+    """
+    with np.errstate(all="ignore"):
+        twins()[name](*(lanes(a) if isinstance(a, np.ndarray) else a for a in args))
 
 
 @functools.cache
