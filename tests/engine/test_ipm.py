@@ -203,3 +203,32 @@ def test_the_lane_source_solves_what_socp_solves(n):
     A, bb = a.transpose(3, 0, 1, 2), b.transpose(2, 0, 1)
     s, _ = socp.minimise(A, bb, c.T, np.zeros((n, d)))
     np.testing.assert_allclose(s, x.T, rtol=1e-12, atol=1e-12)
+
+
+@pytest.mark.parametrize(("K", "k", "d"), [(3, 3, 3), (4, 4, 7), (5, 1, 2)])
+def test_phase_ones_problem_is_written_once(K, k, d):
+    """ipm.widened, phase I's problem, which socp (numpy twin), one.py (float twin) and the kernel (compiled) all
+    make: its definition (each cone widened by the margin r, the cone r + 1 >= 0, the objective r, the start
+    clearing every cone by 1) on random rows, and the float twin's the numpy twin's to the bit."""
+    n = 4
+    a, b, _, _, _ = _problem(np.random.default_rng(K * k * d), K, k, d, n)
+    b[:, 0] -= 3.0  # some cones not holding at x = 0: the start's margin positive
+    wide, bw, c = np.empty((K + 1, k, d + 1, n)), np.empty((K + 1, k, n)), np.empty((d + 1, n))
+    x, z = np.empty((d + 1, n)), np.empty((K + 1, k, n))
+    socp._twins()["widened"](a, b, wide, bw, c, x, z, d, K, k, n)
+    np.testing.assert_array_equal(wide[:K, :, :d], a)
+    np.testing.assert_array_equal(wide[:, 0, d], 1.0)
+    assert (wide[:, 1:, d] == 0).all() and (wide[K, :, :d] == 0).all() and (wide[K, 1:] == 0).all()
+    np.testing.assert_array_equal(bw[:K], b)
+    assert bw[K, 0].tolist() == [1.0] * n and (bw[K, 1:] == 0).all()
+    assert (c[:d] == 0).all() and (c[d] == 1).all() and (x[:d] == 0).all()
+    over = (np.sqrt((b[:, 1:] ** 2).sum(axis=1)) - b[:, 0]).max(axis=0)
+    np.testing.assert_allclose(x[d], np.maximum(over + 1, 0), rtol=1e-15)
+    assert (x[d] > 0).any()
+    assert (z[:, 0] == 0.25).all() and (z[:, 1:] == 0).all()
+    for r in range(n):
+        rows = [[[0.0] * (d + 1) for _ in range(k)] for _ in range(K + 1)], [[0.0] * k for _ in range(K + 1)]
+        cr, xr, zr = [0.0] * (d + 1), [0.0] * (d + 1), [[0.0] * k for _ in range(K + 1)]
+        one._twin()["widened"](a[..., r].tolist(), b[..., r].tolist(), *rows, cr, xr, zr, d, K, k, 1)
+        assert rows[0] == wide[..., r].tolist() and rows[1] == bw[..., r].tolist()
+        assert (cr, xr, zr) == (c[:, r].tolist(), x[:, r].tolist(), z[..., r].tolist())

@@ -33,7 +33,10 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["GAP", "START_MARGIN", "RESIDUAL", "ITERATIONS", "EDGE", "workspace", "newton_part", "step", "spd_solve"]
+__all__ = [
+    *("GAP", "START_MARGIN", "RESIDUAL", "ITERATIONS", "EDGE"),
+    *("workspace", "newton_part", "step", "spd_solve", "widened", "lanes", "every"),
+]
 
 #: A row stops once its duality gap is below this times ``1 + |c^T x|``.
 GAP = 1e-10
@@ -415,6 +418,66 @@ def step(a, b, c, x, z, P, phase_one, work, done, d, K, k, width):
     _update(c, x, z, y, dx, dy, dz, res, to_edge, done, each, phase_one, d, K, k, width)
 
 
+def widened(A, b, wide, bw, c, x, z, d, K, k, width):
+    """Phase I's problem of rows ``A (K, k, d, width)``, ``b (K, k, width)``: each cone widened by the margin ``r``,
+    the last of ``d + 1`` unknowns (``t_m + r >= |z_m|``), and ``r + 1 >= 0`` a cone of its own, into ``wide
+    (K + 1, k, d + 1, width)``, ``bw (K + 1, k, width)``; the objective ``c = e_r`` and the start: ``x = 0`` but
+    ``r``, which clears every cone by 1 (or is 0), and ``z = 0.25 e`` (the dual, feasible in ``r``'s column).
+
+    >>> A, b = np.array([[[[1.0]], [[0.0]]]]), np.array([[[-1.0], [0.5]]])  # one cone: (s - 1, 0.5)
+    >>> wide, bw, z = np.empty((2, 2, 2, 1)), np.empty((2, 2, 1)), np.empty((2, 2, 1))
+    >>> c, x = np.empty((2, 1)), np.empty((2, 1))
+    >>> widened(A, b, wide, bw, c, x, z, 1, 1, 2, 1); x[:, 0].tolist(), wide[:, 0, 1, 0].tolist()
+    ([0.0, 2.5], [1.0, 1.0])
+    """
+    for m in range(K):
+        for j in range(d):
+            for i in every(k):
+                for ln in range(width):
+                    wide[m, i, j, ln] = A[m, i, j, ln]
+        for i in every(k):
+            for ln in range(width):
+                wide[m, i, d, ln] = 0.0
+                bw[m, i, ln] = b[m, i, ln]
+    for j in range(d + 1):
+        for i in every(k):
+            for ln in range(width):
+                wide[K, i, j, ln] = 0.0
+    for i in every(k):
+        for ln in range(width):
+            bw[K, i, ln] = 0.0
+    for m in every(K + 1):
+        for i in every(k):
+            for ln in range(width):
+                z[m, i, ln] = 0.0
+    for ln in range(width):
+        over = -np.inf
+        for m in range(K):
+            t = 0.0
+            for i in range(1, k):
+                t += b[m, i, ln] * b[m, i, ln]
+            over = np.maximum(over, np.sqrt(t) - b[m, 0, ln])
+        for m in range(K + 1):
+            wide[m, 0, d, ln] = 1.0  # t_m + r, and r + 1
+            z[m, 0, ln] = 0.25
+        bw[K, 0, ln] = 1.0
+        for j in range(d):
+            x[j, ln] = 0.0
+            c[j, ln] = 0.0
+        x[d, ln] = np.maximum(over + 1, 0.0)
+        c[d, ln] = 1.0
+
+
+def lanes(a):
+    """A row-major array's view in lane form, its rows last (``np.moveaxis(a, 0, -1)``, without its checks: a
+    tenth of its cost on the small arrays of one grasp).
+
+    >>> lanes(np.zeros((5, 3, 2))).shape
+    (3, 2, 5)
+    """
+    return a.transpose((*range(1, a.ndim), 0))
+
+
 #: The lane-form functions, in the order their twins are made (callers may call any of them).
 LANE_FORM = (_cone_sum, _column, _w_inv, _w_mul, _residual, _scaling, _newton, _centre, spd_solve, _direction)
-LANE_FORM += (_approach, edge, _corrector, _update, step, newton_part)
+LANE_FORM += (_approach, edge, _corrector, _update, step, newton_part, widened)

@@ -60,7 +60,7 @@ def _compiled(functions, **options):
 # the interior-point method's iteration is ipm.py's source, compiled (the numpy path runs its twin); the
 # facial reduction's and the dual polish's scalar pieces are one.py's functions, compiled
 _ipm = _compiled(ipm.LANE_FORM, **_JIT)
-_step, _newton_part, _spd_solve = _ipm["step"], _ipm["newton_part"], _ipm["spd_solve"]
+_step, _newton_part, _spd_solve, _widened = _ipm["step"], _ipm["newton_part"], _ipm["spd_solve"], _ipm["widened"]
 _workspace = njit(**_ALLOC, inline="always")(ipm.workspace)
 _least_on_line, _dual_polish = (njit(**_JIT)(f) for f in (one.least_on_line, one.dual_polish))
 
@@ -183,39 +183,25 @@ def polish_rows(A, b, c, s, z):
 
 
 @njit(**_JIT)
-def _phase_one_problem(A, b, rays, wide, bw, c, x, z):
-    """``socp.phase_one``'s problem for one row into ``wide (K + 1, 3, d + 1)``, ``bw``, ``c``, and its start
-    ``x`` (the margin ``r`` last), ``z``; ``rays``: the cones with no friction limit (``b``'s tangential
-    components taken as 0)."""
-    K, d = A.shape[0], A.shape[2]
-    over = -math.inf
-    for m in range(K + 1):
+def _rays(A, b, ray_a, ray_b):
+    """A row's cones with no friction limit into ``ray_a``, ``ray_b`` (lanes of width 1): their tangential rows 0."""
+    for m in range(3):
         for k in range(3):
-            bw[m, k] = b[m, k] if m < K and (k == 0 or not rays) else 0.0
-            for j in range(d + 1):
-                wide[m, k, j] = A[m, k, j] if m < K and j < d and (k == 0 or not rays) else 0.0
-        wide[m, 0, d] = 1.0
-        z[m, 0], z[m, 1], z[m, 2] = 0.25, 0.0, 0.0
-        if m < K:
-            over = max(over, math.hypot(bw[m, 1], bw[m, 2]) - bw[m, 0])
-    bw[K, 0] = 1.0
-    for j in range(d + 1):
-        x[j] = 0.0
-        c[j] = 0.0
-    x[d] = max(over + 1, 0.0)
-    c[d] = 1.0
+            ray_b[m, k, 0] = b[m, k, 0] if k == 0 else 0.0
+            for j in range(3):
+                ray_a[m, k, j, 0] = A[m, k, j, 0] if k == 0 else 0.0
 
 
 @njit(**_JIT)
 def _start(A, b, inside, c, x):
     """``grip._solve``'s objective ``c`` (the normal forces' sum) and, where the contacts are in force
-    closure (``inside`` finite), its start ``x`` (:func:`set_up.start` on the row's lane); whether there is
-    one (else phase I finds it)."""
+    closure (``inside`` finite), its start ``x`` (:func:`set_up.start`; the row's arrays lanes of width 1);
+    whether there is one (else phase I finds it)."""
     for j in range(3):
-        c[j] = A[0, 0, j] + A[1, 0, j] + A[2, 0, j]
-    if math.isnan(inside[0]):
+        c[j] = A[0, 0, j, 0] + A[1, 0, j, 0] + A[2, 0, j, 0]
+    if math.isnan(inside[0, 0]):
         return False
-    _start_lanes(A.reshape((3, 3, 3, 1)), b.reshape((3, 3, 1)), inside.reshape((3, 1)), x.reshape((3, 1)), 3, 1)
+    _start_lanes(A, b, inside, x, 3, 1)
     return True
 
 
@@ -444,12 +430,12 @@ def _set_up(r, p, n, limit, w, tol, o, codes, lane, q, mv, g, sizes, unit, fm, f
         for k in range(6):
             o[_DUAL + k] = 0.0
         return _NONE, scale
-    # the cones, the squeezes' map and the method's rows (A, b in the iteration's layout); a squeeze inside
+    # the cones, the squeezes' map and the method's rows; a squeeze strictly inside them
     scale1[0] = scale
     _cone_frames(unit, ll, frame, 1)
     _squeeze_map(e, M, 1)
-    _cone_rows(frame, M, fm, scale1, A.reshape((3, 3, 3, 1)), b.reshape((3, 3, 1)), 3, 1)
-    _internal_inside(pl, unit, mv, M, ll, inside.reshape((3, 1)), work, 1)
+    _cone_rows(frame, M, fm, scale1, A, b, 3, 1)
+    _internal_inside(pl, unit, mv, M, ll, inside, work, 1)
     return _OPEN, scale
 
 
@@ -546,10 +532,11 @@ def grip_rows(p, n, limit, w, tol, out, codes):
 
 @njit(**_ALLOC)
 def _chunk(rows):
-    """What the passes keep of each of ``rows`` rows: geometry, ``G^+ w``, cones (a row's each a lane of width 1,
-    as :mod:`~grasptwist.engine.forces.set_up` writes them), both phases' problems and answers (the method's
-    layout), sizes (``t``, the largest ``|q_i|^2``, the conditioning; the scale), stage, culprit, and the rows of
-    each phase."""
+    """What the passes keep of each of ``rows`` rows: geometry, ``G^+ w``, cones, both phases' problems and answers,
+    a squeeze inside the cones, sizes (``t``, the largest ``|q_i|^2``, the conditioning; the scale), stage,
+    culprit, and the rows of each phase.  Each row's arrays are lanes of width 1 (a trailing axis), as
+    :mod:`~grasptwist.engine.forces.set_up`'s and :func:`ipm.widened` write them; the method sees them
+    without it (one reshape of the chunk: a row's reshape costs 14 ns)."""
     f, i = np.empty, np.int64
     return (
         (
@@ -560,8 +547,16 @@ def _chunk(rows):
             f((rows, 3, 3, 1)),
             f((rows, 3, 3, 3, 1)),
         ),
-        (f((rows, 3, 3, 3, 1)), f((rows, 3, 3, 3)), f((rows, 3, 3)), f((rows, 3)), f((rows, 3)), f((rows, 3, 3))),
-        (f((rows, _K, 3, _D)), f((rows, _K, 3)), f((rows, _D)), f((rows, _D)), f((rows, _K, 3)), f((rows, 3))),
+        (
+            f((rows, 3, 3, 3, 1)),
+            f((rows, 3, 3, 3, 1)),
+            f((rows, 3, 3, 1)),
+            f((rows, 3)),
+            f((rows, 3, 1)),
+            f((rows, 3, 3)),
+        ),
+        (f((rows, _K, 3, _D, 1)), f((rows, _K, 3, 1)), f((rows, _D, 1)), f((rows, _D, 1)), f((rows, _K, 3, 1))),
+        f((rows, 3, 1)),
         (f((rows, 3, 1)), f(rows)),
         (np.empty(rows, i), np.empty(rows, i), np.empty(rows, i), np.empty(rows, i), np.empty(rows, i)),
     )
@@ -571,7 +566,7 @@ def _chunk(rows):
 def _grip_workspace():
     """One row's scratch arrays, lanes of width 1: its inputs and the set-up's (``p, n, limit, w, e``, the sides,
     the scale, omega), :func:`set_up.internal_inside`'s, the dual twist's ``d`` and twist; :func:`_dual_polish`'s,
-    :func:`_on_the_edge`'s and :func:`set_up.culprit`'s."""
+    :func:`_on_the_edge`'s, :func:`set_up.culprit`'s and the rays' cones."""
     f = np.empty
     return (
         (f((3, 3, 1)), f((3, 3, 1)), f((3, 1)), f((6, 1)), f((3, 3, 1)), f((3, 1)), f(1), f((3, 1))),
@@ -580,7 +575,7 @@ def _grip_workspace():
         f((6, 1)),
         (np.empty(3), np.empty((3, 3, 1)), np.empty((3, 1)), np.empty((3, 1)), np.empty((3, 3))),
         (np.empty((2, 3)), np.empty((2, 3)), np.empty((3, 4))),
-        (np.empty(1, np.int64), np.empty(1, np.bool_)),
+        (np.empty(1, np.int64), np.empty(1, np.bool_), f((3, 3, 3, 1)), f((3, 3, 1))),
     )
 
 
@@ -588,9 +583,18 @@ def _grip_workspace():
 def _grip_rows(p, n, limit, w, tol, out, codes, chunk, gw):
     """:func:`grip_rows` a chunk of rows at a time, in passes: set-up, phase I (then phase I on the rays,
     for a culprit), phase II, finish; the phases' rows in step (:func:`_iterate`)."""
-    (q, mv, g, unit, fm, frame), (M, A, b, c, x, z), (wide, bw, cw, xw, zw, inside), (sizes, scale), lists = chunk
+    (q, mv, g, unit, fm, frame), (M, A, b, c, x, z), (wide, bw, cw, xw, zw), inside, (sizes, scale), lists = chunk
     stage, blame, one, two, again = lists
-    lane, inside_work, d, lam, (omega, h, res, delta, dz), (line_a, line_b, polish), (who, pulling) = gw
+    # the method's view of the rows' lanes (one reshape each, of the whole chunk)
+    A4, b4, x2, cw2, xw2 = (
+        A.reshape(A.shape[:4]),
+        b.reshape(b.shape[:3]),
+        x.reshape(x.shape[:2]),
+        cw.reshape(cw.shape[:2]),
+        xw.reshape(xw.shape[:2]),
+    )
+    wide4, bw3, zw3 = wide.reshape(wide.shape[:4]), bw.reshape(bw.shape[:3]), zw.reshape(zw.shape[:3])
+    lane, inside_work, d, lam, (omega, h, res, delta, dz), (line_a, line_b, polish), (who, pulling, ray_a, ray_b) = gw
     for first in range(0, p.shape[0], _CHUNK):  # no rows: no chunk
         rows = min(_CHUNK, p.shape[0] - first)
         ones, twos, agains = 0, 0, 0
@@ -621,49 +625,50 @@ def _grip_rows(p, n, limit, w, tol, out, codes, chunk, gw):
             )
             blame[i] = -1
             if stage[i] == _NONE:
-                x[i, 0], x[i, 1], x[i, 2] = 0.0, 0.0, 0.0
+                x2[i, 0], x2[i, 1], x2[i, 2] = 0.0, 0.0, 0.0
             elif stage[i] == _OPEN:
                 if _start(A[i], b[i], inside[i], c[i], x[i]):
                     stage[i], two[twos] = _HOLD, i
                     twos += 1
                 else:
-                    _phase_one_problem(A[i], b[i], False, wide[i], bw[i], cw[i], xw[i], zw[i])
+                    _widened(A[i], b[i], wide[i], bw[i], cw[i], xw[i], zw[i], 3, 3, 3, 1)
                     one[ones] = i
                     ones += 1
-        _in_lanes(wide, bw, cw, xw, zw, one[:ones], True, _D, _K, _COMPONENTS)
+        _in_lanes(wide4, bw3, cw2, xw2, zw3, one[:ones], True, _D, _K, _COMPONENTS)
         for k in range(ones):
             i = one[k]
             for j in range(3):
-                x[i, j] = xw[i, j]
-            if xw[i, 3] < 0:
+                x2[i, j] = xw2[i, j]
+            if xw2[i, 3] < 0:
                 stage[i], two[twos] = _HOLD, i
                 twos += 1
                 continue
             stage[i] = _FAIL
             for m in range(3):
                 for j in range(3):
-                    z[i, m, j] = zw[i, m, j]
-            _culprit(A[i].reshape((3, 3, 3, 1)), b[i].reshape((3, 3, 1)), x[i].reshape((3, 1)), who, pulling, 3, 1)
+                    z[i, m, j] = zw3[i, m, j]
+            _culprit(A[i], b[i], x[i], who, pulling, 3, 1)
             blame[i] = who[0]
             if pulling[0]:
-                _phase_one_problem(A[i], b[i], True, wide[i], bw[i], cw[i], xw[i], zw[i])
+                _rays(A[i], b[i], ray_a, ray_b)
+                _widened(ray_a, ray_b, wide[i], bw[i], cw[i], xw[i], zw[i], 3, 3, 3, 1)
                 again[agains] = i
                 agains += 1
             for j in range(3):
-                x[i, j] = math.nan
-        _in_lanes(wide, bw, cw, xw, zw, again[:agains], True, _D, _K, _COMPONENTS)
+                x2[i, j] = math.nan
+        _in_lanes(wide4, bw3, cw2, xw2, zw3, again[:agains], True, _D, _K, _COMPONENTS)
         for k in range(agains):
-            if not xw[again[k], 3] < 0:
+            if not xw2[again[k], 3] < 0:
                 blame[again[k]] = -1
         for k in range(twos):
             for m in range(3):
                 z[two[k], m, 0], z[two[k], m, 1], z[two[k], m, 2] = 1.0, 0.0, 0.0
-        _in_lanes(A, b, c, x, z, two[:twos], False, _SQUEEZES, _CONES, _COMPONENTS)
+        _in_lanes(A4, b4, c, x2, z, two[:twos], False, _SQUEEZES, _CONES, _COMPONENTS)
         for i in range(rows):
             if stage[i] == _SKIP:
                 continue
             if stage[i] == _HOLD:
-                _dual_polish(A[i], b[i], c[i], x[i], z[i], omega, polish, dz)
+                _dual_polish(A4[i], b4[i], c[i], x2[i], z[i], omega, polish, dz)
             r = first + i
             _finish(
                 r,
@@ -681,11 +686,11 @@ def _grip_rows(p, n, limit, w, tol, out, codes, chunk, gw):
                 frame[i],
                 M[i],
                 scale[i],
-                x[i],
+                x2[i],
                 z[i],
                 d,
                 lam,
-                A[i],
-                b[i],
+                A4[i],
+                b4[i],
                 (h, res, delta, dz, line_a, line_b),
             )

@@ -144,14 +144,11 @@ def iterate(A, b, c, x, z, P, phase):
 
 def phase_one(A, b):
     """:func:`socp.phase_one` for one row: ``(x, r, z)`` (``z`` of the row's cones)."""
-    d = len(A[0][0])
-    wide = [[row[:] + [1.0 if k == 0 else 0.0] for k, row in enumerate(a)] for a in A]
-    wide.append([[0.0] * d + [1.0], [0.0] * (d + 1), [0.0] * (d + 1)])
-    bw = [list(bm) for bm in b] + [[1.0, 0.0, 0.0]]
-    over = max(math.hypot(bm[1], bm[2]) - bm[0] for bm in b)
-    x = [0.0] * d + [max(over + 1, 0.0)]
-    z = [[0.25, 0.0, 0.0] for _ in range(len(A) + 1)]
-    c = [0.0] * d + [1.0]
+    K, k, d = len(A), len(A[0]), len(A[0][0])
+    wide = [[[0.0] * (d + 1) for _ in range(k)] for _ in range(K + 1)]
+    bw, z = [[0.0] * k for _ in range(K + 1)], [[0.0] * k for _ in range(K + 1)]
+    c, x = [0.0] * (d + 1), [0.0] * (d + 1)
+    _twin()["widened"](A, b, wide, bw, c, x, z, d, K, k, 1)
     iterate(wide, bw, c, x, z, newton_matrices(wide), True)
     return x[:d], x[d], z[: len(A)]
 

@@ -32,7 +32,7 @@ from itertools import combinations
 
 import numpy as np
 
-from .ipm import START_MARGIN, every
+from .ipm import START_MARGIN, every, lanes
 
 __all__ = [
     "CLOSURE_PAIRS",
@@ -74,16 +74,6 @@ _J, _K = np.array((1, 2, 0)), np.array((2, 0, 1))
 # normal's squares overflow or underflow; within them, n / |n| to the last bit
 _HUGE, _TINY = 1e290, 1e-290
 _DOWN, _UP = 2.0**-600, 2.0**600
-
-
-def lanes(a):
-    """A row-major array's view in lane form, its rows last, for the twins (``np.moveaxis(a, 0, -1)``, without
-    its checks: a tenth of its cost on the small arrays of one grasp).
-
-    >>> lanes(np.zeros((5, 3, 2))).shape
-    (3, 2, 5)
-    """
-    return a.transpose((*range(1, a.ndim), 0))
 
 
 def _cross(a0, a1, a2, b0, b1, b2):

@@ -64,16 +64,6 @@ def _twins():
     return twins(ipm.LANE_FORM)
 
 
-def _norm_z(p):
-    """``|z|`` of each cone's ``(t, z)``: ``(k, ...)`` -> ``(...)`` (0 for a ray, ``k = 1``)."""
-    if len(p) == 1:
-        return np.zeros_like(p[0])
-    out = p[1] ** 2
-    for i in range(2, len(p)):
-        out = out + p[i] ** 2
-    return np.sqrt(out)
-
-
 #: The most rows :func:`_iterate` takes one at a time in Python floats: a step of the numpy twin costs some
 #: 600 us whatever the rows (700 calls of numpy on a few numbers), the float twin's some 75 us a row; a
 #: grip of 12 rows took 13.6 ms so against 16.2 ms, one of 16 rows 18.1 against 18.8, of 24 27.6 against 26.8.
@@ -158,20 +148,10 @@ def phase_one(A, b):
     (Farkas).
     """
     n, K, k, d = A.shape
-    wide = np.zeros((n, K + 1, k, d + 1))
-    wide[:, :K, :, :d] = A
-    wide[:, :K, 0, d] = 1.0  # t_m + r
-    wide[:, K, 0, d] = 1.0  # r + 1 >= 0
-    bw = np.zeros((n, K + 1, k))
-    bw[:, :K] = b
-    bw[:, K, 0] = 1.0
-    over = _norm_z(np.moveaxis(b, -1, 0)) - b[..., 0]
-    x = np.zeros((n, d + 1))
-    x[:, d] = np.maximum(over.max(axis=-1) + 1, 0.0)
-    z = np.zeros((n, K + 1, k))
-    z[..., 0] = 0.25  # makes the r column of the dual, not yet the squeezes' columns
-    c = np.zeros((n, d + 1))
-    c[:, d] = 1.0
+    wide, bw, z = np.empty((n, K + 1, k, d + 1)), np.empty((n, K + 1, k)), np.empty((n, K + 1, k))
+    c, x = np.empty((n, d + 1)), np.empty((n, d + 1))
+    with np.errstate(all="ignore"):
+        _twins()["widened"](*(ipm.lanes(a) for a in (A, b, wide, bw, c, x, z)), d, K, k, n)
     x, z = _iterated(wide, bw, c, x, z, True)
     return np.ascontiguousarray(x[:, :d]), x[:, d], np.ascontiguousarray(z[:, :K])
 
