@@ -275,7 +275,7 @@ def progress_bar(inputs: list, command: str, out, shown: bool = True, long_input
 
 #: Seconds the compiled grip's first load may take before the command line says it is compiling: numba's
 #: import and its cache take under 2 s on this project's machine, even at a load of 9 on 2 cores; a compile
-#: 20-40 s.
+#: a minute or more.
 COMPILE_NOTICE_AFTER = 10.0
 
 
@@ -296,7 +296,7 @@ def _compile_notice(quiet: bool, more: str, said: list):
 
     def notice():
         to_stderr(
-            "grasptwist: compiling the grip's numba kernels, once per install (20 s to a minute, longer on a busy "
+            "grasptwist: compiling the grip's numba kernels, once per install (20 s to a minute and a half, longer on a busy "
             f"machine){more}"
         )
         said.append(True)

@@ -1,7 +1,7 @@
 """What the engine runs around long one-time work, set by its callers: the engine itself says nothing.
 
 Such work is a first load of compiled code in a process: the grip's kernel, and apart from it the
-interior-point iterations on rows of any sizes (numba compiles them on a fresh install, about 40 s
+interior-point iterations on rows of any sizes (numba compiles them on a fresh install, about a minute
 and some 20 s, and loads them from its cache after: :mod:`~grasptwist.engine.forces.compiled`).
 The command line sets :func:`watching_first_load` so that a load that takes long says so on stderr;
 a library caller may set its own.
