@@ -578,6 +578,16 @@ def test_soft_contacts_from_a_grasp_file_and_their_errors_located(tmp_path):
     assert r.exit_code == 1 and "both.yaml:3:" in r.stderr and "both.yaml:4:" in r.stderr, r.stderr
     assert "contacts[0].torsion: a soft contact needs friction" in r.stderr and "contacts[1].torsion" in r.stderr
     assert "contacts[2]" not in r.stderr  # a point contact needs none
+    # the same where every contact gives its own friction and the grasp none (a trial: it had been solved as
+    # mixed-frictionless, and all three soft ones as cannot-hold)
+    own = tmp_path / "own.yaml"
+    own.write_text(
+        "contacts:\n  - {point: [-0.05, 0, 0], normal: [1, 0, 0], model: soft, torsion: 0.01, friction: 0}\n"
+        "  - {point: [0.05, 0, 0], normal: [-1, 0, 0], friction: 0.5}\n  - {point: [0, 0, 0], normal: [0, 0, 1], friction: 0.5}\n"
+    )
+    r, _ = run("forces", own)
+    assert r.exit_code == 1 and "own.yaml:2:" in r.stderr and "contacts[0].torsion: a soft contact needs" in r.stderr
+    assert not r.stdout
     for keys, message in cases.items():
         bad = tmp_path / "bad.yaml"
         bad.write_text(

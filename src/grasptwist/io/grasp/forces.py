@@ -194,8 +194,10 @@ def _read(fields, found, problems):
             out["friction"] = readonly(np.where(missing, mu, own))
     elif mu is not None:
         out["friction"] = readonly([mu, mu, mu])
+    # each contact's friction: the grasp's, or its own where every contact gives one (out holds it only with the grasp's)
+    each = out.get("friction", own if own is not None and not np.isnan(own).any() else None)
     soft = found.get("torsion")
-    frictionless = np.flatnonzero((soft > 0) & (out["friction"] == 0)) if soft is not None and "friction" in out else ()
+    frictionless = np.flatnonzero((soft > 0) & (each == 0)) if soft is not None and each is not None else ()
     for i in frictionless:  # torsional friction is friction: each such contact located
         problems.add(
             Reject(
