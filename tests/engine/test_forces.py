@@ -963,6 +963,18 @@ def test_nan_normals_are_nonfinite_input_and_a_zero_one_beside_finite_ones_zero_
     assert int(gt.prepare_grip(EQ, n[0], 0.5).grip([0, 0, G, 0, 0, 0]).status) == code.NONFINITE_INPUT
 
 
+def test_a_nan_friction_is_nonfinite_input_in_force_closure_as_in_the_grip():
+    """A trial: force_closure with a NaN friction had said ok, closure friction 0 and no closure, where the grip says
+    nonfinite-input; with point contacts and soft ones, one NaN of three frictions or all."""
+    mu = np.array([[np.nan, 0.5, 0.5], [np.nan] * 3, [0.5] * 3])
+    code = gt.forces.Status.NONFINITE_INPUT
+    for torsion in (None, 0.01):
+        c = gt.forces.force_closure(EQ, -EQ, mu, torsion=torsion)
+        g = gt.grip(EQ, -EQ, [0, 0, G, 0, 0, 0], mu, torsion=torsion)
+        assert c.status.tolist() == g.status.tolist() == [code, code, 0]
+        assert np.isnan(c.closure_friction[:2]).all() and not c.force_closure[:2].any() and c.force_closure[2]
+
+
 def _kernel_as_python():
     """engine/forces/kernel.py's own source run by Python and numpy: numba replaced by a stub whose ``njit``
     returns the function it is given (as ``NUMBA_DISABLE_JIT`` would, without loading numba)."""

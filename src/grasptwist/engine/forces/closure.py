@@ -629,19 +629,22 @@ def force_closure(
     return Closure(**{k: None if v is None else v.reshape(shape + v.shape[1:]) for k, v in out.items()})
 
 
-def _statuses(p, n, tol):
-    """The contacts' geometry, unit normals and per-row status and culprit before any closure is judged."""
+def _statuses(p, n, tol, mu=None):
+    """The contacts' geometry, unit normals and per-row status and culprit before any closure is judged (a NaN
+    friction ``mu`` is ``nonfinite-input``, as the grip's)."""
     geo = geometry(p, tol)
     status, culprit = geo.status.copy(), geo.culprit.copy()
     unit, zero, bad = unit_normals(n)
     hit = (status == 0) & zero.any(axis=1)
     status[hit], culprit[hit] = ForceStatus.ZERO_NORMAL, np.argmax(zero, axis=1)[hit]
+    if mu is not None:
+        bad = bad | np.isnan(mu).any(axis=1)
     status[(status == 0) & bad] = ForceStatus.NONFINITE_INPUT
     return geo, unit, status, culprit
 
 
 def _closure_rows(p, n, mu, quality, edges, tol):
-    geo, unit, status, culprit = _statuses(p, n, tol)
+    geo, unit, status, culprit = _statuses(p, n, tol, mu)
     friction = np.full(len(p), np.nan)
     closes = None if mu is None else np.zeros(len(p), bool)
     rows = np.flatnonzero(status == 0)
@@ -692,7 +695,7 @@ def _with_soft(p, n, mu, e, quality, edges, tol):
 def _soft_rows(p, n, mu, quality, edges, tol, *, e):
     r"""Closure over the contacts' cones (rows with a soft contact): ``rank G = 6`` (of the models'
     generalised forces) and phase I's margin of an internal force inside every cone, bisected on ``theta``."""
-    geo, unit, status, culprit = _statuses(p, n, tol)
+    geo, unit, status, culprit = _statuses(p, n, tol, mu)
     line = status == ForceStatus.COLLINEAR_CONTACTS
     status[line] = 0  # a soft contact's torsion may make the moment the line cannot
     status[(status == 0) & np.isnan(e).any(axis=1)] = ForceStatus.NONFINITE_INPUT
