@@ -34,6 +34,7 @@ rim, where a face is split along another piece), the winding number's
 
 from __future__ import annotations
 
+import atexit
 import weakref
 
 import numpy as np
@@ -210,6 +211,9 @@ def _unit(v):
 
 
 _CACHE: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
+# libigl's trees freed before the interpreter tears its modules down: a shape still held then (a module's
+# object) kept its tree past libigl's own teardown, and nanobind printed a leak report at every such exit
+atexit.register(_CACHE.clear)
 
 
 def _derived(shape: Shape) -> _Derived:
