@@ -1,5 +1,7 @@
-"""Fixtures shared by the tests: both YAML parsers; the bytecode cache and the numpy grip of the run."""
+"""Fixtures shared by the tests: both YAML parsers; the bytecode cache and the numpy grip of the run;
+the collected objects frozen out of the cyclic collector's sight."""
 
+import gc
 import os
 import sys
 
@@ -30,6 +32,14 @@ from loaders import LOADERS  # noqa: E402
 
 # a script run in processes of its own (see its docstring), not a module for --doctest-modules to import
 collect_ignore = ["dask_checks.py"]
+
+
+def pytest_collection_finish(session):
+    """Freeze what collection made (the modules, the test functions, their parameters: all live to the
+    run's end) out of the cyclic collector's sight, as the ``grasptwist`` script freezes its start-up's
+    (``grasptwist.cli.main``): each oldest-generation collection during the tests went through them all
+    again, some 0.1 s a pass in a worker (docs/reference/development.md, Test time)."""
+    gc.freeze()
 
 
 @pytest.fixture(params=LOADERS, ids=lambda loader: loader.__name__)
