@@ -1,5 +1,8 @@
-"""Fixtures shared by the tests: both YAML parsers; the bytecode cache and the numpy grip of the run."""
+"""Fixtures shared by the tests: both YAML parsers; the bytecode cache and the numpy grip of the run;
+the collected objects frozen out of the cyclic collector's sight; the command line built once."""
 
+import functools
+import gc
 import os
 import sys
 
@@ -30,6 +33,28 @@ from loaders import LOADERS  # noqa: E402
 
 # a script run in processes of its own (see its docstring), not a module for --doctest-modules to import
 collect_ignore = ["dask_checks.py"]
+
+
+def pytest_collection_finish(session):
+    """In each process that runs tests, once they are collected (docs/reference/development.md, Test time):
+    what collection made (the modules, the test functions, their parameters: all live to the run's end)
+    frozen out of the cyclic collector's sight, as the ``grasptwist`` script freezes its start-up's
+    (``grasptwist.cli.main``): each oldest-generation collection during the tests went through them all
+    again, some 0.1 s a pass in a worker; and the command line built once."""
+    gc.freeze()
+    _build_the_command_line_once()
+
+
+def _build_the_command_line_once():
+    """typer's ``CliRunner.invoke(app, ...)`` builds the click group of ``app`` (its every command's options)
+    at each call, 10 ms for the nine commands: some 8 s of the default run's CPU over its ~800 in-process
+    command lines.  Built once per app here (typer builds it from the app's declarations alone: the
+    commands, their functions and options are fixed when the app is made), and run as before, a context
+    a call (``tests/cli/test_cli.py`` holds that it is built once)."""
+    import typer.main
+    import typer.testing
+
+    typer.testing._get_command = functools.cache(typer.main.get_command)
 
 
 @pytest.fixture(params=LOADERS, ids=lambda loader: loader.__name__)

@@ -52,12 +52,17 @@ class Block:
         return f"{name(self.page)}:{self.line}"
 
 
+#: CommonMark's block rules only: a fence is a block, and the inline pass (links, emphasis) was two thirds
+#: of the parse, paid by each test worker at collection (docs/reference/development.md, Test time).
+FENCES = MarkdownIt("commonmark").disable("inline")
+
+
 def blocks(page: Path) -> list[Block]:
     """The fenced blocks of ``page``, in page order (those nested in lists too)."""
     text = page.read_text("utf-8")
     lines = text.splitlines()
     found = []
-    for token in MarkdownIt("commonmark").parse(text):
+    for token in FENCES.parse(text):
         if token.type != "fence":
             continue
         lang, *words = token.info.split() or [""]

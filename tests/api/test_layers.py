@@ -42,13 +42,27 @@ MODULES = {module_name(p): p for p in sorted(PACKAGE.rglob("*.py"))}
 
 
 @functools.cache
+def tree(name: str) -> ast.Module:
+    """The module's source parsed, once per process: three parametrised tests read each module
+    (its imports, its ``__all__``, its branches on a command's name), and parsing was most of their time."""
+    path = MODULES[name]
+    return ast.parse(path.read_text(), str(path))
+
+
+@functools.cache
+def nodes(name: str) -> tuple[ast.AST, ...]:
+    """Every node of the module's tree (``ast.walk``), walked once for the imports and the branches."""
+    return tuple(ast.walk(tree(name)))
+
+
+@functools.cache
 def imports(name: str) -> set[str]:
     """The package's modules ``name`` imports anywhere in its code (parsed once per process: a
     module's test parses its own file, not the whole package's)."""
     path = MODULES[name]
     package = name if path.name == "__init__.py" else name.rpartition(".")[0]
     found = set()
-    for node in ast.walk(ast.parse(path.read_text(), str(path))):
+    for node in nodes(name):
         if isinstance(node, ast.Import):
             found.update(a.name for a in node.names)
         elif isinstance(node, ast.ImportFrom):
@@ -136,8 +150,7 @@ def test_the_loader_only_reads():
 
 @pytest.mark.parametrize("name", FACADES)
 def test_facades_only_re_export(name):
-    tree = ast.parse(MODULES[name].read_text())
-    for node in tree.body:
+    for node in tree(name).body:
         docstring = isinstance(node, ast.Expr) and isinstance(node.value, ast.Constant)
         targets = [t.id for t in node.targets if isinstance(t, ast.Name)] if isinstance(node, ast.Assign) else []
         # __all__, and __getattr__: its moved names' deprecated aliases (grasptwist/_moved.py)
@@ -158,10 +171,9 @@ def test_a_topic_imports_nothing_that_runs_the_command_line(name):
 )
 def test_every_module_says_what_is_public(name):
     # the public API is grasptwist's _EXPORTS; each module marks its own public names
-    tree = ast.parse(MODULES[name].read_text())
     assert any(
         isinstance(node, ast.Assign) and any(isinstance(t, ast.Name) and t.id == "__all__" for t in node.targets)
-        for node in tree.body
+        for node in tree(name).body
     ), f"{name} has no __all__"
 
 
@@ -171,9 +183,8 @@ REGISTRY = "grasptwist.run.families"
 
 def _command_names() -> set[str]:
     """The registry's command names, read from its source (no import: this file only reads)."""
-    tree = ast.parse(MODULES[REGISTRY].read_text())
     names = set()
-    for node in ast.walk(tree):
+    for node in nodes(REGISTRY):
         if isinstance(node, ast.Call) and getattr(node.func, "id", None) == "Command":
             first = node.args[0] if node.args else next((k.value for k in node.keywords if k.arg == "name"), None)
             if isinstance(first, ast.Constant) and isinstance(first.value, str):
@@ -184,10 +195,11 @@ def _command_names() -> set[str]:
 COMMAND_NAMES = _command_names()
 
 
-def branches_on_a_name(tree: ast.AST) -> list[tuple[int, str]]:
+def branches_on_a_name(walked) -> list[tuple[int, str]]:
     """``(line, text)`` of each comparison with a command's name (``kind == "forces"``,
     ``job.kind != "resolve"``, ``kind in ("basis", "check")``) and each mapping keyed by commands
-    (``{"resolve": TableWriter, "basis": ...}``; one such key is a name that is also a function's)."""
+    (``{"resolve": TableWriter, "basis": ...}``; one such key is a name that is also a function's),
+    among ``walked``, the nodes of a tree (``ast.walk``'s)."""
 
     def named(node) -> bool:
         if isinstance(node, ast.Constant):
@@ -197,7 +209,7 @@ def branches_on_a_name(tree: ast.AST) -> list[tuple[int, str]]:
         return False
 
     found = []
-    for node in ast.walk(tree):
+    for node in walked:
         if isinstance(node, ast.Compare) and any(named(c) for c in (node.left, *node.comparators)):
             found.append((node.lineno, ast.unparse(node)))
         elif isinstance(node, ast.Dict) and sum(k is not None and named(k) for k in node.keys) > 1:
@@ -210,15 +222,17 @@ def test_the_walk_finds_branches_on_a_command_name():
     code = (
         'if job.kind == "forces": pass\nx = kind != "resolve"\ny = k in ("basis", "x")\nw = {"check": 1, "basis": 2}\n'
     )
-    assert [line for line, _ in branches_on_a_name(ast.parse(code))] == [1, 2, 3, 4]
-    assert not branches_on_a_name(ast.parse('f.kind == "fingers"\nCOMMANDS["forces"].formats\n{"resolve": ".api"}'))
+    assert [line for line, _ in branches_on_a_name(ast.walk(ast.parse(code)))] == [1, 2, 3, 4]
+    assert not branches_on_a_name(
+        ast.walk(ast.parse('f.kind == "fingers"\nCOMMANDS["forces"].formats\n{"resolve": ".api"}'))
+    )
 
 
 @pytest.mark.parametrize("name", sorted(n for n in MODULES if n != REGISTRY and group(n)[0] < len(LAYERS) - 1))
 def test_no_layer_branches_on_a_command_name(name):
     # the public modules (the last group) name API functions, some called like a command (gt.resolve)
     # every layer loops over the registry (run/families.py); looking a command up there is fine;
-    found = branches_on_a_name(ast.parse(MODULES[name].read_text()))
+    found = branches_on_a_name(nodes(name))
     assert not found, f"{name} branches on a command's name: " + "; ".join(f"line {n}: {t}" for n, t in found)
 
 

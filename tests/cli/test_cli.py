@@ -388,6 +388,16 @@ def test_a_usage_error_is_one_line_and_exit_2(args, line):
     assert (done.returncode, done.stdout, done.stderr) == (2, "", f"grasptwist: error: {line} (see '{command} -h')\n")
 
 
+def test_the_tests_build_the_command_line_once_and_run_it_a_context_a_call():
+    # tests/conftest.py: typer's CliRunner built the click group of every command at each invoke (10 ms)
+    import typer.testing
+
+    assert typer.testing._get_command(app) is typer.testing._get_command(app)
+    first, again = run("check", "--bogus"), run("resolve", "--twist", "1,2", "x.yaml")
+    assert (first.exit_code, again.exit_code) == (2, 2)  # the second call knows nothing of the first's
+    assert "--bogus" in first.stderr and "--bogus" not in again.stderr and "--twist" in again.stderr
+
+
 def test_no_command_prints_the_help_on_stdout_and_succeeds():
     done, _ = run_installed()  # so that `grasptwist | less` shows it
     assert (done.returncode, done.stderr) == (0, "")

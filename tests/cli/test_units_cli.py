@@ -10,6 +10,9 @@ from small_meshes import cube_obj
 
 #: The weight alone: the hold test's loads (tests/cli/test_synthesize_cli.py) would cost numpy's grip five more grips a grasp.
 SEARCH = ("--friction", "0.8", "--mass", "0.19", "-n", "2", "--candidates", "200", "--loads", "weight")
+#: One grasp where the point is a warning, a path or a refusal, not how grasps compare: each grasp found is
+#: verified (its hold friction bisected), most of a search's time.
+ONE = (*SEARCH[:4], "-n", "1", *SEARCH[6:])
 
 
 @pytest.fixture
@@ -39,12 +42,12 @@ def test_a_mesh_in_millimetres_and_one_in_metres_give_the_same_grasps_up_to_scal
 
 
 def test_a_mesh_in_millimetres_read_in_metres_warns_in_the_records_and_on_stderr(objects):
-    r, _ = run("synthesize", objects / "cube_mm.obj", *SEARCH, "-f", "jsonl")
+    r, _ = run("synthesize", objects / "cube_mm.obj", *ONE, "-f", "jsonl")
     assert r.exit_code == 0, r.stderr
     (said,) = {w for rec in jsonl(r.stdout) for w in rec["warnings"]}
     assert said.startswith("mesh-size-unlikely: the mesh spans 65 m: is it in millimetres?")
     assert "warning: mesh-size-unlikely" in r.stderr
-    bad, _ = run("synthesize", objects / "cube_mm.obj", "--units", "px", *SEARCH)
+    bad, _ = run("synthesize", objects / "cube_mm.obj", "--units", "px", *ONE)
     assert bad.exit_code == 2 and "--units" in bad.stderr
 
 
@@ -52,7 +55,7 @@ def test_a_grasp_file_written_from_another_folder_reads_back_from_anywhere(objec
     elsewhere = tmp_path / "elsewhere"
     elsewhere.mkdir()
     monkeypatch.chdir(elsewhere)
-    r, _ = run("synthesize", "../objects/cube.yaml", *SEARCH, "-o", "../objects/found.yaml", "-f", "jsonl")
+    r, _ = run("synthesize", "../objects/cube.yaml", *ONE, "-o", "../objects/found.yaml", "-f", "jsonl")
     assert r.exit_code == 0, r.stderr
     found = (objects / "found.yaml").read_text()
     assert "units: mm" in found and "mesh: cube_mm.obj" in found  # from the new file's folder
@@ -60,7 +63,7 @@ def test_a_grasp_file_written_from_another_folder_reads_back_from_anywhere(objec
     back, _ = run("resolve", "objects/found.yaml", "--twist", "0,0,1,0,0,0", "-f", "jsonl")
     assert back.exit_code == 0, back.stderr
     recs = jsonl(back.stdout)
-    assert [x["units"] for x in recs] == ["mm"] * 2
+    assert [x["units"] for x in recs] == ["mm"]
     np.testing.assert_allclose(
         [[c["point"] for c in x["contacts"]] for x in recs],
         [[c["point"] for c in x["contacts"]] for x in jsonl(r.stdout)],
@@ -105,7 +108,7 @@ def test_o_file_yaml_that_a_grasp_file_names_as_its_mesh_is_not_written(objects,
     out.write_text("kept\n")
     (objects / "link.obj").symlink_to(out)
     (objects / "linked.yaml").write_text("object:\n  mesh: link.obj\n  mass: 0.2\nfriction: 0.8\n")
-    r, _ = run("synthesize", objects / "cube.yaml", objects / "linked.yaml", *SEARCH, "-o", out, "-f", "jsonl")
+    r, _ = run("synthesize", objects / "cube.yaml", objects / "linked.yaml", *ONE, "-o", out, "-f", "jsonl")
     assert r.exit_code == 2 and "linked.yaml:2:9: error: output-is-input" in r.stderr
     assert out.read_text() == "kept\n"
 

@@ -54,15 +54,24 @@ FILE_POSITIONS = dict(
 )
 
 
-def without_positions(tmp_path, seed=None, **contacts):
-    """The bundled TriFinger grasp (with ``seed``; contact ``i`` moved), and the positions once typed."""
+@pytest.fixture(scope="module")
+def folder(tmp_path_factory):
+    """The folder of the grasp files the tests write, one for the module: a URDF hand's link meshes, their
+    hulls and clusters are kept per URDF and grasp folder (run/collisions.py), as a folder's grasps share
+    them; a folder per test cost each test 0.04-0.1 s of CPU reading and hulling the same meshes again."""
+    return tmp_path_factory.mktemp("ik")
+
+
+def without_positions(folder, name, seed=None, **contacts):
+    """The bundled TriFinger grasp (with ``seed``; contact ``i`` moved) as ``name``.yaml in ``folder``,
+    and the positions once typed."""
     doc = yaml.safe_load(TRIFINGER.read_text("utf-8"))
     file_positions = FILE_POSITIONS
     if seed is not None:
         doc["hand"]["seed"] = seed
     for i, point in contacts.items():
         doc["contacts"][int(i[1:])]["point"] = point
-    path = tmp_path / "trifinger-ik.yaml"
+    path = folder / f"{name}.yaml"
     path.write_text(yaml.safe_dump(doc, sort_keys=False), "utf-8")
     return path, file_positions
 
@@ -73,9 +82,9 @@ def tips(hand, q):
 
 
 @urdf
-def test_a_grasp_without_joint_positions_puts_each_tip_on_its_contact(tmp_path):
+def test_a_grasp_without_joint_positions_puts_each_tip_on_its_contact(folder):
     """Each tip link's origin, its fingertip sphere's centre, one radius (10 mm) behind its contact."""
-    path, _ = without_positions(tmp_path)
+    path, _ = without_positions(folder, "solved")
     (g,) = read_grasps(path)
     lengths = np.array([f.length for f in g.hand.fingers])
     distance = np.linalg.norm(tips(g.hand, g.joint_positions) - (g.points - 0.01 * g.normals), axis=-1)
@@ -90,7 +99,7 @@ def test_a_grasp_without_joint_positions_puts_each_tip_on_its_contact(tmp_path):
 
 
 @urdf
-def test_the_tip_error_is_measured_to_the_spheres_centre_not_the_contact(tmp_path):
+def test_the_tip_error_is_measured_to_the_spheres_centre_not_the_contact(folder):
     """Given joint positions a little off: each finger's tip_error is its tip link origin's distance
     from ``p - r n`` (what the docs say), not from the contact ``p``."""
     doc = yaml.safe_load(TRIFINGER.read_text("utf-8"))
@@ -98,7 +107,7 @@ def test_the_tip_error_is_measured_to_the_spheres_centre_not_the_contact(tmp_pat
         FILE_POSITIONS, finger_upper_to_middle_joint_120=FILE_POSITIONS["finger_upper_to_middle_joint_120"] + 0.05
     )
     doc["hand"]["joint_positions"] = moved
-    path = tmp_path / "trifinger-given.yaml"
+    path = folder / "one-joint-moved.yaml"
     path.write_text(yaml.safe_dump(doc, sort_keys=False), "utf-8")
     (g,) = read_grasps(path)
     at = tips(g.hand, g.joint_positions)
@@ -112,12 +121,12 @@ def test_the_tip_error_is_measured_to_the_spheres_centre_not_the_contact(tmp_pat
 
 
 @urdf
-def test_the_seed_is_where_the_solution_starts(tmp_path):
+def test_the_seed_is_where_the_solution_starts(folder):
     """The elbow-down solution the file's positions hold (each sphere centre one radius inside its
     contact) from a seed there; the same as the engine's hand_ik from that seed."""
-    path, file_positions = without_positions(tmp_path, seed=None)
+    path, file_positions = without_positions(folder, "unseeded", seed=None)
     seed = {k: round(v, 1) for k, v in FILE_POSITIONS.items()}
-    seeded, _ = without_positions(tmp_path / "..", seed=seed)
+    seeded, _ = without_positions(folder, "seeded", seed=seed)
     (g,) = read_grasps(seeded)
     want = hand_ik(g.hand, g.points - 0.01 * g.normals, seed=[seed[name] for name in g.hand.joint_names])
     np.testing.assert_array_equal(g.joint_positions, want.positions)
@@ -126,8 +135,8 @@ def test_the_seed_is_where_the_solution_starts(tmp_path):
 
 
 @urdf
-def test_an_unknown_seed_joint_is_located(tmp_path):
-    path, _ = without_positions(tmp_path, seed={"no_such_joint": 0.5})
+def test_an_unknown_seed_joint_is_located(folder):
+    path, _ = without_positions(folder, "unknown-seed", seed={"no_such_joint": 0.5})
     (err,) = read_grasps(path)
     assert err.code == "unknown-joint"
     assert err.message.startswith("hand.seed.no_such_joint: not a joint of the hand's fingers")
@@ -161,9 +170,9 @@ def test_a_finger_that_cannot_reach_fails_the_grasp_at_its_tip(fixture, code, ma
 
 
 @urdf
-def test_the_table_labels_positions_and_tip_errors(tmp_path, monkeypatch):
+def test_the_table_labels_positions_and_tip_errors(folder, monkeypatch):
     monkeypatch.setenv("COLUMNS", "200")  # one part: narrower, the table splits its columns
-    path, _ = without_positions(tmp_path)
+    path, _ = without_positions(folder, "table")
     (g,) = read_grasps(path)
     out = run("resolve", path, "--twist", "0,0,0.5,0,0,0").stdout
     header = next(line for line in out.splitlines() if "position" in line and "tip error" in line)
@@ -241,20 +250,21 @@ def test_a_hand_files_seed_is_refused_not_dropped(tmp_path):
     assert "conflicting-keys" in result.stderr and "hand.seed: only in a grasp file" in " ".join(result.stderr.split())
 
 
-def given(tmp_path, **moved):
-    """The bundled TriFinger grasp at the positions once typed, joints ``moved`` by so many radians."""
+def given(folder, name, **moved):
+    """The bundled TriFinger grasp at the positions once typed, joints ``moved`` by so many radians, as
+    ``name``.yaml in ``folder``."""
     doc = yaml.safe_load(TRIFINGER.read_text("utf-8"))
     doc["hand"]["joint_positions"] = {j: q + moved.get(j, 0.0) for j, q in FILE_POSITIONS.items()}
-    path = tmp_path / "trifinger-given.yaml"
+    path = folder / f"{name}.yaml"
     path.write_text(yaml.safe_dump(doc, sort_keys=False), "utf-8")
     return path
 
 
 @urdf
-def test_given_positions_that_leave_a_tip_off_its_contact_are_warned_of(tmp_path):
+def test_given_positions_that_leave_a_tip_off_its_contact_are_warned_of(folder):
     # the trial's: finger 0's joints moved ~0.2 rad said 'all ok' with its tip 47 mm off; now a warning
     # past 1% of the finger's length (3.8 mm), in the record and on stderr, naming finger, distance, tolerance
-    path = given(tmp_path, finger_upper_to_middle_joint_0=0.2)
+    path = given(folder, "tip-off", finger_upper_to_middle_joint_0=0.2)
     (g,) = read_grasps(path)
     off = np.linalg.norm(tips(g.hand, g.joint_positions) - (g.points - 0.01 * g.normals), axis=-1)
     assert off[0] > 0.02 and off[1] < 1e-4 and off[2] < 1e-4  # the moved finger only
@@ -268,10 +278,10 @@ def test_given_positions_that_leave_a_tip_off_its_contact_are_warned_of(tmp_path
 
 
 @urdf
-def test_positions_typed_to_a_few_decimals_or_just_off_are_not_warned_of(tmp_path):
+def test_positions_typed_to_a_few_decimals_or_just_off_are_not_warned_of(folder):
     # the positions once typed (tips 1e-5 m off) and a joint moved 0.005 rad (2.4 mm, under 3.8 mm)
     for moved in ({}, {"finger_upper_to_middle_joint_120": 0.005}):
-        (g,) = read_grasps(given(tmp_path, **moved))
+        (g,) = read_grasps(given(folder, "typed", **moved))
         off = np.linalg.norm(tips(g.hand, g.joint_positions) - (g.points - 0.01 * g.normals), axis=-1)
         assert off.max() < 0.0038 and g.warnings == (), (off, g.warnings)
     assert off.max() > 0.001  # the moved joint moved its tip
