@@ -441,7 +441,8 @@ def largest_peak(run: Run) -> int:
     600 MB after the slow tier's compiled tests, where the run's own are 90 MB)."""
     peak = 0
     for pid in session(run.p.pid):
-        with contextlib.suppress(OSError, ValueError):
+        # gone meanwhile (OSError), or a zombie, whose status has no memory lines (IndexError)
+        with contextlib.suppress(OSError, ValueError, IndexError):
             status = Path(f"/proc/{pid}/status").read_text()
             peak = max(peak, int(status.split("VmHWM:")[1].split()[0]))
     return peak
