@@ -435,3 +435,14 @@ def test_a_weight_off_the_line_of_the_contacts_is_held_along_a_path_by_soft_pads
     record = grip_record(soft, 0)
     assert record["contact_model"] == "soft" and record["torsion"] == pytest.approx(soft.torsion[0].tolist())
     assert "contact_model" not in grip_record(grip_along(EQ, -EQ, 0.5, *weight[3:], times)[1], 0)
+
+
+def test_soft_closure_of_a_batch_whose_rows_close_and_do_not():
+    """A review: soft closure friction of a batch with a row that phase I finds no internal force for, beside one it
+    does, raised a shape mismatch (every row's cones paired with the live rows' forces); each row is now its own,
+    as alone."""
+    none = np.array([[-1.0, 0, 0]] * 3)  # every normal the same way: no internal force inside the cones
+    both = gt.forces.force_closure([EQ, EQ], [-EQ, none], torsion=0.01).closure_friction
+    alone = [float(gt.forces.force_closure(EQ, n, torsion=0.01).closure_friction) for n in (-EQ, none)]
+    np.testing.assert_array_equal(both, alone)
+    assert np.isnan(both[1]) and 0 <= both[0] < 1e-3

@@ -118,7 +118,11 @@ class _Twin(ast.NodeTransformer):
 SCALAR = {
     "sqrt": "_sqrt",  # math's, bound in the twins' globals: no attribute to look up
     "isfinite": "_isfinite",
+    "isnan": "_isnan",
+    "isinf": "_isinf",
+    "hypot": "_hypot",
     "inf": "_inf",
+    "nan": "_nan",
     "minimum": "min",
     "maximum": "max",
     "abs": "abs",
@@ -228,7 +232,8 @@ def floats(functions):
     >>> twin([[4.0], [0.5]], y, out, 2, 1); y, out
     ([1.0, 0.5], [1.0])
     """
-    scalar = {"_sqrt": math.sqrt, "_isfinite": math.isfinite, "_inf": math.inf}
+    scalar = {"_sqrt": math.sqrt, "_isfinite": math.isfinite, "_isnan": math.isnan, "_isinf": math.isinf}
+    scalar |= {"_hypot": math.hypot, "_inf": math.inf, "_nan": math.nan}
     return _made(functions, _Float, dict(functions[0].__globals__, **scalar), "float")
 
 

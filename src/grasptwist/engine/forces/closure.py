@@ -405,7 +405,7 @@ def _least_soft_friction(group):
     mu = np.full(len(group.rows), np.nan)
     r, _, x = group.phase_one(np.full(len(mu), np.arctan(MAX_FRICTION)))
     live = np.flatnonzero(r < 0)
-    ratio, fn = group.ratios(x[live])
+    ratio, fn = group.part(live).ratios(x[live])
     mu[live] = ratio.max(axis=1)
     for _ in range(_STEPS):
         if not live.size:
@@ -698,7 +698,8 @@ def _soft_rows(p, n, mu, quality, edges, tol, *, e):
     geo, unit, status, culprit = _statuses(p, n, tol, mu)
     line = status == ForceStatus.COLLINEAR_CONTACTS
     status[line] = 0  # a soft contact's torsion may make the moment the line cannot
-    status[(status == 0) & np.isnan(e).any(axis=1)] = ForceStatus.NONFINITE_INPUT
+    odd = np.isnan(e).any(axis=1) | (False if mu is None else np.isnan(mu).any(axis=1))
+    status[(status == 0) & odd] = ForceStatus.NONFINITE_INPUT
     friction = np.full(len(p), np.nan)
     closes = None if mu is None else np.zeros(len(p), bool)
     rows = np.flatnonzero(status == 0)

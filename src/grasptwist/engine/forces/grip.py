@@ -724,19 +724,12 @@ class _Prepared:
 def _one_row(frame, m, inside):
     """What :func:`one.solve` needs of one grasp's row (with friction, not collinear), as lists of floats."""
     A, _, c = _cones(frame, m, np.zeros((1, 3, 3)), np.ones(1))
-    pulling = np.empty(1, bool)
-    set_up.on_rows("pulling_possible", A, pulling, 3, 1)
-    start = None
-    if not np.isnan(inside[0]).any():
-        y = A[0] @ inside[0]
-        start = (inside[0].tolist(), (y[:, 0] - np.sqrt(y[:, 1] ** 2 + y[:, 2] ** 2)).tolist())
     A_list = A[0].tolist()
     return {
         "A": A_list,
         "c": c[0].tolist(),
         "P": one.newton_matrices(A_list),
-        "inside": start,
-        "regular": not pulling[0],
+        "inside": None if np.isnan(inside[0]).any() else inside[0].tolist(),
         "rays": _rays(A)[0].tolist(),
     }
 
@@ -745,7 +738,7 @@ def _solve_floats(row, b):
     """:func:`_solve` for one row through :func:`one.solve`, with :func:`_solve`'s shapes (``b (1, 3, 3)``: its
     :func:`_cones`)."""
     b = b[0].tolist()
-    s, z, fail, blame = one.solve(row["A"], b, row["c"], row["P"], row["inside"], row["regular"], row["rays"])
+    s, z, fail, blame = one.solve(row["A"], b, row["c"], row["P"], row["inside"], row["rays"])
     return np.array([s]), np.array([z]), np.array([fail]), np.array([blame], np.int8)
 
 
@@ -883,7 +876,7 @@ def _solve(frame, m, fm, scale, inside):
         start = x[closing]
         set_up.on_rows("start", A[closing], b[closing], inside[closing], start, d, closing.size)
         x[closing] = start
-    other = np.flatnonzero(np.isnan(inside).any(axis=1))
+    other = np.flatnonzero(np.isnan(x).any(axis=1) | np.isnan(inside).any(axis=1))
     if other.size:
         x[other], r[other], z[other] = socp.phase_one(A[other], b[other])
     fail = ~(r < 0)

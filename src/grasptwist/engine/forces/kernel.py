@@ -202,7 +202,7 @@ def _start(A, b, inside, c, x):
     if math.isnan(inside[0, 0]):
         return False
     _start_lanes(A, b, inside, x, 3, 1)
-    return True
+    return not math.isnan(x[0, 0])
 
 
 @njit(**_JIT)

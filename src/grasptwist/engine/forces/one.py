@@ -23,7 +23,7 @@ import math
 import numpy as np
 
 from . import ipm
-from .ipm import ITERATIONS, START_MARGIN
+from .ipm import ITERATIONS
 
 __all__ = ["iterate", "phase_one", "minimise", "newton_matrices", "solve", "least_on_line", "dual_polish"]
 
@@ -34,6 +34,15 @@ def _twin():
     from ._twin import floats  # ast and inspect: not at start-up
 
     return floats(ipm.LANE_FORM)
+
+
+@functools.cache
+def _set_up_twin():
+    """:mod:`~grasptwist.engine.forces.set_up`'s float twins (made at the first one-grasp grip)."""
+    from . import set_up
+    from ._twin import floats
+
+    return floats(set_up.LANE_FORM)
 
 
 def least_on_line(a, b, count):
@@ -161,10 +170,6 @@ def minimise(A, b, c, x, P):
     return x, z
 
 
-def _cone_value(a, bm, x):
-    return [bm[k] + sum(a[k][j] * x[j] for j in range(len(x))) for k in range(3)]
-
-
 def dual_polish(A, b, c, x, z, omega, h, dz):
     """:func:`socp.dual_polish` for one row: ``z (K, k)`` moved in place to ``sum_m A_m^T z_m = c`` again.
 
@@ -219,29 +224,26 @@ def dual_polish(A, b, c, x, z, omega, h, dz):
             z[m, q] += dz[m, q]
 
 
-def solve(A, b, c, P, inside, normal_det, rays):
+def solve(A, b, c, P, inside, rays):
     """``grip._solve`` for one row of lists: ``(s, z, fail, blame)``.
 
-    ``inside``: the unknowns of an internal force strictly inside every cone, or None;
-    ``normal_det``: whether the squeezes reach every pattern of normal forces (so no
-    wrench needs pulling); ``rays``: the row's ``A`` with unlimited friction (the
-    cones' first rows), for the pulling test.
+    ``inside``: the unknowns of an internal force strictly inside every cone, or None; ``rays``: the row's
+    ``A`` with unlimited friction (the cones' first rows), for the pulling test.  The start and the culprit
+    are :mod:`~grasptwist.engine.forces.set_up`'s, through their float twins.
     """
     d = len(c)
-    x, r, z = None, -1.0, None
+    lanes = _set_up_twin()
+    x, r, z = [0.0] * d, -1.0, None
     if inside is not None:
-        reach = max(
-            (START_MARGIN + abs(b[m][0]) + math.hypot(b[m][1], b[m][2])) / depth for m, depth in enumerate(inside[1])
-        )
-        x = [reach * v for v in inside[0]]
-    else:
+        lanes["start"](A, b, inside, x, d, 1)
+    if inside is None or math.isnan(x[0]):  # no squeeze inside, or one on a cone's edge: phase I's start
         x, r, z = phase_one(A, b)
     if not r < 0:
-        y = [_cone_value(A[m], b[m], x) for m in range(3)]
-        blame = max(range(3), key=lambda m: math.hypot(y[m][1], y[m][2]) - y[m][0])
-        if not normal_det and phase_one(rays, [[bm[0], 0.0, 0.0] for bm in b])[1] >= 0:
-            blame = -1
-        return [math.nan] * d, z, True, blame
+        blame, pulling = [0], [False]
+        lanes["culprit"](A, b, x, blame, pulling, d, 1)
+        if pulling[0] and phase_one(rays, [[bm[0], 0.0, 0.0] for bm in b])[1] >= 0:
+            blame[0] = -1
+        return [math.nan] * d, z, True, blame[0]
     s, z = minimise(A, b, c, x, P)
     A, b, x, z = np.array(A), np.array(b), np.array(s), np.array(z)
     K, d = A.shape[0], A.shape[2]

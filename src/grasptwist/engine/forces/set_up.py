@@ -1,14 +1,15 @@
 r"""The grip's set-up, written once for the numpy path and the compiled one: the contacts' geometry, ``G^+ w``,
-the cones and a squeeze strictly inside them.
+the cones, a squeeze strictly inside them and the start it gives, the culprit of a grip that fails.
 
 Lane form, as :mod:`~grasptwist.engine.forces.ipm`'s iteration is: each array's last axis is the
 rows (the lanes), and a loop ``for ln in range(width):`` does one row's straight-line arithmetic
 (no ``if``; choices ``a if c else b``).  numba compiles these functions
 (:mod:`~grasptwist.engine.forces.kernel`: each row's arrays a lane of width 1), and numpy runs
-their twins on all the rows at once (:func:`twins`, :mod:`~grasptwist.engine.forces._twin`):
+their twins on all the rows at once (:func:`twins`, :func:`on_rows`, :mod:`~grasptwist.engine.forces._twin`):
 :func:`grasp_map.geometry`, :func:`~grasp_map.unit_normals`, ``G^+ w``, the cones' frames and
-problems of :mod:`~grasptwist.engine.forces.grip`, the dual twist, and the closure test of
-:mod:`~grasptwist.engine.forces.closure` are these functions' twins.  So the two paths share
+problems of :mod:`~grasptwist.engine.forces.grip`, its start and culprit, the dual twist, and the
+closure test of :mod:`~grasptwist.engine.forces.closure` are these functions' twins; one grasp's
+float path (:func:`one.solve`) runs the start's and the culprit's float twins.  So the paths share
 every formula of the set-up, as they share the iteration's.
 
 The formulas (a grasp ``p (3, 3)``, rows the contacts):
@@ -37,6 +38,7 @@ from .ipm import START_MARGIN, every, lanes
 __all__ = [
     "CLOSURE_PAIRS",
     "STRICT_MARGIN",
+    "ROUND_OFF",
     "LANE_FORM",
     "twins",
     "lanes",
@@ -66,6 +68,9 @@ CLOSURE_PAIRS = np.array(list(combinations(range(6), 2)))
 
 #: The closure test's margin below which a row's or a direction's is not strict.
 STRICT_MARGIN = 1e-12
+
+#: A normal's component along a unit internal force at most this is round-off of 0 (:func:`cone_rows`).
+ROUND_OFF = 1e-12
 
 # side i joins contacts _J[i] and _K[i] (screws.J, screws.K; arrays, so that the twins index them by a slice)
 _J, _K = np.array((1, 2, 0)), np.array((2, 0, 1))
@@ -232,7 +237,13 @@ def squeeze_map(e, M, width):
 
 def cone_rows(frame, M, fm, scale, A, b, d, width):
     """The method's rows ``A_i = F_i M_i`` (``A (3, 3, d, width)``, ``M (3, 3, d, width)``: the internal forces' map,
-    ``d`` unknowns) and ``b_i = F_i f_i / scale`` (``b (3, 3, width)``)."""
+    ``d`` unknowns) and ``b_i = F_i f_i / scale`` (``b (3, 3, width)``).
+
+    A normal row's entry is a unit normal's dot product with a unit internal force: at most
+    :data:`ROUND_OFF` it is round-off of a normal perpendicular to that force (a contact no squeeze
+    pushes, in a rotated frame), and exactly 0, as it is unrotated.  Left at ``1e-16``, it let an infinite
+    friction's half-space hold with squeezes of ``1e16`` and the pulling test call the row regular, so the
+    verdicts turned with the grasp's frame."""
     for k in range(3):
         for i in every(3):
             for ln in range(width):
@@ -243,11 +254,9 @@ def cone_rows(frame, M, fm, scale, A, b, d, width):
                 )
             for j in range(d):
                 for ln in range(width):
-                    A[i, k, j, ln] = (
-                        frame[i, k, 0, ln] * M[i, 0, j, ln]
-                        + frame[i, k, 1, ln] * M[i, 1, j, ln]
-                        + frame[i, k, 2, ln] * M[i, 2, j, ln]
-                    )
+                    t = frame[i, k, 0, ln] * M[i, 0, j, ln] + frame[i, k, 1, ln] * M[i, 1, j, ln]
+                    t += frame[i, k, 2, ln] * M[i, 2, j, ln]
+                    A[i, k, j, ln] = t if (k > 0) | (np.abs(t) > ROUND_OFF) else 0.0
 
 
 def plane_reduction(p, unit, mv, M, axes, tilt, dirs, forces, width):
@@ -401,9 +410,10 @@ def start(A, b, inside, x, d, width):
     """Phase II's start from a squeeze strictly inside every cone: ``x (d, width)`` = ``inside (d, width)`` scaled
     so that each ``A_m x + b_m`` clears its cone by :data:`~ipm.START_MARGIN` (``A (3, 3, d, width)``,
     ``b (3, 3, width)``; NaN where ``inside`` is): ``max_m (START_MARGIN + |b_m0| + |b_mt|) / depth_m``,
-    ``depth_m = y_m0 - |y_mt|`` of ``y_m = A_m inside`` (positive: strictly inside)."""
+    ``depth_m = y_m0 - |y_mt|`` of ``y_m = A_m inside`` (positive: strictly inside; else, a squeeze the closure
+    test found inside the sectors but on a cone's edge, NaN: phase I finds the start)."""
     for ln in range(width):
-        reach = -np.inf
+        reach, ok = -np.inf, True
         for m in range(3):
             y0, y1, y2 = 0.0, 0.0, 0.0
             for j in range(d):
@@ -412,9 +422,10 @@ def start(A, b, inside, x, d, width):
                 y2 += A[m, 2, j, ln] * inside[j, ln]
             depth = y0 - np.sqrt(y1 * y1 + y2 * y2)
             span = START_MARGIN + np.abs(b[m, 0, ln]) + np.sqrt(b[m, 1, ln] * b[m, 1, ln] + b[m, 2, ln] * b[m, 2, ln])
-            reach = np.maximum(reach, span / depth)
+            ok = ok & (depth > 0)
+            reach = np.maximum(reach, span / depth if depth > 0 else 0.0)
         for j in range(d):
-            x[j, ln] = reach * inside[j, ln]
+            x[j, ln] = reach * inside[j, ln] if ok else np.nan
 
 
 def culprit(A, b, x, blame, pulling, d, width):
