@@ -229,8 +229,8 @@ def _least_friction(plane):
     """Bisection on ``theta = atan(mu)``: ``(n)`` least common friction, NaN where none."""
     rows = len(plane.cos)
     lo = plane.phi.max(axis=1)
-    ends = _at_theta(_subset(plane, np.tile(np.arange(rows), 2)), np.concatenate((np.full(rows, _TOP), lo + 1e-9)))
-    some, at_lo = ends[:rows], ends[rows:]  # at lo the answer is max tan(phi_i), to 1e-9 rad
+    ends = _at_thetas(plane, np.stack((np.full(rows, _TOP), lo + 1e-9), axis=1))
+    some, at_lo = ends[:, 0], ends[:, 1]  # at lo the answer is max tan(phi_i), to 1e-9 rad
     todo = np.flatnonzero(some & ~at_lo)
     a, b = lo[todo], np.full(todo.size, _TOP)
     depth = _AT_ONCE if todo.size <= _FEW else 1
@@ -254,19 +254,26 @@ _AT_ONCE, _FEW = 4, 128
 
 def _halvings(plane, a, b, depth):
     """``depth`` halvings of each row's ``[a, b]`` at once, the same brackets as one at a time: the ``2^depth - 1``
-    midpoints those halvings could test, in one closure test of each row's plane that many times, then the path
-    the halvings take through them."""
+    midpoints those halvings could test (:func:`_at_thetas`), then the path the halvings take through them."""
     mids = _midpoints(a, b, depth)
-    count = mids.shape[1]
-    lanes = plane if count == 1 else _subset(plane, np.repeat(np.arange(len(a)), count))
-    ok = _at_theta(lanes, mids.reshape(-1)).reshape(mids.shape)
-    at, size = np.zeros(len(a), int), count
+    ok = _at_thetas(plane, mids)
+    at, size = np.zeros(len(a), int), mids.shape[1]
     for _ in range(depth):
         node = at + size // 2
         mid, held = mids[np.arange(len(a)), node], ok[np.arange(len(a)), node]
         a, b = np.where(held, a, mid), np.where(held, mid, b)
         at, size = np.where(held, at, node + 1), size // 2
     return a, b
+
+
+def _at_thetas(plane, thetas):
+    """Whether each row is force closure at each of its angles ``thetas (n, k)``: ``(n, k)``.  For up to :data:`_FEW`
+    rows in one closure test of each row's plane ``k`` times (a small test costs its call), else a test an angle
+    (the planes never copied: memory as one test's)."""
+    n, k = thetas.shape
+    if k == 1 or n > _FEW:
+        return np.stack([_at_theta(plane, thetas[:, j]) for j in range(k)], axis=1)
+    return _at_theta(_subset(plane, np.repeat(np.arange(n), k)), thetas.reshape(-1)).reshape(n, k)
 
 
 def _midpoints(a, b, depth):
